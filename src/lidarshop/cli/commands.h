@@ -1,0 +1,30 @@
+// The command table of the `lidarshop` executable. Each command group lives in its own file and exposes
+// `int RunX(int argc, char** argv)` where argv[0] is the command's name (e.g. "scan").
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+namespace lidarshop::cli {
+
+int RunScan(int argc, char** argv);      // scan_command.cc
+int RunInfo(int argc, char** argv);      // file_commands.cc
+int RunConvert(int argc, char** argv);   // file_commands.cc
+int RunRender(int argc, char** argv);    // file_commands.cc
+int RunDemo(int argc, char** argv);      // demo_command.cc
+int RunVerify(int argc, char** argv);    // verify_commands.cc
+int RunSweep(int argc, char** argv);     // verify_commands.cc
+int RunSegment(int argc, char** argv);   // segment_command.cc
+int RunInpaint(int argc, char** argv);   // image_commands.cc
+int RunPoisson(int argc, char** argv);   // image_commands.cc
+
+// Parses argv with `app` and runs `body`, turning every exception into one line on stderr
+// ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.
+int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+
+// Adds --quiet (no progress bars) to `app`; the flag is stored in *quiet.
+void AddQuietFlag(CLI::App& app, bool* quiet);
+
+}  // namespace lidarshop::cli

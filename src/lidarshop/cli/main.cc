@@ -1,0 +1,63 @@
+// lidarshop — edit terrestrial LiDAR scans. `lidarshop <command> --help` for each command.
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "lidarshop/cli/commands.h"
+
+namespace {
+
+struct Command {
+  const char* name;
+  int (*run)(int, char**);
+  const char* summary;
+};
+
+const std::vector<Command>& Commands() {
+  static const std::vector<Command> commands = {
+      {"demo", lidarshop::cli::RunDemo, "run the main job on a built-in scene, results in ./out/"},
+      {"scan", lidarshop::cli::RunScan, "synthesize a scan of a scene description (JSON)"},
+      {"info", lidarshop::cli::RunInfo, "describe a scan file as JSON"},
+      {"convert", lidarshop::cli::RunConvert, "convert between PTX, E57, PLY and PCD"},
+      {"render", lidarshop::cli::RunRender, "render a channel of a scan as a picture"},
+      {"verify", lidarshop::cli::RunVerify, "consistency and confidence of an object pose"},
+      {"sweep", lidarshop::cli::RunSweep, "verification heat maps over candidate poses"},
+      {"segment", lidarshop::cli::RunSegment, "cut an object out of a scan from two strokes"},
+      {"inpaint", lidarshop::cli::RunInpaint, "patch-based image inpainting"},
+      {"poisson", lidarshop::cli::RunPoisson, "Poisson image editing: fill, clone, reconstruct"},
+  };
+  return commands;
+}
+
+void PrintUsage(std::FILE* stream) {
+  fmt::print(stream, "lidarshop — edit terrestrial LiDAR scans\n\nUsage: lidarshop <command> [options]\n\n");
+  fmt::print(stream, "Commands:\n");
+  for (const Command& command : Commands()) fmt::print(stream, "  {:<10} {}\n", command.name, command.summary);
+  fmt::print(stream, "\n`lidarshop <command> --help` describes each command.\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) {
+    PrintUsage(stderr);
+    return 2;
+  }
+  const std::string name = argv[1];
+  if (name == "--help" || name == "-h" || name == "help") {
+    PrintUsage(stdout);
+    return 0;
+  }
+  if (name == "--version") {
+    fmt::print("lidarshop 0.1.0\n");
+    return 0;
+  }
+  for (const Command& command : Commands()) {
+    if (name == command.name) return command.run(argc - 1, argv + 1);
+  }
+  fmt::print(stderr, "lidarshop: unknown command '{}'\n", name);
+  PrintUsage(stderr);
+  return 2;
+}

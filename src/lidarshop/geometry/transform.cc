@@ -1,0 +1,54 @@
+#include "lidarshop/geometry/transform.h"
+
+#include <cmath>
+
+namespace lidarshop {
+
+Eigen::Matrix3d RotationFromEulerDegrees(const Eigen::Vector3d& rotate_deg) {
+  const Eigen::Vector3d radians = rotate_deg * (M_PI / 180.0);
+  return (Eigen::AngleAxisd(radians.z(), Eigen::Vector3d::UnitZ()) *
+          Eigen::AngleAxisd(radians.y(), Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(radians.x(), Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+Eigen::Matrix4d ComposeTransform(const Eigen::Vector3d& translate, const Eigen::Vector3d& rotate_deg,
+                                 const Eigen::Vector3d& scale) {
+  Eigen::Matrix4d transform = Eigen::Matrix4d::Identity();
+  transform.topLeftCorner<3, 3>() = RotationFromEulerDegrees(rotate_deg) * scale.asDiagonal();
+  transform.topRightCorner<3, 1>() = translate;
+  return transform;
+}
+
+TriangleMesh TransformMesh(const TriangleMesh& mesh, const Eigen::Matrix4d& b_from_a) {
+  TriangleMesh result = mesh;
+  for (auto& vertex : result.vertices) vertex = TransformPoint(b_from_a, vertex);
+  const Eigen::Matrix3d normal_matrix = b_from_a.topLeftCorner<3, 3>().inverse().transpose();
+  for (auto& normal : result.vertex_normals) {
+    normal = (normal_matrix * normal.cast<double>()).normalized().cast<float>();
+  }
+  // A mirroring transform flips the winding; restore counter-clockwise fronts.
+  if (b_from_a.topLeftCorner<3, 3>().determinant() < 0) {
+    for (auto& triangle : result.triangles) std::swap(triangle[1], triangle[2]);
+    for (auto& corners : result.triangle_texcoords) std::swap(corners[1], corners[2]);
+  }
+  return result;
+}
+
+PointCloud TransformPointCloud(const PointCloud& cloud, const Eigen::Matrix4d& b_from_a) {
+  PointCloud result = cloud;
+  for (auto& point : result.points) point = TransformPoint(b_from_a, point);
+  const Eigen::Matrix3d normal_matrix = b_from_a.topLeftCorner<3, 3>().inverse().transpose();
+  for (auto& normal : result.normals) normal = (normal_matrix * normal.cast<double>()).normalized().cast<float>();
+  return result;
+}
+
+bool IsRigid(const Eigen::Matrix4d& transform, double tolerance) {
+  const Eigen::Matrix3d rotation = transform.topLeftCorner<3, 3>();
+  const bool orthonormal = (rotation.transpose() * rotation - Eigen::Matrix3d::Identity()).norm() < tolerance;
+  const bool proper = std::abs(rotation.determinant() - 1.0) < tolerance;
+  const bool affine_row = (transform.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() < tolerance;
+  return orthonormal && proper && affine_row;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,33 @@
+// Rigid and similarity transforms. Names carry frames: `world_from_model` maps model coordinates to world ones.
+//
+// Conventions shared by scene files and the CLI: an object is scaled, then rotated, then translated;
+// `rotate_deg` = [x, y, z] rotates about the fixed axes x, then y, then z, i.e. R = Rz * Ry * Rx.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "lidarshop/geometry/mesh.h"
+
+namespace lidarshop {
+
+// R = Rz(z) * Ry(y) * Rx(x), angles in degrees.
+Eigen::Matrix3d RotationFromEulerDegrees(const Eigen::Vector3d& rotate_deg);
+
+// 4x4 matrix of translate * rotate * scale (scale per axis).
+Eigen::Matrix4d ComposeTransform(const Eigen::Vector3d& translate, const Eigen::Vector3d& rotate_deg,
+                                 const Eigen::Vector3d& scale = Eigen::Vector3d::Ones());
+
+// Applies a 4x4 affine transform to positions (normals by the inverse transpose, renormalized).
+TriangleMesh TransformMesh(const TriangleMesh& mesh, const Eigen::Matrix4d& b_from_a);
+PointCloud TransformPointCloud(const PointCloud& cloud, const Eigen::Matrix4d& b_from_a);
+
+inline Eigen::Vector3f TransformPoint(const Eigen::Matrix4d& b_from_a, const Eigen::Vector3f& point_in_a) {
+  return (b_from_a.topLeftCorner<3, 3>() * point_in_a.cast<double>() + b_from_a.topRightCorner<3, 1>())
+      .cast<float>();
+}
+
+// True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is 0 0 0 1.
+bool IsRigid(const Eigen::Matrix4d& transform, double tolerance = 1e-6);
+
+}  // namespace lidarshop

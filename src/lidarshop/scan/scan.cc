@@ -1,0 +1,215 @@
+#include "lidarshop/scan/scan.h"
+
+#include <cmath>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+
+double AzimuthOf(const Eigen::Vector3f& direction) { return std::atan2(direction.x(), direction.y()); }
+
+double ElevationOf(const Eigen::Vector3f& direction) {
+  const double norm = direction.norm();
+  if (norm == 0) return 0.0;
+  return std::asin(std::clamp(direction.z() / norm, -1.0, 1.0));
+}
+
+int64_t Scan::CountValid() const { return valid.empty() ? 0 : cv::countNonZero(valid); }
+
+Scan Clone(const Scan& scan) {
+  Scan copy = scan;
+  for (cv::Mat* channel : {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity, &copy.color,
+                           &copy.label, &copy.normal, &copy.true_range, &copy.synthesized}) {
+    *channel = channel->clone();
+  }
+  return copy;
+}
+
+Scan MakeScan(int rows, int cols, bool with_color) {
+  if (rows < 0 || cols < 0) throw std::logic_error("MakeScan: negative size");
+  Scan scan;
+  scan.rows = rows;
+  scan.cols = cols;
+  scan.direction = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  scan.valid = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  scan.range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  scan.point = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  scan.intensity = cv::Mat(rows, cols, CV_32F, cv::Scalar(0.5));
+  if (with_color) scan.color = cv::Mat(rows, cols, CV_8UC3, cv::Scalar::all(0));
+  return scan;
+}
+
+void CheckScan(const Scan& scan) {
+  auto check = [&](const cv::Mat& channel, int type, const char* name, bool required) {
+    if (channel.empty()) {
+      if (required && scan.rows * scan.cols > 0) {
+        throw std::logic_error(std::string("scan channel missing: ") + name);
+      }
+      return;
+    }
+    if (channel.rows != scan.rows || channel.cols != scan.cols || channel.type() != type) {
+      throw std::logic_error(std::string("scan channel has the wrong size or type: ") + name);
+    }
+  };
+  check(scan.direction, CV_32FC3, "direction", true);
+  check(scan.valid, CV_8U, "valid", true);
+  check(scan.range, CV_32F, "range", true);
+  check(scan.point, CV_32FC3, "point", true);
+  check(scan.intensity, CV_32F, "intensity", true);
+  check(scan.color, CV_8UC3, "color", false);
+  check(scan.label, CV_32S, "label", false);
+  check(scan.normal, CV_32FC3, "normal", false);
+  check(scan.true_range, CV_32F, "true_range", false);
+  check(scan.synthesized, CV_8U, "synthesized", false);
+}
+
+std::vector<std::string> ChannelNames(const Scan& scan) {
+  std::vector<std::string> names = {"xyz", "range", "intensity", "valid", "direction"};
+  if (!scan.color.empty()) names.push_back("rgb");
+  if (!scan.label.empty()) names.push_back("label");
+  if (!scan.normal.empty()) names.push_back("normal");
+  if (!scan.true_range.empty()) names.push_back("true_range");
+  if (!scan.synthesized.empty()) names.push_back("synthesized");
+  return names;
+}
+
+ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_max_rad, double elevation_min_rad,
+                     double elevation_max_rad) {
+  ScanGrid grid;
+  grid.azimuth_rad.resize(cols);
+  grid.elevation_rad.resize(rows);
+  const double azimuth_step = cols > 1 ? (azimuth_max_rad - azimuth_min_rad) / (cols - 1) : 0.0;
+  const double elevation_step = rows > 1 ? (elevation_max_rad - elevation_min_rad) / (rows - 1) : 0.0;
+  for (int col = 0; col < cols; ++col) grid.azimuth_rad[col] = azimuth_min_rad + col * azimuth_step;
+  // Image row 0 is the top: the highest elevation.
+  for (int row = 0; row < rows; ++row) {
+    grid.elevation_rad[row] = elevation_min_rad + (rows - 1 - row) * elevation_step;
+  }
+  return grid;
+}
+
+cv::Mat DirectionsFromGrid(const ScanGrid& grid) {
+  const int rows = static_cast<int>(grid.elevation_rad.size());
+  const int cols = static_cast<int>(grid.azimuth_rad.size());
+  cv::Mat directions(rows, cols, CV_32FC3);
+  for (int row = 0; row < rows; ++row) {
+    auto* out = directions.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      const Eigen::Vector3f direction = DirectionFromAngles(grid.azimuth_rad[col], grid.elevation_rad[row]);
+      out[col] = cv::Vec3f(direction.x(), direction.y(), direction.z());
+    }
+  }
+  return directions;
+}
+
+PointCloud ToPointCloud(const Scan& scan, bool world, std::vector<int64_t>* cell_index) {
+  CheckScan(scan);
+  PointCloud cloud;
+  const int64_t count = scan.CountValid();
+  cloud.points.reserve(count);
+  if (cell_index != nullptr) {
+    cell_index->clear();
+    cell_index->reserve(count);
+  }
+  const Eigen::Matrix3f rotation = scan.world_from_scanner.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f translation = scan.world_from_scanner.topRightCorner<3, 1>().cast<float>();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (scan.valid.at<uint8_t>(row, col) == 0) continue;
+      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+      Eigen::Vector3f point(p[0], p[1], p[2]);
+      if (world) point = rotation * point + translation;
+      cloud.points.push_back(point);
+      cloud.intensities.push_back(scan.intensity.at<float>(row, col));
+      if (!scan.color.empty()) {
+        const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
+        cloud.colors.emplace_back(c[0], c[1], c[2]);
+      }
+      if (!scan.normal.empty()) {
+        const cv::Vec3f& n = scan.normal.at<cv::Vec3f>(row, col);
+        Eigen::Vector3f normal(n[0], n[1], n[2]);
+        if (world) normal = rotation * normal;
+        cloud.normals.push_back(normal);
+      }
+      if (!scan.label.empty()) cloud.labels.push_back(scan.label.at<int32_t>(row, col));
+      if (!scan.synthesized.empty()) cloud.synthesized.push_back(scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
+      if (cell_index != nullptr) cell_index->push_back(static_cast<int64_t>(row) * scan.cols + col);
+    }
+  }
+  return cloud;
+}
+
+cv::Mat RangeImage(const Scan& scan) { return scan.range.clone(); }
+
+cv::Mat DepthImage(const Scan& scan) {
+  cv::Mat depth(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (scan.valid.at<uint8_t>(row, col)) depth.at<float>(row, col) = scan.point.at<cv::Vec3f>(row, col)[1];
+    }
+  }
+  return depth;
+}
+
+cv::Mat RgbdImage(const Scan& scan) {
+  cv::Mat rgbd(scan.rows, scan.cols, CV_32FC4, cv::Scalar::all(0));
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      cv::Vec4f& out = rgbd.at<cv::Vec4f>(row, col);
+      if (!scan.color.empty()) {
+        const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
+        out = cv::Vec4f(c[0] / 255.f, c[1] / 255.f, c[2] / 255.f, 0.f);
+      } else {
+        const float gray = scan.intensity.at<float>(row, col);
+        out = cv::Vec4f(gray, gray, gray, 0.f);
+      }
+      out[3] = scan.range.at<float>(row, col);
+    }
+  }
+  return rgbd;
+}
+
+cv::Mat ValidMask(const Scan& scan) { return scan.valid.clone(); }
+
+Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synthesized) {
+  CheckScan(scan);
+  if (range.rows != scan.rows || range.cols != scan.cols || range.type() != CV_32F) {
+    throw std::logic_error("WithRange: the range image must be CV_32F of the scan's size");
+  }
+  Scan result = scan;
+  result.valid = scan.valid.clone();
+  result.range = range.clone();
+  result.point = scan.point.clone();
+  result.intensity = scan.intensity.clone();
+  if (!mark_synthesized.empty() && result.synthesized.empty()) {
+    result.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  } else if (!result.synthesized.empty()) {
+    result.synthesized = scan.synthesized.clone();
+  }
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      float& new_range = result.range.at<float>(row, col);
+      cv::Vec3f& point = result.point.at<cv::Vec3f>(row, col);
+      if (!std::isfinite(new_range) || new_range <= 0) {
+        new_range = 0;
+        point = cv::Vec3f(0, 0, 0);
+        result.valid.at<uint8_t>(row, col) = 0;
+        continue;
+      }
+      cv::Vec3f ray = scan.direction.at<cv::Vec3f>(row, col);
+      if (scan.valid.at<uint8_t>(row, col)) {
+        const cv::Vec3f& old_point = scan.point.at<cv::Vec3f>(row, col);
+        const float old_range = static_cast<float>(cv::norm(old_point));
+        if (old_range > 0) ray = old_point / old_range;
+      }
+      point = ray * new_range;
+      result.valid.at<uint8_t>(row, col) = kValid;
+      if (!mark_synthesized.empty() && mark_synthesized.at<uint8_t>(row, col)) {
+        result.synthesized.at<uint8_t>(row, col) = kValid;
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace lidarshop

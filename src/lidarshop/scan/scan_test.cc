@@ -1,0 +1,64 @@
+#include "lidarshop/scan/scan.h"
+
+#include <gtest/gtest.h>
+
+namespace lidarshop {
+namespace {
+
+TEST(ScanTest, DirectionConventions) {
+  // θ = 0 looks forward (+y), θ = +π/2 looks right (+x), φ = +π/2 looks up (+z).
+  EXPECT_TRUE(DirectionFromAngles(0, 0).isApprox(Eigen::Vector3f(0, 1, 0)));
+  EXPECT_TRUE(DirectionFromAngles(M_PI / 2, 0).isApprox(Eigen::Vector3f(1, 0, 0), 1e-6f));
+  EXPECT_NEAR(DirectionFromAngles(0.3, M_PI / 2).z(), 1.0f, 1e-6f);
+  const Eigen::Vector3f direction = DirectionFromAngles(-0.7, 0.2);
+  EXPECT_NEAR(AzimuthOf(direction), -0.7, 1e-6);
+  EXPECT_NEAR(ElevationOf(direction), 0.2, 1e-6);
+}
+
+TEST(ScanTest, UniformGridPutsHighestElevationInRowZero) {
+  const ScanGrid grid = UniformGrid(3, 4, -0.5, 0.5, -0.2, 0.2);
+  EXPECT_DOUBLE_EQ(grid.elevation_rad.front(), 0.2);
+  EXPECT_DOUBLE_EQ(grid.elevation_rad.back(), -0.2);
+  EXPECT_DOUBLE_EQ(grid.azimuth_rad.front(), -0.5);
+  EXPECT_DOUBLE_EQ(grid.azimuth_rad.back(), 0.5);
+  const cv::Mat directions = DirectionsFromGrid(grid);
+  EXPECT_GT(directions.at<cv::Vec3f>(0, 0)[2], 0.0f);
+  EXPECT_LT(directions.at<cv::Vec3f>(2, 0)[0], 0.0f);
+}
+
+TEST(ScanTest, WithRangeKeepsRaysAndMarksSynthesized) {
+  Scan scan = MakeScan(2, 2);
+  scan.direction = DirectionsFromGrid(UniformGrid(2, 2, -0.1, 0.1, -0.1, 0.1));
+  scan.valid.at<uint8_t>(0, 0) = kValid;
+  scan.range.at<float>(0, 0) = 2.0f;
+  scan.point.at<cv::Vec3f>(0, 0) = cv::Vec3f(0, 2, 0);  // a measured point off the nominal direction
+  cv::Mat range(2, 2, CV_32F, cv::Scalar(0));
+  range.at<float>(0, 0) = 3.0f;
+  range.at<float>(1, 1) = 5.0f;
+  cv::Mat mark(2, 2, CV_8U, cv::Scalar(0));
+  mark.at<uint8_t>(1, 1) = 255;
+  const Scan result = WithRange(scan, range, mark);
+  EXPECT_EQ(result.point.at<cv::Vec3f>(0, 0), cv::Vec3f(0, 3, 0));
+  const cv::Vec3f filled = result.point.at<cv::Vec3f>(1, 1);
+  const cv::Vec3f ray = scan.direction.at<cv::Vec3f>(1, 1);
+  EXPECT_NEAR(cv::norm(filled - ray * 5.0f), 0.0, 1e-5);
+  EXPECT_EQ(result.synthesized.at<uint8_t>(1, 1), 255);
+  EXPECT_EQ(result.synthesized.at<uint8_t>(0, 0), 0);
+  EXPECT_EQ(result.CountValid(), 2);
+  EXPECT_EQ(scan.CountValid(), 1);  // the input is untouched
+}
+
+TEST(ScanTest, ToPointCloudInWorldFrame) {
+  Scan scan = MakeScan(1, 1, /*with_color=*/true);
+  scan.valid.at<uint8_t>(0, 0) = kValid;
+  scan.point.at<cv::Vec3f>(0, 0) = cv::Vec3f(1, 2, 3);
+  scan.range.at<float>(0, 0) = std::sqrt(14.0f);
+  scan.world_from_scanner(0, 3) = 10.0;
+  const PointCloud cloud = ToPointCloud(scan, /*world=*/true);
+  ASSERT_EQ(cloud.size(), 1u);
+  EXPECT_TRUE(cloud.points[0].isApprox(Eigen::Vector3f(11, 2, 3)));
+  EXPECT_EQ(cloud.colors.size(), 1u);
+}
+
+}  // namespace
+}  // namespace lidarshop

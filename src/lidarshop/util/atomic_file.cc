@@ -1,0 +1,64 @@
+#include "lidarshop/util/atomic_file.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+std::string TemporaryPathFor(const std::string& path) {
+  static std::atomic<int> counter{0};
+  const std::filesystem::path target(path);
+  const std::string name = fmt::format(".{}.tmp{}-{}{}", target.stem().string(), getpid(), counter++,
+                                       target.extension().string());
+  return (target.parent_path() / name).string();
+}
+
+void Commit(const std::string& temporary, const std::string& path) {
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) {
+    std::filesystem::remove(temporary, error);
+    ThrowInputError(path, "", "", "cannot write the file (rename failed)");
+  }
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  WritePathAtomically(path, [&](const std::string& temporary) {
+    std::ofstream stream(temporary, std::ios::binary | std::ios::trunc);
+    if (!stream) return false;
+    write(stream);
+    stream.flush();
+    return static_cast<bool>(stream);
+  });
+}
+
+void WritePathAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
+  if (path.empty()) ThrowInputError("", "", "", "empty output path");
+  const std::string temporary = TemporaryPathFor(path);
+  bool written = false;
+  try {
+    written = write(temporary);
+  } catch (...) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
+  if (!written || !std::filesystem::exists(temporary)) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    ThrowInputError(path, "", "", "cannot write the file (folder missing or not writable?)");
+  }
+  Commit(temporary, path);
+}
+
+}  // namespace lidarshop
