@@ -10,9 +10,4 @@ int RunInpaint(int argc, char** argv) {
   return 1;
 }
 
-int RunPoisson(int argc, char** argv) {
-  fmt::print(stderr, "lidarshop {}: not built yet\n", argv[0]);
-  return 1;
-}
-
 }  // namespace lidarshop::cli

@@ -1,0 +1,39 @@
+// Reading and writing scan files, chosen by file extension (a table, Open3D style).
+//
+//   .ptx  Leica ASCII, one or many organized scans            read + write
+//   .e57  ASTM E2807, organized and unstructured scans, images read + write (io/e57.h)
+//   .ply  points with colour/normal/label/synthesized fields   read + write (a scan becomes its valid points;
+//         the grid is kept in element properties `row`/`col` when written by lidarshop)
+//   .pcd  PCL, organized clouds (ascii, binary, binary_compressed) read + write
+//
+// Readers reject malformed input with an InputError naming the file, the line or byte offset and the field; they
+// refuse before allocating when a header claims more cells than memory allows. Writers are atomic.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+struct ScanFile {
+  std::string path;
+  std::string format;       // "ptx", "e57", "ply", "pcd"
+  std::vector<Scan> scans;  // several registered scans where the format allows it
+};
+
+// Reads every scan in `path`. Throws InputError (unknown extension, malformed content).
+ScanFile ReadScanFile(const std::string& path);
+
+// Writes `scans` in the format of `path`'s extension. A format that holds one scan only (PCD) throws
+// InputError when given several. Atomic.
+void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
+
+// The lower-case extension without the dot ("ptx"), or "" when none.
+std::string FileExtension(const std::string& path);
+
+// The largest number of cells a header may claim before a reader refuses it (about 4 GiB of channels).
+constexpr int64_t kMaxScanCells = int64_t{1} << 28;
+
+}  // namespace lidarshop
