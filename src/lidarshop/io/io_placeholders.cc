@@ -19,7 +19,5 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud, bool asci
 cv::Mat ReadImage(const std::string& path) { NotBuilt("ReadImage"); }
 void WriteImage(const std::string& path, const cv::Mat& image) { NotBuilt("WriteImage"); }
 cv::Mat DecodeImage(const std::vector<uint8_t>& bytes, const std::string& what) { NotBuilt("DecodeImage"); }
-E57File ReadE57(const std::string& path) { NotBuilt("ReadE57"); }
-void WriteE57(const std::string& path, const std::vector<Scan>& scans) { NotBuilt("WriteE57"); }
 
 }  // namespace lidarshop
