@@ -1,0 +1,406 @@
+#include "lidarshop/poisson/poisson.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <Eigen/CholmodSupport>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/poisson/multigrid.h"
+#include "lidarshop/poisson/operators.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
+#include "lidarshop/util/timer.h"
+
+namespace lidarshop {
+
+using poisson_internal::MaskedMultigrid;
+
+const char* ToString(PoissonSolverKind kind) {
+  switch (kind) {
+    case PoissonSolverKind::kAuto:
+      return "auto";
+    case PoissonSolverKind::kDirect:
+      return "direct";
+    case PoissonSolverKind::kMultigrid:
+      return "multigrid";
+  }
+  return "?";
+}
+
+const char* ToString(PoissonDirectBackend backend) {
+  switch (backend) {
+    case PoissonDirectBackend::kCholmod:
+      return "cholmod";
+    case PoissonDirectBackend::kEigenLdlt:
+      return "eigen-ldlt";
+  }
+  return "?";
+}
+
+void PoissonOptions::Check() const {
+  CheckOption(
+      auto_direct_max_unknowns >= 0,
+      fmt::format("PoissonOptions.auto_direct_max_unknowns must be >= 0, got {}", auto_direct_max_unknowns));
+  CheckOption(tolerance > 0.0 && tolerance < 1.0,
+              fmt::format("PoissonOptions.tolerance must be in (0, 1), got {}", tolerance));
+  CheckOption(max_iterations >= 1,
+              fmt::format("PoissonOptions.max_iterations must be >= 1, got {}", max_iterations));
+  CheckOption(smoothing_sweeps >= 1,
+              fmt::format("PoissonOptions.smoothing_sweeps must be >= 1, got {}", smoothing_sweeps));
+  CheckOption(
+      coarsest_max_unknowns >= 1,
+      fmt::format("PoissonOptions.coarsest_max_unknowns must be >= 1, got {}", coarsest_max_unknowns));
+  CheckOption(max_levels >= 1, fmt::format("PoissonOptions.max_levels must be >= 1, got {}", max_levels));
+}
+
+namespace {
+
+// A factored sparse matrix; Solve may be called from several threads.
+class DirectSolver {
+ public:
+  virtual ~DirectSolver() = default;
+  virtual Eigen::VectorXd Solve(const Eigen::VectorXd& b) const = 0;
+};
+
+class CholmodSolver : public DirectSolver {
+ public:
+  explicit CholmodSolver(const Eigen::SparseMatrix<double>& matrix) {
+    factorization_.compute(matrix);
+    if (factorization_.info() != Eigen::Success) throw std::runtime_error("CHOLMOD factorization failed");
+  }
+  Eigen::VectorXd Solve(const Eigen::VectorXd& b) const override {
+    std::lock_guard<std::mutex> lock(mutex_);  // CHOLMOD's workspace (cholmod_common) is shared
+    return factorization_.solve(b);
+  }
+
+ private:
+  mutable std::mutex mutex_;
+  mutable Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> factorization_;
+};
+
+class EigenLdltSolver : public DirectSolver {
+ public:
+  explicit EigenLdltSolver(const Eigen::SparseMatrix<double>& matrix) {
+    factorization_.compute(matrix);
+    if (factorization_.info() != Eigen::Success)
+      throw std::runtime_error("SimplicialLDLT factorization failed");
+  }
+  Eigen::VectorXd Solve(const Eigen::VectorXd& b) const override { return factorization_.solve(b); }
+
+ private:
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> factorization_;
+};
+
+cv::Mat NormalizeMask(const cv::Mat& mask, const char* what) {
+  if (mask.empty()) throw InputError(fmt::format("{}: empty mask", what));
+  if (mask.depth() != CV_8U) {
+    throw InputError(fmt::format("{}: mask must be 8-bit (CV_8U), got depth {}", what, mask.depth()));
+  }
+  cv::Mat single;
+  if (mask.channels() == 1) {
+    single = mask;
+  } else {
+    std::vector<cv::Mat> planes;
+    cv::split(mask, planes);
+    single = planes[0].clone();
+    for (size_t c = 1; c < planes.size(); ++c) cv::max(single, planes[c], single);
+  }
+  cv::Mat binary;
+  cv::compare(single, 0, binary, cv::CMP_NE);  // 255 where non-zero
+  return binary;
+}
+
+}  // namespace
+
+struct PoissonSystem::Impl {
+  PoissonOptions options;
+  cv::Size size;
+  cv::Mat mask;  // H x W CV_8U, 255 in Ω
+  PoissonSolverKind solver = PoissonSolverKind::kDirect;
+  double prepare_seconds = 0.0;
+  std::vector<int32_t> unknown_pixels;  // y * W + x of each unknown, row-major
+  cv::Mat index;                        // H x W CV_32S: compact index of an unknown, −1 for known pixels
+  std::unique_ptr<DirectSolver> direct;
+  std::unique_ptr<MaskedMultigrid> multigrid;
+
+  // ||b − A x|| for compact vectors (double precision).
+  double ResidualNorm(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
+    const int W = size.width, H = size.height;
+    std::vector<double> partial(unknown_pixels.size());
+    ParallelForRange(
+        static_cast<int64_t>(unknown_pixels.size()),
+        [&](int64_t begin, int64_t end) {
+          for (int64_t k = begin; k < end; ++k) {
+            const int y = unknown_pixels[k] / W, x_ = unknown_pixels[k] % W;
+            double ax = 0.0;
+            int degree = 0;
+            auto visit = [&](int ny, int nx) {
+              if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+              ++degree;
+              const int n = index.at<int32_t>(ny, nx);
+              if (n >= 0) ax -= x[n];
+            };
+            visit(y, x_ - 1);
+            visit(y, x_ + 1);
+            visit(y - 1, x_);
+            visit(y + 1, x_);
+            ax += degree * x[k];
+            partial[k] = (b[k] - ax) * (b[k] - ax);
+          }
+        },
+        4096);
+    double sum = 0.0;
+    for (double value : partial) sum += value;
+    return std::sqrt(sum);
+  }
+};
+
+PoissonSystem::PoissonSystem() = default;
+PoissonSystem::~PoissonSystem() = default;
+PoissonSystem::PoissonSystem(const PoissonSystem&) = default;
+PoissonSystem& PoissonSystem::operator=(const PoissonSystem&) = default;
+PoissonSystem::PoissonSystem(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
+
+const PoissonSystem::Impl& PoissonSystem::impl() const {
+  if (!impl_) throw std::logic_error("PoissonSystem used before PreparePoisson");
+  return *impl_;
+}
+cv::Size PoissonSystem::ImageSize() const { return impl().size; }
+int PoissonSystem::NumUnknowns() const { return static_cast<int>(impl().unknown_pixels.size()); }
+PoissonSolverKind PoissonSystem::Solver() const { return impl().solver; }
+const cv::Mat& PoissonSystem::Mask() const { return impl().mask; }
+double PoissonSystem::PrepareSeconds() const { return impl().prepare_seconds; }
+const PoissonOptions& PoissonSystem::Options() const { return impl().options; }
+
+PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options) {
+  options.Check();
+  Timer timer;
+  auto impl = std::make_shared<PoissonSystem::Impl>();
+  impl->options = options;
+  impl->mask = NormalizeMask(mask_in, "PreparePoisson");
+  impl->size = impl->mask.size();
+  const int W = impl->size.width, H = impl->size.height;
+  const int num_unknowns = cv::countNonZero(impl->mask);
+  if (num_unknowns == W * H) {
+    throw InputError(fmt::format(
+        "PreparePoisson: the mask ({}x{}) covers the whole image; at least one known pixel is needed for the "
+        "Dirichlet boundary",
+        W, H));
+  }
+  impl->index.create(impl->size, CV_32S);
+  impl->unknown_pixels.reserve(num_unknowns);
+  for (int y = 0; y < H; ++y) {
+    const uint8_t* row = impl->mask.ptr<uint8_t>(y);
+    int32_t* index_row = impl->index.ptr<int32_t>(y);
+    for (int x = 0; x < W; ++x) {
+      if (row[x]) {
+        index_row[x] = static_cast<int32_t>(impl->unknown_pixels.size());
+        impl->unknown_pixels.push_back(y * W + x);
+      } else {
+        index_row[x] = -1;
+      }
+    }
+  }
+  impl->solver = options.solver;
+  if (impl->solver == PoissonSolverKind::kAuto) {
+    impl->solver = num_unknowns <= options.auto_direct_max_unknowns ? PoissonSolverKind::kDirect
+                                                                    : PoissonSolverKind::kMultigrid;
+  }
+  if (num_unknowns > 0) {
+    if (impl->solver == PoissonSolverKind::kDirect) {
+      std::vector<Eigen::Triplet<double>> triplets;
+      triplets.reserve(static_cast<size_t>(num_unknowns) * 5);
+      for (int k = 0; k < num_unknowns; ++k) {
+        const int y = impl->unknown_pixels[k] / W, x = impl->unknown_pixels[k] % W;
+        int degree = 0;
+        auto visit = [&](int ny, int nx) {
+          if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+          ++degree;
+          const int n = impl->index.at<int32_t>(ny, nx);
+          if (n >= 0) triplets.emplace_back(k, n, -1.0);
+        };
+        visit(y, x - 1);
+        visit(y, x + 1);
+        visit(y - 1, x);
+        visit(y + 1, x);
+        triplets.emplace_back(k, k, static_cast<double>(degree));
+      }
+      Eigen::SparseMatrix<double> matrix(num_unknowns, num_unknowns);
+      matrix.setFromTriplets(triplets.begin(), triplets.end());
+      if (options.direct_backend == PoissonDirectBackend::kCholmod) {
+        impl->direct = std::make_unique<CholmodSolver>(matrix);
+      } else {
+        impl->direct = std::make_unique<EigenLdltSolver>(matrix);
+      }
+    } else {
+      impl->multigrid = std::make_unique<MaskedMultigrid>(impl->mask, options);
+    }
+  }
+  impl->prepare_seconds = timer.Seconds();
+  return PoissonSystem(std::move(impl));
+}
+
+std::string PoissonResult::Summary() const {
+  return fmt::format("poisson {}: {} channel(s), {} iteration(s), relative residual {:.3g}, {:.3f} s",
+                     ToString(solver), channels, iterations, relative_residual, seconds);
+}
+
+namespace {
+
+template <typename T>
+void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, const cv::Mat& divergence,
+                   cv::Mat& output, PoissonResult& result) {
+  const int W = system.size.width, H = system.size.height;
+  const int n = boundary.channels();
+  const auto num_unknowns = static_cast<int64_t>(system.unknown_pixels.size());
+  for (int c = 0; c < n; ++c) {
+    // b = −f + sum of Dirichlet neighbours.
+    Eigen::VectorXd b(num_unknowns);
+    ParallelForRange(
+        num_unknowns,
+        [&](int64_t begin, int64_t end) {
+          for (int64_t k = begin; k < end; ++k) {
+            const int y = system.unknown_pixels[k] / W, x = system.unknown_pixels[k] % W;
+            double value = divergence.empty() ? 0.0 : -static_cast<double>(divergence.ptr<T>(y)[x * n + c]);
+            auto visit = [&](int ny, int nx) {
+              if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+              if (system.index.at<int32_t>(ny, nx) < 0) value += boundary.ptr<T>(ny)[nx * n + c];
+            };
+            visit(y, x - 1);
+            visit(y, x + 1);
+            visit(y - 1, x);
+            visit(y + 1, x);
+            b[k] = value;
+          }
+        },
+        4096);
+    Eigen::VectorXd x;
+    if (system.direct) {
+      x = system.direct->Solve(b);
+    } else {
+      std::vector<double> b_vector(b.data(), b.data() + b.size()), x_vector;
+      const poisson_internal::MultigridStats stats = system.multigrid->Solve(b_vector, x_vector);
+      if (!stats.converged) {
+        throw std::runtime_error(fmt::format(
+            "Poisson multigrid did not reach the relative residual {} within {} iterations (reached {:.3g})",
+            system.options.tolerance, system.options.max_iterations, stats.relative_residual));
+      }
+      result.iterations = std::max(result.iterations, stats.iterations);
+      x = Eigen::Map<Eigen::VectorXd>(x_vector.data(), static_cast<Eigen::Index>(x_vector.size()));
+    }
+    const double b_norm = b.norm();
+    const double residual = b_norm > 0.0 ? system.ResidualNorm(b, x) / b_norm : system.ResidualNorm(b, x);
+    result.relative_residual = std::max(result.relative_residual, residual);
+    for (int64_t k = 0; k < num_unknowns; ++k) {
+      const int y = system.unknown_pixels[k] / W, px = system.unknown_pixels[k] % W;
+      output.ptr<T>(y)[px * n + c] = static_cast<T>(x[k]);
+    }
+  }
+}
+
+}  // namespace
+
+PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& boundary_in,
+                           const cv::Mat& divergence_in) {
+  const PoissonSystem::Impl& system = system_handle.impl();
+  Timer timer;
+  if (boundary_in.empty()) throw InputError("SolvePoisson: empty boundary image");
+  if (boundary_in.size() != system.size) {
+    throw InputError(fmt::format("SolvePoisson: boundary image is {}x{}, the mask is {}x{}", boundary_in.cols,
+                                 boundary_in.rows, system.size.width, system.size.height));
+  }
+  const int depth = boundary_in.depth() == CV_64F ? CV_64F : CV_32F;
+  const int n = boundary_in.channels();
+  cv::Mat boundary;
+  boundary_in.convertTo(boundary, depth);  // copies: the input is never modified
+  cv::Mat divergence;
+  if (!divergence_in.empty()) {
+    if (divergence_in.size() != system.size || divergence_in.channels() != n) {
+      throw InputError(fmt::format(
+          "SolvePoisson: divergence is {}x{} with {} channel(s), expected {}x{} with {} (the boundary's)",
+          divergence_in.cols, divergence_in.rows, divergence_in.channels(), system.size.width,
+          system.size.height, n));
+    }
+    divergence_in.convertTo(divergence, depth);
+  }
+  PoissonResult result;
+  result.solver = system.solver;
+  result.channels = n;
+  result.image = boundary;
+  if (!system.unknown_pixels.empty()) {
+    if (depth == CV_64F) {
+      SolveChannels<double>(system, boundary, divergence, result.image, result);
+    } else {
+      SolveChannels<float>(system, boundary, divergence, result.image, result);
+    }
+  }
+  result.seconds = timer.Seconds();
+  return result;
+}
+
+PoissonResult FillLaplace(const PoissonSystem& system, const cv::Mat& image) {
+  return SolvePoisson(system, image, cv::Mat());
+}
+
+PoissonResult ReconstructFromGradients(const PoissonSystem& system, const cv::Mat& boundary,
+                                       const cv::Mat& gx, const cv::Mat& gy) {
+  return SolvePoisson(system, boundary, BackwardDivergence(gx, gy));
+}
+
+cv::Mat CloneMaskInTarget(const cv::Mat& source_mask, cv::Size target_size, cv::Point offset) {
+  const cv::Mat mask = NormalizeMask(source_mask, "SeamlessClone");
+  const cv::Rect box = cv::boundingRect(mask);
+  const cv::Rect placed = box + offset;
+  if (box.area() > 0 && (placed & cv::Rect(0, 0, target_size.width, target_size.height)) != placed) {
+    throw InputError(fmt::format(
+        "SeamlessClone: the cloned region (source box {}x{} at ({}, {})) placed at offset ({}, {}) lands at "
+        "({}, {})–({}, {}), outside the {}x{} target",
+        box.width, box.height, box.x, box.y, offset.x, offset.y, placed.x, placed.y, placed.br().x - 1,
+        placed.br().y - 1, target_size.width, target_size.height));
+  }
+  cv::Mat target_mask = cv::Mat::zeros(target_size, CV_8U);
+  if (box.area() > 0) mask(box).copyTo(target_mask(placed));
+  return target_mask;
+}
+
+cv::Mat CloneDivergence(const cv::Mat& source_in, const cv::Mat& source_mask, cv::Size target_size,
+                        cv::Point offset) {
+  if (source_in.empty()) throw InputError("SeamlessClone: empty source image");
+  if (source_mask.size() != source_in.size()) {
+    throw InputError(fmt::format("SeamlessClone: mask is {}x{}, the source is {}x{}", source_mask.cols,
+                                 source_mask.rows, source_in.cols, source_in.rows));
+  }
+  const cv::Mat target_mask = CloneMaskInTarget(source_mask, target_size, offset);
+  const int depth = source_in.depth() == CV_64F ? CV_64F : CV_32F;
+  cv::Mat source;
+  source_in.convertTo(source, depth);
+  // Divergence of the source's own gradients (edges leaving the source image are 0), placed at the offset;
+  // the solver reads it only inside the pasted region, which lies inside the target.
+  const cv::Mat source_divergence = Laplacian5(source);
+  cv::Mat divergence = cv::Mat::zeros(target_size, CV_MAKETYPE(depth, source.channels()));
+  const cv::Rect source_rect(0, 0, source.cols, source.rows);
+  const cv::Rect placed = (source_rect + offset) & cv::Rect(0, 0, target_size.width, target_size.height);
+  if (placed.area() > 0) source_divergence(placed - offset).copyTo(divergence(placed), target_mask(placed));
+  return divergence;
+}
+
+PoissonResult SeamlessClone(const cv::Mat& source, const cv::Mat& source_mask, const cv::Mat& target,
+                            cv::Point offset, const PoissonOptions& options) {
+  if (target.empty()) throw InputError("SeamlessClone: empty target image");
+  if (source.channels() != target.channels()) {
+    throw InputError(fmt::format("SeamlessClone: source has {} channel(s), target {}", source.channels(),
+                                 target.channels()));
+  }
+  const cv::Mat divergence = CloneDivergence(source, source_mask, target.size(), offset);
+  const PoissonSystem system = PreparePoisson(CloneMaskInTarget(source_mask, target.size(), offset), options);
+  cv::Mat boundary;
+  target.convertTo(boundary, divergence.depth());
+  return SolvePoisson(system, boundary, divergence);
+}
+
+}  // namespace lidarshop
