@@ -1,13 +1,110 @@
-// Placeholder until this command group is built; replace the whole file.
+// lidarshop segment: cut an object out of a scan from strokes (segment/segment.h, docs/segment.md).
+#include <filesystem>
+#include <string>
+#include <vector>
+
 #include <fmt/format.h>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/io/mesh_io.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/segment/strokes.h"
+#include "lidarshop/util/error.h"
 
 namespace lidarshop::cli {
+namespace {
+
+// The valid points of `scan` where `mask` is (inside = true) or is not (inside = false) set, scanner frame.
+PointCloud SelectPoints(const Scan& scan, const cv::Mat& mask, bool inside) {
+  std::vector<int64_t> cells;
+  const PointCloud all = ToPointCloud(scan, /*world=*/false, &cells);
+  std::vector<size_t> keep;
+  const uint8_t* m = mask.ptr<uint8_t>();
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if ((m[cells[i]] != 0) == inside) keep.push_back(i);
+  }
+  PointCloud out;
+  auto pick = [&](const auto& source, auto& target) {
+    if (source.empty()) return;
+    target.reserve(keep.size());
+    for (size_t i : keep) target.push_back(source[i]);
+  };
+  pick(all.points, out.points);
+  pick(all.normals, out.normals);
+  pick(all.colors, out.colors);
+  pick(all.intensities, out.intensities);
+  pick(all.labels, out.labels);
+  pick(all.synthesized, out.synthesized);
+  return out;
+}
+
+std::string DefaultOverlayPath(const std::string& mask_path) {
+  std::filesystem::path path(mask_path);
+  return (path.parent_path() / (path.stem().string() + "_overlay.png")).string();
+}
+
+}  // namespace
 
 int RunSegment(int argc, char** argv) {
-  fmt::print(stderr, "lidarshop {}: not built yet\n", argv[0]);
-  return 1;
+  CLI::App app{
+      "Cut an object out of a scan from strokes: two-step RGB + depth graph cut (docs/segment.md).\n"
+      "Strokes: a PNG of the scan image's size (green = object, red = background) or JSON polylines in grid "
+      "coordinates. Writes the mask (PNG, 255 = object) and an overlay picture (mask outline and strokes "
+      "over the "
+      "scan's colours; default MASK_overlay.png next to the mask, --overlay none to skip).",
+      "segment"};
+  std::string scan_path, strokes_path, mask_path, object_path, rest_path, overlay_path, refine_path;
+  std::string method = "two-step", model = "histogram";
+  int scan_index = 0;
+  bool eight = false, quiet = false;
+  app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
+  app.add_option("--strokes", strokes_path, "strokes: .png (green object, red background) or .json polylines")
+      ->required();
+  app.add_option("-o,--output", mask_path, "output mask PNG (255 = object, image orientation)")->required();
+  app.add_option("--object", object_path, "write the object's points here (.ply)");
+  app.add_option("--rest", rest_path, "write the other valid points here (.ply)");
+  app.add_option("--overlay", overlay_path,
+                 "overlay picture path (default: MASK_overlay.png; 'none' = skip)");
+  app.add_option("--refine", refine_path, "extra strokes applied as a fast refinement of the first cut");
+  app.add_option("--method", method, "two-step | depth | color | rgbd")->capture_default_str();
+  app.add_option("--model", model, "appearance model: histogram | gmm")->capture_default_str();
+  app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
+  app.add_flag("--eight", eight, "8-connected n-links (default 4)");
+  AddQuietFlag(app, &quiet);
+  return RunCommand(app, argc, argv, [&]() {
+    SegmentOptions options;
+    options.method = ParseSegmentMethod(method);
+    options.model = ParseAppearanceModel(model);
+    options.eight_connected = eight;
+    options.Check();
+    const ScanFile file = ReadScanFile(scan_path);
+    if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size())) {
+      throw OptionsError(fmt::format("--scan-index {} out of range: {} holds {} scan(s)", scan_index,
+                                     scan_path, file.scans.size()));
+    }
+    const Scan& scan = file.scans[scan_index];
+    cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
+    SegmentSession session(scan, options);
+    SegmentResult result = session.Run(strokes);
+    if (!quiet) fmt::print("{}: {}\n", ToString(options.method), result.Summary());
+    if (!refine_path.empty()) {
+      const cv::Mat extra = ReadStrokes(refine_path, scan.rows, scan.cols);
+      result = session.Refine(extra);
+      strokes.setTo(kStrokeObject, extra == kStrokeObject);
+      strokes.setTo(kStrokeBackground, extra == kStrokeBackground);
+      if (!quiet) fmt::print("refined: {}\n", result.Summary());
+    }
+    WriteImage(mask_path, result.mask);
+    if (overlay_path != "none") {
+      WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,
+                 SegmentOverlay(scan, result.mask, strokes));
+    }
+    if (!object_path.empty()) WritePointCloud(object_path, SelectPoints(scan, result.mask, true));
+    if (!rest_path.empty()) WritePointCloud(rest_path, SelectPoints(scan, result.mask, false));
+    return 0;
+  });
 }
 
 }  // namespace lidarshop::cli

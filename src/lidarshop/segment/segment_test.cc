@@ -1,0 +1,233 @@
+#include "lidarshop/segment/segment.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/segment/strokes.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A hand-made scan (analytic ray casting): a box face 1.2 m wide and 1.3 m tall at y = 8 m standing on a
+// ground plane 1.5 m below the scanner, a wall at y = 20 m behind, sky (no return) above the wall. The box's
+// colour is `box_rgb`; the ground is noisy green, the wall brick red. Label 1 = box, 0 = the rest.
+Scan MakeBoxOnGround(int rows, int cols, cv::Vec3b box_rgb, uint64_t seed, double range_noise_m = 0.005) {
+  Scan scan = MakeScan(rows, cols, /*with_color=*/true);
+  scan.grid = UniformGrid(rows, cols, -20 * kPi / 180, 20 * kPi / 180, -25 * kPi / 180, 10 * kPi / 180);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) {
+      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+      double t = std::numeric_limits<double>::infinity();
+      int label = kNoLabel;
+      cv::Vec3b rgb;
+      const double g1 = noise(rng), g2 = noise(rng);
+      if (d[2] < 0) {  // ground z = -1.5
+        const double tg = -1.5 / d[2];
+        if (tg < t && tg * d[1] < 30) {
+          t = tg;
+          label = 0;
+          rgb = cv::Vec3b(cv::saturate_cast<uint8_t>(74 + 20 * g1), cv::saturate_cast<uint8_t>(112 + 25 * g2),
+                          cv::saturate_cast<uint8_t>(42 + 10 * g1));
+        }
+      }
+      {  // box face y = 8
+        const double tb = 8.0 / d[1];
+        const double x = tb * d[0], z = tb * d[2];
+        if (std::abs(x) <= 0.6 && z >= -1.5 && z <= -0.2 && tb < t) {
+          t = tb;
+          label = 1;
+          rgb = cv::Vec3b(cv::saturate_cast<uint8_t>(box_rgb[0] + 6 * g1),
+                          cv::saturate_cast<uint8_t>(box_rgb[1] + 6 * g2),
+                          cv::saturate_cast<uint8_t>(box_rgb[2] + 6 * g1));
+        }
+      }
+      {  // wall y = 20
+        const double tw = 20.0 / d[1];
+        const double z = tw * d[2];
+        if (z >= -1.5 && z <= 3.0 && tw < t) {
+          t = tw;
+          label = 0;
+          rgb = cv::Vec3b(cv::saturate_cast<uint8_t>(170 + 15 * g1), 80, 60);
+        }
+      }
+      if (label == kNoLabel) continue;
+      const double range = t + range_noise_m * noise(rng);
+      scan.valid.at<uint8_t>(row, col) = kValid;
+      scan.range.at<float>(row, col) = static_cast<float>(range);
+      scan.point.at<cv::Vec3f>(row, col) = d * static_cast<float>(range);
+      scan.color.at<cv::Vec3b>(row, col) = rgb;
+      scan.label.at<int32_t>(row, col) = label;
+    }
+  }
+  return scan;
+}
+
+cv::Mat TruthMask(const Scan& scan) { return scan.label == 1; }
+
+// One short object stroke in the middle of the box, one background stroke on the ground to the left.
+cv::Mat MakeStrokes(const Scan& scan) {
+  cv::Mat strokes(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  cv::Mat truth = TruthMask(scan);
+  cv::Rect box = cv::boundingRect(truth);
+  const cv::Point c(box.x + box.width / 2, box.y + box.height / 2);
+  cv::line(strokes, c - cv::Point(box.width / 6, 0), c + cv::Point(box.width / 6, 0),
+           cv::Scalar(kStrokeObject), 2);
+  cv::line(strokes, cv::Point(scan.cols / 10, scan.rows - 10), cv::Point(scan.cols / 4, scan.rows - 10),
+           cv::Scalar(kStrokeBackground), 2);
+  return strokes;
+}
+
+TEST(SegmentTest, TwoStepCutsTheBoxAndStepOneIsInsideIt) {
+  const Scan scan = MakeBoxOnGround(160, 200, cv::Vec3b(118, 138, 112), 3);
+  const cv::Mat strokes = MakeStrokes(scan);
+  const SegmentResult result = SegmentObject(scan, strokes, SegmentOptions());
+  const MaskScores step1 = ScoreMask(result.step1_mask, TruthMask(scan), scan.valid);
+  const MaskScores final_scores = ScoreMask(result.mask, TruthMask(scan), scan.valid);
+  EXPECT_GE(step1.precision, 0.99);
+  EXPECT_GT(final_scores.iou, 0.9) << "precision " << final_scores.precision << " recall "
+                                   << final_scores.recall;
+  EXPECT_GE(final_scores.recall, step1.recall);
+  // Some ring cells must have been inferred as background (the wall around the box), none on the box.
+  EXPECT_GT(cv::countNonZero(result.inferred_background), 0);
+  EXPECT_EQ(cv::countNonZero(result.inferred_background & TruthMask(scan)), 0);
+}
+
+TEST(SegmentTest, CellsWithoutReturnAreNeverObjectAndSplitTheGraph) {
+  Scan scan = MakeBoxOnGround(120, 160, cv::Vec3b(118, 138, 112), 4);
+  // Punch a hole of no returns through the middle of the box.
+  cv::Rect box = cv::boundingRect(TruthMask(scan));
+  cv::Rect hole(box.x + box.width / 2 - 2, box.y, 4, box.height / 3);
+  scan.valid(hole).setTo(0);
+  scan.range(hole).setTo(0);
+  scan.point(hole).setTo(cv::Scalar::all(0));
+  scan.label(hole).setTo(kNoLabel);
+  for (SegmentMethod method :
+       {SegmentMethod::kTwoStep, SegmentMethod::kDepth, SegmentMethod::kColor, SegmentMethod::kRgbd}) {
+    SegmentOptions options;
+    options.method = method;
+    const SegmentResult result = SegmentObject(scan, MakeStrokes(scan), options);
+    EXPECT_EQ(cv::countNonZero(result.mask & (scan.valid == 0)), 0) << ToString(method);
+    EXPECT_GT(result.object_cells, 0) << ToString(method);
+  }
+}
+
+TEST(SegmentTest, DeterministicAndGmmWorks) {
+  const Scan scan = MakeBoxOnGround(100, 140, cv::Vec3b(118, 138, 112), 5);
+  SegmentOptions options;
+  options.model = AppearanceModel::kGmm;
+  const SegmentResult a = SegmentObject(scan, MakeStrokes(scan), options);
+  const SegmentResult b = SegmentObject(scan, MakeStrokes(scan), options);
+  EXPECT_EQ(cv::countNonZero(a.mask != b.mask), 0);
+  EXPECT_GT(ScoreMask(a.mask, TruthMask(scan), scan.valid).iou, 0.85);
+}
+
+TEST(SegmentTest, RefineAddsHardConstraintsIncrementally) {
+  const Scan scan = MakeBoxOnGround(120, 160, cv::Vec3b(118, 138, 112), 6);
+  SegmentOptions options;
+  options.method = SegmentMethod::kColor;
+  SegmentSession session(scan, options);
+  const SegmentResult first = session.Run(MakeStrokes(scan));
+  // Mark a band across the box's lower half as background: those cells must leave the object.
+  cv::Rect box = cv::boundingRect(TruthMask(scan));
+  cv::Mat extra(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const int band_row = box.y + (3 * box.height) / 4;
+  cv::line(extra, cv::Point(box.x - 3, band_row), cv::Point(box.x + box.width + 3, band_row),
+           cv::Scalar(kStrokeBackground), 1);
+  const SegmentResult refined = session.Refine(extra);
+  EXPECT_EQ(cv::countNonZero(refined.mask & (extra == kStrokeBackground)), 0);
+  EXPECT_LT(refined.object_cells, first.object_cells);
+  // The band cuts the box: what is below it is no longer connected to the object stroke.
+  EXPECT_EQ(cv::countNonZero(refined.mask(cv::Rect(box.x, band_row + 2, box.width, 1))), 0);
+  // Refine before Run is a programming error.
+  SegmentSession fresh(scan, options);
+  EXPECT_THROW(fresh.Refine(extra), std::logic_error);
+}
+
+TEST(SegmentTest, BadStrokesAndOptionsAreRejected) {
+  const Scan scan = MakeBoxOnGround(60, 80, cv::Vec3b(118, 138, 112), 7);
+  cv::Mat only_object(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  only_object.at<uint8_t>(30, 40) = kStrokeObject;
+  EXPECT_THROW(SegmentObject(scan, only_object), InputError);
+  EXPECT_THROW(SegmentObject(scan, cv::Mat(10, 10, CV_8U, cv::Scalar(0))), InputError);
+  SegmentOptions options;
+  options.sigma_scale = 0;
+  EXPECT_THROW(options.Check(), OptionsError);
+  options = SegmentOptions();
+  options.depth_step.smoothness = -1;
+  EXPECT_THROW(options.Check(), OptionsError);
+  EXPECT_THROW(ParseSegmentMethod("magic"), OptionsError);
+  EXPECT_EQ(ParseSegmentMethod("two-step"), SegmentMethod::kTwoStep);
+}
+
+TEST(SegmentTest, ScoreMaskCounts) {
+  cv::Mat truth(4, 4, CV_8U, cv::Scalar(0)), mask(4, 4, CV_8U, cv::Scalar(0));
+  truth(cv::Rect(0, 0, 2, 2)).setTo(255);  // 4 cells
+  mask(cv::Rect(1, 0, 2, 2)).setTo(255);   // 2 overlap, 2 false positives
+  const MaskScores s = ScoreMask(mask, truth);
+  EXPECT_EQ(s.true_positive, 2);
+  EXPECT_EQ(s.false_positive, 2);
+  EXPECT_EQ(s.false_negative, 2);
+  EXPECT_DOUBLE_EQ(s.iou, 2.0 / 6.0);
+  EXPECT_DOUBLE_EQ(s.precision, 0.5);
+}
+
+TEST(SegmentTest, GrabCutBaselineAndOverlayRun) {
+  const Scan scan = MakeBoxOnGround(80, 100, cv::Vec3b(40, 60, 200), 8);
+  const cv::Mat strokes = MakeStrokes(scan);
+  const cv::Mat gc = GrabCutFromStrokes(scan, strokes, 3);
+  ASSERT_EQ(gc.type(), CV_8U);
+  // A blue box on green grass is easy for colour alone.
+  EXPECT_GT(ScoreMask(gc, TruthMask(scan), scan.valid).iou, 0.6);
+  const cv::Mat overlay = SegmentOverlay(scan, gc, strokes);
+  EXPECT_EQ(overlay.type(), CV_8UC3);
+  const cv::Point stroke_cell = [&] {
+    std::vector<cv::Point> cells;
+    cv::findNonZero(strokes == kStrokeObject, cells);
+    return cells.front();
+  }();
+  EXPECT_EQ(overlay.at<cv::Vec3b>(stroke_cell), cv::Vec3b(0, 255, 0));
+}
+
+TEST(SegmentStrokesTest, PaintedImageAndJson) {
+  cv::Mat painted(4, 5, CV_8UC3, cv::Scalar(0, 0, 0));
+  painted.at<cv::Vec3b>(1, 1) = cv::Vec3b(0, 255, 0);
+  painted.at<cv::Vec3b>(2, 3) = cv::Vec3b(250, 10, 20);
+  painted.at<cv::Vec3b>(3, 4) = cv::Vec3b(74, 112, 42);  // grass-like green: not saturated, not a stroke
+  const cv::Mat s = StrokesFromImage(painted);
+  EXPECT_EQ(s.at<uint8_t>(1, 1), kStrokeObject);
+  EXPECT_EQ(s.at<uint8_t>(2, 3), kStrokeBackground);
+  EXPECT_EQ(s.at<uint8_t>(3, 4), kStrokeNone);
+  EXPECT_EQ(cv::countNonZero(StrokesFromImage(StrokesToImage(s)) != s), 0);
+
+  const cv::Mat j = StrokesFromJson(
+      R"({"strokes": [{"label": "object", "points": [[1, 1], [3, 1]]}, {"label": "background", "points": [[0, 3]]}]})",
+      4, 5);
+  EXPECT_EQ(j.at<uint8_t>(1, 2), kStrokeObject);  // row 1, col 2: on the polyline
+  EXPECT_EQ(j.at<uint8_t>(3, 0), kStrokeBackground);
+  EXPECT_EQ(cv::countNonZero(j), 4);
+
+  EXPECT_THROW(StrokesFromJson("{", 4, 5), InputError);
+  EXPECT_THROW(StrokesFromJson(R"({"strokes": [{"label": "tree", "points": [[0, 0]]}]})", 4, 5), InputError);
+  EXPECT_THROW(StrokesFromJson(R"({"strokes": [{"label": "object", "points": [[9, 0]]}]})", 4, 5),
+               InputError);
+  try {
+    StrokesFromJson(R"({"strokes": [{"label": "object", "points": [[0, 0], ["a", 1]]}]})", 4, 5, "s.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stroke 0"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("points[1]"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace lidarshop

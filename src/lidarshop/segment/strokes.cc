@@ -1,0 +1,129 @@
+#include "lidarshop/segment/strokes.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+
+cv::Mat StrokesFromImage(const cv::Mat& painted, const std::string& what) {
+  if (painted.depth() != CV_8U || (painted.channels() != 3 && painted.channels() != 4)) {
+    ThrowInputError(what, "", "", "a stroke image must be 8-bit RGB or RGBA");
+  }
+  cv::Mat strokes(painted.rows, painted.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const int channels = painted.channels();
+  for (int row = 0; row < painted.rows; ++row) {
+    const uint8_t* in = painted.ptr<uint8_t>(row);
+    uint8_t* out = strokes.ptr<uint8_t>(row);
+    for (int col = 0; col < painted.cols; ++col) {
+      const uint8_t* px = in + col * channels;
+      if (channels == 4 && px[3] < 128) continue;
+      const int r = px[0], g = px[1], b = px[2];
+      if (g >= 160 && r <= 96 && b <= 96)
+        out[col] = kStrokeObject;
+      else if (r >= 160 && g <= 96 && b <= 96)
+        out[col] = kStrokeBackground;
+    }
+  }
+  return strokes;
+}
+
+cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols, const std::string& what) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(json_text);
+  } catch (const nlohmann::json::parse_error& e) {
+    ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
+  }
+  if (!doc.is_object() || !doc.contains("strokes") || !doc["strokes"].is_array()) {
+    ThrowInputError(what, "", "strokes", "expected an object with an array \"strokes\"");
+  }
+  cv::Mat strokes(rows, cols, CV_8U, cv::Scalar(kStrokeNone));
+  const nlohmann::json& list = doc["strokes"];
+  for (size_t k = 0; k < list.size(); ++k) {
+    const nlohmann::json& stroke = list[k];
+    const std::string place = fmt::format("stroke {}", k);
+    if (!stroke.is_object()) ThrowInputError(what, place, "", "a stroke must be an object");
+    if (!stroke.contains("label") || !stroke["label"].is_string()) {
+      ThrowInputError(what, place, "label", "missing or not a string");
+    }
+    const std::string label = stroke["label"].get<std::string>();
+    uint8_t value = kStrokeNone;
+    if (label == "object" || label == "foreground")
+      value = kStrokeObject;
+    else if (label == "background")
+      value = kStrokeBackground;
+    else
+      ThrowInputError(what, place, "label",
+                      fmt::format("must be \"object\" or \"background\", got \"{}\"", label));
+    int width = 1;
+    if (stroke.contains("width")) {
+      if (!stroke["width"].is_number_integer() || stroke["width"].get<int>() < 1 ||
+          stroke["width"].get<int>() > 255) {
+        ThrowInputError(what, place, "width", "must be an integer in [1, 255]");
+      }
+      width = stroke["width"].get<int>();
+    }
+    if (!stroke.contains("points") || !stroke["points"].is_array() || stroke["points"].empty()) {
+      ThrowInputError(what, place, "points", "missing, not an array, or empty");
+    }
+    std::vector<cv::Point> points;
+    for (size_t j = 0; j < stroke["points"].size(); ++j) {
+      const nlohmann::json& p = stroke["points"][j];
+      const std::string field = fmt::format("points[{}]", j);
+      if (!p.is_array() || p.size() != 2 || !p[0].is_number() || !p[1].is_number()) {
+        ThrowInputError(what, place, field, "must be a [col, row] pair of numbers");
+      }
+      const double col = p[0].get<double>(), row = p[1].get<double>();
+      if (!(col >= 0 && col <= cols - 1 && row >= 0 && row <= rows - 1)) {
+        ThrowInputError(
+            what, place, field,
+            fmt::format("[{}, {}] lies outside the {} x {} image (cols x rows)", col, row, cols, rows));
+      }
+      points.emplace_back(static_cast<int>(std::lround(col)), static_cast<int>(std::lround(row)));
+    }
+    if (points.size() == 1) points.push_back(points[0]);
+    for (size_t j = 0; j + 1 < points.size(); ++j) {
+      cv::line(strokes, points[j], points[j + 1], cv::Scalar(value), width, cv::LINE_8);
+    }
+  }
+  return strokes;
+}
+
+cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
+  cv::Mat strokes;
+  if (FileExtension(path) == "json") {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) ThrowInputError(path, "", "", "cannot open the stroke file");
+    std::stringstream text;
+    text << in.rdbuf();
+    strokes = StrokesFromJson(text.str(), rows, cols, path);
+  } else {
+    cv::Mat painted = ReadImage(path);
+    if (painted.rows != rows || painted.cols != cols) {
+      ThrowInputError(path, "", "",
+                      fmt::format("the stroke image is {} x {} but the scan is {} x {} (cols x rows)",
+                                  painted.cols, painted.rows, cols, rows));
+    }
+    if (painted.depth() != CV_8U) ThrowInputError(path, "", "", "a stroke image must be 8-bit");
+    strokes = StrokesFromImage(painted, path);
+  }
+  return strokes;
+}
+
+cv::Mat StrokesToImage(const cv::Mat& strokes) {
+  cv::Mat image(strokes.rows, strokes.cols, CV_8UC3, cv::Scalar(0, 0, 0));
+  image.setTo(cv::Scalar(0, 255, 0), strokes == kStrokeObject);
+  image.setTo(cv::Scalar(255, 0, 0), strokes == kStrokeBackground);
+  return image;
+}
+
+}  // namespace lidarshop
