@@ -1,0 +1,202 @@
+#include "lidarshop/inpaint/search.h"
+
+#include <algorithm>
+#include <mutex>
+#include <unordered_set>
+
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
+
+namespace lidarshop {
+
+namespace {
+
+// Keeps the k best candidates seen (by CandidateBefore); Bound() is the k-th best difference (infinity until
+// k).
+class TopK {
+ public:
+  explicit TopK(int k) : k_(k) { best_.reserve(k + 1); }
+  float Bound() const {
+    return static_cast<int>(best_.size()) < k_ ? std::numeric_limits<float>::infinity()
+                                               : best_.back().difference;
+  }
+  void Offer(const SourceCandidate& candidate) {
+    if (static_cast<int>(best_.size()) == k_ && !CandidateBefore(candidate, best_.back())) return;
+    auto it = std::upper_bound(best_.begin(), best_.end(), candidate, CandidateBefore);
+    best_.insert(it, candidate);
+    if (static_cast<int>(best_.size()) > k_) best_.pop_back();
+  }
+  const std::vector<SourceCandidate>& best() const { return best_; }
+
+ private:
+  int k_;
+  std::vector<SourceCandidate> best_;
+};
+
+uint64_t SplitMix64(uint64_t& state) {
+  uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+int UniformInt(uint64_t& state, int n) {
+  return static_cast<int>((SplitMix64(state) >> 11) % static_cast<uint64_t>(n));
+}
+
+}  // namespace
+
+bool CandidateBefore(const SourceCandidate& a, const SourceCandidate& b) {
+  if (a.difference != b.difference) return a.difference < b.difference;
+  if (a.source.row != b.source.row) return a.source.row < b.source.row;
+  return a.source.col < b.source.col;
+}
+
+std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& canvas,
+                                                         const TargetDifference& difference, int count,
+                                                         float bound, int row_begin, int row_end,
+                                                         int col_begin, int col_end) {
+  const auto& cols_by_row = canvas.source_cols_by_row();
+  row_begin = std::max(row_begin, 0);
+  row_end = std::min(row_end, canvas.rows());
+  if (row_end <= row_begin) return {};
+  std::mutex merge_mutex;
+  TopK merged(count);
+  ParallelForRange(
+      row_end - row_begin,
+      [&](int64_t begin, int64_t end) {
+        TopK local(count);
+        int64_t evaluated = 0;
+        for (int64_t i = begin; i < end; ++i) {
+          const int r = row_begin + static_cast<int>(i);
+          const std::vector<int>& cols = cols_by_row[r];
+          auto first = std::lower_bound(cols.begin(), cols.end(), col_begin);
+          for (auto it = first; it != cols.end() && *it < col_end; ++it) {
+            const float limit = std::min(bound, local.Bound());
+            const float d = difference.Evaluate({r, *it}, limit);
+            ++evaluated;
+            if (d <= limit) local.Offer({{r, *it}, d});
+          }
+        }
+        evaluations_ += evaluated;
+        std::lock_guard<std::mutex> lock(merge_mutex);
+        for (const SourceCandidate& c : local.best()) merged.Offer(c);
+      },
+      4);
+  return merged.best();
+}
+
+std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
+                                                    const TargetDifference& difference, Pixel target,
+                                                    int count) {
+  return FindBelow(canvas, difference, count, std::numeric_limits<float>::infinity(), 0, canvas.rows(), 0,
+                   canvas.cols());
+}
+
+std::vector<SourceCandidate> LocalSearch::Find(const InpaintCanvas& canvas,
+                                               const TargetDifference& difference, Pixel target, int count) {
+  const int w = window_radius_;
+  auto result = exhaustive_.FindBelow(canvas, difference, count, std::numeric_limits<float>::infinity(),
+                                      target.row - w, target.row + w + 1, target.col - w, target.col + w + 1);
+  if (result.empty()) result = exhaustive_.Find(canvas, difference, target, count);
+  evaluations_ = exhaustive_.evaluations();
+  return result;
+}
+
+std::vector<SourceCandidate> TwoStepSearch::Find(const InpaintCanvas& canvas,
+                                                 const TargetDifference& difference, Pixel target,
+                                                 int count) {
+  const int w = window_radius_;
+  const float inf = std::numeric_limits<float>::infinity();
+  auto local = exhaustive_.FindBelow(canvas, difference, count, inf, target.row - w, target.row + w + 1,
+                                     target.col - w, target.col + w + 1);
+  const float local_bound = static_cast<int>(local.size()) == count ? local.back().difference : inf;
+  // A global candidate must satisfy difference·gain <= local bound to enter the merged top-k.
+  auto global =
+      exhaustive_.FindBelow(canvas, difference, count, static_cast<float>(local_bound / global_gain_), 0,
+                            canvas.rows(), 0, canvas.cols());
+  evaluations_ = exhaustive_.evaluations();
+  // Rank: local candidates by their difference, global ones (not inside the window) by difference·gain.
+  auto in_window = [&](Pixel p) {
+    return std::abs(p.row - target.row) <= w && std::abs(p.col - target.col) <= w;
+  };
+  std::vector<std::pair<SourceCandidate, SourceCandidate>> ranked;  // (ranking key, true candidate)
+  for (const auto& c : local) ranked.push_back({c, c});
+  for (const auto& c : global) {
+    if (in_window(c.source)) continue;
+    ranked.push_back({{c.source, static_cast<float>(c.difference * global_gain_)}, c});
+  }
+  std::sort(ranked.begin(), ranked.end(),
+            [](const auto& a, const auto& b) { return CandidateBefore(a.first, b.first); });
+  std::vector<SourceCandidate> result;
+  for (size_t i = 0; i < ranked.size() && static_cast<int>(i) < count; ++i)
+    result.push_back(ranked[i].second);
+  return result;
+}
+
+void PatchMatchOptions::Check() const {
+  CheckOption(random_samples >= 1,
+              fmt::format("PatchMatchOptions.random_samples must be >= 1, got {}", random_samples));
+  CheckOption(iterations >= 0, fmt::format("PatchMatchOptions.iterations must be >= 0, got {}", iterations));
+  CheckOption(alpha > 0.0 && alpha < 1.0,
+              fmt::format("PatchMatchOptions.alpha must be in (0, 1), got {}", alpha));
+}
+
+PatchMatchSearch::PatchMatchSearch(PatchMatchOptions options) : options_(options) { options_.Check(); }
+
+std::vector<SourceCandidate> PatchMatchSearch::Find(const InpaintCanvas& canvas,
+                                                    const TargetDifference& difference, Pixel target,
+                                                    int count) {
+  const auto& sources = canvas.source_centers();
+  if (sources.empty()) return {};
+  uint64_t rng =
+      options_.seed * 0x9e3779b97f4a7c15ull + static_cast<uint64_t>(canvas.Index(target.row, target.col));
+  TopK top(count);
+  std::unordered_set<int64_t> seen;
+  int64_t evaluated = 0;
+  auto offer = [&](int r, int c) {
+    if (!canvas.Inside(r, c) || !canvas.IsSource(r, c)) return;
+    if (!seen.insert(canvas.Index(r, c)).second) return;
+    const float bound = top.Bound();
+    const float d = difference.Evaluate({r, c}, bound);
+    ++evaluated;
+    if (d <= bound) top.Offer({{r, c}, d});
+  };
+  // Propagation from filled pixels in and around the target patch.
+  const int R = canvas.patch_radius(), reach = R + 1;
+  const cv::Mat& source_pixel = canvas.source_pixel();
+  for (int r = target.row - reach; r <= target.row + reach; ++r) {
+    for (int c = target.col - reach; c <= target.col + reach; ++c) {
+      if (!canvas.Inside(r, c)) continue;
+      const cv::Vec2i s = source_pixel.at<cv::Vec2i>(r, c);
+      if (s[0] < 0) continue;
+      offer(s[0] - (r - target.row), s[1] - (c - target.col));
+    }
+  }
+  for (const cv::Point& offset : recent_offsets_) offer(target.row + offset.y, target.col + offset.x);
+  for (int i = 0; i < options_.random_samples; ++i) {
+    const Pixel& s = sources[UniformInt(rng, static_cast<int>(sources.size()))];
+    offer(s.row, s.col);
+  }
+  const int max_radius = std::max(canvas.rows(), canvas.cols());
+  for (int it = 0; it < options_.iterations && !top.best().empty(); ++it) {
+    const Pixel best = top.best().front().source;
+    for (const auto& [dr, dc] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}})
+      offer(best.row + dr, best.col + dc);
+    for (double radius = max_radius; radius >= 1.0; radius *= options_.alpha) {
+      const int rad = static_cast<int>(radius);
+      const Pixel center = top.best().front().source;
+      offer(center.row + UniformInt(rng, 2 * rad + 1) - rad, center.col + UniformInt(rng, 2 * rad + 1) - rad);
+    }
+  }
+  evaluations_ += evaluated;
+  std::vector<SourceCandidate> result = top.best();
+  if (!result.empty()) {
+    recent_offsets_.insert(recent_offsets_.begin(), cv::Point(result.front().source.col - target.col,
+                                                              result.front().source.row - target.row));
+    if (recent_offsets_.size() > 8) recent_offsets_.pop_back();
+  }
+  return result;
+}
+
+}  // namespace lidarshop
