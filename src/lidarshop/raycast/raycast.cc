@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -18,6 +19,7 @@ struct RaycastScene::Impl {
   bool committed = false;
   // Embree's geometry ids are dense from 0; the user's ids are mapped through this table.
   std::vector<int32_t> user_id_of_geometry;
+  RTCBuildQuality build_quality = RTC_BUILD_QUALITY_MEDIUM;
 
   ~Impl() {
     if (scene != nullptr) rtcReleaseScene(scene);
@@ -46,11 +48,27 @@ void FillRayHit(const Ray& ray, RTCRayHit* ray_hit) {
 
 }  // namespace
 
-RaycastScene::RaycastScene() : impl_(std::make_unique<Impl>()) {
+void RaycastSceneOptions::Check() const {
+  CheckOption(
+      build_quality == "low" || build_quality == "medium" || build_quality == "high",
+      fmt::format("RaycastSceneOptions.build_quality must be low, medium or high, got '{}'", build_quality));
+}
+
+RaycastScene::RaycastScene() : RaycastScene(RaycastSceneOptions()) {}
+
+RaycastScene::RaycastScene(const RaycastSceneOptions& options) : impl_(std::make_unique<Impl>()) {
+  options.Check();
   impl_->device = rtcNewDevice(nullptr);
   if (impl_->device == nullptr) throw std::runtime_error("Embree: cannot create a device");
   impl_->scene = rtcNewScene(impl_->device);
-  rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  impl_->build_quality = options.build_quality == "low"    ? RTC_BUILD_QUALITY_LOW
+                         : options.build_quality == "high" ? RTC_BUILD_QUALITY_HIGH
+                                                           : RTC_BUILD_QUALITY_MEDIUM;
+  rtcSetSceneBuildQuality(impl_->scene, impl_->build_quality);
+  int flags = RTC_SCENE_FLAG_NONE;
+  if (options.robust) flags |= RTC_SCENE_FLAG_ROBUST;
+  if (options.compact) flags |= RTC_SCENE_FLAG_COMPACT;
+  rtcSetSceneFlags(impl_->scene, static_cast<RTCSceneFlags>(flags));
 }
 
 RaycastScene::~RaycastScene() = default;
@@ -61,14 +79,14 @@ void RaycastScene::AddMesh(const TriangleMesh& mesh, int32_t id) {
   if (impl_->committed) throw std::logic_error("RaycastScene::AddMesh after Commit");
   if (id < 0) throw std::invalid_argument(fmt::format("RaycastScene::AddMesh: id must be >= 0, got {}", id));
   for (int32_t existing : impl_->user_id_of_geometry) {
-    if (existing == id) throw std::invalid_argument(fmt::format("RaycastScene::AddMesh: id {} used twice", id));
+    if (existing == id)
+      throw std::invalid_argument(fmt::format("RaycastScene::AddMesh: id {} used twice", id));
   }
   ValidateMesh(mesh, fmt::format("mesh {}", id));
   RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   // Embree reads vertex buffers 16 bytes at a time: stride 12 with one padding float at the end.
-  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                               RTC_FORMAT_FLOAT3, 3 * sizeof(float),
-                                                               mesh.vertices.size() + 1));
+  auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+      geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh.vertices.size() + 1));
   for (size_t v = 0; v < mesh.vertices.size(); ++v) {
     vertices[3 * v + 0] = mesh.vertices[v].x();
     vertices[3 * v + 1] = mesh.vertices[v].y();
@@ -81,10 +99,12 @@ void RaycastScene::AddMesh(const TriangleMesh& mesh, int32_t id) {
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {
     for (int corner = 0; corner < 3; ++corner) indices[3 * f + corner] = mesh.triangles[f][corner];
   }
+  rtcSetGeometryBuildQuality(geometry, impl_->build_quality);
   rtcCommitGeometry(geometry);
   const unsigned geometry_id = rtcAttachGeometry(impl_->scene, geometry);
   rtcReleaseGeometry(geometry);
-  if (geometry_id != impl_->user_id_of_geometry.size()) throw std::logic_error("Embree geometry ids not dense");
+  if (geometry_id != impl_->user_id_of_geometry.size())
+    throw std::logic_error("Embree geometry ids not dense");
   impl_->user_id_of_geometry.push_back(id);
 }
 
@@ -100,7 +120,8 @@ void* RaycastScene::native_scene() const { return impl_->scene; }
 
 void RaycastScene::CastSerial(std::span<const Ray> rays, std::span<RayHit> hits) const {
   if (!impl_->committed) throw std::logic_error("RaycastScene: cast before Commit");
-  if (hits.size() != rays.size()) throw std::invalid_argument("RaycastScene::Cast: rays and hits differ in size");
+  if (hits.size() != rays.size())
+    throw std::invalid_argument("RaycastScene::Cast: rays and hits differ in size");
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRayHit ray_hit;
@@ -122,7 +143,8 @@ void RaycastScene::CastSerial(std::span<const Ray> rays, std::span<RayHit> hits)
 }
 
 void RaycastScene::Cast(std::span<const Ray> rays, std::span<RayHit> hits) const {
-  if (hits.size() != rays.size()) throw std::invalid_argument("RaycastScene::Cast: rays and hits differ in size");
+  if (hits.size() != rays.size())
+    throw std::invalid_argument("RaycastScene::Cast: rays and hits differ in size");
   ParallelForRange(
       static_cast<int64_t>(rays.size()),
       [&](int64_t begin, int64_t end) {
@@ -151,38 +173,143 @@ void RaycastScene::Occluded(std::span<const Ray> rays, std::span<uint8_t> occlud
 
 RayHitImages RaycastScene::CastImage(const Eigen::Vector3f& origin, const cv::Mat& directions, float t_near,
                                      float t_far) const {
-  if (directions.type() != CV_32FC3) throw std::invalid_argument("RaycastScene::CastImage: directions must be CV_32FC3");
-  const int rows = directions.rows;
-  const int cols = directions.cols;
+  Eigen::Matrix4d world_from_sensor = Eigen::Matrix4d::Identity();
+  world_from_sensor.topRightCorner<3, 1>() = origin.cast<double>();
+  return CastImage(world_from_sensor, directions, t_near, t_far, CastMethod::kPacket16);
+}
+
+namespace {
+
+// Image rows are cast in bands of kTileRows; packets are kTileRows x kTileCols tiles of neighbouring cells,
+// whose rays are nearly parallel, so Embree's packet traversal visits the same BVH nodes for all 16.
+constexpr int kTileRows = 4;
+constexpr int kTileCols = 4;
+
+struct HitWriter {
+  const std::vector<int32_t>& user_id_of_geometry;
+  RayHitImages& images;
+
+  void Miss(int row, int col) const {
+    images.t_hit.at<float>(row, col) = std::numeric_limits<float>::infinity();
+    images.geometry_id.at<int32_t>(row, col) = kInvalidId;
+    images.primitive_id.at<int32_t>(row, col) = kInvalidId;
+    images.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(0, 0, 0);
+    images.barycentric.at<cv::Vec2f>(row, col) = cv::Vec2f(0, 0);
+  }
+  void Write(int row, int col, float t, unsigned geometry, unsigned primitive, float nx, float ny, float nz,
+             float u, float v) const {
+    if (geometry == RTC_INVALID_GEOMETRY_ID) return Miss(row, col);
+    images.t_hit.at<float>(row, col) = t;
+    images.geometry_id.at<int32_t>(row, col) = user_id_of_geometry[geometry];
+    images.primitive_id.at<int32_t>(row, col) = static_cast<int32_t>(primitive);
+    const float inverse_norm = 1.0f / std::sqrt(nx * nx + ny * ny + nz * nz);
+    images.normal.at<cv::Vec3f>(row, col) =
+        cv::Vec3f(nx * inverse_norm, ny * inverse_norm, nz * inverse_norm);
+    images.barycentric.at<cv::Vec2f>(row, col) = cv::Vec2f(u, v);
+  }
+};
+
+}  // namespace
+
+RayHitImages RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor,
+                                     const cv::Mat& directions_in_sensor, float t_near, float t_far,
+                                     CastMethod method) const {
+  if (!impl_->committed) throw std::logic_error("RaycastScene: cast before Commit");
+  if (directions_in_sensor.type() != CV_32FC3) {
+    throw std::invalid_argument("RaycastScene::CastImage: directions must be CV_32FC3");
+  }
+  const int rows = directions_in_sensor.rows;
+  const int cols = directions_in_sensor.cols;
   RayHitImages images;
   images.t_hit.create(rows, cols, CV_32F);
   images.geometry_id.create(rows, cols, CV_32S);
   images.primitive_id.create(rows, cols, CV_32S);
   images.normal.create(rows, cols, CV_32FC3);
   images.barycentric.create(rows, cols, CV_32FC2);
-  ParallelFor(
-      rows,
-      [&](int64_t row) {
-        std::vector<Ray> rays(cols);
-        std::vector<RayHit> hits(cols);
-        const auto* direction = directions.ptr<cv::Vec3f>(static_cast<int>(row));
-        for (int col = 0; col < cols; ++col) {
-          rays[col].origin = origin;
-          rays[col].direction = Eigen::Vector3f(direction[col][0], direction[col][1], direction[col][2]);
-          rays[col].t_near = t_near;
-          rays[col].t_far = t_far;
+  if (rows == 0 || cols == 0) return images;
+  const Eigen::Matrix3f rotation = world_from_sensor.topLeftCorner<3, 3>().cast<float>();
+  const Eigen::Vector3f origin = world_from_sensor.topRightCorner<3, 1>().cast<float>();
+  const HitWriter writer{impl_->user_id_of_geometry, images};
+  RTCScene scene = impl_->scene;
+  auto direction_at = [&](int row, int col) {
+    const cv::Vec3f& d = directions_in_sensor.at<cv::Vec3f>(row, col);
+    return Eigen::Vector3f(rotation * Eigen::Vector3f(d[0], d[1], d[2]));
+  };
+  const int bands = (rows + kTileRows - 1) / kTileRows;
+  ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    if (method != CastMethod::kSingle) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    std::vector<RTCRayHit> stream;
+    std::vector<std::pair<int, int>> stream_cells;
+    for (int64_t band = band_begin; band < band_end; ++band) {
+      const int row0 = static_cast<int>(band) * kTileRows;
+      const int row1 = std::min(rows, row0 + kTileRows);
+      if (method == CastMethod::kSingle) {
+        RTCRayHit ray_hit;
+        for (int row = row0; row < row1; ++row) {
+          for (int col = 0; col < cols; ++col) {
+            const Eigen::Vector3f d = direction_at(row, col);
+            FillRayHit(Ray{origin, d, t_near, t_far}, &ray_hit);
+            rtcIntersect1(scene, &context, &ray_hit);
+            writer.Write(row, col, ray_hit.ray.tfar, ray_hit.hit.geomID, ray_hit.hit.primID, ray_hit.hit.Ng_x,
+                         ray_hit.hit.Ng_y, ray_hit.hit.Ng_z, ray_hit.hit.u, ray_hit.hit.v);
+          }
         }
-        CastSerial(rays, hits);
-        const int r = static_cast<int>(row);
-        for (int col = 0; col < cols; ++col) {
-          const RayHit& hit = hits[col];
-          images.t_hit.at<float>(r, col) = hit.t_hit;
-          images.geometry_id.at<int32_t>(r, col) = hit.geometry_id;
-          images.primitive_id.at<int32_t>(r, col) = hit.primitive_id;
-          images.normal.at<cv::Vec3f>(r, col) = cv::Vec3f(hit.normal.x(), hit.normal.y(), hit.normal.z());
-          images.barycentric.at<cv::Vec2f>(r, col) = cv::Vec2f(hit.u, hit.v);
+      } else if (method == CastMethod::kStream) {
+        stream.clear();
+        stream_cells.clear();
+        for (int col0 = 0; col0 < cols; col0 += kTileCols) {
+          for (int row = row0; row < row1; ++row) {
+            for (int col = col0; col < std::min(cols, col0 + kTileCols); ++col) {
+              stream.emplace_back();
+              FillRayHit(Ray{origin, direction_at(row, col), t_near, t_far}, &stream.back());
+              stream_cells.emplace_back(row, col);
+            }
+          }
         }
-      });
+        rtcIntersect1M(scene, &context, stream.data(), static_cast<unsigned>(stream.size()),
+                       sizeof(RTCRayHit));
+        for (size_t i = 0; i < stream.size(); ++i) {
+          const RTCRayHit& h = stream[i];
+          writer.Write(stream_cells[i].first, stream_cells[i].second, h.ray.tfar, h.hit.geomID, h.hit.primID,
+                       h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.hit.u, h.hit.v);
+        }
+      } else {
+        alignas(64) RTCRayHit16 packet;
+        alignas(64) int valid[16];
+        for (int col0 = 0; col0 < cols; col0 += kTileCols) {
+          for (int i = 0; i < 16; ++i) {
+            const int row = row0 + i / kTileCols, col = col0 + i % kTileCols;
+            const bool inside = row < row1 && col < cols;
+            valid[i] = inside ? -1 : 0;
+            const Eigen::Vector3f d = inside ? direction_at(row, col) : Eigen::Vector3f::UnitZ();
+            packet.ray.org_x[i] = origin.x();
+            packet.ray.org_y[i] = origin.y();
+            packet.ray.org_z[i] = origin.z();
+            packet.ray.dir_x[i] = d.x();
+            packet.ray.dir_y[i] = d.y();
+            packet.ray.dir_z[i] = d.z();
+            packet.ray.tnear[i] = t_near;
+            packet.ray.tfar[i] = t_far;
+            packet.ray.mask[i] = 0xFFFFFFFFu;
+            packet.ray.time[i] = 0.0f;
+            packet.ray.flags[i] = 0;
+            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+          }
+          rtcIntersect16(valid, scene, &context, &packet);
+          for (int i = 0; i < 16; ++i) {
+            if (valid[i] == 0) continue;
+            writer.Write(row0 + i / kTileCols, col0 + i % kTileCols, packet.ray.tfar[i], packet.hit.geomID[i],
+                         packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
+                         packet.hit.u[i], packet.hit.v[i]);
+          }
+        }
+      }
+    }
+  });
   return images;
 }
 

@@ -1,10 +1,10 @@
 // Ray casting against triangle meshes, over Embree 3.
 //
-// Build once, query many: add meshes (each with an id), Commit(), then cast any number of ray batches from any
-// number of threads. A committed scene is immutable and thread-safe to query. Rays are given either as flat arrays
-// (hot loops: verification casts a few thousand rays per pose) or as images (a scanner's {rows, cols} grid), and
-// hits come back as named arrays/images in the style of Open3D's RaycastingScene: t_hit, geometry_id, primitive_id,
-// normal, and barycentric u, v.
+// Build once, query many: add meshes (each with an id), Commit(), then cast any number of ray batches from
+// any number of threads. A committed scene is immutable and thread-safe to query. Rays are given either as
+// flat arrays (hot loops: verification casts a few thousand rays per pose) or as images (a scanner's {rows,
+// cols} grid), and hits come back as named arrays/images in the style of Open3D's RaycastingScene: t_hit,
+// geometry_id, primitive_id, normal, and barycentric u, v.
 //
 //   RaycastScene scene;
 //   scene.AddMesh(car_in_world, /*id=*/4);
@@ -16,6 +16,7 @@
 #include <limits>
 #include <memory>
 #include <span>
+#include <string>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
@@ -35,10 +36,10 @@ struct Ray {
 
 struct RayHit {
   float t_hit = std::numeric_limits<float>::infinity();  // +inf on a miss
-  int32_t geometry_id = kInvalidId;                       // the id given to AddMesh, kInvalidId on a miss
-  int32_t primitive_id = kInvalidId;                      // triangle index within that mesh
-  Eigen::Vector3f normal = Eigen::Vector3f::Zero();       // unit geometric normal (winding side), scene frame
-  float u = 0.0f, v = 0.0f;                               // barycentric: hit = (1-u-v)*v0 + u*v1 + v*v2
+  int32_t geometry_id = kInvalidId;                      // the id given to AddMesh, kInvalidId on a miss
+  int32_t primitive_id = kInvalidId;                     // triangle index within that mesh
+  Eigen::Vector3f normal = Eigen::Vector3f::Zero();      // unit geometric normal (winding side), scene frame
+  float u = 0.0f, v = 0.0f;                              // barycentric: hit = (1-u-v)*v0 + u*v1 + v*v2
   bool hit() const { return geometry_id != kInvalidId; }
 };
 
@@ -51,14 +52,33 @@ struct RayHitImages {
   cv::Mat barycentric;   // CV_32FC2 (u, v)
 };
 
+// How CastImage traces an image of rays (all give the same hits; they differ in speed only).
+enum class CastMethod {
+  kPacket16,  // 4 x 4 tiles of neighbouring cells as rtcIntersect16 packets (coherent; the default, fastest
+              // here)
+  kStream,    // rows of tiles as rtcIntersect1M streams with the coherent flag
+  kSingle,    // one rtcIntersect1 per ray (Open3D's RaycastingScene way; the reference)
+};
+
+struct RaycastSceneOptions {
+  // Embree BVH build quality: "low" builds fastest, "high" (SAH with spatial splits) traces fastest. Measured
+  // in bench/scanner_bench.cc; "medium" is the default (see bench/results/scanner.md).
+  std::string build_quality = "medium";
+  bool robust = false;   // RTC_SCENE_FLAG_ROBUST: watertight-er traversal at some speed cost
+  bool compact = false;  // RTC_SCENE_FLAG_COMPACT: less memory, slower traversal
+  void Check() const;
+};
+
 class RaycastScene {
  public:
   RaycastScene();
+  explicit RaycastScene(const RaycastSceneOptions& options);
   ~RaycastScene();
   RaycastScene(RaycastScene&&) noexcept;
   RaycastScene& operator=(RaycastScene&&) noexcept;
 
-  // Adds a mesh under `id` (>= 0, unique). Throws before Commit() only. The mesh is copied into Embree's buffers.
+  // Adds a mesh under `id` (>= 0, unique). Throws before Commit() only. The mesh is copied into Embree's
+  // buffers.
   void AddMesh(const TriangleMesh& mesh, int32_t id);
   // Builds the acceleration structure. Casting before Commit() throws.
   void Commit();
@@ -75,6 +95,12 @@ class RaycastScene {
   // One origin, an image of directions (CV_32FC3, need not be unit). Multithreaded.
   RayHitImages CastImage(const Eigen::Vector3f& origin, const cv::Mat& directions, float t_near = 0.0f,
                          float t_far = std::numeric_limits<float>::infinity()) const;
+  // A sensor pose: rays start at the origin of `world_from_sensor` with directions_in_sensor (CV_32FC3)
+  // rotated into the scene frame; hits (normals included) are in the scene frame. Casting the same scene from
+  // many poses needs no rebuild. `method` chooses the Embree API (same hits).
+  RayHitImages CastImage(const Eigen::Matrix4d& world_from_sensor, const cv::Mat& directions_in_sensor,
+                         float t_near = 0.0f, float t_far = std::numeric_limits<float>::infinity(),
+                         CastMethod method = CastMethod::kPacket16) const;
 
   // For benchmarks and advanced callers: the RTCScene handle (opaque here to keep Embree out of this header).
   void* native_scene() const;

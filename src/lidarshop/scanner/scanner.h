@@ -1,0 +1,65 @@
+// The synthetic scanner: ground truth for every later algorithm.
+//
+// Casts the scanner's uniform azimuth x elevation grid (scanner/scene.h: ScannerOptions) into a scene of
+// meshes and returns an organized Scan (scan/scan.h) in image orientation (row 0 = highest elevation, columns
+// left to right) with every channel filled:
+//   valid, range (noisy), point (noisy, scanner frame), intensity (ScannerOptions' model), color (material,
+//   triangle colours or texture looked up at the hit point), label (object label, kNoLabel where no return),
+//   normal (true surface normal, scanner frame, facing the scanner: interpolated vertex normals where the
+//   mesh has them, else the geometric normal), true_range (noise-free range), direction (every cell),
+//   world_from_scanner.
+//
+// Noise (per cell, from a counter-based hash of (seed, cell index), so identical whatever the thread count):
+//   point = (true_range + e_los) · d + e_orth · (cos ψ · b1 + sin ψ · b2), e_los ~ N(0, σ_los²),
+//   e_orth ~ N(0, σ_orth²), ψ ~ U[0, 2π), (b1, b2) an orthonormal basis perpendicular to the ray d.
+//   range = |point|.
+//
+// Build once, scan many: SyntheticScanner builds the ray-casting scene of a SceneDescription once; Acquire()
+// can then be called for any ScannerOptions (other poses, grids, noise).
+#pragma once
+
+#include <memory>
+
+#include "lidarshop/raycast/raycast.h"
+#include "lidarshop/scan/scan.h"
+#include "lidarshop/scanner/scene.h"
+#include "lidarshop/util/progress.h"
+
+namespace lidarshop {
+
+struct ScanStats {
+  int64_t rays = 0;
+  int64_t returns = 0;
+  double cast_seconds = 0.0;   // ray casting
+  double shade_seconds = 0.0;  // noise, colour, intensity, normals
+};
+
+class SyntheticScanner {
+ public:
+  // Builds the ray-casting scene (object i gets geometry id i). Throws InputError for a broken mesh.
+  explicit SyntheticScanner(const SceneDescription& scene);
+  ~SyntheticScanner();
+  SyntheticScanner(SyntheticScanner&&) noexcept;
+  SyntheticScanner& operator=(SyntheticScanner&&) noexcept;
+
+  // One scan with `options` (throws OptionsError from options.Check()). `progress` advances by rows.
+  Scan Acquire(const ScannerOptions& options, Progress* progress = nullptr, ScanStats* stats = nullptr) const;
+
+  const RaycastScene& raycast_scene() const;
+  int64_t num_triangles() const;
+  double build_seconds() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Convenience: builds the scanner for `scene` and scans with scene.scanner.
+Scan SynthesizeScan(const SceneDescription& scene, Progress* progress = nullptr);
+
+// A deterministic standard normal / uniform draw for (seed, cell, stream): the scanner's noise source,
+// exposed for tests and other synthetic-data makers.
+double CellNormal(uint64_t seed, uint64_t cell, uint32_t stream);
+double CellUniform(uint64_t seed, uint64_t cell, uint32_t stream);
+
+}  // namespace lidarshop

@@ -1,0 +1,95 @@
+// Scene descriptions of the synthetic scanner: objects (meshes in their own frame, a pose, a label, a
+// material) and the scanner's settings, read from JSON (docs/scene-format.md has every key, unit and
+// default).
+//
+//   {"scanner": {"position": [0, 0, 1.5], "rotate_deg": [0, 0, 0], "azimuth_deg": [-45, 45],
+//                "elevation_deg": [-30, 30], "columns": 900, "rows": 600, "max_range": 100,
+//                "los_noise_sigma": 0.0, "orthogonal_noise_sigma": 0.0, "seed": 1},
+//    "objects": [{"primitive": "plane", "size": [200, 200], "label": 0, "texture": "grass"},
+//                {"mesh": "meshes/car.obj", "scale": 4.2, "rotate_deg": [90, 0, 30], "translate": [0, 15,
+//                0]}]}
+//
+// Transforms: an object is scaled, then rotated (R = Rz * Ry * Rx of `rotate_deg` = [x, y, z] degrees about
+// fixed axes), then translated; or given as a 4x4 `matrix` (row-major rows). The scanner's `rotate_deg`
+// orients its frame (z up, y forward, x right) in the world the same way; `position` is its origin in the
+// world.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lidarshop/geometry/mesh.h"
+#include "lidarshop/scan/scan.h"
+#include "lidarshop/scanner/texture.h"
+
+namespace lidarshop {
+
+// The scanner model (Leica HDS3000-like): a uniform azimuth x elevation grid from one origin.
+struct ScannerOptions {
+  Eigen::Vector3d position = Eigen::Vector3d(0, 0, 1.5);  // scanner origin in the world, metres
+  Eigen::Vector3d rotate_deg =
+      Eigen::Vector3d::Zero();       // world_from_scanner rotation, degrees (R = Rz Ry Rx)
+  double azimuth_min_deg = -45.0;    // θ of the leftmost column, degrees from +y, positive right
+  double azimuth_max_deg = 45.0;     // θ of the rightmost column (> min; at most min + 360)
+  double elevation_min_deg = -30.0;  // φ of the bottom row, degrees, positive up, >= -90
+  double elevation_max_deg = 30.0;   // φ of the top row (> min), <= 90
+  int columns = 900;                 // strips, left to right
+  int rows = 600;                    // points per strip
+  double max_range_m = 100.0;        // farther hits are no return, metres
+  double min_range_m = 0.0;          // nearer hits are ignored (the ray continues), metres
+  double los_noise_sigma_m = 0.0;    // σ of the Gaussian error along the ray, metres
+  // σ of the Gaussian error perpendicular to the ray (signed length along a direction drawn uniformly in the
+  // plane perpendicular to the ray, so the RMS displacement is σ), metres.
+  double orthogonal_noise_sigma_m = 0.0;
+  uint64_t seed = 1;  // noise seed; same seed = same scan whatever the thread count
+  // Intensity model: I = clamp(ρ_eff · |cos α| · exp(-r / intensity_falloff_m), 0, 1) with α the incidence
+  // angle and ρ_eff = reflectivity · (0.5 + luminance of the surface colour in [0, 1]); metres.
+  double intensity_falloff_m = 150.0;
+
+  void Check() const;  // throws OptionsError
+  Eigen::Matrix4d WorldFromScanner() const;
+  ScanGrid Grid() const;  // the uniform grid of this scanner (image orientation)
+};
+
+struct Material {
+  Rgb8 color = Rgb8(180, 180, 180);          // RGB; used where the mesh has no colours of its own
+  float reflectivity = 0.5f;                 // Lambertian reflectivity in [0, 1] of a mid-grey surface
+  TextureKind texture = TextureKind::kNone;  // procedural texture, coloured from the surface colour
+  float texture_scale = 1.0f;                // > 0; 2 = the texture twice as large
+};
+
+struct SceneObject {
+  std::string name;   // the object's "name", or "objects[i]"
+  TriangleMesh mesh;  // in the object frame (unscaled); may carry triangle/vertex colours and a texture
+  Eigen::Matrix4d world_from_object = Eigen::Matrix4d::Identity();
+  int32_t label = 0;  // in [0, 65534] (65535 marks no return in label PNGs)
+  Material material;
+};
+
+struct SceneDescription {
+  ScannerOptions scanner;
+  std::vector<SceneObject> objects;
+  std::string path;  // the file it was read from ("" when built in code)
+
+  int64_t NumTriangles() const;
+};
+
+// Reads a scene file. Throws InputError naming the file and the field ("parking_lot.json: objects[2]: field
+// 'radius': expected a number > 0, got -1"; unknown keys, missing mesh files and bad types included).
+SceneDescription LoadScene(const std::string& path);
+// Parses JSON text; `what` names the source in errors, mesh paths are relative to `base_dir`.
+SceneDescription ParseScene(const std::string& json_text, const std::string& what,
+                            const std::string& base_dir);
+
+// The mesh of one object of a scene in world coordinates (vertex normals transformed along).
+TriangleMesh MeshInWorld(const SceneObject& object);
+
+// The mesh of a primitive, by name, as a scene file would make it ("plane", "box", "sphere", "cylinder",
+// "cone", "car", "lamp_post", "electric_box", "mailbox", "facade", "wall"): parameters are a JSON object's
+// text, e.g. MakePrimitive("car", R"({"style": "van"})"). For generators and tests.
+TriangleMesh MakePrimitive(const std::string& primitive, const std::string& parameters_json = "{}");
+
+}  // namespace lidarshop

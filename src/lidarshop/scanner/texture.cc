@@ -1,0 +1,155 @@
+#include "lidarshop/scanner/texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+inline uint32_t Hash(int32_t x, int32_t y, uint32_t salt) {
+  uint32_t h =
+      static_cast<uint32_t>(x) * 0x8da6b343u ^ static_cast<uint32_t>(y) * 0xd8163841u ^ salt * 0xcb1ab31fu;
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
+
+// Uniform in [0, 1).
+inline float Hash01(int32_t x, int32_t y, uint32_t salt) {
+  return (Hash(x, y, salt) >> 8) * (1.0f / 16777216.0f);
+}
+
+// Smooth value noise in [0, 1) with unit lattice spacing.
+inline float ValueNoise(float x, float y, uint32_t salt) {
+  const float fx = std::floor(x), fy = std::floor(y);
+  const int32_t ix = static_cast<int32_t>(fx), iy = static_cast<int32_t>(fy);
+  float tx = x - fx, ty = y - fy;
+  tx = tx * tx * (3 - 2 * tx);
+  ty = ty * ty * (3 - 2 * ty);
+  const float a = Hash01(ix, iy, salt), b = Hash01(ix + 1, iy, salt);
+  const float c = Hash01(ix, iy + 1, salt), d = Hash01(ix + 1, iy + 1, salt);
+  return (a + (b - a) * tx) + ((c + (d - c) * tx) - (a + (b - a) * tx)) * ty;
+}
+
+inline Rgb8 Shade(Rgb8 color, float factor) {
+  return Rgb8(static_cast<uint8_t>(std::clamp(color[0] * factor, 0.0f, 255.0f)),
+              static_cast<uint8_t>(std::clamp(color[1] * factor, 0.0f, 255.0f)),
+              static_cast<uint8_t>(std::clamp(color[2] * factor, 0.0f, 255.0f)));
+}
+
+inline Rgb8 Mix(Rgb8 a, Rgb8 b, float t) {
+  return Rgb8(static_cast<uint8_t>(a[0] + (b[0] - a[0]) * t), static_cast<uint8_t>(a[1] + (b[1] - a[1]) * t),
+              static_cast<uint8_t>(a[2] + (b[2] - a[2]) * t));
+}
+
+}  // namespace
+
+TextureKind ParseTextureKind(const std::string& name, const std::string& what) {
+  if (name == "checker") return TextureKind::kChecker;
+  if (name == "grass") return TextureKind::kGrass;
+  if (name == "gravel") return TextureKind::kGravel;
+  if (name == "brick") return TextureKind::kBrick;
+  if (name == "none") return TextureKind::kNone;
+  ThrowInputError(what, "", "texture",
+                  fmt::format("unknown texture '{}' (checker, grass, gravel, brick)", name));
+}
+
+std::string TextureName(TextureKind kind) {
+  switch (kind) {
+    case TextureKind::kChecker:
+      return "checker";
+    case TextureKind::kGrass:
+      return "grass";
+    case TextureKind::kGravel:
+      return "gravel";
+    case TextureKind::kBrick:
+      return "brick";
+    case TextureKind::kNone:
+      break;
+  }
+  return "none";
+}
+
+Rgb8 DefaultTextureColor(TextureKind kind) {
+  switch (kind) {
+    case TextureKind::kChecker:
+      return Rgb8(220, 220, 220);
+    case TextureKind::kGrass:
+      return Rgb8(74, 112, 42);
+    case TextureKind::kGravel:
+      return Rgb8(138, 132, 122);
+    case TextureKind::kBrick:
+      return Rgb8(158, 68, 48);
+    case TextureKind::kNone:
+      break;
+  }
+  return Rgb8(180, 180, 180);
+}
+
+Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale) {
+  u /= scale;
+  v /= scale;
+  switch (kind) {
+    case TextureKind::kNone:
+      return base;
+    case TextureKind::kChecker: {
+      const int parity = (static_cast<int>(std::floor(u)) + static_cast<int>(std::floor(v))) & 1;
+      return parity ? Shade(base, 0.3f) : base;
+    }
+    case TextureKind::kGrass: {
+      const float blades = ValueNoise(u * 33.0f, v * 33.0f, 11);
+      const float clumps = ValueNoise(u * 2.5f, v * 2.5f, 12);
+      const float dry = ValueNoise(u * 0.33f, v * 0.33f, 13);
+      const Rgb8 green = Shade(base, 0.55f + 0.5f * blades + 0.25f * (clumps - 0.5f));
+      const float dryness = std::clamp((dry - 0.6f) * 2.5f, 0.0f, 0.6f);
+      return Mix(green, Rgb8(150, 140, 78), dryness);
+    }
+    case TextureKind::kGravel: {
+      const float size = 0.03f;
+      const float row = std::floor(v / size);
+      const float shifted = u / size + 0.5f * (static_cast<int>(row) & 1);
+      const float col = std::floor(shifted);
+      const float fu = shifted - col, fv = v / size - row;
+      const int32_t ci = static_cast<int32_t>(col), ri = static_cast<int32_t>(row);
+      const float edge = std::min(std::min(fu, 1 - fu), std::min(fv, 1 - fv));
+      if (edge < 0.08f + 0.1f * Hash01(ci, ri, 23)) return Shade(base, 0.35f);
+      const float shade = 0.65f + 0.6f * Hash01(ci, ri, 21);
+      const float warm = Hash01(ci, ri, 22) - 0.5f;
+      Rgb8 stone = Shade(base, shade);
+      stone[0] = static_cast<uint8_t>(std::clamp(stone[0] * (1 + 0.15f * warm), 0.0f, 255.0f));
+      stone[2] = static_cast<uint8_t>(std::clamp(stone[2] * (1 - 0.15f * warm), 0.0f, 255.0f));
+      return stone;
+    }
+    case TextureKind::kBrick: {
+      const float course_height = 0.075f, brick_pitch = 0.225f, joint = 0.01f;
+      const float course = std::floor(v / course_height);
+      const float shifted = u + (static_cast<int>(course) & 1) * (brick_pitch / 2);
+      const float column = std::floor(shifted / brick_pitch);
+      const float in_u = shifted - column * brick_pitch, in_v = v - course * course_height;
+      if (in_u < joint || in_v < joint) return Rgb8(188, 182, 170);
+      const int32_t ci = static_cast<int32_t>(column), ri = static_cast<int32_t>(course);
+      const float shade = 0.8f + 0.35f * Hash01(ci, ri, 31) + 0.12f * (ValueNoise(u * 60, v * 60, 32) - 0.5f);
+      return Shade(base, shade);
+    }
+  }
+  return base;
+}
+
+Rgb8 SampleImageTexture(const cv::Mat& texture, float s, float t) {
+  if (texture.empty()) return Rgb8(180, 180, 180);
+  s -= std::floor(s);
+  t -= std::floor(t);
+  const int col = std::clamp(static_cast<int>(s * texture.cols), 0, texture.cols - 1);
+  const int row = std::clamp(static_cast<int>((1 - t) * texture.rows), 0, texture.rows - 1);
+  const cv::Vec3b& pixel = texture.at<cv::Vec3b>(row, col);
+  return Rgb8(pixel[0], pixel[1], pixel[2]);
+}
+
+}  // namespace lidarshop

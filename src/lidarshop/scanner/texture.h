@@ -1,0 +1,47 @@
+// Procedural surface textures of the synthetic scanner, at a realistic scale in metres, deterministic (hashes
+// of lattice coordinates, no global state), cheap enough to evaluate once per ray.
+//
+//   checker  squares of `scale` metres (default 1 m), the base colour and a darker shade of it
+//   grass    green base (default RGB 74 112 42), blade-scale noise (3 cm), clumps (0.4 m), dry patches (3 m)
+//   gravel   stones of about 3 cm on a staggered grid, grey shades, dark gaps between stones
+//   brick    0.215 x 0.065 m bricks with 10 mm mortar joints in a running bond, per-brick shade variation
+//
+// Surface coordinates come from a triplanar projection in the object frame (metres, not scaled): the two axes
+// perpendicular to the dominant axis of the surface normal, with z as the vertical coordinate on walls so
+// that brick courses are horizontal.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "lidarshop/geometry/mesh.h"
+
+namespace lidarshop {
+
+enum class TextureKind { kNone, kChecker, kGrass, kGravel, kBrick };
+
+// "checker", "grass", "gravel", "brick"; throws InputError naming `what` and field 'texture' otherwise.
+TextureKind ParseTextureKind(const std::string& name, const std::string& what);
+std::string TextureName(TextureKind kind);
+// The colour a texture uses when the object gives none.
+Rgb8 DefaultTextureColor(TextureKind kind);
+
+// (u, v) in metres on the surface through `point_in_object` with normal `normal_in_object`.
+inline Eigen::Vector2f TriplanarCoordinates(const Eigen::Vector3f& point_in_object,
+                                            const Eigen::Vector3f& normal_in_object) {
+  const Eigen::Vector3f a = normal_in_object.cwiseAbs();
+  if (a.z() >= a.x() && a.z() >= a.y()) return {point_in_object.x(), point_in_object.y()};
+  if (a.x() >= a.y()) return {point_in_object.y(), point_in_object.z()};
+  return {point_in_object.x(), point_in_object.z()};
+}
+
+// Colour of `kind` at surface coordinates (u, v) in metres, divided by `scale` (1 = the realistic size
+// above). `base` is the main colour (the brick, the grass, the light checker square).
+Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale = 1.0f);
+
+// Nearest-texel lookup of an image texture (CV_8UC3 RGB) at (s, t), (0, 0) = bottom left, wrapping.
+Rgb8 SampleImageTexture(const cv::Mat& texture, float s, float t);
+
+}  // namespace lidarshop
