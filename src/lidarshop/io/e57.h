@@ -1,6 +1,7 @@
 // E57 (ASTM E2807) scans and images, implemented in lidarshop (no Debian package reads it).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -14,11 +15,15 @@ namespace lidarshop {
 // A photo stored in an E57 file's images2D section (pinhole or spherical representation).
 struct E57Image {
   std::string name;
-  std::string projection;  // "pinhole", "spherical", "cylindrical" or "visual" (visualReferenceRepresentation)
-  cv::Mat image;           // decoded, RGB
+  std::string
+      projection;  // "pinhole", "spherical", "cylindrical" or "visual" (visualReferenceRepresentation)
+  cv::Mat image;   // decoded, RGB
   Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
   // Pinhole intrinsics (metres, as E57 stores them); 0 when absent.
   double focal_length_m = 0, pixel_width_m = 0, pixel_height_m = 0, principal_x_px = 0, principal_y_px = 0;
+  // Additions (E57 engineer):
+  int width_px = 0, height_px = 0;  // imageWidth / imageHeight as the XML states them
+  std::string decode_error;  // why `image` is empty when its blob does not decode (e.g. a zero-filled blob)
 };
 
 struct E57File {
@@ -31,5 +36,25 @@ E57File ReadE57(const std::string& path);
 
 // Writes organized scans with pose, intensity, colour, row/column index and invalid state; atomic.
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
+
+// ---- Additions (E57 engineer)
+// --------------------------------------------------------------------------------
+
+// ReadE57 on the bytes of a file already in memory; `name` is used in error messages (fuzzing, tests,
+// streams).
+E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& name);
+
+struct E57WriteOptions {
+  // Coordinates: 0 = IEEE single floats (bit-exact round trip of the float32 points); > 0 = ScaledInteger
+  // with this step in metres (e.g. 1e-4 = 0.1 mm), using the fewest bits that hold the scan's extent.
+  double coordinate_scale_m = 0.0;
+  // Cells without a return but with a direction are written as cartesianInvalidState = 1 (the xyz is the unit
+  // direction), so directions survive a round trip exactly; false writes valid cells only (smaller files).
+  bool write_no_return_directions = true;
+  void Check() const;  // throws OptionsError
+};
+void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options);
+// The bytes WriteE57 would write (bench, tests).
+std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options = {});
 
 }  // namespace lidarshop

@@ -1,0 +1,123 @@
+// Internals of the E57 (ASTM E2807) reader and writer, shared by e57_*.cc and their tests. Not a public
+// contract: use io/e57.h.
+//
+// An E57 file is a sequence of 1024-byte *physical* pages; each page holds 1020 bytes of payload followed by
+// the CRC-32C (Castagnoli) of those bytes, stored big-endian. Removing the checksums gives the *logical* byte
+// stream, in which everything else lives: the 48-byte header, binary sections (blobs, compressed vectors) and
+// the XML section. Offsets in the header and in the XML are physical; lengths are logical.
+//
+// A compressed vector section holds data packets; each packet carries one chunk of every bytestream (one
+// bytestream per terminal field of the prototype, in depth-first order). A bytestream is the concatenation of
+// its chunks over all packets and holds the field's values bit-packed little-endian, LSB first: an Integer /
+// ScaledInteger field in [min, max] takes ceil(log2(max - min + 1)) bits and stores value - min; a Float
+// field takes 32 or 64 bits (IEEE).
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace lidarshop::e57 {
+
+constexpr uint64_t kPageSize = 1024;     // physical bytes per page
+constexpr uint64_t kPagePayload = 1020;  // logical bytes per page (the CRC takes the last 4)
+constexpr uint64_t kHeaderSize = 48;
+constexpr uint64_t kMaxPacketSize = 65536;  // logical bytes per packet (16-bit length minus one)
+constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a corrupt file
+
+// CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing-by-8.
+uint32_t Crc32c(const uint8_t* data, size_t size);
+
+inline uint64_t LogicalFromPhysical(uint64_t physical) {
+  return physical / kPageSize * kPagePayload + physical % kPageSize;
+}
+inline uint64_t PhysicalFromLogical(uint64_t logical) {
+  return logical / kPagePayload * kPageSize + logical % kPagePayload;
+}
+
+// Verifies every page's CRC and returns the logical bytes. Throws InputError naming `path`, the page index
+// and its byte offset when a checksum does not match or the size is not whole pages.
+std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical);
+
+// Splits logical bytes into pages with their CRCs (the last page is zero-padded).
+std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical);
+
+// The 48-byte file header.
+struct Header {
+  char signature[8] = {'A', 'S', 'T', 'M', '-', 'E', '5', '7'};
+  uint32_t major_version = 1;
+  uint32_t minor_version = 0;
+  uint64_t file_physical_length = 0;
+  uint64_t xml_physical_offset = 0;
+  uint64_t xml_logical_length = 0;
+  uint64_t page_size = kPageSize;
+};
+Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical);
+void StoreHeader(const Header& header, uint8_t* out48);
+
+template <typename T>
+inline T LoadLe(const uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));  // E57 is little-endian; so is every machine we build for
+  return v;
+}
+template <typename T>
+inline void AppendLe(std::vector<uint8_t>* out, T v) {
+  const size_t at = out->size();
+  out->resize(at + sizeof(T));
+  std::memcpy(out->data() + at, &v, sizeof(T));
+}
+
+// One terminal field of a compressed vector's prototype.
+struct Field {
+  enum class Type { kInteger, kScaledInteger, kFloat, kDouble };
+  std::string name;  // top-level element name, e.g. "cartesianX" (nested ones: "parent/child")
+  Type type = Type::kInteger;
+  int64_t minimum = 0;  // Integer / ScaledInteger
+  int64_t maximum = 0;
+  double scale = 1.0;  // ScaledInteger: value = raw * scale + offset
+  double offset = 0.0;
+  int bits = 0;  // bits per value in the bytestream
+};
+
+// Bits needed for an integer in [minimum, maximum] (0 when minimum == maximum).
+int BitsForRange(int64_t minimum, int64_t maximum);
+
+// Decodes `count` values of `field` from its bytestream into `out` (as doubles: scaled integers are scaled).
+// Throws InputError (naming `where`) when the stream holds fewer values.
+void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, int64_t count, double* out,
+                 const std::string& where);
+
+// Bit-packs raw values (integers already offset by nothing: pass the integer itself, minimum is subtracted
+// here).
+class BitWriter {
+ public:
+  explicit BitWriter(int bits) : bits_(bits) {}
+  void PutInteger(int64_t value, int64_t minimum);
+  void PutFloat(float value) { PutRaw(BitsOf(value), 32); }
+  void PutDouble(double value) { PutRaw(BitsOf(value), 64); }
+  // The stream, flushed to whole bytes.
+  std::vector<uint8_t> Finish();
+
+ private:
+  template <typename F>
+  static uint64_t BitsOf(F value) {
+    if constexpr (sizeof(F) == 4) {
+      uint32_t b;
+      std::memcpy(&b, &value, 4);
+      return b;
+    } else {
+      uint64_t b;
+      std::memcpy(&b, &value, 8);
+      return b;
+    }
+  }
+  void PutRaw(uint64_t value, int bits);
+  int bits_;
+  std::vector<uint8_t> bytes_;
+  uint64_t accumulator_ = 0;
+  int pending_ = 0;  // bits in accumulator_
+};
+
+}  // namespace lidarshop::e57

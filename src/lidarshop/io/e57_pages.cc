@@ -1,0 +1,120 @@
+// E57 physical pages: CRC-32C and the logical/physical mapping (see e57_format.h).
+#include <array>
+
+#include "lidarshop/io/e57_format.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop::e57 {
+namespace {
+
+// tables[k][b]: CRC of byte b followed by k zero bytes (slicing-by-8, Kounavis & Berry 2008).
+struct CrcTables {
+  std::array<std::array<uint32_t, 256>, 8> t;
+  CrcTables() {
+    for (uint32_t b = 0; b < 256; ++b) {
+      uint32_t c = b;
+      for (int k = 0; k < 8; ++k) c = (c & 1) ? (c >> 1) ^ 0x82F63B78u : c >> 1;
+      t[0][b] = c;
+    }
+    for (uint32_t b = 0; b < 256; ++b) {
+      for (int k = 1; k < 8; ++k) t[k][b] = (t[k - 1][b] >> 8) ^ t[0][t[k - 1][b] & 0xFF];
+    }
+  }
+};
+const CrcTables& Tables() {
+  static const CrcTables tables;
+  return tables;
+}
+
+}  // namespace
+
+uint32_t Crc32c(const uint8_t* data, size_t size) {
+  const auto& t = Tables().t;
+  uint32_t crc = 0xFFFFFFFFu;
+  while (size >= 8) {
+    const uint32_t lo = LoadLe<uint32_t>(data) ^ crc;
+    const uint32_t hi = LoadLe<uint32_t>(data + 4);
+    crc = t[7][lo & 0xFF] ^ t[6][(lo >> 8) & 0xFF] ^ t[5][(lo >> 16) & 0xFF] ^ t[4][lo >> 24] ^
+          t[3][hi & 0xFF] ^ t[2][(hi >> 8) & 0xFF] ^ t[1][(hi >> 16) & 0xFF] ^ t[0][hi >> 24];
+    data += 8;
+    size -= 8;
+  }
+  while (size--) crc = t[0][(crc ^ *data++) & 0xFF] ^ (crc >> 8);
+  return crc ^ 0xFFFFFFFFu;
+}
+
+std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical) {
+  if (physical.size() < kPageSize || physical.size() % kPageSize != 0) {
+    ThrowInputError(
+        path, fmt::format("file size {} bytes", physical.size()), "",
+        fmt::format("not a whole number of {}-byte E57 pages (truncated or not an E57 file)", kPageSize));
+  }
+  const size_t pages = physical.size() / kPageSize;
+  std::vector<uint8_t> logical(pages * kPagePayload);
+  for (size_t p = 0; p < pages; ++p) {
+    const uint8_t* page = physical.data() + p * kPageSize;
+    const uint32_t stored = (uint32_t{page[1020]} << 24) | (uint32_t{page[1021]} << 16) |
+                            (uint32_t{page[1022]} << 8) | uint32_t{page[1023]};
+    const uint32_t computed = Crc32c(page, kPagePayload);
+    if (stored != computed) {
+      ThrowInputError(path, fmt::format("page {} (byte offset {})", p, p * kPageSize), "CRC-32C",
+                      fmt::format("checksum mismatch: stored 0x{:08x}, computed 0x{:08x} (corrupt page)",
+                                  stored, computed));
+    }
+    std::memcpy(logical.data() + p * kPagePayload, page, kPagePayload);
+  }
+  return logical;
+}
+
+std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical) {
+  const size_t pages = std::max<size_t>(1, (logical.size() + kPagePayload - 1) / kPagePayload);
+  std::vector<uint8_t> physical(pages * kPageSize, 0);
+  for (size_t p = 0; p < pages; ++p) {
+    uint8_t* page = physical.data() + p * kPageSize;
+    const size_t begin = p * kPagePayload;
+    const size_t n = std::min<size_t>(kPagePayload, logical.size() - std::min(begin, logical.size()));
+    if (n) std::memcpy(page, logical.data() + begin, n);
+    const uint32_t crc = Crc32c(page, kPagePayload);
+    page[1020] = crc >> 24;
+    page[1021] = (crc >> 16) & 0xFF;
+    page[1022] = (crc >> 8) & 0xFF;
+    page[1023] = crc & 0xFF;
+  }
+  return physical;
+}
+
+Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical) {
+  if (logical.size() < kHeaderSize) ThrowInputError(path, "byte offset 0", "header", "shorter than 48 bytes");
+  Header h;
+  std::memcpy(h.signature, logical.data(), 8);
+  if (std::memcmp(h.signature, "ASTM-E57", 8) != 0) {
+    ThrowInputError(path, "byte offset 0", "fileSignature", "not 'ASTM-E57': not an E57 file");
+  }
+  h.major_version = LoadLe<uint32_t>(logical.data() + 8);
+  h.minor_version = LoadLe<uint32_t>(logical.data() + 12);
+  h.file_physical_length = LoadLe<uint64_t>(logical.data() + 16);
+  h.xml_physical_offset = LoadLe<uint64_t>(logical.data() + 24);
+  h.xml_logical_length = LoadLe<uint64_t>(logical.data() + 32);
+  h.page_size = LoadLe<uint64_t>(logical.data() + 40);
+  if (h.major_version != 1) {
+    ThrowInputError(path, "byte offset 8", "majorVersion",
+                    fmt::format("unsupported E57 major version {} (expected 1)", h.major_version));
+  }
+  if (h.page_size != kPageSize) {
+    ThrowInputError(path, "byte offset 40", "pageSize",
+                    fmt::format("{} (only 1024 is defined)", h.page_size));
+  }
+  return h;
+}
+
+void StoreHeader(const Header& h, uint8_t* out) {
+  std::memcpy(out, h.signature, 8);
+  std::memcpy(out + 8, &h.major_version, 4);
+  std::memcpy(out + 12, &h.minor_version, 4);
+  std::memcpy(out + 16, &h.file_physical_length, 8);
+  std::memcpy(out + 24, &h.xml_physical_offset, 8);
+  std::memcpy(out + 32, &h.xml_logical_length, 8);
+  std::memcpy(out + 40, &h.page_size, 8);
+}
+
+}  // namespace lidarshop::e57

@@ -1,0 +1,690 @@
+// E57 reader: pages -> XML (pugixml) -> data3D scans and images2D photos. See io/e57.h and e57_format.h.
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <unordered_map>
+
+#include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <pugixml.hpp>
+
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace e57 {
+
+// The largest record count / grid a file may claim; lowered by the fuzzer to keep its memory bounded.
+int64_t g_max_cells = kMaxScanCells;
+
+namespace {
+
+struct Context {
+  const std::string& path;
+  const std::vector<uint8_t>& logical;
+};
+
+std::string ElementPath(pugi::xml_node node) {
+  std::string p;
+  for (pugi::xml_node n = node; n && n.type() == pugi::node_element; n = n.parent()) {
+    p = p.empty() ? std::string(n.name()) : std::string(n.name()) + "/" + p;
+  }
+  return p;
+}
+
+[[noreturn]] void XmlError(const Context& ctx, pugi::xml_node node, const std::string& message) {
+  ThrowInputError(ctx.path, "XML section", ElementPath(node), message);
+}
+
+int64_t ParseInt(const Context& ctx, pugi::xml_node node, const char* text) {
+  std::string_view s(text);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  if (s.empty()) return 0;
+  if (s.front() == '+') s.remove_prefix(1);
+  int64_t v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) {
+    XmlError(ctx, node, fmt::format("not an integer: '{}'", std::string(s.substr(0, 40))));
+  }
+  return v;
+}
+
+double ParseDouble(const Context& ctx, pugi::xml_node node, const char* text) {
+  std::string_view s(text);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.front()))) s.remove_prefix(1);
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.remove_suffix(1);
+  if (s.empty()) return 0.0;
+  if (s.front() == '+') s.remove_prefix(1);
+  double v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc() || end != s.data() + s.size()) {
+    XmlError(ctx, node, fmt::format("not a number: '{}'", std::string(s.substr(0, 40))));
+  }
+  return v;
+}
+
+std::string TypeOf(pugi::xml_node node) { return node.attribute("type").value(); }
+
+// The numeric value of an Integer, ScaledInteger or Float element; `fallback` when the element is absent.
+double NumberValue(const Context& ctx, pugi::xml_node node, double fallback) {
+  if (!node) return fallback;
+  const std::string type = TypeOf(node);
+  if (type == "Integer") return static_cast<double>(ParseInt(ctx, node, node.text().get()));
+  if (type == "Float") return ParseDouble(ctx, node, node.text().get());
+  if (type == "ScaledInteger") {
+    const double scale =
+        node.attribute("scale") ? ParseDouble(ctx, node, node.attribute("scale").value()) : 1.0;
+    const double offset =
+        node.attribute("offset") ? ParseDouble(ctx, node, node.attribute("offset").value()) : 0.0;
+    return static_cast<double>(ParseInt(ctx, node, node.text().get())) * scale + offset;
+  }
+  XmlError(ctx, node, fmt::format("expected a number element, found type '{}'", type));
+}
+
+// An integral value in [lo, hi] (indices, image sizes); `fallback` when absent.
+int64_t BoundedInteger(const Context& ctx, pugi::xml_node node, int64_t fallback, int64_t lo, int64_t hi) {
+  if (!node) return fallback;
+  const double v = NumberValue(ctx, node, static_cast<double>(fallback));
+  if (!(v >= static_cast<double>(lo) && v <= static_cast<double>(hi))) {
+    XmlError(ctx, node, fmt::format("value {} is outside [{}, {}]", v, lo, hi));
+  }
+  return static_cast<int64_t>(v);
+}
+
+std::string StringValue(pugi::xml_node node) { return node ? std::string(node.text().get()) : std::string(); }
+
+Eigen::Matrix4d PoseOf(const Context& ctx, pugi::xml_node pose) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  if (!pose) return m;
+  const pugi::xml_node r = pose.child("rotation");
+  const pugi::xml_node t = pose.child("translation");
+  if (r) {
+    Eigen::Quaterniond q(NumberValue(ctx, r.child("w"), 1.0), NumberValue(ctx, r.child("x"), 0.0),
+                         NumberValue(ctx, r.child("y"), 0.0), NumberValue(ctx, r.child("z"), 0.0));
+    const double norm = q.norm();
+    if (!std::isfinite(norm) || norm < 1e-12) XmlError(ctx, r, "rotation quaternion is zero or not finite");
+    q.coeffs() /= norm;  // some writers store unnormalized quaternions
+    m.topLeftCorner<3, 3>() = q.toRotationMatrix();
+  }
+  if (t) {
+    m(0, 3) = NumberValue(ctx, t.child("x"), 0.0);
+    m(1, 3) = NumberValue(ctx, t.child("y"), 0.0);
+    m(2, 3) = NumberValue(ctx, t.child("z"), 0.0);
+    if (!m.topRightCorner<3, 1>().allFinite()) XmlError(ctx, t, "translation is not finite");
+  }
+  return m;
+}
+
+// Terminal fields of a prototype, depth first (the order of the bytestreams).
+void CollectFields(const Context& ctx, pugi::xml_node node, const std::string& prefix,
+                   std::vector<Field>* fields) {
+  for (pugi::xml_node child : node.children()) {
+    if (child.type() != pugi::node_element) continue;
+    const std::string type = TypeOf(child);
+    const std::string name = prefix.empty() ? child.name() : prefix + "/" + child.name();
+    if (type == "Structure" || type == "Vector") {
+      CollectFields(ctx, child, name, fields);
+      continue;
+    }
+    Field f;
+    f.name = name;
+    if (type == "Integer" || type == "ScaledInteger") {
+      f.type = type == "Integer" ? Field::Type::kInteger : Field::Type::kScaledInteger;
+      f.minimum = child.attribute("minimum") ? ParseInt(ctx, child, child.attribute("minimum").value())
+                                             : std::numeric_limits<int64_t>::min();
+      f.maximum = child.attribute("maximum") ? ParseInt(ctx, child, child.attribute("maximum").value())
+                                             : std::numeric_limits<int64_t>::max();
+      if (f.maximum < f.minimum) {
+        XmlError(ctx, child, fmt::format("maximum {} < minimum {}", f.maximum, f.minimum));
+      }
+      if (f.type == Field::Type::kScaledInteger) {
+        f.scale = child.attribute("scale") ? ParseDouble(ctx, child, child.attribute("scale").value()) : 1.0;
+        f.offset =
+            child.attribute("offset") ? ParseDouble(ctx, child, child.attribute("offset").value()) : 0.0;
+        if (!std::isfinite(f.scale) || !std::isfinite(f.offset) || f.scale == 0.0) {
+          XmlError(ctx, child, "scale must be finite and non-zero, offset finite");
+        }
+      }
+      f.bits = BitsForRange(f.minimum, f.maximum);
+    } else if (type == "Float") {
+      const std::string precision = child.attribute("precision").value();
+      f.type = precision == "single" ? Field::Type::kFloat : Field::Type::kDouble;
+      f.bits = precision == "single" ? 32 : 64;
+    } else {
+      XmlError(ctx, child,
+               fmt::format("prototype field type '{}' is not supported (expected Integer, "
+                           "ScaledInteger or Float)",
+                           type));
+    }
+    fields->push_back(f);
+    if (fields->size() > static_cast<size_t>(kMaxPrototypeFields)) {
+      XmlError(ctx, node, fmt::format("more than {} prototype fields", kMaxPrototypeFields));
+    }
+  }
+}
+
+// Logical offset of a physical offset found in the XML; rejects offsets outside the file or inside a
+// checksum.
+uint64_t LogicalOffset(const Context& ctx, pugi::xml_node node, uint64_t physical) {
+  if (physical % kPageSize >= kPagePayload) {
+    XmlError(ctx, node, fmt::format("fileOffset {} points into a page checksum", physical));
+  }
+  const uint64_t logical = LogicalFromPhysical(physical);
+  if (logical >= ctx.logical.size()) {
+    XmlError(ctx, node, fmt::format("fileOffset {} is beyond the end of the file", physical));
+  }
+  return logical;
+}
+
+uint64_t OffsetAttribute(const Context& ctx, pugi::xml_node node, const char* name) {
+  if (!node.attribute(name)) XmlError(ctx, node, fmt::format("attribute '{}' is missing", name));
+  const int64_t v = ParseInt(ctx, node, node.attribute(name).value());
+  if (v < 0) XmlError(ctx, node, fmt::format("attribute '{}' is negative: {}", name, v));
+  return static_cast<uint64_t>(v);
+}
+
+// Reads the bytestreams of a compressed vector section, concatenating each stream's chunks over the data
+// packets. Stops once every stream holds `needed_bytes[i]`.
+std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_node cv_node,
+                                                  const std::vector<uint64_t>& needed_bytes) {
+  const size_t n = needed_bytes.size();
+  std::vector<std::vector<uint8_t>> streams(n);
+  const std::vector<uint8_t>& L = ctx.logical;
+  const uint64_t phys = OffsetAttribute(ctx, cv_node, "fileOffset");
+  const uint64_t start = LogicalOffset(ctx, cv_node, phys);
+  auto where = [&](uint64_t logical) {
+    return fmt::format("compressed vector '{}' at byte offset {}", ElementPath(cv_node),
+                       PhysicalFromLogical(logical));
+  };
+  if (start + 32 > L.size()) ThrowInputError(ctx.path, where(start), "section header", "truncated");
+  if (L[start] != 1) {
+    ThrowInputError(ctx.path, where(start), "sectionId",
+                    fmt::format("{} is not a compressed vector section (expected 1)", int{L[start]}));
+  }
+  const uint64_t section_length = LoadLe<uint64_t>(&L[start + 8]);
+  const uint64_t data_physical = LoadLe<uint64_t>(&L[start + 16]);
+  if (section_length < 32 || section_length > L.size() - start) {
+    ThrowInputError(ctx.path, where(start), "sectionLogicalLength",
+                    fmt::format("{} does not fit in the file", section_length));
+  }
+  const uint64_t end = start + section_length;
+  auto done = [&] {
+    for (size_t i = 0; i < n; ++i) {
+      if (streams[i].size() < needed_bytes[i]) return false;
+    }
+    return true;
+  };
+  if (done()) return streams;
+  if (data_physical % kPageSize >= kPagePayload) {
+    ThrowInputError(ctx.path, where(start), "dataPhysicalOffset", "points into a page checksum");
+  }
+  uint64_t pos = LogicalFromPhysical(data_physical);
+  if (pos < start + 32 || pos > end) {
+    ThrowInputError(ctx.path, where(start), "dataPhysicalOffset",
+                    fmt::format("{} is outside its section", data_physical));
+  }
+  std::vector<size_t> lengths(n);
+  while (!done()) {
+    if (pos + 4 > end) {
+      ThrowInputError(ctx.path, where(pos), "packet",
+                      "the section ends before every bytestream holds its records (truncated data)");
+    }
+    const uint8_t type = L[pos];
+    const uint64_t length = uint64_t{LoadLe<uint16_t>(&L[pos + 2])} + 1;
+    if (length > end - pos) {
+      ThrowInputError(ctx.path, where(pos), "packetLogicalLengthMinus1",
+                      fmt::format("packet of {} bytes runs past the end of its section", length));
+    }
+    if (type == 1) {
+      if (length < 6) ThrowInputError(ctx.path, where(pos), "data packet", "shorter than its header");
+      const size_t count = LoadLe<uint16_t>(&L[pos + 4]);
+      if (count != n) {
+        ThrowInputError(ctx.path, where(pos), "bytestreamCount",
+                        fmt::format("{} bytestreams, the prototype has {} fields", count, n));
+      }
+      uint64_t at = pos + 6 + 2 * uint64_t{count};
+      if (at > pos + length)
+        ThrowInputError(ctx.path, where(pos), "data packet", "header longer than the packet");
+      for (size_t i = 0; i < n; ++i) lengths[i] = LoadLe<uint16_t>(&L[pos + 6 + 2 * i]);
+      for (size_t i = 0; i < n; ++i) {
+        if (lengths[i] > pos + length - at) {
+          ThrowInputError(ctx.path, where(pos), fmt::format("bytestream {}", i),
+                          "buffer lengths exceed the packet length");
+        }
+        streams[i].insert(streams[i].end(), L.begin() + at, L.begin() + at + lengths[i]);
+        at += lengths[i];
+      }
+    } else if (type != 0 && type != 2) {
+      ThrowInputError(ctx.path, where(pos), "packetType",
+                      fmt::format("unknown packet type {} (expected 0 index, 1 data or 2 empty)", int{type}));
+    }
+    pos += length;
+  }
+  return streams;
+}
+
+struct Limits {
+  double minimum = 0, maximum = 0;
+  bool known = false;
+};
+
+Limits LimitsFrom(const Context& ctx, pugi::xml_node limits, const char* min_name, const char* max_name,
+                  const Field* field) {
+  Limits l;
+  if (limits && (limits.child(min_name) || limits.child(max_name))) {
+    l.minimum = NumberValue(ctx, limits.child(min_name), 0.0);
+    l.maximum = NumberValue(ctx, limits.child(max_name), 0.0);
+    l.known = true;
+  } else if (field && field->type == Field::Type::kInteger) {
+    l = {static_cast<double>(field->minimum), static_cast<double>(field->maximum), true};
+  } else if (field && field->type == Field::Type::kScaledInteger) {
+    l = {field->minimum * field->scale + field->offset, field->maximum * field->scale + field->offset, true};
+    if (l.maximum < l.minimum) std::swap(l.minimum, l.maximum);
+  }
+  return l;
+}
+
+struct GridOrientation {
+  bool flip_rows = false, flip_cols = false;
+};
+
+// Votes over neighbouring valid cells: does elevation fall with the row index (image order) and does our
+// azimuth (from +y, positive to the right) rise with the column index? A flip needs a 75 % majority, so that
+// grids without angular structure (synthetic data, a few points) keep the file's order.
+GridOrientation OrientationOf(const Scan& scan) {
+  int64_t rows_up = 0, rows_down = 0, cols_up = 0, cols_down = 0;
+  auto elevation = [](const cv::Vec3f& p) { return std::atan2(p[2], std::hypot(p[0], p[1])); };
+  auto azimuth = [](const cv::Vec3f& p) { return std::atan2(p[0], p[1]); };
+  for (int r = 0; r < scan.rows; ++r) {
+    const uint8_t* v = scan.valid.ptr<uint8_t>(r);
+    const uint8_t* v_next = r + 1 < scan.rows ? scan.valid.ptr<uint8_t>(r + 1) : nullptr;
+    const cv::Vec3f* p = scan.point.ptr<cv::Vec3f>(r);
+    const cv::Vec3f* p_next = r + 1 < scan.rows ? scan.point.ptr<cv::Vec3f>(r + 1) : nullptr;
+    for (int c = 0; c < scan.cols; ++c) {
+      if (!v[c]) continue;
+      if (v_next && v_next[c]) {
+        const double d = elevation(p_next[c]) - elevation(p[c]);
+        rows_up += d > 0, rows_down += d < 0;
+      }
+      if (c + 1 < scan.cols && v[c + 1]) {
+        double d = azimuth(p[c + 1]) - azimuth(p[c]);
+        if (d > M_PI) d -= 2 * M_PI;
+        if (d < -M_PI) d += 2 * M_PI;
+        cols_up += d > 0, cols_down += d < 0;
+      }
+    }
+  }
+  GridOrientation o;
+  o.flip_rows = rows_up > 3 * rows_down && rows_up >= 8;
+  o.flip_cols = cols_down > 3 * cols_up && cols_down >= 8;
+  return o;
+}
+
+Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
+  const pugi::xml_node points = child.child("points");
+  if (!points) XmlError(ctx, child, "data3D entry has no 'points'");
+  if (TypeOf(points) != "CompressedVector") XmlError(ctx, points, "'points' is not a CompressedVector");
+  const int64_t record_count = ParseInt(ctx, points, points.attribute("recordCount").value());
+  if (record_count < 0 || record_count > g_max_cells) {
+    XmlError(ctx, points, fmt::format("recordCount {} is outside [0, {}]", record_count, g_max_cells));
+  }
+  std::vector<Field> fields;
+  CollectFields(ctx, points.child("prototype"), "", &fields);
+  std::unordered_map<std::string, int> field_index;
+  for (size_t i = 0; i < fields.size(); ++i) field_index.emplace(fields[i].name, static_cast<int>(i));
+  auto find = [&](const char* name) -> const Field* {
+    const auto it = field_index.find(name);
+    return it == field_index.end() ? nullptr : &fields[it->second];
+  };
+  const bool cartesian = find("cartesianX") && find("cartesianY") && find("cartesianZ");
+  const bool spherical = find("sphericalRange") && find("sphericalAzimuth") && find("sphericalElevation");
+  const bool structured = find("rowIndex") && find("columnIndex");
+  if (!cartesian && !spherical && record_count > 0) {
+    XmlError(ctx, points, "prototype has neither cartesianX/Y/Z nor sphericalRange/Azimuth/Elevation");
+  }
+
+  // Refuse before allocating: every field's bytestream must be able to hold recordCount values, and the
+  // section cannot hold more bytes than the file.
+  std::vector<uint64_t> needed(fields.size());
+  uint64_t needed_total = 0;
+  for (size_t i = 0; i < fields.size(); ++i) {
+    needed[i] = (static_cast<uint64_t>(record_count) * static_cast<uint64_t>(fields[i].bits) + 7) / 8;
+    needed_total += needed[i];
+  }
+  if (needed_total > ctx.logical.size()) {
+    XmlError(ctx, points,
+             fmt::format("recordCount {} needs {} bytes of bytestreams, the file has {}", record_count,
+                         needed_total, ctx.logical.size()));
+  }
+  const std::vector<std::vector<uint8_t>> streams = record_count > 0
+                                                        ? ReadBytestreams(ctx, points, needed)
+                                                        : std::vector<std::vector<uint8_t>>(fields.size());
+  const std::string stream_where = fmt::format("{}: {}", ctx.path, ElementPath(points));
+  std::vector<double> buffer;
+  auto decode = [&](const Field* f) -> const std::vector<double>& {
+    buffer.resize(record_count);
+    const auto& s = streams[f - fields.data()];
+    DecodeField(*f, s.data(), s.size(), record_count, buffer.data(), stream_where);
+    return buffer;
+  };
+
+  // The grid.
+  std::vector<int64_t> cell(record_count);
+  int64_t rows = 0, cols = 0;
+  if (structured) {
+    std::vector<int64_t> row(record_count);
+    int64_t max_row = -1, max_col = -1;
+    {
+      const auto& r = decode(find("rowIndex"));
+      for (int64_t i = 0; i < record_count; ++i) {
+        if (!(r[i] >= 0 && r[i] < 2147483647.0)) {
+          XmlError(ctx, points, fmt::format("record {}: rowIndex {} is out of range", i, r[i]));
+        }
+        row[i] = static_cast<int64_t>(r[i]);
+        max_row = std::max(max_row, row[i]);
+      }
+    }
+    {
+      const auto& c = decode(find("columnIndex"));
+      for (int64_t i = 0; i < record_count; ++i) {
+        if (!(c[i] >= 0 && c[i] < 2147483647.0)) {
+          XmlError(ctx, points, fmt::format("record {}: columnIndex {} is out of range", i, c[i]));
+        }
+        cell[i] = static_cast<int64_t>(c[i]);
+        max_col = std::max(max_col, cell[i]);
+      }
+    }
+    const pugi::xml_node bounds = child.child("indexBounds");
+    if (bounds) {
+      max_row = std::max(max_row, BoundedInteger(ctx, bounds.child("rowMaximum"), -1, -1, 2147483646));
+      max_col = std::max(max_col, BoundedInteger(ctx, bounds.child("columnMaximum"), -1, -1, 2147483646));
+    }
+    rows = max_row + 1;
+    cols = max_col + 1;
+    if (rows > 2147483647 || cols > 2147483647 || (rows > 0 && cols > g_max_cells / rows)) {
+      XmlError(ctx, points,
+               fmt::format("grid of {} x {} cells exceeds the limit of {} cells", rows, cols, g_max_cells));
+    }
+    for (int64_t i = 0; i < record_count; ++i) cell[i] += row[i] * cols;
+  } else {
+    rows = record_count > 0 ? 1 : 0;
+    cols = record_count;
+    for (int64_t i = 0; i < record_count; ++i) cell[i] = i;
+  }
+
+  const Field* intensity_field = find("intensity");
+  const Field* red = find("colorRed");
+  const Field* green = find("colorGreen");
+  const Field* blue = find("colorBlue");
+  const bool has_color = red && green && blue;
+  Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
+  scan.name = StringValue(child.child("name"));
+  scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
+
+  // Invalid state: 0 = valid point, 1 = direction only, 2 = nothing meaningful.
+  std::vector<uint8_t> state(record_count, 0);
+  const Field* state_field = cartesian ? find("cartesianInvalidState") : find("sphericalInvalidState");
+  if (state_field) {
+    const auto& s = decode(state_field);
+    for (int64_t i = 0; i < record_count; ++i) state[i] = s[i] == 0.0 ? 0 : s[i] == 1.0 ? 1 : 2;
+  }
+
+  // Geometry: decode the three coordinates into floats.
+  std::vector<float> xyz(3 * record_count);
+  {
+    const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
+    if (!cartesian)
+      names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
+    std::vector<double> a[3];
+    for (int k = 0; k < 3; ++k) a[k] = decode(find(names[k]));
+    for (int64_t i = 0; i < record_count; ++i) {
+      double x = a[0][i], y = a[1][i], z = a[2][i];
+      if (!cartesian) {
+        // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
+        const double r = a[0][i], az = a[1][i], el = a[2][i];
+        if (state[i] == 1 || r == 0.0) {
+          x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
+          if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
+        } else {
+          x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
+        }
+      }
+      xyz[3 * i] = static_cast<float>(x), xyz[3 * i + 1] = static_cast<float>(y),
+              xyz[3 * i + 2] = static_cast<float>(z);
+    }
+  }
+  int64_t duplicates = 0;
+  std::vector<uint8_t> has_direction(static_cast<size_t>(rows * cols), 0);
+  for (int64_t i = 0; i < record_count; ++i) {
+    const int64_t c = cell[i];
+    const int r = static_cast<int>(c / std::max<int64_t>(cols, 1));
+    const int k = static_cast<int>(c % std::max<int64_t>(cols, 1));
+    const cv::Vec3f p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    const float range = static_cast<float>(cv::norm(p));
+    const bool finite = std::isfinite(range);
+    if (scan.valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
+      ++duplicates;
+      cell[i] = -1;
+      continue;
+    }
+    if (state[i] == 0 && finite && range > 0.0f) {
+      scan.valid.at<uint8_t>(r, k) = kValid;
+      scan.point.at<cv::Vec3f>(r, k) = p;
+      scan.range.at<float>(r, k) = range;
+      scan.direction.at<cv::Vec3f>(r, k) = p / range;
+      has_direction[c] = 1;
+    } else {
+      if (state[i] != 2 && finite && range > 0.0f) {
+        // Keep a stored unit direction bit for bit (renormalizing would change its last bits).
+        scan.direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
+        has_direction[c] = 2;
+      }
+      cell[i] = -1;  // no return: intensity and colour stay at their no-return values
+    }
+  }
+  (void)duplicates;
+
+  if (intensity_field) {
+    Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
+                          intensity_field);
+    const auto& v = decode(intensity_field);
+    if (!l.known) {
+      // Float intensities without limits: take them as [0, 1] when they are, else stretch the returned range.
+      double lo = 0, hi = 1;
+      for (int64_t i = 0; i < record_count; ++i) {
+        if (cell[i] < 0 || !std::isfinite(v[i])) continue;
+        lo = std::min(lo, v[i]);
+        hi = std::max(hi, v[i]);
+      }
+      l = {lo, hi, true};
+    }
+    const double span = l.maximum - l.minimum;
+    float* out = scan.intensity.ptr<float>();
+    for (int64_t i = 0; i < record_count; ++i) {
+      if (cell[i] < 0) continue;
+      const double t = span > 0 ? (v[i] - l.minimum) / span : 0.5;
+      out[cell[i]] = std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
+    }
+  }
+  if (has_color) {
+    const pugi::xml_node limits = child.child("colorLimits");
+    const char* min_names[3] = {"colorRedMinimum", "colorGreenMinimum", "colorBlueMinimum"};
+    const char* max_names[3] = {"colorRedMaximum", "colorGreenMaximum", "colorBlueMaximum"};
+    const Field* channel_fields[3] = {red, green, blue};
+    uint8_t* out = scan.color.ptr<uint8_t>();
+    for (int ch = 0; ch < 3; ++ch) {
+      Limits l = LimitsFrom(ctx, limits, min_names[ch], max_names[ch], channel_fields[ch]);
+      if (!l.known) l = {0.0, 255.0, true};
+      const double span = l.maximum - l.minimum;
+      const auto& v = decode(channel_fields[ch]);
+      for (int64_t i = 0; i < record_count; ++i) {
+        if (cell[i] < 0) continue;
+        const double t = span > 0 ? (v[i] - l.minimum) / span : 0.0;
+        out[3 * cell[i] + ch] =
+            std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
+      }
+    }
+  }
+
+  if (structured && scan.num_cells() > 0) {
+    // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turn the
+    // grid into image orientation (row 0 = highest elevation, our azimuth increasing to the right) by the
+    // data.
+    const GridOrientation o = OrientationOf(scan);
+    if (o.flip_rows || o.flip_cols) {
+      const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
+      for (cv::Mat* m :
+           {&scan.direction, &scan.valid, &scan.range, &scan.point, &scan.intensity, &scan.color}) {
+        if (!m->empty()) cv::flip(*m, *m, code);
+      }
+      cv::Mat d(static_cast<int>(rows), static_cast<int>(cols), CV_8U, has_direction.data());
+      cv::flip(d, d, code);
+    }
+    // Give no-return cells directions from the fitted angular grid; keep directions the file stored.
+    if (scan.CountValid() > 0) {
+      const cv::Mat stored = scan.direction.clone();
+      FitGrid(&scan);
+      const cv::Vec3f* from = stored.ptr<cv::Vec3f>();
+      cv::Vec3f* to = scan.direction.ptr<cv::Vec3f>();
+      for (int64_t c = 0; c < scan.num_cells(); ++c) {
+        if (has_direction[c] == 2) to[c] = from[c];
+      }
+    }
+  }
+  (void)index;
+  return scan;
+}
+
+// The bytes of a Blob element.
+std::pair<const uint8_t*, size_t> BlobBytes(const Context& ctx, pugi::xml_node blob) {
+  const uint64_t phys = OffsetAttribute(ctx, blob, "fileOffset");
+  const uint64_t length = OffsetAttribute(ctx, blob, "length");
+  const uint64_t start = LogicalOffset(ctx, blob, phys);
+  const auto& L = ctx.logical;
+  if (start + 16 > L.size()) XmlError(ctx, blob, "blob section header is truncated");
+  if (L[start] != 0)
+    XmlError(ctx, blob, fmt::format("sectionId {} is not a blob section (expected 0)", int{L[start]}));
+  const uint64_t section_length = LoadLe<uint64_t>(&L[start + 8]);
+  if (section_length < 16 || section_length > L.size() - start || length > section_length - 16) {
+    XmlError(ctx, blob,
+             fmt::format("blob of {} bytes does not fit its section of {} bytes in the file", length,
+                         section_length));
+  }
+  return {L.data() + start + 16, static_cast<size_t>(length)};
+}
+
+void ReadImage(const Context& ctx, pugi::xml_node child, std::vector<E57Image>* images) {
+  static const std::pair<const char*, const char*> kRepresentations[] = {
+      {"pinholeRepresentation", "pinhole"},
+      {"sphericalRepresentation", "spherical"},
+      {"cylindricalRepresentation", "cylindrical"},
+      {"visualReferenceRepresentation", "visual"}};
+  for (const auto& [element, projection] : kRepresentations) {
+    const pugi::xml_node rep = child.child(element);
+    if (!rep) continue;
+    pugi::xml_node blob = rep.child("jpegImage");
+    if (!blob) blob = rep.child("pngImage");
+    if (!blob) XmlError(ctx, rep, "has neither jpegImage nor pngImage");
+    E57Image image;
+    image.name = StringValue(child.child("name"));
+    image.projection = projection;
+    image.world_from_camera = PoseOf(ctx, child.child("pose"));
+    image.focal_length_m = NumberValue(ctx, rep.child("focalLength"), 0.0);
+    image.pixel_width_m = NumberValue(ctx, rep.child("pixelWidth"), 0.0);
+    image.pixel_height_m = NumberValue(ctx, rep.child("pixelHeight"), 0.0);
+    image.principal_x_px = NumberValue(ctx, rep.child("principalPointX"), 0.0);
+    image.principal_y_px = NumberValue(ctx, rep.child("principalPointY"), 0.0);
+    image.width_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageWidth"), 0, 0, 1 << 30));
+    image.height_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageHeight"), 0, 0, 1 << 30));
+    const auto [bytes, size] = BlobBytes(ctx, blob);
+    cv::Mat decoded;
+    try {
+      decoded = cv::imdecode(
+          cv::Mat(1, static_cast<int>(std::min<size_t>(size, INT32_MAX)), CV_8U, const_cast<uint8_t*>(bytes)),
+          cv::IMREAD_COLOR);
+    } catch (const cv::Exception& e) {
+      decoded.release();
+    }
+    // A blob that does not decode does not make the scans unreadable: keep the entry and say why it is empty.
+    if (decoded.empty()) {
+      image.decode_error =
+          FormatInputError(ctx.path, ElementPath(blob), "",
+                           fmt::format("the {}-byte {} blob does not decode", size, blob.name()));
+    } else {
+      cv::cvtColor(decoded, image.image, cv::COLOR_BGR2RGB);
+    }
+    images->push_back(std::move(image));
+    return;
+  }
+}
+
+}  // namespace
+
+E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical) {
+  const Header header = ParseHeader(path, logical);
+  const Context ctx{path, logical};
+  const uint64_t physical_size = logical.size() / kPagePayload * kPageSize;
+  if (header.file_physical_length != physical_size) {
+    ThrowInputError(path, "byte offset 16", "filePhysicalLength",
+                    fmt::format("header says {} bytes, the file has {} (truncated or padded)",
+                                header.file_physical_length, physical_size));
+  }
+  if (header.xml_physical_offset % kPageSize >= kPagePayload) {
+    ThrowInputError(path, "byte offset 24", "xmlPhysicalOffset", "points into a page checksum");
+  }
+  const uint64_t xml_start = LogicalFromPhysical(header.xml_physical_offset);
+  if (xml_start > logical.size() || header.xml_logical_length > logical.size() - xml_start) {
+    ThrowInputError(path, "byte offset 24", "xmlPhysicalOffset",
+                    fmt::format("XML section ({} bytes at {}) runs past the end of the file",
+                                header.xml_logical_length, header.xml_physical_offset));
+  }
+  pugi::xml_document doc;
+  const pugi::xml_parse_result parsed = doc.load_buffer(logical.data() + xml_start, header.xml_logical_length,
+                                                        pugi::parse_default, pugi::encoding_utf8);
+  if (!parsed) {
+    ThrowInputError(path, fmt::format("XML section, byte {} of {}", parsed.offset, header.xml_logical_length),
+                    "", fmt::format("malformed XML: {}", parsed.description()));
+  }
+  const pugi::xml_node root = doc.child("e57Root");
+  if (!root) ThrowInputError(path, "XML section", "e57Root", "missing: not an E57 file");
+
+  E57File file;
+  int index = 0;
+  for (pugi::xml_node child : root.child("data3D").children()) {
+    if (child.type() != pugi::node_element) continue;
+    file.scans.push_back(ReadScan(ctx, child, index++));
+  }
+  for (pugi::xml_node child : root.child("images2D").children()) {
+    if (child.type() != pugi::node_element) continue;
+    ReadImage(ctx, child, &file.images);
+  }
+  return file;
+}
+
+}  // namespace e57
+
+E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& name) {
+  return e57::ReadLogical(name, e57::LogicalFromPages(name, file_bytes));
+}
+
+E57File ReadE57(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) ThrowInputError(path, "", "", "cannot determine the file size");
+  in.seekg(0);
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
+    ThrowInputError(path, "", "", "read failed");
+  }
+  return ReadE57Bytes(bytes, path);
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,378 @@
+// E57 writer: one compressed-vector section per scan, then the XML section, then pages with CRC-32C.
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <pugixml.hpp>
+
+#include "lidarshop/geometry/transform.h"
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/e57_format.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace e57 {
+namespace {
+
+std::string Num(double v) { return fmt::format("{}", v); }
+
+pugi::xml_node AddTyped(pugi::xml_node parent, const char* name, const char* type) {
+  pugi::xml_node n = parent.append_child(name);
+  n.append_attribute("type") = type;
+  return n;
+}
+void AddFloat(pugi::xml_node parent, const char* name, double v) {
+  AddTyped(parent, name, "Float").text() = Num(v).c_str();
+}
+void AddInteger(pugi::xml_node parent, const char* name, int64_t v) {
+  AddTyped(parent, name, "Integer").text() = std::to_string(v).c_str();
+}
+void AddString(pugi::xml_node parent, const char* name, const std::string& v) {
+  AddTyped(parent, name, "String").append_child(pugi::node_cdata).set_value(v.c_str());
+}
+
+struct Stream {
+  Field field;
+  std::vector<uint8_t> bytes;
+};
+
+// Appends a compressed vector section at the end of `logical` (4-byte aligned) and returns its physical
+// offset.
+uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
+                                std::vector<uint8_t>* logical) {
+  while (logical->size() % 8) logical->push_back(0);
+  const uint64_t start = logical->size();
+  logical->resize(start + 32, 0);
+  (*logical)[start] = 1;  // sectionId: compressed vector
+  const uint64_t data_start = logical->size();
+  const size_t n = streams.size();
+  uint64_t bits_per_record = 0;
+  for (const Stream& s : streams) bits_per_record += s.field.bits;
+  // Records per packet so that every packet (header + one chunk per stream + rounding) fits in 64 KiB.
+  const uint64_t budget = kMaxPacketSize - 6 - 2 * n - n - 4;
+  const int64_t per_packet = bits_per_record == 0
+                                 ? std::max<int64_t>(record_count, 1)
+                                 : std::max<int64_t>(1, static_cast<int64_t>(budget * 8 / bits_per_record));
+  auto byte_at = [&](const Stream& s, int64_t record) {
+    return std::min<uint64_t>(s.bytes.size(), (static_cast<uint64_t>(record) * s.field.bits + 7) / 8);
+  };
+  for (int64_t first = 0; first < std::max<int64_t>(record_count, 1); first += per_packet) {
+    const int64_t last = std::min(record_count, first + per_packet);
+    const uint64_t packet_start = logical->size();
+    logical->push_back(1);           // data packet
+    logical->push_back(0);           // flags
+    AppendLe<uint16_t>(logical, 0);  // length - 1, patched below
+    AppendLe<uint16_t>(logical, static_cast<uint16_t>(n));
+    std::vector<std::pair<uint64_t, uint64_t>> ranges(n);
+    for (size_t i = 0; i < n; ++i) {
+      // The last packet takes whatever is left (the final partial byte).
+      const uint64_t b = byte_at(streams[i], first);
+      const uint64_t e = last >= record_count ? streams[i].bytes.size() : byte_at(streams[i], last);
+      ranges[i] = {b, e};
+      AppendLe<uint16_t>(logical, static_cast<uint16_t>(e - b));
+    }
+    for (size_t i = 0; i < n; ++i) {
+      logical->insert(logical->end(), streams[i].bytes.begin() + ranges[i].first,
+                      streams[i].bytes.begin() + ranges[i].second);
+    }
+    while ((logical->size() - packet_start) % 4) logical->push_back(0);
+    const uint64_t length = logical->size() - packet_start;
+    LIDARSHOP_CHECK(length <= kMaxPacketSize);
+    const uint16_t length_minus_1 = static_cast<uint16_t>(length - 1);
+    std::memcpy(logical->data() + packet_start + 2, &length_minus_1, 2);
+  }
+  const uint64_t section_length = logical->size() - start;
+  const uint64_t data_physical = PhysicalFromLogical(data_start);
+  const uint64_t index_physical = 0;
+  std::memcpy(logical->data() + start + 8, &section_length, 8);
+  std::memcpy(logical->data() + start + 16, &data_physical, 8);
+  std::memcpy(logical->data() + start + 24, &index_physical, 8);
+  return PhysicalFromLogical(start);
+}
+
+void AddPrototypeField(pugi::xml_node prototype, const Field& f) {
+  switch (f.type) {
+    case Field::Type::kInteger: {
+      pugi::xml_node n = AddTyped(prototype, f.name.c_str(), "Integer");
+      n.append_attribute("minimum") = std::to_string(f.minimum).c_str();
+      n.append_attribute("maximum") = std::to_string(f.maximum).c_str();
+      break;
+    }
+    case Field::Type::kScaledInteger: {
+      pugi::xml_node n = AddTyped(prototype, f.name.c_str(), "ScaledInteger");
+      n.append_attribute("minimum") = std::to_string(f.minimum).c_str();
+      n.append_attribute("maximum") = std::to_string(f.maximum).c_str();
+      n.append_attribute("scale") = Num(f.scale).c_str();
+      if (f.offset != 0.0) n.append_attribute("offset") = Num(f.offset).c_str();
+      break;
+    }
+    case Field::Type::kFloat:
+      AddTyped(prototype, f.name.c_str(), "Float").append_attribute("precision") = "single";
+      break;
+    case Field::Type::kDouble:
+      AddTyped(prototype, f.name.c_str(), "Float").append_attribute("precision") = "double";
+      break;
+  }
+}
+
+Field IntegerField(const char* name, int64_t minimum, int64_t maximum) {
+  Field f;
+  f.name = name;
+  f.type = Field::Type::kInteger;
+  f.minimum = minimum;
+  f.maximum = maximum;
+  f.bits = BitsForRange(minimum, maximum);
+  return f;
+}
+
+void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std::vector<uint8_t>* logical,
+                pugi::xml_node data3d) {
+  CheckScan(scan);
+  if (!IsRigid(scan.world_from_scanner, 1e-6)) {
+    throw InputError(
+        fmt::format("scan {} ('{}'): world_from_scanner is not rigid; E57 stores a rotation and a "
+                    "translation only",
+                    index, scan.name));
+  }
+  // The records: valid cells, and (optionally) no-return cells that have a direction.
+  std::vector<int64_t> cells;
+  std::vector<uint8_t> states;
+  cells.reserve(static_cast<size_t>(scan.num_cells()));
+  for (int64_t c = 0; c < scan.num_cells(); ++c) {
+    const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
+    if (scan.valid.at<uint8_t>(r, k)) {
+      cells.push_back(c);
+      states.push_back(0);
+    } else if (options.write_no_return_directions) {
+      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
+      if (d.dot(d) > 0.0f && std::isfinite(d.dot(d))) {
+        cells.push_back(c);
+        states.push_back(1);
+      }
+    }
+  }
+  const int64_t n = static_cast<int64_t>(cells.size());
+  auto xyz_of = [&](int64_t i, int axis) {
+    const int64_t c = cells[i];
+    const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
+    return states[i] == 0 ? scan.point.at<cv::Vec3f>(r, k)[axis] : scan.direction.at<cv::Vec3f>(r, k)[axis];
+  };
+
+  std::vector<Stream> streams;
+  const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
+  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  for (int axis = 0; axis < 3; ++axis) {
+    Stream s;
+    s.field.name = axis_names[axis];
+    if (options.coordinate_scale_m > 0) {
+      std::vector<int64_t> raw(n);
+      int64_t raw_min = 0, raw_max = 0;
+      for (int64_t i = 0; i < n; ++i) {
+        const double v = xyz_of(i, axis);
+        if (!std::isfinite(v) || std::abs(v / options.coordinate_scale_m) > 4e18) {
+          throw InputError(fmt::format("scan {}: coordinate {} does not fit a scaled integer", index, v));
+        }
+        raw[i] = std::llround(v / options.coordinate_scale_m);
+        raw_min = i == 0 ? raw[i] : std::min(raw_min, raw[i]);
+        raw_max = i == 0 ? raw[i] : std::max(raw_max, raw[i]);
+      }
+      s.field.type = Field::Type::kScaledInteger;
+      s.field.scale = options.coordinate_scale_m;
+      s.field.minimum = raw_min;
+      s.field.maximum = raw_max;
+      s.field.bits = BitsForRange(raw_min, raw_max);
+      BitWriter w(s.field.bits);
+      for (int64_t i = 0; i < n; ++i) w.PutInteger(raw[i], raw_min);
+      s.bytes = w.Finish();
+    } else {
+      s.field.type = Field::Type::kFloat;
+      s.field.bits = 32;
+      BitWriter w(32);
+      for (int64_t i = 0; i < n; ++i) w.PutFloat(xyz_of(i, axis));
+      s.bytes = w.Finish();
+    }
+    for (int64_t i = 0; i < n; ++i) {
+      if (states[i] != 0) continue;
+      const double v = xyz_of(i, axis);
+      lo[axis] = std::min(lo[axis], v);
+      hi[axis] = std::max(hi[axis], v);
+    }
+    streams.push_back(std::move(s));
+  }
+  {
+    Stream s;
+    s.field.name = "intensity";
+    s.field.type = Field::Type::kFloat;
+    s.field.bits = 32;
+    BitWriter w(32);
+    const float* in = scan.intensity.ptr<float>();
+    for (int64_t i = 0; i < n; ++i) w.PutFloat(in[cells[i]]);
+    s.bytes = w.Finish();
+    streams.push_back(std::move(s));
+  }
+  if (scan.has_color()) {
+    const char* names[3] = {"colorRed", "colorGreen", "colorBlue"};
+    const uint8_t* in = scan.color.ptr<uint8_t>();
+    for (int ch = 0; ch < 3; ++ch) {
+      Stream s;
+      s.field = IntegerField(names[ch], 0, 255);
+      BitWriter w(s.field.bits);
+      for (int64_t i = 0; i < n; ++i) w.PutInteger(in[3 * cells[i] + ch], 0);
+      s.bytes = w.Finish();
+      streams.push_back(std::move(s));
+    }
+  }
+  {
+    Stream row, col;
+    row.field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
+    col.field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
+    BitWriter wr(row.field.bits), wc(col.field.bits);
+    for (int64_t i = 0; i < n; ++i) {
+      wr.PutInteger(cells[i] / scan.cols, 0);
+      wc.PutInteger(cells[i] % scan.cols, 0);
+    }
+    row.bytes = wr.Finish();
+    col.bytes = wc.Finish();
+    streams.push_back(std::move(row));
+    streams.push_back(std::move(col));
+  }
+  {
+    const bool any_direction_only =
+        std::any_of(states.begin(), states.end(), [](uint8_t s) { return s != 0; });
+    Stream s;
+    s.field = IntegerField("cartesianInvalidState", 0, any_direction_only ? 2 : 0);
+    BitWriter w(s.field.bits);
+    for (int64_t i = 0; i < n; ++i) w.PutInteger(states[i], 0);
+    s.bytes = w.Finish();
+    streams.push_back(std::move(s));
+  }
+
+  const uint64_t offset = AppendCompressedVector(streams, n, logical);
+
+  pugi::xml_node child = AddTyped(data3d, "vectorChild", "Structure");
+  AddString(child, "guid",
+            fmt::format("{{lidarshop-scan-{:04d}-{:08x}}}", index,
+                        Crc32c(logical->data() + logical->size() - std::min<size_t>(logical->size(), 4096),
+                               std::min<size_t>(logical->size(), 4096))));
+  AddString(child, "name", scan.name.empty() ? fmt::format("scan{:03d}", index) : scan.name);
+  AddString(child, "description", "written by lidarshop");
+  {
+    const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+    Eigen::Quaterniond q(rotation);
+    q.normalize();
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    pugi::xml_node pose = AddTyped(child, "pose", "Structure");
+    pugi::xml_node r = AddTyped(pose, "rotation", "Structure");
+    AddFloat(r, "w", q.w());
+    AddFloat(r, "x", q.x());
+    AddFloat(r, "y", q.y());
+    AddFloat(r, "z", q.z());
+    pugi::xml_node t = AddTyped(pose, "translation", "Structure");
+    AddFloat(t, "x", scan.world_from_scanner(0, 3));
+    AddFloat(t, "y", scan.world_from_scanner(1, 3));
+    AddFloat(t, "z", scan.world_from_scanner(2, 3));
+  }
+  {
+    pugi::xml_node b = AddTyped(child, "indexBounds", "Structure");
+    AddInteger(b, "rowMinimum", 0);
+    AddInteger(b, "rowMaximum", std::max(scan.rows - 1, 0));
+    AddInteger(b, "columnMinimum", 0);
+    AddInteger(b, "columnMaximum", std::max(scan.cols - 1, 0));
+    AddInteger(b, "returnMinimum", 0);
+    AddInteger(b, "returnMaximum", 0);
+  }
+  {
+    pugi::xml_node b = AddTyped(child, "cartesianBounds", "Structure");
+    AddFloat(b, "xMinimum", lo[0]);
+    AddFloat(b, "xMaximum", hi[0]);
+    AddFloat(b, "yMinimum", lo[1]);
+    AddFloat(b, "yMaximum", hi[1]);
+    AddFloat(b, "zMinimum", lo[2]);
+    AddFloat(b, "zMaximum", hi[2]);
+  }
+  {
+    pugi::xml_node l = AddTyped(child, "intensityLimits", "Structure");
+    AddFloat(l, "intensityMinimum", 0.0);
+    AddFloat(l, "intensityMaximum", 1.0);
+  }
+  if (scan.has_color()) {
+    pugi::xml_node l = AddTyped(child, "colorLimits", "Structure");
+    AddInteger(l, "colorRedMinimum", 0);
+    AddInteger(l, "colorRedMaximum", 255);
+    AddInteger(l, "colorGreenMinimum", 0);
+    AddInteger(l, "colorGreenMaximum", 255);
+    AddInteger(l, "colorBlueMinimum", 0);
+    AddInteger(l, "colorBlueMaximum", 255);
+  }
+  pugi::xml_node points = AddTyped(child, "points", "CompressedVector");
+  points.append_attribute("fileOffset") = std::to_string(offset).c_str();
+  points.append_attribute("recordCount") = std::to_string(n).c_str();
+  pugi::xml_node prototype = AddTyped(points, "prototype", "Structure");
+  for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
+  pugi::xml_node codecs = AddTyped(points, "codecs", "Vector");
+  codecs.append_attribute("allowHeterogeneousChildren") = "1";
+}
+
+}  // namespace
+}  // namespace e57
+
+void E57WriteOptions::Check() const {
+  CheckOption(
+      std::isfinite(coordinate_scale_m) && coordinate_scale_m >= 0.0,
+      fmt::format("E57WriteOptions.coordinate_scale_m must be >= 0 (0 = float), got {}", coordinate_scale_m));
+}
+
+std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options) {
+  using namespace e57;
+  options.Check();
+  std::vector<uint8_t> logical(kHeaderSize, 0);
+  pugi::xml_document doc;
+  pugi::xml_node decl = doc.append_child(pugi::node_declaration);
+  decl.append_attribute("version") = "1.0";
+  decl.append_attribute("encoding") = "UTF-8";
+  pugi::xml_node root = AddTyped(doc, "e57Root", "Structure");
+  root.append_attribute("xmlns") = "http://www.astm.org/COMMIT/E57/2010-e57-v1.0";
+  AddString(root, "formatName", "ASTM E57 3D Imaging Data File");
+  AddInteger(root, "versionMajor", 1);
+  AddInteger(root, "versionMinor", 0);
+  AddString(root, "e57LibraryVersion", "lidarshop");
+  pugi::xml_node data3d = AddTyped(root, "data3D", "Vector");
+  data3d.append_attribute("allowHeterogeneousChildren") = "1";
+  for (size_t i = 0; i < scans.size(); ++i)
+    AppendScan(scans[i], static_cast<int>(i), options, &logical, data3d);
+  pugi::xml_node images = AddTyped(root, "images2D", "Vector");
+  images.append_attribute("allowHeterogeneousChildren") = "1";
+  // The file guid: a checksum of the binary sections, so that the same scans give the same bytes.
+  pugi::xml_node guid = AddTyped(root, "guid", "String");
+  guid.append_child(pugi::node_cdata)
+      .set_value(fmt::format("{{lidarshop-{:08x}-{:016x}}}", Crc32c(logical.data(), logical.size()),
+                             static_cast<uint64_t>(logical.size()))
+                     .c_str());
+  root.insert_move_after(guid, root.child("formatName"));
+
+  std::ostringstream xml;
+  doc.save(xml, "  ", pugi::format_default, pugi::encoding_utf8);
+  const std::string text = xml.str();
+  while (logical.size() % 8) logical.push_back(0);
+  Header header;
+  header.xml_physical_offset = PhysicalFromLogical(logical.size());
+  header.xml_logical_length = text.size();
+  logical.insert(logical.end(), text.begin(), text.end());
+  const uint64_t pages = (logical.size() + kPagePayload - 1) / kPagePayload;
+  header.file_physical_length = pages * kPageSize;
+  StoreHeader(header, logical.data());
+  return PagesFromLogical(logical);
+}
+
+void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options) {
+  const std::vector<uint8_t> bytes = EncodeE57(scans, options);
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  });
+}
+
+void WriteE57(const std::string& path, const std::vector<Scan>& scans) { WriteE57(path, scans, {}); }
+
+}  // namespace lidarshop
