@@ -202,7 +202,7 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
     options.style = ParseCarStyle(fields.String("style", "sedan"), fields.what() + ": " + fields.place());
     options.paint = fields.Color("color", options.paint);
     options.subdivisions = static_cast<int>(fields.Integer("subdivisions", 0, 0, 7));
-    options.wheel_segments = static_cast<int>(fields.Integer("wheel_segments", 32, 8, 4096));
+    options.wheel_segments = static_cast<int>(fields.Integer("wheel_segments", 48, 8, 4096));
     *color_used = true;
     return MakeCarMesh(options);
   }
