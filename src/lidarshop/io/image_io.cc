@@ -1,0 +1,81 @@
+#include "lidarshop/io/image_io.h"
+
+#include <cstdlib>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+// OpenCV's BGR(A) <-> lidarshop's RGB(A); the conversion is its own inverse.
+cv::Mat SwapRedBlue(const cv::Mat& image) {
+  cv::Mat swapped;
+  if (image.channels() == 3) {
+    cv::cvtColor(image, swapped, cv::COLOR_BGR2RGB);
+  } else if (image.channels() == 4) {
+    cv::cvtColor(image, swapped, cv::COLOR_BGRA2RGBA);
+  } else {
+    swapped = image;
+  }
+  return swapped;
+}
+
+}  // namespace
+
+cv::Mat ReadImage(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path))
+    ThrowInputError(path, "", "", "cannot open the image (missing?)");
+  if (FileExtension(path) == "exr") {
+    // OpenCV 4.6 reads EXR only when this is set before the first use.
+    setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+  }
+  cv::Mat image;
+  try {
+    image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& error) {
+    ThrowInputError(path, "", "", fmt::format("not a readable image ({})", error.what()));
+  }
+  if (image.empty()) ThrowInputError(path, "", "", "not a readable image");
+  return SwapRedBlue(image);
+}
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
+  if (image.empty()) ThrowInputError(path, "", "", "cannot write an empty image");
+  const std::string extension = FileExtension(path);
+  if (extension == "exr") setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+  if ((extension == "jpg" || extension == "jpeg") && image.depth() != CV_8U) {
+    ThrowInputError(path, "", "", "JPEG holds 8-bit images only; use .png (16-bit) or .exr (float)");
+  }
+  if (extension == "png" && image.depth() != CV_8U && image.depth() != CV_16U) {
+    ThrowInputError(path, "", "", "PNG holds 8- or 16-bit images only; use .exr or .tif for float images");
+  }
+  const cv::Mat bgr = SwapRedBlue(image);
+  WritePathAtomically(path, [&](const std::string& temporary) {
+    try {
+      return cv::imwrite(temporary, bgr);
+    } catch (const cv::Exception& error) {
+      ThrowInputError(path, "", "", fmt::format("cannot write the image ({})", error.what()));
+    }
+  });
+}
+
+cv::Mat DecodeImage(const std::vector<uint8_t>& bytes, const std::string& what) {
+  if (bytes.empty()) ThrowInputError(what, "", "", "empty image data");
+  cv::Mat image;
+  try {
+    image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& error) {
+    ThrowInputError(what, "", "", fmt::format("not a decodable image ({})", error.what()));
+  }
+  if (image.empty()) ThrowInputError(what, "", "", "not a decodable image");
+  return SwapRedBlue(image);
+}
+
+}  // namespace lidarshop

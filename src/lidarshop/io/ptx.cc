@@ -1,0 +1,211 @@
+#include "lidarshop/io/ptx.h"
+
+#include <fmt/format.h>
+
+#include "lidarshop/io/io_common.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/text_cursor.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using io_internal::TextCursor;
+
+// Reads "a b c" (or "a b c d") of a header line into `values`.
+template <int N>
+void ReadHeaderLine(TextCursor* cursor, const char* what, double* values) {
+  cursor->SkipEmptyLines();
+  if (cursor->AtEnd()) cursor->Fail(what, "the file ends inside the scan header");
+  static const char* kNames[] = {"1st value", "2nd value", "3rd value", "4th value"};
+  for (int i = 0; i < N; ++i) values[i] = cursor->Double(fmt::format("{} ({})", what, kNames[i]));
+  cursor->EndLine(what);
+}
+
+int64_t ReadCount(TextCursor* cursor, const char* what, int scan_index) {
+  cursor->SkipEmptyLines();
+  if (cursor->AtEnd()) cursor->Fail(what, "the file ends inside the scan header");
+  const std::string_view token = cursor->Token();
+  TextCursor number(token, cursor->file(), cursor->line());
+  int64_t count = 0;
+  try {
+    count = number.Int(what);
+  } catch (const InputError&) {
+    std::string hint;
+    if (scan_index > 0) {
+      hint = fmt::format(
+          " (expected the header of scan {}; does scan {} have more point lines than its header "
+          "claims?)",
+          scan_index + 1, scan_index);
+    }
+    cursor->Fail(what,
+                 fmt::format("expected a whole number, found '{}'{}", io_internal::Printable(token), hint));
+  }
+  if (!cursor->AtEndOfLine()) {
+    cursor->Fail(what,
+                 fmt::format("expected one whole number on the line{}",
+                             scan_index > 0 ? fmt::format(" (header of scan {}; does scan {} have more point "
+                                                          "lines than its header claims?)",
+                                                          scan_index + 1, scan_index)
+                                            : std::string()));
+  }
+  cursor->NextLine();
+  return count;
+}
+
+Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& options) {
+  const std::string place = fmt::format("scan {}", scan_index + 1);
+  const int64_t header_line = cursor->line();
+  const int64_t cols = ReadCount(cursor, "columns", scan_index);
+  const int64_t rows = ReadCount(cursor, "rows", scan_index);
+  io_internal::CheckScanSize(rows, cols, cursor->file(), fmt::format("line {}: {}", header_line, place));
+  double position[3], axes[3][3], printed[4][4];
+  ReadHeaderLine<3>(cursor, "scanner position", position);
+  ReadHeaderLine<3>(cursor, "scanner x axis", axes[0]);
+  ReadHeaderLine<3>(cursor, "scanner y axis", axes[1]);
+  ReadHeaderLine<3>(cursor, "scanner z axis", axes[2]);
+  for (int i = 0; i < 4; ++i) {
+    ReadHeaderLine<4>(cursor,
+                      i == 0   ? "matrix row 1"
+                      : i == 1 ? "matrix row 2"
+                      : i == 2 ? "matrix row 3"
+                               : "matrix row 4",
+                      printed[i]);
+  }
+  Eigen::Matrix4d matrix;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) matrix(r, c) = printed[r][c];
+  }
+  // Leica prints the transpose (translation in the 4th printed row). A matrix printed the usual way has "0 0
+  // 0 1" as its last row and a translation in the last column: take it as printed.
+  const bool usual_layout = printed[3][0] == 0 && printed[3][1] == 0 && printed[3][2] == 0 &&
+                            (printed[0][3] != 0 || printed[1][3] != 0 || printed[2][3] != 0);
+  Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols));
+  scan.world_from_scanner = usual_layout ? matrix : Eigen::Matrix4d(matrix.transpose());
+  const Eigen::RowVector4d last_row = scan.world_from_scanner.row(3);
+  if (!last_row.isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) {
+    ThrowInputError(cursor->file(), fmt::format("line {}: {}", cursor->line() - 1, place), "matrix",
+                    "not an affine transform: the printed 4th column (Leica layout) must be 0 0 0 1");
+  }
+
+  const int64_t total = rows * cols;
+  int64_t done = 0;
+  for (int64_t col = 0; col < cols; ++col) {
+    for (int64_t r = 0; r < rows; ++r, ++done) {
+      cursor->SkipEmptyLines();
+      if (cursor->AtEnd()) {
+        cursor->Fail("", fmt::format("truncated: {} expects {} point lines ({} columns x {} rows), found {}",
+                                     place, total, cols, rows, done));
+      }
+      const int image_row = static_cast<int>(rows - 1 - r);
+      const float x = cursor->Float("x");
+      const float y = cursor->Float("y");
+      const float z = cursor->Float("z");
+      const float intensity = cursor->Float("intensity");
+      const bool valid = x != 0 || y != 0 || z != 0;
+      if (!cursor->AtEndOfLine()) {
+        const int64_t red = cursor->Int("red");
+        const int64_t green = cursor->Int("green");
+        const int64_t blue = cursor->Int("blue");
+        if ((red | green | blue) < 0 || red > 255 || green > 255 || blue > 255) {
+          cursor->Fail("colour", fmt::format("{} {} {} is outside 0-255", red, green, blue));
+        }
+        if (!cursor->AtEndOfLine()) {
+          cursor->Fail("", "expected 4 fields (x y z intensity) or 7 fields (x y z intensity r g b)");
+        }
+        if (scan.color.empty()) scan.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+        if (valid) {
+          scan.color.ptr<cv::Vec3b>(image_row)[col] =
+              cv::Vec3b(static_cast<uint8_t>(red), static_cast<uint8_t>(green), static_cast<uint8_t>(blue));
+        }
+      }
+      cursor->NextLine();
+      if (valid) {
+        scan.valid.ptr<uint8_t>(image_row)[col] = kValid;
+        scan.point.ptr<cv::Vec3f>(image_row)[col] = cv::Vec3f(x, y, z);
+        scan.intensity.ptr<float>(image_row)[col] = intensity;
+      }
+    }
+  }
+  io_internal::FinishScan(&scan, options.fit_grid);
+  return scan;
+}
+
+}  // namespace
+
+std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const PtxReadOptions& options) {
+  TextCursor cursor(text, file);
+  std::vector<Scan> scans;
+  cursor.SkipEmptyLines();
+  if (cursor.AtEnd()) ThrowInputError(file, "line 1", "columns", "the file is empty");
+  while (!cursor.AtEnd()) {
+    scans.push_back(ParseOneScan(&cursor, static_cast<int>(scans.size()), options));
+    cursor.SkipEmptyLines();
+  }
+  return scans;
+}
+
+std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options) {
+  const std::string text = io_internal::ReadFileToString(path);
+  return ParsePtx(text, path, options);
+}
+
+std::string FormatPtx(const std::vector<Scan>& scans) {
+  using io_internal::AppendNumber;
+  std::string out;
+  int64_t cells = 0;
+  for (const Scan& scan : scans) cells += scan.num_cells();
+  out.reserve(static_cast<size_t>(cells) * 40 + 1024);
+  for (const Scan& scan : scans) {
+    CheckScan(scan);
+    const Eigen::Matrix4d& pose = scan.world_from_scanner;
+    out += fmt::format("{}\n{}\n", scan.cols, scan.rows);
+    auto append_row = [&](std::initializer_list<double> values) {
+      bool first = true;
+      for (double value : values) {
+        if (!first) out += ' ';
+        AppendNumber(&out, value);
+        first = false;
+      }
+      out += '\n';
+    };
+    append_row({pose(0, 3), pose(1, 3), pose(2, 3)});
+    for (int axis = 0; axis < 3; ++axis) append_row({pose(0, axis), pose(1, axis), pose(2, axis)});
+    // Leica layout: the transpose of world_from_scanner.
+    for (int c = 0; c < 4; ++c) append_row({pose(0, c), pose(1, c), pose(2, c), pose(3, c)});
+    const bool color = scan.has_color();
+    for (int col = 0; col < scan.cols; ++col) {
+      for (int row = scan.rows - 1; row >= 0; --row) {
+        if (!scan.valid.ptr<uint8_t>(row)[col]) {
+          out += color ? "0 0 0 0.5 0 0 0\n" : "0 0 0 0.5\n";
+          continue;
+        }
+        const cv::Vec3f& point = scan.point.ptr<cv::Vec3f>(row)[col];
+        AppendNumber(&out, point[0]);
+        out += ' ';
+        AppendNumber(&out, point[1]);
+        out += ' ';
+        AppendNumber(&out, point[2]);
+        out += ' ';
+        AppendNumber(&out, scan.intensity.ptr<float>(row)[col]);
+        if (color) {
+          const cv::Vec3b& rgb = scan.color.ptr<cv::Vec3b>(row)[col];
+          for (int channel = 0; channel < 3; ++channel) {
+            out += ' ';
+            AppendNumber(&out, static_cast<int64_t>(rgb[channel]));
+          }
+        }
+        out += '\n';
+      }
+    }
+  }
+  return out;
+}
+
+void WritePtx(const std::string& path, const std::vector<Scan>& scans) {
+  const std::string text = FormatPtx(scans);
+  WriteFileAtomically(path, [&](std::ostream& stream) { stream.write(text.data(), text.size()); });
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,51 @@
+// PTX, Leica's ASCII scan format: one or several organized scans after each other in one file.
+//
+// Each scan is a header of 10 lines, then columns x rows point lines:
+//   line 1      columns                       (number of vertical strips)
+//   line 2      rows                          (points per strip)
+//   line 3      scanner position              x y z (registered, world frame)
+//   lines 4-6   scanner axes                  the world directions of the scanner's x, y and z axes
+//   lines 7-10  4 x 4 matrix, as Leica prints it: the TRANSPOSE of world_from_scanner, i.e. the first three
+//   printed
+//               rows hold the rotation's columns followed by 0, the fourth printed row is "tx ty tz 1".
+//               (A file that prints the usual layout, translation in the 4th column and "0 0 0 1" last, is
+//               recognised by that last row and read as printed.)
+//   points      "x y z intensity" or "x y z intensity r g b", scanner frame, metres, intensity as printed
+//               (usually [0, 1]), colour 0-255; column-major: each column a vertical strip listed bottom to
+//               top, columns left to right. PTX row r (counted from the bottom) is image row rows - 1 - r.
+// A no-return cell is "0 0 0 0.5" (colour "0 0 0"); reading x = y = z = 0 marks the cell invalid.
+//
+// Readers accept 4- and 7-field lines (a 7-field line in a 4-field scan adds a colour channel), CRLF endings
+// and blank lines, and reject anything else with an InputError naming the file, the line and the field. The
+// header is checked against kMaxScanCells before any allocation.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+struct PtxReadOptions {
+  // Fit the angular grid (FitGrid) so that every cell, also without a return, gets a direction. Off only for
+  // benchmarks of the parser itself.
+  bool fit_grid = true;
+};
+
+// Reads every scan of a PTX file.
+std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options = {});
+
+// Parses PTX text held in memory; `file` names it in error messages.
+std::vector<Scan> ParsePtx(std::string_view text, const std::string& file,
+                           const PtxReadOptions& options = {});
+
+// The PTX text of `scans` (floats printed in their shortest round-trip form). Colour lines have 7 fields when
+// the scan has colour.
+std::string FormatPtx(const std::vector<Scan>& scans);
+
+// Writes `scans` to `path` atomically.
+void WritePtx(const std::string& path, const std::vector<Scan>& scans);
+
+}  // namespace lidarshop

@@ -1,0 +1,286 @@
+#include "lidarshop/io/scan_io.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <Eigen/LU>
+
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/io_common.h"
+#include "lidarshop/io/pcd.h"
+#include "lidarshop/io/ply.h"
+#include "lidarshop/io/ply_fields.h"
+#include "lidarshop/io/ptx.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using namespace io_internal;  // NOLINT: the PLY field helpers
+
+constexpr char kScanComment[] = "lidarshop_scan ";
+
+// ---- PLY: a scan is its valid points in the world frame plus row/col/scan properties and a pose comment
+// ----
+
+struct PlyScanHeader {
+  int index = 0;
+  int64_t rows = 0, cols = 0;
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
+};
+
+std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path) {
+  std::vector<PlyScanHeader> headers;
+  for (const std::string& comment : ply.comments) {
+    if (comment.rfind(kScanComment, 0) != 0) continue;
+    std::istringstream stream(comment.substr(sizeof(kScanComment) - 1));
+    PlyScanHeader header;
+    stream >> header.index >> header.rows >> header.cols;
+    for (int i = 0; i < 16; ++i) stream >> header.world_from_scanner(i / 4, i % 4);
+    if (!stream || header.index != static_cast<int>(headers.size())) {
+      ThrowInputError(
+          path, "header", "comment lidarshop_scan",
+          "expected 'lidarshop_scan <index> <rows> <cols> <16 matrix values>' with indices 0, 1, ...");
+    }
+    CheckScanSize(header.rows, header.cols, path, fmt::format("header: scan {}", header.index));
+    headers.push_back(header);
+  }
+  return headers;
+}
+
+std::vector<Scan> ReadPlyScans(const std::string& path) {
+  const PlyData ply = ReadPly(path);
+  const PlyElement& vertex = RequireElement(ply, "vertex", path);
+  const PointCloud cloud = PointCloudFromPly(ply, path);
+  const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path);
+  const PlyProperty* row_property = FindScalar(vertex, {"row"});
+  const PlyProperty* col_property = FindScalar(vertex, {"col"});
+  const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
+  const PlyProperty* true_range_property = FindScalar(vertex, {"true_range"});
+
+  if (headers.empty() || row_property == nullptr || col_property == nullptr) {
+    // A plain point cloud: one 1 x N scan, every point a return, in the identity pose.
+    if (cloud.size() == 0) ThrowInputError(path, "header", "element vertex", "no points");
+    CheckScanSize(1, static_cast<int64_t>(cloud.size()), path, "header");
+    Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty());
+    if (!cloud.labels.empty()) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
+    if (!cloud.normals.empty()) scan.normal = cv::Mat(1, scan.cols, CV_32FC3, cv::Scalar::all(0));
+    if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
+    for (int i = 0; i < scan.cols; ++i) {
+      const Eigen::Vector3f& p = cloud.points[i];
+      if (p.isZero()) continue;  // (0, 0, 0) has no ray
+      scan.valid.at<uint8_t>(0, i) = kValid;
+      scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
+      if (!cloud.intensities.empty()) scan.intensity.at<float>(0, i) = cloud.intensities[i];
+      if (!cloud.colors.empty())
+        scan.color.at<cv::Vec3b>(0, i) =
+            cv::Vec3b(cloud.colors[i][0], cloud.colors[i][1], cloud.colors[i][2]);
+      if (!cloud.labels.empty()) scan.label.at<int32_t>(0, i) = cloud.labels[i];
+      if (!cloud.normals.empty()) {
+        scan.normal.at<cv::Vec3f>(0, i) =
+            cv::Vec3f(cloud.normals[i].x(), cloud.normals[i].y(), cloud.normals[i].z());
+      }
+      if (!cloud.synthesized.empty()) scan.synthesized.at<uint8_t>(0, i) = cloud.synthesized[i] ? kValid : 0;
+    }
+    FinishScan(&scan, /*fit_grid=*/false);
+    return {scan};
+  }
+
+  std::vector<Scan> scans;
+  std::vector<Eigen::Matrix4d> scanner_from_world;
+  for (const PlyScanHeader& header : headers) {
+    Scan scan = MakeScan(static_cast<int>(header.rows), static_cast<int>(header.cols), !cloud.colors.empty());
+    scan.world_from_scanner = header.world_from_scanner;
+    if (!cloud.labels.empty()) scan.label = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
+    if (!cloud.normals.empty()) scan.normal = cv::Mat(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
+    if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    if (true_range_property != nullptr)
+      scan.true_range = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
+    scanner_from_world.push_back(header.world_from_scanner.inverse());
+    scans.push_back(std::move(scan));
+  }
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const int64_t index = scan_property != nullptr ? static_cast<int64_t>(scan_property->values[i]) : 0;
+    const int64_t row = static_cast<int64_t>(row_property->values[i]);
+    const int64_t col = static_cast<int64_t>(col_property->values[i]);
+    if (index < 0 || index >= static_cast<int64_t>(scans.size()) || row < 0 || row >= scans[index].rows ||
+        col < 0 || col >= scans[index].cols) {
+      ThrowInputError(
+          path, fmt::format("vertex {}", i), "scan/row/col",
+          fmt::format("scan {} row {} col {} is outside the scans the header declares", index, row, col));
+    }
+    Scan& scan = scans[index];
+    const Eigen::Matrix4d& inverse = scanner_from_world[index];
+    const Eigen::Vector3d p =
+        inverse.topLeftCorner<3, 3>() * cloud.points[i].cast<double>() + inverse.topRightCorner<3, 1>();
+    if (p.isZero()) continue;
+    scan.valid.at<uint8_t>(row, col) = kValid;
+    scan.point.at<cv::Vec3f>(row, col) = cv::Vec3f(p.x(), p.y(), p.z());
+    if (!cloud.intensities.empty()) scan.intensity.at<float>(row, col) = cloud.intensities[i];
+    if (!cloud.colors.empty()) {
+      scan.color.at<cv::Vec3b>(row, col) =
+          cv::Vec3b(cloud.colors[i][0], cloud.colors[i][1], cloud.colors[i][2]);
+    }
+    if (!cloud.labels.empty()) scan.label.at<int32_t>(row, col) = cloud.labels[i];
+    if (!cloud.normals.empty()) {
+      const Eigen::Vector3d n = inverse.topLeftCorner<3, 3>() * cloud.normals[i].cast<double>();
+      scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
+    }
+    if (!cloud.synthesized.empty())
+      scan.synthesized.at<uint8_t>(row, col) = cloud.synthesized[i] ? kValid : 0;
+    if (true_range_property != nullptr) scan.true_range.at<float>(row, col) = true_range_property->values[i];
+  }
+  for (Scan& scan : scans) FinishScan(&scan, /*fit_grid=*/true);
+  return scans;
+}
+
+void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
+  PlyData ply;
+  ply.comments.push_back("written by lidarshop: points in the world frame; row/col in image orientation");
+  int64_t total = 0;
+  bool color = false, label = false, normal = false, synthesized = false, true_range = false, far = false;
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const Scan& scan = scans[k];
+    CheckScan(scan);
+    std::string comment = fmt::format("{}{} {} {}", kScanComment, k, scan.rows, scan.cols);
+    for (int i = 0; i < 16; ++i) comment += fmt::format(" {}", scan.world_from_scanner(i / 4, i % 4));
+    ply.comments.push_back(comment);
+    total += scan.CountValid();
+    color |= scan.has_color();
+    label |= !scan.label.empty();
+    normal |= !scan.normal.empty();
+    synthesized |= !scan.synthesized.empty();
+    true_range |= !scan.true_range.empty();
+    far |= scan.world_from_scanner.topRightCorner<3, 1>().norm() > 1e4;  // floats would lose millimetres
+  }
+  std::vector<double> x, y, z, nx, ny, nz, red, green, blue, intensity, labels, synth, truth, rows, cols,
+      index;
+  for (std::vector<double>* column : {&x, &y, &z, &intensity, &rows, &cols, &index}) column->reserve(total);
+  for (size_t k = 0; k < scans.size(); ++k) {
+    const Scan& scan = scans[k];
+    const Eigen::Matrix4d& pose = scan.world_from_scanner;
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 0; col < scan.cols; ++col) {
+        if (!scan.valid.at<uint8_t>(row, col)) continue;
+        const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+        const Eigen::Vector3d world =
+            pose.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) + pose.topRightCorner<3, 1>();
+        x.push_back(world.x());
+        y.push_back(world.y());
+        z.push_back(world.z());
+        intensity.push_back(scan.intensity.at<float>(row, col));
+        rows.push_back(row);
+        cols.push_back(col);
+        index.push_back(static_cast<double>(k));
+        if (color) {
+          const cv::Vec3b c = scan.has_color() ? scan.color.at<cv::Vec3b>(row, col) : cv::Vec3b(0, 0, 0);
+          red.push_back(c[0]);
+          green.push_back(c[1]);
+          blue.push_back(c[2]);
+        }
+        if (normal) {
+          Eigen::Vector3d n = Eigen::Vector3d::Zero();
+          if (!scan.normal.empty()) {
+            const cv::Vec3f& v = scan.normal.at<cv::Vec3f>(row, col);
+            n = pose.topLeftCorner<3, 3>() * Eigen::Vector3d(v[0], v[1], v[2]);
+          }
+          nx.push_back(n.x());
+          ny.push_back(n.y());
+          nz.push_back(n.z());
+        }
+        if (label) labels.push_back(scan.label.empty() ? kNoLabel : scan.label.at<int32_t>(row, col));
+        if (synthesized)
+          synth.push_back(!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
+        if (true_range) truth.push_back(scan.true_range.empty() ? 0.0 : scan.true_range.at<float>(row, col));
+      }
+    }
+  }
+  PlyElement vertex{"vertex", total, {}};
+  const PlyType position_type = far ? PlyType::kFloat64 : PlyType::kFloat32;
+  AddScalarProperty(&vertex, "x", position_type, std::move(x));
+  AddScalarProperty(&vertex, "y", position_type, std::move(y));
+  AddScalarProperty(&vertex, "z", position_type, std::move(z));
+  if (normal) {
+    AddScalarProperty(&vertex, "nx", PlyType::kFloat32, std::move(nx));
+    AddScalarProperty(&vertex, "ny", PlyType::kFloat32, std::move(ny));
+    AddScalarProperty(&vertex, "nz", PlyType::kFloat32, std::move(nz));
+  }
+  if (color) {
+    AddScalarProperty(&vertex, "red", PlyType::kUInt8, std::move(red));
+    AddScalarProperty(&vertex, "green", PlyType::kUInt8, std::move(green));
+    AddScalarProperty(&vertex, "blue", PlyType::kUInt8, std::move(blue));
+  }
+  AddScalarProperty(&vertex, "intensity", PlyType::kFloat32, std::move(intensity));
+  if (label) AddScalarProperty(&vertex, "label", PlyType::kInt32, std::move(labels));
+  if (synthesized) AddScalarProperty(&vertex, "synthesized", PlyType::kUInt8, std::move(synth));
+  if (true_range) AddScalarProperty(&vertex, "true_range", PlyType::kFloat32, std::move(truth));
+  AddScalarProperty(&vertex, "row", PlyType::kInt32, std::move(rows));
+  AddScalarProperty(&vertex, "col", PlyType::kInt32, std::move(cols));
+  AddScalarProperty(&vertex, "scan", PlyType::kInt32, std::move(index));
+  ply.elements.push_back(std::move(vertex));
+  WritePly(path, ply);
+}
+
+// ---- The table ----
+
+struct ScanFormat {
+  const char* extension;
+  std::vector<Scan> (*read)(const std::string& path);
+  void (*write)(const std::string& path, const std::vector<Scan>& scans);
+};
+
+const std::vector<ScanFormat>& ScanFormats() {
+  static const std::vector<ScanFormat> formats = {
+      {"ptx", [](const std::string& path) { return ReadPtx(path); }, &WritePtx},
+      {"ply", &ReadPlyScans, &WritePlyScans},
+      {"pcd", [](const std::string& path) { return std::vector<Scan>{ReadPcd(path)}; },
+       [](const std::string& path, const std::vector<Scan>& scans) {
+         if (scans.size() != 1) {
+           ThrowInputError(path, "", "",
+                           fmt::format("PCD holds one scan, got {}; write .ptx, .ply or .e57", scans.size()));
+         }
+         WritePcd(path, scans[0]);
+       }},
+      {"e57", [](const std::string& path) { return ReadE57(path).scans; }, &WriteE57},
+  };
+  return formats;
+}
+
+const ScanFormat& FormatFor(const std::string& path) {
+  const std::string extension = FileExtension(path);
+  for (const ScanFormat& format : ScanFormats()) {
+    if (extension == format.extension) return format;
+  }
+  ThrowInputError(path, "", "",
+                  fmt::format("unknown scan format '{}' (lidarshop reads .ptx, .e57, .ply and .pcd)",
+                              extension.empty() ? std::string("no extension") : "." + extension));
+}
+
+}  // namespace
+
+std::string FileExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  if (!extension.empty() && extension[0] == '.') extension.erase(0, 1);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+ScanFile ReadScanFile(const std::string& path) {
+  const ScanFormat& format = FormatFor(path);
+  ScanFile file;
+  file.path = path;
+  file.format = format.extension;
+  file.scans = format.read(path);
+  return file;
+}
+
+void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
+  const ScanFormat& format = FormatFor(path);
+  if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
+  format.write(path, scans);
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,219 @@
+// FitGrid: the angular grid of a real scan from its measured points (scan.h).
+//
+// Per column the azimuth and per image row the elevation are the median of the valid points' angles (circular
+// for azimuth), then each axis is cleaned up: lines that disagree with their neighbours by more than the
+// noise allows are dropped, the rest is made monotone (pool-adjacent-violators, weighted by the number of
+// points), and lines without data are interpolated linearly or extrapolated with the median step.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kTwoPi = 2.0 * M_PI;
+// Points closer than this to the zenith or nadir (|cos φ| below it) carry no usable azimuth.
+constexpr double kMinCosElevationForAzimuth = 0.1;
+
+double Median(std::vector<double>* values) {
+  if (values->empty()) return kNaN;
+  const size_t middle = values->size() / 2;
+  std::nth_element(values->begin(), values->begin() + middle, values->end());
+  double median = (*values)[middle];
+  if (values->size() % 2 == 0) {
+    median = 0.5 * (median + *std::max_element(values->begin(), values->begin() + middle));
+  }
+  return median;
+}
+
+double WrapAngle(double angle) { return angle - kTwoPi * std::round(angle / kTwoPi); }
+
+// Weighted pool-adjacent-violators: the non-decreasing sequence closest to `values` in weighted least
+// squares.
+std::vector<double> IsotonicIncreasing(const std::vector<double>& values,
+                                       const std::vector<double>& weights) {
+  struct Block {
+    double sum, weight;
+    int count;
+  };
+  std::vector<Block> blocks;
+  for (size_t i = 0; i < values.size(); ++i) {
+    blocks.push_back({values[i] * weights[i], weights[i], 1});
+    while (blocks.size() > 1) {
+      const Block& last = blocks.back();
+      const Block& previous = blocks[blocks.size() - 2];
+      if (previous.sum / previous.weight <= last.sum / last.weight) break;
+      Block merged{previous.sum + last.sum, previous.weight + last.weight, previous.count + last.count};
+      blocks.pop_back();
+      blocks.back() = merged;
+    }
+  }
+  std::vector<double> result;
+  result.reserve(values.size());
+  for (const Block& block : blocks) result.insert(result.end(), block.count, block.sum / block.weight);
+  return result;
+}
+
+// Signed median step between consecutive known lines (NaN when fewer than two are known).
+double MedianStep(const std::vector<double>& medians) {
+  std::vector<double> steps;
+  int previous = -1;
+  for (int i = 0; i < static_cast<int>(medians.size()); ++i) {
+    if (std::isnan(medians[i])) continue;
+    if (previous >= 0) steps.push_back((medians[i] - medians[previous]) / (i - previous));
+    previous = i;
+  }
+  return Median(&steps);
+}
+
+// One axis: per-line medians (NaN = no data) and their point counts in, a complete monotone sequence out.
+std::vector<double> FitAxis(std::vector<double> medians, const std::vector<int>& counts, double step) {
+  const int n = static_cast<int>(medians.size());
+  std::vector<int> known;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isnan(medians[i])) known.push_back(i);
+  }
+  if (known.empty()) return {};
+  if (std::isnan(step)) step = 0.0;
+
+  // Drop lines that disagree with what their neighbours (within kWindow known lines) predict.
+  if (known.size() >= 3) {
+    constexpr int kWindow = 4;
+    std::vector<double> residuals(known.size());
+    for (size_t k = 0; k < known.size(); ++k) {
+      std::vector<double> predictions;
+      for (int j = std::max<int>(0, k - kWindow); j <= std::min<int>(known.size() - 1, k + kWindow); ++j) {
+        if (j == static_cast<int>(k)) continue;
+        predictions.push_back(medians[known[j]] + step * (known[k] - known[j]));
+      }
+      residuals[k] = medians[known[k]] - Median(&predictions);
+    }
+    std::vector<double> magnitudes(residuals.size());
+    for (size_t k = 0; k < residuals.size(); ++k) magnitudes[k] = std::abs(residuals[k]);
+    const double sigma = 1.4826 * Median(&magnitudes);
+    const double threshold = std::max({5.0 * sigma, 0.3 * std::abs(step), 1e-9});
+    std::vector<int> kept;
+    for (size_t k = 0; k < known.size(); ++k) {
+      if (std::abs(residuals[k]) <= threshold) {
+        kept.push_back(known[k]);
+      } else {
+        medians[known[k]] = kNaN;
+      }
+    }
+    if (!kept.empty()) known = kept;
+  }
+
+  // Monotone in the direction of the step.
+  const double sign = step < 0 ? -1.0 : 1.0;
+  std::vector<double> values(known.size()), weights(known.size());
+  for (size_t k = 0; k < known.size(); ++k) {
+    values[k] = sign * medians[known[k]];
+    weights[k] = std::max(1, counts[known[k]]);
+  }
+  values = IsotonicIncreasing(values, weights);
+  std::vector<double> result(n, kNaN);
+  for (size_t k = 0; k < known.size(); ++k) result[known[k]] = sign * values[k];
+
+  // Fill the gaps.
+  for (int i = 0; i < known.front(); ++i) result[i] = result[known.front()] - step * (known.front() - i);
+  for (int i = known.back() + 1; i < n; ++i) result[i] = result[known.back()] + step * (i - known.back());
+  for (size_t k = 0; k + 1 < known.size(); ++k) {
+    const int a = known[k], b = known[k + 1];
+    for (int i = a + 1; i < b; ++i) {
+      const double t = static_cast<double>(i - a) / (b - a);
+      result[i] = (1 - t) * result[a] + t * result[b];
+    }
+  }
+  return result;
+}
+
+}  // namespace
+
+void FitGrid(Scan* scan) {
+  CheckScan(*scan);
+  const int rows = scan->rows, cols = scan->cols;
+  std::vector<std::vector<double>> column_azimuths(cols), row_elevations(rows);
+  for (int row = 0; row < rows; ++row) {
+    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      if (!valid[col]) continue;
+      const double x = point[col][0], y = point[col][1], z = point[col][2];
+      const double horizontal = std::hypot(x, y);
+      if (horizontal == 0 && z == 0) continue;
+      row_elevations[row].push_back(std::atan2(z, horizontal));
+      if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
+        column_azimuths[col].push_back(std::atan2(x, y));
+      }
+    }
+  }
+
+  std::vector<double> azimuth_medians(cols, kNaN), elevation_medians(rows, kNaN);
+  std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
+  for (int col = 0; col < cols; ++col) {
+    std::vector<double>& samples = column_azimuths[col];
+    azimuth_counts[col] = static_cast<int>(samples.size());
+    if (samples.empty()) continue;
+    double sum_sin = 0, sum_cos = 0;
+    for (double angle : samples) {
+      sum_sin += std::sin(angle);
+      sum_cos += std::cos(angle);
+    }
+    const double reference = std::atan2(sum_sin, sum_cos);
+    for (double& angle : samples) angle = WrapAngle(angle - reference);
+    azimuth_medians[col] = reference + Median(&samples);
+  }
+  // Unwrap across columns so that a scan crossing θ = ±π stays continuous.
+  int previous = -1;
+  for (int col = 0; col < cols; ++col) {
+    if (std::isnan(azimuth_medians[col])) continue;
+    if (previous >= 0) {
+      azimuth_medians[col] +=
+          kTwoPi * std::round((azimuth_medians[previous] - azimuth_medians[col]) / kTwoPi);
+    }
+    previous = col;
+  }
+  for (int row = 0; row < rows; ++row) {
+    elevation_counts[row] = static_cast<int>(row_elevations[row].size());
+    elevation_medians[row] = Median(&row_elevations[row]);
+  }
+
+  double azimuth_step = MedianStep(azimuth_medians);
+  double elevation_step = MedianStep(elevation_medians);
+  // With a single known line the other axis' resolution is the best guess (scanners step both axes alike).
+  if (std::isnan(azimuth_step) && !std::isnan(elevation_step)) azimuth_step = std::abs(elevation_step);
+  if (std::isnan(elevation_step) && !std::isnan(azimuth_step)) elevation_step = -std::abs(azimuth_step);
+
+  ScanGrid grid;
+  grid.azimuth_rad = FitAxis(azimuth_medians, azimuth_counts, azimuth_step);
+  grid.elevation_rad = FitAxis(elevation_medians, elevation_counts, elevation_step);
+  if (grid.azimuth_rad.empty() || grid.elevation_rad.empty()) return;  // no usable return: nothing to fit
+  grid.fitted = true;
+  scan->direction = DirectionsFromGrid(grid);
+
+  double sum_squares = 0, max_residual = 0;
+  int64_t count = 0;
+  for (int row = 0; row < rows; ++row) {
+    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+    const cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      if (!valid[col]) continue;
+      const cv::Vec3d p(point[col]), d(direction[col]);
+      const double angle = std::atan2(cv::norm(p.cross(d)), p.dot(d));
+      sum_squares += angle * angle;
+      max_residual = std::max(max_residual, angle);
+      ++count;
+    }
+  }
+  grid.rms_residual_rad = count > 0 ? std::sqrt(sum_squares / count) : 0.0;
+  grid.max_residual_rad = max_residual;
+  scan->grid = std::move(grid);
+}
+
+}  // namespace lidarshop
