@@ -1,0 +1,135 @@
+#include "lidarshop/io/ptx.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "lidarshop/io/io_test_util.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using testing_io::TempFolder;
+
+// A 2-column, 3-row scan; the pose translates by (1, 2, 3) and rotates 90° about z. Leica prints the
+// transpose: rotation columns first, "tx ty tz 1" last.
+const char kHeader[] =
+    "2\n3\n"
+    "1 2 3\n0 1 0\n-1 0 0\n0 0 1\n"
+    "0 1 0 0\n-1 0 0 0\n0 0 1 0\n1 2 3 1\n";
+
+std::string FourFieldScan() {
+  return std::string(kHeader) +
+         // column 0, bottom to top
+         "-0.1 1 -0.1 0.25\n-0.1 1 0 0.5\n0 0 0 0.5\n"
+         // column 1, bottom to top
+         "0.1 1 -0.1 0.75\n0.1 1 0 1\n0.1 1 0.1 0.125\n";
+}
+
+TEST(PtxTest, ReadsLayoutOrientationAndPose) {
+  const std::vector<Scan> scans = ParsePtx(FourFieldScan(), "test.ptx");
+  ASSERT_EQ(scans.size(), 1u);
+  const Scan& scan = scans[0];
+  EXPECT_EQ(scan.rows, 3);
+  EXPECT_EQ(scan.cols, 2);
+  EXPECT_EQ(scan.CountValid(), 5);
+  EXPECT_FALSE(scan.has_color());
+  // PTX row r (bottom to top) is image row rows - 1 - r: the first line of column 0 is the bottom-left cell.
+  EXPECT_EQ(scan.point.at<cv::Vec3f>(2, 0), cv::Vec3f(-0.1f, 1, -0.1f));
+  EXPECT_FLOAT_EQ(scan.intensity.at<float>(2, 0), 0.25f);
+  // The third line of column 0 is "0 0 0": no return at the top-left cell.
+  EXPECT_EQ(scan.valid.at<uint8_t>(0, 0), 0);
+  EXPECT_EQ(scan.point.at<cv::Vec3f>(0, 1), cv::Vec3f(0.1f, 1, 0.1f));
+  EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 1), 0.125f);
+  EXPECT_NEAR(scan.range.at<float>(1, 1), std::sqrt(1.01f), 1e-6);
+  // world_from_scanner is the transpose of what is printed.
+  Eigen::Matrix4d expected;
+  expected << 0, -1, 0, 1, 1, 0, 0, 2, 0, 0, 1, 3, 0, 0, 0, 1;
+  EXPECT_TRUE(scan.world_from_scanner.isApprox(expected)) << scan.world_from_scanner;
+  // Every cell has a direction, also the one without a return, pointing up-left.
+  ASSERT_TRUE(scan.grid.fitted);
+  const cv::Vec3f up_left = scan.direction.at<cv::Vec3f>(0, 0);
+  EXPECT_LT(up_left[0], 0);
+  EXPECT_GT(up_left[2], 0);
+  EXPECT_NEAR(cv::norm(up_left), 1.0, 1e-6);
+}
+
+TEST(PtxTest, WriteOfReadGivesTheSameContent) {
+  const std::string text = FourFieldScan();
+  const std::string written = FormatPtx(ParsePtx(text, "test.ptx"));
+  EXPECT_EQ(written, text);
+}
+
+TEST(PtxTest, SevenFieldsSeveralScansAndCrlf) {
+  std::string one = std::string(kHeader) +
+                    "-0.1 1 -0.1 0.25 10 20 30\n-0.1 1 0 0.5 40 50 60\n0 0 0 0.5 0 0 0\n"
+                    "0.1 1 -0.1 0.75 70 80 90\n0.1 1 0 1 100 110 120\n0.1 1 0.1 0.125 255 0 1\n";
+  std::string two =
+      "1\n2\n5 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n5 0 0 1\n"
+      "0 2.5 -1 0.5 1 2 3\n0 2.5 1 0.5 4 5 6\n";
+  const std::string text = one + two;
+  std::string crlf;
+  for (char c : text) {
+    if (c == '\n') crlf += '\r';
+    crlf += c;
+  }
+  const std::vector<Scan> scans = ParsePtx(crlf, "test.ptx");
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_TRUE(scans[0].has_color());
+  EXPECT_EQ(scans[0].color.at<cv::Vec3b>(2, 0), cv::Vec3b(10, 20, 30));
+  EXPECT_EQ(scans[0].color.at<cv::Vec3b>(0, 1), cv::Vec3b(255, 0, 1));
+  EXPECT_EQ(scans[1].rows, 2);
+  EXPECT_EQ(scans[1].cols, 1);
+  EXPECT_DOUBLE_EQ(scans[1].world_from_scanner(0, 3), 5.0);
+  EXPECT_EQ(scans[1].point.at<cv::Vec3f>(0, 0), cv::Vec3f(0, 2.5f, 1));  // top = the last line of the column
+  // Written back (LF endings), the content is the same.
+  EXPECT_EQ(FormatPtx(scans), text);
+}
+
+TEST(PtxTest, FileRoundTripThroughScanIo) {
+  TempFolder folder;
+  const std::string path = folder.File("scan.ptx");
+  const std::vector<Scan> scans = ParsePtx(FourFieldScan(), "test.ptx");
+  WriteScanFile(path, scans);
+  const ScanFile file = ReadScanFile(path);
+  EXPECT_EQ(file.format, "ptx");
+  ASSERT_EQ(file.scans.size(), 1u);
+  EXPECT_EQ(cv::norm(file.scans[0].point, scans[0].point, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(file.scans[0].valid, scans[0].valid, cv::NORM_INF), 0.0);
+  EXPECT_EQ(testing_io::ReadText(path), FourFieldScan());
+}
+
+TEST(PtxTest, ShortestFloatsRoundTripExactly) {
+  Scan scan = MakeScan(2, 2);
+  const float values[] = {1.0f / 3.0f, 123456.789f, -1e-5f, 7.0f};
+  for (int i = 0; i < 4; ++i) {
+    scan.valid.at<uint8_t>(i / 2, i % 2) = kValid;
+    scan.point.at<cv::Vec3f>(i / 2, i % 2) = cv::Vec3f(values[i], 1.0f, -values[i]);
+    scan.intensity.at<float>(i / 2, i % 2) = 0.1f * i;
+  }
+  scan.world_from_scanner(0, 3) = 1.0 / 7.0;
+  const Scan back = ParsePtx(FormatPtx({scan}), "mem.ptx")[0];
+  EXPECT_EQ(cv::norm(back.point, scan.point, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(back.intensity, scan.intensity, cv::NORM_INF), 0.0);
+  EXPECT_EQ(back.world_from_scanner(0, 3), 1.0 / 7.0);
+}
+
+TEST(PtxTest, UsualMatrixLayoutIsRecognised) {
+  std::string text =
+      "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+      "1 0 0 4\n0 1 0 5\n0 0 1 6\n0 0 0 1\n"
+      "0 1 0 0.5\n";
+  const Scan scan = ParsePtx(text, "usual.ptx")[0];
+  EXPECT_TRUE((scan.world_from_scanner.topRightCorner<3, 1>() == Eigen::Vector3d(4, 5, 6)));
+}
+
+TEST(PtxTest, ErrorsNameLineAndField) {
+  std::string text = FourFieldScan();
+  text.replace(text.find("0.1 1 0 1"), 9, "0.1 x 0 1");
+  EXPECT_THAT([&] { ParsePtx(text, "bad.ptx"); }, testing::ThrowsMessage<InputError>(testing::HasSubstr(
+                                                      "bad.ptx: line 15: field 'y': not a number: 'x'")));
+}
+
+}  // namespace
+}  // namespace lidarshop
