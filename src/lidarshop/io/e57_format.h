@@ -26,6 +26,10 @@ constexpr uint64_t kHeaderSize = 48;
 constexpr uint64_t kMaxPacketSize = 65536;  // logical bytes per packet (16-bit length minus one)
 constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a corrupt file
 
+// The largest record count or grid (cells) a file may claim; kMaxScanCells unless lowered (the fuzzer does,
+// to keep its memory bounded). Not thread-safe to change while reading.
+extern int64_t g_max_cells;
+
 // CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing-by-8.
 uint32_t Crc32c(const uint8_t* data, size_t size);
 

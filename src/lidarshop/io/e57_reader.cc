@@ -368,6 +368,7 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
   const std::string stream_where = fmt::format("{}: {}", ctx.path, ElementPath(points));
   std::vector<double> buffer;
   auto decode = [&](const Field* f) -> const std::vector<double>& {
+    LIDARSHOP_CHECK(f != nullptr);
     buffer.resize(record_count);
     const auto& s = streams[f - fields.data()];
     DecodeField(*f, s.data(), s.size(), record_count, buffer.data(), stream_where);
@@ -437,7 +438,7 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
 
   // Geometry: decode the three coordinates into floats.
   std::vector<float> xyz(3 * record_count);
-  {
+  if (record_count > 0) {  // cartesian || spherical (checked above)
     const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
     if (!cartesian)
       names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";

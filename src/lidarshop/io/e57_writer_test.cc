@@ -1,6 +1,7 @@
 // E57 writer round trips, the bit-pack codec, CRC-32C pages and hostile inputs.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -336,6 +337,27 @@ TEST(E57Reader, TruncatedAndFlippedFilesFailCleanly) {
     } catch (const InputError&) {
     }
   }
+}
+
+// Inputs the fuzzer (fuzz/run_e57_fuzz.sh) found crashing, stored as logical streams: each must now read or
+// fail with an InputError.
+TEST(E57Reader, FuzzRegressions) {
+  int files = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(LIDARSHOP_SOURCE_DIR "/data/fuzz_regressions")) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("e57_", 0) != 0) continue;
+    SCOPED_TRACE(name);
+    std::ifstream in(entry.path(), std::ios::binary);
+    const std::vector<uint8_t> logical((std::istreambuf_iterator<char>(in)),
+                                       std::istreambuf_iterator<char>());
+    try {
+      ReadE57Bytes(e57::PagesFromLogical(logical), name);
+    } catch (const InputError&) {
+    }
+    ++files;
+  }
+  EXPECT_GE(files, 1);
 }
 
 }  // namespace
