@@ -66,12 +66,17 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
   ReadHeaderLine<3>(cursor, "scanner y axis", axes[1]);
   ReadHeaderLine<3>(cursor, "scanner z axis", axes[2]);
   for (int i = 0; i < 4; ++i) {
-    ReadHeaderLine<4>(cursor,
-                      i == 0   ? "matrix row 1"
-                      : i == 1 ? "matrix row 2"
-                      : i == 2 ? "matrix row 3"
-                               : "matrix row 4",
-                      printed[i]);
+    static const char* kRows[] = {"matrix row 1", "matrix row 2", "matrix row 3", "matrix row 4"};
+    ReadHeaderLine<4>(cursor, kRows[i], printed[i]);
+  }
+  // Every point line takes at least 7 characters ("0 0 0 0") and a line end: refuse a header that claims more
+  // lines than the rest of the file can hold before allocating the scan.
+  const int64_t remaining = cursor->remaining();
+  if (rows * cols * 8 - 1 > remaining) {
+    ThrowInputError(
+        cursor->file(), fmt::format("line {}: {}", header_line, place), "size",
+        fmt::format("truncated: {} rows x {} columns need at least {} bytes of point lines, {} follow", rows,
+                    cols, rows * cols * 8 - 1, remaining));
   }
   Eigen::Matrix4d matrix;
   for (int r = 0; r < 4; ++r) {

@@ -40,6 +40,7 @@ class TextCursor {
   bool AtEnd() const { return p_ >= end_; }
   int64_t line() const { return line_; }
   int64_t offset() const { return p_ - begin_; }
+  int64_t remaining() const { return end_ - p_; }
   const std::string& file() const { return file_; }
   const char* position() const { return p_; }
 
