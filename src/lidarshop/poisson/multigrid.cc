@@ -21,25 +21,37 @@ constexpr int64_t kRowGrain = 8;
 // Prolongation in one dimension: fine index f takes 3/4 of its own coarse cell and 1/4 of the nearer
 // neighbouring coarse cell (clamped to the grid, which gives 1 at the edge).
 struct Transfer1D {
-  std::vector<std::array<int, 2>> coarse_of_fine;     // per fine index
-  std::vector<std::array<double, 2>> weight_of_fine;  // per fine index
-  // The transpose: per coarse index, the fine indices and weights that prolong from it.
-  std::vector<std::vector<std::pair<int, double>>> fine_of_coarse;
+  std::vector<std::array<int, 2>> coarse_of_fine;    // per fine index
+  std::vector<std::array<float, 2>> weight_of_fine;  // per fine index
+  // The transpose: per coarse index, up to 4 fine indices and weights that prolong from it (unused entries
+  // have weight 0 and a valid index).
+  std::vector<std::array<int, 4>> fine_of_coarse;
+  std::vector<std::array<float, 4>> fine_weight_of_coarse;
 };
 
 Transfer1D MakeTransfer(int fine_count, int coarse_count) {
   Transfer1D t;
   t.coarse_of_fine.resize(fine_count);
   t.weight_of_fine.resize(fine_count);
-  t.fine_of_coarse.resize(coarse_count);
+  std::vector<std::vector<std::pair<int, double>>> transpose(coarse_count);
   for (int f = 0; f < fine_count; ++f) {
     const int own = f / 2;
     int other = (f % 2 == 0) ? own - 1 : own + 1;
     other = std::clamp(other, 0, coarse_count - 1);
     t.coarse_of_fine[f] = {own, other};
-    t.weight_of_fine[f] = {0.75, 0.25};
-    t.fine_of_coarse[own].push_back({f, 0.75});
-    t.fine_of_coarse[other].push_back({f, 0.25});
+    t.weight_of_fine[f] = {0.75f, 0.25f};
+    transpose[own].push_back({f, 0.75});
+    transpose[other].push_back({f, 0.25});
+  }
+  t.fine_of_coarse.resize(coarse_count);
+  t.fine_weight_of_coarse.resize(coarse_count);
+  for (int c = 0; c < coarse_count; ++c) {
+    LIDARSHOP_CHECK(transpose[c].size() <= 4);
+    for (int k = 0; k < 4; ++k) {
+      const bool used = k < static_cast<int>(transpose[c].size());
+      t.fine_of_coarse[c][k] = used ? transpose[c][k].first : transpose[c][0].first;
+      t.fine_weight_of_coarse[c][k] = used ? static_cast<float>(transpose[c][k].second) : 0.0f;
+    }
   }
   return t;
 }
@@ -50,8 +62,7 @@ struct MaskedMultigrid::Level {
   int rows = 0, cols = 0;
   int64_t stride = 0;  // cols + 2 (a ring of outside cells around the grid)
   std::vector<uint8_t> type;
-  std::vector<double> diag;      // in-image neighbour count of unknown cells
-  std::vector<double> inv_diag;  // 1 / diag, 0 elsewhere
+  std::vector<uint8_t> degree;  // in-image neighbour count of unknown cells (the diagonal of A), 0 elsewhere
   // Unknown columns per row and colour ((y + x) % 2): columns of row y, colour c are
   // columns[c][row_begin[c][y] .. row_begin[c][y + 1]).
   std::array<std::vector<int32_t>, 2> columns;
@@ -65,8 +76,7 @@ struct MaskedMultigrid::Level {
 
   void Finish() {
     stride = cols + 2;
-    diag.assign(Size(), 0.0);
-    inv_diag.assign(Size(), 0.0);
+    degree.assign(Size(), 0);
     num_unknowns = 0;
     for (int c = 0; c < 2; ++c) {
       columns[c].clear();
@@ -77,10 +87,8 @@ struct MaskedMultigrid::Level {
       for (int x = 0; x < cols; ++x) {
         const int64_t i = Index(y, x);
         if (type[i] != kUnknown) continue;
-        const int degree = (type[i - 1] != kOutside) + (type[i + 1] != kOutside) +
-                           (type[i - stride] != kOutside) + (type[i + stride] != kOutside);
-        diag[i] = degree;
-        inv_diag[i] = degree > 0 ? 1.0 / degree : 0.0;
+        degree[i] = static_cast<uint8_t>((type[i - 1] != kOutside) + (type[i + 1] != kOutside) +
+                                         (type[i - stride] != kOutside) + (type[i + stride] != kOutside));
         columns[(y + x) % 2].push_back(x);
         ++num_unknowns;
       }
@@ -98,158 +106,103 @@ namespace {
 
 using Level = MaskedMultigrid::Level;
 
-// One Gauss–Seidel half sweep over the cells of one colour: x = (b + sum of neighbours) / diag.
-void Sweep(const Level& level, int colour, const double* b, double* x) {
-  const int64_t stride = level.stride;
+// 1 / degree (a cell with no in-image neighbour cannot be unknown in a valid system, its entry is unused).
+constexpr float kInverseDegree[5] = {0.0f, 1.0f, 0.5f, 1.0f / 3.0f, 0.25f};
+
+// Calls op(row_base, columns, count) for every row of a level and colour(s), rows in parallel.
+template <typename Op>
+void ForRows(const Level& level, int first_colour, int last_colour, Op op) {
   ParallelForRange(
       level.rows,
       [&](int64_t y_begin, int64_t y_end) {
         for (int64_t y = y_begin; y < y_end; ++y) {
-          const int32_t* cols = level.columns[colour].data();  // colour = (y + x) % 2
-          const int64_t row_base = (y + 1) * stride + 1;
-          for (int64_t k = level.row_begin[colour][y]; k < level.row_begin[colour][y + 1]; ++k) {
-            const int64_t i = row_base + cols[k];
-            x[i] = (b[i] + x[i - 1] + x[i + 1] + x[i - stride] + x[i + stride]) * level.inv_diag[i];
+          const int64_t row_base = (y + 1) * level.stride + 1;
+          for (int colour = first_colour; colour <= last_colour; ++colour) {
+            const int64_t begin = level.row_begin[colour][y];
+            op(y, row_base, level.columns[colour].data() + begin, level.row_begin[colour][y + 1] - begin);
           }
         }
       },
       kRowGrain);
 }
 
-// r = b − A x on unknown cells (other cells of r are left at 0).
-void Residual(const Level& level, const double* b, const double* x, double* r) {
+// One Gauss–Seidel half sweep over the cells of one colour ((y + x) % 2): x = (b + sum of neighbours) /
+// degree. Cells of one colour only read cells of the other, so rows run in parallel and the result is
+// order-free.
+void Sweep(const Level& level, int colour, const float* b, float* x) {
   const int64_t stride = level.stride;
-  ParallelForRange(
-      level.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const int64_t row_base = (y + 1) * stride + 1;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = level.columns[colour].data();
-            for (int64_t k = level.row_begin[colour][y]; k < level.row_begin[colour][y + 1]; ++k) {
-              const int64_t i = row_base + cols[k];
-              r[i] = b[i] - (level.diag[i] * x[i] - x[i - 1] - x[i + 1] - x[i - stride] - x[i + stride]);
-            }
-          }
-        }
-      },
-      kRowGrain);
+  const uint8_t* degree = level.degree.data();
+  ForRows(level, colour, colour, [&](int64_t, int64_t row_base, const int32_t* cols, int64_t count) {
+    for (int64_t k = 0; k < count; ++k) {
+      const int64_t i = row_base + cols[k];
+      x[i] = (b[i] + x[i - 1] + x[i + 1] + x[i - stride] + x[i + stride]) * kInverseDegree[degree[i]];
+    }
+  });
 }
 
-// q = A p on unknown cells.
-void Apply(const Level& level, const double* p, double* q) {
+// r = b − A x on unknown cells (other cells of r stay 0).
+void Residual(const Level& level, const float* b, const float* x, float* r) {
   const int64_t stride = level.stride;
-  ParallelForRange(
-      level.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const int64_t row_base = (y + 1) * stride + 1;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = level.columns[colour].data();
-            for (int64_t k = level.row_begin[colour][y]; k < level.row_begin[colour][y + 1]; ++k) {
-              const int64_t i = row_base + cols[k];
-              q[i] = level.diag[i] * p[i] - p[i - 1] - p[i + 1] - p[i - stride] - p[i + stride];
-            }
-          }
-        }
-      },
-      kRowGrain);
+  const uint8_t* degree = level.degree.data();
+  ForRows(level, 0, 1, [&](int64_t, int64_t row_base, const int32_t* cols, int64_t count) {
+    for (int64_t k = 0; k < count; ++k) {
+      const int64_t i = row_base + cols[k];
+      r[i] = b[i] - (degree[i] * x[i] - x[i - 1] - x[i + 1] - x[i - stride] - x[i + stride]);
+    }
+  });
 }
 
 // coarse_b = P^T fine_r on the unknown cells of the coarse level.
-void Restrict(const Level& fine, const Level& coarse, const double* fine_r, double* coarse_b) {
-  ParallelForRange(
-      coarse.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const int64_t row_base = (y + 1) * coarse.stride + 1;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = coarse.columns[colour].data();
-            for (int64_t k = coarse.row_begin[colour][y]; k < coarse.row_begin[colour][y + 1]; ++k) {
-              const int x = cols[k];
-              double sum = 0.0;
-              for (const auto& [fy, wy] : fine.transfer_y.fine_of_coarse[y]) {
-                const double* fine_row = fine_r + (fy + 1) * fine.stride + 1;
-                double row_sum = 0.0;
-                for (const auto& [fx, wx] : fine.transfer_x.fine_of_coarse[x]) row_sum += wx * fine_row[fx];
-                sum += wy * row_sum;
-              }
-              coarse_b[row_base + x] = sum;
-            }
-          }
-        }
-      },
-      kRowGrain);
+void Restrict(const Level& fine, const Level& coarse, const float* fine_r, float* coarse_b) {
+  ForRows(coarse, 0, 1, [&](int64_t y, int64_t row_base, const int32_t* cols, int64_t count) {
+    const auto& fy = fine.transfer_y.fine_of_coarse[y];
+    const auto& wy = fine.transfer_y.fine_weight_of_coarse[y];
+    const float* rows[4];
+    for (int j = 0; j < 4; ++j) rows[j] = fine_r + (fy[j] + 1) * fine.stride + 1;
+    for (int64_t k = 0; k < count; ++k) {
+      const int x = cols[k];
+      const auto& fx = fine.transfer_x.fine_of_coarse[x];
+      const auto& wx = fine.transfer_x.fine_weight_of_coarse[x];
+      float sum = 0.0f;
+      for (int j = 0; j < 4; ++j) {
+        sum += wy[j] * (wx[0] * rows[j][fx[0]] + wx[1] * rows[j][fx[1]] + wx[2] * rows[j][fx[2]] +
+                        wx[3] * rows[j][fx[3]]);
+      }
+      coarse_b[row_base + x] = sum;
+    }
+  });
 }
 
 // fine_x += P coarse_x on the unknown cells of the fine level.
-void ProlongAdd(const Level& fine, const Level& coarse, const double* coarse_x, double* fine_x) {
-  ParallelForRange(
-      fine.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const auto& cy = fine.transfer_y.coarse_of_fine[y];
-          const auto& wy = fine.transfer_y.weight_of_fine[y];
-          const double* row0 = coarse_x + (cy[0] + 1) * coarse.stride + 1;
-          const double* row1 = coarse_x + (cy[1] + 1) * coarse.stride + 1;
-          const int64_t row_base = (y + 1) * fine.stride + 1;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = fine.columns[colour].data();
-            for (int64_t k = fine.row_begin[colour][y]; k < fine.row_begin[colour][y + 1]; ++k) {
-              const int x = cols[k];
-              const auto& cx = fine.transfer_x.coarse_of_fine[x];
-              const auto& wx = fine.transfer_x.weight_of_fine[x];
-              fine_x[row_base + x] += wy[0] * (wx[0] * row0[cx[0]] + wx[1] * row0[cx[1]]) +
-                                      wy[1] * (wx[0] * row1[cx[0]] + wx[1] * row1[cx[1]]);
-            }
-          }
-        }
-      },
-      kRowGrain);
+void ProlongAdd(const Level& fine, const Level& coarse, const float* coarse_x, float* fine_x) {
+  ForRows(fine, 0, 1, [&](int64_t y, int64_t row_base, const int32_t* cols, int64_t count) {
+    const auto& cy = fine.transfer_y.coarse_of_fine[y];
+    const auto& wy = fine.transfer_y.weight_of_fine[y];
+    const float* row0 = coarse_x + (cy[0] + 1) * coarse.stride + 1;
+    const float* row1 = coarse_x + (cy[1] + 1) * coarse.stride + 1;
+    for (int64_t k = 0; k < count; ++k) {
+      const int x = cols[k];
+      const auto& cx = fine.transfer_x.coarse_of_fine[x];
+      const auto& wx = fine.transfer_x.weight_of_fine[x];
+      fine_x[row_base + x] += wy[0] * (wx[0] * row0[cx[0]] + wx[1] * row0[cx[1]]) +
+                              wy[1] * (wx[0] * row1[cx[0]] + wx[1] * row1[cx[1]]);
+    }
+  });
 }
 
-// Deterministic dot product over a level's unknown cells: per-row partials summed in row order.
-double Dot(const Level& level, const double* a, const double* b) {
+// Runs op(i) on every unknown cell of a level and returns the sum of its results; per-row partial sums are
+// added in row order, so the total does not depend on the thread count.
+template <typename Op>
+double SumOverUnknowns(const Level& level, Op op) {
   std::vector<double> partial(level.rows, 0.0);
-  ParallelForRange(
-      level.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const int64_t row_base = (y + 1) * level.stride + 1;
-          double sum = 0.0;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = level.columns[colour].data();
-            for (int64_t k = level.row_begin[colour][y]; k < level.row_begin[colour][y + 1]; ++k) {
-              const int64_t i = row_base + cols[k];
-              sum += a[i] * b[i];
-            }
-          }
-          partial[y] = sum;
-        }
-      },
-      kRowGrain);
+  ForRows(level, 0, 1, [&](int64_t y, int64_t row_base, const int32_t* cols, int64_t count) {
+    double sum = 0.0;
+    for (int64_t k = 0; k < count; ++k) sum += op(row_base + cols[k]);
+    partial[y] += sum;
+  });
   double total = 0.0;
   for (double value : partial) total += value;
   return total;
-}
-
-// y = a * x + y (axpy) or y = x + beta * y (when scale_y), on a level's unknown cells.
-template <typename Op>
-void ForUnknowns(const Level& level, Op op) {
-  ParallelForRange(
-      level.rows,
-      [&](int64_t y_begin, int64_t y_end) {
-        for (int64_t y = y_begin; y < y_end; ++y) {
-          const int64_t row_base = (y + 1) * level.stride + 1;
-          for (int colour = 0; colour < 2; ++colour) {
-            const int32_t* cols = level.columns[colour].data();
-            for (int64_t k = level.row_begin[colour][y]; k < level.row_begin[colour][y + 1]; ++k) {
-              op(row_base + cols[k]);
-            }
-          }
-        }
-      },
-      kRowGrain);
 }
 
 }  // namespace
@@ -326,7 +279,7 @@ MaskedMultigrid::MaskedMultigrid(const cv::Mat& mask, const PoissonOptions& opti
   std::vector<Eigen::Triplet<double>> triplets;
   for (size_t k = 0; k < coarsest_->cells.size(); ++k) {
     const int64_t i = coarsest_->cells[k];
-    triplets.emplace_back(k, k, last.diag[i]);
+    triplets.emplace_back(k, k, static_cast<double>(last.degree[i]));
     for (int64_t n : {i - 1, i + 1, i - last.stride, i + last.stride}) {
       if (compact[n] >= 0) triplets.emplace_back(k, compact[n], -1.0);
     }
@@ -347,27 +300,35 @@ MultigridStats MaskedMultigrid::Solve(const std::vector<double>& b_compact,
   LIDARSHOP_CHECK(b_compact.size() == compact_to_grid_.size());
   const int num_levels = NumLevels();
   const Level& fine = *levels_[0];
-  // Work arrays: per level x, b, r (level 0's b and x are the CG residual and preconditioned residual).
-  std::vector<std::vector<double>> xs(num_levels), bs(num_levels), rs(num_levels);
+  const int64_t stride = fine.stride;
+  const uint8_t* degree = fine.degree.data();
+  // The V-cycle runs in single precision (it only preconditions); CG runs in double.
+  std::vector<std::vector<float>> xs(num_levels), bs(num_levels), rs(num_levels);
   for (int l = 0; l < num_levels; ++l) {
-    xs[l].assign(levels_[l]->Size(), 0.0);
-    bs[l].assign(levels_[l]->Size(), 0.0);
-    rs[l].assign(levels_[l]->Size(), 0.0);
+    xs[l].assign(levels_[l]->Size(), 0.0f);
+    bs[l].assign(levels_[l]->Size(), 0.0f);
+    rs[l].assign(levels_[l]->Size(), 0.0f);
   }
-  std::vector<double> x(fine.Size(), 0.0), r(fine.Size(), 0.0), p(fine.Size(), 0.0), q(fine.Size(), 0.0);
+  std::vector<double> x(fine.Size(), 0.0), r(fine.Size(), 0.0), z(fine.Size(), 0.0), p(fine.Size(), 0.0),
+      q(fine.Size(), 0.0);
 
   Eigen::VectorXd coarse_b(static_cast<Eigen::Index>(coarsest_->cells.size()));
   const int sweeps = options_.smoothing_sweeps;
-  // z = V-cycle(r): writes xs[0].
-  auto v_cycle = [&](const double* residual) {
-    std::copy(residual, residual + fine.Size(), bs[0].begin());
+  // z = V-cycle(r); returns r · z.
+  auto v_cycle = [&]() {
+    ForRows(fine, 0, 1, [&](int64_t, int64_t row_base, const int32_t* cols, int64_t count) {
+      for (int64_t k = 0; k < count; ++k)
+        bs[0][row_base + cols[k]] = static_cast<float>(r[row_base + cols[k]]);
+    });
     for (int l = 0; l < num_levels; ++l) {
       const Level& level = *levels_[l];
-      std::fill(xs[l].begin(), xs[l].end(), 0.0);
+      std::fill(xs[l].begin(), xs[l].end(), 0.0f);
       if (l == num_levels - 1) {
         for (size_t k = 0; k < coarsest_->cells.size(); ++k) coarse_b[k] = bs[l][coarsest_->cells[k]];
         const Eigen::VectorXd solution = coarsest_->factorization.solve(coarse_b);
-        for (size_t k = 0; k < coarsest_->cells.size(); ++k) xs[l][coarsest_->cells[k]] = solution[k];
+        for (size_t k = 0; k < coarsest_->cells.size(); ++k) {
+          xs[l][coarsest_->cells[k]] = static_cast<float>(solution[k]);
+        }
         break;
       }
       for (int s = 0; s < sweeps; ++s) {
@@ -385,39 +346,48 @@ MultigridStats MaskedMultigrid::Solve(const std::vector<double>& b_compact,
         Sweep(level, 0, bs[l].data(), xs[l].data());
       }
     }
+    return SumOverUnknowns(fine, [&](int64_t i) {
+      z[i] = xs[0][i];
+      return r[i] * z[i];
+    });
   };
 
   for (size_t k = 0; k < compact_to_grid_.size(); ++k) r[compact_to_grid_[k]] = b_compact[k];
   MultigridStats stats;
-  const double b_norm = std::sqrt(Dot(fine, r.data(), r.data()));
+  const double b_norm = std::sqrt(SumOverUnknowns(fine, [&](int64_t i) { return r[i] * r[i]; }));
   x_compact.assign(compact_to_grid_.size(), 0.0);
   if (b_norm == 0.0) {
     stats.converged = true;
     return stats;
   }
-  v_cycle(r.data());
-  std::vector<double>& z = xs[0];
-  std::copy(z.begin(), z.end(), p.begin());
-  double rz = Dot(fine, r.data(), z.data());
+  double rz = v_cycle();
+  p = z;
   double r_norm = b_norm;
   for (int iteration = 1; iteration <= options_.max_iterations; ++iteration) {
-    Apply(fine, p.data(), q.data());
-    const double alpha = rz / Dot(fine, p.data(), q.data());
-    ForUnknowns(fine, [&](int64_t i) {
+    // q = A p and p · q in one pass.
+    const double pq = SumOverUnknowns(fine, [&](int64_t i) {
+      q[i] = degree[i] * p[i] - p[i - 1] - p[i + 1] - p[i - stride] - p[i + stride];
+      return p[i] * q[i];
+    });
+    const double alpha = rz / pq;
+    // x += alpha p, r −= alpha q and r · r in one pass.
+    r_norm = std::sqrt(SumOverUnknowns(fine, [&](int64_t i) {
       x[i] += alpha * p[i];
       r[i] -= alpha * q[i];
-    });
-    r_norm = std::sqrt(Dot(fine, r.data(), r.data()));
+      return r[i] * r[i];
+    }));
     stats.iterations = iteration;
     if (r_norm <= options_.tolerance * b_norm) {
       stats.converged = true;
       break;
     }
-    v_cycle(r.data());
-    const double rz_new = Dot(fine, r.data(), z.data());
+    const double rz_new = v_cycle();
     const double beta = rz_new / rz;
     rz = rz_new;
-    ForUnknowns(fine, [&](int64_t i) { p[i] = z[i] + beta * p[i]; });
+    SumOverUnknowns(fine, [&](int64_t i) {
+      p[i] = z[i] + beta * p[i];
+      return 0.0;
+    });
   }
   stats.relative_residual = r_norm / b_norm;
   for (size_t k = 0; k < compact_to_grid_.size(); ++k) x_compact[k] = x[compact_to_grid_[k]];

@@ -391,16 +391,46 @@ cv::Mat CloneDivergence(const cv::Mat& source_in, const cv::Mat& source_mask, cv
 
 PoissonResult SeamlessClone(const cv::Mat& source, const cv::Mat& source_mask, const cv::Mat& target,
                             cv::Point offset, const PoissonOptions& options) {
+  options.Check();
   if (target.empty()) throw InputError("SeamlessClone: empty target image");
+  if (source.empty()) throw InputError("SeamlessClone: empty source image");
   if (source.channels() != target.channels()) {
     throw InputError(fmt::format("SeamlessClone: source has {} channel(s), target {}", source.channels(),
                                  target.channels()));
   }
-  const cv::Mat divergence = CloneDivergence(source, source_mask, target.size(), offset);
-  const PoissonSystem system = PreparePoisson(CloneMaskInTarget(source_mask, target.size(), offset), options);
-  cv::Mat boundary;
-  target.convertTo(boundary, divergence.depth());
-  return SolvePoisson(system, boundary, divergence);
+  if (source_mask.size() != source.size()) {
+    throw InputError(fmt::format("SeamlessClone: mask is {}x{}, the source is {}x{}", source_mask.cols,
+                                 source_mask.rows, source.cols, source.rows));
+  }
+  const int depth = (source.depth() == CV_64F || target.depth() == CV_64F) ? CV_64F : CV_32F;
+  // Only the pasted region and its 1-pixel ring matter, so the work is done on that window of the target
+  // (cost follows the region, not the images); the solution is the same as on the whole target, because the
+  // window is cut by the target's border only where the target itself ends.
+  const cv::Mat target_mask_check =
+      CloneMaskInTarget(source_mask, target.size(), offset);  // validates placement
+  const cv::Rect region = cv::boundingRect(target_mask_check);
+  PoissonResult result;
+  cv::Mat output;
+  target.convertTo(output, depth);
+  if (region.area() == 0) {
+    result.image = output;
+    result.channels = output.channels();
+    return result;
+  }
+  const cv::Rect window = cv::Rect(region.x - 1, region.y - 1, region.width + 2, region.height + 2) &
+                          cv::Rect(cv::Point(), target.size());
+  const cv::Rect window_in_source = (window - offset) & cv::Rect(cv::Point(), source.size());
+  cv::Mat source_window;
+  source(window_in_source).convertTo(source_window, depth);
+  const cv::Mat window_mask = target_mask_check(window);
+  cv::Mat divergence = cv::Mat::zeros(window.size(), CV_MAKETYPE(depth, source.channels()));
+  const cv::Rect placed(window_in_source.tl() + offset - window.tl(), window_in_source.size());
+  Laplacian5(source_window).copyTo(divergence(placed), window_mask(placed));
+  const PoissonSystem system = PreparePoisson(window_mask, options);
+  result = SolvePoisson(system, output(window), divergence);
+  result.image.copyTo(output(window));
+  result.image = output;
+  return result;
 }
 
 }  // namespace lidarshop

@@ -245,6 +245,25 @@ TEST(PoissonTest, SeamlessCloneOfAShiftedBrighterCopyReturnsTheTarget) {
   EXPECT_THROW(SeamlessClone(source, source_mask, target, cv::Point(60, 9), Direct()), InputError);
 }
 
+TEST(PoissonTest, SeamlessCloneOnItsWindowEqualsTheWholeTargetSolve) {
+  const cv::Mat target = RandomImage(50, 70, 2, 10);
+  const cv::Mat source = RandomImage(30, 40, 2, 11);
+  cv::Mat source_mask = cv::Mat::zeros(source.size(), CV_8U);
+  cv::circle(source_mask, cv::Point(15, 12), 9, 255, cv::FILLED);
+  source_mask.col(0).setTo(255);  // touches the source border
+  for (const cv::Point offset : {cv::Point(5, 7), cv::Point(30, 20), cv::Point(0, 0)}) {
+    const PoissonResult windowed = SeamlessClone(source, source_mask, target, offset, Direct());
+    const cv::Mat mask = CloneMaskInTarget(source_mask, target.size(), offset);
+    const PoissonResult whole = SolvePoisson(PreparePoisson(mask, Direct()), target,
+                                             CloneDivergence(source, source_mask, target.size(), offset));
+    EXPECT_LT(MaxAbsDiff(windowed.image, whole.image), 1e-9) << offset;
+    cv::Mat outside_diff;
+    cv::absdiff(windowed.image, target, outside_diff);
+    outside_diff.setTo(0.0, mask);
+    EXPECT_EQ(cv::norm(outside_diff, cv::NORM_INF), 0.0);  // untouched outside the region
+  }
+}
+
 TEST(PoissonTest, RejectsBadInput) {
   const cv::Mat image = RandomImage(10, 12, 1, 9);
   EXPECT_THROW(PreparePoisson(cv::Mat()), InputError);
