@@ -171,6 +171,20 @@ cv::Mat RgbdImage(const Scan& scan) {
 
 cv::Mat ValidMask(const Scan& scan) { return scan.valid.clone(); }
 
+cv::Mat LabelImage16(const Scan& scan) {
+  if (scan.label.empty()) throw std::logic_error("LabelImage16: the scan has no label channel");
+  cv::Mat labels(scan.rows, scan.cols, CV_16U, cv::Scalar(kNoReturnLabel16));
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      const int32_t label = scan.label.at<int32_t>(row, col);
+      if (scan.valid.at<uint8_t>(row, col) && label >= 0 && label < kNoReturnLabel16) {
+        labels.at<uint16_t>(row, col) = static_cast<uint16_t>(label);
+      }
+    }
+  }
+  return labels;
+}
+
 Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synthesized) {
   CheckScan(scan);
   if (range.rows != scan.rows || range.cols != scan.cols || range.type() != CV_32F) {

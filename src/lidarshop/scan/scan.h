@@ -122,6 +122,11 @@ cv::Mat DepthImage(const Scan& scan);                       // CV_32F, y in the 
 cv::Mat RgbdImage(const Scan& scan);                        // CV_32FC4: R, G, B in [0,1], range in metres
 cv::Mat ValidMask(const Scan& scan);                        // CV_8U 255/0 (a copy of scan.valid)
 
+// The label image of the file convention (`--labels L.png`): CV_16U, pixel = the object's label, kNoReturnLabel16
+// where the ray returned nothing or the cell has no label. Throws std::logic_error when the scan has no labels.
+constexpr uint16_t kNoReturnLabel16 = 65535;
+cv::Mat LabelImage16(const Scan& scan);
+
 // Puts points back along the rays from a changed range image (CV_32F metres, 0 or NaN = no return). Cells that
 // were valid keep their measured ray (point / |point|); other cells use `direction`. Returns the new scan; all
 // other channels are copied. Cells listed in `mark_synthesized` (CV_8U, non-zero) get synthesized = 255.
