@@ -1,0 +1,212 @@
+// Verification of a hypothesized object pose against one or many registered scans: consistency, confidence
+// and the trimmed-ICP baseline (thesis chapter 4, eqs. 4.1–4.6).
+//
+// An object detector or a registration proposes "model M is here, in pose world_from_model". Two measures in
+// [0, 1] answer, independently of the method that produced the pose:
+//
+//  * Consistency (eqs. 4.1–4.3) — does the pose make physical sense? For every scene point j whose scanner
+//  ray meets
+//    the posed model, d_m = distance along the ray to the model's first hit, d_s = measured range, a =
+//    allowance:
+//        consistent_j = [(d_m + a) − d_s ≥ 0]            (the point lies in front of the model or on it)
+//        consistency  = Σ_scans Σ_j consistent_j / Σ_scans #comparable pairs
+//    A ray that returned from *behind* the model went through it: the model cannot be there. Rays without a
+//    return are not comparable (nothing was measured). With no comparable pair at all, consistency is NaN and
+//    `has_comparable_pairs` is false — never a silent 1.
+//
+//  * Confidence (eqs. 4.4–4.5) — how much of the model has been seen? Model point i carries information I_i
+//    (Σ I_i = 1; uniform 1/N, or weighted by shape distinctiveness), observed information O_i starts at 0,
+//    and every scene point j (of every scan: the points of all scans accumulate) within 3σ of model point i
+//    updates
+//        O_i ← min(I_i, O_i + I_i · exp(−d_ij² / 2σ²)),      confidence = Σ_i O_i.
+//    The update only adds and clamps, so O_i = I_i · min(1, Σ_j exp(−d_ij²/2σ²)) whatever the order of the
+//    points.
+//
+//  * Trimmed ICP cost (eq. 4.6, the baseline): mean distance from the scene points near the posed model
+//  (inside its
+//    bounding box grown by the trim distance) to their nearest model point, pairs beyond `icp_trim_m`
+//    excluded; the inlier fraction is the share of those scene points whose nearest model point is within the
+//    trim distance.
+//
+// Speed (build once, query many; libigl-style precompute/query split):
+//   VerifierModel model = PrepareModel(mesh_in_model, model_options);   // Embree scene + KD-tree, model
+//   frame std::vector<PreparedScan> scans = {PrepareScan(scan_a), PrepareScan(scan_b)}; VerifyResult result =
+//   VerifyPose(model, scans, world_from_model, options);
+// Per pose and scan, only the cells inside the model's angular footprint (its bounding box projected to
+// azimuth / elevation → a column set and a row window of the organized grid) are visited; their rays are
+// moved into the MODEL frame and cast against the model scene built once in its own frame, and their points
+// are looked up in the model-point KD-tree built once (so nothing is rebuilt per pose). VerifyPoses runs many
+// poses in parallel.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+
+#include "lidarshop/geometry/mesh.h"
+#include "lidarshop/pointset/kdtree.h"
+#include "lidarshop/raycast/raycast.h"
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+class Progress;
+
+// How the model points of the confidence measure are chosen.
+enum class ModelPointSource {
+  kSurfaceSamples,  // uniform over the surface area (default: independent of the triangulation)
+  kVertices,        // the mesh's vertices (the original work; biased towards finely triangulated parts)
+};
+
+// How the information I_i of the model points is distributed (it always sums to 1).
+enum class InformationWeighting {
+  kUniform,               // I_i = 1/N
+  kShapeDistinctiveness,  // I_i ∝ floor + surface variation (pointset/sampling.h) within
+                          // distinctiveness_radius_m
+};
+
+struct ModelOptions {
+  ModelPointSource point_source = ModelPointSource::kSurfaceSamples;
+  int64_t num_surface_samples =
+      10000;          // count; for kSurfaceSamples. ≈ 5 cm apart on a car (25 m²): keep the spacing ≲ σ
+  uint64_t seed = 1;  // seed of the surface sampling
+  InformationWeighting information = InformationWeighting::kUniform;
+  double distinctiveness_radius_m =
+      0.0;  // metres; neighbourhood of the surface variation; 0 = 3% of the bbox diagonal
+  double distinctiveness_floor = 0.02;  // unitless, added to every point's variation (flat parts still count)
+
+  void Check() const;  // throws OptionsError
+};
+
+// The model points within a kernel radius (3σ) of every voxel of a grid over the model's box: a scene point's
+// neighbours are one array lookup away instead of a tree descent (the confidence measure's hot loop). Each
+// voxel lists the points within radius + half its diagonal of its centre, so the exact distance test that
+// follows misses nothing. Built once by PrepareModel for VerifyOptions::sigma_m and icp_trim_m; VerifyPose
+// falls back to the KD-tree for other values (same results, slower). Covers the model's box grown by max(3σ,
+// trim).
+struct KernelNeighbourGrid {
+  float kernel_radius_m = 0.0f;  // 3σ it was built for; 0 = not built
+  float voxel_m = 0.0f;          // edge of a voxel, metres (σ, or larger to keep at most ~2 M voxels)
+  Eigen::Vector3f origin_in_model = Eigen::Vector3f::Zero();  // corner of voxel (0, 0, 0)
+  Eigen::Vector3i dims = Eigen::Vector3i::Zero();             // voxels along x, y, z
+  std::vector<uint32_t> offsets;  // #voxels + 1, CSR into `indices` (voxel = (z * dims.y + y) * dims.x + x)
+  std::vector<uint32_t> indices;  // model point indices
+  // The trimmed-ICP nearest neighbour the same way: every model point that can be the nearest one of some
+  // point of the voxel (within d_centre + 2 · half diagonal of its centre); empty for voxels farther than the
+  // trim distance.
+  float trim_m = 0.0f;                    // the icp_trim_m it was built for
+  std::vector<uint32_t> nearest_offsets;  // #voxels + 1
+  std::vector<uint32_t> nearest_indices;
+  bool built() const { return kernel_radius_m > 0; }
+};
+
+// The model side, built once (model frame = the mesh's own coordinates).
+struct VerifierModel {
+  TriangleMesh mesh_in_model;
+  RaycastScene scene_in_model;          // Embree scene of mesh_in_model, committed
+  Eigen::AlignedBox3f bounds_in_model;  // of the vertices
+  PointKdTree points_in_model;          // #N model points (the confidence measure's i), KD-tree built once
+  std::vector<float> information;       // #N I_i, Σ = 1
+  KernelNeighbourGrid kernel_grid;      // for the σ given to PrepareModel
+  double surface_area_m2 = 0.0;
+  size_t num_points() const { return information.size(); }
+};
+
+struct VerifyOptions;
+
+// Throws InputError for an empty mesh or one with no surface area. `verify_options.sigma_m` is the σ the
+// kernel grid is built for (VerifyPose with another σ is still exact, only slower).
+VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions& options,
+                           const VerifyOptions& verify_options);
+VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions& options = {});
+
+// The scene side, built once per scan: the scan (buffers shared, not copied), its pose, and its angular grid
+// (one azimuth per column, one elevation per image row) used to find a model's footprint.
+struct PreparedScan {
+  Scan scan;
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d scanner_from_world = Eigen::Matrix4d::Identity();
+  std::vector<double> column_azimuth_rad;  // #cols, from scan.grid when it matches, else from the directions
+  std::vector<double> row_elevation_rad;   // #rows
+  double azimuth_step_rad = 0.0;  // largest step between neighbouring columns / rows (footprint margin)
+  double elevation_step_rad = 0.0;
+  int64_t num_valid = 0;
+};
+
+// Throws InputError when the scan has no cells or no usable directions.
+PreparedScan PrepareScan(const Scan& scan);
+
+struct VerifyOptions {
+  double allowance_m = 0.10;  // a, metres (eq. 4.1). ≈ 2–3× range noise + model inaccuracy; 0.02 for a 30 cm
+                              // sculpture, 0.10 for cars
+  double sigma_m =
+      0.05;  // σ, metres (eq. 4.4). ≈ scan point spacing on the object; 0.005 for a 30 cm sculpture
+  double icp_trim_m = 0.20;             // metres: ICP pairs beyond this are excluded (eq. 4.6)
+  double footprint_margin_cells = 1.0;  // cells added around the model's angular footprint (noise, rounding)
+  bool keep_details = false;  // fill VerifyResult::scene_status and ::observed_information (for PLY output)
+
+  void Check() const;  // throws OptionsError
+};
+
+// The outcome for one scan alone (consistency and confidence as if it were the only scan).
+struct ScanVerifyStats {
+  int64_t comparable_pairs = 0;  // valid points whose ray meets the posed model
+  int64_t consistent_pairs = 0;  // of those, (d_m + a) − d_s ≥ 0
+  double consistency = std::numeric_limits<double>::quiet_NaN();  // NaN when comparable_pairs == 0
+  double confidence = 0.0;                                        // from this scan's points only
+  int64_t footprint_cells = 0;                                    // cells of the angular footprint visited
+  int64_t rays_cast = 0;  // rays cast against the model (valid cells whose ray meets its bounding box)
+};
+
+// Status of a scene point in VerifyResult::scene_status.
+enum SceneStatus : uint8_t { kNotComparable = 0, kConsistent = 1, kInconsistent = 2 };
+
+struct VerifyResult {
+  double consistency = std::numeric_limits<double>::quiet_NaN();  // [0, 1]; NaN when no comparable pair
+  bool has_comparable_pairs = false;
+  int64_t comparable_pairs = 0;
+  int64_t consistent_pairs = 0;
+  double confidence = 0.0;  // [0, 1], Σ O_i over the points of all scans
+  double icp_cost_m = std::numeric_limits<double>::quiet_NaN();  // NaN when no inlier pair
+  double inlier_fraction = 0.0;  // inliers / scene points near the model (0 when none near)
+  int64_t icp_inliers = 0;
+  int64_t icp_candidates = 0;  // scene points inside the model's bounding box grown by icp_trim_m
+  std::vector<ScanVerifyStats> per_scan;
+
+  // With VerifyOptions::keep_details:
+  std::vector<cv::Mat> scene_status;        // per scan, CV_8U rows x cols of SceneStatus
+  std::vector<float> observed_information;  // #N O_i (all scans)
+
+  // One line: "consistency 0.98 (1234 pairs), confidence 0.41, icp 0.012 m (inliers 0.93)".
+  std::string BriefReport() const;
+};
+
+// Verifies one pose. `world_from_model` may include a uniform scale; distances stay in scanner (world)
+// metres.
+VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan> scans,
+                        const Eigen::Matrix4d& world_from_model, const VerifyOptions& options = {});
+
+// Verifies many poses in parallel (each pose single-threaded; results do not depend on the thread count).
+std::vector<VerifyResult> VerifyPoses(const VerifierModel& model, std::span<const PreparedScan> scans,
+                                      std::span<const Eigen::Matrix4d> world_from_model,
+                                      const VerifyOptions& options = {}, Progress* progress = nullptr);
+
+// The scene points of every scan in the world frame, coloured by status (green consistent, red inconsistent,
+// grey not comparable); needs a result computed with keep_details.
+PointCloud SceneStatusCloud(std::span<const PreparedScan> scans, const VerifyResult& result);
+// The model points in the world frame coloured by O_i / I_i (red unseen → green seen); needs keep_details.
+PointCloud ObservedModelCloud(const VerifierModel& model, const Eigen::Matrix4d& world_from_model,
+                              const VerifyResult& result);
+
+// world_from_model of an object standing on the ground: translate (x, y, z), then yaw about +z (degrees, x→y
+// counter-clockwise), pitch about the model's x, roll about its y (R = Rz(yaw) * Rx(pitch) * Ry(roll)).
+Eigen::Matrix4d PoseFromXyzYaw(double x_m, double y_m, double z_m, double yaw_deg, double pitch_deg = 0.0,
+                               double roll_deg = 0.0);
+
+}  // namespace lidarshop
