@@ -56,7 +56,7 @@ int RunSegment(int argc, char** argv) {
       "scan's colours; default MASK_overlay.png next to the mask, --overlay none to skip).",
       "segment"};
   std::string scan_path, strokes_path, mask_path, object_path, rest_path, overlay_path, refine_path;
-  std::string method = "two-step", model = "histogram";
+  std::string method = "two-step", model = "gmm";
   int scan_index = 0;
   bool eight = false, quiet = false;
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();

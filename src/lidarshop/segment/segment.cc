@@ -218,7 +218,22 @@ NLinks ComputeNLinks(const Nodes& nodes, const CutWeights& w, bool eight_connect
   const double total = std::accumulate(row_sum.begin(), row_sum.end(), 0.0);
   const int64_t count = std::accumulate(row_count.begin(), row_count.end(), int64_t{0});
   const double mean = count > 0 ? total / count : 0.0;
-  links.sigma2 = std::max(1e-12, sigma_scale * sigma_scale * mean);
+  double typical = mean;
+  if (w.median_sigma && count > 0) {
+    // Median over a deterministic stride sample of at most ~200k n-links.
+    const int64_t stride = std::max<int64_t>(1, n / 100000);
+    std::vector<float> sample;
+    for (int64_t i = 0; i < n; i += stride) {
+      for (int d = 0; d < links.directions; ++d) {
+        if (links.weight[d][i] >= 0) sample.push_back(links.weight[d][i]);
+      }
+    }
+    if (!sample.empty()) {
+      std::nth_element(sample.begin(), sample.begin() + sample.size() / 2, sample.end());
+      typical = std::max(0.01 * mean, double(sample[sample.size() / 2]));
+    }
+  }
+  links.sigma2 = std::max(1e-12, sigma_scale * sigma_scale * typical);
   const float inv_two_sigma2 = static_cast<float>(1.0 / (2.0 * links.sigma2));
   // Pass 2: weights.
   ParallelForRange(

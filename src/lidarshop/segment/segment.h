@@ -70,24 +70,30 @@ struct CutWeights {
   double smoothness = 20.0;        // γ, the n-link weight relative to the data term
   double color_data_weight = 1.0;  // α_c in D_p = −α_c log P(rgb) − α_d log P(range)
   double depth_data_weight = 1.0;  // α_d
-  double foreground_bias =
-      0.0;  // nats added to the object cost of every non-stroke cell (> 0 = conservative)
+  // Nats added to the object cost of every non-stroke cell (> 0 = conservative).
+  double foreground_bias = 0.0;
+  // σ² from the median of the n-link ‖ΔI‖² (robust: slopes such as the ground seen at grazing angles count as
+  // edges) instead of the mean (GrabCut's β); floored at 1% of the mean.
+  bool median_sigma = false;
 
   void Check(const std::string& name) const;  // throws OptionsError naming `name`
 };
 
 struct SegmentOptions {
   SegmentMethod method = SegmentMethod::kTwoStep;
-  AppearanceModel model = AppearanceModel::kHistogram;
+  AppearanceModel model = AppearanceModel::kGmm;  // measured better than histograms (segment.md)
   bool eight_connected = false;  // 8-neighbour n-links (diagonals weighted 1/√2) instead of 4
   double sigma_scale = 1.0;      // σ² = sigma_scale² · mean n-link ‖ΔI‖² (dimensionless, > 0)
 
-  // Step 1 / the "depth" baseline: depth-dominant n-links, conservative data term.
-  CutWeights depth_step = {0.01, 0.01, 0.01, 1.0, 20.0, 1.0, 1.0, 1.0};
-  // Step 3 / the "color" baseline: colour-dominant n-links.
-  CutWeights color_step = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.05, 20.0, 1.0, 0.0, 0.0};
+  // Step 1 / the "depth" baseline: n-links on the range channel alone (λ_rgb = 0: after standardization over
+  // the image, neighbouring range differences are tiny next to colour texture, so any colour weight takes
+  // over), a weak colour data term that keeps the cut off ground of another colour, and a foreground bias
+  // that keeps it conservative. Tuned on data/segment_eval (bench/results/segment.md).
+  CutWeights depth_step = {0.0, 0.0, 0.0, 1.0, 50.0, 0.2, 0.5, 1.5, false};
+  // Step 3 / the "color" baseline: colour-dominant n-links, colour data term.
+  CutWeights color_step = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.05, 20.0, 1.0, 0.0, 0.0, false};
   // The "rgbd" baseline: one cut with the standardized default weights (eqs. 5.6–5.11).
-  CutWeights rgbd_step = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0, 20.0, 1.0, 1.0, 0.0};
+  CutWeights rgbd_step = {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 1.0, 20.0, 1.0, 1.0, 0.0, false};
 
   // Step 2, background inference.
   int ring_radius_cells = 4;  // dilation radius of the step-1 object, cells (>= 1)

@@ -1,0 +1,71 @@
+#include "lidarshop/segment/segment_eval.h"
+
+#include <random>
+
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/timer.h"
+
+namespace lidarshop {
+namespace {
+
+// A horizontal stroke of `length` centred on a random cell of `allowed`, clipped to `allowed`.
+void DrawRandomStroke(const cv::Mat& allowed, std::mt19937_64* rng, int length, int width, uint8_t value,
+                      cv::Mat* strokes) {
+  std::vector<cv::Point> cells;
+  cv::findNonZero(allowed, cells);
+  if (cells.empty()) ThrowInputError("evaluation strokes", "", "", "no room for a stroke");
+  const cv::Point c = cells[std::uniform_int_distribution<size_t>(0, cells.size() - 1)(*rng)];
+  cv::Mat line(allowed.size(), CV_8U, cv::Scalar(0));
+  cv::line(line, c - cv::Point(length / 2, 0), c + cv::Point(length / 2, 0), cv::Scalar(255), width);
+  strokes->setTo(value, line & allowed);
+}
+
+}  // namespace
+
+cv::Mat MakeEvalStrokes(const cv::Mat& truth, const cv::Mat& valid, uint64_t seed,
+                        const EvalStrokeOptions& o) {
+  LIDARSHOP_CHECK(truth.type() == CV_8U && valid.type() == CV_8U && truth.size() == valid.size());
+  std::mt19937_64 rng(seed);
+  cv::Mat object = (truth != 0) & (valid != 0), eroded;
+  const int k = 2 * o.object_erosion_cells + 1;
+  // Cells without a return count as outside the object, so the stroke stays clear of holes and edges.
+  cv::erode(object, eroded, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(k, k)), cv::Point(-1, -1), 1,
+            cv::BORDER_CONSTANT, cv::Scalar(0));
+  if (cv::countNonZero(eroded) == 0) eroded = object;  // thin objects: any object cell
+  cv::Mat near_object;
+  const int m = 2 * o.background_margin_cells + 1;
+  cv::dilate(object, near_object, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(m, m)));
+  const cv::Mat background = (valid != 0) & (near_object == 0);
+  cv::Mat strokes(truth.size(), CV_8U, cv::Scalar(kStrokeNone));
+  DrawRandomStroke(eroded, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeObject, &strokes);
+  DrawRandomStroke(background, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeBackground,
+                   &strokes);
+  return strokes;
+}
+
+std::vector<MethodScores> EvaluateMethods(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes,
+                                          const SegmentOptions& options, int grabcut_iterations) {
+  std::vector<MethodScores> out;
+  for (SegmentMethod method :
+       {SegmentMethod::kTwoStep, SegmentMethod::kDepth, SegmentMethod::kColor, SegmentMethod::kRgbd}) {
+    SegmentOptions o = options;
+    o.method = method;
+    Timer timer;
+    const SegmentResult result = SegmentObject(scan, strokes, o);
+    const double seconds = timer.Seconds();
+    out.push_back({ToString(method), ScoreMask(result.mask, truth, scan.valid), seconds});
+    if (method == SegmentMethod::kTwoStep) {
+      out.push_back({"step-1", ScoreMask(result.step1_mask, truth, scan.valid), seconds});
+    }
+  }
+  if (grabcut_iterations > 0) {
+    Timer timer;
+    const cv::Mat mask = GrabCutFromStrokes(scan, strokes, grabcut_iterations);
+    out.push_back({"grabcut", ScoreMask(mask, truth, scan.valid), timer.Seconds()});
+  }
+  return out;
+}
+
+}  // namespace lidarshop
