@@ -209,6 +209,34 @@ TEST(PoissonTest, MultigridAgreesWithCholmodAndEigenOnALargeHole) {
   EXPECT_LT(multigrid.iterations, 40) << multigrid.Summary();  // a working preconditioner, not plain CG
 }
 
+TEST(PoissonTest, MultigridConvergesOnLidarLikeMasks) {
+  // Masks a scan produces: random dropouts, missing scan lines (thin stripes that vanish on coarse levels),
+  // and a large hole with a ragged boundary touching the image border.
+  const int rows = 240, cols = 320;
+  const cv::Mat image = RandomImage(rows, cols, 1, 12);
+  std::mt19937 rng(13);
+  cv::Mat dropouts(rows, cols, CV_8U), stripes = cv::Mat::zeros(rows, cols, CV_8U), ragged;
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) dropouts.at<uint8_t>(y, x) = rng() % 100 < 45 ? 255 : 0;
+    if (y % 3 == 1) stripes.row(y).setTo(255);
+  }
+  cv::Mat noise(rows, cols, CV_32F);
+  cv::randu(noise, 0.0f, 1.0f);
+  cv::GaussianBlur(noise, noise, cv::Size(0, 0), 6.0);
+  cv::Mat distance(rows, cols, CV_32F);
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) distance.at<float>(y, x) = std::hypot(y - 100.0f, x - 20.0f) / 200.0f;
+  }
+  ragged = (distance + 4.0f * (noise - 0.5f)) < 0.8f;
+  for (const cv::Mat& mask : {dropouts, stripes, ragged}) {
+    const PoissonResult direct = FillLaplace(PreparePoisson(mask, Direct()), image);
+    const PoissonResult multigrid = FillLaplace(PreparePoisson(mask, Multigrid(1e-8, 200)), image);
+    EXPECT_LT(multigrid.relative_residual, 1e-8);
+    EXPECT_LE(multigrid.iterations, 25) << multigrid.Summary() << " unknowns " << cv::countNonZero(mask);
+    EXPECT_LT(MaxAbsDiff(direct.image, multigrid.image), 1e-4);
+  }
+}
+
 TEST(PoissonTest, MultigridIsIndependentOfTheThreadCount) {
   const cv::Mat image = RandomImage(200, 200, 1, 7);
   cv::Mat mask = cv::Mat::zeros(200, 200, CV_8U);
