@@ -1,0 +1,62 @@
+// Colour maps and legends for showing scan channels as pictures (RGB, 8-bit).
+//
+// Metric channels (range, depth, intensity) use perceptual maps: viridis and magma are perceptually uniform
+// with monotone lightness (van der Walt & Smith, matplotlib 2015); turbo (Mikhailov, Google 2019) is a
+// rainbow with smooth lightness for more contrast. The tables come from OpenCV's colormap module, sampled at
+// 256 levels. Labels get distinct colours from a golden-ratio walk around the hue circle.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace lidarshop {
+
+enum class ColorMap { kViridis, kTurbo, kMagma, kGray };
+
+// "viridis", "turbo", "magma", "gray"; throws OptionsError for anything else.
+ColorMap ParseColorMap(const std::string& name);
+std::string ColorMapName(ColorMap map);
+
+// The 256 RGB colours of `map`, low to high.
+const std::vector<cv::Vec3b>& ColorMapTable(ColorMap map);
+
+// The values between `min_value` (first colour) and `max_value` (last colour), in `unit` (shown on the
+// legend).
+struct ColorScale {
+  double min_value = 0.0;
+  double max_value = 1.0;
+  ColorMap map = ColorMap::kViridis;
+  std::string unit;  // e.g. "m"
+};
+
+// A scale from the `low_fraction` and `high_fraction` quantiles of the finite values of `values` (CV_32F)
+// where `mask` (CV_8U, empty = everywhere) is non-zero; robust to a few stray far points. {0, 1} when nothing
+// is valid.
+ColorScale AutoScale(const cv::Mat& values, const cv::Mat& mask, ColorMap map, const std::string& unit,
+                     double low_fraction = 0.01, double high_fraction = 0.99);
+
+// Maps a CV_32F image through `scale` to CV_8UC3 RGB; values outside the scale are clamped; cells where
+// `mask` is zero or the value is not finite get `invalid_color`.
+cv::Mat ApplyColorMap(const cv::Mat& values, const cv::Mat& mask, const ColorScale& scale,
+                      const cv::Vec3b& invalid_color = cv::Vec3b(0, 0, 0));
+
+// A vertical colour bar, highest value at the top, with tick values and the unit, on a white background
+// (CV_8UC3 RGB, `height` rows, about 100 columns).
+cv::Mat ColorScaleBar(const ColorScale& scale, int height);
+
+// The colour of an object label: distinct, stable, never black; `negative_color` for labels < 0 (no label).
+cv::Vec3b LabelColor(int32_t label, const cv::Vec3b& negative_color = cv::Vec3b(0, 0, 0));
+
+// Colours a CV_32S label image; cells where `mask` (CV_8U, empty = everywhere) is zero get black.
+cv::Mat ColorLabels(const cv::Mat& labels, const cv::Mat& mask);
+
+// A legend of label swatches with their numbers (CV_8UC3 RGB, `height` rows at least).
+cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height);
+
+// `image` (CV_8UC3) with `legend` to its right, both padded with white to the taller height.
+cv::Mat BesideLegend(const cv::Mat& image, const cv::Mat& legend);
+
+}  // namespace lidarshop
