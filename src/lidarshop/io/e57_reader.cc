@@ -298,25 +298,25 @@ struct GridOrientation {
 // azimuth (from +y, positive to the right) rise with the column index? A flip needs a 75 % majority, so that
 // grids without angular structure (synthetic data, a few points) keep the file's order.
 GridOrientation OrientationOf(const Scan& scan) {
+  // Without trigonometry: elevation rises with z / range; our azimuth rises from a to b when the xy cross
+  // product a x b is negative (clockwise seen from above).
   int64_t rows_up = 0, rows_down = 0, cols_up = 0, cols_down = 0;
-  auto elevation = [](const cv::Vec3f& p) { return std::atan2(p[2], std::hypot(p[0], p[1])); };
-  auto azimuth = [](const cv::Vec3f& p) { return std::atan2(p[0], p[1]); };
   for (int r = 0; r < scan.rows; ++r) {
     const uint8_t* v = scan.valid.ptr<uint8_t>(r);
     const uint8_t* v_next = r + 1 < scan.rows ? scan.valid.ptr<uint8_t>(r + 1) : nullptr;
     const cv::Vec3f* p = scan.point.ptr<cv::Vec3f>(r);
     const cv::Vec3f* p_next = r + 1 < scan.rows ? scan.point.ptr<cv::Vec3f>(r + 1) : nullptr;
+    const float* range = scan.range.ptr<float>(r);
+    const float* range_next = r + 1 < scan.rows ? scan.range.ptr<float>(r + 1) : nullptr;
     for (int c = 0; c < scan.cols; ++c) {
       if (!v[c]) continue;
       if (v_next && v_next[c]) {
-        const double d = elevation(p_next[c]) - elevation(p[c]);
+        const float d = p_next[c][2] / range_next[c] - p[c][2] / range[c];
         rows_up += d > 0, rows_down += d < 0;
       }
       if (c + 1 < scan.cols && v[c + 1]) {
-        double d = azimuth(p[c + 1]) - azimuth(p[c]);
-        if (d > M_PI) d -= 2 * M_PI;
-        if (d < -M_PI) d += 2 * M_PI;
-        cols_up += d > 0, cols_down += d < 0;
+        const float cross = p[c][0] * p[c + 1][1] - p[c][1] * p[c + 1][0];
+        cols_up += cross<0, cols_down += cross> 0;
       }
     }
   }

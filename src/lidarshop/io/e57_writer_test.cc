@@ -226,6 +226,21 @@ TEST(E57Writer, SeveralScansAndUnstructuredRoundTrip) {
   std::filesystem::remove(path);
 }
 
+TEST(E57Reader, TurnsBottomUpAndMirroredGridsIntoImageOrientation) {
+  // A file whose rowIndex 0 is the bottom row (like pumpA) and whose columns run against our azimuth.
+  const Scan scan = SyntheticScan(30, 50, 11, true);
+  for (int code : {0, 1, -1}) {
+    SCOPED_TRACE(code);
+    Scan turned = Clone(scan);
+    for (cv::Mat* m :
+         {&turned.direction, &turned.valid, &turned.range, &turned.point, &turned.intensity, &turned.color}) {
+      cv::flip(*m, *m, code);
+    }
+    const E57File f = ReadE57Bytes(EncodeE57({turned}), "turned.e57");
+    ExpectSameScan(scan, f.scans[0], 0.0);
+  }
+}
+
 TEST(E57Writer, ScaledIntegerCoordinatesWithinHalfAStep) {
   const Scan scan = SyntheticScan(25, 40, 5, true);
   E57WriteOptions options;
