@@ -1,13 +1,113 @@
-// Placeholder until this command group is built; replace the whole file.
+// lidarshop inpaint: greedy patch-based inpainting of an image (inpaint/inpaint.h, docs/inpaint.md).
+#include <filesystem>
+#include <map>
+#include <sstream>
+#include <string>
+
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/inpaint/debug_images.h"
+#include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/progress.h"
 
 namespace lidarshop::cli {
 
 int RunInpaint(int argc, char** argv) {
-  fmt::print(stderr, "lidarshop {}: not built yet\n", argv[0]);
-  return 1;
+  CLI::App app{
+      "Fill the hole of an image with patches copied from the rest of it (Criminisi et al. 2004 and "
+      "variants; "
+      "docs/inpaint.md). MASK: white (> 127) = hole, same size as IMAGE. 8-bit and 16-bit images come back "
+      "in "
+      "their depth; float images (EXR, TIFF) stay float.",
+      "inpaint"};
+  std::string image_path, mask_path, output_path, debug_dir;
+  InpaintOptions options;
+  bool quiet = false;
+  const std::map<std::string, InpaintPriorityKind> methods = {{"criminisi", InpaintPriorityKind::kCriminisi},
+                                                              {"onion-peel", InpaintPriorityKind::kOnionPeel},
+                                                              {"random", InpaintPriorityKind::kRandom}};
+  const std::map<std::string, InpaintSearchKind> searches = {{"exhaustive", InpaintSearchKind::kExhaustive},
+                                                             {"local", InpaintSearchKind::kLocal},
+                                                             {"two-step", InpaintSearchKind::kTwoStep},
+                                                             {"patchmatch", InpaintSearchKind::kPatchMatch}};
+  app.add_option("image", image_path, "image to fill (.png, .jpg, .exr, .tif)")->required();
+  app.add_option("--mask", mask_path, "hole mask (white = hole)")->required();
+  app.add_option("-o,--output", output_path, "filled image (.png/.jpg for 8/16-bit, .exr/.tif for float)")
+      ->required();
+  app.add_option("--method", options.priority, "fill order: criminisi | onion-peel | random")
+      ->transform(CLI::CheckedTransformer(methods, CLI::ignore_case))
+      ->default_str("criminisi");
+  app.add_option("--search", options.search, "source search: exhaustive | local | two-step | patchmatch")
+      ->transform(CLI::CheckedTransformer(searches, CLI::ignore_case))
+      ->default_str("exhaustive");
+  app.add_option("--patch-radius", options.patch_radius, "patch half-width in pixels (patches are 2R+1 wide)")
+      ->capture_default_str();
+  app.add_option("--window", options.local_window_radius, "local / two-step search window half-width, pixels")
+      ->capture_default_str();
+  app.add_option("--global-gain", options.global_gain,
+                 "two-step: a distant source must be this many times better than the local one")
+      ->capture_default_str();
+  app.add_option("--seed", options.seed, "seed of the random priority and of PatchMatch")
+      ->capture_default_str();
+  app.add_option("--debug", debug_dir,
+                 "write fill_order.png, source_map.png, source_locations.png and steps.csv into this folder");
+  AddQuietFlag(app, &quiet);
+  return RunCommand(app, argc, argv, [&]() {
+    options.Check();
+    const cv::Mat input = ReadImage(image_path);
+    cv::Mat mask = ReadImage(mask_path);
+    if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
+    if (mask.channels() == 4) cv::cvtColor(mask, mask, cv::COLOR_RGBA2GRAY);
+    if (mask.depth() != CV_8U) ThrowInputError(mask_path, "", "", "the mask must be an 8-bit image");
+    if (mask.size() != input.size()) {
+      ThrowInputError(
+          mask_path, "", "",
+          fmt::format("mask is {}x{} but the image is {}x{}", mask.cols, mask.rows, input.cols, input.rows));
+    }
+    mask = mask > 127;
+    cv::Mat image;
+    input.convertTo(image, CV_32F);
+    // Data-term scale: the intensity range (255 for 8-bit images).
+    if (input.depth() == CV_8U) {
+      options.alpha = 255.0;
+    } else {
+      double low = 0.0, high = 0.0;
+      cv::minMaxLoc(image.reshape(1), &low, &high);
+      options.alpha = std::max(high - low, 1e-6);
+    }
+    auto progress = Progress::ForTerminal("inpaint", cv::countNonZero(mask), quiet);
+    const InpaintResult result = Inpaint(image, mask, options, progress.get());
+    cv::Mat output;
+    result.image.convertTo(output, input.depth());
+    WriteImage(output_path, output);
+    if (!debug_dir.empty()) {
+      std::filesystem::create_directories(debug_dir);
+      cv::Mat background = result.image;
+      if (input.depth() != CV_8U) cv::normalize(result.image, background, 0, 255, cv::NORM_MINMAX);
+      const std::string dir = debug_dir + "/";
+      WriteImage(dir + "fill_order.png", RenderFillOrder(result, background));
+      WriteImage(dir + "source_map.png", RenderSourceMap(result, background));
+      InpaintResult scaled;
+      scaled.image = background;
+      scaled.steps = result.steps;
+      WriteImage(dir + "source_locations.png", RenderSourceLocations(scaled, options.patch_radius));
+      WriteFileAtomically(dir + "steps.csv", [&](std::ostream& out) {
+        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels\n";
+        for (size_t i = 0; i < result.steps.size(); ++i) {
+          const FillStep& s = result.steps[i];
+          out << fmt::format("{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col, s.source.row,
+                             s.source.col, s.difference, s.priority, s.filled_pixels);
+        }
+      });
+    }
+    if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
+    return 0;
+  });
 }
 
 }  // namespace lidarshop::cli

@@ -54,8 +54,12 @@ std::unique_ptr<PatchSearch> MakeSearch(const InpaintOptions& options) {
     case InpaintSearchKind::kTwoStep:
       return std::make_unique<TwoStepSearch>(options.local_window_radius, options.global_gain);
     case InpaintSearchKind::kPatchMatch:
-      return std::make_unique<PatchMatchSearch>(PatchMatchOptions{
-          options.patchmatch_random_samples, options.patchmatch_iterations, 0.5, options.seed});
+      return std::make_unique<PatchMatchSearch>(
+          PatchMatchOptions{.random_samples = options.patchmatch_random_samples,
+                            .local_samples = options.patchmatch_local_samples,
+                            .local_radius = options.local_window_radius,
+                            .iterations = options.patchmatch_iterations,
+                            .seed = options.seed});
     case InpaintSearchKind::kExhaustive:
       break;
   }

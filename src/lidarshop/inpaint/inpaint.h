@@ -56,6 +56,7 @@ struct InpaintOptions {
   double global_gain = 1.0;  // two-step: a global source must be this many times better than the local one
   // PatchMatch.
   int patchmatch_random_samples = 48;  // uniform draws per query
+  int patchmatch_local_samples = 32;   // draws within local_window_radius of the target per query
   int patchmatch_iterations = 4;       // propagation + random-search rounds per query
   // Acceptance hook: how many ranked candidates are offered to it.
   int acceptance_candidates = 8;

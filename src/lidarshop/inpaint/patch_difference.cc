@@ -6,7 +6,9 @@
 #include <immintrin.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <string_view>
 
 #include "lidarshop/util/error.h"
 
@@ -16,8 +18,15 @@ namespace {
 
 enum class Kernel { kScalar, kAvx2, kAvx512 };
 
+// LIDARSHOP_SSD_KERNEL=scalar|avx2 forces a slower kernel (for benchmarks and tests of the fallbacks).
 Kernel DetectKernel() {
   __builtin_cpu_init();
+  const char* forced = std::getenv("LIDARSHOP_SSD_KERNEL");
+  if (forced != nullptr && std::string_view(forced) == "scalar") return Kernel::kScalar;
+  if (forced != nullptr && std::string_view(forced) == "avx2" && __builtin_cpu_supports("avx2") &&
+      __builtin_cpu_supports("fma")) {
+    return Kernel::kAvx2;
+  }
   if (__builtin_cpu_supports("avx512f")) return Kernel::kAvx512;
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return Kernel::kAvx2;
   return Kernel::kScalar;
@@ -25,27 +34,32 @@ Kernel DetectKernel() {
 
 const Kernel kKernel = DetectKernel();
 
-// Per target row: sqrt(weight) and target·sqrt(weight), padded with zeros to a multiple of 16 floats, so that
+// Per target row: sqrt(weight) and target·sqrt(weight), so that
 //   Σ (s·√w − t·√w)²  =  Σ w (s − t)²
-// and every lane beyond the patch row contributes exactly 0 whatever the (finite) source floats there are.
-struct PreparedRows {
-  int row_floats = 0;     // (2R+1)·C
-  int padded_floats = 0;  // rounded up to 16
-  std::vector<int> rows;  // patch rows (0..2R) with at least one weighted float
-  std::vector<float, std::allocator<float>> sqrt_weight, target_times_sqrt_weight;  // rows.size() x padded
+// Only the span of 8-float blocks that hold a non-zero weight is evaluated (at the hole's rim about half of a
+// patch is unknown); the stored rows are zero-padded by 16 floats, so a kernel may read up to one AVX-512
+// vector past a span and every lane beyond it contributes exactly 0 whatever the (finite) source floats there
+// are.
+struct RowSpan {
+  int64_t source_offset = 0;  // floats from the source patch's top-left pixel to the span's first float
+  int stored_offset = 0;      // floats into sqrt_weight / target_times_sqrt_weight
+  int blocks8 = 0;            // 8-float blocks in the span
 };
 
-float ScalarSsd(const PreparedRows& p, const float* source_top_left, int64_t stride, float bound) {
-  float lanes[16] = {};
-  for (size_t i = 0; i < p.rows.size(); ++i) {
-    const float* s = source_top_left + p.rows[i] * stride;
-    const float* sw = p.sqrt_weight.data() + i * p.padded_floats;
-    const float* tw = p.target_times_sqrt_weight.data() + i * p.padded_floats;
-    for (int v = 0; v < p.padded_floats; v += 16) {
-      for (int l = 0; l < 16; ++l) {
-        const float d = s[v + l] * sw[v + l] - tw[v + l];
-        lanes[l] += d * d;
-      }
+struct PreparedRows {
+  std::vector<RowSpan> spans;
+  std::vector<float> sqrt_weight, target_times_sqrt_weight;
+};
+
+float ScalarSsd(const PreparedRows& p, const float* source_top_left, float bound) {
+  float lanes[8] = {};
+  for (const RowSpan& span : p.spans) {
+    const float* s = source_top_left + span.source_offset;
+    const float* sw = p.sqrt_weight.data() + span.stored_offset;
+    const float* tw = p.target_times_sqrt_weight.data() + span.stored_offset;
+    for (int v = 0; v < 8 * span.blocks8; ++v) {
+      const float d = s[v] * sw[v] - tw[v];
+      lanes[v & 7] += d * d;
     }
     float partial = 0.0f;
     for (float lane : lanes) partial += lane;
@@ -56,54 +70,76 @@ float ScalarSsd(const PreparedRows& p, const float* source_top_left, int64_t str
   return sum;
 }
 
-__attribute__((target("avx2,fma"), always_inline)) inline float Avx2Reduce(__m256 a, __m256 b) {
-  const __m256 s = _mm256_add_ps(a, b);
+__attribute__((target("avx2,fma"), always_inline)) inline float Avx2Reduce(__m256 s) {
   __m128 x = _mm_add_ps(_mm256_castps256_ps128(s), _mm256_extractf128_ps(s, 1));
   x = _mm_add_ps(x, _mm_movehl_ps(x, x));
   x = _mm_add_ss(x, _mm_shuffle_ps(x, x, 1));
   return _mm_cvtss_f32(x);
 }
 
+// Four accumulators (block index mod 4) keep the FMA dependency chains short.
 __attribute__((target("avx2,fma"))) float Avx2Ssd(const PreparedRows& p, const float* source_top_left,
-                                                  int64_t stride, float bound) {
-  __m256 acc0 = _mm256_setzero_ps(), acc1 = _mm256_setzero_ps();
-  for (size_t i = 0; i < p.rows.size(); ++i) {
-    const float* s = source_top_left + p.rows[i] * stride;
-    const float* sw = p.sqrt_weight.data() + i * p.padded_floats;
-    const float* tw = p.target_times_sqrt_weight.data() + i * p.padded_floats;
-    for (int v = 0; v < p.padded_floats; v += 16) {
-      const __m256 d0 =
-          _mm256_fmsub_ps(_mm256_loadu_ps(s + v), _mm256_load_ps(sw + v), _mm256_load_ps(tw + v));
-      const __m256 d1 =
-          _mm256_fmsub_ps(_mm256_loadu_ps(s + v + 8), _mm256_load_ps(sw + v + 8), _mm256_load_ps(tw + v + 8));
-      acc0 = _mm256_fmadd_ps(d0, d0, acc0);
-      acc1 = _mm256_fmadd_ps(d1, d1, acc1);
-    }
-    if (Avx2Reduce(acc0, acc1) > bound) return Avx2Reduce(acc0, acc1);
-  }
-  return Avx2Reduce(acc0, acc1);
-}
-
-__attribute__((target("avx512f"))) float Avx512Ssd(const PreparedRows& p, const float* source_top_left,
-                                                   int64_t stride, float bound) {
-  __m512 acc = _mm512_setzero_ps();
-  const size_t n = p.rows.size();
+                                                  float bound) {
+  __m256 acc[4] = {_mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps()};
+  const size_t n = p.spans.size();
   for (size_t i = 0; i < n; ++i) {
-    const float* s = source_top_left + p.rows[i] * stride;
-    const float* sw = p.sqrt_weight.data() + i * p.padded_floats;
-    const float* tw = p.target_times_sqrt_weight.data() + i * p.padded_floats;
-    for (int v = 0; v < p.padded_floats; v += 16) {
-      const __m512 d =
-          _mm512_fmsub_ps(_mm512_loadu_ps(s + v), _mm512_loadu_ps(sw + v), _mm512_loadu_ps(tw + v));
-      acc = _mm512_fmadd_ps(d, d, acc);
+    const RowSpan& span = p.spans[i];
+    const float* s = source_top_left + span.source_offset;
+    const float* sw = p.sqrt_weight.data() + span.stored_offset;
+    const float* tw = p.target_times_sqrt_weight.data() + span.stored_offset;
+    for (int b = 0; b < span.blocks8; ++b) {
+      const __m256 d = _mm256_fmsub_ps(_mm256_loadu_ps(s + 8 * b), _mm256_loadu_ps(sw + 8 * b),
+                                       _mm256_loadu_ps(tw + 8 * b));
+      acc[b & 3] = _mm256_fmadd_ps(d, d, acc[b & 3]);
     }
     // Lanes only grow, so a partial sum above the bound proves the full sum is above it too.
     if ((i & 1) && i + 1 < n) {
-      const float partial = _mm512_reduce_add_ps(acc);
+      const float partial =
+          Avx2Reduce(_mm256_add_ps(_mm256_add_ps(acc[0], acc[1]), _mm256_add_ps(acc[2], acc[3])));
       if (partial > bound) return partial;
     }
   }
-  return _mm512_reduce_add_ps(acc);
+  return Avx2Reduce(_mm256_add_ps(_mm256_add_ps(acc[0], acc[1]), _mm256_add_ps(acc[2], acc[3])));
+}
+
+__attribute__((target("avx512f"))) float Avx512Ssd(const PreparedRows& p, const float* source_top_left,
+                                                   float bound) {
+  __m512 acc0 = _mm512_setzero_ps(), acc1 = _mm512_setzero_ps(), acc2 = _mm512_setzero_ps();
+  const size_t n = p.spans.size();
+  for (size_t i = 0; i < n; ++i) {
+    const RowSpan& span = p.spans[i];
+    const float* s = source_top_left + span.source_offset;
+    const float* sw = p.sqrt_weight.data() + span.stored_offset;
+    const float* tw = p.target_times_sqrt_weight.data() + span.stored_offset;
+    const int blocks16 = (span.blocks8 + 1) / 2;
+    int b = 0;
+    for (; b + 3 <= blocks16; b += 3) {
+      const __m512 d0 = _mm512_fmsub_ps(_mm512_loadu_ps(s + 16 * b), _mm512_loadu_ps(sw + 16 * b),
+                                        _mm512_loadu_ps(tw + 16 * b));
+      const __m512 d1 = _mm512_fmsub_ps(_mm512_loadu_ps(s + 16 * b + 16), _mm512_loadu_ps(sw + 16 * b + 16),
+                                        _mm512_loadu_ps(tw + 16 * b + 16));
+      const __m512 d2 = _mm512_fmsub_ps(_mm512_loadu_ps(s + 16 * b + 32), _mm512_loadu_ps(sw + 16 * b + 32),
+                                        _mm512_loadu_ps(tw + 16 * b + 32));
+      acc0 = _mm512_fmadd_ps(d0, d0, acc0);
+      acc1 = _mm512_fmadd_ps(d1, d1, acc1);
+      acc2 = _mm512_fmadd_ps(d2, d2, acc2);
+    }
+    if (b < blocks16) {
+      const __m512 d0 = _mm512_fmsub_ps(_mm512_loadu_ps(s + 16 * b), _mm512_loadu_ps(sw + 16 * b),
+                                        _mm512_loadu_ps(tw + 16 * b));
+      acc0 = _mm512_fmadd_ps(d0, d0, acc0);
+      if (b + 1 < blocks16) {
+        const __m512 d1 = _mm512_fmsub_ps(_mm512_loadu_ps(s + 16 * b + 16), _mm512_loadu_ps(sw + 16 * b + 16),
+                                          _mm512_loadu_ps(tw + 16 * b + 16));
+        acc1 = _mm512_fmadd_ps(d1, d1, acc1);
+      }
+    }
+    if ((i & 1) && i + 1 < n) {
+      const float partial = _mm512_reduce_add_ps(_mm512_add_ps(_mm512_add_ps(acc0, acc1), acc2));
+      if (partial > bound) return partial;
+    }
+  }
+  return _mm512_reduce_add_ps(_mm512_add_ps(_mm512_add_ps(acc0, acc1), acc2));
 }
 
 class WeightedSsdTarget : public TargetDifference {
@@ -111,34 +147,43 @@ class WeightedSsdTarget : public TargetDifference {
   WeightedSsdTarget(const InpaintCanvas& canvas, Pixel target, const std::vector<float>& channel_weights)
       : canvas_(canvas) {
     const int R = canvas.patch_radius(), C = canvas.channels(), side = 2 * R + 1;
-    prepared_.row_floats = side * C;
-    prepared_.padded_floats = (prepared_.row_floats + 15) / 16 * 16;
-    std::vector<float> sw(prepared_.padded_floats), tw(prepared_.padded_floats);
+    const int row_floats = side * C;
+    const int padded = (row_floats + 7) / 8 * 8;
+    std::vector<float> sw(padded), tw(padded);
     for (int i = 0; i < side; ++i) {
       const int r = target.row - R + i;
+      if (r < 0 || r >= canvas.rows()) continue;
       std::fill(sw.begin(), sw.end(), 0.0f);
       std::fill(tw.begin(), tw.end(), 0.0f);
-      bool any = false;
-      if (r >= 0 && r < canvas.rows()) {
-        for (int j = 0; j < side; ++j) {
-          const int c = target.col - R + j;
-          if (c < 0 || c >= canvas.cols() || !canvas.IsKnown(r, c)) continue;
-          const float* t = canvas.PixelData(r, c);
-          for (int k = 0; k < C; ++k) {
-            const float w = channel_weights.empty() ? 1.0f : channel_weights[k];
-            if (w == 0.0f) continue;
-            const float root = std::sqrt(w);
-            sw[j * C + k] = root;
-            tw[j * C + k] = t[k] * root;
-            any = true;
-          }
+      int first = padded, last = -1;
+      for (int j = 0; j < side; ++j) {
+        const int c = target.col - R + j;
+        if (c < 0 || c >= canvas.cols() || !canvas.IsKnown(r, c)) continue;
+        const float* t = canvas.PixelData(r, c);
+        for (int k = 0; k < C; ++k) {
+          const float w = channel_weights.empty() ? 1.0f : channel_weights[k];
+          if (w == 0.0f) continue;
+          const float root = std::sqrt(w);
+          sw[j * C + k] = root;
+          tw[j * C + k] = t[k] * root;
+          first = std::min(first, j * C + k);
+          last = std::max(last, j * C + k);
         }
       }
-      if (!any) continue;
-      prepared_.rows.push_back(i);
-      prepared_.sqrt_weight.insert(prepared_.sqrt_weight.end(), sw.begin(), sw.end());
-      prepared_.target_times_sqrt_weight.insert(prepared_.target_times_sqrt_weight.end(), tw.begin(),
-                                                tw.end());
+      if (last < 0) continue;
+      RowSpan span;
+      const int first_block = first / 8, end_block = last / 8 + 1;
+      span.blocks8 = end_block - first_block;
+      span.source_offset = int64_t{i} * canvas.row_stride() + 8 * first_block;
+      span.stored_offset = static_cast<int>(prepared_.sqrt_weight.size());
+      prepared_.sqrt_weight.insert(prepared_.sqrt_weight.end(), sw.begin() + 8 * first_block,
+                                   sw.begin() + 8 * end_block);
+      prepared_.target_times_sqrt_weight.insert(prepared_.target_times_sqrt_weight.end(),
+                                                tw.begin() + 8 * first_block, tw.begin() + 8 * end_block);
+      // Zero padding so that 16-float loads past the span read weights of 0.
+      prepared_.sqrt_weight.insert(prepared_.sqrt_weight.end(), 16, 0.0f);
+      prepared_.target_times_sqrt_weight.insert(prepared_.target_times_sqrt_weight.end(), 16, 0.0f);
+      prepared_.spans.push_back(span);
     }
   }
 
@@ -147,11 +192,11 @@ class WeightedSsdTarget : public TargetDifference {
     const float* top_left = canvas_.PixelData(source.row - R, source.col - R);
     switch (kKernel) {
       case Kernel::kAvx512:
-        return Avx512Ssd(prepared_, top_left, canvas_.row_stride(), bound);
+        return Avx512Ssd(prepared_, top_left, bound);
       case Kernel::kAvx2:
-        return Avx2Ssd(prepared_, top_left, canvas_.row_stride(), bound);
+        return Avx2Ssd(prepared_, top_left, bound);
       default:
-        return ScalarSsd(prepared_, top_left, canvas_.row_stride(), bound);
+        return ScalarSsd(prepared_, top_left, bound);
     }
   }
 

@@ -89,8 +89,23 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& ca
 std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
                                                     const TargetDifference& difference, Pixel target,
                                                     int count) {
-  return FindBelow(canvas, difference, count, std::numeric_limits<float>::infinity(), 0, canvas.rows(), 0,
-                   canvas.cols());
+  // Nearby sources are often good, so a small window first gives the scan of the whole image a tight early-
+  // termination bound from its first candidate on. Exact: the scan keeps every candidate <= that bound.
+  const float inf = std::numeric_limits<float>::infinity();
+  const int w = 2 * canvas.patch_radius() + 1;
+  auto nearby = FindBelow(canvas, difference, count, inf, target.row - w, target.row + w + 1, target.col - w,
+                          target.col + w + 1);
+  const float bound = static_cast<int>(nearby.size()) == count ? nearby.back().difference : inf;
+  auto all = FindBelow(canvas, difference, count, bound, 0, canvas.rows(), 0, canvas.cols());
+  // Merge (the scan re-finds the nearby ones that are good enough; keep each source once).
+  all.insert(all.end(), nearby.begin(), nearby.end());
+  std::sort(all.begin(), all.end(), CandidateBefore);
+  all.erase(
+      std::unique(all.begin(), all.end(),
+                  [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
+      all.end());
+  if (static_cast<int>(all.size()) > count) all.resize(count);
+  return all;
 }
 
 std::vector<SourceCandidate> LocalSearch::Find(const InpaintCanvas& canvas,
@@ -137,6 +152,10 @@ std::vector<SourceCandidate> TwoStepSearch::Find(const InpaintCanvas& canvas,
 void PatchMatchOptions::Check() const {
   CheckOption(random_samples >= 1,
               fmt::format("PatchMatchOptions.random_samples must be >= 1, got {}", random_samples));
+  CheckOption(local_samples >= 0,
+              fmt::format("PatchMatchOptions.local_samples must be >= 0, got {}", local_samples));
+  CheckOption(local_radius >= 1,
+              fmt::format("PatchMatchOptions.local_radius must be >= 1, got {}", local_radius));
   CheckOption(iterations >= 0, fmt::format("PatchMatchOptions.iterations must be >= 0, got {}", iterations));
   CheckOption(alpha > 0.0 && alpha < 1.0,
               fmt::format("PatchMatchOptions.alpha must be in (0, 1), got {}", alpha));
@@ -177,6 +196,10 @@ std::vector<SourceCandidate> PatchMatchSearch::Find(const InpaintCanvas& canvas,
   for (int i = 0; i < options_.random_samples; ++i) {
     const Pixel& s = sources[UniformInt(rng, static_cast<int>(sources.size()))];
     offer(s.row, s.col);
+  }
+  for (int i = 0; i < options_.local_samples; ++i) {
+    const int w = options_.local_radius;
+    offer(target.row + UniformInt(rng, 2 * w + 1) - w, target.col + UniformInt(rng, 2 * w + 1) - w);
   }
   const int max_radius = std::max(canvas.rows(), canvas.cols());
   for (int it = 0; it < options_.iterations && !top.best().empty(); ++it) {

@@ -82,6 +82,8 @@ class TwoStepSearch : public PatchSearch {
 
 struct PatchMatchOptions {
   int random_samples = 48;  // uniformly drawn source centres per query
+  int local_samples = 32;   // draws within local_radius of the target (nearby sources are often coherent)
+  int local_radius = 40;    // pixels
   int iterations = 4;       // rounds of propagation + random search around the best so far
   double alpha = 0.5;       // radius ratio of successive random-search samples (Barnes et al. 2009, §3.2)
   uint64_t seed = 0;
@@ -93,7 +95,8 @@ struct PatchMatchOptions {
 //  may come
 //    from s(q) − (q − p)) and of the patches filled last, plus ±1-pixel moves of the current best;
 //  * random search: samples around the current best at radii max(H, W)·αⁱ down to 1 pixel;
-//  * `random_samples` uniform draws. The random stream is seeded from (seed, target); the search runs on one
+//  * `random_samples` uniform draws over the image and `local_samples` draws near the target. The random
+//  stream is seeded from (seed, target); the search runs on one
 //    thread, so the fill is a deterministic function of (inputs, seed).
 class PatchMatchSearch : public PatchSearch {
  public:
