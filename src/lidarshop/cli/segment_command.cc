@@ -72,9 +72,16 @@ int RunSegment(int argc, char** argv) {
   app.add_option("--model", model, "appearance model: histogram | gmm")->capture_default_str();
   app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
   app.add_flag("--eight", eight, "8-connected n-links (default 4)");
+  SegmentOptions options;
+  app.add_option("--ring-threshold", options.ring_depth_threshold_m,
+                 "step 2: range jump (metres) that marks a ring cell background")
+      ->capture_default_str();
+  app.add_option("--depth-bin", options.depth_bin_m, "range histogram bin, metres (GMM: variance floor)")
+      ->capture_default_str();
+  app.add_option("--depth-smoothing", options.depth_smoothing_m, "range model smoothing, metres")
+      ->capture_default_str();
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
-    SegmentOptions options;
     options.method = ParseSegmentMethod(method);
     options.model = ParseAppearanceModel(model);
     options.eight_connected = eight;

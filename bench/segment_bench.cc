@@ -1,0 +1,124 @@
+// Speed of the two-step segmentation on a 1000 x 1000 scan (the electric box in grass of data/segment_eval,
+// scanned at 1000 x 1000), of a refinement after one extra stroke, and of OpenCV grabCut on the same image
+// and strokes in the same run.
+//
+//   ninja -C build/segment segment_bench && build/segment/bench/segment_bench
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/segment/segment_eval.h"
+
+namespace lidarshop {
+namespace {
+
+struct Fixture {
+  Scan scan;
+  cv::Mat truth, strokes, extra;
+};
+
+const Fixture& GetFixture() {
+  static const Fixture fixture = [] {
+    Fixture f;
+    SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/segment_eval/electric_box_grass.json");
+    scene.scanner.columns = 1000;
+    scene.scanner.rows = 1000;
+    f.scan = SynthesizeScan(scene);
+    f.truth = (f.scan.label == 1) & (f.scan.valid != 0);
+    EvalStrokeOptions stroke_options;
+    stroke_options.stroke_length_cells = 40;
+    stroke_options.stroke_width_cells = 3;
+    f.strokes = MakeEvalStrokes(f.truth, f.scan.valid, 1, stroke_options);
+    // The extra stroke: background, a 40-cell line on the ground just below the object's bounding box.
+    f.extra = cv::Mat(f.scan.rows, f.scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+    const cv::Rect box = cv::boundingRect(f.truth);
+    const int row = std::min(f.scan.rows - 1, box.y + box.height + 8);
+    cv::line(f.extra, cv::Point(box.x + box.width / 2 - 20, row), cv::Point(box.x + box.width / 2 + 20, row),
+             cv::Scalar(kStrokeBackground), 3);
+    return f;
+  }();
+  return fixture;
+}
+
+void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel model) {
+  const Fixture& f = GetFixture();
+  SegmentOptions options;
+  options.method = method;
+  options.model = model;
+  SegmentResult result;
+  for (auto _ : state) {
+    SegmentSession session(f.scan, options);
+    result = session.Run(f.strokes);
+    benchmark::DoNotOptimize(result.mask.data);
+  }
+  const MaskScores scores = ScoreMask(result.mask, f.truth, f.scan.valid);
+  state.counters["IoU"] = scores.iou;
+  state.counters["maxflow_s"] = result.timings.maxflow_s;
+  state.counters["graph_s"] = result.timings.graph_s;
+  state.counters["models_s"] = result.timings.models_s;
+  state.counters["features_s"] = result.timings.features_s;
+  state.counters["cells"] = static_cast<double>(f.scan.CountValid());
+}
+
+void BM_TwoStepGmm(benchmark::State& state) {
+  Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm);
+}
+void BM_TwoStepHistogram(benchmark::State& state) {
+  Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kHistogram);
+}
+void BM_OneCutDepthHistogram(benchmark::State& state) {
+  Segment(state, SegmentMethod::kDepth, AppearanceModel::kHistogram);
+}
+
+// Refinement after one extra stroke: the session has run (untimed); the timed part is Refine().
+void BM_RefineOneStroke(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  SegmentOptions options;
+  SegmentResult result;
+  for (auto _ : state) {
+    state.PauseTiming();
+    SegmentSession session(f.scan, options);
+    session.Run(f.strokes);
+    state.ResumeTiming();
+    result = session.Refine(f.extra);
+    benchmark::DoNotOptimize(result.mask.data);
+  }
+  state.counters["IoU"] = ScoreMask(result.mask, f.truth, f.scan.valid).iou;
+}
+
+// The same refinement done the slow way: a full two-step Run with the extra stroke added (for the ratio).
+void BM_RerunWithExtraStroke(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  cv::Mat strokes = f.strokes.clone();
+  strokes.setTo(kStrokeBackground, f.extra == kStrokeBackground);
+  SegmentResult result;
+  for (auto _ : state) {
+    SegmentSession session(f.scan, SegmentOptions());
+    result = session.Run(strokes);
+    benchmark::DoNotOptimize(result.mask.data);
+  }
+  state.counters["IoU"] = ScoreMask(result.mask, f.truth, f.scan.valid).iou;
+}
+
+void BM_OpenCvGrabCut(benchmark::State& state) {
+  const Fixture& f = GetFixture();
+  cv::Mat mask;
+  for (auto _ : state) {
+    mask = GrabCutFromStrokes(f.scan, f.strokes, static_cast<int>(state.range(0)));
+    benchmark::DoNotOptimize(mask.data);
+  }
+  state.counters["IoU"] = ScoreMask(mask, f.truth, f.scan.valid).iou;
+}
+
+BENCHMARK(BM_TwoStepGmm)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_TwoStepHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_OneCutDepthHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_RefineOneStroke)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_RerunWithExtraStroke)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_OpenCvGrabCut)->Arg(1)->Arg(5)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+}  // namespace
+}  // namespace lidarshop
+
+BENCHMARK_MAIN();
