@@ -123,13 +123,14 @@ Eigen::Matrix4d PoseOf(const Context& ctx, pugi::xml_node pose) {
 
 // Terminal fields of a prototype, depth first (the order of the bytestreams).
 void CollectFields(const Context& ctx, pugi::xml_node node, const std::string& prefix,
-                   std::vector<Field>* fields) {
+                   std::vector<Field>* fields, int depth = 0) {
+  if (depth > 32) XmlError(ctx, node, "prototype nested more than 32 levels deep");
   for (pugi::xml_node child : node.children()) {
     if (child.type() != pugi::node_element) continue;
     const std::string type = TypeOf(child);
     const std::string name = prefix.empty() ? child.name() : prefix + "/" + child.name();
     if (type == "Structure" || type == "Vector") {
-      CollectFields(ctx, child, name, fields);
+      CollectFields(ctx, child, name, fields, depth + 1);
       continue;
     }
     Field f;
@@ -330,6 +331,7 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
   const pugi::xml_node points = child.child("points");
   if (!points) XmlError(ctx, child, "data3D entry has no 'points'");
   if (TypeOf(points) != "CompressedVector") XmlError(ctx, points, "'points' is not a CompressedVector");
+  if (!points.attribute("recordCount")) XmlError(ctx, points, "attribute 'recordCount' is missing");
   const int64_t record_count = ParseInt(ctx, points, points.attribute("recordCount").value());
   if (record_count < 0 || record_count > g_max_cells) {
     XmlError(ctx, points, fmt::format("recordCount {} is outside [0, {}]", record_count, g_max_cells));

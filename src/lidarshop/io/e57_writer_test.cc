@@ -325,6 +325,24 @@ TEST(E57Reader, RefusesAbsurdSizesBeforeAllocating) {
         </prototype></points>)" +
                            tail;
   EXPECT_THROW(ReadE57Bytes(FileWithXml(grid), "grid.e57"), InputError);
+  // Deeply nested prototypes and a missing recordCount.
+  std::string deep =
+      head +
+      R"(<points type="CompressedVector" fileOffset="48" recordCount="0"><prototype type="Structure">)";
+  for (int i = 0; i < 10000; ++i) deep += R"(<s type="Structure">)";
+  for (int i = 0; i < 10000; ++i) deep += "</s>";
+  deep += "</prototype></points>" + tail;
+  EXPECT_THROW(ReadE57Bytes(FileWithXml(deep), "deep.e57"), InputError);
+  const std::string no_count = head +
+                               R"(<points type="CompressedVector" fileOffset="48"><prototype type="Structure">
+        <cartesianX type="Float"/><cartesianY type="Float"/><cartesianZ type="Float"/></prototype></points>)" +
+                               tail;
+  try {
+    ReadE57Bytes(FileWithXml(no_count), "no_count.e57");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("'recordCount' is missing"));
+  }
   // Broken XML names the offset.
   try {
     ReadE57Bytes(FileWithXml("<e57Root><data3D></e57Root>"), "bad.e57");
