@@ -1,6 +1,7 @@
 // E57 writer: one compressed-vector section per scan, then the XML section, then pages with CRC-32C.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -162,7 +163,9 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
 
   std::vector<Stream> streams;
   const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
-  double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo[3] = {kInf, kInf, kInf},
+         hi[3] = {-kInf, -kInf, -kInf};  // over valid points; 0 when there are none
   for (int axis = 0; axis < 3; ++axis) {
     Stream s;
     s.field.name = axis_names[axis];
@@ -249,6 +252,9 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
     streams.push_back(std::move(s));
   }
 
+  for (int axis = 0; axis < 3; ++axis) {
+    if (lo[axis] > hi[axis]) lo[axis] = hi[axis] = 0.0;
+  }
   const uint64_t offset = AppendCompressedVector(streams, n, logical);
 
   pugi::xml_node child = AddTyped(data3d, "vectorChild", "Structure");

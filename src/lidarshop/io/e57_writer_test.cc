@@ -190,6 +190,20 @@ TEST(E57Writer, OrganizedRoundTripIsExact) {
   ASSERT_EQ(f.scans.size(), 1u);
   ExpectSameScan(scan, f.scans[0], 0.0);
   EXPECT_TRUE(f.scans[0].grid.fitted);
+  // The XML's cartesianBounds are the valid points' bounds.
+  const std::vector<uint8_t> logical = e57::LogicalFromPages(path, EncodeE57({scan}));
+  const std::string text(logical.begin(), logical.end());
+  float y_min = 1e9f, y_max = -1e9f;  // all y > 0 here: a bound stuck at 0 would show
+  for (int64_t c = 0; c < scan.num_cells(); ++c) {
+    if (!scan.valid.ptr<uint8_t>()[c]) continue;
+    y_min = std::min(y_min, scan.point.ptr<cv::Vec3f>()[c][1]);
+    y_max = std::max(y_max, scan.point.ptr<cv::Vec3f>()[c][1]);
+  }
+  ASSERT_GT(y_min, 0.0f);
+  EXPECT_THAT(text,
+              HasSubstr(fmt::format("<yMinimum type=\"Float\">{}</yMinimum>", static_cast<double>(y_min))));
+  EXPECT_THAT(text,
+              HasSubstr(fmt::format("<yMaximum type=\"Float\">{}</yMaximum>", static_cast<double>(y_max))));
   std::filesystem::remove(path);
 }
 
