@@ -521,15 +521,37 @@ LogDensities ComputeLogDensities(const Nodes& nodes, const std::vector<int32_t>&
   auto color_density = [&](const std::vector<float>& lut) {
     return [&](int32_t i) { return lut[lut_index(i)]; };
   };
-  auto depth_density = [&](const Gmm<1>& g) {
+  // The range mixtures likewise, on a grid of an eighth of the variance floor (at most 2^20 entries).
+  const double depth_step_m =
+      std::max(std::max(options.depth_smoothing_m, options.depth_bin_m) / 8.0, span_m / double(1 << 20));
+  const int depth_entries = static_cast<int>(span_m / depth_step_m) + 2;
+  auto tabulate_depth = [&](const Gmm<1>& g) {
+    std::vector<float> lut(depth_entries);
+    ParallelForRange(
+        depth_entries,
+        [&](int64_t begin, int64_t end) {
+          for (int64_t k = begin; k < end; ++k) {
+            const double range = nodes.range_min + (k + 0.5) * depth_step_m;
+            lut[k] = static_cast<float>(std::exp(g.LogDensity(Eigen::Matrix<double, 1, 1>(range))));
+          }
+        },
+        1024);
+    return lut;
+  };
+  const std::vector<float> depth_lut_object = tabulate_depth(dob), depth_lut_background = tabulate_depth(dbg);
+  auto depth_density = [&](const std::vector<float>& lut) {
     return [&](int32_t i) {
-      return static_cast<float>(std::exp(g.LogDensity(Eigen::Matrix<double, 1, 1>(nodes.raw[i][3]))));
+      const int k = std::clamp(static_cast<int>((nodes.raw[i][3] - nodes.range_min) / depth_step_m), 0,
+                               depth_entries - 1);
+      return lut[k];
     };
   };
   out.color_object = MixWithUniform(n, options.object_uniform, 1.0, color_density(lut_object));
   out.color_background = MixWithUniform(n, options.background_uniform, 1.0, color_density(lut_background));
-  out.depth_object = MixWithUniform(n, options.object_uniform, depth_uniform, depth_density(dob));
-  out.depth_background = MixWithUniform(n, options.background_uniform, depth_uniform, depth_density(dbg));
+  out.depth_object =
+      MixWithUniform(n, options.object_uniform, depth_uniform, depth_density(depth_lut_object));
+  out.depth_background =
+      MixWithUniform(n, options.background_uniform, depth_uniform, depth_density(depth_lut_background));
   return out;
 }
 
