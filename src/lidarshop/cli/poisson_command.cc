@@ -3,6 +3,8 @@
 //   lidarshop poisson fill IMAGE --mask MASK -o OUT.png
 //   lidarshop poisson clone SOURCE --mask MASK --target TARGET --offset X,Y -o OUT.png
 //   lidarshop poisson reconstruct --gx GX.exr --gy GY.exr --boundary IMAGE --mask MASK -o OUT.exr
+#include <cctype>
+#include <sstream>
 #include <string>
 
 #include <fmt/format.h>
