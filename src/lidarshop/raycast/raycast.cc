@@ -185,27 +185,51 @@ namespace {
 constexpr int kTileRows = 4;
 constexpr int kTileCols = 4;
 
+// Writes hits into the images through raw pointers (the hot loop of every cast).
 struct HitWriter {
-  const std::vector<int32_t>& user_id_of_geometry;
-  RayHitImages& images;
+  const int32_t* user_id_of_geometry;
+  float* t_hit;
+  int32_t* geometry_id;
+  int32_t* primitive_id;
+  float* normal;                                          // 3 per cell
+  float* barycentric;                                     // 2 per cell
+  size_t t_step, id_step, normal_step, barycentric_step;  // row steps in elements
 
-  void Miss(int row, int col) const {
-    images.t_hit.at<float>(row, col) = std::numeric_limits<float>::infinity();
-    images.geometry_id.at<int32_t>(row, col) = kInvalidId;
-    images.primitive_id.at<int32_t>(row, col) = kInvalidId;
-    images.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(0, 0, 0);
-    images.barycentric.at<cv::Vec2f>(row, col) = cv::Vec2f(0, 0);
-  }
-  void Write(int row, int col, float t, unsigned geometry, unsigned primitive, float nx, float ny, float nz,
-             float u, float v) const {
-    if (geometry == RTC_INVALID_GEOMETRY_ID) return Miss(row, col);
-    images.t_hit.at<float>(row, col) = t;
-    images.geometry_id.at<int32_t>(row, col) = user_id_of_geometry[geometry];
-    images.primitive_id.at<int32_t>(row, col) = static_cast<int32_t>(primitive);
+  explicit HitWriter(const int32_t* ids, RayHitImages& images)
+      : user_id_of_geometry(ids),
+        t_hit(images.t_hit.ptr<float>()),
+        geometry_id(images.geometry_id.ptr<int32_t>()),
+        primitive_id(images.primitive_id.ptr<int32_t>()),
+        normal(images.normal.ptr<float>()),
+        barycentric(images.barycentric.ptr<float>()),
+        t_step(images.t_hit.step1()),
+        id_step(images.geometry_id.step1()),
+        normal_step(images.normal.step1()),
+        barycentric_step(images.barycentric.step1()) {}
+
+  inline __attribute__((always_inline)) void Write(int row, int col, float t, unsigned geometry,
+                                                   unsigned primitive, float nx, float ny, float nz, float u,
+                                                   float v) const {
+    const size_t id_index = row * id_step + col;
+    float* n = normal + row * normal_step + 3 * col;
+    float* uv = barycentric + row * barycentric_step + 2 * col;
+    if (geometry == RTC_INVALID_GEOMETRY_ID) {
+      t_hit[row * t_step + col] = std::numeric_limits<float>::infinity();
+      geometry_id[id_index] = kInvalidId;
+      primitive_id[id_index] = kInvalidId;
+      n[0] = n[1] = n[2] = 0.0f;
+      uv[0] = uv[1] = 0.0f;
+      return;
+    }
+    t_hit[row * t_step + col] = t;
+    geometry_id[id_index] = user_id_of_geometry[geometry];
+    primitive_id[id_index] = static_cast<int32_t>(primitive);
     const float inverse_norm = 1.0f / std::sqrt(nx * nx + ny * ny + nz * nz);
-    images.normal.at<cv::Vec3f>(row, col) =
-        cv::Vec3f(nx * inverse_norm, ny * inverse_norm, nz * inverse_norm);
-    images.barycentric.at<cv::Vec2f>(row, col) = cv::Vec2f(u, v);
+    n[0] = nx * inverse_norm;
+    n[1] = ny * inverse_norm;
+    n[2] = nz * inverse_norm;
+    uv[0] = u;
+    uv[1] = v;
   }
 };
 
@@ -214,26 +238,37 @@ struct HitWriter {
 RayHitImages RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor,
                                      const cv::Mat& directions_in_sensor, float t_near, float t_far,
                                      CastMethod method) const {
+  RayHitImages images;
+  CastImage(world_from_sensor, directions_in_sensor, t_near, t_far, method, &images);
+  return images;
+}
+
+void RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor, const cv::Mat& directions_in_sensor,
+                             float t_near, float t_far, CastMethod method, RayHitImages* hits) const {
   if (!impl_->committed) throw std::logic_error("RaycastScene: cast before Commit");
   if (directions_in_sensor.type() != CV_32FC3) {
     throw std::invalid_argument("RaycastScene::CastImage: directions must be CV_32FC3");
   }
   const int rows = directions_in_sensor.rows;
   const int cols = directions_in_sensor.cols;
-  RayHitImages images;
+  RayHitImages& images = *hits;
   images.t_hit.create(rows, cols, CV_32F);
   images.geometry_id.create(rows, cols, CV_32S);
   images.primitive_id.create(rows, cols, CV_32S);
   images.normal.create(rows, cols, CV_32FC3);
   images.barycentric.create(rows, cols, CV_32FC2);
-  if (rows == 0 || cols == 0) return images;
+  if (rows == 0 || cols == 0) return;
   const Eigen::Matrix3f rotation = world_from_sensor.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f origin = world_from_sensor.topRightCorner<3, 1>().cast<float>();
-  const HitWriter writer{impl_->user_id_of_geometry, images};
+  const HitWriter writer(impl_->user_id_of_geometry.data(), images);
   RTCScene scene = impl_->scene;
-  auto direction_at = [&](int row, int col) {
-    const cv::Vec3f& d = directions_in_sensor.at<cv::Vec3f>(row, col);
-    return Eigen::Vector3f(rotation * Eigen::Vector3f(d[0], d[1], d[2]));
+  const float r00 = rotation(0, 0), r01 = rotation(0, 1), r02 = rotation(0, 2);
+  const float r10 = rotation(1, 0), r11 = rotation(1, 1), r12 = rotation(1, 2);
+  const float r20 = rotation(2, 0), r21 = rotation(2, 1), r22 = rotation(2, 2);
+  auto direction_at = [&](int row, int col) __attribute__((always_inline)) {
+    const float* d = directions_in_sensor.ptr<float>(row) + 3 * col;
+    return Eigen::Vector3f(r00 * d[0] + r01 * d[1] + r02 * d[2], r10 * d[0] + r11 * d[1] + r12 * d[2],
+                           r20 * d[0] + r21 * d[1] + r22 * d[2]);
   };
   const int bands = (rows + kTileRows - 1) / kTileRows;
   ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
@@ -275,28 +310,66 @@ RayHitImages RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor,
           writer.Write(stream_cells[i].first, stream_cells[i].second, h.ray.tfar, h.hit.geomID, h.hit.primID,
                        h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.hit.u, h.hit.v);
         }
+      } else if (method == CastMethod::kPacket8) {
+        // 2 x 4 tiles (two rows of a band at a time).
+        alignas(32) RTCRayHit8 packet;
+        alignas(32) int valid[8];
+        for (int sub = row0; sub < row1; sub += 2) {
+          for (int col0 = 0; col0 < cols; col0 += 4) {
+            for (int i = 0; i < 8; ++i) {
+              const int row = sub + i / 4, col = col0 + i % 4;
+              const bool inside = row < row1 && col < cols;
+              valid[i] = inside ? -1 : 0;
+              const Eigen::Vector3f d = inside ? direction_at(row, col) : Eigen::Vector3f::UnitZ();
+              packet.ray.org_x[i] = origin.x();
+              packet.ray.org_y[i] = origin.y();
+              packet.ray.org_z[i] = origin.z();
+              packet.ray.dir_x[i] = d.x();
+              packet.ray.dir_y[i] = d.y();
+              packet.ray.dir_z[i] = d.z();
+              packet.ray.tnear[i] = t_near;
+              packet.ray.tfar[i] = t_far;
+              packet.ray.mask[i] = 0xFFFFFFFFu;
+              packet.ray.time[i] = 0.0f;
+              packet.ray.flags[i] = 0;
+              packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+              packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+              packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+            }
+            rtcIntersect8(valid, scene, &context, &packet);
+            for (int i = 0; i < 8; ++i) {
+              if (valid[i] == 0) continue;
+              writer.Write(sub + i / 4, col0 + i % 4, packet.ray.tfar[i], packet.hit.geomID[i],
+                           packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
+                           packet.hit.u[i], packet.hit.v[i]);
+            }
+          }
+        }
       } else {
         alignas(64) RTCRayHit16 packet;
         alignas(64) int valid[16];
+        // Fields Embree does not change are set once per band.
+        for (int i = 0; i < 16; ++i) {
+          packet.ray.org_x[i] = origin.x();
+          packet.ray.org_y[i] = origin.y();
+          packet.ray.org_z[i] = origin.z();
+          packet.ray.tnear[i] = t_near;
+          packet.ray.mask[i] = 0xFFFFFFFFu;
+          packet.ray.time[i] = 0.0f;
+          packet.ray.flags[i] = 0;
+        }
         for (int col0 = 0; col0 < cols; col0 += kTileCols) {
+          const bool full = row0 + kTileRows <= row1 && col0 + kTileCols <= cols;
           for (int i = 0; i < 16; ++i) {
             const int row = row0 + i / kTileCols, col = col0 + i % kTileCols;
-            const bool inside = row < row1 && col < cols;
+            const bool inside = full || (row < row1 && col < cols);
             valid[i] = inside ? -1 : 0;
             const Eigen::Vector3f d = inside ? direction_at(row, col) : Eigen::Vector3f::UnitZ();
-            packet.ray.org_x[i] = origin.x();
-            packet.ray.org_y[i] = origin.y();
-            packet.ray.org_z[i] = origin.z();
             packet.ray.dir_x[i] = d.x();
             packet.ray.dir_y[i] = d.y();
             packet.ray.dir_z[i] = d.z();
-            packet.ray.tnear[i] = t_near;
             packet.ray.tfar[i] = t_far;
-            packet.ray.mask[i] = 0xFFFFFFFFu;
-            packet.ray.time[i] = 0.0f;
-            packet.ray.flags[i] = 0;
             packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
             packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
           }
           rtcIntersect16(valid, scene, &context, &packet);
@@ -310,7 +383,6 @@ RayHitImages RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor,
       }
     }
   });
-  return images;
 }
 
 }  // namespace lidarshop

@@ -56,6 +56,7 @@ struct RayHitImages {
 enum class CastMethod {
   kPacket16,  // 4 x 4 tiles of neighbouring cells as rtcIntersect16 packets (coherent; the default, fastest
               // here)
+  kPacket8,   // 2 x 4 tiles as rtcIntersect8 packets (the native width of AVX2)
   kStream,    // rows of tiles as rtcIntersect1M streams with the coherent flag
   kSingle,    // one rtcIntersect1 per ray (Open3D's RaycastingScene way; the reference)
 };
@@ -101,6 +102,10 @@ class RaycastScene {
   RayHitImages CastImage(const Eigen::Matrix4d& world_from_sensor, const cv::Mat& directions_in_sensor,
                          float t_near = 0.0f, float t_far = std::numeric_limits<float>::infinity(),
                          CastMethod method = CastMethod::kPacket16) const;
+  // Same, writing into `hits` (its images are reused when they already have the right size and type: casting
+  // many ray images of one size allocates once).
+  void CastImage(const Eigen::Matrix4d& world_from_sensor, const cv::Mat& directions_in_sensor, float t_near,
+                 float t_far, CastMethod method, RayHitImages* hits) const;
 
   // For benchmarks and advanced callers: the RTCScene handle (opaque here to keep Embree out of this header).
   void* native_scene() const;

@@ -1,6 +1,7 @@
 #include "lidarshop/scanner/scanner.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -41,7 +42,69 @@ struct ObjectData {
   Material material;
   int32_t label = 0;
   bool has_texture_image = false;
+  // Per triangle: 1 where the vertex normals differ from the face normal (curved surfaces); empty when no
+  // triangle is curved (the geometric normal is then exact and no vertex normal is read).
+  std::vector<uint8_t> smooth;
 };
+
+// 65,536 standard-normal quantiles Φ^-1((i + 0.5) / 65536): Acklam's rational approximation refined by one
+// Halley step with erfc (accurate to ~1e-15).
+const std::vector<float>& NormalQuantiles() {
+  static const std::vector<float> table = [] {
+    constexpr double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                            1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+    constexpr double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                            6.680131188771972e+01, -1.328068155288572e+01};
+    constexpr double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                            -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+    constexpr double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                            3.754408661907416e+00};
+    std::vector<float> quantiles(4097);
+    for (int i = 0; i <= 4096; ++i) {
+      const double p = std::clamp(i / 4096.0, 0.5 / 65536.0, 1.0 - 0.5 / 65536.0);
+      double x;
+      if (p < 0.02425) {
+        const double q = std::sqrt(-2 * std::log(p));
+        x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+            ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+      } else if (p <= 1 - 0.02425) {
+        const double q = p - 0.5, r = q * q;
+        x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+            (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1);
+      } else {
+        const double q = std::sqrt(-2 * std::log(1 - p));
+        x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+            ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1);
+      }
+      const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
+      const double u = e * std::sqrt(2 * M_PI) * std::exp(x * x / 2);
+      x = x - u / (1 + x * u / 2);
+      quantiles[i] = static_cast<float>(x);
+    }
+    return quantiles;
+  }();
+  return table;
+}
+
+// A standard normal from 16 uniform bits (inverse-CDF sampling through the quantile table).
+inline float NormalFrom16Bits(const float* quantiles, uint32_t bits) {
+  const uint32_t index = bits >> 4;
+  const float fraction = static_cast<float>(bits & 15u) * (1.0f / 16.0f) + (1.0f / 32.0f);
+  return quantiles[index] + fraction * (quantiles[index + 1] - quantiles[index]);
+}
+
+// cos and sin of (i + 0.5) * 2π / 1024.
+const std::vector<Eigen::Vector2f>& UnitCircle() {
+  static const std::vector<Eigen::Vector2f> table = [] {
+    std::vector<Eigen::Vector2f> circle(1024);
+    for (int i = 0; i < 1024; ++i) {
+      const double angle = (i + 0.5) * 2 * M_PI / 1024;
+      circle[i] = Eigen::Vector2f(static_cast<float>(std::cos(angle)), static_cast<float>(std::sin(angle)));
+    }
+    return circle;
+  }();
+  return table;
+}
 
 inline float Luminance(Rgb8 color) {
   return (0.299f * color[0] + 0.587f * color[1] + 0.114f * color[2]) / 255.0f;
@@ -50,6 +113,7 @@ inline float Luminance(Rgb8 color) {
 }  // namespace
 
 struct SyntheticScanner::Impl {
+  explicit Impl(const RaycastSceneOptions& options) : raycast(options) {}
   RaycastScene raycast;
   std::vector<ObjectData> objects;
   int64_t num_triangles = 0;
@@ -61,7 +125,8 @@ double CellUniform(uint64_t seed, uint64_t cell, uint32_t stream) {
 }
 double CellNormal(uint64_t seed, uint64_t cell, uint32_t stream) { return Normal(seed, cell, 1000 + stream); }
 
-SyntheticScanner::SyntheticScanner(const SceneDescription& scene) : impl_(std::make_unique<Impl>()) {
+SyntheticScanner::SyntheticScanner(const SceneDescription& scene, const RaycastSceneOptions& raycast_options)
+    : impl_(std::make_unique<Impl>(raycast_options)) {
   Timer timer;
   impl_->objects.resize(scene.objects.size());
   ParallelFor(static_cast<int64_t>(scene.objects.size()), [&](int64_t i) {
@@ -76,6 +141,22 @@ SyntheticScanner::SyntheticScanner(const SceneDescription& scene) : impl_(std::m
     data.material = object.material;
     data.label = object.label;
     data.has_texture_image = !object.mesh.texture.empty() && !object.mesh.triangle_texcoords.empty();
+    const TriangleMesh& mesh = data.mesh_in_world;
+    if (!mesh.vertex_normals.empty()) {
+      data.smooth.resize(mesh.triangles.size(), 0);
+      bool any = false;
+      for (size_t f = 0; f < mesh.triangles.size(); ++f) {
+        const Eigen::Vector3i& t = mesh.triangles[f];
+        const Eigen::Vector3f face = (mesh.vertices[t[1]] - mesh.vertices[t[0]])
+                                         .cross(mesh.vertices[t[2]] - mesh.vertices[t[0]])
+                                         .normalized();
+        for (int corner = 0; corner < 3; ++corner) {
+          if (mesh.vertex_normals[t[corner]].dot(face) < 1.0f - 1e-6f) data.smooth[f] = 1;
+        }
+        any = any || data.smooth[f];
+      }
+      if (!any) data.smooth.clear();
+    }
   });
   for (size_t i = 0; i < impl_->objects.size(); ++i) {
     impl_->raycast.AddMesh(impl_->objects[i].mesh_in_world, static_cast<int32_t>(i));
@@ -94,16 +175,44 @@ int64_t SyntheticScanner::num_triangles() const { return impl_->num_triangles; }
 double SyntheticScanner::build_seconds() const { return impl_->build_seconds; }
 
 Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress, ScanStats* stats) const {
+  Scan scan;
+  AcquireInto(options, &scan, progress, stats);
+  return scan;
+}
+
+void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out, Progress* progress,
+                                   ScanStats* stats) const {
   options.Check();
   const int rows = options.rows, cols = options.columns;
-  Scan scan = MakeScan(rows, cols, /*with_color=*/true);
+  // Every channel is written for every cell by the loops below, so nothing is pre-filled.
+  Scan& scan = *scan_out;
+  scan.synthesized.release();
+  scan.rows = rows;
+  scan.cols = cols;
   scan.name = "synthetic";
   scan.grid = options.Grid();
-  scan.direction = DirectionsFromGrid(scan.grid);
   scan.world_from_scanner = options.WorldFromScanner();
-  scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
-  scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
-  scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  scan.direction.create(rows, cols, CV_32FC3);
+  scan.valid.create(rows, cols, CV_8U);
+  scan.range.create(rows, cols, CV_32F);
+  scan.point.create(rows, cols, CV_32FC3);
+  scan.intensity.create(rows, cols, CV_32F);
+  scan.color.create(rows, cols, CV_8UC3);
+  scan.label.create(rows, cols, CV_32S);
+  scan.normal.create(rows, cols, CV_32FC3);
+  scan.true_range.create(rows, cols, CV_32F);
+
+  // Directions exactly as DirectionsFromGrid (double products, then float), from per-row and per-column
+  // sines.
+  std::vector<double> sin_azimuth(cols), cos_azimuth(cols), sin_elevation(rows), cos_elevation(rows);
+  for (int col = 0; col < cols; ++col) {
+    sin_azimuth[col] = std::sin(scan.grid.azimuth_rad[col]);
+    cos_azimuth[col] = std::cos(scan.grid.azimuth_rad[col]);
+  }
+  for (int row = 0; row < rows; ++row) {
+    sin_elevation[row] = std::sin(scan.grid.elevation_rad[row]);
+    cos_elevation[row] = std::cos(scan.grid.elevation_rad[row]);
+  }
 
   const Eigen::Matrix3f world_from_scanner_rotation =
       scan.world_from_scanner.topLeftCorner<3, 3>().cast<float>();
@@ -111,21 +220,42 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
   const Eigen::Vector3f origin = options.position.cast<float>();
   const float los_sigma = static_cast<float>(options.los_noise_sigma_m);
   const float orthogonal_sigma = static_cast<float>(options.orthogonal_noise_sigma_m);
-  const float inverse_falloff = static_cast<float>(1.0 / options.intensity_falloff_m);
   const bool noisy = los_sigma > 0 || orthogonal_sigma > 0;
+  const uint64_t seed_key = SplitMix64(options.seed ^ 0x5851F42D4C957F2Dull);
   const std::vector<ObjectData>& objects = impl_->objects;
 
   // Rows are cast and shaded in chunks, so that progress moves and the hit images of a chunk stay in cache.
   const int chunk_rows = std::clamp(rows / 16, 16, 128);
   ScanStats local_stats;
   local_stats.rays = scan.num_cells();
+  std::atomic<int64_t> returns{0};
+  RayHitImages hits;
+  const std::vector<float>& quantiles = NormalQuantiles();
+  const std::vector<Eigen::Vector2f>& circle = UnitCircle();
+  // exp(-t / falloff) tabulated over [0, max range] (linear interpolation, relative error < 1e-6).
+  constexpr int kFalloffSteps = 1024;
+  std::vector<float> falloff(kFalloffSteps + 2);
+  const float falloff_step = static_cast<float>(options.max_range_m / kFalloffSteps);
+  for (int i = 0; i < kFalloffSteps + 2; ++i) {
+    falloff[i] =
+        static_cast<float>(std::exp(-i * options.max_range_m / kFalloffSteps / options.intensity_falloff_m));
+  }
   Timer timer;
   for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
     const int chunk_end = std::min(rows, chunk_begin + chunk_rows);
     timer.Restart();
-    const RayHitImages hits = impl_->raycast.CastImage(
-        scan.world_from_scanner, scan.direction.rowRange(chunk_begin, chunk_end),
-        static_cast<float>(options.min_range_m), static_cast<float>(options.max_range_m));
+    ParallelFor(chunk_end - chunk_begin, [&](int64_t chunk_row) {
+      const int row = chunk_begin + static_cast<int>(chunk_row);
+      auto* direction = scan.direction.ptr<cv::Vec3f>(row);
+      for (int col = 0; col < cols; ++col) {
+        direction[col] = cv::Vec3f(static_cast<float>(cos_elevation[row] * sin_azimuth[col]),
+                                   static_cast<float>(cos_elevation[row] * cos_azimuth[col]),
+                                   static_cast<float>(sin_elevation[row]));
+      }
+    });
+    impl_->raycast.CastImage(scan.world_from_scanner, scan.direction.rowRange(chunk_begin, chunk_end),
+                             static_cast<float>(options.min_range_m), static_cast<float>(options.max_range_m),
+                             options.cast_method, &hits);
     local_stats.cast_seconds += timer.Seconds();
     timer.Restart();
     ParallelFor(
@@ -147,9 +277,21 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
           auto* label = scan.label.ptr<int32_t>(row);
           auto* normal = scan.normal.ptr<cv::Vec3f>(row);
           auto* true_range = scan.true_range.ptr<float>(row);
+          int64_t row_returns = 0;
           for (int col = 0; col < cols; ++col) {
             const int32_t id = geometry_id[col];
-            if (id < 0) continue;
+            if (id < 0) {
+              valid[col] = 0;
+              range[col] = 0.0f;
+              point[col] = cv::Vec3f(0, 0, 0);
+              intensity[col] = 0.5f;
+              color[col] = cv::Vec3b(0, 0, 0);
+              label[col] = kNoLabel;
+              normal[col] = cv::Vec3f(0, 0, 0);
+              true_range[col] = 0.0f;
+              continue;
+            }
+            ++row_returns;
             const ObjectData& object = objects[id];
             const TriangleMesh& mesh = object.mesh_in_world;
             const int32_t triangle = primitive_id[col];
@@ -160,7 +302,7 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
             const Eigen::Vector3i& corners = mesh.triangles[triangle];
             Eigen::Vector3f n_world(geometric_normal[col][0], geometric_normal[col][1],
                                     geometric_normal[col][2]);
-            if (!mesh.vertex_normals.empty()) {
+            if (!object.smooth.empty() && object.smooth[triangle]) {
               const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] +
                                              u * mesh.vertex_normals[corners[1]] +
                                              v * mesh.vertex_normals[corners[2]];
@@ -196,24 +338,25 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
               surface = SampleImageTexture(mesh.texture, st.x(), st.y());
             }
             const float reflectivity = object.material.reflectivity * (0.5f + Luminance(surface));
-            intensity[col] =
-                std::clamp(reflectivity * cos_incidence * std::exp(-t * inverse_falloff), 0.0f, 1.0f);
+            const float f = std::clamp(t / falloff_step, 0.0f, static_cast<float>(kFalloffSteps));
+            const int fi = static_cast<int>(f);
+            const float attenuation = falloff[fi] + (f - fi) * (falloff[fi + 1] - falloff[fi]);
+            intensity[col] = std::clamp(reflectivity * cos_incidence * attenuation, 0.0f, 1.0f);
 
             Eigen::Vector3f p = t * d_scanner;
             if (noisy) {
-              const uint64_t cell = static_cast<uint64_t>(row) * cols + col;
-              const float e_los =
-                  los_sigma > 0 ? los_sigma * static_cast<float>(Normal(options.seed, cell, 0)) : 0.0f;
-              p += e_los * d_scanner;
+              // One 64-bit hash per cell: 16 bits for e_los, 16 for e_orth, 10 for ψ.
+              const uint64_t bits = SplitMix64(seed_key ^ (static_cast<uint64_t>(row) * cols + col));
+              p += (los_sigma * NormalFrom16Bits(quantiles.data(), bits & 0xFFFFu)) * d_scanner;
               if (orthogonal_sigma > 0) {
-                const float e_orthogonal =
-                    orthogonal_sigma * static_cast<float>(Normal(options.seed, cell, 1));
-                const float psi = static_cast<float>(2.0 * M_PI * Uniform(options.seed, cell, 4));
-                Eigen::Vector3f b1 = d_scanner.cross(Eigen::Vector3f::UnitZ());
-                if (b1.squaredNorm() < 1e-8f) b1 = d_scanner.cross(Eigen::Vector3f::UnitX());
+                Eigen::Vector3f b1(d_scanner.y(), -d_scanner.x(), 0.0f);  // d x z
+                if (b1.squaredNorm() < 1e-8f)
+                  b1 = Eigen::Vector3f(0.0f, d_scanner.z(), -d_scanner.y());  // d x x
                 b1.normalize();
                 const Eigen::Vector3f b2 = d_scanner.cross(b1);
-                p += e_orthogonal * (std::cos(psi) * b1 + std::sin(psi) * b2);
+                const Eigen::Vector2f& psi = circle[(bits >> 32) & 0x3FFu];
+                p += (orthogonal_sigma * NormalFrom16Bits(quantiles.data(), (bits >> 16) & 0xFFFFu)) *
+                     (psi.x() * b1 + psi.y() * b2);
               }
             }
             const Eigen::Vector3f n_scanner = scanner_from_world_rotation * n_world;
@@ -225,14 +368,14 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
             label[col] = object.label;
             normal[col] = cv::Vec3f(n_scanner.x(), n_scanner.y(), n_scanner.z());
           }
+          returns += row_returns;
         },
         4);
     local_stats.shade_seconds += timer.Seconds();
     Advance(progress, chunk_end - chunk_begin);
   }
-  local_stats.returns = scan.CountValid();
+  local_stats.returns = returns.load();
   if (stats != nullptr) *stats = local_stats;
-  return scan;
 }
 
 Scan SynthesizeScan(const SceneDescription& scene, Progress* progress) {

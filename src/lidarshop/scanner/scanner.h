@@ -12,7 +12,9 @@
 // Noise (per cell, from a counter-based hash of (seed, cell index), so identical whatever the thread count):
 //   point = (true_range + e_los) · d + e_orth · (cos ψ · b1 + sin ψ · b2), e_los ~ N(0, σ_los²),
 //   e_orth ~ N(0, σ_orth²), ψ ~ U[0, 2π), (b1, b2) an orthonormal basis perpendicular to the ray d.
-//   range = |point|.
+//   range = |point|. One SplitMix64 hash of (seed, row * cols + col) gives two independent 16-bit uniforms
+//   mapped to standard normals through a 4,097-entry quantile table (inverse-CDF sampling, |e| <= 4.17 σ) and
+//   10 bits for ψ.
 //
 // Build once, scan many: SyntheticScanner builds the ray-casting scene of a SceneDescription once; Acquire()
 // can then be called for any ScannerOptions (other poses, grids, noise).
@@ -37,13 +39,19 @@ struct ScanStats {
 class SyntheticScanner {
  public:
   // Builds the ray-casting scene (object i gets geometry id i). Throws InputError for a broken mesh.
-  explicit SyntheticScanner(const SceneDescription& scene);
+  // `raycast_options` tune Embree (build quality, robust traversal); the defaults were chosen by measurement
+  // (bench/results/scanner.md).
+  explicit SyntheticScanner(const SceneDescription& scene, const RaycastSceneOptions& raycast_options = {});
   ~SyntheticScanner();
   SyntheticScanner(SyntheticScanner&&) noexcept;
   SyntheticScanner& operator=(SyntheticScanner&&) noexcept;
 
   // One scan with `options` (throws OptionsError from options.Check()). `progress` advances by rows.
   Scan Acquire(const ScannerOptions& options, Progress* progress = nullptr, ScanStats* stats = nullptr) const;
+  // Same, into `scan`, whose channel buffers are reused when they have the right size (scanning many poses or
+  // seeds allocates once). Buffers shared with other Scans are overwritten: pass a Scan you own.
+  void AcquireInto(const ScannerOptions& options, Scan* scan, Progress* progress = nullptr,
+                   ScanStats* stats = nullptr) const;
 
   const RaycastScene& raycast_scene() const;
   int64_t num_triangles() const;

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/raycast/raycast.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/texture.h"
 
@@ -48,6 +49,8 @@ struct ScannerOptions {
   // Intensity model: I = clamp(ρ_eff · |cos α| · exp(-r / intensity_falloff_m), 0, 1) with α the incidence
   // angle and ρ_eff = reflectivity · (0.5 + luminance of the surface colour in [0, 1]); metres.
   double intensity_falloff_m = 150.0;
+  // How rays are traced (speed only: every method gives the same hits). Not part of scene files.
+  CastMethod cast_method = CastMethod::kPacket16;
 
   void Check() const;  // throws OptionsError
   Eigen::Matrix4d WorldFromScanner() const;

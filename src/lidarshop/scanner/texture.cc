@@ -21,6 +21,12 @@ inline uint32_t Hash(int32_t x, int32_t y, uint32_t salt) {
   return h;
 }
 
+// floor without SSE4.1's roundss (the Debian baseline is x86-64): a truncation and a compare.
+inline float FastFloor(float x) {
+  const float t = static_cast<float>(static_cast<int32_t>(x));
+  return t > x ? t - 1.0f : t;
+}
+
 // Uniform in [0, 1).
 inline float Hash01(int32_t x, int32_t y, uint32_t salt) {
   return (Hash(x, y, salt) >> 8) * (1.0f / 16777216.0f);
@@ -28,7 +34,7 @@ inline float Hash01(int32_t x, int32_t y, uint32_t salt) {
 
 // Smooth value noise in [0, 1) with unit lattice spacing.
 inline float ValueNoise(float x, float y, uint32_t salt) {
-  const float fx = std::floor(x), fy = std::floor(y);
+  const float fx = FastFloor(x), fy = FastFloor(y);
   const int32_t ix = static_cast<int32_t>(fx), iy = static_cast<int32_t>(fy);
   float tx = x - fx, ty = y - fy;
   tx = tx * tx * (3 - 2 * tx);
@@ -100,11 +106,12 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale)
     case TextureKind::kNone:
       return base;
     case TextureKind::kChecker: {
-      const int parity = (static_cast<int>(std::floor(u)) + static_cast<int>(std::floor(v))) & 1;
+      const int parity = (static_cast<int>(FastFloor(u)) + static_cast<int>(FastFloor(v))) & 1;
       return parity ? Shade(base, 0.3f) : base;
     }
     case TextureKind::kGrass: {
-      const float blades = ValueNoise(u * 33.0f, v * 33.0f, 11);
+      const float blades =
+          Hash01(static_cast<int32_t>(FastFloor(u * 33.0f)), static_cast<int32_t>(FastFloor(v * 33.0f)), 11);
       const float clumps = ValueNoise(u * 2.5f, v * 2.5f, 12);
       const float dry = ValueNoise(u * 0.33f, v * 0.33f, 13);
       const Rgb8 green = Shade(base, 0.55f + 0.5f * blades + 0.25f * (clumps - 0.5f));
@@ -113,15 +120,16 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale)
     }
     case TextureKind::kGravel: {
       const float size = 0.03f;
-      const float row = std::floor(v / size);
+      const float row = FastFloor(v / size);
       const float shifted = u / size + 0.5f * (static_cast<int>(row) & 1);
-      const float col = std::floor(shifted);
+      const float col = FastFloor(shifted);
       const float fu = shifted - col, fv = v / size - row;
-      const int32_t ci = static_cast<int32_t>(col), ri = static_cast<int32_t>(row);
+      // One hash per stone: 8 bits each for the gap width, the shade and the warmth.
+      const uint32_t h = Hash(static_cast<int32_t>(col), static_cast<int32_t>(row), 21);
       const float edge = std::min(std::min(fu, 1 - fu), std::min(fv, 1 - fv));
-      if (edge < 0.08f + 0.1f * Hash01(ci, ri, 23)) return Shade(base, 0.35f);
-      const float shade = 0.65f + 0.6f * Hash01(ci, ri, 21);
-      const float warm = Hash01(ci, ri, 22) - 0.5f;
+      if (edge < 0.08f + 0.1f / 255.0f * (h & 0xFFu)) return Shade(base, 0.35f);
+      const float shade = 0.65f + 0.6f / 255.0f * ((h >> 8) & 0xFFu);
+      const float warm = ((h >> 16) & 0xFFu) / 255.0f - 0.5f;
       Rgb8 stone = Shade(base, shade);
       stone[0] = static_cast<uint8_t>(std::clamp(stone[0] * (1 + 0.15f * warm), 0.0f, 255.0f));
       stone[2] = static_cast<uint8_t>(std::clamp(stone[2] * (1 - 0.15f * warm), 0.0f, 255.0f));
@@ -129,13 +137,16 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale)
     }
     case TextureKind::kBrick: {
       const float course_height = 0.075f, brick_pitch = 0.225f, joint = 0.01f;
-      const float course = std::floor(v / course_height);
+      const float course = FastFloor(v / course_height);
       const float shifted = u + (static_cast<int>(course) & 1) * (brick_pitch / 2);
-      const float column = std::floor(shifted / brick_pitch);
+      const float column = FastFloor(shifted / brick_pitch);
       const float in_u = shifted - column * brick_pitch, in_v = v - course * course_height;
       if (in_u < joint || in_v < joint) return Rgb8(188, 182, 170);
       const int32_t ci = static_cast<int32_t>(column), ri = static_cast<int32_t>(course);
-      const float shade = 0.8f + 0.35f * Hash01(ci, ri, 31) + 0.12f * (ValueNoise(u * 60, v * 60, 32) - 0.5f);
+      // Per-brick shade plus a 1.5 cm speckle.
+      const float speckle =
+          Hash01(static_cast<int32_t>(FastFloor(u * 66.0f)), static_cast<int32_t>(FastFloor(v * 66.0f)), 32);
+      const float shade = 0.8f + 0.35f * Hash01(ci, ri, 31) + 0.12f * (speckle - 0.5f);
       return Shade(base, shade);
     }
   }
@@ -144,8 +155,8 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale)
 
 Rgb8 SampleImageTexture(const cv::Mat& texture, float s, float t) {
   if (texture.empty()) return Rgb8(180, 180, 180);
-  s -= std::floor(s);
-  t -= std::floor(t);
+  s -= FastFloor(s);
+  t -= FastFloor(t);
   const int col = std::clamp(static_cast<int>(s * texture.cols), 0, texture.cols - 1);
   const int row = std::clamp(static_cast<int>((1 - t) * texture.rows), 0, texture.rows - 1);
   const cv::Vec3b& pixel = texture.at<cv::Vec3b>(row, col);
