@@ -84,7 +84,9 @@ int main(int argc, char** argv) {
     emit(fmt::format("\n### Appearance model: {} ({} scenes x {} stroke seeds)\n\n", ToString(m),
                      scene_paths.size(), seeds));
     emit("| scene | cells | object | " + fmt::format("{}", fmt::join(order, " | ")) + " |\n");
-    emit("|---|---|---|" + std::string(order.size() * 4, '-') + "\n");
+    std::string separator = "|---|---|---|";
+    for (size_t k = 0; k < order.size(); ++k) separator += "---|";
+    emit(separator + "\n");
     for (const std::string& path : scene_paths) {
       const SceneDescription scene = LoadScene(path);
       const Scan scan = SynthesizeScan(scene);
