@@ -11,6 +11,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
@@ -132,6 +133,18 @@ void WriteText(const std::string& path, const std::string& text) {
   WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
 }
 
+// A mesh file, or "builtin:sedan" / "builtin:hatchback" / "builtin:van": the scanner module's procedural cars
+// (the ones of data/scenes/parking_lot.json), in their own frame (standing on z = 0, length along y).
+TriangleMesh LoadModel(const std::string& path) {
+  const std::string prefix = "builtin:";
+  if (path.rfind(prefix, 0) == 0) {
+    CarMeshOptions options;
+    options.style = ParseCarStyle(path.substr(prefix.size()), "--model");
+    return MakeCarMesh(options);
+  }
+  return ReadMesh(path);
+}
+
 struct CommonFlags {
   std::vector<std::string> scans;
   std::string model;
@@ -144,7 +157,10 @@ struct CommonFlags {
   void Add(CLI::App& app) {
     app.add_option("--scan", scans, "scan file (.ptx, .e57, .ply, .pcd); repeat for several registered scans")
         ->required();
-    app.add_option("--model", model, "model mesh (.obj, .ply) in its own frame, metres")->required();
+    app.add_option("--model", model,
+                   "model mesh (.obj, .ply) in its own frame, metres; or builtin:sedan|hatchback|van "
+                   "(procedural cars)")
+        ->required();
     app.add_option(
            "--allowance", verify.allowance_m,
            "mismatch allowance a, metres (consistency: (d_m + a) - d_s >= 0); ~2-3x range noise + model "
@@ -173,7 +189,7 @@ struct CommonFlags {
     if (distinctiveness) model_options.information = InformationWeighting::kShapeDistinctiveness;
     model_options.Check();
     verify.Check();
-    return PrepareModel(ReadMesh(model), model_options, verify);
+    return PrepareModel(LoadModel(model), model_options, verify);
   }
 };
 
