@@ -1,4 +1,5 @@
 // lidarshop inpaint: greedy patch-based inpainting of an image (inpaint/inpaint.h, docs/inpaint.md).
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -70,6 +71,12 @@ int RunInpaint(int argc, char** argv) {
           fmt::format("mask is {}x{} but the image is {}x{}", mask.cols, mask.rows, input.cols, input.rows));
     }
     mask = mask > 127;
+    std::string extension = std::filesystem::path(output_path).extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+    if ((input.depth() == CV_32F || input.depth() == CV_64F) &&
+        (extension == ".png" || extension == ".jpg" || extension == ".jpeg")) {
+      ThrowInputError(output_path, "", "", "a float image must be written as .exr or .tif");
+    }
     cv::Mat image;
     input.convertTo(image, CV_32F);
     // Data-term scale: the intensity range (255 for 8-bit images).

@@ -97,7 +97,8 @@ struct PatchMatchOptions {
 //  * random search: samples around the current best at radii max(H, W)·αⁱ down to 1 pixel;
 //  * `random_samples` uniform draws over the image and `local_samples` draws near the target. The random
 //  stream is seeded from (seed, target); the search runs on one
-//    thread, so the fill is a deterministic function of (inputs, seed).
+//    thread, so the fill is a deterministic function of (inputs, seed). It remembers the offsets of its last
+//    answers: use a fresh object per fill.
 class PatchMatchSearch : public PatchSearch {
  public:
   explicit PatchMatchSearch(PatchMatchOptions options);
