@@ -456,14 +456,16 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
             const uint32_t i = grid.indices[k];
             const float distance_sq = (model_points[i] - point_in_model).squaredNorm();
             if (distance_sq < kernel_radius_sq) {
-              sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
+              // Only min(1, sum) matters: a saturated point needs no more exp (exact, and most of the cost).
+              if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
               closest_sq = std::min(closest_sq, distance_sq);
             }
           }
         } else {
           model.points_in_model.ForEachInRadius(point_in_model, kernel_radius,
                                                 [&](uint32_t i, float distance_sq) {
-                                                  sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
+                                                  if (sum[i] < 1.0f)
+                                                    sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
                                                   closest_sq = std::min(closest_sq, distance_sq);
                                                 });
         }
