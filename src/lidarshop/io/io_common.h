@@ -24,6 +24,15 @@ void FinishScan(Scan* scan, bool fit_grid);
 // An image as CV_8UC3 RGB (grey and RGBA converted, 16-bit scaled down), for mesh textures.
 cv::Mat TextureToRgb8(const cv::Mat& image);
 
+// `value` as an int32 when it is a whole number in range, else `fallback` (no undefined float-to-int casts on
+// hostile input).
+inline int32_t ToInt32(double value, int32_t fallback = -1) {
+  return value >= -2147483648.0 && value <= 2147483647.0 &&
+                 value == static_cast<double>(static_cast<int64_t>(value))
+             ? static_cast<int32_t>(value)
+             : fallback;
+}
+
 // Appends the shortest decimal form of `value` that reads back to the same float/double (std::to_chars).
 void AppendNumber(std::string* out, float value);
 void AppendNumber(std::string* out, double value);

@@ -51,9 +51,8 @@ TriangleMesh MeshFromPly(const PlyData& ply, const std::string& path) {
                       fmt::format("a face needs 3 vertices, found {}", end - begin));
     }
     for (int64_t i = begin + 1; i + 1 < end; ++i) {
-      mesh.triangles.emplace_back(static_cast<int>(indices->values[begin]),
-                                  static_cast<int>(indices->values[i]),
-                                  static_cast<int>(indices->values[i + 1]));
+      mesh.triangles.emplace_back(ToInt32(indices->values[begin]), ToInt32(indices->values[i]),
+                                  ToInt32(indices->values[i + 1]));
       if (!face_colors.empty()) mesh.triangle_colors.push_back(face_colors[f]);
       if (face_texcoord != nullptr && face_texcoord->is_list &&
           face_texcoord->offsets[f + 1] - face_texcoord->offsets[f] == 2 * (end - begin)) {

@@ -343,7 +343,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       }
       if (flabel >= 0) {
         scan.label.at<int32_t>(row, col) =
-            static_cast<int32_t>(LoadValue(record + f[flabel].offset, f[flabel]));
+            io_internal::ToInt32(LoadValue(record + f[flabel].offset, f[flabel]), kNoLabel);
       }
       if (normals) {
         const double nx = LoadValue(record + f[fnx].offset, f[fnx]);

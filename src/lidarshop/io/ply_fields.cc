@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/io/io_common.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::io_internal {
@@ -97,7 +98,7 @@ PointCloud PointCloudFromPly(const PlyData& ply, const std::string& file) {
   }
   if (const PlyProperty* p = FindScalar(vertex, {"label", "scalar_label", "class", "classification"})) {
     cloud.labels.reserve(p->values.size());
-    for (double value : p->values) cloud.labels.push_back(static_cast<int32_t>(value));
+    for (double value : p->values) cloud.labels.push_back(ToInt32(value, kNoLabel));
   }
   if (const PlyProperty* p = FindScalar(vertex, {"synthesized"})) {
     cloud.synthesized.reserve(p->values.size());

@@ -102,9 +102,9 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     scans.push_back(std::move(scan));
   }
   for (size_t i = 0; i < cloud.size(); ++i) {
-    const int64_t index = scan_property != nullptr ? static_cast<int64_t>(scan_property->values[i]) : 0;
-    const int64_t row = static_cast<int64_t>(row_property->values[i]);
-    const int64_t col = static_cast<int64_t>(col_property->values[i]);
+    const int64_t index = scan_property != nullptr ? ToInt32(scan_property->values[i]) : 0;
+    const int64_t row = ToInt32(row_property->values[i]);
+    const int64_t col = ToInt32(col_property->values[i]);
     if (index < 0 || index >= static_cast<int64_t>(scans.size()) || row < 0 || row >= scans[index].rows ||
         col < 0 || col >= scans[index].cols) {
       ThrowInputError(
