@@ -464,8 +464,24 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
   }
   int64_t duplicates = 0;
   std::vector<uint8_t> has_direction(static_cast<size_t>(rows * cols), 0);
+  // Several records of one grid cell are several returns of one ray, which E57 marks with returnIndex.
+  // Without it, two records claiming the same rowIndex/columnIndex contradict the grid: the file is corrupt
+  // (e.g. zeroed compressed-vector data), and guessing which record to keep would be a silent wrong answer.
+  const bool has_return_index = find("returnIndex") != nullptr;
+  std::vector<int64_t> first_record_of_cell;
+  if (structured && !has_return_index) first_record_of_cell.assign(static_cast<size_t>(rows * cols), -1);
   for (int64_t i = 0; i < record_count; ++i) {
     const int64_t c = cell[i];
+    if (!first_record_of_cell.empty()) {
+      if (first_record_of_cell[c] >= 0) {
+        XmlError(ctx, points,
+                 fmt::format("records {} and {} both claim row {}, column {} and the prototype has no "
+                             "returnIndex: the grid indices are corrupt",
+                             first_record_of_cell[c], i, c / std::max<int64_t>(cols, 1),
+                             c % std::max<int64_t>(cols, 1)));
+      }
+      first_record_of_cell[c] = i;
+    }
     const int r = static_cast<int>(c / std::max<int64_t>(cols, 1));
     const int k = static_cast<int>(c % std::max<int64_t>(cols, 1));
     const cv::Vec3f p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);

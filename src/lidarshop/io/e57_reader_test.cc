@@ -219,14 +219,16 @@ TEST(E57Reader, CorruptChecksumNamesThePage) {
   }
 }
 
-TEST(E57Reader, ReadErrorFileIsValidButDegenerate) {
-  // All checksums hold and every bytestream holds its 2651 records (it reproduces a read bug of another
-  // library), but every record is zero: 2651 records at row 0 / column 0 with range 0, i.e. no return.
-  const E57File f = ReadE57(kDir + "read_error.e57");
-  ASSERT_EQ(f.scans.size(), 1u);
-  EXPECT_EQ(f.scans[0].rows, 1);
-  EXPECT_EQ(f.scans[0].cols, 1);
-  EXPECT_EQ(f.scans[0].CountValid(), 0);
+TEST(E57Reader, ReadErrorFileFailsWithClearMessage) {
+  // All checksums hold, but every one of its 2651 records claims row 0 / column 0 (zeroed data, as written by
+  // the read bug this file reproduces) and the prototype has no returnIndex: the grid is contradictory.
+  try {
+    ReadE57(kDir + "read_error.e57");
+    FAIL() << "read_error.e57 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("read_error.e57"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("both claim row 0, column 0"));
+  }
 }
 
 TEST(E57Reader, MissingFileAndNotE57) {
