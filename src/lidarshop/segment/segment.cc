@@ -560,8 +560,49 @@ constexpr uint8_t kFree = 0, kHardObject = 1, kHardBackground = 2;
 
 struct Cut {
   std::unique_ptr<Graph> graph;
-  float hard_cap = 0;  // capacity of a hard t-link
+  float hard_cap = 0;                       // capacity of a hard t-link
+  std::vector<float> source_cap, sink_cap;  // #nodes: the t-link capacities given to the graph so far
+  const CutWeights* weights = nullptr;      // the weights the graph was built with
 };
+
+// t-link capacities (source = object side, i.e. the cost of labelling the node background; sink = the cost of
+// labelling it object) for every node from the models, or the hard capacity for hard nodes. `hard_cap` <= 0
+// means "compute it" (1 + 8γ + the largest data cost) and returns it there.
+void TLinkCapacities(const LogDensities& logp, const CutWeights& w, const std::vector<uint8_t>& hard,
+                     float* hard_cap, std::vector<float>* source_cap, std::vector<float>* sink_cap) {
+  const int n = static_cast<int>(hard.size());
+  const float ac = static_cast<float>(w.color_data_weight), ad = static_cast<float>(w.depth_data_weight);
+  const float bias = static_cast<float>(w.foreground_bias);
+  source_cap->resize(n);
+  sink_cap->resize(n);
+  ParallelForRange(
+      n,
+      [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) {
+          float cost_object = -(ac * logp.color_object[i] + ad * logp.depth_object[i]) + bias;
+          float cost_background = -(ac * logp.color_background[i] + ad * logp.depth_background[i]);
+          // Only the difference matters; keep both non-negative.
+          const float m = std::min(cost_object, cost_background);
+          (*source_cap)[i] = cost_background - m;
+          (*sink_cap)[i] = cost_object - m;
+        }
+      },
+      4096);
+  if (*hard_cap <= 0) {
+    float max_cost = 0;
+    for (int i = 0; i < n; ++i) max_cost = std::max({max_cost, (*source_cap)[i], (*sink_cap)[i]});
+    *hard_cap = static_cast<float>(1.0 + 8.0 * w.smoothness + max_cost);
+  }
+  for (int i = 0; i < n; ++i) {
+    if (hard[i] == kHardObject) {
+      (*source_cap)[i] = *hard_cap;
+      (*sink_cap)[i] = 0;
+    } else if (hard[i] == kHardBackground) {
+      (*source_cap)[i] = 0;
+      (*sink_cap)[i] = *hard_cap;
+    }
+  }
+}
 
 // Builds the graph of one cut and runs the max-flow. `hard` holds kFree / kHardObject / kHardBackground per
 // node.
@@ -577,35 +618,9 @@ Cut BuildAndCut(const Nodes& nodes, const NLinks& links, const LogDensities& log
   Graph& g = *cut.graph;
   g.add_node(n);
   // A hard t-link outweighs every n-link of its node and every data cost.
-  const float ac = static_cast<float>(w.color_data_weight), ad = static_cast<float>(w.depth_data_weight);
-  const float bias = static_cast<float>(w.foreground_bias);
-  std::vector<float> cost_object(n), cost_background(n);
-  ParallelForRange(
-      n,
-      [&](int64_t begin, int64_t end) {
-        for (int64_t i = begin; i < end; ++i) {
-          cost_object[i] = -(ac * logp.color_object[i] + ad * logp.depth_object[i]) + bias;
-          cost_background[i] = -(ac * logp.color_background[i] + ad * logp.depth_background[i]);
-          // Only the difference matters; keep both non-negative.
-          const float m = std::min(cost_object[i], cost_background[i]);
-          cost_object[i] -= m;
-          cost_background[i] -= m;
-        }
-      },
-      4096);
-  float max_cost = 0;
-  for (int i = 0; i < n; ++i) max_cost = std::max({max_cost, cost_object[i], cost_background[i]});
-  cut.hard_cap = static_cast<float>(1.0 + 8.0 * w.smoothness + max_cost);
-  for (int i = 0; i < n; ++i) {
-    if (hard[i] == kHardObject) {
-      g.add_tweights(i, cut.hard_cap, 0);
-    } else if (hard[i] == kHardBackground) {
-      g.add_tweights(i, 0, cut.hard_cap);
-    } else {
-      // source = object: the source link is cut when the node is background.
-      g.add_tweights(i, cost_background[i], cost_object[i]);
-    }
-  }
+  TLinkCapacities(logp, w, hard, &cut.hard_cap, &cut.source_cap, &cut.sink_cap);
+  cut.weights = &w;
+  for (int i = 0; i < n; ++i) g.add_tweights(i, cut.source_cap[i], cut.sink_cap[i]);
   for (int i = 0; i < n; ++i) {
     const int32_t cell = nodes.cell_of_node[i];
     const int row = cell / nodes.cols, col = cell % nodes.cols;
@@ -823,19 +838,49 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
   Graph& g = *s.last.graph;
-  // Outweigh whatever the node had (a data cost or an earlier hard link): 3 hard capacities.
-  const float cap = 3 * s.last.hard_cap;
-  int changed = 0;
+  bool any = false;
   for (int i = 0; i < s.nodes.num(); ++i) {
     if (extra[i] == kFree || extra[i] == s.last_hard[i]) continue;
-    if (extra[i] == kHardObject)
-      g.add_tweights(i, cap, 0);
-    else
-      g.add_tweights(i, 0, cap);
-    g.mark_node(i);
     s.last_hard[i] = extra[i];
+    any = true;
+  }
+  // New t-link capacities: the models re-learnt from all hard cells (options.refine_relearn_models) or only
+  // the new hard cells; the graph gets the differences (BK add_tweights accepts negative changes) and the
+  // changed nodes are marked for the tree-reusing max-flow.
+  std::vector<float> source_cap = s.last.source_cap, sink_cap = s.last.sink_cap;
+  if (any && s.options.refine_relearn_models) {
+    Timer models;
+    std::vector<int32_t> object, background;
+    for (int i = 0; i < s.nodes.num(); ++i) {
+      if (s.last_hard[i] == kHardObject)
+        object.push_back(i);
+      else if (s.last_hard[i] == kHardBackground)
+        background.push_back(i);
+    }
+    const LogDensities logp = ComputeLogDensities(s.nodes, object, background, s.options);
+    float hard_cap = s.last.hard_cap;
+    TLinkCapacities(logp, *s.last.weights, s.last_hard, &hard_cap, &source_cap, &sink_cap);
+    result.timings.models_s = models.Seconds();
+  } else {
+    for (int i = 0; i < s.nodes.num(); ++i) {
+      if (s.last_hard[i] == kHardObject)
+        source_cap[i] = s.last.hard_cap, sink_cap[i] = 0;
+      else if (s.last_hard[i] == kHardBackground)
+        source_cap[i] = 0, sink_cap[i] = s.last.hard_cap;
+    }
+  }
+  Timer graph_timer;
+  int changed = 0;
+  for (int i = 0; i < s.nodes.num(); ++i) {
+    const float ds = source_cap[i] - s.last.source_cap[i], dt = sink_cap[i] - s.last.sink_cap[i];
+    if (ds == 0 && dt == 0) continue;
+    g.add_tweights(i, ds, dt);
+    g.mark_node(i);
     ++changed;
   }
+  s.last.source_cap.swap(source_cap);
+  s.last.sink_cap.swap(sink_cap);
+  result.timings.graph_s = graph_timer.Seconds();
   Timer timer;
   if (changed > 0) result.flow = g.maxflow(/*reuse_trees=*/true);
   result.timings.maxflow_s = timer.Seconds();

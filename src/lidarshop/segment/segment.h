@@ -111,6 +111,11 @@ struct SegmentOptions {
   double object_uniform = 0.01;     // weight of the uniform density in the object model, (0, 1)
   double background_uniform = 0.3;  // weight of the uniform density in the background model, (0, 1)
 
+  // Refine(): re-learn the appearance models from all hard cells (the last cut's seeds + every stroke so far)
+  // and update every t-link (true), or only turn the new stroke cells into hard constraints (false, cheaper,
+  // but an object stroke on a missed part then adds little more than the stroke itself).
+  bool refine_relearn_models = true;
+
   void Check() const;
 };
 
