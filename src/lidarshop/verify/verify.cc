@@ -222,6 +222,11 @@ KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::Aligne
   };
   flatten(lists, &grid.offsets, &grid.indices);
   flatten(nearest_lists, &grid.nearest_offsets, &grid.nearest_indices);
+  const auto points = tree.points();
+  grid.positions.reserve(grid.indices.size());
+  for (uint32_t i : grid.indices) grid.positions.push_back(points[i]);
+  grid.nearest_positions.reserve(grid.nearest_indices.size());
+  for (uint32_t i : grid.nearest_indices) grid.nearest_positions.push_back(points[i]);
   return grid;
 }
 
@@ -392,7 +397,6 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
   const bool use_grid = grid.built() &&
                         std::abs(grid.kernel_radius_m - kernel_radius) <= 1e-6f * kernel_radius &&
                         std::abs(grid.trim_m - trim) <= 1e-6f * trim;
-  const auto model_points = model.points_in_model.points();
 
   std::vector<float> observed_sum(n, 0.0f);  // Σ_j exp(−d²/2σ²) over all scans
   std::vector<float> scan_sum;               // the same for one scan (only with several scans)
@@ -453,9 +457,9 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
           voxel = (static_cast<int64_t>(z) * grid.dims.y() + y) * grid.dims.x() + x;
           const float kernel_radius_sq = kernel_radius * kernel_radius;
           for (uint32_t k = grid.offsets[voxel]; k < grid.offsets[voxel + 1]; ++k) {
-            const uint32_t i = grid.indices[k];
-            const float distance_sq = (model_points[i] - point_in_model).squaredNorm();
+            const float distance_sq = (grid.positions[k] - point_in_model).squaredNorm();
             if (distance_sq < kernel_radius_sq) {
+              const uint32_t i = grid.indices[k];
               // Only min(1, sum) matters: a saturated point needs no more exp (exact, and most of the cost).
               if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
               closest_sq = std::min(closest_sq, distance_sq);
@@ -474,8 +478,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         if (!(closest_sq < kernel_radius * kernel_radius)) {
           if (use_grid) {
             for (uint32_t k = grid.nearest_offsets[voxel]; k < grid.nearest_offsets[voxel + 1]; ++k) {
-              closest_sq = std::min(closest_sq,
-                                    (model_points[grid.nearest_indices[k]] - point_in_model).squaredNorm());
+              closest_sq = std::min(closest_sq, (grid.nearest_positions[k] - point_in_model).squaredNorm());
             }
           } else {
             closest_sq = model.points_in_model.NearestWithin(point_in_model, trim).distance_sq;

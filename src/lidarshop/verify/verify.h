@@ -97,12 +97,15 @@ struct KernelNeighbourGrid {
   Eigen::Vector3i dims = Eigen::Vector3i::Zero();             // voxels along x, y, z
   std::vector<uint32_t> offsets;  // #voxels + 1, CSR into `indices` (voxel = (z * dims.y + y) * dims.x + x)
   std::vector<uint32_t> indices;  // model point indices
+  std::vector<Eigen::Vector3f>
+      positions;  // their positions, same order (streamed, not gathered: the hot loop)
   // The trimmed-ICP nearest neighbour the same way: every model point that can be the nearest one of some
   // point of the voxel (within d_centre + 2 · half diagonal of its centre); empty for voxels farther than the
   // trim distance.
   float trim_m = 0.0f;                    // the icp_trim_m it was built for
   std::vector<uint32_t> nearest_offsets;  // #voxels + 1
   std::vector<uint32_t> nearest_indices;
+  std::vector<Eigen::Vector3f> nearest_positions;  // same order
   bool built() const { return kernel_radius_m > 0; }
 };
 
