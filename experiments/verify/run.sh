@@ -12,11 +12,11 @@ mkdir -p "$OUT"
 ninja -C "$BUILD" -j2 lidarshop_cli verify_analytic_test verify_multiscan_test verify_parking_lot_test >/dev/null
 
 echo "== analytic (box seen from the front) =="
-"$BUILD/src/lidarshop/verify/verify_analytic_test" --gtest_brief=1 | tail -n 3
+"$BUILD/src/lidarshop/verify/verify_analytic_test" --gtest_brief=1 | tail -n 3 || echo "(failures above)"
 echo "== several scans, smaller model, occlusion =="
-"$BUILD/src/lidarshop/verify/verify_multiscan_test" --gtest_brief=1 | grep -E "vehicle|model|open|fenced|PASSED|FAILED"
+"$BUILD/src/lidarshop/verify/verify_multiscan_test" --gtest_brief=1 | grep -E "vehicle|model|open|fenced|PASSED|FAILED" || echo "(failures above)"
 echo "== parking lot (tests) =="
-"$BUILD/src/lidarshop/verify/verify_parking_lot_test" --gtest_brief=1 | grep -E "truth|PASSED|FAILED"
+"$BUILD/src/lidarshop/verify/verify_parking_lot_test" --gtest_brief=1 | grep -E "truth|PASSED|FAILED" || echo "(failures above)"
 
 echo "== parking lot (CLI) =="
 L="$BUILD/lidarshop"

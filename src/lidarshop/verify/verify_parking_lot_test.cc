@@ -40,7 +40,8 @@ SweepOptions CarSweep() {
   options.y_min_m = 7.7;
   options.y_max_m = 13.3;
   options.step_m = 0.5;
-  options.yaws_deg = {0, 30, 60, 90, 120, 150};  // cars are nearly symmetric front to back
+  options.yaws_deg = {0,  30,  60,
+                      90, 120, 150};  // cars are nearly symmetric front to back (0, 60, 120 misses the van)
   return options;
 }
 
