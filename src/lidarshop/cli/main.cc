@@ -4,6 +4,8 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include "lidarshop/cli/commands.h"
 
@@ -34,13 +36,16 @@ const std::vector<Command>& Commands() {
 void PrintUsage(std::FILE* stream) {
   fmt::print(stream, "lidarshop — edit terrestrial LiDAR scans\n\nUsage: lidarshop <command> [options]\n\n");
   fmt::print(stream, "Commands:\n");
-  for (const Command& command : Commands()) fmt::print(stream, "  {:<10} {}\n", command.name, command.summary);
+  for (const Command& command : Commands())
+    fmt::print(stream, "  {:<10} {}\n", command.name, command.summary);
   fmt::print(stream, "\n`lidarshop <command> --help` describes each command.\n");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+  // Warnings go to stderr: stdout carries the JSON that scripts read (info, scan --stats).
+  spdlog::set_default_logger(spdlog::stderr_color_mt("lidarshop"));
   if (argc < 2) {
     PrintUsage(stderr);
     return 2;
@@ -57,7 +62,6 @@ int main(int argc, char** argv) {
   for (const Command& command : Commands()) {
     if (name == command.name) return command.run(argc - 1, argv + 1);
   }
-  fmt::print(stderr, "lidarshop: unknown command '{}'\n", name);
-  PrintUsage(stderr);
+  fmt::print(stderr, "lidarshop: unknown command '{}' (lidarshop --help lists the commands)\n", name);
   return 2;
 }

@@ -104,6 +104,7 @@ int RunPoisson(int argc, char** argv) {
       "from a gradient field (docs/poisson.md). Masks: white = hole / region.",
       "poisson"};
   app.require_subcommand(1);
+  app.fallthrough();  // --quiet may also follow the subcommand
   bool quiet = false;
   AddQuietFlag(app, &quiet);
 

@@ -1,0 +1,195 @@
+#!/usr/bin/env bash
+# End-to-end test of the `lidarshop` command line: every command on small inputs, the JSON contracts scripts rely
+# on, exit codes, and one-line errors on bad input. Run by ctest as `cli_test` with the binary and the shared data.
+# Usage: cli_test.sh LIDARSHOP_BINARY SHARED_DATA_DIR
+set -uo pipefail
+lidarshop=$1
+shared=$2
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+passed=0
+failed=0
+
+check() {  # check NAME COMMAND...: the command must succeed
+  local name=$1
+  shift
+  if "$@" >"$work/last.out" 2>"$work/last.err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name: $*"
+    sed 's/^/  | /' "$work/last.out" "$work/last.err" | head -20
+  fi
+}
+
+fails_clearly() {  # fails_clearly NAME PATTERN COMMAND...: non-zero exit, one line on stderr matching PATTERN
+  local name=$1 pattern=$2
+  shift 2
+  if "$@" >"$work/last.out" 2>"$work/last.err"; then
+    failed=$((failed + 1))
+    echo "FAILED: $name: succeeded but should have failed: $*"
+    return
+  fi
+  if [ "$(wc -l <"$work/last.err")" -eq 1 ] && grep -qE "$pattern" "$work/last.err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name: expected one line matching '$pattern' on stderr, got:"
+    sed 's/^/  | /' "$work/last.err" | head -10
+  fi
+}
+
+json_check() {  # json_check NAME FILE PYTHON_EXPRESSION (on `d`, the parsed JSON)
+  check "$1" python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); assert ($3), 'expression false'" "$2"
+}
+
+# The issue's scene form, with a mesh from the shared data (paths relative to the scene file).
+mkdir -p "$work/scene/meshes"
+cp "$shared/meshes/beetle.obj" "$work/scene/meshes/car.obj"
+cat >"$work/scene/scene.json" <<'JSON'
+{"scanner": {"position": [0, 0, 1.5], "rotate_deg": [0, 0, 0],
+             "azimuth_deg": [-45, 45], "elevation_deg": [-30, 30], "columns": 180, "rows": 120,
+             "max_range": 100, "los_noise_sigma": 0.0, "orthogonal_noise_sigma": 0.0, "seed": 1},
+ "objects": [
+   {"primitive": "plane", "size": [200, 200], "translate": [0, 0, 0], "label": 0, "texture": "grass"},
+   {"primitive": "sphere", "radius": 1.0, "translate": [2, 10, 1], "label": 1, "color": [200, 40, 40]},
+   {"primitive": "box", "size": [1, 0.6, 1.2], "translate": [-2, 8, 0.6], "label": 2},
+   {"primitive": "cylinder", "radius": 0.1, "height": 3, "translate": [4, 12, 1.5], "label": 3},
+   {"mesh": "meshes/car.obj", "scale": 4.2, "rotate_deg": [90, 0, 30], "translate": [0, 15, 0], "label": 4}]}
+JSON
+
+# Usage.
+check "help" "$lidarshop" --help
+check "scan help" "$lidarshop" scan --help
+fails_clearly "unknown command" "unknown command" "$lidarshop" no-such-command
+
+# scan: PTX, labels, mesh, stats.
+check "scan" "$lidarshop" scan "$work/scene/scene.json" -o "$work/scan.ptx" --labels "$work/labels.png" \
+  --mesh "$work/mesh.ply" --stats
+cp "$work/last.out" "$work/stats.json"
+json_check "scan --stats is one JSON object with stage seconds" "$work/stats.json" \
+  "isinstance(d, dict) and len(json.dumps(d)) > 10"
+check "scan wrote its outputs" test -s "$work/scan.ptx" -a -s "$work/labels.png" -a -s "$work/mesh.ply"
+check "scan is quiet when stderr is not a terminal" test ! -s "$work/last.err"
+fails_clearly "scan: missing scene" "no_such_scene.json" "$lidarshop" scan "$work/no_such_scene.json" -o "$work/x.ptx"
+
+# info: the keys scripts rely on.
+check "info" "$lidarshop" info "$work/scan.ptx"
+cp "$work/last.out" "$work/info.json"
+json_check "info keys" "$work/info.json" \
+  "d['format'] == 'ptx' and d['file'].endswith('scan.ptx') and len(d['scans']) == 1 and \
+   all(k in d['scans'][0] for k in ('rows', 'cols', 'valid', 'bounds', 'world_from_scanner', 'channels')) and \
+   d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and 0 < d['scans'][0]['valid'] <= 120 * 180 and \
+   len(d['scans'][0]['world_from_scanner']) == 4 and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+
+# convert: every format keeps every return.
+valid=$(python3 -c "import json; print(json.load(open('$work/info.json'))['scans'][0]['valid'])")
+for format in e57 ply pcd; do
+  check "convert ptx -> $format" "$lidarshop" convert "$work/scan.ptx" "$work/scan.$format" --quiet
+  check "info $format" "$lidarshop" info "$work/scan.$format"
+  cp "$work/last.out" "$work/info_$format.json"
+  json_check "convert to $format keeps the returns" "$work/info_$format.json" "d['scans'][0]['valid'] == $valid"
+done
+check "convert e57 -> ptx" "$lidarshop" convert "$work/scan.e57" "$work/back.ptx" --quiet
+check "info back.ptx" "$lidarshop" info "$work/back.ptx"
+cp "$work/last.out" "$work/info_back.json"
+json_check "ptx -> e57 -> ptx keeps the grid" "$work/info_back.json" \
+  "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and d['scans'][0]['valid'] == $valid"
+
+# render: every channel, one pixel per ray.
+for channel in range rgb intensity normals valid; do
+  check "render $channel" "$lidarshop" render "$work/scan.ptx" -o "$work/render_$channel.png" --channel "$channel"
+done
+# PTX has no label channel (a clear error); PLY keeps the synthetic scanner's labels.
+fails_clearly "render labels of a PTX" "label" "$lidarshop" render "$work/scan.ptx" -o "$work/x.png" --channel labels
+check "scan to PLY" "$lidarshop" scan "$work/scene/scene.json" -o "$work/scan_labels.ply" --quiet
+check "render labels of a PLY" "$lidarshop" render "$work/scan_labels.ply" -o "$work/render_labels.png" --channel labels
+check "render with legend" "$lidarshop" render "$work/scan.ptx" -o "$work/legend.png" --channel range --legend
+fails_clearly "render into a missing folder" "no_such_dir" \
+  "$lidarshop" render "$work/scan.ptx" -o "$work/no_such_dir/x.png" --channel range
+fails_clearly "render: bad channel" "channel" "$lidarshop" render "$work/scan.ptx" -o "$work/x.png" --channel nope
+
+# Bad input: a truncated PTX names the file and the line; the input is untouched, no output is left behind.
+head -c 2000 "$work/scan.ptx" >"$work/truncated.ptx"
+before=$(md5sum <"$work/truncated.ptx")
+fails_clearly "truncated ptx" "truncated.ptx.*line" "$lidarshop" convert "$work/truncated.ptx" "$work/out.ply"
+check "no partial output" test ! -e "$work/out.ply"
+check "input untouched" test "$before" = "$(md5sum <"$work/truncated.ptx")"
+printf 'garbage\n' >"$work/garbage.e57"
+fails_clearly "garbage e57" "garbage.e57" "$lidarshop" info "$work/garbage.e57"
+fails_clearly "corrupt e57 names the page" "page [0-9]+" "$lidarshop" info "$shared/e57/corrupt_crc.e57"
+
+# Real data: the E57 scan and the organized RGB-D cloud.
+check "info pumpA" "$lidarshop" info "$shared/e57/pumpA.e57"
+cp "$work/last.out" "$work/pump.json"
+json_check "pumpA grid and counts" "$work/pump.json" \
+  "d['scans'][0]['rows'] * d['scans'][0]['cols'] == 1074 * 345 and d['scans'][0]['valid'] == 155201"
+check "render pumpA" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump.png" --channel rgb
+check "info mug pcd" "$lidarshop" info "$shared/rgbd/table_scene_mug_stereo_textured.pcd"
+
+# verify: the box (label 2) at its true pose, and 1 m towards the scanner.
+cat >"$work/box.obj" <<'OBJ'
+v -0.5 -0.3 -0.6
+v 0.5 -0.3 -0.6
+v 0.5 0.3 -0.6
+v -0.5 0.3 -0.6
+v -0.5 -0.3 0.6
+v 0.5 -0.3 0.6
+v 0.5 0.3 0.6
+v -0.5 0.3 0.6
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+OBJ
+check "verify at the true pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
+  --pose "-2,8,0.6,0" --json "$work/verify.json" --scene-points "$work/scene_points.ply" \
+  --model-points "$work/model_points.ply"
+json_check "verify JSON keys and a consistent pose" "$work/verify.json" \
+  "all(k in d for k in ('consistency', 'confidence', 'comparable_pairs', 'icp_cost', 'inlier_fraction', \
+   'per_scan')) and d['comparable_pairs'] > 0 and d['consistency'] > 0.95 and d['confidence'] > 0"
+check "verify 1 m towards the scanner" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
+  --pose "-2,7,0.6,0" --json "$work/verify_front.json"
+json_check "a pose in front of the seen surface is inconsistent" "$work/verify_front.json" "d['consistency'] < 0.3"
+fails_clearly "verify: bad pose" "pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
+  --pose "1,2"
+
+# segment: the sphere (label 1) from JSON strokes in grid coordinates. Its centre (2, 10, 1) seen from (0, 0, 1.5)
+# is at azimuth atan2(2, 10) = 11.31 deg and elevation atan2(-0.5, sqrt(104)) = -2.81 deg: column
+# (11.31 + 45) / 90 * 179 = 112, image row (30 + 2.81) / 60 * 119 = 65 (row 0 = top).
+cat >"$work/strokes.json" <<'JSON'
+{"strokes": [{"label": "object", "width": 3, "points": [[110, 65], [114, 65]]},
+             {"label": "background", "width": 2, "points": [[5, 115], [175, 115]]}]}
+JSON
+check "segment" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/mask.png" \
+  --object "$work/object.ply" --rest "$work/rest.ply" --quiet
+check "segment wrote mask, overlay and points" test -s "$work/mask.png" -a -s "$work/mask_overlay.png" \
+  -a -s "$work/object.ply" -a -s "$work/rest.ply"
+fails_clearly "segment: strokes of the wrong size" "stroke" "$lidarshop" segment "$work/scan.ptx" \
+  --strokes "$shared/images/bungee/bungee_mask.png" -o "$work/mask2.png" --quiet
+
+# Image editing: inpainting and Poisson.
+images=$shared/images
+check "inpaint lettera" "$lidarshop" inpaint "$images/lettera/lettera.png" --mask "$images/lettera/lettera_mask.png" \
+  -o "$work/lettera_filled.png" --quiet
+check "poisson fill" "$lidarshop" poisson fill "$images/bungee/bungee.png" --mask "$images/bungee/bungee_mask.png" \
+  -o "$work/bungee_fill.png" --quiet
+check "poisson clone" "$lidarshop" poisson clone "$images/f16/f16.png" --mask "$images/f16/f16_mask.png" \
+  --target "$images/f16/canyon.png" --offset 110,130 -o "$work/clone.png" --quiet
+fails_clearly "inpaint: mask of another size" "mask" "$lidarshop" inpaint "$images/lettera/lettera.png" \
+  --mask "$images/bungee/bungee_mask.png" -o "$work/x.png" --quiet
+
+# The demo on a small built-in scene.
+check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet
+json_check "demo summary" "$work/demo/summary.json" "d['scene'] == 'mailbox' and d['scan']['valid'] > 0"
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]
