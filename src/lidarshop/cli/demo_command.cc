@@ -1,7 +1,8 @@
 // `lidarshop demo`: the main job on a built-in scene, end to end, with every result in one folder.
 //
 //   1. scan      synthesize the scene (ground truth included): scan.ptx, scan.e57, labels.png, pictures
-//   2. verify    every labelled object at its true pose, and at wrong poses, against the scan: verify.json
+//   2. verify    every standing object at its true pose, and at wrong poses, against the scan: verify.json;
+//                in the parking lot, a sweep of one car's model over the lot: sweep_*.png, sweep.csv
 //   3. segment   cut one object out from two automatic strokes, compared with the true labels: segment_*.png
 //   4. summary   summary.json and index.html, which shows everything on one page
 //
@@ -9,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -29,6 +31,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/util/timer.h"
+#include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
 
 namespace lidarshop::cli {
@@ -131,6 +134,60 @@ json RunVerifyStep(const SceneDescription& scene, const Scan& scan, const fs::pa
   return entries;
 }
 
+// Step 2b (scenes with cars): sweep one car's model over the lot — heat maps and detections.
+struct DemoSweep {
+  std::string object;  // the scene object whose mesh is the model
+  SweepOptions options;
+};
+
+std::optional<DemoSweep> DefaultSweep(const std::string& scene_name) {
+  if (scene_name != "parking_lot") return std::nullopt;
+  DemoSweep sweep;
+  sweep.object = "sedan";
+  sweep.options.x_min_m = -9.3;  // the lot in front of the façade, 0.5 m grid, three headings then refinement
+  sweep.options.x_max_m = 9.3;
+  sweep.options.y_min_m = 7.7;
+  sweep.options.y_max_m = 13.3;
+  sweep.options.step_m = 0.5;
+  sweep.options.yaws_deg = {0, 60, 120};
+  return sweep;
+}
+
+json RunSweepStep(const SceneDescription& scene, const Scan& scan, const DemoSweep& demo_sweep,
+                  const fs::path& out_dir, Progress* progress) {
+  const SceneObject* model_object = nullptr;
+  for (const SceneObject& object : scene.objects) {
+    if (object.name == demo_sweep.object) model_object = &object;
+  }
+  if (model_object == nullptr) {
+    throw InputError(fmt::format("demo: the scene has no object named '{}' to sweep", demo_sweep.object));
+  }
+  const std::vector<PreparedScan> scans = {PrepareScan(scan)};
+  const VerifyOptions verify_options;
+  const VerifierModel model = PrepareModel(model_object->mesh, ModelOptions{}, verify_options);
+  const SweepResult sweep = Sweep(model, scans, demo_sweep.options, verify_options, progress);
+  WriteImage((out_dir / "sweep_consistency.png").string(),
+             RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",
+                           demo_sweep.options.min_consistency));
+  WriteImage((out_dir / "sweep_confidence.png").string(),
+             RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
+                           demo_sweep.options.min_confidence));
+  WriteText(out_dir / "sweep.csv", SweepCsv(sweep));
+  json detections = json::array();
+  for (const Detection& detection : sweep.detections) {
+    detections.push_back({{"x", detection.x_m},
+                          {"y", detection.y_m},
+                          {"yaw_deg", detection.yaw_deg},
+                          {"consistency", detection.consistency},
+                          {"confidence", detection.confidence}});
+  }
+  const Eigen::Vector3d truth = model_object->world_from_object.topRightCorner<3, 1>();
+  return {{"model", demo_sweep.object},
+          {"true_position", {truth.x(), truth.y()}},
+          {"poses", sweep.poses.size() + static_cast<size_t>(sweep.refine_evaluations)},
+          {"detections", detections}};
+}
+
 // Step 3: cut one object out from automatic strokes and score it against the scanner's labels.
 json RunSegmentStep(const SceneDescription& scene, const Scan& scan, const std::string& object_name,
                     const fs::path& out_dir) {
@@ -181,6 +238,18 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
                         format_number(entry["icp_cost"]));
   }
   html += "</table>";
+  if (summary.contains("sweep")) {
+    const json& sweep = summary["sweep"];
+    html += fmt::format(
+        "<h3>Sweep</h3><p>The {} model at {} candidate poses over the lot (0.5 m grid, three headings, then "
+        "local "
+        "refinement); white rings mark the {} detection(s) that pass consistency &gt; 0.75 and confidence "
+        "&gt; "
+        "0.3. The true position is ({:.2f}, {:.2f}).</p><img src=\"sweep_consistency.png\" width=\"49%\">"
+        "<img src=\"sweep_confidence.png\" width=\"49%\">",
+        sweep["model"].get<std::string>(), sweep["poses"].get<size_t>(), sweep["detections"].size(),
+        sweep["true_position"][0].get<double>(), sweep["true_position"][1].get<double>());
+  }
   if (summary.contains("segment")) {
     const json& segment = summary["segment"];
     html += fmt::format(
@@ -242,6 +311,14 @@ int RunDemoSteps(const DemoSettings& settings) {
   progress->Restart("demo: verifying", objects_to_verify);
   summary["verify"] = RunVerifyStep(scene, scan, out_dir, progress.get());
   seconds["verify"] = timer.Seconds();
+
+  if (const std::optional<DemoSweep> demo_sweep = DefaultSweep(scene_name)) {
+    timer.Restart();
+    progress->Restart("demo: sweeping", 1);
+    summary["sweep"] = RunSweepStep(scene, scan, *demo_sweep, out_dir, nullptr);
+    progress->Advance();
+    seconds["sweep"] = timer.Seconds();
+  }
 
   const std::string segment_object =
       settings.segment_object.empty() ? DefaultSegmentObject(scene_name) : settings.segment_object;
