@@ -76,6 +76,52 @@ TEST(InpaintSearch, WeightedSsdMatchesReference) {
   }
 }
 
+// EvaluateRun (several adjacent candidates per pass) returns bit-identical values to Evaluate, for equal,
+// unequal and partly zero channel weights, 1 and 3 channels, radii whose rows need 1 to 5 SIMD vectors, and
+// targets at the border; with a finite bound, a value <= bound is the exact one and anything else is > bound.
+TEST(InpaintSearch, EvaluateRunMatchesEvaluate) {
+  const std::vector<std::vector<float>> weight_sets = {
+      {}, {2.0f, 2.0f, 2.0f}, {1.0f, 0.5f, 2.0f}, {0.0f, 3.0f, 3.0f}};
+  for (int channels : {1, 3}) {
+    for (int radius : {1, 2, 5, 7, 10, 11}) {
+      const cv::Mat image = RandomImage(50, 70, channels, 5);
+      const InpaintCanvas canvas(image, BlobMask(50, 70, {3, 30}, 9), radius);
+      for (const auto& weights : weight_sets) {
+        if (channels == 1 && !weights.empty()) continue;
+        const WeightedSsd ssd(weights);
+        const auto front = FrontPixels(canvas);
+        for (size_t f = 0; f < front.size(); f += 5) {
+          const auto prepared = ssd.ForTarget(canvas, front[f]);
+          for (int r = 0; r < canvas.rows(); r += 7) {
+            const auto& cols = canvas.source_cols_by_row()[r];
+            for (size_t i = 0; i + 6 <= cols.size() && cols[i + 5] == cols[i] + 5; i += 11) {
+              float run[6];
+              prepared->EvaluateRun({r, cols[i]}, 6, std::numeric_limits<float>::infinity(), run);
+              for (int k = 0; k < 6; ++k) {
+                const float one =
+                    prepared->Evaluate({r, cols[i] + k}, std::numeric_limits<float>::infinity());
+                ASSERT_EQ(run[k], one) << "radius " << radius << " channels " << channels;
+                ASSERT_NEAR(one, ReferenceSsd(canvas, front[f], {r, cols[i] + k}, weights),
+                            1e-5 * one + 1e-3);
+              }
+              const float bound = run[2];
+              float bounded[6];
+              prepared->EvaluateRun({r, cols[i]}, 6, bound, bounded);
+              for (int k = 0; k < 6; ++k) {
+                if (run[k] <= bound) {
+                  EXPECT_EQ(bounded[k], run[k]);
+                } else {
+                  EXPECT_GT(bounded[k], bound);
+                }
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+}
+
 TEST(InpaintSearch, ExhaustiveFindsTheTrueMinimum) {
   const cv::Mat image = RandomImage(64, 80, 3, 11);
   const InpaintCanvas canvas(image, BlobMask(64, 80, {40, 30}, 10), 5);

@@ -5,6 +5,7 @@
 #pragma GCC diagnostic ignored "-Wpsabi"
 #include <immintrin.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -33,6 +34,15 @@ Kernel DetectKernel() {
 }
 
 const Kernel kKernel = DetectKernel();
+
+// LIDARSHOP_SSD_KERNEL=avx512rows keeps the generic per-row AVX-512 kernel (no unrolled kernel, no runs of
+// candidates), for before/after benchmarks.
+bool DetectUnrolled() {
+  const char* forced = std::getenv("LIDARSHOP_SSD_KERNEL");
+  return kKernel == Kernel::kAvx512 && !(forced != nullptr && std::string_view(forced) == "avx512rows");
+}
+
+const bool kUnrolled = DetectUnrolled();
 
 // Per target row: sqrt(weight) and target·sqrt(weight), so that
 //   Σ (s·√w − t·√w)²  =  Σ w (s − t)²
@@ -142,12 +152,117 @@ __attribute__((target("avx512f"))) float Avx512Ssd(const PreparedRows& p, const 
   return _mm512_reduce_add_ps(_mm512_add_ps(_mm512_add_ps(acc0, acc1), acc2));
 }
 
+// The unrolled AVX-512 kernel (V = 16-float vectors per patch row, 1..4). Per target row that holds a known
+// pixel: the target's floats (times √w when the channel weights differ, else as they are) with zeros where
+// unknown, and one lane mask per vector (known pixel and weight > 0). The source is read with masked loads,
+// so masked lanes read nothing and contribute exactly 0. Equal non-zero weights (the common case) are
+// factored out: Σ w (s − t)² = w · Σ (s − t)², one subtraction and one FMA per vector.
+struct FastRows {
+  int vectors = 0;                     // V
+  bool uniform = true;                 // all non-zero channel weights equal: scale · Σ (s − t)²
+  float scale = 1.0f;                  // that common weight (uniform only)
+  std::vector<int64_t> source_offset;  // per stored row: floats from the source patch's top-left float
+  std::vector<float> target;           // per stored row, 16·V floats
+  std::vector<float> sqrt_weight;      // per stored row, 16·V floats (not uniform only)
+  std::vector<__mmask16> masks;        // per stored row, V masks
+};
+
+// Early termination is checked every kCheckRows rows (a horizontal reduction per candidate costs about as
+// much as a row).
+constexpr int kCheckRows = 2;
+
+template <int V>
+__attribute__((target("avx512f"), always_inline)) inline float SumOf(const __m512* acc, float scale) {
+  __m512 sum = acc[0];
+#pragma GCC unroll 16
+  for (int v = 1; v < V; ++v) sum = _mm512_add_ps(sum, acc[v]);
+  return _mm512_reduce_add_ps(sum) * scale;
+}
+
+template <int V, int N, bool kUniform>
+__attribute__((target("avx512f"))) void FastSsd(const FastRows& p, const float* source_top_left,
+                                                int64_t candidate_step, float bound, float* out) {
+  __m512 acc[N][V];
+#pragma GCC unroll 16
+  for (int c = 0; c < N; ++c)
+#pragma GCC unroll 16
+    for (int v = 0; v < V; ++v) acc[c][v] = _mm512_setzero_ps();
+  const int rows = static_cast<int>(p.source_offset.size());
+  const float* target = p.target.data();
+  const float* sqrt_weight = p.sqrt_weight.data();
+  const __mmask16* masks = p.masks.data();
+  const bool check = bound < std::numeric_limits<float>::infinity();
+  for (int i = 0; i < rows; ++i) {
+    const float* s = source_top_left + p.source_offset[i];
+#pragma GCC unroll 16
+    for (int v = 0; v < V; ++v) {
+      const __m512 t = _mm512_loadu_ps(target + 16 * (V * i + v));
+      const __mmask16 m = masks[V * i + v];
+      // Vectors without a known pixel (at the hole's rim, about half of the target) are skipped; the branch
+      // takes the same way for every candidate of a target, so it is predicted.
+      if (m == 0) continue;
+      if constexpr (kUniform) {
+#pragma GCC unroll 16
+        for (int c = 0; c < N; ++c) {
+          const __m512 d = _mm512_maskz_sub_ps(m, _mm512_loadu_ps(s + c * candidate_step + 16 * v), t);
+          acc[c][v] = _mm512_fmadd_ps(d, d, acc[c][v]);
+        }
+      } else {
+        const __m512 w = _mm512_loadu_ps(sqrt_weight + 16 * (V * i + v));
+#pragma GCC unroll 16
+        for (int c = 0; c < N; ++c) {
+          const __m512 d = _mm512_maskz_fmsub_ps(m, _mm512_loadu_ps(s + c * candidate_step + 16 * v), w, t);
+          acc[c][v] = _mm512_fmadd_ps(d, d, acc[c][v]);
+        }
+      }
+    }
+    // Lanes only grow, so partial sums above the bound prove the full sums are above it too; stop when every
+    // candidate of the pass is out.
+    if (check && i % kCheckRows == kCheckRows - 1 && i + 1 < rows) {
+      bool all_out = true;
+#pragma GCC unroll 16
+      for (int c = 0; c < N && all_out; ++c) all_out = SumOf<V>(acc[c], p.scale) > bound;
+      if (all_out) {
+#pragma GCC unroll 16
+        for (int c = 0; c < N; ++c) out[c] = SumOf<V>(acc[c], p.scale);
+        return;
+      }
+    }
+  }
+#pragma GCC unroll 16
+  for (int c = 0; c < N; ++c) out[c] = SumOf<V>(acc[c], p.scale);
+}
+
+using FastKernel = void (*)(const FastRows&, const float*, int64_t, float, float*);
+
+template <int N>
+FastKernel PickFast(int vectors, bool uniform) {
+  switch (vectors) {
+    case 1:
+      return uniform ? FastSsd<1, N, true> : FastSsd<1, N, false>;
+    case 2:
+      return uniform ? FastSsd<2, N, true> : FastSsd<2, N, false>;
+    case 3:
+      return uniform ? FastSsd<3, N, true> : FastSsd<3, N, false>;
+    case 4:
+      return uniform ? FastSsd<4, N, true> : FastSsd<4, N, false>;
+    default:
+      return nullptr;
+  }
+}
+
+constexpr int kRun = 4;  // candidates per pass of EvaluateRun
+
 class WeightedSsdTarget : public TargetDifference {
  public:
   WeightedSsdTarget(const InpaintCanvas& canvas, Pixel target, const std::vector<float>& channel_weights)
       : canvas_(canvas) {
     const int R = canvas.patch_radius(), C = canvas.channels(), side = 2 * R + 1;
     const int row_floats = side * C;
+    if (kUnrolled && row_floats <= 64) {
+      PrepareFast(target, channel_weights);
+      return;
+    }
     const int padded = (row_floats + 7) / 8 * 8;
     std::vector<float> sw(padded), tw(padded);
     for (int i = 0; i < side; ++i) {
@@ -190,6 +305,11 @@ class WeightedSsdTarget : public TargetDifference {
   float Evaluate(Pixel source, float bound) const override {
     const int R = canvas_.patch_radius();
     const float* top_left = canvas_.PixelData(source.row - R, source.col - R);
+    if (fast_single_ != nullptr) {
+      float out;
+      fast_single_(fast_, top_left, 0, bound, &out);
+      return out;
+    }
     switch (kKernel) {
       case Kernel::kAvx512:
         return Avx512Ssd(prepared_, top_left, bound);
@@ -200,9 +320,84 @@ class WeightedSsdTarget : public TargetDifference {
     }
   }
 
+  void EvaluateRun(Pixel source, int count, float bound, float* out) const override {
+    const int R = canvas_.patch_radius(), C = canvas_.channels();
+    int i = 0;
+    if (fast_run_ != nullptr) {
+      for (; i + kRun <= count; i += kRun)
+        fast_run_(fast_, canvas_.PixelData(source.row - R, source.col + i - R), C, bound, out + i);
+    }
+    for (; i < count; ++i) out[i] = Evaluate({source.row, source.col + i}, bound);
+  }
+
  private:
+  void PrepareFast(Pixel target, const std::vector<float>& channel_weights) {
+    const InpaintCanvas& canvas = canvas_;
+    const int R = canvas.patch_radius(), C = canvas.channels(), side = 2 * R + 1;
+    const int V = (side * C + 15) / 16;
+    fast_.vectors = V;
+    float common = -1.0f;
+    for (int k = 0; k < C; ++k) {
+      const float w = channel_weights.empty() ? 1.0f : channel_weights[k];
+      if (w == 0.0f) continue;
+      if (common < 0.0f) common = w;
+      if (w != common) fast_.uniform = false;
+    }
+    fast_.scale = fast_.uniform && common > 0.0f ? common : 1.0f;
+    std::vector<float> t(16 * V), sw(16 * V);
+    std::vector<__mmask16> m(V);
+    struct StoredRow {
+      int lanes, index;
+      std::vector<float> target, sqrt_weight;
+      std::vector<__mmask16> masks;
+    };
+    std::vector<StoredRow> rows;
+    for (int i = 0; i < side; ++i) {
+      const int r = target.row - R + i;
+      if (r < 0 || r >= canvas.rows()) continue;
+      std::fill(t.begin(), t.end(), 0.0f);
+      std::fill(sw.begin(), sw.end(), 0.0f);
+      std::fill(m.begin(), m.end(), __mmask16{0});
+      bool any = false;
+      for (int j = 0; j < side; ++j) {
+        const int c = target.col - R + j;
+        if (c < 0 || c >= canvas.cols() || !canvas.IsKnown(r, c)) continue;
+        const float* value = canvas.PixelData(r, c);
+        for (int k = 0; k < C; ++k) {
+          const float w = channel_weights.empty() ? 1.0f : channel_weights[k];
+          if (w == 0.0f) continue;
+          const int lane = j * C + k;
+          const float root = fast_.uniform ? 1.0f : std::sqrt(w);
+          t[lane] = value[k] * root;
+          sw[lane] = root;
+          m[lane / 16] = static_cast<__mmask16>(m[lane / 16] | (1u << (lane % 16)));
+          any = true;
+        }
+      }
+      if (!any) continue;
+      int lanes = 0;
+      for (__mmask16 mask : m) lanes += __builtin_popcount(mask);
+      rows.push_back({lanes, i, t, sw, m});
+    }
+    // Rows with the most known floats first: the partial sums grow fastest, so early termination comes
+    // sooner (the sum's order is fixed per target, so Evaluate and EvaluateRun still agree bit for bit).
+    std::stable_sort(rows.begin(), rows.end(),
+                     [](const StoredRow& a, const StoredRow& b) { return a.lanes > b.lanes; });
+    for (const StoredRow& row : rows) {
+      fast_.source_offset.push_back(int64_t{row.index} * canvas.row_stride());
+      fast_.target.insert(fast_.target.end(), row.target.begin(), row.target.end());
+      if (!fast_.uniform)
+        fast_.sqrt_weight.insert(fast_.sqrt_weight.end(), row.sqrt_weight.begin(), row.sqrt_weight.end());
+      fast_.masks.insert(fast_.masks.end(), row.masks.begin(), row.masks.end());
+    }
+    fast_single_ = PickFast<1>(V, fast_.uniform);
+    fast_run_ = PickFast<kRun>(V, fast_.uniform);
+  }
+
   const InpaintCanvas& canvas_;
   PreparedRows prepared_;
+  FastRows fast_;
+  FastKernel fast_single_ = nullptr, fast_run_ = nullptr;
 };
 
 }  // namespace
@@ -223,7 +418,7 @@ std::unique_ptr<TargetDifference> WeightedSsd::ForTarget(const InpaintCanvas& ca
 const char* WeightedSsd::KernelName() {
   switch (kKernel) {
     case Kernel::kAvx512:
-      return "avx512";
+      return kUnrolled ? "avx512 unrolled" : "avx512 rows";
     case Kernel::kAvx2:
       return "avx2";
     default:

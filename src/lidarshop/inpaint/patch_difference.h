@@ -19,6 +19,13 @@ class TargetDifference {
   // Difference to the source patch centred at `source` (a source centre of the canvas). Early termination:
   // once the difference is known to exceed `bound`, any value > bound may be returned. Thread-safe.
   virtual float Evaluate(Pixel source, float bound) const = 0;
+  // The same for `count` source centres in a row: (source.row, source.col + i) for i in [0, count), all of
+  // them source centres; out[i] gets what Evaluate() would return for each (bit-identical whenever it is <=
+  // bound; any value > bound otherwise). Implementations may share the target's loads between neighbouring
+  // candidates. The default calls Evaluate() per candidate.
+  virtual void EvaluateRun(Pixel source, int count, float bound, float* out) const {
+    for (int i = 0; i < count; ++i) out[i] = Evaluate({source.row, source.col + i}, bound);
+  }
 };
 
 class PatchDifference {
@@ -32,7 +39,10 @@ class PatchDifference {
 //   Ψq)")
 // channel_weights: one weight ≥ 0 per channel, or empty for all 1. Evaluated with AVX-512 or AVX2+FMA when
 // the CPU has them (runtime dispatch), on (2R+1)·C contiguous floats per patch row, with early termination
-// per row.
+// checked every few rows. With AVX-512 and (2R+1)·C ≤ 64 (e.g. radius ≤ 10 for RGB) the kernel is unrolled
+// for the row's vector count: per target row the known pixels' values are stored with a lane mask (masked
+// loads of the source, subtract, FMA; the common weight of equal-weight channels is applied once at the end),
+// and EvaluateRun() evaluates four adjacent candidates per pass so they share the target's loads.
 class WeightedSsd : public PatchDifference {
  public:
   explicit WeightedSsd(std::vector<float> channel_weights = {});

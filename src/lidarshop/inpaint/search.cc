@@ -71,11 +71,22 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& ca
           const int r = row_begin + static_cast<int>(i);
           const std::vector<int>& cols = cols_by_row[r];
           auto first = std::lower_bound(cols.begin(), cols.end(), col_begin);
-          for (auto it = first; it != cols.end() && *it < col_end; ++it) {
-            const float limit = std::min(bound, local.Bound());
-            const float d = difference.Evaluate({r, *it}, limit);
-            ++evaluated;
-            if (d <= limit) local.Offer({{r, *it}, d});
+          auto last = std::lower_bound(first, cols.end(), col_end);
+          // Runs of up to kRun adjacent columns are evaluated together (they share the target's loads). The
+          // run is evaluated against the bound at its start; each result is re-checked against the bound at
+          // its turn, so the kept candidates are exactly those a one-by-one scan keeps.
+          constexpr int kRun = 4;
+          float d[kRun];
+          for (auto it = first; it != last;) {
+            int run = 1;
+            while (run < kRun && it + run != last && *(it + run) == *it + run) ++run;
+            difference.EvaluateRun({r, *it}, run, std::min(bound, local.Bound()), d);
+            for (int k = 0; k < run; ++k) {
+              const float limit = std::min(bound, local.Bound());
+              if (d[k] <= limit) local.Offer({{r, *it + k}, d[k]});
+            }
+            evaluated += run;
+            it += run;
           }
         }
         evaluations_ += evaluated;
