@@ -35,7 +35,7 @@ double HolePsnr(const cv::Mat& result_rgb8, const cv::Mat& original_gray8, const
   for (int r = 0; r < mask.rows; ++r)
     for (int c = 0; c < mask.cols; ++c) {
       if (!mask.at<uint8_t>(r, c)) continue;
-      const double d = double{gray.at<uint8_t>(r, c)} - double{original_gray8.at<uint8_t>(r, c)};
+      const double d = static_cast<double>(gray.at<uint8_t>(r, c)) - original_gray8.at<uint8_t>(r, c);
       sum += d * d;
       ++n;
     }
