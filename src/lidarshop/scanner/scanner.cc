@@ -1,5 +1,7 @@
 #include "lidarshop/scanner/scanner.h"
 
+#include <embree3/rtcore.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -180,6 +182,153 @@ Scan SyntheticScanner::Acquire(const ScannerOptions& options, Progress* progress
   return scan;
 }
 
+namespace {
+
+// Output channels of one image row (raw pointers: the hot loop writes them directly).
+struct RowOut {
+  cv::Vec3f* direction;
+  uint8_t* valid;
+  float* range;
+  cv::Vec3f* point;
+  float* intensity;
+  cv::Vec3b* color;
+  int32_t* label;
+  cv::Vec3f* normal;
+  float* true_range;
+
+  RowOut(Scan& scan, int row)
+      : direction(scan.direction.ptr<cv::Vec3f>(row)),
+        valid(scan.valid.ptr<uint8_t>(row)),
+        range(scan.range.ptr<float>(row)),
+        point(scan.point.ptr<cv::Vec3f>(row)),
+        intensity(scan.intensity.ptr<float>(row)),
+        color(scan.color.ptr<cv::Vec3b>(row)),
+        label(scan.label.ptr<int32_t>(row)),
+        normal(scan.normal.ptr<cv::Vec3f>(row)),
+        true_range(scan.true_range.ptr<float>(row)) {}
+};
+
+// Everything the per-hit shading reads, set up once per scan; Hit() and Miss() fill one cell.
+struct Shader {
+  const ObjectData* objects = nullptr;
+  Eigen::Matrix3f world_from_scanner_rotation;
+  Eigen::Matrix3f scanner_from_world_rotation;
+  Eigen::Vector3f origin;
+  float los_sigma = 0, orthogonal_sigma = 0;
+  bool noisy = false;
+  uint64_t seed_key = 0;
+  int cols = 0;
+  const float* quantiles = nullptr;
+  const Eigen::Vector2f* circle = nullptr;
+  const float* falloff = nullptr;  // exp(-t / falloff_m) at t = i * max_range / kFalloffSteps
+  float inverse_falloff_step = 0;
+  float angular_step_rad = 0;          // the larger of the azimuth and elevation steps (texture footprint)
+  const float* sin_azimuth = nullptr;  // per column
+  const float* cos_azimuth = nullptr;
+  static constexpr int kFalloffSteps = 1024;
+
+  static inline void Miss(const RowOut& out, int col) {
+    out.valid[col] = 0;
+    out.range[col] = 0.0f;
+    out.point[col] = cv::Vec3f(0, 0, 0);
+    out.intensity[col] = 0.5f;
+    out.color[col] = cv::Vec3b(0, 0, 0);
+    out.label[col] = kNoLabel;
+    out.normal[col] = cv::Vec3f(0, 0, 0);
+    out.true_range[col] = 0.0f;
+  }
+
+  // One return: t along the unit scanner-frame direction d_scanner (d_world in the world frame), object `id`,
+  // `triangle`, barycentric (u, v), geometric normal (any length) in the world frame.
+  inline __attribute__((always_inline)) void Hit(const RowOut& out, int row, int col, float t, int32_t id,
+                                                 int32_t triangle, float u, float v,
+                                                 const Eigen::Vector3f& geometric_normal,
+                                                 const Eigen::Vector3f& d_scanner,
+                                                 const Eigen::Vector3f& d_world) const {
+    const ObjectData& object = objects[id];
+    const TriangleMesh& mesh = object.mesh_in_world;
+    const float w = 1.0f - u - v;
+    Eigen::Vector3f n_world = geometric_normal * (1.0f / std::sqrt(geometric_normal.squaredNorm()));
+    if (!object.smooth.empty() && object.smooth[triangle]) {
+      const Eigen::Vector3i& corners = mesh.triangles[triangle];
+      const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] +
+                                     u * mesh.vertex_normals[corners[1]] +
+                                     v * mesh.vertex_normals[corners[2]];
+      const float norm = smooth.norm();
+      if (norm > 1e-6f) n_world = smooth / norm;
+    }
+    float n_dot_d = n_world.dot(d_world);
+    if (n_dot_d > 0) {  // facing the scanner
+      n_world = -n_world;
+      n_dot_d = -n_dot_d;
+    }
+    const float cos_incidence = std::min(-n_dot_d, 1.0f);
+
+    Rgb8 surface;
+    if (!mesh.triangle_colors.empty()) {
+      surface = mesh.triangle_colors[triangle];
+    } else if (!mesh.vertex_colors.empty()) {
+      const Eigen::Vector3i& corners = mesh.triangles[triangle];
+      const Eigen::Vector3f mixed = w * mesh.vertex_colors[corners[0]].cast<float>() +
+                                    u * mesh.vertex_colors[corners[1]].cast<float>() +
+                                    v * mesh.vertex_colors[corners[2]].cast<float>();
+      surface = (mixed.array() + 0.5f).cast<uint8_t>();
+    } else {
+      surface = object.material.color;
+    }
+    if (object.material.texture != TextureKind::kNone) {
+      const Eigen::Vector3f p_world = origin + t * d_world;
+      const Eigen::Vector3f p_object =
+          object.texture_from_world_rotation * (p_world - object.world_origin_of_object);
+      const Eigen::Vector2f uv = TriplanarCoordinates(p_object, object.texture_from_world_rotation * n_world);
+      // The ray's footprint on the surface (band-limits the texture: no moiré at range).
+      const float footprint_m = t * angular_step_rad / std::max(cos_incidence, 0.02f);
+      surface = EvaluateTexture(object.material.texture, uv.x(), uv.y(), surface,
+                                object.material.texture_scale, footprint_m);
+    } else if (object.has_texture_image) {
+      const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
+      const Eigen::Vector2f st =
+          w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
+      surface = SampleImageTexture(mesh.texture, st.x(), st.y());
+    }
+    const float reflectivity = object.material.reflectivity * (0.5f + Luminance(surface));
+    const float f = std::clamp(t * inverse_falloff_step, 0.0f, static_cast<float>(kFalloffSteps));
+    const int fi = static_cast<int>(f);
+    const float attenuation = falloff[fi] + (f - fi) * (falloff[fi + 1] - falloff[fi]);
+    out.intensity[col] = std::clamp(reflectivity * std::max(cos_incidence, 0.0f) * attenuation, 0.0f, 1.0f);
+
+    Eigen::Vector3f p = t * d_scanner;
+    float range = t;
+    if (noisy) {
+      // One 64-bit hash per cell: 16 bits for e_los, 16 for e_orth, 10 for ψ.
+      const uint64_t bits = SplitMix64(seed_key ^ (static_cast<uint64_t>(row) * cols + col));
+      const float e_los = los_sigma * NormalFrom16Bits(quantiles, bits & 0xFFFFu);
+      p += e_los * d_scanner;
+      if (orthogonal_sigma > 0) {
+        // b1 = (cos θ, -sin θ, 0) (horizontal, ⟂ d for every elevation), b2 = d × b1.
+        const float ca = cos_azimuth[col], sa = sin_azimuth[col];
+        const Eigen::Vector3f b1(ca, -sa, 0.0f);
+        const Eigen::Vector3f b2(d_scanner.z() * sa, d_scanner.z() * ca,
+                                 -(d_scanner.x() * sa + d_scanner.y() * ca));
+        const Eigen::Vector2f& psi = circle[(bits >> 32) & 0x3FFu];
+        const float e_orth = orthogonal_sigma * NormalFrom16Bits(quantiles, (bits >> 16) & 0xFFFFu);
+        p += (e_orth * psi.x()) * b1 + (e_orth * psi.y()) * b2;
+      }
+      range = p.norm();
+    }
+    const Eigen::Vector3f n_scanner = scanner_from_world_rotation * n_world;
+    out.valid[col] = kValid;
+    out.true_range[col] = t;
+    out.range[col] = range;
+    out.point[col] = cv::Vec3f(p.x(), p.y(), p.z());
+    out.color[col] = cv::Vec3b(surface[0], surface[1], surface[2]);
+    out.label[col] = object.label;
+    out.normal[col] = cv::Vec3f(n_scanner.x(), n_scanner.y(), n_scanner.z());
+  }
+};
+
+}  // namespace
+
 void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out, Progress* progress,
                                    ScanStats* stats) const {
   options.Check();
@@ -205,174 +354,221 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
   // Directions exactly as DirectionsFromGrid (double products, then float), from per-row and per-column
   // sines.
   std::vector<double> sin_azimuth(cols), cos_azimuth(cols), sin_elevation(rows), cos_elevation(rows);
+  std::vector<float> sin_azimuth_f(cols), cos_azimuth_f(cols);
   for (int col = 0; col < cols; ++col) {
     sin_azimuth[col] = std::sin(scan.grid.azimuth_rad[col]);
     cos_azimuth[col] = std::cos(scan.grid.azimuth_rad[col]);
+    sin_azimuth_f[col] = static_cast<float>(sin_azimuth[col]);
+    cos_azimuth_f[col] = static_cast<float>(cos_azimuth[col]);
   }
   for (int row = 0; row < rows; ++row) {
     sin_elevation[row] = std::sin(scan.grid.elevation_rad[row]);
     cos_elevation[row] = std::cos(scan.grid.elevation_rad[row]);
   }
+  auto fill_directions = [&](int row) {
+    auto* direction = scan.direction.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      direction[col] = cv::Vec3f(static_cast<float>(cos_elevation[row] * sin_azimuth[col]),
+                                 static_cast<float>(cos_elevation[row] * cos_azimuth[col]),
+                                 static_cast<float>(sin_elevation[row]));
+    }
+  };
 
-  const Eigen::Matrix3f world_from_scanner_rotation =
-      scan.world_from_scanner.topLeftCorner<3, 3>().cast<float>();
-  const Eigen::Matrix3f scanner_from_world_rotation = world_from_scanner_rotation.transpose();
-  const Eigen::Vector3f origin = options.position.cast<float>();
-  const float los_sigma = static_cast<float>(options.los_noise_sigma_m);
-  const float orthogonal_sigma = static_cast<float>(options.orthogonal_noise_sigma_m);
-  const bool noisy = los_sigma > 0 || orthogonal_sigma > 0;
-  const uint64_t seed_key = SplitMix64(options.seed ^ 0x5851F42D4C957F2Dull);
-  const std::vector<ObjectData>& objects = impl_->objects;
-
-  // Rows are cast and shaded in chunks, so that progress moves and the hit images of a chunk stay in cache.
-  const int chunk_rows = std::clamp(rows / 16, 16, 128);
-  ScanStats local_stats;
-  local_stats.rays = scan.num_cells();
-  std::atomic<int64_t> returns{0};
-  RayHitImages hits;
-  const std::vector<float>& quantiles = NormalQuantiles();
-  const std::vector<Eigen::Vector2f>& circle = UnitCircle();
   // exp(-t / falloff) tabulated over [0, max range] (linear interpolation, relative error < 1e-6).
-  constexpr int kFalloffSteps = 1024;
+  constexpr int kFalloffSteps = Shader::kFalloffSteps;
   std::vector<float> falloff(kFalloffSteps + 2);
-  const float falloff_step = static_cast<float>(options.max_range_m / kFalloffSteps);
   for (int i = 0; i < kFalloffSteps + 2; ++i) {
     falloff[i] =
         static_cast<float>(std::exp(-i * options.max_range_m / kFalloffSteps / options.intensity_falloff_m));
   }
+  Shader shader;
+  shader.objects = impl_->objects.data();
+  shader.world_from_scanner_rotation = scan.world_from_scanner.topLeftCorner<3, 3>().cast<float>();
+  shader.scanner_from_world_rotation = shader.world_from_scanner_rotation.transpose();
+  shader.origin = options.position.cast<float>();
+  shader.los_sigma = static_cast<float>(options.los_noise_sigma_m);
+  shader.orthogonal_sigma = static_cast<float>(options.orthogonal_noise_sigma_m);
+  shader.noisy = shader.los_sigma > 0 || shader.orthogonal_sigma > 0;
+  shader.seed_key = SplitMix64(options.seed ^ 0x5851F42D4C957F2Dull);
+  shader.cols = cols;
+  shader.quantiles = NormalQuantiles().data();
+  shader.circle = UnitCircle().data();
+  shader.falloff = falloff.data();
+  shader.inverse_falloff_step = static_cast<float>(kFalloffSteps / options.max_range_m);
+  const double azimuth_step = cols > 1 ? std::abs(scan.grid.azimuth_rad[1] - scan.grid.azimuth_rad[0]) : 0.0;
+  const double elevation_step =
+      rows > 1 ? std::abs(scan.grid.elevation_rad[1] - scan.grid.elevation_rad[0]) : 0.0;
+  shader.angular_step_rad =
+      options.filter_textures ? static_cast<float>(std::max(azimuth_step, elevation_step)) : 0.0f;
+  shader.sin_azimuth = sin_azimuth_f.data();
+  shader.cos_azimuth = cos_azimuth_f.data();
+  const Eigen::Matrix3f& rotation = shader.world_from_scanner_rotation;
+  const float t_near = static_cast<float>(options.min_range_m);
+  const float t_far = static_cast<float>(options.max_range_m);
+
+  ScanStats local_stats;
+  local_stats.rays = scan.num_cells();
+  std::atomic<int64_t> returns{0};
   Timer timer;
-  for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
-    const int chunk_end = std::min(rows, chunk_begin + chunk_rows);
-    timer.Restart();
-    ParallelFor(chunk_end - chunk_begin, [&](int64_t chunk_row) {
-      const int row = chunk_begin + static_cast<int>(chunk_row);
-      auto* direction = scan.direction.ptr<cv::Vec3f>(row);
-      for (int col = 0; col < cols; ++col) {
-        direction[col] = cv::Vec3f(static_cast<float>(cos_elevation[row] * sin_azimuth[col]),
-                                   static_cast<float>(cos_elevation[row] * cos_azimuth[col]),
-                                   static_cast<float>(sin_elevation[row]));
-      }
-    });
-    impl_->raycast.CastImage(scan.world_from_scanner, scan.direction.rowRange(chunk_begin, chunk_end),
-                             static_cast<float>(options.min_range_m), static_cast<float>(options.max_range_m),
-                             options.cast_method, &hits);
-    local_stats.cast_seconds += timer.Seconds();
-    timer.Restart();
-    ParallelFor(
-        chunk_end - chunk_begin,
-        [&](int64_t chunk_row) {
-          const int row = chunk_begin + static_cast<int>(chunk_row);
-          const int hit_row = static_cast<int>(chunk_row);
-          const auto* t_hit = hits.t_hit.ptr<float>(hit_row);
-          const auto* geometry_id = hits.geometry_id.ptr<int32_t>(hit_row);
-          const auto* primitive_id = hits.primitive_id.ptr<int32_t>(hit_row);
-          const auto* geometric_normal = hits.normal.ptr<cv::Vec3f>(hit_row);
-          const auto* barycentric = hits.barycentric.ptr<cv::Vec2f>(hit_row);
-          const auto* direction = scan.direction.ptr<cv::Vec3f>(row);
-          auto* valid = scan.valid.ptr<uint8_t>(row);
-          auto* range = scan.range.ptr<float>(row);
-          auto* point = scan.point.ptr<cv::Vec3f>(row);
-          auto* intensity = scan.intensity.ptr<float>(row);
-          auto* color = scan.color.ptr<cv::Vec3b>(row);
-          auto* label = scan.label.ptr<int32_t>(row);
-          auto* normal = scan.normal.ptr<cv::Vec3f>(row);
-          auto* true_range = scan.true_range.ptr<float>(row);
-          int64_t row_returns = 0;
-          for (int col = 0; col < cols; ++col) {
-            const int32_t id = geometry_id[col];
-            if (id < 0) {
-              valid[col] = 0;
-              range[col] = 0.0f;
-              point[col] = cv::Vec3f(0, 0, 0);
-              intensity[col] = 0.5f;
-              color[col] = cv::Vec3b(0, 0, 0);
-              label[col] = kNoLabel;
-              normal[col] = cv::Vec3f(0, 0, 0);
-              true_range[col] = 0.0f;
-              continue;
-            }
-            ++row_returns;
-            const ObjectData& object = objects[id];
-            const TriangleMesh& mesh = object.mesh_in_world;
-            const int32_t triangle = primitive_id[col];
-            const float t = t_hit[col];
-            const float u = barycentric[col][0], v = barycentric[col][1], w = 1.0f - u - v;
-            const Eigen::Vector3f d_scanner(direction[col][0], direction[col][1], direction[col][2]);
-            const Eigen::Vector3f d_world = world_from_scanner_rotation * d_scanner;
-            const Eigen::Vector3i& corners = mesh.triangles[triangle];
-            Eigen::Vector3f n_world(geometric_normal[col][0], geometric_normal[col][1],
-                                    geometric_normal[col][2]);
-            if (!object.smooth.empty() && object.smooth[triangle]) {
-              const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] +
-                                             u * mesh.vertex_normals[corners[1]] +
-                                             v * mesh.vertex_normals[corners[2]];
-              const float norm = smooth.norm();
-              if (norm > 1e-6f) n_world = smooth / norm;
-            }
-            if (n_world.dot(d_world) > 0) n_world = -n_world;  // facing the scanner
-            const float cos_incidence = std::clamp(-n_world.dot(d_world), 0.0f, 1.0f);
+  // Rows are cast and shaded in chunks (a multiple of the 4-row tile bands), so that progress moves.
+  const int chunk_rows = (std::clamp(rows / 16, 16, 128) + 3) / 4 * 4;
 
-            Rgb8 surface;
-            if (!mesh.triangle_colors.empty()) {
-              surface = mesh.triangle_colors[triangle];
-            } else if (!mesh.vertex_colors.empty()) {
-              const Eigen::Vector3f mixed = w * mesh.vertex_colors[corners[0]].cast<float>() +
-                                            u * mesh.vertex_colors[corners[1]].cast<float>() +
-                                            v * mesh.vertex_colors[corners[2]].cast<float>();
-              surface = (mixed.array() + 0.5f).cast<uint8_t>();
-            } else {
-              surface = object.material.color;
+  if (options.cast_method == CastMethod::kPacket16 || options.cast_method == CastMethod::kStream) {
+    // Fused: each band of 4 rows is cast as 4 x 4 tiles (rtcIntersect16 packets, or one rtcIntersect1M stream
+    // per band in tile order), and every hit is shaded right after, while the rays and the output rows are in
+    // cache (no hit images).
+    RTCScene rtc_scene = static_cast<RTCScene>(impl_->raycast.native_scene());
+    const bool use_stream = options.cast_method == CastMethod::kStream;
+    for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
+      const int chunk_end = std::min(rows, chunk_begin + chunk_rows);
+      const int bands = (chunk_end - chunk_begin + 3) / 4;
+      ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        alignas(64) RTCRayHit16 packet;
+        alignas(64) int lane_valid[16];
+        for (int i = 0; i < 16; ++i) {
+          packet.ray.org_x[i] = shader.origin.x();
+          packet.ray.org_y[i] = shader.origin.y();
+          packet.ray.org_z[i] = shader.origin.z();
+          packet.ray.tnear[i] = t_near;
+          packet.ray.mask[i] = 0xFFFFFFFFu;
+          packet.ray.time[i] = 0.0f;
+          packet.ray.flags[i] = 0;
+        }
+        std::vector<RTCRayHit> stream;
+        std::vector<int32_t> stream_cells;  // (row in band << 24) | col
+        int64_t band_returns = 0;
+        for (int64_t band = band_begin; band < band_end; ++band) {
+          const int row0 = chunk_begin + static_cast<int>(band) * 4;
+          const int row1 = std::min(chunk_end, row0 + 4);
+          const RowOut outs[4] = {RowOut(scan, row0), RowOut(scan, std::min(row0 + 1, row1 - 1)),
+                                  RowOut(scan, std::min(row0 + 2, row1 - 1)),
+                                  RowOut(scan, std::min(row0 + 3, row1 - 1))};
+          for (int row = row0; row < row1; ++row) fill_directions(row);
+          auto shade = [&](int r, int col, unsigned geometry, unsigned primitive, float t, float u, float v,
+                           float nx, float ny, float nz, float dx, float dy, float dz)
+              __attribute__((always_inline)) {
+            const RowOut& out = outs[r];
+            if (geometry == RTC_INVALID_GEOMETRY_ID) {
+              Shader::Miss(out, col);
+              return;
             }
-            if (object.material.texture != TextureKind::kNone) {
-              const Eigen::Vector3f p_world = origin + t * d_world;
-              const Eigen::Vector3f p_object =
-                  object.texture_from_world_rotation * (p_world - object.world_origin_of_object);
-              const Eigen::Vector2f uv =
-                  TriplanarCoordinates(p_object, object.texture_from_world_rotation * n_world);
-              surface = EvaluateTexture(object.material.texture, uv.x(), uv.y(), surface,
-                                        object.material.texture_scale);
-            } else if (object.has_texture_image) {
-              const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
-              const Eigen::Vector2f st =
-                  w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
-              surface = SampleImageTexture(mesh.texture, st.x(), st.y());
-            }
-            const float reflectivity = object.material.reflectivity * (0.5f + Luminance(surface));
-            const float f = std::clamp(t / falloff_step, 0.0f, static_cast<float>(kFalloffSteps));
-            const int fi = static_cast<int>(f);
-            const float attenuation = falloff[fi] + (f - fi) * (falloff[fi + 1] - falloff[fi]);
-            intensity[col] = std::clamp(reflectivity * cos_incidence * attenuation, 0.0f, 1.0f);
-
-            Eigen::Vector3f p = t * d_scanner;
-            if (noisy) {
-              // One 64-bit hash per cell: 16 bits for e_los, 16 for e_orth, 10 for ψ.
-              const uint64_t bits = SplitMix64(seed_key ^ (static_cast<uint64_t>(row) * cols + col));
-              p += (los_sigma * NormalFrom16Bits(quantiles.data(), bits & 0xFFFFu)) * d_scanner;
-              if (orthogonal_sigma > 0) {
-                Eigen::Vector3f b1(d_scanner.y(), -d_scanner.x(), 0.0f);  // d x z
-                if (b1.squaredNorm() < 1e-8f)
-                  b1 = Eigen::Vector3f(0.0f, d_scanner.z(), -d_scanner.y());  // d x x
-                b1.normalize();
-                const Eigen::Vector3f b2 = d_scanner.cross(b1);
-                const Eigen::Vector2f& psi = circle[(bits >> 32) & 0x3FFu];
-                p += (orthogonal_sigma * NormalFrom16Bits(quantiles.data(), (bits >> 16) & 0xFFFFu)) *
-                     (psi.x() * b1 + psi.y() * b2);
+            ++band_returns;
+            const cv::Vec3f& d = out.direction[col];
+            shader.Hit(out, row0 + r, col, t, static_cast<int32_t>(geometry), static_cast<int32_t>(primitive),
+                       u, v, Eigen::Vector3f(nx, ny, nz), Eigen::Vector3f(d[0], d[1], d[2]),
+                       Eigen::Vector3f(dx, dy, dz));
+          };
+          if (use_stream) {
+            stream.clear();
+            stream_cells.clear();
+            for (int col0 = 0; col0 < cols; col0 += 4) {
+              for (int row = row0; row < row1; ++row) {
+                for (int col = col0; col < std::min(cols, col0 + 4); ++col) {
+                  const cv::Vec3f d = outs[row - row0].direction[col];
+                  RTCRayHit& ray_hit = stream.emplace_back();
+                  ray_hit.ray.org_x = shader.origin.x();
+                  ray_hit.ray.org_y = shader.origin.y();
+                  ray_hit.ray.org_z = shader.origin.z();
+                  ray_hit.ray.dir_x = rotation(0, 0) * d[0] + rotation(0, 1) * d[1] + rotation(0, 2) * d[2];
+                  ray_hit.ray.dir_y = rotation(1, 0) * d[0] + rotation(1, 1) * d[1] + rotation(1, 2) * d[2];
+                  ray_hit.ray.dir_z = rotation(2, 0) * d[0] + rotation(2, 1) * d[1] + rotation(2, 2) * d[2];
+                  ray_hit.ray.tnear = t_near;
+                  ray_hit.ray.tfar = t_far;
+                  ray_hit.ray.mask = 0xFFFFFFFFu;
+                  ray_hit.ray.flags = 0;
+                  ray_hit.ray.time = 0.0f;
+                  ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                  ray_hit.hit.primID = RTC_INVALID_GEOMETRY_ID;
+                  ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                  stream_cells.push_back(((row - row0) << 24) | col);
+                }
               }
             }
-            const Eigen::Vector3f n_scanner = scanner_from_world_rotation * n_world;
-            valid[col] = kValid;
-            true_range[col] = t;
-            range[col] = noisy ? p.norm() : t;
-            point[col] = cv::Vec3f(p.x(), p.y(), p.z());
-            color[col] = cv::Vec3b(surface[0], surface[1], surface[2]);
-            label[col] = object.label;
-            normal[col] = cv::Vec3f(n_scanner.x(), n_scanner.y(), n_scanner.z());
+            rtcIntersect1M(rtc_scene, &context, stream.data(), static_cast<unsigned>(stream.size()),
+                           sizeof(RTCRayHit));
+            for (size_t i = 0; i < stream.size(); ++i) {
+              const RTCRayHit& h = stream[i];
+              shade(stream_cells[i] >> 24, stream_cells[i] & 0xFFFFFF, h.hit.geomID, h.hit.primID, h.ray.tfar,
+                    h.hit.u, h.hit.v, h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.ray.dir_x, h.ray.dir_y,
+                    h.ray.dir_z);
+            }
+            continue;
           }
-          returns += row_returns;
-        },
-        4);
-    local_stats.shade_seconds += timer.Seconds();
-    Advance(progress, chunk_end - chunk_begin);
+          for (int col0 = 0; col0 < cols; col0 += 4) {
+            const bool full = row1 - row0 == 4 && col0 + 4 <= cols;
+            for (int i = 0; i < 16; ++i) {
+              const int r = i >> 2, col = col0 + (i & 3);
+              const bool inside = full || (row0 + r < row1 && col < cols);
+              lane_valid[i] = inside ? -1 : 0;
+              const cv::Vec3f d = inside ? outs[r].direction[col] : cv::Vec3f(0, 0, 1);
+              packet.ray.dir_x[i] = rotation(0, 0) * d[0] + rotation(0, 1) * d[1] + rotation(0, 2) * d[2];
+              packet.ray.dir_y[i] = rotation(1, 0) * d[0] + rotation(1, 1) * d[1] + rotation(1, 2) * d[2];
+              packet.ray.dir_z[i] = rotation(2, 0) * d[0] + rotation(2, 1) * d[1] + rotation(2, 2) * d[2];
+              packet.ray.tfar[i] = t_far;
+              packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+              packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+            }
+            rtcIntersect16(lane_valid, rtc_scene, &context, &packet);
+            for (int i = 0; i < 16; ++i) {
+              if (lane_valid[i] == 0) continue;
+              shade(i >> 2, col0 + (i & 3), packet.hit.geomID[i], packet.hit.primID[i], packet.ray.tfar[i],
+                    packet.hit.u[i], packet.hit.v[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i],
+                    packet.hit.Ng_z[i], packet.ray.dir_x[i], packet.ray.dir_y[i], packet.ray.dir_z[i]);
+            }
+          }
+        }
+        returns += band_returns;
+      });
+      Advance(progress, chunk_end - chunk_begin);
+    }
+    local_stats.cast_seconds = timer.Seconds();  // casting and shading, fused
+  } else {
+    // Other cast methods: cast a chunk into hit images, then shade them.
+    RayHitImages hits;
+    for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
+      const int chunk_end = std::min(rows, chunk_begin + chunk_rows);
+      timer.Restart();
+      ParallelFor(chunk_end - chunk_begin,
+                  [&](int64_t chunk_row) { fill_directions(chunk_begin + chunk_row); });
+      impl_->raycast.CastImage(scan.world_from_scanner, scan.direction.rowRange(chunk_begin, chunk_end),
+                               t_near, t_far, options.cast_method, &hits);
+      local_stats.cast_seconds += timer.Seconds();
+      timer.Restart();
+      ParallelFor(
+          chunk_end - chunk_begin,
+          [&](int64_t chunk_row) {
+            const int row = chunk_begin + static_cast<int>(chunk_row);
+            const int hit_row = static_cast<int>(chunk_row);
+            const auto* t_hit = hits.t_hit.ptr<float>(hit_row);
+            const auto* geometry_id = hits.geometry_id.ptr<int32_t>(hit_row);
+            const auto* primitive_id = hits.primitive_id.ptr<int32_t>(hit_row);
+            const auto* geometric_normal = hits.normal.ptr<cv::Vec3f>(hit_row);
+            const auto* barycentric = hits.barycentric.ptr<cv::Vec2f>(hit_row);
+            const RowOut out(scan, row);
+            int64_t row_returns = 0;
+            for (int col = 0; col < cols; ++col) {
+              const int32_t id = geometry_id[col];
+              if (id < 0) {
+                Shader::Miss(out, col);
+                continue;
+              }
+              ++row_returns;
+              const Eigen::Vector3f d_scanner(out.direction[col][0], out.direction[col][1],
+                                              out.direction[col][2]);
+              const cv::Vec3f& n = geometric_normal[col];
+              shader.Hit(out, row, col, t_hit[col], id, primitive_id[col], barycentric[col][0],
+                         barycentric[col][1], Eigen::Vector3f(n[0], n[1], n[2]), d_scanner,
+                         rotation * d_scanner);
+            }
+            returns += row_returns;
+          },
+          4);
+      local_stats.shade_seconds += timer.Seconds();
+      Advance(progress, chunk_end - chunk_begin);
+    }
   }
   local_stats.returns = returns.load();
   if (stats != nullptr) *stats = local_stats;

@@ -4,14 +4,16 @@
 // meshes and returns an organized Scan (scan/scan.h) in image orientation (row 0 = highest elevation, columns
 // left to right) with every channel filled:
 //   valid, range (noisy), point (noisy, scanner frame), intensity (ScannerOptions' model), color (material,
-//   triangle colours or texture looked up at the hit point), label (object label, kNoLabel where no return),
-//   normal (true surface normal, scanner frame, facing the scanner: interpolated vertex normals where the
-//   mesh has them, else the geometric normal), true_range (noise-free range), direction (every cell),
-//   world_from_scanner.
+//   triangle colours or texture looked up at the hit point; procedural textures are band-limited to the ray's
+//   footprint range · angular step / cos(incidence), so they do not alias at range: scanner/texture.h), label
+//   (object label, kNoLabel where no return), normal (true surface normal, scanner frame, facing the scanner:
+//   interpolated vertex normals where the mesh has them, else the geometric normal), true_range (noise-free
+//   range), direction (every cell), world_from_scanner.
 //
 // Noise (per cell, from a counter-based hash of (seed, cell index), so identical whatever the thread count):
 //   point = (true_range + e_los) · d + e_orth · (cos ψ · b1 + sin ψ · b2), e_los ~ N(0, σ_los²),
-//   e_orth ~ N(0, σ_orth²), ψ ~ U[0, 2π), (b1, b2) an orthonormal basis perpendicular to the ray d.
+//   e_orth ~ N(0, σ_orth²), ψ ~ U[0, 2π), (b1, b2) an orthonormal basis perpendicular to the ray d
+//   (b1 = (cos θ, -sin θ, 0), horizontal; b2 = d × b1).
 //   range = |point|. One SplitMix64 hash of (seed, row * cols + col) gives two independent 16-bit uniforms
 //   mapped to standard normals through a 4,097-entry quantile table (inverse-CDF sampling, |e| <= 4.17 σ) and
 //   10 bits for ψ.
@@ -32,8 +34,10 @@ namespace lidarshop {
 struct ScanStats {
   int64_t rays = 0;
   int64_t returns = 0;
-  double cast_seconds = 0.0;   // ray casting
-  double shade_seconds = 0.0;  // noise, colour, intensity, normals
+  // Ray casting. With CastMethod::kPacket16 (the default) shading is fused into the packet loop (each hit is
+  // shaded as its packet returns): cast_seconds then covers both and shade_seconds is 0.
+  double cast_seconds = 0.0;
+  double shade_seconds = 0.0;  // noise, colour, intensity, normals (separate pass: the other cast methods)
 };
 
 class SyntheticScanner {

@@ -9,6 +9,7 @@
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/scanner/primitives.h"
+#include "lidarshop/scanner/texture.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
@@ -238,6 +239,96 @@ TEST(Scanner, TexturesAreDeterministicAndVaried) {
   std::set<int> greens;
   for (int col = 0; col < a.cols; ++col) greens.insert(a.color.at<cv::Vec3b>(a.rows - 1, col)[1]);
   EXPECT_GT(greens.size(), 20u);
+}
+
+TEST(Scanner, FusedPacketPathMatchesTheSingleRayPath) {
+  testing::GroundAndBoxOptions box_options;
+  box_options.los_noise_sigma = 0.01;
+  box_options.orthogonal_noise_sigma = 0.005;
+  SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  ASSERT_EQ(scene.scanner.cast_method, CastMethod::kPacket16);  // the fused cast-and-shade loop
+  const Scan fused = testing::ScanScene(scene);
+  scene.scanner.cast_method = CastMethod::kSingle;  // cast into hit images, then shade
+  const Scan single = testing::ScanScene(scene);
+  ASSERT_GT(fused.CountValid(), 1000);
+  int64_t label_mismatches = 0, compared = 0;
+  for (int row = 0; row < fused.rows; ++row) {
+    for (int col = 0; col < fused.cols; ++col) {
+      const int32_t label = fused.label.at<int32_t>(row, col);
+      if (label != single.label.at<int32_t>(row, col)) {
+        ++label_mismatches;
+        continue;
+      }
+      if (label == kNoLabel) continue;
+      ++compared;
+      EXPECT_NEAR(fused.range.at<float>(row, col), single.range.at<float>(row, col), 1e-4f);
+      EXPECT_NEAR(fused.intensity.at<float>(row, col), single.intensity.at<float>(row, col), 1e-4f);
+      EXPECT_NEAR(cv::norm(fused.normal.at<cv::Vec3f>(row, col) - single.normal.at<cv::Vec3f>(row, col)), 0.0,
+                  1e-4);
+    }
+  }
+  EXPECT_LE(label_mismatches, fused.num_cells() / 1000);  // only rays through a shared edge may differ
+  EXPECT_GT(compared, 1000);
+}
+
+// Std and mean (green channel) of a texture sampled on a 0.1 m grid (coarser than its fine detail).
+std::pair<double, double> SampledGreen(TextureKind kind, float footprint_m) {
+  double sum = 0, sum2 = 0;
+  int n = 0;
+  for (int i = 0; i < 200; ++i) {
+    for (int j = 0; j < 200; ++j) {
+      const float g =
+          EvaluateTexture(kind, 0.1037f * i, 0.0991f * j, DefaultTextureColor(kind), 1.0f, footprint_m)[1];
+      sum += g;
+      sum2 += g * g;
+      ++n;
+    }
+  }
+  const double mean = sum / n;
+  return {std::sqrt(sum2 / n - mean * mean), mean};
+}
+
+TEST(Texture, FootprintFilteringRemovesSubSampleDetailAndKeepsTheMean) {
+  for (TextureKind kind : {TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
+    const auto [point_std, point_mean] = SampledGreen(kind, 0.0f);
+    const auto [filtered_std, filtered_mean] = SampledGreen(kind, 0.1f);
+    SCOPED_TRACE(TextureName(kind));
+    EXPECT_GT(point_std, 5.0);                    // point sampling shows the (aliased) detail
+    EXPECT_LT(filtered_std, 0.5 * point_std);     // the footprint removes it
+    EXPECT_NEAR(filtered_mean, point_mean, 4.0);  // ... and keeps the average colour
+  }
+  // Detail coarser than the footprint stays: 1 m checker squares under a 0.1 m footprint.
+  EXPECT_EQ(EvaluateTexture(TextureKind::kChecker, 0.5f, 0.5f, Rgb8(200, 200, 200), 1.0f, 0.1f),
+            Rgb8(200, 200, 200));
+  EXPECT_EQ(EvaluateTexture(TextureKind::kChecker, 1.5f, 0.5f, Rgb8(200, 200, 200), 1.0f, 0.1f),
+            Rgb8(60, 60, 60));
+}
+
+TEST(Scanner, DistantTexturedGroundDoesNotAlias) {
+  testing::GroundAndBoxOptions box_options;
+  box_options.box_center = Eigen::Vector3d(0, -50, 0.5);  // out of view: only ground
+  SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  for (auto& object : scene.objects) object.material.texture = TextureKind::kGravel;
+  // Mean absolute colour step between horizontal neighbours over the ground rows beyond 10 m.
+  auto roughness = [&](bool filter) {
+    scene.scanner.filter_textures = filter;
+    const Scan scan = testing::ScanScene(scene);
+    double sum = 0;
+    int64_t n = 0;
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 1; col < scan.cols; ++col) {
+        if (scan.label.at<int32_t>(row, col) != 0 || scan.label.at<int32_t>(row, col - 1) != 0) continue;
+        if (scan.true_range.at<float>(row, col) < 10.0f) continue;
+        sum += std::abs(scan.color.at<cv::Vec3b>(row, col)[1] - scan.color.at<cv::Vec3b>(row, col - 1)[1]);
+        ++n;
+      }
+    }
+    EXPECT_GT(n, 1000);
+    return sum / std::max<int64_t>(n, 1);
+  };
+  const double aliased = roughness(false), filtered = roughness(true);
+  EXPECT_GT(aliased, 10.0);
+  EXPECT_LT(filtered, 0.2 * aliased);
 }
 
 std::string WriteTemporary(const std::string& name, const std::string& text) {

@@ -49,6 +49,10 @@ struct ScannerOptions {
   // Intensity model: I = clamp(ρ_eff · |cos α| · exp(-r / intensity_falloff_m), 0, 1) with α the incidence
   // angle and ρ_eff = reflectivity · (0.5 + luminance of the surface colour in [0, 1]); metres.
   double intensity_falloff_m = 150.0;
+  // Band-limit procedural textures to each ray's footprint (range · angular step / cos(incidence)), so that
+  // detail finer than the ray spacing fades to its mean colour instead of aliasing into moiré at range;
+  // false = point-sample the full-detail texture (scanner/texture.h). Not part of scene files.
+  bool filter_textures = true;
   // How rays are traced (speed only: every method gives the same hits). Not part of scene files.
   CastMethod cast_method = CastMethod::kPacket16;
 

@@ -39,7 +39,16 @@ inline Eigen::Vector2f TriplanarCoordinates(const Eigen::Vector3f& point_in_obje
 
 // Colour of `kind` at surface coordinates (u, v) in metres, divided by `scale` (1 = the realistic size
 // above). `base` is the main colour (the brick, the grass, the light checker square).
-Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale = 1.0f);
+//
+// `footprint_m` band-limits the texture to what one ray can resolve (anti-aliasing, no moiré at range): the
+// width of the ray's footprint on the surface in metres, range · angular step / cos(incidence). Each detail
+// level of period (feature size) s keeps full contrast while footprint <= s / 4 and fades linearly to its
+// mean colour at footprint >= s / 2 (the Nyquist limit of the ray spacing), coarse levels staying while fine
+// ones fade: grass blades (3 cm) -> clumps (0.4 m) -> dry patches (3 m); gravel stones (3 cm); brick speckle
+// and mortar joints (1-3 cm) -> per-brick shade (7.5 cm courses); checker squares (`scale`). The means are
+// the area averages of each level (computed once by sampling the full-detail texture). 0 = point sampling.
+Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale = 1.0f,
+                     float footprint_m = 0.0f);
 
 // Nearest-texel lookup of an image texture (CV_8UC3 RGB) at (s, t), (0, 0) = bottom left, wrapping.
 Rgb8 SampleImageTexture(const cv::Mat& texture, float s, float t);
