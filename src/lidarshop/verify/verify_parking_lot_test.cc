@@ -48,10 +48,12 @@ std::vector<VerifierModel>* ParkingLotTest::models_ = nullptr;
 
 SweepOptions CarSweep() {
   SweepOptions options;
-  options.x_min_m = -9.3;  // positions 0.5 m apart, offset so that no car stands exactly on the grid
-  options.x_max_m = 9.3;
-  options.y_min_m = 7.7;
-  options.y_max_m = 13.3;
+  // The row of bays (car centres at y 10–11 m, x within ±6.5 m) with 2.3 m to spare around them; positions
+  // 0.5 m apart, offset so that no car stands exactly on the grid.
+  options.x_min_m = -8.8;
+  options.x_max_m = 8.8;
+  options.y_min_m = 8.2;
+  options.y_max_m = 12.7;
   options.step_m = 0.5;
   // Half a turn: every car's true yaw lies in [0°, 180°); the cars are nearly symmetric front to back, so the
   // test accepts either heading (the other half would double the run time).
