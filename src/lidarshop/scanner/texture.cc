@@ -57,8 +57,9 @@ inline Rgb8 Mix(Rgb8 a, Rgb8 b, float t) {
 
 // Contrast weight of a detail level of period `size` under a footprint (see EvaluateTexture): 1 for
 // footprint <= size / 4, 0 for footprint >= size / 2, linear between.
+// (A multiplication by the constant 4 / size: no division in the per-ray path.)
 inline float Fade(float size, float footprint) {
-  return std::clamp(2.0f - 4.0f * footprint / size, 0.0f, 1.0f);
+  return std::clamp(2.0f - (4.0f / size) * footprint, 0.0f, 1.0f);
 }
 
 inline Rgb8 MixRgb(const Eigen::Vector3f& mean, Rgb8 detail, float weight) {
@@ -137,9 +138,10 @@ Rgb8 DefaultTextureColor(TextureKind kind) {
 }
 
 Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale, float footprint_m) {
-  u /= scale;
-  v /= scale;
-  const float footprint = footprint_m / scale;  // in texture units
+  const float inverse_scale = 1.0f / scale;
+  u *= inverse_scale;
+  v *= inverse_scale;
+  const float footprint = footprint_m * inverse_scale;  // in texture units
   switch (kind) {
     case TextureKind::kNone:
       return base;
@@ -171,10 +173,10 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale,
       const float weight = Fade(kGravelSize, footprint);
       // (The mean is only read when fading: MeanFactor samples this case with footprint 0.)
       if (weight <= 0.0f) return MixRgb(GravelMeanFactor().cwiseProduct(base.cast<float>()), base, 0.0f);
-      const float row = FastFloor(v / kGravelSize);
-      const float shifted = u / kGravelSize + 0.5f * (static_cast<int>(row) & 1);
+      const float row = FastFloor(v * (1.0f / kGravelSize));
+      const float shifted = u * (1.0f / kGravelSize) + 0.5f * (static_cast<int>(row) & 1);
       const float col = FastFloor(shifted);
-      const float fu = shifted - col, fv = v / kGravelSize - row;
+      const float fu = shifted - col, fv = v * (1.0f / kGravelSize) - row;
       // One hash per stone: 8 bits each for the gap width, the shade and the warmth.
       const uint32_t h = Hash(static_cast<int32_t>(col), static_cast<int32_t>(row), 21);
       const float edge = std::min(std::min(fu, 1 - fu), std::min(fv, 1 - fv));
@@ -203,9 +205,9 @@ Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale,
             kMortarFraction * mortar + (1 - kMortarFraction) * Shade(base, 0.8f + 0.35f * 0.5f).cast<float>();
         return MixRgb(wall, base, 0.0f);
       }
-      const float course = FastFloor(v / kCourseHeight);
+      const float course = FastFloor(v * (1.0f / kCourseHeight));
       const float shifted = u + (static_cast<int>(course) & 1) * (kBrickPitch / 2);
-      const float column = FastFloor(shifted / kBrickPitch);
+      const float column = FastFloor(shifted * (1.0f / kBrickPitch));
       const float in_u = shifted - column * kBrickPitch, in_v = v - course * kCourseHeight;
       const int32_t ci = static_cast<int32_t>(column), ri = static_cast<int32_t>(course);
       // Per-brick shade (faded to its mean 0.975 at range) plus a 1.5 cm speckle.
