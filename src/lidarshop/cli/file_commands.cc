@@ -162,6 +162,8 @@ int RunRender(int argc, char** argv) {
   app.add_option("--min", options.min_value,
                  "value of the first colour (metres for range); default: 1 % quantile");
   app.add_option("--max", options.max_value, "value of the last colour; default: 99 % quantile");
+  bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
+  AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
     options.channel = ParseRenderChannel(channel);
     if (!color_map.empty()) options.color_map = ParseColorMap(color_map);
