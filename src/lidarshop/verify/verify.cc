@@ -172,6 +172,19 @@ void CastDistances(const RaycastScene& scene, std::span<const Ray> rays, std::sp
   }
 }
 
+// Integer cell coordinates (clamped to the grid) of a point in the kernel cell grid.
+Eigen::Vector3i KernelCellCoords(const KernelNeighbourGrid& grid, const Eigen::Vector3f& p) {
+  const Eigen::Vector3f cell = (p - grid.origin_in_model) / grid.cell_m;
+  return Eigen::Vector3i(std::clamp(static_cast<int>(std::floor(cell.x())), 0, grid.cell_dims.x() - 1),
+                         std::clamp(static_cast<int>(std::floor(cell.y())), 0, grid.cell_dims.y() - 1),
+                         std::clamp(static_cast<int>(std::floor(cell.z())), 0, grid.cell_dims.z() - 1));
+}
+
+int64_t KernelCellOf(const KernelNeighbourGrid& grid, const Eigen::Vector3f& p) {
+  const Eigen::Vector3i c = KernelCellCoords(grid, p);
+  return (static_cast<int64_t>(c.z()) * grid.cell_dims.y() + c.y()) * grid.cell_dims.x() + c.x();
+}
+
 KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::AlignedBox3f& bounds,
                                     float kernel_radius, float trim) {
   KernelNeighbourGrid grid;
@@ -187,7 +200,8 @@ KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::Aligne
     grid.dims[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / grid.voxel_m)));
   const int64_t voxels = static_cast<int64_t>(grid.dims.x()) * grid.dims.y() * grid.dims.z();
   const float half_diagonal = 0.5f * std::sqrt(3.0f) * grid.voxel_m;
-  std::vector<std::vector<uint32_t>> lists(voxels), nearest_lists(voxels);
+  const auto points = tree.points();
+  std::vector<std::vector<uint32_t>> nearest_lists(voxels);
   ParallelFor(
       voxels,
       [&](int64_t v) {
@@ -195,9 +209,6 @@ KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::Aligne
         const int y = static_cast<int>((v / grid.dims.x()) % grid.dims.y());
         const int z = static_cast<int>(v / (static_cast<int64_t>(grid.dims.x()) * grid.dims.y()));
         const Eigen::Vector3f centre = lo + grid.voxel_m * Eigen::Vector3f(x + 0.5f, y + 0.5f, z + 0.5f);
-        tree.ForEachInRadius(centre, kernel_radius + half_diagonal,
-                             [&](uint32_t i, float) { lists[v].push_back(i); });
-        std::sort(lists[v].begin(), lists[v].end());
         const NearestResult nearest = tree.NearestWithin(centre, trim + half_diagonal);
         if (nearest.found()) {
           const float reach_of_voxel = std::sqrt(nearest.distance_sq) + 2.0f * half_diagonal;
@@ -208,25 +219,39 @@ KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::Aligne
         }
       },
       256);
-  auto flatten = [voxels](std::vector<std::vector<uint32_t>>& from, std::vector<uint32_t>* offsets,
-                          std::vector<uint32_t>* indices) {
-    offsets->resize(voxels + 1);
-    (*offsets)[0] = 0;
-    for (int64_t v = 0; v < voxels; ++v)
-      (*offsets)[v + 1] = (*offsets)[v] + static_cast<uint32_t>(from[v].size());
-    indices->reserve(offsets->back());
-    for (auto& list : from) {
-      indices->insert(indices->end(), list.begin(), list.end());
-      std::vector<uint32_t>().swap(list);
-    }
-  };
-  flatten(lists, &grid.offsets, &grid.indices);
-  flatten(nearest_lists, &grid.nearest_offsets, &grid.nearest_indices);
-  const auto points = tree.points();
-  grid.positions.reserve(grid.indices.size());
-  for (uint32_t i : grid.indices) grid.positions.push_back(points[i]);
+  grid.nearest_offsets.resize(voxels + 1);
+  grid.nearest_offsets[0] = 0;
+  for (int64_t v = 0; v < voxels; ++v) {
+    grid.nearest_offsets[v + 1] = grid.nearest_offsets[v] + static_cast<uint32_t>(nearest_lists[v].size());
+  }
+  grid.nearest_indices.reserve(grid.nearest_offsets.back());
+  for (auto& list : nearest_lists) {
+    grid.nearest_indices.insert(grid.nearest_indices.end(), list.begin(), list.end());
+    std::vector<uint32_t>().swap(list);
+  }
   grid.nearest_positions.reserve(grid.nearest_indices.size());
   for (uint32_t i : grid.nearest_indices) grid.nearest_positions.push_back(points[i]);
+
+  // Kernel cells: the points sorted by cell (counting sort, stable: ascending index within a cell).
+  grid.cell_m = std::max(kernel_radius * 1.001f, static_cast<float>(std::cbrt(extent.prod() / kMaxVoxels)));
+  for (int k = 0; k < 3; ++k)
+    grid.cell_dims[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / grid.cell_m)));
+  const int64_t cells = static_cast<int64_t>(grid.cell_dims.x()) * grid.cell_dims.y() * grid.cell_dims.z();
+  std::vector<uint32_t> cell_of(points.size());
+  grid.cell_offsets.assign(cells + 1, 0);
+  for (size_t i = 0; i < points.size(); ++i) {
+    cell_of[i] = static_cast<uint32_t>(KernelCellOf(grid, points[i]));
+    ++grid.cell_offsets[cell_of[i] + 1];
+  }
+  for (int64_t c = 0; c < cells; ++c) grid.cell_offsets[c + 1] += grid.cell_offsets[c];
+  std::vector<uint32_t> next(grid.cell_offsets.begin(), grid.cell_offsets.end() - 1);
+  grid.cell_indices.resize(points.size());
+  grid.cell_positions.resize(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    const uint32_t slot = next[cell_of[i]]++;
+    grid.cell_indices[slot] = static_cast<uint32_t>(i);
+    grid.cell_positions[slot] = points[i];
+  }
   return grid;
 }
 
@@ -448,21 +473,25 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         // object): its closest match is the ICP nearest neighbour too.
         if (!near_box.contains(point_in_model)) continue;
         float closest_sq = std::numeric_limits<float>::infinity();
-        int64_t voxel = -1;
         if (use_grid) {
-          const Eigen::Vector3f cell = (point_in_model - grid.origin_in_model) / grid.voxel_m;
-          const int x = std::clamp(static_cast<int>(cell.x()), 0, grid.dims.x() - 1);
-          const int y = std::clamp(static_cast<int>(cell.y()), 0, grid.dims.y() - 1);
-          const int z = std::clamp(static_cast<int>(cell.z()), 0, grid.dims.z() - 1);
-          voxel = (static_cast<int64_t>(z) * grid.dims.y() + y) * grid.dims.x() + x;
+          // The 3 x 3 x 3 kernel cells around the point's own: nine runs of three cells, contiguous in x.
+          const Eigen::Vector3i c = KernelCellCoords(grid, point_in_model);
+          const int x0 = std::max(c.x() - 1, 0), x1 = std::min(c.x() + 1, grid.cell_dims.x() - 1);
           const float kernel_radius_sq = kernel_radius * kernel_radius;
-          for (uint32_t k = grid.offsets[voxel]; k < grid.offsets[voxel + 1]; ++k) {
-            const float distance_sq = (grid.positions[k] - point_in_model).squaredNorm();
-            if (distance_sq < kernel_radius_sq) {
-              const uint32_t i = grid.indices[k];
-              // Only min(1, sum) matters: a saturated point needs no more exp (exact, and most of the cost).
-              if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
-              closest_sq = std::min(closest_sq, distance_sq);
+          for (int z = std::max(c.z() - 1, 0); z <= std::min(c.z() + 1, grid.cell_dims.z() - 1); ++z) {
+            for (int y = std::max(c.y() - 1, 0); y <= std::min(c.y() + 1, grid.cell_dims.y() - 1); ++y) {
+              const int64_t row = (static_cast<int64_t>(z) * grid.cell_dims.y() + y) * grid.cell_dims.x();
+              const uint32_t end = grid.cell_offsets[row + x1 + 1];
+              for (uint32_t k = grid.cell_offsets[row + x0]; k < end; ++k) {
+                const float distance_sq = (grid.cell_positions[k] - point_in_model).squaredNorm();
+                if (distance_sq < kernel_radius_sq) {
+                  const uint32_t i = grid.cell_indices[k];
+                  // Only min(1, sum) matters: a saturated point needs no more exp (exact, and most of the
+                  // cost).
+                  if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
+                  closest_sq = std::min(closest_sq, distance_sq);
+                }
+              }
             }
           }
         } else {
@@ -477,6 +506,11 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         ++result.icp_candidates;
         if (!(closest_sq < kernel_radius * kernel_radius)) {
           if (use_grid) {
+            const Eigen::Vector3f cell = (point_in_model - grid.origin_in_model) / grid.voxel_m;
+            const int x = std::clamp(static_cast<int>(cell.x()), 0, grid.dims.x() - 1);
+            const int y = std::clamp(static_cast<int>(cell.y()), 0, grid.dims.y() - 1);
+            const int z = std::clamp(static_cast<int>(cell.z()), 0, grid.dims.z() - 1);
+            const int64_t voxel = (static_cast<int64_t>(z) * grid.dims.y() + y) * grid.dims.x() + x;
             for (uint32_t k = grid.nearest_offsets[voxel]; k < grid.nearest_offsets[voxel + 1]; ++k) {
               closest_sq = std::min(closest_sq, (grid.nearest_positions[k] - point_in_model).squaredNorm());
             }
