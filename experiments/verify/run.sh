@@ -22,10 +22,10 @@ echo "== parking lot (CLI) =="
 L="$BUILD/lidarshop"
 "$L" scan data/scenes/parking_lot.json -o "$OUT/parking_lot.ptx" --quiet
 echo -n "sedan at its true pose:        "
-"$L" verify --scan "$OUT/parking_lot.ptx" --model builtin:sedan --pose 6.5,10,0,110 --json "$OUT/sedan_truth.json" \
+"$L" verify --scan "$OUT/parking_lot.ptx" --model builtin:sedan --pose 6.5,10,0,120 --json "$OUT/sedan_truth.json" \
   --scene-points "$OUT/sedan_truth_scene.ply" --model-points "$OUT/sedan_truth_model.ply" --quiet
 echo -n "sedan halfway to the hatchback: "
-"$L" verify --scan "$OUT/parking_lot.ptx" --model builtin:sedan --pose 3.25,10.5,0,110 --json "$OUT/halfway.json" \
+"$L" verify --scan "$OUT/parking_lot.ptx" --model builtin:sedan --pose 3.25,10.5,0,120 --json "$OUT/halfway.json" \
   --scene-points "$OUT/halfway_scene.ply" --quiet
 for car in sedan hatchback van; do
   echo "-- sweep with the $car model --"

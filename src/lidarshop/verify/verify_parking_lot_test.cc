@@ -21,7 +21,7 @@ struct Car {
   double x, y, yaw_deg;
 };
 // As placed in parking_lot.json (rotate_deg z = yaw).
-const std::vector<Car> kCars = {{"sedan", 6.5, 10, 110}, {"hatchback", 0, 11, 120}, {"van", -6.5, 10.5, 80}};
+const std::vector<Car> kCars = {{"sedan", 6.5, 10, 120}, {"hatchback", 0, 11, 120}, {"van", -6.5, 10.5, 80}};
 
 class ParkingLotTest : public ::testing::Test {
  protected:
@@ -110,9 +110,9 @@ TEST_F(ParkingLotTest, SweepWithEachCarModelFindsThatCarOnly) {
 
 TEST_F(ParkingLotTest, HalfwayBetweenTwoCarsIsRejectedByConsistencyNotByIcp) {
   const VerifierModel& sedan = (*models_)[0];
-  const VerifyResult truth = VerifyPose(sedan, *scans_, PoseFromXyzYaw(kCars[0].x, kCars[0].y, 0, 110));
+  const VerifyResult truth = VerifyPose(sedan, *scans_, PoseFromXyzYaw(kCars[0].x, kCars[0].y, 0, 120));
   // Halfway between the sedan (6.5, 10) and the hatchback (0, 11).
-  const VerifyResult halfway = VerifyPose(sedan, *scans_, PoseFromXyzYaw(3.25, 10.5, 0, 110));
+  const VerifyResult halfway = VerifyPose(sedan, *scans_, PoseFromXyzYaw(3.25, 10.5, 0, 120));
   fmt::print("sedan model: truth {}\nhalfway {}\n", truth.BriefReport(), halfway.BriefReport());
   SCOPED_TRACE("truth: " + truth.BriefReport() + "\nhalfway: " + halfway.BriefReport());
   EXPECT_GT(truth.consistency, 0.9);
