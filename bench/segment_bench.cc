@@ -58,11 +58,14 @@ const Fixture& GetFixture() {
   return fixture;
 }
 
-void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel model) {
+void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel model, int roi_margin_cells = -1,
+             double roi_margin_fraction = -1) {
   const Fixture& f = GetFixture();
   SegmentOptions options;
   options.method = method;
   options.model = model;
+  if (roi_margin_cells >= 0) options.roi_margin_cells = roi_margin_cells;
+  if (roi_margin_fraction >= 0) options.roi_margin_fraction = roi_margin_fraction;
   SegmentResult result;
   for (auto _ : state) {
     SegmentSession session(f.scan, options);
@@ -76,10 +79,19 @@ void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel mode
   state.counters["models_s"] = result.timings.models_s;
   state.counters["features_s"] = result.timings.features_s;
   state.counters["cells"] = static_cast<double>(f.scan.CountValid());
+  state.counters["last_graph_nodes"] = static_cast<double>(result.graph_nodes);
 }
 
 void BM_TwoStepGmm(benchmark::State& state) {
   Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm);
+}
+// Step 3 on the whole image (roi_margin_cells = 0), the behaviour before the region of interest.
+void BM_TwoStepGmmWholeImage(benchmark::State& state) {
+  Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm, 0);
+}
+// Step 3's ROI margin as a fraction of the step-1 box, in percent (the margin is at least 50 cells).
+void BM_TwoStepGmmRoiFraction(benchmark::State& state) {
+  Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm, 50, state.range(0) / 100.0);
 }
 void BM_TwoStepHistogram(benchmark::State& state) {
   Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kHistogram);
@@ -136,6 +148,8 @@ void BM_OpenCvGrabCut(benchmark::State& state) {
 }
 
 BENCHMARK(BM_TwoStepGmm)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_TwoStepGmmWholeImage)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_TwoStepGmmRoiFraction)->Arg(10)->Arg(25)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_TwoStepHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_OneCutDepthHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_RefineOneStroke)->Unit(benchmark::kMillisecond)->Iterations(5);

@@ -80,6 +80,10 @@ void SegmentOptions::Check() const {
   CheckOption(std::isfinite(ring_depth_threshold_fraction) && ring_depth_threshold_fraction >= 0,
               fmt::format("SegmentOptions.ring_depth_threshold_fraction must be >= 0, got {}",
                           ring_depth_threshold_fraction));
+  CheckOption(roi_margin_cells >= 0,
+              fmt::format("SegmentOptions.roi_margin_cells must be >= 0, got {}", roi_margin_cells));
+  CheckOption(std::isfinite(roi_margin_fraction) && roi_margin_fraction >= 0,
+              fmt::format("SegmentOptions.roi_margin_fraction must be >= 0, got {}", roi_margin_fraction));
   CheckOption(color_bins >= 2 && color_bins <= 64,
               fmt::format("SegmentOptions.color_bins must be in [2, 64], got {}", color_bins));
   CheckOption(std::isfinite(depth_bin_m) && depth_bin_m > 0,
@@ -443,22 +447,55 @@ std::vector<float> MixWithUniform(int n, double uniform_weight, double uniform_d
   return out;
 }
 
+// The table log((1 − u) p + u · uniform) of a table of densities p: the same float expression as
+// MixWithUniform, evaluated once per entry instead of once per node.
+std::vector<float> LogMixTable(const std::vector<float>& density, double uniform_weight,
+                               double uniform_density) {
+  std::vector<float> out(density.size());
+  const float u = static_cast<float>(uniform_weight * uniform_density),
+              keep = static_cast<float>(1 - uniform_weight);
+  ParallelForRange(
+      static_cast<int64_t>(density.size()),
+      [&](int64_t begin, int64_t end) {
+        for (int64_t i = begin; i < end; ++i) out[i] = std::log(keep * density[i] + u);
+      },
+      4096);
+  return out;
+}
+
+// out[k] = table[index(k)] for k < n.
+template <typename F>
+std::vector<float> LookUp(int n, const std::vector<float>& table, F index) {
+  std::vector<float> out(n);
+  ParallelForRange(
+      n,
+      [&](int64_t begin, int64_t end) {
+        for (int64_t k = begin; k < end; ++k) out[k] = table[index(static_cast<int32_t>(k))];
+      },
+      4096);
+  return out;
+}
+
+// Log densities of the nodes `subset` (nullptr = every node; the outputs are indexed like `subset`) under the
+// models learnt from the nodes `object` and `background`.
 LogDensities ComputeLogDensities(const Nodes& nodes, const std::vector<int32_t>& object,
-                                 const std::vector<int32_t>& background, const SegmentOptions& options) {
+                                 const std::vector<int32_t>& background, const SegmentOptions& options,
+                                 const std::vector<int32_t>* subset = nullptr) {
   LogDensities out;
-  const int n = nodes.num();
+  const int n = subset != nullptr ? static_cast<int>(subset->size()) : nodes.num();
+  auto node = [subset](int32_t k) { return subset != nullptr ? (*subset)[k] : k; };
   const double span_m = std::max(double(nodes.range_max - nodes.range_min), options.depth_bin_m);
   const double depth_uniform = 1.0 / span_m;
   if (options.model == AppearanceModel::kHistogram) {
     const int bins = options.color_bins;
     auto color_index = [&](int32_t i) {
-      const cv::Vec4f& v = nodes.raw[i];
+      const cv::Vec4f& v = nodes.raw[node(i)];
       auto b = [bins](float x) { return std::clamp(static_cast<int>(x * bins), 0, bins - 1); };
       return (b(v[0]) * bins + b(v[1])) * bins + b(v[2]);
     };
     const int depth_bins = std::min(1 << 20, static_cast<int>(span_m / options.depth_bin_m) + 1);
     auto depth_index = [&](int32_t i) {
-      return std::clamp(static_cast<int>((nodes.raw[i][3] - nodes.range_min) / options.depth_bin_m), 0,
+      return std::clamp(static_cast<int>((nodes.raw[node(i)][3] - nodes.range_min) / options.depth_bin_m), 0,
                         depth_bins - 1);
     };
     const std::vector<float> co = ColorHistogram(nodes, object, bins);
@@ -514,12 +551,9 @@ LogDensities ComputeLogDensities(const Nodes& nodes, const std::vector<int32_t>&
   };
   const std::vector<float> lut_object = tabulate(co), lut_background = tabulate(cb);
   auto lut_index = [&](int32_t i) {
-    const cv::Vec4f& v = nodes.raw[i];
+    const cv::Vec4f& v = nodes.raw[node(i)];
     auto q = [](float x) { return std::clamp(static_cast<int>(x * kLut), 0, kLut - 1); };
     return (q(v[0]) * kLut + q(v[1])) * kLut + q(v[2]);
-  };
-  auto color_density = [&](const std::vector<float>& lut) {
-    return [&](int32_t i) { return lut[lut_index(i)]; };
   };
   // The range mixtures likewise, on a grid of an eighth of the variance floor (at most 2^20 entries).
   const double depth_step_m =
@@ -539,19 +573,17 @@ LogDensities ComputeLogDensities(const Nodes& nodes, const std::vector<int32_t>&
     return lut;
   };
   const std::vector<float> depth_lut_object = tabulate_depth(dob), depth_lut_background = tabulate_depth(dbg);
-  auto depth_density = [&](const std::vector<float>& lut) {
-    return [&](int32_t i) {
-      const int k = std::clamp(static_cast<int>((nodes.raw[i][3] - nodes.range_min) / depth_step_m), 0,
-                               depth_entries - 1);
-      return lut[k];
-    };
+  auto depth_index = [&](int32_t i) {
+    return std::clamp(static_cast<int>((nodes.raw[node(i)][3] - nodes.range_min) / depth_step_m), 0,
+                      depth_entries - 1);
   };
-  out.color_object = MixWithUniform(n, options.object_uniform, 1.0, color_density(lut_object));
-  out.color_background = MixWithUniform(n, options.background_uniform, 1.0, color_density(lut_background));
+  // The logarithm and the uniform mixture are tabulated too, so a node costs two table look-ups per model.
+  out.color_object = LookUp(n, LogMixTable(lut_object, options.object_uniform, 1.0), lut_index);
+  out.color_background = LookUp(n, LogMixTable(lut_background, options.background_uniform, 1.0), lut_index);
   out.depth_object =
-      MixWithUniform(n, options.object_uniform, depth_uniform, depth_density(depth_lut_object));
+      LookUp(n, LogMixTable(depth_lut_object, options.object_uniform, depth_uniform), depth_index);
   out.depth_background =
-      MixWithUniform(n, options.background_uniform, depth_uniform, depth_density(depth_lut_background));
+      LookUp(n, LogMixTable(depth_lut_background, options.background_uniform, depth_uniform), depth_index);
   return out;
 }
 
@@ -563,6 +595,15 @@ struct Cut {
   float hard_cap = 0;                       // capacity of a hard t-link
   std::vector<float> source_cap, sink_cap;  // #nodes: the t-link capacities given to the graph so far
   const CutWeights* weights = nullptr;      // the weights the graph was built with
+  // The graph's nodes when it covers a region of interest only: graph node k is node node_of_local[k], and
+  // local_of_node[i] is node i's graph node or -1. Both empty = the graph covers every node (k = i).
+  std::vector<int32_t> node_of_local, local_of_node;
+  std::vector<uint8_t> on_roi_edge;  // per graph node: on the ROI's edge inside the image
+  const NLinks* links = nullptr;     // the n-links the graph was built with
+  int num_local(int num_nodes) const {
+    return node_of_local.empty() ? num_nodes : static_cast<int>(node_of_local.size());
+  }
+  int32_t Node(int32_t k) const { return node_of_local.empty() ? k : node_of_local[k]; }
 };
 
 // t-link capacities (source = object side, i.e. the cost of labelling the node background; sink = the cost of
@@ -605,12 +646,14 @@ void TLinkCapacities(const LogDensities& logp, const CutWeights& w, const std::v
 }
 
 // Builds the graph of one cut and runs the max-flow. `hard` holds kFree / kHardObject / kHardBackground per
-// node.
-Cut BuildAndCut(const Nodes& nodes, const NLinks& links, const LogDensities& logp, const CutWeights& w,
-                const std::vector<uint8_t>& hard, SegmentTimings* timings, double* flow) {
+// graph node; `cut` comes with node_of_local / local_of_node set (or empty for the whole image), and `logp`
+// and `hard` are indexed by graph node. n-links to nodes outside the graph are dropped.
+void BuildAndCut(const Nodes& nodes, const NLinks& links, const LogDensities& logp, const CutWeights& w,
+                 const std::vector<uint8_t>& hard, SegmentTimings* timings, double* flow, Cut* cut_out) {
   Timer timer;
-  const int n = nodes.num();
-  Cut cut;
+  Cut& cut = *cut_out;
+  const int n = cut.num_local(nodes.num());
+  const bool subset = !cut.node_of_local.empty();
   int64_t num_edges = 0;
   for (int d = 0; d < links.directions; ++d) num_edges += n;
   cut.graph =
@@ -620,32 +663,36 @@ Cut BuildAndCut(const Nodes& nodes, const NLinks& links, const LogDensities& log
   // A hard t-link outweighs every n-link of its node and every data cost.
   TLinkCapacities(logp, w, hard, &cut.hard_cap, &cut.source_cap, &cut.sink_cap);
   cut.weights = &w;
-  for (int i = 0; i < n; ++i) g.add_tweights(i, cut.source_cap[i], cut.sink_cap[i]);
-  for (int i = 0; i < n; ++i) {
+  for (int k = 0; k < n; ++k) g.add_tweights(k, cut.source_cap[k], cut.sink_cap[k]);
+  for (int k = 0; k < n; ++k) {
+    const int32_t i = cut.Node(k);
     const int32_t cell = nodes.cell_of_node[i];
     const int row = cell / nodes.cols, col = cell % nodes.cols;
     for (int d = 0; d < links.directions; ++d) {
       const float weight = links.weight[d][i];
       if (weight <= 0) continue;
-      const int32_t q =
-          nodes.node_of_cell[static_cast<int64_t>(row + kDirRow[d]) * nodes.cols + col + kDirCol[d]];
-      g.add_edge(i, q, weight, weight);
+      int32_t q = nodes.node_of_cell[static_cast<int64_t>(row + kDirRow[d]) * nodes.cols + col + kDirCol[d]];
+      if (subset) {
+        q = cut.local_of_node[q];
+        if (q < 0) continue;
+      }
+      g.add_edge(k, q, weight, weight);
     }
   }
   timings->graph_s += timer.Seconds();
   timer.Restart();
   *flow = g.maxflow();
   timings->maxflow_s += timer.Seconds();
-  return cut;
 }
 
 // Object cells (255) from a cut, keeping only the 4-connected components that contain a cell of `keep` (node
 // flags); cells of other components are dropped.
-cv::Mat MaskFromCut(const Nodes& nodes, const Graph& g, const std::vector<uint8_t>& hard) {
+cv::Mat MaskFromCut(const Nodes& nodes, const Cut& cut, const std::vector<uint8_t>& hard) {
   cv::Mat mask(nodes.rows, nodes.cols, CV_8U, cv::Scalar(0));
   uint8_t* data = mask.ptr<uint8_t>();
-  for (int i = 0; i < nodes.num(); ++i) {
-    if (g.what_segment(i, Graph::SINK) == Graph::SOURCE) data[nodes.cell_of_node[i]] = 255;
+  const int n = cut.num_local(nodes.num());
+  for (int k = 0; k < n; ++k) {
+    if (cut.graph->what_segment(k, Graph::SINK) == Graph::SOURCE) data[nodes.cell_of_node[cut.Node(k)]] = 255;
   }
   // Keep the components that hold a hard object cell.
   cv::Mat labels;
@@ -705,10 +752,51 @@ struct SegmentSession::Impl {
     return hard;
   }
 
-  // One cut with the given weights: models from the hard cells, graph, max-flow. Keeps the graph in `last`.
+  // The hard labels of the last graph's nodes: `hard` (per node) mapped to the graph.
+  std::vector<uint8_t> LocalHard(const std::vector<uint8_t>& hard) const {
+    if (last.node_of_local.empty()) return hard;
+    std::vector<uint8_t> local(last.node_of_local.size());
+    for (size_t k = 0; k < local.size(); ++k) local[k] = hard[last.node_of_local[k]];
+    return local;
+  }
+
+  // Whether `mask` (the last cut's) holds a cell on an edge of the last graph's ROI that is not an image
+  // edge: then the object may go on beyond the ROI, which was too small.
+  bool ReachesRoiEdge(const cv::Mat& mask) const {
+    const uint8_t* data = mask.ptr<uint8_t>();
+    for (size_t k = 0; k < last.on_roi_edge.size(); ++k) {
+      if (last.on_roi_edge[k] && data[nodes.cell_of_node[last.node_of_local[k]]] != 0) return true;
+    }
+    return false;
+  }
+
+  // Sets last's node maps to the valid cells of `roi` (an empty rectangle or the whole image = every node).
+  void SetRoi(const cv::Rect& roi) {
+    last.node_of_local.clear();
+    last.local_of_node.clear();
+    last.on_roi_edge.clear();
+    if (roi.empty() || roi == cv::Rect(0, 0, nodes.cols, nodes.rows)) return;
+    last.local_of_node.assign(nodes.num(), -1);
+    for (int row = roi.y; row < roi.y + roi.height; ++row) {
+      for (int col = roi.x; col < roi.x + roi.width; ++col) {
+        const int32_t i = nodes.node_of_cell[static_cast<int64_t>(row) * nodes.cols + col];
+        if (i < 0) continue;
+        last.local_of_node[i] = static_cast<int32_t>(last.node_of_local.size());
+        last.node_of_local.push_back(i);
+        const bool edge = (row == roi.y && row > 0) ||
+                          (row == roi.y + roi.height - 1 && row < nodes.rows - 1) ||
+                          (col == roi.x && col > 0) || (col == roi.x + roi.width - 1 && col < nodes.cols - 1);
+        last.on_roi_edge.push_back(edge ? 1 : 0);
+      }
+    }
+  }
+
+  // One cut with the given weights: models from the hard cells (all of them, also outside the ROI), graph
+  // over the valid cells of `roi` (empty = the whole image), max-flow. Keeps the graph in `last`.
   cv::Mat RunCut(const CutWeights& w, const NLinks& links, const std::vector<uint8_t>& hard,
-                 SegmentResult* result) {
+                 SegmentResult* result, const cv::Rect& roi = cv::Rect()) {
     Timer timer;
+    SetRoi(roi);
     std::vector<int32_t> object, background;
     for (int i = 0; i < nodes.num(); ++i) {
       if (hard[i] == kHardObject)
@@ -716,11 +804,28 @@ struct SegmentSession::Impl {
       else if (hard[i] == kHardBackground)
         background.push_back(i);
     }
-    const LogDensities logp = ComputeLogDensities(nodes, object, background, options);
+    const LogDensities logp = ComputeLogDensities(nodes, object, background, options,
+                                                  last.node_of_local.empty() ? nullptr : &last.node_of_local);
     result->timings.models_s += timer.Seconds();
-    last = BuildAndCut(nodes, links, logp, w, hard, &result->timings, &result->flow);
+    last.hard_cap = 0;
+    last.links = &links;
+    BuildAndCut(nodes, links, logp, w, LocalHard(hard), &result->timings, &result->flow, &last);
     last_hard = hard;
-    return MaskFromCut(nodes, *last.graph, hard);
+    return MaskFromCut(nodes, last, hard);
+  }
+
+  // Step 3's region of interest around the step-1 object (SegmentOptions::roi_margin_cells); empty = whole.
+  cv::Rect Step3Roi(const cv::Mat& step1) const {
+    if (options.roi_margin_cells <= 0) return cv::Rect();
+    const cv::Rect box = cv::boundingRect(step1);
+    if (box.empty()) return cv::Rect();
+    const int margin =
+        std::max(options.roi_margin_cells,
+                 static_cast<int>(std::ceil(options.roi_margin_fraction * std::max(box.width, box.height))));
+    const int x0 = std::max(0, box.x - margin), y0 = std::max(0, box.y - margin);
+    const int x1 = std::min(nodes.cols, box.x + box.width + margin);
+    const int y1 = std::min(nodes.rows, box.y + box.height + margin);
+    return cv::Rect(x0, y0, x1 - x0, y1 - y0);
   }
 
   // Step 2: ring cells whose range differs from every step-1 object cell in their window.
@@ -818,12 +923,16 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
         else if (inferred[cell] != 0)
           seeds[i] = kHardBackground;
       }
-      result.mask =
-          s.RunCut(o.color_step, s.Links(o.color_step, &s.color_links, &result.timings), seeds, &result);
+      const NLinks& color_links = s.Links(o.color_step, &s.color_links, &result.timings);
+      result.mask = s.RunCut(o.color_step, color_links, seeds, &result, s.Step3Roi(result.step1_mask));
+      // The object reached the ROI's edge: the ROI was too small, cut the whole image (the time of both cuts
+      // is counted).
+      if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
       break;
     }
   }
   result.object_cells = cv::countNonZero(result.mask);
+  result.graph_nodes = s.last.num_local(s.nodes.num());
   result.timings.total_s = total.Seconds() + result.timings.features_s;
   s.last_result = result;
   s.ran = true;
@@ -837,13 +946,27 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   const std::vector<uint8_t> extra = s.HardFromStrokes(extra_strokes, "extra strokes");
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
-  Graph& g = *s.last.graph;
-  bool any = false;
+  bool any = false, outside = false;
   for (int i = 0; i < s.nodes.num(); ++i) {
     if (extra[i] == kFree || extra[i] == s.last_hard[i]) continue;
     s.last_hard[i] = extra[i];
     any = true;
+    if (!s.last.local_of_node.empty() && s.last.local_of_node[i] < 0) outside = true;
   }
+  if (outside) {
+    // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
+    // cell so far.
+    result.flow = 0;
+    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+    result.object_cells = cv::countNonZero(result.mask);
+    result.graph_nodes = s.last.num_local(s.nodes.num());
+    result.timings.total_s = total.Seconds();
+    s.last_result = result;
+    return result;
+  }
+  Graph& g = *s.last.graph;
+  const std::vector<uint8_t> local_hard = s.LocalHard(s.last_hard);
+  const int n = static_cast<int>(local_hard.size());
   // New t-link capacities: the models re-learnt from all hard cells (options.refine_relearn_models) or only
   // the new hard cells; the graph gets the differences (BK add_tweights accepts negative changes) and the
   // changed nodes are marked for the tree-reusing max-flow.
@@ -857,25 +980,27 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
       else if (s.last_hard[i] == kHardBackground)
         background.push_back(i);
     }
-    const LogDensities logp = ComputeLogDensities(s.nodes, object, background, s.options);
+    const LogDensities logp =
+        ComputeLogDensities(s.nodes, object, background, s.options,
+                            s.last.node_of_local.empty() ? nullptr : &s.last.node_of_local);
     float hard_cap = s.last.hard_cap;
-    TLinkCapacities(logp, *s.last.weights, s.last_hard, &hard_cap, &source_cap, &sink_cap);
+    TLinkCapacities(logp, *s.last.weights, local_hard, &hard_cap, &source_cap, &sink_cap);
     result.timings.models_s = models.Seconds();
   } else {
-    for (int i = 0; i < s.nodes.num(); ++i) {
-      if (s.last_hard[i] == kHardObject)
-        source_cap[i] = s.last.hard_cap, sink_cap[i] = 0;
-      else if (s.last_hard[i] == kHardBackground)
-        source_cap[i] = 0, sink_cap[i] = s.last.hard_cap;
+    for (int k = 0; k < n; ++k) {
+      if (local_hard[k] == kHardObject)
+        source_cap[k] = s.last.hard_cap, sink_cap[k] = 0;
+      else if (local_hard[k] == kHardBackground)
+        source_cap[k] = 0, sink_cap[k] = s.last.hard_cap;
     }
   }
   Timer graph_timer;
   int changed = 0;
-  for (int i = 0; i < s.nodes.num(); ++i) {
-    const float ds = source_cap[i] - s.last.source_cap[i], dt = sink_cap[i] - s.last.sink_cap[i];
+  for (int k = 0; k < n; ++k) {
+    const float ds = source_cap[k] - s.last.source_cap[k], dt = sink_cap[k] - s.last.sink_cap[k];
     if (ds == 0 && dt == 0) continue;
-    g.add_tweights(i, ds, dt);
-    g.mark_node(i);
+    g.add_tweights(k, ds, dt);
+    g.mark_node(k);
     ++changed;
   }
   s.last.source_cap.swap(source_cap);
@@ -884,8 +1009,13 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   Timer timer;
   if (changed > 0) result.flow = g.maxflow(/*reuse_trees=*/true);
   result.timings.maxflow_s = timer.Seconds();
-  result.mask = MaskFromCut(s.nodes, g, s.last_hard);
+  result.mask = MaskFromCut(s.nodes, s.last, s.last_hard);
+  if (s.ReachesRoiEdge(result.mask)) {
+    // The refined object reached the ROI's edge: re-run the cut on the whole image.
+    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+  }
   result.object_cells = cv::countNonZero(result.mask);
+  result.graph_nodes = s.last.num_local(s.nodes.num());
   result.timings.total_s = total.Seconds();
   s.last_result = result;
   return result;

@@ -101,6 +101,15 @@ struct SegmentOptions {
       0.1;  // a ring cell is background when |range − object range| exceeds this ...
   double ring_depth_threshold_fraction = 0.02;  // ... plus this fraction of its range (dimensionless)
 
+  // Step 3 region of interest: the colour-dominant cut only grows the object near the step-1 seed, so its
+  // graph covers the bounding box of the step-1 object (and the object strokes) dilated by
+  // max(roi_margin_cells, roi_margin_fraction · the box's larger side) on every side, clipped to the image.
+  // Cells outside the ROI are background. When the cut's object reaches an ROI edge that is not an image
+  // edge, the ROI was too small and the cut is re-run on the whole image (also in Refine(), as is a stroke
+  // outside the ROI). roi_margin_cells = 0 = always the whole image.
+  int roi_margin_cells = 50;          // cells (>= 0; 0 disables the ROI)
+  double roi_margin_fraction = 0.25;  // of the box's larger side (dimensionless, >= 0)
+
   // Appearance models.
   int color_bins = 16;              // histogram bins per colour channel (2..64)
   double depth_bin_m = 0.05;        // histogram bin width of the range, metres (> 0)
@@ -128,7 +137,8 @@ struct SegmentResult {
   cv::Mat step1_mask;           // two-step only: the depth-dominant cut, CV_8U 255/0 (else empty)
   cv::Mat inferred_background;  // two-step only: ring cells marked background in step 2, CV_8U 255/0
   int64_t object_cells = 0;
-  double flow = 0;  // value of the last max-flow (the minimum energy, up to constants)
+  int64_t graph_nodes = 0;  // nodes of the last cut's graph (two-step: step 3's region of interest)
+  double flow = 0;          // value of the last max-flow (the minimum energy, up to constants)
   SegmentTimings timings;
   std::string Summary() const;  // one line
 };

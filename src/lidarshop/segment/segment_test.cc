@@ -153,6 +153,68 @@ TEST(SegmentTest, RefineAddsHardConstraintsIncrementally) {
   EXPECT_THROW(fresh.Refine(extra), std::logic_error);
 }
 
+TEST(SegmentTest, StepThreeRegionOfInterestMatchesTheWholeImageCut) {
+  const Scan scan = MakeBoxOnGround(160, 200, cv::Vec3b(118, 138, 112), 3);
+  const cv::Mat strokes = MakeStrokes(scan);
+  SegmentOptions whole;
+  whole.roi_margin_cells = 0;
+  SegmentOptions roi;
+  roi.roi_margin_cells = 10;
+  roi.roi_margin_fraction = 0.2;
+  const SegmentResult a = SegmentObject(scan, strokes, whole);
+  const SegmentResult b = SegmentObject(scan, strokes, roi);
+  EXPECT_EQ(a.graph_nodes, scan.CountValid());
+  EXPECT_GT(b.graph_nodes, 0);
+  EXPECT_LT(b.graph_nodes, scan.CountValid() / 2);
+  EXPECT_EQ(cv::countNonZero(a.step1_mask != b.step1_mask), 0);
+  // Same object up to a few boundary cells.
+  EXPECT_GT(ScoreMask(b.mask, a.mask, scan.valid).iou, 0.98);
+  EXPECT_GT(ScoreMask(b.mask, TruthMask(scan), scan.valid).iou, 0.9);
+  // Deterministic.
+  const SegmentResult c = SegmentObject(scan, strokes, roi);
+  EXPECT_EQ(cv::countNonZero(b.mask != c.mask), 0);
+  // Nothing outside the region of interest.
+  const cv::Rect box = cv::boundingRect(b.step1_mask);
+  const int margin = std::max(10, static_cast<int>(std::ceil(0.2 * std::max(box.width, box.height))));
+  cv::Mat outside(scan.rows, scan.cols, CV_8U, cv::Scalar(255));
+  outside(cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+          cv::Rect(0, 0, scan.cols, scan.rows))
+      .setTo(0);
+  EXPECT_EQ(cv::countNonZero(b.mask & outside), 0);
+}
+
+TEST(SegmentTest, RefineOutsideTheRegionOfInterestReRunsOnTheWholeImage) {
+  const Scan scan = MakeBoxOnGround(160, 200, cv::Vec3b(118, 138, 112), 3);
+  SegmentOptions options;
+  options.roi_margin_cells = 5;
+  options.roi_margin_fraction = 0;
+  SegmentSession session(scan, options);
+  const SegmentResult first = session.Run(MakeStrokes(scan));
+  ASSERT_LT(first.graph_nodes, scan.CountValid());
+  // An object stroke inside the ROI: incremental, the graph stays the ROI's.
+  const cv::Rect box = cv::boundingRect(TruthMask(scan));
+  cv::Mat inside(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  cv::line(inside, cv::Point(box.x + 3, box.y + box.height - 4), cv::Point(box.x + 8, box.y + box.height - 4),
+           cv::Scalar(kStrokeObject), 1);
+  const SegmentResult refined = session.Refine(inside);
+  EXPECT_EQ(refined.graph_nodes, first.graph_nodes);
+  EXPECT_EQ(cv::countNonZero((inside == kStrokeObject) & (refined.mask == 0) & (scan.valid != 0)), 0);
+  // An object stroke on the wall far from the box (a second object): outside the ROI, so the cut is re-run on
+  // the whole image and the stroke cells become object.
+  cv::Mat far(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const cv::Mat wall = (scan.valid != 0) & (TruthMask(scan) == 0);
+  int far_row = -1;
+  for (int row = 0; row < scan.rows && far_row < 0; ++row) {
+    if (wall.at<uint8_t>(row, 5) != 0 && wall.at<uint8_t>(row, 15) != 0) far_row = row;
+  }
+  ASSERT_GE(far_row, 0);
+  cv::line(far, cv::Point(5, far_row), cv::Point(15, far_row), cv::Scalar(kStrokeObject), 1);
+  const SegmentResult again = session.Refine(far);
+  EXPECT_EQ(again.graph_nodes, scan.CountValid());
+  EXPECT_EQ(cv::countNonZero((far == kStrokeObject) & (again.mask == 0)), 0);
+  EXPECT_GT(ScoreMask(again.mask & TruthMask(scan), TruthMask(scan), scan.valid).iou, 0.9);
+}
+
 TEST(SegmentTest, BadStrokesAndOptionsAreRejected) {
   const Scan scan = MakeBoxOnGround(60, 80, cv::Vec3b(118, 138, 112), 7);
   cv::Mat only_object(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));

@@ -48,6 +48,8 @@ int main(int argc, char** argv) {
   app.add_option("--color-color-data", options.color_step.color_data_weight);
   app.add_option("--color-bias", options.color_step.foreground_bias);
   app.add_option("--ring-radius", options.ring_radius_cells);
+  app.add_option("--roi-margin", options.roi_margin_cells, "step-3 ROI margin, cells (0 = whole image)");
+  app.add_option("--roi-fraction", options.roi_margin_fraction, "step-3 ROI margin, fraction of the box");
   app.add_option("--ring-threshold", options.ring_depth_threshold_m);
   app.add_option("--background-uniform", options.background_uniform);
   app.add_option("--sigma-scale", options.sigma_scale);
