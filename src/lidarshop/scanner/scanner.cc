@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
+#include <vector>
 
 #include <fmt/format.h>
 #include <Eigen/SVD>
@@ -206,6 +208,59 @@ struct RowOut {
         label(scan.label.ptr<int32_t>(row)),
         normal(scan.normal.ptr<cv::Vec3f>(row)),
         true_range(scan.true_range.ptr<float>(row)) {}
+  RowOut() = default;
+};
+
+// Per-thread staging rows for one 4-row band: the fused loop shades into these (in L2, written in tile
+// order), then each channel row is copied out contiguously (a few long sequential streams instead of 36
+// interleaved ones, which stalled the store buffer on read-for-ownership misses).
+struct BandStaging {
+  int cols = 0;
+  std::vector<uint8_t> valid;
+  std::vector<float> range, intensity, true_range;
+  std::vector<cv::Vec3f> point, normal;
+  std::vector<cv::Vec3b> color;
+  std::vector<int32_t> label;
+
+  void Resize(int new_cols) {
+    if (cols == new_cols) return;
+    cols = new_cols;
+    const size_t n = static_cast<size_t>(4) * cols;
+    valid.resize(n);
+    range.resize(n);
+    intensity.resize(n);
+    true_range.resize(n);
+    point.resize(n);
+    normal.resize(n);
+    color.resize(n);
+    label.resize(n);
+  }
+  // Row r of the band; `direction` is the scan's own (already filled) direction row.
+  RowOut Row(int r, cv::Vec3f* direction) {
+    RowOut out;
+    const size_t o = static_cast<size_t>(r) * cols;
+    out.direction = direction;
+    out.valid = valid.data() + o;
+    out.range = range.data() + o;
+    out.point = point.data() + o;
+    out.intensity = intensity.data() + o;
+    out.color = color.data() + o;
+    out.label = label.data() + o;
+    out.normal = normal.data() + o;
+    out.true_range = true_range.data() + o;
+    return out;
+  }
+  void CopyOut(int r, const RowOut& to) const {
+    const size_t o = static_cast<size_t>(r) * cols;
+    std::memcpy(to.valid, valid.data() + o, cols * sizeof(uint8_t));
+    std::memcpy(to.range, range.data() + o, cols * sizeof(float));
+    std::memcpy(to.point, point.data() + o, cols * sizeof(cv::Vec3f));
+    std::memcpy(to.intensity, intensity.data() + o, cols * sizeof(float));
+    std::memcpy(to.color, color.data() + o, cols * sizeof(cv::Vec3b));
+    std::memcpy(to.label, label.data() + o, cols * sizeof(int32_t));
+    std::memcpy(to.normal, normal.data() + o, cols * sizeof(cv::Vec3f));
+    std::memcpy(to.true_range, true_range.data() + o, cols * sizeof(float));
+  }
 };
 
 // Everything the per-hit shading reads, set up once per scan; Hit() and Miss() fill one cell.
@@ -415,8 +470,8 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
 
   if (options.cast_method == CastMethod::kPacket16 || options.cast_method == CastMethod::kStream) {
     // Fused: each band of 4 rows is cast as 4 x 4 tiles (rtcIntersect16 packets, or one rtcIntersect1M stream
-    // per band in tile order), and every hit is shaded right after, while the rays and the output rows are in
-    // cache (no hit images).
+    // per band in tile order), and every hit is shaded right after into the thread's staging rows (no hit
+    // images); the band's rows are then copied out channel by channel.
     RTCScene rtc_scene = static_cast<RTCScene>(impl_->raycast.native_scene());
     const bool use_stream = options.cast_method == CastMethod::kStream;
     for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
@@ -437,16 +492,19 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
           packet.ray.time[i] = 0.0f;
           packet.ray.flags[i] = 0;
         }
+        thread_local BandStaging staging;
+        staging.Resize(cols);
         std::vector<RTCRayHit> stream;
         std::vector<int32_t> stream_cells;  // (row in band << 24) | col
         int64_t band_returns = 0;
         for (int64_t band = band_begin; band < band_end; ++band) {
           const int row0 = chunk_begin + static_cast<int>(band) * 4;
           const int row1 = std::min(chunk_end, row0 + 4);
-          const RowOut outs[4] = {RowOut(scan, row0), RowOut(scan, std::min(row0 + 1, row1 - 1)),
-                                  RowOut(scan, std::min(row0 + 2, row1 - 1)),
-                                  RowOut(scan, std::min(row0 + 3, row1 - 1))};
           for (int row = row0; row < row1; ++row) fill_directions(row);
+          RowOut outs[4];
+          for (int r = 0; r < 4; ++r) {
+            outs[r] = staging.Row(r, scan.direction.ptr<cv::Vec3f>(std::min(row0 + r, row1 - 1)));
+          }
           auto shade = [&](int r, int col, unsigned geometry, unsigned primitive, float t, float u, float v,
                            float nx, float ny, float nz, float dx, float dy, float dz)
               __attribute__((always_inline)) {
@@ -495,6 +553,7 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
                     h.hit.u, h.hit.v, h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.ray.dir_x, h.ray.dir_y,
                     h.ray.dir_z);
             }
+            for (int row = row0; row < row1; ++row) staging.CopyOut(row - row0, RowOut(scan, row));
             continue;
           }
           for (int col0 = 0; col0 < cols; col0 += 4) {
@@ -519,6 +578,7 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
                     packet.hit.Ng_z[i], packet.ray.dir_x[i], packet.ray.dir_y[i], packet.ray.dir_z[i]);
             }
           }
+          for (int row = row0; row < row1; ++row) staging.CopyOut(row - row0, RowOut(scan, row));
         }
         returns += band_returns;
       });
