@@ -161,7 +161,12 @@ void BM_VerifyPoses_Footprint(benchmark::State& state) {
   state.counters["footprint_cells_per_pose"] = static_cast<double>(cells) / poses;
   state.counters["threads"] = static_cast<double>(state.range(0));
 }
-BENCHMARK(BM_VerifyPoses_Footprint)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_VerifyPoses_Footprint)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime();
 
 // Where the time goes: consistency alone (a kernel and trim so small that no scene point is near a model
 // point).
@@ -195,7 +200,12 @@ void BM_VerifyPoses_Naive(benchmark::State& state) {
   state.SetItemsProcessed(poses);
   state.counters["threads"] = static_cast<double>(state.range(0));
 }
-BENCHMARK(BM_VerifyPoses_Naive)->Arg(2)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->UseRealTime()->MinTime(3.0);
+BENCHMARK(BM_VerifyPoses_Naive)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime()
+    ->MinTime(3.0);
 
 // Not timed: the two implementations agree (printed once, so the results file can quote it).
 void BM_Agreement(benchmark::State& state) {

@@ -70,7 +70,8 @@ std::vector<Eigen::Vector3f> ComputeVertexNormals(const TriangleMesh& mesh) {
   std::vector<Eigen::Vector3f> normals(mesh.vertices.size(), Eigen::Vector3f::Zero());
   for (const auto& triangle : mesh.triangles) {
     const Eigen::Vector3f& a = mesh.vertices[triangle[0]];
-    const Eigen::Vector3f area_normal = (mesh.vertices[triangle[1]] - a).cross(mesh.vertices[triangle[2]] - a);
+    const Eigen::Vector3f area_normal =
+        (mesh.vertices[triangle[1]] - a).cross(mesh.vertices[triangle[2]] - a);
     for (int corner = 0; corner < 3; ++corner) normals[triangle[corner]] += area_normal;
   }
   for (auto& normal : normals) {

@@ -39,7 +39,8 @@ PointCloud TransformPointCloud(const PointCloud& cloud, const Eigen::Matrix4d& b
   PointCloud result = cloud;
   for (auto& point : result.points) point = TransformPoint(b_from_a, point);
   const Eigen::Matrix3d normal_matrix = b_from_a.topLeftCorner<3, 3>().inverse().transpose();
-  for (auto& normal : result.normals) normal = (normal_matrix * normal.cast<double>()).normalized().cast<float>();
+  for (auto& normal : result.normals)
+    normal = (normal_matrix * normal.cast<double>()).normalized().cast<float>();
   return result;
 }
 

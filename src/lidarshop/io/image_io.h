@@ -1,6 +1,6 @@
-// Images as files, through OpenCV. lidarshop keeps 3-channel 8-bit images in RGB order everywhere (a scan's colour,
-// rendered pictures, strokes); these functions convert to and from OpenCV's BGR at the file boundary, so never
-// call cv::imread / cv::imwrite on lidarshop images directly.
+// Images as files, through OpenCV. lidarshop keeps 3-channel 8-bit images in RGB order everywhere (a scan's
+// colour, rendered pictures, strokes); these functions convert to and from OpenCV's BGR at the file boundary,
+// so never call cv::imread / cv::imwrite on lidarshop images directly.
 //
 //   .png  8-bit (1, 3, 4 channels) and 16-bit single-channel (labels, metric depth in millimetres)
 //   .jpg  8-bit
@@ -14,8 +14,8 @@
 
 namespace lidarshop {
 
-// Reads an image keeping its depth and channel count (IMREAD_UNCHANGED), 3/4-channel ones converted to RGB(A).
-// Throws InputError when the file is missing or not an image.
+// Reads an image keeping its depth and channel count (IMREAD_UNCHANGED), 3/4-channel ones converted to
+// RGB(A). Throws InputError when the file is missing or not an image.
 cv::Mat ReadImage(const std::string& path);
 
 // Writes an RGB(A) or single-channel image; the format follows the extension. Atomic.

@@ -6,8 +6,8 @@
 //         the grid is kept in element properties `row`/`col` when written by lidarshop)
 //   .pcd  PCL, organized clouds (ascii, binary, binary_compressed) read + write
 //
-// Readers reject malformed input with an InputError naming the file, the line or byte offset and the field; they
-// refuse before allocating when a header claims more cells than memory allows. Writers are atomic.
+// Readers reject malformed input with an InputError naming the file, the line or byte offset and the field;
+// they refuse before allocating when a header claims more cells than memory allows. Writers are atomic.
 #pragma once
 
 #include <string>

@@ -18,8 +18,8 @@ int64_t Scan::CountValid() const { return valid.empty() ? 0 : cv::countNonZero(v
 
 Scan Clone(const Scan& scan) {
   Scan copy = scan;
-  for (cv::Mat* channel : {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity, &copy.color,
-                           &copy.label, &copy.normal, &copy.true_range, &copy.synthesized}) {
+  for (cv::Mat* channel : {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity,
+                           &copy.color, &copy.label, &copy.normal, &copy.true_range, &copy.synthesized}) {
     *channel = channel->clone();
   }
   return copy;
@@ -73,8 +73,8 @@ std::vector<std::string> ChannelNames(const Scan& scan) {
   return names;
 }
 
-ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_max_rad, double elevation_min_rad,
-                     double elevation_max_rad) {
+ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_max_rad,
+                     double elevation_min_rad, double elevation_max_rad) {
   ScanGrid grid;
   grid.azimuth_rad.resize(cols);
   grid.elevation_rad.resize(rows);
@@ -132,7 +132,8 @@ PointCloud ToPointCloud(const Scan& scan, bool world, std::vector<int64_t>* cell
         cloud.normals.push_back(normal);
       }
       if (!scan.label.empty()) cloud.labels.push_back(scan.label.at<int32_t>(row, col));
-      if (!scan.synthesized.empty()) cloud.synthesized.push_back(scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
+      if (!scan.synthesized.empty())
+        cloud.synthesized.push_back(scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
       if (cell_index != nullptr) cell_index->push_back(static_cast<int64_t>(row) * scan.cols + col);
     }
   }

@@ -1,28 +1,27 @@
 // The organized scan: a rows x cols grid of laser rays from one scanner origin.
 //
 // Every channel is an image of the scan's shape, stored in *image orientation*: column = scan column (azimuth
-// increasing to the right), row 0 = the top row (highest elevation). A PTX/E57 row r counted bottom to top is image
-// row `rows - 1 - r`. Rendered pictures, label images, masks and user strokes all use this orientation.
+// increasing to the right), row 0 = the top row (highest elevation). A PTX/E57 row r counted bottom to top is
+// image row `rows - 1 - r`. Rendered pictures, label images, masks and user strokes all use this orientation.
 //
-// Scanner frame (the Leica HDS3000 model of the original work): z up, y forward, x right. Azimuth θ is measured from
-// +y, positive to the right (θ = +π/2 is +x); elevation φ is positive up. Direction(θ, φ) = (cos φ sin θ,
-// cos φ cos θ, sin φ).
+// Scanner frame (the Leica HDS3000 model of the original work): z up, y forward, x right. Azimuth θ is
+// measured from +y, positive to the right (θ = +π/2 is +x); elevation φ is positive up. Direction(θ, φ) =
+// (cos φ sin θ, cos φ cos θ, sin φ).
 //
 // Channels (cv::Mat, each rows x cols):
-//   direction   CV_32FC3  unit ray direction in the scanner frame, known for EVERY cell (also without a return)
-//   valid       CV_8U     255 = the ray returned, 0 = no return
-//   range       CV_32F    metres from the scanner origin to the point; 0 where invalid
-//   point       CV_32FC3  x y z in the scanner frame, metres; 0 where invalid
-//   intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid
-//   color       CV_8UC3   R G B (RGB order, not OpenCV's BGR); empty when the scan has no colour
+//   direction   CV_32FC3  unit ray direction in the scanner frame, known for EVERY cell (also without a
+//   return) valid       CV_8U     255 = the ray returned, 0 = no return range       CV_32F    metres from the
+//   scanner origin to the point; 0 where invalid point       CV_32FC3  x y z in the scanner frame, metres; 0
+//   where invalid intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid color
+//   CV_8UC3   R G B (RGB order, not OpenCV's BGR); empty when the scan has no colour
 // Optional channels (empty when absent):
 //   label       CV_32S    object label (synthetic scans); kNoLabel where invalid
 //   normal      CV_32FC3  unit surface normal in the scanner frame (true normals of synthetic scans)
 //   true_range  CV_32F    noise-free range (synthetic scans), 0 where invalid
 //   synthesized CV_8U     255 = created by lidarshop (e.g. hole filling), 0 = measured
 //
-// For a valid cell the measured point need not lie exactly on `direction` (orthogonal noise, real scanners); the
-// cell's direction is the nominal grid direction, the point's own direction is point / range.
+// For a valid cell the measured point need not lie exactly on `direction` (orthogonal noise, real scanners);
+// the cell's direction is the nominal grid direction, the point's own direction is point / range.
 #pragma once
 
 #include <cstdint>
@@ -53,8 +52,8 @@ double ElevationOf(const Eigen::Vector3f& direction);
 struct ScanGrid {
   std::vector<double> azimuth_rad;    // #cols, increasing to the right
   std::vector<double> elevation_rad;  // #rows, decreasing downwards (image order)
-  // How well the grid explains the measured directions (fitted grids): RMS and max angle between a valid point's
-  // direction and its cell's grid direction, radians. 0 for exact (synthetic) grids.
+  // How well the grid explains the measured directions (fitted grids): RMS and max angle between a valid
+  // point's direction and its cell's grid direction, radians. 0 for exact (synthetic) grids.
   double rms_residual_rad = 0.0;
   double max_residual_rad = 0.0;
   bool fitted = false;  // true when estimated from measured points (FitGrid), false when nominal
@@ -89,7 +88,8 @@ struct Scan {
 // changes a channel of a scan it was given must clone first: inputs are never modified.
 Scan Clone(const Scan& scan);
 
-// A scan with every required channel allocated (no returns, directions zero, intensity 0.5) and no optional ones.
+// A scan with every required channel allocated (no returns, directions zero, intensity 0.5) and no optional
+// ones.
 Scan MakeScan(int rows, int cols, bool with_color = false);
 
 // Throws std::logic_error when a channel has the wrong size or type (programming error, not input error).
@@ -103,33 +103,36 @@ cv::Mat DirectionsFromGrid(const ScanGrid& grid);
 
 // A uniform grid: azimuth from min to max over `cols`, elevation from min (bottom) to max (top) over `rows`,
 // steps (max - min) / (N - 1).
-ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_max_rad, double elevation_min_rad,
-                     double elevation_max_rad);
+ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_max_rad,
+                     double elevation_min_rad, double elevation_max_rad);
 
-// For real scans: fits per-column azimuth and per-row elevation to the valid points' directions (robust to noise:
-// a median per column/row, then a monotone cleanup; columns or rows without any return are interpolated from their
-// neighbours or extrapolated with the median step), fills `direction` of every cell from the fitted grid and stores
-// the grid and its residual in scan->grid. Valid cells keep their measured points.
+// For real scans: fits per-column azimuth and per-row elevation to the valid points' directions (robust to
+// noise: a median per column/row, then a monotone cleanup; columns or rows without any return are
+// interpolated from their neighbours or extrapolated with the median step), fills `direction` of every cell
+// from the fitted grid and stores the grid and its residual in scan->grid. Valid cells keep their measured
+// points.
 void FitGrid(Scan* scan);
 
-// Points with all per-point channels, valid cells only, in the scanner frame or (world = true) the world frame.
-// `cell_index` (optional) receives row * cols + col of each point.
+// Points with all per-point channels, valid cells only, in the scanner frame or (world = true) the world
+// frame. `cell_index` (optional) receives row * cols + col of each point.
 PointCloud ToPointCloud(const Scan& scan, bool world = false, std::vector<int64_t>* cell_index = nullptr);
 
 // Image views. All CV_32F unless stated; invalid cells are 0 (range) or NaN where said.
-cv::Mat RangeImage(const Scan& scan);                       // CV_32F metres
-cv::Mat DepthImage(const Scan& scan);                       // CV_32F, y in the scanner frame (forward distance)
-cv::Mat RgbdImage(const Scan& scan);                        // CV_32FC4: R, G, B in [0,1], range in metres
-cv::Mat ValidMask(const Scan& scan);                        // CV_8U 255/0 (a copy of scan.valid)
+cv::Mat RangeImage(const Scan& scan);  // CV_32F metres
+cv::Mat DepthImage(const Scan& scan);  // CV_32F, y in the scanner frame (forward distance)
+cv::Mat RgbdImage(const Scan& scan);   // CV_32FC4: R, G, B in [0,1], range in metres
+cv::Mat ValidMask(const Scan& scan);   // CV_8U 255/0 (a copy of scan.valid)
 
-// The label image of the file convention (`--labels L.png`): CV_16U, pixel = the object's label, kNoReturnLabel16
-// where the ray returned nothing or the cell has no label. Throws std::logic_error when the scan has no labels.
+// The label image of the file convention (`--labels L.png`): CV_16U, pixel = the object's label,
+// kNoReturnLabel16 where the ray returned nothing or the cell has no label. Throws std::logic_error when the
+// scan has no labels.
 constexpr uint16_t kNoReturnLabel16 = 65535;
 cv::Mat LabelImage16(const Scan& scan);
 
-// Puts points back along the rays from a changed range image (CV_32F metres, 0 or NaN = no return). Cells that
-// were valid keep their measured ray (point / |point|); other cells use `direction`. Returns the new scan; all
-// other channels are copied. Cells listed in `mark_synthesized` (CV_8U, non-zero) get synthesized = 255.
+// Puts points back along the rays from a changed range image (CV_32F metres, 0 or NaN = no return). Cells
+// that were valid keep their measured ray (point / |point|); other cells use `direction`. Returns the new
+// scan; all other channels are copied. Cells listed in `mark_synthesized` (CV_8U, non-zero) get synthesized =
+// 255.
 Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synthesized = cv::Mat());
 
 }  // namespace lidarshop

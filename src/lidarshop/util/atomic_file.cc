@@ -16,8 +16,8 @@ namespace {
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
   const std::filesystem::path target(path);
-  const std::string name = fmt::format(".{}.tmp{}-{}{}", target.stem().string(), getpid(), counter++,
-                                       target.extension().string());
+  const std::string name =
+      fmt::format(".{}.tmp{}-{}{}", target.stem().string(), getpid(), counter++, target.extension().string());
   return (target.parent_path() / name).string();
 }
 

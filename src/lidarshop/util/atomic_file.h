@@ -1,6 +1,6 @@
-// Atomic output: every file lidarshop writes first goes to a temporary file beside the target, which is renamed
-// over the target only when writing succeeded. A crash or an error never leaves a half-written output, and an
-// input is never opened for writing.
+// Atomic output: every file lidarshop writes first goes to a temporary file beside the target, which is
+// renamed over the target only when writing succeeded. A crash or an error never leaves a half-written
+// output, and an input is never opened for writing.
 #pragma once
 
 #include <functional>
@@ -9,13 +9,14 @@
 
 namespace lidarshop {
 
-// Calls `write(stream)` on a binary stream to a temporary file in the target's folder, then renames it to `path`.
-// Throws InputError naming `path` when the folder is not writable or the stream fails; the temporary is removed.
+// Calls `write(stream)` on a binary stream to a temporary file in the target's folder, then renames it to
+// `path`. Throws InputError naming `path` when the folder is not writable or the stream fails; the temporary
+// is removed.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
-// For writers that need a path (OpenCV's imwrite, a C library): `write(temporary_path)` must create the file at
-// temporary_path, which keeps the target's extension so that format detection still works; it is then renamed to
-// `path`. `write` returns false (or throws) on failure.
+// For writers that need a path (OpenCV's imwrite, a C library): `write(temporary_path)` must create the file
+// at temporary_path, which keeps the target's extension so that format detection still works; it is then
+// renamed to `path`. `write` returns false (or throws) on failure.
 void WritePathAtomically(const std::string& path, const std::function<bool(const std::string&)>& write);
 
 }  // namespace lidarshop

@@ -2,10 +2,11 @@
 //
 // Two kinds, both exceptions so that no caller can ignore them:
 //  * InputError   — the data given to us is wrong (a file that does not parse, a mask of the wrong size). The
-//                   message names the file, the place (line, byte offset, page) and the field, so a user can fix
-//                   the input: "scan.ptx: line 12: field 'x': not a number: 'abc'".
+//                   message names the file, the place (line, byte offset, page) and the field, so a user can
+//                   fix the input: "scan.ptx: line 12: field 'x': not a number: 'abc'".
 //  * OptionsError — a parameter is out of its documented range ("VerifyOptions.sigma_m must be > 0, got -1").
-// Broken internal invariants are bugs and use LIDARSHOP_CHECK, which throws std::logic_error with file and line.
+// Broken internal invariants are bugs and use LIDARSHOP_CHECK, which throws std::logic_error with file and
+// line.
 #pragma once
 
 #include <stdexcept>

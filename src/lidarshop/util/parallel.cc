@@ -23,8 +23,8 @@ void ParallelFor(int64_t count, const std::function<void(int64_t)>& body, int64_
 
 ThreadLimit::ThreadLimit(int threads) {
   if (threads > 0) {
-    control_ = new tbb::global_control(tbb::global_control::max_allowed_parallelism,
-                                       static_cast<size_t>(threads));
+    control_ =
+        new tbb::global_control(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(threads));
   }
 }
 

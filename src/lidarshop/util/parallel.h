@@ -1,5 +1,5 @@
-// Parallel loops over oneTBB. Hot loops are written as "for every cell / every row, independently", which is the
-// shape a GPU back end would take over; results never depend on the thread count.
+// Parallel loops over oneTBB. Hot loops are written as "for every cell / every row, independently", which is
+// the shape a GPU back end would take over; results never depend on the thread count.
 #pragma once
 
 #include <cstdint>

@@ -1,8 +1,8 @@
 // Progress of long operations, shown on a terminal.
 //
-// A library function that may run for seconds takes a `Progress*` (nullptr = silent) and calls Advance() from any
-// thread. The CLI makes one with `Progress::ForTerminal(label, total, quiet)`, which draws a bar on stderr only when
-// stderr is a TTY and --quiet was not given, at most ~10 times a second.
+// A library function that may run for seconds takes a `Progress*` (nullptr = silent) and calls Advance() from
+// any thread. The CLI makes one with `Progress::ForTerminal(label, total, quiet)`, which draws a bar on
+// stderr only when stderr is a TTY and --quiet was not given, at most ~10 times a second.
 #pragma once
 
 #include <atomic>
