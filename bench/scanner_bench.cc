@@ -220,95 +220,57 @@ void BM_EmbreeSingle(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kRows * kCols);
 }
 
-void BM_EmbreePacket16(benchmark::State& state) {
+// Packets of N rays (8 or 16) on tiles of N / 4 rows x 4 columns: coherent rays, as the scanner casts them.
+template <int N, typename RayHitN, void (*IntersectN)(const int*, RTCScene, RTCIntersectContext*, RayHitN*)>
+void BM_EmbreePacket(benchmark::State& state) {
+  constexpr int kTileRows = N / 4;
   RTCScene scene = NativeScene(state);
   const WorldRays& rays = Rays();
   RawOutputs out;
   for (auto _ : state) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, kRows / 4), [&](const tbb::blocked_range<int>& bands) {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
-      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      alignas(64) RTCRayHit16 packet;
-      alignas(64) int valid[16];
-      for (int i = 0; i < 16; ++i) valid[i] = -1;
-      for (int band = bands.begin(); band < bands.end(); ++band) {
-        for (int col0 = 0; col0 < kCols; col0 += 4) {
-          for (int i = 0; i < 16; ++i) {
-            const size_t index = static_cast<size_t>(band * 4 + i / 4) * kCols + col0 + i % 4;
-            packet.ray.org_x[i] = rays.origin.x();
-            packet.ray.org_y[i] = rays.origin.y();
-            packet.ray.org_z[i] = rays.origin.z();
-            packet.ray.dir_x[i] = rays.directions[index].x();
-            packet.ray.dir_y[i] = rays.directions[index].y();
-            packet.ray.dir_z[i] = rays.directions[index].z();
-            packet.ray.tnear[i] = 0.0f;
-            packet.ray.tfar[i] = 120.0f;
-            packet.ray.mask[i] = 0xFFFFFFFFu;
-            packet.ray.flags[i] = 0;
-            packet.ray.time[i] = 0;
-            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, kRows / kTileRows), [&](const tbb::blocked_range<int>& tiles) {
+          RTCIntersectContext context;
+          rtcInitIntersectContext(&context);
+          context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+          alignas(64) RayHitN packet;
+          alignas(64) int valid[N];
+          for (int i = 0; i < N; ++i) valid[i] = -1;
+          for (int tile_row = tiles.begin(); tile_row < tiles.end(); ++tile_row) {
+            for (int col0 = 0; col0 < kCols; col0 += 4) {
+              for (int i = 0; i < N; ++i) {
+                const size_t index = static_cast<size_t>(tile_row * kTileRows + i / 4) * kCols + col0 + i % 4;
+                packet.ray.org_x[i] = rays.origin.x();
+                packet.ray.org_y[i] = rays.origin.y();
+                packet.ray.org_z[i] = rays.origin.z();
+                packet.ray.dir_x[i] = rays.directions[index].x();
+                packet.ray.dir_y[i] = rays.directions[index].y();
+                packet.ray.dir_z[i] = rays.directions[index].z();
+                packet.ray.tnear[i] = 0.0f;
+                packet.ray.tfar[i] = 120.0f;
+                packet.ray.mask[i] = 0xFFFFFFFFu;
+                packet.ray.flags[i] = 0;
+                packet.ray.time[i] = 0;
+                packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+                packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+              }
+              IntersectN(valid, scene, &context, &packet);
+              for (int i = 0; i < N; ++i) {
+                const size_t index = static_cast<size_t>(tile_row * kTileRows + i / 4) * kCols + col0 + i % 4;
+                out.Write(index, packet.ray.tfar[i], packet.hit.geomID[i], packet.hit.primID[i],
+                          packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i], packet.hit.u[i],
+                          packet.hit.v[i]);
+              }
+            }
           }
-          rtcIntersect16(valid, scene, &context, &packet);
-          for (int i = 0; i < 16; ++i) {
-            const size_t index = static_cast<size_t>(band * 4 + i / 4) * kCols + col0 + i % 4;
-            out.Write(index, packet.ray.tfar[i], packet.hit.geomID[i], packet.hit.primID[i],
-                      packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i], packet.hit.u[i],
-                      packet.hit.v[i]);
-          }
-        }
-      }
-    });
+        });
     benchmark::DoNotOptimize(out.t_hit.data());
   }
   state.SetItemsProcessed(state.iterations() * kRows * kCols);
 }
 
-void BM_EmbreePacket8(benchmark::State& state) {
-  RTCScene scene = NativeScene(state);
-  const WorldRays& rays = Rays();
-  RawOutputs out;
-  for (auto _ : state) {
-    tbb::parallel_for(tbb::blocked_range<int>(0, kRows / 2), [&](const tbb::blocked_range<int>& pairs) {
-      RTCIntersectContext context;
-      rtcInitIntersectContext(&context);
-      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-      alignas(32) RTCRayHit8 packet;
-      alignas(32) int valid[8];
-      for (int i = 0; i < 8; ++i) valid[i] = -1;
-      for (int pair = pairs.begin(); pair < pairs.end(); ++pair) {
-        for (int col0 = 0; col0 < kCols; col0 += 4) {
-          for (int i = 0; i < 8; ++i) {
-            const size_t index = static_cast<size_t>(pair * 2 + i / 4) * kCols + col0 + i % 4;
-            packet.ray.org_x[i] = rays.origin.x();
-            packet.ray.org_y[i] = rays.origin.y();
-            packet.ray.org_z[i] = rays.origin.z();
-            packet.ray.dir_x[i] = rays.directions[index].x();
-            packet.ray.dir_y[i] = rays.directions[index].y();
-            packet.ray.dir_z[i] = rays.directions[index].z();
-            packet.ray.tnear[i] = 0.0f;
-            packet.ray.tfar[i] = 120.0f;
-            packet.ray.mask[i] = 0xFFFFFFFFu;
-            packet.ray.flags[i] = 0;
-            packet.ray.time[i] = 0;
-            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect8(valid, scene, &context, &packet);
-          for (int i = 0; i < 8; ++i) {
-            const size_t index = static_cast<size_t>(pair * 2 + i / 4) * kCols + col0 + i % 4;
-            out.Write(index, packet.ray.tfar[i], packet.hit.geomID[i], packet.hit.primID[i],
-                      packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i], packet.hit.u[i],
-                      packet.hit.v[i]);
-          }
-        }
-      }
-    });
-    benchmark::DoNotOptimize(out.t_hit.data());
-  }
-  state.SetItemsProcessed(state.iterations() * kRows * kCols);
-}
+void BM_EmbreePacket16(benchmark::State& state) { BM_EmbreePacket<16, RTCRayHit16, rtcIntersect16>(state); }
+void BM_EmbreePacket8(benchmark::State& state) { BM_EmbreePacket<8, RTCRayHit8, rtcIntersect8>(state); }
 
 void BM_EmbreeStream(benchmark::State& state) {
   RTCScene scene = NativeScene(state);

@@ -13,6 +13,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
@@ -83,14 +84,7 @@ int RunScan(int argc, char** argv) {
     int64_t mesh_triangles = 0;
     if (!labels_path.empty()) {
       stage.Restart();
-      cv::Mat labels(scan.rows, scan.cols, CV_16U);
-      for (int r = 0; r < scan.rows; ++r) {
-        for (int c = 0; c < scan.cols; ++c) {
-          const int32_t label = scan.label.at<int32_t>(r, c);
-          labels.at<uint16_t>(r, c) = label < 0 ? uint16_t{65535} : static_cast<uint16_t>(label);
-        }
-      }
-      WriteImage(labels_path, labels);
+      WriteImage(labels_path, LabelImage16(scan));
       writing_labels_seconds = stage.Seconds();
     }
     if (!mesh_path.empty()) {

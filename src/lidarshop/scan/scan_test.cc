@@ -60,5 +60,20 @@ TEST(ScanTest, ToPointCloudInWorldFrame) {
   EXPECT_EQ(cloud.colors.size(), 1u);
 }
 
+TEST(ScanTest, LabelImage16MarksNoReturnAndMissingLabels) {
+  Scan scan = MakeScan(1, 3);
+  EXPECT_THROW(LabelImage16(scan), std::logic_error);  // no label channel
+  scan.label = cv::Mat(1, 3, CV_32S, cv::Scalar(kNoLabel));
+  scan.valid.at<uint8_t>(0, 0) = kValid;
+  scan.label.at<int32_t>(0, 0) = 7;
+  scan.valid.at<uint8_t>(0, 1) = kValid;  // a return without a label
+  scan.label.at<int32_t>(0, 2) = 4;       // a label without a return
+  const cv::Mat labels = LabelImage16(scan);
+  ASSERT_EQ(labels.type(), CV_16U);
+  EXPECT_EQ(labels.at<uint16_t>(0, 0), 7);
+  EXPECT_EQ(labels.at<uint16_t>(0, 1), kNoReturnLabel16);
+  EXPECT_EQ(labels.at<uint16_t>(0, 2), kNoReturnLabel16);
+}
+
 }  // namespace
 }  // namespace lidarshop
