@@ -12,6 +12,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/verify/kernel_grid.h"
 
 namespace lidarshop {
 namespace {
@@ -135,131 +136,72 @@ Footprint FindFootprint(const PreparedScan& prepared, const Eigen::Matrix4d& sca
   return footprint;
 }
 
-// Distances to the first hit (+inf on a miss) of rays that share nothing but coherence (neighbouring cells of
-// one scanner): Embree packets of 16, several times faster than one rtcIntersect1 per ray on a big model.
-void CastDistances(const RaycastScene& scene, std::span<const Ray> rays, std::span<float> t_hit) {
+// The consistency status of rays (model frame; t_near = just before the model's box) whose scene points lie
+// at distance `limit` + a along them (limit = d_s − a), by two occlusion (any-hit) queries instead of one
+// closest-hit query: (d_m + a) − d_s < 0 ⇔ the model has surface on [0, limit).
+//   1. surface on [0, limit]?  → inconsistent. Skipped when limit is before the box (it cannot be).
+//   2. otherwise, surface on [limit, ∞)?  → consistent; else the ray misses the model: not comparable.
+// An any-hit query stops at the first triangle it meets, and the first one ends 10 cm (a) short of the
+// surface that the scene point usually lies on, so it prunes early; together they cost ~30 % less than the
+// closest hit here (bench/results/verify.md). Rays go in Embree packets of 16 neighbouring cells.
+void ClassifyRays(const RaycastScene& scene, std::span<const Ray> rays, std::span<const float> limit,
+                  std::span<uint8_t> status) {
   RTCScene handle = static_cast<RTCScene>(scene.native_scene());
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  RTCRayHit16 packet;
-  alignas(64) int valid[16];
+  RTCRay16 packet;
+  alignas(64) int active[16];
   for (size_t start = 0; start < rays.size(); start += 16) {
     const size_t count = std::min<size_t>(16, rays.size() - start);
-    for (size_t k = 0; k < 16; ++k) {
-      const Ray& ray = rays[start + std::min(k, count - 1)];
-      valid[k] = k < count ? -1 : 0;
-      packet.ray.org_x[k] = ray.origin.x();
-      packet.ray.org_y[k] = ray.origin.y();
-      packet.ray.org_z[k] = ray.origin.z();
-      packet.ray.dir_x[k] = ray.direction.x();
-      packet.ray.dir_y[k] = ray.direction.y();
-      packet.ray.dir_z[k] = ray.direction.z();
-      packet.ray.tnear[k] = ray.t_near;
-      packet.ray.tfar[k] = ray.t_far;
-      packet.ray.time[k] = 0.0f;
-      packet.ray.mask[k] = 0xFFFFFFFFu;
-      packet.ray.flags[k] = 0;
-      packet.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-      packet.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    bool any_active = false;
+    for (size_t lane = 0; lane < 16; ++lane) {
+      const size_t k = start + std::min(lane, count - 1);
+      const Ray& ray = rays[k];
+      active[lane] = lane < count && limit[k] > ray.t_near ? -1 : 0;
+      any_active |= active[lane] != 0;
+      packet.org_x[lane] = ray.origin.x();
+      packet.org_y[lane] = ray.origin.y();
+      packet.org_z[lane] = ray.origin.z();
+      packet.dir_x[lane] = ray.direction.x();
+      packet.dir_y[lane] = ray.direction.y();
+      packet.dir_z[lane] = ray.direction.z();
+      packet.tnear[lane] = ray.t_near;
+      packet.tfar[lane] = limit[k];
+      packet.time[lane] = 0.0f;
+      packet.mask[lane] = 0xFFFFFFFFu;
+      packet.flags[lane] = 0;
     }
-    rtcIntersect16(valid, handle, &context, &packet);
-    for (size_t k = 0; k < count; ++k) {
-      t_hit[start + k] = packet.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID
-                             ? packet.ray.tfar[k]
-                             : std::numeric_limits<float>::infinity();
+    if (any_active) rtcOccluded16(active, handle, &context, &packet);
+    any_active = false;
+    for (size_t lane = 0; lane < 16; ++lane) {
+      const size_t k = start + std::min(lane, count - 1);
+      const bool occluded =
+          active[lane] != 0 && packet.tfar[lane] < 0;  // Embree marks a hit with tfar = −inf
+      if (lane < count) status[k] = occluded ? kInconsistent : kNotComparable;
+      active[lane] = lane < count && !occluded ? -1 : 0;
+      any_active |= active[lane] != 0;
+      packet.tnear[lane] = std::max(rays[k].t_near, limit[k]);
+      packet.tfar[lane] = std::numeric_limits<float>::infinity();
+    }
+    if (any_active) rtcOccluded16(active, handle, &context, &packet);
+    for (size_t lane = 0; lane < count; ++lane) {
+      if (active[lane] != 0 && packet.tfar[lane] < 0) status[start + lane] = kConsistent;
     }
   }
-}
-
-// Integer cell coordinates (clamped to the grid) of a point in the kernel cell grid.
-Eigen::Vector3i KernelCellCoords(const KernelNeighbourGrid& grid, const Eigen::Vector3f& p) {
-  const Eigen::Vector3f cell = (p - grid.origin_in_model) / grid.cell_m;
-  return Eigen::Vector3i(std::clamp(static_cast<int>(std::floor(cell.x())), 0, grid.cell_dims.x() - 1),
-                         std::clamp(static_cast<int>(std::floor(cell.y())), 0, grid.cell_dims.y() - 1),
-                         std::clamp(static_cast<int>(std::floor(cell.z())), 0, grid.cell_dims.z() - 1));
-}
-
-int64_t KernelCellOf(const KernelNeighbourGrid& grid, const Eigen::Vector3f& p) {
-  const Eigen::Vector3i c = KernelCellCoords(grid, p);
-  return (static_cast<int64_t>(c.z()) * grid.cell_dims.y() + c.y()) * grid.cell_dims.x() + c.x();
-}
-
-KernelNeighbourGrid BuildKernelGrid(const PointKdTree& tree, const Eigen::AlignedBox3f& bounds,
-                                    float kernel_radius, float trim) {
-  KernelNeighbourGrid grid;
-  grid.kernel_radius_m = kernel_radius;
-  grid.trim_m = trim;
-  const float reach = std::max(kernel_radius, trim);
-  const Eigen::Vector3f lo = bounds.min().array() - reach;
-  const Eigen::Vector3f extent = bounds.sizes().array() + 2 * reach;
-  constexpr double kMaxVoxels = 2e6;
-  grid.voxel_m = std::max(kernel_radius / 3.0f, static_cast<float>(std::cbrt(extent.prod() / kMaxVoxels)));
-  grid.origin_in_model = lo;
-  for (int k = 0; k < 3; ++k)
-    grid.dims[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / grid.voxel_m)));
-  const int64_t voxels = static_cast<int64_t>(grid.dims.x()) * grid.dims.y() * grid.dims.z();
-  const float half_diagonal = 0.5f * std::sqrt(3.0f) * grid.voxel_m;
-  const auto points = tree.points();
-  std::vector<std::vector<uint32_t>> nearest_lists(voxels);
-  ParallelFor(
-      voxels,
-      [&](int64_t v) {
-        const int x = static_cast<int>(v % grid.dims.x());
-        const int y = static_cast<int>((v / grid.dims.x()) % grid.dims.y());
-        const int z = static_cast<int>(v / (static_cast<int64_t>(grid.dims.x()) * grid.dims.y()));
-        const Eigen::Vector3f centre = lo + grid.voxel_m * Eigen::Vector3f(x + 0.5f, y + 0.5f, z + 0.5f);
-        const NearestResult nearest = tree.NearestWithin(centre, trim + half_diagonal);
-        if (nearest.found()) {
-          const float reach_of_voxel = std::sqrt(nearest.distance_sq) + 2.0f * half_diagonal;
-          // A little slack so that float rounding never drops the true nearest point.
-          tree.ForEachInRadius(centre, reach_of_voxel * 1.0001f + 1e-6f,
-                               [&](uint32_t i, float) { nearest_lists[v].push_back(i); });
-          std::sort(nearest_lists[v].begin(), nearest_lists[v].end());
-        }
-      },
-      256);
-  grid.nearest_offsets.resize(voxels + 1);
-  grid.nearest_offsets[0] = 0;
-  for (int64_t v = 0; v < voxels; ++v) {
-    grid.nearest_offsets[v + 1] = grid.nearest_offsets[v] + static_cast<uint32_t>(nearest_lists[v].size());
-  }
-  grid.nearest_indices.reserve(grid.nearest_offsets.back());
-  for (auto& list : nearest_lists) {
-    grid.nearest_indices.insert(grid.nearest_indices.end(), list.begin(), list.end());
-    std::vector<uint32_t>().swap(list);
-  }
-  grid.nearest_positions.reserve(grid.nearest_indices.size());
-  for (uint32_t i : grid.nearest_indices) grid.nearest_positions.push_back(points[i]);
-
-  // Kernel cells: the points sorted by cell (counting sort, stable: ascending index within a cell).
-  grid.cell_m = std::max(kernel_radius * 1.001f, static_cast<float>(std::cbrt(extent.prod() / kMaxVoxels)));
-  for (int k = 0; k < 3; ++k)
-    grid.cell_dims[k] = std::max(1, static_cast<int>(std::ceil(extent[k] / grid.cell_m)));
-  const int64_t cells = static_cast<int64_t>(grid.cell_dims.x()) * grid.cell_dims.y() * grid.cell_dims.z();
-  std::vector<uint32_t> cell_of(points.size());
-  grid.cell_offsets.assign(cells + 1, 0);
-  for (size_t i = 0; i < points.size(); ++i) {
-    cell_of[i] = static_cast<uint32_t>(KernelCellOf(grid, points[i]));
-    ++grid.cell_offsets[cell_of[i] + 1];
-  }
-  for (int64_t c = 0; c < cells; ++c) grid.cell_offsets[c + 1] += grid.cell_offsets[c];
-  std::vector<uint32_t> next(grid.cell_offsets.begin(), grid.cell_offsets.end() - 1);
-  grid.cell_indices.resize(points.size());
-  grid.cell_positions.resize(points.size());
-  for (size_t i = 0; i < points.size(); ++i) {
-    const uint32_t slot = next[cell_of[i]]++;
-    grid.cell_indices[slot] = static_cast<uint32_t>(i);
-    grid.cell_positions[slot] = points[i];
-  }
-  return grid;
 }
 
 struct Workspace {
   std::vector<Ray> rays;
-  std::vector<float> t_hit;
   std::vector<float> ray_range;
   std::vector<int64_t> ray_cell;
+  std::vector<Eigen::Vector3f> near_points;  // scene points inside the near box, model frame, in scan order
+  std::vector<float> closest_sq;             // per near point: squared distance to the nearest model point
+  std::vector<Eigen::Vector3f> far_points;   // near points in the ICP box without a model point within 3σ
+  std::vector<uint32_t> far_index;           // their index among the near points
+  std::vector<float> far_closest_sq;
+  std::vector<float> limit;     // per ray: d_s − a
+  std::vector<uint8_t> status;  // per ray: SceneStatus
 };
 
 }  // namespace
@@ -304,6 +246,7 @@ VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions
   // Built once and cast millions of times: the slowest, best BVH pays for itself.
   RaycastSceneOptions raycast_options;
   raycast_options.build_quality = "high";
+  raycast_options.robust = false;  // ~8 % faster; a ray grazing an edge decides nothing here
   model.scene_in_model = RaycastScene(raycast_options);
   model.scene_in_model.AddMesh(mesh_in_model, 0);
   model.scene_in_model.Commit();
@@ -328,9 +271,9 @@ VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions
       model.information[i] = static_cast<float>((variation[i] + options.distinctiveness_floor) / total);
     }
   }
-  model.kernel_grid = BuildKernelGrid(model.points_in_model, model.bounds_in_model,
-                                      static_cast<float>(3.0 * verify_options.sigma_m),
-                                      static_cast<float>(verify_options.icp_trim_m));
+  model.kernel_grid = verify_internal::BuildKernelGrid(model.points_in_model.points(), model.bounds_in_model,
+                                                       static_cast<float>(3.0 * verify_options.sigma_m),
+                                                       static_cast<float>(verify_options.icp_trim_m));
   return model;
 }
 
@@ -420,11 +363,15 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
   // The grid covers the model's box grown by max(3σ, trim); only points inside near_box (the same box) use
   // it.
   const bool use_grid = grid.built() &&
-                        std::abs(grid.kernel_radius_m - kernel_radius) <= 1e-6f * kernel_radius &&
-                        std::abs(grid.trim_m - trim) <= 1e-6f * trim;
+                        std::abs(grid.kernel.radius_m - kernel_radius) <= 1e-6f * kernel_radius &&
+                        std::abs(grid.icp.radius_m - trim) <= 1e-6f * trim;
 
-  std::vector<float> observed_sum(n, 0.0f);  // Σ_j exp(−d²/2σ²) over all scans
-  std::vector<float> scan_sum;               // the same for one scan (only with several scans)
+  // Σ_j exp(−d²/2σ²) per model point: in the kernel grid's sorted order with the grid (so that its vector
+  // loop can read 8 neighbouring sums at once), by point index without it.
+  const size_t sum_size = n;
+  auto point_of_slot = [&](size_t k) { return use_grid ? grid.kernel.indices[k] : static_cast<uint32_t>(k); };
+  std::vector<float> observed_sum(sum_size, 0.0f);  // over all scans
+  std::vector<float> scan_sum;                      // the same for one scan (only with several scans)
   double icp_distance_sum = 0.0;
   result.per_scan.resize(scans.size());
   if (options.keep_details) result.scene_status.resize(scans.size());
@@ -435,7 +382,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     ScanVerifyStats& stats = result.per_scan[s];
     if (options.keep_details) result.scene_status[s] = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
     const bool separate = scans.size() > 1;
-    if (separate) scan_sum.assign(n, 0.0f);
+    if (separate) scan_sum.assign(sum_size, 0.0f);
     std::vector<float>& sum = separate ? scan_sum : observed_sum;
 
     const Eigen::Matrix4d scanner_from_model = prepared.scanner_from_world * world_from_model;
@@ -449,93 +396,95 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     workspace.rays.clear();
     workspace.ray_range.clear();
     workspace.ray_cell.clear();
-    for (int r = footprint.row_begin; r < footprint.row_end; ++r) {
-      const uint8_t* valid = scan.valid.ptr<uint8_t>(r);
-      const float* range = scan.range.ptr<float>(r);
-      const cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(r);
+    workspace.near_points.clear();
+    // Bands of kBandRows rows, column after column within a band: consecutive rays are neighbouring cells
+    // in a small block (coherent Embree packets) and consecutive points stay in the same kernel cells.
+    constexpr int kBandRows = 4;
+    for (int band = footprint.row_begin; band < footprint.row_end; band += kBandRows) {
+      const int band_end = std::min(band + kBandRows, footprint.row_end);
       for (int c : footprint.columns) {
-        if (valid[c] == 0 || !(range[c] > 0)) continue;
-        const Eigen::Vector3f point_in_scanner(point[c][0], point[c][1], point[c][2]);
-        const Eigen::Vector3f point_in_model = linear * point_in_scanner + origin;
-        const Eigen::Vector3f direction_in_model = linear * (point_in_scanner / range[c]);
-        // Consistency: only rays that meet the model's box can meet the model.
-        const auto [t0, t1] = LineBoxInterval(origin, direction_in_model, model.bounds_in_model);
-        if (t0 <= t1 && t1 >= 0) {
-          Ray ray;
-          ray.origin = origin;
-          ray.direction = direction_in_model;
-          workspace.rays.push_back(ray);
-          workspace.ray_range.push_back(range[c]);
-          workspace.ray_cell.push_back(static_cast<int64_t>(r) * scan.cols + c);
-        }
-        // Confidence and ICP: scene points near the model, looked up in the model's KD-tree.
-        // One radius search serves both when a model point lies within 3σ (the usual case for points on the
-        // object): its closest match is the ICP nearest neighbour too.
-        if (!near_box.contains(point_in_model)) continue;
-        float closest_sq = std::numeric_limits<float>::infinity();
-        if (use_grid) {
-          // The 3 x 3 x 3 kernel cells around the point's own: nine runs of three cells, contiguous in x.
-          const Eigen::Vector3i c = KernelCellCoords(grid, point_in_model);
-          const int x0 = std::max(c.x() - 1, 0), x1 = std::min(c.x() + 1, grid.cell_dims.x() - 1);
-          const float kernel_radius_sq = kernel_radius * kernel_radius;
-          for (int z = std::max(c.z() - 1, 0); z <= std::min(c.z() + 1, grid.cell_dims.z() - 1); ++z) {
-            for (int y = std::max(c.y() - 1, 0); y <= std::min(c.y() + 1, grid.cell_dims.y() - 1); ++y) {
-              const int64_t row = (static_cast<int64_t>(z) * grid.cell_dims.y() + y) * grid.cell_dims.x();
-              const uint32_t end = grid.cell_offsets[row + x1 + 1];
-              for (uint32_t k = grid.cell_offsets[row + x0]; k < end; ++k) {
-                const float distance_sq = (grid.cell_positions[k] - point_in_model).squaredNorm();
-                if (distance_sq < kernel_radius_sq) {
-                  const uint32_t i = grid.cell_indices[k];
-                  // Only min(1, sum) matters: a saturated point needs no more exp (exact, and most of the
-                  // cost).
-                  if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
-                  closest_sq = std::min(closest_sq, distance_sq);
-                }
-              }
-            }
+        for (int r = band; r < band_end; ++r) {
+          const float range = scan.range.ptr<float>(r)[c];
+          if (scan.valid.ptr<uint8_t>(r)[c] == 0 || !(range > 0)) continue;
+          const cv::Vec3f& point = scan.point.ptr<cv::Vec3f>(r)[c];
+          const Eigen::Vector3f point_in_model =
+              linear * Eigen::Vector3f(point[0], point[1], point[2]) + origin;
+          // Consistency: only rays that meet the model's box can meet the model.
+          const Eigen::Vector3f direction_in_model = (point_in_model - origin) / range;
+          const auto [t0, t1] = LineBoxInterval(origin, direction_in_model, model.bounds_in_model);
+          if (t0 <= t1 && t1 >= 0) {
+            Ray ray;
+            ray.origin = origin;
+            ray.direction = direction_in_model;
+            ray.t_near = std::max(0.0f, t0 - 1e-4f * (1.0f + t0));  // slack: the box is float-rounded too
+            workspace.rays.push_back(ray);
+            workspace.ray_range.push_back(range);
+            workspace.ray_cell.push_back(static_cast<int64_t>(r) * scan.cols + c);
           }
-        } else {
-          model.points_in_model.ForEachInRadius(point_in_model, kernel_radius,
-                                                [&](uint32_t i, float distance_sq) {
-                                                  if (sum[i] < 1.0f)
-                                                    sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
-                                                  closest_sq = std::min(closest_sq, distance_sq);
-                                                });
-        }
-        if (!icp_box.contains(point_in_model)) continue;
-        ++result.icp_candidates;
-        if (!(closest_sq < kernel_radius * kernel_radius)) {
-          if (use_grid) {
-            const Eigen::Vector3f cell = (point_in_model - grid.origin_in_model) / grid.voxel_m;
-            const int x = std::clamp(static_cast<int>(cell.x()), 0, grid.dims.x() - 1);
-            const int y = std::clamp(static_cast<int>(cell.y()), 0, grid.dims.y() - 1);
-            const int z = std::clamp(static_cast<int>(cell.z()), 0, grid.dims.z() - 1);
-            const int64_t voxel = (static_cast<int64_t>(z) * grid.dims.y() + y) * grid.dims.x() + x;
-            for (uint32_t k = grid.nearest_offsets[voxel]; k < grid.nearest_offsets[voxel + 1]; ++k) {
-              closest_sq = std::min(closest_sq, (grid.nearest_positions[k] - point_in_model).squaredNorm());
-            }
-          } else {
-            closest_sq = model.points_in_model.NearestWithin(point_in_model, trim).distance_sq;
-          }
-        }
-        if (closest_sq <= trim * trim) {
-          ++result.icp_inliers;
-          icp_distance_sum += std::sqrt(closest_sq);
+          if (near_box.contains(point_in_model)) workspace.near_points.push_back(point_in_model);
         }
       }
     }
-    workspace.t_hit.resize(workspace.rays.size());
-    CastDistances(model.scene_in_model, workspace.rays, workspace.t_hit);
-    stats.rays_cast = static_cast<int64_t>(workspace.rays.size());
-    for (size_t k = 0; k < workspace.rays.size(); ++k) {
-      const float t_hit = workspace.t_hit[k];
-      if (!std::isfinite(t_hit)) continue;
-      ++stats.comparable_pairs;
-      const bool consistent = (t_hit + allowance) - workspace.ray_range[k] >= 0.0f;
-      if (consistent) ++stats.consistent_pairs;
-      if (options.keep_details) {
-        result.scene_status[s].data[workspace.ray_cell[k]] = consistent ? kConsistent : kInconsistent;
+
+    // Confidence and ICP: the scene points near the model. One kernel search serves both when a model point
+    // lies within 3σ (the usual case for points on the object): the closest one is the ICP nearest neighbour
+    // too.
+    const size_t num_near = workspace.near_points.size();
+    const float kernel_radius_sq = kernel_radius * kernel_radius;
+    workspace.closest_sq.assign(num_near, std::numeric_limits<float>::infinity());
+    if (use_grid) {
+      verify_internal::AccumulateKernel(grid, workspace.near_points, kernel_radius_sq, inverse_two_sigma_sq,
+                                        sum.data(), workspace.closest_sq.data());
+    } else {
+      for (size_t j = 0; j < num_near; ++j) {
+        model.points_in_model.ForEachInRadius(
+            workspace.near_points[j], kernel_radius, [&](uint32_t i, float distance_sq) {
+              if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
+              workspace.closest_sq[j] = std::min(workspace.closest_sq[j], distance_sq);
+            });
       }
+    }
+    // The ICP candidates without a model point within 3σ need a nearest-neighbour search of their own.
+    workspace.far_points.clear();
+    workspace.far_index.clear();
+    for (size_t j = 0; j < num_near; ++j) {
+      if (icp_box.contains(workspace.near_points[j]) && !(workspace.closest_sq[j] < kernel_radius_sq)) {
+        workspace.far_points.push_back(workspace.near_points[j]);
+        workspace.far_index.push_back(static_cast<uint32_t>(j));
+      }
+    }
+    workspace.far_closest_sq.resize(workspace.far_points.size());
+    if (use_grid) {
+      verify_internal::NearestSquaredDistance(grid, workspace.far_points, workspace.far_closest_sq.data());
+    } else {
+      for (size_t f = 0; f < workspace.far_points.size(); ++f) {
+        workspace.far_closest_sq[f] =
+            model.points_in_model.NearestWithin(workspace.far_points[f], trim).distance_sq;
+      }
+    }
+    for (size_t f = 0; f < workspace.far_points.size(); ++f) {
+      workspace.closest_sq[workspace.far_index[f]] = workspace.far_closest_sq[f];
+    }
+    for (size_t j = 0; j < num_near; ++j) {
+      if (!icp_box.contains(workspace.near_points[j])) continue;
+      ++result.icp_candidates;
+      if (workspace.closest_sq[j] <= trim * trim) {
+        ++result.icp_inliers;
+        icp_distance_sum += std::sqrt(workspace.closest_sq[j]);
+      }
+    }
+    const size_t num_rays = workspace.rays.size();
+    workspace.limit.resize(num_rays);
+    workspace.status.resize(num_rays);
+    for (size_t k = 0; k < num_rays; ++k) workspace.limit[k] = workspace.ray_range[k] - allowance;
+    ClassifyRays(model.scene_in_model, workspace.rays, workspace.limit, workspace.status);
+    stats.rays_cast = static_cast<int64_t>(num_rays);
+    for (size_t k = 0; k < num_rays; ++k) {
+      const uint8_t status = workspace.status[k];
+      if (status == kNotComparable) continue;
+      ++stats.comparable_pairs;
+      if (status == kConsistent) ++stats.consistent_pairs;
+      if (options.keep_details) result.scene_status[s].data[workspace.ray_cell[k]] = status;
     }
     if (stats.comparable_pairs > 0) {
       stats.consistency = static_cast<double>(stats.consistent_pairs) / stats.comparable_pairs;
@@ -543,10 +492,10 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     result.comparable_pairs += stats.comparable_pairs;
     result.consistent_pairs += stats.consistent_pairs;
     double confidence = 0.0;
-    for (size_t i = 0; i < n; ++i) confidence += model.information[i] * std::min(1.0f, sum[i]);
+    for (size_t k = 0; k < n; ++k) confidence += model.information[point_of_slot(k)] * std::min(1.0f, sum[k]);
     stats.confidence = confidence;
     if (separate) {
-      for (size_t i = 0; i < n; ++i) observed_sum[i] += scan_sum[i];
+      for (size_t k = 0; k < n; ++k) observed_sum[k] += scan_sum[k];
     }
   }
 
@@ -556,8 +505,9 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
   }
   double confidence = 0.0;
   if (options.keep_details) result.observed_information.resize(n);
-  for (size_t i = 0; i < n; ++i) {
-    const float observed = model.information[i] * std::min(1.0f, observed_sum[i]);
+  for (size_t k = 0; k < n; ++k) {
+    const uint32_t i = point_of_slot(k);
+    const float observed = model.information[i] * std::min(1.0f, observed_sum[k]);
     confidence += observed;
     if (options.keep_details) result.observed_information[i] = observed;
   }

@@ -29,14 +29,18 @@
 //    trim distance.
 //
 // Speed (build once, query many; libigl-style precompute/query split):
-//   VerifierModel model = PrepareModel(mesh_in_model, model_options);   // Embree scene + KD-tree, model
-//   frame std::vector<PreparedScan> scans = {PrepareScan(scan_a), PrepareScan(scan_b)}; VerifyResult result =
-//   VerifyPose(model, scans, world_from_model, options);
+//
+//   VerifierModel model = PrepareModel(mesh_in_model, model_options);  // Embree scene + point grids
+//   std::vector<PreparedScan> scans = {PrepareScan(scan_a), PrepareScan(scan_b)};
+//   VerifyResult result = VerifyPose(model, scans, world_from_model, options);
+//
 // Per pose and scan, only the cells inside the model's angular footprint (its bounding box projected to
-// azimuth / elevation → a column set and a row window of the organized grid) are visited; their rays are
-// moved into the MODEL frame and cast against the model scene built once in its own frame, and their points
-// are looked up in the model-point KD-tree built once (so nothing is rebuilt per pose). VerifyPoses runs many
-// poses in parallel.
+// azimuth / elevation → a column set and a row window of the organized grid) are visited, in bands of 4
+// rows so that consecutive cells are neighbours. Their rays are moved into the MODEL frame and tested
+// against the model scene built once in its own frame (two any-hit queries per ray, 16-ray packets), and
+// their points are looked up in the model-point cell grids built once (KernelNeighbourGrid), grouped by
+// cell, 8 model points per AVX2 instruction. Nothing is rebuilt per pose. VerifyPoses runs poses in
+// parallel. bench/results/verify.md has the numbers.
 #pragma once
 
 #include <cstdint>
@@ -84,33 +88,35 @@ struct ModelOptions {
   void Check() const;  // throws OptionsError
 };
 
-// Neighbour lookups of the model points without a tree descent (the confidence measure's hot loop). Built
-// once by PrepareModel for VerifyOptions::sigma_m and icp_trim_m; VerifyPose falls back to the KD-tree for
-// other values (same results, slower). Covers the model's box grown by max(3σ, trim).
-//  * Kernel (3σ) neighbours: the model points sorted into cells of edge 3σ (· 1.001, so that float rounding
-//    never puts a point within 3σ two cells away); a scene point tests the points of the 3 x 3 x 3 cells
-//    around its own — nine contiguous runs of the sorted array. The points (12 bytes each, ~120 KB for
-//    10,000) stay in the L2 cache; per-voxel candidate lists (each point copied into ~70 lists, tens of MB)
-//    did not, and the hot loop was bound by their cache misses.
-//  * Trimmed-ICP nearest neighbour (below): per voxel of `voxel_m`, the model points that can be the nearest.
+// Positions as three coordinate arrays (structure of arrays, for SIMD loads).
+struct PointColumns {
+  std::vector<float> x, y, z;
+  void Assign(std::span<const Eigen::Vector3f> points);
+  size_t size() const { return x.size(); }
+};
+
+// The model points sorted into cubic cells of edge ≥ `radius_m` (· 1.001, so that float rounding never puts
+// a point within the radius two cells away): every model point within radius_m of a query lies in the
+// 3 x 3 x 3 cells around the query's own, i.e. in nine contiguous runs of the sorted arrays. The points (12
+// bytes each, ~120 KB for 10,000) stay in the L2 cache, which per-voxel candidate lists (tens of MB) did not.
+struct PointCellGrid {
+  float radius_m = 0.0f;                                      // the query radius it serves; 0 = not built
+  Eigen::Vector3f origin_in_model = Eigen::Vector3f::Zero();  // corner of cell (0, 0, 0)
+  float cell_m = 0.0f;                                        // edge of a cell, metres
+  Eigen::Vector3i dims = Eigen::Vector3i::Zero();             // cells along x, y, z
+  std::vector<uint32_t> offsets;  // #cells + 1, CSR (cell = (z * dims.y + y) * dims.x + x)
+  std::vector<uint32_t> indices;  // model point indices sorted by cell (ascending within a cell)
+  PointColumns positions;         // their positions, same order
+};
+
+// Neighbour lookups of the model points without a tree descent (the hot loops of confidence and of the
+// trimmed ICP), built once by PrepareModel for VerifyOptions::sigma_m and icp_trim_m; VerifyPose falls back
+// to the KD-tree for other values (same results, slower). Both grids cover the model's box grown by
+// max(3σ, trim); a query scans its 3 x 3 x 3 cells, 8 points per AVX2 instruction.
 struct KernelNeighbourGrid {
-  float kernel_radius_m = 0.0f;                               // 3σ it was built for; 0 = not built
-  Eigen::Vector3f origin_in_model = Eigen::Vector3f::Zero();  // corner of cell / voxel (0, 0, 0)
-  float cell_m = 0.0f;  // edge of a kernel cell, metres (3σ · 1.001, larger to keep at most ~2 M cells)
-  Eigen::Vector3i cell_dims = Eigen::Vector3i::Zero();  // kernel cells along x, y, z
-  std::vector<uint32_t> cell_offsets;              // #cells + 1, CSR (cell = (z * dims.y + y) * dims.x + x)
-  std::vector<uint32_t> cell_indices;              // model point indices sorted by cell
-  std::vector<Eigen::Vector3f> cell_positions;     // their positions, same order
-  float voxel_m = 0.0f;                            // edge of an ICP voxel, metres
-  Eigen::Vector3i dims = Eigen::Vector3i::Zero();  // ICP voxels along x, y, z
-  // The trimmed-ICP nearest neighbour per ICP voxel: every model point that can be the nearest one of some
-  // point of the voxel (within d_centre + 2 · half diagonal of its centre); empty for voxels farther than the
-  // trim distance.
-  float trim_m = 0.0f;                    // the icp_trim_m it was built for
-  std::vector<uint32_t> nearest_offsets;  // #voxels + 1
-  std::vector<uint32_t> nearest_indices;
-  std::vector<Eigen::Vector3f> nearest_positions;  // same order
-  bool built() const { return kernel_radius_m > 0; }
+  PointCellGrid kernel;  // radius 3σ: the confidence kernel's neighbours (and the ICP nearest when closer)
+  PointCellGrid icp;     // radius = the ICP trim distance: the nearest model point when within it
+  bool built() const { return kernel.radius_m > 0; }
 };
 
 // The model side, built once (model frame = the mesh's own coordinates).

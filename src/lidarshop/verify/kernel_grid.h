@@ -1,0 +1,40 @@
+// Internal to the verify module: building the KernelNeighbourGrid (verify.h) and its two queries, the hot
+// loops of the confidence measure and of the trimmed-ICP baseline. The queries run 8 model points per
+// instruction with AVX2 where the CPU has it (checked once at run time; Debian builds for plain x86-64) and
+// give bit-identical results on the scalar path: no FMA contraction, the same summation order, hits visited
+// in the same order.
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "lidarshop/verify/verify.h"
+
+namespace lidarshop::verify_internal {
+
+// Both grids over `bounds` (the model's box) grown by max(kernel_radius, trim).
+KernelNeighbourGrid BuildKernelGrid(std::span<const Eigen::Vector3f> points,
+                                    const Eigen::AlignedBox3f& bounds, float kernel_radius, float trim);
+
+// Both paths give bit-identical results; the AVX2 one is chosen when the CPU has it (tests pin each).
+enum class SimdPath { kScalar, kAvx2 };
+SimdPath BestSimdPath();
+
+// The kernel step for scene points (model frame, inside the grids' box), in order: for every model point
+// with d² = |p − m|² < radius_sq, sum[k] += exp(−d² · inverse_two_sigma_sq) unless sum[k] ≥ 1 already (only
+// min(1, sum) is used, so this is exact), where k is the point's slot in the kernel grid's sorted order
+// (grid.kernel.indices[k] is its model point index). closest_sq[j] = the smallest such d² of points[j]
+// (+inf when none). Fastest when consecutive points are neighbours (scan order).
+void AccumulateKernel(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
+                      float radius_sq, float inverse_two_sigma_sq, float* sum, float* closest_sq,
+                      SimdPath path = BestSimdPath());
+
+// closest_sq[j] = the squared distance from points[j] (model frame) to its nearest model point when that is
+// within the ICP grid's radius (the trim distance); otherwise some value > trim² (possibly +inf).
+void NearestSquaredDistance(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
+                            float* closest_sq, SimdPath path = BestSimdPath());
+
+}  // namespace lidarshop::verify_internal
