@@ -207,6 +207,36 @@ BENCHMARK(BM_VerifyPoses_Naive)
     ->UseRealTime()
     ->MinTime(3.0);
 
+// The same straightforward implementation in the harness of the fast one: poses in parallel, one per thread
+// (each pose's own cast may use the other thread too). The fair wall-clock comparison: BM_VerifyPoses_Naive
+// runs one pose at a time, leaving a core idle during its serial KD-tree queries.
+void BM_VerifyPoses_NaiveParallel(benchmark::State& state) {
+  Fixture& fixture = GetFixture();
+  const ThreadLimit limit(static_cast<int>(state.range(0)));
+  constexpr int kBatch = 8;
+  int64_t poses = 0;
+  size_t next = 0;
+  for (auto _ : state) {
+    std::vector<double> confidence(kBatch);
+    ParallelFor(kBatch, [&](int64_t p) {
+      confidence[p] = VerifyPoseNaive(fixture.model, fixture.scans[0],
+                                      fixture.poses[(next + p) % fixture.poses.size()], fixture.options)
+                          .confidence;
+    });
+    next += kBatch;
+    benchmark::DoNotOptimize(confidence.data());
+    poses += kBatch;
+  }
+  state.SetItemsProcessed(poses);
+  state.counters["threads"] = static_cast<double>(state.range(0));
+}
+BENCHMARK(BM_VerifyPoses_NaiveParallel)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime()
+    ->UseRealTime()
+    ->MinTime(3.0);
+
 // Not timed: the two implementations agree (printed once, so the results file can quote it).
 void BM_Agreement(benchmark::State& state) {
   Fixture& fixture = GetFixture();

@@ -144,33 +144,46 @@ Footprint FindFootprint(const PreparedScan& prepared, const Eigen::Matrix4d& sca
 // An any-hit query stops at the first triangle it meets, and the first one ends 10 cm (a) short of the
 // surface that the scene point usually lies on, so it prunes early; together they cost ~30 % less than the
 // closest hit here (bench/results/verify.md). Rays go in Embree packets of 16 neighbouring cells.
-void ClassifyRays(const RaycastScene& scene, std::span<const Ray> rays, std::span<const float> limit,
-                  std::span<uint8_t> status) {
+// Rays from one origin as columns (the footprint's rays, model frame).
+struct FootprintRays {
+  std::vector<float> dir_x, dir_y, dir_z;
+  std::vector<float> t_near;  // just before the model's box
+  std::vector<float> limit;   // d_s − a
+  std::vector<int64_t> cell;  // row * cols + col
+  void Resize(size_t size) {
+    for (auto* column : {&dir_x, &dir_y, &dir_z, &t_near, &limit}) column->resize(size);
+    cell.resize(size);
+  }
+};
+
+void ClassifyRays(const RaycastScene& scene, const Eigen::Vector3f& origin, const FootprintRays& rays,
+                  size_t num_rays, std::span<uint8_t> status) {
   RTCScene handle = static_cast<RTCScene>(scene.native_scene());
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   RTCRay16 packet;
+  for (int lane = 0; lane < 16; ++lane) {
+    packet.org_x[lane] = origin.x();
+    packet.org_y[lane] = origin.y();
+    packet.org_z[lane] = origin.z();
+    packet.time[lane] = 0.0f;
+    packet.mask[lane] = 0xFFFFFFFFu;
+    packet.flags[lane] = 0;
+  }
   alignas(64) int active[16];
-  for (size_t start = 0; start < rays.size(); start += 16) {
-    const size_t count = std::min<size_t>(16, rays.size() - start);
+  for (size_t start = 0; start < num_rays; start += 16) {
+    const size_t count = std::min<size_t>(16, num_rays - start);
     bool any_active = false;
     for (size_t lane = 0; lane < 16; ++lane) {
       const size_t k = start + std::min(lane, count - 1);
-      const Ray& ray = rays[k];
-      active[lane] = lane < count && limit[k] > ray.t_near ? -1 : 0;
+      active[lane] = lane < count && rays.limit[k] > rays.t_near[k] ? -1 : 0;
       any_active |= active[lane] != 0;
-      packet.org_x[lane] = ray.origin.x();
-      packet.org_y[lane] = ray.origin.y();
-      packet.org_z[lane] = ray.origin.z();
-      packet.dir_x[lane] = ray.direction.x();
-      packet.dir_y[lane] = ray.direction.y();
-      packet.dir_z[lane] = ray.direction.z();
-      packet.tnear[lane] = ray.t_near;
-      packet.tfar[lane] = limit[k];
-      packet.time[lane] = 0.0f;
-      packet.mask[lane] = 0xFFFFFFFFu;
-      packet.flags[lane] = 0;
+      packet.dir_x[lane] = rays.dir_x[k];
+      packet.dir_y[lane] = rays.dir_y[k];
+      packet.dir_z[lane] = rays.dir_z[k];
+      packet.tnear[lane] = rays.t_near[k];
+      packet.tfar[lane] = rays.limit[k];
     }
     if (any_active) rtcOccluded16(active, handle, &context, &packet);
     any_active = false;
@@ -181,7 +194,7 @@ void ClassifyRays(const RaycastScene& scene, std::span<const Ray> rays, std::spa
       if (lane < count) status[k] = occluded ? kInconsistent : kNotComparable;
       active[lane] = lane < count && !occluded ? -1 : 0;
       any_active |= active[lane] != 0;
-      packet.tnear[lane] = std::max(rays[k].t_near, limit[k]);
+      packet.tnear[lane] = std::max(rays.t_near[k], rays.limit[k]);
       packet.tfar[lane] = std::numeric_limits<float>::infinity();
     }
     if (any_active) rtcOccluded16(active, handle, &context, &packet);
@@ -192,15 +205,12 @@ void ClassifyRays(const RaycastScene& scene, std::span<const Ray> rays, std::spa
 }
 
 struct Workspace {
-  std::vector<Ray> rays;
-  std::vector<float> ray_range;
-  std::vector<int64_t> ray_cell;
+  FootprintRays rays;
   std::vector<Eigen::Vector3f> near_points;  // scene points inside the near box, model frame, in scan order
   std::vector<float> closest_sq;             // per near point: squared distance to the nearest model point
   std::vector<Eigen::Vector3f> far_points;   // near points in the ICP box without a model point within 3σ
   std::vector<uint32_t> far_index;           // their index among the near points
   std::vector<float> far_closest_sq;
-  std::vector<float> limit;     // per ray: d_s − a
   std::vector<uint8_t> status;  // per ray: SceneStatus
 };
 
@@ -393,10 +403,13 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         FindFootprint(prepared, scanner_from_model, near_box, options.footprint_margin_cells);
     stats.footprint_cells = footprint.num_cells();
 
-    workspace.rays.clear();
-    workspace.ray_range.clear();
-    workspace.ray_cell.clear();
-    workspace.near_points.clear();
+    // Every cell is written to the next free slot of the rays and of the near points, and kept by advancing
+    // the count: the loop has no data-dependent branch (the silhouette's are unpredictable).
+    const size_t max_cells = static_cast<size_t>(footprint.num_cells());
+    workspace.rays.Resize(max_cells);
+    workspace.near_points.resize(max_cells);
+    size_t num_rays = 0, num_near = 0;
+    const Eigen::Vector3f box_lo = model.bounds_in_model.min(), box_hi = model.bounds_in_model.max();
     // Bands of kBandRows rows, column after column within a band: consecutive rays are neighbouring cells
     // in a small block (coherent Embree packets) and consecutive points stay in the same kernel cells.
     constexpr int kBandRows = 4;
@@ -405,31 +418,37 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
       for (int c : footprint.columns) {
         for (int r = band; r < band_end; ++r) {
           const float range = scan.range.ptr<float>(r)[c];
-          if (scan.valid.ptr<uint8_t>(r)[c] == 0 || !(range > 0)) continue;
+          const bool returned = scan.valid.ptr<uint8_t>(r)[c] != 0 && range > 0;
           const cv::Vec3f& point = scan.point.ptr<cv::Vec3f>(r)[c];
           const Eigen::Vector3f point_in_model =
               linear * Eigen::Vector3f(point[0], point[1], point[2]) + origin;
-          // Consistency: only rays that meet the model's box can meet the model.
+          // Consistency: only rays that meet the model's box can meet the model (slab test; a zero
+          // direction component gives ±inf and keeps the slab's answer).
           const Eigen::Vector3f direction_in_model = (point_in_model - origin) / range;
-          const auto [t0, t1] = LineBoxInterval(origin, direction_in_model, model.bounds_in_model);
-          if (t0 <= t1 && t1 >= 0) {
-            Ray ray;
-            ray.origin = origin;
-            ray.direction = direction_in_model;
-            ray.t_near = std::max(0.0f, t0 - 1e-4f * (1.0f + t0));  // slack: the box is float-rounded too
-            workspace.rays.push_back(ray);
-            workspace.ray_range.push_back(range);
-            workspace.ray_cell.push_back(static_cast<int64_t>(r) * scan.cols + c);
-          }
-          if (near_box.contains(point_in_model)) workspace.near_points.push_back(point_in_model);
+          const Eigen::Vector3f inverse = direction_in_model.cwiseInverse();
+          const Eigen::Vector3f t_lo = (box_lo - origin).cwiseProduct(inverse);
+          const Eigen::Vector3f t_hi = (box_hi - origin).cwiseProduct(inverse);
+          const float t0 = t_lo.cwiseMin(t_hi).maxCoeff(), t1 = t_lo.cwiseMax(t_hi).minCoeff();
+          const size_t k = num_rays;
+          workspace.rays.dir_x[k] = direction_in_model.x();
+          workspace.rays.dir_y[k] = direction_in_model.y();
+          workspace.rays.dir_z[k] = direction_in_model.z();
+          workspace.rays.t_near[k] =
+              std::max(0.0f, t0 - 1e-4f * (1.0f + t0));  // slack: the box is rounded too
+          workspace.rays.limit[k] = range - allowance;
+          workspace.rays.cell[k] = static_cast<int64_t>(r) * scan.cols + c;
+          // Written so that a NaN (0 · inf: the origin on a face plane) keeps the ray; Embree decides.
+          num_rays += returned && !(t0 > t1) && !(t1 < 0);
+          workspace.near_points[num_near] = point_in_model;
+          num_near += returned && near_box.contains(point_in_model);
         }
       }
     }
+    workspace.near_points.resize(num_near);
 
     // Confidence and ICP: the scene points near the model. One kernel search serves both when a model point
     // lies within 3σ (the usual case for points on the object): the closest one is the ICP nearest neighbour
     // too.
-    const size_t num_near = workspace.near_points.size();
     const float kernel_radius_sq = kernel_radius * kernel_radius;
     workspace.closest_sq.assign(num_near, std::numeric_limits<float>::infinity());
     if (use_grid) {
@@ -473,18 +492,15 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         icp_distance_sum += std::sqrt(workspace.closest_sq[j]);
       }
     }
-    const size_t num_rays = workspace.rays.size();
-    workspace.limit.resize(num_rays);
     workspace.status.resize(num_rays);
-    for (size_t k = 0; k < num_rays; ++k) workspace.limit[k] = workspace.ray_range[k] - allowance;
-    ClassifyRays(model.scene_in_model, workspace.rays, workspace.limit, workspace.status);
+    ClassifyRays(model.scene_in_model, origin, workspace.rays, num_rays, workspace.status);
     stats.rays_cast = static_cast<int64_t>(num_rays);
     for (size_t k = 0; k < num_rays; ++k) {
       const uint8_t status = workspace.status[k];
       if (status == kNotComparable) continue;
       ++stats.comparable_pairs;
       if (status == kConsistent) ++stats.consistent_pairs;
-      if (options.keep_details) result.scene_status[s].data[workspace.ray_cell[k]] = status;
+      if (options.keep_details) result.scene_status[s].data[workspace.rays.cell[k]] = status;
     }
     if (stats.comparable_pairs > 0) {
       stats.consistency = static_cast<double>(stats.consistent_pairs) / stats.comparable_pairs;
