@@ -295,6 +295,17 @@ PreparedScan PrepareScan(const Scan& scan) {
   prepared.world_from_scanner = scan.world_from_scanner;
   prepared.scanner_from_world = scan.world_from_scanner.inverse();
   prepared.num_valid = scan.CountValid();
+  const int bands = (scan.rows + PreparedScan::kBandRows - 1) / PreparedScan::kBandRows;
+  prepared.band_cells.assign(static_cast<size_t>(bands) * PreparedScan::kBandRows * scan.cols,
+                             Eigen::Vector4f::Zero());
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      const float range = scan.range.at<float>(r, c);
+      if (scan.valid.at<uint8_t>(r, c) == 0 || !(range > 0)) continue;
+      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(r, c);
+      prepared.band_cells[prepared.BandCellIndex(r, c)] = Eigen::Vector4f(p[0], p[1], p[2], range);
+    }
+  }
   const bool grid_matches = static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
                             static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows;
   if (grid_matches) {
@@ -412,16 +423,18 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     const Eigen::Vector3f box_lo = model.bounds_in_model.min(), box_hi = model.bounds_in_model.max();
     // Bands of kBandRows rows, column after column within a band: consecutive rays are neighbouring cells
     // in a small block (coherent Embree packets) and consecutive points stay in the same kernel cells.
-    constexpr int kBandRows = 4;
-    for (int band = footprint.row_begin; band < footprint.row_end; band += kBandRows) {
-      const int band_end = std::min(band + kBandRows, footprint.row_end);
+    constexpr int kBandRows = PreparedScan::kBandRows;
+    for (int band = footprint.row_begin / kBandRows * kBandRows; band < footprint.row_end;
+         band += kBandRows) {
+      const int r_begin = std::max(band, footprint.row_begin),
+                r_end = std::min(band + kBandRows, footprint.row_end);
       for (int c : footprint.columns) {
-        for (int r = band; r < band_end; ++r) {
-          const float range = scan.range.ptr<float>(r)[c];
-          const bool returned = scan.valid.ptr<uint8_t>(r)[c] != 0 && range > 0;
-          const cv::Vec3f& point = scan.point.ptr<cv::Vec3f>(r)[c];
-          const Eigen::Vector3f point_in_model =
-              linear * Eigen::Vector3f(point[0], point[1], point[2]) + origin;
+        const Eigen::Vector4f* cells = prepared.band_cells.data() + prepared.BandCellIndex(band, c);
+        for (int r = r_begin; r < r_end; ++r) {
+          const Eigen::Vector4f& cell = cells[r - band];
+          const float range = cell.w();
+          const bool returned = range > 0;
+          const Eigen::Vector3f point_in_model = linear * cell.head<3>() + origin;
           // Consistency: only rays that meet the model's box can meet the model (slab test; a zero
           // direction component gives ±inf and keeps the slab's answer).
           const Eigen::Vector3f direction_in_model = (point_in_model - origin) / range;

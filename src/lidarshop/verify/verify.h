@@ -150,6 +150,14 @@ struct PreparedScan {
   double azimuth_step_rad = 0.0;  // largest step between neighbouring columns / rows (footprint margin)
   double elevation_step_rad = 0.0;
   int64_t num_valid = 0;
+  // The cells again as (x, y, z, range) in the scanner frame, range 0 without a return, in the order the
+  // footprint is walked: bands of kBandRows image rows, column after column within a band, top row first.
+  // One sequential 16-byte read per cell instead of three arrays (and 4 rows' pointers) per cell.
+  static constexpr int kBandRows = 4;
+  std::vector<Eigen::Vector4f> band_cells;  // #ceil(rows / kBandRows) * kBandRows * cols
+  size_t BandCellIndex(int row, int col) const {
+    return (static_cast<size_t>(row / kBandRows) * scan.cols + col) * kBandRows + row % kBandRows;
+  }
 };
 
 // Throws InputError when the scan has no cells or no usable directions.
