@@ -172,20 +172,6 @@ void NearestGroupScalar(const PointCellGrid& grid, const Run* runs, int num_runs
   }
 }
 
-// For the AVX2 left-pack: kLeftPack[mask] lists the lanes set in `mask`, in order (then zeros).
-struct LeftPackTable {
-  alignas(8) uint8_t lanes[256][8] = {};
-  constexpr LeftPackTable() {
-    for (int mask = 0; mask < 256; ++mask) {
-      int count = 0;
-      for (int lane = 0; lane < 8; ++lane) {
-        if (mask & (1 << lane)) lanes[mask][count++] = static_cast<uint8_t>(lane);
-      }
-    }
-  }
-};
-constexpr LeftPackTable kLeftPack;
-
 // The candidates of one 3 x 3 x 3 neighbourhood that can matter to a group of queries, copied into one
 // contiguous, 8-padded block (with their sums): the nine short runs (seven points each on average: mostly
 // partial vectors and mispredicted loop exits) become one straight loop for all the queries of the cell, and
@@ -376,8 +362,6 @@ void NearestSquaredDistance(const KernelNeighbourGrid& grid, std::span<const Eig
     begin = end;
   }
 }
-
-SimdPath BestSimdPath() { return kHasAvx2 ? SimdPath::kAvx2 : SimdPath::kScalar; }
 
 }  // namespace verify_internal
 }  // namespace lidarshop

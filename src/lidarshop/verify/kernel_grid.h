@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "lidarshop/verify/simd_util.h"
 #include "lidarshop/verify/verify.h"
 
 namespace lidarshop::verify_internal {
@@ -18,10 +19,6 @@ namespace lidarshop::verify_internal {
 // Both grids over `bounds` (the model's box) grown by max(kernel_radius, trim).
 KernelNeighbourGrid BuildKernelGrid(std::span<const Eigen::Vector3f> points,
                                     const Eigen::AlignedBox3f& bounds, float kernel_radius, float trim);
-
-// Both paths give bit-identical results; the AVX2 one is chosen when the CPU has it (tests pin each).
-enum class SimdPath { kScalar, kAvx2 };
-SimdPath BestSimdPath();
 
 // The kernel step for scene points (model frame, inside the grids' box), in order: for every model point
 // with d² = |p − m|² < radius_sq, sum[k] += exp(−d² · inverse_two_sigma_sq) unless sum[k] ≥ 1 already (only

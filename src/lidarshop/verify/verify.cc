@@ -12,6 +12,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/verify/footprint_gather.h"
 #include "lidarshop/verify/kernel_grid.h"
 
 namespace lidarshop {
@@ -144,20 +145,11 @@ Footprint FindFootprint(const PreparedScan& prepared, const Eigen::Matrix4d& sca
 // An any-hit query stops at the first triangle it meets, and the first one ends 10 cm (a) short of the
 // surface that the scene point usually lies on, so it prunes early; together they cost ~30 % less than the
 // closest hit here (bench/results/verify.md). Rays go in Embree packets of 16 neighbouring cells.
-// Rays from one origin as columns (the footprint's rays, model frame).
-struct FootprintRays {
-  std::vector<float> dir_x, dir_y, dir_z;
-  std::vector<float> t_near;  // just before the model's box
-  std::vector<float> limit;   // d_s − a
-  std::vector<int64_t> cell;  // row * cols + col
-  void Resize(size_t size) {
-    for (auto* column : {&dir_x, &dir_y, &dir_z, &t_near, &limit}) column->resize(size);
-    cell.resize(size);
-  }
-};
+using verify_internal::FootprintRays;
 
 void ClassifyRays(const RaycastScene& scene, const Eigen::Vector3f& origin, const FootprintRays& rays,
-                  size_t num_rays, std::span<uint8_t> status) {
+                  std::span<uint8_t> status) {
+  const size_t num_rays = rays.size;
   RTCScene handle = static_cast<RTCScene>(scene.native_scene());
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
@@ -206,6 +198,7 @@ void ClassifyRays(const RaycastScene& scene, const Eigen::Vector3f& origin, cons
 
 struct Workspace {
   FootprintRays rays;
+  verify_internal::NearPoints near;
   std::vector<Eigen::Vector3f> near_points;  // scene points inside the near box, model frame, in scan order
   std::vector<float> closest_sq;             // per near point: squared distance to the nearest model point
   std::vector<Eigen::Vector3f> far_points;   // near points in the ICP box without a model point within 3σ
@@ -414,50 +407,40 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
         FindFootprint(prepared, scanner_from_model, near_box, options.footprint_margin_cells);
     stats.footprint_cells = footprint.num_cells();
 
-    // Every cell is written to the next free slot of the rays and of the near points, and kept by advancing
-    // the count: the loop has no data-dependent branch (the silhouette's are unpredictable).
-    const size_t max_cells = static_cast<size_t>(footprint.num_cells());
-    workspace.rays.Resize(max_cells);
-    workspace.near_points.resize(max_cells);
-    size_t num_rays = 0, num_near = 0;
-    const Eigen::Vector3f box_lo = model.bounds_in_model.min(), box_hi = model.bounds_in_model.max();
     // Bands of kBandRows rows, column after column within a band: consecutive rays are neighbouring cells
     // in a small block (coherent Embree packets) and consecutive points stay in the same kernel cells.
+    static_assert(PreparedScan::kBandRows == 4, "footprint_gather.cc assumes bands of 4 rows");
     constexpr int kBandRows = PreparedScan::kBandRows;
+    workspace.rays.size = 0;
+    workspace.near.size = 0;
+    verify_internal::ReserveGather(
+        static_cast<size_t>(footprint.num_cells()) + kBandRows * footprint.columns.size(), workspace.rays,
+        workspace.near);
+    const verify_internal::GatherFrame frame{linear, origin, model.bounds_in_model, near_box, allowance};
     for (int band = footprint.row_begin / kBandRows * kBandRows; band < footprint.row_end;
          band += kBandRows) {
-      const int r_begin = std::max(band, footprint.row_begin),
-                r_end = std::min(band + kBandRows, footprint.row_end);
-      for (int c : footprint.columns) {
-        const Eigen::Vector4f* cells = prepared.band_cells.data() + prepared.BandCellIndex(band, c);
-        for (int r = r_begin; r < r_end; ++r) {
-          const Eigen::Vector4f& cell = cells[r - band];
-          const float range = cell.w();
-          const bool returned = range > 0;
-          const Eigen::Vector3f point_in_model = linear * cell.head<3>() + origin;
-          // Consistency: only rays that meet the model's box can meet the model (slab test; a zero
-          // direction component gives ±inf and keeps the slab's answer).
-          const Eigen::Vector3f direction_in_model = (point_in_model - origin) / range;
-          const Eigen::Vector3f inverse = direction_in_model.cwiseInverse();
-          const Eigen::Vector3f t_lo = (box_lo - origin).cwiseProduct(inverse);
-          const Eigen::Vector3f t_hi = (box_hi - origin).cwiseProduct(inverse);
-          const float t0 = t_lo.cwiseMin(t_hi).maxCoeff(), t1 = t_lo.cwiseMax(t_hi).minCoeff();
-          const size_t k = num_rays;
-          workspace.rays.dir_x[k] = direction_in_model.x();
-          workspace.rays.dir_y[k] = direction_in_model.y();
-          workspace.rays.dir_z[k] = direction_in_model.z();
-          workspace.rays.t_near[k] =
-              std::max(0.0f, t0 - 1e-4f * (1.0f + t0));  // slack: the box is rounded too
-          workspace.rays.limit[k] = range - allowance;
-          workspace.rays.cell[k] = static_cast<int64_t>(r) * scan.cols + c;
-          // Written so that a NaN (0 · inf: the origin on a face plane) keeps the ray; Embree decides.
-          num_rays += returned && !(t0 > t1) && !(t1 < 0);
-          workspace.near_points[num_near] = point_in_model;
-          num_near += returned && near_box.contains(point_in_model);
+      // Runs of consecutive footprint columns (one run, or two where the footprint wraps around ±180°).
+      for (size_t first = 0; first < footprint.columns.size();) {
+        size_t last = first;
+        while (last + 1 < footprint.columns.size() &&
+               footprint.columns[last + 1] == footprint.columns[last] + 1) {
+          ++last;
         }
+        const int first_col = footprint.columns[first];
+        verify_internal::GatherBand(prepared.band_cells.data() + prepared.BandCellIndex(band, first_col),
+                                    band, footprint.row_begin, footprint.row_end, first_col,
+                                    static_cast<int>(last - first + 1), scan.cols, frame, workspace.rays,
+                                    workspace.near);
+        first = last + 1;
       }
     }
+    const size_t num_rays = workspace.rays.size;
+    const size_t num_near = workspace.near.size;
     workspace.near_points.resize(num_near);
+    for (size_t j = 0; j < num_near; ++j) {
+      workspace.near_points[j] =
+          Eigen::Vector3f(workspace.near.x[j], workspace.near.y[j], workspace.near.z[j]);
+    }
 
     // Confidence and ICP: the scene points near the model. One kernel search serves both when a model point
     // lies within 3σ (the usual case for points on the object): the closest one is the ICP nearest neighbour
@@ -506,7 +489,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
       }
     }
     workspace.status.resize(num_rays);
-    ClassifyRays(model.scene_in_model, origin, workspace.rays, num_rays, workspace.status);
+    ClassifyRays(model.scene_in_model, origin, workspace.rays, workspace.status);
     stats.rays_cast = static_cast<int64_t>(num_rays);
     for (size_t k = 0; k < num_rays; ++k) {
       const uint8_t status = workspace.status[k];
