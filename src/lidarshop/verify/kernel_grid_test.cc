@@ -48,6 +48,16 @@ struct Fixture {
 
 constexpr float kSigma = 0.03f, kTrim = 0.2f;
 
+TEST(KernelGridTest, KernelExpIsWithinTwoUlpOfStdExp) {
+  float worst = 0;
+  for (float x = -87.0f; x <= 0.0f; x += 0.000731f) {
+    const float expected = std::exp(x), actual = KernelExp(x);
+    worst = std::max(worst, std::abs(actual - expected) / (expected * std::numeric_limits<float>::epsilon()));
+  }
+  EXPECT_LE(worst, 2.0f);
+  EXPECT_EQ(KernelExp(0.0f), 1.0f);
+}
+
 TEST(KernelGridTest, ScalarAndAvx2PathsAreBitIdenticalAndMatchBruteForce) {
   const Fixture fixture;
   const KernelNeighbourGrid grid = BuildKernelGrid(fixture.model_points, fixture.bounds, 3 * kSigma, kTrim);

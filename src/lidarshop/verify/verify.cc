@@ -454,7 +454,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
       for (size_t j = 0; j < num_near; ++j) {
         model.points_in_model.ForEachInRadius(
             workspace.near_points[j], kernel_radius, [&](uint32_t i, float distance_sq) {
-              if (sum[i] < 1.0f) sum[i] += std::exp(-distance_sq * inverse_two_sigma_sq);
+              if (sum[i] < 1.0f) sum[i] += verify_internal::KernelExp(-distance_sq * inverse_two_sigma_sq);
               workspace.closest_sq[j] = std::min(workspace.closest_sq[j], distance_sq);
             });
       }
