@@ -173,7 +173,8 @@ BENCHMARK(BM_VerifyPoses_Footprint)
     ->Arg(2)
     ->Unit(benchmark::kMillisecond)
     ->MeasureProcessCPUTime()
-    ->UseRealTime();
+    ->UseRealTime()
+    ->MinTime(3.0);
 
 void BM_VerifyPoses_Naive(benchmark::State& state) {
   Fixture& fixture = GetFixture();

@@ -260,10 +260,15 @@ __attribute__((target("avx2"), always_inline)) inline __m256 KernelExp8(__m256 x
                                    _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
   const __m256 r = _mm256_sub_ps(_mm256_sub_ps(x, _mm256_mul_ps(n, _mm256_set1_ps(0.693145751953125f))),
                                  _mm256_mul_ps(n, _mm256_set1_ps(1.42860682030941723212e-6f)));
-  __m256 p = _mm256_set1_ps(1.0f / 5040.0f);
-  for (const float c : {1.0f / 720.0f, 1.0f / 120.0f, 1.0f / 24.0f, 1.0f / 6.0f, 0.5f, 1.0f, 1.0f}) {
-    p = _mm256_add_ps(_mm256_mul_ps(p, r), _mm256_set1_ps(c));
-  }
+  const __m256 r2 = _mm256_mul_ps(r, r), r4 = _mm256_mul_ps(r2, r2);
+  const __m256 low = _mm256_add_ps(
+      _mm256_add_ps(_mm256_set1_ps(1.0f), r),
+      _mm256_mul_ps(r2, _mm256_add_ps(_mm256_set1_ps(0.5f), _mm256_mul_ps(r, _mm256_set1_ps(1.0f / 6.0f)))));
+  const __m256 high = _mm256_add_ps(
+      _mm256_add_ps(_mm256_set1_ps(1.0f / 24.0f), _mm256_mul_ps(r, _mm256_set1_ps(1.0f / 120.0f))),
+      _mm256_mul_ps(r2, _mm256_add_ps(_mm256_set1_ps(1.0f / 720.0f),
+                                      _mm256_mul_ps(r, _mm256_set1_ps(1.0f / 5040.0f)))));
+  const __m256 p = _mm256_add_ps(low, _mm256_mul_ps(r4, high));
   const __m256i scale =
       _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
   return _mm256_mul_ps(p, _mm256_castsi256_ps(scale));
