@@ -350,36 +350,43 @@ KernelNeighbourGrid BuildKernelGrid(std::span<const Eigen::Vector3f> points,
   return grid;
 }
 
-void AccumulateKernel(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
-                      float radius_sq, float inverse_two_sigma_sq, float* sum, float* closest_sq,
-                      SimdPath path) {
-  const bool avx2 = path == SimdPath::kAvx2 && kHasAvx2;
+namespace {
+
+// Calls group_step(runs, num_runs, group, group_size) for each group of the points that share a cell of
+// `grid`.
+template <typename GroupStep>
+void ForEachCellGroup(const PointCellGrid& grid, std::span<const Eigen::Vector3f> points,
+                      GroupStep&& group_step) {
   thread_local CellGroups groups;
-  groups.Sort(grid.kernel, points);
+  groups.Sort(grid, points);
   for (size_t begin = 0; begin < points.size();) {
     const size_t end = groups.GroupEnd(begin);
     Run runs[9];
-    const int num_runs = NeighbourRuns(grid.kernel, CellFromIndex(grid.kernel, groups.cell[begin]), runs);
-    (avx2 ? AccumulateGroupAvx2 : AccumulateGroupScalar)(grid.kernel, runs, num_runs, points,
-                                                         groups.order.data() + begin, end - begin, radius_sq,
-                                                         inverse_two_sigma_sq, sum, closest_sq);
+    const int num_runs = NeighbourRuns(grid, CellFromIndex(grid, groups.cell[begin]), runs);
+    group_step(runs, num_runs, groups.order.data() + begin, end - begin);
     begin = end;
   }
 }
 
+}  // namespace
+
+void AccumulateKernel(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
+                      float radius_sq, float inverse_two_sigma_sq, float* sum, float* closest_sq,
+                      SimdPath path) {
+  const auto group_step = path == SimdPath::kAvx2 && kHasAvx2 ? AccumulateGroupAvx2 : AccumulateGroupScalar;
+  ForEachCellGroup(grid.kernel, points,
+                   [&](const Run* runs, int num_runs, const uint32_t* group, size_t size) {
+                     group_step(grid.kernel, runs, num_runs, points, group, size, radius_sq,
+                                inverse_two_sigma_sq, sum, closest_sq);
+                   });
+}
+
 void NearestSquaredDistance(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
                             float* closest_sq, SimdPath path) {
-  const bool avx2 = path == SimdPath::kAvx2 && kHasAvx2;
-  thread_local CellGroups groups;
-  groups.Sort(grid.icp, points);
-  for (size_t begin = 0; begin < points.size();) {
-    const size_t end = groups.GroupEnd(begin);
-    Run runs[9];
-    const int num_runs = NeighbourRuns(grid.icp, CellFromIndex(grid.icp, groups.cell[begin]), runs);
-    (avx2 ? NearestGroupAvx2 : NearestGroupScalar)(grid.icp, runs, num_runs, points,
-                                                   groups.order.data() + begin, end - begin, closest_sq);
-    begin = end;
-  }
+  const auto group_step = path == SimdPath::kAvx2 && kHasAvx2 ? NearestGroupAvx2 : NearestGroupScalar;
+  ForEachCellGroup(grid.icp, points, [&](const Run* runs, int num_runs, const uint32_t* group, size_t size) {
+    group_step(grid.icp, runs, num_runs, points, group, size, closest_sq);
+  });
 }
 
 }  // namespace verify_internal
