@@ -381,11 +381,10 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
                         std::abs(grid.icp.radius_m - trim) <= 1e-6f * trim;
 
   // Σ_j exp(−d²/2σ²) per model point: in the kernel grid's sorted order with the grid (so that its vector
-  // loop can read 8 neighbouring sums at once), by point index without it.
-  const size_t sum_size = n;
+  // loop reads 8 neighbouring sums at once), by point index without it.
   auto point_of_slot = [&](size_t k) { return use_grid ? grid.kernel.indices[k] : static_cast<uint32_t>(k); };
-  std::vector<float> observed_sum(sum_size, 0.0f);  // over all scans
-  std::vector<float> scan_sum;                      // the same for one scan (only with several scans)
+  std::vector<float> observed_sum(n, 0.0f);  // over all scans
+  std::vector<float> scan_sum;               // the same for one scan (only with several scans)
   double icp_distance_sum = 0.0;
   result.per_scan.resize(scans.size());
   if (options.keep_details) result.scene_status.resize(scans.size());
@@ -396,7 +395,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     ScanVerifyStats& stats = result.per_scan[s];
     if (options.keep_details) result.scene_status[s] = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
     const bool separate = scans.size() > 1;
-    if (separate) scan_sum.assign(sum_size, 0.0f);
+    if (separate) scan_sum.assign(n, 0.0f);
     std::vector<float>& sum = separate ? scan_sum : observed_sum;
 
     const Eigen::Matrix4d scanner_from_model = prepared.scanner_from_world * world_from_model;
