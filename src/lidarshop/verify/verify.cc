@@ -296,6 +296,10 @@ PreparedScan PrepareScan(const Scan& scan) {
       const float range = scan.range.at<float>(r, c);
       if (scan.valid.at<uint8_t>(r, c) == 0 || !(range > 0)) continue;
       const cv::Vec3f& p = scan.point.at<cv::Vec3f>(r, c);
+      if (!std::isfinite(range) || !std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        throw InputError(fmt::format(
+            "scan '{}': row {}, column {}: a return with a non-finite point or range", scan.name, r, c));
+      }
       prepared.band_cells[prepared.BandCellIndex(r, c)] = Eigen::Vector4f(p[0], p[1], p[2], range);
     }
   }

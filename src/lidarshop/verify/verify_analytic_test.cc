@@ -1,6 +1,9 @@
 // Analytic checks of consistency and confidence (thesis eqs. 4.1–4.5) on a car-sized box seen from the front.
 #include <cmath>
+#include <limits>
+#include <string>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "lidarshop/geometry/transform.h"
@@ -115,6 +118,28 @@ TEST_F(VerifyAnalyticTest, NoComparablePairIsReportedNotScoredAsOne) {
   EXPECT_TRUE(std::isnan(result.consistency));
   EXPECT_EQ(result.confidence, 0.0);
   EXPECT_NE(result.BriefReport().find("no comparable pair"), std::string::npos);
+}
+
+TEST_F(VerifyAnalyticTest, AReturnWithANonFinitePointIsRejectedByCell) {
+  Scan scan = scene_.MakeScanWithDensity(1);
+  int row = -1, col = -1;
+  for (int r = 0; r < scan.rows && row < 0; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (scan.valid.at<uint8_t>(r, c) != 0) {
+        row = r, col = c;
+        break;
+      }
+    }
+  }
+  ASSERT_GE(row, 0);
+  scan.point.at<cv::Vec3f>(row, col)[1] = std::numeric_limits<float>::quiet_NaN();
+  try {
+    PrepareScan(scan);
+    FAIL() << "PrepareScan accepted a NaN point";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(fmt::format("row {}, column {}", row, col)), std::string::npos)
+        << error.what();
+  }
 }
 
 TEST_F(VerifyAnalyticTest, FootprintVisitsFewCellsAndGivesTheSameAnswerAsAFullWindow) {
