@@ -174,11 +174,7 @@ __attribute__((target("avx2"))) void GatherBandAvx2(const Eigen::Vector4f* cells
   }
 }
 
-const bool kHasAvx2 = __builtin_cpu_supports("avx2");
-
 }  // namespace
-
-SimdPath BestSimdPath() { return kHasAvx2 ? SimdPath::kAvx2 : SimdPath::kScalar; }
 
 void ReserveGather(size_t cells, FootprintRays& rays, NearPoints& near) {
   const size_t ray_capacity = rays.size + cells + 8;
@@ -197,7 +193,7 @@ void ReserveGather(size_t cells, FootprintRays& rays, NearPoints& near) {
 void GatherBand(const Eigen::Vector4f* cells, int band_row, int row_begin, int row_end, int first_col,
                 int num_cols, int scan_cols, const GatherFrame& frame, FootprintRays& rays, NearPoints& near,
                 SimdPath path) {
-  if (path == SimdPath::kAvx2 && kHasAvx2) {
+  if (path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2) {
     GatherBandAvx2(cells, band_row, row_begin, row_end, first_col, num_cols, scan_cols, frame, rays, near);
   } else {
     GatherBandScalar(cells, band_row, row_begin, row_end, first_col, num_cols, scan_cols, frame, rays, near);

@@ -335,8 +335,6 @@ __attribute__((target("avx2"))) void NearestGroupAvx2(const PointCellGrid& grid,
   }
 }
 
-const bool kHasAvx2 = __builtin_cpu_supports("avx2");
-
 }  // namespace
 
 KernelNeighbourGrid BuildKernelGrid(std::span<const Eigen::Vector3f> points,
@@ -373,7 +371,9 @@ void ForEachCellGroup(const PointCellGrid& grid, std::span<const Eigen::Vector3f
 void AccumulateKernel(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
                       float radius_sq, float inverse_two_sigma_sq, float* sum, float* closest_sq,
                       SimdPath path) {
-  const auto group_step = path == SimdPath::kAvx2 && kHasAvx2 ? AccumulateGroupAvx2 : AccumulateGroupScalar;
+  const auto group_step = path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2
+                              ? AccumulateGroupAvx2
+                              : AccumulateGroupScalar;
   ForEachCellGroup(grid.kernel, points,
                    [&](const Run* runs, int num_runs, const uint32_t* group, size_t size) {
                      group_step(grid.kernel, runs, num_runs, points, group, size, radius_sq,
@@ -383,7 +383,8 @@ void AccumulateKernel(const KernelNeighbourGrid& grid, std::span<const Eigen::Ve
 
 void NearestSquaredDistance(const KernelNeighbourGrid& grid, std::span<const Eigen::Vector3f> points,
                             float* closest_sq, SimdPath path) {
-  const auto group_step = path == SimdPath::kAvx2 && kHasAvx2 ? NearestGroupAvx2 : NearestGroupScalar;
+  const auto group_step =
+      path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2 ? NearestGroupAvx2 : NearestGroupScalar;
   ForEachCellGroup(grid.icp, points, [&](const Run* runs, int num_runs, const uint32_t* group, size_t size) {
     group_step(grid.icp, runs, num_runs, points, group, size, closest_sq);
   });

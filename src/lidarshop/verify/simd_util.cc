@@ -1,0 +1,13 @@
+#include "lidarshop/verify/simd_util.h"
+
+namespace lidarshop::verify_internal {
+
+SimdPath BestSimdPath() {
+  static const SimdPath best = [] {
+    __builtin_cpu_init();  // may run before libgcc's own initializer of the CPU model
+    return __builtin_cpu_supports("avx2") ? SimdPath::kAvx2 : SimdPath::kScalar;
+  }();
+  return best;
+}
+
+}  // namespace lidarshop::verify_internal
