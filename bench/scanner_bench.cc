@@ -145,6 +145,23 @@ struct WorldRays {
   std::vector<Eigen::Vector3f> directions;
 };
 
+// Ray `index` of `rays` as a fresh RTCRayHit (what the single-ray and the stream paths cast).
+void FillRayHit(const WorldRays& rays, size_t index, RTCRayHit* rh) {
+  rh->ray.org_x = rays.origin.x();
+  rh->ray.org_y = rays.origin.y();
+  rh->ray.org_z = rays.origin.z();
+  rh->ray.dir_x = rays.directions[index].x();
+  rh->ray.dir_y = rays.directions[index].y();
+  rh->ray.dir_z = rays.directions[index].z();
+  rh->ray.tnear = 0.0f;
+  rh->ray.tfar = 120.0f;
+  rh->ray.mask = 0xFFFFFFFFu;
+  rh->ray.flags = 0;
+  rh->ray.time = 0;
+  rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 const WorldRays& Rays() {
   static const WorldRays rays = [] {
     WorldRays result;
@@ -197,19 +214,7 @@ void BM_EmbreeSingle(benchmark::State& state) {
                         rtcInitIntersectContext(&context);
                         RTCRayHit rh;
                         for (size_t i = range.begin(); i < range.end(); ++i) {
-                          rh.ray.org_x = rays.origin.x();
-                          rh.ray.org_y = rays.origin.y();
-                          rh.ray.org_z = rays.origin.z();
-                          rh.ray.dir_x = rays.directions[i].x();
-                          rh.ray.dir_y = rays.directions[i].y();
-                          rh.ray.dir_z = rays.directions[i].z();
-                          rh.ray.tnear = 0.0f;
-                          rh.ray.tfar = 120.0f;
-                          rh.ray.mask = 0xFFFFFFFFu;
-                          rh.ray.flags = 0;
-                          rh.ray.time = 0;
-                          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                          rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                          FillRayHit(rays, i, &rh);
                           rtcIntersect1(scene, &context, &rh);
                           out.Write(i, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, rh.hit.Ng_x, rh.hit.Ng_y,
                                     rh.hit.Ng_z, rh.hit.u, rh.hit.v);
@@ -288,20 +293,7 @@ void BM_EmbreeStream(benchmark::State& state) {
         for (int col0 = 0; col0 < kCols; col0 += 4) {
           for (int i = 0; i < 16; ++i, ++k) {
             const size_t index = static_cast<size_t>(band * 4 + i / 4) * kCols + col0 + i % 4;
-            RTCRayHit& rh = stream[k];
-            rh.ray.org_x = rays.origin.x();
-            rh.ray.org_y = rays.origin.y();
-            rh.ray.org_z = rays.origin.z();
-            rh.ray.dir_x = rays.directions[index].x();
-            rh.ray.dir_y = rays.directions[index].y();
-            rh.ray.dir_z = rays.directions[index].z();
-            rh.ray.tnear = 0.0f;
-            rh.ray.tfar = 120.0f;
-            rh.ray.mask = 0xFFFFFFFFu;
-            rh.ray.flags = 0;
-            rh.ray.time = 0;
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            FillRayHit(rays, index, &stream[k]);
             index_of[k] = index;
           }
         }
