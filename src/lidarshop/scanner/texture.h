@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/simd.h"
 
 namespace lidarshop {
 
@@ -49,6 +50,16 @@ inline Eigen::Vector2f TriplanarCoordinates(const Eigen::Vector3f& point_in_obje
 // the area averages of each level (computed once by sampling the full-detail texture). 0 = point sampling.
 Rgb8 EvaluateTexture(TextureKind kind, float u, float v, Rgb8 base, float scale = 1.0f,
                      float footprint_m = 0.0f);
+
+// An 8-bit RGB colour packed as r | g << 8 | b << 16 (what the batch below reads and writes).
+inline uint32_t PackRgb(Rgb8 color) { return color[0] | color[1] << 8 | color[2] << 16; }
+inline Rgb8 UnpackRgb(uint32_t rgb) { return Rgb8(rgb & 0xFF, rgb >> 8 & 0xFF, rgb >> 16 & 0xFF); }
+
+// EvaluateTexture for `count` points at once (8 per SIMD step): rgb[i] = the colour at (u[i], v[i]) with
+// base colour base_rgb[i] (packed) and footprint footprint_m[i]. Both paths give identical colours.
+void EvaluateTextures(TextureKind kind, float scale, int count, const float* u, const float* v,
+                      const float* footprint_m, const uint32_t* base_rgb, uint32_t* rgb,
+                      SimdPath path = BestSimdPath());
 
 // Nearest-texel lookup of an image texture (CV_8UC3 RGB) at (s, t), (0, 0) = bottom left, wrapping.
 Rgb8 SampleImageTexture(const cv::Mat& texture, float s, float t);

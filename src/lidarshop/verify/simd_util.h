@@ -3,12 +3,14 @@
 
 #include <cstdint>
 
+#include "lidarshop/util/simd.h"
+
 namespace lidarshop::verify_internal {
 
 // Both the scalar and the AVX2 versions of a loop give bit-identical results; the AVX2 one is chosen when
 // the CPU has it (tests pin each).
-enum class SimdPath { kScalar, kAvx2 };
-SimdPath BestSimdPath();
+using lidarshop::BestSimdPath;
+using lidarshop::SimdPath;
 
 // For the AVX2 left-pack (keeping some lanes of a vector, in order, at the front): kLeftPack.lanes[mask]
 // lists the lanes set in the 8-bit `mask`, in order, then zeros.

@@ -1,6 +1,6 @@
-#include "lidarshop/verify/simd_util.h"
+#include "lidarshop/util/simd.h"
 
-namespace lidarshop::verify_internal {
+namespace lidarshop {
 
 SimdPath BestSimdPath() {
   static const SimdPath best = [] {
@@ -10,4 +10,4 @@ SimdPath BestSimdPath() {
   return best;
 }
 
-}  // namespace lidarshop::verify_internal
+}  // namespace lidarshop
