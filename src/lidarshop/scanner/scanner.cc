@@ -134,43 +134,45 @@ void CastRays(RTCScene rtc_scene, const ShadeSetup& setup, bool stream, float t_
   rtcInitIntersectContext(&context);
   if (stream) context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   thread_local std::vector<RTCRayHit> rays;
-  thread_local std::vector<int32_t> cells;
-  rays.clear();
-  cells.clear();
+  rays.resize(std::max(rays.size(), static_cast<size_t>(band->cells())));
   const int cols = band->cols;
-  for (int col0 = 0; col0 < cols; col0 += 4) {
-    for (int r = 0; r < band->rows; ++r) {
-      for (int col = col0; col < std::min(cols, col0 + 4); ++col) {
-        const int k = r * cols + col;
-        RTCRayHit& ray_hit = rays.emplace_back();
-        ray_hit.ray.org_x = setup.origin[0];
-        ray_hit.ray.org_y = setup.origin[1];
-        ray_hit.ray.org_z = setup.origin[2];
-        ray_hit.ray.dir_x = band->w_x[k];
-        ray_hit.ray.dir_y = band->w_y[k];
-        ray_hit.ray.dir_z = band->w_z[k];
-        ray_hit.ray.tnear = t_near;
-        ray_hit.ray.tfar = t_far;
-        ray_hit.ray.mask = 0xFFFFFFFFu;
-        ray_hit.ray.flags = 0;
-        ray_hit.ray.time = 0.0f;
-        ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        ray_hit.hit.primID = RTC_INVALID_GEOMETRY_ID;
-        ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        cells.push_back(k);
+  // Visits the band's cells in tile order: f(index in the stream, cell).
+  auto for_each_cell = [&](auto&& f) {
+    int i = 0;
+    for (int col0 = 0; col0 < cols; col0 += 4) {
+      const int col_end = std::min(cols, col0 + 4);
+      for (int r = 0; r < band->rows; ++r) {
+        for (int col = col0; col < col_end; ++col) f(i++, r * cols + col);
       }
     }
-  }
+  };
+  RTCRayHit* stream_rays = rays.data();
+  for_each_cell([&](int i, int k) {
+    RTCRayHit& ray_hit = stream_rays[i];
+    ray_hit.ray.org_x = setup.origin[0];
+    ray_hit.ray.org_y = setup.origin[1];
+    ray_hit.ray.org_z = setup.origin[2];
+    ray_hit.ray.dir_x = band->w_x[k];
+    ray_hit.ray.dir_y = band->w_y[k];
+    ray_hit.ray.dir_z = band->w_z[k];
+    ray_hit.ray.tnear = t_near;
+    ray_hit.ray.tfar = t_far;
+    ray_hit.ray.mask = 0xFFFFFFFFu;
+    ray_hit.ray.flags = 0;
+    ray_hit.ray.time = 0.0f;
+    ray_hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    ray_hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  });
   if (stream) {
-    rtcIntersect1M(rtc_scene, &context, rays.data(), static_cast<unsigned>(rays.size()), sizeof(RTCRayHit));
+    rtcIntersect1M(rtc_scene, &context, stream_rays, static_cast<unsigned>(band->cells()), sizeof(RTCRayHit));
   } else {
-    for (RTCRayHit& ray_hit : rays) rtcIntersect1(rtc_scene, &context, &ray_hit);
+    for (int i = 0; i < band->cells(); ++i) rtcIntersect1(rtc_scene, &context, &stream_rays[i]);
   }
-  for (size_t i = 0; i < rays.size(); ++i) {
-    const RTCRayHit& h = rays[i];
-    StoreHit(cells[i], h.ray.tfar, h.hit.geomID, h.hit.primID, h.hit.u, h.hit.v, h.hit.Ng_x, h.hit.Ng_y,
-             h.hit.Ng_z, band);
-  }
+  for_each_cell([&](int i, int k) {
+    const RTCRayHit& h = stream_rays[i];
+    StoreHit(k, h.ray.tfar, h.hit.geomID, h.hit.primID, h.hit.u, h.hit.v, h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z,
+             band);
+  });
 }
 
 void CastBand(RTCScene rtc_scene, const ShadeSetup& setup, CastMethod method, float t_near, float t_far,
@@ -277,7 +279,7 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
     const int bands = (chunk_end - chunk_begin + 3) / 4;
     ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
       thread_local Band band;
-      band.Resize(cols, setup.num_objects);
+      band.Resize(cols);
       int64_t band_returns = 0;
       for (int64_t band_index = band_begin; band_index < band_end; ++band_index) {
         const int row0 = chunk_begin + static_cast<int>(band_index) * 4;

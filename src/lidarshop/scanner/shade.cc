@@ -6,7 +6,7 @@
 
 #include <Eigen/SVD>
 
-#include "lidarshop/scanner/texture.h"
+#include "lidarshop/scanner/texture_lanes.h"
 
 namespace lidarshop::scanner_internal {
 namespace {
@@ -110,6 +110,15 @@ LIDARSHOP_LANES_INLINE void StoreFirst(T* destination, V values, int count) {
   }
 }
 
+// Packed colours (scanner/texture.h: PackRgb) to `count` consecutive 3-byte cells.
+LIDARSHOP_LANES_INLINE void StoreColors(cv::Vec3b* destination, U8 rgb, int count) {
+  using B32 = uint8_t __attribute__((vector_size(32)));
+  const B32 bytes = reinterpret_cast<const B32&>(rgb);
+  const B32 triples = __builtin_shufflevector(bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20,
+                                              21, 22, 24, 25, 26, 28, 29, 30, 0, 0, 0, 0, 0, 0, 0, 0);
+  std::memcpy(static_cast<void*>(destination), &triples, count == kWidth ? 3 * kWidth : 3 * count);
+}
+
 // Lanes (x, y, z) to `count` consecutive 3-float cells.
 LIDARSHOP_LANES_INLINE void StoreTriples(cv::Vec3f* destination, F8 x, F8 y, F8 z, int count) {
   float interleaved[3 * kWidth];
@@ -192,39 +201,83 @@ void PerCellSurface(const ObjectData& object, Band& band, int k) {
   band.rgb[k] = PackRgb(surface);
 }
 
-LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band, Scan& scan, SimdPath path) {
+// Bit i set where lane i of `mask` is set.
+LIDARSHOP_LANES_INLINE unsigned LaneBits(I8 mask) {
+  unsigned bits = 0;
+  for (int lane = 0; lane < kWidth; ++lane) bits |= (mask[lane] & 1u) << lane;
+  return bits;
+}
+
+// What a group of 8 cells takes from its objects (most groups lie on one object).
+struct GroupSurface {
+  I8 label = lanes::SplatInt(kNoLabel);
+  F8 reflectivity = {};
+  U8 rgb = {};
+  int textured[kWidth];  // objects with a procedural texture
+  int num_textured = 0;
+};
+
+// Per-object values of the group's hit lanes `pending`, object by object; per-cell objects (curved
+// triangles, mesh colours, image textures) are resolved lane by lane into the band's n and rgb.
+LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, Band& band, int k, I8 id,
+                                                   unsigned pending) {
+  GroupSurface surface;
+  while (pending != 0) {
+    const int object_id = id[__builtin_ctz(pending)];
+    const ObjectData& object = setup.objects[object_id];
+    const I8 mine = id == object_id;
+    const unsigned mine_bits = LaneBits(mine) & pending;
+    pending &= ~mine_bits;
+    surface.label = mine ? lanes::SplatInt(object.label) : surface.label;
+    surface.reflectivity = mine ? Splat(object.material.reflectivity) : surface.reflectivity;
+    if (object.per_cell) {
+      for (unsigned bits = mine_bits; bits != 0; bits &= bits - 1) PerCellSurface(object, band, k + __builtin_ctz(bits));
+      surface.rgb = mine ? lanes::Load<U8>(band.rgb.data() + k) : surface.rgb;
+    } else {
+      surface.rgb = mine ? U8{} + PackRgb(object.material.color) : surface.rgb;
+    }
+    if (object.material.texture != TextureKind::kNone) surface.textured[surface.num_textured++] = object_id;
+  }
+  return surface;
+}
+
+LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band, Scan& scan) {
   const int cols = band.cols;
   const NoiseTables& tables = Tables();
-
-  // 1. Base colours, smooth normals, texture lists.
-  for (auto& cells : band.texture_cells) cells.clear();
-  for (int k = 0; k < band.cells(); ++k) {
-    const int32_t id = band.geometry[k];
-    if (id < 0) continue;
-    const ObjectData& object = setup.objects[id];
-    if (object.per_cell) {
-      PerCellSurface(object, band, k);
-    } else {
-      band.rgb[k] = PackRgb(object.material.color);
-    }
-    if (object.material.texture != TextureKind::kNone) band.texture_cells[id].push_back(k);
-  }
-
-  // 2. Geometry and noise.
-  I8 returns_per_lane = {};  // (at most 4 * cols / 8 per lane: no overflow)
+  const float max_step = static_cast<float>(ShadeSetup::kFalloffSteps);
   const I8 lane_index = {0, 1, 2, 3, 4, 5, 6, 7};
+  int64_t returns = 0;
   for (int r = 0; r < band.rows; ++r) {
     const int row = band.row0 + r;
     uint8_t* valid_out = scan.valid.ptr<uint8_t>(row);
     float* range_out = scan.range.ptr<float>(row);
     cv::Vec3f* point_out = scan.point.ptr<cv::Vec3f>(row);
+    float* intensity_out = scan.intensity.ptr<float>(row);
+    cv::Vec3b* color_out = scan.color.ptr<cv::Vec3b>(row);
     int32_t* label_out = scan.label.ptr<int32_t>(row);
     cv::Vec3f* normal_out = scan.normal.ptr<cv::Vec3f>(row);
     float* true_range_out = scan.true_range.ptr<float>(row);
     for (int col = 0; col < cols; col += kWidth) {
       const int k = r * cols + col, count = std::min(kWidth, cols - col);
       const I8 id = lanes::Load<I8>(band.geometry.data() + k);
-      const I8 hit = id >= 0;
+      const I8 hit = (id >= 0) & (lane_index < count);
+      const unsigned hit_bits = LaneBits(hit);
+      returns += __builtin_popcount(hit_bits);
+      const F8 zero = F8{};
+      if (hit_bits == 0) {  // no return in the whole group (sky, or beyond the maximum range)
+        StoreFirst(valid_out + col, lanes::LowBytes(lanes::I8{}), count);
+        StoreFirst(range_out + col, zero, count);
+        StoreTriples(point_out + col, zero, zero, zero, count);
+        StoreFirst(intensity_out + col, Splat(0.5f), count);
+        StoreColors(color_out + col, U8{}, count);
+        StoreFirst(label_out + col, lanes::SplatInt(kNoLabel), count);
+        StoreTriples(normal_out + col, zero, zero, zero, count);
+        StoreFirst(true_range_out + col, zero, count);
+        continue;
+      }
+      const GroupSurface surface = SurfaceOfGroup(setup, band, k, id, hit_bits);
+
+      // The unit normal, facing the scanner.
       const F8 t = lanes::Load<F8>(band.t.data() + k);
       F8 n_x = lanes::Load<F8>(band.n_x.data() + k), n_y = lanes::Load<F8>(band.n_y.data() + k),
          n_z = lanes::Load<F8>(band.n_z.data() + k);
@@ -236,23 +289,20 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
       const F8 w_x = lanes::Load<F8>(band.w_x.data() + k), w_y = lanes::Load<F8>(band.w_y.data() + k),
                w_z = lanes::Load<F8>(band.w_z.data() + k);
       F8 n_dot_d = n_x * w_x + n_y * w_y + n_z * w_z;
-      const I8 away = n_dot_d > 0.0f;  // turn the normal to face the scanner
+      const I8 away = n_dot_d > 0.0f;
       n_x = away ? -n_x : n_x;
       n_y = away ? -n_y : n_y;
       n_z = away ? -n_z : n_z;
       n_dot_d = away ? -n_dot_d : n_dot_d;
-      lanes::Store(band.n_x.data() + k, n_x);
-      lanes::Store(band.n_y.data() + k, n_y);
-      lanes::Store(band.n_z.data() + k, n_z);
-      lanes::Store(band.cos_incidence.data() + k, lanes::Min(-n_dot_d, Splat(1.0f)));
+      const F8 cos_incidence = lanes::Min(-n_dot_d, Splat(1.0f));
 
+      // The point, with noise.
       const F8 d_x = lanes::Load<F8>(band.d_x.data() + k), d_y = lanes::Load<F8>(band.d_y.data() + k),
                d_z = lanes::Load<F8>(band.d_z.data() + k);
       F8 p_x = t * d_x, p_y = t * d_y, p_z = t * d_z, range = t;
       if (setup.noisy) {
         // One 32-bit hash per cell gives 16 bits for e_los and 16 for e_orth, a second one 10 bits for ψ.
-        const U8 cell =
-            U8{} + static_cast<uint32_t>(row * cols + col) + reinterpret_cast<const U8&>(lane_index);
+        const U8 cell = U8{} + static_cast<uint32_t>(row * cols + col) + reinterpret_cast<const U8&>(lane_index);
         const U8 bits = Mix32(cell ^ setup.noise_seed[0]);
         const F8 e_los = setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu);
         p_x += e_los * d_x;
@@ -273,96 +323,58 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
         }
         range = lanes::Sqrt(p_x * p_x + p_y * p_y + p_z * p_z);
       }
-      F8 ns_x, ns_y, ns_z;
-      Rotate(setup.scanner_from_world, n_x, n_y, n_z, &ns_x, &ns_y, &ns_z);
-      const F8 zero = F8{};
-      const lanes::B8 valid = lanes::LowBytes(hit & kValid);
-      if (count == kWidth) {
-        lanes::Store(valid_out + col, valid);
-      } else {
-        for (int lane = 0; lane < count; ++lane) valid_out[col + lane] = valid[lane];
+
+      // Procedural textures, object by object.
+      U8 rgb = surface.rgb;
+      for (int i = 0; i < surface.num_textured; ++i) {
+        const int object_id = surface.textured[i];
+        const ObjectData& object = setup.objects[object_id];
+        const float* m = object.texture_from_world_rotation.data();  // column-major
+        const float to_texture[9] = {m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
+        const Eigen::Vector3f& object_origin = object.world_origin_of_object;
+        F8 q_x, q_y, q_z, m_x, m_y, m_z;
+        Rotate(to_texture, (setup.origin[0] - object_origin.x()) + t * w_x,
+               (setup.origin[1] - object_origin.y()) + t * w_y, (setup.origin[2] - object_origin.z()) + t * w_z,
+               &q_x, &q_y, &q_z);
+        Rotate(to_texture, n_x, n_y, n_z, &m_x, &m_y, &m_z);
+        // Triplanar coordinates (scanner/texture.h: TriplanarCoordinates).
+        const F8 a_x = lanes::Abs(m_x), a_y = lanes::Abs(m_y), a_z = lanes::Abs(m_z);
+        const I8 z_major = (a_z >= a_x) & (a_z >= a_y), x_major = a_x >= a_y;
+        const F8 u = z_major ? q_x : (x_major ? q_y : q_x);
+        const F8 v = z_major ? q_y : q_z;
+        // The ray's footprint on the surface (band-limits the texture: no moiré at range).
+        const F8 footprint = t * setup.angular_step_rad / lanes::Max(cos_incidence, Splat(0.02f));
+        const float inverse_scale = 1.0f / object.material.texture_scale;
+        const U8 textured = texture_internal::Pack(
+            texture_internal::TextureLanes(object.material.texture, u * inverse_scale, v * inverse_scale,
+                                           footprint * inverse_scale, texture_internal::Unpack(rgb)));
+        rgb = id == object_id ? textured : rgb;
       }
-      StoreFirst(range_out + col, hit ? range : zero, count);
-      StoreTriples(point_out + col, hit ? p_x : zero, hit ? p_y : zero, hit ? p_z : zero, count);
-      StoreFirst(label_out + col, lanes::Gather<I8>(setup.labels.data(), id + 1), count);
-      StoreTriples(normal_out + col, hit ? ns_x : zero, hit ? ns_y : zero, hit ? ns_z : zero, count);
-      StoreFirst(true_range_out + col, hit ? t : zero, count);
-      returns_per_lane -= count == kWidth ? hit : hit & (lane_index < count);
-    }
-  }
 
-  int64_t returns = 0;
-  for (int lane = 0; lane < kWidth; ++lane) returns += returns_per_lane[lane];
-
-  // 3. Procedural textures, object by object.
-  for (int id = 0; id < setup.num_objects; ++id) {
-    std::vector<int32_t>& cells = band.texture_cells[id];
-    const int count = static_cast<int>(cells.size());
-    if (count == 0) continue;
-    const ObjectData& object = setup.objects[id];
-    const float* rotation = object.texture_from_world_rotation.data();  // column-major
-    const float to_texture[9] = {rotation[0], rotation[3], rotation[6], rotation[1], rotation[4],
-                                 rotation[7], rotation[2], rotation[5], rotation[8]};
-    const Eigen::Vector3f& object_origin = object.world_origin_of_object;
-    cells.resize((count + kWidth - 1) / kWidth * kWidth, cells.back());  // whole steps
-    for (int i = 0; i < count; i += kWidth) {
-      const I8 k = lanes::Load<I8>(cells.data() + i);
-      const F8 t = lanes::Gather<F8>(band.t.data(), k);
-      F8 p_x, p_y, p_z, n_x, n_y, n_z;
-      Rotate(to_texture, (setup.origin[0] - object_origin.x()) + t * lanes::Gather<F8>(band.w_x.data(), k),
-             (setup.origin[1] - object_origin.y()) + t * lanes::Gather<F8>(band.w_y.data(), k),
-             (setup.origin[2] - object_origin.z()) + t * lanes::Gather<F8>(band.w_z.data(), k), &p_x, &p_y,
-             &p_z);
-      Rotate(to_texture, lanes::Gather<F8>(band.n_x.data(), k), lanes::Gather<F8>(band.n_y.data(), k),
-             lanes::Gather<F8>(band.n_z.data(), k), &n_x, &n_y, &n_z);
-      // Triplanar coordinates (scanner/texture.h: TriplanarCoordinates).
-      const F8 a_x = lanes::Abs(n_x), a_y = lanes::Abs(n_y), a_z = lanes::Abs(n_z);
-      const I8 z_major = (a_z >= a_x) & (a_z >= a_y), x_major = a_x >= a_y;
-      const F8 u = z_major ? p_x : (x_major ? p_y : p_x);
-      const F8 v = z_major ? p_y : p_z;
-      const F8 cos_incidence = lanes::Gather<F8>(band.cos_incidence.data(), k);
-      // The ray's footprint on the surface (band-limits the texture: no moiré at range).
-      const F8 footprint = t * setup.angular_step_rad / lanes::Max(cos_incidence, Splat(0.02f));
-      lanes::Store(band.texture_u.data() + i, u);
-      lanes::Store(band.texture_v.data() + i, v);
-      lanes::Store(band.texture_footprint.data() + i, footprint);
-      lanes::Store(band.texture_base.data() + i, lanes::Gather<U8>(band.rgb.data(), k));
-    }
-    EvaluateTextures(object.material.texture, object.material.texture_scale, count, band.texture_u.data(),
-                     band.texture_v.data(), band.texture_footprint.data(), band.texture_base.data(),
-                     band.texture_rgb.data(), path);
-    for (int i = 0; i < count; ++i) band.rgb[cells[i]] = band.texture_rgb[i];
-  }
-
-  // 4. Intensity and colour.
-  const float max_step = static_cast<float>(ShadeSetup::kFalloffSteps);
-  for (int r = 0; r < band.rows; ++r) {
-    const int row = band.row0 + r;
-    float* intensity_out = scan.intensity.ptr<float>(row);
-    cv::Vec3b* color_out = scan.color.ptr<cv::Vec3b>(row);
-    for (int col = 0; col < cols; col += kWidth) {
-      const int k = r * cols + col, count = std::min(kWidth, cols - col);
-      const I8 id = lanes::Load<I8>(band.geometry.data() + k);
-      const I8 hit = id >= 0;
-      const U8 rgb = hit ? lanes::Load<U8>(band.rgb.data() + k) : U8{};
+      // Intensity, from the colour.
       const I8 channels = reinterpret_cast<const I8&>(rgb);
       const F8 luminance = (0.299f * ToFloat(channels & 0xFF) + 0.587f * ToFloat(channels >> 8 & 0xFF) +
                             0.114f * ToFloat(channels >> 16 & 0xFF)) /
                            255.0f;
-      const F8 reflectivity = lanes::Gather<F8>(setup.reflectivities.data(), id + 1) * (0.5f + luminance);
-      const F8 t = lanes::Load<F8>(band.t.data() + k);
       const F8 step = lanes::Clamp(t * setup.inverse_falloff_step, 0.0f, max_step);
-      const I8 step_index = ToInt(step);
+      const I8 step_index = ToInt(hit ? step : zero);
       const F8 low = lanes::Gather<F8>(setup.falloff.data(), step_index);
-      const F8 attenuation = low + (step - ToFloat(step_index)) *
-                                       (lanes::Gather<F8>(setup.falloff.data(), step_index + 1) - low);
-      const F8 cos_incidence = lanes::Max(lanes::Load<F8>(band.cos_incidence.data() + k), F8{});
-      const F8 intensity = lanes::Clamp(reflectivity * cos_incidence * attenuation, 0.0f, 1.0f);
+      const F8 attenuation =
+          low + (step - ToFloat(step_index)) * (lanes::Gather<F8>(setup.falloff.data(), step_index + 1) - low);
+      const F8 intensity = lanes::Clamp(surface.reflectivity * (0.5f + luminance) * lanes::Max(cos_incidence, zero) *
+                                            attenuation,
+                                        0.0f, 1.0f);
+
+      F8 ns_x, ns_y, ns_z;
+      Rotate(setup.scanner_from_world, n_x, n_y, n_z, &ns_x, &ns_y, &ns_z);
+      StoreFirst(valid_out + col, lanes::LowBytes(hit & kValid), count);
+      StoreFirst(range_out + col, hit ? range : zero, count);
+      StoreTriples(point_out + col, hit ? p_x : zero, hit ? p_y : zero, hit ? p_z : zero, count);
       StoreFirst(intensity_out + col, hit ? intensity : Splat(0.5f), count);
-      uint32_t packed[kWidth];
-      lanes::Store(packed, rgb);
-      for (int lane = 0; lane < count; ++lane)
-        std::memcpy(static_cast<void*>(&color_out[col + lane]), &packed[lane], 3);
+      StoreColors(color_out + col, hit ? rgb : U8{}, count);
+      StoreFirst(label_out + col, surface.label, count);
+      StoreTriples(normal_out + col, hit ? ns_x : zero, hit ? ns_y : zero, hit ? ns_z : zero, count);
+      StoreFirst(true_range_out + col, hit ? t : zero, count);
     }
   }
   return returns;
@@ -376,10 +388,10 @@ void PrepareBandBaseline(const ShadeSetup& setup, int row0, int rows, Band& band
   PrepareBandBody(setup, row0, rows, band, scan);
 }
 __attribute__((target("avx2"))) int64_t ShadeBandAvx2(const ShadeSetup& setup, Band& band, Scan& scan) {
-  return ShadeBandBody(setup, band, scan, SimdPath::kAvx2);
+  return ShadeBandBody(setup, band, scan);
 }
 int64_t ShadeBandBaseline(const ShadeSetup& setup, Band& band, Scan& scan) {
-  return ShadeBandBody(setup, band, scan, SimdPath::kScalar);
+  return ShadeBandBody(setup, band, scan);
 }
 
 bool UseAvx2(SimdPath path) { return path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2; }
@@ -471,18 +483,16 @@ ShadeSetup::ShadeSetup(const std::vector<ObjectData>& object_data, const Scanner
       options.filter_textures ? static_cast<float>(std::max(azimuth_step, elevation_step)) : 0.0f;
 }
 
-void Band::Resize(int new_cols, int num_objects) {
-  texture_cells.resize(num_objects);
+void Band::Resize(int new_cols) {
   if (cols == new_cols) return;
   cols = new_cols;
   const size_t n = static_cast<size_t>(4) * cols + kWidth;
-  for (auto* array : {&d_x, &d_y, &d_z, &w_x, &w_y, &w_z, &t, &u, &v, &n_x, &n_y, &n_z, &cos_incidence,
-                      &texture_u, &texture_v, &texture_footprint}) {
+  for (auto* array : {&d_x, &d_y, &d_z, &w_x, &w_y, &w_z, &t, &u, &v, &n_x, &n_y, &n_z}) {
     array->assign(n, 0.0f);
   }
   geometry.assign(n, -1);  // the padding stays "no return"
   primitive.assign(n, -1);
-  for (auto* array : {&rgb, &texture_base, &texture_rgb}) array->assign(n, 0u);
+  rgb.assign(n, 0u);
 }
 
 void PrepareBand(const ShadeSetup& setup, int row0, int rows, Band* band, Scan* scan, SimdPath path) {

@@ -83,14 +83,10 @@ struct Band {
   // shading turns it into the unit normal facing the scanner).
   std::vector<float> t, u, v, n_x, n_y, n_z;
   std::vector<int32_t> geometry, primitive;
-  // Shading.
-  std::vector<float> cos_incidence;
-  std::vector<uint32_t> rgb;                        // packed (scanner/texture.h: PackRgb)
-  std::vector<std::vector<int32_t>> texture_cells;  // per object: its returns in this band
-  std::vector<float> texture_u, texture_v, texture_footprint;
-  std::vector<uint32_t> texture_base, texture_rgb;
+  // Base colour of cells on per-cell objects (packed, scanner/texture.h: PackRgb).
+  std::vector<uint32_t> rgb;
 
-  void Resize(int new_cols, int num_objects);
+  void Resize(int new_cols);
   int cells() const { return rows * cols; }
 };
 
