@@ -167,20 +167,16 @@ LIDARSHOP_LANES_INLINE void PrepareBandBody(const ShadeSetup& setup, int row0, i
   }
 }
 
-// Step 1: base colour and smooth normal of a return on an object with per-cell data.
-void PerCellSurface(const ObjectData& object, Band& band, int k) {
+// The base colour (packed) and, on curved triangles, the interpolated vertex normal (any length) of a return
+// on an object with per-cell data; the normal is left alone elsewhere.
+uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v, Eigen::Vector3f* normal) {
   const TriangleMesh& mesh = object.mesh_in_world;
-  const int triangle = band.primitive[k];
-  const float u = band.u[k], v = band.v[k], w = 1.0f - u - v;
+  const float w = 1.0f - u - v;
   if (!object.smooth.empty() && object.smooth[triangle]) {
     const Eigen::Vector3i& corners = mesh.triangles[triangle];
     const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] + u * mesh.vertex_normals[corners[1]] +
                                    v * mesh.vertex_normals[corners[2]];
-    if (smooth.squaredNorm() > 1e-12f) {  // else keep the geometric normal
-      band.n_x[k] = smooth.x();
-      band.n_y[k] = smooth.y();
-      band.n_z[k] = smooth.z();
-    }
+    if (smooth.squaredNorm() > 1e-12f) *normal = smooth;  // else keep the geometric normal
   }
   Rgb8 surface = object.material.color;
   if (!mesh.triangle_colors.empty()) {
@@ -194,11 +190,10 @@ void PerCellSurface(const ObjectData& object, Band& band, int k) {
   }
   if (object.has_texture_image && object.material.texture == TextureKind::kNone) {
     const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
-    const Eigen::Vector2f st =
-        w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
+    const Eigen::Vector2f st = w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
     surface = SampleImageTexture(mesh.texture, st.x(), st.y());
   }
-  band.rgb[k] = PackRgb(surface);
+  return PackRgb(surface);
 }
 
 // Bit i set where lane i of `mask` is set.
@@ -210,6 +205,7 @@ LIDARSHOP_LANES_INLINE unsigned LaneBits(I8 mask) {
 
 // What a group of 8 cells takes from its objects (most groups lie on one object).
 struct GroupSurface {
+  F8 n_x, n_y, n_z;  // normal, world frame, any length
   I8 label = lanes::SplatInt(kNoLabel);
   F8 reflectivity = {};
   U8 rgb = {};
@@ -218,10 +214,14 @@ struct GroupSurface {
 };
 
 // Per-object values of the group's hit lanes `pending`, object by object; per-cell objects (curved
-// triangles, mesh colours, image textures) are resolved lane by lane into the band's n and rgb.
-LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, Band& band, int k, I8 id,
+// triangles, mesh colours, image textures) are resolved lane by lane (in registers: a vector load of values
+// just stored one by one would stall store forwarding).
+LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, const Band& band, int k, I8 id,
                                                    unsigned pending) {
   GroupSurface surface;
+  surface.n_x = lanes::Load<F8>(band.n_x.data() + k);
+  surface.n_y = lanes::Load<F8>(band.n_y.data() + k);
+  surface.n_z = lanes::Load<F8>(band.n_z.data() + k);
   while (pending != 0) {
     const int object_id = id[__builtin_ctz(pending)];
     const ObjectData& object = setup.objects[object_id];
@@ -231,8 +231,14 @@ LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, Band
     surface.label = mine ? lanes::SplatInt(object.label) : surface.label;
     surface.reflectivity = mine ? Splat(object.material.reflectivity) : surface.reflectivity;
     if (object.per_cell) {
-      for (unsigned bits = mine_bits; bits != 0; bits &= bits - 1) PerCellSurface(object, band, k + __builtin_ctz(bits));
-      surface.rgb = mine ? lanes::Load<U8>(band.rgb.data() + k) : surface.rgb;
+      for (unsigned bits = mine_bits; bits != 0; bits &= bits - 1) {
+        const int lane = __builtin_ctz(bits);
+        Eigen::Vector3f normal(surface.n_x[lane], surface.n_y[lane], surface.n_z[lane]);
+        surface.rgb[lane] = PerCellSurface(object, band.primitive[k + lane], band.u[k + lane], band.v[k + lane], &normal);
+        surface.n_x[lane] = normal.x();
+        surface.n_y[lane] = normal.y();
+        surface.n_z[lane] = normal.z();
+      }
     } else {
       surface.rgb = mine ? U8{} + PackRgb(object.material.color) : surface.rgb;
     }
@@ -279,8 +285,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
 
       // The unit normal, facing the scanner.
       const F8 t = lanes::Load<F8>(band.t.data() + k);
-      F8 n_x = lanes::Load<F8>(band.n_x.data() + k), n_y = lanes::Load<F8>(band.n_y.data() + k),
-         n_z = lanes::Load<F8>(band.n_z.data() + k);
+      F8 n_x = surface.n_x, n_y = surface.n_y, n_z = surface.n_z;
       // (A miss has a zero normal: its lanes are NaN here and masked below.)
       const F8 inverse_norm = 1.0f / lanes::Sqrt(n_x * n_x + n_y * n_y + n_z * n_z);
       n_x *= inverse_norm;
@@ -492,7 +497,6 @@ void Band::Resize(int new_cols) {
   }
   geometry.assign(n, -1);  // the padding stays "no return"
   primitive.assign(n, -1);
-  rgb.assign(n, 0u);
 }
 
 void PrepareBand(const ShadeSetup& setup, int row0, int rows, Band* band, Scan* scan, SimdPath path) {

@@ -83,8 +83,6 @@ struct Band {
   // shading turns it into the unit normal facing the scanner).
   std::vector<float> t, u, v, n_x, n_y, n_z;
   std::vector<int32_t> geometry, primitive;
-  // Base colour of cells on per-cell objects (packed, scanner/texture.h: PackRgb).
-  std::vector<uint32_t> rgb;
 
   void Resize(int new_cols);
   int cells() const { return rows * cols; }
