@@ -85,11 +85,12 @@ LIDARSHOP_LANES_INLINE U8 Mix32(U8 h) {
 
 // A standard normal from 16 uniform bits: inverse-CDF sampling through the quantile table (12 bits of index,
 // 4 of linear interpolation).
-LIDARSHOP_LANES_INLINE F8 NormalFrom16Bits(const float* quantiles, U8 bits) {
+template <typename Gather>
+LIDARSHOP_LANES_INLINE F8 NormalFrom16Bits(const float* quantiles, U8 bits, Gather gather) {
   const I8 index = reinterpret_cast<const I8&>(bits) >> 4;
   const F8 fraction = ToFloat(reinterpret_cast<const I8&>(bits) & 15) * (1.0f / 16.0f) + (1.0f / 32.0f);
-  const F8 low = lanes::Gather<F8>(quantiles, index);
-  const F8 high = lanes::Gather<F8>(quantiles, index + 1);
+  const F8 low = gather(quantiles, index);
+  const F8 high = gather(quantiles, index + 1);
   return low + fraction * (high - low);
 }
 
@@ -247,7 +248,8 @@ LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, cons
   return surface;
 }
 
-LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band, Scan& scan) {
+template <typename Gather>
+LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band, Scan& scan, Gather gather) {
   const int cols = band.cols;
   const NoiseTables& tables = Tables();
   const float max_step = static_cast<float>(ShadeSetup::kFalloffSteps);
@@ -309,7 +311,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
         // One 32-bit hash per cell gives 16 bits for e_los and 16 for e_orth, a second one 10 bits for ψ.
         const U8 cell = U8{} + static_cast<uint32_t>(row * cols + col) + reinterpret_cast<const U8&>(lane_index);
         const U8 bits = Mix32(cell ^ setup.noise_seed[0]);
-        const F8 e_los = setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu);
+        const F8 e_los = setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu, gather);
         p_x += e_los * d_x;
         p_y += e_los * d_y;
         p_z += e_los * d_z;
@@ -319,9 +321,9 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
           const F8 sa = lanes::Load<F8>(setup.sin_azimuth_f.data() + col);
           const U8 psi_bits = Mix32(bits ^ setup.noise_seed[1]) & 0x3FFu;
           const I8 psi = reinterpret_cast<const I8&>(psi_bits);
-          const F8 e_orth = setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16);
-          const F8 along_b1 = e_orth * lanes::Gather<F8>(tables.circle_cos.data(), psi);
-          const F8 along_b2 = e_orth * lanes::Gather<F8>(tables.circle_sin.data(), psi);
+          const F8 e_orth = setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16, gather);
+          const F8 along_b1 = e_orth * gather(tables.circle_cos.data(), psi);
+          const F8 along_b2 = e_orth * gather(tables.circle_sin.data(), psi);
           p_x += along_b1 * ca + along_b2 * (d_z * sa);
           p_y += along_b1 * -sa + along_b2 * (d_z * ca);
           p_z += along_b2 * -(d_x * sa + d_y * ca);
@@ -363,7 +365,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
                            255.0f;
       const F8 step = lanes::Clamp(t * setup.inverse_falloff_step, 0.0f, max_step);
       const I8 step_index = ToInt(hit ? step : zero);
-      const F8 low = lanes::Gather<F8>(setup.falloff.data(), step_index);
+      const F8 low = gather(setup.falloff.data(), step_index);
       const F8 attenuation =
           low + (step - ToFloat(step_index)) * (lanes::Gather<F8>(setup.falloff.data(), step_index + 1) - low);
       const F8 intensity = lanes::Clamp(surface.reflectivity * (0.5f + luminance) * lanes::Max(cos_incidence, zero) *
@@ -392,11 +394,11 @@ __attribute__((target("avx2"))) void PrepareBandAvx2(const ShadeSetup& setup, in
 void PrepareBandBaseline(const ShadeSetup& setup, int row0, int rows, Band& band, Scan& scan) {
   PrepareBandBody(setup, row0, rows, band, scan);
 }
-__attribute__((target("avx2"))) int64_t ShadeBandAvx2(const ShadeSetup& setup, Band& band, Scan& scan) {
-  return ShadeBandBody(setup, band, scan);
+__attribute__((target("avx2"), flatten)) int64_t ShadeBandAvx2(const ShadeSetup& setup, Band& band, Scan& scan) {
+  return ShadeBandBody(setup, band, scan, lanes::Avx2FloatGather());
 }
 int64_t ShadeBandBaseline(const ShadeSetup& setup, Band& band, Scan& scan) {
-  return ShadeBandBody(setup, band, scan);
+  return ShadeBandBody(setup, band, scan, lanes::FloatGather());
 }
 
 bool UseAvx2(SimdPath path) { return path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2; }

@@ -6,6 +6,8 @@
 // registers elsewhere. Neither target has FMA, so no multiply-add is fused and both round identically.
 #pragma once
 
+#include <immintrin.h>
+
 #include <cstdint>
 
 namespace lidarshop {
@@ -48,6 +50,18 @@ LIDARSHOP_LANES_INLINE V Gather(const T* values, I8 index) {
   for (int lane = 0; lane < kWidth; ++lane) result[lane] = values[index[lane]];
   return result;
 }
+
+// Gathers of floats as a policy for lanes code: FloatGather loads lane by lane (every path); Avx2FloatGather
+// is one vgatherdps, for code compiled into a function marked target("avx2") and flatten (which inlines it
+// there; elsewhere it stays a call into AVX2 code). Both load the same values.
+struct FloatGather {
+  LIDARSHOP_LANES_INLINE F8 operator()(const float* values, I8 index) const { return Gather<F8>(values, index); }
+};
+struct Avx2FloatGather {
+  __attribute__((target("avx2"))) F8 operator()(const float* values, I8 index) const {
+    return reinterpret_cast<F8>(_mm256_i32gather_ps(values, reinterpret_cast<__m256i>(index), 4));
+  }
+};
 
 LIDARSHOP_LANES_INLINE I8 ToInt(F8 x) { return __builtin_convertvector(x, I8); }  // truncates
 LIDARSHOP_LANES_INLINE F8 ToFloat(I8 x) { return __builtin_convertvector(x, F8); }
