@@ -272,25 +272,22 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
   local_stats.rays = scan.num_cells();
   std::atomic<int64_t> returns{0};
   Timer timer;
-  // Rows are cast and shaded in chunks (a multiple of the 4-row bands), so that progress moves.
-  const int chunk_rows = (std::clamp(rows / 16, 16, 128) + 3) / 4 * 4;
-  for (int chunk_begin = 0; chunk_begin < rows; chunk_begin += chunk_rows) {
-    const int chunk_end = std::min(rows, chunk_begin + chunk_rows);
-    const int bands = (chunk_end - chunk_begin + 3) / 4;
-    ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
-      thread_local Band band;
-      band.Resize(cols);
-      int64_t band_returns = 0;
-      for (int64_t band_index = band_begin; band_index < band_end; ++band_index) {
-        const int row0 = chunk_begin + static_cast<int>(band_index) * 4;
-        PrepareBand(setup, row0, std::min(chunk_end, row0 + 4) - row0, &band, &scan);
-        CastBand(rtc_scene, setup, options.cast_method, t_near, t_far, &band);
-        band_returns += ShadeBand(setup, &band, &scan);
-      }
-      returns += band_returns;
-    });
-    Advance(progress, chunk_end - chunk_begin);
-  }
+  // One loop over all bands of 4 rows (no barriers between chunks of rows: a thread never waits for
+  // another); progress advances as ranges of bands finish.
+  const int bands = (rows + 3) / 4;
+  ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
+    thread_local Band band;
+    band.Resize(cols);
+    int64_t band_returns = 0;
+    for (int64_t band_index = band_begin; band_index < band_end; ++band_index) {
+      const int row0 = static_cast<int>(band_index) * 4;
+      PrepareBand(setup, row0, std::min(rows, row0 + 4) - row0, &band, &scan);
+      CastBand(rtc_scene, setup, options.cast_method, t_near, t_far, &band);
+      band_returns += ShadeBand(setup, &band, &scan);
+    }
+    returns += band_returns;
+    Advance(progress, std::min<int64_t>(rows, band_end * 4) - band_begin * 4);
+  });
   local_stats.cast_seconds = timer.Seconds();  // casting and shading, fused
   local_stats.returns = returns.load();
   if (stats != nullptr) *stats = local_stats;

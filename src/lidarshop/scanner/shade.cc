@@ -197,6 +197,30 @@ uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v
   return PackRgb(surface);
 }
 
+// The noise of one image row, into the band's noise arrays: e_los, and e_orth · (cos ψ, sin ψ) along (b1, b2).
+// (A loop of its own: short enough for the CPU to overlap the hash -> table -> interpolation chains of
+// several steps, which the long shading loop cannot.)
+template <typename Gather>
+LIDARSHOP_LANES_INLINE void DrawNoise(const ShadeSetup& setup, int row, int cols, Band& band, Gather gather) {
+  const NoiseTables& tables = Tables();
+  const I8 lane_index = {0, 1, 2, 3, 4, 5, 6, 7};
+  for (int col = 0; col < cols; col += kWidth) {
+    // One 32-bit hash per cell gives 16 bits for e_los and 16 for e_orth, a second one 10 bits for ψ.
+    const U8 cell =
+        lanes::SplatUint(static_cast<uint32_t>(row * cols + col)) + reinterpret_cast<const U8&>(lane_index);
+    const U8 bits = Mix32(cell ^ setup.noise_seed[0]);
+    lanes::Store(band.noise_los.data() + col,
+                 setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu, gather));
+    if (setup.orthogonal_sigma > 0) {
+      const U8 psi_bits = Mix32(bits ^ setup.noise_seed[1]) & 0x3FFu;
+      const I8 psi = reinterpret_cast<const I8&>(psi_bits);
+      const F8 e_orth = setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16, gather);
+      lanes::Store(band.noise_b1.data() + col, e_orth * gather(tables.circle_cos.data(), psi));
+      lanes::Store(band.noise_b2.data() + col, e_orth * gather(tables.circle_sin.data(), psi));
+    }
+  }
+}
+
 // Bit i set where lane i of `mask` is set.
 LIDARSHOP_LANES_INLINE unsigned LaneBits(I8 mask) {
   unsigned bits = 0;
@@ -241,7 +265,7 @@ LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, cons
         surface.n_z[lane] = normal.z();
       }
     } else {
-      surface.rgb = mine ? U8{} + PackRgb(object.material.color) : surface.rgb;
+      surface.rgb = mine ? lanes::SplatUint(PackRgb(object.material.color)) : surface.rgb;
     }
     if (object.material.texture != TextureKind::kNone) surface.textured[surface.num_textured++] = object_id;
   }
@@ -251,7 +275,6 @@ LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, cons
 template <typename Gather>
 LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band, Scan& scan, Gather gather) {
   const int cols = band.cols;
-  const NoiseTables& tables = Tables();
   const float max_step = static_cast<float>(ShadeSetup::kFalloffSteps);
   const I8 lane_index = {0, 1, 2, 3, 4, 5, 6, 7};
   int64_t returns = 0;
@@ -265,6 +288,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
     int32_t* label_out = scan.label.ptr<int32_t>(row);
     cv::Vec3f* normal_out = scan.normal.ptr<cv::Vec3f>(row);
     float* true_range_out = scan.true_range.ptr<float>(row);
+    if (setup.noisy) DrawNoise(setup, row, cols, band, gather);
     for (int col = 0; col < cols; col += kWidth) {
       const int k = r * cols + col, count = std::min(kWidth, cols - col);
       const I8 id = lanes::Load<I8>(band.geometry.data() + k);
@@ -308,10 +332,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
                d_z = lanes::Load<F8>(band.d_z.data() + k);
       F8 p_x = t * d_x, p_y = t * d_y, p_z = t * d_z, range = t;
       if (setup.noisy) {
-        // One 32-bit hash per cell gives 16 bits for e_los and 16 for e_orth, a second one 10 bits for ψ.
-        const U8 cell = U8{} + static_cast<uint32_t>(row * cols + col) + reinterpret_cast<const U8&>(lane_index);
-        const U8 bits = Mix32(cell ^ setup.noise_seed[0]);
-        const F8 e_los = setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu, gather);
+        const F8 e_los = lanes::Load<F8>(band.noise_los.data() + col);
         p_x += e_los * d_x;
         p_y += e_los * d_y;
         p_z += e_los * d_z;
@@ -319,11 +340,8 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
           // b1 = (cos θ, -sin θ, 0) (horizontal, ⟂ d for every elevation), b2 = d × b1.
           const F8 ca = lanes::Load<F8>(setup.cos_azimuth_f.data() + col);
           const F8 sa = lanes::Load<F8>(setup.sin_azimuth_f.data() + col);
-          const U8 psi_bits = Mix32(bits ^ setup.noise_seed[1]) & 0x3FFu;
-          const I8 psi = reinterpret_cast<const I8&>(psi_bits);
-          const F8 e_orth = setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16, gather);
-          const F8 along_b1 = e_orth * gather(tables.circle_cos.data(), psi);
-          const F8 along_b2 = e_orth * gather(tables.circle_sin.data(), psi);
+          const F8 along_b1 = lanes::Load<F8>(band.noise_b1.data() + col);
+          const F8 along_b2 = lanes::Load<F8>(band.noise_b2.data() + col);
           p_x += along_b1 * ca + along_b2 * (d_z * sa);
           p_y += along_b1 * -sa + along_b2 * (d_z * ca);
           p_z += along_b2 * -(d_x * sa + d_y * ca);
@@ -494,7 +512,8 @@ void Band::Resize(int new_cols) {
   if (cols == new_cols) return;
   cols = new_cols;
   const size_t n = static_cast<size_t>(4) * cols + kWidth;
-  for (auto* array : {&d_x, &d_y, &d_z, &w_x, &w_y, &w_z, &t, &u, &v, &n_x, &n_y, &n_z}) {
+  for (auto* array :
+       {&d_x, &d_y, &d_z, &w_x, &w_y, &w_z, &t, &u, &v, &n_x, &n_y, &n_z, &noise_los, &noise_b1, &noise_b2}) {
     array->assign(n, 0.0f);
   }
   geometry.assign(n, -1);  // the padding stays "no return"

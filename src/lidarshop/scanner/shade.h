@@ -83,6 +83,8 @@ struct Band {
   // shading turns it into the unit normal facing the scanner).
   std::vector<float> t, u, v, n_x, n_y, n_z;
   std::vector<int32_t> geometry, primitive;
+  // The noise of the row being shaded (metres): along the ray, and along b1 and b2 perpendicular to it.
+  std::vector<float> noise_los, noise_b1, noise_b2;
 
   void Resize(int new_cols);
   int cells() const { return rows * cols; }

@@ -30,8 +30,10 @@ using U8 = uint32_t __attribute__((vector_size(32)));
 
 #define LIDARSHOP_LANES_INLINE __attribute__((always_inline)) inline
 
-LIDARSHOP_LANES_INLINE F8 Splat(float value) { return F8{} + value; }
-LIDARSHOP_LANES_INLINE I8 SplatInt(int32_t value) { return I8{} + value; }
+// (Element lists: GCC builds "I8{} + value" in memory, lane by lane, and stalls reloading it.)
+LIDARSHOP_LANES_INLINE F8 Splat(float v) { return F8{v, v, v, v, v, v, v, v}; }
+LIDARSHOP_LANES_INLINE I8 SplatInt(int32_t v) { return I8{v, v, v, v, v, v, v, v}; }
+LIDARSHOP_LANES_INLINE U8 SplatUint(uint32_t v) { return U8{v, v, v, v, v, v, v, v}; }
 
 template <typename V, typename T>
 LIDARSHOP_LANES_INLINE V Load(const T* values) {
