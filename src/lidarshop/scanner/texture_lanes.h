@@ -11,6 +11,7 @@
 
 namespace lidarshop::texture_internal {
 
+using lanes::Any;
 using lanes::F8;
 using lanes::I8;
 using lanes::Splat;
@@ -76,12 +77,6 @@ LIDARSHOP_LANES_INLINE Colors Select(I8 mask, const Colors& a, const Colors& b) 
 
 LIDARSHOP_LANES_INLINE Colors Splat(Rgb8 color) {
   return {Splat(color[0]), Splat(color[1]), Splat(color[2])};
-}
-
-LIDARSHOP_LANES_INLINE bool Any(I8 mask) {
-  int any = 0;
-  for (int lane = 0; lane < lanes::kWidth; ++lane) any |= mask[lane];
-  return any != 0;
 }
 
 // Contrast weight of a detail level of period `size` under a footprint (see EvaluateTexture): 1 for

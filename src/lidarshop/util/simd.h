@@ -65,6 +65,13 @@ struct Avx2FloatGather {
   }
 };
 
+// True if any lane of `mask` is set.
+LIDARSHOP_LANES_INLINE bool Any(I8 mask) {
+  int any = 0;
+  for (int lane = 0; lane < kWidth; ++lane) any |= mask[lane];
+  return any != 0;
+}
+
 LIDARSHOP_LANES_INLINE I8 ToInt(F8 x) { return __builtin_convertvector(x, I8); }  // truncates
 LIDARSHOP_LANES_INLINE F8 ToFloat(I8 x) { return __builtin_convertvector(x, F8); }
 LIDARSHOP_LANES_INLINE F8 ToFloat(U8 x) { return __builtin_convertvector(x, F8); }
