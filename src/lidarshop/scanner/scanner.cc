@@ -79,6 +79,7 @@ void CastPackets(RTCScene rtc_scene, const ShadeSetup& setup, float t_near, floa
     for (int col0 = 0; col0 < cols; col0 += 4) {
       const bool full = tile_row + kTileRows <= band->rows && col0 + 4 <= cols;
       if (full) {
+        for (int i = 0; i < N; ++i) lane_valid[i] = -1;
         for (int r = 0; r < kTileRows; ++r) {
           const int k = (tile_row + r) * cols + col0;
           copy_lanes(packet.ray.dir_x + 4 * r, band->w_x.data() + k);
@@ -86,8 +87,8 @@ void CastPackets(RTCScene rtc_scene, const ShadeSetup& setup, float t_near, floa
           copy_lanes(packet.ray.dir_z + 4 * r, band->w_z.data() + k);
         }
       }
-      for (int i = 0; i < N; ++i) {
-        if (!full) {
+      if (!full) {
+        for (int i = 0; i < N; ++i) {
           const int r = tile_row + i / 4, col = col0 + i % 4;
           const bool inside = r < band->rows && col < cols;
           const int k = inside ? r * cols + col : 0;
@@ -95,13 +96,12 @@ void CastPackets(RTCScene rtc_scene, const ShadeSetup& setup, float t_near, floa
           packet.ray.dir_x[i] = band->w_x[k];
           packet.ray.dir_y[i] = band->w_y[k];
           packet.ray.dir_z[i] = band->w_z[k];
-        } else {
-          lane_valid[i] = -1;
         }
-        packet.ray.tfar[i] = t_far;
-        packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-        packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
       }
+      // (Separate loops of constant stores: they vectorize.)
+      for (int i = 0; i < N; ++i) packet.ray.tfar[i] = t_far;
+      for (int i = 0; i < N; ++i) packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      for (int i = 0; i < N; ++i) packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
       IntersectN(lane_valid, rtc_scene, &context, &packet);
       if (full) {
         for (int r = 0; r < kTileRows; ++r) {

@@ -355,15 +355,11 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
       U8 rgb = surface.rgb;
       for (int i = 0; i < surface.num_textured; ++i) {
         const int object_id = surface.textured[i];
-        const ObjectData& object = setup.objects[object_id];
-        const float* m = object.texture_from_world_rotation.data();  // column-major
-        const float to_texture[9] = {m[0], m[3], m[6], m[1], m[4], m[7], m[2], m[5], m[8]};
-        const Eigen::Vector3f& object_origin = object.world_origin_of_object;
+        const ShadeSetup::TextureFrame& frame = setup.texture_frames[object_id];
         F8 q_x, q_y, q_z, m_x, m_y, m_z;
-        Rotate(to_texture, (setup.origin[0] - object_origin.x()) + t * w_x,
-               (setup.origin[1] - object_origin.y()) + t * w_y, (setup.origin[2] - object_origin.z()) + t * w_z,
+        Rotate(frame.to_texture, frame.offset[0] + t * w_x, frame.offset[1] + t * w_y, frame.offset[2] + t * w_z,
                &q_x, &q_y, &q_z);
-        Rotate(to_texture, n_x, n_y, n_z, &m_x, &m_y, &m_z);
+        Rotate(frame.to_texture, n_x, n_y, n_z, &m_x, &m_y, &m_z);
         // Triplanar coordinates (scanner/texture.h: TriplanarCoordinates).
         const F8 a_x = lanes::Abs(m_x), a_y = lanes::Abs(m_y), a_z = lanes::Abs(m_z);
         const I8 z_major = (a_z >= a_x) & (a_z >= a_y), x_major = a_x >= a_y;
@@ -371,10 +367,10 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
         const F8 v = z_major ? q_y : q_z;
         // The ray's footprint on the surface (band-limits the texture: no moiré at range).
         const F8 footprint = t * setup.angular_step_rad / lanes::Max(cos_incidence, Splat(0.02f));
-        const float inverse_scale = 1.0f / object.material.texture_scale;
-        const U8 textured = texture_internal::Pack(
-            texture_internal::TextureLanes(object.material.texture, u * inverse_scale, v * inverse_scale,
-                                           footprint * inverse_scale, texture_internal::Unpack(rgb)));
+        const float inverse_scale = frame.inverse_scale;
+        const U8 textured = texture_internal::Pack(texture_internal::TextureLanes(
+            setup.objects[object_id].material.texture, u * inverse_scale, v * inverse_scale,
+            footprint * inverse_scale, texture_internal::Unpack(rgb)));
         rgb = id == object_id ? textured : rgb;
       }
 
@@ -463,6 +459,12 @@ ShadeSetup::ShadeSetup(const std::vector<ObjectData>& object_data, const Scanner
   for (const ObjectData& object : object_data) {
     labels.push_back(object.label);
     reflectivities.push_back(object.material.reflectivity);
+    TextureFrame& frame = texture_frames.emplace_back();
+    for (int i = 0; i < 3; ++i) {
+      frame.offset[i] = static_cast<float>(options.position[i]) - object.world_origin_of_object[i];
+      for (int j = 0; j < 3; ++j) frame.to_texture[3 * i + j] = object.texture_from_world_rotation(i, j);
+    }
+    frame.inverse_scale = 1.0f / object.material.texture_scale;
   }
   const Eigen::Matrix3f rotation = world_from_scanner_pose.topLeftCorner<3, 3>().cast<float>();
   for (int i = 0; i < 3; ++i) {

@@ -68,6 +68,14 @@ struct ShadeSetup {
   std::vector<float> falloff;
   float inverse_falloff_step = 0;
   float angular_step_rad = 0;  // the larger grid step (texture footprint); 0 = point-sampled textures
+  // Per object: world -> texture coordinates, q = to_texture * (offset + t * w) for a hit at t along the
+  // world direction w (offset = scanner origin - object origin), and 1 / texture scale.
+  struct TextureFrame {
+    float to_texture[9];
+    float offset[3];
+    float inverse_scale;
+  };
+  std::vector<TextureFrame> texture_frames;
 
   ShadeSetup(const std::vector<ObjectData>& objects, const ScannerOptions& options, const ScanGrid& grid,
              const Eigen::Matrix4d& world_from_scanner);
