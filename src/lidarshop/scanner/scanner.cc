@@ -281,9 +281,9 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
     int64_t band_returns = 0;
     for (int64_t band_index = band_begin; band_index < band_end; ++band_index) {
       const int row0 = static_cast<int>(band_index) * 4;
-      PrepareBand(setup, row0, std::min(rows, row0 + 4) - row0, &band, &scan);
+      PrepareBand(setup, row0, std::min(rows, row0 + 4) - row0, &band, &scan, options.simd_path);
       CastBand(rtc_scene, setup, options.cast_method, t_near, t_far, &band);
-      band_returns += ShadeBand(setup, &band, &scan);
+      band_returns += ShadeBand(setup, &band, &scan, options.simd_path);
     }
     returns += band_returns;
     Advance(progress, std::min<int64_t>(rows, band_end * 4) - band_begin * 4);

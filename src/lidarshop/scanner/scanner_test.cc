@@ -1,9 +1,11 @@
 #include "lidarshop/scanner/scanner.h"
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <tuple>
 
 #include <gtest/gtest.h>
 
@@ -269,6 +271,68 @@ TEST(Scanner, FusedPacketPathMatchesTheSingleRayPath) {
   }
   EXPECT_LE(label_mismatches, fused.num_cells() / 1000);  // only rays through a shared edge may differ
   EXPECT_GT(compared, 1000);
+}
+
+// The two SIMD paths of the shading (scanner/shade.h) give the same scan, bit for bit: the parking lot with
+// noise, procedural textures and curved (per-cell) car bodies, on a grid whose rows and columns are not
+// multiples of the band (4) and of the SIMD width (8). On a CPU without AVX2 both runs take the baseline path.
+TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
+  SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/scenes/parking_lot.json");
+  scene.scanner.rows = 237;
+  scene.scanner.columns = 301;
+  ASSERT_GT(scene.scanner.los_noise_sigma_m, 0.0);
+  const SyntheticScanner scanner(scene);
+  ScannerOptions options = scene.scanner;
+  options.simd_path = SimdPath::kScalar;
+  const Scan baseline = scanner.Acquire(options);
+  options.simd_path = SimdPath::kAvx2;
+  const Scan avx2 = scanner.Acquire(options);
+  ASSERT_GT(baseline.CountValid(), baseline.num_cells() / 2);
+  for (const auto& [name, a, b] : {std::tuple{"valid", baseline.valid, avx2.valid},
+                                   {"range", baseline.range, avx2.range},
+                                   {"point", baseline.point, avx2.point},
+                                   {"intensity", baseline.intensity, avx2.intensity},
+                                   {"color", baseline.color, avx2.color},
+                                   {"label", baseline.label, avx2.label},
+                                   {"normal", baseline.normal, avx2.normal},
+                                   {"true_range", baseline.true_range, avx2.true_range},
+                                   {"direction", baseline.direction, avx2.direction}}) {
+    SCOPED_TRACE(name);
+    ASSERT_EQ(a.total() * a.elemSize(), b.total() * b.elemSize());
+    EXPECT_EQ(std::memcmp(a.data, b.data, a.total() * a.elemSize()), 0);
+  }
+  // The scan has what the comparison is meant to cover: textured ground, several objects, noise.
+  std::set<int32_t> labels;
+  for (int row = 0; row < avx2.rows; ++row) {
+    for (int col = 0; col < avx2.cols; ++col) labels.insert(avx2.label.at<int32_t>(row, col));
+  }
+  EXPECT_GE(labels.size(), 5u);
+}
+
+TEST(Texture, BatchPathsAgreeWithEachOtherAndWithSinglePoints) {
+  std::vector<float> u, v, footprint;
+  std::vector<uint32_t> base;
+  for (int i = 0; i < 1003; ++i) {  // not a multiple of 8: the last group is partial
+    u.push_back(-7.3f + 0.0137f * i);
+    v.push_back(2.1f - 0.0093f * i);
+    footprint.push_back(0.0002f * (i % 300));
+    base.push_back(PackRgb(Rgb8(40 + i % 200, 90, 160 - i % 100)));
+  }
+  const int count = static_cast<int>(u.size());
+  for (TextureKind kind : {TextureKind::kChecker, TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
+    SCOPED_TRACE(TextureName(kind));
+    std::vector<uint32_t> baseline(u.size()), avx2(u.size());
+    EvaluateTextures(kind, 1.3f, count, u.data(), v.data(), footprint.data(), base.data(), baseline.data(),
+                     SimdPath::kScalar);
+    EvaluateTextures(kind, 1.3f, count, u.data(), v.data(), footprint.data(), base.data(), avx2.data(),
+                     SimdPath::kAvx2);
+    EXPECT_EQ(baseline, avx2);
+    std::set<uint32_t> distinct(baseline.begin(), baseline.end());
+    EXPECT_GT(distinct.size(), 10u);
+    for (int i = 0; i < count; i += 97) {
+      EXPECT_EQ(PackRgb(EvaluateTexture(kind, u[i], v[i], UnpackRgb(base[i]), 1.3f, footprint[i])), baseline[i]);
+    }
+  }
 }
 
 // Std and mean (green channel) of a texture sampled on a 0.1 m grid (coarser than its fine detail).

@@ -55,6 +55,9 @@ struct ScannerOptions {
   bool filter_textures = true;
   // How rays are traced (speed only: every method gives the same hits). Not part of scene files.
   CastMethod cast_method = CastMethod::kPacket16;
+  // Which SIMD path shading takes (speed only: the baseline x86-64 path and the AVX2 one give bit-identical
+  // scans). kAvx2 = AVX2 where the CPU has it. Not part of scene files.
+  SimdPath simd_path = SimdPath::kAvx2;
 
   void Check() const;  // throws OptionsError
   Eigen::Matrix4d WorldFromScanner() const;
