@@ -14,9 +14,13 @@
 //   point = (true_range + e_los) · d + e_orth · (cos ψ · b1 + sin ψ · b2), e_los ~ N(0, σ_los²),
 //   e_orth ~ N(0, σ_orth²), ψ ~ U[0, 2π), (b1, b2) an orthonormal basis perpendicular to the ray d
 //   (b1 = (cos θ, -sin θ, 0), horizontal; b2 = d × b1).
-//   range = |point|. One SplitMix64 hash of (seed, row * cols + col) gives two independent 16-bit uniforms
-//   mapped to standard normals through a 4,097-entry quantile table (inverse-CDF sampling, |e| <= 4.17 σ) and
-//   10 bits for ψ.
+//   range = |point|. A 32-bit hash (the "lowbias32" mixer) of the cell index row * cols + col, keyed by the
+//   seed, gives two 16-bit uniforms, mapped to standard normals through a 65,536-entry quantile table
+//   (inverse-CDF sampling, |e| <= 4.17 σ); a second hash of the first gives 10 bits for ψ.
+//
+// Speed: the scanner works through bands of 4 image rows per thread: directions, 4 x 4 packets of rays
+// (rtcIntersect16), then shading 8 cells per SIMD step (scanner/shade.h), with an AVX2 path chosen at run
+// time whose scans are bit-identical to the baseline one. bench/results/scanner.md has the measurements.
 //
 // Build once, scan many: SyntheticScanner builds the ray-casting scene of a SceneDescription once; Acquire()
 // can then be called for any ScannerOptions (other poses, grids, noise).

@@ -1,17 +1,16 @@
 // Internal to the scanner module: the shading of the synthetic scanner, one band of up to 4 image rows at a
-// time, over structure-of-arrays buffers 8 cells per SIMD step (util/simd.h; the baseline and the AVX2 paths
-// give bit-identical scans).
+// time, over structure-of-arrays buffers, 8 cells per SIMD step (util/simd.h lanes: the baseline and the AVX2
+// paths come from one source and give bit-identical scans).
 //
-// A band goes through: PrepareBand (ray directions, written to the scan), the cast (scanner.cc fills t,
-// geometry, primitive, u, v and the geometric normal), then ShadeBand:
-//   1. per return, scalar: the object's base colour (material, triangle or vertex colours, image texture) and
-//      the interpolated vertex normal on curved triangles; procedural-texture cells are listed per object;
-//   2. per 8 cells: unit normal facing the scanner, incidence, noise, point, range, label, normal, true
-//   range;
-//   3. per textured object, 8 listed cells at a time: triplanar coordinates, ray footprint, texture colour;
-//   4. per 8 cells: intensity (which depends on the colour) and colour.
-// Every loop reads and writes the band's own arrays (in L2) and the scan's rows, so that a GPU back end could
-// run the same steps as kernels.
+// A band goes through: PrepareBand (ray directions, also written to the scan), the cast (scanner.cc fills t,
+// geometry, primitive, u, v and the geometric normal), then ShadeBand, row by row:
+//   - the row's noise, in a loop of its own (hash -> quantile table);
+//   - per group of 8 cells: the objects hit (most groups lie on one object, whose label, reflectivity and
+//     colour are then broadcast; curved triangles, mesh colours and image textures are looked up lane by
+//     lane), the unit normal facing the scanner, the noisy point and range, procedural textures per object
+//     (scanner/texture_lanes.h), intensity, and every output channel of the 8 cells.
+// Groups without a return are filled directly. Each step reads the band's arrays and writes the scan's rows,
+// so that a GPU back end could run the same steps as kernels.
 #pragma once
 
 #include <cstdint>
