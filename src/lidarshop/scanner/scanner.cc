@@ -271,6 +271,7 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
   ScanStats local_stats;
   local_stats.rays = scan.num_cells();
   std::atomic<int64_t> returns{0};
+  std::atomic<int64_t> cast_nanoseconds{0}, shade_nanoseconds{0};  // summed over threads
   Timer timer;
   // One loop over all bands of 4 rows (no barriers between chunks of rows: a thread never waits for
   // another); progress advances as ranges of bands finish.
@@ -279,16 +280,26 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
     thread_local Band band;
     band.Resize(cols);
     int64_t band_returns = 0;
+    double cast_time = 0, shade_time = 0;
     for (int64_t band_index = band_begin; band_index < band_end; ++band_index) {
       const int row0 = static_cast<int>(band_index) * 4;
+      Timer stage;
       PrepareBand(setup, row0, std::min(rows, row0 + 4) - row0, &band, &scan, options.simd_path);
       CastBand(rtc_scene, setup, options.cast_method, t_near, t_far, &band);
+      cast_time += stage.Seconds();
+      stage.Restart();
       band_returns += ShadeBand(setup, &band, &scan, options.simd_path);
+      shade_time += stage.Seconds();
     }
     returns += band_returns;
+    cast_nanoseconds += static_cast<int64_t>(1e9 * cast_time);
+    shade_nanoseconds += static_cast<int64_t>(1e9 * shade_time);
     Advance(progress, std::min<int64_t>(rows, band_end * 4) - band_begin * 4);
   });
-  local_stats.cast_seconds = timer.Seconds();  // casting and shading, fused
+  const double seconds = timer.Seconds();
+  const double busy = static_cast<double>(cast_nanoseconds + shade_nanoseconds);
+  local_stats.cast_seconds = busy > 0 ? seconds * static_cast<double>(cast_nanoseconds) / busy : seconds;
+  local_stats.shade_seconds = seconds - local_stats.cast_seconds;
   local_stats.returns = returns.load();
   if (stats != nullptr) *stats = local_stats;
 }

@@ -38,10 +38,11 @@ namespace lidarshop {
 struct ScanStats {
   int64_t rays = 0;
   int64_t returns = 0;
-  // Ray casting. With CastMethod::kPacket16 (the default) shading is fused into the packet loop (each hit is
-  // shaded as its packet returns): cast_seconds then covers both and shade_seconds is 0.
+  // Wall-clock seconds of the scan, split between ray casting (directions and Embree) and shading (noise,
+  // colour, intensity, normals, writing the channels). The two alternate band by band on every thread, so the
+  // wall time is split in proportion to the time the threads spent in each.
   double cast_seconds = 0.0;
-  double shade_seconds = 0.0;  // noise, colour, intensity, normals (separate pass: the other cast methods)
+  double shade_seconds = 0.0;
 };
 
 class SyntheticScanner {
