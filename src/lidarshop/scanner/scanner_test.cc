@@ -275,7 +275,8 @@ TEST(Scanner, FusedPacketPathMatchesTheSingleRayPath) {
 
 // The two SIMD paths of the shading (scanner/shade.h) give the same scan, bit for bit: the parking lot with
 // noise, procedural textures and curved (per-cell) car bodies, on a grid whose rows and columns are not
-// multiples of the band (4) and of the SIMD width (8). On a CPU without AVX2 both runs take the baseline path.
+// multiples of the band (4) and of the SIMD width (8). On a CPU without AVX2 both runs take the baseline
+// path.
 TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
   SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/scenes/parking_lot.json");
   scene.scanner.rows = 237;
@@ -319,7 +320,8 @@ TEST(Texture, BatchPathsAgreeWithEachOtherAndWithSinglePoints) {
     base.push_back(PackRgb(Rgb8(40 + i % 200, 90, 160 - i % 100)));
   }
   const int count = static_cast<int>(u.size());
-  for (TextureKind kind : {TextureKind::kChecker, TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
+  for (TextureKind kind :
+       {TextureKind::kChecker, TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
     SCOPED_TRACE(TextureName(kind));
     std::vector<uint32_t> baseline(u.size()), avx2(u.size());
     EvaluateTextures(kind, 1.3f, count, u.data(), v.data(), footprint.data(), base.data(), baseline.data(),
@@ -330,7 +332,8 @@ TEST(Texture, BatchPathsAgreeWithEachOtherAndWithSinglePoints) {
     std::set<uint32_t> distinct(baseline.begin(), baseline.end());
     EXPECT_GT(distinct.size(), 10u);
     for (int i = 0; i < count; i += 97) {
-      EXPECT_EQ(PackRgb(EvaluateTexture(kind, u[i], v[i], UnpackRgb(base[i]), 1.3f, footprint[i])), baseline[i]);
+      EXPECT_EQ(PackRgb(EvaluateTexture(kind, u[i], v[i], UnpackRgb(base[i]), 1.3f, footprint[i])),
+                baseline[i]);
     }
   }
 }

@@ -74,16 +74,6 @@ const NoiseTables& Tables() {
   return tables;
 }
 
-// A bijective 32-bit mixer (the "lowbias32" constants): the per-cell noise hash.
-LIDARSHOP_LANES_INLINE U8 Mix32(U8 h) {
-  h ^= h >> 16;
-  h *= 0x7feb352du;
-  h ^= h >> 15;
-  h *= 0x846ca68bu;
-  h ^= h >> 16;
-  return h;
-}
-
 // A standard normal from 16 uniform bits (inverse-CDF sampling: |e| <= 4.17).
 template <typename Gather>
 LIDARSHOP_LANES_INLINE F8 NormalFrom16Bits(const float* quantiles, U8 bits, Gather gather) {
@@ -111,8 +101,8 @@ LIDARSHOP_LANES_INLINE void StoreFirst(T* destination, V values, int count) {
 LIDARSHOP_LANES_INLINE void StoreColors(cv::Vec3b* destination, U8 rgb, int count) {
   using B32 = uint8_t __attribute__((vector_size(32)));
   const B32 bytes = reinterpret_cast<const B32&>(rgb);
-  const B32 triples = __builtin_shufflevector(bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17, 18, 20,
-                                              21, 22, 24, 25, 26, 28, 29, 30, 0, 0, 0, 0, 0, 0, 0, 0);
+  const B32 triples = __builtin_shufflevector(bytes, bytes, 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, 16, 17,
+                                              18, 20, 21, 22, 24, 25, 26, 28, 29, 30, 0, 0, 0, 0, 0, 0, 0, 0);
   if (count == kWidth) {  // (constant sizes: plain stores, no rep movs)
     std::memcpy(static_cast<void*>(destination), &triples, 3 * kWidth);
   } else {
@@ -191,14 +181,15 @@ uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v
   }
   if (object.has_texture_image && object.material.texture == TextureKind::kNone) {
     const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
-    const Eigen::Vector2f st = w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
+    const Eigen::Vector2f st =
+        w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
     surface = SampleImageTexture(mesh.texture, st.x(), st.y());
   }
   return PackRgb(surface);
 }
 
-// The noise of one image row, into the band's noise arrays: e_los, and e_orth · (cos ψ, sin ψ) along (b1, b2).
-// (A loop of its own: short enough for the CPU to overlap the hash -> table -> interpolation chains of
+// The noise of one image row, into the band's noise arrays: e_los, and e_orth · (cos ψ, sin ψ) along (b1,
+// b2). (A loop of its own: short enough for the CPU to overlap the hash -> table chains of
 // several steps, which the long shading loop cannot.)
 template <typename Gather>
 LIDARSHOP_LANES_INLINE void DrawNoise(const ShadeSetup& setup, int row, int cols, Band& band, Gather gather) {
@@ -210,13 +201,14 @@ LIDARSHOP_LANES_INLINE void DrawNoise(const ShadeSetup& setup, int row, int cols
     // One 32-bit hash per cell gives 16 bits for e_los and 16 for e_orth, a second one 10 bits for ψ.
     const U8 cell =
         lanes::SplatUint(static_cast<uint32_t>(row * cols + col)) + reinterpret_cast<const U8&>(lane_index);
-    const U8 bits = Mix32(cell ^ setup.noise_seed[0]);
+    const U8 bits = lanes::Mix32(cell ^ setup.noise_seed[0]);
     lanes::Store(band.noise_los.data() + col,
                  setup.los_sigma * NormalFrom16Bits(tables.quantiles.data(), bits & 0xFFFFu, gather));
     if (setup.orthogonal_sigma > 0) {
-      const U8 psi_bits = Mix32(bits ^ setup.noise_seed[1]) & 0x3FFu;
+      const U8 psi_bits = lanes::Mix32(bits ^ setup.noise_seed[1]) & 0x3FFu;
       const I8 psi = reinterpret_cast<const I8&>(psi_bits);
-      const F8 e_orth = setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16, gather);
+      const F8 e_orth =
+          setup.orthogonal_sigma * NormalFrom16Bits(tables.quantiles.data(), bits >> 16, gather);
       lanes::Store(band.noise_b1.data() + col, e_orth * gather(tables.circle_cos.data(), psi));
       lanes::Store(band.noise_b2.data() + col, e_orth * gather(tables.circle_sin.data(), psi));
     }
@@ -261,7 +253,8 @@ LIDARSHOP_LANES_INLINE GroupSurface SurfaceOfGroup(const ShadeSetup& setup, cons
       for (unsigned bits = mine_bits; bits != 0; bits &= bits - 1) {
         const int lane = __builtin_ctz(bits);
         Eigen::Vector3f normal(surface.n_x[lane], surface.n_y[lane], surface.n_z[lane]);
-        surface.rgb[lane] = PerCellSurface(object, band.primitive[k + lane], band.u[k + lane], band.v[k + lane], &normal);
+        surface.rgb[lane] =
+            PerCellSurface(object, band.primitive[k + lane], band.u[k + lane], band.v[k + lane], &normal);
         surface.n_x[lane] = normal.x();
         surface.n_y[lane] = normal.y();
         surface.n_z[lane] = normal.z();
@@ -357,8 +350,8 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
         const int object_id = surface.textured[i];
         const ShadeSetup::TextureFrame& frame = setup.texture_frames[object_id];
         F8 q_x, q_y, q_z, m_x, m_y, m_z;
-        Rotate(frame.to_texture, frame.offset[0] + t * w_x, frame.offset[1] + t * w_y, frame.offset[2] + t * w_z,
-               &q_x, &q_y, &q_z);
+        Rotate(frame.to_texture, frame.offset[0] + t * w_x, frame.offset[1] + t * w_y,
+               frame.offset[2] + t * w_z, &q_x, &q_y, &q_z);
         Rotate(frame.to_texture, n_x, n_y, n_z, &m_x, &m_y, &m_z);
         // Triplanar coordinates (scanner/texture.h: TriplanarCoordinates).
         const F8 a_x = lanes::Abs(m_x), a_y = lanes::Abs(m_y), a_z = lanes::Abs(m_z);
@@ -383,10 +376,10 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
       const I8 step_index = ToInt(hit ? step : zero);
       const F8 low = gather(setup.falloff.data(), step_index);
       const F8 attenuation =
-          low + (step - ToFloat(step_index)) * (lanes::Gather<F8>(setup.falloff.data(), step_index + 1) - low);
-      const F8 intensity = lanes::Clamp(surface.reflectivity * (0.5f + luminance) * lanes::Max(cos_incidence, zero) *
-                                            attenuation,
-                                        0.0f, 1.0f);
+          low + (step - ToFloat(step_index)) * (gather(setup.falloff.data(), step_index + 1) - low);
+      const F8 intensity = lanes::Clamp(
+          surface.reflectivity * (0.5f + luminance) * lanes::Max(cos_incidence, zero) * attenuation, 0.0f,
+          1.0f);
 
       F8 ns_x, ns_y, ns_z;
       Rotate(setup.scanner_from_world, n_x, n_y, n_z, &ns_x, &ns_y, &ns_z);
@@ -410,7 +403,8 @@ __attribute__((target("avx2"))) void PrepareBandAvx2(const ShadeSetup& setup, in
 void PrepareBandBaseline(const ShadeSetup& setup, int row0, int rows, Band& band, Scan& scan) {
   PrepareBandBody(setup, row0, rows, band, scan);
 }
-__attribute__((target("avx2"), flatten)) int64_t ShadeBandAvx2(const ShadeSetup& setup, Band& band, Scan& scan) {
+__attribute__((target("avx2"), flatten)) int64_t ShadeBandAvx2(const ShadeSetup& setup, Band& band,
+                                                               Scan& scan) {
   return ShadeBandBody(setup, band, scan, lanes::Avx2FloatGather());
 }
 int64_t ShadeBandBaseline(const ShadeSetup& setup, Band& band, Scan& scan) {

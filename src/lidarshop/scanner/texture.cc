@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
-#include "lidarshop/util/error.h"
 #include "lidarshop/scanner/texture_lanes.h"
+#include "lidarshop/util/error.h"
 #include "lidarshop/util/simd.h"
 
 namespace lidarshop {

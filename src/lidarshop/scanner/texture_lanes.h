@@ -25,13 +25,8 @@ struct Colors {
 };
 
 LIDARSHOP_LANES_INLINE U8 Hash(I8 x, I8 y, uint32_t salt) {
-  U8 h = reinterpret_cast<U8&>(x) * 0x8da6b343u ^ reinterpret_cast<U8&>(y) * 0xd8163841u ^ salt * 0xcb1ab31fu;
-  h ^= h >> 16;
-  h *= 0x7feb352du;
-  h ^= h >> 15;
-  h *= 0x846ca68bu;
-  h ^= h >> 16;
-  return h;
+  return lanes::Mix32(reinterpret_cast<U8&>(x) * 0x8da6b343u ^ reinterpret_cast<U8&>(y) * 0xd8163841u ^
+                      salt * 0xcb1ab31fu);
 }
 
 // Uniform in [0, 1).

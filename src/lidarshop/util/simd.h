@@ -1,7 +1,7 @@
 // Which SIMD path a loop takes, and 8-lane vector types for loops written once for every path.
 //
 // Loops that have an AVX2 version choose it with BestSimdPath() and keep a baseline (x86-64, SSE2) version
-// that gives bit-identical results: tests pin both. The Lanes types below are GCC vector extensions, so one
+// that gives bit-identical results: tests pin both. The lanes types below are GCC vector extensions, so one
 // source compiles to AVX2 inside a function marked __attribute__((target("avx2"))) and to pairs of SSE2
 // registers elsewhere. Neither target has FMA, so no multiply-add is fused and both round identically.
 #pragma once
@@ -57,13 +57,25 @@ LIDARSHOP_LANES_INLINE V Gather(const T* values, I8 index) {
 // is one vgatherdps, for code compiled into a function marked target("avx2") and flatten (which inlines it
 // there; elsewhere it stays a call into AVX2 code). Both load the same values.
 struct FloatGather {
-  LIDARSHOP_LANES_INLINE F8 operator()(const float* values, I8 index) const { return Gather<F8>(values, index); }
+  LIDARSHOP_LANES_INLINE F8 operator()(const float* values, I8 index) const {
+    return Gather<F8>(values, index);
+  }
 };
 struct Avx2FloatGather {
   __attribute__((target("avx2"))) F8 operator()(const float* values, I8 index) const {
     return reinterpret_cast<F8>(_mm256_i32gather_ps(values, reinterpret_cast<__m256i>(index), 4));
   }
 };
+
+// A bijective 32-bit mixer per lane (the "lowbias32" constants): hashes for noise and procedural textures.
+LIDARSHOP_LANES_INLINE U8 Mix32(U8 h) {
+  h ^= h >> 16;
+  h *= 0x7feb352du;
+  h ^= h >> 15;
+  h *= 0x846ca68bu;
+  h ^= h >> 16;
+  return h;
+}
 
 // True if any lane of `mask` is set.
 LIDARSHOP_LANES_INLINE bool Any(I8 mask) {
