@@ -86,8 +86,7 @@ void CastPackets(RTCScene rtc_scene, const ShadeSetup& setup, float t_near, floa
           copy_lanes(packet.ray.dir_y + 4 * r, band->w_y.data() + k);
           copy_lanes(packet.ray.dir_z + 4 * r, band->w_z.data() + k);
         }
-      }
-      if (!full) {
+      } else {
         for (int i = 0; i < N; ++i) {
           const int r = tile_row + i / 4, col = col0 + i % 4;
           const bool inside = r < band->rows && col < cols;

@@ -307,7 +307,7 @@ LIDARSHOP_LANES_INLINE int64_t ShadeBandBody(const ShadeSetup& setup, Band& band
       // The unit normal, facing the scanner.
       const F8 t = lanes::Load<F8>(band.t.data() + k);
       F8 n_x = surface.n_x, n_y = surface.n_y, n_z = surface.n_z;
-      // (A miss has a zero normal: its lanes are NaN here and masked below.)
+      // (A miss's normal is undefined, maybe zero or stale: its lanes are masked below.)
       const F8 inverse_norm = 1.0f / lanes::Sqrt(n_x * n_x + n_y * n_y + n_z * n_z);
       n_x *= inverse_norm;
       n_y *= inverse_norm;
