@@ -310,6 +310,59 @@ TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
   EXPECT_GE(labels.size(), 5u);
 }
 
+// Per-cell colours: an image texture on one half of a wall, vertex colours on the other; groups of 8 cells
+// that straddle the two objects take each lane from its own object.
+TEST(Scanner, ImageTexturesAndVertexColoursColourEachReturn) {
+  auto quad = [](float x0, float x1) {
+    TriangleMesh mesh;
+    mesh.vertices = {{x0, 5, 0}, {x1, 5, 0}, {x1, 5, 3}, {x0, 5, 3}};
+    mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    return mesh;
+  };
+  SceneDescription scene;
+  scene.scanner = Scanner(60, 90, -30, 30, -20, 20, Eigen::Vector3d(0, 0, 1.5));
+  SceneObject textured;
+  textured.mesh = quad(-2, 0);
+  textured.mesh.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // s = (x + 2) / 2
+  textured.mesh.triangle_texcoords = textured.mesh.triangles;
+  textured.mesh.texture = cv::Mat(1, 2, CV_8UC3);
+  textured.mesh.texture.at<cv::Vec3b>(0, 0) = cv::Vec3b(255, 0, 0);  // RGB: red left, green right
+  textured.mesh.texture.at<cv::Vec3b>(0, 1) = cv::Vec3b(0, 255, 0);
+  textured.label = 1;
+  SceneObject painted;
+  painted.mesh = quad(0, 2);
+  painted.mesh.vertex_colors.assign(4, Rgb8(20, 40, 200));
+  painted.label = 2;
+  scene.objects = {textured, painted};
+  const SyntheticScanner scanner(scene);
+  int red = 0, green = 0, blue = 0;
+  for (const SimdPath path : {SimdPath::kScalar, SimdPath::kAvx2}) {
+    ScannerOptions options = scene.scanner;
+    options.simd_path = path;
+    const Scan scan = scanner.Acquire(options);
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 0; col < scan.cols; ++col) {
+        const int32_t label = scan.label.at<int32_t>(row, col);
+        const float x = scan.point.at<cv::Vec3f>(row, col)[0];
+        const cv::Vec3b color = scan.color.at<cv::Vec3b>(row, col);
+        if (label == 1 && x < -1.05f) {
+          EXPECT_EQ(color, cv::Vec3b(255, 0, 0)) << row << " " << col;
+          ++red;
+        } else if (label == 1 && x > -0.95f && x < -0.05f) {
+          EXPECT_EQ(color, cv::Vec3b(0, 255, 0)) << row << " " << col;
+          ++green;
+        } else if (label == 2) {
+          EXPECT_EQ(color, cv::Vec3b(20, 40, 200)) << row << " " << col;
+          ++blue;
+        }
+      }
+    }
+  }
+  EXPECT_GT(red, 200);
+  EXPECT_GT(green, 200);
+  EXPECT_GT(blue, 400);
+}
+
 TEST(Texture, BatchPathsAgreeWithEachOtherAndWithSinglePoints) {
   std::vector<float> u, v, footprint;
   std::vector<uint32_t> base;
