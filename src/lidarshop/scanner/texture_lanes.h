@@ -118,6 +118,12 @@ LIDARSHOP_LANES_INLINE Colors TextureLanes(TextureKind kind, F8 u, F8 v, F8 foot
     }
     case TextureKind::kGravel: {
       const F8 weight = Fade(kGravelSize, footprint);
+      // Where every lane sees only the mean (far ground), skip the stones: a zero weight makes the detail
+      // drop out exactly, so the colours are the same either way.
+      if (!Any(weight > 0.0f)) {
+        const Eigen::Vector3f& factor = GravelMeanFactor();
+        return MixRgb({factor[0] * base.r, factor[1] * base.g, factor[2] * base.b}, base, weight);
+      }
       const F8 row = lanes::Floor(v * (1.0f / kGravelSize));
       const F8 shifted = u * (1.0f / kGravelSize) + 0.5f * ToFloat(ToInt(row) & 1);
       const F8 col = lanes::Floor(shifted);
@@ -149,17 +155,21 @@ LIDARSHOP_LANES_INLINE Colors TextureLanes(TextureKind kind, F8 u, F8 v, F8 foot
       const F8 column = lanes::Floor(shifted * (1.0f / kBrickPitch));
       const F8 in_u = shifted - column * kBrickPitch, in_v = v - course * kCourseHeight;
       // Per-brick shade (faded to its mean 0.975 at range) plus a 1.5 cm speckle.
+      // (Faded levels are skipped where every lane has faded them: a zero weight drops them out exactly.)
       const F8 brick_shade =
-          0.8f + 0.35f * (0.5f + brick_weight * (Hash01(ToInt(column), ToInt(course), 31) - 0.5f));
-      const F8 speckle = Hash01(ToInt(lanes::Floor(u * 66.0f)), ToInt(lanes::Floor(v * 66.0f)), 32);
-      const Colors mortar = Splat(kMortar);
-      const Colors detail = Select((in_u < kJoint) | (in_v < kJoint), mortar,
-                                   Shade(base, brick_shade + 0.12f * fine_weight * (speckle - 0.5f)));
+          Any(brick_weight > 0.0f)
+              ? 0.8f + 0.35f * (0.5f + brick_weight * (Hash01(ToInt(column), ToInt(course), 31) - 0.5f))
+              : Splat(0.8f + 0.35f * 0.5f);
       // Joints and speckle averaged over the footprint: the mortar and the brick in proportion.
+      const Colors mortar = Splat(kMortar);
       const Colors brick = Shade(base, brick_shade);
       const Colors mean = {kMortarFraction * mortar.r + (1 - kMortarFraction) * brick.r,
                            kMortarFraction * mortar.g + (1 - kMortarFraction) * brick.g,
                            kMortarFraction * mortar.b + (1 - kMortarFraction) * brick.b};
+      if (!Any(fine_weight > 0.0f)) return MixRgb(mean, brick, fine_weight);
+      const F8 speckle = Hash01(ToInt(lanes::Floor(u * 66.0f)), ToInt(lanes::Floor(v * 66.0f)), 32);
+      const Colors detail = Select((in_u < kJoint) | (in_v < kJoint), mortar,
+                                   Shade(base, brick_shade + 0.12f * fine_weight * (speckle - 0.5f)));
       return MixRgb(mean, detail, fine_weight);
     }
   }
