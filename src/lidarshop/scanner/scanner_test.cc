@@ -310,6 +310,45 @@ TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
   EXPECT_GE(labels.size(), 5u);
 }
 
+// Grids smaller than a band (4 rows) or a SIMD step (8 columns; the smallest grid is 2 x 2), and ragged ones:
+// every cell is shaded, the two SIMD paths agree, and the hits are those of one ray at a time.
+TEST(Scanner, SmallAndRaggedGridsShadeEveryCell) {
+  testing::GroundAndBoxOptions box_options;
+  box_options.los_noise_sigma = 0.01;
+  box_options.orthogonal_noise_sigma = 0.005;
+  const SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  const SyntheticScanner scanner(scene);
+  for (const auto& [rows, cols] : {std::pair{2, 2}, {2, 9}, {3, 5}, {5, 17}, {4, 8}, {9, 23}}) {
+    SCOPED_TRACE(::testing::Message() << rows << " x " << cols);
+    ScannerOptions options = scene.scanner;
+    options.rows = rows;
+    options.columns = cols;
+    options.elevation_max_deg = -5;  // every ray meets the ground or the box
+    options.simd_path = SimdPath::kScalar;
+    const Scan baseline = scanner.Acquire(options);
+    options.simd_path = SimdPath::kAvx2;
+    const Scan avx2 = scanner.Acquire(options);
+    options.cast_method = CastMethod::kSingle;
+    const Scan single = scanner.Acquire(options);
+    EXPECT_EQ(baseline.CountValid(), rows * cols);
+    for (const auto& [a, b] : {std::pair{baseline.point, avx2.point},
+                               {baseline.color, avx2.color},
+                               {baseline.intensity, avx2.intensity},
+                               {baseline.label, avx2.label},
+                               {baseline.normal, avx2.normal},
+                               {baseline.direction, avx2.direction}}) {
+      EXPECT_EQ(std::memcmp(a.data, b.data, a.total() * a.elemSize()), 0);
+    }
+    for (int row = 0; row < rows; ++row) {
+      for (int col = 0; col < cols; ++col) {
+        EXPECT_EQ(avx2.label.at<int32_t>(row, col), single.label.at<int32_t>(row, col));
+        EXPECT_NEAR(avx2.true_range.at<float>(row, col), single.true_range.at<float>(row, col), 1e-4f);
+        EXPECT_GT(avx2.range.at<float>(row, col), 0.0f);
+      }
+    }
+  }
+}
+
 // Per-cell colours: an image texture on one half of a wall, vertex colours on the other; groups of 8 cells
 // that straddle the two objects take each lane from its own object.
 TEST(Scanner, ImageTexturesAndVertexColoursColourEachReturn) {
