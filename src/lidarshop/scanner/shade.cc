@@ -444,15 +444,9 @@ void ObjectData::Prepare(const Eigen::Matrix4d& world_from_object) {
 
 ShadeSetup::ShadeSetup(const std::vector<ObjectData>& object_data, const ScannerOptions& options,
                        const ScanGrid& grid, const Eigen::Matrix4d& world_from_scanner_pose)
-    : objects(object_data.data()),
-      num_objects(static_cast<int>(object_data.size())),
-      rows(options.rows),
-      cols(options.columns) {
-  labels.push_back(kNoLabel);
-  reflectivities.push_back(0.0f);
+    : objects(object_data.data()) {
+  const int rows = options.rows, cols = options.columns;
   for (const ObjectData& object : object_data) {
-    labels.push_back(object.label);
-    reflectivities.push_back(object.material.reflectivity);
     TextureFrame& frame = texture_frames.emplace_back();
     for (int i = 0; i < 3; ++i) {
       frame.offset[i] = static_cast<float>(options.position[i]) - object.world_origin_of_object[i];

@@ -45,13 +45,8 @@ struct ObjectData {
 
 // What shading needs of one scan, set up once per Acquire.
 struct ShadeSetup {
-  const ObjectData* objects = nullptr;
-  int num_objects = 0;
-  int rows = 0, cols = 0;
-  // Indexed by geometry id + 1 (entry 0: no return).
-  std::vector<int32_t> labels;
-  std::vector<float> reflectivities;
-  float world_from_scanner[9] = {};  // row-major rotation
+  const ObjectData* objects = nullptr;  // indexed by geometry id
+  float world_from_scanner[9] = {};     // row-major rotation
   float scanner_from_world[9] = {};
   float origin[3] = {};  // scanner origin in the world
   float los_sigma = 0, orthogonal_sigma = 0;
