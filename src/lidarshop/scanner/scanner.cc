@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <cstring>
 #include <vector>
 
@@ -19,26 +18,6 @@ namespace {
 using scanner_internal::Band;
 using scanner_internal::ObjectData;
 using scanner_internal::ShadeSetup;
-
-inline uint64_t SplitMix64(uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-// Uniform in (0, 1), 53 bits.
-inline double Uniform(uint64_t seed, uint64_t cell, uint32_t stream) {
-  const uint64_t key = SplitMix64(SplitMix64(seed ^ 0x5851F42D4C957F2Dull) ^ cell) ^ (uint64_t{stream} << 56);
-  return (static_cast<double>(SplitMix64(key) >> 11) + 0.5) * (1.0 / 9007199254740992.0);
-}
-
-inline double Normal(uint64_t seed, uint64_t cell, uint32_t stream) {
-  // Box-Muller with two independent uniforms of the same (seed, cell).
-  const double u1 = Uniform(seed, cell, 2 * stream);
-  const double u2 = Uniform(seed, cell, 2 * stream + 1);
-  return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
-}
 
 // One ray's hit into the band's cell k.
 inline void StoreHit(int k, float t, unsigned geometry, unsigned primitive, float u, float v, float n_x,
@@ -199,11 +178,6 @@ struct SyntheticScanner::Impl {
   int64_t num_triangles = 0;
   double build_seconds = 0.0;
 };
-
-double CellUniform(uint64_t seed, uint64_t cell, uint32_t stream) {
-  return Uniform(seed, cell, 1000 + stream);
-}
-double CellNormal(uint64_t seed, uint64_t cell, uint32_t stream) { return Normal(seed, cell, 1000 + stream); }
 
 SyntheticScanner::SyntheticScanner(const SceneDescription& scene, const RaycastSceneOptions& raycast_options)
     : impl_(std::make_unique<Impl>(raycast_options)) {

@@ -74,9 +74,4 @@ class SyntheticScanner {
 // Convenience: builds the scanner for `scene` and scans with scene.scanner.
 Scan SynthesizeScan(const SceneDescription& scene, Progress* progress = nullptr);
 
-// A deterministic standard normal / uniform draw for (seed, cell, stream): the scanner's noise source,
-// exposed for tests and other synthetic-data makers.
-double CellNormal(uint64_t seed, uint64_t cell, uint32_t stream);
-double CellUniform(uint64_t seed, uint64_t cell, uint32_t stream);
-
 }  // namespace lidarshop

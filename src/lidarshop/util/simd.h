@@ -86,7 +86,6 @@ LIDARSHOP_LANES_INLINE bool Any(I8 mask) {
 
 LIDARSHOP_LANES_INLINE I8 ToInt(F8 x) { return __builtin_convertvector(x, I8); }  // truncates
 LIDARSHOP_LANES_INLINE F8 ToFloat(I8 x) { return __builtin_convertvector(x, F8); }
-LIDARSHOP_LANES_INLINE F8 ToFloat(U8 x) { return __builtin_convertvector(x, F8); }
 // floor for |x| < 2^31 (a truncation and a compare: the baseline has no roundps).
 LIDARSHOP_LANES_INLINE F8 Floor(F8 x) {
   const F8 truncated = ToFloat(ToInt(x));
