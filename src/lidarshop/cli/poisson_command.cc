@@ -43,26 +43,6 @@ PoissonOptions Options(const SolverFlags& flags) {
   return options;
 }
 
-// Masks are pictures: white (>= 128 in any channel) = the hole / region.
-cv::Mat ReadMask(const std::string& path, cv::Size expected, const std::string& image_path) {
-  cv::Mat mask = ReadImage(path);
-  if (mask.depth() != CV_8U) ThrowInputError(path, "", "", "a mask must be an 8-bit image");
-  if (mask.size() != expected) {
-    ThrowInputError(path, "", "",
-                    fmt::format("the mask is {}x{} but {} is {}x{}", mask.cols, mask.rows, image_path,
-                                expected.width, expected.height));
-  }
-  if (mask.channels() > 1) {
-    std::vector<cv::Mat> planes;
-    cv::split(mask, planes);
-    mask = planes[0];
-    for (size_t c = 1; c < std::min<size_t>(planes.size(), 3); ++c) cv::max(mask, planes[c], mask);
-  }
-  cv::Mat binary;
-  cv::threshold(mask, binary, 127, 255, cv::THRESH_BINARY);
-  return binary;
-}
-
 cv::Mat ReadFloat(const std::string& path) {
   const cv::Mat image = ReadImage(path);
   cv::Mat result;

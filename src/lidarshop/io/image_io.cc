@@ -78,4 +78,23 @@ cv::Mat DecodeImage(const std::vector<uint8_t>& bytes, const std::string& what) 
   return SwapRedBlue(image);
 }
 
+cv::Mat ReadMask(const std::string& path, cv::Size expected, const std::string& what) {
+  cv::Mat mask = ReadImage(path);
+  if (mask.depth() != CV_8U) ThrowInputError(path, "", "", "a mask must be an 8-bit image");
+  if (mask.size() != expected) {
+    ThrowInputError(path, "", "",
+                    fmt::format("the mask is {}x{} but {} is {}x{}", mask.cols, mask.rows, what,
+                                expected.width, expected.height));
+  }
+  if (mask.channels() > 1) {
+    std::vector<cv::Mat> planes;
+    cv::split(mask, planes);
+    mask = planes[0];
+    for (size_t c = 1; c < std::min<size_t>(planes.size(), 3); ++c) cv::max(mask, planes[c], mask);
+  }
+  cv::Mat binary;
+  cv::threshold(mask, binary, 127, 255, cv::THRESH_BINARY);
+  return binary;
+}
+
 }  // namespace lidarshop

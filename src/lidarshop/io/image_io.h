@@ -21,6 +21,11 @@ cv::Mat ReadImage(const std::string& path);
 // Writes an RGB(A) or single-channel image; the format follows the extension. Atomic.
 void WriteImage(const std::string& path, const cv::Mat& image);
 
+// Reads a mask picture: white (>= 128 in any colour channel) = true. Returns CV_8U 255/0 of `expected` size;
+// throws InputError naming the file when it is not 8-bit or its size differs (`what` names the image it must
+// match, e.g. "the scan").
+cv::Mat ReadMask(const std::string& path, cv::Size expected, const std::string& what);
+
 // Decodes an encoded JPEG/PNG buffer (e.g. an E57 image blob) into RGB.
 cv::Mat DecodeImage(const std::vector<uint8_t>& bytes, const std::string& what);
 

@@ -125,12 +125,19 @@ struct PoissonSystem::Impl {
   double prepare_seconds = 0.0;
   std::vector<int32_t> unknown_pixels;  // y * W + x of each unknown, row-major
   cv::Mat index;                        // H x W CV_32S: compact index of an unknown, −1 for known pixels
+  cv::Mat no_data;  // H x W CV_8U, non-zero = no value and no edge (like outside the image); empty = none
+
+  // Whether the edge from an unknown to (ny, nx) is part of the equation.
+  bool Linked(int ny, int nx) const {
+    if (ny < 0 || ny >= size.height || nx < 0 || nx >= size.width) return false;
+    return no_data.empty() || no_data.at<uint8_t>(ny, nx) == 0;
+  }
   std::unique_ptr<DirectSolver> direct;
   std::unique_ptr<MaskedMultigrid> multigrid;
 
   // ||b − A x|| for compact vectors (double precision).
   double ResidualNorm(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
-    const int W = size.width, H = size.height;
+    const int W = size.width;
     std::vector<double> partial(unknown_pixels.size());
     ParallelForRange(
         static_cast<int64_t>(unknown_pixels.size()),
@@ -140,7 +147,7 @@ struct PoissonSystem::Impl {
             double ax = 0.0;
             int degree = 0;
             auto visit = [&](int ny, int nx) {
-              if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+              if (!Linked(ny, nx)) return;
               ++degree;
               const int n = index.at<int32_t>(ny, nx);
               if (n >= 0) ax -= x[n];
@@ -178,6 +185,10 @@ double PoissonSystem::PrepareSeconds() const { return impl().prepare_seconds; }
 const PoissonOptions& PoissonSystem::Options() const { return impl().options; }
 
 PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options) {
+  return PreparePoisson(mask_in, options, cv::Mat());
+}
+
+PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options, const cv::Mat& no_data_in) {
   options.Check();
   Timer timer;
   auto impl = std::make_shared<PoissonSystem::Impl>();
@@ -185,6 +196,19 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
   impl->mask = NormalizeMask(mask_in, "PreparePoisson");
   impl->size = impl->mask.size();
   const int W = impl->size.width, H = impl->size.height;
+  bool no_data_touches_domain = false;
+  if (!no_data_in.empty()) {
+    if (no_data_in.size() != impl->size) {
+      throw InputError(fmt::format("PreparePoisson: the no-data mask is {}x{}, the mask is {}x{}", no_data_in.cols,
+                                   no_data_in.rows, W, H));
+    }
+    impl->no_data = NormalizeMask(no_data_in, "PreparePoisson (no-data mask)");
+    impl->no_data.setTo(0, impl->mask);  // a pixel of Ω is an unknown, whatever the no-data mask says
+    cv::Mat grown;
+    cv::dilate(impl->no_data, grown, cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3)));
+    no_data_touches_domain = cv::countNonZero(grown & impl->mask) > 0;
+    if (!no_data_touches_domain) impl->no_data.release();  // nothing to leave out: the plain system
+  }
   const int num_unknowns = cv::countNonZero(impl->mask);
   if (num_unknowns == W * H) {
     throw InputError(fmt::format(
@@ -211,6 +235,8 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
     impl->solver = num_unknowns <= options.auto_direct_max_unknowns ? PoissonSolverKind::kDirect
                                                                     : PoissonSolverKind::kMultigrid;
   }
+  // The multigrid hierarchy knows only the image border as a no-flux boundary.
+  if (no_data_touches_domain) impl->solver = PoissonSolverKind::kDirect;
   if (num_unknowns > 0) {
     if (impl->solver == PoissonSolverKind::kDirect) {
       std::vector<Eigen::Triplet<double>> triplets;
@@ -219,7 +245,7 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
         const int y = impl->unknown_pixels[k] / W, x = impl->unknown_pixels[k] % W;
         int degree = 0;
         auto visit = [&](int ny, int nx) {
-          if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+          if (!impl->Linked(ny, nx)) return;
           ++degree;
           const int n = impl->index.at<int32_t>(ny, nx);
           if (n >= 0) triplets.emplace_back(k, n, -1.0);
@@ -255,7 +281,7 @@ namespace {
 template <typename T>
 void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, const cv::Mat& divergence,
                    cv::Mat& output, PoissonResult& result) {
-  const int W = system.size.width, H = system.size.height;
+  const int W = system.size.width;
   const int n = boundary.channels();
   const auto num_unknowns = static_cast<int64_t>(system.unknown_pixels.size());
   for (int c = 0; c < n; ++c) {
@@ -268,7 +294,7 @@ void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, c
             const int y = system.unknown_pixels[k] / W, x = system.unknown_pixels[k] % W;
             double value = divergence.empty() ? 0.0 : -static_cast<double>(divergence.ptr<T>(y)[x * n + c]);
             auto visit = [&](int ny, int nx) {
-              if (ny < 0 || ny >= H || nx < 0 || nx >= W) return;
+              if (!system.Linked(ny, nx)) return;
               if (system.index.at<int32_t>(ny, nx) < 0) value += boundary.ptr<T>(ny)[nx * n + c];
             };
             visit(y, x - 1);

@@ -96,7 +96,8 @@ class PoissonSystem {
  private:
   explicit PoissonSystem(std::shared_ptr<const Impl> impl);
   std::shared_ptr<const Impl> impl_;
-  friend PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options);
+  friend PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options,
+                                      const cv::Mat& no_data);
 };
 
 // Analyses `mask` (H x W, CV_8U, non-zero = unknown; 1- or 3-channel accepted, any non-zero channel counts)
@@ -104,6 +105,15 @@ class PoissonSystem {
 // image). Throws InputError for an empty or wrong-typed mask, or a mask with no known pixel; OptionsError for
 // bad options.
 PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options = {});
+
+// The same, with pixels that hold no value at all (H x W CV_8U, non-zero = no data; e.g. LiDAR cells without a
+// return): an edge between Ω and such a pixel is left out of the equation, as an edge leaving the image is
+// (natural boundary, no flux), and the pixel's boundary value is never read. Pixels of Ω are unknowns whatever
+// this mask says. The divergence given to SolvePoisson must leave those edges out too (guidance 0 on them).
+// Every connected part of Ω must still touch a known pixel with data, or the matrix is singular and the
+// factorization throws. When such pixels border Ω the direct solver is used (the multigrid hierarchy knows only
+// the image border).
+PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options, const cv::Mat& no_data);
 
 struct PoissonResult {
   cv::Mat image;  // H x W x n: the boundary image with Ω replaced by the solution

@@ -61,4 +61,23 @@ void WritePathAtomically(const std::string& path, const std::function<bool(const
   Commit(temporary, path);
 }
 
+void CheckOutputPath(const std::string& path, const std::vector<std::string>& others) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path target = fs::absolute(path, error);
+  if (fs::is_directory(target, error)) throw OptionsError(fmt::format("{}: is a folder, not a file", path));
+  const fs::path folder = target.parent_path();
+  if (!fs::is_directory(folder, error)) {
+    throw OptionsError(fmt::format("{}: the folder {} does not exist", path, folder.string()));
+  }
+  const fs::path canonical = fs::weakly_canonical(target, error);
+  for (const std::string& other : others) {
+    if (other.empty()) continue;
+    const bool same_file = fs::exists(target, error) && fs::exists(other, error) && fs::equivalent(target, other, error);
+    if (same_file || canonical == fs::weakly_canonical(fs::absolute(other, error), error)) {
+      throw OptionsError(fmt::format("{}: the output would overwrite {}; choose another path", path, other));
+    }
+  }
+}
+
 }  // namespace lidarshop

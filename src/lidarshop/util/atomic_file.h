@@ -6,6 +6,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace lidarshop {
 
@@ -18,5 +19,10 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 // at temporary_path, which keeps the target's extension so that format detection still works; it is then
 // renamed to `path`. `write` returns false (or throws) on failure.
 void WritePathAtomically(const std::string& path, const std::function<bool(const std::string&)>& write);
+
+// Checks an output path before any long work: its folder must exist, it must not be a folder, and it must not
+// name the same file as any of `others` (the inputs, and the outputs already checked; empty strings are
+// skipped). Throws OptionsError naming the path.
+void CheckOutputPath(const std::string& path, const std::vector<std::string>& others);
 
 }  // namespace lidarshop

@@ -1,0 +1,218 @@
+// fill_eval: quality of the hole fill against ground truth no one else has.
+//
+//   fill_eval [--scenes DIR] [--methods gradient,laplace,...] [--margin CELLS] [--markdown FILE]
+//             [--pictures DIR] [--planar NAME,...]
+//
+// Every data/fill_eval/*.json scene is scanned twice with the same seed: as it is, and without its label-1
+// objects (the ones to remove). The hole is the removed object's cells grown by the margin; the truth is the
+// scan without the object. Each method fills the same hole of the same scan, and MeasureFill scores it inside
+// the hole. Prints one table per scene and a summary; --markdown writes them, --pictures writes the range
+// images and a second-viewpoint rendering per scene.
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/fill/fill.h"
+#include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/image/colormap.h"
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/io/render.h"
+#include "lidarshop/io/render_view.h"
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/util/atomic_file.h"
+
+using namespace lidarshop;
+
+namespace {
+
+std::vector<std::string> SplitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::stringstream stream(text);
+  for (std::string item; std::getline(stream, item, ',');) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+cv::Mat RangePicture(const Scan& scan, double min_m, double max_m) {
+  RenderOptions options;
+  options.channel = RenderChannel::kRange;
+  options.min_value = min_m;
+  options.max_value = max_m;
+  return RenderScan(scan, options).image;
+}
+
+// |range error| inside the hole, 0 (black) .. 0.5 m (yellow); grey where either scan has no return.
+cv::Mat ErrorPicture(const Scan& filled, const Scan& truth, const cv::Mat& hole) {
+  cv::Mat error(truth.rows, truth.cols, CV_32F, cv::Scalar(0));
+  cv::Mat shown(truth.rows, truth.cols, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < truth.rows; ++y) {
+    for (int x = 0; x < truth.cols; ++x) {
+      if (!hole.at<uint8_t>(y, x) || !filled.valid.at<uint8_t>(y, x) || !truth.valid.at<uint8_t>(y, x)) continue;
+      error.at<float>(y, x) = std::abs(filled.range.at<float>(y, x) - truth.range.at<float>(y, x));
+      shown.at<uint8_t>(y, x) = 255;
+    }
+  }
+  ColorScale scale = AutoScale(error, shown, ColorMap::kMagma, "m");
+  scale.min_value = 0;
+  scale.max_value = 0.5;
+  cv::Mat picture = ApplyColorMap(error, shown, scale);
+  picture.setTo(cv::Scalar(90, 90, 90), hole & ~shown);
+  return picture;
+}
+
+cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
+  cv::Mat out = picture.clone();
+  cv::putText(out, text, {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(255, 255, 255), 2);
+  cv::putText(out, text, {6, 18}, cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0), 1);
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
+  std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
+  std::string methods_text = "gradient,laplace,depth-patch,telea", markdown_path, pictures_dir;
+  std::string planar_text = "textured_ground";
+  int margin = 2;
+  FillOptions base;
+  app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the objects to remove)");
+  app.add_option("--methods", methods_text, "comma-separated fill methods")->capture_default_str();
+  app.add_option("--margin", margin, "hole = object cells grown by this many cells")->capture_default_str();
+  app.add_option("--planar", planar_text, "scenes that are planar behind the object (left out of the target mean)")
+      ->capture_default_str();
+  app.add_option("--markdown", markdown_path, "also write the tables to this file");
+  app.add_option("--pictures", pictures_dir, "write range and second-viewpoint pictures here");
+  app.add_option("--patch-radius", base.patch_radius)->capture_default_str();
+  app.add_option("--window", base.search_window_radius)->capture_default_str();
+  app.add_option("--color-weight", base.color_weight)->capture_default_str();
+  app.add_option("--gradient-weight", base.gradient_weight)->capture_default_str();
+  app.add_option("--return-weight", base.return_weight)->capture_default_str();
+  std::string priority = "criminisi", search;  // empty search = FillOptions' default
+  app.add_option("--priority", priority, "criminisi | onion-peel | random")->capture_default_str();
+  app.add_option("--search", search, "local | two-step | exhaustive | patchmatch (default: FillOptions')");
+  CLI11_PARSE(app, argc, argv);
+  base.priority = priority == "onion-peel" ? InpaintPriorityKind::kOnionPeel
+                  : priority == "random"   ? InpaintPriorityKind::kRandom
+                                           : InpaintPriorityKind::kCriminisi;
+  if (!search.empty()) {
+    base.search = search == "two-step"     ? InpaintSearchKind::kTwoStep
+                  : search == "exhaustive" ? InpaintSearchKind::kExhaustive
+                  : search == "local"      ? InpaintSearchKind::kLocal
+                                           : InpaintSearchKind::kPatchMatch;
+  }
+  const std::vector<std::string> methods = SplitList(methods_text);
+  const std::vector<std::string> planar_list = SplitList(planar_text);
+  const std::set<std::string> planar(planar_list.begin(), planar_list.end());
+
+  std::vector<std::string> scene_paths;
+  for (const auto& entry : std::filesystem::directory_iterator(scenes_dir)) {
+    if (entry.path().extension() == ".json") scene_paths.push_back(entry.path().string());
+  }
+  std::sort(scene_paths.begin(), scene_paths.end());
+  if (!pictures_dir.empty()) std::filesystem::create_directories(pictures_dir);
+
+  std::string report;
+  auto emit = [&](const std::string& text) {
+    fmt::print("{}", text);
+    std::fflush(stdout);
+    report += text;
+  };
+  emit(fmt::format("Hole = the removed object's cells grown by {} cells; truth = the same scan without the object "
+                   "(same seed). Patch radius {}, window {}, weights colour {} / gradient {} / return {}.\n",
+                   margin, base.patch_radius, base.search_window_radius, base.color_weight, base.gradient_weight,
+                   base.return_weight));
+  std::map<std::string, std::vector<double>> rmse_nonplanar, floating_all;
+  std::map<std::string, double> seconds_all;
+  std::vector<std::string> worse_than_laplace;
+  for (const std::string& path : scene_paths) {
+    const std::string stem = std::filesystem::path(path).stem().string();
+    SceneDescription scene = LoadScene(path);
+    const Scan with_object = SynthesizeScan(scene);
+    SceneDescription without = scene;
+    std::erase_if(without.objects, [](const SceneObject& object) { return object.label == 1; });
+    const Scan truth = SynthesizeScan(without);
+    const cv::Mat hole = GrowHole((with_object.label == 1) & (with_object.valid != 0), margin);
+    emit(fmt::format("\n#### {} ({} x {} cells, hole {} cells{})\n\n", stem, with_object.cols, with_object.rows,
+                     cv::countNonZero(hole), planar.count(stem) ? ", planar behind the object" : ""));
+    emit("| method | range RMSE mm | MAE mm | within 20 mm | normal error ° | seam mm (outside) | floating % | "
+         "return acc. | colour PSNR dB | seconds |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    std::map<std::string, FillResult> results;
+    std::map<std::string, double> rmse;
+    for (const std::string& name : methods) {
+      FillOptions options = base;
+      options.method = ParseFillMethod(name);
+      FillResult result = FillScan(with_object, hole, options);
+      const FillMetrics m = MeasureFill(result.scan, truth, hole);
+      emit(fmt::format("| {} | {:.1f} | {:.1f} | {:.1f} % | {:.1f} | {:.1f} ({:.1f}) | {:.2f} | {:.3f} | {:.1f} | {:.2f} |\n",
+                       name, m.range_rmse_mm, m.range_mae_mm, 100 * m.within_share, m.normal_error_deg, m.seam_mm,
+                       m.seam_outside_mm, 100 * m.floating_share, m.return_accuracy, m.color_psnr_db,
+                       result.timings.total_s));
+      rmse[name] = m.range_rmse_mm;
+      if (!planar.count(stem)) rmse_nonplanar[name].push_back(m.range_rmse_mm);
+      floating_all[name].push_back(100 * m.floating_share);
+      seconds_all[name] += result.timings.total_s;
+      results.emplace(name, std::move(result));
+    }
+    if (rmse.count("gradient") && rmse.count("laplace") && rmse["gradient"] > rmse["laplace"]) {
+      worse_than_laplace.push_back(stem);
+    }
+    if (!pictures_dir.empty()) {
+      // Range before / after / truth, same colour scale; a second viewpoint of truth, laplace and gradient.
+      const double lo = 0.0, hi = scene.scanner.max_range_m * 0.5;
+      std::vector<cv::Mat> row1 = {Labelled(RangePicture(with_object, lo, hi), "scan"),
+                                   Labelled(RangePicture(truth, lo, hi), "truth (no object)")};
+      std::vector<cv::Mat> row2;
+      const PointViewOptions view = [&] {
+        PointViewOptions v = SideView(truth, hole, 35.0);
+        v.width_px = 480;
+        v.height_px = 360;
+        return v;
+      }();
+      row2.push_back(Labelled(RenderPointView(truth, view), "truth, second viewpoint"));
+      for (const std::string& name : {std::string("laplace"), std::string("depth-patch"), std::string("gradient")}) {
+        if (!results.count(name)) continue;
+        row1.push_back(Labelled(RangePicture(results.at(name).scan, lo, hi), name));
+        PointViewOptions tinted = view;
+        tinted.synthesized_tint = 0.0;
+        row2.push_back(Labelled(RenderPointView(results.at(name).scan, tinted), name + ", second viewpoint"));
+      }
+      std::vector<cv::Mat> row3 = {Labelled(RangePicture(with_object, lo, hi), "hole: |error| 0..0.5 m")};
+      for (const auto& [name, result] : results) row3.push_back(Labelled(ErrorPicture(result.scan, truth, hole), name));
+      cv::Mat errors;
+      cv::hconcat(row3, errors);
+      WriteImage(pictures_dir + "/" + stem + "_error.png", errors);
+      cv::Mat top, bottom;
+      cv::hconcat(row1, top);
+      cv::hconcat(row2, bottom);
+      WriteImage(pictures_dir + "/" + stem + "_range.png", top);
+      WriteImage(pictures_dir + "/" + stem + "_view.png", bottom);
+    }
+  }
+  emit("\n#### Summary\n\n| method | mean range RMSE mm, non-planar scenes | mean floating % | total seconds |\n"
+       "|---|---|---|---|\n");
+  auto mean = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double x : v) s += x;
+    return v.empty() ? 0.0 : s / static_cast<double>(v.size());
+  };
+  for (const std::string& name : methods) {
+    emit(fmt::format("| {} | {:.1f} | {:.2f} | {:.1f} |\n", name, mean(rmse_nonplanar[name]), mean(floating_all[name]),
+                     seconds_all[name]));
+  }
+  if (rmse_nonplanar.count("gradient") && rmse_nonplanar.count("laplace")) {
+    emit(fmt::format("\nGradient / Laplace mean RMSE over the non-planar scenes: {:.2f} (target <= 0.5); scenes where "
+                     "gradient is worse than Laplace: {}\n",
+                     mean(rmse_nonplanar["gradient"]) / std::max(1e-9, mean(rmse_nonplanar["laplace"])),
+                     worse_than_laplace.empty() ? "none" : fmt::format("{}", fmt::join(worse_than_laplace, ", "))));
+  }
+  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  return 0;
+}

@@ -1,0 +1,491 @@
+#include "lidarshop/fill/fill.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/photo.hpp>
+
+#include "lidarshop/fill/range_gradient.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/timer.h"
+
+namespace lidarshop {
+
+using fill_internal::AbsQuantile;
+using fill_internal::GuidanceDivergence;
+using fill_internal::NearestKnownCell;
+using fill_internal::OneSidedRangeGradient;
+using fill_internal::UnanchoredCells;
+
+std::string ToString(FillMethod method) {
+  switch (method) {
+    case FillMethod::kGradient:
+      return "gradient";
+    case FillMethod::kLaplace:
+      return "laplace";
+    case FillMethod::kDepthPatch:
+      return "depth-patch";
+    case FillMethod::kTelea:
+      return "telea";
+  }
+  return "?";
+}
+
+FillMethod ParseFillMethod(const std::string& name) {
+  for (FillMethod method : {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+    if (name == ToString(method)) return method;
+  }
+  throw OptionsError(fmt::format("unknown fill method '{}' (gradient|laplace|depth-patch|telea)", name));
+}
+
+void FillOptions::Check() const {
+  CheckOption(patch_radius >= 1 && patch_radius <= 15,
+              fmt::format("FillOptions.patch_radius must be in [1, 15] cells, got {}", patch_radius));
+  CheckOption(search_window_radius >= patch_radius,
+              fmt::format("FillOptions.search_window_radius must be >= patch_radius ({}), got {}", patch_radius,
+                          search_window_radius));
+  CheckOption(std::isfinite(color_weight) && color_weight >= 0,
+              fmt::format("FillOptions.color_weight must be >= 0, got {}", color_weight));
+  CheckOption(std::isfinite(gradient_weight) && gradient_weight >= 0,
+              fmt::format("FillOptions.gradient_weight must be >= 0, got {}", gradient_weight));
+  CheckOption(std::isfinite(return_weight) && return_weight >= 0,
+              fmt::format("FillOptions.return_weight must be >= 0, got {}", return_weight));
+  CheckOption(color_weight + gradient_weight + return_weight > 0,
+              "FillOptions: at least one of color_weight, gradient_weight, return_weight must be > 0");
+  CheckOption(std::isfinite(telea_radius_cells) && telea_radius_cells > 0,
+              fmt::format("FillOptions.telea_radius_cells must be > 0, got {}", telea_radius_cells));
+  poisson.Check();
+}
+
+std::string FillResult::Summary() const {
+  return fmt::format(
+      "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s (gradients "
+      "{:.2f}, inpaint {:.2f}, poisson {:.2f}, placement {:.2f})",
+      hole_cells, synthesized_cells, no_return_cells,
+      unanchored_cells ? fmt::format(" ({} cut off from every known range)", unanchored_cells) : "", patches,
+      timings.total_s, timings.gradients_s, timings.inpaint_s, timings.poisson_s, timings.placement_s);
+}
+
+cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
+  if (margin_cells < 0) throw OptionsError(fmt::format("the hole margin must be >= 0 cells, got {}", margin_cells));
+  cv::Mat binary = hole != 0;
+  if (margin_cells == 0) return binary;
+  cv::Mat grown;
+  const int size = 2 * margin_cells + 1;
+  cv::dilate(binary, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size)));
+  return grown;
+}
+
+namespace {
+
+// What a method decides for the cells of the hole; the known cells keep the scan's values.
+struct HoleValues {
+  cv::Mat has_return;  // CV_8U 255 = the hole cell gets a return
+  cv::Mat range;       // CV_32F, reconstructed range in the hole
+  cv::Mat color;       // CV_8UC3 (scans with colour)
+  cv::Mat intensity;   // CV_32F
+  cv::Mat label;       // CV_32S (scans with labels)
+  cv::Mat source;      // CV_32SC2 (row, col) the cell's attributes came from, patch methods
+};
+
+struct Inputs {
+  const Scan* scan = nullptr;
+  cv::Mat hole;         // CV_8U 255/0
+  cv::Mat known_valid;  // CV_8U 255 = outside the hole with a return
+  cv::Mat range;        // CV_32F, 0 where no return
+  cv::Mat guide;        // CV_32FC(1 or 3): colour in grey levels, or intensity × 255
+};
+
+cv::Mat Guide(const Scan& scan) {
+  cv::Mat guide;
+  if (scan.has_color()) {
+    scan.color.convertTo(guide, CV_32FC3);
+  } else if (!scan.intensity.empty()) {
+    scan.intensity.convertTo(guide, CV_32F, 255.0);
+  } else {
+    guide = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
+  }
+  // Cells without a return are black in the guide, whatever the file held there.
+  guide.setTo(cv::Scalar::all(0), scan.valid == 0);
+  return guide;
+}
+
+// Copies the attributes of each hole cell's source cell (patch methods).
+void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
+  const Scan& scan = *in.scan;
+  out->source = source;
+  out->has_return = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  out->range = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
+  if (scan.has_color()) out->color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  if (!scan.intensity.empty()) out->intensity = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0.5));
+  if (!scan.label.empty()) out->label = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (!in.hole.at<uint8_t>(y, x)) continue;
+      const cv::Vec2i s = source.at<cv::Vec2i>(y, x);
+      if (s[0] < 0) continue;  // unreachable hole cell: stays without a return
+      if (!scan.valid.at<uint8_t>(s[0], s[1])) continue;
+      out->has_return.at<uint8_t>(y, x) = 255;
+      out->range.at<float>(y, x) = in.range.at<float>(s[0], s[1]);
+      if (!out->color.empty()) out->color.at<cv::Vec3b>(y, x) = scan.color.at<cv::Vec3b>(s[0], s[1]);
+      if (!out->intensity.empty()) out->intensity.at<float>(y, x) = scan.intensity.at<float>(s[0], s[1]);
+      if (!out->label.empty()) out->label.at<int32_t>(y, x) = scan.label.at<int32_t>(s[0], s[1]);
+    }
+  }
+}
+
+// The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
+// has-return channel; zero in the hole.
+cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
+  std::vector<cv::Mat> planes;
+  cv::split(in.guide, planes);
+  for (const cv::Mat& s : structure) planes.push_back(s.clone());
+  cv::Mat has_return;
+  in.scan->valid.convertTo(has_return, CV_32F, 255.0 / 255.0);
+  planes.push_back(has_return);
+  for (cv::Mat& plane : planes) plane.setTo(0, in.hole);  // (cv::Scalar holds 4 channels, the joint image more)
+  cv::Mat joint;
+  cv::merge(planes, joint);
+  return joint;
+}
+
+// 255 · asinh(v / scale) / asinh(1): linear near 0, logarithmic for large values, so that steep ground near the
+// horizon and depth jumps keep their order without drowning the colour.
+cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
+  cv::Mat scaled(values.size(), CV_32F);
+  const double gain = 255.0 / std::asinh(1.0);
+  for (int y = 0; y < values.rows; ++y) {
+    const float* in = values.ptr<float>(y);
+    float* out = scaled.ptr<float>(y);
+    for (int x = 0; x < values.cols; ++x) out[x] = static_cast<float>(gain * std::asinh(in[x] / scale));
+  }
+  return scaled;
+}
+
+InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure, const FillOptions& options,
+                        Progress* progress) {
+  InpaintOptions inpaint;
+  inpaint.patch_radius = options.patch_radius;
+  inpaint.search = options.search;
+  inpaint.priority = options.priority;
+  inpaint.local_window_radius = options.search_window_radius;
+  inpaint.seed = options.seed;
+  inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()), static_cast<float>(options.color_weight));
+  for (size_t k = 0; k < structure.size(); ++k) inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
+  inpaint.channel_weights.push_back(static_cast<float>(options.return_weight));
+  return Inpaint(JointImage(in, structure), in.hole, inpaint, progress);
+}
+
+// Range in Ω = the hole cells with a return, from the Poisson equation with divergence `divergence` (empty =
+// Laplace); returns the channels of `boundary` solved. Cells of Ω cut off from every known range lose their
+// return.
+cv::Mat SolveInHole(const Inputs& in, const FillOptions& options, HoleValues* values, const cv::Mat& boundary,
+                    const cv::Mat& guidance_x, const cv::Mat& guidance_y, int64_t* unanchored) {
+  cv::Mat domain = values->has_return.clone();
+  const cv::Mat cut_off = UnanchoredCells(domain, in.known_valid);
+  *unanchored = cv::countNonZero(cut_off);
+  domain.setTo(0, cut_off);
+  values->has_return.setTo(0, cut_off);
+  const cv::Mat no_data = (in.known_valid | domain) == 0;
+  if (cv::countNonZero(domain) == 0) return boundary.clone();
+  const PoissonSystem system = PreparePoisson(domain, options.poisson, no_data);
+  cv::Mat divergence;
+  if (!guidance_x.empty()) divergence = GuidanceDivergence(guidance_x, guidance_y, no_data);
+  return SolvePoisson(system, boundary, divergence).image;
+}
+
+void GradientFill(const Inputs& in, const FillOptions& options, Progress* progress, HoleValues* values,
+                  FillResult* result) {
+  Timer timer;
+  // The field whose gradients are copied: the range, or its inverse, which is an affine function of the ray
+  // direction on every plane (1/r = n·d / c for the plane n·p = c), so that its gradients change slowly across
+  // a surface and a patch from a few rows away still fits.
+  cv::Mat field = in.range.clone();
+  if (options.inverse_range) {
+    for (int y = 0; y < field.rows; ++y) {
+      float* row = field.ptr<float>(y);
+      for (int x = 0; x < field.cols; ++x) row[x] = row[x] > 0 ? 1.0f / row[x] : 0.0f;
+    }
+  }
+  const auto gradient = OneSidedRangeGradient(field, in.known_valid);
+  // Patches are matched on the range gradients (they tell a wall from the ground more sharply than those of
+  // 1/r), and the gradients of `field` are copied.
+  const auto matched = options.inverse_range ? OneSidedRangeGradient(in.range, in.known_valid) : gradient;
+  const double scale = std::max(AbsQuantile(matched.gx, in.known_valid, 0.9, 1e-9),
+                                AbsQuantile(matched.gy, in.known_valid, 0.9, 1e-9));
+  result->timings.gradients_s = timer.Seconds();
+
+  timer.Restart();
+  const InpaintResult patches =
+      PatchFill(in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress);
+  result->timings.inpaint_s = timer.Seconds();
+  result->patches = patches.iterations;
+  result->candidates_evaluated = patches.candidates_evaluated;
+  result->fill_order = patches.fill_iteration;
+  CopyFromSources(in, patches.source_pixel, values);
+
+  // The guidance field: known gradients outside, the copied ones inside.
+  cv::Mat gx = gradient.gx.clone(), gy = gradient.gy.clone();
+  for (int y = 0; y < in.hole.rows; ++y) {
+    for (int x = 0; x < in.hole.cols; ++x) {
+      if (!in.hole.at<uint8_t>(y, x)) continue;
+      const cv::Vec2i s = patches.source_pixel.at<cv::Vec2i>(y, x);
+      if (s[0] < 0) continue;
+      gx.at<float>(y, x) = gradient.gx.at<float>(s[0], s[1]);
+      gy.at<float>(y, x) = gradient.gy.at<float>(s[0], s[1]);
+    }
+  }
+  cv::magnitude(gradient.gx, gradient.gy, result->gradient_magnitude_before);
+  result->gradient_magnitude_before.setTo(0, in.hole);
+  cv::magnitude(gx, gy, result->gradient_magnitude_after);
+
+  timer.Restart();
+  cv::Mat boundary;
+  field.convertTo(boundary, CV_64F);
+  const cv::Mat solved = SolveInHole(in, options, values, boundary, gx, gy, &result->unanchored_cells);
+  solved.convertTo(values->range, CV_32F);
+  if (options.inverse_range) {
+    // A non-positive inverse range would be a point behind the scanner or at infinity: no return.
+    for (int y = 0; y < values->range.rows; ++y) {
+      for (int x = 0; x < values->range.cols; ++x) {
+        float& r = values->range.at<float>(y, x);
+        r = r > 0 ? 1.0f / r : 0.0f;
+      }
+    }
+  }
+  result->timings.poisson_s = timer.Seconds();
+}
+
+void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* progress, HoleValues* values,
+                    FillResult* result) {
+  Timer timer;
+  // The range itself as the structure channel, scaled by its spread over the known cells.
+  const double low = AbsQuantile(in.range, in.known_valid, 0.05, 0.0);
+  const double high = AbsQuantile(in.range, in.known_valid, 0.95, low + 1e-3);
+  cv::Mat shifted;
+  in.range.convertTo(shifted, CV_32F, 1.0, -low);
+  const InpaintResult patches = PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress);
+  result->timings.inpaint_s = timer.Seconds();
+  result->patches = patches.iterations;
+  result->candidates_evaluated = patches.candidates_evaluated;
+  result->fill_order = patches.fill_iteration;
+  CopyFromSources(in, patches.source_pixel, values);  // copies the range as it is: the method under test
+  result->unanchored_cells = 0;
+}
+
+// "Has a return" and the label from the nearest known cell (laplace and telea make no decision of their own).
+void NearestKnownDecision(const Inputs& in, HoleValues* values) {
+  const cv::Mat nearest = NearestKnownCell(in.hole);
+  const Scan& scan = *in.scan;
+  values->has_return = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  if (!scan.label.empty()) values->label = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      const cv::Vec2i s = nearest.at<cv::Vec2i>(y, x);
+      if (s[0] < 0 || !scan.valid.at<uint8_t>(s[0], s[1])) continue;
+      values->has_return.at<uint8_t>(y, x) = 255;
+      if (!values->label.empty()) values->label.at<int32_t>(y, x) = scan.label.at<int32_t>(s[0], s[1]);
+    }
+  }
+}
+
+void LaplaceFill(const Inputs& in, const FillOptions& options, HoleValues* values, FillResult* result) {
+  const Scan& scan = *in.scan;
+  NearestKnownDecision(in, values);
+  Timer timer;
+  // Range, intensity and colour in one solve.
+  std::vector<cv::Mat> planes = {in.range};
+  if (!scan.intensity.empty()) planes.push_back(scan.intensity);
+  if (scan.has_color()) {
+    cv::Mat color;
+    scan.color.convertTo(color, CV_32FC3);
+    std::vector<cv::Mat> rgb;
+    cv::split(color, rgb);
+    planes.insert(planes.end(), rgb.begin(), rgb.end());
+  }
+  cv::Mat boundary;
+  cv::merge(planes, boundary);
+  boundary.convertTo(boundary, CV_64F);
+  const cv::Mat solved = SolveInHole(in, options, values, boundary, {}, {}, &result->unanchored_cells);
+  std::vector<cv::Mat> out;
+  cv::split(solved, out);
+  out[0].convertTo(values->range, CV_32F);
+  int next = 1;
+  if (!scan.intensity.empty()) out[next++].convertTo(values->intensity, CV_32F);
+  if (scan.has_color()) {
+    cv::Mat color;
+    cv::merge(std::vector<cv::Mat>(out.begin() + next, out.begin() + next + 3), color);
+    color.convertTo(values->color, CV_8UC3);  // rounds and saturates
+  }
+  result->timings.poisson_s = timer.Seconds();
+}
+
+void TeleaFill(const Inputs& in, const FillOptions& options, HoleValues* values, FillResult* result) {
+  const Scan& scan = *in.scan;
+  NearestKnownDecision(in, values);
+  Timer timer;
+  // Cells without a return near the hole are not sources either: mask them with the hole.
+  const int reach = static_cast<int>(std::ceil(options.telea_radius_cells)) + 2;
+  const cv::Mat near_hole = GrowHole(in.hole, reach);
+  const cv::Mat mask = in.hole | (near_hole & (scan.valid == 0));
+  // OpenCV's float path carries an absolute bias of about 0.1 per fill (measured: a constant 25.3 becomes
+  // 25.40), so the range is inpainted on the 0..255 scale of its spread near the hole, then scaled back.
+  double low = 0, high = 0;
+  cv::minMaxLoc(in.range, &low, &high, nullptr, nullptr, near_hole & in.known_valid);
+  const double span = std::max(high - low, 1e-3);
+  cv::Mat scaled;
+  in.range.convertTo(scaled, CV_32F, 255.0 / span, -low * 255.0 / span);
+  cv::inpaint(scaled, mask, values->range, options.telea_radius_cells, cv::INPAINT_TELEA);
+  values->range.convertTo(values->range, CV_32F, span / 255.0, low);
+  if (!scan.intensity.empty()) cv::inpaint(scan.intensity, mask, values->intensity, options.telea_radius_cells, cv::INPAINT_TELEA);
+  if (scan.has_color()) cv::inpaint(scan.color, mask, values->color, options.telea_radius_cells, cv::INPAINT_TELEA);
+  result->timings.inpaint_s = timer.Seconds();
+  result->unanchored_cells = 0;
+}
+
+void CheckInputs(const Scan& scan, const cv::Mat& hole) {
+  if (hole.empty() || hole.rows != scan.rows || hole.cols != scan.cols) {
+    throw InputError(fmt::format("the hole mask is {} x {} (cols x rows), the scan is {} x {}: they must match",
+                                 hole.cols, hole.rows, scan.cols, scan.rows));
+  }
+  if (hole.depth() != CV_8U || hole.channels() != 1) {
+    throw InputError("the hole mask must be a single-channel 8-bit image (white = fill)");
+  }
+  if (scan.direction.empty()) {
+    throw InputError("the scan has no ray directions (an unorganized cloud): only organized scans can be filled");
+  }
+}
+
+// Normals of filled cells from their grid neighbours, oriented toward the scanner (scans with a normal channel).
+void GridNormals(const cv::Mat& filled, Scan* scan) {
+  auto point = [&](int y, int x, Eigen::Vector3f* p) {
+    if (y < 0 || y >= scan->rows || x < 0 || x >= scan->cols || !scan->valid.at<uint8_t>(y, x)) return false;
+    const cv::Vec3f v = scan->point.at<cv::Vec3f>(y, x);
+    *p = Eigen::Vector3f(v[0], v[1], v[2]);
+    return true;
+  };
+  for (int y = 0; y < scan->rows; ++y) {
+    for (int x = 0; x < scan->cols; ++x) {
+      if (!filled.at<uint8_t>(y, x)) continue;
+      Eigen::Vector3f c;
+      point(y, x, &c);
+      // Forward difference, or backward where the forward neighbour has no return.
+      auto step = [&](int dy, int dx) {
+        Eigen::Vector3f q;
+        if (point(y + dy, x + dx, &q)) return Eigen::Vector3f(q - c);
+        if (point(y - dy, x - dx, &q)) return Eigen::Vector3f(c - q);
+        return Eigen::Vector3f(Eigen::Vector3f::Zero());
+      };
+      Eigen::Vector3f n = step(0, 1).cross(step(1, 0));
+      if (n.norm() > 0) {
+        n.normalize();
+        if (n.dot(c) > 0) n = -n;
+      }
+      scan->normal.at<cv::Vec3f>(y, x) = cv::Vec3f(n.x(), n.y(), n.z());
+    }
+  }
+}
+
+Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* result) {
+  const Scan& scan = *in.scan;
+  Scan out = Clone(scan);
+  if (out.synthesized.empty()) out.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  result->filled = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (!in.hole.at<uint8_t>(y, x)) continue;
+      const float range = values.range.empty() ? 0.0f : values.range.at<float>(y, x);
+      const bool keep = values.has_return.at<uint8_t>(y, x) && std::isfinite(range) && range > 0.0f;
+      out.valid.at<uint8_t>(y, x) = keep ? kValid : 0;
+      out.range.at<float>(y, x) = keep ? range : 0.0f;
+      const cv::Vec3f direction = scan.direction.at<cv::Vec3f>(y, x);
+      out.point.at<cv::Vec3f>(y, x) = keep ? direction * range : cv::Vec3f(0, 0, 0);
+      out.synthesized.at<uint8_t>(y, x) = keep ? kValid : 0;
+      if (!out.intensity.empty()) {
+        out.intensity.at<float>(y, x) =
+            keep && !values.intensity.empty() ? std::clamp(values.intensity.at<float>(y, x), 0.0f, 1.0f) : 0.5f;
+      }
+      if (out.has_color()) {
+        out.color.at<cv::Vec3b>(y, x) = keep && !values.color.empty() ? values.color.at<cv::Vec3b>(y, x) : cv::Vec3b(0, 0, 0);
+      }
+      if (!out.label.empty()) {
+        out.label.at<int32_t>(y, x) = keep && !values.label.empty() ? values.label.at<int32_t>(y, x) : kNoLabel;
+      }
+      if (!out.true_range.empty()) out.true_range.at<float>(y, x) = 0.0f;  // no truth for a synthesized point
+      if (!out.normal.empty()) out.normal.at<cv::Vec3f>(y, x) = cv::Vec3f(0, 0, 0);
+      if (keep) {
+        result->filled.at<uint8_t>(y, x) = 255;
+        ++result->synthesized_cells;
+      } else {
+        ++result->no_return_cells;
+      }
+    }
+  }
+  if (!out.normal.empty()) GridNormals(result->filled, &out);
+  return out;
+}
+
+}  // namespace
+
+FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options, Progress* progress) {
+  options.Check();
+  CheckInputs(scan, hole_in);
+  Timer total;
+  FillResult result;
+  Inputs in;
+  in.scan = &scan;
+  in.hole = hole_in != 0;
+  result.hole_cells = cv::countNonZero(in.hole);
+  if (result.hole_cells == 0) {
+    result.scan = Clone(scan);
+    result.filled = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    result.timings.total_s = total.Seconds();
+    return result;
+  }
+  in.known_valid = (scan.valid != 0) & (in.hole == 0);
+  if (cv::countNonZero(in.known_valid) == 0) {
+    throw InputError(
+        "the hole mask leaves no known cell with a return: there is nothing to fill it from (the mask covers "
+        "every return of the scan)");
+  }
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (!in.hole.at<uint8_t>(y, x)) continue;
+      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);
+      if (!(std::abs(d.dot(d) - 1.0f) < 1e-2f)) {
+        throw InputError(fmt::format(
+            "cell (row {}, col {}) of the hole has no ray direction: the scan's grid is unknown there", y, x));
+      }
+    }
+  }
+  in.range = RangeImage(scan);
+  in.range.setTo(0, scan.valid == 0);
+  in.guide = Guide(scan);
+
+  HoleValues values;
+  switch (options.method) {
+    case FillMethod::kGradient:
+      GradientFill(in, options, progress, &values, &result);
+      break;
+    case FillMethod::kDepthPatch:
+      DepthPatchFill(in, options, progress, &values, &result);
+      break;
+    case FillMethod::kLaplace:
+      LaplaceFill(in, options, &values, &result);
+      break;
+    case FillMethod::kTelea:
+      TeleaFill(in, options, &values, &result);
+      break;
+  }
+  if (!values.source.empty()) result.source_cell = values.source;
+  Timer timer;
+  result.scan = PlaceAlongRays(in, values, &result);
+  result.timings.placement_s = timer.Seconds();
+  result.timings.total_s = total.Seconds();
+  return result;
+}
+
+}  // namespace lidarshop

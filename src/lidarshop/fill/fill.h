@@ -1,0 +1,103 @@
+// Hole filling in organized scans: remove an object, or complete the surface hidden behind it (thesis ch. 6).
+//
+// A hole is a set of cells of the scan's ray image (CV_8U rows x cols, image orientation, non-zero = fill this
+// cell; returns already there are replaced). The default method works in the gradient domain (thesis 6.4–6.5):
+//   1. range gradients: forward differences of the range image, one-sided (backward) where the forward
+//      neighbour is in the hole or has no return, 0 where neither neighbour has a return;
+//   2. patch-based inpainting (inpaint/) of a joint image — colour (or intensity), the two range-gradient
+//      channels and a has-return channel — the colour leading the choice of patches. Every filled cell records
+//      the cell it was copied from; its gradients, colour, intensity, label and whether it has a return are
+//      copied from that cell (so sky stays sky behind a lamp post);
+//   3. range in the hole from the Poisson equation ∇²r = div G with the copied gradients as guidance G and the
+//      known ranges around the hole as Dirichlet boundary (poisson/); cells without a return are no-flux
+//      boundaries (edges to them are left out), not zero-range Dirichlet values;
+//   4. every new point is placed along its own cell's ray (`direction`) at the reconstructed range — never on
+//      a height field — and flagged in `synthesized`.
+// Baselines in the same code path (the same return decision where they make none of their own):
+//   laplace      membrane fill ∇²r = 0 of range, colour and intensity (thesis eq. 6.5);
+//   depth-patch  the same patch fill with the range itself in place of its gradients, copied directly (the
+//                failure of thesis 6.3: patches from another distance float);
+//   telea        OpenCV's fast-marching inpainting (Telea 2004) of the range image and the colours.
+// Laplace and Telea decide "has a return" from the nearest known cell.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/poisson/poisson.h"
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+class Progress;
+
+enum class FillMethod { kGradient, kLaplace, kDepthPatch, kTelea };
+// "gradient", "laplace", "depth-patch", "telea"; the parser throws OptionsError naming the choices.
+std::string ToString(FillMethod method);
+FillMethod ParseFillMethod(const std::string& name);
+
+struct FillOptions {
+  FillMethod method = FillMethod::kGradient;
+  // Patch fill (gradient and depth-patch).
+  int patch_radius = 4;  // cells; patches are (2r+1)² (9 x 9: with 6 channels one AVX-512 row per patch row)
+  InpaintPriorityKind priority = InpaintPriorityKind::kCriminisi;  // fill order
+  // PatchMatch: random samples over the whole scan plus samples near the target; measured best on
+  // data/fill_eval (a surface hidden behind a large object is found far away, e.g. a facade above a car).
+  InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
+  int search_window_radius = 50;  // cells; local window (local search; PatchMatch's near samples)
+  // Channel weights of the patch difference. Colour is in grey levels (0..255, or intensity × 255); a range
+  // gradient g becomes 255 · asinh(g / s) / asinh(1) with s its 90th percentile over the known cells (range
+  // channel of depth-patch: s = its 5–95 % spread), linear near 0 and logarithmic for steep ground and jumps.
+  double color_weight = 1.0;     // per colour channel (>= 0)
+  double gradient_weight = 1.0;  // per range-gradient channel (>= 0)
+  double return_weight = 1.0;    // has-return channel, 0 or 255 (>= 0)
+  // Gradient method: copy the gradients of the inverse range 1/r instead of the range (patches are still
+  // matched on the range gradients). On a plane 1/r is an affine function of the ray direction, so its
+  // gradients vary slowly over a surface and a patch taken a few rows away (steep ground near the horizon)
+  // still continues it correctly; false = the thesis's range gradients, matched and copied.
+  bool inverse_range = true;
+  // Telea baseline.
+  double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
+  PoissonOptions poisson;           // range reconstruction (and the laplace baseline)
+  uint64_t seed = 0;                // random choices of the patch fill (ties are broken by position)
+  void Check() const;               // throws OptionsError
+};
+
+struct FillTimings {
+  double gradients_s = 0, inpaint_s = 0, poisson_s = 0, placement_s = 0, total_s = 0;  // wall seconds
+};
+
+struct FillResult {
+  Scan scan;  // the input with the hole filled; every cell outside the hole is a bit-exact copy
+  // CV_8U rows x cols, 255 = a hole cell that got a (synthesized) return; the same as scan.synthesized there.
+  cv::Mat filled;
+  int64_t hole_cells = 0;         // non-zero cells of the mask
+  int64_t synthesized_cells = 0;  // hole cells given a return
+  int64_t no_return_cells = 0;    // hole cells left without a return (sky, beyond range)
+  int64_t unanchored_cells = 0;   // cells decided "return" but cut off from every known range (left empty)
+  int patches = 0;                // patches copied (patch methods)
+  int64_t candidates_evaluated = 0;
+  // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
+  cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole
+  cv::Mat gradient_magnitude_after;   // |∇r| of the guidance after inpainting
+  cv::Mat fill_order;                 // CV_32S: patch iteration that filled each cell, −1 = known
+  cv::Mat source_cell;                // CV_32SC2: (row, col) each hole cell was copied from, (−1, −1) = known
+  FillTimings timings;
+  std::string Summary() const;  // one line
+};
+
+// Fills `hole` in `scan`. Throws InputError when the mask's size differs from the scan's, when the mask
+// leaves no known cell with a return, or when the scan has no ray directions (an unorganized cloud).
+// An empty mask returns a copy of the scan.
+FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
+                    Progress* progress = nullptr);
+
+// The hole grown by `margin_cells` (a disc), e.g. an object mask grown so that mixed pixels at its silhouette
+// are filled too. CV_8U 255/0.
+cv::Mat GrowHole(const cv::Mat& hole, int margin_cells);
+
+}  // namespace lidarshop

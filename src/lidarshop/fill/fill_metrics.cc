@@ -1,0 +1,152 @@
+#include "lidarshop/fill/fill_metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/pointset/kdtree.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+bool Valid(const Scan& scan, int y, int x) {
+  return y >= 0 && y < scan.rows && x >= 0 && x < scan.cols && scan.valid.at<uint8_t>(y, x) != 0;
+}
+
+Eigen::Vector3f PointAt(const Scan& scan, int y, int x) {
+  const cv::Vec3f p = scan.point.at<cv::Vec3f>(y, x);
+  return {p[0], p[1], p[2]};
+}
+
+// Unit normal of the least-squares plane through the valid points of a window, or zero when too few.
+Eigen::Vector3f WindowNormal(const Scan& scan, int y, int x, int radius) {
+  std::vector<Eigen::Vector3f> points;
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      if (Valid(scan, y + dy, x + dx)) points.push_back(PointAt(scan, y + dy, x + dx));
+    }
+  }
+  if (points.size() < 5) return Eigen::Vector3f::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += p.cast<double>();
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto& p : points) {
+    const Eigen::Vector3d d = p.cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  return solver.eigenvectors().col(0).cast<float>();  // smallest eigenvalue first
+}
+
+float TruthRange(const Scan& truth, int y, int x) {
+  if (!truth.true_range.empty() && truth.true_range.at<float>(y, x) > 0) return truth.true_range.at<float>(y, x);
+  return truth.range.at<float>(y, x);
+}
+
+}  // namespace
+
+FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& hole_in,
+                        const FillMetricsOptions& options) {
+  if (filled.rows != truth.rows || filled.cols != truth.cols || hole_in.rows != truth.rows ||
+      hole_in.cols != truth.cols) {
+    throw InputError(fmt::format("MeasureFill: the fill ({} x {}), truth ({} x {}) and hole ({} x {}) differ",
+                                 filled.cols, filled.rows, truth.cols, truth.rows, hole_in.cols, hole_in.rows));
+  }
+  const cv::Mat hole = hole_in != 0;
+  FillMetrics m;
+  m.hole_cells = cv::countNonZero(hole);
+  if (m.hole_cells == 0) return m;
+
+  std::vector<Eigen::Vector3f> truth_points;
+  for (int y = 0; y < truth.rows; ++y) {
+    for (int x = 0; x < truth.cols; ++x) {
+      if (Valid(truth, y, x)) truth_points.push_back(PointAt(truth, y, x));
+    }
+  }
+  const PointKdTree tree(std::move(truth_points));
+
+  double sum_sq = 0, sum_abs = 0, color_sq = 0, normal_deg = 0;
+  int64_t within = 0, same_return = 0, synthesized = 0, floating = 0, normals = 0, color_values = 0;
+  const bool color = filled.has_color() && truth.has_color();
+  for (int y = 0; y < truth.rows; ++y) {
+    for (int x = 0; x < truth.cols; ++x) {
+      if (!hole.at<uint8_t>(y, x)) continue;
+      const bool f = Valid(filled, y, x), t = Valid(truth, y, x);
+      if (f == t) ++same_return;
+      if (f) {
+        ++synthesized;
+        const NearestResult nearest = tree.NearestWithin(PointAt(filled, y, x), static_cast<float>(options.floating_m));
+        if (!nearest.found()) ++floating;
+      }
+      if (!f || !t) continue;
+      ++m.compared_cells;
+      const double error = static_cast<double>(filled.range.at<float>(y, x)) - TruthRange(truth, y, x);
+      sum_sq += error * error;
+      sum_abs += std::abs(error);
+      if (std::abs(error) <= options.within_m) ++within;
+      if (color) {
+        const cv::Vec3b a = filled.color.at<cv::Vec3b>(y, x), b = truth.color.at<cv::Vec3b>(y, x);
+        for (int c = 0; c < 3; ++c) color_sq += (a[c] - b[c]) * (a[c] - b[c]);
+        color_values += 3;
+      }
+      if (!truth.normal.empty()) {
+        const Eigen::Vector3f n = WindowNormal(filled, y, x, options.normal_window_radius);
+        const cv::Vec3f tn = truth.normal.at<cv::Vec3f>(y, x);
+        const Eigen::Vector3f true_normal(tn[0], tn[1], tn[2]);
+        if (n.norm() > 0.5f && true_normal.norm() > 0.5f) {
+          const double cosine = std::min(1.0, std::abs(static_cast<double>(n.dot(true_normal.normalized()))));
+          normal_deg += std::acos(cosine) * 180.0 / M_PI;
+          ++normals;
+        }
+      }
+    }
+  }
+  if (m.compared_cells > 0) {
+    m.range_rmse_mm = 1000.0 * std::sqrt(sum_sq / static_cast<double>(m.compared_cells));
+    m.range_mae_mm = 1000.0 * sum_abs / static_cast<double>(m.compared_cells);
+    m.within_share = static_cast<double>(within) / static_cast<double>(m.compared_cells);
+  }
+  if (normals > 0) m.normal_error_deg = normal_deg / static_cast<double>(normals);
+  if (synthesized > 0) m.floating_share = static_cast<double>(floating) / static_cast<double>(synthesized);
+  m.return_accuracy = static_cast<double>(same_return) / static_cast<double>(m.hole_cells);
+  if (color_values > 0) {
+    const double mse = color_sq / static_cast<double>(color_values);
+    m.color_psnr_db = mse > 0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : 99.0;
+  }
+
+  // Seams: range jumps across the hole boundary against those just outside it.
+  cv::Mat band;
+  const int size = 2 * options.seam_band_cells + 1;
+  cv::dilate(hole, band, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+  band &= ~hole;
+  double seam = 0, outside = 0;
+  int64_t seam_edges = 0, outside_edges = 0;
+  for (int y = 0; y < filled.rows; ++y) {
+    for (int x = 0; x < filled.cols; ++x) {
+      for (const auto& [dy, dx] : {std::pair{0, 1}, std::pair{1, 0}}) {
+        const int ny = y + dy, nx = x + dx;
+        if (!Valid(filled, y, x) || !Valid(filled, ny, nx)) continue;
+        const double jump = std::abs(filled.range.at<float>(y, x) - filled.range.at<float>(ny, nx));
+        const bool a = hole.at<uint8_t>(y, x) != 0, b = hole.at<uint8_t>(ny, nx) != 0;
+        if (a != b) {
+          seam += jump;
+          ++seam_edges;
+        } else if (!a && band.at<uint8_t>(y, x) && band.at<uint8_t>(ny, nx)) {
+          outside += jump;
+          ++outside_edges;
+        }
+      }
+    }
+  }
+  if (seam_edges > 0) m.seam_mm = 1000.0 * seam / static_cast<double>(seam_edges);
+  if (outside_edges > 0) m.seam_outside_mm = 1000.0 * outside / static_cast<double>(outside_edges);
+  return m;
+}
+
+}  // namespace lidarshop

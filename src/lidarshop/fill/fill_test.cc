@@ -1,0 +1,226 @@
+#include "lidarshop/fill/fill.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/fill/range_gradient.h"
+#include "lidarshop/poisson/poisson.h"
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using fill_internal::GuidanceDivergence;
+using fill_internal::NearestKnownCell;
+using fill_internal::OneSidedRangeGradient;
+using fill_internal::UnanchoredCells;
+
+// A box in front of a wall that meets textured ground: non-planar behind the box. Label 1 = the box.
+constexpr const char* kWallScene = R"({
+  "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-20, 20], "elevation_deg": [-20, 10], "columns": 160,
+              "rows": 120, "max_range": 40, "los_noise_sigma": 0.002, "seed": 5},
+  "objects": [
+    {"primitive": "plane", "size": [40, 40], "translate": [0, 15, 0], "label": 0, "texture": "grass"},
+    {"primitive": "wall", "size": [12, 0.3, 2.5], "translate": [0, 7, 0], "label": 2, "texture": "brick",
+     "color": [158, 68, 48]},
+    {"primitive": "box", "size": [0.8, 0.5, 1.2], "translate": [0.2, 4.5, 0.6], "label": 1, "color": [40, 60, 200]}
+  ]
+})";
+
+// A post against the sky: the top of the hole has nothing behind it.
+constexpr const char* kSkyScene = R"({
+  "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-12, 12], "elevation_deg": [-20, 35], "columns": 90,
+              "rows": 160, "max_range": 40, "seed": 6},
+  "objects": [
+    {"primitive": "plane", "size": [40, 40], "translate": [0, 15, 0], "label": 0, "texture": "grass"},
+    {"primitive": "cylinder", "radius": 0.12, "height": 5, "translate": [0, 4, 2.5], "label": 1,
+     "color": [90, 90, 90]}
+  ]
+})";
+
+struct Case {
+  Scan scan, truth;
+  cv::Mat hole;
+};
+
+Case MakeCase(const char* json, int margin) {
+  const SceneDescription scene = ParseScene(json, "test scene", ".");
+  SceneDescription without = scene;
+  std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
+  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  c.hole = GrowHole((c.scan.label == 1) & (c.scan.valid != 0), margin);
+  return c;
+}
+
+TEST(RangeGradient, OneSidedAtTheHoleAndZeroWhereIsolated) {
+  // Row 0: 1 2 [hole] 5 ; row 1: 3 4 6 7, all with returns; (0, 3) isolated horizontally and vertically used.
+  cv::Mat range = (cv::Mat_<float>(2, 4) << 1, 2, 0, 5, 3, 4, 6, 7.5f);
+  cv::Mat usable = (cv::Mat_<uint8_t>(2, 4) << 255, 255, 0, 255, 255, 255, 255, 255);
+  const auto g = OneSidedRangeGradient(range, usable);
+  EXPECT_FLOAT_EQ(g.gx.at<float>(0, 0), 1.0f);  // forward
+  EXPECT_FLOAT_EQ(g.gx.at<float>(0, 1), 1.0f);  // right neighbour in the hole: backward 2 − 1
+  EXPECT_FLOAT_EQ(g.gx.at<float>(0, 2), 0.0f);  // the hole itself
+  EXPECT_FLOAT_EQ(g.gx.at<float>(0, 3), 0.0f);  // no usable horizontal neighbour
+  EXPECT_FLOAT_EQ(g.gx.at<float>(1, 3), 1.5f);  // last column: backward 7.5 − 6
+  EXPECT_FLOAT_EQ(g.gy.at<float>(0, 3), 2.5f);  // forward down
+  EXPECT_FLOAT_EQ(g.gy.at<float>(1, 0), 2.0f);  // last row: backward 3 − 1
+}
+
+TEST(RangeGradient, NearestKnownCellAndUnanchoredParts) {
+  cv::Mat hole(5, 5, CV_8U, cv::Scalar(0));
+  hole(cv::Rect(1, 1, 3, 3)) = 255;
+  const cv::Mat nearest = NearestKnownCell(hole);
+  EXPECT_EQ(nearest.at<cv::Vec2i>(1, 1), cv::Vec2i(0, 1));  // first reached from above
+  EXPECT_EQ(nearest.at<cv::Vec2i>(0, 0), cv::Vec2i(-1, -1));  // known cells point nowhere
+  EXPECT_GE(nearest.at<cv::Vec2i>(2, 2)[0], 0);
+  cv::Mat anchor(5, 5, CV_8U, cv::Scalar(0));
+  anchor.at<uint8_t>(0, 0) = 255;  // touches nothing of the hole (diagonal only)
+  EXPECT_EQ(cv::countNonZero(UnanchoredCells(hole, anchor)), 9);
+  anchor.at<uint8_t>(0, 2) = 255;
+  EXPECT_EQ(cv::countNonZero(UnanchoredCells(hole, anchor)), 0);
+}
+
+TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {
+  // A ramp r = 2 + 0.5 x + 0.25 y; the hole is a block; one known cell beside the hole has no data and must
+  // not pull the solution (it holds a wrong value on purpose).
+  cv::Mat ramp(12, 14, CV_64F);
+  for (int y = 0; y < ramp.rows; ++y)
+    for (int x = 0; x < ramp.cols; ++x) ramp.at<double>(y, x) = 2 + 0.5 * x + 0.25 * y;
+  cv::Mat hole(ramp.size(), CV_8U, cv::Scalar(0));
+  hole(cv::Rect(4, 3, 5, 5)) = 255;
+  cv::Mat no_data(ramp.size(), CV_8U, cv::Scalar(0));
+  no_data.at<uint8_t>(5, 3) = 255;
+  cv::Mat boundary = ramp.clone();
+  boundary.setTo(-100.0, no_data);
+  cv::Mat gx(ramp.size(), CV_32F, cv::Scalar(0.5f)), gy(ramp.size(), CV_32F, cv::Scalar(0.25f));
+  const PoissonSystem system = PreparePoisson(hole, {}, no_data);
+  const cv::Mat solved = SolvePoisson(system, boundary, GuidanceDivergence(gx, gy, no_data)).image;
+  for (int y = 3; y < 8; ++y)
+    for (int x = 4; x < 9; ++x) EXPECT_NEAR(solved.at<double>(y, x), ramp.at<double>(y, x), 1e-9) << y << "," << x;
+  // Without the no-data mask the wrong value leaks in: the test can fail.
+  const cv::Mat leaked = SolvePoisson(PreparePoisson(hole), boundary, GuidanceDivergence(gx, gy, cv::Mat::zeros(ramp.size(), CV_8U))).image;
+  EXPECT_GT(std::abs(leaked.at<double>(5, 4) - ramp.at<double>(5, 4)), 1.0);
+}
+
+TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
+  const Case c = MakeCase(kWallScene, 2);
+  ASSERT_GT(cv::countNonZero(c.hole), 500);
+  FillOptions options;
+  const FillResult gradient = FillScan(c.scan, c.hole, options);
+  options.method = FillMethod::kLaplace;
+  const FillResult laplace = FillScan(c.scan, c.hole, options);
+  const FillMetrics g = MeasureFill(gradient.scan, c.truth, c.hole);
+  const FillMetrics l = MeasureFill(laplace.scan, c.truth, c.hole);
+  EXPECT_LT(g.range_rmse_mm, l.range_rmse_mm) << "gradient " << g.range_rmse_mm << " laplace " << l.range_rmse_mm;
+  EXPECT_LT(g.floating_share, 0.01);
+  EXPECT_GT(g.return_accuracy, 0.97);
+
+  // Outside the hole: a bit-exact copy of every channel.
+  const cv::Mat outside = c.hole == 0;
+  auto changed_outside = [&](const cv::Mat& a, const cv::Mat& b) {
+    std::vector<cv::Mat> pa, pb;
+    cv::split(a, pa);
+    cv::split(b, pb);
+    int count = 0;
+    for (size_t k = 0; k < pa.size(); ++k) count += cv::countNonZero((pa[k] != pb[k]) & outside);
+    return count;
+  };
+  EXPECT_EQ(changed_outside(gradient.scan.range, c.scan.range), 0);
+  EXPECT_EQ(changed_outside(gradient.scan.point, c.scan.point), 0);
+  EXPECT_EQ(changed_outside(gradient.scan.color, c.scan.color), 0);
+  EXPECT_EQ(changed_outside(gradient.scan.intensity, c.scan.intensity), 0);
+  EXPECT_EQ(changed_outside(gradient.scan.valid, c.scan.valid), 0);
+
+  // Filled cells: flagged, on their own rays at the reconstructed range.
+  int checked = 0;
+  for (int y = 0; y < c.scan.rows; ++y) {
+    for (int x = 0; x < c.scan.cols; ++x) {
+      if (!c.hole.at<uint8_t>(y, x)) continue;
+      const bool valid = gradient.scan.valid.at<uint8_t>(y, x) != 0;
+      EXPECT_EQ(gradient.scan.synthesized.at<uint8_t>(y, x) != 0, valid);
+      if (!valid) continue;
+      const cv::Vec3f p = gradient.scan.point.at<cv::Vec3f>(y, x);
+      const cv::Vec3f d = c.scan.direction.at<cv::Vec3f>(y, x);
+      const float r = gradient.scan.range.at<float>(y, x);
+      EXPECT_LT(cv::norm(p - d * r), 1e-5 * r);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, gradient.synthesized_cells);
+  EXPECT_EQ(gradient.synthesized_cells + gradient.no_return_cells, gradient.hole_cells);
+}
+
+TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
+  const Case c = MakeCase(kSkyScene, 1);
+  int sky = 0;
+  for (int y = 0; y < c.scan.rows; ++y)
+    for (int x = 0; x < c.scan.cols; ++x) sky += c.hole.at<uint8_t>(y, x) && !c.truth.valid.at<uint8_t>(y, x);
+  ASSERT_GT(sky, 50);  // the post's top is against the sky
+  for (FillMethod method : {FillMethod::kGradient, FillMethod::kLaplace}) {
+    FillOptions options;
+    options.method = method;
+    const FillResult result = FillScan(c.scan, c.hole, options);
+    const FillMetrics m = MeasureFill(result.scan, c.truth, c.hole);
+    EXPECT_GT(m.return_accuracy, 0.95) << ToString(method);
+    EXPECT_GT(result.no_return_cells, sky / 2) << ToString(method);
+    if (method == FillMethod::kGradient) EXPECT_LT(m.floating_share, 0.01);
+  }
+}
+
+TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
+  const Case c = MakeCase(kWallScene, 2);
+  FillOptions options;
+  options.method = FillMethod::kDepthPatch;
+  const FillMetrics d = MeasureFill(FillScan(c.scan, c.hole, options).scan, c.truth, c.hole);
+  options.method = FillMethod::kGradient;
+  const FillMetrics g = MeasureFill(FillScan(c.scan, c.hole, options).scan, c.truth, c.hole);
+  EXPECT_GT(d.range_rmse_mm, g.range_rmse_mm);
+}
+
+TEST(FillScan, SameSeedSameFill) {
+  const Case c = MakeCase(kWallScene, 1);
+  FillOptions options;
+  options.seed = 3;
+  const FillResult a = FillScan(c.scan, c.hole, options), b = FillScan(c.scan, c.hole, options);
+  EXPECT_EQ(cv::norm(a.scan.range, b.scan.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(a.scan.color, b.scan.color, cv::NORM_INF), 0.0);
+}
+
+TEST(FillScan, BadAndEdgeCaseMasks) {
+  Case c = MakeCase(kWallScene, 1);
+  EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows + 1, c.scan.cols, CV_8U, cv::Scalar(0))), InputError);
+  EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(255))), InputError);
+  EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_32F, cv::Scalar(1))), InputError);
+  // An empty mask: an exact copy, nothing synthesized.
+  const FillResult empty = FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(0)));
+  EXPECT_EQ(empty.synthesized_cells, 0);
+  EXPECT_EQ(cv::norm(empty.scan.range, c.scan.range, cv::NORM_INF), 0.0);
+  // A hole touching the image border, in a scan without colour (intensity guides).
+  Scan grey = c.scan;
+  grey.color.release();
+  cv::Mat border(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(0));
+  border(cv::Rect(0, c.scan.rows - 20, 30, 20)) = 255;
+  for (FillMethod method : {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+    FillOptions options;
+    options.method = method;
+    const FillResult result = FillScan(grey, border, options);
+    const FillMetrics m = MeasureFill(result.scan, c.truth, border);
+    EXPECT_GT(result.synthesized_cells, 500) << ToString(method);
+    double low = 0, high = 0;
+    cv::minMaxLoc(result.scan.range, &low, &high, nullptr, nullptr, border & (result.scan.valid != 0));
+    EXPECT_GT(low, 0.5) << ToString(method);  // finite, in front of the scanner
+    EXPECT_LT(high, 40.0) << ToString(method);
+    // The membrane and fast marching flatten the ground against the image border (no flux there); the
+    // gradient fill continues its slope.
+    if (method == FillMethod::kGradient) EXPECT_LT(m.range_rmse_mm, 100.0);
+  }
+  FillOptions bad;
+  bad.patch_radius = 0;
+  EXPECT_THROW(FillScan(c.scan, border, bad), OptionsError);
+  EXPECT_THROW(ParseFillMethod("magic"), OptionsError);
+}
+
+}  // namespace
+}  // namespace lidarshop

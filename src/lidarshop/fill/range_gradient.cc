@@ -1,0 +1,132 @@
+#include "lidarshop/fill/range_gradient.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/poisson/operators.h"
+
+namespace lidarshop::fill_internal {
+
+RangeGradient OneSidedRangeGradient(const cv::Mat& range, const cv::Mat& usable) {
+  const int rows = range.rows, cols = range.cols;
+  RangeGradient g{cv::Mat(rows, cols, CV_32F, cv::Scalar(0)), cv::Mat(rows, cols, CV_32F, cv::Scalar(0))};
+  auto ok = [&](int y, int x) {
+    return y >= 0 && y < rows && x >= 0 && x < cols && usable.at<uint8_t>(y, x) != 0;
+  };
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      if (!ok(y, x)) continue;
+      const float r = range.at<float>(y, x);
+      if (ok(y, x + 1)) {
+        g.gx.at<float>(y, x) = range.at<float>(y, x + 1) - r;
+      } else if (ok(y, x - 1)) {
+        g.gx.at<float>(y, x) = r - range.at<float>(y, x - 1);
+      }
+      if (ok(y + 1, x)) {
+        g.gy.at<float>(y, x) = range.at<float>(y + 1, x) - r;
+      } else if (ok(y - 1, x)) {
+        g.gy.at<float>(y, x) = r - range.at<float>(y - 1, x);
+      }
+    }
+  }
+  return g;
+}
+
+cv::Mat NearestKnownCell(const cv::Mat& hole) {
+  const int rows = hole.rows, cols = hole.cols;
+  cv::Mat nearest(rows, cols, CV_32SC2, cv::Scalar(-1, -1));
+  std::deque<cv::Point> queue;  // (x = col, y = row)
+  // Seeds: known cells next to the hole, in raster order.
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      if (hole.at<uint8_t>(y, x) != 0) continue;
+      const bool borders = (x > 0 && hole.at<uint8_t>(y, x - 1)) || (x + 1 < cols && hole.at<uint8_t>(y, x + 1)) ||
+                           (y > 0 && hole.at<uint8_t>(y - 1, x)) || (y + 1 < rows && hole.at<uint8_t>(y + 1, x));
+      if (!borders) continue;
+      nearest.at<cv::Vec2i>(y, x) = cv::Vec2i(y, x);
+      queue.emplace_back(x, y);
+    }
+  }
+  constexpr int kDx[4] = {-1, 1, 0, 0}, kDy[4] = {0, 0, -1, 1};
+  while (!queue.empty()) {
+    const cv::Point p = queue.front();
+    queue.pop_front();
+    const cv::Vec2i from = nearest.at<cv::Vec2i>(p.y, p.x);
+    for (int k = 0; k < 4; ++k) {
+      const int nx = p.x + kDx[k], ny = p.y + kDy[k];
+      if (nx < 0 || nx >= cols || ny < 0 || ny >= rows || hole.at<uint8_t>(ny, nx) == 0) continue;
+      cv::Vec2i& to = nearest.at<cv::Vec2i>(ny, nx);
+      if (to[0] >= 0) continue;
+      to = from;
+      queue.emplace_back(nx, ny);
+    }
+  }
+  // Known cells point to nothing.
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      if (hole.at<uint8_t>(y, x) == 0) nearest.at<cv::Vec2i>(y, x) = cv::Vec2i(-1, -1);
+    }
+  }
+  return nearest;
+}
+
+cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv::Mat& no_data) {
+  cv::Mat gx, gy;
+  gx_in.convertTo(gx, CV_64F);
+  gy_in.convertTo(gy, CV_64F);
+  const int rows = gx.rows, cols = gx.cols;
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      const bool here = no_data.at<uint8_t>(y, x) != 0;
+      if (here || x + 1 >= cols || no_data.at<uint8_t>(y, x + 1) != 0) gx.at<double>(y, x) = 0.0;
+      if (here || y + 1 >= rows || no_data.at<uint8_t>(y + 1, x) != 0) gy.at<double>(y, x) = 0.0;
+    }
+  }
+  return BackwardDivergence(gx, gy);
+}
+
+cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor) {
+  cv::Mat labels;
+  const int count = cv::connectedComponents(domain != 0, labels, 4, CV_32S);
+  std::vector<uint8_t> anchored(static_cast<size_t>(count), 0);
+  const int rows = domain.rows, cols = domain.cols;
+  auto is_anchor = [&](int y, int x) {
+    return y >= 0 && y < rows && x >= 0 && x < cols && anchor.at<uint8_t>(y, x) != 0;
+  };
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      const int label = labels.at<int32_t>(y, x);
+      if (label == 0 || anchored[label]) continue;
+      if (is_anchor(y, x - 1) || is_anchor(y, x + 1) || is_anchor(y - 1, x) || is_anchor(y + 1, x)) {
+        anchored[label] = 1;
+      }
+    }
+  }
+  cv::Mat out(rows, cols, CV_8U, cv::Scalar(0));
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      const int label = labels.at<int32_t>(y, x);
+      if (label != 0 && !anchored[label]) out.at<uint8_t>(y, x) = 255;
+    }
+  }
+  return out;
+}
+
+double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile, double floor) {
+  std::vector<float> magnitudes;
+  for (int y = 0; y < values.rows; ++y) {
+    for (int x = 0; x < values.cols; ++x) {
+      if (where.at<uint8_t>(y, x) != 0) magnitudes.push_back(std::abs(values.at<float>(y, x)));
+    }
+  }
+  if (magnitudes.empty()) return floor;
+  const auto k = static_cast<size_t>(std::clamp(quantile, 0.0, 1.0) * static_cast<double>(magnitudes.size() - 1));
+  std::nth_element(magnitudes.begin(), magnitudes.begin() + static_cast<std::ptrdiff_t>(k), magnitudes.end());
+  return std::max(floor, static_cast<double>(magnitudes[k]));
+}
+
+}  // namespace lidarshop::fill_internal

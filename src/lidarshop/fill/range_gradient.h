@@ -1,0 +1,37 @@
+// Range-image pieces of the hole fill: gradients with one-sided differences, the nearest known cell, and the
+// guidance field restricted to cells with data.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+namespace lidarshop::fill_internal {
+
+// Forward differences of `range` (CV_32F) at every `usable` cell (CV_8U, non-zero = known with a return):
+//   gx(y, x) = r(y, x+1) − r(y, x)    when (y, x+1) is usable,
+//            = r(y, x) − r(y, x−1)    else when (y, x−1) is usable (one-sided),
+//            = 0                      else;
+// likewise gy downwards. Cells that are not usable get 0. Metres per cell, CV_32F.
+struct RangeGradient {
+  cv::Mat gx, gy;
+};
+RangeGradient OneSidedRangeGradient(const cv::Mat& range, const cv::Mat& usable);
+
+// For every cell of `hole` (CV_8U, non-zero), the nearest cell outside it in 4-connected steps (breadth-first,
+// ties in a fixed order, so the answer does not depend on threads). CV_32SC2 (row, col), (−1, −1) outside the
+// hole and for hole cells that no known cell reaches.
+cv::Mat NearestKnownCell(const cv::Mat& hole);
+
+// The guidance field (gx, gy) with every edge that touches a cell without data (`no_data`, CV_8U non-zero)
+// set to 0, so that its divergence matches a Poisson system that leaves those edges out. Returns the
+// divergence, CV_64F.
+cv::Mat GuidanceDivergence(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& no_data);
+
+// Cells of `domain` (CV_8U) whose 4-connected component touches no `anchor` cell (CV_8U): such parts have no
+// known range to start from. CV_8U 255/0.
+cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor);
+
+// A robust scale of a channel: the `quantile` (0..1) of |values| over the non-zero cells of `where`; `floor`
+// when there are none or the quantile is smaller.
+double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile, double floor);
+
+}  // namespace lidarshop::fill_internal
