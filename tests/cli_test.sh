@@ -187,6 +187,28 @@ check "poisson clone" "$lidarshop" poisson clone "$images/f16/f16.png" --mask "$
 fails_clearly "inpaint: mask of another size" "mask" "$lidarshop" inpaint "$images/lettera/lettera.png" \
   --mask "$images/bungee/bungee_mask.png" -o "$work/x.png" --quiet
 
+# fill and remove (docs/fill.md): the sphere's cells from the segment mask above, then the same from strokes.
+check "fill" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/filled.ply" \
+  --report "$work/fill.json" --synthesized-mask "$work/synthesized.png" --debug "$work/fill_debug" --quiet
+json_check "fill report" "$work/fill.json" \
+  "d['method'] == 'gradient' and d['synthesized_points'] > 0 and \
+   d['synthesized_points'] + d['no_return_cells'] == d['hole_cells']"
+check "fill wrote the mask and the debug pictures" test -s "$work/synthesized.png" \
+  -a -s "$work/fill_debug/gradient_after.png" -a -s "$work/fill_debug/source_cells.png"
+check "fill laplace into E57" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" --method laplace \
+  -o "$work/filled.e57" --quiet
+check "remove" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/removed.ptx" \
+  --report "$work/remove.json" --quiet
+json_check "remove report" "$work/remove.json" "d['object_cells'] > 0 and d['synthesized_points'] > 0"
+fails_clearly "fill: mask of another size" "mask" "$lidarshop" fill "$work/scan.ptx" \
+  --mask "$shared/images/bungee/bungee_mask.png" -o "$work/x.ply" --quiet
+fails_clearly "fill: output onto its input" "overwrite" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \
+  -o "$work/scan.ptx" --quiet
+fails_clearly "fill: unknown method" "method" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \
+  -o "$work/x.ply" --method magic --quiet
+fails_clearly "remove: two layers in PTX" "PTX" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/x.ptx" --keep-object --quiet
+
 # The demo on a small built-in scene.
 check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet
 json_check "demo summary" "$work/demo/summary.json" "d['scene'] == 'mailbox' and d['scan']['valid'] > 0"

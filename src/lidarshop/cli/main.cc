@@ -29,6 +29,8 @@ const std::vector<Command>& Commands() {
       {"segment", lidarshop::cli::RunSegment, "cut an object out of a scan from two strokes"},
       {"inpaint", lidarshop::cli::RunInpaint, "patch-based image inpainting"},
       {"poisson", lidarshop::cli::RunPoisson, "Poisson image editing: fill, clone, reconstruct"},
+      {"fill", lidarshop::cli::RunFill, "fill a hole in a scan (gradient-domain inpainting + Poisson)"},
+      {"remove", lidarshop::cli::RunRemove, "remove an object from a scan: cut it out and fill behind it"},
   };
   return commands;
 }
