@@ -8,6 +8,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
+#include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
@@ -162,9 +163,48 @@ int RunRender(int argc, char** argv) {
   app.add_option("--min", options.min_value,
                  "value of the first colour (metres for range); default: 1 % quantile");
   app.add_option("--max", options.max_value, "value of the last colour; default: 99 % quantile");
+  // A second viewpoint: the points seen by a pinhole camera (colours, or grey intensity).
+  std::vector<double> eye, target;
+  double orbit_deg = std::numeric_limits<double>::quiet_NaN();
+  std::string around_path;
+  PointViewOptions view;
+  app.add_option("--eye", eye, "camera centre x,y,z in the world (metres): draw the points from there")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--target", target, "point x,y,z the camera looks at (with --eye)")->delimiter(',')->expected(3);
+  app.add_option("--orbit", orbit_deg,
+                 "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
+  app.add_option("--around", around_path, "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
+  app.add_option("--fov", view.field_of_view_deg, "horizontal field of view of --eye/--orbit, degrees")
+      ->capture_default_str();
+  app.add_option("--width", view.width_px, "picture width of --eye/--orbit, pixels")->capture_default_str();
+  app.add_option("--height", view.height_px, "picture height of --eye/--orbit, pixels")->capture_default_str();
+  app.add_option("--point-size", view.point_size_px, "drawn point size of --eye/--orbit, pixels")
+      ->capture_default_str();
+  app.add_option("--tint-synthesized", view.synthesized_tint,
+                 "with --eye/--orbit: tint synthesized points magenta by this share (0..1)")
+      ->capture_default_str();
   bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
+    if (!eye.empty() || !std::isnan(orbit_deg)) {
+      if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
+      if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
+      const ScanFile file = ReadScanFile(input);
+      const Scan& scan = file.scans[SelectScan(file, scan_index)];
+      if (!eye.empty()) {
+        view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
+        view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
+      } else {
+        const cv::Mat region = around_path.empty() ? cv::Mat(scan.valid != 0)
+                                                   : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
+        const PointViewOptions side = SideView(scan, region, orbit_deg);
+        view.eye_in_world = side.eye_in_world;
+        view.target_in_world = side.target_in_world;
+      }
+      WriteImage(output, RenderPointView(scan, view));
+      return 0;
+    }
     options.channel = ParseRenderChannel(channel);
     if (!color_map.empty()) options.color_map = ParseColorMap(color_map);
     options.Check();

@@ -27,10 +27,12 @@ namespace {
 
 // The fill options every fill command shares, bound to flags.
 struct FillFlags {
-  std::string method = "gradient";
+  std::string method = "gradient", search = "patchmatch";
   FillOptions options;
   void Add(CLI::App& app) {
     app.add_option("--method", method, "gradient | laplace | depth-patch | telea")->capture_default_str();
+    app.add_option("--search", search, "source search of the patch methods: patchmatch | local | exhaustive")
+        ->capture_default_str();
     app.add_option("--seed", options.seed, "seed of the patch fill's random choices")->capture_default_str();
     app.add_option("--patch-radius", options.patch_radius, "patch half-width, cells")->capture_default_str();
     app.add_option("--window", options.search_window_radius, "half-width of the local source search, cells")
@@ -45,6 +47,15 @@ struct FillFlags {
   }
   FillOptions Parsed() {
     options.method = ParseFillMethod(method);
+    if (search == "patchmatch") {
+      options.search = InpaintSearchKind::kPatchMatch;
+    } else if (search == "local") {
+      options.search = InpaintSearchKind::kLocal;
+    } else if (search == "exhaustive") {
+      options.search = InpaintSearchKind::kTwoStep;  // exact, with the local window as the first bound
+    } else {
+      throw OptionsError(fmt::format("--search '{}': expected patchmatch, local or exhaustive", search));
+    }
     options.Check();
     return options;
   }

@@ -1,0 +1,79 @@
+// Hole filling in scans, every method on the same hole in one run: a van removed from a 1000 x 1000 scan of
+// data/fill_eval/facade_car.json (about 100,000 hole cells) and a disc of 100,000 cells in the same scan.
+// Counters: hole cells, patches, candidates evaluated per patch and the patch fill's microseconds per patch
+// (patch methods), and the seconds of each step.
+//
+//   ninja -C build/release fill_bench && build/release/bench/fill_bench --benchmark_min_time=1
+#include <cmath>
+#include <map>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/fill/fill.h"
+#include "lidarshop/scanner/scanner.h"
+
+namespace lidarshop {
+namespace {
+
+struct Problem {
+  Scan scan;
+  cv::Mat hole;
+};
+
+// kind 0: the van's cells grown by 2; kind 1: a disc of 100,000 cells centred on the van.
+const Problem& GetProblem(int kind) {
+  static std::map<int, Problem> cache;
+  if (auto it = cache.find(kind); it != cache.end()) return it->second;
+  static const Scan scan = [] {
+    SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/fill_eval/facade_car.json");
+    scene.scanner.columns = 1000;
+    scene.scanner.rows = 1000;
+    return SynthesizeScan(scene);
+  }();
+  Problem problem{scan, {}};
+  const cv::Mat van = (scan.label == 1) & (scan.valid != 0);
+  if (kind == 0) {
+    problem.hole = GrowHole(van, 2);
+  } else {
+    const cv::Moments m = cv::moments(van, true);
+    problem.hole = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+    const int radius = static_cast<int>(std::lround(std::sqrt(100000.0 / M_PI)));
+    cv::circle(problem.hole, cv::Point(static_cast<int>(m.m10 / m.m00), static_cast<int>(m.m01 / m.m00)), radius,
+               255, cv::FILLED);
+  }
+  return cache.emplace(kind, std::move(problem)).first->second;
+}
+
+void BM_FillScan(benchmark::State& state, FillMethod method) {
+  const Problem& problem = GetProblem(static_cast<int>(state.range(0)));
+  FillOptions options;
+  options.method = method;
+  FillResult result;
+  for (auto _ : state) {
+    result = FillScan(problem.scan, problem.hole, options);
+    benchmark::DoNotOptimize(result.scan.range.data);
+  }
+  state.counters["hole_cells"] = static_cast<double>(result.hole_cells);
+  state.counters["patches"] = result.patches;
+  if (result.patches > 0) {
+    state.counters["candidates_per_patch"] =
+        static_cast<double>(result.candidates_evaluated) / static_cast<double>(result.patches);
+    // All of the patch fill (canvas, priorities, search, copies) per patch; the patch difference alone is
+    // timed per candidate in inpaint_bench.
+    state.counters["inpaint_us_per_patch"] = 1e6 * result.timings.inpaint_s / result.patches;
+  }
+  state.counters["inpaint_s"] = result.timings.inpaint_s;
+  state.counters["poisson_s"] = result.timings.poisson_s;
+  state.counters["total_s"] = result.timings.total_s;
+}
+
+BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, laplace, FillMethod::kLaplace)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, depth_patch, FillMethod::kDepthPatch)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, telea, FillMethod::kTelea)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace lidarshop
+
+BENCHMARK_MAIN();
