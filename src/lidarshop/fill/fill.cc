@@ -47,6 +47,11 @@ void FillOptions::Check() const {
   CheckOption(search_window_radius >= patch_radius,
               fmt::format("FillOptions.search_window_radius must be >= patch_radius ({}), got {}", patch_radius,
                           search_window_radius));
+  CheckOption(patchmatch_random_samples >= 1 && patchmatch_random_samples <= 100000,
+              fmt::format("FillOptions.patchmatch_random_samples must be in [1, 100000], got {}",
+                          patchmatch_random_samples));
+  CheckOption(patchmatch_iterations >= 1 && patchmatch_iterations <= 100,
+              fmt::format("FillOptions.patchmatch_iterations must be in [1, 100], got {}", patchmatch_iterations));
   CheckOption(std::isfinite(color_weight) && color_weight >= 0,
               fmt::format("FillOptions.color_weight must be >= 0, got {}", color_weight));
   CheckOption(std::isfinite(gradient_weight) && gradient_weight >= 0,
@@ -171,6 +176,8 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   inpaint.patch_radius = options.patch_radius;
   inpaint.search = options.search;
   inpaint.priority = options.priority;
+  inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
+  inpaint.patchmatch_iterations = options.patchmatch_iterations;
   inpaint.local_window_radius = options.search_window_radius;
   inpaint.seed = options.seed;
   inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()), static_cast<float>(options.color_weight));

@@ -49,6 +49,8 @@ struct FillOptions {
   // data/fill_eval (a surface hidden behind a large object is found far away, e.g. a facade above a car).
   InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
   int search_window_radius = 50;  // cells; local window (local search; PatchMatch's near samples)
+  int patchmatch_random_samples = 48;  // PatchMatch: uniform draws over the scan per query (>= 1)
+  int patchmatch_iterations = 4;       // PatchMatch: propagation + random-search rounds per query (>= 1)
   // Channel weights of the patch difference. Colour is in grey levels (0..255, or intensity × 255); a range
   // gradient g becomes 255 · asinh(g / s) / asinh(1) with s its 90th percentile over the known cells (range
   // channel of depth-patch: s = its 5–95 % spread), linear near 0 and logarithmic for steep ground and jumps.
