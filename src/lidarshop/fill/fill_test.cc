@@ -8,6 +8,7 @@
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {
@@ -179,13 +180,22 @@ TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
   EXPECT_GT(d.range_rmse_mm, g.range_rmse_mm);
 }
 
-TEST(FillScan, SameSeedSameFill) {
+TEST(FillScan, SameSeedSameFillOnAnyThreadCount) {
   const Case c = MakeCase(kWallScene, 1);
   FillOptions options;
   options.seed = 3;
-  const FillResult a = FillScan(c.scan, c.hole, options), b = FillScan(c.scan, c.hole, options);
+  const FillResult a = FillScan(c.scan, c.hole, options);
+  FillResult b;
+  {
+    const ThreadLimit one_thread(1);
+    b = FillScan(c.scan, c.hole, options);
+  }
   EXPECT_EQ(cv::norm(a.scan.range, b.scan.range, cv::NORM_INF), 0.0);
   EXPECT_EQ(cv::norm(a.scan.color, b.scan.color, cv::NORM_INF), 0.0);
+  // Another seed draws other patches: the seed is used.
+  options.seed = 4;
+  const FillResult other = FillScan(c.scan, c.hole, options);
+  EXPECT_GT(cv::norm(a.scan.range, other.scan.range, cv::NORM_INF), 0.0);
 }
 
 TEST(FillScan, BadAndEdgeCaseMasks) {
