@@ -26,6 +26,12 @@ constexpr uint64_t kHeaderSize = 48;
 constexpr uint64_t kMaxPacketSize = 65536;  // logical bytes per packet (16-bit length minus one)
 constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a corrupt file
 
+// How the writer spells lidarshop's extension (e57.h, kLidarshopE57Namespace). The reader looks the prefix up
+// by the namespace URI instead, as a file may bind it to another prefix.
+constexpr char kExtensionXmlns[] = "xmlns:lidarshop";
+constexpr char kSynthesizedField[] = "lidarshop:synthesized";
+constexpr char kSynthesizedLocalName[] = "synthesized";
+
 // The largest record count or grid (cells) a file may claim; kMaxScanCells unless lowered (the fuzzer does,
 // to keep its memory bounded). Not thread-safe to change while reading.
 extern int64_t g_max_cells;
