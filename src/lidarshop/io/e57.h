@@ -47,7 +47,8 @@ constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 // Throws InputError naming the file, the page or byte offset and what is wrong (bad CRC, truncated, bad XML).
 E57File ReadE57(const std::string& path);
 
-// Writes organized scans with pose, intensity, colour, row/column index and invalid state; atomic.
+// Writes organized scans with pose, intensity, colour, row/column index and invalid state, and the
+// synthesized channel (when present) as the extension field lidarshop:synthesized; atomic.
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
 
 // ---- Additions (E57 engineer)
@@ -73,10 +74,10 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOpt
 // One scan with a second layer behind it (`remove --keep-object`: the kept object in front, the filled
 // background behind). `front` and `behind` share the grid (rows x cols, directions) and pose; `behind` holds
 // returns only in some cells. Every record of `front` is written as by WriteE57 with returnIndex 0, plus one
-// record per valid `behind` cell with the same rowIndex/columnIndex and returnIndex 1; returnCount is 2 on both
-// records of such a cell, else 1; the `lidarshop:synthesized` field is 1 on every second return and follows
-// front.synthesized on the others. ReadE57 gives the layers back as scans[0] and second_returns[0]. Throws
-// std::logic_error when the layers differ in size (check first: WriteScanWithLayer does). Atomic.
+// record per valid `behind` cell with the same rowIndex/columnIndex and returnIndex 1; returnCount is 2 on
+// both records of such a cell, else 1; the `lidarshop:synthesized` field is 1 on every second return and
+// follows front.synthesized on the others. ReadE57 gives the layers back as scans[0] and second_returns[0].
+// Throws std::logic_error when the layers differ in size (check first: WriteScanWithLayer does). Atomic.
 void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
                        const E57WriteOptions& options = {});
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,

@@ -467,7 +467,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
     }
   }
   int64_t duplicates = 0;
-  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to `second`, later ones are left out.
+  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to `second`, later ones are left
+  // out.
   std::vector<uint8_t> layer(record_count, 0);
   if (structured && find("returnIndex") != nullptr) {
     const auto& v = decode(find("returnIndex"));
@@ -548,9 +549,10 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
         ctx.path, index, scan.name, duplicates));
   }
   if (later_returns > 0) {
-    warnings->push_back(fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
-                                    "returns) are not kept",
-                                    ctx.path, index, scan.name, later_returns));
+    warnings->push_back(
+        fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
+                    "returns) are not kept",
+                    ctx.path, index, scan.name, later_returns));
   }
 
   if (intensity_field) {
@@ -597,7 +599,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   if (const Field* flag = synthesized_field.empty() ? nullptr : find(synthesized_field.c_str())) {
     const auto& v = decode(flag);
     for (Scan* s : layers) {
-      if (s != nullptr && s->num_cells() > 0) s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
+      if (s != nullptr && s->num_cells() > 0)
+        s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
     }
     for (int64_t i = 0; i < record_count; ++i) {
       if (cell[i] >= 0 && v[i] != 0.0) layers[layer[i]]->synthesized.ptr<uint8_t>()[cell[i]] = kValid;
@@ -613,8 +616,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
       const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
       for (Scan* s : layers) {
         if (s == nullptr || s->num_cells() == 0) continue;
-        for (cv::Mat* m : {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color,
-                           &s->synthesized}) {
+        for (cv::Mat* m :
+             {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized}) {
           if (!m->empty()) cv::flip(*m, *m, code);
         }
       }

@@ -135,8 +135,8 @@ struct Record {
   uint8_t layer = 0;  // returnIndex
 };
 
-// Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells become
-// second returns. Returns whether the lidarshop extension field was written.
+// Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
+// become second returns. Returns whether the lidarshop extension field was written.
 bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteOptions& options,
                 std::vector<uint8_t>* logical, pugi::xml_node data3d) {
   CheckScan(scan);
@@ -394,8 +394,8 @@ std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_f
   data3d.append_attribute("allowHeterogeneousChildren") = "1";
   bool extension = false;
   for (size_t i = 0; i < scans.size(); ++i) {
-    extension |= AppendScan(scans[i], i == 0 ? behind_first : nullptr, static_cast<int>(i), options, &logical,
-                            data3d);
+    extension |=
+        AppendScan(scans[i], i == 0 ? behind_first : nullptr, static_cast<int>(i), options, &logical, data3d);
   }
   // E2807 declares extensions by an XML namespace on e57Root; readers that do not know it skip its fields.
   if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
@@ -436,7 +436,8 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOpt
   return e57::Encode(scans, nullptr, options);
 }
 
-std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind, const E57WriteOptions& options) {
+std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
+                                        const E57WriteOptions& options) {
   return e57::Encode({front}, &behind, options);
 }
 

@@ -36,8 +36,8 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 //   .e57  one data3D: `front` as WriteE57 writes it, plus each valid `behind` cell as a second return of the
 //         same rowIndex/columnIndex (returnIndex 1, returnCount 2; lidarshop:synthesized = 1); ReadE57 gives
 //         the layers back as scans[0] and second_returns[0] (io/e57.h, WriteE57WithLayer)
-//   .ply  two scans of one grid (scan 0 = front, scan 1 = behind, synthesized = 1), points in the world frame:
-//         a plain PLY reader sees the union of both layers' points with the `synthesized` field
+//   .ply  two scans of one grid (scan 0 = front, scan 1 = behind, synthesized = 1), world frame: a plain
+//         PLY reader sees the union of both layers' points with the `synthesized` field
 //   .pcd  one unorganized cloud (HEIGHT 1, world frame) of both layers' valid points, `synthesized` 0 for
 //         measured points of `front` (or its own flags) and 1 for `behind`
 //   .ptx  InputError: "PTX cannot hold two returns per cell; write E57, PLY or PCD"
