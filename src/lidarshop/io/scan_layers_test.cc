@@ -175,6 +175,25 @@ TEST(ScanLayers, E57KeepsBothLayersAsFirstAndSecondReturns) {
   EXPECT_EQ(ReadScanFile(path).scans[0].CountValid(), 47);
 }
 
+TEST(ScanLayers, ThirdAndLaterReturnsAreLeftOutAndReported) {
+  // Shift every returnIndex up by one (same bit width, same XML length): the front records become second
+  // returns and the second returns become third returns, which the reader leaves out and reports.
+  const Layers layers = MakeLayers();
+  std::vector<uint8_t> logical =
+      e57::LogicalFromPages("x.e57", EncodeE57WithLayer(layers.front, layers.behind));
+  const std::string from = "<returnIndex type=\"Integer\" minimum=\"0\" maximum=\"1\"";
+  const std::string to = "<returnIndex type=\"Integer\" minimum=\"1\" maximum=\"2\"";
+  const auto at = std::search(logical.begin(), logical.end(), from.begin(), from.end());
+  ASSERT_NE(at, logical.end());
+  std::copy(to.begin(), to.end(), at);
+  const E57File file = ReadE57Bytes(e57::PagesFromLogical(logical), "shifted.e57");
+  ASSERT_EQ(file.scans.size(), 1u);
+  EXPECT_EQ(file.scans[0].CountValid(), 0);
+  EXPECT_EQ(file.second_returns[0].CountValid(), 47);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_THAT(file.warnings[0], HasSubstr("shifted.e57: scan 0 ('wall'): 8 records with returnIndex >= 2"));
+}
+
 TEST(ScanLayers, PlyAndPcdHoldTheUnionOfThePointsFlagged) {
   const Layers layers = MakeLayers();
   TempFolder folder;
