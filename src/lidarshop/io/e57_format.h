@@ -130,4 +130,18 @@ class BitWriter {
   int pending_ = 0;  // bits in accumulator_
 };
 
+// Writing (e57_sections.cc). A bytestream the writer has packed, with its prototype field.
+struct Stream {
+  Field field;
+  std::vector<uint8_t> bytes;
+};
+
+// An Integer field in [minimum, maximum] with the fewest bits.
+Field IntegerField(const char* name, int64_t minimum, int64_t maximum);
+
+// Appends a compressed vector section of `record_count` records at the end of `logical` (8-byte aligned; data
+// packets of at most 64 KiB, no index packets) and returns its physical offset.
+uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
+                                std::vector<uint8_t>* logical);
+
 }  // namespace lidarshop::e57
