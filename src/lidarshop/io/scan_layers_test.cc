@@ -23,8 +23,8 @@ using ::testing::Not;
 using testing_io::TempFolder;
 
 // A 6 x 8 scan before a wall at 5 m with an object at 2 m in the middle 2 x 4 cells, one hole (no return) at
-// (0, 0), colour and a tilted pose. `behind` is the wall filled in behind the object: valid only under it,
-// marked synthesized, intensity 0.25.
+// (0, 0), colour and a tilted pose. `behind` is the wall filled in behind the object and in the hole (9
+// cells), marked synthesized, intensity 0.25.
 struct Layers {
   Scan front;
   Scan behind;
@@ -48,16 +48,18 @@ Layers MakeLayers() {
   behind.color.setTo(cv::Scalar::all(0));
   for (int r = 0; r < front.rows; ++r) {
     for (int c = 0; c < front.cols; ++c) {
-      if (r == 0 && c == 0) continue;
+      const bool hole = r == 0 && c == 0;
       const bool object = r >= 2 && r < 4 && c >= 2 && c < 6;
       const cv::Vec3f d = front.direction.at<cv::Vec3f>(r, c);
-      const float range = object ? 2.0f + 0.01f * c : 5.0f + 0.02f * r;
-      front.valid.at<uint8_t>(r, c) = kValid;
-      front.range.at<float>(r, c) = range;
-      front.point.at<cv::Vec3f>(r, c) = d * range;
-      front.intensity.at<float>(r, c) = object ? 0.9f : 0.1f * (r + 1);
-      front.color.at<cv::Vec3b>(r, c) = object ? cv::Vec3b(200, 10, 10) : cv::Vec3b(20, 30 + r, 40 + c);
-      if (!object) continue;
+      if (!hole) {
+        const float range = object ? 2.0f + 0.01f * c : 5.0f + 0.02f * r;
+        front.valid.at<uint8_t>(r, c) = kValid;
+        front.range.at<float>(r, c) = range;
+        front.point.at<cv::Vec3f>(r, c) = d * range;
+        front.intensity.at<float>(r, c) = object ? 0.9f : 0.1f * (r + 1);
+        front.color.at<cv::Vec3b>(r, c) = object ? cv::Vec3b(200, 10, 10) : cv::Vec3b(20, 30 + r, 40 + c);
+      }
+      if (!object && !hole) continue;
       behind.valid.at<uint8_t>(r, c) = kValid;
       behind.range.at<float>(r, c) = 5.0f;
       behind.point.at<cv::Vec3f>(r, c) = d * 5.0f;
@@ -154,8 +156,8 @@ TEST(ScanLayers, E57KeepsBothLayersAsFirstAndSecondReturns) {
   EXPECT_THAT(xml, HasSubstr("<returnIndex type=\"Integer\" minimum=\"0\" maximum=\"1\""));
   EXPECT_THAT(xml, HasSubstr("<returnCount type=\"Integer\" minimum=\"1\" maximum=\"2\""));
   EXPECT_THAT(xml, HasSubstr("<returnMaximum type=\"Integer\">1</returnMaximum>"));
-  // 47 front returns + 1 direction-only hole + 8 second returns.
-  EXPECT_THAT(xml, HasSubstr("recordCount=\"56\""));
+  // 47 front returns + 1 direction-only hole + 9 second returns.
+  EXPECT_THAT(xml, HasSubstr("recordCount=\"57\""));
 
   const E57File file = ReadE57(path);
   ASSERT_EQ(file.scans.size(), 1u);
@@ -164,7 +166,9 @@ TEST(ScanLayers, E57KeepsBothLayersAsFirstAndSecondReturns) {
   const Scan& front = file.scans[0];
   const Scan& behind = file.second_returns[0];
   EXPECT_EQ(front.CountValid(), 47);
-  EXPECT_EQ(behind.CountValid(), 8);
+  EXPECT_EQ(behind.CountValid(), 9);
+  EXPECT_EQ(behind.valid.at<uint8_t>(0, 0), kValid);  // behind a front record without a return
+  EXPECT_EQ(front.valid.at<uint8_t>(0, 0), 0);
   ExpectSameReturns(layers.front, front);  // front: no synthesized channel given, read back as all 0
   ExpectSameReturns(layers.behind, behind);
   EXPECT_EQ(behind.name, "wall");
@@ -191,7 +195,7 @@ TEST(ScanLayers, ThirdAndLaterReturnsAreLeftOutAndReported) {
   EXPECT_EQ(file.scans[0].CountValid(), 0);
   EXPECT_EQ(file.second_returns[0].CountValid(), 47);
   ASSERT_EQ(file.warnings.size(), 1u);
-  EXPECT_THAT(file.warnings[0], HasSubstr("shifted.e57: scan 0 ('wall'): 8 records with returnIndex >= 2"));
+  EXPECT_THAT(file.warnings[0], HasSubstr("shifted.e57: scan 0 ('wall'): 9 records with returnIndex >= 2"));
 }
 
 TEST(ScanLayers, PlyAndPcdHoldTheUnionOfThePointsFlagged) {
@@ -206,23 +210,23 @@ TEST(ScanLayers, PlyAndPcdHoldTheUnionOfThePointsFlagged) {
   const ScanFile ply = ReadScanFile(folder.File("kept.ply"));
   ASSERT_EQ(ply.scans.size(), 2u);  // front, then the layer behind, on one grid
   EXPECT_EQ(ply.scans[0].CountValid(), 47);
-  EXPECT_EQ(ply.scans[1].CountValid(), 8);
+  EXPECT_EQ(ply.scans[1].CountValid(), 9);
   EXPECT_EQ(cv::countNonZero(ply.scans[0].synthesized), 0);
-  EXPECT_EQ(cv::countNonZero(ply.scans[1].synthesized), 8);
+  EXPECT_EQ(cv::countNonZero(ply.scans[1].synthesized), 9);
   EXPECT_LT(cv::norm(ply.scans[1].point.at<cv::Vec3f>(2, 3) - p), 1e-5);
   const PointCloud ply_points = ReadPointCloud(folder.File("kept.ply"));  // what a plain reader sees
-  ASSERT_EQ(ply_points.size(), 55u);
-  ASSERT_EQ(ply_points.synthesized.size(), 55u);
-  EXPECT_EQ(std::count(ply_points.synthesized.begin(), ply_points.synthesized.end(), 1), 8);
+  ASSERT_EQ(ply_points.size(), 56u);
+  ASSERT_EQ(ply_points.synthesized.size(), 56u);
+  EXPECT_EQ(std::count(ply_points.synthesized.begin(), ply_points.synthesized.end(), 1), 9);
 
   WriteScanWithLayer(folder.File("kept.pcd"), layers.front, layers.behind);
   const ScanFile pcd = ReadScanFile(folder.File("kept.pcd"));
   ASSERT_EQ(pcd.scans.size(), 1u);
   const Scan& cloud = pcd.scans[0];
   EXPECT_EQ(cloud.rows, 1);
-  EXPECT_EQ(cloud.CountValid(), 55);
+  EXPECT_EQ(cloud.CountValid(), 56);
   ASSERT_FALSE(cloud.synthesized.empty());
-  EXPECT_EQ(cv::countNonZero(cloud.synthesized), 8);
+  EXPECT_EQ(cv::countNonZero(cloud.synthesized), 9);
   // The points are in the world frame: the pose is the identity and the behind point is where the pose says.
   EXPECT_TRUE(cloud.world_from_scanner.isIdentity(1e-12));
   bool found = false;
