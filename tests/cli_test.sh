@@ -185,6 +185,8 @@ object_valid=$(python3 -c "import json; print(json.load(open('$work/info_object.
 json_check "segment --rest holds the other returns" "$work/info_rest.json" \
   "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and \
    d['scans'][0]['valid'] + $object_valid == $valid and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+fails_clearly "segment: --object needs a scan format" "unknown scan format" "$lidarshop" segment "$work/scan.ptx" \
+  --strokes "$work/strokes.json" -o "$work/mask3.png" --object "$work/object.txt" --quiet
 fails_clearly "segment: strokes of the wrong size" "stroke" "$lidarshop" segment "$work/scan.ptx" \
   --strokes "$shared/images/bungee/bungee_mask.png" -o "$work/mask2.png" --quiet
 

@@ -63,6 +63,9 @@ int RunSegment(int argc, char** argv) {
     options.model = ParseAppearanceModel(model);
     options.eight_connected = eight;
     options.Check();
+    for (const std::string& path : {object_path, rest_path}) {
+      if (!path.empty()) CheckScanFileFormat(path);
+    }
     const ScanFile file = ReadScanFile(scan_path);
     if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size())) {
       throw OptionsError(fmt::format("--scan-index {} out of range: {} holds {} scan(s)", scan_index,

@@ -272,6 +272,8 @@ std::string FileExtension(const std::string& path) {
   return extension;
 }
 
+void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
+
 ScanFile ReadScanFile(const std::string& path) {
   const ScanFormat& format = FormatFor(path);
   ScanFile file;

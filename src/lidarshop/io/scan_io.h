@@ -44,6 +44,10 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 // Throws InputError naming `path` when the layers differ in size or pose. Atomic.
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind);
 
+// Throws InputError (the same as ReadScanFile / WriteScanFile would) when `path` has no scan format's
+// extension; lets a command refuse an output path before its work.
+void CheckScanFileFormat(const std::string& path);
+
 // The lower-case extension without the dot ("ptx"), or "" when none.
 std::string FileExtension(const std::string& path);
 
