@@ -170,9 +170,23 @@ cat >"$work/strokes.json" <<'JSON'
              {"label": "background", "width": 2, "points": [[5, 115], [175, 115]]}]}
 JSON
 check "segment" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/mask.png" \
-  --object "$work/object.ply" --rest "$work/rest.ply" --quiet
-check "segment wrote mask, overlay and points" test -s "$work/mask.png" -a -s "$work/mask_overlay.png" \
-  -a -s "$work/object.ply" -a -s "$work/rest.ply"
+  --object "$work/object.e57" --rest "$work/rest.ply" --quiet
+check "segment wrote mask, overlay and scans" test -s "$work/mask.png" -a -s "$work/mask_overlay.png" \
+  -a -s "$work/object.e57" -a -s "$work/rest.ply"
+# --object and --rest are organized scans of the input's grid and pose that split its returns between them.
+check "info object.e57" "$lidarshop" info "$work/object.e57"
+cp "$work/last.out" "$work/info_object.json"
+check "info rest.ply" "$lidarshop" info "$work/rest.ply"
+cp "$work/last.out" "$work/info_rest.json"
+json_check "segment --object keeps the grid and pose" "$work/info_object.json" \
+  "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and 0 < d['scans'][0]['valid'] < $valid and \
+   abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+object_valid=$(python3 -c "import json; print(json.load(open('$work/info_object.json'))['scans'][0]['valid'])")
+json_check "segment --rest holds the other returns" "$work/info_rest.json" \
+  "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and \
+   d['scans'][0]['valid'] + $object_valid == $valid and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+fails_clearly "segment: --object needs a scan format" "unknown scan format" "$lidarshop" segment "$work/scan.ptx" \
+  --strokes "$work/strokes.json" -o "$work/mask3.png" --object "$work/object.txt" --quiet
 fails_clearly "segment: strokes of the wrong size" "stroke" "$lidarshop" segment "$work/scan.ptx" \
   --strokes "$shared/images/bungee/bungee_mask.png" -o "$work/mask2.png" --quiet
 

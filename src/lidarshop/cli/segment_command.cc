@@ -7,7 +7,6 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/io/image_io.h"
-#include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
@@ -15,30 +14,6 @@
 
 namespace lidarshop::cli {
 namespace {
-
-// The valid points of `scan` where `mask` is (inside = true) or is not (inside = false) set, scanner frame.
-PointCloud SelectPoints(const Scan& scan, const cv::Mat& mask, bool inside) {
-  std::vector<int64_t> cells;
-  const PointCloud all = ToPointCloud(scan, /*world=*/false, &cells);
-  std::vector<size_t> keep;
-  const uint8_t* m = mask.ptr<uint8_t>();
-  for (size_t i = 0; i < cells.size(); ++i) {
-    if ((m[cells[i]] != 0) == inside) keep.push_back(i);
-  }
-  PointCloud out;
-  auto pick = [&](const auto& source, auto& target) {
-    if (source.empty()) return;
-    target.reserve(keep.size());
-    for (size_t i : keep) target.push_back(source[i]);
-  };
-  pick(all.points, out.points);
-  pick(all.normals, out.normals);
-  pick(all.colors, out.colors);
-  pick(all.intensities, out.intensities);
-  pick(all.labels, out.labels);
-  pick(all.synthesized, out.synthesized);
-  return out;
-}
 
 std::string DefaultOverlayPath(const std::string& mask_path) {
   std::filesystem::path path(mask_path);
@@ -63,8 +38,10 @@ int RunSegment(int argc, char** argv) {
   app.add_option("--strokes", strokes_path, "strokes: .png (green object, red background) or .json polylines")
       ->required();
   app.add_option("-o,--output", mask_path, "output mask PNG (255 = object, image orientation)")->required();
-  app.add_option("--object", object_path, "write the object's points here (.ply)");
-  app.add_option("--rest", rest_path, "write the other valid points here (.ply)");
+  app.add_option("--object", object_path,
+                 "write the object as an organized scan here (.ptx, .e57, .ply, .pcd): grid and pose kept, "
+                 "other cells without a return");
+  app.add_option("--rest", rest_path, "write the rest of the scan (every cell not in the object) likewise");
   app.add_option("--overlay", overlay_path,
                  "overlay picture path (default: MASK_overlay.png; 'none' = skip)");
   app.add_option("--refine", refine_path, "extra strokes applied as a fast refinement of the first cut");
@@ -86,6 +63,9 @@ int RunSegment(int argc, char** argv) {
     options.model = ParseAppearanceModel(model);
     options.eight_connected = eight;
     options.Check();
+    for (const std::string& path : {object_path, rest_path}) {
+      if (!path.empty()) CheckScanFileFormat(path);
+    }
     const ScanFile file = ReadScanFile(scan_path);
     if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size())) {
       throw OptionsError(fmt::format("--scan-index {} out of range: {} holds {} scan(s)", scan_index,
@@ -108,8 +88,8 @@ int RunSegment(int argc, char** argv) {
       WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,
                  SegmentOverlay(scan, result.mask, strokes));
     }
-    if (!object_path.empty()) WritePointCloud(object_path, SelectPoints(scan, result.mask, true));
-    if (!rest_path.empty()) WritePointCloud(rest_path, SelectPoints(scan, result.mask, false));
+    if (!object_path.empty()) WriteScanFile(object_path, {MaskScan(scan, result.mask)});
+    if (!rest_path.empty()) WriteScanFile(rest_path, {MaskScan(scan, result.mask == 0)});
     return 0;
   });
 }

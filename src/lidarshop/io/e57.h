@@ -29,12 +29,26 @@ struct E57Image {
 struct E57File {
   std::vector<Scan> scans;  // data3D: organized scans keep their grid; unstructured ones are 1 x N scans
   std::vector<E57Image> images;
+  // One per scan: the second returns (returnIndex 1) of scans[i] as a scan of the same grid, pose and
+  // directions, valid where a cell has a second return (e.g. the layer behind a kept object written by
+  // WriteE57WithLayer); 0 x 0 when the scan has none.
+  std::vector<Scan> second_returns;
+  // What the reader left out, one sentence each (e.g. "scan 0 ('x'): 12 records with returnIndex >= 2 (third
+  // and later returns) are not kept"). The library does not print them.
+  std::vector<std::string> warnings;
 };
+
+// lidarshop's E57 extension (E2807: extensions are XML namespaces declared on e57Root). Declared as
+// xmlns:lidarshop="http://lidarshop.dev/e57/1.0" when a file uses it; its one field is the points prototype's
+// `lidarshop:synthesized` (Integer 0..1, 1 = created by lidarshop), read back into Scan::synthesized
+// (255 / 0). Readers that do not know the namespace skip the field (libE57Format does).
+constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 
 // Throws InputError naming the file, the page or byte offset and what is wrong (bad CRC, truncated, bad XML).
 E57File ReadE57(const std::string& path);
 
-// Writes organized scans with pose, intensity, colour, row/column index and invalid state; atomic.
+// Writes organized scans with pose, intensity, colour, row/column index and invalid state, and the
+// synthesized channel (when present) as the extension field lidarshop:synthesized; atomic.
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
 
 // ---- Additions (E57 engineer)
@@ -56,5 +70,17 @@ struct E57WriteOptions {
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options);
 // The bytes WriteE57 would write (bench, tests).
 std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options = {});
+
+// One scan with a second layer behind it (`remove --keep-object`: the kept object in front, the filled
+// background behind). `front` and `behind` share the grid (rows x cols, directions) and pose; `behind` holds
+// returns only in some cells. Every record of `front` is written as by WriteE57 with returnIndex 0, plus one
+// record per valid `behind` cell with the same rowIndex/columnIndex and returnIndex 1; returnCount is 2 on
+// both records of such a cell, else 1; the `lidarshop:synthesized` field is 1 on every second return and
+// follows front.synthesized on the others. ReadE57 gives the layers back as scans[0] and second_returns[0].
+// Throws std::logic_error when the layers differ in size (check first: WriteScanWithLayer does). Atomic.
+void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
+                       const E57WriteOptions& options = {});
+std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
+                                        const E57WriteOptions& options = {});
 
 }  // namespace lidarshop

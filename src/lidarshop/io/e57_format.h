@@ -26,6 +26,12 @@ constexpr uint64_t kHeaderSize = 48;
 constexpr uint64_t kMaxPacketSize = 65536;  // logical bytes per packet (16-bit length minus one)
 constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a corrupt file
 
+// How the writer spells lidarshop's extension (e57.h, kLidarshopE57Namespace). The reader looks the prefix up
+// by the namespace URI instead, as a file may bind it to another prefix.
+constexpr char kExtensionXmlns[] = "xmlns:lidarshop";
+constexpr char kSynthesizedField[] = "lidarshop:synthesized";
+constexpr char kSynthesizedLocalName[] = "synthesized";
+
 // The largest record count or grid (cells) a file may claim; kMaxScanCells unless lowered (the fuzzer does,
 // to keep its memory bounded). Not thread-safe to change while reading.
 extern int64_t g_max_cells;
@@ -123,5 +129,19 @@ class BitWriter {
   uint64_t accumulator_ = 0;
   int pending_ = 0;  // bits in accumulator_
 };
+
+// Writing (e57_sections.cc). A bytestream the writer has packed, with its prototype field.
+struct Stream {
+  Field field;
+  std::vector<uint8_t> bytes;
+};
+
+// An Integer field in [minimum, maximum] with the fewest bits.
+Field IntegerField(const char* name, int64_t minimum, int64_t maximum);
+
+// Appends a compressed vector section of `record_count` records at the end of `logical` (8-byte aligned; data
+// packets of at most 64 KiB, no index packets) and returns its physical offset.
+uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
+                                std::vector<uint8_t>* logical);
 
 }  // namespace lidarshop::e57

@@ -327,7 +327,11 @@ GridOrientation OrientationOf(const Scan& scan) {
   return o;
 }
 
-Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
+// The first returns of one data3D entry; records with returnIndex 1 go to `second` (left 0 x 0 when there are
+// none), later ones are counted in `warnings`. `synthesized_field` is the name of lidarshop's extension field
+// under the prefix the file binds to its namespace ("" when the file does not declare it).
+Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::string& synthesized_field,
+              Scan* second, std::vector<std::string>* warnings) {
   const pugi::xml_node points = child.child("points");
   if (!points) XmlError(ctx, child, "data3D entry has no 'points'");
   if (TypeOf(points) != "CompressedVector") XmlError(ctx, points, "'points' is not a CompressedVector");
@@ -463,6 +467,20 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
     }
   }
   int64_t duplicates = 0;
+  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to `second`, later ones are left
+  // out.
+  std::vector<uint8_t> layer(record_count, 0);
+  if (structured && find("returnIndex") != nullptr) {
+    const auto& v = decode(find("returnIndex"));
+    for (int64_t i = 0; i < record_count; ++i) layer[i] = v[i] <= 0.0 ? 0 : v[i] == 1.0 ? 1 : 2;
+    if (std::find(layer.begin(), layer.end(), 1) != layer.end()) {
+      *second = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
+      second->name = scan.name;
+      second->world_from_scanner = scan.world_from_scanner;
+    }
+  }
+  Scan* layers[2] = {&scan, second};
+  int64_t later_returns = 0;
   std::vector<uint8_t> has_direction(static_cast<size_t>(rows * cols), 0);
   // Several records of one grid cell are several returns of one ray, which E57 marks with returnIndex.
   // Without it, two records claiming the same rowIndex/columnIndex contradict the grid: the file is corrupt
@@ -487,6 +505,24 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
     const cv::Vec3f p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
     const float range = static_cast<float>(cv::norm(p));
     const bool finite = std::isfinite(range);
+    if (layer[i] > 1) {
+      ++later_returns;
+      cell[i] = -1;
+      continue;
+    }
+    if (layer[i] == 1) {
+      // A second return: a point of the layer behind; its ray is the cell's (set from the grid below).
+      Scan& behind = *second;
+      if (state[i] == 0 && finite && range > 0.0f && behind.valid.at<uint8_t>(r, k) != kValid) {
+        behind.valid.at<uint8_t>(r, k) = kValid;
+        behind.point.at<cv::Vec3f>(r, k) = p;
+        behind.range.at<float>(r, k) = range;
+      } else {
+        duplicates += behind.valid.at<uint8_t>(r, k) == kValid;
+        cell[i] = -1;
+      }
+      continue;
+    }
     if (scan.valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
       ++duplicates;
       cell[i] = -1;
@@ -507,7 +543,17 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
       cell[i] = -1;  // no return: intensity and colour stay at their no-return values
     }
   }
-  (void)duplicates;
+  if (duplicates > 0) {
+    warnings->push_back(fmt::format(
+        "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
+        ctx.path, index, scan.name, duplicates));
+  }
+  if (later_returns > 0) {
+    warnings->push_back(
+        fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
+                    "returns) are not kept",
+                    ctx.path, index, scan.name, later_returns));
+  }
 
   if (intensity_field) {
     Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
@@ -524,11 +570,11 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
       l = {lo, hi, true};
     }
     const double span = l.maximum - l.minimum;
-    float* out = scan.intensity.ptr<float>();
     for (int64_t i = 0; i < record_count; ++i) {
       if (cell[i] < 0) continue;
       const double t = span > 0 ? (v[i] - l.minimum) / span : 0.5;
-      out[cell[i]] = std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
+      layers[layer[i]]->intensity.ptr<float>()[cell[i]] =
+          std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
     }
   }
   if (has_color) {
@@ -536,7 +582,6 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
     const char* min_names[3] = {"colorRedMinimum", "colorGreenMinimum", "colorBlueMinimum"};
     const char* max_names[3] = {"colorRedMaximum", "colorGreenMaximum", "colorBlueMaximum"};
     const Field* channel_fields[3] = {red, green, blue};
-    uint8_t* out = scan.color.ptr<uint8_t>();
     for (int ch = 0; ch < 3; ++ch) {
       Limits l = LimitsFrom(ctx, limits, min_names[ch], max_names[ch], channel_fields[ch]);
       if (!l.known) l = {0.0, 255.0, true};
@@ -545,9 +590,20 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
       for (int64_t i = 0; i < record_count; ++i) {
         if (cell[i] < 0) continue;
         const double t = span > 0 ? (v[i] - l.minimum) / span : 0.0;
-        out[3 * cell[i] + ch] =
+        layers[layer[i]]->color.ptr<uint8_t>()[3 * cell[i] + ch] =
             std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
       }
+    }
+  }
+
+  if (const Field* flag = synthesized_field.empty() ? nullptr : find(synthesized_field.c_str())) {
+    const auto& v = decode(flag);
+    for (Scan* s : layers) {
+      if (s != nullptr && s->num_cells() > 0)
+        s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
+    }
+    for (int64_t i = 0; i < record_count; ++i) {
+      if (cell[i] >= 0 && v[i] != 0.0) layers[layer[i]]->synthesized.ptr<uint8_t>()[cell[i]] = kValid;
     }
   }
 
@@ -558,9 +614,12 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
     const GridOrientation o = OrientationOf(scan);
     if (o.flip_rows || o.flip_cols) {
       const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
-      for (cv::Mat* m :
-           {&scan.direction, &scan.valid, &scan.range, &scan.point, &scan.intensity, &scan.color}) {
-        if (!m->empty()) cv::flip(*m, *m, code);
+      for (Scan* s : layers) {
+        if (s == nullptr || s->num_cells() == 0) continue;
+        for (cv::Mat* m :
+             {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized}) {
+          if (!m->empty()) cv::flip(*m, *m, code);
+        }
       }
       cv::Mat d(static_cast<int>(rows), static_cast<int>(cols), CV_8U, has_direction.data());
       cv::flip(d, d, code);
@@ -575,8 +634,11 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index) {
         if (has_direction[c] == 2) to[c] = from[c];
       }
     }
+    if (second->num_cells() > 0) {
+      second->direction = scan.direction.clone();  // the same rays
+      second->grid = scan.grid;
+    }
   }
-  (void)index;
   return scan;
 }
 
@@ -673,11 +735,21 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
   const pugi::xml_node root = doc.child("e57Root");
   if (!root) ThrowInputError(path, "XML section", "e57Root", "missing: not an E57 file");
 
+  // lidarshop's extension field, under whatever prefix the file binds to its namespace.
+  std::string synthesized_field;
+  for (const pugi::xml_attribute attribute : root.attributes()) {
+    const std::string_view name = attribute.name();
+    if (name.rfind("xmlns:", 0) == 0 && std::string_view(attribute.value()) == kLidarshopE57Namespace) {
+      synthesized_field = std::string(name.substr(6)) + ":" + kSynthesizedLocalName;
+    }
+  }
   E57File file;
   int index = 0;
   for (pugi::xml_node child : root.child("data3D").children()) {
     if (child.type() != pugi::node_element) continue;
-    file.scans.push_back(ReadScan(ctx, child, index++));
+    Scan second;
+    file.scans.push_back(ReadScan(ctx, child, index++, synthesized_field, &second, &file.warnings));
+    file.second_returns.push_back(std::move(second));
   }
   for (pugi::xml_node child : root.child("images2D").children()) {
     if (child.type() != pugi::node_element) continue;

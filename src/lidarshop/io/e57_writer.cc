@@ -34,65 +34,6 @@ void AddString(pugi::xml_node parent, const char* name, const std::string& v) {
   AddTyped(parent, name, "String").append_child(pugi::node_cdata).set_value(v.c_str());
 }
 
-struct Stream {
-  Field field;
-  std::vector<uint8_t> bytes;
-};
-
-// Appends a compressed vector section at the end of `logical` (4-byte aligned) and returns its physical
-// offset.
-uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
-                                std::vector<uint8_t>* logical) {
-  while (logical->size() % 8) logical->push_back(0);
-  const uint64_t start = logical->size();
-  logical->resize(start + 32, 0);
-  (*logical)[start] = 1;  // sectionId: compressed vector
-  const uint64_t data_start = logical->size();
-  const size_t n = streams.size();
-  uint64_t bits_per_record = 0;
-  for (const Stream& s : streams) bits_per_record += s.field.bits;
-  // Records per packet so that every packet (header + one chunk per stream + rounding) fits in 64 KiB.
-  const uint64_t budget = kMaxPacketSize - 6 - 2 * n - n - 4;
-  const int64_t per_packet = bits_per_record == 0
-                                 ? std::max<int64_t>(record_count, 1)
-                                 : std::max<int64_t>(1, static_cast<int64_t>(budget * 8 / bits_per_record));
-  auto byte_at = [&](const Stream& s, int64_t record) {
-    return std::min<uint64_t>(s.bytes.size(), (static_cast<uint64_t>(record) * s.field.bits + 7) / 8);
-  };
-  for (int64_t first = 0; first < std::max<int64_t>(record_count, 1); first += per_packet) {
-    const int64_t last = std::min(record_count, first + per_packet);
-    const uint64_t packet_start = logical->size();
-    logical->push_back(1);           // data packet
-    logical->push_back(0);           // flags
-    AppendLe<uint16_t>(logical, 0);  // length - 1, patched below
-    AppendLe<uint16_t>(logical, static_cast<uint16_t>(n));
-    std::vector<std::pair<uint64_t, uint64_t>> ranges(n);
-    for (size_t i = 0; i < n; ++i) {
-      // The last packet takes whatever is left (the final partial byte).
-      const uint64_t b = byte_at(streams[i], first);
-      const uint64_t e = last >= record_count ? streams[i].bytes.size() : byte_at(streams[i], last);
-      ranges[i] = {b, e};
-      AppendLe<uint16_t>(logical, static_cast<uint16_t>(e - b));
-    }
-    for (size_t i = 0; i < n; ++i) {
-      logical->insert(logical->end(), streams[i].bytes.begin() + ranges[i].first,
-                      streams[i].bytes.begin() + ranges[i].second);
-    }
-    while ((logical->size() - packet_start) % 4) logical->push_back(0);
-    const uint64_t length = logical->size() - packet_start;
-    LIDARSHOP_CHECK(length <= kMaxPacketSize);
-    const uint16_t length_minus_1 = static_cast<uint16_t>(length - 1);
-    std::memcpy(logical->data() + packet_start + 2, &length_minus_1, 2);
-  }
-  const uint64_t section_length = logical->size() - start;
-  const uint64_t data_physical = PhysicalFromLogical(data_start);
-  const uint64_t index_physical = 0;
-  std::memcpy(logical->data() + start + 8, &section_length, 8);
-  std::memcpy(logical->data() + start + 16, &data_physical, 8);
-  std::memcpy(logical->data() + start + 24, &index_physical, 8);
-  return PhysicalFromLogical(start);
-}
-
 void AddPrototypeField(pugi::xml_node prototype, const Field& f) {
   switch (f.type) {
     case Field::Type::kInteger: {
@@ -118,18 +59,17 @@ void AddPrototypeField(pugi::xml_node prototype, const Field& f) {
   }
 }
 
-Field IntegerField(const char* name, int64_t minimum, int64_t maximum) {
-  Field f;
-  f.name = name;
-  f.type = Field::Type::kInteger;
-  f.minimum = minimum;
-  f.maximum = maximum;
-  f.bits = BitsForRange(minimum, maximum);
-  return f;
-}
+// One record of a compressed vector: a cell of the front scan (layer 0) or of the layer behind it (layer 1).
+struct Record {
+  int64_t cell = 0;   // row * cols + col, image orientation
+  uint8_t state = 0;  // cartesianInvalidState: 0 = a return, 1 = direction only
+  uint8_t layer = 0;  // returnIndex
+};
 
-void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std::vector<uint8_t>* logical,
-                pugi::xml_node data3d) {
+// Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
+// become second returns. Returns whether the lidarshop extension field was written.
+bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteOptions& options,
+                std::vector<uint8_t>* logical, pugi::xml_node data3d) {
   CheckScan(scan);
   if (!IsRigid(scan.world_from_scanner, 1e-6)) {
     throw InputError(
@@ -137,28 +77,31 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
                     "translation only",
                     index, scan.name));
   }
-  // The records: valid cells, and (optionally) no-return cells that have a direction.
-  std::vector<int64_t> cells;
-  std::vector<uint8_t> states;
-  cells.reserve(static_cast<size_t>(scan.num_cells()));
+  if (behind != nullptr) {
+    CheckScan(*behind);
+    LIDARSHOP_CHECK(behind->rows == scan.rows && behind->cols == scan.cols);
+  }
+  // The records: valid cells, (optionally) no-return cells that have a direction, and after each cell its
+  // second return from `behind`.
+  std::vector<Record> records;
+  records.reserve(static_cast<size_t>(scan.num_cells()));
+  const uint8_t* behind_valid = behind != nullptr ? behind->valid.ptr<uint8_t>() : nullptr;
   for (int64_t c = 0; c < scan.num_cells(); ++c) {
     const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
     if (scan.valid.at<uint8_t>(r, k)) {
-      cells.push_back(c);
-      states.push_back(0);
+      records.push_back({c, 0, 0});
     } else if (options.write_no_return_directions) {
       const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
-      if (d.dot(d) > 0.0f && std::isfinite(d.dot(d))) {
-        cells.push_back(c);
-        states.push_back(1);
-      }
+      if (d.dot(d) > 0.0f && std::isfinite(d.dot(d))) records.push_back({c, 1, 0});
     }
+    if (behind_valid != nullptr && behind_valid[c]) records.push_back({c, 0, 1});
   }
-  const int64_t n = static_cast<int64_t>(cells.size());
+  const int64_t n = static_cast<int64_t>(records.size());
+  auto layer_of = [&](int64_t i) -> const Scan& { return records[i].layer == 0 ? scan : *behind; };
   auto xyz_of = [&](int64_t i, int axis) {
-    const int64_t c = cells[i];
-    const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
-    return states[i] == 0 ? scan.point.at<cv::Vec3f>(r, k)[axis] : scan.direction.at<cv::Vec3f>(r, k)[axis];
+    const int64_t c = records[i].cell;
+    const Scan& s = layer_of(i);
+    return records[i].state == 0 ? s.point.ptr<cv::Vec3f>()[c][axis] : s.direction.ptr<cv::Vec3f>()[c][axis];
   };
 
   std::vector<Stream> streams;
@@ -197,7 +140,7 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
       s.bytes = w.Finish();
     }
     for (int64_t i = 0; i < n; ++i) {
-      if (states[i] != 0) continue;
+      if (records[i].state != 0) continue;
       const double v = xyz_of(i, axis);
       lo[axis] = std::min(lo[axis], v);
       hi[axis] = std::max(hi[axis], v);
@@ -210,19 +153,20 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
     s.field.type = Field::Type::kFloat;
     s.field.bits = 32;
     BitWriter w(32);
-    const float* in = scan.intensity.ptr<float>();
-    for (int64_t i = 0; i < n; ++i) w.PutFloat(in[cells[i]]);
+    for (int64_t i = 0; i < n; ++i) w.PutFloat(layer_of(i).intensity.ptr<float>()[records[i].cell]);
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
   }
   if (scan.has_color()) {
     const char* names[3] = {"colorRed", "colorGreen", "colorBlue"};
-    const uint8_t* in = scan.color.ptr<uint8_t>();
     for (int ch = 0; ch < 3; ++ch) {
       Stream s;
       s.field = IntegerField(names[ch], 0, 255);
       BitWriter w(s.field.bits);
-      for (int64_t i = 0; i < n; ++i) w.PutInteger(in[3 * cells[i] + ch], 0);
+      for (int64_t i = 0; i < n; ++i) {
+        const Scan& from = layer_of(i);  // a layer without colour is written black
+        w.PutInteger(from.has_color() ? from.color.ptr<uint8_t>()[3 * records[i].cell + ch] : 0, 0);
+      }
       s.bytes = w.Finish();
       streams.push_back(std::move(s));
     }
@@ -233,8 +177,8 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
     col.field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
     BitWriter wr(row.field.bits), wc(col.field.bits);
     for (int64_t i = 0; i < n; ++i) {
-      wr.PutInteger(cells[i] / scan.cols, 0);
-      wc.PutInteger(cells[i] % scan.cols, 0);
+      wr.PutInteger(records[i].cell / scan.cols, 0);
+      wc.PutInteger(records[i].cell % scan.cols, 0);
     }
     row.bytes = wr.Finish();
     col.bytes = wc.Finish();
@@ -243,11 +187,39 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
   }
   {
     const bool any_direction_only =
-        std::any_of(states.begin(), states.end(), [](uint8_t s) { return s != 0; });
+        std::any_of(records.begin(), records.end(), [](const Record& r) { return r.state != 0; });
     Stream s;
     s.field = IntegerField("cartesianInvalidState", 0, any_direction_only ? 2 : 0);
     BitWriter w(s.field.bits);
-    for (int64_t i = 0; i < n; ++i) w.PutInteger(states[i], 0);
+    for (int64_t i = 0; i < n; ++i) w.PutInteger(records[i].state, 0);
+    s.bytes = w.Finish();
+    streams.push_back(std::move(s));
+  }
+  if (behind != nullptr) {
+    // Only files with a second layer carry return fields, so single-layer files stay as they were.
+    Stream index_stream, count_stream;
+    index_stream.field = IntegerField("returnIndex", 0, 1);
+    count_stream.field = IntegerField("returnCount", 1, 2);
+    BitWriter wi(index_stream.field.bits), wn(count_stream.field.bits);
+    for (int64_t i = 0; i < n; ++i) {
+      wi.PutInteger(records[i].layer, 0);
+      wn.PutInteger(behind_valid[records[i].cell] ? 2 : 1, 1);
+    }
+    index_stream.bytes = wi.Finish();
+    count_stream.bytes = wn.Finish();
+    streams.push_back(std::move(index_stream));
+    streams.push_back(std::move(count_stream));
+  }
+  const bool write_synthesized = behind != nullptr || !scan.synthesized.empty();
+  if (write_synthesized) {
+    // The second layer is synthesized by definition; the front scan says per cell.
+    Stream s;
+    s.field = IntegerField(kSynthesizedField, 0, 1);
+    BitWriter w(s.field.bits);
+    const uint8_t* flags = scan.synthesized.empty() ? nullptr : scan.synthesized.ptr<uint8_t>();
+    for (int64_t i = 0; i < n; ++i) {
+      w.PutInteger(records[i].layer == 1 || (flags != nullptr && flags[records[i].cell] != 0) ? 1 : 0, 0);
+    }
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
   }
@@ -287,7 +259,7 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
     AddInteger(b, "columnMinimum", 0);
     AddInteger(b, "columnMaximum", std::max(scan.cols - 1, 0));
     AddInteger(b, "returnMinimum", 0);
-    AddInteger(b, "returnMaximum", 0);
+    AddInteger(b, "returnMaximum", behind != nullptr ? 1 : 0);
   }
   {
     pugi::xml_node b = AddTyped(child, "cartesianBounds", "Structure");
@@ -319,6 +291,7 @@ void AppendScan(const Scan& scan, int index, const E57WriteOptions& options, std
   for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
   pugi::xml_node codecs = AddTyped(points, "codecs", "Vector");
   codecs.append_attribute("allowHeterogeneousChildren") = "1";
+  return write_synthesized;
 }
 
 }  // namespace
@@ -330,8 +303,12 @@ void E57WriteOptions::Check() const {
       fmt::format("E57WriteOptions.coordinate_scale_m must be >= 0 (0 = float), got {}", coordinate_scale_m));
 }
 
-std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options) {
-  using namespace e57;
+namespace e57 {
+namespace {
+
+// The file of `scans`; `behind_first` (may be null) is a second layer of scans[0].
+std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_first,
+                            const E57WriteOptions& options) {
   options.Check();
   std::vector<uint8_t> logical(kHeaderSize, 0);
   pugi::xml_document doc;
@@ -346,8 +323,13 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOpt
   AddString(root, "e57LibraryVersion", "lidarshop");
   pugi::xml_node data3d = AddTyped(root, "data3D", "Vector");
   data3d.append_attribute("allowHeterogeneousChildren") = "1";
-  for (size_t i = 0; i < scans.size(); ++i)
-    AppendScan(scans[i], static_cast<int>(i), options, &logical, data3d);
+  bool extension = false;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    extension |=
+        AppendScan(scans[i], i == 0 ? behind_first : nullptr, static_cast<int>(i), options, &logical, data3d);
+  }
+  // E2807 declares extensions by an XML namespace on e57Root; readers that do not know it skip its fields.
+  if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
   pugi::xml_node images = AddTyped(root, "images2D", "Vector");
   images.append_attribute("allowHeterogeneousChildren") = "1";
   // The file guid: a checksum of the binary sections, so that the same scans give the same bytes.
@@ -372,11 +354,31 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOpt
   return PagesFromLogical(logical);
 }
 
-void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options) {
-  const std::vector<uint8_t> bytes = EncodeE57(scans, options);
+void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   });
+}
+
+}  // namespace
+}  // namespace e57
+
+std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options) {
+  return e57::Encode(scans, nullptr, options);
+}
+
+std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
+                                        const E57WriteOptions& options) {
+  return e57::Encode({front}, &behind, options);
+}
+
+void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
+                       const E57WriteOptions& options) {
+  e57::WriteBytes(path, EncodeE57WithLayer(front, behind, options));
+}
+
+void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options) {
+  e57::WriteBytes(path, EncodeE57(scans, options));
 }
 
 void WriteE57(const std::string& path, const std::vector<Scan>& scans) { WriteE57(path, scans, {}); }

@@ -25,6 +25,31 @@ constexpr char kScanComment[] = "lidarshop_scan ";
 // ---- PLY: a scan is its valid points in the world frame plus row/col/scan properties and a pose comment
 // ----
 
+// A 1 x N scan of the cloud's points (identity pose; (0, 0, 0) is no return), without a grid.
+Scan ScanFromPointCloud(const PointCloud& cloud) {
+  Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty());
+  if (!cloud.labels.empty()) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
+  if (!cloud.normals.empty()) scan.normal = cv::Mat(1, scan.cols, CV_32FC3, cv::Scalar::all(0));
+  if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
+  for (int i = 0; i < scan.cols; ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (p.isZero()) continue;  // (0, 0, 0) has no ray
+    scan.valid.at<uint8_t>(0, i) = kValid;
+    scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
+    if (!cloud.intensities.empty()) scan.intensity.at<float>(0, i) = cloud.intensities[i];
+    if (!cloud.colors.empty())
+      scan.color.at<cv::Vec3b>(0, i) = cv::Vec3b(cloud.colors[i][0], cloud.colors[i][1], cloud.colors[i][2]);
+    if (!cloud.labels.empty()) scan.label.at<int32_t>(0, i) = cloud.labels[i];
+    if (!cloud.normals.empty()) {
+      scan.normal.at<cv::Vec3f>(0, i) =
+          cv::Vec3f(cloud.normals[i].x(), cloud.normals[i].y(), cloud.normals[i].z());
+    }
+    if (!cloud.synthesized.empty()) scan.synthesized.at<uint8_t>(0, i) = cloud.synthesized[i] ? kValid : 0;
+  }
+  FinishScan(&scan, /*fit_grid=*/false);
+  return scan;
+}
+
 struct PlyScanHeader {
   int index = 0;
   int64_t rows = 0, cols = 0;
@@ -64,28 +89,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     // A plain point cloud: one 1 x N scan, every point a return, in the identity pose.
     if (cloud.size() == 0) ThrowInputError(path, "header", "element vertex", "no points");
     CheckScanSize(1, static_cast<int64_t>(cloud.size()), path, "header");
-    Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty());
-    if (!cloud.labels.empty()) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
-    if (!cloud.normals.empty()) scan.normal = cv::Mat(1, scan.cols, CV_32FC3, cv::Scalar::all(0));
-    if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
-    for (int i = 0; i < scan.cols; ++i) {
-      const Eigen::Vector3f& p = cloud.points[i];
-      if (p.isZero()) continue;  // (0, 0, 0) has no ray
-      scan.valid.at<uint8_t>(0, i) = kValid;
-      scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
-      if (!cloud.intensities.empty()) scan.intensity.at<float>(0, i) = cloud.intensities[i];
-      if (!cloud.colors.empty())
-        scan.color.at<cv::Vec3b>(0, i) =
-            cv::Vec3b(cloud.colors[i][0], cloud.colors[i][1], cloud.colors[i][2]);
-      if (!cloud.labels.empty()) scan.label.at<int32_t>(0, i) = cloud.labels[i];
-      if (!cloud.normals.empty()) {
-        scan.normal.at<cv::Vec3f>(0, i) =
-            cv::Vec3f(cloud.normals[i].x(), cloud.normals[i].y(), cloud.normals[i].z());
-      }
-      if (!cloud.synthesized.empty()) scan.synthesized.at<uint8_t>(0, i) = cloud.synthesized[i] ? kValid : 0;
-    }
-    FinishScan(&scan, /*fit_grid=*/false);
-    return {scan};
+    return {ScanFromPointCloud(cloud)};
   }
 
   std::vector<Scan> scans;
@@ -268,6 +272,8 @@ std::string FileExtension(const std::string& path) {
   return extension;
 }
 
+void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
+
 ScanFile ReadScanFile(const std::string& path) {
   const ScanFormat& format = FormatFor(path);
   ScanFile file;
@@ -281,6 +287,54 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
   const ScanFormat& format = FormatFor(path);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
   format.write(path, scans);
+}
+
+void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind) {
+  const std::string extension = FormatFor(path).extension;
+  CheckScan(front);
+  CheckScan(behind);
+  if (front.rows != behind.rows || front.cols != behind.cols) {
+    ThrowInputError(path, "", "layers",
+                    fmt::format("the layer behind ({} x {}) does not match the front scan's grid ({} x {})",
+                                behind.rows, behind.cols, front.rows, front.cols));
+  }
+  if (!front.world_from_scanner.isApprox(behind.world_from_scanner, 1e-9)) {
+    ThrowInputError(path, "", "layers", "the layer behind has another pose than the front scan");
+  }
+  if (extension == "ptx") {
+    ThrowInputError(path, "", "", "PTX cannot hold two returns per cell; write E57, PLY or PCD");
+  }
+  if (extension == "e57") {
+    WriteE57WithLayer(path, front, behind);
+    return;
+  }
+  // Points of both layers, world frame, the layer behind flagged synthesized.
+  Scan flagged = behind;
+  flagged.synthesized = cv::Mat(behind.rows, behind.cols, CV_8U, cv::Scalar(kValid));
+  if (extension == "ply") {
+    // Two scans of one grid: plain PLY readers see the union of the points, lidarshop gets both layers back.
+    WritePlyScans(path, {front, flagged});
+    return;
+  }
+  PointCloud cloud = ToPointCloud(front, /*world=*/true);
+  const PointCloud more = ToPointCloud(flagged, /*world=*/true);
+  if (cloud.synthesized.empty()) cloud.synthesized.assign(cloud.size(), 0);
+  auto append = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+  // An optional channel only one layer has is dropped rather than padded with made-up values.
+  auto append_optional = [&](auto& to, const auto& from) {
+    if (!to.empty() && !from.empty())
+      append(to, from);
+    else
+      to.clear();
+  };
+  append_optional(cloud.colors, more.colors);
+  append_optional(cloud.normals, more.normals);
+  append_optional(cloud.labels, more.labels);
+  append(cloud.points, more.points);
+  append(cloud.intensities, more.intensities);
+  append(cloud.synthesized, more.synthesized);
+  if (cloud.points.empty()) ThrowInputError(path, "", "", "neither layer has a return to write");
+  WritePcd(path, ScanFromPointCloud(cloud));
 }
 
 }  // namespace lidarshop

@@ -30,6 +30,24 @@ ScanFile ReadScanFile(const std::string& path);
 // InputError when given several. Atomic.
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 
+// Writes `front` with a second layer `behind` it (`remove --keep-object`: the kept object in front, the
+// filled background behind). Both share the grid (rows x cols, directions) and pose; `behind` holds returns
+// only in some cells and is synthesized by definition.
+//   .e57  one data3D: `front` as WriteE57 writes it, plus each valid `behind` cell as a second return of the
+//         same rowIndex/columnIndex (returnIndex 1, returnCount 2; lidarshop:synthesized = 1); ReadE57 gives
+//         the layers back as scans[0] and second_returns[0] (io/e57.h, WriteE57WithLayer)
+//   .ply  two scans of one grid (scan 0 = front, scan 1 = behind, synthesized = 1), world frame: a plain
+//         PLY reader sees the union of both layers' points with the `synthesized` field
+//   .pcd  one unorganized cloud (HEIGHT 1, world frame) of both layers' valid points, `synthesized` 0 for
+//         measured points of `front` (or its own flags) and 1 for `behind`
+//   .ptx  InputError: "PTX cannot hold two returns per cell; write E57, PLY or PCD"
+// Throws InputError naming `path` when the layers differ in size or pose. Atomic.
+void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind);
+
+// Throws InputError (the same as ReadScanFile / WriteScanFile would) when `path` has no scan format's
+// extension; lets a command refuse an output path before its work.
+void CheckScanFileFormat(const std::string& path);
+
 // The lower-case extension without the dot ("ptx"), or "" when none.
 std::string FileExtension(const std::string& path);
 

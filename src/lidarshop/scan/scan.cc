@@ -25,6 +25,26 @@ Scan Clone(const Scan& scan) {
   return copy;
 }
 
+Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
+  CheckScan(scan);
+  if (keep_mask.rows != scan.rows || keep_mask.cols != scan.cols || keep_mask.type() != CV_8U) {
+    throw std::logic_error("MaskScan: the mask must be CV_8U of the scan's size");
+  }
+  Scan masked = Clone(scan);
+  const cv::Mat drop = keep_mask == 0;
+  // Each channel gets its own no-return value (see MakeScan); `direction` stays: every cell keeps its ray.
+  masked.valid.setTo(0, drop);
+  masked.range.setTo(0, drop);
+  masked.point.setTo(cv::Scalar::all(0), drop);
+  masked.intensity.setTo(0.5, drop);
+  if (!masked.color.empty()) masked.color.setTo(cv::Scalar::all(0), drop);
+  if (!masked.label.empty()) masked.label.setTo(kNoLabel, drop);
+  if (!masked.normal.empty()) masked.normal.setTo(cv::Scalar::all(0), drop);
+  if (!masked.true_range.empty()) masked.true_range.setTo(0, drop);
+  if (!masked.synthesized.empty()) masked.synthesized.setTo(0, drop);
+  return masked;
+}
+
 Scan MakeScan(int rows, int cols, bool with_color) {
   if (rows < 0 || cols < 0) throw std::logic_error("MakeScan: negative size");
   Scan scan;

@@ -88,6 +88,13 @@ struct Scan {
 // changes a channel of a scan it was given must clone first: inputs are never modified.
 Scan Clone(const Scan& scan);
 
+// The scan with only the cells where `keep_mask` (CV_8U, rows x cols, non-zero = keep) is set: every other
+// cell becomes a cell without a return (valid 0, range 0, point 0, intensity 0.5, colour 0, label kNoLabel,
+// normal 0, true_range 0, synthesized 0) but keeps its direction; grid, pose and name are kept. Used to write
+// a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error on a mask of the wrong
+// size or type.
+Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);
+
 // A scan with every required channel allocated (no returns, directions zero, intensity 0.5) and no optional
 // ones.
 Scan MakeScan(int rows, int cols, bool with_color = false);

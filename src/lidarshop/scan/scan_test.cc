@@ -48,6 +48,41 @@ TEST(ScanTest, WithRangeKeepsRaysAndMarksSynthesized) {
   EXPECT_EQ(scan.CountValid(), 1);  // the input is untouched
 }
 
+TEST(ScanTest, MaskScanClearsDroppedCellsAndKeepsDirections) {
+  Scan scan = MakeScan(2, 2, /*with_color=*/true);
+  scan.direction = DirectionsFromGrid(UniformGrid(2, 2, -0.1, 0.1, -0.1, 0.1));
+  scan.label = cv::Mat(2, 2, CV_32S, cv::Scalar(3));
+  scan.synthesized = cv::Mat(2, 2, CV_8U, cv::Scalar(kValid));
+  scan.world_from_scanner(1, 3) = 4.0;
+  for (int c = 0; c < 4; ++c) {
+    const int row = c / 2, col = c % 2;
+    scan.valid.at<uint8_t>(row, col) = kValid;
+    scan.point.at<cv::Vec3f>(row, col) = scan.direction.at<cv::Vec3f>(row, col) * (2.0f + c);
+    scan.range.at<float>(row, col) = 2.0f + c;
+    scan.intensity.at<float>(row, col) = 0.1f * c;
+    scan.color.at<cv::Vec3b>(row, col) = cv::Vec3b(10, 20, 30);
+  }
+  cv::Mat keep(2, 2, CV_8U, cv::Scalar(0));
+  keep.at<uint8_t>(0, 1) = 255;
+  const Scan masked = MaskScan(scan, keep);
+  EXPECT_EQ(masked.CountValid(), 1);
+  EXPECT_EQ(masked.valid.at<uint8_t>(0, 1), kValid);
+  EXPECT_EQ(masked.range.at<float>(0, 1), 3.0f);
+  EXPECT_EQ(masked.color.at<cv::Vec3b>(0, 1), cv::Vec3b(10, 20, 30));
+  EXPECT_EQ(masked.valid.at<uint8_t>(1, 0), 0);
+  EXPECT_EQ(masked.range.at<float>(1, 0), 0.0f);
+  EXPECT_EQ(masked.point.at<cv::Vec3f>(1, 0), cv::Vec3f(0, 0, 0));
+  EXPECT_EQ(masked.intensity.at<float>(1, 0), 0.5f);
+  EXPECT_EQ(masked.color.at<cv::Vec3b>(1, 0), cv::Vec3b(0, 0, 0));
+  EXPECT_EQ(masked.label.at<int32_t>(1, 0), kNoLabel);
+  EXPECT_EQ(masked.synthesized.at<uint8_t>(1, 0), 0);
+  EXPECT_EQ(masked.synthesized.at<uint8_t>(0, 1), kValid);
+  EXPECT_EQ(cv::norm(masked.direction, scan.direction, cv::NORM_INF), 0.0);  // every ray kept
+  EXPECT_EQ(masked.world_from_scanner, scan.world_from_scanner);
+  EXPECT_EQ(scan.CountValid(), 4);  // the input is untouched
+  EXPECT_THROW(MaskScan(scan, cv::Mat(3, 2, CV_8U, cv::Scalar(0))), std::logic_error);
+}
+
 TEST(ScanTest, ToPointCloudInWorldFrame) {
   Scan scan = MakeScan(1, 1, /*with_color=*/true);
   scan.valid.at<uint8_t>(0, 0) = kValid;
