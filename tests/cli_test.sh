@@ -214,6 +214,13 @@ check "fill laplace into E57" "$lidarshop" fill "$work/scan.ptx" --mask "$work/m
 check "remove" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/removed.ptx" \
   --report "$work/remove.json" --quiet
 json_check "remove report" "$work/remove.json" "d['object_cells'] > 0 and d['synthesized_points'] > 0"
+check "remove --keep-object into E57 (second returns)" "$lidarshop" remove "$work/scan.ptx" \
+  --strokes "$work/strokes.json" -o "$work/two_layers.e57" --keep-object --quiet
+check "remove --keep-object into PLY" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/two_layers.ply" --keep-object --quiet
+check "info on the two-layer PLY" sh -c "'$lidarshop' info '$work/two_layers.ply' > '$work/two_layers.json'"
+json_check "the PLY holds the scan and the layer behind the object" "$work/two_layers.json" \
+  "len(d['scans']) == 2 and d['scans'][1]['valid'] > 0"
 fails_clearly "fill: mask of another size" "mask" "$lidarshop" fill "$work/scan.ptx" \
   --mask "$shared/images/bungee/bungee_mask.png" -o "$work/x.ply" --quiet
 fails_clearly "fill: output onto its input" "overwrite" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \

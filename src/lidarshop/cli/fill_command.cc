@@ -13,6 +13,7 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/fill/fill.h"
+#include "lidarshop/fill/remove.h"
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
@@ -199,7 +200,6 @@ int RunRemove(int argc, char** argv) {
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
     const FillOptions options = flags.Parsed();
-    if (margin < 0 || margin > 100) throw OptionsError(fmt::format("--margin must be in [0, 100] cells, got {}", margin));
     CheckScanOutput(output_path, {scan_path, strokes_path});
     if (keep_object && FileExtension(output_path) == "ptx") {
       throw OptionsError(
@@ -211,22 +211,25 @@ int RunRemove(int argc, char** argv) {
     const ScanFile file = ReadScanFile(scan_path);
     const Scan& scan = PickScan(file, scan_index, scan_path);
     const cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
-    const SegmentResult cut = SegmentObject(scan, strokes);
-    if (!quiet) fmt::print(stderr, "segment: {}\n", cut.Summary());
-    const cv::Mat hole = GrowHole(cut.mask, margin);
-    auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
-    const FillResult result = FillScan(scan, hole, options, progress.get());
+    RemoveOptions remove;
+    remove.fill = options;
+    remove.margin_cells = margin;
+    remove.keep_object = keep_object;
+    auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
+    const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
     if (progress) progress->Finish();
+    const FillResult& result = removed.fill;
+    const cv::Mat& hole = removed.hole;
+    if (!quiet) fmt::print(stderr, "segment: {}\n", removed.cut.Summary());
     if (keep_object) {
-      // Behind the object only: the margin ring is background in front already.
-      throw OptionsError("MERGE-PENDING");  // MaskScan + WriteScanWithLayer land with the io-layers branch
+      WriteScanWithLayer(output_path, scan, removed.behind);
     } else {
       WriteScanFile(output_path, {result.scan});
     }
     if (!mask_out_path.empty()) WriteImage(mask_out_path, hole);
     if (!report_path.empty()) {
       nlohmann::json report = ReportJson(result, options);
-      report["object_cells"] = cut.object_cells;
+      report["object_cells"] = removed.cut.object_cells;
       report["margin_cells"] = margin;
       report["keep_object"] = keep_object;
       WriteJson(report_path, report);

@@ -1,0 +1,88 @@
+#include "lidarshop/fill/remove.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+// A red box in front of a wall on grass; strokes on the box and on the wall / ground around it.
+constexpr const char* kScene = R"({
+  "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-20, 20], "elevation_deg": [-20, 10], "columns": 160,
+              "rows": 120, "max_range": 40, "seed": 7},
+  "objects": [
+    {"primitive": "plane", "size": [40, 40], "translate": [0, 15, 0], "label": 0, "texture": "grass"},
+    {"primitive": "wall", "size": [12, 0.3, 2.5], "translate": [0, 7, 0], "label": 2, "color": [200, 200, 190]},
+    {"primitive": "box", "size": [0.8, 0.5, 1.2], "translate": [0.2, 4.5, 0.6], "label": 1, "color": [200, 30, 30]}
+  ]
+})";
+
+struct Case {
+  Scan scan, truth;
+  cv::Mat strokes;
+};
+
+Case MakeCase() {
+  const SceneDescription scene = ParseScene(kScene, "test scene", ".");
+  SceneDescription without = scene;
+  std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
+  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  // Object stroke: the box's cells eroded; background stroke: a ring of cells well outside it.
+  const cv::Mat box = (c.scan.label == 1) & (c.scan.valid != 0);
+  cv::Mat inner, outer;
+  cv::erode(box, inner, cv::Mat(), cv::Point(-1, -1), 3);
+  cv::dilate(box, outer, cv::Mat(), cv::Point(-1, -1), 8);
+  cv::Mat ring;
+  cv::dilate(outer, ring, cv::Mat(), cv::Point(-1, -1), 2);
+  ring &= ~outer;
+  c.strokes = cv::Mat(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  c.strokes.setTo(kStrokeObject, inner);
+  c.strokes.setTo(kStrokeBackground, ring & (c.scan.valid != 0));
+  return c;
+}
+
+TEST(RemoveObject, CutsTheBoxAndFillsBehindIt) {
+  const Case c = MakeCase();
+  const RemoveResult removed = RemoveObject(c.scan, c.strokes);
+  const cv::Mat box = (c.scan.label == 1) & (c.scan.valid != 0);
+  EXPECT_EQ(cv::countNonZero(box & ~removed.hole), 0);  // every box cell is in the hole
+  // No box label survives; the fill is close to the scan without the box.
+  EXPECT_EQ(cv::countNonZero(removed.fill.scan.label == 1), 0);
+  const FillMetrics m = MeasureFill(removed.fill.scan, c.truth, removed.hole);
+  EXPECT_LT(m.range_rmse_mm, 100.0);
+  EXPECT_TRUE(removed.behind.valid.empty());
+}
+
+TEST(RemoveObject, KeepObjectGivesTheFillAsALayerBehindTheObjectOnly) {
+  const Case c = MakeCase();
+  RemoveOptions options;
+  options.keep_object = true;
+  const RemoveResult removed = RemoveObject(c.scan, c.strokes, options);
+  ASSERT_FALSE(removed.behind.valid.empty());
+  const cv::Mat behind = removed.behind.valid != 0;
+  EXPECT_GT(cv::countNonZero(behind), 0);
+  EXPECT_EQ(cv::countNonZero(behind & (removed.cut.mask == 0)), 0);  // only behind the object's cells
+  EXPECT_EQ(cv::countNonZero(behind & (removed.behind.synthesized == 0)), 0);
+  // Behind means farther than the object along the same ray.
+  for (int y = 0; y < c.scan.rows; ++y) {
+    for (int x = 0; x < c.scan.cols; ++x) {
+      if (!behind.at<uint8_t>(y, x)) continue;
+      EXPECT_GT(removed.behind.range.at<float>(y, x), c.scan.range.at<float>(y, x));
+    }
+  }
+}
+
+TEST(RemoveObject, BadOptionsAndStrokes) {
+  const Case c = MakeCase();
+  RemoveOptions options;
+  options.margin_cells = -1;
+  EXPECT_THROW(RemoveObject(c.scan, c.strokes, options), OptionsError);
+  EXPECT_THROW(RemoveObject(c.scan, cv::Mat(3, 3, CV_8U, cv::Scalar(0))), InputError);
+}
+
+}  // namespace
+}  // namespace lidarshop
