@@ -211,6 +211,8 @@ check "fill wrote the mask and the debug pictures" test -s "$work/synthesized.pn
   -a -s "$work/fill_debug/gradient_after.png" -a -s "$work/fill_debug/source_cells.png"
 check "fill laplace into E57" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" --method laplace \
   -o "$work/filled.e57" --quiet
+check "info on the filled E57" sh -c "'$lidarshop' info '$work/filled.e57' > '$work/filled_e57.json'"
+json_check "the E57 keeps the synthesized flag" "$work/filled_e57.json" "'synthesized' in d['scans'][0]['channels']"
 check "remove" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/removed.ptx" \
   --report "$work/remove.json" --quiet
 json_check "remove report" "$work/remove.json" "d['object_cells'] > 0 and d['synthesized_points'] > 0"
