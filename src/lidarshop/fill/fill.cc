@@ -15,6 +15,8 @@
 namespace lidarshop {
 
 using fill_internal::AbsQuantile;
+using fill_internal::DepthJumps;
+using fill_internal::EdgeMasks;
 using fill_internal::GuidanceDivergence;
 using fill_internal::NearestKnownCell;
 using fill_internal::OneSidedRangeGradient;
@@ -60,6 +62,8 @@ void FillOptions::Check() const {
               fmt::format("FillOptions.return_weight must be >= 0, got {}", return_weight));
   CheckOption(color_weight + gradient_weight + return_weight > 0,
               "FillOptions: at least one of color_weight, gradient_weight, return_weight must be > 0");
+  CheckOption(std::isfinite(depth_jump_ratio) && depth_jump_ratio >= 0,
+              fmt::format("FillOptions.depth_jump_ratio must be >= 0, got {}", depth_jump_ratio));
   CheckOption(std::isfinite(telea_radius_cells) && telea_radius_cells > 0,
               fmt::format("FillOptions.telea_radius_cells must be > 0, got {}", telea_radius_cells));
   poisson.Check();
@@ -190,17 +194,17 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
 // Laplace); returns the channels of `boundary` solved. Cells of Ω cut off from every known range lose their
 // return.
 cv::Mat SolveInHole(const Inputs& in, const FillOptions& options, HoleValues* values, const cv::Mat& boundary,
-                    const cv::Mat& guidance_x, const cv::Mat& guidance_y, int64_t* unanchored) {
+                    const cv::Mat& guidance_x, const cv::Mat& guidance_y, const EdgeMasks& cuts, int64_t* unanchored) {
   cv::Mat domain = values->has_return.clone();
-  const cv::Mat cut_off = UnanchoredCells(domain, in.known_valid);
+  const cv::Mat cut_off = UnanchoredCells(domain, in.known_valid, cuts);
   *unanchored = cv::countNonZero(cut_off);
   domain.setTo(0, cut_off);
   values->has_return.setTo(0, cut_off);
   const cv::Mat no_data = (in.known_valid | domain) == 0;
   if (cv::countNonZero(domain) == 0) return boundary.clone();
-  const PoissonSystem system = PreparePoisson(domain, options.poisson, no_data);
+  const PoissonSystem system = PreparePoisson(domain, options.poisson, PoissonLinks{no_data, cuts.right, cuts.down});
   cv::Mat divergence;
-  if (!guidance_x.empty()) divergence = GuidanceDivergence(guidance_x, guidance_y, no_data);
+  if (!guidance_x.empty()) divergence = GuidanceDivergence(guidance_x, guidance_y, no_data, cuts);
   return SolvePoisson(system, boundary, divergence).image;
 }
 
@@ -234,8 +238,12 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);
 
-  // The guidance field: known gradients outside, the copied ones inside.
+  // The guidance field: known gradients outside, the copied ones inside; depth jumps are copied along and cut
+  // the Poisson system there, so that surfaces at different distances are not joined by a membrane.
   cv::Mat gx = gradient.gx.clone(), gy = gradient.gy.clone();
+  const EdgeMasks known_jumps = DepthJumps(in.range, in.known_valid, options.depth_jump_ratio);
+  // Only edges leaving a hole cell can be in the system (known-to-known edges never are).
+  EdgeMasks cuts{cv::Mat::zeros(in.hole.size(), CV_8U), cv::Mat::zeros(in.hole.size(), CV_8U)};
   for (int y = 0; y < in.hole.rows; ++y) {
     for (int x = 0; x < in.hole.cols; ++x) {
       if (!in.hole.at<uint8_t>(y, x)) continue;
@@ -243,6 +251,8 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
       if (s[0] < 0) continue;
       gx.at<float>(y, x) = gradient.gx.at<float>(s[0], s[1]);
       gy.at<float>(y, x) = gradient.gy.at<float>(s[0], s[1]);
+      cuts.right.at<uint8_t>(y, x) = known_jumps.right.at<uint8_t>(s[0], s[1]);
+      cuts.down.at<uint8_t>(y, x) = known_jumps.down.at<uint8_t>(s[0], s[1]);
     }
   }
   cv::magnitude(gradient.gx, gradient.gy, result->gradient_magnitude_before);
@@ -252,7 +262,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   timer.Restart();
   cv::Mat boundary;
   field.convertTo(boundary, CV_64F);
-  const cv::Mat solved = SolveInHole(in, options, values, boundary, gx, gy, &result->unanchored_cells);
+  const cv::Mat solved = SolveInHole(in, options, values, boundary, gx, gy, cuts, &result->unanchored_cells);
   solved.convertTo(values->range, CV_32F);
   if (options.inverse_range) {
     // A non-positive inverse range would be a point behind the scanner or at infinity: no return.
@@ -316,7 +326,7 @@ void LaplaceFill(const Inputs& in, const FillOptions& options, HoleValues* value
   cv::Mat boundary;
   cv::merge(planes, boundary);
   boundary.convertTo(boundary, CV_64F);
-  const cv::Mat solved = SolveInHole(in, options, values, boundary, {}, {}, &result->unanchored_cells);
+  const cv::Mat solved = SolveInHole(in, options, values, boundary, {}, {}, {}, &result->unanchored_cells);
   std::vector<cv::Mat> out;
   cv::split(solved, out);
   out[0].convertTo(values->range, CV_32F);

@@ -10,7 +10,8 @@
 //      copied from that cell (so sky stays sky behind a lamp post);
 //   3. range in the hole from the Poisson equation ∇²r = div G with the copied gradients as guidance G and the
 //      known ranges around the hole as Dirichlet boundary (poisson/); cells without a return are no-flux
-//      boundaries (edges to them are left out), not zero-range Dirichlet values;
+//      boundaries (edges to them are left out), not zero-range Dirichlet values, and copied depth jumps cut
+//      the system (FillOptions::depth_jump_ratio);
 //   4. every new point is placed along its own cell's ray (`direction`) at the reconstructed range — never on
 //      a height field — and flagged in `synthesized`.
 // Baselines in the same code path (the same return decision where they make none of their own):
@@ -62,6 +63,11 @@ struct FillOptions {
   // gradients vary slowly over a surface and a patch taken a few rows away (steep ground near the horizon)
   // still continues it correctly; false = the thesis's range gradients, matched and copied.
   bool inverse_range = true;
+  // Gradient method: an edge whose two cells' ranges differ by more than this times the nearer one is a depth
+  // discontinuity (a silhouette). Such edges are copied with the gradients and cut out of the Poisson system,
+  // so that a wall end and the facade far behind it stay apart instead of being joined by a membrane; a part
+  // of the hole cut off from every known range by them is left without a return. 0 = never cut.
+  double depth_jump_ratio = 0.2;
   // Telea baseline.
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
   PoissonOptions poisson;           // range reconstruction (and the laplace baseline)

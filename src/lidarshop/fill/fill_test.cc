@@ -96,7 +96,7 @@ TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {
   cv::Mat boundary = ramp.clone();
   boundary.setTo(-100.0, no_data);
   cv::Mat gx(ramp.size(), CV_32F, cv::Scalar(0.5f)), gy(ramp.size(), CV_32F, cv::Scalar(0.25f));
-  const PoissonSystem system = PreparePoisson(hole, {}, no_data);
+  const PoissonSystem system = PreparePoisson(hole, {}, PoissonLinks{no_data, {}, {}});
   const cv::Mat solved = SolvePoisson(system, boundary, GuidanceDivergence(gx, gy, no_data)).image;
   for (int y = 3; y < 8; ++y)
     for (int x = 4; x < 9; ++x) EXPECT_NEAR(solved.at<double>(y, x), ramp.at<double>(y, x), 1e-9) << y << "," << x;

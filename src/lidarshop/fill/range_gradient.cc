@@ -74,7 +74,31 @@ cv::Mat NearestKnownCell(const cv::Mat& hole) {
   return nearest;
 }
 
-cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv::Mat& no_data) {
+EdgeMasks DepthJumps(const cv::Mat& range, const cv::Mat& usable, double ratio) {
+  const int rows = range.rows, cols = range.cols;
+  EdgeMasks jumps{cv::Mat(rows, cols, CV_8U, cv::Scalar(0)), cv::Mat(rows, cols, CV_8U, cv::Scalar(0))};
+  if (ratio <= 0) return jumps;
+  auto jump = [&](int y, int x, int ny, int nx) {
+    if (ny >= rows || nx >= cols || !usable.at<uint8_t>(y, x) || !usable.at<uint8_t>(ny, nx)) return false;
+    const float a = range.at<float>(y, x), b = range.at<float>(ny, nx);
+    return std::abs(a - b) > ratio * std::min(a, b);
+  };
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < cols; ++x) {
+      if (jump(y, x, y, x + 1)) jumps.right.at<uint8_t>(y, x) = 255;
+      if (jump(y, x, y + 1, x)) jumps.down.at<uint8_t>(y, x) = 255;
+    }
+  }
+  return jumps;
+}
+
+namespace {
+
+bool Cut(const cv::Mat& mask, int y, int x) { return !mask.empty() && mask.at<uint8_t>(y, x) != 0; }
+
+}  // namespace
+
+cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv::Mat& no_data, const EdgeMasks& cuts) {
   cv::Mat gx, gy;
   gx_in.convertTo(gx, CV_64F);
   gy_in.convertTo(gy, CV_64F);
@@ -82,37 +106,48 @@ cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv:
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < cols; ++x) {
       const bool here = no_data.at<uint8_t>(y, x) != 0;
-      if (here || x + 1 >= cols || no_data.at<uint8_t>(y, x + 1) != 0) gx.at<double>(y, x) = 0.0;
-      if (here || y + 1 >= rows || no_data.at<uint8_t>(y + 1, x) != 0) gy.at<double>(y, x) = 0.0;
+      if (here || x + 1 >= cols || no_data.at<uint8_t>(y, x + 1) != 0 || Cut(cuts.right, y, x)) gx.at<double>(y, x) = 0.0;
+      if (here || y + 1 >= rows || no_data.at<uint8_t>(y + 1, x) != 0 || Cut(cuts.down, y, x)) gy.at<double>(y, x) = 0.0;
     }
   }
   return BackwardDivergence(gx, gy);
 }
 
-cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor) {
-  cv::Mat labels;
-  const int count = cv::connectedComponents(domain != 0, labels, 4, CV_32S);
-  std::vector<uint8_t> anchored(static_cast<size_t>(count), 0);
+cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const EdgeMasks& cuts) {
   const int rows = domain.rows, cols = domain.cols;
-  auto is_anchor = [&](int y, int x) {
-    return y >= 0 && y < rows && x >= 0 && x < cols && anchor.at<uint8_t>(y, x) != 0;
+  // Breadth-first from every domain cell next to an anchor through uncut edges; what is not reached is cut off.
+  cv::Mat reached(rows, cols, CV_8U, cv::Scalar(0));
+  std::deque<cv::Point> queue;
+  auto linked = [&](int y, int x, int ny, int nx) {
+    if (ny < 0 || ny >= rows || nx < 0 || nx >= cols) return false;
+    if (ny == y) return !Cut(cuts.right, y, std::min(x, nx));
+    return !Cut(cuts.down, std::min(y, ny), x);
   };
+  constexpr int kDx[4] = {-1, 1, 0, 0}, kDy[4] = {0, 0, -1, 1};
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < cols; ++x) {
-      const int label = labels.at<int32_t>(y, x);
-      if (label == 0 || anchored[label]) continue;
-      if (is_anchor(y, x - 1) || is_anchor(y, x + 1) || is_anchor(y - 1, x) || is_anchor(y + 1, x)) {
-        anchored[label] = 1;
+      if (!domain.at<uint8_t>(y, x)) continue;
+      for (int k = 0; k < 4; ++k) {
+        const int ny = y + kDy[k], nx = x + kDx[k];
+        if (linked(y, x, ny, nx) && anchor.at<uint8_t>(ny, nx) && !domain.at<uint8_t>(ny, nx)) {
+          reached.at<uint8_t>(y, x) = 255;
+          queue.emplace_back(x, y);
+          break;
+        }
       }
     }
   }
-  cv::Mat out(rows, cols, CV_8U, cv::Scalar(0));
-  for (int y = 0; y < rows; ++y) {
-    for (int x = 0; x < cols; ++x) {
-      const int label = labels.at<int32_t>(y, x);
-      if (label != 0 && !anchored[label]) out.at<uint8_t>(y, x) = 255;
+  while (!queue.empty()) {
+    const cv::Point p = queue.front();
+    queue.pop_front();
+    for (int k = 0; k < 4; ++k) {
+      const int ny = p.y + kDy[k], nx = p.x + kDx[k];
+      if (!linked(p.y, p.x, ny, nx) || !domain.at<uint8_t>(ny, nx) || reached.at<uint8_t>(ny, nx)) continue;
+      reached.at<uint8_t>(ny, nx) = 255;
+      queue.emplace_back(nx, ny);
     }
   }
+  cv::Mat out = (domain != 0) & (reached == 0);
   return out;
 }
 

@@ -21,14 +21,22 @@ RangeGradient OneSidedRangeGradient(const cv::Mat& range, const cv::Mat& usable)
 // hole and for hole cells that no known cell reaches.
 cv::Mat NearestKnownCell(const cv::Mat& hole);
 
-// The guidance field (gx, gy) with every edge that touches a cell without data (`no_data`, CV_8U non-zero)
-// set to 0, so that its divergence matches a Poisson system that leaves those edges out. Returns the
-// divergence, CV_64F.
-cv::Mat GuidanceDivergence(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& no_data);
+// Depth discontinuities between usable neighbours: right(y, x) / down(y, x) = 255 where the edge to (y, x+1) /
+// (y+1, x) joins two usable cells whose ranges differ by more than `ratio` times the nearer one (0 = none).
+// CV_8U rows x cols each.
+struct EdgeMasks {
+  cv::Mat right, down;
+};
+EdgeMasks DepthJumps(const cv::Mat& range, const cv::Mat& usable, double ratio);
 
-// Cells of `domain` (CV_8U) whose 4-connected component touches no `anchor` cell (CV_8U): such parts have no
-// known range to start from. CV_8U 255/0.
-cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor);
+// The guidance field (gx, gy) with every edge that touches a cell without data (`no_data`, CV_8U non-zero)
+// or is cut (`cuts`, may be empty) set to 0, so that its divergence matches a Poisson system that leaves
+// those edges out. Returns the divergence, CV_64F.
+cv::Mat GuidanceDivergence(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& no_data, const EdgeMasks& cuts = {});
+
+// Cells of `domain` (CV_8U) that reach no `anchor` cell (CV_8U) through 4-neighbour edges that are not cut:
+// such parts have no known range to start from. CV_8U 255/0.
+cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const EdgeMasks& cuts = {});
 
 // A robust scale of a channel: the `quantile` (0..1) of |values| over the non-zero cells of `where`; `floor`
 // when there are none or the quantile is smaller.

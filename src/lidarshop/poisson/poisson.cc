@@ -126,11 +126,15 @@ struct PoissonSystem::Impl {
   std::vector<int32_t> unknown_pixels;  // y * W + x of each unknown, row-major
   cv::Mat index;                        // H x W CV_32S: compact index of an unknown, −1 for known pixels
   cv::Mat no_data;  // H x W CV_8U, non-zero = no value and no edge (like outside the image); empty = none
+  cv::Mat cut_right, cut_down;  // H x W CV_8U, non-zero = that edge is left out; empty = none
 
-  // Whether the edge from an unknown to (ny, nx) is part of the equation.
-  bool Linked(int ny, int nx) const {
+  // Whether the edge from the unknown (y, x) to its neighbour (ny, nx) is part of the equation.
+  bool Linked(int y, int x, int ny, int nx) const {
     if (ny < 0 || ny >= size.height || nx < 0 || nx >= size.width) return false;
-    return no_data.empty() || no_data.at<uint8_t>(ny, nx) == 0;
+    if (!no_data.empty() && no_data.at<uint8_t>(ny, nx) != 0) return false;
+    if (!cut_right.empty() && ny == y && cut_right.at<uint8_t>(y, std::min(x, nx)) != 0) return false;
+    if (!cut_down.empty() && nx == x && cut_down.at<uint8_t>(std::min(y, ny), x) != 0) return false;
+    return true;
   }
   std::unique_ptr<DirectSolver> direct;
   std::unique_ptr<MaskedMultigrid> multigrid;
@@ -147,7 +151,7 @@ struct PoissonSystem::Impl {
             double ax = 0.0;
             int degree = 0;
             auto visit = [&](int ny, int nx) {
-              if (!Linked(ny, nx)) return;
+              if (!Linked(y, x_, ny, nx)) return;
               ++degree;
               const int n = index.at<int32_t>(ny, nx);
               if (n >= 0) ax -= x[n];
@@ -185,10 +189,11 @@ double PoissonSystem::PrepareSeconds() const { return impl().prepare_seconds; }
 const PoissonOptions& PoissonSystem::Options() const { return impl().options; }
 
 PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options) {
-  return PreparePoisson(mask_in, options, cv::Mat());
+  return PreparePoisson(mask_in, options, PoissonLinks{});
 }
 
-PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options, const cv::Mat& no_data_in) {
+PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options, const PoissonLinks& links) {
+  const cv::Mat& no_data_in = links.no_data;
   options.Check();
   Timer timer;
   auto impl = std::make_shared<PoissonSystem::Impl>();
@@ -208,6 +213,16 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
     cv::dilate(impl->no_data, grown, cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3)));
     no_data_touches_domain = cv::countNonZero(grown & impl->mask) > 0;
     if (!no_data_touches_domain) impl->no_data.release();  // nothing to leave out: the plain system
+  }
+  for (const auto& [cut, stored] : {std::pair{&links.cut_right, &impl->cut_right}, std::pair{&links.cut_down, &impl->cut_down}}) {
+    if (cut->empty()) continue;
+    if (cut->size() != impl->size || cut->type() != CV_8U) {
+      throw InputError(fmt::format("PreparePoisson: an edge-cut mask must be {}x{} CV_8U", W, H));
+    }
+    if (cv::countNonZero(*cut) > 0) {
+      *stored = *cut;
+      no_data_touches_domain = true;  // (any cut: the multigrid hierarchy knows no cut edges either)
+    }
   }
   const int num_unknowns = cv::countNonZero(impl->mask);
   if (num_unknowns == W * H) {
@@ -245,7 +260,7 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
         const int y = impl->unknown_pixels[k] / W, x = impl->unknown_pixels[k] % W;
         int degree = 0;
         auto visit = [&](int ny, int nx) {
-          if (!impl->Linked(ny, nx)) return;
+          if (!impl->Linked(y, x, ny, nx)) return;
           ++degree;
           const int n = impl->index.at<int32_t>(ny, nx);
           if (n >= 0) triplets.emplace_back(k, n, -1.0);
@@ -294,7 +309,7 @@ void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, c
             const int y = system.unknown_pixels[k] / W, x = system.unknown_pixels[k] % W;
             double value = divergence.empty() ? 0.0 : -static_cast<double>(divergence.ptr<T>(y)[x * n + c]);
             auto visit = [&](int ny, int nx) {
-              if (!system.Linked(ny, nx)) return;
+              if (!system.Linked(y, x, ny, nx)) return;
               if (system.index.at<int32_t>(ny, nx) < 0) value += boundary.ptr<T>(ny)[nx * n + c];
             };
             visit(y, x - 1);

@@ -76,6 +76,8 @@ struct PoissonOptions {
 
 // A prepared Poisson system: the domain of one mask and its factorization or multigrid hierarchy. Cheap to
 // copy (shared, immutable), safe to use from several threads at once.
+struct PoissonLinks;
+
 class PoissonSystem {
  public:
   PoissonSystem();
@@ -97,7 +99,7 @@ class PoissonSystem {
   explicit PoissonSystem(std::shared_ptr<const Impl> impl);
   std::shared_ptr<const Impl> impl_;
   friend PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options,
-                                      const cv::Mat& no_data);
+                                      const PoissonLinks& links);
 };
 
 // Analyses `mask` (H x W, CV_8U, non-zero = unknown; 1- or 3-channel accepted, any non-zero channel counts)
@@ -106,14 +108,21 @@ class PoissonSystem {
 // bad options.
 PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options = {});
 
-// The same, with pixels that hold no value at all (H x W CV_8U, non-zero = no data; e.g. LiDAR cells without a
-// return): an edge between Ω and such a pixel is left out of the equation, as an edge leaving the image is
-// (natural boundary, no flux), and the pixel's boundary value is never read. Pixels of Ω are unknowns whatever
-// this mask says. The divergence given to SolvePoisson must leave those edges out too (guidance 0 on them).
-// Every connected part of Ω must still touch a known pixel with data, or the matrix is singular and the
-// factorization throws. When such pixels border Ω the direct solver is used (the multigrid hierarchy knows only
-// the image border).
-PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options, const cv::Mat& no_data);
+// Edges left out of the equation, as an edge leaving the image is (natural boundary, no flux):
+//   no_data    H x W CV_8U, non-zero = a pixel with no value at all (e.g. a LiDAR cell without a return): every
+//              edge between Ω and it is left out and its boundary value is never read; pixels of Ω are
+//              unknowns whatever this mask says;
+//   cut_right  H x W CV_8U, non-zero at (y, x) = the edge between (y, x) and (y, x+1) is left out (e.g. a depth
+//              discontinuity: the two sides are solved apart);
+//   cut_down   likewise for the edge between (y, x) and (y+1, x).
+// Empty masks leave nothing out. The divergence given to SolvePoisson must leave those edges out too (guidance
+// 0 on them). Every connected part of Ω must still reach a known pixel with data through linked edges, or the
+// matrix is singular and the factorization throws. With any left-out edge at Ω the direct solver is used (the
+// multigrid hierarchy knows only the image border).
+struct PoissonLinks {
+  cv::Mat no_data, cut_right, cut_down;
+};
+PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options, const PoissonLinks& links);
 
 struct PoissonResult {
   cv::Mat image;  // H x W x n: the boundary image with Ω replaced by the solution
