@@ -108,11 +108,11 @@ int RunInpaint(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--debug", debug_dir,
                  "write fill_order.png, source_map.png, source_locations.png and steps.csv into this folder");
-  app.add_option(
-         "--accept", accept,
-         "acceptance tests, comma-separated, ANDed: combined (= mean,histogram-compressed,smooth-texture "
-         "on a 3-px band) | none | mean | representative | histogram | histogram-compressed | "
-         "histogram-quadrants | smooth-texture")
+  app.add_option("--accept", accept,
+                 "acceptance tests, comma-separated, ANDed: combined (= "
+                 "representative,histogram-quadrants,smooth-texture "
+                 "on a 3-px band) | none | mean | representative | histogram | histogram-compressed | "
+                 "histogram-quadrants | smooth-texture")
       ->capture_default_str();
   app.add_option("--accept-band", options.acceptance.band_px,
                  "compare only bands this many pixels wide along the hole boundary (0 = whole regions)");

@@ -250,10 +250,9 @@ class SmoothTextureTest : public AcceptanceTest {
   const char* Name() const override { return "smooth-texture"; }
   double Threshold() const override { return options_.max_value; }
   double Value(const RegionView& a, const RegionView& b, const std::vector<float>& w) const override {
-    const double sa = Sigma(a, w), sb = Sigma(b, w);
-    const double high = std::max(sa, sb), low = std::min(sa, sb);
-    if (high <= options_.texture_sigma) return 0.0;
-    return 1.0 - low / high;
+    const double known = Sigma(a, w), other = Sigma(b, w);
+    if (known <= options_.texture_sigma) return 0.0;
+    return std::max(0.0, 1.0 - other / known);
   }
 
  private:
@@ -315,9 +314,9 @@ void AcceptanceOptions::Check() const {
 AcceptanceOptions AcceptanceOptions::Combined() {
   AcceptanceOptions options;
   options.enabled = true;
-  options.mean.enabled = true;
+  options.representative.enabled = true;
   options.histogram.enabled = true;
-  options.histogram.range = HistogramRange::kCompressed;
+  options.histogram.quadrants = true;
   options.smooth_texture.enabled = true;
   options.band_px = 3;
   return options;

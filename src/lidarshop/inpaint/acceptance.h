@@ -118,12 +118,12 @@ struct HistogramTestOptions {
 };
 struct SmoothTextureTestOptions {
   bool enabled = false;
-  // Rejects copying a flat region into a textured one (and vice versa): a flat patch C at the texture's mean
-  // differs from a textured target by variance σ² per pixel, a matching textured patch by 2σ², so SSD
-  // prefers the flat one (thesis fig. 7.9). Value = 1 − min(σ_K, σ_H) / max(σ_K, σ_H) when the larger σ
-  // exceeds texture_sigma, else 0.
-  double texture_sigma = 0.02;  // range units: below this both regions count as smooth
-  double max_value = 0.6;       // reject when σ_min / σ_max < 0.4
+  // Rejects copying a flat region into a textured one: a flat patch at the texture's mean differs from a
+  // textured target by variance σ² per pixel, a matching textured patch by 2σ², so SSD prefers the flat one
+  // (thesis fig. 7.9). Value = 1 − σ_copied / σ_known (0 when the copied region is the rougher one, or when
+  // σ_known <= texture_sigma: a smooth target may receive structure, e.g. an edge continuing into the hole).
+  double texture_sigma = 0.02;  // range units: a known region below this counts as smooth
+  double max_value = 0.6;       // reject when σ_copied < 0.4 σ_known
 };
 
 struct AcceptanceOptions {
@@ -138,8 +138,8 @@ struct AcceptanceOptions {
   int min_region_pixels = 4;                // fewer pixels in a region: the test passes (too few to judge)
   void Check() const;                       // throws OptionsError naming the field
 
-  // The recommended combination (bench/results/inpaint.md): mean, compressed-range EMD histogram and
-  // smooth-versus-textured, on a 3-pixel band.
+  // The recommended combination (bench/results/inpaint.md): representative colour, half-patch EMD
+  // histograms and smooth-versus-textured, on a 3-pixel band.
   static AcceptanceOptions Combined();
 };
 

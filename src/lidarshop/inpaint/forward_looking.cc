@@ -84,6 +84,7 @@ TargetDecision TargetChooser::Choose(const Front& front) {
     ++considered;
     if (decision.passed() && (best == nullptr || decision.verdict.margin > best->verdict.margin))
       best = &decision;
+    if (best != nullptr && !options_.lookahead_by_margin) break;
     if (considered >= options_.lookahead) break;
   }
   if (best != nullptr) return *best;

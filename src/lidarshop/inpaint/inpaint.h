@@ -63,6 +63,9 @@ struct InpaintOptions {
   // Forward-looking filling (thesis ch. 7.2): the M highest-priority targets that have not failed are
   // decided at once and the one accepted with the largest margin is filled; 1 = plain greedy order.
   int lookahead = 1;
+  // Which of the passing lookahead targets is filled: the one with the largest acceptance margin (thesis
+  // 7.2), or the highest-priority one (failing targets are still deferred).
+  bool lookahead_by_margin = true;
   // Review (thesis "User action"): at a target where no candidate passes, take the next entry of
   // review_decisions; when there is none, stop and return InpaintResult::review if stop_for_review, else
   // copy the best candidate (an acceptance fallback).

@@ -77,6 +77,7 @@ double HoleSsim(const cv::Mat& a, const cv::Mat& b, const cv::Mat& hole) {
 cv::Mat ReadRgb(const std::string& path) {
   cv::Mat image = ReadImage(path);
   if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_RGBA2RGB);
+  if (image.channels() == 1) cv::cvtColor(image, image, cv::COLOR_GRAY2RGB);
   return image;
 }
 
@@ -140,14 +141,18 @@ std::vector<Config> MakeConfigs(int lookahead) {
   InpaintOptions combined = plain;
   combined.acceptance = AcceptanceOptions::Combined();
   configs.push_back({"combined", combined});
+  combined.acceptance_local_first = false;
+  configs.push_back({"combined, whole image first", combined});
+  combined.acceptance_local_first = true;
   combined.lookahead = lookahead;
-  configs.push_back({fmt::format("combined + lookahead {}", lookahead), combined});
+  configs.push_back({fmt::format("combined + lookahead {} (largest margin)", lookahead), combined});
+  combined.lookahead_by_margin = false;
+  configs.push_back({fmt::format("combined + lookahead {} (first passing)", lookahead), combined});
   return configs;
 }
 
 cv::Mat ColourOf(const cv::Mat& filled) {
   cv::Mat colour, out;
-  cv::extractChannel(filled, colour, 0);
   std::vector<cv::Mat> c(3);
   for (int k = 0; k < 3; ++k) cv::extractChannel(filled, c[k], k);
   cv::merge(c, colour);
@@ -159,9 +164,8 @@ cv::Mat ColourOf(const cv::Mat& filled) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Inpainting quality of the acceptance tests and forward-looking filling on images with truth"};
-  std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/inpaint_eval", images_dir = LIDARSHOP_SHARED_DATA_DIR
-                                                                                   "/images",
-              markdown_path, pictures_dir, only;
+  std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/inpaint_eval",
+              images_dir = LIDARSHOP_SHARED_DATA_DIR "/images", markdown_path, pictures_dir, only;
   int lookahead = 8;
   bool skip_trashcan = false;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the object to remove)");
@@ -209,8 +213,10 @@ int main(int argc, char** argv) {
     const int hole = cv::countNonZero(e.hole);
     emit(fmt::format("\n### {} ({}x{}, {} channels, hole {} px)\n\n", e.name, e.image.cols, e.image.rows,
                      e.image.channels(), hole));
-    emit("| configuration | PSNR dB | SSIM | depth RMSE m | rejected | fallbacks | targets | candidates / target "
-         "| s |\n|---|---|---|---|---|---|---|---|---|\n");
+    emit(
+        "| configuration | PSNR dB | SSIM | depth RMSE m | rejected | fallbacks | targets | candidates / "
+        "target "
+        "| s |\n|---|---|---|---|---|---|---|---|---|\n");
     for (size_t i = 0; i < configs.size(); ++i) {
       if (!run[i]) continue;
       InpaintOptions options = configs[i].options;
@@ -232,14 +238,13 @@ int main(int argc, char** argv) {
         cv::Mat d = depth.image - e.true_range;
         rmse = fmt::format("{:.4f}", std::sqrt(cv::mean(d.mul(d), e.hole)[0]));
       }
-      emit(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.2f} |\n", configs[i].name, psnr, ssim,
-                       rmse, result.rejected, result.acceptance_fallbacks, result.iterations,
+      emit(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.2f} |\n", configs[i].name, psnr,
+                       ssim, rmse, result.rejected, result.acceptance_fallbacks, result.iterations,
                        static_cast<double>(result.candidates_evaluated) / std::max(result.iterations, 1),
                        result.seconds));
-      if (!pictures_dir.empty() && (i == 0 || i + 1 == configs.size())) {
+      if (!pictures_dir.empty() && (i == 0 || i == 8)) {
         std::filesystem::create_directories(pictures_dir);
-        WriteImage(fmt::format("{}/{}_{}.png", pictures_dir, e.name, i == 0 ? "plain" : "accept_lookahead"),
-                   rgb);
+        WriteImage(fmt::format("{}/{}_{}.png", pictures_dir, e.name, i == 0 ? "plain" : "combined"), rgb);
         if (i == 0) {
           cv::Mat input = ColourOf(e.image);
           input.setTo(cv::Scalar(255, 0, 255), e.hole);
