@@ -11,29 +11,45 @@ std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
   std::vector<float> low, range;
   ChannelRanges(canvas, &low, &range);
   std::vector<double> w(C, 1.0);
-  double weight_sum = C;
-  if (!channel_weights.empty()) {
-    weight_sum = 0.0;
-    for (int k = 0; k < C; ++k) weight_sum += w[k] = channel_weights[k];
-  }
-  const double pixels = (2.0 * R + 1) * (2.0 * R + 1);
-  auto rms = [&](Pixel a, Pixel b) {
-    double sum = 0.0;
+  if (!channel_weights.empty()) std::copy(channel_weights.begin(), channel_weights.end(), w.begin());
+  // Descriptor: per channel, the mean of each quadrant and the standard deviation of the whole patch (5 C
+  // values, range units, scaled by √w).
+  auto describe = [&](Pixel s) {
+    std::vector<double> sum(5 * C, 0.0), count(4, 0.0), square(C, 0.0), all(C, 0.0);
     for (int dr = -R; dr <= R; ++dr)
       for (int dc = -R; dc <= R; ++dc) {
-        const float* pa = canvas.PixelData(a.row + dr, a.col + dc);
-        const float* pb = canvas.PixelData(b.row + dr, b.col + dc);
+        const int q = (dr > 0 ? 2 : 0) + (dc > 0 ? 1 : 0);
+        const float* p = canvas.PixelData(s.row + dr, s.col + dc);
+        count[q] += 1.0;
         for (int k = 0; k < C; ++k) {
-          const double d = (pa[k] - pb[k]) / range[k];
-          sum += w[k] * d * d;
+          const double v = (p[k] - low[k]) / range[k];
+          sum[q * C + k] += v;
+          all[k] += v;
+          square[k] += v * v;
         }
       }
-    return std::sqrt(sum / (pixels * std::max(weight_sum, 1e-12)));
+    const double n = (2.0 * R + 1) * (2.0 * R + 1);
+    for (int q = 0; q < 4; ++q)
+      for (int k = 0; k < C; ++k) sum[q * C + k] = std::sqrt(w[k]) * sum[q * C + k] / count[q];
+    for (int k = 0; k < C; ++k) {
+      const double mean = all[k] / n;
+      sum[4 * C + k] = std::sqrt(w[k] * std::max(0.0, square[k] / n - mean * mean));
+    }
+    return sum;
+  };
+  double weight_sum = 0.0;
+  for (double x : w) weight_sum += x;
+  std::vector<std::vector<double>> descriptors;
+  for (const SourceCandidate& c : candidates) descriptors.push_back(describe(c.source));
+  auto rms = [&](const std::vector<double>& a, const std::vector<double>& b) {
+    double s = 0.0;
+    for (size_t i = 0; i < a.size(); ++i) s += (a[i] - b[i]) * (a[i] - b[i]);
+    return std::sqrt(s / (5.0 * std::max(weight_sum, 1e-12)));
   };
   std::vector<int> cluster(candidates.size(), -1), representatives;
   for (size_t i = 0; i < candidates.size(); ++i) {
     for (size_t c = 0; c < representatives.size(); ++c) {
-      if (rms(candidates[representatives[c]].source, candidates[i].source) <= max_rms) {
+      if (rms(descriptors[representatives[c]], descriptors[i]) <= max_rms) {
         cluster[i] = static_cast<int>(c);
         break;
       }

@@ -37,10 +37,12 @@ struct InpaintReview {
   cv::Mat known;            // H x W CV_8U, 1 = known before the paste
 };
 
-// Groups ranked candidates: each joins the first cluster whose representative's whole source patch differs
-// from its own by at most max_rms (weighted RMS over pixels and channels, in units of each channel's value
-// range over the known pixels, see ChannelRanges) or starts a new one. Returns per candidate its cluster
-// index; representatives are the first member of each cluster.
+// Groups ranked candidates: each joins the first cluster whose representative's descriptor differs from its
+// own by at most max_rms, or starts a new one. The descriptor of a source patch is, per channel, the mean of
+// each of its four quadrants and its standard deviation (in units of the channel's value range over the
+// known pixels, see ChannelRanges; weighted RMS over channels): patches of one texture at other phases or
+// with other noise group together, which a pixel-wise distance would keep apart. Returns per candidate its
+// cluster index; representatives are the first member of each cluster.
 std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
                                    const std::vector<SourceCandidate>& candidates, double max_rms,
                                    const std::vector<float>& channel_weights);
