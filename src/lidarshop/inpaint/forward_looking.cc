@@ -1,6 +1,7 @@
 #include "lidarshop/inpaint/forward_looking.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "lidarshop/util/error.h"
 
@@ -8,13 +9,46 @@ namespace lidarshop {
 
 TargetChooser::TargetChooser(const InpaintCanvas& canvas, const InpaintOptions& options,
                              const PatchDifference& difference, PatchSearch& search,
-                             const PatchAcceptance* acceptance)
+                             const PatchAcceptance* acceptance, bool search_is_exhaustive)
     : canvas_(canvas),
       options_(options),
       difference_(difference),
       search_(search),
       acceptance_(acceptance),
-      local_(options.local_window_radius) {}
+      search_is_exhaustive_(search_is_exhaustive) {}
+
+namespace {
+
+// Sorted by CandidateBefore, each source once, at most count.
+void MergeTop(std::vector<SourceCandidate>& all, int count) {
+  std::sort(all.begin(), all.end(), CandidateBefore);
+  all.erase(
+      std::unique(all.begin(), all.end(),
+                  [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
+      all.end());
+  if (static_cast<int>(all.size()) > count) all.resize(count);
+}
+
+}  // namespace
+
+std::vector<SourceCandidate> TargetChooser::LocalBest(const TargetDifference& difference, Pixel target,
+                                                      int count) {
+  const float inf = std::numeric_limits<float>::infinity();
+  const int w = 2 * canvas_.patch_radius() + 1;
+  const std::vector<SourceCandidate> nearby =
+      exhaustive_.FindBelow(canvas_, difference, count, inf, target.row - w, target.row + w + 1,
+                            target.col - w, target.col + w + 1);
+  const float bound = static_cast<int>(nearby.size()) == count ? nearby.back().difference : inf;
+  for (int radius = options_.local_window_radius;; radius *= 2) {
+    std::vector<SourceCandidate> all =
+        exhaustive_.FindBelow(canvas_, difference, count, bound, target.row - radius, target.row + radius + 1,
+                              target.col - radius, target.col + radius + 1);
+    all.insert(all.end(), nearby.begin(), nearby.end());
+    MergeTop(all, count);
+    const bool whole = radius >= std::max(canvas_.rows(), canvas_.cols());
+    if (static_cast<int>(all.size()) == count || whole) return all;
+  }
+}
 
 TargetDecision TargetChooser::Compute(Pixel target) {
   TargetDecision decision;
@@ -46,10 +80,26 @@ TargetDecision TargetChooser::Compute(Pixel target) {
     }
     return false;
   };
+  std::vector<SourceCandidate> local;
   if (options_.acceptance_local_first) {
-    if (try_list(local_.Find(canvas_, *difference, target, count))) return decision;
+    local = LocalBest(*difference, target, count);
+    if (try_list(local)) return decision;
   }
-  decision.candidates = search_.Find(canvas_, *difference, target, count);
+  ++global_searches_;
+  if (search_is_exhaustive_ && static_cast<int>(local.size()) == count) {
+    std::vector<SourceCandidate> all = exhaustive_.FindBelow(
+        canvas_, *difference, count, local.back().difference, 0, canvas_.rows(), 0, canvas_.cols());
+    all.insert(all.end(), local.begin(), local.end());
+    std::sort(all.begin(), all.end(), CandidateBefore);
+    all.erase(
+        std::unique(all.begin(), all.end(),
+                    [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
+        all.end());
+    all.resize(count);
+    decision.candidates = std::move(all);
+  } else {
+    decision.candidates = search_.Find(canvas_, *difference, target, count);
+  }
   LIDARSHOP_CHECK(!decision.candidates.empty());
   try_list(decision.candidates);
   if (!decision.passed()) decision.verdict = acceptance_->Judge(canvas_, target, decision.candidates.front());

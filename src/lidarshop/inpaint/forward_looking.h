@@ -5,7 +5,9 @@
 //   1. the best `acceptance_candidates` (K) sources of the local window (local_window_radius) in ranked
 //   order;
 //      the first that the acceptance accepts is taken;
-//   2. if none passes, the best K of the configured search over the whole image, in ranked order;
+//   2. if none passes, the best K of the configured search over the whole image, in ranked order (with the
+//      exhaustive search, pruned: the scan of the image keeps only candidates no worse than the local K-th
+//      best, which gives exactly the image's top K, since the local K are all at or below that bound);
 //   3. if none passes either, the target fails (the caller falls back to the best, or asks for a review).
 // Without a hook the configured search's best is taken (plain greedy filling, unchanged).
 //
@@ -40,23 +42,28 @@ class TargetChooser {
  public:
   // The strategies must outlive the chooser; acceptance may be null.
   TargetChooser(const InpaintCanvas& canvas, const InpaintOptions& options, const PatchDifference& difference,
-                PatchSearch& search, const PatchAcceptance* acceptance);
+                PatchSearch& search, const PatchAcceptance* acceptance, bool search_is_exhaustive);
   TargetDecision Choose(const Front& front);
   // After Ψtarget was filled.
   void Filled(Pixel target);
   // The decision for one target (cached); public for the review.
   const TargetDecision& Decide(Pixel target);
-  int64_t evaluations() const { return search_.evaluations() + local_.evaluations(); }
+  int64_t evaluations() const { return search_.evaluations() + exhaustive_.evaluations(); }
+  int global_searches() const { return global_searches_; }  // targets that needed the whole image
 
  private:
   TargetDecision Compute(Pixel target);
+  // The best `count` sources of the smallest window of radius local_window_radius·2^i holding `count`.
+  std::vector<SourceCandidate> LocalBest(const TargetDifference& difference, Pixel target, int count);
 
   const InpaintCanvas& canvas_;
   const InpaintOptions& options_;
   const PatchDifference& difference_;
   PatchSearch& search_;
   const PatchAcceptance* acceptance_;
-  LocalSearch local_;
+  bool search_is_exhaustive_;
+  ExhaustiveSearch exhaustive_;
+  int global_searches_ = 0;
   std::unordered_map<int64_t, TargetDecision> cache_;  // by pixel index
 };
 

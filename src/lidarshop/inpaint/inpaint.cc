@@ -75,8 +75,13 @@ std::unique_ptr<PatchSearch> MakeSearch(const InpaintOptions& options) {
 }
 
 std::string InpaintResult::Summary() const {
-  return fmt::format("filled {} hole pixels in {} iterations, {} candidate patches evaluated, {:.3f} s",
-                     hole_pixels, iterations, candidates_evaluated, seconds);
+  std::string s = fmt::format("filled {} hole pixels in {} iterations, {} candidate patches evaluated",
+                              hole_pixels, iterations, candidates_evaluated);
+  if (rejected > 0 || global_searches > 0) {
+    s += fmt::format(", {} rejected, {} targets searched the whole image, {} fallbacks", rejected,
+                     global_searches, acceptance_fallbacks);
+  }
+  return s + fmt::format(", {:.3f} s", seconds);
 }
 
 InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const InpaintOptions& options,
@@ -105,6 +110,7 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
   }
   if (!strategies.priority) strategies.priority = MakePriority(options);
   if (!strategies.difference) strategies.difference = std::make_unique<WeightedSsd>(options.channel_weights);
+  const bool search_is_exhaustive = !strategies.search && options.search == InpaintSearchKind::kExhaustive;
   if (!strategies.search) strategies.search = MakeSearch(options);
   PatchPriority& priority = *strategies.priority;
   PatchSearch& search = *strategies.search;
@@ -115,7 +121,8 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
 
   priority.Initialize(canvas);
   Front front(canvas, priority);
-  TargetChooser chooser(canvas, options, *strategies.difference, search, strategies.acceptance.get());
+  TargetChooser chooser(canvas, options, *strategies.difference, search, strategies.acceptance.get(),
+                        search_is_exhaustive);
   int remaining = result.hole_pixels;
   int review_points = 0;
   if (progress) progress->Restart("inpaint", remaining);
@@ -183,6 +190,7 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
   result.fill_iteration = canvas.fill_iteration().clone();
   result.source_pixel = canvas.source_pixel().clone();
   result.candidates_evaluated = chooser.evaluations();
+  result.global_searches = chooser.global_searches();
   result.seconds = timer.Seconds();
   return result;
 }

@@ -109,10 +109,11 @@ struct InpaintResult {
   std::vector<FillStep> steps;  // fill order
   int iterations = 0;
   int hole_pixels = 0;
-  int64_t candidates_evaluated = 0;     // patch differences evaluated (including early-terminated ones)
-  int acceptance_fallbacks = 0;         // steps where no offered candidate was accepted (the best was used)
-  int rejected = 0;                     // candidates rejected by the acceptance over the whole fill
-  bool complete = true;                 // false: stopped for a review; image holds the partial fill
+  int64_t candidates_evaluated = 0;  // patch differences evaluated (including early-terminated ones)
+  int acceptance_fallbacks = 0;      // steps where no offered candidate was accepted (the best was used)
+  int rejected = 0;                  // candidates rejected by the acceptance over the whole fill
+  int global_searches = 0;  // targets whose local window held no accepted candidate (acceptance only)
+  bool complete = true;     // false: stopped for a review; image holds the partial fill
   std::optional<InpaintReview> review;  // set when stopped for a review
   double seconds = 0.0;                 // wall-clock time of the fill
   std::string Summary() const;          // one line
