@@ -111,7 +111,7 @@ int RunInpaint(int argc, char** argv) {
   app.add_option("--accept", accept,
                  "acceptance tests, comma-separated, ANDed: combined (= "
                  "representative,histogram-quadrants,smooth-texture "
-                 "on a 3-px band) | none | mean | representative | histogram | histogram-compressed | "
+                 "on a 2-px band) | none | mean | representative | histogram | histogram-compressed | "
                  "histogram-quadrants | smooth-texture")
       ->capture_default_str();
   app.add_option("--accept-band", options.acceptance.band_px,

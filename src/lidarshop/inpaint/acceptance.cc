@@ -318,7 +318,7 @@ AcceptanceOptions AcceptanceOptions::Combined() {
   options.histogram.enabled = true;
   options.histogram.quadrants = true;
   options.smooth_texture.enabled = true;
-  options.band_px = 3;
+  options.band_px = 2;
   return options;
 }
 

@@ -139,7 +139,7 @@ struct AcceptanceOptions {
   void Check() const;                       // throws OptionsError naming the field
 
   // The recommended combination (bench/results/inpaint.md): representative colour, half-patch EMD
-  // histograms and smooth-versus-textured, on a 3-pixel band.
+  // histograms and smooth-versus-textured, on a 2-pixel band.
   static AcceptanceOptions Combined();
 };
 

@@ -109,7 +109,13 @@ struct Config {
   InpaintOptions options;
 };
 
-std::vector<Config> MakeConfigs(int lookahead) {
+// Overrides of the combined configurations (for tuning; negative = keep).
+struct Tuning {
+  int band_px = -1, candidates = -1, window = -1;
+  double representative = -1, histogram = -1, smooth = -1;
+};
+
+std::vector<Config> MakeConfigs(int lookahead, const Tuning& t) {
   std::vector<Config> configs;
   InpaintOptions plain;
   plain.search = InpaintSearchKind::kExhaustive;
@@ -117,7 +123,7 @@ std::vector<Config> MakeConfigs(int lookahead) {
   auto alone = [&](const std::string& name, auto enable) {
     InpaintOptions o = plain;
     o.acceptance.enabled = true;
-    o.acceptance.band_px = 3;
+    o.acceptance.band_px = 2;
     enable(o.acceptance);
     configs.push_back({name, o});
   };
@@ -140,6 +146,12 @@ std::vector<Config> MakeConfigs(int lookahead) {
   alone("smooth vs textured", [](AcceptanceOptions& a) { a.smooth_texture.enabled = true; });
   InpaintOptions combined = plain;
   combined.acceptance = AcceptanceOptions::Combined();
+  if (t.band_px >= 0) combined.acceptance.band_px = t.band_px;
+  if (t.candidates > 0) combined.acceptance_candidates = t.candidates;
+  if (t.window > 0) combined.local_window_radius = t.window;
+  if (t.representative > 0) combined.acceptance.representative.max_difference = t.representative;
+  if (t.histogram > 0) combined.acceptance.histogram.max_distance = t.histogram;
+  if (t.smooth > 0) combined.acceptance.smooth_texture.max_value = t.smooth;
   configs.push_back({"combined", combined});
   combined.acceptance_local_first = false;
   configs.push_back({"combined, whole image first", combined});
@@ -175,6 +187,13 @@ int main(int argc, char** argv) {
   app.add_option("--markdown", markdown_path, "also write the tables to this file");
   app.add_option("--pictures", pictures_dir, "write plain and combined + lookahead fills here");
   app.add_flag("--skip-trashcan", skip_trashcan);
+  Tuning tuning;
+  app.add_option("--band", tuning.band_px, "combined: band_px");
+  app.add_option("--candidates", tuning.candidates, "combined: acceptance_candidates");
+  app.add_option("--window", tuning.window, "combined: local_window_radius");
+  app.add_option("--representative", tuning.representative, "combined: representative.max_difference");
+  app.add_option("--histogram", tuning.histogram, "combined: histogram.max_distance");
+  app.add_option("--smooth", tuning.smooth, "combined: smooth_texture.max_value");
   CLI11_PARSE(app, argc, argv);
 
   std::vector<EvalImage> images;
@@ -198,7 +217,7 @@ int main(int argc, char** argv) {
     t.hole = ReadImage(images_dir + "/trashcan/trashcan_mask.png") > 127;
     images.push_back(t);
   }
-  std::vector<Config> configs = MakeConfigs(lookahead);
+  std::vector<Config> configs = MakeConfigs(lookahead, tuning);
   std::vector<bool> run(configs.size(), only.empty());
   std::stringstream list(only);
   for (std::string item; std::getline(list, item, ',');) run.at(std::stoi(item)) = true;
