@@ -108,22 +108,6 @@ std::vector<double> ChannelMeans(const RegionView& region) {
   return mean;
 }
 
-class MeanTest : public AcceptanceTest {
- public:
-  explicit MeanTest(MeanTestOptions options) : options_(options) {}
-  const char* Name() const override { return "mean"; }
-  double Threshold() const override { return options_.max_difference; }
-  double Value(const RegionView& a, const RegionView& b, const std::vector<float>& w) const override {
-    const std::vector<double> ma = ChannelMeans(a), mb = ChannelMeans(b);
-    double sum = 0.0;
-    for (int k = 0; k < a.channels; ++k) sum += w[k] * (ma[k] - mb[k]) * (ma[k] - mb[k]);
-    return std::sqrt(sum / WeightSum(w));
-  }
-
- private:
-  MeanTestOptions options_;
-};
-
 double ChannelMedian(const RegionView& region, int k, std::vector<float>& scratch) {
   scratch.clear();
   for (int i = 0; i < region.count; ++i) scratch.push_back(region.values[i * region.channels + k]);
@@ -132,23 +116,30 @@ double ChannelMedian(const RegionView& region, int k, std::vector<float>& scratc
   return scratch[mid];
 }
 
-class RepresentativeTest : public AcceptanceTest {
+// Weighted RMS over channels of the difference of a per-channel centre: the mean ("mean") or the median
+// ("representative", the MPEG-7 representative colour).
+class CentreTest : public AcceptanceTest {
  public:
-  explicit RepresentativeTest(RepresentativeTestOptions options) : options_(options) {}
-  const char* Name() const override { return "representative"; }
-  double Threshold() const override { return options_.max_difference; }
+  CentreTest(bool median, double max_difference) : median_(median), max_difference_(max_difference) {}
+  const char* Name() const override { return median_ ? "representative" : "mean"; }
+  double Threshold() const override { return max_difference_; }
   double Value(const RegionView& a, const RegionView& b, const std::vector<float>& w) const override {
-    std::vector<float> scratch;
-    double sum = 0.0;
-    for (int k = 0; k < a.channels; ++k) {
-      const double d = ChannelMedian(a, k, scratch) - ChannelMedian(b, k, scratch);
-      sum += w[k] * d * d;
+    std::vector<double> ca = ChannelMeans(a), cb = ChannelMeans(b);
+    if (median_) {
+      std::vector<float> scratch;
+      for (int k = 0; k < a.channels; ++k) {
+        ca[k] = ChannelMedian(a, k, scratch);
+        cb[k] = ChannelMedian(b, k, scratch);
+      }
     }
+    double sum = 0.0;
+    for (int k = 0; k < a.channels; ++k) sum += w[k] * (ca[k] - cb[k]) * (ca[k] - cb[k]);
     return std::sqrt(sum / WeightSum(w));
   }
 
  private:
-  RepresentativeTestOptions options_;
+  bool median_;
+  double max_difference_;
 };
 
 class HistogramTest : public AcceptanceTest {
@@ -277,10 +268,10 @@ class SmoothTextureTest : public AcceptanceTest {
 }  // namespace
 
 std::unique_ptr<AcceptanceTest> MakeMeanTest(const MeanTestOptions& o) {
-  return std::make_unique<MeanTest>(o);
+  return std::make_unique<CentreTest>(false, o.max_difference);
 }
 std::unique_ptr<AcceptanceTest> MakeRepresentativeTest(const RepresentativeTestOptions& o) {
-  return std::make_unique<RepresentativeTest>(o);
+  return std::make_unique<CentreTest>(true, o.max_difference);
 }
 std::unique_ptr<AcceptanceTest> MakeHistogramTest(const HistogramTestOptions& o) {
   return std::make_unique<HistogramTest>(o);

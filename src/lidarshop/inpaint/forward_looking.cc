@@ -1,7 +1,6 @@
 #include "lidarshop/inpaint/forward_looking.h"
 
 #include <algorithm>
-#include <limits>
 
 #include "lidarshop/util/error.h"
 
@@ -17,36 +16,12 @@ TargetChooser::TargetChooser(const InpaintCanvas& canvas, const InpaintOptions& 
       acceptance_(acceptance),
       search_is_exhaustive_(search_is_exhaustive) {}
 
-namespace {
-
-// Sorted by CandidateBefore, each source once, at most count.
-void MergeTop(std::vector<SourceCandidate>& all, int count) {
-  std::sort(all.begin(), all.end(), CandidateBefore);
-  all.erase(
-      std::unique(all.begin(), all.end(),
-                  [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
-      all.end());
-  if (static_cast<int>(all.size()) > count) all.resize(count);
-}
-
-}  // namespace
-
 std::vector<SourceCandidate> TargetChooser::LocalBest(const TargetDifference& difference, Pixel target,
                                                       int count) {
-  const float inf = std::numeric_limits<float>::infinity();
-  const int w = 2 * canvas_.patch_radius() + 1;
-  const std::vector<SourceCandidate> nearby =
-      exhaustive_.FindBelow(canvas_, difference, count, inf, target.row - w, target.row + w + 1,
-                            target.col - w, target.col + w + 1);
-  const float bound = static_cast<int>(nearby.size()) == count ? nearby.back().difference : inf;
   for (int radius = options_.local_window_radius;; radius *= 2) {
-    std::vector<SourceCandidate> all =
-        exhaustive_.FindBelow(canvas_, difference, count, bound, target.row - radius, target.row + radius + 1,
-                              target.col - radius, target.col + radius + 1);
-    all.insert(all.end(), nearby.begin(), nearby.end());
-    MergeTop(all, count);
-    const bool whole = radius >= std::max(canvas_.rows(), canvas_.cols());
-    if (static_cast<int>(all.size()) == count || whole) return all;
+    std::vector<SourceCandidate> best = exhaustive_.FindNear(canvas_, difference, target, count, radius);
+    if (static_cast<int>(best.size()) == count || radius >= std::max(canvas_.rows(), canvas_.cols()))
+      return best;
   }
 }
 
@@ -90,12 +65,7 @@ TargetDecision TargetChooser::Compute(Pixel target) {
     std::vector<SourceCandidate> all = exhaustive_.FindBelow(
         canvas_, *difference, count, local.back().difference, 0, canvas_.rows(), 0, canvas_.cols());
     all.insert(all.end(), local.begin(), local.end());
-    std::sort(all.begin(), all.end(), CandidateBefore);
-    all.erase(
-        std::unique(all.begin(), all.end(),
-                    [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
-        all.end());
-    all.resize(count);
+    MergeCandidates(all, count);
     decision.candidates = std::move(all);
   } else {
     decision.candidates = search_.Find(canvas_, *difference, target, count);
