@@ -84,7 +84,8 @@ struct InpaintStrategies {
   std::unique_ptr<PatchPriority> priority;
   std::unique_ptr<PatchDifference> difference;
   std::unique_ptr<PatchSearch> search;
-  std::unique_ptr<PatchAcceptance> acceptance;  // null = accept the best
+  std::unique_ptr<PatchAcceptance>
+      acceptance;  // null = MakeAcceptance(options.acceptance): none unless enabled
 };
 
 std::unique_ptr<PatchPriority> MakePriority(const InpaintOptions& options);
