@@ -215,11 +215,13 @@ int RunInpaint(int argc, char** argv) {
       scaled.steps = result.steps;
       WriteImage(dir + "source_locations.png", RenderSourceLocations(scaled, options.patch_radius));
       WriteFileAtomically(dir + "steps.csv", [&](std::ostream& out) {
-        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels\n";
+        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels,"
+               "rejected,accepted,margin\n";
         for (size_t i = 0; i < result.steps.size(); ++i) {
           const FillStep& s = result.steps[i];
-          out << fmt::format("{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col, s.source.row,
-                             s.source.col, s.difference, s.priority, s.filled_pixels);
+          out << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col,
+                             s.source.row, s.source.col, s.difference, s.priority, s.filled_pixels,
+                             s.rejected, s.accepted ? 1 : 0, s.margin);
         }
       });
     }
