@@ -2,11 +2,8 @@
 
 #include <fmt/format.h>
 
-#include "lidarshop/inpaint/fill_front.h"
-#include "lidarshop/inpaint/forward_looking.h"
+#include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/progress.h"
-#include "lidarshop/util/timer.h"
 
 namespace lidarshop {
 
@@ -91,108 +88,9 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
 
 InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const InpaintOptions& options,
                       InpaintStrategies strategies, Progress* progress) {
-  options.Check();
-  const Timer timer;
-  if (!options.channel_weights.empty() &&
-      static_cast<int>(options.channel_weights.size()) != image.channels()) {
-    throw OptionsError(
-        fmt::format("InpaintOptions.channel_weights has {} weights for an image of {} channels",
-                    options.channel_weights.size(), image.channels()));
-  }
-  InpaintCanvas canvas(image, hole_mask, options.patch_radius);
-  InpaintResult result;
-  result.hole_pixels = static_cast<int>(cv::countNonZero(hole_mask));
-  if (result.hole_pixels > 0 && canvas.source_centers().empty()) {
-    ThrowInputError(
-        "", "", "mask",
-        fmt::format("no fully known {0}x{0} source patch: the hole leaves no patch of the image whole",
-                    2 * options.patch_radius + 1));
-  }
-  if (!strategies.priority) strategies.priority = MakePriority(options);
-  if (!strategies.difference) strategies.difference = std::make_unique<WeightedSsd>(options.channel_weights);
-  const bool search_is_exhaustive = !strategies.search && options.search == InpaintSearchKind::kExhaustive;
-  if (!strategies.search) strategies.search = MakeSearch(options);
-  PatchPriority& priority = *strategies.priority;
-  PatchSearch& search = *strategies.search;
-
-  if (!strategies.acceptance)
-    strategies.acceptance = MakeAcceptance(options.acceptance, options.channel_weights);
-  if (strategies.acceptance) strategies.acceptance->Initialize(canvas);
-
-  priority.Initialize(canvas);
-  Front front(canvas, priority);
-  TargetChooser chooser(canvas, options, *strategies.difference, search, strategies.acceptance.get(),
-                        search_is_exhaustive);
-  int remaining = result.hole_pixels;
-  int review_points = 0;
-  if (progress) progress->Restart("inpaint", remaining);
-  while (!front.empty()) {
-    const TargetDecision decision = chooser.Choose(front);
-    const Pixel target = decision.target;
-    FillStep step;
-    step.target = target;
-    step.priority = front.Value(target);
-    step.rejected = decision.rejected;
-    step.accepted = decision.passed();
-    step.margin = strategies.acceptance ? decision.verdict.margin : 0.0;
-    result.rejected += decision.rejected;
-    SourceCandidate chosen = decision.candidates[std::max(decision.chosen, 0)];
-    if (!decision.passed()) {
-      if (review_points < static_cast<int>(options.review_decisions.size())) {
-        const ReviewDecision& made = options.review_decisions[review_points];
-        if (!(made.target == target) || !canvas.Inside(made.source.row, made.source.col) ||
-            !canvas.IsSource(made.source.row, made.source.col)) {
-          ThrowInputError(
-              "", "", fmt::format("review decision {}", review_points),
-              fmt::format("decision for target ({}, {}) with source ({}, {}) does not fit this fill "
-                          "(target ({}, {}); the source must be a source centre)",
-                          made.target.row, made.target.col, made.source.row, made.source.col, target.row,
-                          target.col));
-        }
-        step.review_point = review_points;
-        chosen = {made.source, strategies.difference->ForTarget(canvas, target)
-                                   ->Evaluate(made.source, std::numeric_limits<float>::infinity())};
-      } else if (options.stop_for_review) {
-        const std::unique_ptr<TargetDifference> difference = strategies.difference->ForTarget(canvas, target);
-        InpaintReview review =
-            MakeReview(canvas, target, search.Find(canvas, *difference, target, options.review_candidates),
-                       strategies.acceptance.get(), options.review_cluster_rms, options.channel_weights);
-        review.review_point = review_points;
-        review.iteration = result.iterations;
-        result.review = std::move(review);
-        result.complete = false;
-        break;
-      } else {
-        ++result.acceptance_fallbacks;
-      }
-      ++review_points;
-    }
-    step.source = chosen.source;
-    step.difference = chosen.difference;
-    const std::vector<Pixel> filled = canvas.CopyPatch(target, chosen.source, result.iterations);
-    step.filled_pixels = static_cast<int>(filled.size());
-    LIDARSHOP_CHECK(!filled.empty());
-    priority.Update(canvas, target, filled);
-    front.Update(target);
-    chooser.Filled(target);
-    if (options.check_bookkeeping) {
-      front.Check();
-      priority.CheckConsistency(canvas);
-    }
-    result.steps.push_back(step);
-    ++result.iterations;
-    remaining -= step.filled_pixels;
-    Advance(progress, step.filled_pixels);
-  }
-  LIDARSHOP_CHECK(remaining == 0 || !result.complete);
-  if (progress) progress->Finish();
-  result.image = canvas.Image();
-  result.fill_iteration = canvas.fill_iteration().clone();
-  result.source_pixel = canvas.source_pixel().clone();
-  result.candidates_evaluated = chooser.evaluations();
-  result.global_searches = chooser.global_searches();
-  result.seconds = timer.Seconds();
-  return result;
+  InpaintSession session(image, hole_mask, options, std::move(strategies), progress);
+  session.Run();
+  return session.Result();
 }
 
 }  // namespace lidarshop

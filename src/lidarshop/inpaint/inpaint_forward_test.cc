@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 
@@ -144,6 +145,35 @@ TEST(InpaintForward, ReviewAndResumeEqualsAnUninterruptedFill) {
   EXPECT_GT(cv::norm(Inpaint(truth, hole, once).image, result.image, cv::NORM_INF), 0.0);
   once.review_decisions.back().source = {0, 0};
   EXPECT_THROW(Inpaint(truth, hole, once), InputError);
+}
+
+// The in-process session: stop, decide, continue — the same fill as a replay with its decisions.
+TEST(InpaintForward, SessionDecisionsEqualReplay) {
+  cv::Mat hole;
+  const cv::Mat truth = BrickOverGrass(40, 90, 20, &hole, cv::Rect(30, 8, 28, 24));
+  const InpaintOptions options = ReviewOptions();
+  InpaintSession session(truth, hole, options);
+  EXPECT_THROW(session.Decide({20, 5}), InputError);  // nothing pending yet
+  int stops = 0;
+  while (!session.Run()) {
+    ASSERT_NE(session.pending_review(), nullptr);
+    const InpaintReview& review = *session.pending_review();
+    EXPECT_FALSE(session.Result().complete);
+    EXPECT_THROW(session.Decide({0, 0}), InputError);  // not a source centre
+    session.Decide(review.candidates[(stops + 1) % 4].source);
+    ASSERT_LT(++stops, 50);
+  }
+  EXPECT_GT(stops, 2);
+  EXPECT_EQ(session.pending_review(), nullptr);
+  const InpaintResult result = session.Result();
+  EXPECT_TRUE(result.complete);
+  ASSERT_EQ(static_cast<int>(session.decisions().size()), stops);
+  InpaintOptions replay = options;
+  replay.stop_for_review = false;
+  replay.review_decisions = session.decisions();
+  const InpaintResult replayed = Inpaint(truth, hole, replay);
+  EXPECT_EQ(cv::norm(replayed.image, result.image, cv::NORM_INF), 0.0);
+  EXPECT_EQ(replayed.steps.size(), result.steps.size());
 }
 
 TEST(InpaintForward, SameResultForAnyThreadCountWithSeed) {

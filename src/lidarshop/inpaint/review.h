@@ -3,10 +3,11 @@
 // top-N candidates grouped into clusters of near-identical patches (hundreds of similar bad patches show as
 // one), and the choice to accept one of them or to place a source patch by hand.
 //
-// The fill state is resumable by replay: a fill is a deterministic function of (inputs, options, decisions),
-// so resuming is Inpaint() again with the user's decision appended to InpaintOptions::review_decisions; the
-// result equals an uninterrupted fill given the same decisions up front (tested). The command line keeps the
-// decisions in review.json (`inpaint --review DIR`, `inpaint --resume DIR --choose N`).
+// The fill state is resumable in process (InpaintSession, inpaint_session.h: Run() stops, Decide() continues)
+// and by replay: a fill is a deterministic function of (inputs, options, decisions), so resuming later is
+// Inpaint() again with the user's decision appended to InpaintOptions::review_decisions; both equal an
+// uninterrupted fill given the same decisions up front (tested). The command line keeps the decisions in
+// review.json (`inpaint --review DIR`, `inpaint --resume DIR --choose N`).
 #pragma once
 
 #include <vector>
