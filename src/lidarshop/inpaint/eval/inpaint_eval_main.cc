@@ -185,7 +185,8 @@ int main(int argc, char** argv) {
   app.add_option("--lookahead", lookahead, "M of the forward-looking configuration")->capture_default_str();
   app.add_option("--configs", only, "comma-separated indices of the configurations to run (default all)");
   app.add_option("--markdown", markdown_path, "also write the tables to this file");
-  app.add_option("--pictures", pictures_dir, "write plain and combined + lookahead fills here");
+  app.add_option("--pictures", pictures_dir,
+                 "write the input, plain and combined fills (and the truth) here, cropped around the hole");
   app.add_flag("--skip-trashcan", skip_trashcan);
   Tuning tuning;
   app.add_option("--band", tuning.band_px, "combined: band_px");
@@ -262,14 +263,19 @@ int main(int argc, char** argv) {
                        static_cast<double>(result.candidates_evaluated) / std::max(result.iterations, 1),
                        result.seconds));
       if (!pictures_dir.empty() && (i == 0 || i == 8)) {
+        // The hole's bounding box with a 24-pixel margin.
+        const cv::Rect box = (cv::boundingRect(e.hole) + cv::Size(48, 48) - cv::Point(24, 24)) &
+                             cv::Rect(0, 0, e.hole.cols, e.hole.rows);
         std::filesystem::create_directories(pictures_dir);
-        WriteImage(fmt::format("{}/{}_{}.png", pictures_dir, e.name, i == 0 ? "plain" : "combined"), rgb);
+        auto write = [&](const std::string& what, const cv::Mat& picture) {
+          WriteImage(fmt::format("{}/{}_{}.png", pictures_dir, e.name, what), picture(box));
+        };
+        write(i == 0 ? "plain" : "combined", rgb);
         if (i == 0) {
           cv::Mat input = ColourOf(e.image);
           input.setTo(cv::Scalar(255, 0, 255), e.hole);
-          WriteImage(fmt::format("{}/{}_input.png", pictures_dir, e.name), input);
-          if (!e.truth_rgb.empty() && e.image.channels() == 5)
-            WriteImage(fmt::format("{}/{}_truth.png", pictures_dir, e.name), e.truth_rgb);
+          write("input", input);
+          if (!e.truth_rgb.empty() && e.image.channels() == 5) write("truth", e.truth_rgb);
         }
       }
     }
