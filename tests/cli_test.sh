@@ -194,6 +194,16 @@ fails_clearly "segment: strokes of the wrong size" "stroke" "$lidarshop" segment
 images=$shared/images
 check "inpaint lettera" "$lidarshop" inpaint "$images/lettera/lettera.png" --mask "$images/lettera/lettera_mask.png" \
   -o "$work/lettera_filled.png" --quiet
+# Review / resume (thesis ch. 7 "User action"): stop at the first target no candidate passes, choose one, go on.
+check "inpaint review" "$lidarshop" inpaint "$images/lettera/lettera.png" --mask "$images/lettera/lettera_mask.png" \
+  -o "$work/lettera_reviewed.png" --search exhaustive --accept combined --review "$work/review" --quiet
+json_check "inpaint review.json" "$work/review/review.json" \
+  "d['decisions'] == [] and len(d['review']['candidates']) == 200 and 1 <= len(d['review']['clusters']) < 200"
+check "inpaint resume" "$lidarshop" inpaint "$images/lettera/lettera.png" --mask "$images/lettera/lettera_mask.png" \
+  -o "$work/lettera_reviewed.png" --search exhaustive --accept combined --resume "$work/review" --choose 1 --quiet
+json_check "inpaint resume keeps the decision" "$work/review/review.json" "len(d['decisions']) == 1"
+fails_clearly "inpaint resume: no such candidate" "choose" "$lidarshop" inpaint "$images/lettera/lettera.png" \
+  --mask "$images/lettera/lettera_mask.png" -o "$work/x.png" --accept combined --resume "$work/review" --choose 999 --quiet
 check "poisson fill" "$lidarshop" poisson fill "$images/bungee/bungee.png" --mask "$images/bungee/bungee_mask.png" \
   -o "$work/bungee_fill.png" --quiet
 check "poisson clone" "$lidarshop" poisson clone "$images/f16/f16.png" --mask "$images/f16/f16_mask.png" \

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/inpaint_review.h"
 #include "lidarshop/inpaint/debug_images.h"
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/io/image_io.h"
@@ -17,6 +18,49 @@
 #include "lidarshop/util/progress.h"
 
 namespace lidarshop::cli {
+
+namespace {
+
+// --accept LIST and --histogram-metric into options.acceptance.
+void ParseAcceptance(const std::string& list, const std::string& metric, InpaintOptions* options) {
+  AcceptanceOptions& a = options->acceptance;
+  const int band = a.band_px;
+  std::stringstream stream(list);
+  std::string name;
+  while (std::getline(stream, name, ',')) {
+    if (name == "none") continue;
+    a.enabled = true;
+    if (name == "combined") {
+      a = AcceptanceOptions::Combined();
+    } else if (name == "mean") {
+      a.mean.enabled = true;
+    } else if (name == "representative") {
+      a.representative.enabled = true;
+    } else if (name == "histogram" || name == "histogram-compressed" || name == "histogram-quadrants") {
+      a.histogram.enabled = true;
+      if (name == "histogram-compressed") a.histogram.range = HistogramRange::kCompressed;
+      if (name == "histogram-quadrants") a.histogram.quadrants = true;
+    } else if (name == "smooth-texture") {
+      a.smooth_texture.enabled = true;
+    } else {
+      throw OptionsError(fmt::format("--accept: unknown test '{}'", name));
+    }
+  }
+  if (band > 0) a.band_px = band;
+  a.histogram.metric =
+      metric == "intersection" ? HistogramMetric::kIntersection : HistogramMetric::kEarthMovers;
+}
+
+// 8-bit display of a filled float image in the input's depth (16-bit and float are stretched to 0..255).
+void ToDisplay(const cv::Mat& image, int depth, cv::Mat* display) {
+  if (depth == CV_8U) {
+    image.convertTo(*display, CV_8U);
+  } else {
+    cv::normalize(image, *display, 0, 255, cv::NORM_MINMAX, CV_8U);
+  }
+}
+
+}  // namespace
 
 int RunInpaint(int argc, char** argv) {
   CLI::App app{
@@ -34,6 +78,8 @@ int RunInpaint(int argc, char** argv) {
   options.search = InpaintSearchKind::kTwoStep;
   options.global_gain = 1.5;
   bool quiet = false;
+  std::string accept = "none", histogram_metric = "emd", review_dir, resume_dir, place;
+  int choose = -1;
   const std::map<std::string, InpaintPriorityKind> methods = {{"criminisi", InpaintPriorityKind::kCriminisi},
                                                               {"onion-peel", InpaintPriorityKind::kOnionPeel},
                                                               {"random", InpaintPriorityKind::kRandom}};
@@ -62,9 +108,55 @@ int RunInpaint(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--debug", debug_dir,
                  "write fill_order.png, source_map.png, source_locations.png and steps.csv into this folder");
+  app.add_option("--accept", accept,
+                 "acceptance tests, comma-separated, ANDed: combined (= "
+                 "representative,histogram-quadrants,smooth-texture "
+                 "on a 2-px band) | none | mean | representative | histogram | histogram-compressed | "
+                 "histogram-quadrants | smooth-texture")
+      ->capture_default_str();
+  app.add_option("--accept-band", options.acceptance.band_px,
+                 "compare only bands this many pixels wide along the hole boundary (0 = whole regions)");
+  app.add_option("--accept-candidates", options.acceptance_candidates,
+                 "ranked candidates offered to the acceptance per search step (K)")
+      ->capture_default_str();
+  app.add_option("--histogram-metric", histogram_metric, "histogram distance: emd | intersection")
+      ->check(CLI::IsMember({"emd", "intersection"}))
+      ->capture_default_str();
+  app.add_option("--lookahead", options.lookahead,
+                 "forward-looking fill: decide this many top-priority targets at once, fill the most clearly "
+                 "accepted (1 = plain greedy)")
+      ->capture_default_str();
+  app.add_option("--review", review_dir,
+                 "stop where no candidate passes and write the review (review.json, tentative.png, "
+                 "clusters.png) into this folder");
+  app.add_option("--resume", resume_dir,
+                 "continue the fill reviewed in this folder (with --choose or --place)");
+  app.add_option("--choose", choose, "with --resume: copy candidate N of review.json");
+  app.add_option("--place", place, "with --resume: copy the source patch centred at ROW,COL instead");
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
+    ParseAcceptance(accept, histogram_metric, &options);
     options.Check();
+    if (!resume_dir.empty()) {
+      if ((choose >= 0) == !place.empty())
+        throw OptionsError("--resume needs exactly one of --choose N and --place ROW,COL");
+      const ReviewFolder folder = ReadReviewFolder(resume_dir);
+      options.review_decisions = folder.decisions;
+      Pixel source;
+      if (choose >= 0) {
+        if (choose >= static_cast<int>(folder.candidates.size()))
+          throw OptionsError(
+              fmt::format("--choose {}: the review lists {} candidates", choose, folder.candidates.size()));
+        source = folder.candidates[choose];
+      } else if (std::sscanf(place.c_str(), "%d,%d", &source.row, &source.col) != 2) {
+        throw OptionsError(fmt::format("--place must be ROW,COL, got '{}'", place));
+      }
+      options.review_decisions.push_back({folder.target, source});
+      if (review_dir.empty()) review_dir = resume_dir;
+    } else if (choose >= 0 || !place.empty()) {
+      throw OptionsError("--choose and --place need --resume DIR");
+    }
+    options.stop_for_review = !review_dir.empty();
     const cv::Mat input = ReadImage(image_path);
     cv::Mat mask = ReadImage(mask_path);
     if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
@@ -94,6 +186,20 @@ int RunInpaint(int argc, char** argv) {
     }
     auto progress = Progress::ForTerminal("inpaint", cv::countNonZero(mask), quiet);
     const InpaintResult result = Inpaint(image, mask, options, progress.get());
+    if (!result.complete) {
+      cv::Mat tentative, canvas;
+      ToDisplay(result.review->tentative_image, input.depth(), &tentative);
+      ToDisplay(result.image, input.depth(), &canvas);
+      WriteReviewFolder(review_dir, *result.review, options.review_decisions, tentative, canvas,
+                        options.patch_radius);
+      fmt::print(stderr,
+                 "stopped for review at iteration {} (target row {}, col {}): {} candidates in {} clusters, "
+                 "see {}/review.json; continue with --resume {} --choose N\n",
+                 result.review->iteration, result.review->target.row, result.review->target.col,
+                 result.review->candidates.size(), result.review->cluster_representative.size(), review_dir,
+                 review_dir);
+      return 0;
+    }
     cv::Mat output;
     result.image.convertTo(output, input.depth());
     WriteImage(output_path, output);
@@ -109,11 +215,13 @@ int RunInpaint(int argc, char** argv) {
       scaled.steps = result.steps;
       WriteImage(dir + "source_locations.png", RenderSourceLocations(scaled, options.patch_radius));
       WriteFileAtomically(dir + "steps.csv", [&](std::ostream& out) {
-        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels\n";
+        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels,"
+               "rejected,accepted,margin\n";
         for (size_t i = 0; i < result.steps.size(); ++i) {
           const FillStep& s = result.steps[i];
-          out << fmt::format("{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col, s.source.row,
-                             s.source.col, s.difference, s.priority, s.filled_pixels);
+          out << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col,
+                             s.source.row, s.source.col, s.difference, s.priority, s.filled_pixels,
+                             s.rejected, s.accepted ? 1 : 0, s.margin);
         }
       });
     }

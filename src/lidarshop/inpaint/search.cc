@@ -97,9 +97,18 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& ca
   return merged.best();
 }
 
-std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
-                                                    const TargetDifference& difference, Pixel target,
-                                                    int count) {
+void MergeCandidates(std::vector<SourceCandidate>& all, int count) {
+  std::sort(all.begin(), all.end(), CandidateBefore);
+  all.erase(
+      std::unique(all.begin(), all.end(),
+                  [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
+      all.end());
+  if (static_cast<int>(all.size()) > count) all.resize(count);
+}
+
+std::vector<SourceCandidate> ExhaustiveSearch::FindNear(const InpaintCanvas& canvas,
+                                                        const TargetDifference& difference, Pixel target,
+                                                        int count, int radius) {
   // Nearby sources are often good, so a small window first gives the scan of the whole image a tight early-
   // termination bound from its first candidate on. Exact: the scan keeps every candidate <= that bound.
   const float inf = std::numeric_limits<float>::infinity();
@@ -107,16 +116,18 @@ std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
   auto nearby = FindBelow(canvas, difference, count, inf, target.row - w, target.row + w + 1, target.col - w,
                           target.col + w + 1);
   const float bound = static_cast<int>(nearby.size()) == count ? nearby.back().difference : inf;
-  auto all = FindBelow(canvas, difference, count, bound, 0, canvas.rows(), 0, canvas.cols());
+  auto all = FindBelow(canvas, difference, count, bound, target.row - radius, target.row + radius + 1,
+                       target.col - radius, target.col + radius + 1);
   // Merge (the scan re-finds the nearby ones that are good enough; keep each source once).
   all.insert(all.end(), nearby.begin(), nearby.end());
-  std::sort(all.begin(), all.end(), CandidateBefore);
-  all.erase(
-      std::unique(all.begin(), all.end(),
-                  [](const SourceCandidate& a, const SourceCandidate& b) { return a.source == b.source; }),
-      all.end());
-  if (static_cast<int>(all.size()) > count) all.resize(count);
+  MergeCandidates(all, count);
   return all;
+}
+
+std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
+                                                    const TargetDifference& difference, Pixel target,
+                                                    int count) {
+  return FindNear(canvas, difference, target, count, std::max(canvas.rows(), canvas.cols()));
 }
 
 std::vector<SourceCandidate> LocalSearch::Find(const InpaintCanvas& canvas,

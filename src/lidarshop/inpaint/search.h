@@ -24,6 +24,9 @@ struct SourceCandidate {
 // Strict weak order: smaller difference first, then smaller (row, col).
 bool CandidateBefore(const SourceCandidate& a, const SourceCandidate& b);
 
+// Sorts by CandidateBefore, keeps each source once and at most `count`.
+void MergeCandidates(std::vector<SourceCandidate>& candidates, int count);
+
 class PatchSearch {
  public:
   virtual ~PatchSearch() = default;
@@ -44,6 +47,10 @@ class ExhaustiveSearch : public PatchSearch {
  public:
   std::vector<SourceCandidate> Find(const InpaintCanvas& canvas, const TargetDifference& difference,
                                     Pixel target, int count) override;
+  // The best `count` of the source centres within `radius` (Chebyshev) of the target: the (4R+3)² window
+  // around it is scanned first and its count-th best bounds the scan of the rest (exact).
+  std::vector<SourceCandidate> FindNear(const InpaintCanvas& canvas, const TargetDifference& difference,
+                                        Pixel target, int count, int radius);
   // The same, with an initial early-termination bound: candidates with difference > bound may be left out.
   std::vector<SourceCandidate> FindBelow(const InpaintCanvas& canvas, const TargetDifference& difference,
                                          int count, float bound, int row_begin, int row_end, int col_begin,

@@ -1,0 +1,56 @@
+// Review of a failing patch (thesis ch. 7.1 "User action"): when no candidate passes the acceptance tests,
+// the fill can stop and hand the decision to the user: the tentative result (the best candidate pasted), the
+// top-N candidates grouped into clusters of near-identical patches (hundreds of similar bad patches show as
+// one), and the choice to accept one of them or to place a source patch by hand.
+//
+// The fill state is resumable in process (InpaintSession, inpaint_session.h: Run() stops, Decide() continues)
+// and by replay: a fill is a deterministic function of (inputs, options, decisions), so resuming later is
+// Inpaint() again with the user's decision appended to InpaintOptions::review_decisions; both equal an
+// uninterrupted fill given the same decisions up front (tested). The command line keeps the decisions in
+// review.json (`inpaint --review DIR`, `inpaint --resume DIR --choose N`).
+#pragma once
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/inpaint/acceptance.h"
+#include "lidarshop/inpaint/canvas.h"
+#include "lidarshop/inpaint/search.h"
+
+namespace lidarshop {
+
+// What the user decided at one review point: copy the source patch centred at `source` into Ψtarget.
+struct ReviewDecision {
+  Pixel target;  // the target the review was about (checked on replay)
+  Pixel source;  // any source centre: a listed candidate or one placed by hand
+};
+
+struct InpaintReview {
+  int review_point = 0;  // how many review points came before this one (index into review_decisions)
+  int iteration = 0;     // fill iteration at which the fill stopped
+  Pixel target;          // the failing target patch's centre
+  std::vector<SourceCandidate> candidates;  // top-N sources, best first
+  std::vector<AcceptanceVerdict> verdicts;  // per candidate: why it was rejected (or accepted)
+  std::vector<int> cluster;                 // per candidate: its cluster's index
+  std::vector<int> cluster_representative;  // per cluster: its best candidate's index
+  cv::Mat tentative_image;  // H x W CV_32FC(C): the fill so far with candidates[0] pasted into Ψtarget
+  cv::Mat known;            // H x W CV_8U, 1 = known before the paste
+};
+
+// Groups ranked candidates: each joins the first cluster whose representative's descriptor differs from its
+// own by at most max_rms, or starts a new one. The descriptor of a source patch is, per channel, the mean of
+// each of its four quadrants and its standard deviation (in units of the channel's value range over the
+// known pixels, see ChannelRanges; weighted RMS over channels): patches of one texture at other phases or
+// with other noise group together, which a pixel-wise distance would keep apart. Returns per candidate its
+// cluster index; representatives are the first member of each cluster.
+std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
+                                   const std::vector<SourceCandidate>& candidates, double max_rms,
+                                   const std::vector<float>& channel_weights);
+
+// The review of `target` with `candidates` (ranked): verdicts, clusters and the tentative image.
+InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<SourceCandidate> candidates,
+                         const PatchAcceptance* acceptance, double cluster_max_rms,
+                         const std::vector<float>& channel_weights);
+
+}  // namespace lidarshop
