@@ -45,10 +45,11 @@ const Problem& GetProblem(int kind) {
   return cache.emplace(kind, std::move(problem)).first->second;
 }
 
-void BM_FillScan(benchmark::State& state, FillMethod method) {
+void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance) {
   const Problem& problem = GetProblem(static_cast<int>(state.range(0)));
   FillOptions options;
   options.method = method;
+  options.acceptance.enabled = acceptance;
   FillResult result;
   for (auto _ : state) {
     result = FillScan(problem.scan, problem.hole, options);
@@ -68,10 +69,12 @@ void BM_FillScan(benchmark::State& state, FillMethod method) {
   state.counters["total_s"] = result.timings.total_s;
 }
 
-BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, laplace, FillMethod::kLaplace)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, depth_patch, FillMethod::kDepthPatch)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, telea, FillMethod::kTelea)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+// The default (acceptance tests on), the same without them, and the baselines.
+BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient, true)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, gradient_plain, FillMethod::kGradient, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, laplace, FillMethod::kLaplace, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, depth_patch, FillMethod::kDepthPatch, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, telea, FillMethod::kTelea, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace lidarshop

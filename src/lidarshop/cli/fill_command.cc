@@ -29,6 +29,7 @@ namespace {
 // The fill options every fill command shares, bound to flags.
 struct FillFlags {
   std::string method = "gradient", search = "patchmatch";
+  bool no_accept = false;
   FillOptions options;
   void Add(CLI::App& app) {
     app.add_option("--method", method, "gradient | laplace | depth-patch | telea")->capture_default_str();
@@ -45,9 +46,12 @@ struct FillFlags {
         ->capture_default_str();
     app.add_option("--return-weight", options.return_weight, "patch difference weight of the has-return channel")
         ->capture_default_str();
+    app.add_flag("--no-accept", no_accept,
+                 "copy the best patch without the acceptance tests (faster; worse where surfaces meet)");
   }
   FillOptions Parsed() {
     options.method = ParseFillMethod(method);
+    if (no_accept) options.acceptance.enabled = false;
     if (search == "patchmatch") {
       options.search = InpaintSearchKind::kPatchMatch;
     } else if (search == "local") {

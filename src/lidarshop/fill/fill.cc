@@ -67,6 +67,7 @@ void FillOptions::Check() const {
   CheckOption(std::isfinite(telea_radius_cells) && telea_radius_cells > 0,
               fmt::format("FillOptions.telea_radius_cells must be > 0, got {}", telea_radius_cells));
   poisson.Check();
+  acceptance.Check();
 }
 
 std::string FillResult::Summary() const {
@@ -182,6 +183,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   inpaint.priority = options.priority;
   inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
   inpaint.patchmatch_iterations = options.patchmatch_iterations;
+  inpaint.acceptance = options.acceptance;
   inpaint.local_window_radius = options.search_window_radius;
   inpaint.seed = options.seed;
   inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()), static_cast<float>(options.color_weight));

@@ -79,12 +79,12 @@ cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
 int main(int argc, char** argv) {
   CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
-  std::string methods_text = "gradient,gradient-range,laplace,depth-patch,telea", markdown_path, pictures_dir;
+  std::string methods_text = "gradient,gradient-plain,gradient-range,laplace,depth-patch,telea", markdown_path, pictures_dir;
   std::string planar_text = "textured_ground";
   int margin = 2, seeds = 3;
   FillOptions base;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the objects to remove)");
-  app.add_option("--methods", methods_text, "comma-separated fill methods (gradient-range = gradient on the range)")->capture_default_str();
+  app.add_option("--methods", methods_text, "comma-separated fill methods (gradient-plain: no acceptance tests; gradient-range: also on the range)")->capture_default_str();
   app.add_option("--seeds", seeds, "fills per patch method (seeds 0..N-1 added to --seed); metrics are means")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
@@ -156,8 +156,10 @@ int main(int argc, char** argv) {
     for (const std::string& name : methods) {
       FillOptions options = base;
       // "gradient-range": the thesis's variant, range gradients matched and copied (no inverse range).
-      options.method = ParseFillMethod(name == "gradient-range" ? "gradient" : name);
+      options.method = ParseFillMethod(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
       if (name == "gradient-range") options.inverse_range = false;
+      // "gradient-plain": without the acceptance tests of inpaint/acceptance.h (the best patch difference wins).
+      if (name == "gradient-plain") options.acceptance.enabled = false;
       // Patch methods draw random samples: their metrics are the mean over `seeds` fills (the pictures show
       // the first); the other methods are deterministic.
       const bool random = options.method == FillMethod::kGradient || options.method == FillMethod::kDepthPatch;
