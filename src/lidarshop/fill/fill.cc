@@ -184,6 +184,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
   inpaint.patchmatch_iterations = options.patchmatch_iterations;
   inpaint.acceptance = options.acceptance;
+  inpaint.acceptance_local_first = options.acceptance_local_first;
   inpaint.local_window_radius = options.search_window_radius;
   inpaint.seed = options.seed;
   inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()), static_cast<float>(options.color_weight));

@@ -100,6 +100,7 @@ int main(int argc, char** argv) {
   app.add_option("--gradient-weight", base.gradient_weight)->capture_default_str();
   app.add_option("--return-weight", base.return_weight)->capture_default_str();
   app.add_option("--pm-samples", base.patchmatch_random_samples)->capture_default_str();
+  app.add_option("--accept-local-first", base.acceptance_local_first)->capture_default_str();
   app.add_option("--pm-iterations", base.patchmatch_iterations)->capture_default_str();
   std::string priority = "criminisi", search;  // empty search = FillOptions' default
   app.add_option("--priority", priority, "criminisi | onion-peel | random")->capture_default_str();
