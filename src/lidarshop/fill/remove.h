@@ -18,17 +18,24 @@ struct RemoveOptions {
   // background) belong to neither surface. In [0, 100].
   int margin_cells = 2;
   bool keep_object = false;  // true: the object stays, the fill is returned as `behind`
+  // Cells without a return enclosed by the object's mask (a dark tyre, a window the ray went through) are part
+  // of its silhouette: fill them too (the cut never takes them, they are not nodes of its graph).
+  bool fill_enclosed_no_return = true;
   void Check() const;        // throws OptionsError
 };
 
 struct RemoveResult {
   SegmentResult cut;  // the object's mask and the cut's numbers
-  cv::Mat hole;       // CV_8U 255 = the object's cells grown by the margin (the cells filled)
+  cv::Mat hole;       // CV_8U 255 = the object's cells (and enclosed no-return cells) grown by the margin
   FillResult fill;    // fill.scan: the scan without the object
   // keep_object: the filled background behind the object's own cells only (the margin ring is background in
   // front already), every other cell without a return, flagged synthesized; empty otherwise.
   Scan behind;
 };
+
+// The cells without a return (`valid` == 0) that `mask` (CV_8U) encloses: not reachable from the image border
+// through cells outside the mask. CV_8U 255/0.
+cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
 
 // Throws InputError for strokes of another size or without object / background cells (as SegmentObject).
 RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options = {},

@@ -76,6 +76,18 @@ TEST(RemoveObject, KeepObjectGivesTheFillAsALayerBehindTheObjectOnly) {
   }
 }
 
+TEST(RemoveObject, EnclosedNoReturnCellsJoinTheHole) {
+  // A ring-shaped object with a no-return cell inside it, one inside its ring band, and one outside.
+  cv::Mat mask(9, 9, CV_8U, cv::Scalar(0));
+  cv::rectangle(mask, cv::Rect(2, 2, 5, 5), cv::Scalar(255), 1);
+  cv::Mat valid(9, 9, CV_8U, cv::Scalar(255));
+  valid.at<uint8_t>(4, 4) = 0;  // enclosed
+  valid.at<uint8_t>(0, 0) = 0;  // outside, reachable from the border
+  const cv::Mat enclosed = EnclosedNoReturnCells(mask, valid);
+  EXPECT_EQ(cv::countNonZero(enclosed), 1);
+  EXPECT_EQ(enclosed.at<uint8_t>(4, 4), 255);
+}
+
 TEST(RemoveObject, BadOptionsAndStrokes) {
   const Case c = MakeCase();
   RemoveOptions options;
