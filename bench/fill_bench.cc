@@ -39,8 +39,8 @@ const Problem& GetProblem(int kind) {
     const cv::Moments m = cv::moments(van, true);
     problem.hole = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
     const int radius = static_cast<int>(std::lround(std::sqrt(100000.0 / M_PI)));
-    cv::circle(problem.hole, cv::Point(static_cast<int>(m.m10 / m.m00), static_cast<int>(m.m01 / m.m00)), radius,
-               255, cv::FILLED);
+    cv::circle(problem.hole, cv::Point(static_cast<int>(m.m10 / m.m00), static_cast<int>(m.m01 / m.m00)),
+               radius, 255, cv::FILLED);
   }
   return cache.emplace(kind, std::move(problem)).first->second;
 }
@@ -70,11 +70,31 @@ void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance) {
 }
 
 // The default (acceptance tests on), the same without them, and the baselines.
-BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient, true)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, gradient_plain, FillMethod::kGradient, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, laplace, FillMethod::kLaplace, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, depth_patch, FillMethod::kDepthPatch, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_FillScan, telea, FillMethod::kTelea, false)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient, true)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, gradient_plain, FillMethod::kGradient, false)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, laplace, FillMethod::kLaplace, false)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, depth_patch, FillMethod::kDepthPatch, false)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_FillScan, telea, FillMethod::kTelea, false)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace lidarshop

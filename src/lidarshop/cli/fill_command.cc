@@ -1,7 +1,7 @@
 // lidarshop fill / remove: fill holes in scans, remove objects (fill/fill.h, docs/fill.md).
 //
-//   lidarshop fill SCAN --mask HOLE.png -o OUT [--method gradient|laplace|depth-patch|telea] [--report R.json]
-//                  [--debug DIR] [--seed N] [--synthesized-mask M.png]
+//   lidarshop fill SCAN --mask HOLE.png -o OUT [--method gradient|laplace|depth-patch|telea]
+//                  [--report R.json] [--debug DIR] [--seed N] [--synthesized-mask M.png]
 //   lidarshop remove SCAN --strokes S -o OUT [--keep-object] [--margin CELLS]
 #include <filesystem>
 #include <string>
@@ -44,7 +44,8 @@ struct FillFlags {
     app.add_option("--gradient-weight", options.gradient_weight,
                    "patch difference weight of the range-gradient channels")
         ->capture_default_str();
-    app.add_option("--return-weight", options.return_weight, "patch difference weight of the has-return channel")
+    app.add_option("--return-weight", options.return_weight,
+                   "patch difference weight of the has-return channel")
         ->capture_default_str();
     app.add_flag("--no-accept", no_accept,
                  "copy the best patch without the acceptance tests (faster; worse where surfaces meet)");
@@ -68,7 +69,8 @@ struct FillFlags {
 
 const Scan& PickScan(const ScanFile& file, int index, const std::string& path) {
   if (index < 0 || index >= static_cast<int>(file.scans.size())) {
-    throw OptionsError(fmt::format("--scan-index {} out of range: {} holds {} scan(s)", index, path, file.scans.size()));
+    throw OptionsError(
+        fmt::format("--scan-index {} out of range: {} holds {} scan(s)", index, path, file.scans.size()));
   }
   return file.scans[index];
 }
@@ -110,7 +112,8 @@ void WriteDebug(const std::string& dir, const FillResult& result, const cv::Mat&
   WriteImage(dir + "/hole.png", hole);
   if (result.gradient_magnitude_before.empty()) return;
   const cv::Mat everywhere(hole.size(), CV_8U, cv::Scalar(255));
-  const ColorScale scale = AutoScale(result.gradient_magnitude_after, everywhere, ColorMap::kViridis, "m/cell");
+  const ColorScale scale =
+      AutoScale(result.gradient_magnitude_after, everywhere, ColorMap::kViridis, "m/cell");
   WriteImage(dir + "/gradient_before.png", ApplyColorMap(result.gradient_magnitude_before, hole == 0, scale));
   WriteImage(dir + "/gradient_after.png", ApplyColorMap(result.gradient_magnitude_after, everywhere, scale));
   if (!result.fill_order.empty()) {
@@ -127,8 +130,9 @@ void WriteDebug(const std::string& dir, const FillResult& result, const cv::Mat&
       for (int x = 0; x < hole.cols; ++x) {
         const cv::Vec2i s = result.source_cell.at<cv::Vec2i>(y, x);
         if (s[0] < 0) continue;
-        sources.at<cv::Vec3b>(y, x) = cv::Vec3b(static_cast<uint8_t>(255 * s[1] / std::max(1, hole.cols - 1)),
-                                                static_cast<uint8_t>(255 * s[0] / std::max(1, hole.rows - 1)), 96);
+        sources.at<cv::Vec3b>(y, x) =
+            cv::Vec3b(static_cast<uint8_t>(255 * s[1] / std::max(1, hole.cols - 1)),
+                      static_cast<uint8_t>(255 * s[0] / std::max(1, hole.rows - 1)), 96);
       }
     }
     WriteImage(dir + "/source_cells.png", sources);
@@ -150,9 +154,11 @@ int RunFill(int argc, char** argv) {
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
   app.add_option("--mask", mask_path, "hole mask PNG, scan image orientation (cols x rows), white = fill")
       ->required();
-  app.add_option("-o,--output", output_path, "filled scan (.ptx, .e57, .ply, .pcd): same grid and pose")->required();
+  app.add_option("-o,--output", output_path, "filled scan (.ptx, .e57, .ply, .pcd): same grid and pose")
+      ->required();
   app.add_option("--report", report_path, "write counts and timings as JSON");
-  app.add_option("--debug", debug_dir, "write gradient magnitude before/after, fill order and source cells here");
+  app.add_option("--debug", debug_dir,
+                 "write gradient magnitude before/after, fill order and source cells here");
   app.add_option("--synthesized-mask", synthesized_mask_path, "write the synthesized cells as a mask PNG");
   app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
   flags.Add(app);
@@ -191,13 +197,16 @@ int RunRemove(int argc, char** argv) {
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
   app.add_option("--strokes", strokes_path, "strokes: .png (green object, red background) or .json polylines")
       ->required();
-  app.add_option("-o,--output", output_path, "the scan without the object (.ptx, .e57, .ply, .pcd)")->required();
+  app.add_option("-o,--output", output_path, "the scan without the object (.ptx, .e57, .ply, .pcd)")
+      ->required();
   app.add_flag("--keep-object", keep_object,
                "keep the object; add the filled background behind it (E57: second return; PLY/PCD: extra "
                "points flagged synthesized; PTX cannot hold it)");
-  app.add_option("--margin", margin, "grow the object's cells by this many cells (mixed pixels at its silhouette)")
+  app.add_option("--margin", margin,
+                 "grow the object's cells by this many cells (mixed pixels at its silhouette)")
       ->capture_default_str();
-  app.add_option("--mask-out", mask_out_path, "write the filled hole (object grown by the margin) as a mask PNG");
+  app.add_option("--mask-out", mask_out_path,
+                 "write the filled hole (object grown by the margin) as a mask PNG");
   app.add_option("--report", report_path, "write counts and timings as JSON");
   app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
   flags.Add(app);

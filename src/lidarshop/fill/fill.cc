@@ -37,7 +37,8 @@ std::string ToString(FillMethod method) {
 }
 
 FillMethod ParseFillMethod(const std::string& name) {
-  for (FillMethod method : {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+  for (FillMethod method :
+       {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
     if (name == ToString(method)) return method;
   }
   throw OptionsError(fmt::format("unknown fill method '{}' (gradient|laplace|depth-patch|telea)", name));
@@ -47,13 +48,14 @@ void FillOptions::Check() const {
   CheckOption(patch_radius >= 1 && patch_radius <= 15,
               fmt::format("FillOptions.patch_radius must be in [1, 15] cells, got {}", patch_radius));
   CheckOption(search_window_radius >= patch_radius,
-              fmt::format("FillOptions.search_window_radius must be >= patch_radius ({}), got {}", patch_radius,
-                          search_window_radius));
+              fmt::format("FillOptions.search_window_radius must be >= patch_radius ({}), got {}",
+                          patch_radius, search_window_radius));
   CheckOption(patchmatch_random_samples >= 1 && patchmatch_random_samples <= 100000,
               fmt::format("FillOptions.patchmatch_random_samples must be in [1, 100000], got {}",
                           patchmatch_random_samples));
-  CheckOption(patchmatch_iterations >= 1 && patchmatch_iterations <= 100,
-              fmt::format("FillOptions.patchmatch_iterations must be in [1, 100], got {}", patchmatch_iterations));
+  CheckOption(
+      patchmatch_iterations >= 1 && patchmatch_iterations <= 100,
+      fmt::format("FillOptions.patchmatch_iterations must be in [1, 100], got {}", patchmatch_iterations));
   CheckOption(std::isfinite(color_weight) && color_weight >= 0,
               fmt::format("FillOptions.color_weight must be >= 0, got {}", color_weight));
   CheckOption(std::isfinite(gradient_weight) && gradient_weight >= 0,
@@ -72,7 +74,8 @@ void FillOptions::Check() const {
 
 std::string FillResult::Summary() const {
   return fmt::format(
-      "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s (gradients "
+      "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s "
+      "(gradients "
       "{:.2f}, inpaint {:.2f}, poisson {:.2f}, placement {:.2f})",
       hole_cells, synthesized_cells, no_return_cells,
       unanchored_cells ? fmt::format(" ({} cut off from every known range)", unanchored_cells) : "", patches,
@@ -80,7 +83,8 @@ std::string FillResult::Summary() const {
 }
 
 cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
-  if (margin_cells < 0) throw OptionsError(fmt::format("the hole margin must be >= 0 cells, got {}", margin_cells));
+  if (margin_cells < 0)
+    throw OptionsError(fmt::format("the hole margin must be >= 0 cells, got {}", margin_cells));
   cv::Mat binary = hole != 0;
   if (margin_cells == 0) return binary;
   cv::Mat grown;
@@ -156,14 +160,15 @@ cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
   cv::Mat has_return;
   in.scan->valid.convertTo(has_return, CV_32F, 255.0 / 255.0);
   planes.push_back(has_return);
-  for (cv::Mat& plane : planes) plane.setTo(0, in.hole);  // (cv::Scalar holds 4 channels, the joint image more)
+  for (cv::Mat& plane : planes)
+    plane.setTo(0, in.hole);  // (cv::Scalar holds 4 channels, the joint image more)
   cv::Mat joint;
   cv::merge(planes, joint);
   return joint;
 }
 
-// 255 · asinh(v / scale) / asinh(1): linear near 0, logarithmic for large values, so that steep ground near the
-// horizon and depth jumps keep their order without drowning the colour.
+// 255 · asinh(v / scale) / asinh(1): linear near 0, logarithmic for large values, so that steep ground near
+// the horizon and depth jumps keep their order without drowning the colour.
 cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
   cv::Mat scaled(values.size(), CV_32F);
   const double gain = 255.0 / std::asinh(1.0);
@@ -187,8 +192,10 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   inpaint.acceptance_local_first = options.acceptance_local_first;
   inpaint.local_window_radius = options.search_window_radius;
   inpaint.seed = options.seed;
-  inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()), static_cast<float>(options.color_weight));
-  for (size_t k = 0; k < structure.size(); ++k) inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
+  inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()),
+                                 static_cast<float>(options.color_weight));
+  for (size_t k = 0; k < structure.size(); ++k)
+    inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
   inpaint.channel_weights.push_back(static_cast<float>(options.return_weight));
   return Inpaint(JointImage(in, structure), in.hole, inpaint, progress);
 }
@@ -197,7 +204,8 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
 // Laplace); returns the channels of `boundary` solved. Cells of Ω cut off from every known range lose their
 // return.
 cv::Mat SolveInHole(const Inputs& in, const FillOptions& options, HoleValues* values, const cv::Mat& boundary,
-                    const cv::Mat& guidance_x, const cv::Mat& guidance_y, const EdgeMasks& cuts, int64_t* unanchored) {
+                    const cv::Mat& guidance_x, const cv::Mat& guidance_y, const EdgeMasks& cuts,
+                    int64_t* unanchored) {
   cv::Mat domain = values->has_return.clone();
   const cv::Mat cut_off = UnanchoredCells(domain, in.known_valid, cuts);
   *unanchored = cv::countNonZero(cut_off);
@@ -205,7 +213,8 @@ cv::Mat SolveInHole(const Inputs& in, const FillOptions& options, HoleValues* va
   values->has_return.setTo(0, cut_off);
   const cv::Mat no_data = (in.known_valid | domain) == 0;
   if (cv::countNonZero(domain) == 0) return boundary.clone();
-  const PoissonSystem system = PreparePoisson(domain, options.poisson, PoissonLinks{no_data, cuts.right, cuts.down});
+  const PoissonSystem system =
+      PreparePoisson(domain, options.poisson, PoissonLinks{no_data, cuts.right, cuts.down});
   cv::Mat divergence;
   if (!guidance_x.empty()) divergence = GuidanceDivergence(guidance_x, guidance_y, no_data, cuts);
   return SolvePoisson(system, boundary, divergence).image;
@@ -215,8 +224,8 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
                   FillResult* result) {
   Timer timer;
   // The field whose gradients are copied: the range, or its inverse, which is an affine function of the ray
-  // direction on every plane (1/r = n·d / c for the plane n·p = c), so that its gradients change slowly across
-  // a surface and a patch from a few rows away still fits.
+  // direction on every plane (1/r = n·d / c for the plane n·p = c), so that its gradients change slowly
+  // across a surface and a patch from a few rows away still fits.
   cv::Mat field = in.range.clone();
   if (options.inverse_range) {
     for (int y = 0; y < field.rows; ++y) {
@@ -360,26 +369,31 @@ void TeleaFill(const Inputs& in, const FillOptions& options, HoleValues* values,
   in.range.convertTo(scaled, CV_32F, 255.0 / span, -low * 255.0 / span);
   cv::inpaint(scaled, mask, values->range, options.telea_radius_cells, cv::INPAINT_TELEA);
   values->range.convertTo(values->range, CV_32F, span / 255.0, low);
-  if (!scan.intensity.empty()) cv::inpaint(scan.intensity, mask, values->intensity, options.telea_radius_cells, cv::INPAINT_TELEA);
-  if (scan.has_color()) cv::inpaint(scan.color, mask, values->color, options.telea_radius_cells, cv::INPAINT_TELEA);
+  if (!scan.intensity.empty())
+    cv::inpaint(scan.intensity, mask, values->intensity, options.telea_radius_cells, cv::INPAINT_TELEA);
+  if (scan.has_color())
+    cv::inpaint(scan.color, mask, values->color, options.telea_radius_cells, cv::INPAINT_TELEA);
   result->timings.inpaint_s = timer.Seconds();
   result->unanchored_cells = 0;
 }
 
 void CheckInputs(const Scan& scan, const cv::Mat& hole) {
   if (hole.empty() || hole.rows != scan.rows || hole.cols != scan.cols) {
-    throw InputError(fmt::format("the hole mask is {} x {} (cols x rows), the scan is {} x {}: they must match",
-                                 hole.cols, hole.rows, scan.cols, scan.rows));
+    throw InputError(
+        fmt::format("the hole mask is {} x {} (cols x rows), the scan is {} x {}: they must match", hole.cols,
+                    hole.rows, scan.cols, scan.rows));
   }
   if (hole.depth() != CV_8U || hole.channels() != 1) {
     throw InputError("the hole mask must be a single-channel 8-bit image (white = fill)");
   }
   if (scan.direction.empty()) {
-    throw InputError("the scan has no ray directions (an unorganized cloud): only organized scans can be filled");
+    throw InputError(
+        "the scan has no ray directions (an unorganized cloud): only organized scans can be filled");
   }
 }
 
-// Normals of filled cells from their grid neighbours, oriented toward the scanner (scans with a normal channel).
+// Normals of filled cells from their grid neighbours, oriented toward the scanner (scans with a normal
+// channel).
 void GridNormals(const cv::Mat& filled, Scan* scan) {
   auto point = [&](int y, int x, Eigen::Vector3f* p) {
     if (y < 0 || y >= scan->rows || x < 0 || x >= scan->cols || !scan->valid.at<uint8_t>(y, x)) return false;
@@ -425,14 +439,17 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
       out.point.at<cv::Vec3f>(y, x) = keep ? direction * range : cv::Vec3f(0, 0, 0);
       out.synthesized.at<uint8_t>(y, x) = keep ? kValid : 0;
       if (!out.intensity.empty()) {
-        out.intensity.at<float>(y, x) =
-            keep && !values.intensity.empty() ? std::clamp(values.intensity.at<float>(y, x), 0.0f, 1.0f) : 0.5f;
+        out.intensity.at<float>(y, x) = keep && !values.intensity.empty()
+                                            ? std::clamp(values.intensity.at<float>(y, x), 0.0f, 1.0f)
+                                            : 0.5f;
       }
       if (out.has_color()) {
-        out.color.at<cv::Vec3b>(y, x) = keep && !values.color.empty() ? values.color.at<cv::Vec3b>(y, x) : cv::Vec3b(0, 0, 0);
+        out.color.at<cv::Vec3b>(y, x) =
+            keep && !values.color.empty() ? values.color.at<cv::Vec3b>(y, x) : cv::Vec3b(0, 0, 0);
       }
       if (!out.label.empty()) {
-        out.label.at<int32_t>(y, x) = keep && !values.label.empty() ? values.label.at<int32_t>(y, x) : kNoLabel;
+        out.label.at<int32_t>(y, x) =
+            keep && !values.label.empty() ? values.label.at<int32_t>(y, x) : kNoLabel;
       }
       if (!out.true_range.empty()) out.true_range.at<float>(y, x) = 0.0f;  // no truth for a synthesized point
       if (!out.normal.empty()) out.normal.at<cv::Vec3f>(y, x) = cv::Vec3f(0, 0, 0);
@@ -450,7 +467,8 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
 
 }  // namespace
 
-FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options, Progress* progress) {
+FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options,
+                    Progress* progress) {
   options.Check();
   CheckInputs(scan, hole_in);
   Timer total;
@@ -477,7 +495,8 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
       const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);
       if (!(std::abs(d.dot(d) - 1.0f) < 1e-2f)) {
         throw InputError(fmt::format(
-            "cell (row {}, col {}) of the hole has no ray direction: the scan's grid is unknown there", y, x));
+            "cell (row {}, col {}) of the hole has no ray direction: the scan's grid is unknown there", y,
+            x));
       }
     }
   }

@@ -1,15 +1,16 @@
 // Hole filling in organized scans: remove an object, or complete the surface hidden behind it (thesis ch. 6).
 //
-// A hole is a set of cells of the scan's ray image (CV_8U rows x cols, image orientation, non-zero = fill this
-// cell; returns already there are replaced). The default method works in the gradient domain (thesis 6.4–6.5):
+// A hole is a set of cells of the scan's ray image (CV_8U rows x cols, image orientation, non-zero = fill
+// this cell; returns already there are replaced). The default method works in the gradient domain (thesis
+// 6.4–6.5):
 //   1. range gradients: forward differences of the range image, one-sided (backward) where the forward
 //      neighbour is in the hole or has no return, 0 where neither neighbour has a return;
 //   2. patch-based inpainting (inpaint/) of a joint image — colour (or intensity), the two range-gradient
-//      channels and a has-return channel — the colour leading the choice of patches. Every filled cell records
-//      the cell it was copied from; its gradients, colour, intensity, label and whether it has a return are
-//      copied from that cell (so sky stays sky behind a lamp post);
-//   3. range in the hole from the Poisson equation ∇²r = div G with the copied gradients as guidance G and the
-//      known ranges around the hole as Dirichlet boundary (poisson/); cells without a return are no-flux
+//      channels and a has-return channel — the colour leading the choice of patches. Every filled cell
+//      records the cell it was copied from; its gradients, colour, intensity, label and whether it has a
+//      return are copied from that cell (so sky stays sky behind a lamp post);
+//   3. range in the hole from the Poisson equation ∇²r = div G with the copied gradients as guidance G and
+//      the known ranges around the hole as Dirichlet boundary (poisson/); cells without a return are no-flux
 //      boundaries (edges to them are left out), not zero-range Dirichlet values, and copied depth jumps cut
 //      the system (FillOptions::depth_jump_ratio);
 //   4. every new point is placed along its own cell's ray (`direction`) at the reconstructed range — never on
@@ -49,7 +50,7 @@ struct FillOptions {
   // PatchMatch: random samples over the whole scan plus samples near the target; measured best on
   // data/fill_eval (a surface hidden behind a large object is found far away, e.g. a facade above a car).
   InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
-  int search_window_radius = 50;  // cells; local window (local search; PatchMatch's near samples)
+  int search_window_radius = 50;       // cells; local window (local search; PatchMatch's near samples)
   int patchmatch_random_samples = 48;  // PatchMatch: uniform draws over the scan per query (>= 1)
   int patchmatch_iterations = 4;       // PatchMatch: propagation + random-search rounds per query (>= 1)
   // Patch acceptance tests (inpaint/acceptance.h, thesis 7.1), the combined set by default: a patch is copied
@@ -101,7 +102,7 @@ struct FillResult {
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole
   cv::Mat gradient_magnitude_after;   // |∇r| of the guidance after inpainting
   cv::Mat fill_order;                 // CV_32S: patch iteration that filled each cell, −1 = known
-  cv::Mat source_cell;                // CV_32SC2: (row, col) each hole cell was copied from, (−1, −1) = known
+  cv::Mat source_cell;  // CV_32SC2: (row, col) each hole cell was copied from, (−1, −1) = known
   FillTimings timings;
   std::string Summary() const;  // one line
 };

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/pointset/kdtree.h"
@@ -45,7 +45,8 @@ Eigen::Vector3f WindowNormal(const Scan& scan, int y, int x, int radius) {
 }
 
 float TruthRange(const Scan& truth, int y, int x) {
-  if (!truth.true_range.empty() && truth.true_range.at<float>(y, x) > 0) return truth.true_range.at<float>(y, x);
+  if (!truth.true_range.empty() && truth.true_range.at<float>(y, x) > 0)
+    return truth.true_range.at<float>(y, x);
   return truth.range.at<float>(y, x);
 }
 
@@ -56,7 +57,8 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
   if (filled.rows != truth.rows || filled.cols != truth.cols || hole_in.rows != truth.rows ||
       hole_in.cols != truth.cols) {
     throw InputError(fmt::format("MeasureFill: the fill ({} x {}), truth ({} x {}) and hole ({} x {}) differ",
-                                 filled.cols, filled.rows, truth.cols, truth.rows, hole_in.cols, hole_in.rows));
+                                 filled.cols, filled.rows, truth.cols, truth.rows, hole_in.cols,
+                                 hole_in.rows));
   }
   const cv::Mat hole = hole_in != 0;
   FillMetrics m;
@@ -81,7 +83,8 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
       if (f == t) ++same_return;
       if (f) {
         ++synthesized;
-        const NearestResult nearest = tree.NearestWithin(PointAt(filled, y, x), static_cast<float>(options.floating_m));
+        const NearestResult nearest =
+            tree.NearestWithin(PointAt(filled, y, x), static_cast<float>(options.floating_m));
         if (!nearest.found()) ++floating;
       }
       if (!f || !t) continue;

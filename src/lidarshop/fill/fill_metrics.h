@@ -12,24 +12,24 @@
 namespace lidarshop {
 
 struct FillMetricsOptions {
-  double within_m = 0.02;          // "within" tolerance of the range error, metres (the 20 mm of the share)
-  double floating_m = 0.10;        // a filled point farther than this from every truth point floats, metres
-  int normal_window_radius = 2;    // plane-fit window of the filled points' normals, cells (5 x 5)
-  int seam_band_cells = 8;         // width of the band outside the hole where the reference jump is measured
+  double within_m = 0.02;        // "within" tolerance of the range error, metres (the 20 mm of the share)
+  double floating_m = 0.10;      // a filled point farther than this from every truth point floats, metres
+  int normal_window_radius = 2;  // plane-fit window of the filled points' normals, cells (5 x 5)
+  int seam_band_cells = 8;       // width of the band outside the hole where the reference jump is measured
 };
 
 struct FillMetrics {
   int64_t hole_cells = 0;
-  int64_t compared_cells = 0;     // hole cells with a return in both the fill and the truth
-  double range_rmse_mm = 0;       // against the truth's noise-free range (true_range) where it has one
+  int64_t compared_cells = 0;  // hole cells with a return in both the fill and the truth
+  double range_rmse_mm = 0;    // against the truth's noise-free range (true_range) where it has one
   double range_mae_mm = 0;
-  double within_share = 0;        // share of compared cells within `within_m`
-  double normal_error_deg = 0;    // mean angle between plane-fit normals of the fill and the true normals
-  double seam_mm = 0;             // mean |range jump| across edges from a filled cell to a known one
-  double seam_outside_mm = 0;     // the same statistic on known-known edges in a band around the hole
-  double floating_share = 0;      // share of synthesized points farther than floating_m from the truth
-  double return_accuracy = 0;     // share of hole cells whose return / no-return matches the truth
-  double color_psnr_db = 0;       // RGB PSNR over compared cells (0 when a scan has no colour)
+  double within_share = 0;      // share of compared cells within `within_m`
+  double normal_error_deg = 0;  // mean angle between plane-fit normals of the fill and the true normals
+  double seam_mm = 0;           // mean |range jump| across edges from a filled cell to a known one
+  double seam_outside_mm = 0;   // the same statistic on known-known edges in a band around the hole
+  double floating_share = 0;    // share of synthesized points farther than floating_m from the truth
+  double return_accuracy = 0;   // share of hole cells whose return / no-return matches the truth
+  double color_psnr_db = 0;     // RGB PSNR over compared cells (0 when a scan has no colour)
 };
 
 // `filled` and `truth` share the grid; `hole` is CV_8U non-zero. Throws InputError on mismatched sizes.

@@ -73,7 +73,7 @@ TEST(RangeGradient, NearestKnownCellAndUnanchoredParts) {
   cv::Mat hole(5, 5, CV_8U, cv::Scalar(0));
   hole(cv::Rect(1, 1, 3, 3)) = 255;
   const cv::Mat nearest = NearestKnownCell(hole);
-  EXPECT_EQ(nearest.at<cv::Vec2i>(1, 1), cv::Vec2i(0, 1));  // first reached from above
+  EXPECT_EQ(nearest.at<cv::Vec2i>(1, 1), cv::Vec2i(0, 1));    // first reached from above
   EXPECT_EQ(nearest.at<cv::Vec2i>(0, 0), cv::Vec2i(-1, -1));  // known cells point nowhere
   EXPECT_GE(nearest.at<cv::Vec2i>(2, 2)[0], 0);
   cv::Mat anchor(5, 5, CV_8U, cv::Scalar(0));
@@ -99,9 +99,12 @@ TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {
   const PoissonSystem system = PreparePoisson(hole, {}, PoissonLinks{no_data, {}, {}});
   const cv::Mat solved = SolvePoisson(system, boundary, GuidanceDivergence(gx, gy, no_data)).image;
   for (int y = 3; y < 8; ++y)
-    for (int x = 4; x < 9; ++x) EXPECT_NEAR(solved.at<double>(y, x), ramp.at<double>(y, x), 1e-9) << y << "," << x;
+    for (int x = 4; x < 9; ++x)
+      EXPECT_NEAR(solved.at<double>(y, x), ramp.at<double>(y, x), 1e-9) << y << "," << x;
   // Without the no-data mask the wrong value leaks in: the test can fail.
-  const cv::Mat leaked = SolvePoisson(PreparePoisson(hole), boundary, GuidanceDivergence(gx, gy, cv::Mat::zeros(ramp.size(), CV_8U))).image;
+  const cv::Mat leaked = SolvePoisson(PreparePoisson(hole), boundary,
+                                      GuidanceDivergence(gx, gy, cv::Mat::zeros(ramp.size(), CV_8U)))
+                             .image;
   EXPECT_GT(std::abs(leaked.at<double>(5, 4) - ramp.at<double>(5, 4)), 1.0);
 }
 
@@ -114,7 +117,8 @@ TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
   const FillResult laplace = FillScan(c.scan, c.hole, options);
   const FillMetrics g = MeasureFill(gradient.scan, c.truth, c.hole);
   const FillMetrics l = MeasureFill(laplace.scan, c.truth, c.hole);
-  EXPECT_LT(g.range_rmse_mm, l.range_rmse_mm) << "gradient " << g.range_rmse_mm << " laplace " << l.range_rmse_mm;
+  EXPECT_LT(g.range_rmse_mm, l.range_rmse_mm)
+      << "gradient " << g.range_rmse_mm << " laplace " << l.range_rmse_mm;
   // Few floating points (1.3 % measured with the acceptance tests on, 0 without; the membrane floats 30 %+).
   EXPECT_LT(g.floating_share, 0.02);
   EXPECT_LT(g.floating_share, l.floating_share / 4);
@@ -214,7 +218,8 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
   grey.color.release();
   cv::Mat border(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(0));
   border(cv::Rect(0, c.scan.rows - 20, 30, 20)) = 255;
-  for (FillMethod method : {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+  for (FillMethod method :
+       {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
     FillOptions options;
     options.method = method;
     const FillResult result = FillScan(grey, border, options);

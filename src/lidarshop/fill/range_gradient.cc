@@ -44,8 +44,9 @@ cv::Mat NearestKnownCell(const cv::Mat& hole) {
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < cols; ++x) {
       if (hole.at<uint8_t>(y, x) != 0) continue;
-      const bool borders = (x > 0 && hole.at<uint8_t>(y, x - 1)) || (x + 1 < cols && hole.at<uint8_t>(y, x + 1)) ||
-                           (y > 0 && hole.at<uint8_t>(y - 1, x)) || (y + 1 < rows && hole.at<uint8_t>(y + 1, x));
+      const bool borders =
+          (x > 0 && hole.at<uint8_t>(y, x - 1)) || (x + 1 < cols && hole.at<uint8_t>(y, x + 1)) ||
+          (y > 0 && hole.at<uint8_t>(y - 1, x)) || (y + 1 < rows && hole.at<uint8_t>(y + 1, x));
       if (!borders) continue;
       nearest.at<cv::Vec2i>(y, x) = cv::Vec2i(y, x);
       queue.emplace_back(x, y);
@@ -98,7 +99,8 @@ bool Cut(const cv::Mat& mask, int y, int x) { return !mask.empty() && mask.at<ui
 
 }  // namespace
 
-cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv::Mat& no_data, const EdgeMasks& cuts) {
+cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv::Mat& no_data,
+                           const EdgeMasks& cuts) {
   cv::Mat gx, gy;
   gx_in.convertTo(gx, CV_64F);
   gy_in.convertTo(gy, CV_64F);
@@ -106,8 +108,10 @@ cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv:
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < cols; ++x) {
       const bool here = no_data.at<uint8_t>(y, x) != 0;
-      if (here || x + 1 >= cols || no_data.at<uint8_t>(y, x + 1) != 0 || Cut(cuts.right, y, x)) gx.at<double>(y, x) = 0.0;
-      if (here || y + 1 >= rows || no_data.at<uint8_t>(y + 1, x) != 0 || Cut(cuts.down, y, x)) gy.at<double>(y, x) = 0.0;
+      if (here || x + 1 >= cols || no_data.at<uint8_t>(y, x + 1) != 0 || Cut(cuts.right, y, x))
+        gx.at<double>(y, x) = 0.0;
+      if (here || y + 1 >= rows || no_data.at<uint8_t>(y + 1, x) != 0 || Cut(cuts.down, y, x))
+        gy.at<double>(y, x) = 0.0;
     }
   }
   return BackwardDivergence(gx, gy);
@@ -115,7 +119,8 @@ cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv:
 
 cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const EdgeMasks& cuts) {
   const int rows = domain.rows, cols = domain.cols;
-  // Breadth-first from every domain cell next to an anchor through uncut edges; what is not reached is cut off.
+  // Breadth-first from every domain cell next to an anchor through uncut edges; what is not reached is cut
+  // off.
   cv::Mat reached(rows, cols, CV_8U, cv::Scalar(0));
   std::deque<cv::Point> queue;
   auto linked = [&](int y, int x, int ny, int nx) {
@@ -159,7 +164,8 @@ double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile,
     }
   }
   if (magnitudes.empty()) return floor;
-  const auto k = static_cast<size_t>(std::clamp(quantile, 0.0, 1.0) * static_cast<double>(magnitudes.size() - 1));
+  const auto k =
+      static_cast<size_t>(std::clamp(quantile, 0.0, 1.0) * static_cast<double>(magnitudes.size() - 1));
   std::nth_element(magnitudes.begin(), magnitudes.begin() + static_cast<std::ptrdiff_t>(k), magnitudes.end());
   return std::max(floor, static_cast<double>(magnitudes[k]));
 }

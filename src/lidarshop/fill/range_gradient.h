@@ -16,13 +16,13 @@ struct RangeGradient {
 };
 RangeGradient OneSidedRangeGradient(const cv::Mat& range, const cv::Mat& usable);
 
-// For every cell of `hole` (CV_8U, non-zero), the nearest cell outside it in 4-connected steps (breadth-first,
-// ties in a fixed order, so the answer does not depend on threads). CV_32SC2 (row, col), (−1, −1) outside the
-// hole and for hole cells that no known cell reaches.
+// For every cell of `hole` (CV_8U, non-zero), the nearest cell outside it in 4-connected steps
+// (breadth-first, ties in a fixed order, so the answer does not depend on threads). CV_32SC2 (row, col),
+// (−1, −1) outside the hole and for hole cells that no known cell reaches.
 cv::Mat NearestKnownCell(const cv::Mat& hole);
 
-// Depth discontinuities between usable neighbours: right(y, x) / down(y, x) = 255 where the edge to (y, x+1) /
-// (y+1, x) joins two usable cells whose ranges differ by more than `ratio` times the nearer one (0 = none).
+// Depth discontinuities between usable neighbours: right(y, x) / down(y, x) = 255 where the edge to (y, x+1)
+// / (y+1, x) joins two usable cells whose ranges differ by more than `ratio` times the nearer one (0 = none).
 // CV_8U rows x cols each.
 struct EdgeMasks {
   cv::Mat right, down;
@@ -32,7 +32,8 @@ EdgeMasks DepthJumps(const cv::Mat& range, const cv::Mat& usable, double ratio);
 // The guidance field (gx, gy) with every edge that touches a cell without data (`no_data`, CV_8U non-zero)
 // or is cut (`cuts`, may be empty) set to 0, so that its divergence matches a Poisson system that leaves
 // those edges out. Returns the divergence, CV_64F.
-cv::Mat GuidanceDivergence(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& no_data, const EdgeMasks& cuts = {});
+cv::Mat GuidanceDivergence(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& no_data,
+                           const EdgeMasks& cuts = {});
 
 // Cells of `domain` (CV_8U) that reach no `anchor` cell (CV_8U) through 4-neighbour edges that are not cut:
 // such parts have no known range to start from. CV_8U 255/0.

@@ -35,7 +35,8 @@ RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const Remove
   result.hole = GrowHole(object, options.margin_cells);
   if (progress) progress->Restart("fill", cv::countNonZero(result.hole));
   result.fill = FillScan(scan, result.hole, options.fill, progress);
-  if (options.keep_object) result.behind = MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask != 0));
+  if (options.keep_object)
+    result.behind = MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask != 0));
   return result;
 }
 

@@ -18,10 +18,10 @@ struct RemoveOptions {
   // background) belong to neither surface. In [0, 100].
   int margin_cells = 2;
   bool keep_object = false;  // true: the object stays, the fill is returned as `behind`
-  // Cells without a return enclosed by the object's mask (a dark tyre, a window the ray went through) are part
-  // of its silhouette: fill them too (the cut never takes them, they are not nodes of its graph).
+  // Cells without a return enclosed by the object's mask (a dark tyre, a window the ray went through) are
+  // part of its silhouette: fill them too (the cut never takes them, they are not nodes of its graph).
   bool fill_enclosed_no_return = true;
-  void Check() const;        // throws OptionsError
+  void Check() const;  // throws OptionsError
 };
 
 struct RemoveResult {

@@ -3,18 +3,20 @@
 #include <cmath>
 #include <limits>
 
-#include <Eigen/Geometry>
 #include <fmt/format.h>
+#include <Eigen/Geometry>
 
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
 
 void PointViewOptions::Check() const {
-  CheckOption(eye_in_world.allFinite() && target_in_world.allFinite() && (target_in_world - eye_in_world).norm() > 0,
-              "PointViewOptions: the eye and the target must be finite and distinct");
-  CheckOption(field_of_view_deg > 0 && field_of_view_deg < 170,
-              fmt::format("PointViewOptions.field_of_view_deg must be in (0, 170), got {}", field_of_view_deg));
+  CheckOption(
+      eye_in_world.allFinite() && target_in_world.allFinite() && (target_in_world - eye_in_world).norm() > 0,
+      "PointViewOptions: the eye and the target must be finite and distinct");
+  CheckOption(
+      field_of_view_deg > 0 && field_of_view_deg < 170,
+      fmt::format("PointViewOptions.field_of_view_deg must be in (0, 170), got {}", field_of_view_deg));
   CheckOption(width_px >= 16 && height_px >= 16 && width_px <= 16384 && height_px <= 16384,
               fmt::format("PointViewOptions: the picture must be 16..16384 pixels wide and high, got {} x {}",
                           width_px, height_px));
@@ -33,7 +35,8 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options) {
   const Eigen::Vector3d up = right.cross(forward);
   const double focal = 0.5 * options.width_px / std::tan(0.5 * options.field_of_view_deg * M_PI / 180.0);
   cv::Mat image(options.height_px, options.width_px, CV_8UC3, cv::Scalar::all(0));
-  cv::Mat depth(options.height_px, options.width_px, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  cv::Mat depth(options.height_px, options.width_px, CV_32F,
+                cv::Scalar(std::numeric_limits<float>::infinity()));
   const int half = options.point_size_px / 2;
   for (int y = 0; y < scan.rows; ++y) {
     for (int x = 0; x < scan.cols; ++x) {
@@ -55,7 +58,8 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options) {
       }
       if (options.synthesized_tint > 0 && !scan.synthesized.empty() && scan.synthesized.at<uint8_t>(y, x)) {
         const double t = options.synthesized_tint;
-        color = cv::Vec3b(cv::saturate_cast<uint8_t>((1 - t) * color[0] + t * 255), cv::saturate_cast<uint8_t>((1 - t) * color[1]),
+        color = cv::Vec3b(cv::saturate_cast<uint8_t>((1 - t) * color[0] + t * 255),
+                          cv::saturate_cast<uint8_t>((1 - t) * color[1]),
                           cv::saturate_cast<uint8_t>((1 - t) * color[2] + t * 255));
       }
       for (int dv = -half; dv < options.point_size_px - half; ++dv) {
@@ -86,7 +90,8 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
     }
   }
   const Eigen::Vector3d scanner = scan.world_from_scanner.block<3, 1>(0, 3);
-  const Eigen::Vector3d centre = count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d(scanner + Eigen::Vector3d::UnitY());
+  const Eigen::Vector3d centre =
+      count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d(scanner + Eigen::Vector3d::UnitY());
   const Eigen::Vector3d arm = scanner - centre;
   const Eigen::Vector3d turned = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * arm;
   PointViewOptions view;

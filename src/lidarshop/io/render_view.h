@@ -11,7 +11,7 @@
 namespace lidarshop {
 
 struct PointViewOptions {
-  Eigen::Vector3d eye_in_world = Eigen::Vector3d::Zero();     // camera centre, metres
+  Eigen::Vector3d eye_in_world = Eigen::Vector3d::Zero();      // camera centre, metres
   Eigen::Vector3d target_in_world = Eigen::Vector3d::UnitY();  // the point the camera looks at, metres
   double field_of_view_deg = 60.0;                             // horizontal, degrees, in (0, 170)
   int width_px = 640, height_px = 480;                         // picture size, >= 16
@@ -21,8 +21,8 @@ struct PointViewOptions {
   void Check() const;  // throws OptionsError
 };
 
-// CV_8UC3 RGB, black background. Points take the scan's colour, or grey intensity when it has none. World z is
-// up in the picture.
+// CV_8UC3 RGB, black background. Points take the scan's colour, or grey intensity when it has none. World z
+// is up in the picture.
 cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 
 // A second viewpoint for a region of the scan (CV_8U non-zero cells, e.g. a hole): the camera stands at the

@@ -14,8 +14,8 @@
 #include <set>
 #include <sstream>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/fill/fill.h"
@@ -54,7 +54,8 @@ cv::Mat ErrorPicture(const Scan& filled, const Scan& truth, const cv::Mat& hole)
   cv::Mat shown(truth.rows, truth.cols, CV_8U, cv::Scalar(0));
   for (int y = 0; y < truth.rows; ++y) {
     for (int x = 0; x < truth.cols; ++x) {
-      if (!hole.at<uint8_t>(y, x) || !filled.valid.at<uint8_t>(y, x) || !truth.valid.at<uint8_t>(y, x)) continue;
+      if (!hole.at<uint8_t>(y, x) || !filled.valid.at<uint8_t>(y, x) || !truth.valid.at<uint8_t>(y, x))
+        continue;
       error.at<float>(y, x) = std::abs(filled.range.at<float>(y, x) - truth.range.at<float>(y, x));
       shown.at<uint8_t>(y, x) = 255;
     }
@@ -79,18 +80,23 @@ cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
 int main(int argc, char** argv) {
   CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
-  std::string methods_text = "gradient,gradient-plain,gradient-range,laplace,depth-patch,telea", markdown_path, pictures_dir;
+  std::string methods_text = "gradient,gradient-plain,gradient-range,laplace,depth-patch,telea",
+              markdown_path, pictures_dir;
   std::string planar_text = "textured_ground";
   int margin = 2, seeds = 3;
   FillOptions base;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the objects to remove)");
-  app.add_option("--methods", methods_text, "comma-separated fill methods (gradient-plain: no acceptance tests; gradient-range: also on the range)")->capture_default_str();
+  app.add_option("--methods", methods_text,
+                 "comma-separated fill methods (gradient-plain: no acceptance tests; gradient-range: also on "
+                 "the range)")
+      ->capture_default_str();
   app.add_option("--seeds", seeds, "fills per patch method (seeds 0..N-1 added to --seed); metrics are means")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
   app.add_option("--seed", base.seed, "first seed")->capture_default_str();
   app.add_option("--margin", margin, "hole = object cells grown by this many cells")->capture_default_str();
-  app.add_option("--planar", planar_text, "scenes that are planar behind the object (left out of the target mean)")
+  app.add_option("--planar", planar_text,
+                 "scenes that are planar behind the object (left out of the target mean)")
       ->capture_default_str();
   app.add_option("--markdown", markdown_path, "also write the tables to this file");
   app.add_option("--pictures", pictures_dir, "write range and second-viewpoint pictures here");
@@ -132,11 +138,12 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     report += text;
   };
-  emit(fmt::format("Hole = the removed object's cells grown by {} cells; truth = the same scan without the object "
-                   "(same seed). Patch methods: mean over {} fill seeds. Patch radius {}, window {}, weights colour "
-                   "{} / gradient {} / return {}.\n",
-                   margin, seeds, base.patch_radius, base.search_window_radius, base.color_weight, base.gradient_weight,
-                   base.return_weight));
+  emit(fmt::format(
+      "Hole = the removed object's cells grown by {} cells; truth = the same scan without the object "
+      "(same seed). Patch methods: mean over {} fill seeds. Patch radius {}, window {}, weights colour "
+      "{} / gradient {} / return {}.\n",
+      margin, seeds, base.patch_radius, base.search_window_radius, base.color_weight, base.gradient_weight,
+      base.return_weight));
   std::map<std::string, std::vector<double>> rmse_nonplanar, floating_all;
   std::map<std::string, double> seconds_all;
   std::vector<std::string> worse_than_laplace;
@@ -148,22 +155,28 @@ int main(int argc, char** argv) {
     std::erase_if(without.objects, [](const SceneObject& object) { return object.label == 1; });
     const Scan truth = SynthesizeScan(without);
     const cv::Mat hole = GrowHole((with_object.label == 1) & (with_object.valid != 0), margin);
-    emit(fmt::format("\n#### {} ({} x {} cells, hole {} cells{})\n\n", stem, with_object.cols, with_object.rows,
-                     cv::countNonZero(hole), planar.count(stem) ? ", planar behind the object" : ""));
-    emit("| method | range RMSE mm | MAE mm | within 20 mm | normal error ° | seam mm (outside) | floating % | "
-         "return acc. | colour PSNR dB | seconds |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    emit(fmt::format("\n#### {} ({} x {} cells, hole {} cells{})\n\n", stem, with_object.cols,
+                     with_object.rows, cv::countNonZero(hole),
+                     planar.count(stem) ? ", planar behind the object" : ""));
+    emit(
+        "| method | range RMSE mm | MAE mm | within 20 mm | normal error ° | seam mm (outside) | floating % "
+        "| "
+        "return acc. | colour PSNR dB | seconds |\n|---|---|---|---|---|---|---|---|---|---|\n");
     std::map<std::string, FillResult> results;
     std::map<std::string, double> rmse;
     for (const std::string& name : methods) {
       FillOptions options = base;
       // "gradient-range": the thesis's variant, range gradients matched and copied (no inverse range).
-      options.method = ParseFillMethod(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
+      options.method =
+          ParseFillMethod(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
       if (name == "gradient-range") options.inverse_range = false;
-      // "gradient-plain": without the acceptance tests of inpaint/acceptance.h (the best patch difference wins).
+      // "gradient-plain": without the acceptance tests of inpaint/acceptance.h (the best patch difference
+      // wins).
       if (name == "gradient-plain") options.acceptance.enabled = false;
       // Patch methods draw random samples: their metrics are the mean over `seeds` fills (the pictures show
       // the first); the other methods are deterministic.
-      const bool random = options.method == FillMethod::kGradient || options.method == FillMethod::kDepthPatch;
+      const bool random =
+          options.method == FillMethod::kGradient || options.method == FillMethod::kDepthPatch;
       FillMetrics m;
       FillResult result;
       double seconds = 0;
@@ -185,10 +198,12 @@ int main(int argc, char** argv) {
         if (k == 0) result = std::move(run);
       }
       result.timings.total_s = seconds;
-      emit(fmt::format("| {} | {:.1f} | {:.1f} | {:.1f} % | {:.1f} | {:.1f} ({:.1f}) | {:.2f} | {:.3f} | {:.1f} | {:.2f} |\n",
-                       name, m.range_rmse_mm, m.range_mae_mm, 100 * m.within_share, m.normal_error_deg, m.seam_mm,
-                       m.seam_outside_mm, 100 * m.floating_share, m.return_accuracy, m.color_psnr_db,
-                       result.timings.total_s));
+      emit(
+          fmt::format("| {} | {:.1f} | {:.1f} | {:.1f} % | {:.1f} | {:.1f} ({:.1f}) | {:.2f} | {:.3f} | "
+                      "{:.1f} | {:.2f} |\n",
+                      name, m.range_rmse_mm, m.range_mae_mm, 100 * m.within_share, m.normal_error_deg,
+                      m.seam_mm, m.seam_outside_mm, 100 * m.floating_share, m.return_accuracy,
+                      m.color_psnr_db, result.timings.total_s));
       rmse[name] = m.range_rmse_mm;
       if (!planar.count(stem)) rmse_nonplanar[name].push_back(m.range_rmse_mm);
       floating_all[name].push_back(100 * m.floating_share);
@@ -211,7 +226,8 @@ int main(int argc, char** argv) {
         return v;
       }();
       row2.push_back(Labelled(RenderPointView(truth, view), "truth, second viewpoint"));
-      for (const std::string& name : {std::string("laplace"), std::string("depth-patch"), std::string("gradient")}) {
+      for (const std::string& name :
+           {std::string("laplace"), std::string("depth-patch"), std::string("gradient")}) {
         if (!results.count(name)) continue;
         row1.push_back(Labelled(RangePicture(results.at(name).scan, lo, hi), name));
         PointViewOptions tinted = view;
@@ -219,7 +235,8 @@ int main(int argc, char** argv) {
         row2.push_back(Labelled(RenderPointView(results.at(name).scan, tinted), name + ", second viewpoint"));
       }
       std::vector<cv::Mat> row3 = {Labelled(RangePicture(with_object, lo, hi), "hole: |error| 0..0.5 m")};
-      for (const auto& [name, result] : results) row3.push_back(Labelled(ErrorPicture(result.scan, truth, hole), name));
+      for (const auto& [name, result] : results)
+        row3.push_back(Labelled(ErrorPicture(result.scan, truth, hole), name));
       cv::Mat errors;
       cv::hconcat(row3, errors);
       WriteImage(pictures_dir + "/" + stem + "_error.png", errors);
@@ -230,22 +247,25 @@ int main(int argc, char** argv) {
       WriteImage(pictures_dir + "/" + stem + "_view.png", bottom);
     }
   }
-  emit("\n#### Summary\n\n| method | mean range RMSE mm, non-planar scenes | mean floating % | total seconds |\n"
-       "|---|---|---|---|\n");
+  emit(
+      "\n#### Summary\n\n| method | mean range RMSE mm, non-planar scenes | mean floating % | total seconds "
+      "|\n"
+      "|---|---|---|---|\n");
   auto mean = [](const std::vector<double>& v) {
     double s = 0;
     for (double x : v) s += x;
     return v.empty() ? 0.0 : s / static_cast<double>(v.size());
   };
   for (const std::string& name : methods) {
-    emit(fmt::format("| {} | {:.1f} | {:.2f} | {:.1f} |\n", name, mean(rmse_nonplanar[name]), mean(floating_all[name]),
-                     seconds_all[name]));
+    emit(fmt::format("| {} | {:.1f} | {:.2f} | {:.1f} |\n", name, mean(rmse_nonplanar[name]),
+                     mean(floating_all[name]), seconds_all[name]));
   }
   if (rmse_nonplanar.count("gradient") && rmse_nonplanar.count("laplace")) {
-    emit(fmt::format("\nGradient / Laplace mean RMSE over the non-planar scenes: {:.2f} (target <= 0.5); scenes where "
-                     "gradient is worse than Laplace: {}\n",
-                     mean(rmse_nonplanar["gradient"]) / std::max(1e-9, mean(rmse_nonplanar["laplace"])),
-                     worse_than_laplace.empty() ? "none" : fmt::format("{}", fmt::join(worse_than_laplace, ", "))));
+    emit(fmt::format(
+        "\nGradient / Laplace mean RMSE over the non-planar scenes: {:.2f} (target <= 0.5); scenes where "
+        "gradient is worse than Laplace: {}\n",
+        mean(rmse_nonplanar["gradient"]) / std::max(1e-9, mean(rmse_nonplanar["laplace"])),
+        worse_than_laplace.empty() ? "none" : fmt::format("{}", fmt::join(worse_than_laplace, ", "))));
   }
   if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
   return 0;
