@@ -33,6 +33,22 @@ void PinholeCamera::Check(const std::string& what) const {
                     "must be a rigid 4x4 transform (rotation and translation)");
 }
 
+PinholeCamera CameraLookingAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width_px,
+                              int height_px, double horizontal_fov_deg) {
+  PinholeCamera camera;
+  camera.width_px = width_px;
+  camera.height_px = height_px;
+  camera.fx_px = camera.fy_px = 0.5 * width_px / std::tan(0.5 * horizontal_fov_deg * M_PI / 180.0);
+  camera.cx_px = 0.5 * width_px;
+  camera.cy_px = 0.5 * height_px;
+  const Eigen::Vector3d z = (target - eye).normalized();
+  const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();  // right
+  const Eigen::Vector3d y = z.cross(x);                                      // down
+  camera.world_from_camera.topLeftCorner<3, 3>() << x, y, z;
+  camera.world_from_camera.topRightCorner<3, 1>() = eye;
+  return camera;
+}
+
 Eigen::Vector2d DistortNormalized(const PinholeCamera& c, const Eigen::Vector2d& n) {
   const double a = n.x(), b = n.y(), r2 = a * a + b * b;
   const double radial = 1 + r2 * (c.k1 + r2 * (c.k2 + r2 * c.k3));

@@ -43,6 +43,12 @@ struct PinholeCamera {
   void Check(const std::string& what = "camera") const;
 };
 
+// An undistorted camera at `eye` looking at `target` (world z up: the image's y runs down along -z), focal
+// length from the horizontal field of view, principal point at the image centre. For scenes, tests and
+// examples.
+PinholeCamera CameraLookingAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width_px,
+                              int height_px, double horizontal_fov_deg);
+
 // Normalized image coordinates (a, b) -> distorted ones (a', b'), the formula above.
 Eigen::Vector2d DistortNormalized(const PinholeCamera& camera, const Eigen::Vector2d& normalized);
 // The inverse, by fixed-point iteration (converges for the distortions of real lenses).

@@ -69,6 +69,18 @@ TEST(Camera, WorldPointsGoThroughThePose) {
   EXPECT_NEAR(pixel.y(), 400, 1e-6);
 }
 
+TEST(Camera, LookingAtPutsTheTargetAtTheCentreWithTheSkyUp) {
+  const PinholeCamera camera = CameraLookingAt({1, 0, 1.5}, {0, 10, 1}, 800, 600, 60);
+  EXPECT_TRUE(IsRigid(camera.world_from_camera));
+  EXPECT_NEAR(camera.fx_px, 400 / std::tan(M_PI / 6), 1e-9);
+  Eigen::Vector2d pixel, above;
+  ASSERT_TRUE(ProjectWorldPoint(camera, {0, 10, 1}, &pixel));
+  EXPECT_NEAR(pixel.x(), 400, 1e-9);
+  EXPECT_NEAR(pixel.y(), 300, 1e-9);
+  ASSERT_TRUE(ProjectWorldPoint(camera, {0, 10, 3}, &above));
+  EXPECT_LT(above.y(), pixel.y());  // higher in the world = higher in the image
+}
+
 TEST(Camera, JsonRoundTripIsExact) {
   const PinholeCamera camera = TestCamera();
   const PinholeCamera back = ParseCameraJson(CameraToJson(camera), "cam.json");
