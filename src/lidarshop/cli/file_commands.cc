@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
@@ -108,13 +109,22 @@ int RunInfo(int argc, char** argv) {
   app.add_option("file", path, "scan file")->required();
   app.add_flag("--compact", compact, "print the JSON on one line");
   return RunCommand(app, argc, argv, [&] {
-    const ScanFile file = ReadScanFile(path);
+    ScanFile file;
+    std::vector<E57Image> images;
+    if (FileExtension(path) == "e57") {  // read once, keeping the photos
+      E57File e57 = ReadE57(path);
+      file = {path, "e57", std::move(e57.scans)};
+      images = std::move(e57.images);
+    } else {
+      file = ReadScanFile(path);
+    }
     nlohmann::json json;
     json["file"] = path;
     json["format"] = file.format;
     json["scans"] = nlohmann::json::array();
     for (size_t i = 0; i < file.scans.size(); ++i)
       json["scans"].push_back(ScanJson(file.scans[i], static_cast<int>(i)));
+    if (file.format == "e57") json["images"] = ImagesJson(images);
     fmt::print("{}\n", json.dump(compact ? -1 : 2));
     return 0;
   });

@@ -29,6 +29,11 @@ const std::vector<Command>& Commands() {
       {"segment", lidarshop::cli::RunSegment, "cut an object out of a scan from two strokes"},
       {"inpaint", lidarshop::cli::RunInpaint, "patch-based image inpainting"},
       {"poisson", lidarshop::cli::RunPoisson, "Poisson image editing: fill, clone, reconstruct"},
+      {"resection", lidarshop::cli::RunResection, "the camera of a photo from pixel <-> point pairs"},
+      {"recolor", lidarshop::cli::RunRecolor, "recolour a scan from a photo (occlusion-aware)"},
+      {"images", lidarshop::cli::RunImages, "list or extract the photos of an E57 file"},
+      {"align", lidarshop::cli::RunAlign, "landmark transform, homography or fundamental matrix"},
+      {"photo", lidarshop::cli::RunPhoto, "render a synthetic photo of a scene"},
   };
   return commands;
 }
