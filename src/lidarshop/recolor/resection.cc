@@ -33,6 +33,8 @@ void ResectionOptions::Check() const {
   CheckOption(min_inliers_for_distortion >= 6,
               fmt::format("ResectionOptions.min_inliers_for_distortion must be >= 6, got {}",
                           min_inliers_for_distortion));
+  CheckOption(max_aspect_deviation > 0,
+              fmt::format("ResectionOptions.max_aspect_deviation must be > 0, got {}", max_aspect_deviation));
   CheckOption(degenerate_ratio > 0 && degenerate_ratio < 1,
               fmt::format("ResectionOptions.degenerate_ratio must be in (0, 1), got {}", degenerate_ratio));
 }
@@ -325,12 +327,21 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
     result.ransac_iterations = iteration + 1;
     const Eigen::Vector3d spread = Spread<3>(sample_points);
     if (spread[2] <= options.degenerate_ratio * spread[0]) continue;  // a planar set: no camera
-    const Matrix34d p = NormalizedDlt(sample);
+    Matrix34d p = NormalizedDlt(sample);
+    if (p.leftCols<3>().determinant() < 0) p = -p;  // then (P X)_z > 0 in front of the camera
+    if (options.square_pixels) {
+      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one.
+      const Eigen::Matrix3d k = DecomposeProjection(p).K;
+      if (std::abs(k(0, 0) / k(1, 1) - 1) > options.max_aspect_deviation ||
+          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0))
+        continue;
+    }
     std::vector<uint8_t> inliers(n, 0);
     int count = 0;
     double score = 0;
     for (int i = 0; i < n; ++i) {
-      const double e = ProjectionError(p, pairs[i]);
+      const bool in_front = (p.row(2) * pairs[i].point_in_world.homogeneous()) > 0;
+      const double e = in_front ? ProjectionError(p, pairs[i]) : std::numeric_limits<double>::infinity();
       inliers[i] = e * e < t2;
       count += inliers[i];
       score += std::min(e * e, t2);  // MSAC: ties in count go to the tighter fit

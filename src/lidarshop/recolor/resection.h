@@ -47,7 +47,11 @@ struct ResectionOptions {
   uint64_t seed = 1;                  // RANSAC's random sets
   bool refine = true;                 // false = the (RANSAC) DLT camera without Levenberg–Marquardt
   bool square_pixels = true;          // refine one focal length (fx = fy)
-  bool refine_skew = false;           // false = skew 0
+  // With square_pixels, RANSAC skips minimal-set cameras with |fx / fy − 1| or |skew| / fx above this (a set
+  // of 6 pairs fits almost any camera; an implausible one comes from outliers). Inliers must also lie in
+  // front of the camera.
+  double max_aspect_deviation = 0.2;
+  bool refine_skew = false;  // false = skew 0
   // How many of k1, k2, k3 are refined (0–3). One by default: with 16-30 noisy pairs k2 fits the noise
   // (a synthetic test reached 3 px error away from the pairs with k1, k2 free).
   int radial_coefficients = 1;

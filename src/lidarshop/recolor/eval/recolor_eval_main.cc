@@ -136,14 +136,17 @@ int main(int argc, char** argv) {
       }
     }
     // Visibility with the true camera: the z-buffer with its margin, without, and the literal segment test.
-    for (int variant = 0; variant < 3; ++variant) {
+    for (int variant = 0; variant < 5; ++variant) {
       RecolorOptions options;
       if (variant == 1) options.silhouette_margin_px = 0;
       if (variant == 2) options.visibility = VisibilityMethod::kSegment;
+      if (variant == 3) options.silhouette_margin_px = 3;
+      if (variant == 4) options.silhouette_margin_px = 4;
       const RecolorResult result = RecolorScan(s.input, s.photo.image, s.camera, options);
       const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input, result.scan, s.camera);
       const char* names[] = {"true camera, z-buffer + 2 px margin (default)",
-                             "true camera, z-buffer, no margin", "true camera, literal segment test"};
+                             "true camera, z-buffer, no margin", "true camera, literal segment test",
+                             "true camera, z-buffer + 3 px margin", "true camera, z-buffer + 4 px margin"};
       fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, names[variant],
                  score.visible_correct_percent(), score.hidden_changed_percent(), score.hidden_changed,
                  score.hidden);
