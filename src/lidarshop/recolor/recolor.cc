@@ -51,13 +51,18 @@ cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px) {
 
 namespace {
 
-// Distance from the camera centre to the first surface of `scene` through each z-buffer pixel (+inf: none).
-cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, double scale) {
+// Distance from the camera centre to the first surface of `scene` through each z-buffer pixel (+inf: none);
+// `back_facing` (CV_8U) marks pixels whose first surface turns its back to the camera (the scan mesh faces
+// the scanner: the camera then sees the side of that surface the scanner did not see).
+cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, double scale,
+                       cv::Mat* back_facing) {
   const int rows = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
   const int cols = std::max(1, static_cast<int>(std::lround(camera.width_px * scale)));
   const double sy = static_cast<double>(camera.height_px) / rows,
                sx = static_cast<double>(camera.width_px) / cols;
   cv::Mat distance(rows, cols, CV_32F);
+  back_facing->create(rows, cols, CV_8U);
+  const Eigen::Matrix3f rotation = camera.world_from_camera.topLeftCorner<3, 3>().cast<float>();
   constexpr int kStrip = 128;  // rows per cast: bounded memory for 3072 x 2304 photos
   RayHitImages hits;
   for (int row0 = 0; row0 < rows; row0 += kStrip) {
@@ -75,6 +80,9 @@ cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, d
       for (int c = 0; c < cols; ++c) {
         const cv::Vec3f d = directions.at<cv::Vec3f>(r, c);
         distance.at<float>(row0 + r, c) = hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
+        const cv::Vec3f n = hits.normal.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
+        back_facing->at<uint8_t>(row0 + r, c) = w.dot(Eigen::Vector3f(n[0], n[1], n[2])) > 0 ? 255 : 0;
       }
     }
   }
@@ -170,7 +178,8 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     }
     raycast.Occluded(rays, hidden);
   } else {
-    const cv::Mat distance_buffer = DistanceBuffer(raycast, camera, options.zbuffer_scale);
+    cv::Mat back_facing;
+    const cv::Mat distance_buffer = DistanceBuffer(raycast, camera, options.zbuffer_scale, &back_facing);
     cv::Mat nearest = distance_buffer;
     const int m = options.silhouette_margin_px;
     if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
@@ -184,7 +193,7 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
           const int zc = std::min(static_cast<int>(candidate.pixel.x() * sx), distance_buffer.cols - 1);
           const double distance = (candidate.point_in_world - center).norm();
           const double allowed = tolerance(distance) + m * Slope(distance_buffer, zr, zc);
-          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed;
+          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
         },
         1024);
   }

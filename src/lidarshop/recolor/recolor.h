@@ -20,6 +20,9 @@
 //   - the window's own depth slope: on surfaces seen at a grazing angle the window minimum is nearer than the
 //     point by (margin · slope); that much is added to the tolerance, with the slope taken one-sided (the
 //     smaller of the forward and backward differences), so that a depth jump does not count as slope.
+// A point is also hidden when the first surface at its pixel turns its back to the camera: the scan mesh
+// faces the scanner, so the camera then sees the side of that surface the scanner never saw (a camera facing
+// the scanner across an object sees the object's other side, whose colour is not the scanned side's).
 // `VisibilityMethod::kSegment` instead casts the exact segment of every point (Embree occlusion rays, no
 // margin): the literal thesis test, kept as the reference of the evaluation.
 #pragma once
