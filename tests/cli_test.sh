@@ -229,6 +229,10 @@ check "images of pumpA" sh -c "'$lidarshop' images '$shared/e57/pumpA.e57' --ext
   >'$work/images.json'"
 json_check "pumpA holds its 3072 x 2304 photo" "$work/images.json" \
   "d['images'][0]['width_px'] == 3072 and d['images'][0]['representation'] == 'visual'"
+check "convert E57 to E57 keeps the photo" "$lidarshop" convert "$shared/e57/pumpA.e57" "$work/pumpA_copy.e57" --quiet
+check "images of the copy" sh -c "'$lidarshop' images '$work/pumpA_copy.e57' >'$work/images_copy.json'"
+json_check "the copy holds the photo" "$work/images_copy.json" \
+  "len(d['images']) == 1 and d['images'][0]['decoded'] and d['images'][0]['width_px'] == 3072"
 check "info lists E57 images" sh -c "'$lidarshop' info '$shared/e57/tiny_pc_and_images.e57' >'$work/info_images.json'"
 json_check "four images, two decoded" "$work/info_images.json" \
   "len(d['images']) == 4 and sum(i['decoded'] for i in d['images']) == 2"

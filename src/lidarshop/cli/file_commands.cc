@@ -143,11 +143,24 @@ int RunConvert(int argc, char** argv) {
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
     const auto progress = Progress::ForTerminal("convert", 2, quiet);
-    const ScanFile file = ReadScanFile(input);
+    ScanFile file;
+    std::vector<E57Image> images;  // E57 -> E57 keeps the photos
+    const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
+    if (e57_to_e57) {
+      E57File e57 = ReadE57(input);
+      file = {input, "e57", std::move(e57.scans)};
+      images = std::move(e57.images);
+    } else {
+      file = ReadScanFile(input);
+    }
     progress->Advance();
     std::vector<Scan> scans = file.scans;
     if (scan_index >= 0) scans = {file.scans[SelectScan(file, scan_index)]};
-    WriteScanFile(output, scans);
+    if (e57_to_e57) {
+      WriteE57(output, scans, images, E57WriteOptions{});
+    } else {
+      WriteScanFile(output, scans);
+    }
     progress->Advance();
     progress->Finish();
     return 0;
