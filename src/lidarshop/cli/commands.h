@@ -4,23 +4,36 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/io/e57.h"
 
 namespace lidarshop::cli {
 
-int RunScan(int argc, char** argv);     // scan_command.cc
-int RunInfo(int argc, char** argv);     // file_commands.cc
-int RunConvert(int argc, char** argv);  // file_commands.cc
-int RunRender(int argc, char** argv);   // file_commands.cc
-int RunDemo(int argc, char** argv);     // demo_command.cc
-int RunVerify(int argc, char** argv);   // verify_commands.cc
-int RunSweep(int argc, char** argv);    // verify_commands.cc
-int RunSegment(int argc, char** argv);  // segment_command.cc
-int RunInpaint(int argc, char** argv);  // inpaint_command.cc
-int RunPoisson(int argc, char** argv);  // poisson_command.cc
-int RunFill(int argc, char** argv);     // fill_command.cc
-int RunRemove(int argc, char** argv);   // fill_command.cc
+int RunScan(int argc, char** argv);       // scan_command.cc
+int RunInfo(int argc, char** argv);       // file_commands.cc
+int RunConvert(int argc, char** argv);    // file_commands.cc
+int RunRender(int argc, char** argv);     // file_commands.cc
+int RunDemo(int argc, char** argv);       // demo_command.cc
+int RunVerify(int argc, char** argv);     // verify_commands.cc
+int RunSweep(int argc, char** argv);      // verify_commands.cc
+int RunSegment(int argc, char** argv);    // segment_command.cc
+int RunInpaint(int argc, char** argv);    // inpaint_command.cc
+int RunPoisson(int argc, char** argv);    // poisson_command.cc
+int RunFill(int argc, char** argv);       // fill_command.cc
+int RunRemove(int argc, char** argv);     // fill_command.cc
+int RunResection(int argc, char** argv);  // recolor_commands.cc
+int RunRecolor(int argc, char** argv);    // recolor_commands.cc
+int RunImages(int argc, char** argv);     // recolor_commands.cc
+int RunAlign(int argc, char** argv);      // recolor_commands.cc
+int RunPhoto(int argc, char** argv);      // recolor_commands.cc
+
+// The images2D entries of an E57 file as JSON (name, size, representation, pose, intrinsics); `images` and
+// `info` print it. recolor_commands.cc.
+nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
 
 // Parses argv with `app` and runs `body`, turning every exception into one line on stderr
 // ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
@@ -109,13 +110,22 @@ int RunInfo(int argc, char** argv) {
   app.add_option("file", path, "scan file")->required();
   app.add_flag("--compact", compact, "print the JSON on one line");
   return RunCommand(app, argc, argv, [&] {
-    const ScanFile file = ReadScanFile(path);
+    ScanFile file;
+    std::vector<E57Image> images;
+    if (FileExtension(path) == "e57") {  // read once, keeping the photos
+      E57File e57 = ReadE57(path);
+      file = {path, "e57", std::move(e57.scans)};
+      images = std::move(e57.images);
+    } else {
+      file = ReadScanFile(path);
+    }
     nlohmann::json json;
     json["file"] = path;
     json["format"] = file.format;
     json["scans"] = nlohmann::json::array();
     for (size_t i = 0; i < file.scans.size(); ++i)
       json["scans"].push_back(ScanJson(file.scans[i], static_cast<int>(i)));
+    if (file.format == "e57") json["images"] = ImagesJson(images);
     fmt::print("{}\n", json.dump(compact ? -1 : 2));
     return 0;
   });
@@ -134,11 +144,24 @@ int RunConvert(int argc, char** argv) {
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
     const auto progress = Progress::ForTerminal("convert", 2, quiet);
-    const ScanFile file = ReadScanFile(input);
+    ScanFile file;
+    std::vector<E57Image> images;  // E57 -> E57 keeps the photos
+    const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
+    if (e57_to_e57) {
+      E57File e57 = ReadE57(input);
+      file = {input, "e57", std::move(e57.scans)};
+      images = std::move(e57.images);
+    } else {
+      file = ReadScanFile(input);
+    }
     progress->Advance();
     std::vector<Scan> scans = file.scans;
     if (scan_index >= 0) scans = {file.scans[SelectScan(file, scan_index)]};
-    WriteScanFile(output, scans);
+    if (e57_to_e57) {
+      WriteE57(output, scans, images, E57WriteOptions{});
+    } else {
+      WriteScanFile(output, scans);
+    }
     progress->Advance();
     progress->Finish();
     return 0;

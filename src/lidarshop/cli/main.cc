@@ -31,6 +31,11 @@ const std::vector<Command>& Commands() {
       {"poisson", lidarshop::cli::RunPoisson, "Poisson image editing: fill, clone, reconstruct"},
       {"fill", lidarshop::cli::RunFill, "fill a hole in a scan (gradient-domain inpainting + Poisson)"},
       {"remove", lidarshop::cli::RunRemove, "remove an object from a scan: cut it out and fill behind it"},
+      {"resection", lidarshop::cli::RunResection, "the camera of a photo from pixel <-> point pairs"},
+      {"recolor", lidarshop::cli::RunRecolor, "recolour a scan from a photo (occlusion-aware)"},
+      {"images", lidarshop::cli::RunImages, "list or extract the photos of an E57 file"},
+      {"align", lidarshop::cli::RunAlign, "landmark transform, homography or fundamental matrix"},
+      {"photo", lidarshop::cli::RunPhoto, "render a synthetic photo of a scene"},
   };
   return commands;
 }

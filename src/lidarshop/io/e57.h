@@ -24,6 +24,10 @@ struct E57Image {
   // Additions (E57 engineer):
   int width_px = 0, height_px = 0;  // imageWidth / imageHeight as the XML states them
   std::string decode_error;  // why `image` is empty when its blob does not decode (e.g. a zero-filled blob)
+  // Additions (recolouring, issue 14): the blob exactly as stored, so that E57 -> E57 keeps the photo
+  // bit-exact.
+  std::vector<uint8_t> encoded;
+  std::string encoding;  // "jpeg" or "png" (the blob's element: jpegImage / pngImage)
 };
 
 struct E57File {
@@ -82,5 +86,12 @@ void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& b
                        const E57WriteOptions& options = {});
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
                                         const E57WriteOptions& options = {});
+// Scans and photos (images2D): each image is written with its name, pose, representation and, for pinhole
+// ones, intrinsics; its blob is `encoded` as stored (encoding "jpeg" or "png"), or `image` encoded as PNG
+// when it has no stored bytes. Images with neither are skipped.
+std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector<E57Image>& images,
+                               const E57WriteOptions& options);
+void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,
+              const E57WriteOptions& options);
 
 }  // namespace lidarshop

@@ -684,6 +684,8 @@ void ReadImage(const Context& ctx, pugi::xml_node child, std::vector<E57Image>* 
     image.width_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageWidth"), 0, 0, 1 << 30));
     image.height_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageHeight"), 0, 0, 1 << 30));
     const auto [bytes, size] = BlobBytes(ctx, blob);
+    image.encoded.assign(bytes, bytes + size);
+    image.encoding = std::string(blob.name()) == "jpegImage" ? "jpeg" : "png";
     cv::Mat decoded;
     try {
       decoded = cv::imdecode(

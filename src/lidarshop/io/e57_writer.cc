@@ -1,10 +1,13 @@
 // E57 writer: one compressed-vector section per scan, then the XML section, then pages with CRC-32C.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <sstream>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <pugixml.hpp>
 
 #include "lidarshop/geometry/transform.h"
@@ -294,6 +297,69 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   return write_synthesized;
 }
 
+void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform) {
+  Eigen::Quaterniond q(Eigen::Matrix3d(transform.topLeftCorner<3, 3>()));
+  q.normalize();
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  pugi::xml_node pose = AddTyped(parent, "pose", "Structure");
+  pugi::xml_node r = AddTyped(pose, "rotation", "Structure");
+  AddFloat(r, "w", q.w());
+  AddFloat(r, "x", q.x());
+  AddFloat(r, "y", q.y());
+  AddFloat(r, "z", q.z());
+  pugi::xml_node t = AddTyped(pose, "translation", "Structure");
+  AddFloat(t, "x", transform(0, 3));
+  AddFloat(t, "y", transform(1, 3));
+  AddFloat(t, "z", transform(2, 3));
+}
+
+// Appends one images2D entry: a blob section with the photo's bytes and its XML element.
+void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical, pugi::xml_node images2d) {
+  std::vector<uint8_t> bytes = image.encoded;
+  std::string encoding = image.encoding;
+  if (bytes.empty()) {
+    if (image.image.empty()) return;
+    cv::Mat bgr;
+    cv::cvtColor(image.image, bgr, cv::COLOR_RGB2BGR);
+    cv::imencode(".png", bgr, bytes);
+    encoding = "png";
+  }
+  while (logical->size() % 8) logical->push_back(0);
+  const uint64_t start = logical->size();
+  logical->resize(start + 16, 0);  // sectionId 0 (blob), reserved, sectionLogicalLength
+  const uint64_t section_length = 16 + bytes.size();
+  std::memcpy(logical->data() + start + 8, &section_length, 8);
+  logical->insert(logical->end(), bytes.begin(), bytes.end());
+
+  static const std::pair<const char*, const char*> kRepresentations[] = {
+      {"pinhole", "pinholeRepresentation"},
+      {"spherical", "sphericalRepresentation"},
+      {"cylindrical", "cylindricalRepresentation"},
+      {"visual", "visualReferenceRepresentation"}};
+  const char* element = "visualReferenceRepresentation";
+  for (const auto& [projection, name] : kRepresentations) {
+    if (image.projection == projection) element = name;
+  }
+  pugi::xml_node child = AddTyped(images2d, "vectorChild", "Structure");
+  AddString(child, "guid",
+            fmt::format("{{lidarshop-image-{:04d}-{:08x}}}", index, Crc32c(bytes.data(), bytes.size())));
+  AddString(child, "name", image.name.empty() ? fmt::format("image{:03d}", index) : image.name);
+  AddPose(child, image.world_from_camera);
+  pugi::xml_node rep = AddTyped(child, element, "Structure");
+  pugi::xml_node blob = AddTyped(rep, encoding == "jpeg" ? "jpegImage" : "pngImage", "Blob");
+  blob.append_attribute("fileOffset") = std::to_string(PhysicalFromLogical(start)).c_str();
+  blob.append_attribute("length") = std::to_string(bytes.size()).c_str();
+  AddInteger(rep, "imageWidth", image.width_px ? image.width_px : image.image.cols);
+  AddInteger(rep, "imageHeight", image.height_px ? image.height_px : image.image.rows);
+  if (image.projection == "pinhole") {
+    AddFloat(rep, "focalLength", image.focal_length_m);
+    AddFloat(rep, "pixelWidth", image.pixel_width_m);
+    AddFloat(rep, "pixelHeight", image.pixel_height_m);
+    AddFloat(rep, "principalPointX", image.principal_x_px);
+    AddFloat(rep, "principalPointY", image.principal_y_px);
+  }
+}
+
 }  // namespace
 }  // namespace e57
 
@@ -306,9 +372,9 @@ void E57WriteOptions::Check() const {
 namespace e57 {
 namespace {
 
-// The file of `scans`; `behind_first` (may be null) is a second layer of scans[0].
+// The file of `scans` and `image_list`; `behind_first` (may be null) is a second layer of scans[0].
 std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_first,
-                            const E57WriteOptions& options) {
+                            const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
   options.Check();
   std::vector<uint8_t> logical(kHeaderSize, 0);
   pugi::xml_document doc;
@@ -332,6 +398,8 @@ std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_f
   if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
   pugi::xml_node images = AddTyped(root, "images2D", "Vector");
   images.append_attribute("allowHeterogeneousChildren") = "1";
+  for (size_t i = 0; i < image_list.size(); ++i)
+    AppendImage(image_list[i], static_cast<int>(i), &logical, images);
   // The file guid: a checksum of the binary sections, so that the same scans give the same bytes.
   pugi::xml_node guid = AddTyped(root, "guid", "String");
   guid.append_child(pugi::node_cdata)
@@ -364,12 +432,17 @@ void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
 }  // namespace e57
 
 std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options) {
-  return e57::Encode(scans, nullptr, options);
+  return e57::Encode(scans, nullptr, {}, options);
+}
+
+std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector<E57Image>& images,
+                               const E57WriteOptions& options) {
+  return e57::Encode(scans, nullptr, images, options);
 }
 
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
                                         const E57WriteOptions& options) {
-  return e57::Encode({front}, &behind, options);
+  return e57::Encode({front}, &behind, {}, options);
 }
 
 void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
@@ -382,5 +455,10 @@ void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57
 }
 
 void WriteE57(const std::string& path, const std::vector<Scan>& scans) { WriteE57(path, scans, {}); }
+
+void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,
+              const E57WriteOptions& options) {
+  e57::WriteBytes(path, EncodeE57(scans, images, options));
+}
 
 }  // namespace lidarshop

@@ -183,15 +183,8 @@ SyntheticScanner::SyntheticScanner(const SceneDescription& scene, const RaycastS
     : impl_(std::make_unique<Impl>(raycast_options)) {
   Timer timer;
   impl_->objects.resize(scene.objects.size());
-  ParallelFor(static_cast<int64_t>(scene.objects.size()), [&](int64_t i) {
-    const SceneObject& object = scene.objects[i];
-    ObjectData& data = impl_->objects[i];
-    data.mesh_in_world = MeshInWorld(object);
-    data.material = object.material;
-    data.label = object.label;
-    data.has_texture_image = !object.mesh.texture.empty() && !object.mesh.triangle_texcoords.empty();
-    data.Prepare(object.world_from_object);
-  });
+  ParallelFor(static_cast<int64_t>(scene.objects.size()),
+              [&](int64_t i) { impl_->objects[i] = scanner_internal::MakeObjectData(scene.objects[i]); });
   for (size_t i = 0; i < impl_->objects.size(); ++i) {
     impl_->raycast.AddMesh(impl_->objects[i].mesh_in_world, static_cast<int32_t>(i));
     impl_->num_triangles += static_cast<int64_t>(impl_->objects[i].mesh_in_world.triangles.size());

@@ -158,36 +158,6 @@ LIDARSHOP_LANES_INLINE void PrepareBandBody(const ShadeSetup& setup, int row0, i
   }
 }
 
-// The base colour (packed) and, on curved triangles, the interpolated vertex normal (any length) of a return
-// on an object with per-cell data; the normal is left alone elsewhere.
-uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v, Eigen::Vector3f* normal) {
-  const TriangleMesh& mesh = object.mesh_in_world;
-  const float w = 1.0f - u - v;
-  if (!object.smooth.empty() && object.smooth[triangle]) {
-    const Eigen::Vector3i& corners = mesh.triangles[triangle];
-    const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] + u * mesh.vertex_normals[corners[1]] +
-                                   v * mesh.vertex_normals[corners[2]];
-    if (smooth.squaredNorm() > 1e-12f) *normal = smooth;  // else keep the geometric normal
-  }
-  Rgb8 surface = object.material.color;
-  if (!mesh.triangle_colors.empty()) {
-    surface = mesh.triangle_colors[triangle];
-  } else if (!mesh.vertex_colors.empty()) {
-    const Eigen::Vector3i& corners = mesh.triangles[triangle];
-    const Eigen::Vector3f mixed = w * mesh.vertex_colors[corners[0]].cast<float>() +
-                                  u * mesh.vertex_colors[corners[1]].cast<float>() +
-                                  v * mesh.vertex_colors[corners[2]].cast<float>();
-    surface = (mixed.array() + 0.5f).cast<uint8_t>();
-  }
-  if (object.has_texture_image && object.material.texture == TextureKind::kNone) {
-    const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
-    const Eigen::Vector2f st =
-        w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
-    surface = SampleImageTexture(mesh.texture, st.x(), st.y());
-  }
-  return PackRgb(surface);
-}
-
 // The noise of one image row, into the band's noise arrays: e_los, and e_orth · (cos ψ, sin ψ) along (b1,
 // b2). (A loop of its own: short enough for the CPU to overlap the hash -> table chains of
 // several steps, which the long shading loop cannot.)
@@ -414,6 +384,44 @@ int64_t ShadeBandBaseline(const ShadeSetup& setup, Band& band, Scan& scan) {
 bool UseAvx2(SimdPath path) { return path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2; }
 
 }  // namespace
+
+uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v, Eigen::Vector3f* normal) {
+  const TriangleMesh& mesh = object.mesh_in_world;
+  const float w = 1.0f - u - v;
+  if (!object.smooth.empty() && object.smooth[triangle]) {
+    const Eigen::Vector3i& corners = mesh.triangles[triangle];
+    const Eigen::Vector3f smooth = w * mesh.vertex_normals[corners[0]] + u * mesh.vertex_normals[corners[1]] +
+                                   v * mesh.vertex_normals[corners[2]];
+    if (smooth.squaredNorm() > 1e-12f) *normal = smooth;  // else keep the geometric normal
+  }
+  Rgb8 surface = object.material.color;
+  if (!mesh.triangle_colors.empty()) {
+    surface = mesh.triangle_colors[triangle];
+  } else if (!mesh.vertex_colors.empty()) {
+    const Eigen::Vector3i& corners = mesh.triangles[triangle];
+    const Eigen::Vector3f mixed = w * mesh.vertex_colors[corners[0]].cast<float>() +
+                                  u * mesh.vertex_colors[corners[1]].cast<float>() +
+                                  v * mesh.vertex_colors[corners[2]].cast<float>();
+    surface = (mixed.array() + 0.5f).cast<uint8_t>();
+  }
+  if (object.has_texture_image && object.material.texture == TextureKind::kNone) {
+    const Eigen::Vector3i& tc = mesh.triangle_texcoords[triangle];
+    const Eigen::Vector2f st =
+        w * mesh.texcoords[tc[0]] + u * mesh.texcoords[tc[1]] + v * mesh.texcoords[tc[2]];
+    surface = SampleImageTexture(mesh.texture, st.x(), st.y());
+  }
+  return PackRgb(surface);
+}
+
+ObjectData MakeObjectData(const SceneObject& object) {
+  ObjectData data;
+  data.mesh_in_world = MeshInWorld(object);
+  data.material = object.material;
+  data.label = object.label;
+  data.has_texture_image = !object.mesh.texture.empty() && !object.mesh.triangle_texcoords.empty();
+  data.Prepare(object.world_from_object);
+  return data;
+}
 
 void ObjectData::Prepare(const Eigen::Matrix4d& world_from_object) {
   const Eigen::Matrix3d linear = world_from_object.topLeftCorner<3, 3>();

@@ -43,6 +43,15 @@ struct ObjectData {
   void Prepare(const Eigen::Matrix4d& world_from_object);
 };
 
+// The ObjectData of a scene object (mesh in the world, material, label, prepared).
+ObjectData MakeObjectData(const SceneObject& object);
+
+// The base colour (packed, scanner/texture.h: PackRgb) of a hit at barycentric (u, v) of `triangle` —
+// triangle or vertex colours, image texture, else the material colour; procedural textures come on top of it
+// — and, on curved triangles, the interpolated vertex normal (any length); the normal is left alone
+// elsewhere. The scanner (per-cell objects) and the synthetic photo (scanner/photo.h) share it.
+uint32_t PerCellSurface(const ObjectData& object, int triangle, float u, float v, Eigen::Vector3f* normal);
+
 // What shading needs of one scan, set up once per Acquire.
 struct ShadeSetup {
   const ObjectData* objects = nullptr;  // indexed by geometry id

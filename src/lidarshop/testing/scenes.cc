@@ -43,6 +43,37 @@ SceneDescription MakeGroundAndBoxScene(const GroundAndBoxOptions& options) {
   return scene;
 }
 
+SceneDescription MakeRecolorScene(bool textured, int rows, int columns) {
+  SceneDescription scene;
+  scene.scanner.position = Eigen::Vector3d(0, 0, 1.5);
+  scene.scanner.azimuth_min_deg = -40;
+  scene.scanner.azimuth_max_deg = 40;
+  scene.scanner.elevation_min_deg = -35;
+  scene.scanner.elevation_max_deg = 25;
+  scene.scanner.rows = rows;
+  scene.scanner.columns = columns;
+  const auto add = [&](const std::string& name, const TriangleMesh& mesh, const Eigen::Vector3d& center,
+                       int32_t label, Rgb8 color, TextureKind texture) {
+    SceneObject object;
+    object.name = name;
+    object.mesh = mesh;
+    object.world_from_object.topRightCorner<3, 1>() = center;
+    object.label = label;
+    object.material.color = color;
+    object.material.texture = texture;
+    scene.objects.push_back(object);
+  };
+  add("ground", MakePlaneMesh(Eigen::Vector2d(60, 60)), Eigen::Vector3d(0, 0, 0), 0, Rgb8(90, 110, 70),
+      textured ? TextureKind::kGrass : TextureKind::kNone);
+  add("wall", MakeBoxMesh(Eigen::Vector3d(24, 0.4, 6)), Eigen::Vector3d(0, 12.2, 3), 1, Rgb8(200, 190, 160),
+      textured ? TextureKind::kBrick : TextureKind::kNone);
+  add("box", MakeBoxMesh(Eigen::Vector3d(1.2, 1.2, 1.2)), Eigen::Vector3d(-0.8, 6, 0.6), 2, Rgb8(200, 50, 40),
+      TextureKind::kNone);
+  add("pillar", MakeBoxMesh(Eigen::Vector3d(0.5, 0.5, 2.5)), Eigen::Vector3d(1.6, 8, 1.25), 3,
+      Rgb8(40, 70, 190), TextureKind::kNone);
+  return scene;
+}
+
 SceneDescription MakeSingleObjectScene(const TriangleMesh& mesh_in_world, int32_t label,
                                        const ScannerOptions& scanner, Rgb8 color) {
   SceneDescription scene;

@@ -35,6 +35,13 @@ struct GroundAndBoxOptions {
 // (0, 0, scanner_height) looking along +y.
 SceneDescription MakeGroundAndBoxScene(const GroundAndBoxOptions& options = {});
 
+// The recolouring scene (recolor/): a uniformly coloured ground (label 0, RGB 90 110 70), a wall 12 m ahead
+// (label 1, 200 190 160), a red box (label 2, 200 50 40) and a blue pillar (label 3, 40 70 190) in front of
+// it, which hide parts of the wall and ground from a camera beside the scanner; `textured` gives the ground
+// grass and the wall bricks instead. Scanner at (0, 0, 1.5) looking along +y, `rows` x `columns` cells over
+// azimuth ±40° and elevation -35°..25°.
+SceneDescription MakeRecolorScene(bool textured = false, int rows = 300, int columns = 450);
+
 // One object (label `label`) in an otherwise empty world, seen by `scanner`.
 SceneDescription MakeSingleObjectScene(const TriangleMesh& mesh_in_world, int32_t label,
                                        const ScannerOptions& scanner, Rgb8 color = Rgb8(200, 60, 50));

@@ -1,0 +1,355 @@
+// lidarshop resection | recolor | images | align | photo: photos and scans (recolor/, docs/recolor.md).
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/cli/commands.h"
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/recolor/align.h"
+#include "lidarshop/recolor/correspondences.h"
+#include "lidarshop/recolor/e57_camera.h"
+#include "lidarshop/recolor/recolor.h"
+#include "lidarshop/recolor/resection.h"
+#include "lidarshop/scanner/photo.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop::cli {
+namespace {
+
+nlohmann::ordered_json Matrix4Json(const Eigen::Matrix4d& m) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
+  return rows;
+}
+
+// Refuses to write onto an input (inputs are never modified).
+void CheckNotInput(const std::string& output, const std::vector<std::string>& inputs) {
+  for (const std::string& input : inputs) {
+    std::error_code error;
+    if (!input.empty() && std::filesystem::equivalent(output, input, error))
+      throw OptionsError(
+          fmt::format("the output {} is an input: lidarshop never writes onto its inputs", output));
+  }
+}
+
+Scan ReadOneScan(const std::string& path, int index) {
+  const ScanFile file = ReadScanFile(path);
+  if (index < 0 || index >= static_cast<int>(file.scans.size()))
+    throw OptionsError(
+        fmt::format("--scan-index {} is out of range: {} holds {} scan(s)", index, path, file.scans.size()));
+  return file.scans[index];
+}
+
+// The entry of `images` named `key` or numbered `key`.
+const E57Image& FindImage(const std::vector<E57Image>& images, const std::string& key,
+                          const std::string& path) {
+  for (const E57Image& image : images) {
+    if (image.name == key) return image;
+  }
+  try {
+    const size_t index = std::stoul(key);
+    if (index < images.size()) return images[index];
+  } catch (const std::exception&) {
+  }
+  throw OptionsError(fmt::format("{} has no image '{}' ({} image(s); `lidarshop images {}` lists them)", path,
+                                 key, images.size(), path));
+}
+
+ResectionResult RunResection(const Correspondences& pairs, const ResectionOptions& options,
+                             const std::string& intrinsics_path, const std::string& what) {
+  if (pairs.kind != PairKind::kPixelPoint)
+    ThrowInputError(what, "", "pairs", "resection needs pixel/point (or pixel/cell) pairs");
+  if (intrinsics_path.empty()) return Resection(pairs.pixel_point, options, what);
+  return ResectWithIntrinsics(pairs.pixel_point, ReadCameraJson(intrinsics_path), options, what);
+}
+
+nlohmann::ordered_json ResectionJson(const ResectionResult& result) {
+  nlohmann::ordered_json json;
+  json["inliers"] = result.num_inliers;
+  json["pairs"] = result.inlier.size();
+  json["rms_px"] = result.rms_px;
+  json["dlt_rms_px"] = result.dlt_rms_px;
+  json["ransac_sets"] = result.ransac_iterations;
+  json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
+  json["principal_point_px"] = {result.camera.cx_px, result.camera.cy_px};
+  json["k1"] = result.camera.k1;
+  json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
+                           result.camera.center_in_world().z()};
+  nlohmann::ordered_json per_pair = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < result.inlier.size(); ++i)
+    per_pair.push_back({{"error_px", result.reprojection_error_px[i]}, {"inlier", result.inlier[i] != 0}});
+  json["per_pair"] = per_pair;
+  return json;
+}
+
+void AddResectionOptions(CLI::App& app, ResectionOptions* options, std::string* intrinsics_path) {
+  app.add_option("--threshold", options->ransac_threshold_px, "RANSAC inlier threshold, pixels")
+      ->capture_default_str();
+  app.add_option("--iterations", options->ransac_iterations, "most RANSAC sets")->capture_default_str();
+  app.add_option("--seed", options->seed, "RANSAC seed")->capture_default_str();
+  app.add_option("--radial", options->radial_coefficients, "radial distortion terms refined (0-3)")
+      ->capture_default_str();
+  app.add_flag("!--no-refine", options->refine, "keep the DLT camera (no Levenberg-Marquardt)");
+  app.add_option("--intrinsics", *intrinsics_path,
+                 "camera JSON whose intrinsics are known: only the pose is estimated (planar targets too)");
+}
+
+}  // namespace
+
+nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < images.size(); ++i) {
+    const E57Image& image = images[i];
+    nlohmann::ordered_json json;
+    json["index"] = i;
+    json["name"] = image.name;
+    json["representation"] = image.projection;
+    json["width_px"] = image.width_px ? image.width_px : image.image.cols;
+    json["height_px"] = image.height_px ? image.height_px : image.image.rows;
+    json["decoded"] = !image.image.empty();
+    if (!image.decode_error.empty()) json["decode_error"] = image.decode_error;
+    json["world_from_camera"] = Matrix4Json(image.world_from_camera);
+    if (image.focal_length_m > 0) {
+      json["intrinsics"] = {{"focal_length_m", image.focal_length_m},
+                            {"pixel_width_m", image.pixel_width_m},
+                            {"pixel_height_m", image.pixel_height_m},
+                            {"principal_point_px", {image.principal_x_px, image.principal_y_px}}};
+    }
+    PinholeCamera camera;
+    std::string why;
+    json["recolor_ready"] = CameraFromE57Image(image, &camera, &why);
+    list.push_back(json);
+  }
+  return list;
+}
+
+int RunResection(int argc, char** argv) {
+  CLI::App app{
+      "Resection: the camera of a photo from pixel <-> point correspondences (normalized DLT, RANSAC, "
+      "Levenberg-Marquardt with distortion; docs/recolor.md). Prints the per-pair errors as JSON.",
+      "resection"};
+  std::string pairs_path, output, scan_path, photo_path, intrinsics_path;
+  std::vector<int> size;
+  int scan_index = 0;
+  ResectionOptions options;
+  app.add_option("--correspondences", pairs_path,
+                 "C.json: {\"pairs\": [{\"pixel\": [u, v], \"point\": [x, y, z]}]}")
+      ->required();
+  app.add_option("-o,--output", output, "camera JSON to write")->required();
+  app.add_option("--scan", scan_path, "the scan whose cells \"cell\": [row, col] refer to");
+  app.add_option("--scan-index", scan_index, "which scan of --scan (from 0)");
+  app.add_option("--photo", photo_path, "the photo (its size goes into the camera)");
+  app.add_option("--size", size, "the photo's size: WIDTH HEIGHT (instead of --photo)")->expected(2);
+  AddResectionOptions(app, &options, &intrinsics_path);
+  return RunCommand(app, argc, argv, [&] {
+    CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
+    Scan scan;
+    if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
+    const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
+    options.width_px = pairs.width_px, options.height_px = pairs.height_px;
+    if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
+    if (!photo_path.empty()) {
+      const cv::Mat photo = ReadImage(photo_path);
+      options.width_px = photo.cols, options.height_px = photo.rows;
+    }
+    if (options.width_px <= 0)
+      throw OptionsError("the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " +
+                         pairs_path);
+    const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
+    WriteCameraJson(output, result.camera);
+    fmt::print("{}\n", ResectionJson(result).dump(1));
+    return 0;
+  });
+}
+
+int RunRecolor(int argc, char** argv) {
+  CLI::App app{
+      "Recolour a scan from a photo: occlusion-aware projection (thesis 3.2.2.1, docs/recolor.md). Points "
+      "the camera does not see keep their colour.",
+      "recolor"};
+  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path,
+      visibility = "zbuffer";
+  int scan_index = 0;
+  RecolorOptions options;
+  ResectionOptions resection;
+  std::string intrinsics_path;
+  app.add_option("scan", scan_path, "scan file to recolour")->required();
+  app.add_option("--photo", photo_path, "the photo (.jpg, .png)");
+  app.add_option("--image", image_key,
+                 "an images2D entry of the E57 scan (name or index) instead of --photo");
+  app.add_option("--camera", camera_path, "camera JSON (lidarshop resection)");
+  app.add_option("--correspondences", pairs_path, "pixel <-> point or cell pairs: resection first");
+  app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
+  app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
+  app.add_option("--scan-index", scan_index, "which scan of the file (from 0)");
+  app.add_option("--visibility", visibility,
+                 "zbuffer (with a silhouette margin) | segment (literal thesis test)")
+      ->check(CLI::IsMember({"zbuffer", "segment"}))
+      ->capture_default_str();
+  app.add_option("--margin", options.silhouette_margin_px, "silhouette margin, z-buffer pixels")
+      ->capture_default_str();
+  app.add_option("--depth-tolerance", options.depth_tolerance_m, "metres")->capture_default_str();
+  app.add_option("--zbuffer-scale", options.zbuffer_scale, "z-buffer size / photo size")
+      ->capture_default_str();
+  AddResectionOptions(app, &resection, &intrinsics_path);
+  return RunCommand(app, argc, argv, [&] {
+    options.visibility = visibility == "segment" ? VisibilityMethod::kSegment : VisibilityMethod::kZBuffer;
+    options.Check();
+    if (photo_path.empty() == image_key.empty())
+      throw OptionsError("give exactly one of --photo and --image");
+    CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
+    if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
+    const Scan scan = ReadOneScan(scan_path, scan_index);
+    cv::Mat photo;
+    PinholeCamera camera;
+    bool have_camera = false;
+    if (!image_key.empty()) {
+      if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
+      const E57File file = ReadE57(scan_path);
+      const E57Image& image = FindImage(file.images, image_key, scan_path);
+      if (image.image.empty()) ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
+      photo = image.image;
+      std::string why;
+      have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
+      if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
+    } else {
+      photo = ReadImage(photo_path);
+      if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
+    }
+    if (!camera_path.empty() && !pairs_path.empty())
+      throw OptionsError("give --camera or --correspondences, not both");
+    if (!camera_path.empty()) {
+      camera = ReadCameraJson(camera_path);
+    } else if (!pairs_path.empty()) {
+      resection.width_px = photo.cols, resection.height_px = photo.rows;
+      const ResectionResult result =
+          RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
+      fmt::print(stderr, "resection: {}\n", result.Summary());
+      camera = result.camera;
+    } else if (!have_camera) {
+      throw OptionsError("give --camera or --correspondences");
+    }
+    const RecolorResult result = RecolorScan(scan, photo, camera, options);
+    WriteScanFile(output, {result.scan});
+    if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
+    nlohmann::ordered_json json;
+    json["returns"] = result.returns;
+    json["recolored"] = result.recolored_count;
+    json["outside_image"] = result.outside_image;
+    json["hidden"] = result.hidden;
+    fmt::print("{}\n", json.dump());
+    return 0;
+  });
+}
+
+int RunImages(int argc, char** argv) {
+  CLI::App app{
+      "List the photos (images2D) of an E57 file as JSON; --extract writes each decoded photo as PNG.",
+      "images"};
+  std::string path, folder;
+  app.add_option("file", path, "E57 file")->required();
+  app.add_option("--extract", folder, "folder to write <index>_<name>.png into (created)");
+  return RunCommand(app, argc, argv, [&] {
+    if (FileExtension(path) != "e57") throw OptionsError(path + " is not an .e57 file");
+    const E57File file = ReadE57(path);
+    nlohmann::ordered_json json;
+    json["file"] = path;
+    json["images"] = ImagesJson(file.images);
+    if (!folder.empty()) {
+      std::filesystem::create_directories(folder);
+      for (size_t i = 0; i < file.images.size(); ++i) {
+        const E57Image& image = file.images[i];
+        if (image.image.empty()) continue;
+        std::string name = image.name;
+        for (char& c : name) {
+          if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+        }
+        const std::string out =
+            (std::filesystem::path(folder) / fmt::format("{:02}_{}.png", i, name)).string();
+        WriteImage(out, image.image);
+        json["images"][i]["extracted"] = out;
+      }
+    }
+    fmt::print("{}\n", json.dump(1));
+    return 0;
+  });
+}
+
+int RunAlign(int argc, char** argv) {
+  CLI::App app{
+      "Transforms from correspondences: scan <-> scan landmarks (\"source\"/\"target\") give a rigid or "
+      "scaled 4x4 (Umeyama); photo <-> photo pairs (\"pixel_a\"/\"pixel_b\") a 3x3 homography or "
+      "fundamental matrix. Writes the matrix as text rows, prints residuals as JSON.",
+      "align"};
+  std::string pairs_path, output, model = "homography";
+  bool with_scale = false;
+  double threshold_px = 3.0;
+  app.add_option("--correspondences", pairs_path, "C.json")->required();
+  app.add_option("-o,--output", output, "T.txt to write")->required();
+  app.add_flag("--scale", with_scale, "landmarks: allow a uniform scale (similarity)");
+  app.add_option("--model", model, "photo pairs: homography | fundamental")
+      ->check(CLI::IsMember({"homography", "fundamental"}))
+      ->capture_default_str();
+  app.add_option("--threshold", threshold_px, "photo pairs: RANSAC threshold, pixels")->capture_default_str();
+  return RunCommand(app, argc, argv, [&] {
+    CheckNotInput(output, {pairs_path});
+    const Correspondences pairs = ReadCorrespondences(pairs_path);
+    nlohmann::ordered_json json;
+    std::string text;
+    if (pairs.kind == PairKind::kLandmark) {
+      const LandmarkAlignment result = AlignLandmarks(pairs.landmarks, with_scale, pairs_path);
+      for (int r = 0; r < 4; ++r) {
+        const Eigen::RowVector4d row = result.target_from_source.row(r);
+        text += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}\n", row[0], row[1], row[2], row[3]);
+      }
+      json["model"] = with_scale ? "similarity" : "rigid";
+      json["scale"] = result.scale;
+      json["rms_m"] = result.rms_m;
+      json["residual_m"] = result.residual_m;
+    } else if (pairs.kind == PairKind::kPixelPixel) {
+      const PhotoPairModel result = model == "fundamental"
+                                        ? EstimateFundamental(pairs.pixel_pixel, threshold_px, pairs_path)
+                                        : EstimateHomography(pairs.pixel_pixel, threshold_px, pairs_path);
+      for (int r = 0; r < 3; ++r)
+        text += fmt::format("{:.17g} {:.17g} {:.17g}\n", result.matrix(r, 0), result.matrix(r, 1),
+                            result.matrix(r, 2));
+      json["model"] = model;
+      json["rms_px"] = result.rms_px;
+      json["error_px"] = result.error_px;
+      json["inlier"] = result.inlier;
+    } else {
+      ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
+    }
+    WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+    fmt::print("{}\n", json.dump());
+    return 0;
+  });
+}
+
+int RunPhoto(int argc, char** argv) {
+  CLI::App app{
+      "The synthetic camera: render what a pinhole camera sees in a scene, with the scanner's colours.",
+      "photo"};
+  std::string scene_path, camera_path, output;
+  PhotoOptions options;
+  app.add_option("scene", scene_path, "scene JSON (docs/scene-format.md)")->required();
+  app.add_option("--camera", camera_path, "camera JSON (geometry/camera.h)")->required();
+  app.add_option("-o,--output", output, "photo to write (.png, .jpg)")->required();
+  app.add_option("--samples", options.samples_per_axis, "rays per pixel per axis (anti-aliasing)")
+      ->capture_default_str();
+  return RunCommand(app, argc, argv, [&] {
+    CheckNotInput(output, {scene_path, camera_path});
+    const Photo photo = RenderPhoto(LoadScene(scene_path), ReadCameraJson(camera_path), options);
+    WriteImage(output, photo.image);
+    return 0;
+  });
+}
+
+}  // namespace lidarshop::cli

@@ -1,0 +1,215 @@
+#include "lidarshop/recolor/recolor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/raycast/raycast.h"
+#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
+
+namespace lidarshop {
+
+void RecolorOptions::Check() const {
+  CheckOption(depth_tolerance_m >= 0,
+              fmt::format("RecolorOptions.depth_tolerance_m must be >= 0, got {}", depth_tolerance_m));
+  CheckOption(relative_depth_tolerance >= 0 && relative_depth_tolerance < 1,
+              fmt::format("RecolorOptions.relative_depth_tolerance must be in [0, 1), got {}",
+                          relative_depth_tolerance));
+  CheckOption(silhouette_margin_px >= 0 && silhouette_margin_px <= 50,
+              fmt::format("RecolorOptions.silhouette_margin_px must be 0..50, got {}", silhouette_margin_px));
+  CheckOption(zbuffer_scale > 0 && zbuffer_scale <= 1,
+              fmt::format("RecolorOptions.zbuffer_scale must be in (0, 1], got {}", zbuffer_scale));
+  CheckOption(max_range_jump_ratio > 0,
+              fmt::format("RecolorOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
+}
+
+std::string RecolorResult::Summary() const {
+  return fmt::format("{} of {} points recoloured; {} outside the photo, {} hidden from the camera",
+                     recolored_count, returns, outside_image, hidden);
+}
+
+cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px) {
+  // Array coordinates: the centre of pixel (0, 0) is at (0, 0).
+  const double x = std::clamp(pixel_px.x() - 0.5, 0.0, photo.cols - 1.0);
+  const double y = std::clamp(pixel_px.y() - 0.5, 0.0, photo.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, photo.cols - 1), y1 = std::min(y0 + 1, photo.rows - 1);
+  const double fx = x - x0, fy = y - y0;
+  cv::Vec3b out;
+  for (int c = 0; c < 3; ++c) {
+    const double top = (1 - fx) * photo.at<cv::Vec3b>(y0, x0)[c] + fx * photo.at<cv::Vec3b>(y0, x1)[c];
+    const double bottom = (1 - fx) * photo.at<cv::Vec3b>(y1, x0)[c] + fx * photo.at<cv::Vec3b>(y1, x1)[c];
+    out[c] = cv::saturate_cast<uint8_t>((1 - fy) * top + fy * bottom);
+  }
+  return out;
+}
+
+namespace {
+
+// Distance from the camera centre to the first surface of `scene` through each z-buffer pixel (+inf: none);
+// `back_facing` (CV_8U) marks pixels whose first surface turns its back to the camera (the scan mesh faces
+// the scanner: the camera then sees the side of that surface the scanner did not see).
+cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, double scale,
+                       cv::Mat* back_facing) {
+  const int rows = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
+  const int cols = std::max(1, static_cast<int>(std::lround(camera.width_px * scale)));
+  const double sy = static_cast<double>(camera.height_px) / rows,
+               sx = static_cast<double>(camera.width_px) / cols;
+  cv::Mat distance(rows, cols, CV_32F);
+  back_facing->create(rows, cols, CV_8U);
+  const Eigen::Matrix3f rotation = camera.world_from_camera.topLeftCorner<3, 3>().cast<float>();
+  constexpr int kStrip = 128;  // rows per cast: bounded memory for 3072 x 2304 photos
+  RayHitImages hits;
+  for (int row0 = 0; row0 < rows; row0 += kStrip) {
+    const int strip_rows = std::min(kStrip, rows - row0);
+    cv::Mat directions(strip_rows, cols, CV_32FC3);
+    ParallelFor(strip_rows, [&](int64_t r) {
+      for (int c = 0; c < cols; ++c) {
+        const Eigen::Vector3d ray = UnprojectPixel(camera, {(c + 0.5) * sx, (row0 + r + 0.5) * sy});
+        directions.at<cv::Vec3f>(static_cast<int>(r), c) = cv::Vec3f(ray.x(), ray.y(), ray.z());
+      }
+    });
+    scene.CastImage(camera.world_from_camera, directions, 0.0f, std::numeric_limits<float>::infinity(),
+                    CastMethod::kPacket16, &hits);
+    for (int r = 0; r < strip_rows; ++r) {
+      for (int c = 0; c < cols; ++c) {
+        const cv::Vec3f d = directions.at<cv::Vec3f>(r, c);
+        distance.at<float>(row0 + r, c) = hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
+        const cv::Vec3f n = hits.normal.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
+        back_facing->at<uint8_t>(row0 + r, c) = w.dot(Eigen::Vector3f(n[0], n[1], n[2])) > 0 ? 255 : 0;
+      }
+    }
+  }
+  return distance;
+}
+
+// |difference| of two distances, +inf when either is infinite.
+float Step(float a, float b) { return std::isfinite(a) && std::isfinite(b) ? std::abs(a - b) : INFINITY; }
+
+// One-sided (smaller) depth slope per z-buffer pixel, x plus y, metres per pixel.
+float Slope(const cv::Mat& d, int r, int c) {
+  const float here = d.at<float>(r, c);
+  const float left = c > 0 ? Step(here, d.at<float>(r, c - 1)) : INFINITY;
+  const float right = c + 1 < d.cols ? Step(here, d.at<float>(r, c + 1)) : INFINITY;
+  const float up = r > 0 ? Step(here, d.at<float>(r - 1, c)) : INFINITY;
+  const float down = r + 1 < d.rows ? Step(here, d.at<float>(r + 1, c)) : INFINITY;
+  const float sx = std::min(left, right), sy = std::min(up, down);
+  return (std::isfinite(sx) ? sx : 0.0f) + (std::isfinite(sy) ? sy : 0.0f);
+}
+
+}  // namespace
+
+RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,
+                          const RecolorOptions& options) {
+  options.Check();
+  camera.Check("camera");
+  if (photo.type() != CV_8UC3) ThrowInputError("photo", "", "", "expected an 8-bit RGB image");
+  if (photo.cols != camera.width_px || photo.rows != camera.height_px)
+    ThrowInputError("photo", "", "",
+                    fmt::format("the photo is {} x {} pixels but the camera is {} x {}", photo.cols,
+                                photo.rows, camera.width_px, camera.height_px));
+  CheckScan(scan);
+
+  RecolorResult result;
+  result.scan = Clone(scan);
+  Scan& out = result.scan;
+  if (!out.has_color()) {
+    out.color.create(scan.rows, scan.cols, CV_8UC3);
+    for (int r = 0; r < scan.rows; ++r) {
+      for (int c = 0; c < scan.cols; ++c) {
+        const uint8_t grey = cv::saturate_cast<uint8_t>(255.0f * scan.intensity.at<float>(r, c));
+        out.color.at<cv::Vec3b>(r, c) = cv::Vec3b(grey, grey, grey);
+      }
+    }
+  }
+  result.recolored = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+
+  ScanMeshOptions mesh_options;
+  mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
+  mesh_options.world_frame = true;
+  RaycastScene raycast;
+  raycast.AddMesh(ScanToMesh(scan, mesh_options), 0);
+  raycast.Commit();
+
+  const Eigen::Vector3d center = camera.center_in_world();
+  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
+
+  // Candidates: valid cells in front of the camera that project inside the photo.
+  struct Candidate {
+    int64_t cell;
+    Eigen::Vector2d pixel;
+    Eigen::Vector3d point_in_world;
+  };
+  std::vector<Candidate> candidates;
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (!scan.valid.at<uint8_t>(r, c)) continue;
+      ++result.returns;
+      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+      const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+      Eigen::Vector2d pixel;
+      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
+        ++result.outside_image;
+        continue;
+      }
+      candidates.push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+    }
+  }
+
+  std::vector<uint8_t> hidden(candidates.size(), 0);
+  const auto tolerance = [&](double distance) {
+    return options.depth_tolerance_m + options.relative_depth_tolerance * distance;
+  };
+  if (options.visibility == VisibilityMethod::kSegment) {
+    std::vector<Ray> rays(candidates.size());
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const Eigen::Vector3d segment = candidates[i].point_in_world - center;
+      const double distance = segment.norm();
+      rays[i].origin = center.cast<float>();
+      rays[i].direction = segment.cast<float>();
+      rays[i].t_far = static_cast<float>(std::max(0.0, 1.0 - tolerance(distance) / distance));
+    }
+    raycast.Occluded(rays, hidden);
+  } else {
+    cv::Mat back_facing;
+    const cv::Mat distance_buffer = DistanceBuffer(raycast, camera, options.zbuffer_scale, &back_facing);
+    cv::Mat nearest = distance_buffer;
+    const int m = options.silhouette_margin_px;
+    if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
+    const double sx = static_cast<double>(distance_buffer.cols) / camera.width_px;
+    const double sy = static_cast<double>(distance_buffer.rows) / camera.height_px;
+    ParallelFor(
+        static_cast<int64_t>(candidates.size()),
+        [&](int64_t i) {
+          const Candidate& candidate = candidates[i];
+          const int zr = std::min(static_cast<int>(candidate.pixel.y() * sy), distance_buffer.rows - 1);
+          const int zc = std::min(static_cast<int>(candidate.pixel.x() * sx), distance_buffer.cols - 1);
+          const double distance = (candidate.point_in_world - center).norm();
+          const double allowed = tolerance(distance) + m * Slope(distance_buffer, zr, zc);
+          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
+        },
+        1024);
+  }
+
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (hidden[i]) {
+      ++result.hidden;
+      continue;
+    }
+    const int r = static_cast<int>(candidates[i].cell / scan.cols),
+              c = static_cast<int>(candidates[i].cell % scan.cols);
+    out.color.at<cv::Vec3b>(r, c) = SamplePhoto(photo, candidates[i].pixel);
+    result.recolored.at<uint8_t>(r, c) = 255;
+    ++result.recolored_count;
+  }
+  return result;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,70 @@
+// Occlusion-aware recolouring of a scan from a photo (thesis 3.2.2.1).
+//
+// A scan point takes the photo's colour (bilinear at its projection) only when
+//   1. it lies in front of the camera and projects inside the photo, and
+//   2. the camera sees it: the segment from the point to the camera centre meets no other surface of the
+//   scan.
+// Otherwise it keeps its own colour. (The thesis's tool let occluded points take the occluder's colour from
+// the photo; here they never change.)
+//
+// Visibility is decided against the scan's own grid mesh (scanner/scan_mesh.h, world frame, edges across
+// depth jumps dropped) with Embree: one ray per photo pixel (or per pixel of a reduced "z-buffer",
+// `zbuffer_scale`) from the camera centre gives the distance to the first surface of the scan seen through
+// that pixel. A point at distance d from the camera is hidden when that first surface is nearer than d −
+// tolerance, which is the segment test of the thesis with the segment's end moved `tolerance` off the point's
+// own surface (tolerance = depth_tolerance_m + relative_depth_tolerance · d). Two safety margins:
+//   - `silhouette_margin_px`: the first-surface distance is the minimum over a (2m + 1)² window of z-buffer
+//     pixels. The scan mesh stops at the last cell of an object, up to one scan step short of its true
+//     silhouette; without a margin, points just behind an occluder's edge see the camera through that gap and
+//     take the occluder's colour (bench/results/recolor.md measures it).
+//   - the window's own depth slope: on surfaces seen at a grazing angle the window minimum is nearer than the
+//     point by (margin · slope); that much is added to the tolerance, with the slope taken one-sided (the
+//     smaller of the forward and backward differences), so that a depth jump does not count as slope.
+// A point is also hidden when the first surface at its pixel turns its back to the camera: the scan mesh
+// faces the scanner, so the camera then sees the side of that surface the scanner never saw (a camera facing
+// the scanner across an object sees the object's other side, whose colour is not the scanned side's).
+// `VisibilityMethod::kSegment` instead casts the exact segment of every point (Embree occlusion rays, no
+// margin): the literal thesis test, kept as the reference of the evaluation.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/geometry/camera.h"
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+enum class VisibilityMethod { kZBuffer, kSegment };
+
+struct RecolorOptions {
+  VisibilityMethod visibility = VisibilityMethod::kZBuffer;
+  double depth_tolerance_m = 0.03;  // metres: a surface this close in front of a point does not hide it
+  double relative_depth_tolerance = 0.01;  // fraction of the camera distance added to the tolerance
+  int silhouette_margin_px = 2;            // z-buffer window radius (z-buffer pixels), 0 = no margin
+  double zbuffer_scale = 1.0;              // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
+  double max_range_jump_ratio = 0.1;       // scan mesh edges (scanner/scan_mesh.h)
+  void Check() const;                      // throws OptionsError
+};
+
+struct RecolorResult {
+  Scan scan;  // a clone of the input with `color` replaced where recolored (created, grey from intensity,
+              // when the input had no colour)
+  cv::Mat recolored;            // CV_8U rows x cols: 255 = the point took the photo's colour
+  int64_t returns = 0;          // valid cells
+  int64_t recolored_count = 0;  // valid cells that took the photo's colour
+  int64_t outside_image = 0;    // behind the camera or projected outside the photo
+  int64_t hidden = 0;           // inside the photo but occluded by another surface of the scan
+  std::string Summary() const;  // one line
+};
+
+// `photo` is CV_8UC3 RGB of the camera's size (camera.width_px x camera.height_px), else InputError.
+RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,
+                          const RecolorOptions& options = {});
+
+// The photo's colour at a continuous pixel position (geometry/camera.h convention), bilinear, edges clamped.
+cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px);
+
+}  // namespace lidarshop

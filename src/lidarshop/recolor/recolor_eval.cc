@@ -1,0 +1,69 @@
+#include "lidarshop/recolor/recolor_eval.h"
+
+#include <cstdlib>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "lidarshop/raycast/raycast.h"
+
+namespace lidarshop {
+
+std::string RecolorScore::Summary() const {
+  return fmt::format("visible {} ({} recoloured, {:.2f} % correct), hidden {} ({:.2f} % changed), outside {}",
+                     visible, visible_recolored, visible_correct_percent(), hidden, hidden_changed_percent(),
+                     outside);
+}
+
+RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, const Scan& input,
+                          const Scan& output, const PinholeCamera& camera, int max_level_difference,
+                          double visibility_tolerance_m) {
+  RaycastScene raycast;
+  for (size_t i = 0; i < scene.objects.size(); ++i)
+    raycast.AddMesh(MeshInWorld(scene.objects[i]), static_cast<int32_t>(i));
+  raycast.Commit();
+  const Eigen::Vector3d center = camera.center_in_world();
+  std::vector<Ray> rays;
+  std::vector<int64_t> cells;
+  RecolorScore score;
+  for (int r = 0; r < truth.rows; ++r) {
+    for (int c = 0; c < truth.cols; ++c) {
+      if (!truth.valid.at<uint8_t>(r, c)) continue;
+      const cv::Vec3f p = truth.point.at<cv::Vec3f>(r, c);
+      const Eigen::Vector3d point_in_world =
+          (truth.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1)).head<3>();
+      Eigen::Vector2d pixel;
+      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
+        ++score.outside;
+        continue;
+      }
+      Ray ray;
+      const Eigen::Vector3d segment = point_in_world - center;
+      ray.origin = center.cast<float>();
+      ray.direction = segment.cast<float>();
+      ray.t_far = static_cast<float>(1.0 - visibility_tolerance_m / segment.norm());
+      rays.push_back(ray);
+      cells.push_back(static_cast<int64_t>(r) * truth.cols + c);
+    }
+  }
+  std::vector<uint8_t> occluded(rays.size());
+  raycast.Occluded(rays, occluded);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const int r = static_cast<int>(cells[i] / truth.cols), c = static_cast<int>(cells[i] % truth.cols);
+    const cv::Vec3b before = input.color.at<cv::Vec3b>(r, c), after = output.color.at<cv::Vec3b>(r, c);
+    if (occluded[i]) {
+      ++score.hidden;
+      score.hidden_changed += before != after;
+      continue;
+    }
+    ++score.visible;
+    score.visible_recolored += before != after;
+    const cv::Vec3b true_color = truth.color.at<cv::Vec3b>(r, c);
+    bool close = true;
+    for (int k = 0; k < 3; ++k) close = close && std::abs(after[k] - true_color[k]) <= max_level_difference;
+    score.visible_correct += close;
+  }
+  return score;
+}
+
+}  // namespace lidarshop

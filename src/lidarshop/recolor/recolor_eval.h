@@ -1,0 +1,34 @@
+// Scoring a recoloured synthetic scan against the truth (tests, bench/results/recolor.md): which scan points
+// the camera really sees (segments cast against the true scene, not the scan mesh), and whether visible
+// points got the true colour while hidden ones kept theirs.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "lidarshop/geometry/camera.h"
+#include "lidarshop/scan/scan.h"
+#include "lidarshop/scanner/scene.h"
+
+namespace lidarshop {
+
+struct RecolorScore {
+  int64_t visible = 0;            // valid points inside the photo that the camera sees (true scene)
+  int64_t visible_recolored = 0;  // ... that took a photo colour
+  int64_t visible_correct = 0;    // ... whose colour is now within `max_level_difference` of the truth
+  int64_t hidden = 0;             // valid points inside the photo hidden from the camera by the true scene
+  int64_t hidden_changed = 0;     // ... whose colour changed (must be 0)
+  int64_t outside = 0;            // behind the camera or outside the photo
+  double visible_correct_percent() const { return visible ? 100.0 * visible_correct / visible : 0.0; }
+  double hidden_changed_percent() const { return hidden ? 100.0 * hidden_changed / hidden : 0.0; }
+  std::string Summary() const;
+};
+
+// `truth` holds the true colours (the synthetic scanner's), `input` the colours before recolouring and
+// `output` after (all the same grid). A point is hidden when the segment from the camera to it meets the true
+// scene more than `visibility_tolerance_m` before the point.
+RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, const Scan& input,
+                          const Scan& output, const PinholeCamera& camera, int max_level_difference = 10,
+                          double visibility_tolerance_m = 0.005);
+
+}  // namespace lidarshop

@@ -1,0 +1,102 @@
+#include "lidarshop/recolor/recolor.h"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/recolor/recolor_eval.h"
+#include "lidarshop/scanner/photo.h"
+#include "lidarshop/testing/scenes.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+// The scan of MakeRecolorScene with every colour replaced by a magenta no object has (a badly exposed scanner
+// camera), the true scan and a photo from a camera 1.5 m right of the scanner.
+struct Fixture {
+  SceneDescription scene = testing::MakeRecolorScene();
+  Scan truth = testing::ScanScene(scene);
+  Scan input = Clone(truth);
+  PinholeCamera camera = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 800, 600, 75);
+  Photo photo;
+  Fixture() {
+    input.color.setTo(cv::Scalar(250, 0, 250));
+    photo = RenderPhoto(scene, camera);
+  }
+};
+
+TEST(Recolor, VisiblePointsTakeTheTrueColourAndHiddenOnesNeverChange) {
+  const Fixture f;
+  const RecolorResult result = RecolorScan(f.input, f.photo.image, f.camera);
+  const RecolorScore score = ScoreRecolor(f.scene, f.truth, f.input, result.scan, f.camera);
+  SCOPED_TRACE(score.Summary());
+  ASSERT_GT(score.hidden, 2000);  // the box and the pillar hide parts of the wall and the ground
+  ASSERT_GT(score.visible, 50000);
+  EXPECT_GT(score.visible_correct_percent(), 99.0);
+  EXPECT_EQ(score.hidden_changed, 0);
+  EXPECT_EQ(result.returns, f.truth.CountValid());
+  EXPECT_EQ(result.recolored_count, cv::countNonZero(result.recolored));
+  EXPECT_EQ(result.returns, result.recolored_count + result.outside_image + result.hidden);
+  // The input is not modified.
+  EXPECT_EQ(f.input.color.at<cv::Vec3b>(0, 0), cv::Vec3b(250, 0, 250));
+}
+
+TEST(Recolor, TheLiteralSegmentTestLeaksAtSilhouettesTheMarginDoesNot) {
+  const Fixture f;
+  RecolorOptions segment;
+  segment.visibility = VisibilityMethod::kSegment;
+  const RecolorScore literal = ScoreRecolor(
+      f.scene, f.truth, f.input, RecolorScan(f.input, f.photo.image, f.camera, segment).scan, f.camera);
+  RecolorOptions no_margin;
+  no_margin.silhouette_margin_px = 0;
+  const RecolorScore zbuffer = ScoreRecolor(
+      f.scene, f.truth, f.input, RecolorScan(f.input, f.photo.image, f.camera, no_margin).scan, f.camera);
+  // Without a margin, points just behind an occluder's edge see the camera through the gap the scan mesh
+  // leaves (up to one scan step) and take the occluder's colour.
+  EXPECT_GT(literal.hidden_changed, 0) << literal.Summary();
+  EXPECT_GT(zbuffer.hidden_changed, 0) << zbuffer.Summary();
+  EXPECT_GT(literal.visible_correct_percent(), 99.0) << literal.Summary();
+}
+
+TEST(Recolor, PointsOutsideThePhotoKeepTheirColour) {
+  const Fixture f;
+  PinholeCamera narrow = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 200, 150, 20);
+  const RecolorResult result = RecolorScan(f.input, RenderPhoto(f.scene, narrow).image, narrow);
+  EXPECT_GT(result.outside_image, result.returns / 2);
+  for (int r = 0; r < f.input.rows; ++r) {
+    for (int c = 0; c < f.input.cols; ++c) {
+      if (!result.recolored.at<uint8_t>(r, c))
+        EXPECT_EQ(result.scan.color.at<cv::Vec3b>(r, c), cv::Vec3b(250, 0, 250));
+    }
+  }
+}
+
+TEST(Recolor, ScansWithoutColourGetOne) {
+  const Fixture f;
+  Scan grey = Clone(f.input);
+  grey.color = cv::Mat();
+  const RecolorResult result = RecolorScan(grey, f.photo.image, f.camera);
+  ASSERT_TRUE(result.scan.has_color());
+  EXPECT_GT(result.recolored_count, 0);
+}
+
+TEST(Recolor, RefusesAPhotoOfTheWrongSize) {
+  const Fixture f;
+  cv::Mat small;
+  cv::resize(f.photo.image, small, cv::Size(400, 300));
+  EXPECT_THROW(RecolorScan(f.input, small, f.camera), InputError);
+  RecolorOptions bad;
+  bad.zbuffer_scale = 0;
+  EXPECT_THROW(RecolorScan(f.input, f.photo.image, f.camera, bad), OptionsError);
+}
+
+TEST(Recolor, SamplesThePhotoAtContinuousPixels) {
+  cv::Mat photo(2, 2, CV_8UC3, cv::Scalar(0, 0, 0));
+  photo.at<cv::Vec3b>(0, 1) = cv::Vec3b(200, 100, 0);
+  EXPECT_EQ(SamplePhoto(photo, {1.5, 0.5}), cv::Vec3b(200, 100, 0));  // the centre of pixel (row 0, col 1)
+  EXPECT_EQ(SamplePhoto(photo, {1.0, 0.5}), cv::Vec3b(100, 50, 0));   // halfway between two centres
+  EXPECT_EQ(SamplePhoto(photo, {0.1, 0.1}), cv::Vec3b(0, 0, 0));      // clamped at the corner
+}
+
+}  // namespace
+}  // namespace lidarshop

@@ -1,0 +1,457 @@
+#include "lidarshop/recolor/resection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <optional>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <Eigen/QR>
+#include <Eigen/SVD>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <unsupported/Eigen/NonLinearOptimization>
+#include <unsupported/Eigen/NumericalDiff>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+
+void ResectionOptions::Check() const {
+  CheckOption(width_px > 0 && height_px > 0,
+              fmt::format("ResectionOptions: the photo size must be > 0, got {} x {}", width_px, height_px));
+  CheckOption(ransac_threshold_px > 0,
+              fmt::format("ResectionOptions.ransac_threshold_px must be > 0, got {}", ransac_threshold_px));
+  CheckOption(ransac_iterations >= 1,
+              fmt::format("ResectionOptions.ransac_iterations must be >= 1, got {}", ransac_iterations));
+  CheckOption(ransac_confidence > 0 && ransac_confidence < 1,
+              fmt::format("ResectionOptions.ransac_confidence must be in (0, 1), got {}", ransac_confidence));
+  CheckOption(radial_coefficients >= 0 && radial_coefficients <= 3,
+              fmt::format("ResectionOptions.radial_coefficients must be 0..3, got {}", radial_coefficients));
+  CheckOption(min_inliers_for_distortion >= 6,
+              fmt::format("ResectionOptions.min_inliers_for_distortion must be >= 6, got {}",
+                          min_inliers_for_distortion));
+  CheckOption(max_aspect_deviation > 0,
+              fmt::format("ResectionOptions.max_aspect_deviation must be > 0, got {}", max_aspect_deviation));
+  CheckOption(degenerate_ratio > 0 && degenerate_ratio < 1,
+              fmt::format("ResectionOptions.degenerate_ratio must be in (0, 1), got {}", degenerate_ratio));
+}
+
+std::string ResectionResult::Summary() const {
+  return fmt::format(
+      "{} of {} pairs are inliers, RMS reprojection error {:.3f} px (DLT {:.3f} px), {} RANSAC sets",
+      num_inliers, inlier.size(), rms_px, dlt_rms_px, ransac_iterations);
+}
+
+namespace {
+
+using Matrix34d = Eigen::Matrix<double, 3, 4>;
+
+// Similarity taking `points` (as columns) to zero mean and mean distance sqrt(dimension).
+template <int D>
+Eigen::Matrix<double, D + 1, D + 1> NormalizingTransform(
+    const std::vector<Eigen::Matrix<double, D, 1>>& points) {
+  Eigen::Matrix<double, D, 1> mean = Eigen::Matrix<double, D, 1>::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  double distance = 0;
+  for (const auto& p : points) distance += (p - mean).norm();
+  distance /= static_cast<double>(points.size());
+  const double scale = distance > 0 ? std::sqrt(static_cast<double>(D)) / distance : 1.0;
+  Eigen::Matrix<double, D + 1, D + 1> t = Eigen::Matrix<double, D + 1, D + 1>::Identity();
+  t.template topLeftCorner<D, D>() *= scale;
+  t.template topRightCorner<D, 1>() = -scale * mean;
+  return t;
+}
+
+// Singular values of centred rows, largest first.
+template <int D>
+Eigen::Matrix<double, D, 1> Spread(const std::vector<Eigen::Matrix<double, D, 1>>& points) {
+  Eigen::Matrix<double, D, 1> mean = Eigen::Matrix<double, D, 1>::Zero();
+  for (const auto& p : points) mean += p;
+  mean /= static_cast<double>(points.size());
+  Eigen::Matrix<double, Eigen::Dynamic, D> centred(points.size(), D);
+  for (size_t i = 0; i < points.size(); ++i) centred.row(i) = (points[i] - mean).transpose();
+  return Eigen::JacobiSVD<Eigen::Matrix<double, Eigen::Dynamic, D>>(centred).singularValues();
+}
+
+// Reprojection error with a projection matrix (no distortion).
+double ProjectionError(const Matrix34d& p, const PixelPointPair& pair) {
+  const Eigen::Vector3d x = p * pair.point_in_world.homogeneous();
+  if (std::abs(x.z()) < 1e-300) return std::numeric_limits<double>::infinity();
+  return (x.hnormalized() - pair.pixel_px).norm();
+}
+
+// The camera parameters LM works on: fx fy cx cy skew k1 k2 k3 p1 p2 | rotation (angle-axis) | translation,
+// the pose as camera_from_world.
+constexpr int kNumParameters = 16;
+using Parameters = Eigen::Matrix<double, kNumParameters, 1>;
+
+Parameters ToParameters(const PinholeCamera& c) {
+  const Eigen::Matrix3d rotation = c.world_from_camera.topLeftCorner<3, 3>().transpose();
+  const Eigen::AngleAxisd angle_axis(rotation);
+  const Eigen::Vector3d r = angle_axis.angle() * angle_axis.axis();
+  const Eigen::Vector3d t = -rotation * c.center_in_world();
+  Parameters x;
+  x << c.fx_px, c.fy_px, c.cx_px, c.cy_px, c.skew_px, c.k1, c.k2, c.k3, c.p1, c.p2, r, t;
+  return x;
+}
+
+PinholeCamera FromParameters(const Parameters& x, int width_px, int height_px) {
+  PinholeCamera c;
+  c.width_px = width_px;
+  c.height_px = height_px;
+  c.fx_px = x[0], c.fy_px = x[1], c.cx_px = x[2], c.cy_px = x[3], c.skew_px = x[4];
+  c.k1 = x[5], c.k2 = x[6], c.k3 = x[7], c.p1 = x[8], c.p2 = x[9];
+  const Eigen::Vector3d r = x.segment<3>(10);
+  const double angle = r.norm();
+  const Eigen::Matrix3d rotation =
+      angle > 0 ? Eigen::AngleAxisd(angle, r / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();
+  c.world_from_camera.setIdentity();
+  c.world_from_camera.topLeftCorner<3, 3>() = rotation.transpose();
+  c.world_from_camera.topRightCorner<3, 1>() = -rotation.transpose() * x.segment<3>(13);
+  return c;
+}
+
+// Residuals (du, dv per pair) over the free parameters; fy follows fx when `tie_fy`.
+struct ReprojectionFunctor {
+  using Scalar = double;
+  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
+  using InputType = Eigen::VectorXd;
+  using ValueType = Eigen::VectorXd;
+  using JacobianType = Eigen::MatrixXd;
+
+  std::vector<PixelPointPair> pairs;
+  std::vector<int> free;  // indices into Parameters
+  Parameters fixed;
+  bool tie_fy = true;
+  int width_px = 0, height_px = 0;
+
+  int inputs() const { return static_cast<int>(free.size()); }
+  int values() const { return static_cast<int>(2 * pairs.size()); }
+  Parameters Full(const Eigen::VectorXd& x) const {
+    Parameters full = fixed;
+    for (size_t i = 0; i < free.size(); ++i) full[free[i]] = x[i];
+    if (tie_fy) full[1] = full[0];
+    return full;
+  }
+  int operator()(const Eigen::VectorXd& x, Eigen::VectorXd& residual) const {
+    const PinholeCamera camera = FromParameters(Full(x), width_px, height_px);
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      Eigen::Vector2d pixel;
+      if (!ProjectWorldPoint(camera, pairs[i].point_in_world, &pixel))
+        pixel = pairs[i].pixel_px.array() + 1e6;
+      residual.segment<2>(2 * i) = pixel - pairs[i].pixel_px;
+    }
+    return 0;
+  }
+};
+
+std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vector<PixelPointPair>& pairs,
+                                    const ResectionOptions& options) {
+  ReprojectionFunctor functor;
+  functor.pairs = pairs;
+  functor.fixed = ToParameters(start);
+  functor.tie_fy = options.square_pixels;
+  functor.width_px = options.width_px;
+  functor.height_px = options.height_px;
+  if (options.square_pixels) functor.fixed[0] = functor.fixed[1] = 0.5 * (start.fx_px + start.fy_px);
+  if (!options.refine_skew) functor.fixed[4] = 0;
+  functor.free = {0, 2, 3};
+  if (!options.square_pixels) functor.free.push_back(1);
+  if (options.refine_skew) functor.free.push_back(4);
+  if (static_cast<int>(pairs.size()) >= options.min_inliers_for_distortion) {
+    for (int k = 0; k < options.radial_coefficients; ++k) functor.free.push_back(5 + k);
+    if (options.refine_tangential) functor.free.insert(functor.free.end(), {8, 9});
+  }
+  for (int i = 10; i < kNumParameters; ++i) functor.free.push_back(i);
+  if (functor.values() < functor.inputs()) return std::nullopt;
+  Eigen::VectorXd x(functor.free.size());
+  for (size_t i = 0; i < functor.free.size(); ++i) x[i] = functor.fixed[functor.free[i]];
+  Eigen::NumericalDiff<ReprojectionFunctor> numeric(functor);
+  Eigen::LevenbergMarquardt<Eigen::NumericalDiff<ReprojectionFunctor>> solver(numeric);
+  solver.parameters.maxfev = 4000;
+  solver.parameters.xtol = 1e-12;
+  solver.parameters.ftol = 1e-12;
+  solver.minimize(x);
+  return FromParameters(functor.Full(x), options.width_px, options.height_px);
+}
+
+double RmsOfInliers(const PinholeCamera& camera, std::span<const PixelPointPair> pairs,
+                    const std::vector<uint8_t>& inlier) {
+  double sum = 0;
+  int count = 0;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!inlier[i]) continue;
+    const double e = ReprojectionError(camera, pairs[i]);
+    sum += e * e;
+    ++count;
+  }
+  return count ? std::sqrt(sum / count) : 0.0;
+}
+
+std::vector<PixelPointPair> Select(std::span<const PixelPointPair> pairs, const std::vector<uint8_t>& keep) {
+  std::vector<PixelPointPair> out;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (keep[i]) out.push_back(pairs[i]);
+  }
+  return out;
+}
+
+}  // namespace
+
+Eigen::Matrix<double, 3, 4> NormalizedDlt(std::span<const PixelPointPair> pairs) {
+  LIDARSHOP_CHECK(pairs.size() >= 6);
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  for (const PixelPointPair& pair : pairs) {
+    pixels.push_back(pair.pixel_px);
+    points.push_back(pair.point_in_world);
+  }
+  const Eigen::Matrix3d t2 = NormalizingTransform<2>(pixels);
+  const Eigen::Matrix4d t3 = NormalizingTransform<3>(points);
+  Eigen::MatrixXd a = Eigen::MatrixXd::Zero(2 * pairs.size(), 12);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const Eigen::Vector2d x = (t2 * pixels[i].homogeneous()).head<2>();
+    const Eigen::RowVector4d big_x = (t3 * points[i].homogeneous()).transpose();
+    // Eq. 3.6.
+    a.block<1, 4>(2 * i, 0) = big_x;
+    a.block<1, 4>(2 * i, 8) = -x.x() * big_x;
+    a.block<1, 4>(2 * i + 1, 4) = big_x;
+    a.block<1, 4>(2 * i + 1, 8) = -x.y() * big_x;
+  }
+  const Eigen::JacobiSVD<Eigen::MatrixXd> svd(a, Eigen::ComputeFullV);
+  const Eigen::VectorXd p = svd.matrixV().col(11);
+  Matrix34d normalized;
+  normalized << p.segment<4>(0).transpose(), p.segment<4>(4).transpose(), p.segment<4>(8).transpose();
+  Matrix34d projection = t2.inverse() * normalized * t3;
+  return projection / projection.norm();
+}
+
+ProjectionFactors DecomposeProjection(const Eigen::Matrix<double, 3, 4>& projection) {
+  Matrix34d p = projection;
+  if (p.leftCols<3>().determinant() < 0) p = -p;
+  Eigen::Matrix3d flip;
+  flip << 0, 0, 1, 0, 1, 0, 1, 0, 0;
+  // RQ from QR: flip * M = (Q R')^T gives M = (flip R'^T flip)(flip Q^T).
+  const Eigen::HouseholderQR<Eigen::Matrix3d> qr((flip * p.leftCols<3>()).transpose());
+  const Eigen::Matrix3d q = qr.householderQ();
+  const Eigen::Matrix3d r_upper = qr.matrixQR().triangularView<Eigen::Upper>();
+  Eigen::Matrix3d k = flip * r_upper.transpose() * flip;
+  Eigen::Matrix3d rotation = flip * q.transpose();
+  const Eigen::Vector3d signs(k(0, 0) < 0 ? -1 : 1, k(1, 1) < 0 ? -1 : 1, k(2, 2) < 0 ? -1 : 1);
+  k = k * signs.asDiagonal();
+  rotation = signs.asDiagonal() * rotation;
+  ProjectionFactors factors;
+  factors.camera_from_world_translation = k.inverse() * p.col(3);
+  factors.K = k / k(2, 2);
+  factors.camera_from_world_rotation = rotation;
+  return factors;
+}
+
+PinholeCamera CameraFromProjection(const Eigen::Matrix<double, 3, 4>& projection, int width_px,
+                                   int height_px) {
+  const ProjectionFactors f = DecomposeProjection(projection);
+  PinholeCamera camera;
+  camera.width_px = width_px;
+  camera.height_px = height_px;
+  camera.fx_px = f.K(0, 0);
+  camera.fy_px = f.K(1, 1);
+  camera.cx_px = f.K(0, 2);
+  camera.cy_px = f.K(1, 2);
+  camera.skew_px = f.K(0, 1);
+  camera.world_from_camera.topLeftCorner<3, 3>() = f.camera_from_world_rotation.transpose();
+  camera.world_from_camera.topRightCorner<3, 1>() =
+      -f.camera_from_world_rotation.transpose() * f.camera_from_world_translation;
+  return camera;
+}
+
+double ReprojectionError(const PinholeCamera& camera, const PixelPointPair& pair) {
+  Eigen::Vector2d pixel;
+  if (!ProjectWorldPoint(camera, pair.point_in_world, &pixel)) return std::numeric_limits<double>::infinity();
+  return (pixel - pair.pixel_px).norm();
+}
+
+void CheckResectionInput(std::span<const PixelPointPair> pairs, double degenerate_ratio,
+                         const std::string& what, bool points_may_be_planar) {
+  const size_t needed = points_may_be_planar ? 4 : 6;
+  if (pairs.size() < needed)
+    ThrowInputError(what, "", "pairs",
+                    fmt::format("resectioning needs at least {} pairs, got {}", needed, pairs.size()));
+  std::vector<Eigen::Vector2d> pixels;
+  std::vector<Eigen::Vector3d> points;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    if (!pairs[i].pixel_px.allFinite() || !pairs[i].point_in_world.allFinite())
+      ThrowInputError(what, fmt::format("pairs[{}]", i), "", "non-finite coordinate (NaN or infinity)");
+    pixels.push_back(pairs[i].pixel_px);
+    points.push_back(pairs[i].point_in_world);
+  }
+  const Eigen::Vector2d pixel_spread = Spread<2>(pixels);
+  if (pixel_spread[1] <= degenerate_ratio * pixel_spread[0])
+    ThrowInputError(what, "", "pairs", "the pixels are collinear (or all equal): they cannot fix a camera");
+  const Eigen::Vector3d point_spread = Spread<3>(points);
+  if (point_spread[1] <= degenerate_ratio * point_spread[0])
+    ThrowInputError(what, "", "pairs", "the points are collinear (or all equal): they cannot fix a camera");
+  if (!points_may_be_planar && point_spread[2] <= degenerate_ratio * point_spread[0])
+    ThrowInputError(what, "", "pairs",
+                    "all points lie on one plane: the DLT cannot recover the intrinsics from a plane; give "
+                    "known intrinsics (--intrinsics CAM.json) or points off the plane");
+}
+
+ResectionResult Resection(std::span<const PixelPointPair> pairs, const ResectionOptions& options,
+                          const std::string& what) {
+  options.Check();
+  CheckResectionInput(pairs, options.degenerate_ratio, what);
+  const int n = static_cast<int>(pairs.size());
+  ResectionResult result;
+
+  // RANSAC over minimal sets of 6 (serial, seeded).
+  std::mt19937_64 rng(options.seed);
+  std::vector<int> order(n);
+  std::vector<uint8_t> best_inliers(n, 1);
+  int best_count = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  int iterations_needed = options.ransac_iterations;
+  const double t2 = options.ransac_threshold_px * options.ransac_threshold_px;
+  std::vector<PixelPointPair> sample(6);
+  std::vector<Eigen::Vector3d> sample_points(6);
+  for (int iteration = 0; iteration < iterations_needed; ++iteration) {
+    std::iota(order.begin(), order.end(), 0);
+    for (int i = 0; i < 6; ++i) {
+      std::swap(order[i], order[i + static_cast<int>(rng() % static_cast<uint64_t>(n - i))]);
+      sample[i] = pairs[order[i]];
+      sample_points[i] = sample[i].point_in_world;
+    }
+    result.ransac_iterations = iteration + 1;
+    const Eigen::Vector3d spread = Spread<3>(sample_points);
+    if (spread[2] <= options.degenerate_ratio * spread[0]) continue;  // a planar set: no camera
+    Matrix34d p = NormalizedDlt(sample);
+    if (p.leftCols<3>().determinant() < 0) p = -p;  // then (P X)_z > 0 in front of the camera
+    if (options.square_pixels) {
+      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one.
+      const Eigen::Matrix3d k = DecomposeProjection(p).K;
+      if (std::abs(k(0, 0) / k(1, 1) - 1) > options.max_aspect_deviation ||
+          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0))
+        continue;
+    }
+    std::vector<uint8_t> inliers(n, 0);
+    int count = 0;
+    double score = 0;
+    for (int i = 0; i < n; ++i) {
+      const bool in_front = (p.row(2) * pairs[i].point_in_world.homogeneous()) > 0;
+      const double e = in_front ? ProjectionError(p, pairs[i]) : std::numeric_limits<double>::infinity();
+      inliers[i] = e * e < t2;
+      count += inliers[i];
+      score += std::min(e * e, t2);  // MSAC: ties in count go to the tighter fit
+    }
+    if (count > best_count || (count == best_count && score < best_score)) {
+      best_count = count;
+      best_score = score;
+      best_inliers = inliers;
+      const double w = static_cast<double>(count) / n;
+      const double miss = 1.0 - std::pow(w, 6);
+      if (miss >= 1) {
+        // No information yet: keep the iteration budget.
+      } else if (miss <= 0) {
+        iterations_needed = iteration + 1;
+      } else {
+        const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
+        iterations_needed = static_cast<int>(std::min<double>(options.ransac_iterations, std::ceil(needed)));
+      }
+    }
+  }
+  if (best_count < 6)
+    ThrowInputError(what, "", "pairs",
+                    fmt::format("no 6 pairs agree on a camera within {} px (best set: {} inliers)",
+                                options.ransac_threshold_px, std::max(best_count, 0)));
+
+  // DLT on the inliers, decomposed; then LM, re-selection and LM again.
+  result.projection = NormalizedDlt(Select(pairs, best_inliers));
+  const PinholeCamera dlt_camera =
+      CameraFromProjection(result.projection, options.width_px, options.height_px);
+  result.dlt_rms_px = RmsOfInliers(dlt_camera, pairs, best_inliers);
+  result.camera = dlt_camera;
+  result.inlier = best_inliers;
+  if (options.refine) {
+    for (int round = 0; round < 2; ++round) {
+      const std::optional<PinholeCamera> refined =
+          Refine(result.camera, Select(pairs, result.inlier), options);
+      if (!refined) break;  // too few residuals for the free parameters
+      // Keep the refinement only when it is a camera that explains its inliers within the threshold (LM can
+      // run off from a poor start). Its RMS may exceed the DLT's: fixed skew and square pixels fit the noise
+      // less.
+      if (!(refined->fx_px > 0 && refined->fy_px > 0) ||
+          !(RmsOfInliers(*refined, pairs, result.inlier) < options.ransac_threshold_px))
+        break;
+      result.camera = *refined;
+      std::vector<uint8_t> inliers(n, 0);
+      for (int i = 0; i < n; ++i)
+        inliers[i] = ReprojectionError(result.camera, pairs[i]) < options.ransac_threshold_px;
+      if (std::count(inliers.begin(), inliers.end(), 1) < 6 || inliers == result.inlier) break;
+      result.inlier = inliers;
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    result.reprojection_error_px.push_back(ReprojectionError(result.camera, pairs[i]));
+  result.num_inliers = static_cast<int>(std::count(result.inlier.begin(), result.inlier.end(), 1));
+  result.rms_px = RmsOfInliers(result.camera, pairs, result.inlier);
+  return result;
+}
+
+ResectionResult ResectWithIntrinsics(std::span<const PixelPointPair> pairs, const PinholeCamera& intrinsics,
+                                     const ResectionOptions& options, const std::string& what) {
+  options.Check();
+  CheckResectionInput(pairs, options.degenerate_ratio, what, /*points_may_be_planar=*/true);
+  std::vector<cv::Point3d> object_points;
+  std::vector<cv::Point2d> image_points;
+  for (const PixelPointPair& pair : pairs) {
+    object_points.emplace_back(pair.point_in_world.x(), pair.point_in_world.y(), pair.point_in_world.z());
+    // OpenCV puts the centre of pixel (0, 0) at (0, 0).
+    image_points.emplace_back(pair.pixel_px.x() - 0.5, pair.pixel_px.y() - 0.5);
+  }
+  cv::Matx33d k(intrinsics.fx_px, intrinsics.skew_px, intrinsics.cx_px - 0.5, 0, intrinsics.fy_px,
+                intrinsics.cy_px - 0.5, 0, 0, 1);
+  const cv::Mat distortion =
+      (cv::Mat_<double>(1, 5) << intrinsics.k1, intrinsics.k2, intrinsics.p1, intrinsics.p2, intrinsics.k3);
+  cv::Mat rvec, tvec;
+  std::vector<int> inlier_indices;
+  cv::theRNG().state = options.seed;
+  const bool ok =
+      cv::solvePnPRansac(object_points, image_points, k, distortion, rvec, tvec, false,
+                         options.ransac_iterations, static_cast<float>(options.ransac_threshold_px),
+                         options.ransac_confidence, inlier_indices, cv::SOLVEPNP_EPNP);
+  if (!ok || inlier_indices.size() < 4)
+    ThrowInputError(what, "", "pairs", "solvePnPRansac found no pose consistent with the known intrinsics");
+  std::vector<cv::Point3d> inlier_objects;
+  std::vector<cv::Point2d> inlier_images;
+  for (int i : inlier_indices) {
+    inlier_objects.push_back(object_points[i]);
+    inlier_images.push_back(image_points[i]);
+  }
+  if (options.refine) cv::solvePnPRefineLM(inlier_objects, inlier_images, k, distortion, rvec, tvec);
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  Eigen::Matrix3d r;
+  cv::cv2eigen(cv::Mat(rotation), r);
+  Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  ResectionResult result;
+  result.camera = intrinsics;
+  result.camera.width_px = options.width_px;
+  result.camera.height_px = options.height_px;
+  result.camera.world_from_camera.setIdentity();
+  result.camera.world_from_camera.topLeftCorner<3, 3>() = r.transpose();
+  result.camera.world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
+  result.projection.leftCols<3>() = result.camera.K() * r;
+  result.projection.col(3) = result.camera.K() * t;
+  result.inlier.assign(pairs.size(), 0);
+  for (int i : inlier_indices) result.inlier[i] = 1;
+  for (const PixelPointPair& pair : pairs)
+    result.reprojection_error_px.push_back(ReprojectionError(result.camera, pair));
+  result.num_inliers = static_cast<int>(inlier_indices.size());
+  result.rms_px = result.dlt_rms_px = RmsOfInliers(result.camera, pairs, result.inlier);
+  return result;
+}
+
+}  // namespace lidarshop

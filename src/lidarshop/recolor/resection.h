@@ -1,0 +1,112 @@
+// Resectioning: the camera that took a photo, from 2-D/3-D correspondences (thesis 3.2.2).
+//
+//   1. Normalized DLT (thesis eqs. 3.1–3.6; Hartley & Zisserman alg. 7.1): pixels moved to zero mean and mean
+//      distance √2, points to zero mean and mean distance √3; the 2N x 12 system A p = 0 solved by the SVD
+//      (the right singular vector of the smallest singular value), then denormalized.
+//   2. RANSAC over minimal sets of 6 pairs (seeded: same result on any thread count; the loop is serial),
+//      inliers = pairs whose DLT reprojection error is below `ransac_threshold_px`; the DLT is refitted on
+//      the best set's inliers.
+//   3. P = K [R | t] decomposed by an RQ decomposition (K upper triangular with positive diagonal, R a
+//      rotation).
+//   4. Levenberg–Marquardt on the reprojection error of the inliers over focal length(s), principal point,
+//      optionally skew, radial (k1, k2, k3) and tangential (p1, p2) distortion, rotation (angle-axis) and
+//      translation; inliers are then re-selected with the refined camera and the refinement repeated once.
+//      The solver is Eigen's unsupported LevenbergMarquardt (MINPACK lmdif) with forward-difference
+//      Jacobians: a 16-parameter problem with at most a few hundred residuals needs no sparse solver, and it
+//      keeps lidarshop free of a new dependency (Ceres is not in the base image) while letting us free or
+//      fix any subset of the intrinsics, which OpenCV's solvePnPRefineLM (fixed intrinsics) cannot.
+//
+// Degenerate input is refused with an InputError naming the reason: fewer than 6 pairs, non-finite values,
+// collinear pixels, or all points on one plane (or a line) — a plane does not determine the intrinsics;
+// give them (`ResectWithIntrinsics`) for planar targets.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "lidarshop/geometry/camera.h"
+
+namespace lidarshop {
+
+// One correspondence: a photo pixel (continuous coordinates, geometry/camera.h) and the world point seen
+// there.
+struct PixelPointPair {
+  Eigen::Vector2d pixel_px = Eigen::Vector2d::Zero();
+  Eigen::Vector3d point_in_world = Eigen::Vector3d::Zero();
+};
+
+struct ResectionOptions {
+  int width_px = 0, height_px = 0;    // the photo's size (stored in the camera); required, > 0
+  double ransac_threshold_px = 4.0;   // a pair is an inlier when its reprojection error is below this, pixels
+  int ransac_iterations = 2000;       // most minimal sets tried (fewer when the confidence is reached)
+  double ransac_confidence = 0.9999;  // stop once a better set is this unlikely
+  uint64_t seed = 1;                  // RANSAC's random sets
+  bool refine = true;                 // false = the (RANSAC) DLT camera without Levenberg–Marquardt
+  bool square_pixels = true;          // refine one focal length (fx = fy)
+  // With square_pixels, RANSAC skips minimal-set cameras with |fx / fy − 1| or |skew| / fx above this (a set
+  // of 6 pairs fits almost any camera; an implausible one comes from outliers). Inliers must also lie in
+  // front of the camera.
+  double max_aspect_deviation = 0.2;
+  bool refine_skew = false;  // false = skew 0
+  // How many of k1, k2, k3 are refined (0–3). One by default: with 16-30 noisy pairs k2 fits the noise
+  // (a synthetic test reached 3 px error away from the pairs with k1, k2 free).
+  int radial_coefficients = 1;
+  bool refine_tangential = false;  // refine p1, p2
+  // Distortion is refined only with at least this many inliers (fewer pairs would fit the noise).
+  int min_inliers_for_distortion = 16;
+  // Points count as coplanar (or collinear) when the smallest spread of their centred coordinates is below
+  // this fraction of the largest; same for collinear pixels.
+  double degenerate_ratio = 1e-3;
+  void Check() const;  // throws OptionsError
+};
+
+struct ResectionResult {
+  PinholeCamera camera;                       // the final camera (refined unless options.refine is false)
+  Eigen::Matrix<double, 3, 4> projection;     // P of the DLT on the RANSAC inliers, pixels (scale: |P| = 1)
+  std::vector<double> reprojection_error_px;  // per pair (all pairs), with `camera`
+  std::vector<uint8_t> inlier;                // per pair: 1 = inlier
+  int num_inliers = 0;
+  double rms_px = 0;      // RMS reprojection error of the inliers with `camera`
+  double dlt_rms_px = 0;  // the same with the DLT camera (before refinement)
+  int ransac_iterations = 0;
+  std::string Summary() const;  // one line
+};
+
+// Thesis eqs. 3.1–3.6 with normalization: P (3x4, |P| = 1) from at least 6 pairs. No degeneracy check.
+Eigen::Matrix<double, 3, 4> NormalizedDlt(std::span<const PixelPointPair> pairs);
+
+// P = K [R | t]: K upper triangular with K(2, 2) = 1 and positive diagonal, R a rotation (camera_from_world).
+struct ProjectionFactors {
+  Eigen::Matrix3d K;
+  Eigen::Matrix3d camera_from_world_rotation;
+  Eigen::Vector3d camera_from_world_translation;
+};
+ProjectionFactors DecomposeProjection(const Eigen::Matrix<double, 3, 4>& projection);
+// The undistorted camera of a projection matrix.
+PinholeCamera CameraFromProjection(const Eigen::Matrix<double, 3, 4>& projection, int width_px,
+                                   int height_px);
+
+// Reprojection error of one pair with a camera (infinity when the point is behind the camera), pixels.
+double ReprojectionError(const PinholeCamera& camera, const PixelPointPair& pair);
+
+// Throws InputError (naming `what`) when the pairs cannot determine a camera: < 6 pairs, non-finite values,
+// collinear pixels, coplanar points (`points_may_be_planar` allows coplanar, non-collinear points).
+void CheckResectionInput(std::span<const PixelPointPair> pairs, double degenerate_ratio,
+                         const std::string& what, bool points_may_be_planar = false);
+
+// Steps 1–4 above. `what` names the source of the pairs in errors.
+ResectionResult Resection(std::span<const PixelPointPair> pairs, const ResectionOptions& options,
+                          const std::string& what = "correspondences");
+
+// Pose only, with known intrinsics (and distortion) in `intrinsics` (its pose is ignored): OpenCV's
+// solvePnPRansac (EPnP minimal sets, seeded through cv::theRNG) then solvePnPRefineLM on the inliers. Works
+// for planar targets; needs at least 4 pairs. The baseline of bench/results/recolor.md.
+ResectionResult ResectWithIntrinsics(std::span<const PixelPointPair> pairs, const PinholeCamera& intrinsics,
+                                     const ResectionOptions& options,
+                                     const std::string& what = "correspondences");
+
+}  // namespace lidarshop

@@ -1,0 +1,149 @@
+#include "lidarshop/recolor/resection.h"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "lidarshop/geometry/transform.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+PinholeCamera TrueCamera() {
+  PinholeCamera camera;
+  camera.width_px = 1024;
+  camera.height_px = 768;
+  camera.fx_px = camera.fy_px = 850;
+  camera.cx_px = 515.3;
+  camera.cy_px = 380.9;
+  // Looking along +y (world) from beside a scanner: camera z = world y, camera x = world x, camera y = -z.
+  camera.world_from_camera = ComposeTransform({1.5, 0.3, 1.4}, {-92, 3, 8});
+  return camera;
+}
+
+// `count` points 3-9 m in front of the camera, seen inside the image; noise on the pixels and a fraction of
+// outliers (pixels moved by 20-200 px). `noise_px` is the RMS length of the pixel error (σ = noise / √2 per
+// axis). `truth` gets the noise-free pairs.
+std::vector<PixelPointPair> MakePairs(const PinholeCamera& camera, int count, double noise_px,
+                                      double outlier_fraction, uint64_t seed,
+                                      std::vector<PixelPointPair>* truth = nullptr) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::normal_distribution<double> gauss(0, noise_px / std::sqrt(2.0));
+  std::vector<PixelPointPair> pairs;
+  const int outliers = static_cast<int>(std::round(outlier_fraction * count));
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector2d pixel(20 + unit(rng) * (camera.width_px - 40),
+                                20 + unit(rng) * (camera.height_px - 40));
+    const double depth = 3 + 6 * unit(rng);
+    const Eigen::Vector3d in_camera = depth * UnprojectPixel(camera, pixel);
+    PixelPointPair pair{
+        pixel, camera.world_from_camera.topLeftCorner<3, 3>() * in_camera + camera.center_in_world()};
+    if (truth) truth->push_back(pair);
+    pair.pixel_px += Eigen::Vector2d(gauss(rng), gauss(rng));
+    if (i < outliers) {
+      const double angle = 2 * M_PI * unit(rng), length = 20 + 180 * unit(rng);
+      pair.pixel_px += length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    }
+    pairs.push_back(pair);
+  }
+  return pairs;
+}
+
+double Rms(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs) {
+  double sum = 0;
+  for (const PixelPointPair& pair : pairs) sum += std::pow(ReprojectionError(camera, pair), 2);
+  return std::sqrt(sum / pairs.size());
+}
+
+ResectionOptions Options(const PinholeCamera& camera) {
+  ResectionOptions options;
+  options.width_px = camera.width_px;
+  options.height_px = camera.height_px;
+  return options;
+}
+
+TEST(Resection, DltIsExactWithoutNoiseAndDecomposesIntoTheTrueCamera) {
+  const PinholeCamera truth = TrueCamera();
+  const std::vector<PixelPointPair> pairs = MakePairs(truth, 8, 0.0, 0.0, 3);
+  const PinholeCamera camera = CameraFromProjection(NormalizedDlt(pairs), truth.width_px, truth.height_px);
+  EXPECT_NEAR(camera.fx_px, truth.fx_px, 1e-5);
+  EXPECT_NEAR(camera.fy_px, truth.fy_px, 1e-5);
+  EXPECT_NEAR(camera.cx_px, truth.cx_px, 1e-5);
+  EXPECT_NEAR(camera.cy_px, truth.cy_px, 1e-5);
+  EXPECT_NEAR(camera.skew_px, 0, 1e-5);
+  EXPECT_LT((camera.world_from_camera - truth.world_from_camera).norm(), 1e-7);
+  EXPECT_LT(Rms(camera, pairs), 1e-6);
+}
+
+TEST(Resection, RansacAndRefinementMeetTheTargetWithNoiseAndOutliers) {
+  const PinholeCamera truth = TrueCamera();
+  for (int count : {10, 20, 40}) {
+    double sum_rms = 0;
+    for (uint64_t seed = 1; seed <= 8; ++seed) {
+      std::vector<PixelPointPair> exact;
+      const std::vector<PixelPointPair> pairs = MakePairs(truth, count, 0.5, 0.2, seed, &exact);
+      const ResectionResult result = Resection(pairs, Options(truth));
+      // The outliers (the first 20 %) are found, every other pair is kept.
+      for (int i = 0; i < count; ++i) EXPECT_EQ(result.inlier[i], i >= std::round(0.2 * count) ? 1 : 0) << i;
+      // Single draws of the noise can exceed 0.5 px (10 pairs = 8 inliers: 16 residuals for 9 unknowns); the
+      // mean over draws stays under 0.5 px.
+      const double rms_true = Rms(result.camera, exact);
+      sum_rms += rms_true;
+      EXPECT_LT(rms_true, 0.75) << count << " pairs, seed " << seed;
+      EXPECT_LT(result.rms_px, 1.0);
+      EXPECT_LT((result.camera.center_in_world() - truth.center_in_world()).norm(), 0.1);
+    }
+    EXPECT_LT(sum_rms / 8, 0.5) << count << " pairs";
+  }
+}
+
+TEST(Resection, SameSeedSameCamera) {
+  const PinholeCamera truth = TrueCamera();
+  const std::vector<PixelPointPair> pairs = MakePairs(truth, 25, 0.5, 0.2, 9);
+  const ResectionResult a = Resection(pairs, Options(truth));
+  const ResectionResult b = Resection(pairs, Options(truth));
+  EXPECT_EQ(a.camera.world_from_camera, b.camera.world_from_camera);
+  EXPECT_EQ(a.camera.fx_px, b.camera.fx_px);
+}
+
+TEST(Resection, KnownIntrinsicsHandlePlanarTargets) {
+  PinholeCamera truth = TrueCamera();
+  std::vector<PixelPointPair> pairs = MakePairs(truth, 12, 0.0, 0.0, 4);
+  for (PixelPointPair& pair : pairs) pair.point_in_world.y() = 6.0;  // a wall; project again
+  for (PixelPointPair& pair : pairs)
+    ASSERT_TRUE(ProjectWorldPoint(truth, pair.point_in_world, &pair.pixel_px));
+  EXPECT_THROW(Resection(pairs, Options(truth)), InputError);
+  const ResectionResult result = ResectWithIntrinsics(pairs, truth, Options(truth));
+  EXPECT_LT(result.rms_px, 1e-3);
+  EXPECT_LT((result.camera.world_from_camera - truth.world_from_camera).norm(), 1e-4);
+}
+
+TEST(Resection, RefusesDegenerateInputWithAReason) {
+  const PinholeCamera truth = TrueCamera();
+  const auto message = [&](std::vector<PixelPointPair> pairs) -> std::string {
+    try {
+      Resection(pairs, Options(truth), "c.json");
+    } catch (const InputError& error) {
+      return error.what();
+    }
+    return "";
+  };
+  EXPECT_NE(message(MakePairs(truth, 5, 0, 0, 1)).find("at least 6 pairs, got 5"), std::string::npos);
+  std::vector<PixelPointPair> nan = MakePairs(truth, 10, 0, 0, 1);
+  nan[3].point_in_world.z() = std::nan("");
+  EXPECT_NE(message(nan).find("c.json: pairs[3]"), std::string::npos) << message(nan);
+  std::vector<PixelPointPair> collinear = MakePairs(truth, 10, 0, 0, 1);
+  for (PixelPointPair& pair : collinear) pair.pixel_px.y() = 2 * pair.pixel_px.x() - 100;
+  EXPECT_NE(message(collinear).find("collinear"), std::string::npos);
+  std::vector<PixelPointPair> planar = MakePairs(truth, 10, 0, 0, 1);
+  for (PixelPointPair& pair : planar) pair.point_in_world.z() = 0.5;
+  EXPECT_NE(message(planar).find("one plane"), std::string::npos);
+  ResectionOptions no_size;
+  EXPECT_THROW(Resection(MakePairs(truth, 10, 0, 0, 1), no_size), OptionsError);
+}
+
+}  // namespace
+}  // namespace lidarshop

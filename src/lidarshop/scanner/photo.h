@@ -1,0 +1,36 @@
+// The synthetic camera: what a pinhole camera (geometry/camera.h) sees in a scene, with the scanner's own
+// colours (material, triangle and vertex colours, image textures, procedural textures band-limited to the
+// pixel's footprint: scanner/shade.h, scanner/texture.h), unlit like the scanner's colour channel. Ground
+// truth for resectioning and recolouring (recolor/): tests know the true camera of the photo.
+//
+// Each pixel (x, y) casts the ray of its centre (x + 0.5, y + 0.5) through the camera's distortion (or
+// `samples_per_axis`² rays on a regular sub-grid, averaged) with Embree (raycast/), from the camera centre.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/geometry/camera.h"
+#include "lidarshop/geometry/mesh.h"
+#include "lidarshop/scanner/scene.h"
+
+namespace lidarshop {
+
+struct PhotoOptions {
+  Rgb8 background = Rgb8(0, 0, 0);  // colour of rays that hit nothing (sky)
+  int samples_per_axis = 1;         // 1..8: rays per pixel = samples², box-filtered (anti-aliased edges)
+  double max_range_m = 1000.0;      // farther hits count as background, metres
+  void Check() const;               // throws OptionsError
+};
+
+struct Photo {
+  cv::Mat image;    // CV_8UC3 RGB, camera.height_px x camera.width_px
+  cv::Mat label;    // CV_32S: the label of the object seen by the pixel centre, kNoLabel for background
+  cv::Mat depth_m;  // CV_32F: distance from the camera centre to the surface seen by the pixel centre, +inf
+                    // for background
+};
+
+// Renders the scene seen by `camera` (camera.Check() must pass; throws InputError otherwise).
+Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera,
+                  const PhotoOptions& options = {});
+
+}  // namespace lidarshop
