@@ -232,6 +232,32 @@ fails_clearly "fill: unknown method" "method" "$lidarshop" fill "$work/scan.ptx"
 fails_clearly "remove: two layers in PTX" "PTX" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
   -o "$work/x.ptx" --keep-object --quiet
 
+# points and register (docs/points.md): every scan keeps its grid; clouds for voxel and merge.
+check "points outliers" "$lidarshop" points outliers "$work/scan.ptx" -o "$work/clean.ptx" --json "$work/clean.json"
+json_check "points outliers summary" "$work/clean.json" "0 < d['output_points'] < d['input_points']"
+check "points crop polygon" "$lidarshop" points crop "$work/scan.ptx" -o "$work/crop.ply" \
+  --polygon=-3,7,-1,7,-1,9,-3,9 --json "$work/crop.json"
+json_check "points crop keeps the box" "$work/crop.json" "100 < d['output_points'] < 2000"
+check "points voxel" "$lidarshop" points voxel "$work/scan.ptx" -o "$work/voxel.ply" --voxel 0.2
+check "points normals" "$lidarshop" points normals "$work/scan.ptx" -o "$work/normals.ptx" --grid
+check "points planes" "$lidarshop" points planes "$work/scan.ptx" -o "$work/planes.ply" --planes 2 --distance 0.02 \
+  --json "$work/planes.json"
+json_check "points planes: the ground first" "$work/planes.json" \
+  "len(d['planes']) == 2 and abs(abs(d['planes'][0]['normal'][2]) - 1) < 1e-3"
+check "points cluster" "$lidarshop" points cluster "$work/scan.ptx" -o "$work/clusters.ply" --radius 0.3 \
+  --json "$work/clusters.json"
+check "points transform" "$lidarshop" points transform "$work/scan.ptx" -o "$work/moved.ptx" \
+  --matrix 1,0,0,0.05,0,1,0,0.02,0,0,1,0,0,0,0,1
+check "register" "$lidarshop" register "$work/scan.ptx" "$work/moved.ptx" -o "$work/registered.ptx" \
+  --json "$work/register.json"
+json_check "register undoes the move" "$work/register.json" \
+  "d['converged'] and abs(d['world_from_scanner'][0][3]) < 1e-3 and abs(d['world_from_scanner'][1][3]) < 1e-3"
+fails_clearly "points: k larger than the cloud" "larger than the cloud" "$lidarshop" points kmeans "$work/scan.ptx" \
+  -o "$work/x.ply" --k 100000000
+fails_clearly "points: radius 0" "radius_m must be > 0" "$lidarshop" points outliers "$work/scan.ptx" \
+  -o "$work/x.ply" --method radius --radius 0
+fails_clearly "points: unknown operation" "unknown operation" "$lidarshop" points smooth "$work/scan.ptx" -o "$work/x.ply"
+
 # The demo on a small built-in scene.
 check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet
 json_check "demo summary" "$work/demo/summary.json" "d['scene'] == 'mailbox' and d['scan']['valid'] > 0"

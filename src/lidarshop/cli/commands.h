@@ -21,6 +21,8 @@ int RunInpaint(int argc, char** argv);  // inpaint_command.cc
 int RunPoisson(int argc, char** argv);  // poisson_command.cc
 int RunFill(int argc, char** argv);     // fill_command.cc
 int RunRemove(int argc, char** argv);   // fill_command.cc
+int RunPoints(int argc, char** argv);    // points_command.cc
+int RunRegister(int argc, char** argv);  // points_command.cc
 
 // Parses argv with `app` and runs `body`, turning every exception into one line on stderr
 // ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.
