@@ -286,6 +286,12 @@ int RunRegister(int argc, char** argv) {
       "register"};
   std::string fixed_path, moving_path, output_path, json_path;
   IcpOptions options;
+  GlobalAlignOptions global;
+  bool use_global = false;
+  app.add_flag("--global", use_global, "no usable pose: align FPFH features by RANSAC first");
+  app.add_option("--voxel", global.voxel_m, "--global: voxel size of the feature clouds, metres")->capture_default_str();
+  app.add_option("--feature-radius", global.feature_radius_m, "--global: FPFH radius, metres")->capture_default_str();
+  app.add_option("--seed", global.seed, "--global: RANSAC seed")->capture_default_str();
   app.add_option("fixed", fixed_path, "the scan that stays (its first scan)")->required();
   app.add_option("moving", moving_path, "the scan to move (its first scan)")->required();
   app.add_option("-o,--output", output_path, "the moving scan with its new pose")->required();
@@ -295,11 +301,12 @@ int RunRegister(int argc, char** argv) {
   app.add_option("--iterations", options.max_iterations, "ICP iterations at most")->capture_default_str();
   return RunCommand(app, argc, argv, [&]() {
     options.Check();
+    if (use_global) global.Check();
     CheckOutputs(output_path, json_path, {fixed_path, moving_path});
     const Timer timer;
     const ScanFile fixed = ReadScanFile(fixed_path), moving = ReadScanFile(moving_path);
     if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
-    const ScanRegistration result = RegisterScans(fixed.scans[0], moving.scans[0], options);
+    const ScanRegistration result = RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
     WriteScanFile(output_path, {result.registered});
     std::vector<std::vector<double>> rows;
     for (int r = 0; r < 4; ++r) {

@@ -128,11 +128,17 @@ IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
   return result;
 }
 
-ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options) {
-  const PointCloud fixed_in_world = ToPointCloud(fixed, true);
-  const PointCloud moving_in_world = ToPointCloud(moving, true);
+ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options,
+                               const GlobalAlignOptions* global) {
+  // Scans without normals get grid normals: oriented toward their scanner, which FPFH needs.
+  const NormalOptions grid_normals;
+  const PointCloud fixed_in_world = ToPointCloud(fixed.normal.empty() ? WithGridNormals(fixed, grid_normals) : fixed, true);
+  const PointCloud moving_in_world =
+      ToPointCloud(moving.normal.empty() ? WithGridNormals(moving, grid_normals) : moving, true);
+  const Eigen::Matrix4d initial = global ? AlignGlobally(fixed_in_world, moving_in_world, *global).fixed_from_moving
+                                         : Eigen::Matrix4d::Identity();
   ScanRegistration out;
-  out.icp = IcpPointToPlane(fixed_in_world, moving_in_world, Eigen::Matrix4d::Identity(), options);
+  out.icp = IcpPointToPlane(fixed_in_world, moving_in_world, initial, options);
   out.registered = moving;
   out.registered.world_from_scanner = out.icp.fixed_from_moving * moving.world_from_scanner;
   return out;

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/pointset/features.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop {
@@ -45,11 +46,13 @@ IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
                           const Eigen::Matrix4d& initial_fixed_from_moving, const IcpOptions& options);
 
 // Registers `moving` onto `fixed` (both in their world frames, moving's world_from_scanner as the initial
-// guess) and returns the moving scan with world_from_scanner corrected.
+// guess, or with `global` a FPFH + RANSAC alignment first) and returns the moving scan with world_from_scanner
+// corrected.
 struct ScanRegistration {
   Scan registered;   // the moving scan, new world_from_scanner
   IcpResult icp;     // fixed_from_moving = the correction applied in world coordinates
 };
-ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options);
+ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options,
+                               const GlobalAlignOptions* global = nullptr);
 
 }  // namespace lidarshop

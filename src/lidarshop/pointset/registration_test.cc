@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/geometry/transform.h"
+#include "lidarshop/pointset/features.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
@@ -66,6 +67,29 @@ TEST(RegistrationTest, IcpRecoversTheRelativePoseOfTwoScans) {
   // Same answer on one thread.
   ThreadLimit one(1);
   EXPECT_EQ(RegisterScans(fixed, moving, {.max_correspondence_m = 0.3}).registered.world_from_scanner, found);
+}
+
+TEST(RegistrationTest, FpfhRansacThenIcpWithoutAGuess) {
+  const SceneDescription scene = ThreeBoxScene();
+  const Scan fixed = testing::ScanScene(scene, Scanner(scene, {0, 0, 1.5}, 0.0));
+  const Scan moving_true = testing::ScanScene(scene, Scanner(scene, {0.8, -0.6, 1.6}, 8.0));
+  // No usable guess: 1.2 m and 30° off.
+  Scan moving = moving_true;
+  moving.world_from_scanner = ComposeTransform({1.0, -0.7, 0.1}, {0, 0, 30}) * moving_true.world_from_scanner;
+  const PointCloud fixed_cloud = ToPointCloud(fixed, true), moving_cloud = ToPointCloud(moving, true);
+  const GlobalAlignResult global = AlignGlobally(fixed_cloud, moving_cloud, {.voxel_m = 0.2, .feature_radius_m = 0.8, .inlier_distance_m = 0.3});
+  const IcpResult icp = IcpPointToPlane(fixed_cloud, moving_cloud, global.fixed_from_moving, {});
+  const Eigen::Matrix4d found = icp.fixed_from_moving * moving.world_from_scanner;
+  const Eigen::Matrix4d& truth = moving_true.world_from_scanner;
+  const Eigen::Matrix4d rough = global.fixed_from_moving * moving.world_from_scanner;
+  std::printf("global: %lld matches, %lld inliers, off by %.3g m and %.3g deg; after ICP %.3g m, %.3g deg\n",
+              static_cast<long long>(global.matches), static_cast<long long>(global.inliers),
+              (rough.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), AngleDeg(rough, truth),
+              (found.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), AngleDeg(found, truth));
+  EXPECT_LT((rough.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), 0.2);
+  EXPECT_LT(AngleDeg(rough, truth), 3.0);
+  EXPECT_LT((found.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), 0.001);
+  EXPECT_LT(AngleDeg(found, truth), 0.01);
 }
 
 TEST(RegistrationTest, BadInput) {
