@@ -252,6 +252,8 @@ check "register" "$lidarshop" register "$work/scan.ptx" "$work/moved.ptx" -o "$w
   --json "$work/register.json"
 json_check "register undoes the move" "$work/register.json" \
   "d['converged'] and abs(d['world_from_scanner'][0][3]) < 1e-3 and abs(d['world_from_scanner'][1][3]) < 1e-3"
+check "points mesh" "$lidarshop" points mesh "$work/clean.ptx" -o "$work/grid_mesh.ply" --json "$work/mesh.json"
+json_check "points mesh summary" "$work/mesh.json" "d['triangles'] > 1000"
 fails_clearly "points: k larger than the cloud" "larger than the cloud" "$lidarshop" points kmeans "$work/scan.ptx" \
   -o "$work/x.ply" --k 100000000
 fails_clearly "points: radius 0" "radius_m must be > 0" "$lidarshop" points outliers "$work/scan.ptx" \
