@@ -254,6 +254,11 @@ json_check "register undoes the move" "$work/register.json" \
   "d['converged'] and abs(d['world_from_scanner'][0][3]) < 1e-3 and abs(d['world_from_scanner'][1][3]) < 1e-3"
 check "points mesh" "$lidarshop" points mesh "$work/clean.ptx" -o "$work/grid_mesh.ply" --json "$work/mesh.json"
 json_check "points mesh summary" "$work/mesh.json" "d['triangles'] > 1000"
+check "points regions" "$lidarshop" points regions "$work/scan.ptx" -o "$work/regions.ply" --min-cells 20 \
+  --json "$work/regions.json"
+json_check "points regions summary" "$work/regions.json" "d['regions'] >= 3"
+check "points superpixels" "$lidarshop" points superpixels "$work/scan.ptx" -o "$work/superpixels.ptx" \
+  --superpixel-method graph
 fails_clearly "points: k larger than the cloud" "larger than the cloud" "$lidarshop" points kmeans "$work/scan.ptx" \
   -o "$work/x.ply" --k 100000000
 fails_clearly "points: radius 0" "radius_m must be > 0" "$lidarshop" points outliers "$work/scan.ptx" \

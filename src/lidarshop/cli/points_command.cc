@@ -22,7 +22,9 @@
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
+#include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -145,7 +147,7 @@ void CheckOutputs(const std::string& output, const std::string& json, const std:
 int RunPoints(int argc, char** argv) {
   CLI::App app{
       "Point-set tools over scans and clouds (docs/points.md). OPERATION: outliers | voxel | sample | crop | "
-      "transform | merge | normals | planes | cluster | kmeans | mesh. Scans keep their grid where the operation allows.",
+      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels. Scans keep their grid where the operation allows.",
       "points"};
   std::string operation, output_path, json_path, method = "statistical";
   std::vector<std::string> inputs;
@@ -160,6 +162,10 @@ int RunPoints(int argc, char** argv) {
   KMeansOptions kmeans;
   double voxel_m = 0.05;
   ScanMeshOptions mesh_options;
+  RegionGrowingOptions region_options;
+  double max_angle_deg = 10.0;
+  SuperpixelOptions superpixel_options;
+  std::string superpixel_method = "slic";
   mesh_options.world_frame = true;
   int64_t count = 100000;
   uint64_t seed = 1;
@@ -193,6 +199,13 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--min-points", clusters.min_points, "cluster: smaller clusters are noise")->capture_default_str();
   app.add_option("--mesh-jump", mesh_options.max_range_jump_ratio,
                  "mesh: drop edges whose ranges differ by more than this fraction of the nearer range")
+      ->capture_default_str();
+  app.add_option("--max-angle", max_angle_deg, "regions: largest normal angle between neighbours, degrees")
+      ->capture_default_str();
+  app.add_option("--min-cells", region_options.min_region_cells, "regions: smaller regions get no label")
+      ->capture_default_str();
+  app.add_option("--superpixel-method", superpixel_method, "superpixels: slic | graph")->capture_default_str();
+  app.add_option("--region-cells", superpixel_options.region_cells, "superpixels (slic): side, cells")
       ->capture_default_str();
   app.add_option("--k", kmeans.clusters, "kmeans: clusters")->capture_default_str();
   return RunCommand(app, argc, argv, [&]() {
@@ -247,6 +260,28 @@ int RunPoints(int argc, char** argv) {
       WriteMesh(output_path, mesh);
       WriteSummary(json_path, summary);
       return 0;
+    } else if (operation == "regions" || operation == "superpixels") {
+      // Per scan, over its grid: labels into the scan's label channel.
+      int total = 0;
+      for (const Scan& scan : g.scans) {
+        Scan labelled = scan;
+        int count = 0;
+        if (operation == "regions") {
+          const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
+          labelled.label = SegmentByRegionGrowing(scan, region_options, NormalAngleCondition(with_normals, max_angle_deg),
+                                                  &count);
+        } else {
+          if (superpixel_method != "slic" && superpixel_method != "graph") {
+            throw OptionsError(fmt::format("--superpixel-method '{}': expected slic or graph", superpixel_method));
+          }
+          superpixel_options.method = superpixel_method == "slic" ? SuperpixelMethod::kSlic : SuperpixelMethod::kGraph;
+          labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
+          labelled.label.setTo(kNoLabel, scan.valid == 0);
+        }
+        total += count;
+        scans_out.push_back(labelled);
+      }
+      summary[operation] = total;
     } else if (operation == "transform") {
       if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
       const Eigen::Matrix4d new_from_world = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
@@ -285,7 +320,7 @@ int RunPoints(int argc, char** argv) {
       scans_out = WithLabels(g, result.labels);
     } else {
       throw OptionsError(fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                                     "normals, planes, cluster, kmeans, mesh)", operation));
+                                     "normals, planes, cluster, kmeans, mesh, regions, superpixels)", operation));
     }
     summary["seconds"] = timer.Seconds();
     if (as_cloud) {
