@@ -244,6 +244,9 @@ check "points planes" "$lidarshop" points planes "$work/scan.ptx" -o "$work/plan
   --json "$work/planes.json"
 json_check "points planes: the ground first" "$work/planes.json" \
   "len(d['planes']) == 2 and abs(abs(d['planes'][0]['normal'][2]) - 1) < 1e-3"
+check "points planes --hough" "$lidarshop" points planes "$work/scan.ptx" -o "$work/hough.ply" --hough \
+  --distance 0.02 --min-inliers 100 --json "$work/hough.json"
+json_check "points planes --hough: the ground" "$work/hough.json" "abs(abs(d['planes'][0]['normal'][2]) - 1) < 1e-3"
 check "points cluster" "$lidarshop" points cluster "$work/scan.ptx" -o "$work/clusters.ply" --radius 0.3 \
   --json "$work/clusters.json"
 check "points transform" "$lidarshop" points transform "$work/scan.ptx" -o "$work/moved.ptx" \

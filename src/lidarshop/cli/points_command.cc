@@ -20,6 +20,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/pointset/clustering.h"
 #include "lidarshop/pointset/filters.h"
+#include "lidarshop/pointset/hough_planes.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
@@ -158,6 +159,8 @@ int RunPoints(int argc, char** argv) {
   NormalOptions normals;
   bool grid = false;
   RansacPlaneOptions planes;
+  HoughPlaneOptions hough_options;
+  bool hough = false;
   EuclideanClusterOptions clusters;
   KMeansOptions kmeans;
   double voxel_m = 0.05;
@@ -194,6 +197,9 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")->capture_default_str();
   app.add_option("--distance", planes.distance_threshold_m, "planes: inlier distance, metres")->capture_default_str();
   app.add_option("--iterations", planes.max_iterations, "planes: RANSAC hypotheses at most")->capture_default_str();
+  app.add_flag("--hough", hough, "planes: Hough detection (ball accumulator) instead of RANSAC");
+  app.add_option("--angle-step", hough_options.angle_step_deg, "planes --hough: normal resolution, degrees")
+      ->capture_default_str();
   app.add_option("--planes", planes.max_planes, "planes: how many, sequentially")->capture_default_str();
   app.add_option("--min-inliers", planes.min_inliers, "planes: stop below this")->capture_default_str();
   app.add_option("--min-points", clusters.min_points, "cluster: smaller clusters are noise")->capture_default_str();
@@ -296,7 +302,12 @@ int RunPoints(int argc, char** argv) {
       }
     } else if (operation == "planes") {
       planes.seed = seed;
-      const std::vector<PlaneFit> fits = DetectPlanesRansac(g.cloud, planes);
+      hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
+      hough_options.max_planes = planes.max_planes;
+      hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
+      hough_options.seed = seed;
+      const std::vector<PlaneFit> fits =
+          hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
       std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
       summary["planes"] = nlohmann::json::array();
       for (size_t p = 0; p < fits.size(); ++p) {

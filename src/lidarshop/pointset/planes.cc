@@ -24,24 +24,6 @@ struct Hypothesis {
   int64_t inliers = -1;  // -1 = degenerate sample
 };
 
-// Least-squares plane through the points (normal = smallest eigenvector of the covariance).
-void Refit(const std::vector<Eigen::Vector3f>& points, PlaneFit* fit) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (uint32_t i : fit->inliers) mean += points[i].cast<double>();
-  mean /= static_cast<double>(fit->inliers.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (uint32_t i : fit->inliers) {
-    const Eigen::Vector3d d = points[i].cast<double>() - mean;
-    covariance += d * d.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-  Eigen::Vector3d normal = solver.eigenvectors().col(0).normalized();
-  if (normal.dot(fit->normal) < 0.0) normal = -normal;  // keep the hypothesis's side
-  fit->normal = normal;
-  fit->offset_m = -normal.dot(mean);
-  fit->rms_m = std::sqrt(std::max(0.0, solver.eigenvalues()[0]) / static_cast<double>(fit->inliers.size()));
-}
-
 PlaneFit FitAmong(const std::vector<Eigen::Vector3f>& points, const std::vector<uint32_t>& candidates,
                   const RansacPlaneOptions& options, std::mt19937_64* random) {
   const int64_t n = static_cast<int64_t>(candidates.size());
@@ -90,7 +72,7 @@ PlaneFit FitAmong(const std::vector<Eigen::Vector3f>& points, const std::vector<
   for (uint32_t i : candidates) {
     if (std::abs(fit.Distance(points[i])) <= threshold) fit.inliers.push_back(i);
   }
-  Refit(points, &fit);
+  RefitPlane(points, &fit);
   // The refitted plane's own inliers (usually a few more than the hypothesis's).
   std::vector<uint32_t> refined;
   for (uint32_t i : candidates) {
@@ -98,12 +80,29 @@ PlaneFit FitAmong(const std::vector<Eigen::Vector3f>& points, const std::vector<
   }
   if (refined.size() >= fit.inliers.size()) {
     fit.inliers = std::move(refined);
-    Refit(points, &fit);
+    RefitPlane(points, &fit);
   }
   return fit;
 }
 
 }  // namespace
+
+void RefitPlane(const std::vector<Eigen::Vector3f>& points, PlaneFit* fit) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (uint32_t i : fit->inliers) mean += points[i].cast<double>();
+  mean /= static_cast<double>(fit->inliers.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (uint32_t i : fit->inliers) {
+    const Eigen::Vector3d d = points[i].cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  Eigen::Vector3d normal = solver.eigenvectors().col(0).normalized();
+  if (normal.dot(fit->normal) < 0.0) normal = -normal;  // keep the hypothesis's side
+  fit->normal = normal;
+  fit->offset_m = -normal.dot(mean);
+  fit->rms_m = std::sqrt(std::max(0.0, solver.eigenvalues()[0]) / static_cast<double>(fit->inliers.size()));
+}
 
 void RansacPlaneOptions::Check() const {
   CheckOption(distance_threshold_m > 0.0,

@@ -34,6 +34,10 @@ struct PlaneFit {
   double Distance(const Eigen::Vector3f& point) const { return normal.dot(point.cast<double>()) + offset_m; }
 };
 
+// Least-squares plane through points[fit->inliers] (normal = smallest eigenvector of their covariance, on the
+// side of the current fit->normal); sets normal, offset_m and rms_m.
+void RefitPlane(const std::vector<Eigen::Vector3f>& points, PlaneFit* fit);
+
 // The plane with most inliers. Throws InputError on fewer than 3 points or identical points.
 PlaneFit FitPlaneRansac(const PointCloud& cloud, const RansacPlaneOptions& options);
 

