@@ -262,6 +262,9 @@ check "points regions" "$lidarshop" points regions "$work/scan.ptx" -o "$work/re
 json_check "points regions summary" "$work/regions.json" "d['regions'] >= 3"
 check "points superpixels" "$lidarshop" points superpixels "$work/scan.ptx" -o "$work/superpixels.ptx" \
   --superpixel-method graph
+check "points sample-mesh" "$lidarshop" points sample-mesh "$work/grid_mesh.ply" -o "$work/mesh_samples.ply" \
+  --count 5000 --json "$work/mesh_samples.json"
+json_check "points sample-mesh summary" "$work/mesh_samples.json" "d['output_points'] == 5000"
 fails_clearly "points: k larger than the cloud" "larger than the cloud" "$lidarshop" points kmeans "$work/scan.ptx" \
   -o "$work/x.ply" --k 100000000
 fails_clearly "points: radius 0" "radius_m must be > 0" "$lidarshop" points outliers "$work/scan.ptx" \

@@ -24,6 +24,7 @@
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
+#include "lidarshop/pointset/sampling.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/scanner/scan_mesh.h"
@@ -148,7 +149,7 @@ void CheckOutputs(const std::string& output, const std::string& json, const std:
 int RunPoints(int argc, char** argv) {
   CLI::App app{
       "Point-set tools over scans and clouds (docs/points.md). OPERATION: outliers | voxel | sample | crop | "
-      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels. Scans keep their grid where the operation allows.",
+      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels | sample-mesh (IN = a triangle mesh). Scans keep their grid where the operation allows.",
       "points"};
   std::string operation, output_path, json_path, method = "statistical";
   std::vector<std::string> inputs;
@@ -182,7 +183,7 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--radius", radius_outliers.radius_m, "outliers, normals, cluster: radius, metres")->capture_default_str();
   app.add_option("--min-neighbors", radius_outliers.min_neighbors, "radius outliers")->capture_default_str();
   app.add_option("--voxel", voxel_m, "voxel: cube side, metres")->capture_default_str();
-  app.add_option("--count", count, "sample: points to keep")->capture_default_str();
+  app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")->capture_default_str();
   app.add_option("--seed", seed, "sample, planes, kmeans: seed")->capture_default_str();
   app.add_option("--box", box_text, "crop: xmin,ymin,zmin,xmax,ymax,zmax (world, metres)");
   app.add_option("--polygon", polygon_text, "crop: x1,y1,x2,y2,... (world xy, metres)");
@@ -225,6 +226,24 @@ int RunPoints(int argc, char** argv) {
     const std::vector<double> box = ParseNumbers(box_text, "--box"), polygon = ParseNumbers(polygon_text, "--polygon"),
                               matrix = ParseNumbers(matrix_text, "--matrix");
     if (!box.empty() && box.size() != 6) throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+    if (operation == "sample-mesh") {
+      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles' normals.
+      if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
+      if (FileExtension(output_path) != "ply") throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
+      const TriangleMesh mesh = ReadMesh(inputs[0]);
+      if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
+      CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
+      const Timer timer;
+      SurfaceSamples samples = SampleSurface(mesh, count, seed);
+      PointCloud cloud;
+      cloud.points = std::move(samples.points);
+      cloud.normals = std::move(samples.normals);
+      const double seconds = timer.Seconds();
+      WritePointCloud(output_path, cloud);
+      WriteSummary(json_path, {{"operation", operation}, {"triangles", mesh.num_triangles()},
+                               {"output_points", cloud.size()}, {"seconds", seconds}});
+      return 0;
+    }
     const Timer read_timer;
     const Gathered g = Gather(inputs);
     nlohmann::json summary = {{"operation", operation}, {"input_points", g.cloud.size()}, {"scans", g.scans.size()},
@@ -331,7 +350,7 @@ int RunPoints(int argc, char** argv) {
       scans_out = WithLabels(g, result.labels);
     } else {
       throw OptionsError(fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                                     "normals, planes, cluster, kmeans, mesh, regions, superpixels)", operation));
+                                     "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)", operation));
     }
     summary["seconds"] = timer.Seconds();
     if (as_cloud) {
