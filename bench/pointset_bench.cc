@@ -23,7 +23,8 @@ const PointCloud& Cloud() {
     std::normal_distribution<float> noise(0.0f, 0.005f);
     PointCloud c;
     const int n = 1000000;
-    for (int i = 0; i < n * 72 / 100; ++i) c.points.emplace_back(ground(random), ground(random), noise(random));
+    for (int i = 0; i < n * 72 / 100; ++i)
+      c.points.emplace_back(ground(random), ground(random), noise(random));
     const float centres[4][2] = {{-6, 5}, {4, 8}, {8, -5}, {-5, -7}};
     for (int i = 0; i < n / 4; ++i) {
       const float* centre = centres[i % 4];
@@ -34,7 +35,8 @@ const PointCloud& Cloud() {
       if (face == 4) p.z() = 2.0f;
       c.points.emplace_back(p.x() + centre[0], p.y() + centre[1], p.z());
     }
-    while (c.points.size() < static_cast<size_t>(n)) c.points.emplace_back(ground(random), ground(random), 3.0f * height(random));
+    while (c.points.size() < static_cast<size_t>(n))
+      c.points.emplace_back(ground(random), ground(random), 3.0f * height(random));
     return c;
   }();
   return cloud;
@@ -61,7 +63,12 @@ void BM_VoxelDownsample(benchmark::State& state) {
 }
 
 BENCHMARK(BM_Normals)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
-BENCHMARK(BM_StatisticalOutliers)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_StatisticalOutliers)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 BENCHMARK(BM_RansacPlane)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK(BM_EuclideanClusters)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
 BENCHMARK(BM_VoxelDownsample)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);

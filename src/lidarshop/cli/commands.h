@@ -9,18 +9,18 @@
 
 namespace lidarshop::cli {
 
-int RunScan(int argc, char** argv);     // scan_command.cc
-int RunInfo(int argc, char** argv);     // file_commands.cc
-int RunConvert(int argc, char** argv);  // file_commands.cc
-int RunRender(int argc, char** argv);   // file_commands.cc
-int RunDemo(int argc, char** argv);     // demo_command.cc
-int RunVerify(int argc, char** argv);   // verify_commands.cc
-int RunSweep(int argc, char** argv);    // verify_commands.cc
-int RunSegment(int argc, char** argv);  // segment_command.cc
-int RunInpaint(int argc, char** argv);  // inpaint_command.cc
-int RunPoisson(int argc, char** argv);  // poisson_command.cc
-int RunFill(int argc, char** argv);     // fill_command.cc
-int RunRemove(int argc, char** argv);   // fill_command.cc
+int RunScan(int argc, char** argv);      // scan_command.cc
+int RunInfo(int argc, char** argv);      // file_commands.cc
+int RunConvert(int argc, char** argv);   // file_commands.cc
+int RunRender(int argc, char** argv);    // file_commands.cc
+int RunDemo(int argc, char** argv);      // demo_command.cc
+int RunVerify(int argc, char** argv);    // verify_commands.cc
+int RunSweep(int argc, char** argv);     // verify_commands.cc
+int RunSegment(int argc, char** argv);   // segment_command.cc
+int RunInpaint(int argc, char** argv);   // inpaint_command.cc
+int RunPoisson(int argc, char** argv);   // poisson_command.cc
+int RunFill(int argc, char** argv);      // fill_command.cc
+int RunRemove(int argc, char** argv);    // fill_command.cc
 int RunPoints(int argc, char** argv);    // points_command.cc
 int RunRegister(int argc, char** argv);  // points_command.cc
 

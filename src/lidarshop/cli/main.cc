@@ -31,7 +31,8 @@ const std::vector<Command>& Commands() {
       {"poisson", lidarshop::cli::RunPoisson, "Poisson image editing: fill, clone, reconstruct"},
       {"fill", lidarshop::cli::RunFill, "fill a hole in a scan (gradient-domain inpainting + Poisson)"},
       {"remove", lidarshop::cli::RunRemove, "remove an object from a scan: cut it out and fill behind it"},
-      {"points", lidarshop::cli::RunPoints, "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
+      {"points", lidarshop::cli::RunPoints,
+       "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
       {"register", lidarshop::cli::RunRegister, "register one scan onto another (point-to-plane ICP)"},
   };
   return commands;

@@ -3,10 +3,11 @@
 //   lidarshop points OPERATION IN... -o OUT [options] [--json FILE|-]
 //   lidarshop register FIXED MOVING -o OUT [--max-distance M] [--json FILE|-]
 //
-// Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations that
-// drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep every scan's
-// grid: dropped cells become cells without a return, labels and normals go into the scans' channels. Operations
-// that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world frame.
+// Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations
+// that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep
+// every scan's grid: dropped cells become cells without a return, labels and normals go into the scans'
+// channels. Operations that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world
+// frame.
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -24,8 +25,8 @@
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
-#include "lidarshop/pointset/sampling.h"
 #include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/sampling.h"
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
@@ -83,7 +84,8 @@ std::vector<Scan> WithLabels(const Gathered& g, const std::vector<int32_t>& labe
   }
   for (size_t i = 0; i < labels.size(); ++i) {
     Scan& scan = out[g.scan_of_point[i]];
-    scan.label.at<int32_t>(static_cast<int>(g.cell_of_point[i] / scan.cols), g.cell_of_point[i] % scan.cols) = labels[i];
+    scan.label.at<int32_t>(static_cast<int>(g.cell_of_point[i] / scan.cols), g.cell_of_point[i] % scan.cols) =
+        labels[i];
   }
   return out;
 }
@@ -98,7 +100,8 @@ std::vector<Scan> WithNormals(const Gathered& g, const std::vector<Eigen::Vector
   }
   for (size_t i = 0; i < normals_in_world.size(); ++i) {
     Scan& scan = out[g.scan_of_point[i]];
-    const Eigen::Matrix3f scanner_from_world = scan.world_from_scanner.topLeftCorner<3, 3>().transpose().cast<float>();
+    const Eigen::Matrix3f scanner_from_world =
+        scan.world_from_scanner.topLeftCorner<3, 3>().transpose().cast<float>();
     const int row = static_cast<int>(g.cell_of_point[i] / scan.cols), col = g.cell_of_point[i] % scan.cols;
     Eigen::Vector3f n = scanner_from_world * normals_in_world[i];
     const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
@@ -134,7 +137,8 @@ void WriteSummary(const std::string& path, const nlohmann::json& json) {
   }
 }
 
-void CheckOutputs(const std::string& output, const std::string& json, const std::vector<std::string>& inputs) {
+void CheckOutputs(const std::string& output, const std::string& json,
+                  const std::vector<std::string>& inputs) {
   CheckScanFileFormat(output);
   CheckOutputPath(output, inputs);
   if (!json.empty() && json != "-") {
@@ -149,7 +153,8 @@ void CheckOutputs(const std::string& output, const std::string& json, const std:
 int RunPoints(int argc, char** argv) {
   CLI::App app{
       "Point-set tools over scans and clouds (docs/points.md). OPERATION: outliers | voxel | sample | crop | "
-      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels | sample-mesh (IN = a triangle mesh). Scans keep their grid where the operation allows.",
+      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels | sample-mesh "
+      "(IN = a triangle mesh). Scans keep their grid where the operation allows.",
       "points"};
   std::string operation, output_path, json_path, method = "statistical";
   std::vector<std::string> inputs;
@@ -179,31 +184,40 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--json", json_path, "write a summary as JSON to FILE, or '-' for stdout");
   app.add_option("--method", method, "outliers: statistical | radius")->capture_default_str();
   app.add_option("--neighbors", statistical.neighbors, "outliers/normals: k nearest")->capture_default_str();
-  app.add_option("--std-ratio", statistical.std_ratio, "statistical outliers: threshold in σ")->capture_default_str();
-  app.add_option("--radius", radius_outliers.radius_m, "outliers, normals, cluster: radius, metres")->capture_default_str();
+  app.add_option("--std-ratio", statistical.std_ratio, "statistical outliers: threshold in σ")
+      ->capture_default_str();
+  app.add_option("--radius", radius_outliers.radius_m, "outliers, normals, cluster: radius, metres")
+      ->capture_default_str();
   app.add_option("--min-neighbors", radius_outliers.min_neighbors, "radius outliers")->capture_default_str();
   app.add_option("--voxel", voxel_m, "voxel: cube side, metres")->capture_default_str();
-  app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")->capture_default_str();
+  app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")
+      ->capture_default_str();
   app.add_option("--seed", seed, "sample, planes, kmeans: seed")->capture_default_str();
   app.add_option("--box", box_text, "crop: xmin,ymin,zmin,xmax,ymax,zmax (world, metres)");
   app.add_option("--polygon", polygon_text, "crop: x1,y1,x2,y2,... (world xy, metres)");
   app.add_option("--labels", crop.labels, "crop: keep these labels");
-  app.add_option("--min-range", crop.min_range_m, "crop: metres from the world origin")->capture_default_str();
+  app.add_option("--min-range", crop.min_range_m, "crop: metres from the world origin")
+      ->capture_default_str();
   app.add_option("--max-range", crop.max_range_m, "crop: metres (0 = none)")->capture_default_str();
   app.add_option("--min-intensity", crop.min_intensity, "crop")->capture_default_str();
   app.add_option("--max-intensity", crop.max_intensity, "crop")->capture_default_str();
   app.add_flag("--invert", crop.invert, "crop: keep the points outside instead");
-  app.add_option("--matrix", matrix_text, "transform: 16 comma-separated numbers, row major, new_world_from_world");
+  app.add_option("--matrix", matrix_text,
+                 "transform: 16 comma-separated numbers, row major, new_world_from_world");
   app.add_flag("--grid", grid, "normals: from the scan grid instead of a KD-tree");
-  app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")->capture_default_str();
-  app.add_option("--distance", planes.distance_threshold_m, "planes: inlier distance, metres")->capture_default_str();
-  app.add_option("--iterations", planes.max_iterations, "planes: RANSAC hypotheses at most")->capture_default_str();
+  app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")
+      ->capture_default_str();
+  app.add_option("--distance", planes.distance_threshold_m, "planes: inlier distance, metres")
+      ->capture_default_str();
+  app.add_option("--iterations", planes.max_iterations, "planes: RANSAC hypotheses at most")
+      ->capture_default_str();
   app.add_flag("--hough", hough, "planes: Hough detection (ball accumulator) instead of RANSAC");
   app.add_option("--angle-step", hough_options.angle_step_deg, "planes --hough: normal resolution, degrees")
       ->capture_default_str();
   app.add_option("--planes", planes.max_planes, "planes: how many, sequentially")->capture_default_str();
   app.add_option("--min-inliers", planes.min_inliers, "planes: stop below this")->capture_default_str();
-  app.add_option("--min-points", clusters.min_points, "cluster: smaller clusters are noise")->capture_default_str();
+  app.add_option("--min-points", clusters.min_points, "cluster: smaller clusters are noise")
+      ->capture_default_str();
   app.add_option("--mesh-jump", mesh_options.max_range_jump_ratio,
                  "mesh: drop edges whose ranges differ by more than this fraction of the nearer range")
       ->capture_default_str();
@@ -211,7 +225,8 @@ int RunPoints(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--min-cells", region_options.min_region_cells, "regions: smaller regions get no label")
       ->capture_default_str();
-  app.add_option("--superpixel-method", superpixel_method, "superpixels: slic | graph")->capture_default_str();
+  app.add_option("--superpixel-method", superpixel_method, "superpixels: slic | graph")
+      ->capture_default_str();
   app.add_option("--region-cells", superpixel_options.region_cells, "superpixels (slic): side, cells")
       ->capture_default_str();
   app.add_option("--k", kmeans.clusters, "kmeans: clusters")->capture_default_str();
@@ -223,13 +238,17 @@ int RunPoints(int argc, char** argv) {
     if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
       throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
     }
-    const std::vector<double> box = ParseNumbers(box_text, "--box"), polygon = ParseNumbers(polygon_text, "--polygon"),
+    const std::vector<double> box = ParseNumbers(box_text, "--box"),
+                              polygon = ParseNumbers(polygon_text, "--polygon"),
                               matrix = ParseNumbers(matrix_text, "--matrix");
-    if (!box.empty() && box.size() != 6) throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+    if (!box.empty() && box.size() != 6)
+      throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
     if (operation == "sample-mesh") {
-      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles' normals.
+      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
+      // normals.
       if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
-      if (FileExtension(output_path) != "ply") throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
+      if (FileExtension(output_path) != "ply")
+        throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
       const TriangleMesh mesh = ReadMesh(inputs[0]);
       if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
       CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
@@ -240,13 +259,17 @@ int RunPoints(int argc, char** argv) {
       cloud.normals = std::move(samples.normals);
       const double seconds = timer.Seconds();
       WritePointCloud(output_path, cloud);
-      WriteSummary(json_path, {{"operation", operation}, {"triangles", mesh.num_triangles()},
-                               {"output_points", cloud.size()}, {"seconds", seconds}});
+      WriteSummary(json_path, {{"operation", operation},
+                               {"triangles", mesh.num_triangles()},
+                               {"output_points", cloud.size()},
+                               {"seconds", seconds}});
       return 0;
     }
     const Timer read_timer;
     const Gathered g = Gather(inputs);
-    nlohmann::json summary = {{"operation", operation}, {"input_points", g.cloud.size()}, {"scans", g.scans.size()},
+    nlohmann::json summary = {{"operation", operation},
+                              {"input_points", g.cloud.size()},
+                              {"scans", g.scans.size()},
                               {"read_seconds", read_timer.Seconds()}};
     const Timer timer;  // the operation alone, without reading and writing
     std::vector<Scan> scans_out;
@@ -263,9 +286,12 @@ int RunPoints(int argc, char** argv) {
       } else if (operation == "sample") {
         keep = RandomSampleInliers(g.cloud, count, seed);
       } else {
-        if (!box.empty()) crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]), Eigen::Vector3f(box[3], box[4], box[5]));
+        if (!box.empty())
+          crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
+                                         Eigen::Vector3f(box[3], box[4], box[5]));
         if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
-        for (size_t i = 0; i + 1 < polygon.size(); i += 2) crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
+        for (size_t i = 0; i + 1 < polygon.size(); i += 2)
+          crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
         keep = CropInliers(g.cloud, crop);
       }
       scans_out = KeepCells(g, keep);
@@ -293,13 +319,15 @@ int RunPoints(int argc, char** argv) {
         int count = 0;
         if (operation == "regions") {
           const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
-          labelled.label = SegmentByRegionGrowing(scan, region_options, NormalAngleCondition(with_normals, max_angle_deg),
-                                                  &count);
+          labelled.label = SegmentByRegionGrowing(scan, region_options,
+                                                  NormalAngleCondition(with_normals, max_angle_deg), &count);
         } else {
           if (superpixel_method != "slic" && superpixel_method != "graph") {
-            throw OptionsError(fmt::format("--superpixel-method '{}': expected slic or graph", superpixel_method));
+            throw OptionsError(
+                fmt::format("--superpixel-method '{}': expected slic or graph", superpixel_method));
           }
-          superpixel_options.method = superpixel_method == "slic" ? SuperpixelMethod::kSlic : SuperpixelMethod::kGraph;
+          superpixel_options.method =
+              superpixel_method == "slic" ? SuperpixelMethod::kSlic : SuperpixelMethod::kGraph;
           labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
           labelled.label.setTo(kNoLabel, scan.valid == 0);
         }
@@ -309,7 +337,8 @@ int RunPoints(int argc, char** argv) {
       summary[operation] = total;
     } else if (operation == "transform") {
       if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
-      const Eigen::Matrix4d new_from_world = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
+      const Eigen::Matrix4d new_from_world =
+          Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
       for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
     } else if (operation == "normals") {
       normals.neighbors = statistical.neighbors;
@@ -332,7 +361,8 @@ int RunPoints(int argc, char** argv) {
       for (size_t p = 0; p < fits.size(); ++p) {
         for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
         summary["planes"].push_back({{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
-                                     {"offset_m", fits[p].offset_m}, {"inliers", fits[p].inliers.size()},
+                                     {"offset_m", fits[p].offset_m},
+                                     {"inliers", fits[p].inliers.size()},
                                      {"rms_m", fits[p].rms_m}});
       }
       scans_out = WithLabels(g, labels);
@@ -349,8 +379,10 @@ int RunPoints(int argc, char** argv) {
       summary["iterations"] = result.iterations;
       scans_out = WithLabels(g, result.labels);
     } else {
-      throw OptionsError(fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                                     "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)", operation));
+      throw OptionsError(
+          fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
+                      "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
+                      operation));
     }
     summary["seconds"] = timer.Seconds();
     if (as_cloud) {
@@ -366,23 +398,27 @@ int RunPoints(int argc, char** argv) {
 
 int RunRegister(int argc, char** argv) {
   CLI::App app{
-      "Register MOVING onto FIXED by point-to-plane ICP from MOVING's pose (docs/points.md); writes MOVING with "
-      "its world_from_scanner corrected.",
+      "Register MOVING onto FIXED by point-to-plane ICP from MOVING's pose (docs/points.md); writes MOVING "
+      "with its world_from_scanner corrected.",
       "register"};
   std::string fixed_path, moving_path, output_path, json_path;
   IcpOptions options;
   GlobalAlignOptions global;
   bool use_global = false;
   app.add_flag("--global", use_global, "no usable pose: align FPFH features by RANSAC first");
-  app.add_option("--voxel", global.voxel_m, "--global: voxel size of the feature clouds, metres")->capture_default_str();
-  app.add_option("--feature-radius", global.feature_radius_m, "--global: FPFH radius, metres")->capture_default_str();
+  app.add_option("--voxel", global.voxel_m, "--global: voxel size of the feature clouds, metres")
+      ->capture_default_str();
+  app.add_option("--feature-radius", global.feature_radius_m, "--global: FPFH radius, metres")
+      ->capture_default_str();
   app.add_option("--seed", global.seed, "--global: RANSAC seed")->capture_default_str();
   app.add_option("fixed", fixed_path, "the scan that stays (its first scan)")->required();
   app.add_option("moving", moving_path, "the scan to move (its first scan)")->required();
   app.add_option("-o,--output", output_path, "the moving scan with its new pose")->required();
   app.add_option("--json", json_path, "write a summary as JSON to FILE, or '-' for stdout");
-  app.add_option("--max-distance", options.max_correspondence_m, "first pairing distance, metres")->capture_default_str();
-  app.add_option("--min-distance", options.min_correspondence_m, "final pairing distance, metres")->capture_default_str();
+  app.add_option("--max-distance", options.max_correspondence_m, "first pairing distance, metres")
+      ->capture_default_str();
+  app.add_option("--min-distance", options.min_correspondence_m, "final pairing distance, metres")
+      ->capture_default_str();
   app.add_option("--iterations", options.max_iterations, "ICP iterations at most")->capture_default_str();
   return RunCommand(app, argc, argv, [&]() {
     options.Check();
@@ -391,16 +427,21 @@ int RunRegister(int argc, char** argv) {
     const Timer timer;
     const ScanFile fixed = ReadScanFile(fixed_path), moving = ReadScanFile(moving_path);
     if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
-    const ScanRegistration result = RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
+    const ScanRegistration result =
+        RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
     WriteScanFile(output_path, {result.registered});
     std::vector<std::vector<double>> rows;
     for (int r = 0; r < 4; ++r) {
       rows.push_back({result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
-                      result.registered.world_from_scanner(r, 2), result.registered.world_from_scanner(r, 3)});
+                      result.registered.world_from_scanner(r, 2),
+                      result.registered.world_from_scanner(r, 3)});
     }
-    WriteSummary(json_path, {{"world_from_scanner", rows}, {"rms_m", result.icp.rms_m},
-                             {"fitness", result.icp.fitness}, {"iterations", result.icp.iterations},
-                             {"converged", result.icp.converged}, {"seconds", timer.Seconds()}});
+    WriteSummary(json_path, {{"world_from_scanner", rows},
+                             {"rms_m", result.icp.rms_m},
+                             {"fitness", result.icp.fitness},
+                             {"iterations", result.icp.iterations},
+                             {"converged", result.icp.converged},
+                             {"seconds", timer.Seconds()}});
     return 0;
   });
 }

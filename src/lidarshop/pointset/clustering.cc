@@ -34,14 +34,17 @@ struct DisjointSets {
 
 void EuclideanClusterOptions::Check() const {
   CheckOption(radius_m > 0.0, fmt::format("EuclideanClusterOptions.radius_m must be > 0, got {}", radius_m));
-  CheckOption(min_points >= 1, fmt::format("EuclideanClusterOptions.min_points must be >= 1, got {}", min_points));
-  CheckOption(max_points == 0 || max_points >= min_points,
-              fmt::format("EuclideanClusterOptions.max_points {} is below min_points {}", max_points, min_points));
+  CheckOption(min_points >= 1,
+              fmt::format("EuclideanClusterOptions.min_points must be >= 1, got {}", min_points));
+  CheckOption(
+      max_points == 0 || max_points >= min_points,
+      fmt::format("EuclideanClusterOptions.max_points {} is below min_points {}", max_points, min_points));
 }
 
 void KMeansOptions::Check() const {
   CheckOption(clusters >= 1, fmt::format("KMeansOptions.clusters must be >= 1, got {}", clusters));
-  CheckOption(max_iterations >= 1, fmt::format("KMeansOptions.max_iterations must be >= 1, got {}", max_iterations));
+  CheckOption(max_iterations >= 1,
+              fmt::format("KMeansOptions.max_iterations must be >= 1, got {}", max_iterations));
   CheckOption(tolerance_m >= 0.0, fmt::format("KMeansOptions.tolerance_m must be >= 0, got {}", tolerance_m));
 }
 
@@ -77,9 +80,11 @@ ClusterResult EuclideanClusters(const PointCloud& cloud, const EuclideanClusterO
   std::vector<uint32_t> roots;
   for (uint32_t i = 0; i < n; ++i) {
     const int64_t size = root_size[i];
-    if (size >= options.min_points && (options.max_points == 0 || size <= options.max_points)) roots.push_back(i);
+    if (size >= options.min_points && (options.max_points == 0 || size <= options.max_points))
+      roots.push_back(i);
   }
-  std::stable_sort(roots.begin(), roots.end(), [&](uint32_t a, uint32_t b) { return root_size[a] > root_size[b]; });
+  std::stable_sort(roots.begin(), roots.end(),
+                   [&](uint32_t a, uint32_t b) { return root_size[a] > root_size[b]; });
   std::vector<int32_t> cluster_of_root(cloud.size(), kNoCluster);
   ClusterResult result;
   for (uint32_t root : roots) {
@@ -95,21 +100,26 @@ KMeansResult KMeans(const PointCloud& cloud, const KMeansOptions& options) {
   options.Check();
   CheckCloudHasPoints(cloud, 1, "k-means");
   if (options.clusters > static_cast<int64_t>(cloud.size())) {
-    throw InputError(fmt::format("k-means: k = {} is larger than the cloud ({} points)", options.clusters, cloud.size()));
+    throw InputError(
+        fmt::format("k-means: k = {} is larger than the cloud ({} points)", options.clusters, cloud.size()));
   }
   const int64_t n = static_cast<int64_t>(cloud.size());
   const int k = options.clusters;
   std::mt19937_64 random(options.seed);
   auto uniform = [&]() { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-  // k-means++: each next centre drawn with probability proportional to the squared distance to the nearest one.
+  // k-means++: each next centre drawn with probability proportional to the squared distance to the nearest
+  // one.
   KMeansResult result;
   std::vector<double> nearest_sq(cloud.size(), std::numeric_limits<double>::infinity());
   result.centers.push_back(cloud.points[random() % n].cast<double>());
   while (static_cast<int>(result.centers.size()) < k) {
     const Eigen::Vector3d& last = result.centers.back();
-    ParallelFor(n, [&](int64_t i) {
-      nearest_sq[i] = std::min(nearest_sq[i], (cloud.points[i].cast<double>() - last).squaredNorm());
-    }, 4096);
+    ParallelFor(
+        n,
+        [&](int64_t i) {
+          nearest_sq[i] = std::min(nearest_sq[i], (cloud.points[i].cast<double>() - last).squaredNorm());
+        },
+        4096);
     const double total = std::accumulate(nearest_sq.begin(), nearest_sq.end(), 0.0);
     int64_t chosen = random() % n;  // all points on the centres already: any point
     if (total > 0.0) {
@@ -123,17 +133,20 @@ KMeansResult KMeans(const PointCloud& cloud, const KMeansOptions& options) {
   }
   result.labels.assign(cloud.size(), 0);
   for (result.iterations = 1; result.iterations <= options.max_iterations; ++result.iterations) {
-    ParallelFor(n, [&](int64_t i) {
-      const Eigen::Vector3d p = cloud.points[i].cast<double>();
-      double best = std::numeric_limits<double>::infinity();
-      for (int c = 0; c < k; ++c) {
-        const double d = (p - result.centers[c]).squaredNorm();
-        if (d < best) {
-          best = d;
-          result.labels[i] = c;
-        }
-      }
-    }, 4096);
+    ParallelFor(
+        n,
+        [&](int64_t i) {
+          const Eigen::Vector3d p = cloud.points[i].cast<double>();
+          double best = std::numeric_limits<double>::infinity();
+          for (int c = 0; c < k; ++c) {
+            const double d = (p - result.centers[c]).squaredNorm();
+            if (d < best) {
+              best = d;
+              result.labels[i] = c;
+            }
+          }
+        },
+        4096);
     // Serial sums in point order: centres do not depend on the thread count.
     std::vector<Eigen::Vector3d> sums(k, Eigen::Vector3d::Zero());
     std::vector<int64_t> counts(k, 0);

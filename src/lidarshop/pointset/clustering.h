@@ -15,10 +15,10 @@ namespace lidarshop {
 constexpr int32_t kNoCluster = -1;
 
 struct EuclideanClusterOptions {
-  double radius_m = 0.05;     // points closer than this are neighbours, metres, > 0
-  int64_t min_points = 1;     // smaller clusters become noise (kNoCluster), >= 1
-  int64_t max_points = 0;     // larger clusters become noise too (0 = no limit)
-  void Check() const;         // throws OptionsError
+  double radius_m = 0.05;  // points closer than this are neighbours, metres, > 0
+  int64_t min_points = 1;  // smaller clusters become noise (kNoCluster), >= 1
+  int64_t max_points = 0;  // larger clusters become noise too (0 = no limit)
+  void Check() const;      // throws OptionsError
 };
 
 struct ClusterResult {
@@ -32,11 +32,11 @@ struct ClusterResult {
 ClusterResult EuclideanClusters(const PointCloud& cloud, const EuclideanClusterOptions& options);
 
 struct KMeansOptions {
-  int clusters = 8;            // k, >= 1 and <= #P
-  int max_iterations = 100;    // Lloyd iterations at most, >= 1
-  double tolerance_m = 1e-6;   // stop when no centre moves more than this, metres, >= 0
-  uint64_t seed = 1;           // k-means++ seeding
-  void Check() const;          // throws OptionsError
+  int clusters = 8;           // k, >= 1 and <= #P
+  int max_iterations = 100;   // Lloyd iterations at most, >= 1
+  double tolerance_m = 1e-6;  // stop when no centre moves more than this, metres, >= 0
+  uint64_t seed = 1;          // k-means++ seeding
+  void Check() const;         // throws OptionsError
 };
 
 struct KMeansResult {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <random>
 
-#include <Eigen/Geometry>
 #include <fmt/format.h>
+#include <Eigen/Geometry>
 
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/pointset/kdtree.h"
@@ -58,16 +58,19 @@ float FeatureDistanceSq(const Fpfh& a, const Fpfh& b) {
 // For every feature of `from`, the index of the nearest feature of `to` (brute force, parallel).
 std::vector<uint32_t> NearestFeatures(const std::vector<Fpfh>& from, const std::vector<Fpfh>& to) {
   std::vector<uint32_t> nearest(from.size());
-  ParallelFor(static_cast<int64_t>(from.size()), [&](int64_t i) {
-    float best = std::numeric_limits<float>::infinity();
-    for (uint32_t j = 0; j < to.size(); ++j) {
-      const float d = FeatureDistanceSq(from[i], to[j]);
-      if (d < best) {
-        best = d;
-        nearest[i] = j;
-      }
-    }
-  }, 16);
+  ParallelFor(
+      static_cast<int64_t>(from.size()),
+      [&](int64_t i) {
+        float best = std::numeric_limits<float>::infinity();
+        for (uint32_t j = 0; j < to.size(); ++j) {
+          const float d = FeatureDistanceSq(from[i], to[j]);
+          if (d < best) {
+            best = d;
+            nearest[i] = j;
+          }
+        }
+      },
+      16);
   return nearest;
 }
 
@@ -89,7 +92,8 @@ void GlobalAlignOptions::Check() const {
   CheckOption(normal_radius_m > 0.0 && feature_radius_m > 0.0, "GlobalAlignOptions radii must be > 0");
   CheckOption(inlier_distance_m > 0.0,
               fmt::format("GlobalAlignOptions.inlier_distance_m must be > 0, got {}", inlier_distance_m));
-  CheckOption(max_iterations >= 1, fmt::format("GlobalAlignOptions.max_iterations must be >= 1, got {}", max_iterations));
+  CheckOption(max_iterations >= 1,
+              fmt::format("GlobalAlignOptions.max_iterations must be >= 1, got {}", max_iterations));
   CheckOption(edge_ratio > 0.0 && edge_ratio <= 1.0,
               fmt::format("GlobalAlignOptions.edge_ratio must be in (0, 1], got {}", edge_ratio));
 }
@@ -101,33 +105,41 @@ std::vector<Fpfh> ComputeFpfh(const PointCloud& cloud, double radius_m) {
   const float radius = static_cast<float>(radius_m);
   const int64_t n = static_cast<int64_t>(cloud.size());
   std::vector<Fpfh> spfh(n, Fpfh{});
-  ParallelFor(n, [&](int64_t i) {
-    tree.ForEachInRadius(cloud.points[i], radius, [&](uint32_t j, float) {
-      if (j != i) AddPair(cloud.points[i], cloud.normals[i], cloud.points[j], cloud.normals[j], &spfh[i]);
-    });
-    Normalize(&spfh[i]);
-  }, 256);
+  ParallelFor(
+      n,
+      [&](int64_t i) {
+        tree.ForEachInRadius(cloud.points[i], radius, [&](uint32_t j, float) {
+          if (j != i) AddPair(cloud.points[i], cloud.normals[i], cloud.points[j], cloud.normals[j], &spfh[i]);
+        });
+        Normalize(&spfh[i]);
+      },
+      256);
   std::vector<Fpfh> fpfh(n, Fpfh{});
-  ParallelFor(n, [&](int64_t i) {
-    Fpfh& f = fpfh[i];
-    f = spfh[i];
-    std::vector<std::pair<uint32_t, float>> matches;
-    tree.RadiusSearch(cloud.points[i], radius, &matches, true);  // sorted: sums in a fixed order
-    for (const auto& [j, distance_sq] : matches) {
-      if (j == i || distance_sq == 0.0f) continue;
-      const float weight = 1.0f / (std::sqrt(distance_sq) * static_cast<float>(matches.size() - 1));
-      for (int b = 0; b < 33; ++b) f[b] += weight * spfh[j][b];
-    }
-    Normalize(&f);
-  }, 256);
+  ParallelFor(
+      n,
+      [&](int64_t i) {
+        Fpfh& f = fpfh[i];
+        f = spfh[i];
+        std::vector<std::pair<uint32_t, float>> matches;
+        tree.RadiusSearch(cloud.points[i], radius, &matches, true);  // sorted: sums in a fixed order
+        for (const auto& [j, distance_sq] : matches) {
+          if (j == i || distance_sq == 0.0f) continue;
+          const float weight = 1.0f / (std::sqrt(distance_sq) * static_cast<float>(matches.size() - 1));
+          for (int b = 0; b < 33; ++b) f[b] += weight * spfh[j][b];
+        }
+        Normalize(&f);
+      },
+      256);
   return fpfh;
 }
 
-GlobalAlignResult AlignGlobally(const PointCloud& fixed, const PointCloud& moving, const GlobalAlignOptions& options) {
+GlobalAlignResult AlignGlobally(const PointCloud& fixed, const PointCloud& moving,
+                                const GlobalAlignOptions& options) {
   options.Check();
   const PointCloud a = Prepare(fixed, options, "global alignment (fixed cloud)");
   const PointCloud b = Prepare(moving, options, "global alignment (moving cloud)");
-  const std::vector<Fpfh> fa = ComputeFpfh(a, options.feature_radius_m), fb = ComputeFpfh(b, options.feature_radius_m);
+  const std::vector<Fpfh> fa = ComputeFpfh(a, options.feature_radius_m),
+                          fb = ComputeFpfh(b, options.feature_radius_m);
   // Mutual nearest neighbours in feature space.
   const std::vector<uint32_t> b_to_a = NearestFeatures(fb, fa), a_to_b = NearestFeatures(fa, fb);
   std::vector<std::pair<uint32_t, uint32_t>> matches;  // (moving, fixed)
@@ -136,14 +148,16 @@ GlobalAlignResult AlignGlobally(const PointCloud& fixed, const PointCloud& movin
   }
   GlobalAlignResult result;
   result.matches = static_cast<int64_t>(matches.size());
-  if (matches.size() < 3) throw InputError(fmt::format("global alignment: only {} feature matches", matches.size()));
+  if (matches.size() < 3)
+    throw InputError(fmt::format("global alignment: only {} feature matches", matches.size()));
   std::mt19937_64 random(options.seed);
   const double inlier_sq = options.inlier_distance_m * options.inlier_distance_m;
   auto count_inliers = [&](const Eigen::Matrix4d& t) {
     int64_t inliers = 0;
     for (const auto& [m, f] : matches) {
       inliers += (t.topLeftCorner<3, 3>() * b.points[m].cast<double>() + t.topRightCorner<3, 1>() -
-                  a.points[f].cast<double>()).squaredNorm() < inlier_sq;
+                  a.points[f].cast<double>())
+                     .squaredNorm() < inlier_sq;
     }
     return inliers;
   };
@@ -164,8 +178,10 @@ GlobalAlignResult AlignGlobally(const PointCloud& fixed, const PointCloud& movin
       }
       bool similar = true;  // a rigid motion keeps the triangle's edge lengths
       for (int k = 0; k < 3; ++k) {
-        const double lf = (from.col(k) - from.col((k + 1) % 3)).norm(), lt = (to.col(k) - to.col((k + 1) % 3)).norm();
-        similar = similar && std::min(lf, lt) >= options.edge_ratio * std::max(lf, lt) && lf > options.voxel_m;
+        const double lf = (from.col(k) - from.col((k + 1) % 3)).norm(),
+                     lt = (to.col(k) - to.col((k + 1) % 3)).norm();
+        similar =
+            similar && std::min(lf, lt) >= options.edge_ratio * std::max(lf, lt) && lf > options.voxel_m;
       }
       if (!similar) continue;
       poses[h] = Eigen::umeyama(from, to, false);
@@ -187,7 +203,8 @@ GlobalAlignResult AlignGlobally(const PointCloud& fixed, const PointCloud& movin
   Eigen::Matrix3Xd from(3, best_inliers), to(3, best_inliers);
   int64_t k = 0;
   for (const auto& [m, f] : matches) {
-    const Eigen::Vector3d p = best.topLeftCorner<3, 3>() * b.points[m].cast<double>() + best.topRightCorner<3, 1>();
+    const Eigen::Vector3d p =
+        best.topLeftCorner<3, 3>() * b.points[m].cast<double>() + best.topRightCorner<3, 1>();
     if ((p - a.points[f].cast<double>()).squaredNorm() >= inlier_sq) continue;
     from.col(k) = b.points[m].cast<double>();
     to.col(k++) = a.points[f].cast<double>();

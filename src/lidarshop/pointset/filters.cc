@@ -18,21 +18,24 @@ namespace lidarshop {
 void CheckCloudHasPoints(const PointCloud& cloud, int64_t count, std::string_view what) {
   if (cloud.empty()) throw InputError(fmt::format("{}: the point cloud is empty", what));
   if (static_cast<int64_t>(cloud.size()) < count) {
-    throw InputError(fmt::format("{}: needs at least {} points, the cloud has {}", what, count, cloud.size()));
+    throw InputError(
+        fmt::format("{}: needs at least {} points, the cloud has {}", what, count, cloud.size()));
   }
 }
 
 void CheckCloudHasShape(const PointCloud& cloud, std::string_view what) {
   CheckCloudHasPoints(cloud, 1, what);
   const Eigen::Vector3f& first = cloud.points.front();
-  const bool all_same =
-      std::all_of(cloud.points.begin(), cloud.points.end(), [&](const Eigen::Vector3f& p) { return p == first; });
+  const bool all_same = std::all_of(cloud.points.begin(), cloud.points.end(),
+                                    [&](const Eigen::Vector3f& p) { return p == first; });
   if (all_same) throw InputError(fmt::format("{}: all {} points are identical", what, cloud.size()));
 }
 
 void StatisticalOutlierOptions::Check() const {
-  CheckOption(neighbors >= 1, fmt::format("StatisticalOutlierOptions.neighbors must be >= 1, got {}", neighbors));
-  CheckOption(std_ratio > 0.0, fmt::format("StatisticalOutlierOptions.std_ratio must be > 0, got {}", std_ratio));
+  CheckOption(neighbors >= 1,
+              fmt::format("StatisticalOutlierOptions.neighbors must be >= 1, got {}", neighbors));
+  CheckOption(std_ratio > 0.0,
+              fmt::format("StatisticalOutlierOptions.std_ratio must be > 0, got {}", std_ratio));
 }
 
 void RadiusOutlierOptions::Check() const {
@@ -51,12 +54,14 @@ void CropOptions::Check() const {
   CheckOption(!box || !box->isEmpty(), "CropOptions.box is empty (min > max)");
 }
 
-std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud, const StatisticalOutlierOptions& options) {
+std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud,
+                                               const StatisticalOutlierOptions& options) {
   options.Check();
   CheckCloudHasPoints(cloud, 1, "statistical outlier removal");
   if (options.neighbors >= static_cast<int64_t>(cloud.size())) {
-    throw InputError(fmt::format("statistical outlier removal: {} neighbours asked, the cloud has only {} points",
-                                 options.neighbors, cloud.size()));
+    throw InputError(
+        fmt::format("statistical outlier removal: {} neighbours asked, the cloud has only {} points",
+                    options.neighbors, cloud.size()));
   }
   const PointKdTree tree(cloud.points);
   std::vector<double> mean_distance(cloud.size());
@@ -110,7 +115,8 @@ bool InsidePolygon(const std::vector<Eigen::Vector2f>& polygon, float x, float y
   for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
     const Eigen::Vector2f& a = polygon[i];
     const Eigen::Vector2f& b = polygon[j];
-    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x()) inside = !inside;
+    if ((a.y() > y) != (b.y() > y) && x < (b.x() - a.x()) * (y - a.y()) / (b.y() - a.y()) + a.x())
+      inside = !inside;
   }
   return inside;
 }
@@ -136,14 +142,16 @@ std::vector<uint8_t> CropInliers(const PointCloud& cloud, const CropOptions& opt
         bool pass = !options.box || options.box->contains(p);
         if (pass && !options.polygon.empty()) pass = InsidePolygon(options.polygon, p.x(), p.y());
         if (pass && !options.labels.empty()) {
-          pass = std::find(options.labels.begin(), options.labels.end(), cloud.labels[i]) != options.labels.end();
+          pass = std::find(options.labels.begin(), options.labels.end(), cloud.labels[i]) !=
+                 options.labels.end();
         }
         if (pass && (min_sq > 0.0 || max_sq > 0.0)) {
           const double range_sq = (p - options.origin).cast<double>().squaredNorm();
           pass = range_sq >= min_sq && (max_sq == 0.0 || range_sq <= max_sq);
         }
         if (pass && by_intensity) {
-          pass = cloud.intensities[i] >= options.min_intensity && cloud.intensities[i] <= options.max_intensity;
+          pass =
+              cloud.intensities[i] >= options.min_intensity && cloud.intensities[i] <= options.max_intensity;
         }
         keep[i] = pass != options.invert;
       },
@@ -169,11 +177,13 @@ PointCloud SelectPoints(const PointCloud& cloud, const std::vector<uint8_t>& kee
   return out;
 }
 
-Scan KeepScanCells(const Scan& scan, const std::vector<int64_t>& cell_index, const std::vector<uint8_t>& keep) {
+Scan KeepScanCells(const Scan& scan, const std::vector<int64_t>& cell_index,
+                   const std::vector<uint8_t>& keep) {
   LIDARSHOP_CHECK(keep.size() == cell_index.size());
   cv::Mat keep_mask(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
   for (size_t i = 0; i < keep.size(); ++i) {
-    if (keep[i]) keep_mask.at<uint8_t>(static_cast<int>(cell_index[i] / scan.cols), cell_index[i] % scan.cols) = 255;
+    if (keep[i])
+      keep_mask.at<uint8_t>(static_cast<int>(cell_index[i] / scan.cols), cell_index[i] % scan.cols) = 255;
   }
   return MaskScan(scan, keep_mask);
 }
@@ -183,7 +193,8 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_m) {
   CheckCloudHasPoints(cloud, 1, "voxel subsampling");
   const Eigen::Vector3f origin = Bounds(cloud).min();
   struct Accumulator {
-    Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero(), color = Eigen::Vector3d::Zero();
+    Eigen::Vector3d point = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::Zero(),
+                    color = Eigen::Vector3d::Zero();
     double intensity = 0.0;
     int64_t count = 0;
     size_t first = 0;
@@ -195,7 +206,8 @@ PointCloud VoxelDownsample(const PointCloud& cloud, double voxel_m) {
              intensities = cloud.intensities.size() == cloud.size();
   for (size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3d cell = ((cloud.points[i] - origin).cast<double>() / voxel_m).array().floor();
-    if (cell.maxCoeff() >= (1 << 21)) throw OptionsError(fmt::format("voxel size {} m is too small for the cloud", voxel_m));
+    if (cell.maxCoeff() >= (1 << 21))
+      throw OptionsError(fmt::format("voxel size {} m is too small for the cloud", voxel_m));
     const uint64_t key = (static_cast<uint64_t>(cell.x()) << 42) | (static_cast<uint64_t>(cell.y()) << 21) |
                          static_cast<uint64_t>(cell.z());
     auto [it, inserted] = slot_of_voxel.try_emplace(key, voxels.size());
@@ -249,7 +261,8 @@ Scan TransformScan(const Scan& scan, const Eigen::Matrix4d& b_from_world) {
 PointCloud MergeClouds(const std::vector<PointCloud>& clouds) {
   PointCloud out;
   auto all_have = [&](auto member) {
-    return std::all_of(clouds.begin(), clouds.end(), [&](const PointCloud& c) { return (c.*member).size() == c.size(); });
+    return std::all_of(clouds.begin(), clouds.end(),
+                       [&](const PointCloud& c) { return (c.*member).size() == c.size(); });
   };
   const bool normals = all_have(&PointCloud::normals), colors = all_have(&PointCloud::colors),
              intensities = all_have(&PointCloud::intensities), labels = all_have(&PointCloud::labels),
@@ -258,9 +271,11 @@ PointCloud MergeClouds(const std::vector<PointCloud>& clouds) {
     out.points.insert(out.points.end(), c.points.begin(), c.points.end());
     if (normals) out.normals.insert(out.normals.end(), c.normals.begin(), c.normals.end());
     if (colors) out.colors.insert(out.colors.end(), c.colors.begin(), c.colors.end());
-    if (intensities) out.intensities.insert(out.intensities.end(), c.intensities.begin(), c.intensities.end());
+    if (intensities)
+      out.intensities.insert(out.intensities.end(), c.intensities.begin(), c.intensities.end());
     if (labels) out.labels.insert(out.labels.end(), c.labels.begin(), c.labels.end());
-    if (synthesized) out.synthesized.insert(out.synthesized.end(), c.synthesized.begin(), c.synthesized.end());
+    if (synthesized)
+      out.synthesized.insert(out.synthesized.end(), c.synthesized.begin(), c.synthesized.end());
   }
   if (out.empty()) throw InputError("merge: every cloud is empty");
   return out;

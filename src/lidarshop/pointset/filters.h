@@ -27,15 +27,16 @@ void CheckCloudHasShape(const PointCloud& cloud, std::string_view what);
 // Throws InputError naming `what` when the cloud has fewer than `count` points.
 void CheckCloudHasPoints(const PointCloud& cloud, int64_t count, std::string_view what);
 
-// Statistical outlier removal (PCL's StatisticalOutlierRemoval, Open3D's remove_statistical_outlier): the mean
-// distance of each point to its `neighbors` nearest others; points whose mean is above μ + std_ratio · σ of
-// all means are outliers.
+// Statistical outlier removal (PCL's StatisticalOutlierRemoval, Open3D's remove_statistical_outlier): the
+// mean distance of each point to its `neighbors` nearest others; points whose mean is above μ + std_ratio · σ
+// of all means are outliers.
 struct StatisticalOutlierOptions {
   int neighbors = 20;      // k nearest neighbours (the point itself not counted), >= 1, < #P
   double std_ratio = 2.0;  // threshold in standard deviations of the mean distances, > 0
   void Check() const;      // throws OptionsError
 };
-std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud, const StatisticalOutlierOptions& options);
+std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud,
+                                               const StatisticalOutlierOptions& options);
 
 // Radius outlier removal: a point is kept when at least `min_neighbors` other points lie within `radius_m`.
 struct RadiusOutlierOptions {
@@ -66,7 +67,8 @@ PointCloud SelectPoints(const PointCloud& cloud, const std::vector<uint8_t>& kee
 
 // Organized scans: `keep` is per point of ToPointCloud(scan, world, &cell_index); the scan keeps its grid,
 // dropped cells become cells without a return (MaskScan).
-Scan KeepScanCells(const Scan& scan, const std::vector<int64_t>& cell_index, const std::vector<uint8_t>& keep);
+Scan KeepScanCells(const Scan& scan, const std::vector<int64_t>& cell_index,
+                   const std::vector<uint8_t>& keep);
 
 // Voxel grid subsampling: one point per occupied cube of side `voxel_m` (metres, > 0), at the centroid of its
 // points; normals (renormalized), colours and intensities are averaged, labels and synthesized come from the
@@ -81,7 +83,8 @@ std::vector<uint8_t> RandomSampleInliers(const PointCloud& cloud, int64_t count,
 // scanner frame). Throws OptionsError when `b_from_world` is not rigid.
 Scan TransformScan(const Scan& scan, const Eigen::Matrix4d& b_from_world);
 
-// All clouds in one; an attribute is kept only when every cloud has it. Throws InputError when none has points.
+// All clouds in one; an attribute is kept only when every cloud has it. Throws InputError when none has
+// points.
 PointCloud MergeClouds(const std::vector<PointCloud>& clouds);
 
 }  // namespace lidarshop

@@ -14,10 +14,12 @@ namespace lidarshop {
 void HoughPlaneOptions::Check() const {
   CheckOption(angle_step_deg > 0.0 && angle_step_deg <= 30.0,
               fmt::format("HoughPlaneOptions.angle_step_deg must be in (0, 30], got {}", angle_step_deg));
-  CheckOption(distance_step_m > 0.0, fmt::format("HoughPlaneOptions.distance_step_m must be > 0, got {}", distance_step_m));
+  CheckOption(distance_step_m > 0.0,
+              fmt::format("HoughPlaneOptions.distance_step_m must be > 0, got {}", distance_step_m));
   CheckOption(max_voters >= 3, fmt::format("HoughPlaneOptions.max_voters must be >= 3, got {}", max_voters));
   CheckOption(max_planes >= 1, fmt::format("HoughPlaneOptions.max_planes must be >= 1, got {}", max_planes));
-  CheckOption(min_inliers >= 3, fmt::format("HoughPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
+  CheckOption(min_inliers >= 3,
+              fmt::format("HoughPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
 }
 
 std::vector<PlaneFit> DetectPlanesHough(const PointCloud& cloud, const HoughPlaneOptions& options) {
@@ -32,12 +34,13 @@ std::vector<PlaneFit> DetectPlanesHough(const PointCloud& cloud, const HoughPlan
       const double azimuth = 2.0 * M_PI * a / cells;
       // Half the ring at elevation 0 duplicates the other half (n and -n); keep azimuth in [0, π) there.
       if (elevation == 0.0 && azimuth >= M_PI - 1e-9) continue;
-      directions.emplace_back(std::cos(elevation) * std::cos(azimuth), std::cos(elevation) * std::sin(azimuth),
-                              std::sin(elevation));
+      directions.emplace_back(std::cos(elevation) * std::cos(azimuth),
+                              std::cos(elevation) * std::sin(azimuth), std::sin(elevation));
     }
   }
   const Eigen::AlignedBox3f bounds = Bounds(cloud);
-  const Eigen::Vector3d centre = bounds.center().cast<double>();  // offsets relative to the centre: fewer cells
+  const Eigen::Vector3d centre =
+      bounds.center().cast<double>();  // offsets relative to the centre: fewer cells
   const double reach = 0.5 * bounds.diagonal().cast<double>().norm();
   const int distance_cells = 2 * static_cast<int>(std::ceil(reach / options.distance_step_m)) + 1;
   const double half_cell = 0.5 * options.distance_step_m;
@@ -54,7 +57,8 @@ std::vector<PlaneFit> DetectPlanesHough(const PointCloud& cloud, const HoughPlan
       }
     }
     if (static_cast<int64_t>(left.size()) < options.min_inliers) break;
-    const std::vector<uint8_t> voter_flags = RandomSampleInliers(left, options.max_voters, options.seed + planes.size());
+    const std::vector<uint8_t> voter_flags =
+        RandomSampleInliers(left, options.max_voters, options.seed + planes.size());
     std::vector<Eigen::Vector3d> voters;
     for (size_t i = 0; i < left.size(); ++i) {
       if (voter_flags[i]) voters.push_back(left.points[i].cast<double>() - centre);

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/pointset/kdtree.h"
@@ -45,9 +45,12 @@ struct Covariance {
 
 void NormalOptions::Check() const {
   CheckOption(neighbors >= 3, fmt::format("NormalOptions.neighbors must be >= 3, got {}", neighbors));
-  CheckOption(radius_m >= 0.0, fmt::format("NormalOptions.radius_m must be >= 0 (0 = k nearest), got {}", radius_m));
-  CheckOption(max_neighbors >= 0, fmt::format("NormalOptions.max_neighbors must be >= 0, got {}", max_neighbors));
-  CheckOption(window_cells >= 1, fmt::format("NormalOptions.window_cells must be >= 1, got {}", window_cells));
+  CheckOption(radius_m >= 0.0,
+              fmt::format("NormalOptions.radius_m must be >= 0 (0 = k nearest), got {}", radius_m));
+  CheckOption(max_neighbors >= 0,
+              fmt::format("NormalOptions.max_neighbors must be >= 0, got {}", max_neighbors));
+  CheckOption(window_cells >= 1,
+              fmt::format("NormalOptions.window_cells must be >= 1, got {}", window_cells));
 }
 
 NormalResult EstimateNormals(const PointCloud& cloud, const NormalOptions& options) {
@@ -71,7 +74,8 @@ NormalResult EstimateNormals(const PointCloud& cloud, const NormalOptions& optio
           if (radius > 0.0f && options.max_neighbors == 0) {
             tree.ForEachInRadius(p, radius, [&](uint32_t j, float) { covariance.Add(cloud.points[j] - p); });
           } else {
-            tree.KNearest(p, radius > 0.0f ? options.max_neighbors : options.neighbors, &indices, &distances_sq);
+            tree.KNearest(p, radius > 0.0f ? options.max_neighbors : options.neighbors, &indices,
+                          &distances_sq);
             for (size_t n = 0; n < indices.size(); ++n) {
               if (radius > 0.0f && distances_sq[n] >= radius * radius) break;
               covariance.Add(cloud.points[indices[n]] - p);

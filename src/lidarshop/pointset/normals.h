@@ -1,7 +1,7 @@
 // Normals and curvature of point sets by principal component analysis of a neighbourhood (Hoppe et al. 1992;
-// PCL's NormalEstimation, Open3D's estimate_normals): the normal is the eigenvector of the smallest eigenvalue
-// of the neighbours' covariance, oriented toward the scanner; the curvature is the surface variation
-// λ0 / (λ0 + λ1 + λ2) (Pauly et al. 2002), 0 on a plane, up to 1/3.
+// PCL's NormalEstimation, Open3D's estimate_normals): the normal is the eigenvector of the smallest
+// eigenvalue of the neighbours' covariance, oriented toward the scanner; the curvature is the surface
+// variation λ0 / (λ0 + λ1 + λ2) (Pauly et al. 2002), 0 on a plane, up to 1/3.
 //
 // Three neighbourhoods: the k nearest points, all points within a radius (KD-tree), or on an organized scan
 // the cells of a square window of the grid whose points lie within a radius (no tree, the grid is the index).

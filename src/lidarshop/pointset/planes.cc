@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <array>
-#include <iterator>
 #include <cmath>
+#include <iterator>
 #include <random>
 
-#include <Eigen/Eigenvalues>
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/util/error.h"
@@ -61,7 +61,8 @@ PlaneFit FitAmong(const std::vector<Eigen::Vector3f>& points, const std::vector<
     const double all_inliers = ratio * ratio * ratio;
     if (all_inliers >= 1.0 - 1e-12) break;
     if (all_inliers > 0.0) {
-      needed = static_cast<int64_t>(std::ceil(std::log(1.0 - options.confidence) / std::log(1.0 - all_inliers)));
+      needed =
+          static_cast<int64_t>(std::ceil(std::log(1.0 - options.confidence) / std::log(1.0 - all_inliers)));
     }
   }
   PlaneFit fit;
@@ -105,25 +106,25 @@ void RefitPlane(const std::vector<Eigen::Vector3f>& points, PlaneFit* fit) {
 }
 
 void RansacPlaneOptions::Check() const {
-  CheckOption(distance_threshold_m > 0.0,
-              fmt::format("RansacPlaneOptions.distance_threshold_m must be > 0, got {}", distance_threshold_m));
-  CheckOption(max_iterations >= 1, fmt::format("RansacPlaneOptions.max_iterations must be >= 1, got {}", max_iterations));
+  CheckOption(
+      distance_threshold_m > 0.0,
+      fmt::format("RansacPlaneOptions.distance_threshold_m must be > 0, got {}", distance_threshold_m));
+  CheckOption(max_iterations >= 1,
+              fmt::format("RansacPlaneOptions.max_iterations must be >= 1, got {}", max_iterations));
   CheckOption(confidence > 0.0 && confidence < 1.0,
               fmt::format("RansacPlaneOptions.confidence must be in (0, 1), got {}", confidence));
-  CheckOption(min_inliers >= 3, fmt::format("RansacPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
+  CheckOption(min_inliers >= 3,
+              fmt::format("RansacPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
   CheckOption(max_planes >= 1, fmt::format("RansacPlaneOptions.max_planes must be >= 1, got {}", max_planes));
 }
 
 PlaneFit FitPlaneRansac(const PointCloud& cloud, const RansacPlaneOptions& options) {
-  options.Check();
-  CheckCloudHasShape(cloud, "RANSAC plane");
-  CheckCloudHasPoints(cloud, 3, "RANSAC plane");
-  std::vector<uint32_t> all(cloud.size());
-  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
-  std::mt19937_64 random(options.seed);
-  PlaneFit fit = FitAmong(cloud.points, all, options, &random);
-  if (fit.inliers.size() < 3) throw InputError("RANSAC plane: every sample was degenerate (collinear points)");
-  return fit;
+  RansacPlaneOptions best_only = options;
+  best_only.max_planes = 1;
+  best_only.min_inliers = 3;
+  std::vector<PlaneFit> planes = DetectPlanesRansac(cloud, best_only);
+  if (planes.empty()) throw InputError("RANSAC plane: every sample was degenerate (collinear points)");
+  return std::move(planes.front());
 }
 
 std::vector<PlaneFit> DetectPlanesRansac(const PointCloud& cloud, const RansacPlaneOptions& options) {

@@ -1,6 +1,6 @@
-// RANSAC plane fitting (Fischler and Bolles 1981; PCL's SACSegmentation, Open3D's segment_plane): planes through
-// three random points, scored by their inliers within a distance; the best one is refitted to its inliers by
-// least squares. Sequential detection takes the best plane, removes its inliers and repeats.
+// RANSAC plane fitting (Fischler and Bolles 1981; PCL's SACSegmentation, Open3D's segment_plane): planes
+// through three random points, scored by their inliers within a distance; the best one is refitted to its
+// inliers by least squares. Sequential detection takes the best plane, removes its inliers and repeats.
 //
 // Determinism: hypotheses are drawn serially from one seeded generator in batches and scored in parallel; the
 // best is the one with most inliers, the earliest on ties, so the answer does not depend on the thread count.

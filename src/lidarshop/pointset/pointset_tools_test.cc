@@ -42,7 +42,8 @@ PointCloud Blobs(int count, int per, uint64_t seed) {
   std::normal_distribution<float> normal(0.0f, 0.05f);
   PointCloud cloud;
   for (int b = 0; b < count; ++b) {
-    for (int i = 0; i < per; ++i) cloud.points.emplace_back(2.0f * b + normal(random), normal(random), normal(random));
+    for (int i = 0; i < per; ++i)
+      cloud.points.emplace_back(2.0f * b + normal(random), normal(random), normal(random));
   }
   return cloud;
 }
@@ -132,7 +133,8 @@ TEST(PlanesTest, RansacFindsTheKnownPlane) {
 
 TEST(PlanesTest, SequentialDetectionFindsTwoPlanes) {
   PointCloud cloud = PlaneWithOutliers(6000, 0, 0.001, 6);
-  for (int i = 0; i < 4000; ++i) cloud.points.emplace_back(0.001f * (i % 100) - 5.0f, 0.001f * (i / 100), 3.0f);
+  for (int i = 0; i < 4000; ++i)
+    cloud.points.emplace_back(0.001f * (i % 100) - 5.0f, 0.001f * (i / 100), 3.0f);
   const std::vector<PlaneFit> planes =
       DetectPlanesRansac(cloud, {.distance_threshold_m = 0.005, .min_inliers = 100, .max_planes = 5});
   ASSERT_EQ(planes.size(), 2u);
@@ -153,8 +155,9 @@ TEST(PlanesTest, HoughFindsTheKnownPlanes) {
   EXPECT_NEAR(std::abs(planes[1].normal.z()), 1.0, 1e-6);
   EXPECT_NEAR(planes[1].inliers.size(), 4000u, 10);  // a few outliers lie within 1 cm of z = 3
   ThreadLimit one(1);
-  EXPECT_EQ(DetectPlanesHough(cloud, {.distance_step_m = 0.02, .max_planes = 3, .min_inliers = 500})[0].inliers,
-            planes[0].inliers);
+  EXPECT_EQ(
+      DetectPlanesHough(cloud, {.distance_step_m = 0.02, .max_planes = 3, .min_inliers = 500})[0].inliers,
+      planes[0].inliers);
 }
 
 TEST(ClusteringTest, EuclideanClustersMatchTheBlobs) {

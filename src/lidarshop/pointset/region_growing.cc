@@ -16,9 +16,10 @@ bool Joined(const Scan& scan, cv::Point a, cv::Point b, double ratio) {
   return std::abs(ra - rb) <= ratio * std::min(ra, rb);
 }
 
-// Breadth-first front from `seed` over cells whose `labels` are kNoLabel; marks them `label`. Returns the count.
-int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& options, const GrowCondition& condition,
-             int32_t label, cv::Mat* labels, std::vector<cv::Point>* cells) {
+// Breadth-first front from `seed` over cells whose `labels` are kNoLabel; marks them `label`. Returns the
+// count.
+int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& options,
+             const GrowCondition& condition, int32_t label, cv::Mat* labels, std::vector<cv::Point>* cells) {
   cells->clear();
   std::deque<cv::Point> front{seed};
   labels->at<int32_t>(seed) = label;
@@ -30,7 +31,8 @@ int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& optio
     for (const cv::Point& step : steps) {
       const cv::Point to = from + step;
       if (to.x < 0 || to.y < 0 || to.x >= scan.cols || to.y >= scan.rows) continue;
-      if (labels->at<int32_t>(to) != kNoLabel || !Joined(scan, from, to, options.max_range_jump_ratio)) continue;
+      if (labels->at<int32_t>(to) != kNoLabel || !Joined(scan, from, to, options.max_range_jump_ratio))
+        continue;
       if (!condition(from, to)) continue;
       labels->at<int32_t>(to) = label;
       front.push_back(to);
@@ -42,8 +44,9 @@ int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& optio
 }  // namespace
 
 void RegionGrowingOptions::Check() const {
-  CheckOption(max_range_jump_ratio > 0.0,
-              fmt::format("RegionGrowingOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
+  CheckOption(
+      max_range_jump_ratio > 0.0,
+      fmt::format("RegionGrowingOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
   CheckOption(min_region_cells >= 1,
               fmt::format("RegionGrowingOptions.min_region_cells must be >= 1, got {}", min_region_cells));
 }
@@ -60,7 +63,8 @@ GrowCondition NormalAngleCondition(const Scan& scan, double max_angle_deg) {
 cv::Mat GrowRegion(const Scan& scan, cv::Point seed, const RegionGrowingOptions& options,
                    const GrowCondition& condition) {
   options.Check();
-  if (seed.x < 0 || seed.y < 0 || seed.x >= scan.cols || seed.y >= scan.rows || !scan.valid.at<uint8_t>(seed)) {
+  if (seed.x < 0 || seed.y < 0 || seed.x >= scan.cols || seed.y >= scan.rows ||
+      !scan.valid.at<uint8_t>(seed)) {
     throw InputError(fmt::format("region growing: seed (row {}, col {}) is outside the scan or has no return",
                                  seed.y, seed.x));
   }
@@ -71,8 +75,8 @@ cv::Mat GrowRegion(const Scan& scan, cv::Point seed, const RegionGrowingOptions&
   return region;
 }
 
-cv::Mat SegmentByRegionGrowing(const Scan& scan, const RegionGrowingOptions& options, const GrowCondition& condition,
-                               int* num_regions) {
+cv::Mat SegmentByRegionGrowing(const Scan& scan, const RegionGrowingOptions& options,
+                               const GrowCondition& condition, int* num_regions) {
   options.Check();
   cv::Mat labels(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
   constexpr int32_t kTooSmall = -2;  // visited, but its region was dropped

@@ -1,6 +1,6 @@
-// Conditional region growing over an organized scan's grid mesh: the thesis's "mesh front iterator". A front of
-// cells starts at a seed and moves to 4-connected neighbours joined by the grid mesh (both returned, range jump
-// within max_range_jump_ratio, as scanner/scan_mesh.h joins them) and accepted by a pluggable condition.
+// Conditional region growing over an organized scan's grid mesh: the thesis's "mesh front iterator". A front
+// of cells starts at a seed and moves to 4-connected neighbours joined by the grid mesh (both returned, range
+// jump within max_range_jump_ratio, as scanner/scan_mesh.h joins them) and accepted by a pluggable condition.
 //
 //   RegionGrowingOptions options;
 //   cv::Mat region = GrowRegion(scan, {row, col}, options, NormalAngleCondition(scan, 10.0));
@@ -34,7 +34,7 @@ cv::Mat GrowRegion(const Scan& scan, cv::Point seed, const RegionGrowingOptions&
 // Every returned cell in one region: regions grown in row-major order of their first cell. Labels CV_32S
 // 0, 1, …; kNoLabel for cells without a return or in regions smaller than min_region_cells. `num_regions`
 // (optional) receives the number of labels given.
-cv::Mat SegmentByRegionGrowing(const Scan& scan, const RegionGrowingOptions& options, const GrowCondition& condition,
-                               int* num_regions = nullptr);
+cv::Mat SegmentByRegionGrowing(const Scan& scan, const RegionGrowingOptions& options,
+                               const GrowCondition& condition, int* num_regions = nullptr);
 
 }  // namespace lidarshop

@@ -2,9 +2,9 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
-#include <fmt/format.h>
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/pointset/filters.h"
@@ -44,9 +44,12 @@ void IcpOptions::Check() const {
                           min_correspondence_m));
   CheckOption(min_normal_cos >= -1.0 && min_normal_cos <= 1.0,
               fmt::format("IcpOptions.min_normal_cos must be in [-1, 1], got {}", min_normal_cos));
-  CheckOption(max_iterations >= 1, fmt::format("IcpOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(min_translation_m >= 0.0 && min_rotation_rad >= 0.0, "IcpOptions convergence thresholds must be >= 0");
-  CheckOption(normal_neighbors >= 3, fmt::format("IcpOptions.normal_neighbors must be >= 3, got {}", normal_neighbors));
+  CheckOption(max_iterations >= 1,
+              fmt::format("IcpOptions.max_iterations must be >= 1, got {}", max_iterations));
+  CheckOption(min_translation_m >= 0.0 && min_rotation_rad >= 0.0,
+              "IcpOptions convergence thresholds must be >= 0");
+  CheckOption(normal_neighbors >= 3,
+              fmt::format("IcpOptions.normal_neighbors must be >= 3, got {}", normal_neighbors));
 }
 
 IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
@@ -114,12 +117,14 @@ IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
     const Eigen::Vector3d rotation_vector = x.head<3>();
     const double angle = rotation_vector.norm();
     Eigen::Matrix4d update = Eigen::Matrix4d::Identity();
-    if (angle > 0.0) update.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, rotation_vector / angle).matrix();
+    if (angle > 0.0)
+      update.topLeftCorner<3, 3>() = Eigen::AngleAxisd(angle, rotation_vector / angle).matrix();
     update.topRightCorner<3, 1>() = x.tail<3>();
     result.fixed_from_moving = update * result.fixed_from_moving;
     const bool distance_settled = next_distance == max_distance;
     max_distance = next_distance;
-    if (distance_settled && x.tail<3>().norm() < options.min_translation_m && angle < options.min_rotation_rad) {
+    if (distance_settled && x.tail<3>().norm() < options.min_translation_m &&
+        angle < options.min_rotation_rad) {
       result.converged = true;
       break;
     }
@@ -132,11 +137,13 @@ ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpO
                                const GlobalAlignOptions* global) {
   // Scans without normals get grid normals: oriented toward their scanner, which FPFH needs.
   const NormalOptions grid_normals;
-  const PointCloud fixed_in_world = ToPointCloud(fixed.normal.empty() ? WithGridNormals(fixed, grid_normals) : fixed, true);
+  const PointCloud fixed_in_world =
+      ToPointCloud(fixed.normal.empty() ? WithGridNormals(fixed, grid_normals) : fixed, true);
   const PointCloud moving_in_world =
       ToPointCloud(moving.normal.empty() ? WithGridNormals(moving, grid_normals) : moving, true);
-  const Eigen::Matrix4d initial = global ? AlignGlobally(fixed_in_world, moving_in_world, *global).fixed_from_moving
-                                         : Eigen::Matrix4d::Identity();
+  const Eigen::Matrix4d initial =
+      global ? AlignGlobally(fixed_in_world, moving_in_world, *global).fixed_from_moving
+             : Eigen::Matrix4d::Identity();
   ScanRegistration out;
   out.icp = IcpPointToPlane(fixed_in_world, moving_in_world, initial, options);
   out.registered = moving;

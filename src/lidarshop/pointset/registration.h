@@ -1,6 +1,6 @@
 // Rigid registration of two point sets: point-to-plane ICP from an initial guess (Chen and Medioni 1992;
-// Open3D's registration_icp with TransformationEstimationPointToPlane), and a global initial alignment from FPFH
-// features (Rusu et al. 2009) matched by RANSAC when there is no guess.
+// Open3D's registration_icp with TransformationEstimationPointToPlane), and a global initial alignment from
+// FPFH features (Rusu et al. 2009) matched by RANSAC when there is no guess.
 //
 // Frames: `fixed` stays where it is; the result maps moving coordinates into the fixed cloud's frame
 // (`fixed_from_moving`). For scans both clouds are taken in the world frame and the correction is applied to
@@ -24,17 +24,17 @@ struct IcpOptions {
   double min_correspondence_m = 0.02;
   // When both clouds have normals, pairs whose normals differ by more than acos(this) are ignored ([-1, 1]).
   double min_normal_cos = 0.7;
-  int max_iterations = 50;            // >= 1
-  double min_translation_m = 1e-5;    // converged when an update moves less than this (metres)
-  double min_rotation_rad = 1e-6;     // and turns less than this (radians), >= 0
-  int normal_neighbors = 20;          // k for the fixed cloud's normals when it has none, >= 3
-  void Check() const;                 // throws OptionsError
+  int max_iterations = 50;          // >= 1
+  double min_translation_m = 1e-5;  // converged when an update moves less than this (metres)
+  double min_rotation_rad = 1e-6;   // and turns less than this (radians), >= 0
+  int normal_neighbors = 20;        // k for the fixed cloud's normals when it has none, >= 3
+  void Check() const;               // throws OptionsError
 };
 
 struct IcpResult {
   Eigen::Matrix4d fixed_from_moving = Eigen::Matrix4d::Identity();
-  double rms_m = 0.0;       // point-to-plane RMS of the last correspondences, metres
-  double fitness = 0.0;     // fraction of moving points with a correspondence at the end
+  double rms_m = 0.0;    // point-to-plane RMS of the last correspondences, metres
+  double fitness = 0.0;  // fraction of moving points with a correspondence at the end
   int64_t correspondences = 0;
   int iterations = 0;
   bool converged = false;
@@ -46,11 +46,11 @@ IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
                           const Eigen::Matrix4d& initial_fixed_from_moving, const IcpOptions& options);
 
 // Registers `moving` onto `fixed` (both in their world frames, moving's world_from_scanner as the initial
-// guess, or with `global` a FPFH + RANSAC alignment first) and returns the moving scan with world_from_scanner
-// corrected.
+// guess, or with `global` a FPFH + RANSAC alignment first) and returns the moving scan with
+// world_from_scanner corrected.
 struct ScanRegistration {
-  Scan registered;   // the moving scan, new world_from_scanner
-  IcpResult icp;     // fixed_from_moving = the correction applied in world coordinates
+  Scan registered;  // the moving scan, new world_from_scanner
+  IcpResult icp;    // fixed_from_moving = the correction applied in world coordinates
 };
 ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options,
                                const GlobalAlignOptions* global = nullptr);

@@ -1,5 +1,5 @@
-// Point-to-plane ICP on two synthetic scans of one scene from two scanner positions: the relative pose is known,
-// the moving scan starts from a perturbed pose and must come back within 1 mm and 0.01°.
+// Point-to-plane ICP on two synthetic scans of one scene from two scanner positions: the relative pose is
+// known, the moving scan starts from a perturbed pose and must come back within 1 mm and 0.01°.
 #include <cmath>
 #include <cstdio>
 
@@ -52,14 +52,17 @@ TEST(RegistrationTest, IcpRecoversTheRelativePoseOfTwoScans) {
   ASSERT_GT(fixed.CountValid(), 50000);
   // The initial guess is off by 8 cm and 1.5°.
   Scan moving = moving_true;
-  moving.world_from_scanner = ComposeTransform({0.05, -0.04, 0.05}, {0.5, -0.5, 1.5}) * moving_true.world_from_scanner;
+  moving.world_from_scanner =
+      ComposeTransform({0.05, -0.04, 0.05}, {0.5, -0.5, 1.5}) * moving_true.world_from_scanner;
   const ScanRegistration registration = RegisterScans(fixed, moving, {.max_correspondence_m = 0.3});
   const Eigen::Matrix4d& found = registration.registered.world_from_scanner;
   const Eigen::Matrix4d& truth = moving_true.world_from_scanner;
   std::printf("ICP: %d iterations, translation error %.3g m, rotation error %.3g deg, fitness %.3f\n",
-              registration.icp.iterations, (found.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(),
-              AngleDeg(found, truth), registration.icp.fitness);
-  EXPECT_TRUE(registration.icp.converged) << registration.icp.iterations << " iterations, rms " << registration.icp.rms_m;
+              registration.icp.iterations,
+              (found.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), AngleDeg(found, truth),
+              registration.icp.fitness);
+  EXPECT_TRUE(registration.icp.converged)
+      << registration.icp.iterations << " iterations, rms " << registration.icp.rms_m;
   EXPECT_LT((found.topRightCorner<3, 1>() - truth.topRightCorner<3, 1>()).norm(), 0.001);
   EXPECT_LT(AngleDeg(found, truth), 0.01);
   EXPECT_GT(registration.icp.fitness, 0.5);
@@ -77,7 +80,8 @@ TEST(RegistrationTest, FpfhRansacThenIcpWithoutAGuess) {
   Scan moving = moving_true;
   moving.world_from_scanner = ComposeTransform({1.0, -0.7, 0.1}, {0, 0, 30}) * moving_true.world_from_scanner;
   const PointCloud fixed_cloud = ToPointCloud(fixed, true), moving_cloud = ToPointCloud(moving, true);
-  const GlobalAlignResult global = AlignGlobally(fixed_cloud, moving_cloud, {.voxel_m = 0.2, .feature_radius_m = 0.8, .inlier_distance_m = 0.3});
+  const GlobalAlignResult global = AlignGlobally(
+      fixed_cloud, moving_cloud, {.voxel_m = 0.2, .feature_radius_m = 0.8, .inlier_distance_m = 0.3});
   const IcpResult icp = IcpPointToPlane(fixed_cloud, moving_cloud, global.fixed_from_moving, {});
   const Eigen::Matrix4d found = icp.fixed_from_moving * moving.world_from_scanner;
   const Eigen::Matrix4d& truth = moving_true.world_from_scanner;
@@ -96,7 +100,8 @@ TEST(RegistrationTest, BadInput) {
   PointCloud empty, line;
   for (int i = 0; i < 10; ++i) line.points.emplace_back(i, 0, 0);
   EXPECT_THROW(IcpPointToPlane(empty, line, Eigen::Matrix4d::Identity(), {}), InputError);
-  EXPECT_THROW(IcpPointToPlane(line, line, Eigen::Matrix4d::Identity(), {.max_correspondence_m = 0.0}), OptionsError);
+  EXPECT_THROW(IcpPointToPlane(line, line, Eigen::Matrix4d::Identity(), {.max_correspondence_m = 0.0}),
+               OptionsError);
 }
 
 }  // namespace

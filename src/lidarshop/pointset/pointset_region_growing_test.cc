@@ -15,7 +15,8 @@ TEST(RegionGrowingTest, SmoothRegionsFollowTheObjects) {
   const Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene());
   ASSERT_FALSE(scan.label.empty());
   int regions = 0;
-  const cv::Mat labels = SegmentByRegionGrowing(scan, {.min_region_cells = 20}, NormalAngleCondition(scan, 10.0), &regions);
+  const cv::Mat labels =
+      SegmentByRegionGrowing(scan, {.min_region_cells = 20}, NormalAngleCondition(scan, 10.0), &regions);
   EXPECT_GE(regions, 2);  // the ground, the box's front face, its top
   EXPECT_LE(regions, 4);
   // Every region lies on one object (ground label 0 or box label 1).

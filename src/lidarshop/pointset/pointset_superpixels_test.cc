@@ -15,7 +15,8 @@ double Purity(const Scan& scan, const cv::Mat& superpixels) {
   std::map<int, std::map<int, int>> counts;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
-      if (scan.valid.at<uint8_t>(row, col)) ++counts[superpixels.at<int32_t>(row, col)][scan.label.at<int32_t>(row, col)];
+      if (scan.valid.at<uint8_t>(row, col))
+        ++counts[superpixels.at<int32_t>(row, col)][scan.label.at<int32_t>(row, col)];
     }
   }
   int64_t majority = 0, total = 0;
