@@ -36,6 +36,9 @@ const std::vector<Command>& Commands() {
       {"images", lidarshop::cli::RunImages, "list or extract the photos of an E57 file"},
       {"align", lidarshop::cli::RunAlign, "landmark transform, homography or fundamental matrix"},
       {"photo", lidarshop::cli::RunPhoto, "render a synthetic photo of a scene"},
+      {"points", lidarshop::cli::RunPoints,
+       "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
+      {"register", lidarshop::cli::RunRegister, "register one scan onto another (point-to-plane ICP)"},
   };
   return commands;
 }

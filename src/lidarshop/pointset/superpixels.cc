@@ -1,0 +1,77 @@
+#include "lidarshop/pointset/superpixels.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc/segmentation.hpp>
+#include <opencv2/ximgproc/slic.hpp>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+
+void SuperpixelOptions::Check() const {
+  CheckOption(region_cells >= 2,
+              fmt::format("SuperpixelOptions.region_cells must be >= 2, got {}", region_cells));
+  CheckOption(ruler > 0.0f, fmt::format("SuperpixelOptions.ruler must be > 0, got {}", ruler));
+  CheckOption(iterations >= 1, fmt::format("SuperpixelOptions.iterations must be >= 1, got {}", iterations));
+  CheckOption(graph_sigma >= 0.0 && graph_k > 0.0f && graph_min_cells >= 1,
+              "SuperpixelOptions graph_sigma must be >= 0, graph_k > 0, graph_min_cells >= 1");
+  CheckOption(range_weight >= 0.0,
+              fmt::format("SuperpixelOptions.range_weight must be >= 0, got {}", range_weight));
+}
+
+cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int* num_superpixels) {
+  options.Check();
+  if (scan.num_cells() == 0) throw InputError("superpixels: the scan has no cells");
+  // Channels in [0, 255]: colour (or intensity) and log range scaled to the scan's own range span.
+  std::vector<cv::Mat> channels;
+  if (scan.has_color()) {
+    cv::Mat color;
+    scan.color.convertTo(color, CV_32FC3);
+    cv::split(color, channels);
+  } else {
+    cv::Mat intensity;
+    scan.intensity.convertTo(intensity, CV_32F, 255.0);
+    channels.push_back(intensity);
+  }
+  if (options.range_weight > 0.0 && scan.CountValid() > 0) {
+    cv::Mat log_range;
+    cv::log(cv::max(scan.range, 1e-3), log_range);
+    double low, high;
+    cv::minMaxLoc(log_range, &low, &high, nullptr, nullptr, scan.valid);
+    cv::Mat scaled = (log_range - low) * (255.0 * options.range_weight / std::max(high - low, 1e-6));
+    scaled.setTo(0, scan.valid == 0);
+    channels.push_back(scaled);
+  }
+  cv::Mat image;
+  cv::merge(channels, image);
+  cv::Mat labels;
+  if (options.method == SuperpixelMethod::kSlic) {
+    const cv::Ptr<cv::ximgproc::SuperpixelSLIC> slic =
+        cv::ximgproc::createSuperpixelSLIC(image, cv::ximgproc::SLICO, options.region_cells, options.ruler);
+    slic->iterate(options.iterations);
+    slic->enforceLabelConnectivity();
+    slic->getLabels(labels);
+    if (num_superpixels) *num_superpixels = slic->getNumberOfSuperpixels();
+  } else {
+    // The graph segmentation takes up to 3 channels of 8 bits or floats; keep the first three.
+    if (image.channels() > 3) {
+      std::vector<cv::Mat> first(channels.begin() + 1, channels.end());
+      cv::merge(first, image);  // drop red: green, blue, range
+    }
+    const cv::Ptr<cv::ximgproc::segmentation::GraphSegmentation> graph =
+        cv::ximgproc::segmentation::createGraphSegmentation(options.graph_sigma, options.graph_k,
+                                                            options.graph_min_cells);
+    graph->processImage(image, labels);
+    if (num_superpixels) {
+      double high;
+      cv::minMaxLoc(labels, nullptr, &high);
+      *num_superpixels = static_cast<int>(high) + 1;
+    }
+  }
+  return labels;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,34 @@
+// Superpixels on the scan image (OpenCV ximgproc): SLIC (Achanta et al. 2012) and graph-based segmentation
+// (Felzenszwalb and Huttenlocher 2004) over an image of the scan: colour when the scan has one, else
+// intensity, with the range (log, so near and far weigh alike) as an extra channel. QuickShift has no
+// well-kept library in Debian (ximgproc has none; VLFeat is not packaged) and is not provided.
+#pragma once
+
+#include <cstdint>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+enum class SuperpixelMethod { kSlic, kGraph };
+
+struct SuperpixelOptions {
+  SuperpixelMethod method = SuperpixelMethod::kSlic;
+  int region_cells = 20;     // SLIC: superpixel side, cells, >= 2
+  float ruler = 10.0f;       // SLIC: compactness, > 0
+  int iterations = 10;       // SLIC iterations, >= 1
+  double graph_sigma = 0.5;  // graph: Gaussian smoothing, cells, >= 0
+  float graph_k = 300.0f;    // graph: larger = larger segments, > 0
+  int graph_min_cells = 50;  // graph: smallest segment, cells, >= 1
+  double range_weight =
+      1.0;             // weight of the log-range channel against colour (both scaled to [0, 255]), >= 0
+  void Check() const;  // throws OptionsError
+};
+
+// CV_32S rows x cols superpixel labels 0, 1, … (cells without a return included: their range channel is 0).
+// `num_superpixels` (optional) receives the count. Deterministic (neither method draws random numbers).
+cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int* num_superpixels = nullptr);
+
+}  // namespace lidarshop
