@@ -13,8 +13,10 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace e57 {
@@ -418,6 +420,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
       XmlError(ctx, points,
                fmt::format("grid of {} x {} cells exceeds the limit of {} cells", rows, cols, g_max_cells));
     }
+    io_internal::CheckGridFromData(rows, cols, static_cast<int64_t>(ctx.logical.size()), ctx.path,
+                                   "data3D points");
     for (int64_t i = 0; i < record_count; ++i) cell[i] += row[i] * cols;
   } else {
     rows = record_count > 0 ? 1 : 0;
@@ -765,6 +769,7 @@ E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& 
 }
 
 E57File ReadE57(const std::string& path) {
+  CheckRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowInputError(path, "", "", "cannot open for reading");
   in.seekg(0, std::ios::end);

@@ -10,6 +10,8 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -30,8 +32,14 @@ cv::Mat SwapRedBlue(const cv::Mat& image) {
 }  // namespace
 
 cv::Mat ReadImage(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path))
-    ThrowInputError(path, "", "", "cannot open the image (missing?)");
+  CheckRegularFile(path);
+  // OpenCV refuses images past this many pixels from the header, before decoding; keep it within the budget
+  // (8 bytes a pixel: 4 channels of 16 bits). Read once by OpenCV, so set before the first imread.
+  static const bool limited = [] {
+    const int64_t pixels = std::min<int64_t>(int64_t{1} << 30, MemoryBudgetBytes() / 8);
+    return setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(pixels).c_str(), 0) == 0;
+  }();
+  (void)limited;
   if (FileExtension(path) == "exr") {
     // OpenCV 4.6 reads EXR only when this is set before the first use.
     setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);

@@ -13,6 +13,7 @@
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace {
@@ -385,11 +386,9 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
 }
 
 SceneDescription LoadScene(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) ThrowInputError(path, "", "", "cannot open the scene file");
-  std::stringstream buffer;
-  buffer << stream.rdbuf();
-  SceneDescription scene = ParseScene(buffer.str(), path, std::filesystem::path(path).parent_path().string());
+  constexpr int64_t kMaxSceneFileBytes = int64_t{64} << 20;  // a scene description, not a mesh
+  SceneDescription scene = ParseScene(ReadRegularFile(path, kMaxSceneFileBytes), path,
+                                      std::filesystem::path(path).parent_path().string());
   scene.path = path;
   return scene;
 }
