@@ -58,13 +58,13 @@ int RunInpaint(int argc, char** argv) {
   app.add_option("--global-gain", options.global_gain,
                  "two-step: a distant source must be this many times better than the local one")
       ->capture_default_str();
-  app.add_option("--seed", options.seed, "seed of the random priority and of PatchMatch")
-      ->capture_default_str();
+  AddSeedOption(app, &options.seed, "seed of the random priority and of PatchMatch");
   app.add_option("--debug", debug_dir,
                  "write fill_order.png, source_map.png, source_locations.png and steps.csv into this folder");
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
     options.Check();
+    CheckOutputPath(output_path, {image_path, mask_path});
     const cv::Mat input = ReadImage(image_path);
     cv::Mat mask = ReadImage(mask_path);
     if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
