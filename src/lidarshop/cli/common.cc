@@ -34,7 +34,14 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
 void AddQuietFlag(CLI::App& app, bool* quiet) {
   app.add_flag("-q,--quiet", *quiet, "no progress output");
   app.add_option_function<std::string>(
-      "--max-memory", [](const std::string& text) { SetMemoryBudgetBytes(ParseMemorySize(text, "--max-memory")); },
+      "--max-memory",
+      [](const std::string& text) {
+        try {
+          SetMemoryBudgetBytes(ParseMemorySize(text, "--max-memory"));
+        } catch (const OptionsError& error) {
+          throw CLI::ValidationError(error.what());  // a usage error like any other, one line
+        }
+      },
       "memory budget (e.g. 512M, 8G): larger requests fail up front; default half of the RAM");
 }
 
@@ -45,7 +52,7 @@ void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help) {
            uint64_t value = 0;
            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
            if (error != std::errc() || end != text.data() + text.size() || value >= (uint64_t{1} << 63)) {
-             throw OptionsError(fmt::format("--seed: '{}' is not a whole number in [0, 2^63)", text));
+             throw CLI::ValidationError(fmt::format("--seed: '{}' is not a whole number in [0, 2^63)", text));
            }
            *seed = value;
          },

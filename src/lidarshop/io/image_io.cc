@@ -1,7 +1,9 @@
 #include "lidarshop/io/image_io.h"
 
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -29,10 +31,26 @@ cv::Mat SwapRedBlue(const cv::Mat& image) {
   return swapped;
 }
 
+// A PNG must end with its IEND chunk: libpng reports a truncated file on stderr itself before OpenCV fails,
+// which would make two lines of one error.
+void CheckPngComplete(const std::string& path, int64_t size) {
+  static const char kSignature[] = "\x89PNG\r\n\x1a\n";
+  static const char kEnd[] = "IEND\xae\x42\x60\x82";
+  std::ifstream in(path, std::ios::binary);
+  char head[8] = {}, tail[8] = {};
+  in.read(head, 8);
+  if (!in || std::memcmp(head, kSignature, 8) != 0) return;  // not a PNG: OpenCV decides by content
+  in.seekg(size >= 8 ? size - 8 : 0);
+  in.read(tail, 8);
+  if (size < 57 || !in || std::memcmp(tail, kEnd, 8) != 0) {
+    ThrowInputError(path, "", "", "a truncated PNG (the file does not end with the IEND chunk)");
+  }
+}
+
 }  // namespace
 
 cv::Mat ReadImage(const std::string& path) {
-  CheckRegularFile(path);
+  CheckPngComplete(path, CheckRegularFile(path));
   // OpenCV refuses images past this many pixels from the header, before decoding; keep it within the budget
   // (8 bytes a pixel: 4 channels of 16 bits). Read once by OpenCV, so set before the first imread.
   static const bool limited = [] {
@@ -48,7 +66,10 @@ cv::Mat ReadImage(const std::string& path) {
   try {
     image = cv::imread(path, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& error) {
-    ThrowInputError(path, "", "", fmt::format("not a readable image ({})", error.what()));
+    // error.err is OpenCV's message without its multi-line location banner.
+    ThrowInputError(path, "", "",
+                    fmt::format("not a readable image (OpenCV: {}; images are limited to {} pixels)", error.err,
+                                getenv("OPENCV_IO_MAX_IMAGE_PIXELS") ? getenv("OPENCV_IO_MAX_IMAGE_PIXELS") : "?"));
   }
   if (image.empty()) ThrowInputError(path, "", "", "not a readable image");
   return SwapRedBlue(image);
