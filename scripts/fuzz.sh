@@ -56,19 +56,23 @@ for reader in "${readers[@]}"; do
   regressions=(data/fuzz_regressions/"${reader}"_*)
   crashes=0
   if [[ -f ${regressions[0]} ]]; then
-    if ! "$build/${reader}_fuzz" -rss_limit_mb=2048 -timeout=20 "${regressions[@]}" >"$build/$reader.regressions.log" 2>&1; then
+    if ! "$build/fuzz/${reader}_fuzz" -rss_limit_mb=2048 -timeout=20 "${regressions[@]}" >"$build/$reader.regressions.log" 2>&1; then
       echo "$reader: a regression input fails again (see $build/$reader.regressions.log)"
       crashes=$((crashes + 1))
     fi
   fi
   before=$(find "$build/artifacts" -name "$reader-*" | wc -l)
-  "$build/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=20 \
+  "$build/fuzz/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=20 \
     -artifact_prefix="$build/artifacts/$reader-" -print_final_stats=1 >"$build/$reader.log" 2>&1
   after=$(find "$build/artifacts" -name "$reader-*" | wc -l)
   crashes=$((crashes + after - before))
   inputs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$build/$reader.log" | grep -oE '[0-9]+$')
-  took=$(grep -oE 'stat::slowest_unit_time_sec|Done [0-9]+ runs in [0-9]+ second' "$build/$reader.log" |
-    grep -oE '[0-9]+ second' | grep -oE '[0-9]+')
+  took=$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$build/$reader.log" | grep -oE '[0-9]+ second' |
+    grep -oE '[0-9]+')
+  if [[ -z $inputs ]]; then  # no final stats: the target did not run, or died without an artifact
+    tail -5 "$build/$reader.log"
+    crashes=$((crashes + 1))
+  fi
   printf '| %s | %s | %s | %d |\n' "$reader" "${inputs:-?}" "${took:-$seconds}" "$crashes"
   [[ $crashes -eq 0 ]] || status=1
 done

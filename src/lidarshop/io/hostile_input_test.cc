@@ -83,8 +83,8 @@ TEST(HostileInputTest, PlyCountsAndCellsMustAgreeWithTheData) {
   EXPECT_THAT(ScanError(path), HasSubstr("more data follows"));
   WriteText(path, PlyScan(2, 2, 0, body));
   EXPECT_THAT(ScanError(path), HasSubstr(path));
-  // A 300-byte file cannot make the reader allocate a 2^28-cell grid.
-  WriteText(path, PlyScan(int64_t{1} << 14, int64_t{1} << 14, 3, body));
+  // A 300-byte file cannot make the reader allocate a 2^24-cell grid (1 GB of channels).
+  WriteText(path, PlyScan(int64_t{1} << 12, int64_t{1} << 12, 3, body));
   EXPECT_THAT(ScanError(path), AllOf(HasSubstr("header: scan 0"), HasSubstr("cells per byte")));
 }
 
