@@ -122,7 +122,8 @@ int RunPoisson(int argc, char** argv) {
   AddSolverFlags(*reconstruct, &reconstruct_flags);
 
   return RunCommand(app, argc, argv, [&]() {
-    CheckOutputPath(output_path, {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
+    CheckOutputPath(output_path,
+                    {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
     PoissonResult result;
     int unknowns = 0;
     if (*fill) {

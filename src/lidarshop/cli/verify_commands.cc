@@ -160,7 +160,8 @@ std::vector<double> ParseYaws(const std::string& text) {
     const double count = std::ceil((parts[1] - parts[0]) / parts[2]);
     if (!(count <= kMaxYaws) || !std::isfinite(parts[0]) || !std::isfinite(parts[1]) ||
         parts[0] + parts[2] == parts[0]) {
-      throw OptionsError(fmt::format("--yaws: '{}' gives {} yaws, more than the {} accepted", text, count, kMaxYaws));
+      throw OptionsError(
+          fmt::format("--yaws: '{}' gives {} yaws, more than the {} accepted", text, count, kMaxYaws));
     }
     std::vector<double> yaws;
     for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {

@@ -58,7 +58,8 @@ std::string PoseProblem(const Eigen::Matrix4d& pose, bool allow_uniform_scale) {
   if (!pose.allFinite()) return "has a non-finite entry";
   if (!pose.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) return "last row is not 0 0 0 1";
   if (pose.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > kMaxCoordinateM) {
-    return fmt::format("translation {} {} {} is beyond {} m", pose(0, 3), pose(1, 3), pose(2, 3), kMaxCoordinateM);
+    return fmt::format("translation {} {} {} is beyond {} m", pose(0, 3), pose(1, 3), pose(2, 3),
+                       kMaxCoordinateM);
   }
   const Eigen::Matrix3d linear = pose.topLeftCorner<3, 3>();
   const double det = linear.determinant();

@@ -50,7 +50,8 @@ TEST(HostileInputTest, PtxPosesMustBeRotations) {
   };
   for (const auto& [matrix, problem] : cases) {
     WriteText(path, Ptx(matrix));
-    EXPECT_THAT(ScanError(path), AllOf(HasSubstr(path), HasSubstr("field 'pose'"), HasSubstr(problem))) << matrix;
+    EXPECT_THAT(ScanError(path), AllOf(HasSubstr(path), HasSubstr("field 'pose'"), HasSubstr(problem)))
+        << matrix;
   }
 }
 
@@ -65,9 +66,10 @@ TEST(HostileInputTest, AbsurdCoordinatesAreNotData) {
 }
 
 std::string PlyScan(int64_t rows, int64_t cols, int count, const std::string& body) {
-  return "ply\nformat ascii 1.0\ncomment lidarshop_scan 0 " + std::to_string(rows) + " " + std::to_string(cols) +
-         " 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\nelement vertex " + std::to_string(count) +
-         "\nproperty float x\nproperty float y\nproperty float z\nproperty int row\nproperty int col\nend_header\n" +
+  return "ply\nformat ascii 1.0\ncomment lidarshop_scan 0 " + std::to_string(rows) + " " +
+         std::to_string(cols) + " 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\nelement vertex " + std::to_string(count) +
+         "\nproperty float x\nproperty float y\nproperty float z\nproperty int row\nproperty int "
+         "col\nend_header\n" +
          body;
 }
 
@@ -112,7 +114,8 @@ TEST(HostileInputTest, OnlyRegularFilesAreRead) {
   const std::string fifo = folder.File("x.ptx");
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
   auto message = std::async(std::launch::async, [&] { return ScanError(fifo); });
-  ASSERT_EQ(message.wait_for(std::chrono::seconds(10)), std::future_status::ready) << "a FIFO blocked the reader";
+  ASSERT_EQ(message.wait_for(std::chrono::seconds(10)), std::future_status::ready)
+      << "a FIFO blocked the reader";
   EXPECT_THAT(message.get(), HasSubstr("named pipe"));
   const std::string e57 = folder.File("y.e57");
   ASSERT_EQ(mkfifo(e57.c_str(), 0600), 0);

@@ -67,9 +67,10 @@ cv::Mat ReadImage(const std::string& path) {
     image = cv::imread(path, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& error) {
     // error.err is OpenCV's message without its multi-line location banner.
-    ThrowInputError(path, "", "",
-                    fmt::format("not a readable image (OpenCV: {}; images are limited to {} pixels)", error.err,
-                                getenv("OPENCV_IO_MAX_IMAGE_PIXELS") ? getenv("OPENCV_IO_MAX_IMAGE_PIXELS") : "?"));
+    ThrowInputError(
+        path, "", "",
+        fmt::format("not a readable image (OpenCV: {}; images are limited to {} pixels)", error.err,
+                    getenv("OPENCV_IO_MAX_IMAGE_PIXELS") ? getenv("OPENCV_IO_MAX_IMAGE_PIXELS") : "?"));
   }
   if (image.empty()) ThrowInputError(path, "", "", "not a readable image");
   return SwapRedBlue(image);

@@ -1,14 +1,14 @@
 #include "lidarshop/io/io_common.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <algorithm>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/io/scan_io.h"
 #include "lidarshop/geometry/transform.h"
+#include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
@@ -35,12 +35,14 @@ void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const st
 void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std::string& file,
                        const std::string& place) {
   CheckScanSize(rows, cols, file, place);
-  const int64_t limit = std::max(int64_t{1} << 22, SaturatingBytes(std::max<int64_t>(data_bytes, 0), kCellsPerDataByte));
+  const int64_t limit =
+      std::max(int64_t{1} << 22, SaturatingBytes(std::max<int64_t>(data_bytes, 0), kCellsPerDataByte));
   if (rows * cols > limit) {
-    ThrowInputError(file, place, "size",
-                    fmt::format("a grid of {} rows x {} columns ({} cells) from {} bytes of data: more than {} "
-                                "cells per byte; the indices are corrupt",
-                                rows, cols, rows * cols, data_bytes, kCellsPerDataByte));
+    ThrowInputError(
+        file, place, "size",
+        fmt::format("a grid of {} rows x {} columns ({} cells) from {} bytes of data: more than {} "
+                    "cells per byte; the indices are corrupt",
+                    rows, cols, rows * cols, data_bytes, kCellsPerDataByte));
   }
 }
 
@@ -54,8 +56,9 @@ void CheckScanNumbers(const Scan& scan, const std::string& file, const std::stri
       if (!valid[col]) continue;
       for (int axis = 0; axis < 3; ++axis) {
         if (!(std::abs(point[col][axis]) <= kMaxCoordinateM)) {
-          ThrowInputError(file, fmt::format("{}: row {} column {}", place, row, col), std::string(1, "xyz"[axis]),
-                          fmt::format("{} is not a coordinate within {} m", point[col][axis], kMaxCoordinateM));
+          ThrowInputError(
+              file, fmt::format("{}: row {} column {}", place, row, col), std::string(1, "xyz"[axis]),
+              fmt::format("{} is not a coordinate within {} m", point[col][axis], kMaxCoordinateM));
         }
       }
     }

@@ -8,8 +8,8 @@
 
 namespace lidarshop::io_internal {
 
-// Reads a whole regular file (util/input_file.h: FIFOs, devices and folders are refused without opening them).
-// Throws InputError naming the file when it cannot be read.
+// Reads a whole regular file (util/input_file.h: FIFOs, devices and folders are refused without opening
+// them). Throws InputError naming the file when it cannot be read.
 std::string ReadFileToString(const std::string& path);
 
 // Throws InputError naming `file` and `place` when rows x cols is negative, more than kMaxScanCells, or more

@@ -227,7 +227,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       ThrowInputError(file, "header", "POINTS",
                       fmt::format("{} bytes of point data is more than lidarshop accepts", size));
     }
-    CheckMemoryBudget(size, fmt::format("{}: header: POINTS: {} points of {} bytes", file, points, header.point_size));
+    CheckMemoryBudget(
+        size, fmt::format("{}: header: POINTS: {} points of {} bytes", file, points, header.point_size));
     records.resize(static_cast<size_t>(size));
   };
   if (header.data == "binary") {

@@ -57,7 +57,8 @@ struct PlyScanHeader {
   Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
 };
 
-std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path, int64_t file_bytes) {
+std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path,
+                                             int64_t file_bytes) {
   std::vector<PlyScanHeader> headers;
   for (const std::string& comment : ply.comments) {
     if (comment.rfind(kScanComment, 0) != 0) continue;
@@ -70,7 +71,8 @@ std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::stri
           path, "header", "comment lidarshop_scan",
           "expected 'lidarshop_scan <index> <rows> <cols> <16 matrix values>' with indices 0, 1, ...");
     }
-    CheckGridFromData(header.rows, header.cols, file_bytes, path, fmt::format("header: scan {}", header.index));
+    CheckGridFromData(header.rows, header.cols, file_bytes, path,
+                      fmt::format("header: scan {}", header.index));
     headers.push_back(header);
   }
   return headers;
@@ -123,8 +125,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     if (p.isZero()) continue;
     if (scan.valid.at<uint8_t>(row, col)) {
       ThrowInputError(path, fmt::format("vertex {}", i), "row/col",
-                      fmt::format("scan {} row {} col {} already holds a point (two points in one cell)", index,
-                                  row, col));
+                      fmt::format("scan {} row {} col {} already holds a point (two points in one cell)",
+                                  index, row, col));
     }
     scan.valid.at<uint8_t>(row, col) = kValid;
     scan.point.at<cv::Vec3f>(row, col) = cv::Vec3f(p.x(), p.y(), p.z());

@@ -345,9 +345,10 @@ static void RefuseNonFinite(const cv::Mat& values, const cv::Mat& mask, bool ins
   values.copyTo(zeroed, read);
   cv::Point at;
   if (!cv::checkRange(zeroed, /*quiet=*/true, &at)) {
-    throw InputError(fmt::format("SolvePoisson: {} holds NaN or inf at pixel (x {}, y {}) {} the hole; fix "
-                                 "or mask that pixel",
-                                 what, at.x, at.y, inside ? "inside" : "next to"));
+    throw InputError(
+        fmt::format("SolvePoisson: {} holds NaN or inf at pixel (x {}, y {}) {} the hole; fix "
+                    "or mask that pixel",
+                    what, at.x, at.y, inside ? "inside" : "next to"));
   }
 }
 
@@ -375,7 +376,8 @@ PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& bo
     divergence_in.convertTo(divergence, depth);
   }
   RefuseNonFinite(boundary, system_handle.Mask(), /*inside=*/false, "the boundary image");
-  if (!divergence.empty()) RefuseNonFinite(divergence, system_handle.Mask(), /*inside=*/true, "the divergence");
+  if (!divergence.empty())
+    RefuseNonFinite(divergence, system_handle.Mask(), /*inside=*/true, "the divergence");
   PoissonResult result;
   result.solver = system.solver;
   result.channels = n;

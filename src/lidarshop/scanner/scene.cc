@@ -172,7 +172,7 @@ const std::set<std::string> kObjectKeys = {
 // Primitive meshes from the object's fields; `color_used` is set when the primitive bakes "color" into its
 // own triangle colours (composite objects).
 constexpr int64_t kMaxSceneTriangles = int64_t{1} << 24;  // ~3 GB with Embree's BVH
-constexpr int64_t kSceneBytesPerTriangle = 256;  // mesh, colours, Embree's BVH
+constexpr int64_t kSceneBytesPerTriangle = 256;           // mesh, colours, Embree's BVH
 
 // Every vertex in the world within kMaxCoordinateM: Embree asserts on huge coordinates (a pose translated by
 // 1e308), and no terrestrial scene spans more. Checked in double, before the float mesh is made.
@@ -203,7 +203,8 @@ void CheckSceneTriangles(const Fields& fields, const char* key, int64_t expected
                                  kMaxSceneTriangles));
   }
   try {
-    CheckMemoryBudget(SaturatingBytes(total, kSceneBytesPerTriangle), fmt::format("{} scene triangles", total));
+    CheckMemoryBudget(SaturatingBytes(total, kSceneBytesPerTriangle),
+                      fmt::format("{} scene triangles", total));
   } catch (const InputError& error) {
     fields.Fail(key, error.what());
   }
@@ -390,8 +391,9 @@ void ScannerOptions::Check() const {
   CheckOption(position.cwiseAbs().maxCoeff() <= kMaxCoordinateM && rotate_deg.cwiseAbs().maxCoeff() <= 1e6,
               fmt::format("ScannerOptions: position must be within {} m and rotate_deg within 1e6 degrees",
                           kMaxCoordinateM));
-  CheckOption(max_range_m <= kMaxCoordinateM,
-              fmt::format("ScannerOptions: max_range_m must be <= {} m, got {}", kMaxCoordinateM, max_range_m));
+  CheckOption(
+      max_range_m <= kMaxCoordinateM,
+      fmt::format("ScannerOptions: max_range_m must be <= {} m, got {}", kMaxCoordinateM, max_range_m));
   CheckMemoryBudget(SaturatingBytes(int64_t{columns} * rows, 64),
                     fmt::format("a scan of {} rows x {} columns", rows, columns));
   CheckOption(

@@ -38,7 +38,8 @@ TEST(AtomicFileTest, OverwritingKeepsThePermissions) {
   text << std::ifstream(path).rdbuf();
   EXPECT_EQ(text.str(), "new");
   ASSERT_EQ(chmod(path.c_str(), 0640), 0);
-  WritePathAtomically(path, [](const std::string& temporary) { return static_cast<bool>(std::ofstream(temporary) << "x"); });
+  WritePathAtomically(
+      path, [](const std::string& temporary) { return static_cast<bool>(std::ofstream(temporary) << "x"); });
   EXPECT_EQ(ModeOf(path), 0640u);
 }
 

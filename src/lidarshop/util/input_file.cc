@@ -40,7 +40,8 @@ int64_t CheckRegularFile(const std::string& path) {
 std::string ReadRegularFile(const std::string& path, int64_t max_bytes) {
   const int64_t size = CheckRegularFile(path);
   if (size > max_bytes) {
-    ThrowInputError(path, "", "", fmt::format("{} bytes is more than the {} bytes accepted", size, max_bytes));
+    ThrowInputError(path, "", "",
+                    fmt::format("{} bytes is more than the {} bytes accepted", size, max_bytes));
   }
   CheckMemoryBudget(size, fmt::format("{}: reading the file", path));
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);

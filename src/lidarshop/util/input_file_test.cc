@@ -21,7 +21,8 @@ namespace {
 using testing::HasSubstr;
 
 std::string Folder() {
-  const std::string folder = std::filesystem::temp_directory_path() / ("input_file_test_" + std::to_string(getpid()));
+  const std::string folder =
+      std::filesystem::temp_directory_path() / ("input_file_test_" + std::to_string(getpid()));
   std::filesystem::create_directories(folder);
   return folder;
 }
@@ -49,7 +50,8 @@ TEST(InputFileTest, RefusesAFifoWithoutBlocking) {
   ASSERT_EQ(mkfifo(path.c_str(), 0600), 0);
   // Opening a FIFO for reading waits for a writer: run on a thread so that a regression fails, not hangs.
   auto message = std::async(std::launch::async, [&] { return ErrorOf(path); });
-  ASSERT_EQ(message.wait_for(std::chrono::seconds(10)), std::future_status::ready) << "reading a FIFO blocked";
+  ASSERT_EQ(message.wait_for(std::chrono::seconds(10)), std::future_status::ready)
+      << "reading a FIFO blocked";
   EXPECT_THAT(message.get(), HasSubstr("named pipe"));
   std::filesystem::remove(path);
 }
@@ -80,7 +82,8 @@ TEST(MemoryBudgetTest, ChecksRequestsAgainstTheBudget) {
   } catch (const InputError& error) {
     EXPECT_THAT(error.what(), HasSubstr("a grid needs about 65 MiB, more than the memory budget of 64 MiB"));
   }
-  EXPECT_THROW(CheckMemoryBudget(SaturatingBytes(int64_t{1} << 40, int64_t{1} << 40), "overflow"), InputError);
+  EXPECT_THROW(CheckMemoryBudget(SaturatingBytes(int64_t{1} << 40, int64_t{1} << 40), "overflow"),
+               InputError);
   EXPECT_THROW(SetMemoryBudgetBytes(0), OptionsError);
   SetMemoryBudgetBytes(before);
 }

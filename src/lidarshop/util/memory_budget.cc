@@ -41,8 +41,8 @@ void CheckMemoryBudget(int64_t bytes, std::string_view what) {
   if (bytes >= 0 && bytes <= budget) return;
   const std::string needed =
       bytes < 0 ? std::string("more than 8 EiB") : fmt::format("about {} MiB", (bytes + (1 << 20) - 1) >> 20);
-  throw InputError(fmt::format("{} needs {}, more than the memory budget of {} MiB (--max-memory)", what, needed,
-                               budget >> 20));
+  throw InputError(fmt::format("{} needs {}, more than the memory budget of {} MiB (--max-memory)", what,
+                               needed, budget >> 20));
 }
 
 int64_t SaturatingBytes(int64_t count, int64_t bytes_each) {

@@ -228,8 +228,9 @@ void VerifyOptions::Check() const {
   // Lengths past kMaxLengthM are not physical for an object in a terrestrial scan (and would overflow the
   // neighbour grid's cell arithmetic).
   constexpr double kMaxLengthM = 1000;
-  CheckOption(allowance_m >= 0 && allowance_m <= kMaxLengthM,
-              fmt::format("VerifyOptions.allowance_m must be in [0, {}] m, got {}", kMaxLengthM, allowance_m));
+  CheckOption(
+      allowance_m >= 0 && allowance_m <= kMaxLengthM,
+      fmt::format("VerifyOptions.allowance_m must be in [0, {}] m, got {}", kMaxLengthM, allowance_m));
   CheckOption(sigma_m > 0 && sigma_m <= kMaxLengthM,
               fmt::format("VerifyOptions.sigma_m must be in (0, {}] m, got {}", kMaxLengthM, sigma_m));
   CheckOption(icp_trim_m > 0 && icp_trim_m <= kMaxLengthM,
