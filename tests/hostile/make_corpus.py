@@ -65,6 +65,15 @@ def e57_pages(logical):
     return out
 
 
+def flips(ext, base, count, rnd):
+    """`count` copies of `base` with 1 to 6 random bytes replaced: a clean error or success, nothing else."""
+    for i in range(count):
+        data = bytearray(base)
+        for _ in range(rnd.randint(1, 6)):
+            data[rnd.randrange(len(data))] = rnd.randrange(256)
+        case(ext, 'any', 'info ' + write(f'flip_{i}.{ext}', bytes(data)))
+
+
 def main():
     lidarshop = sys.argv[1]
     shutil.rmtree(CORPUS, ignore_errors=True)
@@ -145,11 +154,7 @@ def main():
     good_ply = open(os.path.join(CORPUS, 'good.ply'), 'rb').read()
     for cut in [3, 20, len(good_ply) // 2, len(good_ply) - 3]:
         case('ply', 'error', 'info ' + write(f'truncated_{cut}.ply', good_ply[:cut]))
-    for i in range(10):
-        data = bytearray(good_ply)
-        for _ in range(rnd.randint(1, 6)):
-            data[rnd.randrange(len(data))] = rnd.randrange(256)
-        case('ply', 'any', 'info ' + write(f'flip_{i}.ply', bytes(data)))
+    flips('ply', good_ply, 10, rnd)
     case('ply', 'error', 'info {FIFO}.ply')
 
     # ---- PCD
@@ -175,11 +180,7 @@ def main():
     good_pcd = open(os.path.join(CORPUS, 'good.pcd'), 'rb').read()
     for cut in [5, len(good_pcd) // 2, len(good_pcd) - 4]:
         case('pcd', 'error', 'info ' + write(f'truncated_{cut}.pcd', good_pcd[:cut]))
-    for i in range(8):
-        data = bytearray(good_pcd)
-        for _ in range(rnd.randint(1, 6)):
-            data[rnd.randrange(len(data))] = rnd.randrange(256)
-        case('pcd', 'any', 'info ' + write(f'flip_{i}.pcd', bytes(data)))
+    flips('pcd', good_pcd, 8, rnd)
     case('pcd', 'error', 'info {FIFO}.pcd')
 
     # ---- E57: edit the XML of a lidarshop-written file, recompute the page CRCs

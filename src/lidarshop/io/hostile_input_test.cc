@@ -21,12 +21,7 @@ using testing_io::TempFolder;
 using testing_io::WriteText;
 
 std::string ScanError(const std::string& path) {
-  try {
-    ReadScanFile(path);
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "";
+  return testing_io::InputErrorOf([&] { ReadScanFile(path); });
 }
 
 // A 2 x 2 PTX with the given printed matrix and first point.
