@@ -191,7 +191,19 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
         fmt::format("InpaintOptions.channel_weights has {} weights for an image of {} channels",
                     options.channel_weights.size(), image.channels()));
   }
-  InpaintCanvas canvas(image, hole_mask, options.patch_radius);
+  InpaintCanvas canvas(image, hole_mask, options.patch_radius);  // validates the mask against the image
+  if (image.depth() == CV_32F || image.depth() == CV_64F) {
+    // Any known pixel may become a source or enter a patch distance: a NaN or inf there would spread into
+    // the fill. Values inside the hole are replaced and do not matter.
+    cv::Mat known = image.clone();
+    known.setTo(cv::Scalar::all(0), hole_mask);
+    cv::Point at;
+    if (!cv::checkRange(known, /*quiet=*/true, &at)) {
+      throw InputError(fmt::format("Inpaint: the image holds NaN or inf at pixel (x {}, y {}) outside the hole; "
+                                   "add it to the hole or fix it",
+                                   at.x, at.y));
+    }
+  }
   InpaintResult result;
   result.hole_pixels = static_cast<int>(cv::countNonZero(hole_mask));
   if (result.hole_pixels > 0 && canvas.source_centers().empty()) {
