@@ -275,6 +275,7 @@ def main():
     scan_case('scene', 'error', scene('not_json.json', raw='{"scanner": '))
     scan_case('scene', 'error', scene('deep.json', raw='[' * 20000 + ']' * 20000))
     scan_case('scene', 'error', scene('unknown_key.json', [{'primitive': 'box', 'bogus': 1}]))
+    scan_case('scene', 'error', scene('number_overflow.json', raw='{"objects": [{"primitive": "box", "translate": [1e+315, 0, 0]}]}'))
     scan_case('scene', 'error', '{FIFO}.json')
     scan_case('scene', 'error', '{C}/folder.ptx')
 
@@ -296,6 +297,7 @@ def main():
                        'wrong_type': json.dumps({'strokes': 'x'})}.items():
         seg('any' if name == 'many' else 'error', write(f'strokes_{name}.json', body))
     seg('error', '{FIFO}.json')
+    seg('error', write('strokes_number_overflow.json', '{"strokes": [{"label": "object", "points": [[1e+316, 1]]}]}'))
     seg('error', write('strokes_wrong_size.png', png[:0] or open(os.path.join(CORPUS, 'huge.png'), 'rb').read()))
 
     def fill(expect, mask):

@@ -439,6 +439,8 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   } catch (const json::parse_error& error) {
     ThrowInputError(what, fmt::format("byte {}", error.byte), "",
                     fmt::format("not valid JSON: {}", error.what()));
+  } catch (const json::exception& error) {  // e.g. a number past double's range: 1e+315
+    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", error.what()));
   }
   Fields top(root, what, "");
   top.CheckKeys({"scanner", "objects", "name", "description"});

@@ -43,6 +43,8 @@ cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols, const 
     doc = nlohmann::json::parse(json_text);
   } catch (const nlohmann::json::parse_error& e) {
     ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number past double's range: 1e+316
+    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
   }
   if (!doc.is_object() || !doc.contains("strokes") || !doc["strokes"].is_array()) {
     ThrowInputError(what, "", "strokes", "expected an object with an array \"strokes\"");
