@@ -195,8 +195,8 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
   if (image.depth() == CV_32F || image.depth() == CV_64F) {
     // Any known pixel may become a source or enter a patch distance: a NaN or inf there would spread into
     // the fill. Values inside the hole are replaced and do not matter.
-    cv::Mat known = image.clone();
-    known.setTo(cv::Scalar::all(0), hole_mask);
+    cv::Mat known = cv::Mat::zeros(image.size(), image.type());  // any channel count (setTo takes <= 4)
+    image.copyTo(known, hole_mask == 0);
     cv::Point at;
     if (!cv::checkRange(known, /*quiet=*/true, &at)) {
       throw InputError(fmt::format("Inpaint: the image holds NaN or inf at pixel (x {}, y {}) outside the hole; "
