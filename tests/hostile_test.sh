@@ -15,6 +15,14 @@ shared=${2:-$(dirname "$0")/../../shared/data}
 seconds=${3:-30}
 memory_kb=${4:-3000000}
 here=$(cd "$(dirname "$0")" && pwd)
+# Under AddressSanitizer (scripts/test.sh --sanitize) an address-space limit cannot work (the shadow memory
+# alone reserves terabytes): ASan's own RSS limit takes its place.
+limit_memory=(ulimit -v "$memory_kb")
+if ldd "$lidarshop" 2>/dev/null | grep -q libasan; then
+  limit_memory=(true)
+  export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}hard_rss_limit_mb=$((memory_kb / 1024)):detect_leaks=0"
+  seconds=$((seconds * 4))
+fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cp -r "$here/hostile/corpus" "$work/corpus"
@@ -43,14 +51,14 @@ while IFS='|' read -r reader expect arguments; do
   arguments=${arguments//\{S\}/$shared}
   arguments=${arguments//\{FIFO\}/$work/fifo}
   # shellcheck disable=SC2086  # the arguments are words by design
-  (ulimit -v "$memory_kb"; exec timeout -s KILL "$seconds" "$lidarshop" $arguments) \
+  ("${limit_memory[@]}"; exec timeout -s KILL "$seconds" "$lidarshop" $arguments) \
     >"$work/out" 2>"$work/err" </dev/null
   rc=$?
   lines=$(wc -l <"$work/err")
   outcome=clean
   if [[ $rc -eq 137 ]]; then
     outcome=hang
-  elif grep -qE "bad_alloc|Insufficient memory|Failed to allocate|out of memory|Cannot allocate" "$work/err"; then
+  elif grep -qE "bad_alloc|Insufficient memory|Failed to allocate|out of memory|Cannot allocate|hard rss limit" "$work/err"; then
     outcome=memory
   elif [[ $rc -ge 128 ]] || grep -qE "AddressSanitizer|runtime error:|Segmentation|Aborted|terminate called" "$work/err"; then
     outcome=crash
