@@ -309,6 +309,8 @@ def main():
     fill('error', write('mask_garbage.png', bytes(rnd.randrange(256) for _ in range(300))))
     fill('error', write('mask_truncated.png', png[:40]))
     fill('error', '{FIFO}.png')
+    # a DICOM preamble: OpenCV would hand it to gdcm, which aborts on malformed input (found by mask_fuzz)
+    fill('error', write('mask_dicom.png', b'\0' * 128 + b'DICM' + b'\0' * 64))
     fill('error', '{C}/folder.ptx')
 
     # ---- pose files and --pose text (verify)
@@ -325,6 +327,7 @@ def main():
     verify('error', '1e308,0,0,0')
     verify('error', '0,5,0,inf')
     verify('error', '{FIFO}.txt')
+    verify('error', ','.join(['1'] * 200))  # 400 characters: "file name too long" must not escape (pose_fuzz)
 
     # ---- options (the options layer: Check() of each command's options)
     L = base_scan

@@ -1,5 +1,6 @@
 #include "lidarshop/io/image_io.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -31,16 +32,26 @@ cv::Mat SwapRedBlue(const cv::Mat& image) {
   return swapped;
 }
 
-// A PNG must end with its IEND chunk: libpng reports a truncated file on stderr itself before OpenCV fails,
-// which would make two lines of one error.
-void CheckPngComplete(const std::string& path, int64_t size) {
-  static const char kSignature[] = "\x89PNG\r\n\x1a\n";
-  static const char kEnd[] = "IEND\xae\x42\x60\x82";
+// OpenCV picks a decoder by the content, not the name, and some of its decoders abort on malformed input
+// (gdcm asserts on a broken DICOM). Only the formats lidarshop writes and documents reach OpenCV: PNG, JPEG,
+// TIFF, OpenEXR and BMP. A PNG must also end with its IEND chunk: libpng reports a truncated file on stderr
+// itself before OpenCV fails, which would make two lines of one error.
+void CheckImageBytes(const std::string& path, int64_t size) {
   std::ifstream in(path, std::ios::binary);
-  char head[8] = {}, tail[8] = {};
-  in.read(head, 8);
-  if (!in || std::memcmp(head, kSignature, 8) != 0) return;  // not a PNG: OpenCV decides by content
-  in.seekg(size >= 8 ? size - 8 : 0);
+  unsigned char head[8] = {};
+  in.read(reinterpret_cast<char*>(head), 8);
+  auto starts = [&](std::initializer_list<unsigned char> magic) {
+    return size >= static_cast<int64_t>(magic.size()) && std::equal(magic.begin(), magic.end(), head);
+  };
+  const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'});
+  if (!png && !starts({0xff, 0xd8, 0xff}) && !starts({'I', 'I', 42, 0}) && !starts({'M', 'M', 0, 42}) &&
+      !starts({0x76, 0x2f, 0x31, 0x01}) && !starts({'B', 'M'})) {
+    ThrowInputError(path, "byte 0", "signature", "not a PNG, JPEG, TIFF, OpenEXR or BMP image");
+  }
+  if (!png) return;
+  static const char kEnd[] = "IEND\xae\x42\x60\x82";
+  char tail[8] = {};
+  in.seekg(size - 8);
   in.read(tail, 8);
   if (size < 57 || !in || std::memcmp(tail, kEnd, 8) != 0) {
     ThrowInputError(path, "", "", "a truncated PNG (the file does not end with the IEND chunk)");
@@ -50,7 +61,7 @@ void CheckPngComplete(const std::string& path, int64_t size) {
 }  // namespace
 
 cv::Mat ReadImage(const std::string& path) {
-  CheckPngComplete(path, CheckRegularFile(path));
+  CheckImageBytes(path, CheckRegularFile(path));
   // OpenCV refuses images past this many pixels from the header, before decoding; keep it within the budget
   // (8 bytes a pixel: 4 channels of 16 bits). Read once by OpenCV, so set before the first imread.
   static const bool limited = [] {

@@ -40,7 +40,9 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& wha
 Eigen::Matrix4d ParsePose(const std::string& text) {
   std::vector<double> numbers;
   std::string what = "--pose";
-  if (std::filesystem::exists(text)) {  // stat only: a FIFO is refused by ReadRegularFile, never opened
+  std::error_code not_a_path;  // e.g. "File name too long" for 16 numbers: then it is pose text
+  if (std::filesystem::exists(text,
+                              not_a_path)) {  // stat only: a FIFO is refused by ReadRegularFile, never opened
     what = text;
     numbers = ParseNumbers(ReadRegularFile(text, int64_t{1} << 20), what);
     if (numbers.size() != 16) {
