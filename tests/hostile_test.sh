@@ -18,7 +18,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 # Under AddressSanitizer (scripts/test.sh --sanitize) an address-space limit cannot work (the shadow memory
 # alone reserves terabytes): ASan's own RSS limit takes its place.
 limit_memory=(ulimit -v "$memory_kb")
-if ldd "$lidarshop" 2>/dev/null | grep -q libasan; then
+if ldd "$lidarshop" 2>/dev/null | grep libasan >/dev/null; then  # not grep -q: SIGPIPE under pipefail
   limit_memory=(true)
   export ASAN_OPTIONS="${ASAN_OPTIONS:+$ASAN_OPTIONS:}hard_rss_limit_mb=$((memory_kb / 1024)):detect_leaks=0"
   seconds=$((seconds * 4))
