@@ -11,9 +11,11 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   lidarshop::e57::g_max_cells = int64_t{1} << 20;  // keep allocations within the fuzzer's memory limit
+  lidarshop::SetMemoryBudgetBytes(int64_t{256} << 20);
   const std::vector<uint8_t> logical(data, data + size);
   try {
     lidarshop::ReadE57Bytes(lidarshop::e57::PagesFromLogical(logical), "fuzz.e57");

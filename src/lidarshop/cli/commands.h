@@ -41,7 +41,13 @@ nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
 // ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.
 int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
 
-// Adds --quiet (no progress bars) to `app`; the flag is stored in *quiet.
+// Adds --quiet (no progress bars) to `app`; the flag is stored in *quiet. Also adds --max-memory SIZE
+// ("512M", "8G"; default half of the RAM), which sets the memory budget (util/memory_budget.h) that
+// header counts, scene complexity, sample and sweep counts are checked against before any allocation.
 void AddQuietFlag(CLI::App& app, bool* quiet);
+
+// Adds a --seed option storing into *seed: a whole number in [0, 2^63) (CLI11 alone would wrap "-1" to the
+// largest seed).
+void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help);
 
 }  // namespace lidarshop::cli

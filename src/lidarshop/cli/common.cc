@@ -1,8 +1,11 @@
+#include <charconv>
 #include <exception>
 
 #include <fmt/format.h>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop::cli {
 
@@ -28,6 +31,33 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
   }
 }
 
-void AddQuietFlag(CLI::App& app, bool* quiet) { app.add_flag("-q,--quiet", *quiet, "no progress output"); }
+void AddQuietFlag(CLI::App& app, bool* quiet) {
+  app.add_flag("-q,--quiet", *quiet, "no progress output");
+  app.add_option_function<std::string>(
+      "--max-memory",
+      [](const std::string& text) {
+        try {
+          SetMemoryBudgetBytes(ParseMemorySize(text, "--max-memory"));
+        } catch (const OptionsError& error) {
+          throw CLI::ValidationError(error.what());  // a usage error like any other, one line
+        }
+      },
+      "memory budget (e.g. 512M, 8G): larger requests fail up front; default half of the RAM");
+}
+
+void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help) {
+  app.add_option_function<std::string>(
+         "--seed",
+         [seed](const std::string& text) {
+           uint64_t value = 0;
+           const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+           if (error != std::errc() || end != text.data() + text.size() || value >= (uint64_t{1} << 63)) {
+             throw CLI::ValidationError(fmt::format("--seed: '{}' is not a whole number in [0, 2^63)", text));
+           }
+           *seed = value;
+         },
+         help)
+      ->default_str(std::to_string(*seed));
+}
 
 }  // namespace lidarshop::cli

@@ -11,6 +11,7 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
 
@@ -143,6 +144,7 @@ int RunConvert(int argc, char** argv) {
   app.add_option("--scan", scan_index, "write only scan K (from 0); PCD holds one scan");
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
+    CheckOutputPath(output, {input});
     const auto progress = Progress::ForTerminal("convert", 2, quiet);
     ScanFile file;
     std::vector<E57Image> images;  // E57 -> E57 keeps the photos
@@ -210,6 +212,7 @@ int RunRender(int argc, char** argv) {
   bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&] {
+    CheckOutputPath(output, {input, around_path});
     if (!eye.empty() || !std::isnan(orbit_deg)) {
       if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
       if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");

@@ -35,7 +35,7 @@ struct FillFlags {
     app.add_option("--method", method, "gradient | laplace | depth-patch | telea")->capture_default_str();
     app.add_option("--search", search, "source search of the patch methods: patchmatch | local | exhaustive")
         ->capture_default_str();
-    app.add_option("--seed", options.seed, "seed of the patch fill's random choices")->capture_default_str();
+    AddSeedOption(app, &options.seed, "seed of the patch fill's random choices");
     app.add_option("--patch-radius", options.patch_radius, "patch half-width, cells")->capture_default_str();
     app.add_option("--window", options.search_window_radius, "half-width of the local source search, cells")
         ->capture_default_str();

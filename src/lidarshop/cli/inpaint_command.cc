@@ -104,8 +104,7 @@ int RunInpaint(int argc, char** argv) {
   app.add_option("--global-gain", options.global_gain,
                  "two-step: a distant source must be this many times better than the local one")
       ->capture_default_str();
-  app.add_option("--seed", options.seed, "seed of the random priority and of PatchMatch")
-      ->capture_default_str();
+  AddSeedOption(app, &options.seed, "seed of the random priority and of PatchMatch");
   app.add_option("--debug", debug_dir,
                  "write fill_order.png, source_map.png, source_locations.png and steps.csv into this folder");
   app.add_option("--accept", accept,
@@ -137,6 +136,7 @@ int RunInpaint(int argc, char** argv) {
   return RunCommand(app, argc, argv, [&]() {
     ParseAcceptance(accept, histogram_metric, &options);
     options.Check();
+    CheckOutputPath(output_path, {image_path, mask_path});
     if (!resume_dir.empty()) {
       if ((choose >= 0) == !place.empty())
         throw OptionsError("--resume needs exactly one of --choose N and --place ROW,COL");

@@ -13,6 +13,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/poisson/poisson.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::cli {
@@ -121,6 +122,8 @@ int RunPoisson(int argc, char** argv) {
   AddSolverFlags(*reconstruct, &reconstruct_flags);
 
   return RunCommand(app, argc, argv, [&]() {
+    CheckOutputPath(output_path,
+                    {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
     PoissonResult result;
     int unknowns = 0;
     if (*fill) {

@@ -17,6 +17,7 @@
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
@@ -28,7 +29,7 @@ int RunScan(int argc, char** argv) {
   CLI::App app("Synthesize an organized scan of a scene description (JSON) with the synthetic scanner.",
                "scan");
   std::string scene_path, output_path, labels_path, mesh_path;
-  std::optional<uint64_t> seed;
+  uint64_t seed = 0;
   std::optional<int> rows, columns;
   int threads = 0;
   bool stats = false, quiet = false;
@@ -42,7 +43,7 @@ int RunScan(int argc, char** argv) {
   app.add_option("--mesh-jump", mesh_jump_ratio,
                  "with --mesh: drop edges whose ranges differ by more than this fraction of the nearer range")
       ->capture_default_str();
-  app.add_option("--seed", seed, "noise seed (overrides the scene's scanner.seed)");
+  AddSeedOption(app, &seed, "noise seed (overrides the scene's scanner.seed)");
   app.add_option("--rows", rows, "points per strip (overrides scanner.rows)");
   app.add_option("--columns", columns, "strips (overrides scanner.columns)");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->capture_default_str();
@@ -50,11 +51,14 @@ int RunScan(int argc, char** argv) {
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
     CheckOption(threads >= 0, fmt::format("--threads must be >= 0, got {}", threads));
+    CheckOutputPath(output_path, {scene_path});
+    if (!labels_path.empty()) CheckOutputPath(labels_path, {scene_path, output_path});
+    if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
     const ThreadLimit thread_limit(threads);
     Timer total;
     Timer stage;
     SceneDescription scene = LoadScene(scene_path);
-    if (seed) scene.scanner.seed = *seed;
+    if (app.count("--seed") > 0) scene.scanner.seed = seed;
     if (rows) scene.scanner.rows = *rows;
     if (columns) scene.scanner.columns = *columns;
     scene.scanner.Check();

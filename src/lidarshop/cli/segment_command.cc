@@ -10,6 +10,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::cli {
@@ -65,6 +66,12 @@ int RunSegment(int argc, char** argv) {
     options.Check();
     for (const std::string& path : {object_path, rest_path}) {
       if (!path.empty()) CheckScanFileFormat(path);
+    }
+    std::vector<std::string> used = {scan_path, strokes_path, refine_path};
+    for (const std::string& path : {mask_path, object_path, rest_path, overlay_path}) {
+      if (path.empty()) continue;
+      CheckOutputPath(path, used);
+      used.push_back(path);
     }
     const ScanFile file = ReadScanFile(scan_path);
     if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size())) {

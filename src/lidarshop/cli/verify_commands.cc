@@ -15,74 +15,12 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/verify/pose_text.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
 
 namespace lidarshop::cli {
 namespace {
-
-std::vector<double> ParseNumbers(const std::string& text, const std::string& what) {
-  std::vector<double> numbers;
-  std::string normalized = text;
-  for (char& c : normalized) {
-    if (c == ',' || c == ';' || c == '\n' || c == '\t' || c == '\r') c = ' ';
-  }
-  std::istringstream stream(normalized);
-  std::string token;
-  while (stream >> token) {
-    size_t used = 0;
-    double value = 0;
-    try {
-      value = std::stod(token, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != token.size() || !std::isfinite(value)) {
-      throw InputError(fmt::format("{}: not a number: '{}'", what, token));
-    }
-    numbers.push_back(value);
-  }
-  return numbers;
-}
-
-// A 4x4 world_from_model from a file (4 rows of 4 numbers), 16 comma-separated numbers (row major), or
-// x,y,z,yaw_deg[,pitch_deg,roll_deg].
-Eigen::Matrix4d ParsePose(const std::string& text) {
-  std::vector<double> numbers;
-  std::string what = "--pose";
-  if (std::filesystem::is_regular_file(text)) {
-    std::ifstream file(text);
-    std::stringstream buffer;
-    buffer << file.rdbuf();
-    what = text;
-    numbers = ParseNumbers(buffer.str(), what);
-    if (numbers.size() != 16) {
-      throw InputError(
-          fmt::format("{}: a pose file holds 4 rows of 4 numbers, found {} numbers", what, numbers.size()));
-    }
-  } else {
-    numbers = ParseNumbers(text, what);
-  }
-  if (numbers.size() == 4 || numbers.size() == 6) {
-    return PoseFromXyzYaw(numbers[0], numbers[1], numbers[2], numbers[3],
-                          numbers.size() == 6 ? numbers[4] : 0.0, numbers.size() == 6 ? numbers[5] : 0.0);
-  }
-  if (numbers.size() != 16) {
-    throw InputError(
-        fmt::format("{}: expected a file of 4x4 numbers, 16 numbers or x,y,z,yaw_deg[,pitch_deg,roll_deg], "
-                    "got {} numbers",
-                    what, numbers.size()));
-  }
-  Eigen::Matrix4d pose;
-  for (int i = 0; i < 16; ++i) pose(i / 4, i % 4) = numbers[i];
-  if ((pose.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() > 1e-9) {
-    throw InputError(fmt::format("{}: the last row of world_from_model must be 0 0 0 1", what));
-  }
-  if (std::abs(pose.topLeftCorner<3, 3>().determinant()) < 1e-12) {
-    throw InputError(fmt::format("{}: the 3x3 part of world_from_model is singular", what));
-  }
-  return pose;
-}
 
 std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
   std::vector<PreparedScan> scans;
@@ -176,7 +114,7 @@ struct CommonFlags {
     app.add_option("--samples", model_options.num_surface_samples,
                    "model points sampled uniformly on the surface (confidence)")
         ->capture_default_str();
-    app.add_option("--seed", model_options.seed, "seed of the surface sampling")->capture_default_str();
+    AddSeedOption(app, &model_options.seed, "seed of the surface sampling");
     app.add_flag("--vertices", use_vertices,
                  "use the mesh vertices as model points instead of surface samples");
     app.add_flag("--distinctiveness", distinctiveness,
@@ -216,8 +154,20 @@ std::vector<double> ParseYaws(const std::string& text) {
     if (parts.size() != 3 || !(parts[2] > 0) || parts[1] <= parts[0]) {
       throw OptionsError(fmt::format("--yaws: expected START:STOP:STEP with STEP > 0, got '{}'", text));
     }
+    // Count before expanding: 0:1e9:1e-9 must not try to build 10^18 yaws (nor loop forever when the step
+    // vanishes beside the start).
+    constexpr double kMaxYaws = 100000;
+    const double count = std::ceil((parts[1] - parts[0]) / parts[2]);
+    if (!(count <= kMaxYaws) || !std::isfinite(parts[0]) || !std::isfinite(parts[1]) ||
+        parts[0] + parts[2] == parts[0]) {
+      throw OptionsError(
+          fmt::format("--yaws: '{}' gives {} yaws, more than the {} accepted", text, count, kMaxYaws));
+    }
     std::vector<double> yaws;
-    for (double yaw = parts[0]; yaw < parts[1] - 1e-9; yaw += parts[2]) yaws.push_back(yaw);
+    for (int64_t i = 0; i < static_cast<int64_t>(count); ++i) {
+      const double yaw = parts[0] + static_cast<double>(i) * parts[2];
+      if (yaw < parts[1] - 1e-9) yaws.push_back(yaw);
+    }
     return yaws;
   }
   return ParseNumbers(text, "--yaws");
@@ -250,6 +200,14 @@ int RunVerify(int argc, char** argv) {
       "--model-points", model_ply,
       "write the posed model points as PLY coloured by observed information: red unseen -> green seen");
   return RunCommand(app, argc, argv, [&] {
+    std::vector<std::string> used = common.scans;
+    used.push_back(common.model);
+    used.push_back(pose_text);
+    for (const std::string& path : {json_path, scene_ply, model_ply}) {
+      if (path.empty()) continue;
+      CheckOutputPath(path, used);
+      used.push_back(path);
+    }
     const Eigen::Matrix4d world_from_model = ParsePose(pose_text);
     auto progress = Progress::ForTerminal("verify: preparing", 2, common.quiet);
     VerifierModel model = common.PrepareTheModel();

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 namespace lidarshop {
 
 Eigen::Matrix3d RotationFromEulerDegrees(const Eigen::Vector3d& rotate_deg) {
@@ -50,6 +52,28 @@ bool IsRigid(const Eigen::Matrix4d& transform, double tolerance) {
   const bool proper = std::abs(rotation.determinant() - 1.0) < tolerance;
   const bool affine_row = (transform.row(3) - Eigen::RowVector4d(0, 0, 0, 1)).norm() < tolerance;
   return orthonormal && proper && affine_row;
+}
+
+std::string PoseProblem(const Eigen::Matrix4d& pose, bool allow_uniform_scale) {
+  if (!pose.allFinite()) return "has a non-finite entry";
+  if (!pose.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) return "last row is not 0 0 0 1";
+  if (pose.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > kMaxCoordinateM) {
+    return fmt::format("translation {} {} {} is beyond {} m", pose(0, 3), pose(1, 3), pose(2, 3),
+                       kMaxCoordinateM);
+  }
+  const Eigen::Matrix3d linear = pose.topLeftCorner<3, 3>();
+  const double det = linear.determinant();
+  if (!(det > 0)) return det < 0 ? "is mirrored (determinant < 0)" : "is singular (determinant 0)";
+  const double scale = std::cbrt(det);
+  if (scale < 1e-6 || scale > 1e6) return fmt::format("scale {} is outside [1e-6, 1e6]", scale);
+  if (!allow_uniform_scale && std::abs(scale - 1) > 1e-4) {
+    return fmt::format("is scaled by {} (a rotation was expected)", scale);
+  }
+  const Eigen::Matrix3d rotation = linear / scale;
+  if (!(rotation.transpose() * rotation).isApprox(Eigen::Matrix3d::Identity(), 1e-4)) {
+    return "is sheared or scaled per axis (the 3x3 part is not a rotation times one scale)";
+  }
+  return "";
 }
 
 }  // namespace lidarshop

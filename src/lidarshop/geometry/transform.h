@@ -5,6 +5,8 @@
 // `rotate_deg` = [x, y, z] rotates about the fixed axes x, then y, then z, i.e. R = Rz * Ry * Rx.
 #pragma once
 
+#include <string>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -31,5 +33,14 @@ inline Eigen::Vector3f TransformPoint(const Eigen::Matrix4d& b_from_a, const Eig
 // True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is 0 0
 // 0 1.
 bool IsRigid(const Eigen::Matrix4d& transform, double tolerance = 1e-6);
+
+// The largest coordinate or translation (metres) lidarshop accepts: terrestrial scenes span kilometres, so a
+// value past this is corrupt data (1e38 sentinels, overflowed numbers) — and Embree asserts on such values.
+constexpr double kMaxCoordinateM = 1e7;
+
+// Why `pose` is not a usable pose, or "" when it is: every entry finite, last row 0 0 0 1, translation within
+// kMaxCoordinateM, top-left 3x3 a rotation (det +1, no shear, no mirror) times one uniform scale in
+// [1e-6, 1e6] when `allow_uniform_scale`, else a rotation within 1e-4.
+std::string PoseProblem(const Eigen::Matrix4d& pose, bool allow_uniform_scale);
 
 }  // namespace lidarshop

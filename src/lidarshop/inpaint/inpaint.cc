@@ -88,6 +88,21 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
 
 InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const InpaintOptions& options,
                       InpaintStrategies strategies, Progress* progress) {
+  if (image.depth() == CV_32F || image.depth() == CV_64F) {
+    if (image.size() == hole_mask.size() && hole_mask.type() == CV_8U) {
+      // Any known pixel may become a source or enter a patch distance: a NaN or inf there would spread into
+      // the fill. Values inside the hole are replaced and do not matter.
+      cv::Mat known = cv::Mat::zeros(image.size(), image.type());  // any channel count (setTo takes <= 4)
+      image.copyTo(known, hole_mask == 0);
+      cv::Point at;
+      if (!cv::checkRange(known, /*quiet=*/true, &at)) {
+        throw InputError(fmt::format(
+            "Inpaint: the image holds NaN or inf at pixel (x {}, y {}) outside the hole; add it to the hole or "
+            "fix it",
+            at.x, at.y));
+      }
+    }
+  }
   InpaintSession session(image, hole_mask, options, std::move(strategies), progress);
   session.Run();
   return session.Result();

@@ -1,4 +1,6 @@
 // The greedy fill loop: bookkeeping, border holes, determinism, structure continuation, the pluggable parts.
+#include <limits>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -52,6 +54,17 @@ void ExpectCompleteAndUntouched(const cv::Mat& image, const cv::Mat& mask, const
   for (const FillStep& step : result.steps) sum += step.filled_pixels;
   EXPECT_EQ(sum, result.hole_pixels);
   EXPECT_EQ(static_cast<int>(result.steps.size()), result.iterations);
+}
+
+TEST(InpaintFill, NonFiniteKnownPixelsAreRefusedNotSpread) {
+  cv::Mat image(30, 40, CV_32F, cv::Scalar(1.0f));
+  cv::Mat hole = cv::Mat::zeros(30, 40, CV_8U);
+  cv::rectangle(hole, cv::Rect(15, 10, 6, 6), 255, cv::FILLED);
+  image.at<float>(12, 17) = std::numeric_limits<float>::quiet_NaN();  // inside the hole: replaced
+  const InpaintResult filled = Inpaint(image, hole, InpaintOptions{});
+  EXPECT_TRUE(cv::checkRange(filled.image));
+  image.at<float>(3, 30) = std::numeric_limits<float>::infinity();  // a known pixel: could be a source
+  EXPECT_THROW(Inpaint(image, hole, InpaintOptions{}), InputError);
 }
 
 TEST(InpaintFill, FillFrontOfASmallMask) {

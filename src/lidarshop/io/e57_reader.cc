@@ -13,8 +13,10 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace e57 {
@@ -221,7 +223,32 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
     }
     return true;
   };
-  if (done()) return streams;
+  // Data packets past the records recordCount counts mean the count disagrees with the data (a file that
+  // would otherwise read as an empty or partial scan).
+  auto refuse_more_data = [&](uint64_t at) {
+    while (at + 6 <= end) {
+      const uint64_t length = uint64_t{LoadLe<uint16_t>(&L[at + 2])} + 1;
+      if (L[at] == 1) {
+        const size_t count = std::min<size_t>(LoadLe<uint16_t>(&L[at + 4]), (end - at - 6) / 2);
+        for (size_t i = 0; i < count; ++i) {
+          if (LoadLe<uint16_t>(&L[at + 6 + 2 * i]) > 0) {
+            ThrowInputError(ctx.path, where(at), "recordCount",
+                            "the section holds more data than recordCount records (wrong count?)");
+          }
+        }
+      } else if (L[at] != 0 && L[at] != 2) {
+        return;
+      }
+      at += length;
+    }
+  };
+  if (done()) {
+    if (data_physical % kPageSize < kPagePayload) {
+      const uint64_t first = LogicalFromPhysical(data_physical);
+      if (first >= start + 32 && first <= end) refuse_more_data(first);
+    }
+    return streams;
+  }
   if (data_physical % kPageSize >= kPagePayload) {
     ThrowInputError(ctx.path, where(start), "dataPhysicalOffset", "points into a page checksum");
   }
@@ -231,7 +258,9 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
                     fmt::format("{} is outside its section", data_physical));
   }
   std::vector<size_t> lengths(n);
+  int64_t packets = 0;
   while (!done()) {
+    ++packets;
     if (pos + 4 > end) {
       ThrowInputError(ctx.path, where(pos), "packet",
                       "the section ends before every bytestream holds its records (truncated data)");
@@ -266,6 +295,16 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
                       fmt::format("unknown packet type {} (expected 0 index, 1 data or 2 empty)", int{type}));
     }
     pos += length;
+  }
+  refuse_more_data(pos);
+  // A writer may round each packet's bytestreams up to whole bytes; more than that is records recordCount
+  // does not count.
+  for (size_t i = 0; i < n; ++i) {
+    if (streams[i].size() > needed_bytes[i] + static_cast<uint64_t>(packets) + 8) {
+      ThrowInputError(ctx.path, where(start), "recordCount",
+                      fmt::format("bytestream {} holds {} bytes, recordCount needs {} (wrong count?)", i,
+                                  streams[i].size(), needed_bytes[i]));
+    }
   }
   return streams;
 }
@@ -368,7 +407,7 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
              fmt::format("recordCount {} needs {} bytes of bytestreams, the file has {}", record_count,
                          needed_total, ctx.logical.size()));
   }
-  const std::vector<std::vector<uint8_t>> streams = record_count > 0
+  const std::vector<std::vector<uint8_t>> streams = record_count > 0 || points.attribute("fileOffset")
                                                         ? ReadBytestreams(ctx, points, needed)
                                                         : std::vector<std::vector<uint8_t>>(fields.size());
   const std::string stream_where = fmt::format("{}: {}", ctx.path, ElementPath(points));
@@ -418,6 +457,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
       XmlError(ctx, points,
                fmt::format("grid of {} x {} cells exceeds the limit of {} cells", rows, cols, g_max_cells));
     }
+    io_internal::CheckGridFromData(rows, cols, static_cast<int64_t>(ctx.logical.size()), ctx.path,
+                                   "data3D points");
     for (int64_t i = 0; i < record_count; ++i) cell[i] += row[i] * cols;
   } else {
     rows = record_count > 0 ? 1 : 0;
@@ -767,6 +808,7 @@ E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& 
 }
 
 E57File ReadE57(const std::string& path) {
+  CheckRegularFile(path);
   std::ifstream in(path, std::ios::binary);
   if (!in) ThrowInputError(path, "", "", "cannot open for reading");
   in.seekg(0, std::ios::end);

@@ -1,7 +1,10 @@
 #include "lidarshop/io/image_io.h"
 
+#include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -10,6 +13,8 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -27,11 +32,43 @@ cv::Mat SwapRedBlue(const cv::Mat& image) {
   return swapped;
 }
 
+// OpenCV picks a decoder by the content, not the name, and some of its decoders abort on malformed input
+// (gdcm asserts on a broken DICOM). Only the formats lidarshop writes and documents reach OpenCV: PNG, JPEG,
+// TIFF, OpenEXR and BMP. A PNG must also end with its IEND chunk: libpng reports a truncated file on stderr
+// itself before OpenCV fails, which would make two lines of one error.
+void CheckImageBytes(const std::string& path, int64_t size) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8] = {};
+  in.read(reinterpret_cast<char*>(head), 8);
+  auto starts = [&](std::initializer_list<unsigned char> magic) {
+    return size >= static_cast<int64_t>(magic.size()) && std::equal(magic.begin(), magic.end(), head);
+  };
+  const bool png = starts({0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'});
+  if (!png && !starts({0xff, 0xd8, 0xff}) && !starts({'I', 'I', 42, 0}) && !starts({'M', 'M', 0, 42}) &&
+      !starts({0x76, 0x2f, 0x31, 0x01}) && !starts({'B', 'M'})) {
+    ThrowInputError(path, "byte 0", "signature", "not a PNG, JPEG, TIFF, OpenEXR or BMP image");
+  }
+  if (!png) return;
+  static const char kEnd[] = "IEND\xae\x42\x60\x82";
+  char tail[8] = {};
+  in.seekg(size - 8);
+  in.read(tail, 8);
+  if (size < 57 || !in || std::memcmp(tail, kEnd, 8) != 0) {
+    ThrowInputError(path, "", "", "a truncated PNG (the file does not end with the IEND chunk)");
+  }
+}
+
 }  // namespace
 
 cv::Mat ReadImage(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path))
-    ThrowInputError(path, "", "", "cannot open the image (missing?)");
+  CheckImageBytes(path, CheckRegularFile(path));
+  // OpenCV refuses images past this many pixels from the header, before decoding; keep it within the budget
+  // (8 bytes a pixel: 4 channels of 16 bits). Read once by OpenCV, so set before the first imread.
+  static const bool limited = [] {
+    const int64_t pixels = std::min<int64_t>(int64_t{1} << 30, MemoryBudgetBytes() / 8);
+    return setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(pixels).c_str(), 0) == 0;
+  }();
+  (void)limited;
   if (FileExtension(path) == "exr") {
     // OpenCV 4.6 reads EXR only when this is set before the first use.
     setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
@@ -40,7 +77,11 @@ cv::Mat ReadImage(const std::string& path) {
   try {
     image = cv::imread(path, cv::IMREAD_UNCHANGED);
   } catch (const cv::Exception& error) {
-    ThrowInputError(path, "", "", fmt::format("not a readable image ({})", error.what()));
+    // error.err is OpenCV's message without its multi-line location banner.
+    ThrowInputError(
+        path, "", "",
+        fmt::format("not a readable image (OpenCV: {}; images are limited to {} pixels)", error.err,
+                    getenv("OPENCV_IO_MAX_IMAGE_PIXELS") ? getenv("OPENCV_IO_MAX_IMAGE_PIXELS") : "?"));
   }
   if (image.empty()) ThrowInputError(path, "", "", "not a readable image");
   return SwapRedBlue(image);

@@ -1,32 +1,21 @@
 #include "lidarshop/io/io_common.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <memory>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop::io_internal {
 
-std::string ReadFileToString(const std::string& path) {
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!file) ThrowInputError(path, "", "", "cannot open the file (missing or not readable)");
-  if (std::fseek(file.get(), 0, SEEK_END) != 0)
-    ThrowInputError(path, "", "", "cannot seek (not a regular file?)");
-  const long size = std::ftell(file.get());
-  if (size < 0) ThrowInputError(path, "", "", "cannot tell the file size (not a regular file?)");
-  std::rewind(file.get());
-  std::string text(static_cast<size_t>(size), '\0');
-  if (size > 0 && std::fread(text.data(), 1, text.size(), file.get()) != text.size()) {
-    ThrowInputError(path, "", "", "read error");
-  }
-  return text;
-}
+std::string ReadFileToString(const std::string& path) { return ReadRegularFile(path); }
 
 void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const std::string& place) {
   if (rows <= 0 || cols <= 0) {
@@ -36,6 +25,43 @@ void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const st
     ThrowInputError(file, place, "size",
                     fmt::format("{} rows x {} columns is more than the {} cells lidarshop accepts", rows,
                                 cols, kMaxScanCells));
+  }
+  // Every channel a reader may fill (point, direction, range, intensity, colour, flags) and the grid fit.
+  constexpr int64_t kBytesPerCell = 64;
+  CheckMemoryBudget(rows * cols * kBytesPerCell,
+                    fmt::format("{}: {}: a scan of {} rows x {} columns", file, place, rows, cols));
+}
+
+void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std::string& file,
+                       const std::string& place) {
+  CheckScanSize(rows, cols, file, place);
+  const int64_t limit =
+      std::max(int64_t{1} << 22, SaturatingBytes(std::max<int64_t>(data_bytes, 0), kCellsPerDataByte));
+  if (rows * cols > limit) {
+    ThrowInputError(
+        file, place, "size",
+        fmt::format("a grid of {} rows x {} columns ({} cells) from {} bytes of data: more than {} "
+                    "cells per byte; the indices are corrupt",
+                    rows, cols, rows * cols, data_bytes, kCellsPerDataByte));
+  }
+}
+
+void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place) {
+  const std::string problem = PoseProblem(scan.world_from_scanner, /*allow_uniform_scale=*/false);
+  if (!problem.empty()) ThrowInputError(file, place, "pose", "the scanner pose " + problem);
+  for (int row = 0; row < scan.rows; ++row) {
+    const uint8_t* valid = scan.valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!valid[col]) continue;
+      for (int axis = 0; axis < 3; ++axis) {
+        if (!(std::abs(point[col][axis]) <= kMaxCoordinateM)) {
+          ThrowInputError(
+              file, fmt::format("{}: row {} column {}", place, row, col), std::string(1, "xyz"[axis]),
+              fmt::format("{} is not a coordinate within {} m", point[col][axis], kMaxCoordinateM));
+        }
+      }
+    }
   }
 }
 

@@ -8,12 +8,25 @@
 
 namespace lidarshop::io_internal {
 
-// Reads a whole file into memory; throws InputError naming the file when it cannot be opened or read.
+// Reads a whole regular file (util/input_file.h: FIFOs, devices and folders are refused without opening
+// them). Throws InputError naming the file when it cannot be read.
 std::string ReadFileToString(const std::string& path);
 
-// Throws InputError naming `file` and `place` when rows x cols is negative or more than kMaxScanCells, before
-// anything is allocated.
+// Throws InputError naming `file` and `place` when rows x cols is negative, more than kMaxScanCells, or more
+// than the memory budget (util/memory_budget.h) holds, before anything is allocated.
 void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const std::string& place);
+
+// A grid that the file's points index (PLY row/col, E57 rowIndex/columnIndex) is bounded by the bytes: a
+// few hundred bytes cannot make a reader allocate gigabytes. Throws InputError unless rows x cols is at most
+// max(2^22, kCellsPerDataByte x data_bytes) — room for scans that are mostly sky.
+constexpr int64_t kCellsPerDataByte = 64;
+void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std::string& file,
+                       const std::string& place);
+
+// Checks what a reader produced before any algorithm sees it: the pose is rigid (geometry PoseProblem) and
+// every valid point is within kMaxCoordinateM. Throws InputError naming `file`, `place`, the cell and the
+// field.
+void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place);
 
 // After a reader has filled `valid` and `point`: sets range = |point| and direction = point / range of valid
 // cells, clears invalid cells (point 0, range 0, intensity 0.5, colour 0) and, when `fit_grid`, fits the

@@ -4,10 +4,13 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <string>
 
 #include <gtest/gtest.h>
+
+#include "lidarshop/util/error.h"
 
 namespace lidarshop::testing_io {
 
@@ -27,6 +30,16 @@ class TempFolder {
  private:
   std::filesystem::path path_;
 };
+
+// The message of the InputError that `read` throws ("" when nothing is thrown).
+inline std::string InputErrorOf(const std::function<void()>& read) {
+  try {
+    read();
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
 
 inline void WriteText(const std::string& path, const std::string& text) {
   std::ofstream stream(path, std::ios::binary);

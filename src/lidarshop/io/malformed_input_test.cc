@@ -21,21 +21,13 @@ using testing::HasSubstr;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
-// The message of the InputError that reading `path` throws ("" when nothing is thrown).
-std::string ErrorOf(const std::function<void()>& read) {
-  try {
-    read();
-  } catch (const InputError& error) {
-    return error.what();
-  }
-  return "";
-}
+using testing_io::InputErrorOf;
 
 std::string ScanError(const std::string& path) {
-  return ErrorOf([&] { ReadScanFile(path); });
+  return InputErrorOf([&] { ReadScanFile(path); });
 }
 std::string MeshError(const std::string& path) {
-  return ErrorOf([&] { ReadMesh(path); });
+  return InputErrorOf([&] { ReadMesh(path); });
 }
 
 const char kPtxHeader[] = "2\n2\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
@@ -188,8 +180,8 @@ TEST(MalformedInputTest, Pcd) {
 TEST(MalformedInputTest, ImagesAndUnknownFormats) {
   TempFolder folder;
   WriteText(folder.File("bad.png"), Garbage(500, 6));
-  EXPECT_THAT(ErrorOf([&] { ReadImage(folder.File("bad.png")); }), HasSubstr(folder.File("bad.png")));
-  EXPECT_THAT(ErrorOf([&] { ReadImage(folder.File("missing.png")); }), HasSubstr("missing"));
+  EXPECT_THAT(InputErrorOf([&] { ReadImage(folder.File("bad.png")); }), HasSubstr(folder.File("bad.png")));
+  EXPECT_THAT(InputErrorOf([&] { ReadImage(folder.File("missing.png")); }), HasSubstr("missing"));
   WriteText(folder.File("scan.xyz"), "1 2 3\n");
   EXPECT_THAT(ScanError(folder.File("scan.xyz")),
               AllOf(HasSubstr("scan.xyz"), HasSubstr("unknown scan format")));

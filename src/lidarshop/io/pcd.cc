@@ -14,6 +14,7 @@
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -226,6 +227,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       ThrowInputError(file, "header", "POINTS",
                       fmt::format("{} bytes of point data is more than lidarshop accepts", size));
     }
+    CheckMemoryBudget(
+        size, fmt::format("{}: header: POINTS: {} points of {} bytes", file, points, header.point_size));
     records.resize(static_cast<size_t>(size));
   };
   if (header.data == "binary") {
@@ -276,9 +279,13 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
     }
   } else {
     // ascii: every value into a binary record of the declared type.
-    if (static_cast<int64_t>(available) < points) {
+    // Every value takes at least a digit and a separator.
+    int64_t values_per_point = 0;
+    for (const PcdField& field : header.fields) values_per_point += field.count;
+    if (static_cast<int64_t>(available) + 1 < SaturatingBytes(points, 2 * values_per_point)) {
       ThrowInputError(file, fmt::format("line {}", header.data_line), "DATA",
-                      fmt::format("truncated: {} points claimed, only {} bytes follow", points, available));
+                      fmt::format("truncated: {} points of {} values claimed, only {} bytes follow", points,
+                                  values_per_point, available));
     }
     allocate(data_size);
     TextCursor cursor(std::string_view(bytes).substr(header.data_offset), file, header.data_line);
@@ -295,7 +302,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
           } else if (field.type == 'F') {
             std::memcpy(out, &value, 8);
           } else {
-            if (!std::isfinite(value)) cursor.Fail(field.name, "not a finite integer");
+            if (!(std::abs(value) < 0x1p63)) cursor.Fail(field.name, "not an integer in range");
             const int64_t integer = static_cast<int64_t>(value);
             const uint64_t bits = static_cast<uint64_t>(integer);
             std::memcpy(out, &bits, field.size);  // little-endian truncation
@@ -304,6 +311,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       }
       cursor.EndLine("the fields of a point");
     }
+    cursor.SkipEmptyLines();
+    if (!cursor.AtEnd()) cursor.Fail("POINTS", fmt::format("more point lines than the {} claimed", points));
   }
 
   const bool organized = header.height > 1;

@@ -193,6 +193,10 @@ void ReadAscii(const std::string& bytes, const std::string& file, size_t offset,
       cursor.EndLine(fmt::format("the properties of {} {}", element.name, record));
     }
   }
+  cursor.SkipEmptyLines();
+  if (!cursor.AtEnd()) {
+    cursor.Fail("element counts", "more data follows the records the header declares (wrong count?)");
+  }
 }
 
 void ReadBinary(const std::string& bytes, const std::string& file, size_t offset, bool swap, PlyData* data) {
@@ -246,6 +250,11 @@ void ReadBinary(const std::string& bytes, const std::string& file, size_t offset
         }
       }
     }
+  }
+  // A writer may end the file with a line break; anything more means the counts disagree with the data.
+  if (end - p > 1) {
+    ThrowInputError(file, fmt::format("byte {}", p - bytes.data()), "element counts",
+                    fmt::format("{} bytes follow the records the header declares (wrong count?)", end - p));
   }
 }
 

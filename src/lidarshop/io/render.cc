@@ -21,6 +21,11 @@ RenderChannel ParseRenderChannel(const std::string& name) {
 }
 
 void RenderOptions::Check() const {
+  // NaN means "from the data"; anything else must be a finite value a colour can stand for.
+  for (const auto& [name, value] : {std::pair{"min_value", min_value}, std::pair{"max_value", max_value}}) {
+    CheckOption(std::isnan(value) || std::abs(value) <= 1e12,
+                fmt::format("RenderOptions: {} must be finite and within ±1e12, got {}", name, value));
+  }
   if (!std::isnan(min_value) && !std::isnan(max_value)) {
     CheckOption(
         min_value < max_value,

@@ -14,6 +14,7 @@
 #include "lidarshop/io/ply_fields.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace {
@@ -56,7 +57,8 @@ struct PlyScanHeader {
   Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
 };
 
-std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path) {
+std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path,
+                                             int64_t file_bytes) {
   std::vector<PlyScanHeader> headers;
   for (const std::string& comment : ply.comments) {
     if (comment.rfind(kScanComment, 0) != 0) continue;
@@ -69,7 +71,8 @@ std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::stri
           path, "header", "comment lidarshop_scan",
           "expected 'lidarshop_scan <index> <rows> <cols> <16 matrix values>' with indices 0, 1, ...");
     }
-    CheckScanSize(header.rows, header.cols, path, fmt::format("header: scan {}", header.index));
+    CheckGridFromData(header.rows, header.cols, file_bytes, path,
+                      fmt::format("header: scan {}", header.index));
     headers.push_back(header);
   }
   return headers;
@@ -79,7 +82,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
   const PlyData ply = ReadPly(path);
   const PlyElement& vertex = RequireElement(ply, "vertex", path);
   const PointCloud cloud = PointCloudFromPly(ply, path);
-  const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path);
+  const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path, CheckRegularFile(path));
   const PlyProperty* row_property = FindScalar(vertex, {"row"});
   const PlyProperty* col_property = FindScalar(vertex, {"col"});
   const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
@@ -120,6 +123,11 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     const Eigen::Vector3d p =
         inverse.topLeftCorner<3, 3>() * cloud.points[i].cast<double>() + inverse.topRightCorner<3, 1>();
     if (p.isZero()) continue;
+    if (scan.valid.at<uint8_t>(row, col)) {
+      ThrowInputError(path, fmt::format("vertex {}", i), "row/col",
+                      fmt::format("scan {} row {} col {} already holds a point (two points in one cell)",
+                                  index, row, col));
+    }
     scan.valid.at<uint8_t>(row, col) = kValid;
     scan.point.at<cv::Vec3f>(row, col) = cv::Vec3f(p.x(), p.y(), p.z());
     if (!cloud.intensities.empty()) scan.intensity.at<float>(row, col) = cloud.intensities[i];
@@ -279,7 +287,11 @@ ScanFile ReadScanFile(const std::string& path) {
   ScanFile file;
   file.path = path;
   file.format = format.extension;
+  CheckRegularFile(path);  // a FIFO would block the reader, a folder has no bytes to check counts against
   file.scans = format.read(path);
+  for (size_t i = 0; i < file.scans.size(); ++i) {
+    CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));
+  }
   return file;
 }
 

@@ -346,6 +346,27 @@ void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, c
 
 }  // namespace
 
+// A NaN or inf among the values the solve reads (boundary pixels next to Ω, or the divergence in Ω) would
+// spread through the whole hole; refuse it, naming the first such pixel. Values elsewhere are not read.
+static void RefuseNonFinite(const cv::Mat& values, const cv::Mat& mask, bool inside, const char* what) {
+  cv::Mat read;
+  if (inside) {
+    read = mask;
+  } else {
+    cv::dilate(mask, read, cv::Mat::ones(3, 3, CV_8U));
+    read.setTo(0, mask);
+  }
+  cv::Mat zeroed = cv::Mat::zeros(values.size(), values.type());
+  values.copyTo(zeroed, read);
+  cv::Point at;
+  if (!cv::checkRange(zeroed, /*quiet=*/true, &at)) {
+    throw InputError(
+        fmt::format("SolvePoisson: {} holds NaN or inf at pixel (x {}, y {}) {} the hole; fix "
+                    "or mask that pixel",
+                    what, at.x, at.y, inside ? "inside" : "next to"));
+  }
+}
+
 PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& boundary_in,
                            const cv::Mat& divergence_in) {
   const PoissonSystem::Impl& system = system_handle.impl();
@@ -369,6 +390,9 @@ PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& bo
     }
     divergence_in.convertTo(divergence, depth);
   }
+  RefuseNonFinite(boundary, system_handle.Mask(), /*inside=*/false, "the boundary image");
+  if (!divergence.empty())
+    RefuseNonFinite(divergence, system_handle.Mask(), /*inside=*/true, "the divergence");
   PoissonResult result;
   result.solver = system.solver;
   result.channels = n;

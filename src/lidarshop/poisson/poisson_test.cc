@@ -3,6 +3,9 @@
 #include <cmath>
 #include <random>
 
+#include <limits>
+
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -151,6 +154,27 @@ TEST_P(PoissonSolverTest, LaplaceFillReproducesHarmonicRamps) {
   boundary.setTo(0.0, inner_hole);
   result = FillLaplace(PreparePoisson(inner_hole, Options()), boundary);
   EXPECT_LT(MaxAbsDiff(result.image, ramp_xy), 1e-7);
+}
+
+TEST_P(PoissonSolverTest, NonFiniteValuesBesideTheHoleAreRefusedNotSpread) {
+  // One NaN pixel next to the hole used to fill the whole hole with NaN (issue #20); NaN inside the hole or
+  // far from it is not read and must not matter.
+  const int rows = 40, cols = 50;
+  cv::Mat image(rows, cols, CV_32F, cv::Scalar(5.0f));
+  cv::Mat hole = cv::Mat::zeros(rows, cols, CV_8U);
+  cv::rectangle(hole, cv::Rect(20, 15, 10, 10), 255, cv::FILLED);
+  const PoissonSystem system = PreparePoisson(hole, Options());
+  image.at<float>(20, 25) = std::numeric_limits<float>::quiet_NaN();  // inside: an unknown
+  image.at<float>(2, 2) = std::numeric_limits<float>::infinity();     // far away: not read
+  const PoissonResult filled = FillLaplace(system, image);
+  EXPECT_EQ(cv::countNonZero(filled.image(cv::Rect(20, 15, 10, 10)) != 5.0f), 0);
+  image.at<float>(14, 22) = std::numeric_limits<float>::quiet_NaN();  // the row above the hole
+  try {
+    FillLaplace(system, image);
+    ADD_FAILURE() << "a NaN beside the hole was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), testing::HasSubstr("pixel (x 22, y 14)"));
+  }
 }
 
 TEST_P(PoissonSolverTest, SatisfiesTheDiscreteEquationOnAwkwardMasks) {

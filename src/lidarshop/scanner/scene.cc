@@ -13,6 +13,8 @@
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -169,7 +171,48 @@ const std::set<std::string> kObjectKeys = {
 
 // Primitive meshes from the object's fields; `color_used` is set when the primitive bakes "color" into its
 // own triangle colours (composite objects).
-TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& fields, bool* color_used) {
+constexpr int64_t kMaxSceneTriangles = int64_t{1} << 23;  // ~1.5 GB and seconds to build, not minutes
+constexpr int64_t kSceneBytesPerTriangle = 256;           // mesh, colours, Embree's BVH
+
+// Every vertex in the world within kMaxCoordinateM: Embree asserts on huge coordinates (a pose translated by
+// 1e308), and no terrestrial scene spans more. Checked in double, before the float mesh is made.
+void CheckWorldExtent(const SceneObject& object, const Fields& fields) {
+  const Eigen::Matrix4d& m = object.world_from_object;
+  const char* key = fields.Has("matrix") ? "matrix" : "translate";
+  if (!m.allFinite() || m.topRightCorner<3, 1>().cwiseAbs().maxCoeff() > kMaxCoordinateM) {
+    fields.Fail(key, fmt::format("the object's position is beyond {} m", kMaxCoordinateM));
+  }
+  const Eigen::Matrix3d linear = m.topLeftCorner<3, 3>();
+  for (const Eigen::Vector3f& vertex : object.mesh.vertices) {
+    const Eigen::Vector3d world = linear * vertex.cast<double>() + m.topRightCorner<3, 1>();
+    if (!(world.cwiseAbs().maxCoeff() <= kMaxCoordinateM)) {
+      fields.Fail(fields.Has("scale") ? "scale" : key,
+                  fmt::format("a vertex lands at ({}, {}, {}), beyond {} m", world.x(), world.y(), world.z(),
+                              kMaxCoordinateM));
+    }
+  }
+}
+
+// Scene complexity is checked before the triangles are made: a scene file of a few hundred bytes (4,096
+// spheres of 4,096 segments, cars subdivided 7 times) must fail at once, not after minutes and gigabytes.
+// `*scene_triangles` counts the triangles of the objects made so far; `expected` is the next object's.
+void CheckSceneTriangles(const Fields& fields, const char* key, int64_t expected, int64_t* scene_triangles) {
+  const int64_t total = *scene_triangles + expected;
+  if (total > kMaxSceneTriangles) {
+    fields.Fail(key, fmt::format("the scene would hold {} triangles, more than the {} accepted", total,
+                                 kMaxSceneTriangles));
+  }
+  try {
+    CheckMemoryBudget(SaturatingBytes(total, kSceneBytesPerTriangle),
+                      fmt::format("{} scene triangles", total));
+  } catch (const InputError& error) {
+    fields.Fail(key, error.what());
+  }
+  *scene_triangles = total;
+}
+
+TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& fields, bool* color_used,
+                               int64_t* scene_triangles) {
   *color_used = false;
   auto size3 = [&](Eigen::Vector3d fallback) {
     const Eigen::Vector3d size = fields.Vector3("size", fallback);
@@ -177,6 +220,11 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
     return size;
   };
   const int segments = static_cast<int>(fields.Integer("segments", -1, 3, 4096));
+  const int64_t round = segments > 0 ? segments : 96;  // an upper bound of the default segment counts
+  if (primitive == "sphere") CheckSceneTriangles(fields, "segments", 2 * round * round, scene_triangles);
+  if (primitive == "cylinder" || primitive == "cone" || primitive == "lamp_post" || primitive == "mailbox") {
+    CheckSceneTriangles(fields, "segments", 64 * round, scene_triangles);
+  }
   if (primitive == "plane") {
     Eigen::Vector2d size(10, 10);
     if (fields.Has("size")) {
@@ -204,6 +252,12 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
     options.subdivisions = static_cast<int>(fields.Integer("subdivisions", 0, 0, 7));
     options.wheel_segments = static_cast<int>(fields.Integer("wheel_segments", 48, 8, 4096));
     *color_used = true;
+    if (options.subdivisions > 0) {  // each subdivision level quadruples the triangles of the coarse car
+      CarMeshOptions coarse = options;
+      coarse.subdivisions = 0;
+      const int64_t base = static_cast<int64_t>(MakeCarMesh(coarse).triangles.size());
+      CheckSceneTriangles(fields, "subdivisions", base << (2 * options.subdivisions), scene_triangles);
+    }
     return MakeCarMesh(options);
   }
   if (primitive == "lamp_post") {
@@ -233,6 +287,9 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
     } catch (const OptionsError& error) {
       fields.Fail("size", error.what());
     }
+    constexpr int64_t kTrianglesPerWindow = 64;  // frame, sill, recess and glass, with margin
+    CheckSceneTriangles(fields, "windows_per_floor",
+                        kTrianglesPerWindow * options.floors * options.windows_per_floor, scene_triangles);
     return MakeFacadeMesh(options);
   }
   if (primitive == "wall") {
@@ -245,7 +302,8 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
                           primitive));
 }
 
-SceneObject ParseObject(const Fields& fields, size_t index, const std::string& base_dir) {
+SceneObject ParseObject(const Fields& fields, size_t index, const std::string& base_dir,
+                        int64_t* scene_triangles) {
   fields.CheckKeys(kObjectKeys);
   SceneObject object;
   object.name = fields.String("name", fmt::format("objects[{}]", index));
@@ -253,7 +311,7 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
   if (has_primitive == has_mesh) fields.Fail("primitive", "give exactly one of 'primitive' and 'mesh'");
   bool color_used = false;
   if (has_primitive) {
-    object.mesh = MakePrimitiveMesh(fields.String("primitive", ""), fields, &color_used);
+    object.mesh = MakePrimitiveMesh(fields.String("primitive", ""), fields, &color_used, scene_triangles);
   } else {
     const std::string relative = fields.String("mesh", "");
     const std::filesystem::path path = std::filesystem::path(base_dir) / relative;
@@ -318,6 +376,10 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
                                                     : Rgb8(180, 180, 180));
   (void)color_used;
   ValidateMesh(object.mesh, fields.what() + ": " + fields.place());
+  if (!has_primitive) {
+    CheckSceneTriangles(fields, "mesh", static_cast<int64_t>(object.mesh.triangles.size()), scene_triangles);
+  }
+  CheckWorldExtent(object, fields);
   return object;
 }
 
@@ -326,6 +388,14 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
 void ScannerOptions::Check() const {
   CheckOption(position.allFinite() && rotate_deg.allFinite(),
               "ScannerOptions: position and rotate_deg must be finite");
+  CheckOption(position.cwiseAbs().maxCoeff() <= kMaxCoordinateM && rotate_deg.cwiseAbs().maxCoeff() <= 1e6,
+              fmt::format("ScannerOptions: position must be within {} m and rotate_deg within 1e6 degrees",
+                          kMaxCoordinateM));
+  CheckOption(
+      max_range_m <= kMaxCoordinateM,
+      fmt::format("ScannerOptions: max_range_m must be <= {} m, got {}", kMaxCoordinateM, max_range_m));
+  CheckMemoryBudget(SaturatingBytes(int64_t{columns} * rows, 64),
+                    fmt::format("a scan of {} rows x {} columns", rows, columns));
   CheckOption(
       azimuth_max_deg > azimuth_min_deg && azimuth_max_deg - azimuth_min_deg <= 360.0,
       fmt::format("ScannerOptions: azimuth range [{}, {}] must have max > min and span <= 360 degrees",
@@ -369,6 +439,8 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   } catch (const json::parse_error& error) {
     ThrowInputError(what, fmt::format("byte {}", error.byte), "",
                     fmt::format("not valid JSON: {}", error.what()));
+  } catch (const json::exception& error) {  // e.g. a number past double's range: 1e+315
+    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", error.what()));
   }
   Fields top(root, what, "");
   top.CheckKeys({"scanner", "objects", "name", "description"});
@@ -377,19 +449,18 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   if (!top.Has("objects")) top.Fail("objects", "missing (a list of objects)");
   const json& objects = top.Get("objects");
   if (!objects.is_array()) top.Fail("objects", fmt::format("expected an array, got {}", TypeName(objects)));
+  int64_t scene_triangles = 0;
   for (size_t i = 0; i < objects.size(); ++i) {
     scene.objects.push_back(
-        ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir));
+        ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir, &scene_triangles));
   }
   return scene;
 }
 
 SceneDescription LoadScene(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) ThrowInputError(path, "", "", "cannot open the scene file");
-  std::stringstream buffer;
-  buffer << stream.rdbuf();
-  SceneDescription scene = ParseScene(buffer.str(), path, std::filesystem::path(path).parent_path().string());
+  constexpr int64_t kMaxSceneFileBytes = int64_t{64} << 20;  // a scene description, not a mesh
+  SceneDescription scene = ParseScene(ReadRegularFile(path, kMaxSceneFileBytes), path,
+                                      std::filesystem::path(path).parent_path().string());
   scene.path = path;
   return scene;
 }
@@ -404,7 +475,8 @@ TriangleMesh MakePrimitive(const std::string& primitive, const std::string& para
   Fields fields(parameters, "MakePrimitive", primitive);
   fields.CheckKeys(kObjectKeys);
   bool color_used = false;
-  return MakePrimitiveMesh(primitive, fields, &color_used);
+  int64_t triangles = 0;
+  return MakePrimitiveMesh(primitive, fields, &color_used, &triangles);
 }
 
 }  // namespace lidarshop

@@ -11,6 +11,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 
@@ -42,6 +43,8 @@ cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols, const 
     doc = nlohmann::json::parse(json_text);
   } catch (const nlohmann::json::parse_error& e) {
     ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
+  } catch (const nlohmann::json::exception& e) {  // e.g. a number past double's range: 1e+316
+    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
   }
   if (!doc.is_object() || !doc.contains("strokes") || !doc["strokes"].is_array()) {
     ThrowInputError(what, "", "strokes", "expected an object with an array \"strokes\"");
@@ -101,11 +104,8 @@ cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols, const 
 cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
   cv::Mat strokes;
   if (FileExtension(path) == "json") {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) ThrowInputError(path, "", "", "cannot open the stroke file");
-    std::stringstream text;
-    text << in.rdbuf();
-    strokes = StrokesFromJson(text.str(), rows, cols, path);
+    constexpr int64_t kMaxStrokeFileBytes = int64_t{64} << 20;
+    strokes = StrokesFromJson(ReadRegularFile(path, kMaxStrokeFileBytes), rows, cols, path);
   } else {
     cv::Mat painted = ReadImage(path);
     if (painted.rows != rows || painted.cols != cols) {

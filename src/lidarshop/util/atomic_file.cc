@@ -1,5 +1,6 @@
 #include "lidarshop/util/atomic_file.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -23,6 +24,11 @@ std::string TemporaryPathFor(const std::string& path) {
 
 void Commit(const std::string& temporary, const std::string& path) {
   std::error_code error;
+  // A replaced file keeps its permissions (a private 600 scan must not become 644 by being rewritten).
+  struct stat target {};
+  if (stat(path.c_str(), &target) == 0 && S_ISREG(target.st_mode)) {
+    chmod(temporary.c_str(), target.st_mode & 07777);
+  }
   std::filesystem::rename(temporary, path, error);
   if (error) {
     std::filesystem::remove(temporary, error);

@@ -1,6 +1,6 @@
 // Atomic output: every file lidarshop writes first goes to a temporary file beside the target, which is
 // renamed over the target only when writing succeeded. A crash or an error never leaves a half-written
-// output, and an input is never opened for writing.
+// output, and an input is never opened for writing. A file that is replaced keeps its permission bits.
 #pragma once
 
 #include <functional>

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
 
@@ -124,6 +125,8 @@ void SweepOptions::Check() const {
       positions * static_cast<double>(yaws_deg.size()) <= static_cast<double>(max_poses),
       fmt::format("SweepOptions: {} poses exceed max_poses = {} (coarser step, smaller ranges or fewer yaws)",
                   positions * yaws_deg.size(), max_poses));
+  CheckMemoryBudget(static_cast<int64_t>(positions * static_cast<double>(yaws_deg.size()) * 200),
+                    fmt::format("a sweep of {} poses", positions * static_cast<double>(yaws_deg.size())));
 }
 
 std::vector<Detection> SelectDetections(std::span<const SweepPose> poses, const SweepOptions& options,

@@ -10,6 +10,7 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/footprint_gather.h"
@@ -210,8 +211,12 @@ struct Workspace {
 }  // namespace
 
 void ModelOptions::Check() const {
-  CheckOption(num_surface_samples > 0,
-              fmt::format("ModelOptions.num_surface_samples must be > 0, got {}", num_surface_samples));
+  CheckOption(num_surface_samples > 0 && num_surface_samples <= kMaxSurfaceSamples,
+              fmt::format("ModelOptions.num_surface_samples must be in [1, {}], got {}", kMaxSurfaceSamples,
+                          num_surface_samples));
+  // A model point costs its position, weight, normal and grid entry (~64 bytes).
+  CheckMemoryBudget(SaturatingBytes(num_surface_samples, 64),
+                    fmt::format("{} model surface samples", num_surface_samples));
   CheckOption(
       distinctiveness_radius_m >= 0,
       fmt::format("ModelOptions.distinctiveness_radius_m must be >= 0, got {}", distinctiveness_radius_m));
@@ -220,12 +225,16 @@ void ModelOptions::Check() const {
 }
 
 void VerifyOptions::Check() const {
-  CheckOption(allowance_m >= 0 && std::isfinite(allowance_m),
-              fmt::format("VerifyOptions.allowance_m must be >= 0, got {}", allowance_m));
-  CheckOption(sigma_m > 0 && std::isfinite(sigma_m),
-              fmt::format("VerifyOptions.sigma_m must be > 0, got {}", sigma_m));
-  CheckOption(icp_trim_m > 0 && std::isfinite(icp_trim_m),
-              fmt::format("VerifyOptions.icp_trim_m must be > 0, got {}", icp_trim_m));
+  // Lengths past kMaxLengthM are not physical for an object in a terrestrial scan (and would overflow the
+  // neighbour grid's cell arithmetic).
+  constexpr double kMaxLengthM = 1000;
+  CheckOption(
+      allowance_m >= 0 && allowance_m <= kMaxLengthM,
+      fmt::format("VerifyOptions.allowance_m must be in [0, {}] m, got {}", kMaxLengthM, allowance_m));
+  CheckOption(sigma_m > 0 && sigma_m <= kMaxLengthM,
+              fmt::format("VerifyOptions.sigma_m must be in (0, {}] m, got {}", kMaxLengthM, sigma_m));
+  CheckOption(icp_trim_m > 0 && icp_trim_m <= kMaxLengthM,
+              fmt::format("VerifyOptions.icp_trim_m must be in (0, {}] m, got {}", kMaxLengthM, icp_trim_m));
   CheckOption(footprint_margin_cells >= 0 && footprint_margin_cells < 1000,
               fmt::format("VerifyOptions.footprint_margin_cells must be in [0, 1000), got {}",
                           footprint_margin_cells));

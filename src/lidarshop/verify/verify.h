@@ -77,6 +77,7 @@ enum class InformationWeighting {
 
 struct ModelOptions {
   ModelPointSource point_source = ModelPointSource::kSurfaceSamples;
+  static constexpr int64_t kMaxSurfaceSamples = int64_t{1} << 27;
   int64_t num_surface_samples =
       10000;          // count; for kSurfaceSamples. ≈ 5 cm apart on a car (25 m²): keep the spacing ≲ σ
   uint64_t seed = 1;  // seed of the surface sampling

@@ -1,0 +1,79 @@
+#!/usr/bin/env bash
+# Fuzzes every reader with libFuzzer + AddressSanitizer + UBSan (clang 14 from scripts/setup.sh):
+#   scripts/fuzz.sh [SECONDS_PER_READER=300] [READER...]     readers: ptx ply pcd e57 obj scene strokes mask pose
+# Configures build/fuzz (the whole library instrumented, LIDARSHOP_BUILD_FUZZ=ON), replays the regression
+# inputs of data/fuzz_regressions/<reader>_*, seeds each target with the repository's files of its format
+# (tests/hostile/corpus, data/, the shared E57 files) and runs it for the given time. Prints one line per
+# reader (inputs executed, seconds, crashes) and exits non-zero on a crash; crashing inputs are written to
+# build/fuzz/artifacts/ — turn each into data/fuzz_regressions/<reader>_<what>.<ext> after fixing it.
+# scripts/test.sh runs this briefly (15 s a reader); run it longer by hand.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-300}
+shift || true
+readers=("$@")
+[[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd e57 obj scene strokes mask pose)
+shared=${LIDARSHOP_SHARED_DATA_DIR:-$PWD/../shared/data}
+build=build/fuzz
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd .. && pwd)} CCACHE_NOHASHDIR=true
+
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
+  -DLIDARSHOP_BUILD_FUZZ=ON -DLIDARSHOP_BUILD_TESTS=OFF -DLIDARSHOP_BUILD_BENCH=OFF >/dev/null || exit 1
+cmake --build "$build" -j "$(nproc)" --target "${readers[@]/%/_fuzz}" >"$build/build.log" 2>&1 ||
+  { tail -30 "$build/build.log"; exit 1; }
+
+extension_of() {
+  case $1 in scene | strokes) echo json ;; mask) echo png ;; pose) echo txt ;; *) echo "$1" ;; esac
+}
+
+# Large images in a fuzzed PNG must stay within the memory limit inside OpenCV (the targets set it too).
+export OPENCV_IO_MAX_IMAGE_PIXELS=$((1 << 22))
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+mkdir -p "$build/artifacts"
+status=0
+printf '| reader | inputs | seconds | crashes |\n|---|---|---|---|\n'
+for reader in "${readers[@]}"; do
+  ext=$(extension_of "$reader")
+  corpus="$build/corpus/$reader"
+  mkdir -p "$corpus"
+  for f in tests/hostile/corpus/*."$ext" data/*/*."$ext" data/*/*/*."$ext"; do
+    [[ -f $f ]] || continue
+    if [[ $reader == e57 ]]; then
+      # The E57 target reads logical streams (pages without CRCs).
+      python3 -c 'import sys; d=open(sys.argv[1],"rb").read(); open(sys.argv[2],"wb").write(b"".join(d[i:i+1020] for i in range(0,len(d),1024)))' \
+        "$f" "$corpus/$(basename "$f").logical"
+    elif [[ $(stat -c %s "$f") -le 65536 ]]; then
+      cp "$f" "$corpus/"
+    fi
+  done
+  if [[ $reader == e57 ]]; then
+    for f in "$shared"/e57/*.e57; do
+      [[ -f $f && $(stat -c %s "$f") -le 4194304 ]] || continue
+      python3 -c 'import sys; d=open(sys.argv[1],"rb").read(); open(sys.argv[2],"wb").write(b"".join(d[i:i+1020] for i in range(0,len(d),1024)))' \
+        "$f" "$corpus/shared_$(basename "$f").logical"
+    done
+  fi
+  regressions=(data/fuzz_regressions/"${reader}"_*)
+  crashes=0
+  if [[ -f ${regressions[0]} ]]; then
+    if ! "$build/fuzz/${reader}_fuzz" -rss_limit_mb=2048 -timeout=20 "${regressions[@]}" >"$build/$reader.regressions.log" 2>&1; then
+      echo "$reader: a regression input fails again (see $build/$reader.regressions.log)"
+      crashes=$((crashes + 1))
+    fi
+  fi
+  before=$(find "$build/artifacts" -name "$reader-*" | wc -l)
+  "$build/fuzz/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=20 \
+    -artifact_prefix="$build/artifacts/$reader-" -print_final_stats=1 >"$build/$reader.log" 2>&1
+  after=$(find "$build/artifacts" -name "$reader-*" | wc -l)
+  crashes=$((crashes + after - before))
+  inputs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$build/$reader.log" | grep -oE '[0-9]+$')
+  took=$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$build/$reader.log" | grep -oE '[0-9]+ second' |
+    grep -oE '[0-9]+')
+  if [[ -z $inputs ]]; then  # no final stats: the target did not run, or died without an artifact
+    tail -5 "$build/$reader.log"
+    crashes=$((crashes + 1))
+  fi
+  printf '| %s | %s | %s | %d |\n' "$reader" "${inputs:-?}" "${took:-$seconds}" "$crashes"
+  [[ $crashes -eq 0 ]] || status=1
+done
+exit $status
