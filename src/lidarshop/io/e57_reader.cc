@@ -819,7 +819,12 @@ E57File ReadE57(const std::string& path) {
   if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
     ThrowInputError(path, "", "", "read failed");
   }
-  return ReadE57Bytes(bytes, path);
+  E57File file = ReadE57Bytes(bytes, path);
+  // The same number checks as ReadScanFile: `info` and `images` read E57 files here directly.
+  for (size_t i = 0; i < file.scans.size(); ++i) {
+    io_internal::CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));
+  }
+  return file;
 }
 
 }  // namespace lidarshop
