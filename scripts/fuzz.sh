@@ -30,7 +30,7 @@ extension_of() {
 export OPENCV_IO_MAX_IMAGE_PIXELS=$((1 << 22))
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
 mkdir -p "$build/artifacts"
-status=0
+status=0 fuzz_passed=0 fuzz_failed=0
 printf '| reader | inputs | seconds | crashes |\n|---|---|---|---|\n'
 for reader in "${readers[@]}"; do
   ext=$(extension_of "$reader")
@@ -74,6 +74,7 @@ for reader in "${readers[@]}"; do
     crashes=$((crashes + 1))
   fi
   printf '| %s | %s | %s | %d |\n' "$reader" "${inputs:-?}" "${took:-$seconds}" "$crashes"
-  [[ $crashes -eq 0 ]] || status=1
+  if [[ $crashes -eq 0 ]]; then fuzz_passed=$((fuzz_passed + 1)); else status=1; fuzz_failed=$((fuzz_failed + 1)); fi
 done
+echo "fuzz: $fuzz_passed passed, $fuzz_failed failed"
 exit $status
