@@ -71,6 +71,9 @@ struct Record {
 
 // Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
 // become second returns. Returns whether the lidarshop extension field was written.
+// The E57 pose (unit quaternion with w >= 0, translation) of `transform` under `parent`.
+void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
+
 bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteOptions& options,
                 std::vector<uint8_t>* logical, pugi::xml_node data3d) {
   CheckScan(scan);
@@ -239,22 +242,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
                                std::min<size_t>(logical->size(), 4096))));
   AddString(child, "name", scan.name.empty() ? fmt::format("scan{:03d}", index) : scan.name);
   AddString(child, "description", "written by lidarshop");
-  {
-    const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
-    Eigen::Quaterniond q(rotation);
-    q.normalize();
-    if (q.w() < 0) q.coeffs() = -q.coeffs();
-    pugi::xml_node pose = AddTyped(child, "pose", "Structure");
-    pugi::xml_node r = AddTyped(pose, "rotation", "Structure");
-    AddFloat(r, "w", q.w());
-    AddFloat(r, "x", q.x());
-    AddFloat(r, "y", q.y());
-    AddFloat(r, "z", q.z());
-    pugi::xml_node t = AddTyped(pose, "translation", "Structure");
-    AddFloat(t, "x", scan.world_from_scanner(0, 3));
-    AddFloat(t, "y", scan.world_from_scanner(1, 3));
-    AddFloat(t, "z", scan.world_from_scanner(2, 3));
-  }
+  AddPose(child, scan.world_from_scanner);
   {
     pugi::xml_node b = AddTyped(child, "indexBounds", "Structure");
     AddInteger(b, "rowMinimum", 0);
