@@ -308,8 +308,8 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
         "domain, {} new points placed along the scanner's rays (magenta below). Against the scene scanned "
         "again without the object: range RMSE {:.1f} mm, {:.1f} % of the cells within 20 mm, {:.2f} % of the "
         "points farther than 10 cm from the true surface, return / no-return right in {:.1f} % of the cells, "
-        "colour PSNR {:.1f} dB ({:.2f} s). From 35° aside: the scan with the object, the truth without it, the "
-        "fill.</p><img src=\"remove_range.png\"><br><img src=\"remove_view_scan.png\" width=\"32%\">"
+        "colour PSNR {:.1f} dB ({:.2f} s). From 35° aside: the scan with the object, the truth without it, "
+        "the fill.</p><img src=\"remove_range.png\"><br><img src=\"remove_view_scan.png\" width=\"32%\">"
         "<img src=\"remove_view_truth.png\" width=\"32%\"><img src=\"remove_view_filled.png\" "
         "width=\"32%\">",
         remove["hole_cells"].get<int64_t>(), remove["synthesized_points"].get<int64_t>(),

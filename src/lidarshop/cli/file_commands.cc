@@ -196,14 +196,18 @@ int RunRender(int argc, char** argv) {
   app.add_option("--eye", eye, "camera centre x,y,z in the world (metres): draw the points from there")
       ->delimiter(',')
       ->expected(3);
-  app.add_option("--target", target, "point x,y,z the camera looks at (with --eye)")->delimiter(',')->expected(3);
+  app.add_option("--target", target, "point x,y,z the camera looks at (with --eye)")
+      ->delimiter(',')
+      ->expected(3);
   app.add_option("--orbit", orbit_deg,
                  "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
-  app.add_option("--around", around_path, "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
+  app.add_option("--around", around_path,
+                 "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
   app.add_option("--fov", view.field_of_view_deg, "horizontal field of view of --eye/--orbit, degrees")
       ->capture_default_str();
   app.add_option("--width", view.width_px, "picture width of --eye/--orbit, pixels")->capture_default_str();
-  app.add_option("--height", view.height_px, "picture height of --eye/--orbit, pixels")->capture_default_str();
+  app.add_option("--height", view.height_px, "picture height of --eye/--orbit, pixels")
+      ->capture_default_str();
   app.add_option("--point-size", view.point_size_px, "drawn point size of --eye/--orbit, pixels")
       ->capture_default_str();
   app.add_option("--tint-synthesized", view.synthesized_tint,
@@ -222,8 +226,9 @@ int RunRender(int argc, char** argv) {
         view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
         view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
       } else {
-        const cv::Mat region = around_path.empty() ? cv::Mat(scan.valid != 0)
-                                                   : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
+        const cv::Mat region = around_path.empty()
+                                   ? cv::Mat(scan.valid != 0)
+                                   : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
         const PointViewOptions side = SideView(scan, region, orbit_deg);
         view.eye_in_world = side.eye_in_world;
         view.target_in_world = side.target_in_world;

@@ -96,10 +96,10 @@ InpaintResult Inpaint(const cv::Mat& image, const cv::Mat& hole_mask, const Inpa
       image.copyTo(known, hole_mask == 0);
       cv::Point at;
       if (!cv::checkRange(known, /*quiet=*/true, &at)) {
-        throw InputError(fmt::format(
-            "Inpaint: the image holds NaN or inf at pixel (x {}, y {}) outside the hole; add it to the hole or "
-            "fix it",
-            at.x, at.y));
+        throw InputError(
+            fmt::format("Inpaint: the image holds NaN or inf at pixel (x {}, y {}) outside the hole; add it "
+                        "to the hole or fix it",
+                        at.x, at.y));
       }
     }
   }

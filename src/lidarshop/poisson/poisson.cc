@@ -192,7 +192,8 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
   return PreparePoisson(mask_in, options, PoissonLinks{});
 }
 
-PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options, const PoissonLinks& links) {
+PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& options,
+                             const PoissonLinks& links) {
   const cv::Mat& no_data_in = links.no_data;
   options.Check();
   Timer timer;
@@ -204,8 +205,8 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
   bool no_data_touches_domain = false;
   if (!no_data_in.empty()) {
     if (no_data_in.size() != impl->size) {
-      throw InputError(fmt::format("PreparePoisson: the no-data mask is {}x{}, the mask is {}x{}", no_data_in.cols,
-                                   no_data_in.rows, W, H));
+      throw InputError(fmt::format("PreparePoisson: the no-data mask is {}x{}, the mask is {}x{}",
+                                   no_data_in.cols, no_data_in.rows, W, H));
     }
     impl->no_data = NormalizeMask(no_data_in, "PreparePoisson (no-data mask)");
     impl->no_data.setTo(0, impl->mask);  // a pixel of Ω is an unknown, whatever the no-data mask says
@@ -214,7 +215,8 @@ PoissonSystem PreparePoisson(const cv::Mat& mask_in, const PoissonOptions& optio
     no_data_touches_domain = cv::countNonZero(grown & impl->mask) > 0;
     if (!no_data_touches_domain) impl->no_data.release();  // nothing to leave out: the plain system
   }
-  for (const auto& [cut, stored] : {std::pair{&links.cut_right, &impl->cut_right}, std::pair{&links.cut_down, &impl->cut_down}}) {
+  for (const auto& [cut, stored] :
+       {std::pair{&links.cut_right, &impl->cut_right}, std::pair{&links.cut_down, &impl->cut_down}}) {
     if (cut->empty()) continue;
     if (cut->size() != impl->size || cut->type() != CV_8U) {
       throw InputError(fmt::format("PreparePoisson: an edge-cut mask must be {}x{} CV_8U", W, H));

@@ -79,7 +79,8 @@ void CheckOutputPath(const std::string& path, const std::vector<std::string>& ot
   const fs::path canonical = fs::weakly_canonical(target, error);
   for (const std::string& other : others) {
     if (other.empty()) continue;
-    const bool same_file = fs::exists(target, error) && fs::exists(other, error) && fs::equivalent(target, other, error);
+    const bool same_file =
+        fs::exists(target, error) && fs::exists(other, error) && fs::equivalent(target, other, error);
     if (same_file || canonical == fs::weakly_canonical(fs::absolute(other, error), error)) {
       throw OptionsError(fmt::format("{}: the output would overwrite {}; choose another path", path, other));
     }

@@ -40,11 +40,11 @@ void CheckMemoryBudget(int64_t bytes, std::string_view what) {
   const int64_t budget = MemoryBudgetBytes();
   if (bytes >= 0 && bytes <= budget) return;
   // Rounded up without adding to `bytes`, which may be INT64_MAX (a saturated request).
-  const std::string needed =
-      bytes < 0 ? std::string("more than 8 EiB")
-                : fmt::format("about {} MiB", bytes / (1 << 20) + (bytes % (1 << 20) != 0));
-  throw InputError(fmt::format("{} needs {}, more than the memory budget of {} MiB (--max-memory)", what, needed,
-                               budget >> 20));
+  const std::string needed = bytes < 0
+                                 ? std::string("more than 8 EiB")
+                                 : fmt::format("about {} MiB", bytes / (1 << 20) + (bytes % (1 << 20) != 0));
+  throw InputError(fmt::format("{} needs {}, more than the memory budget of {} MiB (--max-memory)", what,
+                               needed, budget >> 20));
 }
 
 int64_t SaturatingBytes(int64_t count, int64_t bytes_each) {
