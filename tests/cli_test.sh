@@ -239,6 +239,16 @@ fails_clearly "fill: output onto its input" "overwrite" "$lidarshop" fill "$work
   -o "$work/scan.ptx" --quiet
 fails_clearly "fill: unknown method" "method" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \
   -o "$work/x.ply" --method magic --quiet
+fails_clearly "fill: --scan-index out of range" "scan-index" "$lidarshop" fill "$work/scan.ptx" \
+  --mask "$work/mask.png" -o "$work/x.ply" --scan-index 3 --quiet
+fails_clearly "fill: unknown search" "search" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \
+  -o "$work/x.ply" --search magic --quiet
+fails_clearly "remove: margin out of range" "margin" "$lidarshop" remove "$work/scan.ptx" \
+  --strokes "$work/strokes.json" -o "$work/x.ply" --margin 500 --quiet
+fails_clearly "render: --eye without --target" "target" "$lidarshop" render "$work/scan.ptx" --eye 1,2,3 \
+  -o "$work/x.png"
+check "render from a second viewpoint" "$lidarshop" render "$work/filled.ply" --orbit 30 \
+  --around "$work/synthesized.png" --tint-synthesized 0.5 -o "$work/second_view.png"
 fails_clearly "remove: two layers in PTX" "PTX" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
   -o "$work/x.ptx" --keep-object --quiet
 # Photos: the synthetic camera, resection, recolouring, E57 images, landmark alignment (docs/recolor.md).

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/scan_io.h"
 
 namespace lidarshop::cli {
 
@@ -40,6 +41,9 @@ nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
 // Parses argv with `app` and runs `body`, turning every exception into one line on stderr
 // ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.
 int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+
+// Scan `index` of `file`; OptionsError naming `flag` (the option the user typed) when out of range.
+const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = "--scan-index");
 
 // Adds --quiet (no progress bars) to `app`; the flag is stored in *quiet. Also adds --max-memory SIZE
 // ("512M", "8G"; default half of the RAM), which sets the memory budget (util/memory_budget.h) that

@@ -31,6 +31,14 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
   }
 }
 
+const Scan& PickScan(const ScanFile& file, int index, const std::string& flag) {
+  if (index < 0 || index >= static_cast<int>(file.scans.size())) {
+    throw OptionsError(fmt::format("{} {} is out of range: {} holds {} scan(s), numbered from 0", flag, index,
+                                   file.path, file.scans.size()));
+  }
+  return file.scans[index];
+}
+
 void AddQuietFlag(CLI::App& app, bool* quiet) {
   app.add_flag("-q,--quiet", *quiet, "no progress output");
   app.add_option_function<std::string>(

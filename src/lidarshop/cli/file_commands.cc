@@ -94,14 +94,6 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
   return json;
 }
 
-int SelectScan(const ScanFile& file, int index) {
-  if (index < 0 || index >= static_cast<int>(file.scans.size())) {
-    throw OptionsError(fmt::format("--scan {} is out of range: {} holds {} scan(s), numbered from 0", index,
-                                   file.path, file.scans.size()));
-  }
-  return index;
-}
-
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
@@ -158,7 +150,7 @@ int RunConvert(int argc, char** argv) {
     }
     progress->Advance();
     std::vector<Scan> scans = file.scans;
-    if (scan_index >= 0) scans = {file.scans[SelectScan(file, scan_index)]};
+    if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
     if (e57_to_e57) {
       WriteE57(output, scans, images, E57WriteOptions{});
     } else {
@@ -221,7 +213,7 @@ int RunRender(int argc, char** argv) {
       if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
       if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
       const ScanFile file = ReadScanFile(input);
-      const Scan& scan = file.scans[SelectScan(file, scan_index)];
+      const Scan& scan = PickScan(file, scan_index, "--scan");
       if (!eye.empty()) {
         view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
         view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
@@ -240,7 +232,7 @@ int RunRender(int argc, char** argv) {
     if (!color_map.empty()) options.color_map = ParseColorMap(color_map);
     options.Check();
     const ScanFile file = ReadScanFile(input);
-    Scan scan = file.scans[SelectScan(file, scan_index)];
+    Scan scan = PickScan(file, scan_index, "--scan");
     if (scan.name.empty()) scan.name = input;
     const RenderResult result = RenderScan(scan, options);
     WriteImage(output, result.image);

@@ -67,14 +67,6 @@ struct FillFlags {
   }
 };
 
-const Scan& PickScan(const ScanFile& file, int index, const std::string& path) {
-  if (index < 0 || index >= static_cast<int>(file.scans.size())) {
-    throw OptionsError(
-        fmt::format("--scan-index {} out of range: {} holds {} scan(s)", index, path, file.scans.size()));
-  }
-  return file.scans[index];
-}
-
 // Outputs are checked before the long work: a scan format, a folder that exists, never an input.
 void CheckScanOutput(const std::string& output, const std::vector<std::string>& inputs) {
   const std::string extension = FileExtension(output);
@@ -170,7 +162,7 @@ int RunFill(int argc, char** argv) {
       if (!path.empty()) CheckOutputPath(path, {scan_path, mask_path, output_path});
     }
     const ScanFile file = ReadScanFile(scan_path);
-    const Scan& scan = PickScan(file, scan_index, scan_path);
+    const Scan& scan = PickScan(file, scan_index);
     const cv::Mat hole = ReadMask(mask_path, cv::Size(scan.cols, scan.rows), scan_path);
     auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
     const FillResult result = FillScan(scan, hole, options, progress.get());
@@ -222,7 +214,7 @@ int RunRemove(int argc, char** argv) {
       if (!path.empty()) CheckOutputPath(path, {scan_path, strokes_path, output_path});
     }
     const ScanFile file = ReadScanFile(scan_path);
-    const Scan& scan = PickScan(file, scan_index, scan_path);
+    const Scan& scan = PickScan(file, scan_index);
     const cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
     RemoveOptions remove;
     remove.fill = options;

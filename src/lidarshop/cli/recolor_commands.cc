@@ -39,13 +39,7 @@ void CheckNotInput(const std::string& output, const std::vector<std::string>& in
   }
 }
 
-Scan ReadOneScan(const std::string& path, int index) {
-  const ScanFile file = ReadScanFile(path);
-  if (index < 0 || index >= static_cast<int>(file.scans.size()))
-    throw OptionsError(
-        fmt::format("--scan-index {} is out of range: {} holds {} scan(s)", index, path, file.scans.size()));
-  return file.scans[index];
-}
+Scan ReadOneScan(const std::string& path, int index) { return PickScan(ReadScanFile(path), index); }
 
 // The entry of `images` named `key` or numbered `key`.
 const E57Image& FindImage(const std::vector<E57Image>& images, const std::string& key,

@@ -74,11 +74,7 @@ int RunSegment(int argc, char** argv) {
       used.push_back(path);
     }
     const ScanFile file = ReadScanFile(scan_path);
-    if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size())) {
-      throw OptionsError(fmt::format("--scan-index {} out of range: {} holds {} scan(s)", scan_index,
-                                     scan_path, file.scans.size()));
-    }
-    const Scan& scan = file.scans[scan_index];
+    const Scan& scan = PickScan(file, scan_index);
     cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
     SegmentSession session(scan, options);
     SegmentResult result = session.Run(strokes);

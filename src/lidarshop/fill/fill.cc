@@ -9,6 +9,7 @@
 #include <opencv2/photo.hpp>
 
 #include "lidarshop/fill/range_gradient.h"
+#include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/timer.h"
 
@@ -392,35 +393,22 @@ void CheckInputs(const Scan& scan, const cv::Mat& hole) {
   }
 }
 
-// Normals of filled cells from their grid neighbours, oriented toward the scanner (scans with a normal
-// channel).
+// Normals of filled cells (scans with a normal channel): the grid normals of pointset/normals.h over a 3 x 3
+// window, computed on the filled cells' bounding box only.
 void GridNormals(const cv::Mat& filled, Scan* scan) {
-  auto point = [&](int y, int x, Eigen::Vector3f* p) {
-    if (y < 0 || y >= scan->rows || x < 0 || x >= scan->cols || !scan->valid.at<uint8_t>(y, x)) return false;
-    const cv::Vec3f v = scan->point.at<cv::Vec3f>(y, x);
-    *p = Eigen::Vector3f(v[0], v[1], v[2]);
-    return true;
-  };
-  for (int y = 0; y < scan->rows; ++y) {
-    for (int x = 0; x < scan->cols; ++x) {
-      if (!filled.at<uint8_t>(y, x)) continue;
-      Eigen::Vector3f c;
-      point(y, x, &c);
-      // Forward difference, or backward where the forward neighbour has no return.
-      auto step = [&](int dy, int dx) {
-        Eigen::Vector3f q;
-        if (point(y + dy, x + dx, &q)) return Eigen::Vector3f(q - c);
-        if (point(y - dy, x - dx, &q)) return Eigen::Vector3f(c - q);
-        return Eigen::Vector3f(Eigen::Vector3f::Zero());
-      };
-      Eigen::Vector3f n = step(0, 1).cross(step(1, 0));
-      if (n.norm() > 0) {
-        n.normalize();
-        if (n.dot(c) > 0) n = -n;
-      }
-      scan->normal.at<cv::Vec3f>(y, x) = cv::Vec3f(n.x(), n.y(), n.z());
-    }
-  }
+  const cv::Rect box = cv::boundingRect(filled);
+  if (box.empty()) return;
+  NormalOptions options;
+  options.window_cells = 1;
+  const cv::Rect roi = (box + cv::Size(2, 2) - cv::Point(1, 1)) & cv::Rect(0, 0, scan->cols, scan->rows);
+  Scan window;  // a view: the grid normals read rows, cols, valid and point only
+  window.rows = roi.height;
+  window.cols = roi.width;
+  window.valid = scan->valid(roi);
+  window.point = scan->point(roi);
+  if (window.CountValid() < 3) return;
+  const cv::Mat normal = EstimateGridNormals(window, options).normal;
+  normal.copyTo(scan->normal(roi), filled(roi));
 }
 
 Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* result) {

@@ -5,10 +5,10 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/pointset/kdtree.h"
+#include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -21,27 +21,6 @@ bool Valid(const Scan& scan, int y, int x) {
 Eigen::Vector3f PointAt(const Scan& scan, int y, int x) {
   const cv::Vec3f p = scan.point.at<cv::Vec3f>(y, x);
   return {p[0], p[1], p[2]};
-}
-
-// Unit normal of the least-squares plane through the valid points of a window, or zero when too few.
-Eigen::Vector3f WindowNormal(const Scan& scan, int y, int x, int radius) {
-  std::vector<Eigen::Vector3f> points;
-  for (int dy = -radius; dy <= radius; ++dy) {
-    for (int dx = -radius; dx <= radius; ++dx) {
-      if (Valid(scan, y + dy, x + dx)) points.push_back(PointAt(scan, y + dy, x + dx));
-    }
-  }
-  if (points.size() < 5) return Eigen::Vector3f::Zero();
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : points) mean += p.cast<double>();
-  mean /= static_cast<double>(points.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) {
-    const Eigen::Vector3d d = p.cast<double>() - mean;
-    covariance += d * d.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-  return solver.eigenvectors().col(0).cast<float>();  // smallest eigenvalue first
 }
 
 float TruthRange(const Scan& truth, int y, int x) {
@@ -76,6 +55,13 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
   double sum_sq = 0, sum_abs = 0, color_sq = 0, normal_deg = 0;
   int64_t within = 0, same_return = 0, synthesized = 0, floating = 0, normals = 0, color_values = 0;
   const bool color = filled.has_color() && truth.has_color();
+  // Plane-fit normals of the filled points over a (2r+1)² window of the grid (pointset/normals.h).
+  cv::Mat filled_normals;
+  if (!truth.normal.empty() && filled.CountValid() >= 3) {
+    NormalOptions normal_options;
+    normal_options.window_cells = options.normal_window_radius;
+    filled_normals = EstimateGridNormals(filled, normal_options).normal;
+  }
   for (int y = 0; y < truth.rows; ++y) {
     for (int x = 0; x < truth.cols; ++x) {
       if (!hole.at<uint8_t>(y, x)) continue;
@@ -98,8 +84,9 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
         for (int c = 0; c < 3; ++c) color_sq += (a[c] - b[c]) * (a[c] - b[c]);
         color_values += 3;
       }
-      if (!truth.normal.empty()) {
-        const Eigen::Vector3f n = WindowNormal(filled, y, x, options.normal_window_radius);
+      if (!filled_normals.empty()) {
+        const cv::Vec3f fn = filled_normals.at<cv::Vec3f>(y, x);
+        const Eigen::Vector3f n(fn[0], fn[1], fn[2]);
         const cv::Vec3f tn = truth.normal.at<cv::Vec3f>(y, x);
         const Eigen::Vector3f true_normal(tn[0], tn[1], tn[2]);
         if (n.norm() > 0.5f && true_normal.norm() > 0.5f) {
