@@ -38,9 +38,30 @@ int RunRegister(int argc, char** argv);   // points_command.cc
 // `info` print it. recolor_commands.cc.
 nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
 
+class OptionBinder;
+
+// Exit codes of every command (README "Exit codes").
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitBadInput = 1;  // input data: a file that does not parse, a missing channel
+inline constexpr int kExitUsage = 2;     // usage: unknown option, bad value, missing argument
+
 // Parses argv with `app` and runs `body`, turning every exception into one line on stderr
-// ("lidarshop scan: <message>") and exit code 1; CLI11 parse errors print CLI11's message and its exit code.
-int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+// ("lidarshop scan: <message>"): usage errors (CLI11's, OptionsError, an unknown option with the closest valid
+// one) exit with kExitUsage, everything else (InputError, a library's exception) with kExitBadInput. With a
+// `binder`, option errors name the flag the user typed.
+int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+               const OptionBinder* binder = nullptr);
+
+// Adds --json FILE ('-' = stdout): where the command's result goes as JSON. Machine output goes only there;
+// summaries for people go to stderr.
+void AddJsonOption(CLI::App& app, std::string* path);
+// Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty.
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json);
+
+// Checks an output before any long work: its extension is one of `extensions` (lower case, no dot; empty =
+// any), its folder exists and is writable, and it names no input or other output. OptionsError naming `flag`.
+void CheckOutputFile(const std::string& flag, const std::string& path, const std::vector<std::string>& extensions,
+                     const std::vector<std::string>& others);
 
 // Scan `index` of `file`; OptionsError naming `flag` (the option the user typed) when out of range.
 const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = "--scan-index");

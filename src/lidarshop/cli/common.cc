@@ -1,15 +1,62 @@
+#include <unistd.h>
+
 #include <charconv>
 #include <exception>
+#include <filesystem>
+#include <iostream>
 
 #include <fmt/format.h>
+#include <opencv2/core.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop::cli {
 
-int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+namespace {
+
+// Every long name of `app` and its subcommands ("--channel").
+void CollectFlags(const CLI::App& app, std::vector<std::string>* flags) {
+  for (const CLI::Option* option : app.get_options()) {
+    for (const std::string& name : option->get_lnames()) flags->push_back("--" + name);
+  }
+  for (const CLI::App* sub : app.get_subcommands({})) CollectFlags(*sub, flags);
+}
+
+// "unknown option --chanel (did you mean --channel?)" for the first unexpected argument.
+std::string ExtrasMessage(const CLI::App& app) {
+  const std::vector<std::string> extras = app.remaining(true);
+  if (extras.empty()) return "unexpected arguments";
+  const std::string& first = extras.front();
+  if (first.rfind("-", 0) != 0) return fmt::format("unexpected argument '{}'", first);
+  std::vector<std::string> flags;
+  CollectFlags(app, &flags);
+  const std::string name = first.substr(0, first.find('='));
+  const std::string closest = ClosestMatch(name, flags);
+  return fmt::format("unknown option {}{}", name, closest.empty() ? "" : fmt::format(" (did you mean {}?)", closest));
+}
+
+// One line of a library's exception: the first line, and OpenCV's message without its source location.
+std::string OneLine(const std::exception& error) {
+  std::string text = error.what();
+  if (const auto* cv_error = dynamic_cast<const cv::Exception*>(&error)) {
+    text = fmt::format("OpenCV: {}{}", cv_error->err,
+                       cv_error->func.empty() ? "" : fmt::format(" (in {})", cv_error->func));
+  }
+  const size_t newline = text.find('\n');
+  if (newline != std::string::npos) text = text.substr(0, newline);
+  return text;
+}
+
+}  // namespace
+
+int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+               const OptionBinder* binder) {
+  const std::string name = "lidarshop " + app.get_name();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -18,16 +65,57 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
     return app.exit(help);
   } catch (const CLI::CallForVersion& version) {
     return app.exit(version);
+  } catch (const CLI::ExtrasError&) {
+    fmt::print(stderr, "{}: {} (see --help)\n", name, ExtrasMessage(app));
+    return kExitUsage;
   } catch (const CLI::ParseError& error) {
-    // Usage errors are one line too, like every other failure.
-    fmt::print(stderr, "lidarshop {}: {} (see --help)\n", app.get_name(), error.what());
-    return error.get_exit_code() != 0 ? error.get_exit_code() : 2;
+    fmt::print(stderr, "{}: {} (see --help)\n", name, error.what());
+    return kExitUsage;
   }
   try {
     return body();
+  } catch (const OptionsFieldError& error) {
+    const std::string message = binder != nullptr ? binder->Reworded(error).what() : std::string(error.what());
+    fmt::print(stderr, "{}: {}\n", name, message);
+    return kExitUsage;
+  } catch (const OptionsError& error) {
+    fmt::print(stderr, "{}: {}\n", name, OneLine(error));
+    return kExitUsage;
   } catch (const std::exception& error) {
-    fmt::print(stderr, "lidarshop {}: {}\n", app.get_name(), error.what());
-    return 1;
+    fmt::print(stderr, "{}: {}\n", name, OneLine(error));
+    return kExitBadInput;
+  }
+}
+
+void AddJsonOption(CLI::App& app, std::string* path) {
+  app.add_option("--json", *path, "write the result as JSON to FILE ('-' = stdout)")->type_name("FILE");
+}
+
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json) {
+  if (path.empty()) return;
+  if (path == "-") {
+    std::cout << json.dump(2) << "\n" << std::flush;
+    return;
+  }
+  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+}
+
+void CheckOutputFile(const std::string& flag, const std::string& path, const std::vector<std::string>& extensions,
+                     const std::vector<std::string>& others) {
+  if (path.empty() || path == "-") return;
+  const std::string extension = FileExtension(path);
+  if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), extension) == extensions.end()) {
+    throw OptionsError(fmt::format("{} {}: expected a .{} file", flag, path, fmt::join(extensions, ", .")));
+  }
+  try {
+    CheckOutputPath(path, others);
+  } catch (const OptionsError& error) {
+    throw OptionsError(fmt::format("{} {}", flag, error.what()));
+  }
+  std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  if (folder.empty()) folder = ".";
+  if (access(folder.c_str(), W_OK) != 0) {
+    throw OptionsError(fmt::format("{} {}: the folder {} is not writable", flag, path, folder.string()));
   }
 }
 

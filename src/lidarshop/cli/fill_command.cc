@@ -51,7 +51,7 @@ struct FillFlags {
                  "copy the best patch without the acceptance tests (faster; worse where surfaces meet)");
   }
   FillOptions Parsed() {
-    options.method = ParseFillMethod(method);
+    options.method = ParseEnum<FillMethod>(method);
     if (no_accept) options.acceptance.enabled = false;
     if (search == "patchmatch") {
       options.search = InpaintSearchKind::kPatchMatch;

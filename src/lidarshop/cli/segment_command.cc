@@ -60,8 +60,8 @@ int RunSegment(int argc, char** argv) {
       ->capture_default_str();
   AddQuietFlag(app, &quiet);
   return RunCommand(app, argc, argv, [&]() {
-    options.method = ParseSegmentMethod(method);
-    options.model = ParseAppearanceModel(model);
+    options.method = ParseEnum<SegmentMethod>(method);
+    options.model = ParseEnum<AppearanceModel>(model);
     options.eight_connected = eight;
     options.Check();
     for (const std::string& path : {object_path, rest_path}) {

@@ -12,6 +12,7 @@
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/timer.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -23,55 +24,7 @@ using fill_internal::NearestKnownCell;
 using fill_internal::OneSidedRangeGradient;
 using fill_internal::UnanchoredCells;
 
-std::string ToString(FillMethod method) {
-  switch (method) {
-    case FillMethod::kGradient:
-      return "gradient";
-    case FillMethod::kLaplace:
-      return "laplace";
-    case FillMethod::kDepthPatch:
-      return "depth-patch";
-    case FillMethod::kTelea:
-      return "telea";
-  }
-  return "?";
-}
-
-FillMethod ParseFillMethod(const std::string& name) {
-  for (FillMethod method :
-       {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
-    if (name == ToString(method)) return method;
-  }
-  throw OptionsError(fmt::format("unknown fill method '{}' (gradient|laplace|depth-patch|telea)", name));
-}
-
-void FillOptions::Check() const {
-  CheckOption(patch_radius >= 1 && patch_radius <= 15,
-              fmt::format("FillOptions.patch_radius must be in [1, 15] cells, got {}", patch_radius));
-  CheckOption(search_window_radius >= patch_radius,
-              fmt::format("FillOptions.search_window_radius must be >= patch_radius ({}), got {}",
-                          patch_radius, search_window_radius));
-  CheckOption(patchmatch_random_samples >= 1 && patchmatch_random_samples <= 100000,
-              fmt::format("FillOptions.patchmatch_random_samples must be in [1, 100000], got {}",
-                          patchmatch_random_samples));
-  CheckOption(
-      patchmatch_iterations >= 1 && patchmatch_iterations <= 100,
-      fmt::format("FillOptions.patchmatch_iterations must be in [1, 100], got {}", patchmatch_iterations));
-  CheckOption(std::isfinite(color_weight) && color_weight >= 0,
-              fmt::format("FillOptions.color_weight must be >= 0, got {}", color_weight));
-  CheckOption(std::isfinite(gradient_weight) && gradient_weight >= 0,
-              fmt::format("FillOptions.gradient_weight must be >= 0, got {}", gradient_weight));
-  CheckOption(std::isfinite(return_weight) && return_weight >= 0,
-              fmt::format("FillOptions.return_weight must be >= 0, got {}", return_weight));
-  CheckOption(color_weight + gradient_weight + return_weight > 0,
-              "FillOptions: at least one of color_weight, gradient_weight, return_weight must be > 0");
-  CheckOption(std::isfinite(depth_jump_ratio) && depth_jump_ratio >= 0,
-              fmt::format("FillOptions.depth_jump_ratio must be >= 0, got {}", depth_jump_ratio));
-  CheckOption(std::isfinite(telea_radius_cells) && telea_radius_cells > 0,
-              fmt::format("FillOptions.telea_radius_cells must be > 0, got {}", telea_radius_cells));
-  poisson.Check();
-  acceptance.Check();
-}
+void FillOptions::Check() const { Validate(*this); }
 
 std::string FillResult::Summary() const {
   return fmt::format(
@@ -185,7 +138,10 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
                         Progress* progress) {
   InpaintOptions inpaint;
   inpaint.patch_radius = options.patch_radius;
-  inpaint.search = options.search;
+  // The exact search is the two-step one with the local window as its first bound: the same best patch,
+  // found sooner.
+  inpaint.search =
+      options.search == InpaintSearchKind::kExhaustive ? InpaintSearchKind::kTwoStep : options.search;
   inpaint.priority = options.priority;
   inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
   inpaint.patchmatch_iterations = options.patchmatch_iterations;

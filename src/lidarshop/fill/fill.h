@@ -32,15 +32,16 @@
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
 class Progress;
 
+// Names (util/enum_names.h): "gradient", "laplace", "depth-patch", "telea".
 enum class FillMethod { kGradient, kLaplace, kDepthPatch, kTelea };
-// "gradient", "laplace", "depth-patch", "telea"; the parser throws OptionsError naming the choices.
-std::string ToString(FillMethod method);
-FillMethod ParseFillMethod(const std::string& name);
+template <>
+const EnumInfo& EnumInfoOf<FillMethod>();
 
 struct FillOptions {
   FillMethod method = FillMethod::kGradient;
@@ -49,6 +50,7 @@ struct FillOptions {
   InpaintPriorityKind priority = InpaintPriorityKind::kCriminisi;  // fill order
   // PatchMatch: random samples over the whole scan plus samples near the target; measured best on
   // data/fill_eval (a surface hidden behind a large object is found far away, e.g. a facade above a car).
+  // kExhaustive runs the two-step search with the local window as its first bound (the same patches).
   InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
   int search_window_radius = 50;       // cells; local window (local search; PatchMatch's near samples)
   int patchmatch_random_samples = 48;  // PatchMatch: uniform draws over the scan per query (>= 1)
@@ -81,8 +83,10 @@ struct FillOptions {
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
   PoissonOptions poisson;           // range reconstruction (and the laplace baseline)
   uint64_t seed = 0;                // random choices of the patch fill (ties are broken by position)
-  void Check() const;               // throws OptionsError
+  void Check() const;               // throws OptionsFieldError naming the field
 };
+template <>
+const StructInfo& InfoOf<FillOptions>();
 
 struct FillTimings {
   double gradients_s = 0, inpaint_s = 0, poisson_s = 0, placement_s = 0, total_s = 0;  // wall seconds

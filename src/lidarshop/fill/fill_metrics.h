@@ -8,6 +8,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -17,6 +18,8 @@ struct FillMetricsOptions {
   int normal_window_radius = 2;  // plane-fit window of the filled points' normals, cells (5 x 5)
   int seam_band_cells = 8;       // width of the band outside the hole where the reference jump is measured
 };
+template <>
+const StructInfo& InfoOf<FillMetricsOptions>();
 
 struct FillMetrics {
   int64_t hole_cells = 0;

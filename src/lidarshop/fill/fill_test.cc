@@ -236,7 +236,7 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
   FillOptions bad;
   bad.patch_radius = 0;
   EXPECT_THROW(FillScan(c.scan, border, bad), OptionsError);
-  EXPECT_THROW(ParseFillMethod("magic"), OptionsError);
+  EXPECT_THROW(ParseEnum<FillMethod>("magic"), OptionsError);
 }
 
 }  // namespace

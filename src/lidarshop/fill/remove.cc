@@ -5,15 +5,11 @@
 
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void RemoveOptions::Check() const {
-  segment.Check();
-  fill.Check();
-  CheckOption(margin_cells >= 0 && margin_cells <= 100,
-              fmt::format("RemoveOptions.margin_cells must be in [0, 100], got {}", margin_cells));
-}
+void RemoveOptions::Check() const { Validate(*this); }
 
 cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid) {
   // Flood the outside of the mask from every border cell (4-connected); what stays unflooded is enclosed.

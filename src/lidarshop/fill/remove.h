@@ -21,8 +21,10 @@ struct RemoveOptions {
   // Cells without a return enclosed by the object's mask (a dark tyre, a window the ray went through) are
   // part of its silhouette: fill them too (the cut never takes them, they are not nodes of its graph).
   bool fill_enclosed_no_return = true;
-  void Check() const;  // throws OptionsError
+  void Check() const;  // throws OptionsFieldError naming the field
 };
+template <>
+const StructInfo& InfoOf<RemoveOptions>();
 
 struct RemoveResult {
   SegmentResult cut;  // the object's mask and the cut's numbers

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -280,27 +281,7 @@ std::unique_ptr<AcceptanceTest> MakeSmoothTextureTest(const SmoothTextureTestOpt
   return std::make_unique<SmoothTextureTest>(o);
 }
 
-void AcceptanceOptions::Check() const {
-  auto positive = [](double v, const char* name) {
-    CheckOption(std::isfinite(v) && v > 0.0,
-                fmt::format("AcceptanceOptions.{} must be > 0, got {}", name, v));
-  };
-  positive(mean.max_difference, "mean.max_difference");
-  positive(representative.max_difference, "representative.max_difference");
-  positive(histogram.max_distance, "histogram.max_distance");
-  positive(smooth_texture.max_value, "smooth_texture.max_value");
-  CheckOption(smooth_texture.texture_sigma >= 0.0,
-              fmt::format("AcceptanceOptions.smooth_texture.texture_sigma must be >= 0, got {}",
-                          smooth_texture.texture_sigma));
-  CheckOption(histogram.bins >= 2 && histogram.bins <= 256,
-              fmt::format("AcceptanceOptions.histogram.bins must be in [2, 256], got {}", histogram.bins));
-  CheckOption(band_px >= 0, fmt::format("AcceptanceOptions.band_px must be >= 0, got {}", band_px));
-  CheckOption(auto_accept_hole_fraction >= 0.0 && auto_accept_hole_fraction <= 1.0,
-              fmt::format("AcceptanceOptions.auto_accept_hole_fraction must be in [0, 1], got {}",
-                          auto_accept_hole_fraction));
-  CheckOption(min_region_pixels >= 1,
-              fmt::format("AcceptanceOptions.min_region_pixels must be >= 1, got {}", min_region_pixels));
-}
+void AcceptanceOptions::Check() const { Validate(*this); }
 
 AcceptanceOptions AcceptanceOptions::Combined() {
   AcceptanceOptions options;

@@ -19,6 +19,7 @@
 
 #include "lidarshop/inpaint/canvas.h"
 #include "lidarshop/inpaint/search.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -142,6 +143,21 @@ struct AcceptanceOptions {
   // histograms and smooth-versus-textured, on a 2-pixel band.
   static AcceptanceOptions Combined();
 };
+
+template <>
+const EnumInfo& EnumInfoOf<HistogramRange>();
+template <>
+const EnumInfo& EnumInfoOf<HistogramMetric>();
+template <>
+const StructInfo& InfoOf<MeanTestOptions>();
+template <>
+const StructInfo& InfoOf<RepresentativeTestOptions>();
+template <>
+const StructInfo& InfoOf<HistogramTestOptions>();
+template <>
+const StructInfo& InfoOf<SmoothTextureTestOptions>();
+template <>
+const StructInfo& InfoOf<AcceptanceOptions>();
 
 // All enabled tests of `options`, combined with AND. Initialize() must be called with the canvas first.
 class CombinedAcceptance : public PatchAcceptance {

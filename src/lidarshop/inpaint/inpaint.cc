@@ -4,40 +4,11 @@
 
 #include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void InpaintOptions::Check() const {
-  CheckOption(patch_radius >= 1 && patch_radius <= 64,
-              fmt::format("InpaintOptions.patch_radius must be in [1, 64], got {}", patch_radius));
-  for (float w : channel_weights) {
-    CheckOption(std::isfinite(w) && w >= 0.0f,
-                fmt::format("InpaintOptions.channel_weights must be >= 0, got {}", w));
-  }
-  CheckOption(normal_sigma > 0.0 && normal_sigma <= 50.0,
-              fmt::format("InpaintOptions.normal_sigma must be in (0, 50], got {}", normal_sigma));
-  CheckOption(alpha > 0.0, fmt::format("InpaintOptions.alpha must be > 0, got {}", alpha));
-  CheckOption(data_floor >= 0.0, fmt::format("InpaintOptions.data_floor must be >= 0, got {}", data_floor));
-  CheckOption(local_window_radius >= 1,
-              fmt::format("InpaintOptions.local_window_radius must be >= 1, got {}", local_window_radius));
-  CheckOption(global_gain >= 1.0,
-              fmt::format("InpaintOptions.global_gain must be >= 1, got {}", global_gain));
-  CheckOption(patchmatch_random_samples >= 1,
-              fmt::format("InpaintOptions.patchmatch_random_samples must be >= 1, got {}",
-                          patchmatch_random_samples));
-  CheckOption(
-      patchmatch_iterations >= 0,
-      fmt::format("InpaintOptions.patchmatch_iterations must be >= 0, got {}", patchmatch_iterations));
-  CheckOption(
-      acceptance_candidates >= 1,
-      fmt::format("InpaintOptions.acceptance_candidates must be >= 1, got {}", acceptance_candidates));
-  acceptance.Check();
-  CheckOption(lookahead >= 1, fmt::format("InpaintOptions.lookahead must be >= 1, got {}", lookahead));
-  CheckOption(review_candidates >= 1,
-              fmt::format("InpaintOptions.review_candidates must be >= 1, got {}", review_candidates));
-  CheckOption(review_cluster_rms >= 0.0,
-              fmt::format("InpaintOptions.review_cluster_rms must be >= 0, got {}", review_cluster_rms));
-}
+void InpaintOptions::Check() const { Validate(*this); }
 
 std::unique_ptr<PatchPriority> MakePriority(const InpaintOptions& options) {
   switch (options.priority) {

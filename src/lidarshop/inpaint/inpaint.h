@@ -30,6 +30,7 @@
 #include "lidarshop/inpaint/priority.h"
 #include "lidarshop/inpaint/review.h"
 #include "lidarshop/inpaint/search.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -78,6 +79,13 @@ struct InpaintOptions {
   bool check_bookkeeping = false;
   void Check() const;  // throws OptionsError
 };
+
+template <>
+const EnumInfo& EnumInfoOf<InpaintPriorityKind>();
+template <>
+const EnumInfo& EnumInfoOf<InpaintSearchKind>();
+template <>
+const StructInfo& InfoOf<InpaintOptions>();
 
 // The pluggable parts; any left null is made from InpaintOptions.
 struct InpaintStrategies {

@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/poisson/multigrid.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/poisson/operators.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
@@ -20,43 +21,7 @@ namespace lidarshop {
 
 using poisson_internal::MaskedMultigrid;
 
-const char* ToString(PoissonSolverKind kind) {
-  switch (kind) {
-    case PoissonSolverKind::kAuto:
-      return "auto";
-    case PoissonSolverKind::kDirect:
-      return "direct";
-    case PoissonSolverKind::kMultigrid:
-      return "multigrid";
-  }
-  return "?";
-}
-
-const char* ToString(PoissonDirectBackend backend) {
-  switch (backend) {
-    case PoissonDirectBackend::kCholmod:
-      return "cholmod";
-    case PoissonDirectBackend::kEigenLdlt:
-      return "eigen-ldlt";
-  }
-  return "?";
-}
-
-void PoissonOptions::Check() const {
-  CheckOption(
-      auto_direct_max_unknowns >= 0,
-      fmt::format("PoissonOptions.auto_direct_max_unknowns must be >= 0, got {}", auto_direct_max_unknowns));
-  CheckOption(tolerance > 0.0 && tolerance < 1.0,
-              fmt::format("PoissonOptions.tolerance must be in (0, 1), got {}", tolerance));
-  CheckOption(max_iterations >= 1,
-              fmt::format("PoissonOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(smoothing_sweeps >= 1,
-              fmt::format("PoissonOptions.smoothing_sweeps must be >= 1, got {}", smoothing_sweeps));
-  CheckOption(
-      coarsest_max_unknowns >= 1,
-      fmt::format("PoissonOptions.coarsest_max_unknowns must be >= 1, got {}", coarsest_max_unknowns));
-  CheckOption(max_levels >= 1, fmt::format("PoissonOptions.max_levels must be >= 1, got {}", max_levels));
-}
+void PoissonOptions::Check() const { Validate(*this); }
 
 namespace {
 

@@ -41,6 +41,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/util/options_fwd.h"
+
 namespace lidarshop {
 
 enum class PoissonSolverKind {
@@ -54,8 +56,10 @@ enum class PoissonDirectBackend {
   kEigenLdlt,  // Eigen::SimplicialLDLT (for comparison; slower on large systems)
 };
 
-const char* ToString(PoissonSolverKind kind);
-const char* ToString(PoissonDirectBackend backend);
+template <>
+const EnumInfo& EnumInfoOf<PoissonSolverKind>();
+template <>
+const EnumInfo& EnumInfoOf<PoissonDirectBackend>();
 
 struct PoissonOptions {
   PoissonSolverKind solver = PoissonSolverKind::kAuto;
@@ -73,6 +77,9 @@ struct PoissonOptions {
   // Throws OptionsError naming the field when a value is out of range.
   void Check() const;
 };
+
+template <>
+const StructInfo& InfoOf<PoissonOptions>();
 
 // A prepared Poisson system: the domain of one mask and its factorization or multigrid hierarchy. Cheap to
 // copy (shared, immutable), safe to use from several threads at once.

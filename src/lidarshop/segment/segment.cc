@@ -15,90 +15,13 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/timer.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-std::string ToString(SegmentMethod method) {
-  switch (method) {
-    case SegmentMethod::kTwoStep:
-      return "two-step";
-    case SegmentMethod::kDepth:
-      return "depth";
-    case SegmentMethod::kColor:
-      return "color";
-    case SegmentMethod::kRgbd:
-      return "rgbd";
-  }
-  return "?";
-}
+void CutWeights::Check() const { Validate(*this); }
 
-SegmentMethod ParseSegmentMethod(const std::string& name) {
-  if (name == "two-step") return SegmentMethod::kTwoStep;
-  if (name == "depth") return SegmentMethod::kDepth;
-  if (name == "color" || name == "colour") return SegmentMethod::kColor;
-  if (name == "rgbd") return SegmentMethod::kRgbd;
-  throw OptionsError(fmt::format("segment method must be two-step, depth, color or rgbd, got '{}'", name));
-}
-
-std::string ToString(AppearanceModel model) { return model == AppearanceModel::kGmm ? "gmm" : "histogram"; }
-
-AppearanceModel ParseAppearanceModel(const std::string& name) {
-  if (name == "histogram") return AppearanceModel::kHistogram;
-  if (name == "gmm") return AppearanceModel::kGmm;
-  throw OptionsError(fmt::format("segment appearance model must be histogram or gmm, got '{}'", name));
-}
-
-void CutWeights::Check(const std::string& name) const {
-  auto non_negative = [&](double value, const char* field) {
-    CheckOption(std::isfinite(value) && value >= 0,
-                fmt::format("SegmentOptions.{}.{} must be finite and >= 0, got {}", name, field, value));
-  };
-  non_negative(lambda_r, "lambda_r");
-  non_negative(lambda_g, "lambda_g");
-  non_negative(lambda_b, "lambda_b");
-  non_negative(lambda_d, "lambda_d");
-  non_negative(smoothness, "smoothness");
-  non_negative(color_data_weight, "color_data_weight");
-  non_negative(depth_data_weight, "depth_data_weight");
-  CheckOption(lambda_r + lambda_g + lambda_b + lambda_d > 0,
-              fmt::format("SegmentOptions.{}: at least one channel weight lambda must be > 0", name));
-  CheckOption(std::isfinite(foreground_bias),
-              fmt::format("SegmentOptions.{}.foreground_bias must be finite, got {}", name, foreground_bias));
-}
-
-void SegmentOptions::Check() const {
-  depth_step.Check("depth_step");
-  color_step.Check("color_step");
-  rgbd_step.Check("rgbd_step");
-  CheckOption(std::isfinite(sigma_scale) && sigma_scale > 0,
-              fmt::format("SegmentOptions.sigma_scale must be > 0, got {}", sigma_scale));
-  CheckOption(ring_radius_cells >= 1 && ring_radius_cells <= 64,
-              fmt::format("SegmentOptions.ring_radius_cells must be in [1, 64], got {}", ring_radius_cells));
-  CheckOption(
-      std::isfinite(ring_depth_threshold_m) && ring_depth_threshold_m >= 0,
-      fmt::format("SegmentOptions.ring_depth_threshold_m must be >= 0, got {}", ring_depth_threshold_m));
-  CheckOption(std::isfinite(ring_depth_threshold_fraction) && ring_depth_threshold_fraction >= 0,
-              fmt::format("SegmentOptions.ring_depth_threshold_fraction must be >= 0, got {}",
-                          ring_depth_threshold_fraction));
-  CheckOption(roi_margin_cells >= 0,
-              fmt::format("SegmentOptions.roi_margin_cells must be >= 0, got {}", roi_margin_cells));
-  CheckOption(std::isfinite(roi_margin_fraction) && roi_margin_fraction >= 0,
-              fmt::format("SegmentOptions.roi_margin_fraction must be >= 0, got {}", roi_margin_fraction));
-  CheckOption(color_bins >= 2 && color_bins <= 64,
-              fmt::format("SegmentOptions.color_bins must be in [2, 64], got {}", color_bins));
-  CheckOption(std::isfinite(depth_bin_m) && depth_bin_m > 0,
-              fmt::format("SegmentOptions.depth_bin_m must be > 0, got {}", depth_bin_m));
-  CheckOption(std::isfinite(depth_smoothing_m) && depth_smoothing_m >= 0,
-              fmt::format("SegmentOptions.depth_smoothing_m must be >= 0, got {}", depth_smoothing_m));
-  CheckOption(gmm_components >= 1 && gmm_components <= 32,
-              fmt::format("SegmentOptions.gmm_components must be in [1, 32], got {}", gmm_components));
-  CheckOption(gmm_iterations >= 0 && gmm_iterations <= 1000,
-              fmt::format("SegmentOptions.gmm_iterations must be in [0, 1000], got {}", gmm_iterations));
-  CheckOption(object_uniform > 0 && object_uniform < 1,
-              fmt::format("SegmentOptions.object_uniform must be in (0, 1), got {}", object_uniform));
-  CheckOption(background_uniform > 0 && background_uniform < 1,
-              fmt::format("SegmentOptions.background_uniform must be in (0, 1), got {}", background_uniform));
-}
+void SegmentOptions::Check() const { Validate(*this); }
 
 std::string SegmentResult::Summary() const {
   return fmt::format(

@@ -44,6 +44,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -52,14 +53,13 @@ constexpr uint8_t kStrokeNone = 0;
 constexpr uint8_t kStrokeObject = 1;
 constexpr uint8_t kStrokeBackground = 2;
 
+// Names (util/enum_names.h): "two-step", "depth", "color", "rgbd".
 enum class SegmentMethod { kTwoStep, kDepth, kColor, kRgbd };
-// "two-step", "depth", "color", "rgbd"; the parser throws OptionsError for anything else.
-std::string ToString(SegmentMethod method);
-SegmentMethod ParseSegmentMethod(const std::string& name);
-
-enum class AppearanceModel { kHistogram, kGmm };
-std::string ToString(AppearanceModel model);
-AppearanceModel ParseAppearanceModel(const std::string& name);
+enum class AppearanceModel { kHistogram, kGmm };  // "histogram", "gmm"
+template <>
+const EnumInfo& EnumInfoOf<SegmentMethod>();
+template <>
+const EnumInfo& EnumInfoOf<AppearanceModel>();
 
 // The weights of one graph cut. All dimensionless (the channels are standardized; costs are in nats).
 struct CutWeights {
@@ -76,8 +76,10 @@ struct CutWeights {
   // edges) instead of the mean (GrabCut's β); floored at 1% of the mean.
   bool median_sigma = false;
 
-  void Check(const std::string& name) const;  // throws OptionsError naming `name`
+  void Check() const;  // throws OptionsFieldError naming the field
 };
+template <>
+const StructInfo& InfoOf<CutWeights>();
 
 struct SegmentOptions {
   SegmentMethod method = SegmentMethod::kTwoStep;
@@ -125,8 +127,10 @@ struct SegmentOptions {
   // but an object stroke on a missed part then adds little more than the stroke itself).
   bool refine_relearn_models = true;
 
-  void Check() const;
+  void Check() const;  // throws OptionsFieldError naming the field
 };
+template <>
+const StructInfo& InfoOf<SegmentOptions>();
 
 struct SegmentTimings {
   double features_s = 0, models_s = 0, graph_s = 0, maxflow_s = 0, total_s = 0;  // seconds

@@ -227,8 +227,8 @@ TEST(SegmentTest, BadStrokesAndOptionsAreRejected) {
   options = SegmentOptions();
   options.depth_step.smoothness = -1;
   EXPECT_THROW(options.Check(), OptionsError);
-  EXPECT_THROW(ParseSegmentMethod("magic"), OptionsError);
-  EXPECT_EQ(ParseSegmentMethod("two-step"), SegmentMethod::kTwoStep);
+  EXPECT_THROW(ParseEnum<SegmentMethod>("magic"), OptionsError);
+  EXPECT_EQ(ParseEnum<SegmentMethod>("two-step"), SegmentMethod::kTwoStep);
 }
 
 TEST(SegmentTest, ScoreMaskCounts) {

@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
       FillOptions options = base;
       // "gradient-range": the thesis's variant, range gradients matched and copied (no inverse range).
       options.method =
-          ParseFillMethod(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
+          ParseEnum<FillMethod>(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
       if (name == "gradient-range") options.inverse_range = false;
       // "gradient-plain": without the acceptance tests of inpaint/acceptance.h (the best patch difference
       // wins).

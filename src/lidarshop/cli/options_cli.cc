@@ -1,0 +1,189 @@
+#include "lidarshop/cli/options_cli.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+namespace lidarshop::cli {
+
+namespace {
+
+std::string DefaultFlag(const std::string& key_path) {
+  std::string flag = "--" + key_path;
+  std::replace(flag.begin(), flag.end(), '_', '-');
+  std::replace(flag.begin(), flag.end(), '.', '-');
+  return flag;
+}
+
+// The long name a user types, from CLI11 names like "-r,--radius".
+std::string LongName(const std::string& names) {
+  std::string best;
+  size_t start = 0;
+  while (start <= names.size()) {
+    const size_t end = std::min(names.find(',', start), names.size());
+    const std::string name = names.substr(start, end - start);
+    if (best.empty() || name.rfind("--", 0) == 0) best = name;
+    start = end + 1;
+  }
+  return best;
+}
+
+// The field at `key_path` ("poisson.solver") of `info`, and the address of its struct inside `object`.
+const FieldInfo* FindPath(const StructInfo& info, void* object, const std::string& key_path, void** owner) {
+  const size_t dot = key_path.find('.');
+  const FieldInfo* field = info.Find(key_path.substr(0, dot));
+  if (field == nullptr) return nullptr;
+  if (dot == std::string::npos) {
+    *owner = object;
+    return field;
+  }
+  if (field->kind != FieldKind::kStruct) return nullptr;
+  return FindPath(*field->nested, field->nested_of(object), key_path.substr(dot + 1), owner);
+}
+
+std::string HelpText(const FieldInfo& field) {
+  std::string help = field.doc;
+  std::vector<std::string> notes;
+  if (!field.unit.empty()) notes.push_back(field.unit);
+  if (!field.RangeText().empty()) notes.push_back(field.RangeText());
+  if (!notes.empty()) help += fmt::format(" ({})", fmt::join(notes, ", "));
+  return help;
+}
+
+std::string TypeName(const FieldInfo& field) {
+  switch (field.kind) {
+    case FieldKind::kEnum:
+      return field.choices->NamesText();
+    case FieldKind::kInt:
+    case FieldKind::kUInt64:
+      return "INT";
+    case FieldKind::kDouble:
+      return "NUMBER";
+    case FieldKind::kNumberList:
+      return "N,N,...";
+    default:
+      return "TEXT";
+  }
+}
+
+}  // namespace
+
+nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
+  switch (field.kind) {
+    case FieldKind::kInt: {
+      int64_t value = 0;
+      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+      if (error != std::errc() || end != text.data() + text.size() || text.empty()) {
+        throw OptionsError(fmt::format("'{}' is not a whole number", text));
+      }
+      return value;
+    }
+    case FieldKind::kUInt64: {
+      uint64_t value = 0;
+      const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+      if (error != std::errc() || end != text.data() + text.size() || text.empty()) {
+        throw OptionsError(fmt::format("'{}' is not a whole number >= 0", text));
+      }
+      return value;
+    }
+    case FieldKind::kDouble: {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(value)) {
+        throw OptionsError(fmt::format("'{}' is not a finite number", text));
+      }
+      return value;
+    }
+    case FieldKind::kBool:
+      if (text == "true" || text == "1" || text == "on") return true;
+      if (text == "false" || text == "0" || text == "off") return false;
+      throw OptionsError(fmt::format("'{}' is not true or false", text));
+    case FieldKind::kEnum:
+    case FieldKind::kString:
+      return text;
+    case FieldKind::kNumberList: {
+      nlohmann::json list = nlohmann::json::array();
+      size_t start = 0;
+      while (start <= text.size()) {
+        const size_t end = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, end - start);
+        char* item_end = nullptr;
+        const double value = std::strtod(item.c_str(), &item_end);
+        if (item.empty() || item_end != item.c_str() + item.size() || !std::isfinite(value)) {
+          throw OptionsError(fmt::format("'{}' is not a comma-separated list of numbers", text));
+        }
+        list.push_back(value);
+        start = end + 1;
+      }
+      return list;
+    }
+    case FieldKind::kStruct:
+      break;
+  }
+  throw OptionsError("a group of options has no flag of its own");
+}
+
+void OptionBinder::BindStruct(const StructInfo& info, void* object, const BindSettings& settings) {
+  std::vector<std::string> keys = settings.keys;
+  if (keys.empty()) {
+    for (const FieldInfo& field : info.fields) {
+      const bool skipped =
+          std::find(settings.skip.begin(), settings.skip.end(), field.key) != settings.skip.end();
+      if (field.kind != FieldKind::kStruct && !skipped) keys.push_back(field.key);
+    }
+  }
+  for (const std::string& key_path : keys) {
+    void* owner = nullptr;
+    const FieldInfo* field = FindPath(info, object, key_path, &owner);
+    LIDARSHOP_CHECK(field != nullptr && field->kind != FieldKind::kStruct);
+    BindField(*field, owner, key_path, settings);
+  }
+}
+
+void OptionBinder::BindField(const FieldInfo& field, void* object, const std::string& key_path,
+                             const BindSettings& settings) {
+  const auto renamed = settings.flags.find(key_path);
+  const std::string names = renamed != settings.flags.end() ? renamed->second : DefaultFlag(key_path);
+  const std::string flag = LongName(names);
+  flag_of_key_[key_path] = flag;
+  const FieldInfo* info = &field;
+  const auto set = [info, object, flag](const std::string& text) {
+    try {
+      const nlohmann::json value = ParseFlagValue(*info, text);
+      info->CheckValue(value);
+      info->set(object, value);
+    } catch (const OptionsError& error) {
+      throw CLI::ValidationError(flag, error.what());
+    }
+  };
+  CLI::Option* option = nullptr;
+  if (field.kind == FieldKind::kBool) {
+    // --name sets true, --no-name false: a default of either kind can be turned around.
+    const std::string negated = "--no-" + flag.substr(2);
+    const bool initially = field.get(object).get<bool>();
+    option = app_.add_flag_callback(
+        names, [set] { set("true"); }, HelpText(field) + (initially ? " (the default)" : ""));
+    CLI::Option* off = app_.add_flag_callback(
+        negated, [set] { set("false"); },
+        fmt::format("turn {} off{}", flag, initially ? "" : " (the default)"));
+    if (!settings.group.empty()) off->group(settings.group);
+  } else {
+    option = app_.add_option_function<std::string>(names, set, HelpText(field));
+    option->type_name(TypeName(field))->default_str(ValueText(field.get(object)));
+  }
+  if (!settings.group.empty()) option->group(settings.group);
+}
+
+std::string OptionBinder::FlagOf(const std::string& key_path) const {
+  const auto found = flag_of_key_.find(key_path);
+  return found != flag_of_key_.end() ? found->second : key_path;
+}
+
+OptionsError OptionBinder::Reworded(const OptionsFieldError& error) const {
+  return OptionsError(fmt::format("{}: {}", FlagOf(error.key_path()), error.reason()));
+}
+
+}  // namespace lidarshop::cli

@@ -1,0 +1,66 @@
+// Command-line flags generated from the library's option descriptions (util/options.h), so that a flag's name,
+// help, default, unit, range and choices come from one place, and a bad value is worded with the flag the user
+// typed ("--patch-radius: 0 is out of range [1, 32]"), never with a struct's name.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/util/options.h"
+
+namespace lidarshop::cli {
+
+// How a command shows the fields of one options struct.
+struct BindSettings {
+  // Keys to bind: "patch_radius", "poisson.solver" (a nested field). Empty = every non-struct top-level field.
+  std::vector<std::string> keys;
+  std::vector<std::string> skip;  // keys left out of the default set
+  // Flag names for keys whose flag is a contract of the command ("search_window_radius" -> "--window");
+  // CLI11 syntax, so "-r,--radius" gives a short name too. Others are "--" + key with '-' for '_' and '.'.
+  std::map<std::string, std::string> flags;
+  std::string group;  // help section; "" = the command's options
+};
+
+// Binds option structs to one command's CLI11 app, remembers which flag sets which key, and rewords
+// OptionsFieldError with those flags.
+class OptionBinder {
+ public:
+  explicit OptionBinder(CLI::App& app) : app_(app) {}
+
+  template <class S>
+  void Bind(S* options, const BindSettings& settings = {}) {
+    BindStruct(InfoOf<S>(), options, settings);
+  }
+
+  // Validates `options` against its description and cross-field checks, naming the flag on failure.
+  template <class S>
+  void Validate(const S& options) const {
+    try {
+      lidarshop::Validate(options);
+    } catch (const OptionsFieldError& error) {
+      throw Reworded(error);
+    }
+  }
+
+  // "--patch-radius" for "patch_radius" when bound, else the key path itself.
+  std::string FlagOf(const std::string& key_path) const;
+  // The error with the flag the user typed in place of the key path.
+  OptionsError Reworded(const OptionsFieldError& error) const;
+
+ private:
+  void BindStruct(const StructInfo& info, void* object, const BindSettings& settings);
+  void BindField(const FieldInfo& field, void* object, const std::string& key_path,
+                 const BindSettings& settings);
+
+  CLI::App& app_;
+  std::map<std::string, std::string> flag_of_key_;
+};
+
+// Converts the text of a flag to the JSON value of a field of this kind (strict: "4x", "1e400", "yes" fail).
+nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text);
+
+}  // namespace lidarshop::cli

@@ -1,0 +1,118 @@
+// Descriptions of the hole-filling options and enums (util/options.h).
+#include "lidarshop/fill/fill.h"
+#include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/fill/remove.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<FillMethod>() {
+  static const EnumInfo info = MakeEnumInfo<FillMethod>(
+      "fill method",
+      {{FillMethod::kGradient, "gradient", "range gradients inpainted by patches, then Poisson"},
+       {FillMethod::kLaplace, "laplace", "membrane (Laplace) fill of range and colour"},
+       {FillMethod::kDepthPatch, "depth-patch", "patches of the range itself (the thesis's failure)"},
+       {FillMethod::kTelea, "telea", "OpenCV fast-marching inpainting of range and colour"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FillOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillOptions> b("FillOptions", "hole filling in scans");
+    b.Field(&FillOptions::method, "method", "fill method");
+    b.Field(&FillOptions::patch_radius, "patch_radius", "patch half-width; patches are 2r+1 wide")
+        .Unit("cells")
+        .Range(1, 15);
+    b.Field(&FillOptions::priority, "priority", "fill order of the patch methods");
+    b.Field(&FillOptions::search, "search", "source search of the patch methods");
+    b.Field(&FillOptions::search_window_radius, "search_window_radius",
+            "half-width of the local source search (and PatchMatch's near samples)")
+        .Unit("cells")
+        .Min(1);
+    b.Field(&FillOptions::patchmatch_random_samples, "patchmatch_random_samples",
+            "PatchMatch: uniform draws over the scan per query")
+        .Range(1, 100000);
+    b.Field(&FillOptions::patchmatch_iterations, "patchmatch_iterations",
+            "PatchMatch: propagation + random-search rounds per query")
+        .Range(1, 100);
+    b.Field(&FillOptions::acceptance, "acceptance", "patch acceptance tests (the combined set by default)");
+    b.Field(&FillOptions::acceptance_local_first, "acceptance_local_first",
+            "with acceptance: search the local window exhaustively before the whole scan");
+    b.Field(&FillOptions::color_weight, "color_weight", "patch difference weight of each colour channel")
+        .Min(0);
+    b.Field(&FillOptions::gradient_weight, "gradient_weight",
+            "patch difference weight of each range-gradient channel")
+        .Min(0);
+    b.Field(&FillOptions::return_weight, "return_weight", "patch difference weight of the has-return channel")
+        .Min(0);
+    b.Field(&FillOptions::inverse_range, "inverse_range",
+            "copy the gradients of 1/range (slowly varying on planes)");
+    b.Field(
+         &FillOptions::depth_jump_ratio, "depth_jump_ratio",
+         "an edge whose ranges differ by more than this times the nearer one is a silhouette; 0 = never cut")
+        .Min(0);
+    b.Field(&FillOptions::telea_radius_cells, "telea_radius_cells",
+            "telea: neighbourhood of the fast marching")
+        .Unit("cells")
+        .AboveZero();
+    b.Field(&FillOptions::poisson, "poisson", "range reconstruction");
+    b.Field(&FillOptions::seed, "seed", "seed of the patch fill's random choices");
+    b.Check([](const FillOptions& o) {
+      if (o.search_window_radius < o.patch_radius) {
+        throw OptionsFieldError("search_window_radius", fmt::format("{} is less than the patch radius {}",
+                                                                    o.search_window_radius, o.patch_radius));
+      }
+      if (o.color_weight + o.gradient_weight + o.return_weight <= 0) {
+        throw OptionsFieldError("color_weight", "one of the colour, gradient and return weights must be > 0");
+      }
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RemoveOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RemoveOptions> b("RemoveOptions", "remove an object: cut it out, fill behind it");
+    b.Field(&RemoveOptions::segment, "segment", "the cut");
+    b.Field(&RemoveOptions::fill, "fill", "the fill of the hole");
+    b.Field(&RemoveOptions::margin_cells, "margin_cells", "the object's mask is grown by this on every side")
+        .Unit("cells")
+        .Range(0, 100);
+    b.Field(&RemoveOptions::keep_object, "keep_object",
+            "keep the object; the fill becomes a second layer behind it");
+    b.Field(&RemoveOptions::fill_enclosed_no_return, "fill_enclosed_no_return",
+            "fill the cells without a return enclosed by the object");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FillMetricsOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillMetricsOptions> b("FillMetricsOptions", "quality of a fill against ground truth");
+    b.Field(&FillMetricsOptions::within_m, "within_m", "tolerance of the 'within' share")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&FillMetricsOptions::floating_m, "floating_m",
+            "a filled point farther than this from the truth floats")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&FillMetricsOptions::normal_window_radius, "normal_window_radius",
+            "plane-fit window of the normals")
+        .Unit("cells")
+        .Range(1, 10);
+    b.Field(&FillMetricsOptions::seam_band_cells, "seam_band_cells",
+            "band outside the hole for the reference jump")
+        .Unit("cells")
+        .Range(1, 100);
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,107 @@
+// Descriptions of the segmentation options and enums (util/options.h).
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<SegmentMethod>() {
+  static const EnumInfo info = MakeEnumInfo<SegmentMethod>(
+      "segmentation method",
+      {{SegmentMethod::kTwoStep, "two-step", "depth cut, background inference, colour cut"},
+       {SegmentMethod::kDepth, "depth", "one range-dominant cut"},
+       {SegmentMethod::kColor, "color", "one colour-dominant cut"},
+       {SegmentMethod::kRgbd, "rgbd", "one cut with standardized RGB + range weights"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<AppearanceModel>() {
+  static const EnumInfo info = MakeEnumInfo<AppearanceModel>(
+      "appearance model", {{AppearanceModel::kHistogram, "histogram", "colour and range histograms"},
+                           {AppearanceModel::kGmm, "gmm", "Gaussian mixtures (colour 3-D, range 1-D)"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<CutWeights>() {
+  static const StructInfo info = [] {
+    StructBuilder<CutWeights> b("CutWeights", "weights of one graph cut (dimensionless)");
+    b.Field(&CutWeights::lambda_r, "lambda_r", "n-link weight of red").Min(0);
+    b.Field(&CutWeights::lambda_g, "lambda_g", "n-link weight of green").Min(0);
+    b.Field(&CutWeights::lambda_b, "lambda_b", "n-link weight of blue").Min(0);
+    b.Field(&CutWeights::lambda_d, "lambda_d", "n-link weight of range").Min(0);
+    b.Field(&CutWeights::smoothness, "smoothness", "n-link weight relative to the data term (gamma)").Min(0);
+    b.Field(&CutWeights::color_data_weight, "color_data_weight", "weight of -log P(rgb) in the data term")
+        .Min(0);
+    b.Field(&CutWeights::depth_data_weight, "depth_data_weight", "weight of -log P(range) in the data term")
+        .Min(0);
+    b.Field(&CutWeights::foreground_bias, "foreground_bias",
+            "added to the object cost of every non-stroke cell")
+        .Unit("nats");
+    b.Field(&CutWeights::median_sigma, "median_sigma",
+            "sigma^2 from the median n-link difference, not the mean");
+    b.Check([](const CutWeights& w) {
+      if (w.lambda_r + w.lambda_g + w.lambda_b + w.lambda_d <= 0) {
+        throw OptionsFieldError("lambda_d", "at least one channel weight lambda must be > 0");
+      }
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SegmentOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<SegmentOptions> b("SegmentOptions", "two-step RGB + depth graph cuts");
+    b.Field(&SegmentOptions::method, "method", "segmentation method");
+    b.Field(&SegmentOptions::model, "model", "appearance model");
+    b.Field(&SegmentOptions::eight_connected, "eight_connected", "8-neighbour n-links instead of 4");
+    b.Field(&SegmentOptions::sigma_scale, "sigma_scale", "sigma^2 = sigma_scale^2 x mean n-link difference")
+        .AboveZero();
+    b.Field(&SegmentOptions::depth_step, "depth_step", "step 1 / the depth baseline");
+    b.Field(&SegmentOptions::color_step, "color_step", "step 3 / the colour baseline");
+    b.Field(&SegmentOptions::rgbd_step, "rgbd_step", "the rgbd baseline");
+    b.Field(&SegmentOptions::ring_radius_cells, "ring_radius_cells", "step 2: dilation of the step-1 object")
+        .Unit("cells")
+        .Range(1, 64);
+    b.Field(&SegmentOptions::ring_depth_threshold_m, "ring_depth_threshold_m",
+            "step 2: a ring cell farther than this from the object is background")
+        .Unit("m")
+        .Min(0);
+    b.Field(&SegmentOptions::ring_depth_threshold_fraction, "ring_depth_threshold_fraction",
+            "step 2: plus this fraction of its range")
+        .Min(0);
+    b.Field(&SegmentOptions::roi_margin_cells, "roi_margin_cells",
+            "step 3 region of interest margin; 0 = whole image")
+        .Unit("cells")
+        .Min(0);
+    b.Field(&SegmentOptions::roi_margin_fraction, "roi_margin_fraction",
+            "step 3 margin as a fraction of the object box's larger side")
+        .Min(0);
+    b.Field(&SegmentOptions::color_bins, "color_bins", "histogram bins per colour channel").Range(2, 64);
+    b.Field(&SegmentOptions::depth_bin_m, "depth_bin_m", "range histogram bin width").Unit("m").AboveZero();
+    b.Field(&SegmentOptions::depth_smoothing_m, "depth_smoothing_m",
+            "Gaussian smoothing of the range histogram")
+        .Unit("m")
+        .Min(0);
+    b.Field(&SegmentOptions::gmm_components, "gmm_components", "Gaussians per mixture").Range(1, 32);
+    b.Field(&SegmentOptions::gmm_iterations, "gmm_iterations", "EM iterations").Range(0, 1000);
+    b.Field(&SegmentOptions::seed, "seed", "seed of the mixtures' k-means++ initialisation");
+    b.Field(&SegmentOptions::object_uniform, "object_uniform",
+            "weight of the uniform density in the object model")
+        .AboveZero()
+        .Below(1);
+    b.Field(&SegmentOptions::background_uniform, "background_uniform",
+            "weight of the uniform density in the background model")
+        .AboveZero()
+        .Below(1);
+    b.Field(&SegmentOptions::refine_relearn_models, "refine_relearn_models",
+            "refinement re-learns the appearance models from every hard cell");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

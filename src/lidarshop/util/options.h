@@ -1,0 +1,224 @@
+// One description per options struct: for each field its JSON key, kind, default, unit, one-line doc and valid
+// range. Every front end is generated from it — the CLI flags and their help (cli/options_cli.h), JSON
+// (ToJson / FromJson below), the HTTP API and the Python objects — so a field is documented and checked once.
+//
+// A module describes its structs in a `<module>/options_info.cc`:
+//
+//   template <>
+//   const StructInfo& InfoOf<FillOptions>() {
+//     static const StructInfo info = [] {
+//       StructBuilder<FillOptions> b("FillOptions", "hole filling in scans");
+//       b.Field(&FillOptions::patch_radius, "patch_radius", "patch half-width").Unit("cells").Range(1, 32);
+//       b.Field(&FillOptions::method, "method", "fill method");  // an enum: its names come from EnumInfoOf
+//       return b.Build();
+//     }();
+//     return info;
+//   }
+//
+// and declares `template <> const StructInfo& InfoOf<FillOptions>();` next to the struct. Enums are described
+// the same way by `EnumInfoOf<E>()` (util/enum_names.h), and convert to and from strings only through it.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/util/enum_names.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options_fwd.h"
+
+namespace lidarshop {
+
+// kNumberList: a std::vector of numbers (per-channel weights); the range applies to every element.
+enum class FieldKind { kBool, kInt, kUInt64, kDouble, kString, kEnum, kStruct, kNumberList };
+
+template <class T>
+struct IsVector : std::false_type {};
+template <class T>
+struct IsVector<std::vector<T>> : std::true_type {};
+
+struct StructInfo;
+
+struct FieldInfo {
+  std::string
+      key;  // JSON key, snake_case; the CLI flag is --key with '-' for '_' unless a command renames it
+  FieldKind kind = FieldKind::kInt;
+  std::string doc;                 // one line, no trailing period
+  std::string unit;                // "cells", "m", "deg", "px", "" for a pure number
+  std::optional<double> min, max;  // valid range, inclusive unless the *_exclusive flag says otherwise
+  bool min_exclusive = false, max_exclusive = false;
+  int64_t integer_low = INT64_MIN, integer_high = INT64_MAX;  // kInt: the C++ type's limits
+  const EnumInfo* choices = nullptr;                          // kEnum
+  const StructInfo* nested = nullptr;                         // kStruct
+  // Type-erased access to the field of a struct instance (`void*` = the struct described by the owner).
+  std::function<nlohmann::ordered_json(const void*)> get;
+  std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
+  std::function<void*(void*)> nested_of;                  // kStruct: the member's address
+
+  FieldInfo& Unit(std::string unit_name);
+  FieldInfo& Range(double low, double high);
+  FieldInfo& Min(double low);
+  FieldInfo& Max(double high);
+  FieldInfo& AboveZero();         // > 0
+  FieldInfo& Below(double high);  // < high
+  // "[1, 32]", "> 0", "[0, 1)" or "" when unbounded.
+  std::string RangeText() const;
+  // Throws OptionsError with a reason (no key) unless `value` is of this field's kind and inside its range.
+  void CheckValue(const nlohmann::json& value) const;
+  void CheckRange(double number, const std::string& text) const;
+};
+
+struct StructInfo {
+  std::string name;  // the C++ struct, e.g. "FillOptions" (for documentation, never in user messages)
+  std::string doc;
+  std::vector<FieldInfo> fields;
+  // Cross-field checks after every field is set (e.g. min < max); throws OptionsError. May be empty.
+  std::function<void(const void*)> check;
+  const FieldInfo* Find(std::string_view key) const;
+  std::vector<std::string> Keys() const;
+};
+
+// An option with a bad value, found by key: `key_path` is the JSON path ("acceptance.band_px"), `reason` what
+// is wrong ("0 is out of range [1, 64]"). what() is "key_path: reason"; the CLI words it with the flag instead.
+class OptionsFieldError : public OptionsError {
+ public:
+  OptionsFieldError(std::string key_path, std::string reason);
+  const std::string& key_path() const { return key_path_; }
+  const std::string& reason() const { return reason_; }
+
+ private:
+  std::string key_path_, reason_;
+};
+
+// The JSON form of `object` under `info`: every field, in declaration order; enums as their names.
+nlohmann::ordered_json StructToJson(const StructInfo& info, const void* object);
+
+// Sets the fields named in `json` (an object; absent keys keep their value in *object). Throws OptionsError
+// naming the key path ("acceptance.band_px: 0 is out of range [1, 64]") for an unknown key (with the closest
+// valid one), a wrong type or a value out of range; then runs the struct's cross-field check.
+void StructFromJson(const StructInfo& info, const nlohmann::json& json, void* object,
+                    const std::string& path = "");
+
+// Checks every field of `object` against its description (kind, range), then the cross-field check; throws
+// OptionsFieldError for the first bad field. Library entry points call it on the options they are given.
+void ValidateStruct(const StructInfo& info, const void* object, const std::string& path = "");
+
+template <class S>
+void Validate(const S& object) {
+  ValidateStruct(InfoOf<S>(), &object);
+}
+
+template <class S>
+nlohmann::ordered_json ToJson(const S& object) {
+  return StructToJson(InfoOf<S>(), &object);
+}
+
+// `base` with the fields of `json` applied (the defaults when `base` is not given).
+template <class S>
+S FromJson(const nlohmann::json& json, S base = S{}) {
+  StructFromJson(InfoOf<S>(), json, &base);
+  return base;
+}
+
+// Sets every field of `object` (recursively) to a valid value other than its current one where the
+// description allows one, keeping the struct valid (a field whose change breaks a cross-field check keeps its
+// value). For round-trip tests of every options struct, here and in the bindings. Returns the fields changed.
+int SetSampleValues(const StructInfo& info, void* object);
+
+// The value of one field as text for help and messages ("4", "0.2", "true", "patchmatch").
+std::string ValueText(const nlohmann::ordered_json& value);
+
+template <class S>
+class StructBuilder {
+ public:
+  StructBuilder(std::string name, std::string doc) {
+    info_.name = std::move(name);
+    info_.doc = std::move(doc);
+  }
+
+  template <class T>
+  FieldInfo& Field(T S::*member, std::string key, std::string doc) {
+    FieldInfo field;
+    field.key = std::move(key);
+    field.doc = std::move(doc);
+    field.get = [member](const void* object) -> nlohmann::ordered_json {
+      const T& value = static_cast<const S*>(object)->*member;
+      if constexpr (std::is_enum_v<T>) {
+        return std::string(ToString(value));
+      } else if constexpr (IsVector<T>::value) {
+        return nlohmann::ordered_json(value);
+      } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
+        return StructToJson(InfoOf<T>(), &value);
+      } else {
+        return value;
+      }
+    };
+    if constexpr (IsVector<T>::value) {
+      static_assert(std::is_arithmetic_v<typename T::value_type>, "list fields hold numbers");
+      field.kind = FieldKind::kNumberList;
+      field.set = [member](void* object, const nlohmann::json& json) {
+        static_cast<S*>(object)->*member = json.get<T>();
+      };
+    } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
+      field.kind = FieldKind::kStruct;
+      field.nested = &InfoOf<T>();
+      field.nested_of = [member](void* object) -> void* { return &(static_cast<S*>(object)->*member); };
+    } else {
+      field.kind = KindOf<T>();
+      if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, uint64_t>) {
+        field.integer_low = std::numeric_limits<T>::min();
+        field.integer_high = std::numeric_limits<T>::max();
+      }
+      if constexpr (std::is_enum_v<T>) field.choices = &EnumInfoOf<T>();
+      field.set = [member](void* object, const nlohmann::json& json) {
+        T& value = static_cast<S*>(object)->*member;
+        if constexpr (std::is_enum_v<T>) {
+          value = ParseEnum<T>(json.get<std::string>());
+        } else {
+          value = json.get<T>();
+        }
+      };
+    }
+    info_.fields.push_back(std::move(field));
+    return info_.fields.back();
+  }
+
+  // Cross-field check of the whole struct, e.g. [](const S& s) { s.Check(); }.
+  void Check(std::function<void(const S&)> check) {
+    info_.check = [check = std::move(check)](const void* object) { check(*static_cast<const S*>(object)); };
+  }
+
+  StructInfo Build() { return std::move(info_); }
+
+ private:
+  template <class T>
+  static constexpr FieldKind KindOf() {
+    if constexpr (std::is_same_v<T, bool>) {
+      return FieldKind::kBool;
+    } else if constexpr (std::is_enum_v<T>) {
+      return FieldKind::kEnum;
+    } else if constexpr (std::is_same_v<T, uint64_t>) {
+      return FieldKind::kUInt64;
+    } else if constexpr (std::is_integral_v<T>) {
+      static_assert(sizeof(T) <= sizeof(int64_t), "integer fields are at most 64-bit");
+      return FieldKind::kInt;
+    } else if constexpr (std::is_floating_point_v<T>) {
+      return FieldKind::kDouble;
+    } else {
+      static_assert(std::is_same_v<T, std::string>,
+                    "a field is bool, a number, an enum, a string or a struct");
+      return FieldKind::kString;
+    }
+  }
+
+  StructInfo info_;
+};
+
+}  // namespace lidarshop

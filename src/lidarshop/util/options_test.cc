@@ -1,0 +1,146 @@
+#include "lidarshop/util/options.h"
+
+#include <gtest/gtest.h>
+
+#include "lidarshop/util/options_test_util.h"
+
+namespace lidarshop {
+
+enum class Flavour { kPlain, kSmoked, kDoubleSmoked };
+struct InnerOptions {
+  int band_px = 2;
+  bool enabled = false;
+};
+struct OuterOptions {
+  int patch_radius = 4;
+  double sigma_m = 0.5;
+  uint64_t seed = 0;
+  Flavour flavour = Flavour::kPlain;
+  std::string label = "scan";
+  std::vector<float> weights;
+  InnerOptions inner;
+  int low = 0, high = 10;
+};
+
+template <>
+const EnumInfo& EnumInfoOf<Flavour>() {
+  static const EnumInfo info =
+      MakeEnumInfo<Flavour>("flavour", {{Flavour::kPlain, "plain", ""},
+                                        {Flavour::kSmoked, "smoked", ""},
+                                        {Flavour::kDoubleSmoked, "double-smoked", ""}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<InnerOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<InnerOptions> b("InnerOptions", "inner");
+    b.Field(&InnerOptions::band_px, "band_px", "band").Unit("px").Range(1, 64);
+    b.Field(&InnerOptions::enabled, "enabled", "on");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<OuterOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<OuterOptions> b("OuterOptions", "outer");
+    b.Field(&OuterOptions::patch_radius, "patch_radius", "radius").Unit("cells").Range(1, 15);
+    b.Field(&OuterOptions::sigma_m, "sigma_m", "sigma").Unit("m").AboveZero();
+    b.Field(&OuterOptions::seed, "seed", "seed");
+    b.Field(&OuterOptions::flavour, "flavour", "flavour");
+    b.Field(&OuterOptions::label, "label", "label");
+    b.Field(&OuterOptions::weights, "weights", "weights").Min(0);
+    b.Field(&OuterOptions::inner, "inner", "inner");
+    b.Field(&OuterOptions::low, "low", "low");
+    b.Field(&OuterOptions::high, "high", "high");
+    b.Check([](const OuterOptions& o) {
+      if (o.low >= o.high) throw OptionsFieldError("high", "must be above low");
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(Options, RoundTripIsExact) {
+  ExpectExactRoundTrip<OuterOptions>();
+  OuterOptions o;
+  o.sigma_m = 0.1 + 0.2;  // 0.30000000000000004: needs 17 digits
+  o.seed = (uint64_t{1} << 63) + 5;
+  o.weights = {0.1f, 3.0f};
+  const OuterOptions back = FromJson<OuterOptions>(nlohmann::json::parse(ToJson(o).dump()));
+  EXPECT_EQ(back.sigma_m, o.sigma_m);
+  EXPECT_EQ(back.seed, o.seed);
+  EXPECT_EQ(back.weights, o.weights);
+}
+
+TEST(Options, JsonFormUsesKeysAndEnumNames) {
+  OuterOptions o;
+  o.flavour = Flavour::kDoubleSmoked;
+  const auto json = ToJson(o);
+  EXPECT_EQ(json["flavour"], "double-smoked");
+  EXPECT_EQ(json["inner"]["band_px"], 2);
+  EXPECT_EQ(json.begin().key(), "patch_radius");  // declaration order
+}
+
+TEST(Options, AbsentKeysKeepTheBase) {
+  OuterOptions base;
+  base.patch_radius = 7;
+  const OuterOptions o = FromJson<OuterOptions>(nlohmann::json{{"sigma_m", 2.0}}, base);
+  EXPECT_EQ(o.patch_radius, 7);
+  EXPECT_EQ(o.sigma_m, 2.0);
+}
+
+TEST(Options, ErrorsNameTheKey) {
+  ExpectRejected<OuterOptions>({{"patch_radus", 3}}, "patch_radus", "did you mean 'patch_radius'");
+  ExpectRejected<OuterOptions>({{"patch_radius", 0}}, "patch_radius", "out of range [1, 15]");
+  ExpectRejected<OuterOptions>({{"patch_radius", 2.5}}, "patch_radius", "whole number");
+  ExpectRejected<OuterOptions>({{"patch_radius", "4"}}, "patch_radius", "whole number");
+  ExpectRejected<OuterOptions>({{"patch_radius", 5000000000}}, "patch_radius", "does not fit");
+  ExpectRejected<OuterOptions>({{"sigma_m", 0}}, "sigma_m", "out of range > 0");
+  ExpectRejected<OuterOptions>({{"sigma_m", true}}, "sigma_m", "expected a number");
+  ExpectRejected<OuterOptions>({{"seed", -1}}, "seed", ">= 0");
+  ExpectRejected<OuterOptions>({{"flavour", "smokd"}}, "flavour", "did you mean 'smoked'");
+  ExpectRejected<OuterOptions>({{"flavour", 1}}, "flavour", "plain|smoked|double-smoked");
+  ExpectRejected<OuterOptions>({{"weights", {1, -1}}}, "weights", "out of range >= 0");
+  ExpectRejected<OuterOptions>({{"inner", {{"band_px", 0}}}}, "inner.band_px", "out of range [1, 64]");
+  ExpectRejected<OuterOptions>({{"inner", {{"bandpx", 1}}}}, "inner.bandpx", "did you mean 'band_px'");
+  ExpectRejected<OuterOptions>({{"inner", 3}}, "inner", "expected an object");
+  ExpectRejected<OuterOptions>({{"low", 20}}, "high", "must be above low");
+  EXPECT_THROW(FromJson<OuterOptions>(nlohmann::json::array()), OptionsError);
+}
+
+TEST(Options, ValidateChecksAnInstance) {
+  OuterOptions o;
+  EXPECT_NO_THROW(Validate(o));
+  o.inner.band_px = 100;
+  try {
+    Validate(o);
+    ADD_FAILURE();
+  } catch (const OptionsFieldError& error) {
+    EXPECT_EQ(error.key_path(), "inner.band_px");
+  }
+}
+
+TEST(Options, EnumsConvertOneWay) {
+  EXPECT_EQ(ToString(Flavour::kSmoked), "smoked");
+  EXPECT_EQ(ParseEnum<Flavour>("double-smoked"), Flavour::kDoubleSmoked);
+  EXPECT_THROW(ParseEnum<Flavour>("Smoked"), OptionsError);  // exact
+  EXPECT_EQ(EnumInfoOf<Flavour>().NamesText(), "plain|smoked|double-smoked");
+}
+
+TEST(Options, ClosestMatch) {
+  EXPECT_EQ(ClosestMatch("--chanel", {"--channel", "--output", "--scale"}), "--channel");
+  EXPECT_EQ(ClosestMatch("--patch", {"--patch-radius", "--output"}), "--patch-radius");
+  EXPECT_EQ(ClosestMatch("--zzzzzz", {"--channel", "--output"}), "");
+}
+
+TEST(Options, RangeText) {
+  const StructInfo& info = InfoOf<OuterOptions>();
+  EXPECT_EQ(info.Find("patch_radius")->RangeText(), "[1, 15]");
+  EXPECT_EQ(info.Find("sigma_m")->RangeText(), "> 0");
+  EXPECT_EQ(info.Find("seed")->RangeText(), "");
+}
+
+}  // namespace lidarshop
