@@ -22,6 +22,20 @@ check() {  # check NAME COMMAND...: the command must succeed
   fi
 }
 
+exits_with() {  # exits_with CODE NAME PATTERN COMMAND...: that exit code and one line on stderr matching PATTERN
+  local code=$1 name=$2 pattern=$3
+  shift 3
+  "$@" >"$work/last.out" 2>"$work/last.err"
+  local status=$?
+  if [ "$status" -eq "$code" ] && [ "$(wc -l <"$work/last.err")" -eq 1 ] && grep -qE -e "$pattern" "$work/last.err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name: expected exit $code and one line matching '$pattern', got exit $status:"
+    sed 's/^/  | /' "$work/last.err" | head -10
+  fi
+}
+
 fails_clearly() {  # fails_clearly NAME PATTERN COMMAND...: non-zero exit, one line on stderr matching PATTERN
   local name=$1 pattern=$2
   shift 2
@@ -30,7 +44,7 @@ fails_clearly() {  # fails_clearly NAME PATTERN COMMAND...: non-zero exit, one l
     echo "FAILED: $name: succeeded but should have failed: $*"
     return
   fi
-  if [ "$(wc -l <"$work/last.err")" -eq 1 ] && grep -qE "$pattern" "$work/last.err"; then
+  if [ "$(wc -l <"$work/last.err")" -eq 1 ] && grep -qE -e "$pattern" "$work/last.err"; then
     passed=$((passed + 1))
   else
     failed=$((failed + 1))
@@ -215,8 +229,8 @@ fails_clearly "inpaint: mask of another size" "mask" "$lidarshop" inpaint "$imag
 check "fill" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/filled.ply" \
   --report "$work/fill.json" --synthesized-mask "$work/synthesized.png" --debug "$work/fill_debug" --quiet
 json_check "fill report" "$work/fill.json" \
-  "d['method'] == 'gradient' and d['synthesized_points'] > 0 and \
-   d['synthesized_points'] + d['no_return_cells'] == d['hole_cells']"
+  "d['options']['method'] == 'gradient' and d['synthesized_cells'] > 0 and \
+   d['synthesized_cells'] + d['no_return_cells'] == d['hole_cells']"
 check "fill wrote the mask and the debug pictures" test -s "$work/synthesized.png" \
   -a -s "$work/fill_debug/gradient_after.png" -a -s "$work/fill_debug/source_cells.png"
 check "fill laplace into E57" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" --method laplace \
@@ -225,7 +239,24 @@ check "info on the filled E57" sh -c "'$lidarshop' info '$work/filled.e57' > '$w
 json_check "the E57 keeps the synthesized flag" "$work/filled_e57.json" "'synthesized' in d['scans'][0]['channels']"
 check "remove" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/removed.ptx" \
   --report "$work/remove.json" --quiet
-json_check "remove report" "$work/remove.json" "d['object_cells'] > 0 and d['synthesized_points'] > 0"
+exits_with 2 "usage: did you mean" "unknown option --patch-radus \(did you mean --patch-radius\?\)" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --patch-radus 3
+exits_with 2 "usage: out of range names the flag" "^lidarshop fill: --patch-radius: 0 is out of range \[1, 15\]" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --patch-radius 0
+exits_with 2 "usage: a value suggests the closest" "'patch-match' is not a source search.*did you mean 'patchmatch'" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --search patch-match
+exits_with 2 "usage: cross-field check names the flag" "--window: 5 is less than the patch radius 9" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --patch-radius 9 --window 5
+exits_with 2 "usage: output extension checked first" "-o .*x.txt: expected a .ptx, .e57, .ply, .pcd file" \
+  "$lidarshop" fill "$work/no_such_scan.ptx" --mask "$work/mask.png" -o "$work/x.txt"
+exits_with 2 "usage: unwritable output folder checked first" "no_such_dir" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/no_such_dir/x.ply"
+exits_with 1 "bad input: a missing scan" "no_such_scan.ptx" \
+  "$lidarshop" fill "$work/no_such_scan.ptx" --mask "$work/mask.png" -o "$work/x.ply"
+printf 'not a scan\n' >"$work/garbage.ptx"
+exits_with 1 "bad input: a file that does not parse" "garbage.ptx" \
+  "$lidarshop" fill "$work/garbage.ptx" --mask "$work/mask.png" -o "$work/x.ply"
+json_check "remove report" "$work/remove.json" "d['cut']['object_cells'] > 0 and d['fill']['synthesized_cells'] > 0 and d['options']['margin_cells'] == 2"
 check "remove --keep-object into E57 (second returns)" "$lidarshop" remove "$work/scan.ptx" \
   --strokes "$work/strokes.json" -o "$work/two_layers.e57" --keep-object --quiet
 check "remove --keep-object into PLY" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \

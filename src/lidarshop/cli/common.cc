@@ -37,7 +37,8 @@ std::string ExtrasMessage(const CLI::App& app) {
   CollectFlags(app, &flags);
   const std::string name = first.substr(0, first.find('='));
   const std::string closest = ClosestMatch(name, flags);
-  return fmt::format("unknown option {}{}", name, closest.empty() ? "" : fmt::format(" (did you mean {}?)", closest));
+  return fmt::format("unknown option {}{}", name,
+                     closest.empty() ? "" : fmt::format(" (did you mean {}?)", closest));
 }
 
 // One line of a library's exception: the first line, and OpenCV's message without its source location.
@@ -75,7 +76,8 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
   try {
     return body();
   } catch (const OptionsFieldError& error) {
-    const std::string message = binder != nullptr ? binder->Reworded(error).what() : std::string(error.what());
+    const std::string message =
+        binder != nullptr ? binder->Reworded(error).what() : std::string(error.what());
     fmt::print(stderr, "{}: {}\n", name, message);
     return kExitUsage;
   } catch (const OptionsError& error) {
@@ -87,8 +89,15 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
   }
 }
 
-void AddJsonOption(CLI::App& app, std::string* path) {
-  app.add_option("--json", *path, "write the result as JSON to FILE ('-' = stdout)")->type_name("FILE");
+nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
+                                   const nlohmann::ordered_json& result) {
+  nlohmann::ordered_json json = result;
+  json["options"] = options;
+  return json;
+}
+
+void AddJsonOption(CLI::App& app, std::string* path, const std::string& names) {
+  app.add_option(names, *path, "write the result as JSON to FILE ('-' = stdout)")->type_name("FILE");
 }
 
 void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json) {
@@ -100,8 +109,8 @@ void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json
   WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
 }
 
-void CheckOutputFile(const std::string& flag, const std::string& path, const std::vector<std::string>& extensions,
-                     const std::vector<std::string>& others) {
+void CheckOutputFile(const std::string& flag, const std::string& path,
+                     const std::vector<std::string>& extensions, const std::vector<std::string>& others) {
   if (path.empty() || path == "-") return;
   const std::string extension = FileExtension(path);
   if (!extensions.empty() && std::find(extensions.begin(), extensions.end(), extension) == extensions.end()) {

@@ -110,6 +110,10 @@ struct FillResult {
   FillTimings timings;
   std::string Summary() const;  // one line
 };
+template <>
+const StructInfo& InfoOf<FillTimings>();
+template <>
+const StructInfo& InfoOf<FillResult>();
 
 // Fills `hole` in `scan`. Throws InputError when the mask's size differs from the scan's, when the mask
 // leaves no known cell with a return, or when the scan has no ray directions (an unorganized cloud).

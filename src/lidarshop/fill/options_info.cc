@@ -116,3 +116,52 @@ const StructInfo& InfoOf<FillMetricsOptions>() {
 }
 
 }  // namespace lidarshop
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<FillTimings>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillTimings> b("FillTimings", "wall seconds per step");
+    b.Field(&FillTimings::gradients_s, "gradients_s", "range gradients and the joint image").Unit("s");
+    b.Field(&FillTimings::inpaint_s, "inpaint_s", "patch fill").Unit("s");
+    b.Field(&FillTimings::poisson_s, "poisson_s", "range reconstruction").Unit("s");
+    b.Field(&FillTimings::placement_s, "placement_s", "points along their rays").Unit("s");
+    b.Field(&FillTimings::total_s, "total_s", "everything").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FillResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillResult> b("FillResult", "counts of a fill (the scan and images are not JSON)");
+    b.Field(&FillResult::hole_cells, "hole_cells", "cells of the mask").Unit("cells");
+    b.Field(&FillResult::synthesized_cells, "synthesized_cells", "hole cells given a synthesized return")
+        .Unit("cells");
+    b.Field(&FillResult::no_return_cells, "no_return_cells", "hole cells left without a return")
+        .Unit("cells");
+    b.Field(&FillResult::unanchored_cells, "unanchored_cells",
+            "cells decided 'return' but cut off from every known range (left empty)")
+        .Unit("cells");
+    b.Field(&FillResult::patches, "patches", "patches copied");
+    b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
+    b.Field(&FillResult::timings, "timings", "wall seconds per step");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RemoveResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<RemoveResult> b("RemoveResult", "an object removal: the cut and the fill");
+    b.Field(&RemoveResult::cut, "cut", "the object's cut");
+    b.Field(&RemoveResult::fill, "fill", "the fill of its hole");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

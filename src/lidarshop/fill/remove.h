@@ -34,6 +34,8 @@ struct RemoveResult {
   // front already), every other cell without a return, flagged synthesized; empty otherwise.
   Scan behind;
 };
+template <>
+const StructInfo& InfoOf<RemoveResult>();
 
 // The cells without a return (`valid` == 0) that `mask` (CV_8U) encloses: not reachable from the image border
 // through cells outside the mask. CV_8U 255/0.

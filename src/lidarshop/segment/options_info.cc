@@ -105,3 +105,34 @@ const StructInfo& InfoOf<SegmentOptions>() {
 }
 
 }  // namespace lidarshop
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<SegmentTimings>() {
+  static const StructInfo info = [] {
+    StructBuilder<SegmentTimings> b("SegmentTimings", "wall seconds per stage");
+    b.Field(&SegmentTimings::features_s, "features_s", "standardized features").Unit("s");
+    b.Field(&SegmentTimings::models_s, "models_s", "appearance models").Unit("s");
+    b.Field(&SegmentTimings::graph_s, "graph_s", "graph construction").Unit("s");
+    b.Field(&SegmentTimings::maxflow_s, "maxflow_s", "max-flow").Unit("s");
+    b.Field(&SegmentTimings::total_s, "total_s", "everything").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SegmentResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<SegmentResult> b("SegmentResult", "a cut (the mask itself is an image, not JSON)");
+    b.Field(&SegmentResult::object_cells, "object_cells", "cells of the object").Unit("cells");
+    b.Field(&SegmentResult::graph_nodes, "graph_nodes", "nodes of the last cut's graph");
+    b.Field(&SegmentResult::flow, "flow", "value of the last max-flow");
+    b.Field(&SegmentResult::timings, "timings", "wall seconds per stage");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

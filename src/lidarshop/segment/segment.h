@@ -146,6 +146,10 @@ struct SegmentResult {
   SegmentTimings timings;
   std::string Summary() const;  // one line
 };
+template <>
+const StructInfo& InfoOf<SegmentTimings>();
+template <>
+const StructInfo& InfoOf<SegmentResult>();
 
 // A segmentation that keeps its last graph for fast refinement. Build once (features and n-link weights),
 // then Run() and any number of Refine() calls. Not thread-safe; the scan's buffers are shared, not copied.
