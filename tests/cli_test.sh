@@ -256,6 +256,14 @@ exits_with 1 "bad input: a missing scan" "no_such_scan.ptx" \
 printf 'not a scan\n' >"$work/garbage.ptx"
 exits_with 1 "bad input: a file that does not parse" "garbage.ptx" \
   "$lidarshop" fill "$work/garbage.ptx" --mask "$work/mask.png" -o "$work/x.ply"
+printf '{"patch_radius": 3, "method": "laplace", "acceptance": {"band_px": 3}}\n' >"$work/fill_options.json"
+check "fill --options FILE, flags win" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/opt.ply" \
+  --options "$work/fill_options.json" --method gradient --json "$work/opt.json" --quiet
+json_check "fill --options keys reach the options" "$work/opt.json" \
+  "d['options']['patch_radius'] == 3 and d['options']['method'] == 'gradient' and d['options']['acceptance']['band_px'] == 3"
+printf '{"patch_radius": 3, "acceptance": {"band": 3}}\n' >"$work/bad_options.json"
+exits_with 2 "--options: an unknown key names the path" "acceptance.band: unknown option \(did you mean 'band_px'\?\)" \
+  "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/opt.ply" --options "$work/bad_options.json"
 json_check "remove report" "$work/remove.json" "d['cut']['object_cells'] > 0 and d['fill']['synthesized_cells'] > 0 and d['options']['margin_cells'] == 2"
 check "remove --keep-object into E57 (second returns)" "$lidarshop" remove "$work/scan.ptx" \
   --strokes "$work/strokes.json" -o "$work/two_layers.e57" --keep-object --quiet

@@ -27,12 +27,20 @@ struct BindSettings {
 
 // Binds option structs to one command's CLI11 app, remembers which flag sets which key, and rewords
 // OptionsFieldError with those flags.
+//
+// The first struct bound is the command's options: `--options FILE.json` sets any of its fields by key (the
+// JSON form of util/options.h, e.g. {"patch_radius": 6, "acceptance": {"band_px": 3}}), flags on the same
+// command line win over the file.
 class OptionBinder {
  public:
-  explicit OptionBinder(CLI::App& app) : app_(app) {}
+  explicit OptionBinder(CLI::App& app);
 
   template <class S>
   void Bind(S* options, const BindSettings& settings = {}) {
+    if (root_ == nullptr) {
+      root_info_ = &InfoOf<S>();
+      root_ = options;
+    }
     BindStruct(InfoOf<S>(), options, settings);
   }
 
@@ -58,6 +66,8 @@ class OptionBinder {
 
   CLI::App& app_;
   std::map<std::string, std::string> flag_of_key_;
+  const StructInfo* root_info_ = nullptr;
+  void* root_ = nullptr;
 };
 
 // Converts the text of a flag to the JSON value of a field of this kind (strict: "4x", "1e400", "yes" fail).
