@@ -39,6 +39,7 @@ const std::vector<Command>& Commands() {
       {"points", lidarshop::cli::RunPoints,
        "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
       {"register", lidarshop::cli::RunRegister, "register one scan onto another (point-to-plane ICP)"},
+      {"serve", lidarshop::cli::RunServe, "the editor in the browser: look, paint, segment, remove, save"},
   };
   return commands;
 }

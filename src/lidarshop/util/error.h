@@ -27,6 +27,12 @@ class OptionsError : public std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };
 
+// An operation stopped by its caller (Progress::Cancel), not a failure.
+class CancelledError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // Builds "<file>: <place>: field '<field>': <message>", leaving out empty parts.
 std::string FormatInputError(std::string_view file, std::string_view place, std::string_view field,
                              std::string_view message);

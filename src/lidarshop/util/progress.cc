@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/util/error.h"
+
 namespace lidarshop {
 
 Progress::Progress(std::string label, int64_t total, bool enabled)
@@ -21,7 +23,18 @@ std::unique_ptr<Progress> Progress::ForTerminal(std::string label, int64_t total
   return std::make_unique<Progress>(std::move(label), total, enabled);
 }
 
+int64_t Progress::total() const {
+  std::lock_guard lock(draw_mutex_);
+  return total_;
+}
+
+std::string Progress::label() const {
+  std::lock_guard lock(draw_mutex_);
+  return label_;
+}
+
 void Progress::Advance(int64_t amount) {
+  if (cancelled_.load(std::memory_order_relaxed)) throw CancelledError("cancelled");
   done_.fetch_add(amount, std::memory_order_relaxed);
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();

@@ -32,7 +32,13 @@ class Progress {
   void Finish();
 
   int64_t done() const { return done_.load(); }
-  int64_t total() const { return total_; }
+  int64_t total() const;
+  std::string label() const;
+
+  // Asks the operation to stop (from any thread): its next Advance() throws CancelledError, which unwinds it
+  // (parallel loops pass the exception on). Used by the editor's cancel button.
+  void Cancel() { cancelled_ = true; }
+  bool cancelled() const { return cancelled_.load(); }
 
  private:
   void Draw(bool final);
@@ -42,7 +48,8 @@ class Progress {
   bool enabled_;
   bool finished_ = false;
   std::atomic<int64_t> done_{0};
-  std::mutex draw_mutex_;
+  std::atomic<bool> cancelled_{false};
+  mutable std::mutex draw_mutex_;
   std::chrono::steady_clock::time_point start_;
   std::chrono::steady_clock::time_point last_draw_;
 };

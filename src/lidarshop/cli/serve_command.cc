@@ -1,0 +1,86 @@
+// lidarshop serve: the editor in the browser (src/server, docs/api.md, web/).
+//
+//   lidarshop serve [SCAN...] [--port 8080] [--host 127.0.0.1] [--root DIR...] [--web DIR]
+#include <csignal>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "lidarshop/cli/builtin_scenes.h"
+#include "lidarshop/cli/commands.h"
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/scanner/scene.h"
+#include "lidarshop/util/error.h"
+#include "server.h"
+
+namespace lidarshop::cli {
+
+namespace {
+
+server::EditorServer* running_server = nullptr;
+
+void StopOnSignal(int) {
+  if (running_server != nullptr) running_server->Stop();
+}
+
+// The built front end: web/ beside the executable (the build copies it there), else the source tree's build.
+std::string DefaultWebDir(const char* argv0) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  const fs::path exe = fs::canonical("/proc/self/exe", error);
+  for (const fs::path& candidate :
+       {exe.parent_path() / "web", fs::path(LIDARSHOP_SOURCE_DIR) / "web" / "dist"}) {
+    if (fs::exists(candidate / "index.html", error)) return candidate.string();
+  }
+  return "";
+}
+
+}  // namespace
+
+int RunServe(int argc, char** argv) {
+  CLI::App app{
+      "The editor in the browser: look at scans in 2-D and 3-D, paint strokes, segment, remove objects, "
+      "undo, save (docs/api.md). Prints the URL to open; loopback only unless --host says otherwise.",
+      "serve"};
+  server::ServerOptions options;
+  std::vector<std::string> scans;
+  app.add_option("scans", scans, "scan files to open at start (their folders may be browsed)");
+  app.add_option("--port", options.port, "TCP port; 0 = any free port")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--host", options.host, "address to listen on (127.0.0.1 = this machine only)")
+      ->capture_default_str();
+  app.add_option("--root", options.roots, "a folder whose scan files the editor may open (repeatable)");
+  app.add_option("--web", options.web_dir, "the built front end (default: web/ beside the executable)");
+  app.add_option("--token", options.token, "the access token (default: a random one)");
+  return RunCommand(app, argc, argv, [&]() {
+    if (options.web_dir.empty()) options.web_dir = DefaultWebDir(argv[0]);
+    for (const BuiltinScene& scene : BuiltinScenes()) options.builtin_scenes.push_back(scene.name);
+    options.scan_builtin = [](const std::string& name) {
+      for (const BuiltinScene& scene : BuiltinScenes()) {
+        if (name != scene.name) continue;
+        const SceneDescription description =
+            ParseScene(scene.json, fmt::format("built-in scene '{}'", name), "");
+        return SyntheticScanner(description).Acquire(description.scanner);
+      }
+      throw InputError(fmt::format("no built-in scene '{}'", name));
+    };
+    server::EditorServer editor(options);
+    for (const std::string& scan : scans) editor.OpenAtStart(scan);
+    editor.Bind();
+    if (options.web_dir.empty()) {
+      fmt::print(stderr,
+                 "serve: no built front end found (run `bash scripts/build.sh`); the API alone is served\n");
+    }
+    fmt::print("{}\n", editor.Url());
+    std::fflush(stdout);
+    running_server = &editor;
+    std::signal(SIGINT, StopOnSignal);
+    std::signal(SIGTERM, StopOnSignal);
+    editor.Run();
+    running_server = nullptr;
+    return 0;
+  });
+}
+
+}  // namespace lidarshop::cli

@@ -1,0 +1,48 @@
+// The server's internals: its state and the route groups. Internal to src/server.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "server.h"
+#include "state.h"
+// After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace lidarshop::server {
+
+struct EditorServer::State {
+  ServerOptions options;
+  httplib::Server http;
+  int port = 0;
+  std::unique_ptr<JobRunner> runner;
+  std::mutex documents_mutex;
+  std::map<int, std::shared_ptr<Document>> documents;
+  int last_document = 0;
+
+  int AddDocument(std::string name, Scan scan);
+  std::shared_ptr<Document> Get(int id);  // an id AddDocument just returned
+  // The document of the request's first path match; nullptr after answering 404.
+  std::shared_ptr<Document> FindDocument(const httplib::Request& request, httplib::Response& response);
+};
+using State = EditorServer::State;
+
+// An error answer: {"error": message} with `status`.
+void SendError(httplib::Response& response, int status, const std::string& message);
+void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, int status = 200);
+// The request body as a JSON object; nullopt after answering 400.
+std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response);
+
+// A path given by a client, resolved against the roots: the canonical path when it lies inside one (after
+// following symlinks), else empty. `..` components are refused before any lookup.
+std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::string& requested);
+
+void AddScanRoutes(State& state);  // routes_scan.cc: open, list, pictures, points, save
+void AddEditRoutes(State& state);  // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
+
+}  // namespace lidarshop::server

@@ -1,0 +1,245 @@
+// Routes that edit scans — strokes, segmentation, removal, fill, undo — and the operations they start
+// (docs/api.md). Long operations run as jobs off the request thread; clients poll /api/jobs/ID.
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "http.h"
+#include "lidarshop/fill/fill.h"
+#include "lidarshop/fill/remove.h"
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop::server {
+
+namespace {
+
+// Replaces the document's state with `next`, keeping the old one for undo. Caller holds document.mutex.
+void Commit(Document& document, Snapshot next, int undo_depth) {
+  document.undo.push_back(std::move(document.now));
+  if (static_cast<int>(document.undo.size()) > undo_depth) document.undo.erase(document.undo.begin());
+  document.redo.clear();
+  document.now = std::move(next);
+  ++document.version;
+}
+
+// Cells [[row, col], ...] of `json[key]` painted with `value` as discs of `radius` into `strokes`.
+void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int radius, cv::Mat& strokes) {
+  if (!json.contains(key)) return;
+  const nlohmann::json& cells = json.at(key);
+  if (!cells.is_array()) throw OptionsFieldError(key, "expected a list of [row, col] cells");
+  if (cells.size() > 1000000) throw OptionsFieldError(key, "more than 1,000,000 cells in one request");
+  for (const auto& cell : cells) {
+    if (!cell.is_array() || cell.size() != 2 || !cell[0].is_number_integer() ||
+        !cell[1].is_number_integer()) {
+      throw OptionsFieldError(key, fmt::format("expected [row, col] whole numbers, got {}", cell.dump()));
+    }
+    const int row = cell[0].get<int>(), col = cell[1].get<int>();
+    if (row < 0 || row >= strokes.rows || col < 0 || col >= strokes.cols) {
+      throw OptionsFieldError(key, fmt::format("cell [{}, {}] is outside the {} x {} scan", row, col,
+                                               strokes.rows, strokes.cols));
+    }
+    cv::circle(strokes, cv::Point(col, row), radius, cv::Scalar(value), cv::FILLED);
+  }
+}
+
+nlohmann::ordered_json JobJson(const Job& job) {
+  nlohmann::ordered_json json = {{"id", job.id},
+                                 {"kind", job.kind},
+                                 {"document", job.document},
+                                 {"state", ToString(job.state.load())},
+                                 {"label", job.progress.label()},
+                                 {"done", job.progress.done()},
+                                 {"total", job.progress.total()}};
+  std::lock_guard lock(const_cast<std::mutex&>(job.mutex));
+  if (!job.error.empty()) json["error"] = job.error;
+  if (!job.result.is_null()) json["result"] = job.result;
+  return json;
+}
+
+// Starts `run` on the document as a job and answers 202 with the job's JSON (503 when too many are queued).
+void StartJob(State& state, const std::shared_ptr<Document>& document, const std::string& kind,
+              std::function<nlohmann::ordered_json(Progress&)> run, httplib::Response& response) {
+  auto job = std::make_shared<Job>();
+  job->id = state.runner->NextId();
+  job->document = document->id;
+  job->kind = kind;
+  job->run = std::move(run);
+  if (!state.runner->Submit(job)) {
+    SendError(response, 503, "too many operations queued; try again");
+    return;
+  }
+  SendJson(response, JobJson(*job), 202);
+}
+
+template <class Options>
+Options OptionsOf(const nlohmann::json& body) {
+  return body.contains("options") ? FromJson<Options>(body.at("options")) : Options{};
+}
+
+void Segment(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+             httplib::Response& response) {
+  const SegmentOptions options = OptionsOf<SegmentOptions>(body);
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "segment",
+      [document, options, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        progress.Restart("segment", 1);
+        const SegmentResult result = SegmentObject(start.scan, start.strokes, options);
+        progress.Advance();
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.object_mask = result.mask.clone();
+        Commit(*document, std::move(next), undo_depth);
+        nlohmann::ordered_json json = ToJson(result);
+        json["version"] = document->version;
+        return json;
+      },
+      response);
+}
+
+void Remove(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+            httplib::Response& response) {
+  const RemoveOptions options = OptionsOf<RemoveOptions>(body);
+  if (options.keep_object)
+    throw OptionsFieldError("keep_object", "the editor shows one layer; use `fill` instead");
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "remove",
+      [document, options, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        const RemoveResult result = RemoveObject(start.scan, start.strokes, options, &progress);
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.scan = result.fill.scan;
+        next.object_mask = cv::Mat();
+        next.strokes = cv::Mat::zeros(next.scan.rows, next.scan.cols, CV_8U);
+        Commit(*document, std::move(next), undo_depth);
+        nlohmann::ordered_json json = ToJson(result);
+        json["version"] = document->version;
+        return json;
+      },
+      response);
+}
+
+// Fills the last segmentation's object grown by margin_cells (the object removed without a new cut).
+void Fill(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+          httplib::Response& response) {
+  const FillOptions options = OptionsOf<FillOptions>(body);
+  const int margin = body.value("margin_cells", 2);
+  if (margin < 0 || margin > 100) throw OptionsFieldError("margin_cells", "out of range [0, 100]");
+  {
+    std::lock_guard lock(document->mutex);
+    if (document->now.object_mask.empty() || cv::countNonZero(document->now.object_mask) == 0) {
+      throw OptionsFieldError("object", "segment an object first: the fill fills the object's cells");
+    }
+  }
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "fill",
+      [document, options, margin, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        const FillResult result =
+            FillScan(start.scan, GrowHole(start.object_mask, margin), options, &progress);
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.scan = result.scan;
+        next.object_mask = cv::Mat();
+        Commit(*document, std::move(next), undo_depth);
+        nlohmann::ordered_json json = ToJson(result);
+        json["version"] = document->version;
+        return json;
+      },
+      response);
+}
+
+// Wraps a document route: finds the document, parses the body, answers 400 for option errors.
+using DocumentHandler =
+    std::function<void(State&, const std::shared_ptr<Document>&, const nlohmann::json&, httplib::Response&)>;
+void PostDocument(State& state, const std::string& pattern, DocumentHandler handler) {
+  state.http.Post(pattern, [&state, handler](const httplib::Request& request, httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    const auto body = BodyJson(request, response);
+    if (!body) return;
+    try {
+      handler(state, document, *body, response);
+    } catch (const OptionsError& error) {
+      SendError(response, 400, error.what());
+    } catch (const InputError& error) {
+      SendError(response, 422, error.what());
+    }
+  });
+}
+
+}  // namespace
+
+void AddEditRoutes(State& state) {
+  PostDocument(
+      state, R"(/api/docs/(\d+)/strokes)",
+      [](State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+         httplib::Response& response) {
+        const int radius = body.value("radius", 2);
+        if (radius < 0 || radius > 200) throw OptionsFieldError("radius", "out of range [0, 200]");
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.strokes =
+            body.value("clear", false) ? cv::Mat::zeros(next.strokes.size(), CV_8U) : next.strokes.clone();
+        PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
+        PaintCells(body, "background", 2, radius, next.strokes);
+        PaintCells(body, "erase", 0, radius, next.strokes);
+        Commit(*document, std::move(next), state.options.undo_depth);
+        SendJson(response, {{"version", document->version},
+                            {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
+                            {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
+      });
+  PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
+  PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);
+  PostDocument(state, R"(/api/docs/(\d+)/fill)", Fill);
+  for (const bool undo : {true, false}) {
+    PostDocument(state, undo ? R"(/api/docs/(\d+)/undo)" : R"(/api/docs/(\d+)/redo)",
+                 [undo](State&, const std::shared_ptr<Document>& document, const nlohmann::json&,
+                        httplib::Response& response) {
+                   std::lock_guard lock(document->mutex);
+                   auto& from = undo ? document->undo : document->redo;
+                   auto& to = undo ? document->redo : document->undo;
+                   if (from.empty()) {
+                     SendError(response, 409, undo ? "nothing to undo" : "nothing to redo");
+                     return;
+                   }
+                   to.push_back(std::move(document->now));
+                   document->now = std::move(from.back());
+                   from.pop_back();
+                   ++document->version;
+                   SendJson(response, {{"version", document->version}});
+                 });
+  }
+  state.http.Get(R"(/api/jobs/(\d+))",
+                 [&state](const httplib::Request& request, httplib::Response& response) {
+                   const auto job = state.runner->Find(std::atoi(request.matches[1].str().c_str()));
+                   if (!job) return SendError(response, 404, "no such job");
+                   SendJson(response, JobJson(*job));
+                 });
+  state.http.Post(R"(/api/jobs/(\d+)/cancel)",
+                  [&state](const httplib::Request& request, httplib::Response& response) {
+                    const auto job = state.runner->Find(std::atoi(request.matches[1].str().c_str()));
+                    if (!job) return SendError(response, 404, "no such job");
+                    job->progress.Cancel();
+                    SendJson(response, JobJson(*job));
+                  });
+}
+
+}  // namespace lidarshop::server

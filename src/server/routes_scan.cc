@@ -1,0 +1,318 @@
+// Routes that open, describe, show and save scans (docs/api.md).
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "http.h"
+#include "lidarshop/io/render.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop::server {
+
+namespace fs = std::filesystem;
+
+void SendError(httplib::Response& response, int status, const std::string& message) {
+  response.status = status;
+  response.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
+}
+
+void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, int status) {
+  response.status = status;
+  response.set_content(json.dump(), "application/json");
+}
+
+std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response) {
+  if (request.body.empty()) return nlohmann::json::object();
+  try {
+    nlohmann::json json = nlohmann::json::parse(request.body);
+    if (!json.is_object()) {
+      SendError(response, 400, "the request body must be a JSON object");
+      return std::nullopt;
+    }
+    return json;
+  } catch (const nlohmann::json::parse_error& error) {
+    SendError(response, 400, fmt::format("the request body is not JSON: {}", error.what()));
+    return std::nullopt;
+  }
+}
+
+std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::string& requested) {
+  if (requested.empty() || requested.find('\0') != std::string::npos) return "";
+  for (const auto& part : fs::path(requested)) {
+    if (part == "..") return "";
+  }
+  std::vector<fs::path> candidates;
+  if (fs::path(requested).is_absolute()) {
+    candidates.push_back(requested);
+  } else {
+    for (const std::string& root : roots) candidates.push_back(fs::path(root) / requested);
+  }
+  for (const fs::path& candidate : candidates) {
+    std::error_code error;
+    const fs::path real = fs::canonical(candidate, error);  // follows every symlink
+    if (error) continue;
+    for (const std::string& root : roots) {
+      const std::string root_slash = root.back() == '/' ? root : root + "/";
+      if (real.string().rfind(root_slash, 0) == 0) return real.string();
+    }
+  }
+  return "";
+}
+
+int State::AddDocument(std::string name, Scan scan) {
+  auto document = std::make_shared<Document>();
+  document->name = std::move(name);
+  document->now.strokes = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+  document->now.scan = std::move(scan);
+  std::lock_guard lock(documents_mutex);
+  document->id = ++last_document;
+  documents[document->id] = document;
+  while (static_cast<int>(documents.size()) > options.max_documents) documents.erase(documents.begin());
+  return document->id;
+}
+
+std::shared_ptr<Document> State::Get(int id) {
+  std::lock_guard lock(documents_mutex);
+  return documents.at(id);
+}
+
+std::shared_ptr<Document> State::FindDocument(const httplib::Request& request, httplib::Response& response) {
+  const int id = std::atoi(request.matches[1].str().c_str());
+  std::lock_guard lock(documents_mutex);
+  const auto found = documents.find(id);
+  if (found == documents.end()) {
+    SendError(response, 404, fmt::format("no open scan {}", id));
+    return nullptr;
+  }
+  return found->second;
+}
+
+namespace {
+
+nlohmann::ordered_json DocumentJson(Document& document) {
+  std::lock_guard lock(document.mutex);
+  const Scan& scan = document.now.scan;
+  std::vector<std::string> channels;
+  for (const auto& [name, image] : {std::pair{"range", &scan.range},
+                                    {"point", &scan.point},
+                                    {"intensity", &scan.intensity},
+                                    {"color", &scan.color},
+                                    {"label", &scan.label},
+                                    {"normal", &scan.normal},
+                                    {"synthesized", &scan.synthesized}}) {
+    if (!image->empty()) channels.push_back(name);
+  }
+  std::vector<double> pose(scan.world_from_scanner.data(), scan.world_from_scanner.data() + 16);
+  return {{"id", document.id},
+          {"name", document.name},
+          {"rows", scan.rows},
+          {"cols", scan.cols},
+          {"channels", channels},
+          {"valid_cells", scan.CountValid()},
+          {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
+          {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
+          {"world_from_scanner_column_major", pose},
+          {"version", document.version},
+          {"can_undo", !document.undo.empty()},
+          {"can_redo", !document.redo.empty()}};
+}
+
+void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
+  cv::Mat out = rgb_or_gray;
+  if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> png;
+  cv::imencode(".png", out, png);
+  response.set_content(std::string(png.begin(), png.end()), "image/png");
+}
+
+// The points of a scan as typed arrays (docs/api.md "Points"): header, xyz float32 (scanner frame), cell index
+// uint32, rgb uint8, flags uint8 (1 = synthesized, 2 = object).
+std::string PointsBinary(const Document& document) {
+  const Scan& scan = document.now.scan;
+  std::vector<float> xyz;
+  std::vector<uint32_t> cells;
+  std::vector<uint8_t> rgb, flags;
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (scan.valid.at<uint8_t>(r, c) == 0) continue;
+      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+      xyz.insert(xyz.end(), {p[0], p[1], p[2]});
+      cells.push_back(static_cast<uint32_t>(r * scan.cols + c));
+      if (scan.has_color()) {
+        const cv::Vec3b color = scan.color.at<cv::Vec3b>(r, c);
+        rgb.insert(rgb.end(), {color[0], color[1], color[2]});
+      } else {
+        const float intensity = scan.intensity.empty() ? 0.7f : scan.intensity.at<float>(r, c);
+        const auto grey = static_cast<uint8_t>(std::clamp(intensity, 0.0f, 1.0f) * 255.0f);
+        rgb.insert(rgb.end(), {grey, grey, grey});
+      }
+      uint8_t flag = 0;
+      if (!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(r, c) != 0) flag |= 1;
+      if (!document.now.object_mask.empty() && document.now.object_mask.at<uint8_t>(r, c) != 0) flag |= 2;
+      flags.push_back(flag);
+    }
+  }
+  const uint32_t header[4] = {0x3150534cu /* "LSP1" */, static_cast<uint32_t>(cells.size()),
+                              static_cast<uint32_t>(scan.rows), static_cast<uint32_t>(scan.cols)};
+  std::string bytes(sizeof(header), '\0');
+  std::memcpy(bytes.data(), header, sizeof(header));
+  bytes.append(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(float));
+  bytes.append(reinterpret_cast<const char*>(cells.data()), cells.size() * sizeof(uint32_t));
+  bytes.append(reinterpret_cast<const char*>(rgb.data()), rgb.size());
+  bytes.append(reinterpret_cast<const char*>(flags.data()), flags.size());
+  return bytes;
+}
+
+void Open(State& state, const httplib::Request& request, httplib::Response& response) {
+  if (request.has_param("scene")) {
+    const std::string name = request.get_param_value("scene");
+    const auto& names = state.options.builtin_scenes;
+    if (std::find(names.begin(), names.end(), name) == names.end() || !state.options.scan_builtin) {
+      SendError(response, 404, fmt::format("no built-in scene '{}'", name));
+      return;
+    }
+    const int id = state.AddDocument(name, state.options.scan_builtin(name));
+    SendJson(response, DocumentJson(*state.Get(id)));
+    return;
+  }
+  const std::string requested = request.get_param_value("path");
+  const std::string path = ResolveUnderRoots(state.options.roots, requested);
+  if (path.empty()) {
+    SendError(response, 403,
+              fmt::format("'{}' is not a file under the folders this server was started with", requested));
+    return;
+  }
+  try {
+    ScanFile file = ReadScanFile(path);
+    const int index = request.has_param("scan") ? std::atoi(request.get_param_value("scan").c_str()) : 0;
+    if (index < 0 || index >= static_cast<int>(file.scans.size())) {
+      SendError(response, 400,
+                fmt::format("scan {} is out of range: the file holds {}", index, file.scans.size()));
+      return;
+    }
+    const int id = state.AddDocument(fs::path(path).filename().string(), std::move(file.scans[index]));
+    SendJson(response, DocumentJson(*state.Get(id)));
+  } catch (const InputError& error) {
+    SendError(response, 422, error.what());
+  }
+}
+
+void Save(Document& document, const httplib::Request& request, httplib::Response& response) {
+  const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
+  if (format != "e57" && format != "ptx" && format != "ply" && format != "pcd") {
+    SendError(response, 400, fmt::format("format '{}': expected e57, ptx, ply or pcd", format));
+    return;
+  }
+  const fs::path folder = fs::temp_directory_path() / fmt::format("lidarshop-save-{}", getpid());
+  fs::create_directories(folder);
+  const fs::path file =
+      folder / fmt::format("doc{}-{}.{}", document.id,
+                           std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
+  {
+    std::lock_guard lock(document.mutex);
+    WriteScanFile(file.string(), {document.now.scan});
+  }
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  fs::remove(file);
+  const std::string stem = fs::path(document.name).stem().string();
+  response.set_header("Content-Disposition", fmt::format("attachment; filename=\"{}.{}\"", stem, format));
+  response.set_content(std::move(bytes), "application/octet-stream");
+}
+
+}  // namespace
+
+void AddScanRoutes(State& state) {
+  httplib::Server& http = state.http;
+  http.Get("/api/health", [](const httplib::Request&, httplib::Response& response) {
+    SendJson(response, {{"ok", true}});
+  });
+  http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
+    SendJson(response, {{"scenes", state.options.builtin_scenes}});
+  });
+  // The file dialog: scan files under the roots (at most 2000, two folders deep).
+  http.Get("/api/files", [&state](const httplib::Request&, httplib::Response& response) {
+    nlohmann::ordered_json files = nlohmann::ordered_json::array();
+    for (const std::string& root : state.options.roots) {
+      std::error_code error;
+      for (auto it = fs::recursive_directory_iterator(root, error);
+           !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
+        if (it.depth() > 1) it.disable_recursion_pending();
+        if (!it->is_regular_file()) continue;
+        const std::string extension = FileExtension(it->path().string());
+        if (extension != "ptx" && extension != "e57" && extension != "ply" && extension != "pcd") continue;
+        files.push_back({{"path", it->path().string()}, {"bytes", it->file_size()}});
+        if (files.size() >= 2000) break;
+      }
+    }
+    SendJson(response, {{"roots", state.options.roots}, {"files", files}});
+  });
+  http.Get("/api/open", [&state](const httplib::Request& request, httplib::Response& response) {
+    Open(state, request, response);
+  });
+  http.Get("/api/docs", [&state](const httplib::Request&, httplib::Response& response) {
+    std::vector<std::shared_ptr<Document>> documents;
+    {
+      std::lock_guard lock(state.documents_mutex);
+      for (const auto& [id, document] : state.documents) documents.push_back(document);
+    }
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const auto& document : documents) list.push_back(DocumentJson(*document));
+    SendJson(response, {{"documents", list}});
+  });
+  http.Get(R"(/api/docs/(\d+))", [&state](const httplib::Request& request, httplib::Response& response) {
+    if (auto document = state.FindDocument(request, response)) SendJson(response, DocumentJson(*document));
+  });
+  http.Delete(R"(/api/docs/(\d+))", [&state](const httplib::Request& request, httplib::Response& response) {
+    if (auto document = state.FindDocument(request, response)) {
+      std::lock_guard lock(state.documents_mutex);
+      state.documents.erase(document->id);
+      SendJson(response, {{"closed", document->id}});
+    }
+  });
+  http.Get(R"(/api/docs/(\d+)/image.png)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             auto document = state.FindDocument(request, response);
+             if (!document) return;
+             RenderOptions options;
+             try {
+               if (request.has_param("channel"))
+                 options.channel = ParseRenderChannel(request.get_param_value("channel"));
+               std::lock_guard lock(document->mutex);
+               SendPng(response, RenderScan(document->now.scan, options).image);
+             } catch (const OptionsError& error) {
+               SendError(response, 400, error.what());
+             } catch (const InputError& error) {
+               SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
+             }
+           });
+  http.Get(R"(/api/docs/(\d+)/mask.png)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             auto document = state.FindDocument(request, response);
+             if (!document) return;
+             std::lock_guard lock(document->mutex);
+             const Scan& scan = document->now.scan;
+             cv::Mat mask = document->now.object_mask.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U)
+                                                              : document->now.object_mask;
+             SendPng(response, mask);
+           });
+  http.Get(R"(/api/docs/(\d+)/points)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             auto document = state.FindDocument(request, response);
+             if (!document) return;
+             std::lock_guard lock(document->mutex);
+             response.set_content(PointsBinary(*document), "application/octet-stream");
+           });
+  http.Get(R"(/api/docs/(\d+)/save)", [&state](const httplib::Request& request, httplib::Response& response) {
+    if (auto document = state.FindDocument(request, response)) Save(*document, request, response);
+  });
+}
+
+}  // namespace lidarshop::server

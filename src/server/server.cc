@@ -1,0 +1,117 @@
+#include "server.h"
+
+#include <filesystem>
+#include <random>
+
+#include <fmt/format.h>
+
+#include "http.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop::server {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string RandomToken() {
+  std::random_device device;  // a secret, not an algorithm's random choice: not seeded on purpose
+  std::uniform_int_distribution<uint32_t> word;
+  return fmt::format("{:08x}{:08x}{:08x}{:08x}", word(device), word(device), word(device), word(device));
+}
+
+// Constant-time comparison: the token must not leak through response times.
+bool SameToken(const std::string& given, const std::string& token) {
+  if (given.size() != token.size()) return false;
+  unsigned char difference = 0;
+  for (size_t i = 0; i < given.size(); ++i) difference |= static_cast<unsigned char>(given[i] ^ token[i]);
+  return difference == 0;
+}
+
+}  // namespace
+
+EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<State>()) {
+  if (options.token.empty()) options.token = RandomToken();
+  for (std::string& root : options.roots) root = fs::weakly_canonical(fs::absolute(root)).string();
+  state_->options = std::move(options);
+  state_->runner = std::make_unique<JobRunner>(1, 256);
+  httplib::Server& http = state_->http;
+  http.new_task_queue = [threads = state_->options.threads] { return new httplib::ThreadPool(threads); };
+  http.set_payload_max_length(static_cast<size_t>(state_->options.max_body_bytes));
+  http.set_keep_alive_timeout(2);
+  // The token is checked before any route is looked at: an unauthenticated caller learns nothing.
+  http.set_pre_routing_handler([this](const httplib::Request& request, httplib::Response& response) {
+    if (request.path.rfind("/api/", 0) != 0) return httplib::Server::HandlerResponse::Unhandled;
+    std::string given = request.get_param_value("token");
+    const std::string header = request.get_header_value("Authorization");
+    if (given.empty() && header.rfind("Bearer ", 0) == 0) given = header.substr(7);
+    if (!SameToken(given, state_->options.token)) {
+      SendError(response, 401, "missing or wrong token (the one `lidarshop serve` printed)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  http.set_exception_handler(
+      [](const httplib::Request&, httplib::Response& response, std::exception_ptr error) {
+        try {
+          std::rethrow_exception(error);
+        } catch (const std::exception& e) {
+          SendError(response, 500, e.what());
+        } catch (...) {
+          SendError(response, 500, "internal error");
+        }
+      });
+  http.set_error_handler([](const httplib::Request& request, httplib::Response& response) {
+    if (response.body.empty()) {
+      SendError(response, response.status, fmt::format("{} {}: no such route", request.method, request.path));
+    }
+  });
+  AddScanRoutes(*state_);
+  AddEditRoutes(*state_);
+  if (!state_->options.web_dir.empty()) {
+    if (!http.set_mount_point("/", state_->options.web_dir)) {
+      throw InputError(
+          fmt::format("{}: not a folder with the built editor (index.html)", state_->options.web_dir));
+    }
+  }
+}
+
+EditorServer::~EditorServer() { Stop(); }
+
+void EditorServer::Bind() {
+  const ServerOptions& options = state_->options;
+  if (options.port == 0) {
+    state_->port = state_->http.bind_to_any_port(options.host);
+  } else if (state_->http.bind_to_port(options.host, options.port)) {
+    state_->port = options.port;
+  }
+  if (state_->port <= 0) {
+    throw InputError(fmt::format("{}:{}: cannot listen there (in use, or not an address of this machine)",
+                                 options.host, options.port));
+  }
+}
+
+void EditorServer::Run() { state_->http.listen_after_bind(); }
+
+void EditorServer::Stop() {
+  if (state_->http.is_running()) state_->http.stop();
+}
+
+int EditorServer::port() const { return state_->port; }
+
+const std::string& EditorServer::token() const { return state_->options.token; }
+
+std::string EditorServer::Url() const {
+  return fmt::format("http://{}:{}/?token={}", state_->options.host, state_->port, state_->options.token);
+}
+
+int EditorServer::OpenAtStart(const std::string& path) {
+  const std::string folder = fs::weakly_canonical(fs::absolute(path)).parent_path().string();
+  state_->options.roots.push_back(folder);
+  ScanFile file = ReadScanFile(path);
+  if (file.scans.empty()) throw InputError(fmt::format("{}: holds no scan", path));
+  return state_->AddDocument(fs::path(path).filename().string(), std::move(file.scans.front()));
+}
+
+}  // namespace lidarshop::server

@@ -1,0 +1,63 @@
+// The editor's HTTP server: a thin layer that turns JSON requests into library calls on open scans
+// (docs/api.md). No algorithm lives here; options and results travel in the library's one JSON form
+// (util/options.h).
+//
+// Safety: it listens on loopback unless told otherwise; every /api/ call needs the token printed at start
+// (401 before any routing); files are opened only under the folders given at start (403 for `..`, symlinks
+// or absolute paths leading outside them); request bodies are size-limited; a malformed request gets a 4xx
+// with a one-line message.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop::server {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";  // loopback only by default
+  int port = 8080;                 // 0 = any free port (tests)
+  std::string token;               // required on /api/ calls; empty = a random 128-bit token
+  std::vector<std::string> roots;  // folders files may be opened from (canonical paths are compared)
+  std::string web_dir;             // the built front end (index.html), served at /; empty = none
+  int64_t max_body_bytes = int64_t{64} << 20;  // request bodies above this get 413
+  // Request threads: a keep-alive connection holds one while open, so this bounds the clients served at once
+  // (operations run on their own threads).
+  int threads = 64;
+  int max_documents = 16;  // open scans at once; the oldest is closed beyond it
+  int undo_depth = 8;      // edits kept per scan for undo
+  // Built-in scenes: their names, and a function scanning one (the CLI passes its compiled-in scenes).
+  std::vector<std::string> builtin_scenes;
+  std::function<Scan(const std::string& name)> scan_builtin;
+};
+
+class EditorServer {
+ public:
+  explicit EditorServer(ServerOptions options);
+  ~EditorServer();
+  EditorServer(const EditorServer&) = delete;
+  EditorServer& operator=(const EditorServer&) = delete;
+
+  // Binds the port (throws InputError naming host:port when it cannot); then Run() serves until Stop().
+  void Bind();
+  void Run();
+  void Stop();
+
+  int port() const;
+  const std::string& token() const;
+  std::string Url() const;  // http://HOST:PORT/?token=T
+
+  // Opens a scan file at start (`serve SCAN…`); its folder becomes a root. Returns the document id.
+  int OpenAtStart(const std::string& path);
+
+  struct State;
+
+ private:
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace lidarshop::server

@@ -1,0 +1,225 @@
+#include "server.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/testing/scenes.h"
+// After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace lidarshop::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One server for the whole suite, on a free loopback port, with a root folder holding a scan, a broken file
+// and a symlink leading out of the root.
+class ServerTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    base_ = fs::temp_directory_path() / fmt::format("lidarshop_server_test_{}", getpid());
+    fs::remove_all(base_);
+    fs::create_directories(base_ / "root" / "sub");
+    fs::create_directories(base_ / "outside");
+    lidarshop::testing::GroundAndBoxOptions scene;
+    scene.rows = 60;
+    scene.columns = 90;
+    scan_ = new Scan(lidarshop::testing::ScanScene(lidarshop::testing::MakeGroundAndBoxScene(scene)));
+    WriteScanFile((base_ / "root" / "sub" / "box.ptx").string(), {*scan_});
+    WriteScanFile((base_ / "outside" / "secret.ptx").string(), {*scan_});
+    std::ofstream(base_ / "root" / "broken.ptx") << "12\nnot a ptx\n";
+    fs::create_symlink(base_ / "outside" / "secret.ptx", base_ / "root" / "link.ptx");
+    ServerOptions options;
+    options.port = 0;
+    options.token = "secret-token";
+    options.roots = {(base_ / "root").string()};
+    options.max_body_bytes = 1 << 20;
+    options.builtin_scenes = {"tiny"};
+    options.scan_builtin = [](const std::string&) { return *scan_; };
+    server_ = new EditorServer(options);
+    server_->Bind();
+    thread_ = new std::thread([] { server_->Run(); });
+    client_ = new httplib::Client("127.0.0.1", server_->port());
+    client_->set_read_timeout(60, 0);
+    for (int i = 0; i < 100 && !client_->Get("/api/health?token=secret-token"); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+  static void TearDownTestSuite() {
+    server_->Stop();
+    thread_->join();
+    delete client_;
+    delete thread_;
+    delete server_;
+    delete scan_;
+    fs::remove_all(base_);
+  }
+
+  static std::string Api(const std::string& path) {
+    return path + (path.find('?') == std::string::npos ? "?" : "&") + "token=secret-token";
+  }
+  static nlohmann::json Json(const httplib::Result& result) { return nlohmann::json::parse(result->body); }
+  static int OpenBox() {
+    const auto result = client_->Get(Api("/api/open?path=sub/box.ptx"));
+    EXPECT_EQ(result->status, 200) << result->body;
+    return Json(result)["id"].get<int>();
+  }
+  // Polls a job until it ends; returns its last JSON.
+  static nlohmann::json Wait(const nlohmann::json& job) {
+    for (int i = 0; i < 600; ++i) {
+      const auto json = Json(client_->Get(Api(fmt::format("/api/jobs/{}", job["id"].get<int>()))));
+      const std::string state = json["state"];
+      if (state != "queued" && state != "running") return json;
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ADD_FAILURE() << "job did not end";
+    return {};
+  }
+  // Strokes: a few object cells on the box (label 1), background cells on the ground (label 0).
+  static std::string StrokesBody() {
+    nlohmann::json object = nlohmann::json::array(), background = nlohmann::json::array();
+    for (int r = 0; r < scan_->rows; ++r) {
+      for (int c = 0; c < scan_->cols; ++c) {
+        if (scan_->valid.at<uint8_t>(r, c) == 0 || (r + c) % 7 != 0) continue;
+        (scan_->label.at<int32_t>(r, c) == 1 ? object : background).push_back({r, c});
+      }
+    }
+    return nlohmann::json{{"object", object}, {"background", background}, {"radius", 0}}.dump();
+  }
+
+  static inline fs::path base_;
+  static inline Scan* scan_ = nullptr;
+  static inline EditorServer* server_ = nullptr;
+  static inline std::thread* thread_ = nullptr;
+  static inline httplib::Client* client_ = nullptr;
+};
+
+TEST_F(ServerTest, TokenIsRequiredBeforeRouting) {
+  EXPECT_EQ(client_->Get("/api/health")->status, 401);
+  EXPECT_EQ(client_->Get("/api/health?token=wrong-token!")->status, 401);
+  EXPECT_EQ(client_->Get("/api/no/such/route")->status, 401);  // no route is revealed without the token
+  EXPECT_EQ(client_->Get(Api("/api/health"))->status, 200);
+  httplib::Headers bearer = {{"Authorization", "Bearer secret-token"}};
+  EXPECT_EQ(client_->Get("/api/health", bearer)->status, 200);
+  EXPECT_EQ(client_->Get(Api("/api/no/such/route"))->status, 404);
+}
+
+TEST_F(ServerTest, FilesOnlyUnderTheRoots) {
+  EXPECT_EQ(client_->Get(Api("/api/open?path=../outside/secret.ptx"))->status, 403);
+  EXPECT_EQ(client_->Get(Api("/api/open?path=sub/../../outside/secret.ptx"))->status, 403);
+  EXPECT_EQ(client_->Get(Api("/api/open?path=" + (base_ / "outside" / "secret.ptx").string()))->status, 403);
+  EXPECT_EQ(client_->Get(Api("/api/open?path=/etc/passwd"))->status, 403);
+  EXPECT_EQ(client_->Get(Api("/api/open?path=link.ptx"))->status, 403);  // a symlink leading out
+  EXPECT_EQ(client_->Get(Api("/api/open?path=missing.ptx"))->status, 403);
+  const auto broken = client_->Get(Api("/api/open?path=broken.ptx"));
+  EXPECT_EQ(broken->status, 422);
+  EXPECT_NE(Json(broken)["error"].get<std::string>().find("broken.ptx"), std::string::npos);
+  const auto files = Json(client_->Get(Api("/api/files")));
+  EXPECT_EQ(files["files"].size(), 3u);  // box.ptx, broken.ptx, link.ptx (listed; opening the link fails)
+  const auto opened = client_->Get(Api("/api/open?path=" + (base_ / "root" / "sub" / "box.ptx").string()));
+  ASSERT_EQ(opened->status, 200);
+  EXPECT_EQ(Json(opened)["rows"], 60);
+  EXPECT_EQ(Json(opened)["cols"], 90);
+}
+
+TEST_F(ServerTest, ImagesAndPoints) {
+  const int id = OpenBox();
+  const auto png = client_->Get(Api(fmt::format("/api/docs/{}/image.png?channel=range", id)));
+  ASSERT_EQ(png->status, 200);
+  EXPECT_EQ(png->body.substr(1, 3), "PNG");
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/image.png?channel=bogus", id)))->status, 400);
+  EXPECT_EQ(client_->Get(Api("/api/docs/9999/image.png"))->status, 404);
+  const auto points = client_->Get(Api(fmt::format("/api/docs/{}/points", id)));
+  ASSERT_EQ(points->status, 200);
+  uint32_t header[4];
+  std::memcpy(header, points->body.data(), sizeof(header));
+  EXPECT_EQ(std::string(points->body.data(), 4), "LSP1");
+  EXPECT_EQ(header[1], static_cast<uint32_t>(scan_->CountValid()));
+  EXPECT_EQ(points->body.size(), 16 + header[1] * (12 + 4 + 3 + 1));
+}
+
+TEST_F(ServerTest, MalformedRequestsGet4xx) {
+  const int id = OpenBox();
+  const std::string strokes = fmt::format("/api/docs/{}/strokes", id);
+  EXPECT_EQ(client_->Post(Api(strokes), "{not json", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(Api(strokes), "[1,2]", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(Api(strokes), R"({"object": [[1000, 5]]})", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(Api(strokes), R"({"object": [["a", 5]]})", "application/json")->status, 400);
+  const auto bad_option = client_->Post(Api(fmt::format("/api/docs/{}/segment", id)),
+                                        R"({"options": {"gmm_component": 3}})", "application/json");
+  EXPECT_EQ(bad_option->status, 400);
+  EXPECT_NE(Json(bad_option)["error"].get<std::string>().find("did you mean 'gmm_components'"),
+            std::string::npos);
+  EXPECT_EQ(client_->Post(Api(strokes), std::string(2 << 20, ' '), "application/json")->status, 413);
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save?format=xyz", id)))->status, 400);
+  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", OpenBox())), "", "application/json")->status,
+            409);
+}
+
+TEST_F(ServerTest, SegmentRemoveUndoSave) {
+  const int id = OpenBox();
+  ASSERT_EQ(
+      client_->Post(Api(fmt::format("/api/docs/{}/strokes", id)), StrokesBody(), "application/json")->status,
+      200);
+  const auto started = client_->Post(Api(fmt::format("/api/docs/{}/segment", id)), "{}", "application/json");
+  ASSERT_EQ(started->status, 202) << started->body;
+  const auto segmented = Wait(Json(started));
+  ASSERT_EQ(segmented["state"], "done") << segmented.dump();
+  EXPECT_GT(segmented["result"]["object_cells"].get<int>(), 50);
+  const auto removed =
+      Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/remove", id)),
+                              R"({"options": {"fill": {"method": "laplace"}}})", "application/json")));
+  ASSERT_EQ(removed["state"], "done") << removed.dump();
+  const auto after = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_GT(after["synthesized_cells"].get<int>(), 50);
+  EXPECT_TRUE(after["can_undo"]);
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"], 0);
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/redo", id)), "", "application/json")->status, 200);
+  EXPECT_GT(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"].get<int>(), 50);
+  const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
+  ASSERT_EQ(saved->status, 200);
+  EXPECT_EQ(saved->body.substr(0, 8), "ASTM-E57");
+}
+
+TEST_F(ServerTest, ConcurrentEditsAreNotLost) {
+  const int id = OpenBox();
+  const int64_t before = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"];
+  constexpr int kClients = 16, kEdits = 10;
+  std::vector<std::thread> clients;
+  std::atomic<int> failures{0};
+  for (int k = 0; k < kClients; ++k) {
+    clients.emplace_back([&, k] {
+      httplib::Client client("127.0.0.1", server_->port());
+      for (int e = 0; e < kEdits; ++e) {
+        const std::string body = fmt::format(R"({{"object": [[{}, {}]], "radius": 0}})", k, e);
+        const auto result =
+            client.Post(Api(fmt::format("/api/docs/{}/strokes", id)), body, "application/json");
+        if (!result || result->status != 200) ++failures;
+      }
+    });
+  }
+  for (std::thread& client : clients) client.join();
+  EXPECT_EQ(failures, 0);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"].get<int64_t>(),
+            before + kClients * kEdits);
+}
+
+TEST_F(ServerTest, BuiltinScenes) {
+  EXPECT_EQ(Json(client_->Get(Api("/api/scenes")))["scenes"][0], "tiny");
+  EXPECT_EQ(client_->Get(Api("/api/open?scene=tiny"))->status, 200);
+  EXPECT_EQ(client_->Get(Api("/api/open?scene=nope"))->status, 404);
+}
+
+}  // namespace
+}  // namespace lidarshop::server

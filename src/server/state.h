@@ -1,0 +1,79 @@
+// The server's state: open documents with their edit history, and the operations running on them.
+// Internal to src/server.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+
+#include "lidarshop/scan/scan.h"
+#include "lidarshop/util/progress.h"
+
+namespace lidarshop::server {
+
+// What an edit changes; undo restores all of it.
+struct Snapshot {
+  Scan scan;
+  cv::Mat strokes;      // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
+  cv::Mat object_mask;  // CV_8U 255 = the object of the last segmentation (empty = none)
+};
+
+struct Document {
+  int id = 0;
+  std::string name;  // file name or built-in scene name
+  Snapshot now;
+  std::vector<Snapshot> undo, redo;
+  int64_t version = 0;  // +1 on every edit: clients see whether their view is current
+  std::mutex mutex;     // guards every field above
+};
+
+enum class JobState { kQueued, kRunning, kDone, kFailed, kCancelled };
+
+struct Job {
+  int id = 0;
+  int document = 0;
+  std::string kind;  // "segment", "remove", "fill"
+  Progress progress{"queued", 1, false};
+  std::atomic<JobState> state{JobState::kQueued};
+  std::mutex mutex;  // guards error and result
+  std::string error;
+  nlohmann::ordered_json result;
+  std::function<nlohmann::ordered_json(Progress&)> run;
+};
+
+// Runs jobs on a fixed number of worker threads, in the order they were queued.
+class JobRunner {
+ public:
+  JobRunner(int workers, int max_queued);
+  ~JobRunner();
+  // Queues `job`; false when the queue is full (the caller answers 503).
+  bool Submit(std::shared_ptr<Job> job);
+  std::shared_ptr<Job> Find(int id) const;
+  int NextId() { return ++last_id_; }
+
+ private:
+  void Work();
+
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::deque<std::shared_ptr<Job>> queue_;
+  std::map<int, std::shared_ptr<Job>> jobs_;  // the last few hundred, for polling
+  std::vector<std::thread> workers_;
+  std::atomic<int> last_id_{0};
+  int max_queued_;
+  bool stopping_ = false;
+};
+
+std::string ToString(JobState state);
+
+}  // namespace lidarshop::server
