@@ -20,6 +20,7 @@ struct EditorServer::State {
   ServerOptions options;
   httplib::Server http;
   int port = 0;
+  int listen_socket = -1;
   std::unique_ptr<JobRunner> runner;
   std::mutex documents_mutex;
   std::map<int, std::shared_ptr<Document>> documents;

@@ -40,6 +40,15 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
   http.new_task_queue = [threads = state_->options.threads] { return new httplib::ThreadPool(threads); };
   http.set_payload_max_length(static_cast<size_t>(state_->options.max_body_bytes));
   http.set_keep_alive_timeout(2);
+  http.set_keep_alive_max_count(1000);
+  // Debian's httplib listens with a backlog of 5: a burst of new clients overflows it and some connections
+  // stall or fail. The socket is remembered here and given a full backlog after binding (a second listen()
+  // on a listening socket only changes its backlog).
+  http.set_socket_options([this](socket_t socket) {
+    int yes = 1;
+    setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    state_->listen_socket = socket;
+  });
   // The token is checked before any route is looked at: an unauthenticated caller learns nothing.
   http.set_pre_routing_handler([this](const httplib::Request& request, httplib::Response& response) {
     if (request.path.rfind("/api/", 0) != 0) return httplib::Server::HandlerResponse::Unhandled;
@@ -86,6 +95,7 @@ void EditorServer::Bind() {
   } else if (state_->http.bind_to_port(options.host, options.port)) {
     state_->port = options.port;
   }
+  if (state_->port > 0 && state_->listen_socket >= 0) ::listen(state_->listen_socket, SOMAXCONN);
   if (state_->port <= 0) {
     throw InputError(fmt::format("{}:{}: cannot listen there (in use, or not an address of this machine)",
                                  options.host, options.port));

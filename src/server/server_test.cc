@@ -205,7 +205,11 @@ TEST_F(ServerTest, ConcurrentEditsAreNotLost) {
         const std::string body = fmt::format(R"({{"object": [[{}, {}]], "radius": 0}})", k, e);
         const auto result =
             client.Post(Api(fmt::format("/api/docs/{}/strokes", id)), body, "application/json");
-        if (!result || result->status != 200) ++failures;
+        if (!result || result->status != 200) {
+          ++failures;
+          ADD_FAILURE() << "edit " << k << "/" << e << ": "
+                        << (result ? result->body : httplib::to_string(result.error()));
+        }
       }
     });
   }
