@@ -12,6 +12,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libmaxflow-dev libsuitesparse-dev liblzf-dev libpugixml-dev
   libcpp-httplib-dev pybind11-dev python3-dev python3-numpy python3-pytest
+  nodejs chromium
 )
 
 missing=()

@@ -20,6 +20,7 @@ if [[ ${1:-} == --sanitize ]]; then
 fi
 bash scripts/build.sh
 ctest --test-dir build/release --output-on-failure -j "$(nproc)" "$@"
+bash scripts/web.sh test
 fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-15}
 if [[ $fuzz_seconds -gt 0 ]] && command -v clang++-14 >/dev/null; then
   bash scripts/fuzz.sh "$fuzz_seconds"

@@ -1,9 +1,12 @@
 // Routes that open, describe, show and save scans (docs/api.md).
 #include <unistd.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <array>
 #include <fstream>
+#include <map>
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
@@ -110,6 +113,11 @@ nlohmann::ordered_json DocumentJson(Document& document) {
     if (!image->empty()) channels.push_back(name);
   }
   std::vector<double> pose(scan.world_from_scanner.data(), scan.world_from_scanner.data() + 16);
+  // Angular steps of the grid, for square angular pixels on screen (0 when the scan has no grid).
+  const auto step_deg = [](const std::vector<double>& angles) {
+    return angles.size() < 2 ? 0.0
+                             : std::abs(angles.back() - angles.front()) / (angles.size() - 1) * 180.0 / M_PI;
+  };
   return {{"id", document.id},
           {"name", document.name},
           {"rows", scan.rows},
@@ -119,6 +127,8 @@ nlohmann::ordered_json DocumentJson(Document& document) {
           {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
           {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
           {"world_from_scanner_column_major", pose},
+          {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
+          {"elevation_step_deg", step_deg(scan.grid.elevation_rad)},
           {"version", document.version},
           {"can_undo", !document.undo.empty()},
           {"can_redo", !document.redo.empty()}};
@@ -310,6 +320,31 @@ void AddScanRoutes(State& state) {
              std::lock_guard lock(document->mutex);
              response.set_content(PointsBinary(*document), "application/octet-stream");
            });
+  // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).
+  http.Get(R"(/api/docs/(\d+)/labels)", [&state](const httplib::Request& request, httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    std::lock_guard lock(document->mutex);
+    const Scan& scan = document->now.scan;
+    std::map<int32_t, std::array<int64_t, 7>> stats;  // cells, min row, min col, max row, max col, sum r, sum c
+    if (!scan.label.empty()) {
+      for (int r = 0; r < scan.rows; ++r) {
+        for (int c = 0; c < scan.cols; ++c) {
+          if (scan.valid.at<uint8_t>(r, c) == 0) continue;
+          auto [it, added] = stats.try_emplace(scan.label.at<int32_t>(r, c), std::array<int64_t, 7>{0, r, c, r, c, 0, 0});
+          auto& s = it->second;
+          s = {s[0] + 1, std::min<int64_t>(s[1], r), std::min<int64_t>(s[2], c), std::max<int64_t>(s[3], r),
+               std::max<int64_t>(s[4], c), s[5] + r, s[6] + c};
+        }
+      }
+    }
+    nlohmann::ordered_json labels = nlohmann::ordered_json::array();
+    for (const auto& [label, s] : stats) {
+      labels.push_back({{"label", label}, {"cells", s[0]}, {"box", {s[1], s[2], s[3], s[4]}},
+                        {"center", {s[5] / s[0], s[6] / s[0]}}});
+    }
+    SendJson(response, {{"labels", labels}});
+  });
   http.Get(R"(/api/docs/(\d+)/save)", [&state](const httplib::Request& request, httplib::Response& response) {
     if (auto document = state.FindDocument(request, response)) Save(*document, request, response);
   });

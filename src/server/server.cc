@@ -124,4 +124,12 @@ int EditorServer::OpenAtStart(const std::string& path) {
   return state_->AddDocument(fs::path(path).filename().string(), std::move(file.scans.front()));
 }
 
+int EditorServer::OpenScene(const std::string& name) {
+  const auto& names = state_->options.builtin_scenes;
+  if (std::find(names.begin(), names.end(), name) == names.end() || !state_->options.scan_builtin) {
+    throw InputError(fmt::format("no built-in scene '{}'", name));
+  }
+  return state_->AddDocument(name, state_->options.scan_builtin(name));
+}
+
 }  // namespace lidarshop::server

@@ -53,6 +53,8 @@ class EditorServer {
 
   // Opens a scan file at start (`serve SCAN…`); its folder becomes a root. Returns the document id.
   int OpenAtStart(const std::string& path);
+  // Scans a built-in scene and opens it (throws InputError for an unknown name).
+  int OpenScene(const std::string& name);
 
   struct State;
 

@@ -1,6 +1,6 @@
 // lidarshop serve: the editor in the browser (src/server, docs/api.md, web/).
 //
-//   lidarshop serve [SCAN...] [--port 8080] [--host 127.0.0.1] [--root DIR...] [--web DIR]
+//   lidarshop serve [SCAN...] [--scene NAME] [--port 8080] [--host 127.0.0.1] [--root DIR...] [--web DIR]
 #include <csignal>
 #include <filesystem>
 
@@ -50,6 +50,8 @@ int RunServe(int argc, char** argv) {
       ->check(CLI::Range(0, 65535));
   app.add_option("--host", options.host, "address to listen on (127.0.0.1 = this machine only)")
       ->capture_default_str();
+  std::vector<std::string> scenes;
+  app.add_option("--scene", scenes, "built-in scenes to scan and open at start (repeatable)");
   app.add_option("--root", options.roots, "a folder whose scan files the editor may open (repeatable)");
   app.add_option("--web", options.web_dir, "the built front end (default: web/ beside the executable)");
   app.add_option("--token", options.token, "the access token (default: a random one)");
@@ -67,6 +69,7 @@ int RunServe(int argc, char** argv) {
     };
     server::EditorServer editor(options);
     for (const std::string& scan : scans) editor.OpenAtStart(scan);
+    for (const std::string& scene : scenes) editor.OpenScene(scene);
     editor.Bind();
     if (options.web_dir.empty()) {
       fmt::print(stderr,

@@ -1,0 +1,145 @@
+// End to end in a real browser: Debian's chromium driven by playwright-core against `lidarshop serve`.
+// Opens the built-in parking lot, paints strokes on the hatchback, segments, removes it, orbits, saves as E57
+// and checks the saved file with `lidarshop info`. Screenshots of each step go to ARTEFACTS (and to
+// docs/results/editor/ with --docs).
+//
+//   node e2e/editor.mjs LIDARSHOP_BINARY ARTEFACTS_DIR [--docs]
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdirSync, readFileSync, copyFileSync, existsSync, mkdtempSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { tmpdir } from 'node:os';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const [binary, artefacts = join(tmpdir(), 'lidarshop-e2e')] = process.argv.slice(2);
+const toDocs = process.argv.includes('--docs');
+if (!binary) throw new Error('usage: node e2e/editor.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--docs]');
+mkdirSync(artefacts, { recursive: true });
+const root = mkdtempSync(join(tmpdir(), 'lidarshop-e2e-root-'));
+const hatchback = JSON.parse(readFileSync(join(here, '../../data/scenes/parking_lot.json'), 'utf8')).objects.find(
+  (object) => object.name === 'hatchback').label;
+
+function fail(message) {
+  console.error(`e2e: FAILED: ${message}`);
+  process.exitCode = 1;
+  throw new Error(message);
+}
+
+// Starts the server on a free port and resolves with the URL it prints.
+function startServer() {
+  const server = spawn(binary, ['serve', '--port', '0', '--web', join(here, '../dist'), '--root', root], {
+    stdio: ['ignore', 'pipe', 'inherit'],
+  });
+  return new Promise((resolve, reject) => {
+    let output = '';
+    server.stdout.on('data', (chunk) => {
+      output += chunk;
+      const match = output.match(/http:\/\/\S+/);
+      if (match) resolve({ server, url: match[0] });
+    });
+    server.on('exit', (code) => reject(new Error(`lidarshop serve exited with ${code}`)));
+    setTimeout(() => reject(new Error('lidarshop serve printed no URL in 20 s')), 20000);
+  });
+}
+
+const { server, url } = await startServer();
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
+         '--disable-component-update', '--disable-sync', '--use-gl=swiftshader', '--enable-unsafe-swiftshader'],
+});
+let step = 0;
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 800 }, acceptDownloads: true });
+  page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
+  const shot = async (name) => {
+    const file = join(artefacts, `${String(++step).padStart(2, '0')}_${name}.png`);
+    await page.screenshot({ path: file });
+    if (toDocs) {
+      mkdirSync(join(here, '../../docs/results/editor'), { recursive: true });
+      copyFileSync(file, join(here, '../../docs/results/editor', `${String(step).padStart(2, '0')}_${name}.png`));
+    }
+    console.log(`e2e: ${name} -> ${file}`);
+  };
+  const statusText = () => page.locator('#status').textContent();
+  const waitForStatus = async (pattern, what, timeout = 120000) => {
+    try {
+      await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent),
+        pattern.source, { timeout });
+    } catch {
+      fail(`${what}: status never matched ${pattern}: '${await statusText()}'`);
+    }
+  };
+
+  await page.goto(url);
+  await page.selectOption('#scene', 'parking_lot');
+  await page.click('#open-scene');
+  await waitForStatus(/^parking_lot: \d+ x \d+ cells/, 'open the parking lot');
+  await shot('opened');
+
+  // Where the hatchback is, from the scan's labels; strokes across it and around it.
+  const doc = await page.evaluate(() => window.lidarshop.current());
+  const token = new URL(url).searchParams.get('token');
+  const labels = await (await fetch(new URL(`/api/docs/${doc.id}/labels?token=${token}`, url))).json();
+  const car = labels.labels.find((entry) => entry.label === hatchback);
+  if (!car || car.cells < 100) fail(`the hatchback (label ${hatchback}) is not in the scan`);
+  const [r0, c0, r1, c1] = car.box;
+  const canvas = await page.locator('#ray').boundingBox();
+  const screen = (row, col) => page.evaluate(([r, c]) => window.lidarshop.rayView.screenOf({ row: r, col: c }), [row, col]);
+  const drag = async (cells) => {
+    const first = await screen(...cells[0]);
+    await page.mouse.move(canvas.x + first.x, canvas.y + first.y);
+    await page.mouse.down();
+    for (const cell of cells.slice(1)) {
+      const point = await screen(...cell);
+      await page.mouse.move(canvas.x + point.x, canvas.y + point.y, { steps: 8 });
+    }
+    await page.mouse.up();
+  };
+  const [cr, cc] = car.center;
+  await page.click('#brush-object');
+  await drag([[cr, Math.round(c0 + 0.25 * (c1 - c0))], [cr, Math.round(c0 + 0.75 * (c1 - c0))]]);
+  await waitForStatus(/object stroke cells painted/, 'object stroke');
+  await page.click('#brush-background');
+  const m = 12;
+  const top = Math.max(0, r0 - m), bottom = Math.min(doc.rows - 1, r1 + m);
+  const left = Math.max(0, c0 - m), right = Math.min(doc.cols - 1, c1 + m);
+  await drag([[top, left], [top, right], [bottom, right], [bottom, left], [top, left]]);
+  await waitForStatus(/background stroke cells painted/, 'background stroke');
+  await shot('strokes');
+
+  await page.click('#segment');
+  await waitForStatus(/^segment done/, 'segment');
+  const segmented = await page.evaluate(() => window.lidarshop.current());
+  if (segmented.object_cells < 0.5 * car.cells) fail(`segmented ${segmented.object_cells} cells of a ${car.cells}-cell car`);
+  await shot('segmented');
+
+  await page.click('#remove');
+  await waitForStatus(/^remove done/, 'remove', 300000);
+  const removed = await page.evaluate(() => window.lidarshop.current());
+  if (removed.synthesized_cells < 0.5 * car.cells) fail(`only ${removed.synthesized_cells} synthesized cells`);
+  await page.selectOption('#point-colour', 'layers');
+  await shot('removed');
+
+  await page.evaluate(() => window.lidarshop.pointView.orbit(35));
+  const points = await page.locator('#points canvas').boundingBox();
+  await page.mouse.move(points.x + points.width / 2, points.y + points.height / 2);
+  await page.mouse.down();
+  await page.mouse.move(points.x + points.width / 2 + 120, points.y + points.height / 2 - 30, { steps: 10 });
+  await page.mouse.up();
+  await shot('orbited');
+
+  await page.selectOption('#format', 'e57');
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click('#save')]);
+  const saved = join(artefacts, 'removed.e57');
+  await download.saveAs(saved);
+  if (!existsSync(saved)) fail('no E57 downloaded');
+  const info = JSON.parse(execFileSync(binary, ['info', saved], { encoding: 'utf8' }));
+  const scan = info.scans[0];
+  if (!scan.channels.includes('synthesized')) fail(`the saved E57 has no synthesized channel: ${scan.channels}`);
+  console.log(`e2e: passed (car ${car.cells} cells, segmented ${segmented.object_cells}, synthesized ${removed.synthesized_cells}, saved ${saved})`);
+} finally {
+  await browser.close();
+  server.kill('SIGTERM');
+}

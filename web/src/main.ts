@@ -1,0 +1,150 @@
+// The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
+import { Api, ApiError, DocumentInfo, JobInfo } from './api';
+import { PointColouring, PointView } from './pointview';
+import { Brush, RayView } from './rayview';
+import { Cell, toCellList } from './strokes';
+
+const api = Api.fromLocation(window.location);
+const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
+const status = (text: string) => (element('status').textContent = text);
+
+const rayView = new RayView(element<HTMLCanvasElement>('ray'));
+const pointView = new PointView(element('points'));
+let doc: DocumentInfo | null = null;
+let runningJob: JobInfo | null = null;
+
+// For end-to-end tests: where a cell is on screen, and what is open.
+(window as unknown as Record<string, unknown>).lidarshop = { rayView, pointView, current: () => doc };
+
+async function refresh(keepView: boolean) {
+  if (!doc) return;
+  doc = await api.json<DocumentInfo>(`/api/docs/${doc.id}`);
+  const channel = element<HTMLSelectElement>('channel').value;
+  const usable = channel === 'rgb' && !doc.channels.includes('color') ? 'intensity' : channel;
+  const aspect = doc.azimuth_step_deg > 0 ? doc.elevation_step_deg / doc.azimuth_step_deg : 1;
+  const mask = doc.object_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { v: doc.version }) : null;
+  await rayView.show(api.url(`/api/docs/${doc.id}/image.png`, { channel: usable, v: doc.version }), mask, doc.rows, doc.cols, aspect, keepView);
+  pointView.show(await api.points(doc.id), keepView);
+  element<HTMLButtonElement>('undo').disabled = !doc.can_undo;
+  element<HTMLButtonElement>('redo').disabled = !doc.can_redo;
+  status(`${doc.name}: ${doc.rows} x ${doc.cols} cells, ${doc.valid_cells} returns, ${doc.synthesized_cells} synthesized, ${doc.object_cells} in the object (version ${doc.version})`);
+}
+
+async function open(params: Record<string, string>) {
+  try {
+    status('opening…');
+    doc = await api.json<DocumentInfo>('/api/open', params);
+    rayView.clearStrokes();
+    await refresh(false);
+  } catch (error) {
+    status(`open failed: ${(error as Error).message}`);
+  }
+}
+
+// Runs an operation as a job; shows the progress bar once it has taken half a second, with cancel.
+async function runJob(path: string, body: unknown, what: string) {
+  if (!doc) return status('open a scan first');
+  const started = Date.now();
+  try {
+    runningJob = await api.json<JobInfo>(path, {}, body);
+    const finished = await api.waitForJob(runningJob, (job) => {
+      const show = Date.now() - started > 500 && (job.state === 'queued' || job.state === 'running');
+      element('progress').hidden = !show;
+      element('progress-label').textContent = `${what}: ${job.label}`;
+      const bar = element<HTMLProgressElement>('progress-bar');
+      bar.max = Math.max(1, job.total);
+      bar.value = job.done;
+    });
+    element('progress').hidden = true;
+    runningJob = null;
+    if (finished.state === 'done') {
+      await refresh(true);
+      status(`${what} done. ${element('status').textContent}`);
+    } else {
+      status(`${what} ${finished.state}${finished.error ? `: ${finished.error}` : ''}`);
+    }
+  } catch (error) {
+    element('progress').hidden = true;
+    status(`${what} failed: ${error instanceof ApiError ? error.message : String(error)}`);
+  }
+}
+
+rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
+  if (!doc || brush === 'none') return;
+  try {
+    await api.json(`/api/docs/${doc.id}/strokes`, {}, { [brush]: toCellList(cells), radius: rayView.radius });
+    status(`${cells.length} ${brush} stroke cells painted`);
+  } catch (error) {
+    status(`stroke failed: ${(error as Error).message}`);
+  }
+};
+rayView.onPick = (cell) => {
+  if (!doc) return;
+  rayView.pick(cell);
+  pointView.highlight(cell.row * doc.cols + cell.col);
+  status(`cell row ${cell.row}, column ${cell.col}`);
+};
+pointView.onPick = (index) => {
+  if (!doc) return;
+  rayView.pick({ row: Math.floor(index / doc.cols), col: index % doc.cols });
+};
+
+for (const button of document.querySelectorAll<HTMLButtonElement>('button.brush')) {
+  button.addEventListener('click', () => {
+    rayView.brush = button.dataset.brush as Brush;
+    document.querySelectorAll('button.brush').forEach((b) => b.classList.toggle('active', b === button));
+  });
+}
+element('brush-object').classList.add('active');
+element<HTMLInputElement>('radius').addEventListener('change', (event) => {
+  rayView.radius = Number((event.target as HTMLInputElement).value);
+});
+element('channel').addEventListener('change', () => refresh(true));
+element<HTMLInputElement>('point-size').addEventListener('input', (event) => pointView.setPointSize(Number((event.target as HTMLInputElement).value)));
+element<HTMLSelectElement>('point-colour').addEventListener('change', (event) => pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring));
+element('open-scene').addEventListener('click', () => open({ scene: element<HTMLSelectElement>('scene').value }));
+element('open-file').addEventListener('click', () => open({ path: element<HTMLSelectElement>('file').value }));
+element('segment').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/segment`, {}, 'segment'));
+element('remove').addEventListener('click', async () => {
+  await runJob(`/api/docs/${doc?.id}/remove`, {}, 'remove');
+  rayView.clearStrokes();
+});
+element('fill').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, {}, 'fill'));
+for (const action of ['undo', 'redo']) {
+  element(action).addEventListener('click', async () => {
+    if (!doc) return;
+    try {
+      await api.json(`/api/docs/${doc.id}/${action}`, {}, {});
+      await refresh(true);
+    } catch (error) {
+      status(`${action}: ${(error as Error).message}`);
+    }
+  });
+}
+element('cancel').addEventListener('click', () => {
+  if (runningJob) api.json(`/api/jobs/${runningJob.id}/cancel`, {}, {}).catch(() => {});
+});
+element('save').addEventListener('click', () => {
+  if (!doc) return;
+  const link = document.createElement('a');
+  link.href = api.url(`/api/docs/${doc.id}/save`, { format: element<HTMLSelectElement>('format').value });
+  link.download = '';
+  link.click();
+});
+
+async function start() {
+  try {
+    const { scenes } = await api.json<{ scenes: string[] }>('/api/scenes');
+    element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
+    const { files } = await api.json<{ files: { path: string }[] }>('/api/files');
+    element('file').replaceChildren(...files.map((file) => new Option(file.path.split('/').pop()!, file.path)));
+    const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
+    if (documents.length > 0) {
+      doc = documents[0];
+      await refresh(false);
+    }
+  } catch (error) {
+    status(error instanceof ApiError && error.status === 401 ? 'open the URL `lidarshop serve` printed (it holds the token)' : String(error));
+  }
+}
+start();

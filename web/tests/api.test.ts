@@ -1,0 +1,54 @@
+import { describe, expect, it } from 'vitest';
+import { Api, FLAG_OBJECT, FLAG_SYNTHESIZED, parsePoints } from '../src/api';
+import { pointColours } from '../src/pointview';
+
+function encode(points: { xyz: number[]; cell: number; rgb: number[]; flag: number }[], rows = 4, cols = 5) {
+  const n = points.length;
+  const buffer = new ArrayBuffer(16 + n * 20);
+  const header = new DataView(buffer);
+  header.setUint32(0, 0x3150534c, true);
+  header.setUint32(4, n, true);
+  header.setUint32(8, rows, true);
+  header.setUint32(12, cols, true);
+  new Float32Array(buffer, 16, 3 * n).set(points.flatMap((p) => p.xyz));
+  new Uint32Array(buffer, 16 + 12 * n, n).set(points.map((p) => p.cell));
+  new Uint8Array(buffer, 16 + 16 * n, 3 * n).set(points.flatMap((p) => p.rgb));
+  new Uint8Array(buffer, 16 + 19 * n, n).set(points.map((p) => p.flag));
+  return buffer;
+}
+
+describe('parsePoints', () => {
+  const sample = [
+    { xyz: [1, 2, 3], cell: 7, rgb: [10, 20, 30], flag: 0 },
+    { xyz: [-1.5, 0.25, 9], cell: 19, rgb: [255, 0, 128], flag: FLAG_SYNTHESIZED | FLAG_OBJECT },
+  ];
+  it('reads every array', () => {
+    const points = parsePoints(encode(sample));
+    expect(points.count).toBe(2);
+    expect(points.rows).toBe(4);
+    expect(points.cols).toBe(5);
+    expect(Array.from(points.xyz)).toEqual([1, 2, 3, -1.5, 0.25, 9]);
+    expect(Array.from(points.cells)).toEqual([7, 19]);
+    expect(Array.from(points.rgb)).toEqual([10, 20, 30, 255, 0, 128]);
+    expect(Array.from(points.flags)).toEqual([0, 3]);
+  });
+  it('refuses short or foreign data', () => {
+    expect(() => parsePoints(new ArrayBuffer(8))).toThrow(/shorter than the header/);
+    expect(() => parsePoints(encode(sample).slice(0, 40))).toThrow(/expected/);
+    const foreign = encode(sample);
+    new DataView(foreign).setUint32(0, 0, true);
+    expect(() => parsePoints(foreign)).toThrow(/not LSP1/);
+  });
+  it('colours by layer', () => {
+    const colours = pointColours(parsePoints(encode(sample)), 'layers');
+    expect(Array.from(colours.slice(0, 3)).map((v) => v.toFixed(2))).toEqual(['0.60', '0.60', '0.60']);
+    expect(colours[3]).toBe(1); // object orange wins over synthesized
+  });
+});
+
+describe('Api', () => {
+  it('puts the token on every URL', () => {
+    const api = Api.fromLocation({ search: '?token=abc123', origin: 'http://127.0.0.1:9' });
+    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range&token=abc123');
+  });
+});
