@@ -43,6 +43,17 @@ void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int 
   }
 }
 
+// The polygon [[row, col], ...] of `json[key]` (a lasso), filled with 255 into `mask`.
+void FillPolygon(const nlohmann::json& json, const char* key, cv::Mat& mask) {
+  if (!json.contains(key)) return;
+  cv::Mat vertices(mask.size(), CV_8U, cv::Scalar(0));
+  PaintCells(json, key, 255, 0, vertices);  // checks every vertex
+  std::vector<cv::Point> polygon;
+  for (const auto& cell : json.at(key)) polygon.emplace_back(cell[1].get<int>(), cell[0].get<int>());
+  if (polygon.size() < 3) throw OptionsFieldError(key, "a lasso needs at least 3 cells");
+  cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{polygon}, cv::Scalar(255));
+}
+
 nlohmann::ordered_json JobJson(const Job& job) {
   nlohmann::ordered_json json = {{"id", job.id},
                                  {"kind", job.kind},
@@ -106,8 +117,6 @@ void Segment(State& state, const std::shared_ptr<Document>& document, const nloh
 void Remove(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
             httplib::Response& response) {
   const RemoveOptions options = OptionsOf<RemoveOptions>(body);
-  if (options.keep_object)
-    throw OptionsFieldError("keep_object", "the editor shows one layer; use `fill` instead");
   const int undo_depth = state.options.undo_depth;
   StartJob(
       state, document, "remove",
@@ -120,8 +129,14 @@ void Remove(State& state, const std::shared_ptr<Document>& document, const nlohm
         const RemoveResult result = RemoveObject(start.scan, start.strokes, options, &progress);
         std::lock_guard lock(document->mutex);
         Snapshot next = document->now;
-        next.scan = result.fill.scan;
-        next.object_mask = cv::Mat();
+        if (options.keep_object) {  // fill shadow: the object stays, the surface behind it is a second layer
+          next.behind = result.behind;
+          next.object_mask = result.cut.mask.clone();
+        } else {
+          next.scan = result.fill.scan;
+          next.object_mask = cv::Mat();
+          next.behind = Scan();
+        }
         next.strokes = cv::Mat::zeros(next.scan.rows, next.scan.cols, CV_8U);
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
@@ -137,27 +152,33 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
   const FillOptions options = OptionsOf<FillOptions>(body);
   const int margin = body.value("margin_cells", 2);
   if (margin < 0 || margin > 100) throw OptionsFieldError("margin_cells", "out of range [0, 100]");
+  const std::string which = body.value("hole", std::string("object"));
+  if (which != "object" && which != "painted")
+    throw OptionsFieldError("hole", "expected \"object\" or \"painted\"");
+  const bool painted = which == "painted";
   {
     std::lock_guard lock(document->mutex);
-    if (document->now.object_mask.empty() || cv::countNonZero(document->now.object_mask) == 0) {
-      throw OptionsFieldError("object", "segment an object first: the fill fills the object's cells");
+    const cv::Mat& mask = painted ? document->now.hole : document->now.object_mask;
+    if (mask.empty() || cv::countNonZero(mask) == 0) {
+      throw OptionsFieldError("hole", painted ? "paint a hole first (hole brush or lasso)"
+                                              : "segment an object first: the fill fills the object's cells");
     }
   }
   const int undo_depth = state.options.undo_depth;
   StartJob(
       state, document, "fill",
-      [document, options, margin, undo_depth](Progress& progress) {
+      [document, options, margin, painted, undo_depth](Progress& progress) {
         Snapshot start;
         {
           std::lock_guard lock(document->mutex);
           start = document->now;
         }
-        const FillResult result =
-            FillScan(start.scan, GrowHole(start.object_mask, margin), options, &progress);
+        const cv::Mat hole = painted ? start.hole : GrowHole(start.object_mask, margin);
+        const FillResult result = FillScan(start.scan, hole, options, &progress);
         std::lock_guard lock(document->mutex);
         Snapshot next = document->now;
         next.scan = result.scan;
-        next.object_mask = cv::Mat();
+        (painted ? next.hole : next.object_mask) = cv::Mat();
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
         json["version"] = document->version;
@@ -201,10 +222,18 @@ void AddEditRoutes(State& state) {
         PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
         PaintCells(body, "background", 2, radius, next.strokes);
         PaintCells(body, "erase", 0, radius, next.strokes);
+        if (body.contains("hole") || body.contains("hole_polygon") || body.contains("erase_hole")) {
+          next.hole = next.hole.empty() ? cv::Mat::zeros(next.strokes.size(), CV_8U) : next.hole.clone();
+          PaintCells(body, "hole", 255, radius, next.hole);
+          PaintCells(body, "erase_hole", 0, radius, next.hole);
+          FillPolygon(body, "hole_polygon", next.hole);
+        }
         Commit(*document, std::move(next), state.options.undo_depth);
-        SendJson(response, {{"version", document->version},
-                            {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
-                            {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
+        SendJson(response,
+                 {{"version", document->version},
+                  {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
+                  {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
+                  {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
       });
   PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
   PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);

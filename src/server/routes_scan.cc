@@ -1,10 +1,10 @@
 // Routes that open, describe, show and save scans (docs/api.md).
 #include <unistd.h>
 
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <array>
 #include <fstream>
 #include <map>
 
@@ -118,20 +118,23 @@ nlohmann::ordered_json DocumentJson(Document& document) {
     return angles.size() < 2 ? 0.0
                              : std::abs(angles.back() - angles.front()) / (angles.size() - 1) * 180.0 / M_PI;
   };
-  return {{"id", document.id},
-          {"name", document.name},
-          {"rows", scan.rows},
-          {"cols", scan.cols},
-          {"channels", channels},
-          {"valid_cells", scan.CountValid()},
-          {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
-          {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
-          {"world_from_scanner_column_major", pose},
-          {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
-          {"elevation_step_deg", step_deg(scan.grid.elevation_rad)},
-          {"version", document.version},
-          {"can_undo", !document.undo.empty()},
-          {"can_redo", !document.redo.empty()}};
+  return {
+      {"id", document.id},
+      {"name", document.name},
+      {"rows", scan.rows},
+      {"cols", scan.cols},
+      {"channels", channels},
+      {"valid_cells", scan.CountValid()},
+      {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
+      {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
+      {"hole_cells", document.now.hole.empty() ? 0 : cv::countNonZero(document.now.hole)},
+      {"behind_cells", document.now.behind.valid.empty() ? 0 : cv::countNonZero(document.now.behind.valid)},
+      {"world_from_scanner_column_major", pose},
+      {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
+      {"elevation_step_deg", step_deg(scan.grid.elevation_rad)},
+      {"version", document.version},
+      {"can_undo", !document.undo.empty()},
+      {"can_redo", !document.redo.empty()}};
 }
 
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
@@ -145,30 +148,36 @@ void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
 // The points of a scan as typed arrays (docs/api.md "Points"): header, xyz float32 (scanner frame), cell index
 // uint32, rgb uint8, flags uint8 (1 = synthesized, 2 = object).
 std::string PointsBinary(const Document& document) {
-  const Scan& scan = document.now.scan;
   std::vector<float> xyz;
   std::vector<uint32_t> cells;
   std::vector<uint8_t> rgb, flags;
-  for (int r = 0; r < scan.rows; ++r) {
-    for (int c = 0; c < scan.cols; ++c) {
-      if (scan.valid.at<uint8_t>(r, c) == 0) continue;
-      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-      xyz.insert(xyz.end(), {p[0], p[1], p[2]});
-      cells.push_back(static_cast<uint32_t>(r * scan.cols + c));
-      if (scan.has_color()) {
-        const cv::Vec3b color = scan.color.at<cv::Vec3b>(r, c);
-        rgb.insert(rgb.end(), {color[0], color[1], color[2]});
-      } else {
-        const float intensity = scan.intensity.empty() ? 0.7f : scan.intensity.at<float>(r, c);
-        const auto grey = static_cast<uint8_t>(std::clamp(intensity, 0.0f, 1.0f) * 255.0f);
-        rgb.insert(rgb.end(), {grey, grey, grey});
+  for (const Scan* layer : {&document.now.scan, &document.now.behind}) {
+    const Scan& scan = *layer;
+    const bool behind = layer == &document.now.behind;
+    if (scan.valid.empty()) continue;
+    for (int r = 0; r < scan.rows; ++r) {
+      for (int c = 0; c < scan.cols; ++c) {
+        if (scan.valid.at<uint8_t>(r, c) == 0) continue;
+        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+        xyz.insert(xyz.end(), {p[0], p[1], p[2]});
+        cells.push_back(static_cast<uint32_t>(r * scan.cols + c));
+        if (scan.has_color()) {
+          const cv::Vec3b color = scan.color.at<cv::Vec3b>(r, c);
+          rgb.insert(rgb.end(), {color[0], color[1], color[2]});
+        } else {
+          const float intensity = scan.intensity.empty() ? 0.7f : scan.intensity.at<float>(r, c);
+          const auto grey = static_cast<uint8_t>(std::clamp(intensity, 0.0f, 1.0f) * 255.0f);
+          rgb.insert(rgb.end(), {grey, grey, grey});
+        }
+        uint8_t flag = 0;
+        if (!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(r, c) != 0) flag |= 1;
+        if (!behind && !document.now.object_mask.empty() && document.now.object_mask.at<uint8_t>(r, c) != 0)
+          flag |= 2;
+        flags.push_back(flag);
       }
-      uint8_t flag = 0;
-      if (!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(r, c) != 0) flag |= 1;
-      if (!document.now.object_mask.empty() && document.now.object_mask.at<uint8_t>(r, c) != 0) flag |= 2;
-      flags.push_back(flag);
     }
   }
+  const Scan& scan = document.now.scan;
   const uint32_t header[4] = {0x3150534cu /* "LSP1" */, static_cast<uint32_t>(cells.size()),
                               static_cast<uint32_t>(scan.rows), static_cast<uint32_t>(scan.cols)};
   std::string bytes(sizeof(header), '\0');
@@ -227,7 +236,14 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
                            std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
   {
     std::lock_guard lock(document.mutex);
-    WriteScanFile(file.string(), {document.now.scan});
+    if (document.now.behind.valid.empty()) {
+      WriteScanFile(file.string(), {document.now.scan});
+    } else if (format == "ptx") {
+      SendError(response, 400, "PTX cannot hold the second layer behind the object; save as e57, ply or pcd");
+      return;
+    } else {
+      WriteScanWithLayer(file.string(), document.now.scan, document.now.behind);
+    }
   }
   std::ifstream in(file, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -309,9 +325,16 @@ void AddScanRoutes(State& state) {
              if (!document) return;
              std::lock_guard lock(document->mutex);
              const Scan& scan = document->now.scan;
-             cv::Mat mask = document->now.object_mask.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U)
-                                                              : document->now.object_mask;
-             SendPng(response, mask);
+             const bool hole = request.get_param_value("layer") == "hole";
+             const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
+             cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
+             if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
+             // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
+             cv::Mat overlay(mask.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+             overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask);
+             std::vector<uint8_t> png;
+             cv::imencode(".png", overlay, png);
+             response.set_content(std::string(png.begin(), png.end()), "image/png");
            });
   http.Get(R"(/api/docs/(\d+)/points)",
            [&state](const httplib::Request& request, httplib::Response& response) {
@@ -321,30 +344,40 @@ void AddScanRoutes(State& state) {
              response.set_content(PointsBinary(*document), "application/octet-stream");
            });
   // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).
-  http.Get(R"(/api/docs/(\d+)/labels)", [&state](const httplib::Request& request, httplib::Response& response) {
-    auto document = state.FindDocument(request, response);
-    if (!document) return;
-    std::lock_guard lock(document->mutex);
-    const Scan& scan = document->now.scan;
-    std::map<int32_t, std::array<int64_t, 7>> stats;  // cells, min row, min col, max row, max col, sum r, sum c
-    if (!scan.label.empty()) {
-      for (int r = 0; r < scan.rows; ++r) {
-        for (int c = 0; c < scan.cols; ++c) {
-          if (scan.valid.at<uint8_t>(r, c) == 0) continue;
-          auto [it, added] = stats.try_emplace(scan.label.at<int32_t>(r, c), std::array<int64_t, 7>{0, r, c, r, c, 0, 0});
-          auto& s = it->second;
-          s = {s[0] + 1, std::min<int64_t>(s[1], r), std::min<int64_t>(s[2], c), std::max<int64_t>(s[3], r),
-               std::max<int64_t>(s[4], c), s[5] + r, s[6] + c};
-        }
-      }
-    }
-    nlohmann::ordered_json labels = nlohmann::ordered_json::array();
-    for (const auto& [label, s] : stats) {
-      labels.push_back({{"label", label}, {"cells", s[0]}, {"box", {s[1], s[2], s[3], s[4]}},
-                        {"center", {s[5] / s[0], s[6] / s[0]}}});
-    }
-    SendJson(response, {{"labels", labels}});
-  });
+  http.Get(R"(/api/docs/(\d+)/labels)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             auto document = state.FindDocument(request, response);
+             if (!document) return;
+             std::lock_guard lock(document->mutex);
+             const Scan& scan = document->now.scan;
+             std::map<int32_t, std::array<int64_t, 7>>
+                 stats;  // cells, min row, min col, max row, max col, sum r, sum c
+             if (!scan.label.empty()) {
+               for (int r = 0; r < scan.rows; ++r) {
+                 for (int c = 0; c < scan.cols; ++c) {
+                   if (scan.valid.at<uint8_t>(r, c) == 0) continue;
+                   auto [it, added] = stats.try_emplace(scan.label.at<int32_t>(r, c),
+                                                        std::array<int64_t, 7>{0, r, c, r, c, 0, 0});
+                   auto& s = it->second;
+                   s = {s[0] + 1,
+                        std::min<int64_t>(s[1], r),
+                        std::min<int64_t>(s[2], c),
+                        std::max<int64_t>(s[3], r),
+                        std::max<int64_t>(s[4], c),
+                        s[5] + r,
+                        s[6] + c};
+                 }
+               }
+             }
+             nlohmann::ordered_json labels = nlohmann::ordered_json::array();
+             for (const auto& [label, s] : stats) {
+               labels.push_back({{"label", label},
+                                 {"cells", s[0]},
+                                 {"box", {s[1], s[2], s[3], s[4]}},
+                                 {"center", {s[5] / s[0], s[6] / s[0]}}});
+             }
+             SendJson(response, {{"labels", labels}});
+           });
   http.Get(R"(/api/docs/(\d+)/save)", [&state](const httplib::Request& request, httplib::Response& response) {
     if (auto document = state.FindDocument(request, response)) Save(*document, request, response);
   });

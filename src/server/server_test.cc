@@ -192,6 +192,48 @@ TEST_F(ServerTest, SegmentRemoveUndoSave) {
   EXPECT_EQ(saved->body.substr(0, 8), "ASTM-E57");
 }
 
+TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
+  const int id = OpenBox();
+  const std::string strokes = Api(fmt::format("/api/docs/{}/strokes", id));
+  const auto lasso = client_->Post(strokes, R"({"hole_polygon": [[40, 10], [40, 30], [55, 30], [55, 10]]})",
+                                   "application/json");
+  ASSERT_EQ(lasso->status, 200) << lasso->body;
+  const int lasso_cells = Json(lasso)["hole_cells"];
+  EXPECT_NEAR(lasso_cells, 16 * 21, 40);  // the filled quadrilateral, boundary included
+  EXPECT_EQ(client_->Post(strokes, R"({"hole_polygon": [[1, 1], [2, 2]]})", "application/json")->status, 400);
+  const auto brushed = client_->Post(strokes, R"({"hole": [[20, 60]], "radius": 3})", "application/json");
+  EXPECT_GT(Json(brushed)["hole_cells"].get<int>(), lasso_cells);
+  const auto filled = Wait(
+      Json(client_->Post(Api(fmt::format("/api/docs/{}/fill", id)),
+                         R"({"hole": "painted", "options": {"method": "laplace"}})", "application/json")));
+  ASSERT_EQ(filled["state"], "done") << filled.dump();
+  EXPECT_GT(filled["result"]["synthesized_cells"].get<int>(), 0);
+  const auto after_fill = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_EQ(after_fill["hole_cells"], 0);
+  EXPECT_EQ(
+      client_->Post(Api(fmt::format("/api/docs/{}/fill", id)), R"({"hole": "painted"})", "application/json")
+          ->status,
+      400);  // nothing painted any more
+
+  // Fill shadow: the object stays, the surface behind it becomes a second layer, saved as a second return.
+  ASSERT_EQ(client_->Post(strokes, StrokesBody(), "application/json")->status, 200);
+  const auto shadow = Wait(Json(client_->Post(
+      Api(fmt::format("/api/docs/{}/remove", id)),
+      R"({"options": {"keep_object": true, "fill": {"method": "laplace"}}})", "application/json")));
+  ASSERT_EQ(shadow["state"], "done") << shadow.dump();
+  const auto doc = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_GT(doc["behind_cells"].get<int>(), 50);
+  EXPECT_GT(doc["object_cells"].get<int>(), 50);  // the object is still there
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save?format=ptx", id)))->status, 400);
+  const auto e57 = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
+  ASSERT_EQ(e57->status, 200);
+  const fs::path saved = base_ / "shadow.e57";
+  std::ofstream(saved, std::ios::binary) << e57->body;
+  const ScanFile file = ReadScanFile(saved.string());
+  ASSERT_FALSE(file.scans.empty());
+  EXPECT_EQ(file.scans[0].rows, scan_->rows);
+}
+
 TEST_F(ServerTest, ConcurrentEditsAreNotLost) {
   const int id = OpenBox();
   const int64_t before = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"];

@@ -26,6 +26,10 @@ struct Snapshot {
   Scan scan;
   cv::Mat strokes;      // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
   cv::Mat object_mask;  // CV_8U 255 = the object of the last segmentation (empty = none)
+  cv::Mat hole;         // CV_8U 255 = cells painted with the hole brush or lasso (empty = none)
+  // The surface completed behind a kept object (fill shadow): a second layer, every cell synthesized or
+  // without a return; empty = none. Saved as a second return (E57) or extra points (PLY, PCD).
+  Scan behind;
 };
 
 struct Document {

@@ -9,6 +9,8 @@ export interface DocumentInfo {
   valid_cells: number;
   synthesized_cells: number;
   object_cells: number;
+  hole_cells: number;
+  behind_cells: number;
   azimuth_step_deg: number;
   elevation_step_deg: number;
   version: number;

@@ -22,12 +22,14 @@ async function refresh(keepView: boolean) {
   const channel = element<HTMLSelectElement>('channel').value;
   const usable = channel === 'rgb' && !doc.channels.includes('color') ? 'intensity' : channel;
   const aspect = doc.azimuth_step_deg > 0 ? doc.elevation_step_deg / doc.azimuth_step_deg : 1;
-  const mask = doc.object_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { v: doc.version }) : null;
-  await rayView.show(api.url(`/api/docs/${doc.id}/image.png`, { channel: usable, v: doc.version }), mask, doc.rows, doc.cols, aspect, keepView);
+  const mask = doc.object_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', v: doc.version }) : null;
+  const hole = doc.hole_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', layer: 'hole', v: doc.version }) : null;
+  await rayView.show(api.url(`/api/docs/${doc.id}/image.png`, { channel: usable, v: doc.version }), mask, hole, doc.rows, doc.cols, aspect, keepView);
   pointView.show(await api.points(doc.id), keepView);
   element<HTMLButtonElement>('undo').disabled = !doc.can_undo;
   element<HTMLButtonElement>('redo').disabled = !doc.can_redo;
-  status(`${doc.name}: ${doc.rows} x ${doc.cols} cells, ${doc.valid_cells} returns, ${doc.synthesized_cells} synthesized, ${doc.object_cells} in the object (version ${doc.version})`);
+  const behind = doc.behind_cells > 0 ? `, ${doc.behind_cells} behind the object` : '';
+  status(`${doc.name}: ${doc.rows} x ${doc.cols} cells, ${doc.valid_cells} returns, ${doc.synthesized_cells} synthesized, ${doc.object_cells} in the object, ${doc.hole_cells} in the hole${behind} (version ${doc.version})`);
 }
 
 async function open(params: Record<string, string>) {
@@ -72,8 +74,13 @@ async function runJob(path: string, body: unknown, what: string) {
 rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
   if (!doc || brush === 'none') return;
   try {
-    await api.json(`/api/docs/${doc.id}/strokes`, {}, { [brush]: toCellList(cells), radius: rayView.radius });
-    status(`${cells.length} ${brush} stroke cells painted`);
+    const key = brush === 'lasso' ? 'hole_polygon' : brush;
+    await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
+    if (brush === 'hole' || brush === 'lasso') {
+      rayView.clearStrokes(['hole', 'lasso']);
+      await refresh(true);
+    }
+    status(`${cells.length} ${brush} stroke cells painted. ${element('status').textContent}`);
   } catch (error) {
     status(`stroke failed: ${(error as Error).message}`);
   }
@@ -110,6 +117,11 @@ element('remove').addEventListener('click', async () => {
   rayView.clearStrokes();
 });
 element('fill').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, {}, 'fill'));
+element('fill-hole').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, { hole: 'painted' }, 'fill hole'));
+element('fill-shadow').addEventListener('click', async () => {
+  await runJob(`/api/docs/${doc?.id}/remove`, { options: { keep_object: true } }, 'fill shadow');
+  rayView.clearStrokes(['object', 'background']);
+});
 for (const action of ['undo', 'redo']) {
   element(action).addEventListener('click', async () => {
     if (!doc) return;

@@ -2,7 +2,7 @@
 // button), strokes painted with the brushes, the segmented object tinted, the picked cell marked.
 import { Cell, ImageView, cellsAlong, cellToScreen, fitView, screenToCell, zoomAt } from './strokes';
 
-export type Brush = 'object' | 'background' | 'none';
+export type Brush = 'object' | 'background' | 'hole' | 'lasso' | 'none';
 
 export class RayView {
   brush: Brush = 'object';
@@ -12,6 +12,7 @@ export class RayView {
 
   private image: HTMLImageElement | null = null;
   private mask: HTMLImageElement | null = null;
+  private holeMask: HTMLImageElement | null = null;
   private view: ImageView = { scale: 1, aspect: 1, offsetX: 0, offsetY: 0 };
   private rows = 0;
   private cols = 0;
@@ -33,8 +34,11 @@ export class RayView {
     new ResizeObserver(() => this.fit()).observe(canvas);
   }
 
-  async show(imageUrl: string, maskUrl: string | null, rows: number, cols: number, aspect: number, keepView: boolean) {
-    const [image, mask] = await Promise.all([load(imageUrl), maskUrl ? load(maskUrl) : Promise.resolve(null)]);
+  async show(imageUrl: string, maskUrl: string | null, holeUrl: string | null, rows: number, cols: number, aspect: number,
+             keepView: boolean) {
+    const [image, mask, hole] = await Promise.all([load(imageUrl), maskUrl ? load(maskUrl) : Promise.resolve(null),
+                                                   holeUrl ? load(holeUrl) : Promise.resolve(null)]);
+    this.holeMask = hole;
     const sizeChanged = rows !== this.rows || cols !== this.cols;
     this.image = image;
     this.mask = mask;
@@ -45,8 +49,8 @@ export class RayView {
     this.draw();
   }
 
-  clearStrokes() {
-    this.strokes = [];
+  clearStrokes(brushes: Brush[] = ['object', 'background', 'hole', 'lasso']) {
+    this.strokes = this.strokes.filter((stroke) => !brushes.includes(stroke.brush));
     this.draw();
   }
 
@@ -114,16 +118,16 @@ export class RayView {
     const { scale, aspect, offsetX, offsetY } = this.view;
     context.imageSmoothingEnabled = false;
     context.drawImage(this.image, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
+    if (this.holeMask) {
+      context.drawImage(this.holeMask, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
+    }
     if (this.mask) {
-      context.globalAlpha = 0.35;
-      context.globalCompositeOperation = 'screen';
       context.drawImage(this.mask, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
-      context.globalCompositeOperation = 'source-over';
-      context.globalAlpha = 1;
     }
     for (const stroke of [...this.strokes, ...(this.pending ? [this.pending] : [])]) {
-      context.fillStyle = stroke.brush === 'object' ? 'rgba(60, 220, 60, 0.8)' : 'rgba(230, 60, 60, 0.8)';
-      const r = Math.max(this.radius, 0.5);
+      context.fillStyle = stroke.brush === 'object' ? 'rgba(60, 220, 60, 0.8)'
+        : stroke.brush === 'background' ? 'rgba(230, 60, 60, 0.8)' : 'rgba(60, 120, 255, 0.8)';
+      const r = stroke.brush === 'lasso' ? 0.5 : Math.max(this.radius, 0.5);
       for (const cell of stroke.cells) {
         context.fillRect(offsetX + (cell.col - r + 0.5) * scale, offsetY + (cell.row - r + 0.5) * scale * aspect, 2 * r * scale, 2 * r * scale * aspect);
       }
