@@ -9,12 +9,21 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/verify/verify.h"
 #include "server.h"
 #include "state.h"
 // After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
 #include <httplib.h>
 
 namespace lidarshop::server {
+
+// A model placed in scans: its mesh (for drawing) and its verification side (built once).
+struct ModelEntry {
+  int id = 0;
+  std::string name;
+  TriangleMesh mesh;
+  VerifierModel model;
+};
 
 struct EditorServer::State {
   ServerOptions options;
@@ -25,9 +34,13 @@ struct EditorServer::State {
   std::mutex documents_mutex;
   std::map<int, std::shared_ptr<Document>> documents;
   int last_document = 0;
+  std::map<int, std::shared_ptr<ModelEntry>> models;  // guarded by documents_mutex
+  int last_model = 0;
 
   int AddDocument(std::string name, Scan scan);
-  std::shared_ptr<Document> Get(int id);  // an id AddDocument just returned
+  std::shared_ptr<Document> Get(int id);
+  std::shared_ptr<ModelEntry> FindModel(
+      int id);  // nullptr when there is none  // an id AddDocument just returned
   // The document of the request's first path match; nullptr after answering 404.
   std::shared_ptr<Document> FindDocument(const httplib::Request& request, httplib::Response& response);
 };
@@ -44,6 +57,9 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
 std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::string& requested);
 
 void AddScanRoutes(State& state);  // routes_scan.cc: open, list, pictures, points, save
-void AddEditRoutes(State& state);  // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
+void AddEditRoutes(State& state);
+void AddVerifyRoutes(
+    State&
+        state);  // routes_verify.cc: models, pose verification  // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
 
 }  // namespace lidarshop::server

@@ -86,6 +86,12 @@ std::shared_ptr<Document> State::Get(int id) {
   return documents.at(id);
 }
 
+std::shared_ptr<ModelEntry> State::FindModel(int id) {
+  std::lock_guard lock(documents_mutex);
+  const auto found = models.find(id);
+  return found == models.end() ? nullptr : found->second;
+}
+
 std::shared_ptr<Document> State::FindDocument(const httplib::Request& request, httplib::Response& response) {
   const int id = std::atoi(request.matches[1].str().c_str());
   std::lock_guard lock(documents_mutex);

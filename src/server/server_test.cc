@@ -234,6 +234,42 @@ TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
   EXPECT_EQ(file.scans[0].rows, scan_->rows);
 }
 
+TEST_F(ServerTest, PlaceAndVerifyAModel) {
+  const int id = OpenBox();
+  const auto models = Json(client_->Get(Api("/api/models")));
+  EXPECT_EQ(models["builtin"][0], "car:sedan");
+  const auto placed = client_->Post(Api("/api/models"), R"({"model": "car:sedan"})", "application/json");
+  ASSERT_EQ(placed->status, 200) << placed->body;
+  const int model = Json(placed)["id"];
+  EXPECT_NEAR(Json(placed)["size_m"][1].get<double>(), 4.6, 0.25);  // a sedan is 4.6 m long (+ mirrors)
+  const auto mesh = client_->Get(Api(fmt::format("/api/models/{}/mesh", model)));
+  uint32_t header[4];
+  std::memcpy(header, mesh->body.data(), sizeof(header));
+  EXPECT_EQ(mesh->body.size(), 16 + header[1] * 12 + header[2] * 12);
+  EXPECT_EQ(client_->Post(Api("/api/models"), R"({"model": "car:limo"})", "application/json")->status, 403);
+  EXPECT_EQ(client_->Post(Api("/api/models"), R"({"model": "/etc/passwd"})", "application/json")->status,
+            403);
+  // A car standing where the 1 m box is seen: the scan sees the box's front face where the car's surface would
+  // hide it, so the pose is mostly inconsistent; the same car far to the side, out of view, is not comparable.
+  const std::string verify = Api(fmt::format("/api/docs/{}/verify", id));
+  const auto at_box = Json(client_->Post(
+      verify, fmt::format(R"({{"model": {}, "pose": {{"x_m": 0, "y_m": 8.5, "yaw_deg": 90}}}})", model),
+      "application/json"));
+  ASSERT_TRUE(at_box["has_comparable_pairs"]) << at_box.dump();
+  EXPECT_LT(at_box["consistency"].get<double>(), 0.5) << at_box.dump();
+  const auto behind =
+      Json(client_->Post(verify, fmt::format(R"({{"model": {}, "pose": {{"x_m": 0, "y_m": -20}}}})", model),
+                         "application/json"));
+  EXPECT_FALSE(behind["has_comparable_pairs"]) << behind.dump();
+  EXPECT_TRUE(behind["consistency"].is_null());
+  EXPECT_EQ(client_
+                ->Post(verify, fmt::format(R"({{"model": {}, "pose": {{"x_m": "left"}}}})", model),
+                       "application/json")
+                ->status,
+            400);
+  EXPECT_EQ(client_->Post(verify, R"({"model": 999})", "application/json")->status, 404);
+}
+
 TEST_F(ServerTest, ConcurrentEditsAreNotLost) {
   const int id = OpenBox();
   const int64_t before = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"];

@@ -19,6 +19,10 @@
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/progress.h"
 
+namespace lidarshop {
+struct PreparedScan;  // verify/verify.h
+}  // namespace lidarshop
+
 namespace lidarshop::server {
 
 // What an edit changes; undo restores all of it.
@@ -38,7 +42,10 @@ struct Document {
   Snapshot now;
   std::vector<Snapshot> undo, redo;
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
-  std::mutex mutex;     // guards every field above
+  // The scan prepared for verification (verify/), rebuilt when the version changes.
+  std::shared_ptr<const PreparedScan> prepared;
+  int64_t prepared_version = -1;
+  std::mutex mutex;  // guards every field above
 };
 
 enum class JobState { kQueued, kRunning, kDone, kFailed, kCancelled };

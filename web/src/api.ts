@@ -11,6 +11,7 @@ export interface DocumentInfo {
   object_cells: number;
   hole_cells: number;
   behind_cells: number;
+  world_from_scanner_column_major: number[];
   azimuth_step_deg: number;
   elevation_step_deg: number;
   version: number;
@@ -70,6 +71,45 @@ export function parsePoints(buffer: ArrayBuffer): PointSet {
   return { count, rows, cols, xyz, cells, rgb, flags };
 }
 
+// A model mesh from GET /api/models/ID/mesh: header (magic "LSM1", vertices, triangles, 0; uint32
+// little-endian), float32 xyz per vertex (model frame), uint32 corner indices per triangle.
+export interface MeshData {
+  vertices: number;
+  triangles: number;
+  xyz: Float32Array;
+  indices: Uint32Array;
+}
+
+export function parseMesh(buffer: ArrayBuffer): MeshData {
+  if (buffer.byteLength < 16) throw new Error('mesh: shorter than the header');
+  const header = new DataView(buffer, 0, 16);
+  if (header.getUint32(0, true) !== 0x314d534c) throw new Error('mesh: not LSM1 data');
+  const vertices = header.getUint32(4, true), triangles = header.getUint32(8, true);
+  if (buffer.byteLength !== 16 + vertices * 12 + triangles * 12) throw new Error('mesh: size does not match its header');
+  return { vertices, triangles, xyz: new Float32Array(buffer, 16, vertices * 3), indices: new Uint32Array(buffer, 16 + vertices * 12, triangles * 3) };
+}
+
+// world_from_model of a pose on the ground (verify/PoseFromXyzYaw with no pitch or roll): translate, then yaw
+// about +z, x towards y. Column-major 4x4.
+export function poseMatrix(x: number, y: number, z: number, yawDeg: number): number[] {
+  const c = Math.cos((yawDeg * Math.PI) / 180), s = Math.sin((yawDeg * Math.PI) / 180);
+  return [c, s, 0, 0, -s, c, 0, 0, 0, 0, 1, 0, x, y, z, 1];
+}
+
+// a * b for column-major 4x4 matrices.
+export function multiply(a: number[], b: number[]): number[] {
+  const out = new Array(16).fill(0);
+  for (let col = 0; col < 4; ++col) for (let row = 0; row < 4; ++row) for (let k = 0; k < 4; ++k) out[col * 4 + row] += a[k * 4 + row] * b[col * 4 + k];
+  return out;
+}
+
+// The inverse of a rigid transform (rotation + translation), column-major.
+export function inverseRigid(m: number[]): number[] {
+  const out = [m[0], m[4], m[8], 0, m[1], m[5], m[9], 0, m[2], m[6], m[10], 0, 0, 0, 0, 1];
+  for (let row = 0; row < 3; ++row) out[12 + row] = -(out[row] * m[12] + out[4 + row] * m[13] + out[8 + row] * m[14]);
+  return out;
+}
+
 export class ApiError extends Error {
   constructor(public status: number, message: string) {
     super(message);
@@ -99,6 +139,12 @@ export class Api {
     const json = text ? JSON.parse(text) : {};
     if (!response.ok) throw new ApiError(response.status, json.error ?? `${response.status} ${response.statusText}`);
     return json as T;
+  }
+
+  async mesh(id: number): Promise<MeshData> {
+    const response = await fetch(this.url(`/api/models/${id}/mesh`));
+    if (!response.ok) throw new ApiError(response.status, `mesh: ${response.status}`);
+    return parseMesh(await response.arrayBuffer());
   }
 
   async points(id: number): Promise<PointSet> {

@@ -1,5 +1,5 @@
 // The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
-import { Api, ApiError, DocumentInfo, JobInfo } from './api';
+import { Api, ApiError, DocumentInfo, JobInfo, MeshData, inverseRigid, multiply, poseMatrix } from './api';
 import { PointColouring, PointView } from './pointview';
 import { Brush, RayView } from './rayview';
 import { Cell, toCellList } from './strokes';
@@ -12,9 +12,11 @@ const rayView = new RayView(element<HTMLCanvasElement>('ray'));
 const pointView = new PointView(element('points'));
 let doc: DocumentInfo | null = null;
 let runningJob: JobInfo | null = null;
+let placed: { id: number; mesh: MeshData } | null = null;
+let picked: { row: number; col: number } | null = null;
 
 // For end-to-end tests: where a cell is on screen, and what is open.
-(window as unknown as Record<string, unknown>).lidarshop = { rayView, pointView, current: () => doc };
+(window as unknown as Record<string, unknown>).lidarshop = { rayView, pointView, current: () => doc, verify: () => verify() };
 
 async function refresh(keepView: boolean) {
   if (!doc) return;
@@ -87,12 +89,14 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
 };
 rayView.onPick = (cell) => {
   if (!doc) return;
+  picked = cell;
   rayView.pick(cell);
   pointView.highlight(cell.row * doc.cols + cell.col);
   status(`cell row ${cell.row}, column ${cell.col}`);
 };
 pointView.onPick = (index) => {
   if (!doc) return;
+  picked = { row: Math.floor(index / doc.cols), col: index % doc.cols };
   rayView.pick({ row: Math.floor(index / doc.cols), col: index % doc.cols });
 };
 
@@ -144,12 +148,60 @@ element('save').addEventListener('click', () => {
   link.click();
 });
 
+// Verification: place a model, then every change of the pose re-verifies it (thesis ch. 4).
+const poseInputs = ['pose-x', 'pose-y', 'pose-z', 'pose-yaw'].map((id) => element<HTMLInputElement>(id));
+let verifyTimer: ReturnType<typeof setTimeout> | undefined;
+async function verify() {
+  if (!doc || !placed) return;
+  const [x, y, z, yaw] = poseInputs.map((input) => Number(input.value));
+  try {
+    const result = await api.json<{ consistency: number | null; confidence: number; summary: string }>(
+      `/api/docs/${doc.id}/verify`, {}, { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } });
+    element('verify-result').textContent = result.summary;
+    const scannerFromWorld = inverseRigid(doc.world_from_scanner_column_major);
+    pointView.showModel(placed.mesh, multiply(scannerFromWorld, poseMatrix(x, y, z, yaw)), result.consistency);
+  } catch (error) {
+    element('verify-result').textContent = `verify: ${(error as Error).message}`;
+  }
+}
+for (const input of poseInputs) {
+  input.addEventListener('input', () => {
+    clearTimeout(verifyTimer);
+    verifyTimer = setTimeout(verify, 120);
+  });
+}
+element('place').addEventListener('click', async () => {
+  if (!doc) return status('open a scan first');
+  try {
+    const model = await api.json<{ id: number }>('/api/models', {}, { model: element<HTMLSelectElement>('model').value });
+    placed = { id: model.id, mesh: await api.mesh(model.id) };
+    if (picked) {
+      // The picked cell's point in the world frame (the scan's pose): the model stands there.
+      const points = await api.points(doc.id);
+      const index = points.cells.indexOf(picked.row * doc.cols + picked.col);
+      if (index >= 0) {
+        const w = doc.world_from_scanner_column_major;
+        const [px, py, pz] = [points.xyz[3 * index], points.xyz[3 * index + 1], points.xyz[3 * index + 2]];
+        poseInputs[0].value = (w[0] * px + w[4] * py + w[8] * pz + w[12]).toFixed(2);
+        poseInputs[1].value = (w[1] * px + w[5] * py + w[9] * pz + w[13]).toFixed(2);
+        poseInputs[2].value = (w[2] * px + w[6] * py + w[10] * pz + w[14]).toFixed(2);
+      }
+    }
+    await verify();
+  } catch (error) {
+    status(`place: ${(error as Error).message}`);
+  }
+});
+
 async function start() {
   try {
     const { scenes } = await api.json<{ scenes: string[] }>('/api/scenes');
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
     const { files } = await api.json<{ files: { path: string }[] }>('/api/files');
     element('file').replaceChildren(...files.map((file) => new Option(file.path.split('/').pop()!, file.path)));
+    const models = await api.json<{ builtin: string[]; files: string[] }>('/api/models');
+    element('model').replaceChildren(...models.builtin.map((name) => new Option(name, name)),
+      ...models.files.map((path) => new Option(path.split('/').pop()!, path)));
     const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
     if (documents.length > 0) {
       doc = documents[0];

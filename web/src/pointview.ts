@@ -2,7 +2,7 @@
 // (original grey, synthesized cyan, object orange) or by height; the picked cell's point is marked.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { FLAG_OBJECT, FLAG_SYNTHESIZED, PointSet } from './api';
+import { FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet } from './api';
 
 export type PointColouring = 'rgb' | 'layers' | 'height';
 
@@ -39,6 +39,7 @@ export class PointView {
   private cloud: THREE.Points | null = null;
   private marker = new THREE.Mesh(new THREE.SphereGeometry(0.08), new THREE.MeshBasicMaterial({ color: 0xffff00 }));
   private points: PointSet | null = null;
+  private model: THREE.Mesh | null = null;
   private mode: PointColouring = 'rgb';
   private size = 2;
 
@@ -90,6 +91,28 @@ export class PointView {
   setPointSize(size: number) {
     this.size = size;
     if (this.cloud) (this.cloud.material as THREE.PointsMaterial).size = size;
+    this.render();
+  }
+
+  // Shows a model mesh (parseMesh) placed by `scannerFromModel` (column-major 4x4), coloured by how
+  // consistent its pose is (green consistent, red not, grey unknown).
+  showModel(mesh: MeshData, scannerFromModel: number[], consistency: number | null) {
+    if (!this.model) {
+      this.model = new THREE.Mesh(new THREE.BufferGeometry(), new THREE.MeshBasicMaterial({ transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
+      this.model.matrixAutoUpdate = false;
+      this.scene.add(this.model);
+    }
+    if (this.model.userData.mesh !== mesh) {
+      const geometry = new THREE.BufferGeometry();
+      geometry.setAttribute('position', new THREE.BufferAttribute(mesh.xyz, 3));
+      geometry.setIndex(new THREE.BufferAttribute(mesh.indices, 1));
+      this.model.geometry.dispose();
+      this.model.geometry = geometry;
+      this.model.userData.mesh = mesh;
+    }
+    this.model.matrix.fromArray(scannerFromModel);
+    const colour = consistency === null ? new THREE.Color(0.7, 0.7, 0.7) : new THREE.Color(1 - consistency, consistency, 0.1);
+    (this.model.material as THREE.MeshBasicMaterial).color = colour;
     this.render();
   }
 

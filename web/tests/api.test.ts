@@ -52,3 +52,27 @@ describe('Api', () => {
     expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range&token=abc123');
   });
 });
+
+import { inverseRigid, multiply, parseMesh, poseMatrix } from '../src/api';
+
+describe('poses', () => {
+  it('yaw turns x towards y, and the inverse undoes the pose', () => {
+    const pose = poseMatrix(1, 2, 3, 90);
+    const x = multiply(pose, [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1]);
+    expect(x[0]).toBeCloseTo(0);
+    expect(x[1]).toBeCloseTo(1); // the model's x axis points along world y
+    const identity = multiply(inverseRigid(pose), pose);
+    identity.forEach((value, i) => expect(value).toBeCloseTo([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]));
+  });
+  it('reads a mesh and refuses a wrong size', () => {
+    const buffer = new ArrayBuffer(16 + 3 * 12 + 12);
+    const header = new DataView(buffer);
+    header.setUint32(0, 0x314d534c, true);
+    header.setUint32(4, 3, true);
+    header.setUint32(8, 1, true);
+    new Float32Array(buffer, 16, 9).set([0, 0, 0, 1, 0, 0, 0, 1, 0]);
+    new Uint32Array(buffer, 52, 3).set([0, 1, 2]);
+    expect(Array.from(parseMesh(buffer).indices)).toEqual([0, 1, 2]);
+    expect(() => parseMesh(buffer.slice(0, 60))).toThrow(/size/);
+  });
+});
