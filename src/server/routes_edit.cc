@@ -91,23 +91,48 @@ Options OptionsOf(const nlohmann::json& body) {
 void Segment(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
              httplib::Response& response) {
   const SegmentOptions options = OptionsOf<SegmentOptions>(body);
+  // refine: add the strokes painted since the last cut to it as hard constraints and re-run its max-flow
+  // incrementally (SegmentSession::Refine) — the live update after each stroke. Without a usable session
+  // (first cut, other options, the scan edited since) it is a full cut.
+  const bool refine = body.value("refine", false);
   const int undo_depth = state.options.undo_depth;
   StartJob(
       state, document, "segment",
-      [document, options, undo_depth](Progress& progress) {
+      [document, options, refine, undo_depth](Progress& progress) {
         Snapshot start;
+        std::shared_ptr<SegmentCut> cut;
         {
           std::lock_guard lock(document->mutex);
           start = document->now;
+          cut = document->cut;
         }
         progress.Restart("segment", 1);
-        const SegmentResult result = SegmentObject(start.scan, start.strokes, options);
+        // A refinement only adds constraints: strokes erased or undone since the cut need a full one.
+        const bool usable = cut && refine && cut->scan_data == start.scan.range.data &&
+                            ToJson(cut->options) == ToJson(options) &&
+                            cv::countNonZero((cut->strokes != 0) & (start.strokes != cut->strokes)) == 0;
+        SegmentResult result;
+        bool refined = false;
+        if (usable) {
+          const cv::Mat extra = (start.strokes != cut->strokes) & (start.strokes != 0);
+          cv::Mat extra_strokes = cv::Mat::zeros(start.strokes.size(), CV_8U);
+          start.strokes.copyTo(extra_strokes, extra);
+          result = cut->session.Refine(extra_strokes);
+          refined = true;
+        } else {
+          cut = std::make_shared<SegmentCut>(
+              SegmentCut{SegmentSession(start.scan, options), options, {}, start.scan.range.data});
+          result = cut->session.Run(start.strokes);
+        }
+        cut->strokes = start.strokes.clone();
         progress.Advance();
         std::lock_guard lock(document->mutex);
+        document->cut = cut;
         Snapshot next = document->now;
         next.object_mask = result.mask.clone();
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
+        json["refined"] = refined;
         json["version"] = document->version;
         return json;
       },

@@ -176,6 +176,20 @@ TEST_F(ServerTest, SegmentRemoveUndoSave) {
   const auto segmented = Wait(Json(started));
   ASSERT_EQ(segmented["state"], "done") << segmented.dump();
   EXPECT_GT(segmented["result"]["object_cells"].get<int>(), 50);
+  EXPECT_FALSE(segmented["result"]["refined"]);
+  // A live refinement after one more background stroke: the session's incremental cut.
+  ASSERT_EQ(client_
+                ->Post(Api(fmt::format("/api/docs/{}/strokes", id)), R"({"background": [[2, 2]]})",
+                       "application/json")
+                ->status,
+            200);
+  const auto refined = Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/segment", id)),
+                                               R"({"refine": true})", "application/json")));
+  ASSERT_EQ(refined["state"], "done") << refined.dump();
+  EXPECT_TRUE(refined["result"]["refined"]);
+  EXPECT_NEAR(refined["result"]["object_cells"].get<double>(),
+              segmented["result"]["object_cells"].get<double>(),
+              0.05 * segmented["result"]["object_cells"].get<double>());
   const auto removed =
       Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/remove", id)),
                               R"({"options": {"fill": {"method": "laplace"}}})", "application/json")));

@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/segment/segment.h"
 #include "lidarshop/util/progress.h"
 
 namespace lidarshop {
@@ -36,6 +37,14 @@ struct Snapshot {
   Scan behind;
 };
 
+// The last cut of a document, kept for live refinement (segment/SegmentSession). Used by one job at a time.
+struct SegmentCut {
+  SegmentSession session;
+  SegmentOptions options;
+  cv::Mat strokes;                     // the strokes the cut has seen
+  const uint8_t* scan_data = nullptr;  // the scan it was built on (its range buffer)
+};
+
 struct Document {
   int id = 0;
   std::string name;  // file name or built-in scene name
@@ -44,6 +53,7 @@ struct Document {
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
+  std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
   int64_t prepared_version = -1;
   std::mutex mutex;  // guards every field above
 };

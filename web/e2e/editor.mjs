@@ -106,7 +106,8 @@ try {
   const top = Math.max(0, r0 - m), bottom = Math.min(doc.rows - 1, r1 + m);
   const left = Math.max(0, c0 - m), right = Math.min(doc.cols - 1, c1 + m);
   await drag([[top, left], [top, right], [bottom, right], [bottom, left], [top, left]]);
-  await waitForStatus(/background stroke cells painted/, 'background stroke');
+  // Live segmentation: the background stroke (the second kind) starts the cut by itself.
+  await waitForStatus(/^segment done/, 'live segmentation after the background stroke');
   await shot('strokes');
 
   await page.click('#segment');

@@ -14,6 +14,7 @@ let doc: DocumentInfo | null = null;
 let runningJob: JobInfo | null = null;
 let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
+const strokeKinds = new Set<Brush>();  // brushes used on the open scan since its last cut was reset
 
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = { rayView, pointView, current: () => doc, verify: () => verify() };
@@ -39,6 +40,7 @@ async function open(params: Record<string, string>) {
     status('opening…');
     doc = await api.json<DocumentInfo>('/api/open', params);
     rayView.clearStrokes();
+    strokeKinds.clear();
     await refresh(false);
   } catch (error) {
     status(`open failed: ${(error as Error).message}`);
@@ -78,11 +80,14 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
   try {
     const key = brush === 'lasso' ? 'hole_polygon' : brush;
     await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
+    status(`${cells.length} ${brush} stroke cells painted`);
     if (brush === 'hole' || brush === 'lasso') {
       rayView.clearStrokes(['hole', 'lasso']);
       await refresh(true);
+    } else if (element<HTMLInputElement>('live').checked && (strokeKinds.add(brush), strokeKinds.size === 2)) {
+      // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut).
+      await runJob(`/api/docs/${doc.id}/segment`, { refine: doc.object_cells > 0 }, 'segment');
     }
-    status(`${cells.length} ${brush} stroke cells painted. ${element('status').textContent}`);
   } catch (error) {
     status(`stroke failed: ${(error as Error).message}`);
   }
@@ -119,6 +124,7 @@ element('segment').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/
 element('remove').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, {}, 'remove');
   rayView.clearStrokes();
+  strokeKinds.clear();
 });
 element('fill').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, {}, 'fill'));
 element('fill-hole').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, { hole: 'painted' }, 'fill hole'));
