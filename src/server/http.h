@@ -56,10 +56,10 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
 // following symlinks), else empty. `..` components are refused before any lookup.
 std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::string& requested);
 
-void AddScanRoutes(State& state);  // routes_scan.cc: open, list, pictures, points, save
-void AddEditRoutes(State& state);
-void AddVerifyRoutes(
-    State&
-        state);  // routes_verify.cc: models, pose verification  // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
+// Route groups, one file each.
+void AddScanRoutes(State& state);     // routes_scan.cc: open, list, pictures, points, save
+void AddEditRoutes(State& state);     // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
+void AddVerifyRoutes(State& state);   // routes_verify.cc: models, pose verification
+void AddRecolorRoutes(State& state);  // routes_recolor.cc: photo, resection, recolouring
 
 }  // namespace lidarshop::server

@@ -53,7 +53,9 @@ struct Document {
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
-  std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
+  std::shared_ptr<SegmentCut> cut;
+  cv::Mat
+      photo;  // CV_8UC3 RGB: the photo to recolour from (empty = none)  // the last segmentation's session (null = none yet)
   int64_t prepared_version = -1;
   std::mutex mutex;  // guards every field above
 };

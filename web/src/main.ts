@@ -95,6 +95,7 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
 rayView.onPick = (cell) => {
   if (!doc) return;
   picked = cell;
+  addPairForCell(cell);
   rayView.pick(cell);
   pointView.highlight(cell.row * doc.cols + cell.col);
   status(`cell row ${cell.row}, column ${cell.col}`);
@@ -198,6 +199,62 @@ element('place').addEventListener('click', async () => {
     status(`place: ${(error as Error).message}`);
   }
 });
+
+// Recolouring (thesis 3.2): click a pixel in the photo, then the same spot in the ray image (Pick tool); six or
+// more pairs give the camera; the photo's colours then go to the points it sees.
+const photoCanvas = element<HTMLCanvasElement>('photo');
+let photo: HTMLImageElement | null = null;
+let pendingPixel: [number, number] | null = null;
+const pairs: { pixel: [number, number]; cell: [number, number] }[] = [];
+function drawPhoto() {
+  const context = photoCanvas.getContext('2d');
+  if (!context || !photo) return;
+  photoCanvas.width = photoCanvas.clientWidth;
+  photoCanvas.height = photoCanvas.clientHeight;
+  const scale = Math.min(photoCanvas.width / photo.width, photoCanvas.height / photo.height);
+  context.drawImage(photo, 0, 0, photo.width * scale, photo.height * scale);
+  context.fillStyle = '#ff0';
+  for (const pair of pairs) context.fillRect(pair.pixel[0] * scale - 3, pair.pixel[1] * scale - 3, 6, 6);
+  if (pendingPixel) {
+    context.strokeStyle = '#0ff';
+    context.strokeRect(pendingPixel[0] * scale - 5, pendingPixel[1] * scale - 5, 10, 10);
+  }
+  photoCanvas.dataset.scale = String(scale);
+}
+photoCanvas.addEventListener('click', (event) => {
+  if (!photo) return;
+  const scale = Number(photoCanvas.dataset.scale);
+  const pixel: [number, number] = [event.offsetX / scale, event.offsetY / scale];
+  if (pixel[0] >= photo.width || pixel[1] >= photo.height) return;
+  pendingPixel = pixel;
+  drawPhoto();
+  status(`photo pixel (${pixel[0].toFixed(1)}, ${pixel[1].toFixed(1)}): now pick the same spot in the ray image`);
+});
+function addPairForCell(cell: { row: number; col: number }) {
+  if (!pendingPixel) return;
+  pairs.push({ pixel: pendingPixel, cell: [cell.row, cell.col] });
+  pendingPixel = null;
+  element('pairs').textContent = `${pairs.length} pairs`;
+  drawPhoto();
+}
+element<HTMLInputElement>('photo-file').addEventListener('change', async (event) => {
+  const file = (event.target as HTMLInputElement).files?.[0];
+  if (!file || !doc) return;
+  try {
+    await fetch(api.url(`/api/docs/${doc.id}/photo`), { method: 'POST', body: file, headers: { 'Content-Type': file.type } })
+      .then(async (response) => { if (!response.ok) throw new Error((await response.json()).error); });
+    photo = new Image();
+    photo.onload = drawPhoto;
+    photo.src = api.url(`/api/docs/${doc.id}/photo.png`, { v: Date.now() });
+    element('photo-panel').hidden = false;
+    pairs.length = 0;
+    element('pairs').textContent = '0 pairs';
+    status('photo loaded: click a pixel in it, then the same spot in the ray image (Pick tool)');
+  } catch (error) {
+    status(`photo: ${(error as Error).message}`);
+  }
+});
+element('recolor').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/recolor`, { pairs }, 'recolour'));
 
 async function start() {
   try {
