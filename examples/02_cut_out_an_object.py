@@ -13,12 +13,16 @@ from _common import mailbox_scene, parse_args
 args = parse_args(__doc__)
 scan = lidarshop.scan_scene(mailbox_scene(args.small))
 
-# Where is the mailbox? (A synthetic scan knows its labels: 2 = mailbox.) One object stroke down the box and
-# its post, background strokes along the top (the wall) and the bottom (the lawn).
+# Where is the mailbox? (A synthetic scan knows its labels: 2 = mailbox.) Object strokes across the box and
+# down its post; background strokes along the wall above it, the top of the scan and the lawn at the bottom.
 rows, cols = np.nonzero(scan.label == 2)
-c = int(np.median(cols))
+r, c = int(np.median(rows)), int(np.median(cols))
+top, bottom, left, right = int(rows.min()), int(rows.max()), int(cols.min()), int(cols.max())
+width = right - left
 strokes = {"strokes": [
-    {"label": "object", "width": 2, "points": [[c, int(rows.min()) + 2], [c, int(rows.max()) - 3]]},
+    {"label": "object", "width": 3, "points": [[c - 2, r], [c + 2, r]]},
+    {"label": "object", "width": 2, "points": [[c, top + 2], [c, bottom - 3]]},
+    {"label": "background", "width": 2, "points": [[left - width, top - 4], [right + width, top - 4]]},
     {"label": "background", "width": 3, "points": [[5, 5], [scan.cols - 6, 5]]},
     {"label": "background", "width": 3, "points": [[5, scan.rows - 6], [scan.cols - 6, scan.rows - 6]]},
 ]}
