@@ -26,8 +26,11 @@ Why the CLI per step: any command works with exactly its flags, checks and JSON 
 blow-up of one scan fails that scan, not the worker; the library stays free of Dask.
 """
 import argparse
+import ctypes
+import glob
 import json
 import os
+import signal
 import shutil
 import subprocess
 import sys
@@ -139,6 +142,26 @@ def step_argv(lidarshop, step, index, input_path, output_path, name, scan_dir, o
     return argv
 
 
+def die_with_parent():
+    """In the step's process: be killed when the worker that started it dies (Linux), so that no step of a
+    lost task keeps writing while its re-run elsewhere writes the same files."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
+def remove_stale_temporaries(output):
+    """Temporary files of lidarshop's atomic writes (util/atomic_file.cc: DIR/.STEM.tmpPID-N.EXT) left by an
+    earlier attempt of this scan that was killed while writing."""
+    stem, extension = os.path.splitext(os.path.basename(output))
+    for path in glob.glob(os.path.join(glob.escape(os.path.dirname(output)), f".{glob.escape(stem)}.tmp*{extension}")):
+        try:
+            os.remove(path)
+        except OSError:
+            pass
+
+
 def run_scan(job):
     """One task: every step for one scan. Returns the record (also written to DIR/records/NAME.json)."""
     pipeline, scan_path, out_dir, lidarshop = job["pipeline"], job["scan"], job["out"], job["lidarshop"]
@@ -147,6 +170,8 @@ def run_scan(job):
     record = {"scan": scan_path, "name": name, "status": "ok", "steps": [], "host": os.uname().nodename,
               "pid": os.getpid()}
     outputs = step_outputs(pipeline, name, out_dir, scan_path)
+    for output in outputs:
+        remove_stale_temporaries(output)
     input_path = scan_path
     for index, (step, output) in enumerate(zip(pipeline["steps"], outputs)):
         os.makedirs(os.path.dirname(output), exist_ok=True)
@@ -154,7 +179,8 @@ def run_scan(job):
                          os.path.join(out_dir, ".batch"))
         step_start = time.monotonic()
         try:
-            process = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+            process = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                                     preexec_fn=die_with_parent)
             returncode, stderr = process.returncode, process.stderr
         except OSError as error:
             returncode, stderr = -1, f"{argv[0]}: {error.strerror}"

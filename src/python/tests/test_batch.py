@@ -94,10 +94,15 @@ def test_two_step_pipeline_on_a_local_cluster_with_a_killed_worker(scans, tmp_pa
     while driver.poll() is None and time.monotonic() < deadline:
         done = len(glob.glob(os.path.join(out, "records", "*.json")))
         if killed is None and done >= 3:
-            workers = [p for p in psutil.Process(driver.pid).children(recursive=True)
-                       if "spawn_main" in " ".join(p.cmdline())]
-            if workers:
-                killed = workers[0].pid
+            # A worker process in the middle of a scan: a lidarshop step is running under it.
+            try:
+                busy = [p for p in psutil.Process(driver.pid).children(recursive=True)
+                        if "spawn_main" in " ".join(p.cmdline())
+                        and any(child.name() == "lidarshop" for child in p.children())]
+            except psutil.NoSuchProcess:
+                busy = []
+            if busy:
+                killed = busy[0].pid
                 os.kill(killed, signal.SIGKILL)
         time.sleep(0.05)
     stdout, stderr = driver.communicate(timeout=60)
