@@ -16,6 +16,7 @@
 // the hand-written parts (images, scans) are added to the returned py::class_.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <map>
 #include <string>
@@ -83,6 +84,19 @@ py::class_<S> BindStruct(py::module_& m, bool read_only = false) {
           doc.c_str());
     }
   }
+  // A misspelt attribute raises AttributeError with the closest field (pybind11 would say only "no attribute").
+  cls.def("__setattr__", [](py::object self, const std::string& name, py::object value) {
+    if (name.empty() || name[0] != '_') {
+      const std::vector<std::string> keys = InfoOf<S>().Keys();
+      if (std::find(keys.begin(), keys.end(), name) == keys.end()) {
+        const std::string closest = ClosestMatch(name, keys);
+        throw py::attribute_error(
+            fmt::format("{} has no field '{}'{}", InfoOf<S>().name, name,
+                        closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest)));
+      }
+    }
+    py::module_::import("builtins").attr("object").attr("__setattr__")(self, name, value);
+  });
   cls.def(
       "to_dict", [](const S& self) { return FromJsonValue(ToJson(self)); },
       "Every field as a dict (JSON order, enums as names, nested structs as dicts): the JSON form of the "

@@ -74,7 +74,7 @@ def test_errors_carry_the_library_messages():
         lidarshop.FillOptions.from_dict({"poisson": {"tolerance": 2.0}})
     with pytest.raises(lidarshop.OptionsError, match="expected true or false"):
         options.inverse_range = "yes"
-    with pytest.raises(AttributeError):
+    with pytest.raises(AttributeError, match="FillOptions has no field 'patch_radus' \\(did you mean 'patch_radius'\\?\\)"):
         options.patch_radus = 3  # no silent new attributes
     assert issubclass(lidarshop.OptionsError, ValueError)
 
