@@ -602,20 +602,36 @@ void BindVerify(py::module_& m) {
         } else {
           list = scans.cast<std::vector<Scan>>();
         }
-        const Eigen::Matrix4d pose = ArrayToMatrix(world_from_model, "world_from_model");
+        // One 4 x 4 pose, or many (N x 4 x 4): the model and the scans are prepared once, the poses run in
+        // parallel (VerifyPoses) and a list of results comes back.
+        const py::array poses = py::module_::import("numpy").attr("asarray")(world_from_model, "float64");
+        std::vector<Eigen::Matrix4d> pose_list;
+        if (poses.ndim() == 3) {
+          for (py::ssize_t i = 0; i < poses.shape(0); ++i) {
+            pose_list.push_back(ArrayToMatrix(poses[py::int_(i)], fmt::format("world_from_model[{}]", i)));
+          }
+        } else {
+          pose_list.push_back(ArrayToMatrix(poses, "world_from_model"));
+        }
         const VerifyOptions options = VerifyOptionsOf(kwargs);
-        py::gil_scoped_release release;
-        const VerifierModel model = PrepareModel(mesh, ModelOptions{}, options);
-        std::vector<PreparedScan> prepared;
-        for (const Scan& scan : list) prepared.push_back(PrepareScan(scan));
-        return VerifyPose(model, prepared, pose, options);
+        std::vector<VerifyResult> results;
+        {
+          py::gil_scoped_release release;
+          const VerifierModel model = PrepareModel(mesh, ModelOptions{}, options);
+          std::vector<PreparedScan> prepared;
+          for (const Scan& scan : list) prepared.push_back(PrepareScan(scan));
+          results = VerifyPoses(model, prepared, pose_list, options);
+        }
+        if (poses.ndim() == 3) return py::cast(results);
+        return py::cast(results.front());
       },
       py::arg("model"), py::arg("scans"), py::arg("world_from_model"),
       R"doc(Verifies an object pose against registered scans: consistency (does the pose make physical sense:
 no measured point behind the model) and confidence (how much of the model was seen), thesis eqs. 4.1-4.5.
 
 model: a TriangleMesh in its own frame (read_mesh, make_primitive); scans: a Scan or a list (their
-world_from_scanner register them); world_from_model: 4 x 4. Keywords: allowance_m, sigma_m, icp_trim_m,
+world_from_scanner register them); world_from_model: 4 x 4, or N x 4 x 4 for a list of results (the model
+and scans are prepared once, the poses verified in parallel). Keywords: allowance_m, sigma_m, icp_trim_m,
 footprint_margin_cells (VerifyOptions, verify/verify.h; defaults from the library).)doc");
   m.def("pose_from_xyz_yaw", &PoseFromXyzYaw, py::arg("x_m"), py::arg("y_m"), py::arg("z_m"),
         py::arg("yaw_deg"), py::arg("pitch_deg") = 0.0, py::arg("roll_deg") = 0.0,

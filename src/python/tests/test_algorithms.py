@@ -1,4 +1,6 @@
 """Segment, fill, remove, inpaint, Poisson and verify on synthetic data whose truth is known."""
+import time
+
 import numpy as np
 import pytest
 
@@ -109,5 +111,35 @@ def test_verify_pose(scan):
     # Hidden behind the wall: consistent (nothing contradicts it) but not seen at all.
     hidden = lidarshop.verify_pose(box, [scan], lidarshop.pose_from_xyz_yaw(0, 11, 0.6, 0), allowance_m=0.05)
     assert hidden.consistency > 0.95 and hidden.confidence < 0.01
+    # Many poses at once: the same numbers as one by one.
+    many = lidarshop.verify_pose(box, [scan], np.stack([truth, lidarshop.pose_from_xyz_yaw(0, 3, 0.6, 0)]),
+                                 allowance_m=0.05)
+    assert len(many) == 2
+    assert many[1].consistency == floating.consistency and many[1].confidence == floating.confidence
     with pytest.raises(lidarshop.OptionsError, match="unknown verify option 'sigma'"):
         lidarshop.verify_pose(box, scan, truth, sigma=1)
+
+
+def test_long_calls_release_the_gil(scan):
+    """Python threads run while a fill runs: the binding releases the GIL around the library call."""
+    import threading
+
+    hole = lidarshop.grow_hole((scan.label == 2).astype(np.uint8), 2) > 0
+    span = {}
+
+    def work():
+        span["start"] = time.monotonic()
+        for _ in range(10):
+            lidarshop.fill(scan, hole, patch_radius=3)
+        span["end"] = time.monotonic()
+
+    ticks = []
+    thread = threading.Thread(target=work)
+    thread.start()
+    while thread.is_alive():
+        ticks.append(time.monotonic())
+        time.sleep(0.001)
+    thread.join()
+    length = span["end"] - span["start"]
+    middle = [t for t in ticks if span["start"] + 0.25 * length < t < span["start"] + 0.75 * length]
+    assert len(middle) > 10, (length, len(middle))
