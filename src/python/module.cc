@@ -1,6 +1,7 @@
 // The `lidarshop` Python module: a thin layer over the library (parse, check, call, return), like the CLI.
 // Scans and images are numpy arrays; options are the generated classes of options_py.h; out-parameters come
 // back as return values; the GIL is released around the library's long calls.
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -19,6 +20,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/pointset/filters.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/scanner.h"
@@ -547,6 +549,56 @@ Returns a FillResult: .scan (the filled Scan, synthesized cells flagged), .fille
       "boundary elsewhere. Returns a PoissonResult.");
 }
 
+// ---- point sets ----
+// Only the tools without an options struct for now: the point-set options are being described
+// (util/options.h); each then binds like fill (BindStruct + OptionsOf).
+
+PointCloud CloudOf(const py::handle& points) {
+  const cv::Mat mat = ArrayToMat(points, CV_32F, 3, -1, -1, "points");  // (N, 3) read as N x 1 x 3
+  PointCloud cloud;
+  cloud.points.resize(mat.rows * mat.cols);
+  std::memcpy(cloud.points.data(), mat.data, cloud.points.size() * sizeof(Eigen::Vector3f));
+  return cloud;
+}
+
+py::array_t<float> PointsArray(const std::vector<Eigen::Vector3f>& points) {
+  py::array_t<float> array({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
+  if (!points.empty())
+    std::memcpy(array.mutable_data(), points.data(), points.size() * sizeof(Eigen::Vector3f));
+  return array;
+}
+
+void BindPointSets(py::module_& m) {
+  m.def(
+      "voxel_downsample",
+      [](const py::object& points, double voxel_m) {
+        const py::array input = py::module_::import("numpy").attr("asarray")(points, "float32");
+        if (input.ndim() != 2 || input.shape(1) != 3)
+          throw py::value_error("points: expected an array of shape (N, 3)");
+        const PointCloud cloud = CloudOf(input.attr("reshape")(input.shape(0), 1, 3));
+        if (!(voxel_m > 0)) throw OptionsError(fmt::format("voxel_m: {} is out of range > 0", voxel_m));
+        PointCloud result;
+        {
+          py::gil_scoped_release release;
+          result = VoxelDownsample(cloud, voxel_m);
+        }
+        return PointsArray(result.points);
+      },
+      py::arg("points"), py::arg("voxel_m"),
+      "One point per occupied cube of side voxel_m (metres), at the centroid of its points: float32 (M, 3).");
+  m.def(
+      "transform_scan",
+      [](const Scan& scan, const py::object& b_from_world) {
+        const Eigen::Matrix4d transform = ArrayToMatrix(b_from_world, "b_from_world");
+        py::gil_scoped_release release;
+        return TransformScan(scan, transform);
+      },
+      py::arg("scan"), py::arg("b_from_world"),
+      "The scan moved rigidly: world_from_scanner becomes b_from_world @ world_from_scanner (points stay in "
+      "the "
+      "scanner frame). Raises OptionsError when the transform is not rigid.");
+}
+
 // ---- verify ----
 // VerifyOptions is not described on main yet (util/options.h): its keywords are set by name below, with the
 // library's defaults and checks. When InfoOf<VerifyOptions> exists, this becomes BindStruct<VerifyOptions>
@@ -669,5 +721,6 @@ PYBIND11_MODULE(lidarshop, m) {
   python::BindFiles(m);
   python::BindResults(m);
   python::BindAlgorithms(m);
+  python::BindPointSets(m);
   python::BindVerify(m);
 }

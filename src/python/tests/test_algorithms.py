@@ -143,3 +143,20 @@ def test_long_calls_release_the_gil(scan):
     length = span["end"] - span["start"]
     middle = [t for t in ticks if span["start"] + 0.25 * length < t < span["start"] + 0.75 * length]
     assert len(middle) > 10, (length, len(middle))
+
+
+def test_point_set_tools(scan):
+    points = scan.points()
+    coarse = lidarshop.voxel_downsample(points, 0.5)
+    assert coarse.dtype == np.float32 and coarse.shape[1] == 3 and 0 < len(coarse) < len(points)
+    cells = {tuple(c) for c in np.floor((points - points.min(axis=0)) / 0.5).astype(int)}
+    assert len(coarse) == len(cells)  # one point per occupied voxel
+    with pytest.raises(lidarshop.OptionsError, match="voxel_m"):
+        lidarshop.voxel_downsample(points, 0)
+    shift = np.eye(4)
+    shift[:3, 3] = [1, 2, 3]
+    moved = lidarshop.transform_scan(scan, shift)
+    np.testing.assert_allclose(moved.world_from_scanner[:3, 3], [1, 2, 4.5])
+    np.testing.assert_array_equal(moved.point, scan.point)
+    with pytest.raises(lidarshop.OptionsError):
+        lidarshop.transform_scan(scan, np.diag([2.0, 2, 2, 1]))
