@@ -194,3 +194,15 @@ def test_the_cli_runs_the_driver(scans, tmp_path):
     assert result.returncode == 0, result.stderr
     assert "2 scans: 2 done" in result.stderr
     check_complete(out, names_of(scans[:2]))
+
+
+def test_an_existing_cluster_through_scheduler(scans, tmp_path):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        out = str(tmp_path / "out")
+        result = run([write_pipeline(str(tmp_path))] + scans[:4] + ["--out", out, "--scheduler",
+                                                                     cluster.scheduler_address])
+        assert result.returncode == 0, result.stderr
+        assert summary(out)["mode"] == f"scheduler {cluster.scheduler_address}"
+        check_complete(out, names_of(scans[:4]))
