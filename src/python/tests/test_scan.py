@@ -80,7 +80,7 @@ def test_new_scan():
     assert scan.range.shape == (4, 5) and scan.color.shape == (4, 5, 3) and scan.count_valid() == 0
 
 
-@pytest.mark.parametrize("extension", ["ptx", "e57", "pcd"])
+@pytest.mark.parametrize("extension", ["ptx", "e57", "pcd", "ply"])
 def test_write_read_round_trip(scan, tmp_path, extension):
     path = tmp_path / f"box.{extension}"
     lidarshop.write_scan(scan, str(path))
