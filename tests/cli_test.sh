@@ -239,6 +239,17 @@ check "info on the filled E57" sh -c "'$lidarshop' info '$work/filled.e57' > '$w
 json_check "the E57 keeps the synthesized flag" "$work/filled_e57.json" "'synthesized' in d['scans'][0]['channels']"
 check "remove" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/removed.ptx" \
   --report "$work/remove.json" --quiet
+# batch (src/python/lidarshop_batch.py through the CLI): a two-step pipeline, then a bad pipeline file.
+# Builds without the Python layer (the sanitizer builds) answer "built without Python" and skip this.
+if "$lidarshop" batch --help >/dev/null 2>&1; then
+  printf '{"steps": [{"command": "fill", "options": {"method": "laplace"}, "mask": "%s", "output": "{name}_filled.e57"},
+    {"command": "convert", "output": "{name}.ply"}]}' "$work/mask.png" >"$work/pipeline.json"
+  check "batch" "$lidarshop" batch "$work/pipeline.json" "$work/scan.ptx" --out "$work/batch" --serial --quiet
+  json_check "batch summary" "$work/batch/summary.json" "d['scans'] == 1 and d['done'] == 1 and d['failed'] == 0"
+  echo '{"steps": []}' >"$work/empty_pipeline.json"
+  exits_with 2 "usage: batch names the pipeline's problem" "empty_pipeline.json: expected .*at least one step" \
+    "$lidarshop" batch "$work/empty_pipeline.json" "$work/scan.ptx" --out "$work/batch2"
+fi
 exits_with 2 "usage: did you mean" "unknown option --patch-radus \(did you mean --patch-radius\?\)" \
   "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --patch-radus 3
 exits_with 2 "usage: out of range names the flag" "^lidarshop fill: --patch-radius: 0 is out of range \[1, 15\]" \

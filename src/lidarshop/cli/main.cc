@@ -40,6 +40,7 @@ const std::vector<Command>& Commands() {
        "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
       {"register", lidarshop::cli::RunRegister, "register one scan onto another (point-to-plane ICP)"},
       {"serve", lidarshop::cli::RunServe, "the editor in the browser: look, paint, segment, remove, save"},
+      {"batch", lidarshop::cli::RunBatch, "a pipeline of commands over many scans (local or Dask cluster)"},
   };
   return commands;
 }

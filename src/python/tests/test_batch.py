@@ -1,0 +1,208 @@
+"""lidarshop batch: pipelines over many scans, on a local Dask cluster, resumable, sharded."""
+import glob
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import lidarshop
+from conftest import small_scene
+
+CLI = os.environ.get("LIDARSHOP_CLI")
+DRIVER = [sys.executable, "-m", "lidarshop_batch"]
+PIPELINE = {"steps": [
+    {"command": "fill", "options": {"method": "laplace", "poisson": {"solver": "direct"}},
+     "mask": "{name}_mask.png", "output": "{name}_filled.e57"},
+    {"command": "convert", "output": "{name}.ply"},
+]}
+
+pytestmark = pytest.mark.skipif(not CLI, reason="LIDARSHOP_CLI (set by ctest) names the lidarshop executable")
+
+
+@pytest.fixture(scope="module")
+def scans(tmp_path_factory):
+    """20 small synthetic scans (different noise seeds) with a hole mask each: the box's cells."""
+    folder = tmp_path_factory.mktemp("scans")
+    paths = []
+    for index in range(20):
+        scene = small_scene(columns=48, rows=32)
+        scene["scanner"]["seed"] = index + 1
+        scan = lidarshop.scan_scene(scene)
+        name = f"scan{index:02d}"
+        lidarshop.write_scan(scan, str(folder / f"{name}.ptx"))
+        lidarshop.write_image(str(folder / f"{name}_mask.png"), scan.label == 2)
+        paths.append(str(folder / f"{name}.ptx"))
+    return paths
+
+
+def write_pipeline(folder, pipeline=PIPELINE):
+    path = os.path.join(folder, "pipeline.json")
+    with open(path, "w") as stream:
+        json.dump(pipeline, stream)
+    return path
+
+
+def run(args, **kwargs):
+    return subprocess.run(DRIVER + ["--lidarshop", CLI, "--quiet"] + args, capture_output=True, text=True,
+                          timeout=600, **kwargs)
+
+
+def summary(out, name="summary.json"):
+    with open(os.path.join(out, name)) as stream:
+        return json.load(stream)
+
+
+def records(out):
+    result = {}
+    for path in glob.glob(os.path.join(out, "records", "*.json")):
+        with open(path) as stream:
+            result[os.path.basename(path)[:-5]] = json.load(stream)
+    return result
+
+
+def check_complete(out, names):
+    found = records(out)
+    assert sorted(found) == sorted(names)
+    assert all(record["status"] == "ok" for record in found.values())
+    for name in names:
+        filled = lidarshop.read_scan(os.path.join(out, f"{name}_filled.e57"))
+        assert filled.synthesized is not None and (filled.synthesized > 0).sum() > 0
+        assert os.path.getsize(os.path.join(out, f"{name}.ply")) > 0
+    # Nothing half-written: no temporary file of an atomic write is left.
+    leftovers = [p for p in glob.glob(os.path.join(out, "**", "*"), recursive=True) if ".tmp" in os.path.basename(p)]
+    assert leftovers == []
+
+
+def names_of(paths):
+    return [os.path.splitext(os.path.basename(p))[0] for p in paths]
+
+
+def test_two_step_pipeline_on_a_local_cluster_with_a_killed_worker(scans, tmp_path):
+    import psutil
+
+    out = str(tmp_path / "out")
+    driver = subprocess.Popen(DRIVER + ["--lidarshop", CLI, "--quiet", write_pipeline(str(tmp_path))] + scans
+                              + ["--out", out, "--workers", "2"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True)
+    killed = None
+    deadline = time.monotonic() + 300
+    while driver.poll() is None and time.monotonic() < deadline:
+        done = len(glob.glob(os.path.join(out, "records", "*.json")))
+        if killed is None and done >= 3:
+            # A worker process in the middle of a scan: a lidarshop step is running under it.
+            try:
+                busy = [p for p in psutil.Process(driver.pid).children(recursive=True)
+                        if "spawn_main" in " ".join(p.cmdline())
+                        and any(child.name() == "lidarshop" for child in p.children())]
+            except psutil.NoSuchProcess:
+                busy = []
+            if busy:
+                killed = busy[0].pid
+                os.kill(killed, signal.SIGKILL)
+        time.sleep(0.05)
+    stdout, stderr = driver.communicate(timeout=60)
+    assert killed is not None, "the run ended before a worker could be killed"
+    assert driver.returncode == 0, stderr
+    result = summary(out)
+    assert (result["scans"], result["done"], result["failed"], result["skipped"]) == (20, 20, 0, 0)
+    assert result["mode"] == "local cluster of 2 workers"
+    check_complete(out, names_of(scans))
+
+
+def test_resume_redoes_only_what_is_missing(scans, tmp_path):
+    subset = scans[:6]
+    out = str(tmp_path / "out")
+    pipeline = write_pipeline(str(tmp_path))
+    # An interrupted run: the driver killed after two scans.
+    driver = subprocess.Popen(DRIVER + ["--lidarshop", CLI, "--quiet", pipeline] + subset + ["--out", out, "--serial"])
+    while len(glob.glob(os.path.join(out, "records", "*.json"))) < 2 and driver.poll() is None:
+        time.sleep(0.01)
+    driver.kill()
+    driver.wait()
+    first = records(out)
+    assert 2 <= len(first) < 6
+    stamps = {name: os.path.getmtime(os.path.join(out, f"{name}.ply")) for name in first}
+    again = run([pipeline] + subset + ["--out", out, "--serial"])
+    assert again.returncode == 0, again.stderr
+    result = summary(out)
+    assert result["skipped"] == len(first) and result["done"] == 6 - len(first)
+    check_complete(out, names_of(subset))
+    for name, stamp in stamps.items():  # the scans done before were not redone
+        assert os.path.getmtime(os.path.join(out, f"{name}.ply")) == stamp
+    # A missing output makes its scan redone, and only it.
+    os.remove(os.path.join(out, "scan01.ply"))
+    third = run([pipeline] + subset + ["--out", out, "--serial"])
+    assert third.returncode == 0 and (summary(out)["done"], summary(out)["skipped"]) == (1, 5)
+    check_complete(out, names_of(subset))
+
+
+def test_shards_cover_every_scan_once(scans, tmp_path):
+    subset = scans[:7]
+    pipeline = write_pipeline(str(tmp_path))
+    seen = []
+    for index in range(3):
+        out = str(tmp_path / f"shard{index}")
+        result = run([pipeline] + subset + ["--out", out, "--serial", "--shard", f"{index}/3"])
+        assert result.returncode == 0, result.stderr
+        assert summary(out, f"summary.shard{index}of3.json")["shard"] == f"{index}/3"
+        seen += list(records(out))
+    assert sorted(seen) == sorted(names_of(subset))  # each scan once, none missing
+
+
+def test_failures_are_recorded_and_the_others_go_on(scans, tmp_path):
+    folder = tmp_path / "inputs"
+    folder.mkdir()
+    for path in scans[:3]:
+        for source in (path, path.replace(".ptx", "_mask.png")):
+            os.symlink(source, folder / os.path.basename(source))
+    os.remove(folder / "scan01_mask.png")
+    inputs = sorted(str(p) for p in folder.glob("*.ptx"))
+    out = str(tmp_path / "out")
+    result = run([write_pipeline(str(tmp_path))] + inputs + ["--out", out, "--serial"])
+    assert result.returncode == 1
+    report = summary(out)
+    assert (report["done"], report["failed"]) == (2, 1)
+    assert report["failures"][0]["name"] == "scan01"
+    assert "steps[0] (fill) exit 1" in report["failures"][0]["error"]
+    assert "scan01_mask.png" in report["failures"][0]["error"]
+    assert records(out)["scan01"]["status"] == "failed"
+
+
+def test_bad_pipelines_and_arguments(scans, tmp_path):
+    bad = write_pipeline(str(tmp_path), {"steps": [{"options": {}}]})
+    result = run([bad, scans[0], "--out", str(tmp_path / "out")])
+    assert result.returncode == 2 and "steps[0]: field 'command'" in result.stderr
+    result = run([write_pipeline(str(tmp_path)), scans[0], "--out", str(tmp_path / "out"), "--shard", "3/2"])
+    assert result.returncode == 2 and "--shard" in result.stderr
+    # Options are checked by the command with its own message.
+    wrong = write_pipeline(str(tmp_path), {"steps": [{"command": "fill", "options": {"patch_radius": 0},
+                                                      "mask": "{name}_mask.png", "output": "{name}_f.e57"}]})
+    result = run([wrong, scans[0], "--out", str(tmp_path / "out2"), "--serial"])
+    assert result.returncode == 1
+    assert "patch_radius" in summary(str(tmp_path / "out2"))["failures"][0]["error"]
+
+
+def test_the_cli_runs_the_driver(scans, tmp_path):
+    out = str(tmp_path / "out")
+    result = subprocess.run([CLI, "batch", write_pipeline(str(tmp_path))] + scans[:2] + ["--out", out, "--serial"],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "2 scans: 2 done" in result.stderr
+    check_complete(out, names_of(scans[:2]))
+
+
+def test_an_existing_cluster_through_scheduler(scans, tmp_path):
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        out = str(tmp_path / "out")
+        result = run([write_pipeline(str(tmp_path))] + scans[:4] + ["--out", out, "--scheduler",
+                                                                     cluster.scheduler_address])
+        assert result.returncode == 0, result.stderr
+        assert summary(out)["mode"] == f"scheduler {cluster.scheduler_address}"
+        check_complete(out, names_of(scans[:4]))

@@ -1,0 +1,122 @@
+"""Scans as numpy arrays: shapes, dtypes, no copies, setting channels, files."""
+import copy
+
+import numpy as np
+import pytest
+
+import lidarshop
+
+
+def test_channel_shapes_and_dtypes(scan):
+    assert (scan.rows, scan.cols) == (80, 120)
+    expected = {"range": (np.float32, ()), "point": (np.float32, (3,)), "direction": (np.float32, (3,)),
+                "valid": (np.uint8, ()), "intensity": (np.float32, ()), "color": (np.uint8, (3,)),
+                "label": (np.int32, ()), "normal": (np.float32, (3,)), "true_range": (np.float32, ())}
+    for name, (dtype, tail) in expected.items():
+        array = getattr(scan, name)
+        assert array.dtype == dtype, name
+        assert array.shape == (80, 120) + tail, name
+    assert scan.world_from_scanner.shape == (4, 4)
+    assert scan.world_from_scanner.dtype == np.float64
+    np.testing.assert_allclose(scan.world_from_scanner[:3, 3], [0, 0, 1.5])
+    assert scan.synthesized is None  # optional channel absent in a fresh scan
+    assert scan.count_valid() == int((scan.valid > 0).sum())
+    assert 0 < scan.count_valid() < scan.num_cells
+    # The range is the length of the point where valid, 0 elsewhere.
+    valid = scan.valid > 0
+    np.testing.assert_allclose(np.linalg.norm(scan.point[valid], axis=1), scan.range[valid], rtol=1e-5)
+    assert np.all(scan.range[~valid] == 0)
+    assert scan.points().shape == (scan.count_valid(), 3)
+
+
+def test_arrays_share_the_scans_memory(scan):
+    work = scan.clone()
+    view = work.range
+    assert not view.flags["OWNDATA"] and view.flags["WRITEABLE"]
+    r, c = np.argwhere(work.valid > 0)[0]
+    view[r, c] = 123.5
+    assert work.range[r, c] == np.float32(123.5)  # seen through a new view: the same memory
+    assert scan.range[r, c] != np.float32(123.5)  # clone() copied
+    work.color[0, 0] = (1, 2, 3)
+    assert tuple(work.color[0, 0]) == (1, 2, 3)
+    pose = work.world_from_scanner
+    pose[0, 3] = 7.0
+    assert work.world_from_scanner[0, 3] == 7.0
+    # A view outlives the scan it came from.
+    fresh = scan.clone()
+    kept = fresh.range
+    del fresh
+    assert kept.sum() == pytest.approx(scan.range.sum(), rel=1e-6)
+    # copy.copy is deep (a Scan copies its channels in Python).
+    other = copy.copy(scan)
+    other.range[r, c] = -1
+    assert scan.range[r, c] != -1
+
+
+def test_set_channels_from_numpy(scan):
+    work = scan.clone()
+    new_range = np.full((work.rows, work.cols), 2.0)  # float64 is converted to the channel's float32
+    work.range = new_range
+    assert work.range.dtype == np.float32 and np.all(work.range == 2.0)
+    work.synthesized = np.zeros((work.rows, work.cols), bool)
+    assert work.synthesized.dtype == np.uint8
+    mask = np.zeros((work.rows, work.cols), bool)
+    mask[3, 4] = True
+    work.synthesized = mask
+    assert work.synthesized[3, 4] == 255  # True becomes the project's 255
+    work.label = None
+    assert work.label is None
+    with pytest.raises(ValueError, match=r"Scan.range: expected an array of shape \(80, 120\), got shape \(3, 3\)"):
+        work.range = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="cannot be None"):
+        work.valid = None
+    work.world_from_scanner = np.eye(4) * 1.0
+    with pytest.raises(ValueError, match="4 x 4"):
+        work.world_from_scanner = np.eye(3)
+
+
+def test_new_scan():
+    scan = lidarshop.Scan(4, 5, with_color=True)
+    assert scan.range.shape == (4, 5) and scan.color.shape == (4, 5, 3) and scan.count_valid() == 0
+
+
+@pytest.mark.parametrize("extension", ["ptx", "e57", "pcd", "ply"])
+def test_write_read_round_trip(scan, tmp_path, extension):
+    path = tmp_path / f"box.{extension}"
+    lidarshop.write_scan(scan, str(path))
+    back = lidarshop.read_scan(str(path))
+    assert (back.rows, back.cols) == (scan.rows, scan.cols)
+    np.testing.assert_array_equal(back.valid > 0, scan.valid > 0)
+    valid = scan.valid > 0
+    np.testing.assert_allclose(back.range[valid], scan.range[valid], atol=2e-3)
+    np.testing.assert_allclose(back.world_from_scanner, scan.world_from_scanner, atol=1e-9)
+    if extension != "ptx":
+        np.testing.assert_array_equal(back.color[valid], scan.color[valid])
+
+
+def test_bad_files_raise_input_error(tmp_path):
+    bad = tmp_path / "bad.ptx"
+    bad.write_text("12\nnot a number\n")
+    with pytest.raises(lidarshop.InputError, match="bad.ptx"):
+        lidarshop.read_scan(str(bad))
+    with pytest.raises(ValueError):  # InputError is a ValueError ...
+        lidarshop.read_scan(str(bad))
+    with pytest.raises(OSError):  # ... and an OSError
+        lidarshop.read_scan(str(tmp_path / "missing.e57"))
+    with pytest.raises(lidarshop.InputError, match="unknown scan format"):
+        lidarshop.write_scan(lidarshop.Scan(2, 2), str(tmp_path / "scan.xyz"))
+
+
+def test_builtin_scenes_and_dict_scenes():
+    names = lidarshop.builtin_scenes()
+    assert "mailbox" in names and "parking_lot" in names
+    scene = lidarshop.builtin_scene("mailbox")
+    scene["scanner"]["columns"], scene["scanner"]["rows"] = 60, 40
+    small = lidarshop.scan_scene(scene)
+    assert (small.rows, small.cols) == (40, 60)
+    assert set(np.unique(small.label[small.valid > 0])) <= {0, 1, 2}
+    with pytest.raises(lidarshop.InputError, match="no built-in scene 'nope'"):
+        lidarshop.builtin_scene("nope")
+    scene["objects"][0]["size"] = [-1, 60]
+    with pytest.raises(lidarshop.InputError, match="size"):
+        lidarshop.scan_scene(scene)
