@@ -10,6 +10,7 @@
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -32,21 +33,9 @@ struct DisjointSets {
 
 }  // namespace
 
-void EuclideanClusterOptions::Check() const {
-  CheckOption(radius_m > 0.0, fmt::format("EuclideanClusterOptions.radius_m must be > 0, got {}", radius_m));
-  CheckOption(min_points >= 1,
-              fmt::format("EuclideanClusterOptions.min_points must be >= 1, got {}", min_points));
-  CheckOption(
-      max_points == 0 || max_points >= min_points,
-      fmt::format("EuclideanClusterOptions.max_points {} is below min_points {}", max_points, min_points));
-}
+void EuclideanClusterOptions::Check() const { Validate(*this); }
 
-void KMeansOptions::Check() const {
-  CheckOption(clusters >= 1, fmt::format("KMeansOptions.clusters must be >= 1, got {}", clusters));
-  CheckOption(max_iterations >= 1,
-              fmt::format("KMeansOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(tolerance_m >= 0.0, fmt::format("KMeansOptions.tolerance_m must be >= 0, got {}", tolerance_m));
-}
+void KMeansOptions::Check() const { Validate(*this); }
 
 ClusterResult EuclideanClusters(const PointCloud& cloud, const EuclideanClusterOptions& options) {
   options.Check();

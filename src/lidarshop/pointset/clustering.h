@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -20,6 +21,8 @@ struct EuclideanClusterOptions {
   int64_t max_points = 0;  // larger clusters become noise too (0 = no limit)
   void Check() const;      // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<EuclideanClusterOptions>();
 
 struct ClusterResult {
   std::vector<int32_t> labels;  // #P cluster of each point, kNoCluster for noise
@@ -38,6 +41,8 @@ struct KMeansOptions {
   uint64_t seed = 1;          // k-means++ seeding
   void Check() const;         // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<KMeansOptions>();
 
 struct KMeansResult {
   std::vector<int32_t> labels;           // #P index of the nearest centre

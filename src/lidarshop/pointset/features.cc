@@ -12,6 +12,7 @@
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -87,16 +88,7 @@ PointCloud Prepare(const PointCloud& cloud, const GlobalAlignOptions& options, s
 
 }  // namespace
 
-void GlobalAlignOptions::Check() const {
-  CheckOption(voxel_m > 0.0, fmt::format("GlobalAlignOptions.voxel_m must be > 0, got {}", voxel_m));
-  CheckOption(normal_radius_m > 0.0 && feature_radius_m > 0.0, "GlobalAlignOptions radii must be > 0");
-  CheckOption(inlier_distance_m > 0.0,
-              fmt::format("GlobalAlignOptions.inlier_distance_m must be > 0, got {}", inlier_distance_m));
-  CheckOption(max_iterations >= 1,
-              fmt::format("GlobalAlignOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(edge_ratio > 0.0 && edge_ratio <= 1.0,
-              fmt::format("GlobalAlignOptions.edge_ratio must be in (0, 1], got {}", edge_ratio));
-}
+void GlobalAlignOptions::Check() const { Validate(*this); }
 
 std::vector<Fpfh> ComputeFpfh(const PointCloud& cloud, double radius_m) {
   CheckOption(radius_m > 0.0, fmt::format("FPFH radius must be > 0 m, got {}", radius_m));

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -30,6 +31,8 @@ struct GlobalAlignOptions {
   uint64_t seed = 1;
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<GlobalAlignOptions>();
 
 struct GlobalAlignResult {
   Eigen::Matrix4d fixed_from_moving = Eigen::Matrix4d::Identity();

@@ -12,6 +12,7 @@
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -31,27 +32,15 @@ void CheckCloudHasShape(const PointCloud& cloud, std::string_view what) {
   if (all_same) throw InputError(fmt::format("{}: all {} points are identical", what, cloud.size()));
 }
 
-void StatisticalOutlierOptions::Check() const {
-  CheckOption(neighbors >= 1,
-              fmt::format("StatisticalOutlierOptions.neighbors must be >= 1, got {}", neighbors));
-  CheckOption(std_ratio > 0.0,
-              fmt::format("StatisticalOutlierOptions.std_ratio must be > 0, got {}", std_ratio));
-}
+void StatisticalOutlierOptions::Check() const { Validate(*this); }
 
-void RadiusOutlierOptions::Check() const {
-  CheckOption(radius_m > 0.0, fmt::format("RadiusOutlierOptions.radius_m must be > 0, got {}", radius_m));
-  CheckOption(min_neighbors >= 1,
-              fmt::format("RadiusOutlierOptions.min_neighbors must be >= 1, got {}", min_neighbors));
-}
+void RadiusOutlierOptions::Check() const { Validate(*this); }
 
 void CropOptions::Check() const {
+  Validate(*this);
   CheckOption(polygon.empty() || polygon.size() >= 3,
-              fmt::format("CropOptions.polygon needs at least 3 corners, got {}", polygon.size()));
-  CheckOption(min_range_m >= 0.0 && max_range_m >= 0.0 && (max_range_m == 0.0 || max_range_m >= min_range_m),
-              fmt::format("CropOptions range [{}, {}] m is not a range", min_range_m, max_range_m));
-  CheckOption(min_intensity <= max_intensity,
-              fmt::format("CropOptions intensity [{}, {}] is empty", min_intensity, max_intensity));
-  CheckOption(!box || !box->isEmpty(), "CropOptions.box is empty (min > max)");
+              fmt::format("crop polygon: needs at least 3 corners, got {}", polygon.size()));
+  CheckOption(!box || !box->isEmpty(), "crop box: empty (min > max)");
 }
 
 std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud,

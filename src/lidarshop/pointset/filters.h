@@ -19,6 +19,7 @@
 
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -35,6 +36,8 @@ struct StatisticalOutlierOptions {
   double std_ratio = 2.0;  // threshold in standard deviations of the mean distances, > 0
   void Check() const;      // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<StatisticalOutlierOptions>();
 std::vector<uint8_t> StatisticalOutlierInliers(const PointCloud& cloud,
                                                const StatisticalOutlierOptions& options);
 
@@ -44,6 +47,8 @@ struct RadiusOutlierOptions {
   int min_neighbors = 2;   // other points needed within the radius, >= 1
   void Check() const;      // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<RadiusOutlierOptions>();
 std::vector<uint8_t> RadiusOutlierInliers(const PointCloud& cloud, const RadiusOutlierOptions& options);
 
 // Crop: a point is kept when it passes every test that is set (AND); `invert` keeps the others instead.
@@ -59,6 +64,8 @@ struct CropOptions {
   bool invert = false;
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<CropOptions>();
 // Throws InputError when a test needs an attribute the cloud lacks.
 std::vector<uint8_t> CropInliers(const PointCloud& cloud, const CropOptions& options);
 

@@ -8,19 +8,11 @@
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void HoughPlaneOptions::Check() const {
-  CheckOption(angle_step_deg > 0.0 && angle_step_deg <= 30.0,
-              fmt::format("HoughPlaneOptions.angle_step_deg must be in (0, 30], got {}", angle_step_deg));
-  CheckOption(distance_step_m > 0.0,
-              fmt::format("HoughPlaneOptions.distance_step_m must be > 0, got {}", distance_step_m));
-  CheckOption(max_voters >= 3, fmt::format("HoughPlaneOptions.max_voters must be >= 3, got {}", max_voters));
-  CheckOption(max_planes >= 1, fmt::format("HoughPlaneOptions.max_planes must be >= 1, got {}", max_planes));
-  CheckOption(min_inliers >= 3,
-              fmt::format("HoughPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
-}
+void HoughPlaneOptions::Check() const { Validate(*this); }
 
 std::vector<PlaneFit> DetectPlanesHough(const PointCloud& cloud, const HoughPlaneOptions& options) {
   options.Check();

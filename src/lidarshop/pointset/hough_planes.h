@@ -10,6 +10,7 @@
 
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/pointset/planes.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -22,6 +23,8 @@ struct HoughPlaneOptions {
   uint64_t seed = 1;              // the sample of voters
   void Check() const;             // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<HoughPlaneOptions>();
 
 // Planes as PlaneFit (inliers within half a distance cell of the cell's plane, then refitted by least
 // squares; `iterations` = the votes of the cell). Throws InputError on empty or degenerate clouds.

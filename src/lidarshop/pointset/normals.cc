@@ -9,6 +9,7 @@
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -43,15 +44,7 @@ struct Covariance {
 
 }  // namespace
 
-void NormalOptions::Check() const {
-  CheckOption(neighbors >= 3, fmt::format("NormalOptions.neighbors must be >= 3, got {}", neighbors));
-  CheckOption(radius_m >= 0.0,
-              fmt::format("NormalOptions.radius_m must be >= 0 (0 = k nearest), got {}", radius_m));
-  CheckOption(max_neighbors >= 0,
-              fmt::format("NormalOptions.max_neighbors must be >= 0, got {}", max_neighbors));
-  CheckOption(window_cells >= 1,
-              fmt::format("NormalOptions.window_cells must be >= 1, got {}", window_cells));
-}
+void NormalOptions::Check() const { Validate(*this); }
 
 NormalResult EstimateNormals(const PointCloud& cloud, const NormalOptions& options) {
   options.Check();

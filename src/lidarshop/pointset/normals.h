@@ -14,6 +14,7 @@
 
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -26,6 +27,8 @@ struct NormalOptions {
   Eigen::Vector3f viewpoint = Eigen::Vector3f::Zero();
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<NormalOptions>();
 
 struct NormalResult {
   std::vector<Eigen::Vector3f> normals;  // #P unit normals toward the viewpoint; 0 where < 3 neighbours

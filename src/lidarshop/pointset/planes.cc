@@ -12,6 +12,7 @@
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -105,18 +106,7 @@ void RefitPlane(const std::vector<Eigen::Vector3f>& points, PlaneFit* fit) {
   fit->rms_m = std::sqrt(std::max(0.0, solver.eigenvalues()[0]) / static_cast<double>(fit->inliers.size()));
 }
 
-void RansacPlaneOptions::Check() const {
-  CheckOption(
-      distance_threshold_m > 0.0,
-      fmt::format("RansacPlaneOptions.distance_threshold_m must be > 0, got {}", distance_threshold_m));
-  CheckOption(max_iterations >= 1,
-              fmt::format("RansacPlaneOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(confidence > 0.0 && confidence < 1.0,
-              fmt::format("RansacPlaneOptions.confidence must be in (0, 1), got {}", confidence));
-  CheckOption(min_inliers >= 3,
-              fmt::format("RansacPlaneOptions.min_inliers must be >= 3, got {}", min_inliers));
-  CheckOption(max_planes >= 1, fmt::format("RansacPlaneOptions.max_planes must be >= 1, got {}", max_planes));
-}
+void RansacPlaneOptions::Check() const { Validate(*this); }
 
 PlaneFit FitPlaneRansac(const PointCloud& cloud, const RansacPlaneOptions& options) {
   RansacPlaneOptions best_only = options;

@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -24,6 +25,8 @@ struct RansacPlaneOptions {
   uint64_t seed = 1;                   // every random choice
   void Check() const;                  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<RansacPlaneOptions>();
 
 struct PlaneFit {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  // unit normal

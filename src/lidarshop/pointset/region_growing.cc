@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -43,13 +44,7 @@ int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& optio
 
 }  // namespace
 
-void RegionGrowingOptions::Check() const {
-  CheckOption(
-      max_range_jump_ratio > 0.0,
-      fmt::format("RegionGrowingOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
-  CheckOption(min_region_cells >= 1,
-              fmt::format("RegionGrowingOptions.min_region_cells must be >= 1, got {}", min_region_cells));
-}
+void RegionGrowingOptions::Check() const { Validate(*this); }
 
 GrowCondition NormalAngleCondition(const Scan& scan, double max_angle_deg) {
   CheckOption(max_angle_deg > 0.0, fmt::format("normal angle must be > 0 degrees, got {}", max_angle_deg));

@@ -11,6 +11,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -19,6 +20,8 @@ struct RegionGrowingOptions {
   int64_t min_region_cells = 1;       // SegmentByRegionGrowing: smaller regions get kNoLabel, >= 1
   void Check() const;                 // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<RegionGrowingOptions>();
 
 // Whether the front may move from cell `from` to its neighbour `to` (cv::Point(col, row)).
 using GrowCondition = std::function<bool(cv::Point from, cv::Point to)>;

@@ -12,6 +12,7 @@
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -36,21 +37,7 @@ constexpr int64_t kBlock = 4096;  // fixed blocks summed in order: the same sums
 
 }  // namespace
 
-void IcpOptions::Check() const {
-  CheckOption(max_correspondence_m > 0.0,
-              fmt::format("IcpOptions.max_correspondence_m must be > 0, got {}", max_correspondence_m));
-  CheckOption(min_correspondence_m > 0.0 && min_correspondence_m <= max_correspondence_m,
-              fmt::format("IcpOptions.min_correspondence_m must be in (0, max_correspondence_m], got {}",
-                          min_correspondence_m));
-  CheckOption(min_normal_cos >= -1.0 && min_normal_cos <= 1.0,
-              fmt::format("IcpOptions.min_normal_cos must be in [-1, 1], got {}", min_normal_cos));
-  CheckOption(max_iterations >= 1,
-              fmt::format("IcpOptions.max_iterations must be >= 1, got {}", max_iterations));
-  CheckOption(min_translation_m >= 0.0 && min_rotation_rad >= 0.0,
-              "IcpOptions convergence thresholds must be >= 0");
-  CheckOption(normal_neighbors >= 3,
-              fmt::format("IcpOptions.normal_neighbors must be >= 3, got {}", normal_neighbors));
-}
+void IcpOptions::Check() const { Validate(*this); }
 
 IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
                           const Eigen::Matrix4d& initial_fixed_from_moving, const IcpOptions& options) {

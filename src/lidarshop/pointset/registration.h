@@ -14,6 +14,7 @@
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/pointset/features.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -30,6 +31,8 @@ struct IcpOptions {
   int normal_neighbors = 20;        // k for the fixed cloud's normals when it has none, >= 3
   void Check() const;               // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<IcpOptions>();
 
 struct IcpResult {
   Eigen::Matrix4d fixed_from_moving = Eigen::Matrix4d::Identity();

@@ -8,19 +8,11 @@
 #include <opencv2/ximgproc/slic.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void SuperpixelOptions::Check() const {
-  CheckOption(region_cells >= 2,
-              fmt::format("SuperpixelOptions.region_cells must be >= 2, got {}", region_cells));
-  CheckOption(ruler > 0.0f, fmt::format("SuperpixelOptions.ruler must be > 0, got {}", ruler));
-  CheckOption(iterations >= 1, fmt::format("SuperpixelOptions.iterations must be >= 1, got {}", iterations));
-  CheckOption(graph_sigma >= 0.0 && graph_k > 0.0f && graph_min_cells >= 1,
-              "SuperpixelOptions graph_sigma must be >= 0, graph_k > 0, graph_min_cells >= 1");
-  CheckOption(range_weight >= 0.0,
-              fmt::format("SuperpixelOptions.range_weight must be >= 0, got {}", range_weight));
-}
+void SuperpixelOptions::Check() const { Validate(*this); }
 
 cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int* num_superpixels) {
   options.Check();

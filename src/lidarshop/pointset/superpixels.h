@@ -9,10 +9,13 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
-enum class SuperpixelMethod { kSlic, kGraph };
+enum class SuperpixelMethod { kSlic, kGraph };  // "slic", "graph"
+template <>
+const EnumInfo& EnumInfoOf<SuperpixelMethod>();
 
 struct SuperpixelOptions {
   SuperpixelMethod method = SuperpixelMethod::kSlic;
@@ -26,6 +29,8 @@ struct SuperpixelOptions {
       1.0;             // weight of the log-range channel against colour (both scaled to [0, 255]), >= 0
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<SuperpixelOptions>();
 
 // CV_32S rows x cols superpixel labels 0, 1, … (cells without a return included: their range channel is 0).
 // `num_superpixels` (optional) receives the count. Deterministic (neither method draws random numbers).

@@ -141,6 +141,10 @@ void FieldInfo::CheckValue(const nlohmann::json& value) const {
         if (!element.is_number() || !std::isfinite(element.get<double>())) {
           throw OptionsError(fmt::format("expected a list of numbers, got {}", value.dump()));
         }
+        if (integer_elements && (!element.is_number_integer() || element.get<double>() < integer_low ||
+                                 element.get<double>() > integer_high)) {
+          throw OptionsError(fmt::format("expected a list of whole numbers, got {}", value.dump()));
+        }
         CheckRange(element.get<double>(), element.dump());
       }
       return;
@@ -305,6 +309,7 @@ nlohmann::json SampleValue(const FieldInfo& field, const nlohmann::ordered_json&
       return value;
     }
     case FieldKind::kNumberList:
+      if (field.integer_elements) return nlohmann::json::array({1, 3, 7});
       for (double candidate : {0.1, 1.5, 2.0 / 3.0}) {
         if (!inside(candidate)) return current;
       }

@@ -54,9 +54,11 @@ struct FieldInfo {
   std::string unit;                // "cells", "m", "deg", "px", "" for a pure number
   std::optional<double> min, max;  // valid range, inclusive unless the *_exclusive flag says otherwise
   bool min_exclusive = false, max_exclusive = false;
-  int64_t integer_low = INT64_MIN, integer_high = INT64_MAX;  // kInt: the C++ type's limits
-  const EnumInfo* choices = nullptr;                          // kEnum
-  const StructInfo* nested = nullptr;                         // kStruct
+  int64_t integer_low = INT64_MIN,
+          integer_high = INT64_MAX;    // kInt (and kNumberList of integers): type limits
+  bool integer_elements = false;       // kNumberList of an integer type
+  const EnumInfo* choices = nullptr;   // kEnum
+  const StructInfo* nested = nullptr;  // kStruct
   // Type-erased access to the field of a struct instance (`void*` = the struct described by the owner).
   std::function<nlohmann::ordered_json(const void*)> get;
   std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
@@ -161,8 +163,15 @@ class StructBuilder {
       }
     };
     if constexpr (IsVector<T>::value) {
-      static_assert(std::is_arithmetic_v<typename T::value_type>, "list fields hold numbers");
+      using Element = typename T::value_type;
+      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers");
       field.kind = FieldKind::kNumberList;
+      if constexpr (std::is_integral_v<Element>) {
+        field.integer_elements = true;
+        field.integer_low = std::numeric_limits<Element>::min();
+        field.integer_high =
+            static_cast<int64_t>(std::min<uint64_t>(std::numeric_limits<Element>::max(), INT64_MAX));
+      }
       field.set = [member](void* object, const nlohmann::json& json) {
         static_cast<S*>(object)->*member = json.get<T>();
       };

@@ -1,0 +1,256 @@
+// Descriptions of the point-set options (util/options.h). Not described (geometry, not options): CropOptions'
+// box, polygon and origin, NormalOptions' viewpoint — their Check() keeps checking them.
+#include "lidarshop/pointset/clustering.h"
+#include "lidarshop/pointset/features.h"
+#include "lidarshop/pointset/filters.h"
+#include "lidarshop/pointset/hough_planes.h"
+#include "lidarshop/pointset/normals.h"
+#include "lidarshop/pointset/planes.h"
+#include "lidarshop/pointset/region_growing.h"
+#include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/superpixels.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<RansacPlaneOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RansacPlaneOptions> b("RansacPlaneOptions", "RANSAC plane detection");
+    b.Field(&RansacPlaneOptions::distance_threshold_m, "distance_threshold_m", "inlier distance to the plane")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&RansacPlaneOptions::max_iterations, "max_iterations", "hypotheses at most").Min(1);
+    b.Field(&RansacPlaneOptions::confidence, "confidence", "stop when a better plane is this unlikely")
+        .AboveZero()
+        .Below(1);
+    b.Field(&RansacPlaneOptions::min_inliers, "min_inliers", "sequential detection stops below this").Min(3);
+    b.Field(&RansacPlaneOptions::max_planes, "max_planes", "planes at most").Min(1);
+    b.Field(&RansacPlaneOptions::seed, "seed", "seed of every random choice");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<IcpOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<IcpOptions> b("IcpOptions", "point-to-plane ICP");
+    b.Field(&IcpOptions::max_correspondence_m, "max_correspondence_m",
+            "pairs farther apart are ignored at first")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&IcpOptions::min_correspondence_m, "min_correspondence_m",
+            "the pair distance shrinks down to this")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&IcpOptions::min_normal_cos, "min_normal_cos", "pairs whose normals differ more are ignored")
+        .Range(-1, 1);
+    b.Field(&IcpOptions::max_iterations, "max_iterations", "iterations at most").Min(1);
+    b.Field(&IcpOptions::min_translation_m, "min_translation_m", "converged when an update moves less")
+        .Unit("m")
+        .Min(0);
+    b.Field(&IcpOptions::min_rotation_rad, "min_rotation_rad", "and turns less").Unit("rad").Min(0);
+    b.Field(&IcpOptions::normal_neighbors, "normal_neighbors",
+            "k of the fixed cloud's normals when it has none")
+        .Min(3);
+    b.Check([](const IcpOptions& o) {
+      if (o.min_correspondence_m > o.max_correspondence_m) {
+        throw OptionsFieldError("min_correspondence_m", "is above max_correspondence_m");
+      }
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<EuclideanClusterOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<EuclideanClusterOptions> b("EuclideanClusterOptions", "Euclidean clustering");
+    b.Field(&EuclideanClusterOptions::radius_m, "radius_m", "points closer than this are neighbours")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&EuclideanClusterOptions::min_points, "min_points", "smaller clusters become noise").Min(1);
+    b.Field(&EuclideanClusterOptions::max_points, "max_points", "larger clusters become noise; 0 = no limit")
+        .Min(0);
+    b.Check([](const EuclideanClusterOptions& o) {
+      if (o.max_points != 0 && o.max_points < o.min_points) {
+        throw OptionsFieldError("max_points", "is below min_points");
+      }
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<KMeansOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<KMeansOptions> b("KMeansOptions", "k-means++ clustering");
+    b.Field(&KMeansOptions::clusters, "clusters", "k").Min(1);
+    b.Field(&KMeansOptions::max_iterations, "max_iterations", "Lloyd iterations at most").Min(1);
+    b.Field(&KMeansOptions::tolerance_m, "tolerance_m", "stop when no centre moves more").Unit("m").Min(0);
+    b.Field(&KMeansOptions::seed, "seed", "seed of the k-means++ seeding");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<GlobalAlignOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<GlobalAlignOptions> b("GlobalAlignOptions", "FPFH + RANSAC global alignment");
+    b.Field(&GlobalAlignOptions::voxel_m, "voxel_m", "voxel size of the subsampling").Unit("m").AboveZero();
+    b.Field(&GlobalAlignOptions::normal_radius_m, "normal_radius_m", "normal radius of the subsampled clouds")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&GlobalAlignOptions::feature_radius_m, "feature_radius_m", "FPFH radius").Unit("m").AboveZero();
+    b.Field(&GlobalAlignOptions::inlier_distance_m, "inlier_distance_m",
+            "a match agrees with a pose within this")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&GlobalAlignOptions::max_iterations, "max_iterations", "RANSAC triples").Min(1);
+    b.Field(&GlobalAlignOptions::edge_ratio, "edge_ratio", "triples whose edges differ more are skipped")
+        .AboveZero()
+        .Max(1);
+    b.Field(&GlobalAlignOptions::seed, "seed", "seed of the RANSAC triples");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<SuperpixelMethod>() {
+  static const EnumInfo info = MakeEnumInfo<SuperpixelMethod>(
+      "superpixel method", {{SuperpixelMethod::kSlic, "slic", "SLIC (OpenCV ximgproc)"},
+                            {SuperpixelMethod::kGraph, "graph", "Felzenszwalb graph segmentation"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SuperpixelOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<SuperpixelOptions> b("SuperpixelOptions", "superpixels of a scan's ray image");
+    b.Field(&SuperpixelOptions::method, "method", "superpixel method");
+    b.Field(&SuperpixelOptions::region_cells, "region_cells", "SLIC: superpixel side").Unit("cells").Min(2);
+    b.Field(&SuperpixelOptions::ruler, "ruler", "SLIC: compactness").AboveZero();
+    b.Field(&SuperpixelOptions::iterations, "iterations", "SLIC iterations").Min(1);
+    b.Field(&SuperpixelOptions::graph_sigma, "graph_sigma", "graph: Gaussian smoothing").Unit("cells").Min(0);
+    b.Field(&SuperpixelOptions::graph_k, "graph_k", "graph: larger = larger segments").AboveZero();
+    b.Field(&SuperpixelOptions::graph_min_cells, "graph_min_cells", "graph: smallest segment")
+        .Unit("cells")
+        .Min(1);
+    b.Field(&SuperpixelOptions::range_weight, "range_weight",
+            "weight of the log-range channel against colour")
+        .Min(0);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<StatisticalOutlierOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<StatisticalOutlierOptions> b("StatisticalOutlierOptions", "statistical outlier removal");
+    b.Field(&StatisticalOutlierOptions::neighbors, "neighbors", "k nearest neighbours").Min(1);
+    b.Field(&StatisticalOutlierOptions::std_ratio, "std_ratio", "threshold in standard deviations")
+        .AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RadiusOutlierOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RadiusOutlierOptions> b("RadiusOutlierOptions", "radius outlier removal");
+    b.Field(&RadiusOutlierOptions::radius_m, "radius_m", "neighbourhood radius").Unit("m").AboveZero();
+    b.Field(&RadiusOutlierOptions::min_neighbors, "min_neighbors", "other points needed within the radius")
+        .Min(1);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<CropOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<CropOptions> b("CropOptions",
+                                 "crops by label, range and intensity (box and polygon: C++ only)");
+    b.Field(&CropOptions::labels, "labels", "keep points with one of these labels; empty = any");
+    b.Field(&CropOptions::min_range_m, "min_range_m", "keep points at least this far from the origin")
+        .Unit("m")
+        .Min(0);
+    b.Field(&CropOptions::max_range_m, "max_range_m", "and at most this far; 0 = no upper bound")
+        .Unit("m")
+        .Min(0);
+    b.Field(&CropOptions::min_intensity, "min_intensity", "keep intensities from this");
+    b.Field(&CropOptions::max_intensity, "max_intensity", "up to this");
+    b.Field(&CropOptions::invert, "invert", "keep the points outside instead");
+    b.Check([](const CropOptions& o) {
+      if (o.max_range_m != 0.0 && o.max_range_m < o.min_range_m) {
+        throw OptionsFieldError("max_range_m", "is below min_range_m");
+      }
+      if (o.min_intensity > o.max_intensity)
+        throw OptionsFieldError("max_intensity", "is below min_intensity");
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<NormalOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<NormalOptions> b("NormalOptions", "normals and curvature (viewpoint: C++ only)");
+    b.Field(&NormalOptions::neighbors, "neighbors", "k nearest points, used when radius_m is 0").Min(3);
+    b.Field(&NormalOptions::radius_m, "radius_m", "all points within this radius instead; 0 = k nearest")
+        .Unit("m")
+        .Min(0);
+    b.Field(&NormalOptions::max_neighbors, "max_neighbors", "radius mode: at most this many; 0 = all").Min(0);
+    b.Field(&NormalOptions::window_cells, "window_cells", "grid mode: half-width of the window")
+        .Unit("cells")
+        .Min(1);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<HoughPlaneOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<HoughPlaneOptions> b("HoughPlaneOptions", "Hough plane detection");
+    b.Field(&HoughPlaneOptions::angle_step_deg, "angle_step_deg", "normal direction resolution")
+        .Unit("deg")
+        .AboveZero()
+        .Max(30);
+    b.Field(&HoughPlaneOptions::distance_step_m, "distance_step_m", "plane offset resolution")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&HoughPlaneOptions::max_voters, "max_voters", "points sampled to vote").Min(3);
+    b.Field(&HoughPlaneOptions::max_planes, "max_planes", "planes at most").Min(1);
+    b.Field(&HoughPlaneOptions::min_inliers, "min_inliers", "stop when the next plane has fewer points")
+        .Min(3);
+    b.Field(&HoughPlaneOptions::seed, "seed", "seed of the sample of voters");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RegionGrowingOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RegionGrowingOptions> b("RegionGrowingOptions", "region growing over the scan grid");
+    b.Field(&RegionGrowingOptions::max_range_jump_ratio, "max_range_jump_ratio",
+            "neighbours join when their ranges differ by at most this times the nearer")
+        .AboveZero();
+    b.Field(&RegionGrowingOptions::min_region_cells, "min_region_cells", "smaller regions get no label")
+        .Unit("cells")
+        .Min(1);
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
