@@ -61,10 +61,6 @@ double Number(const nlohmann::json& pose, const char* key, double fallback) {
   return value.get<double>();
 }
 
-nlohmann::ordered_json NumberOrNull(double value) {
-  return std::isfinite(value) ? nlohmann::ordered_json(value) : nullptr;
-}
-
 }  // namespace
 
 void AddVerifyRoutes(State& state) {
@@ -154,14 +150,9 @@ void AddVerifyRoutes(State& state) {
       }
       const VerifyResult result =
           VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
-      SendJson(response, {{"consistency", NumberOrNull(result.consistency)},
-                          {"has_comparable_pairs", result.has_comparable_pairs},
-                          {"comparable_pairs", result.comparable_pairs},
-                          {"consistent_pairs", result.consistent_pairs},
-                          {"confidence", result.confidence},
-                          {"icp_cost_m", NumberOrNull(result.icp_cost_m)},
-                          {"inlier_fraction", result.inlier_fraction},
-                          {"summary", result.BriefReport()}});
+      nlohmann::ordered_json json = ToJson(result);
+      json["summary"] = result.BriefReport();
+      SendJson(response, json);
     } catch (const OptionsError& error) {
       SendError(response, 400, error.what());
     } catch (const InputError& error) {

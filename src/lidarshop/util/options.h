@@ -19,6 +19,7 @@
 // the same way by `EnumInfoOf<E>()` (util/enum_names.h), and convert to and from strings only through it.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -154,6 +155,9 @@ class StructBuilder {
       const T& value = static_cast<const S*>(object)->*member;
       if constexpr (std::is_enum_v<T>) {
         return std::string(ToString(value));
+      } else if constexpr (std::is_floating_point_v<T>) {
+        // NaN ("none", e.g. a consistency with nothing to compare) is JSON null.
+        return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
       } else if constexpr (IsVector<T>::value) {
         return nlohmann::ordered_json(value);
       } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {

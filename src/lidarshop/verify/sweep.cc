@@ -10,6 +10,7 @@
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -100,31 +101,9 @@ void RefineSeeds(const VerifierModel& model, std::span<const PreparedScan> scans
 }  // namespace
 
 void SweepOptions::Check() const {
-  CheckOption(
-      std::isfinite(x_min_m) && std::isfinite(x_max_m) && x_max_m >= x_min_m,
-      fmt::format("SweepOptions: x range must be finite with max >= min, got [{}, {}]", x_min_m, x_max_m));
-  CheckOption(
-      std::isfinite(y_min_m) && std::isfinite(y_max_m) && y_max_m >= y_min_m,
-      fmt::format("SweepOptions: y range must be finite with max >= min, got [{}, {}]", y_min_m, y_max_m));
-  CheckOption(step_m > 0 && std::isfinite(step_m),
-              fmt::format("SweepOptions.step_m must be > 0, got {}", step_m));
-  CheckOption(std::isfinite(z_m), "SweepOptions.z_m must be finite");
-  CheckOption(!yaws_deg.empty(), "SweepOptions.yaws_deg must not be empty");
-  for (double yaw : yaws_deg) CheckOption(std::isfinite(yaw), "SweepOptions.yaws_deg must be finite");
-  CheckOption(min_consistency >= 0 && min_consistency <= 1,
-              fmt::format("SweepOptions.min_consistency must be in [0, 1], got {}", min_consistency));
-  CheckOption(min_confidence >= 0 && min_confidence <= 1,
-              fmt::format("SweepOptions.min_confidence must be in [0, 1], got {}", min_confidence));
-  CheckOption(min_comparable_pairs >= 0, "SweepOptions.min_comparable_pairs must be >= 0");
-  CheckOption(nms_radius_m >= 0 && std::isfinite(nms_radius_m), "SweepOptions.nms_radius_m must be >= 0");
-  CheckOption(refine_min_step_m > 0 && refine_min_yaw_deg > 0 && refine_max_seeds >= 0,
-              "SweepOptions: refine_min_step_m and refine_min_yaw_deg must be > 0, refine_max_seeds >= 0");
+  Validate(*this);
   const double positions =
       (std::floor((x_max_m - x_min_m) / step_m) + 1) * (std::floor((y_max_m - y_min_m) / step_m) + 1);
-  CheckOption(
-      positions * static_cast<double>(yaws_deg.size()) <= static_cast<double>(max_poses),
-      fmt::format("SweepOptions: {} poses exceed max_poses = {} (coarser step, smaller ranges or fewer yaws)",
-                  positions * yaws_deg.size(), max_poses));
   CheckMemoryBudget(static_cast<int64_t>(positions * static_cast<double>(yaws_deg.size()) * 200),
                     fmt::format("a sweep of {} poses", positions * static_cast<double>(yaws_deg.size())));
 }

@@ -45,6 +45,8 @@ struct SweepOptions {
 
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<SweepOptions>();
 
 struct Detection {
   double x_m = 0, y_m = 0, z_m = 0, yaw_deg = 0;

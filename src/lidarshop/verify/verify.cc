@@ -15,6 +15,7 @@
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/footprint_gather.h"
 #include "lidarshop/verify/kernel_grid.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -211,34 +212,13 @@ struct Workspace {
 }  // namespace
 
 void ModelOptions::Check() const {
-  CheckOption(num_surface_samples > 0 && num_surface_samples <= kMaxSurfaceSamples,
-              fmt::format("ModelOptions.num_surface_samples must be in [1, {}], got {}", kMaxSurfaceSamples,
-                          num_surface_samples));
+  Validate(*this);
   // A model point costs its position, weight, normal and grid entry (~64 bytes).
   CheckMemoryBudget(SaturatingBytes(num_surface_samples, 64),
                     fmt::format("{} model surface samples", num_surface_samples));
-  CheckOption(
-      distinctiveness_radius_m >= 0,
-      fmt::format("ModelOptions.distinctiveness_radius_m must be >= 0, got {}", distinctiveness_radius_m));
-  CheckOption(distinctiveness_floor >= 0 && std::isfinite(distinctiveness_floor),
-              fmt::format("ModelOptions.distinctiveness_floor must be >= 0, got {}", distinctiveness_floor));
 }
 
-void VerifyOptions::Check() const {
-  // Lengths past kMaxLengthM are not physical for an object in a terrestrial scan (and would overflow the
-  // neighbour grid's cell arithmetic).
-  constexpr double kMaxLengthM = 1000;
-  CheckOption(
-      allowance_m >= 0 && allowance_m <= kMaxLengthM,
-      fmt::format("VerifyOptions.allowance_m must be in [0, {}] m, got {}", kMaxLengthM, allowance_m));
-  CheckOption(sigma_m > 0 && sigma_m <= kMaxLengthM,
-              fmt::format("VerifyOptions.sigma_m must be in (0, {}] m, got {}", kMaxLengthM, sigma_m));
-  CheckOption(icp_trim_m > 0 && icp_trim_m <= kMaxLengthM,
-              fmt::format("VerifyOptions.icp_trim_m must be in (0, {}] m, got {}", kMaxLengthM, icp_trim_m));
-  CheckOption(footprint_margin_cells >= 0 && footprint_margin_cells < 1000,
-              fmt::format("VerifyOptions.footprint_margin_cells must be in [0, 1000), got {}",
-                          footprint_margin_cells));
-}
+void VerifyOptions::Check() const { Validate(*this); }
 
 VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions& options) {
   return PrepareModel(mesh_in_model, options, VerifyOptions());

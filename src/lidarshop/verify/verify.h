@@ -57,6 +57,7 @@
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -69,11 +70,16 @@ enum class ModelPointSource {
 };
 
 // How the information I_i of the model points is distributed (it always sums to 1).
+template <>
+const EnumInfo& EnumInfoOf<ModelPointSource>();  // "surface-samples", "vertices"
+
 enum class InformationWeighting {
   kUniform,               // I_i = 1/N
   kShapeDistinctiveness,  // I_i ∝ floor + surface variation (pointset/sampling.h) within
                           // distinctiveness_radius_m
 };
+template <>
+const EnumInfo& EnumInfoOf<InformationWeighting>();  // "uniform", "shape-distinctiveness"
 
 struct ModelOptions {
   ModelPointSource point_source = ModelPointSource::kSurfaceSamples;
@@ -88,6 +94,8 @@ struct ModelOptions {
 
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<ModelOptions>();
 
 // Positions as three coordinate arrays (structure of arrays, for SIMD loads).
 struct PointColumns {
@@ -175,6 +183,8 @@ struct VerifyOptions {
 
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<VerifyOptions>();
 
 // The outcome for one scan alone (consistency and confidence as if it were the only scan).
 struct ScanVerifyStats {
@@ -208,6 +218,8 @@ struct VerifyResult {
   // One line: "consistency 0.98 (1234 pairs), confidence 0.41, icp 0.012 m (inliers 0.93)".
   std::string BriefReport() const;
 };
+template <>
+const StructInfo& InfoOf<VerifyResult>();
 
 // Verifies one pose. `world_from_model` may include a uniform scale; distances stay in scanner (world)
 // metres.

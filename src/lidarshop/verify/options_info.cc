@@ -1,0 +1,147 @@
+// Descriptions of the verification options, enums and result (util/options.h).
+#include "lidarshop/util/options.h"
+#include "lidarshop/verify/sweep.h"
+#include "lidarshop/verify/verify.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<ModelPointSource>() {
+  static const EnumInfo info = MakeEnumInfo<ModelPointSource>(
+      "model point source",
+      {{ModelPointSource::kSurfaceSamples, "surface-samples", "uniform over the surface area"},
+       {ModelPointSource::kVertices, "vertices", "the mesh's vertices (the original work)"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<InformationWeighting>() {
+  static const EnumInfo info = MakeEnumInfo<InformationWeighting>(
+      "information weighting", {{InformationWeighting::kUniform, "uniform", "every model point carries 1/N"},
+                                {InformationWeighting::kShapeDistinctiveness, "shape-distinctiveness",
+                                 "in proportion to surface variation"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ModelOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<ModelOptions> b("ModelOptions", "the model side of verification");
+    b.Field(&ModelOptions::point_source, "point_source", "where the model points come from");
+    b.Field(&ModelOptions::num_surface_samples, "num_surface_samples", "model points (surface samples)")
+        .Range(1, static_cast<double>(ModelOptions::kMaxSurfaceSamples));
+    b.Field(&ModelOptions::seed, "seed", "seed of the surface sampling");
+    b.Field(&ModelOptions::information, "information", "how the information of the model points is spread");
+    b.Field(&ModelOptions::distinctiveness_radius_m, "distinctiveness_radius_m",
+            "neighbourhood of the surface variation; 0 = 3% of the bounding-box diagonal")
+        .Unit("m")
+        .Min(0);
+    b.Field(&ModelOptions::distinctiveness_floor, "distinctiveness_floor", "added to every point's variation")
+        .Min(0);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<VerifyOptions>() {
+  static const StructInfo info = [] {
+    // Lengths past 1 km are not physical for an object in a terrestrial scan (and would overflow the
+    // neighbour grid's cell arithmetic).
+    StructBuilder<VerifyOptions> b("VerifyOptions", "consistency and confidence of a pose (thesis ch. 4)");
+    b.Field(&VerifyOptions::allowance_m, "allowance_m", "a: how far behind the model a scan point may lie")
+        .Unit("m")
+        .Range(0, 1000);
+    b.Field(&VerifyOptions::sigma_m, "sigma_m", "sigma of the confidence kernel, about the point spacing")
+        .Unit("m")
+        .AboveZero()
+        .Max(1000);
+    b.Field(&VerifyOptions::icp_trim_m, "icp_trim_m", "ICP pairs beyond this are excluded")
+        .Unit("m")
+        .AboveZero()
+        .Max(1000);
+    b.Field(&VerifyOptions::footprint_margin_cells, "footprint_margin_cells",
+            "cells around the model's footprint")
+        .Unit("cells")
+        .Min(0)
+        .Below(1000);
+    b.Field(&VerifyOptions::keep_details, "keep_details",
+            "keep the per-cell status and per-point information");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SweepOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<SweepOptions> b("SweepOptions", "verification over a grid of candidate poses");
+    b.Field(&SweepOptions::x_min_m, "x_min_m", "world x range of the model origin, from").Unit("m");
+    b.Field(&SweepOptions::x_max_m, "x_max_m", "to").Unit("m");
+    b.Field(&SweepOptions::y_min_m, "y_min_m", "world y range, from").Unit("m");
+    b.Field(&SweepOptions::y_max_m, "y_max_m", "to").Unit("m");
+    b.Field(&SweepOptions::step_m, "step_m", "between candidate positions").Unit("m").AboveZero();
+    b.Field(&SweepOptions::z_m, "z_m", "world z of the model origin").Unit("m");
+    b.Field(&SweepOptions::yaws_deg, "yaws_deg", "yaws tried at every position").Unit("deg");
+    b.Field(&SweepOptions::min_consistency, "min_consistency", "detections need consistency above this")
+        .Range(0, 1);
+    b.Field(&SweepOptions::min_confidence, "min_confidence", "and confidence above this").Range(0, 1);
+    b.Field(&SweepOptions::min_comparable_pairs, "min_comparable_pairs",
+            "and at least this many comparable pairs")
+        .Min(0);
+    b.Field(&SweepOptions::nms_radius_m, "nms_radius_m", "non-maximum suppression radius; 0 = from the model")
+        .Unit("m")
+        .Min(0);
+    b.Field(&SweepOptions::max_poses, "max_poses", "refuse larger sweeps").Min(1);
+    b.Field(&SweepOptions::refine, "refine", "refine the best grid poses by coordinate ascent");
+    b.Field(&SweepOptions::refine_min_consistency, "refine_min_consistency", "grid poses refined above this")
+        .Range(0, 1);
+    b.Field(&SweepOptions::refine_min_confidence, "refine_min_confidence", "and above this confidence")
+        .Range(0, 1);
+    b.Field(&SweepOptions::refine_max_seeds, "refine_max_seeds", "grid poses refined at most").Min(0);
+    b.Field(&SweepOptions::refine_min_step_m, "refine_min_step_m", "smallest refinement step")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&SweepOptions::refine_min_yaw_deg, "refine_min_yaw_deg", "smallest refinement yaw step")
+        .Unit("deg")
+        .AboveZero();
+    b.Check([](const SweepOptions& o) {
+      if (o.x_max_m < o.x_min_m) throw OptionsFieldError("x_max_m", "is below x_min_m");
+      if (o.y_max_m < o.y_min_m) throw OptionsFieldError("y_max_m", "is below y_min_m");
+      if (o.yaws_deg.empty()) throw OptionsFieldError("yaws_deg", "must not be empty");
+      const double positions = (std::floor((o.x_max_m - o.x_min_m) / o.step_m) + 1) *
+                               (std::floor((o.y_max_m - o.y_min_m) / o.step_m) + 1);
+      const double poses = positions * static_cast<double>(o.yaws_deg.size());
+      if (poses > static_cast<double>(o.max_poses)) {
+        throw OptionsFieldError("max_poses",
+                                fmt::format("{} poses exceed it (coarser step, smaller ranges or "
+                                            "fewer yaws)",
+                                            poses));
+      }
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<VerifyResult>() {
+  static const StructInfo info = [] {
+    // consistency and icp_cost_m are NaN when there is nothing to compare: JSON writes them as null.
+    StructBuilder<VerifyResult> b("VerifyResult", "a verified pose (per-cell details are not JSON)");
+    b.Field(&VerifyResult::consistency, "consistency", "share of comparable pairs that agree; null = none");
+    b.Field(&VerifyResult::has_comparable_pairs, "has_comparable_pairs", "whether any pair was comparable");
+    b.Field(&VerifyResult::comparable_pairs, "comparable_pairs", "scan point / model pairs compared");
+    b.Field(&VerifyResult::consistent_pairs, "consistent_pairs", "of which consistent");
+    b.Field(&VerifyResult::confidence, "confidence", "information of the model seen by the scans, [0, 1]");
+    b.Field(&VerifyResult::icp_cost_m, "icp_cost_m", "trimmed ICP cost; null = no inlier pair").Unit("m");
+    b.Field(&VerifyResult::inlier_fraction, "inlier_fraction", "inliers / scene points near the model");
+    b.Field(&VerifyResult::icp_inliers, "icp_inliers", "ICP inlier pairs");
+    b.Field(&VerifyResult::icp_candidates, "icp_candidates",
+            "scene points in the model's grown bounding box");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
