@@ -145,7 +145,7 @@ void BM_Textures(benchmark::State& state) {
     EvaluateTextures(kind, 1.0f, kPoints, u.data(), v.data(), footprint.data(), base.data(), rgb.data());
     benchmark::DoNotOptimize(rgb.data());
   }
-  state.SetLabel(TextureName(kind));
+  state.SetLabel(ToString(kind));
   state.SetItemsProcessed(state.iterations() * kPoints);
 }
 BENCHMARK(BM_Textures)

@@ -10,6 +10,7 @@
 
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -48,11 +49,7 @@ void FillRayHit(const Ray& ray, RTCRayHit* ray_hit) {
 
 }  // namespace
 
-void RaycastSceneOptions::Check() const {
-  CheckOption(
-      build_quality == "low" || build_quality == "medium" || build_quality == "high",
-      fmt::format("RaycastSceneOptions.build_quality must be low, medium or high, got '{}'", build_quality));
-}
+void RaycastSceneOptions::Check() const { Validate(*this); }
 
 RaycastScene::RaycastScene() : RaycastScene(RaycastSceneOptions()) {}
 

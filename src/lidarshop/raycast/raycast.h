@@ -22,6 +22,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -60,6 +61,8 @@ enum class CastMethod {
   kStream,    // rows of tiles as rtcIntersect1M streams with the coherent flag
   kSingle,    // one rtcIntersect1 per ray (Open3D's RaycastingScene way; the reference)
 };
+template <>
+const EnumInfo& EnumInfoOf<CastMethod>();
 
 struct RaycastSceneOptions {
   // Embree BVH build quality: "low" builds fastest, "high" (SAH with spatial splits) builds slowest. On the
@@ -73,6 +76,8 @@ struct RaycastSceneOptions {
   bool compact = false;  // RTC_SCENE_FLAG_COMPACT: less memory, slower traversal
   void Check() const;
 };
+template <>
+const StructInfo& InfoOf<RaycastSceneOptions>();
 
 class RaycastScene {
  public:

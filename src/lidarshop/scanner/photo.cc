@@ -11,14 +11,11 @@
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void PhotoOptions::Check() const {
-  CheckOption(samples_per_axis >= 1 && samples_per_axis <= 8,
-              fmt::format("PhotoOptions.samples_per_axis must be 1..8, got {}", samples_per_axis));
-  CheckOption(max_range_m > 0, fmt::format("PhotoOptions.max_range_m must be > 0, got {}", max_range_m));
-}
+void PhotoOptions::Check() const { Validate(*this); }
 
 namespace {
 

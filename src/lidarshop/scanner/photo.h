@@ -12,6 +12,7 @@
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -21,6 +22,8 @@ struct PhotoOptions {
   double max_range_m = 1000.0;      // farther hits count as background, metres
   void Check() const;               // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<PhotoOptions>();
 
 struct Photo {
   cv::Mat image;    // CV_8UC3 RGB, camera.height_px x camera.width_px

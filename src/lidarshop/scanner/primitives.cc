@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -200,18 +201,15 @@ TriangleMesh MakeConeMesh(double radius, double height, int segments) {
 }
 
 CarStyle ParseCarStyle(const std::string& style, const std::string& what) {
-  if (style == "sedan") return CarStyle::kSedan;
-  if (style == "hatchback") return CarStyle::kHatchback;
-  if (style == "van" || style == "suv") return CarStyle::kVan;
-  ThrowInputError(what, "", "style", fmt::format("unknown car style '{}' (sedan, hatchback, van)", style));
+  if (style == "suv") return CarStyle::kVan;  // an older name scene files may use
+  try {
+    return ParseEnum<CarStyle>(style);
+  } catch (const OptionsError& error) {
+    ThrowInputError(what, "", "style", error.what());
+  }
 }
 
-void CarMeshOptions::Check() const {
-  CheckOption(wheel_segments >= 8,
-              fmt::format("CarMeshOptions.wheel_segments must be >= 8, got {}", wheel_segments));
-  CheckOption(subdivisions >= 0 && subdivisions <= 7,
-              fmt::format("CarMeshOptions.subdivisions must be in [0, 7], got {}", subdivisions));
-}
+void CarMeshOptions::Check() const { Validate(*this); }
 
 TriangleMesh MakeCarMesh(const CarMeshOptions& options) {
   options.Check();
@@ -342,16 +340,7 @@ TriangleMesh MakeMailboxMesh(Rgb8 paint, int segments) {
   return builder.Take();
 }
 
-void FacadeMeshOptions::Check() const {
-  CheckOption(width > 2 && height > 2 && depth > 0.2,
-              fmt::format("FacadeMeshOptions: width, height > 2 m and depth > 0.2 m, got {} x {} x {}", width,
-                          height, depth));
-  CheckOption(floors >= 1 && floors <= 100,
-              fmt::format("FacadeMeshOptions.floors must be in [1, 100], got {}", floors));
-  CheckOption(
-      windows_per_floor >= 1 && windows_per_floor <= 200,
-      fmt::format("FacadeMeshOptions.windows_per_floor must be in [1, 200], got {}", windows_per_floor));
-}
+void FacadeMeshOptions::Check() const { Validate(*this); }
 
 TriangleMesh MakeFacadeMesh(const FacadeMeshOptions& options) {
   options.Check();

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -31,6 +32,8 @@ TriangleMesh MakeCylinderMesh(double radius, double height, int segments = 64);
 TriangleMesh MakeConeMesh(double radius, double height, int segments = 64);
 
 enum class CarStyle { kSedan, kHatchback, kVan };
+template <>
+const EnumInfo& EnumInfoOf<CarStyle>();
 // Throws InputError naming `what` for an unknown style ("sedan", "hatchback", "van"; "suv" = "van").
 CarStyle ParseCarStyle(const std::string& style, const std::string& what);
 
@@ -44,6 +47,8 @@ struct CarMeshOptions {
   int subdivisions = 0;
   void Check() const;
 };
+template <>
+const StructInfo& InfoOf<CarMeshOptions>();
 // A believable car silhouette: extruded side profiles for the body and the glass house, four wheels, lights.
 // Sizes: sedan 4.6 x 1.8 x 1.45 m, hatchback 4.0 x 1.75 x 1.5 m, van/SUV 4.9 x 1.95 x 1.95 m (length x width
 // x height). Standing on z = 0, length along y, bonnet towards -y.
@@ -68,6 +73,8 @@ struct FacadeMeshOptions {
   Rgb8 glass = Rgb8(52, 64, 80);
   void Check() const;
 };
+template <>
+const StructInfo& InfoOf<FacadeMeshOptions>();
 TriangleMesh MakeFacadeMesh(const FacadeMeshOptions& options);
 // A free-standing wall: `size` = length (x), thickness (y), height (z), with a coping slab on top.
 TriangleMesh MakeWallMesh(const Eigen::Vector3d& size, Rgb8 color = Rgb8(170, 80, 60));

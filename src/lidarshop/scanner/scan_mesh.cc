@@ -6,13 +6,11 @@
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void ScanMeshOptions::Check() const {
-  CheckOption(max_range_jump_ratio > 0 && std::isfinite(max_range_jump_ratio),
-              fmt::format("ScanMeshOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
-}
+void ScanMeshOptions::Check() const { Validate(*this); }
 
 TriangleMesh ScanToMesh(const Scan& scan, const ScanMeshOptions& options) {
   options.Check();

@@ -8,6 +8,7 @@
 
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -19,6 +20,8 @@ struct ScanMeshOptions {
   bool world_frame = false;  // vertices in the world frame (world_from_scanner) instead of the scanner frame
   void Check() const;        // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<ScanMeshOptions>();
 
 // #V = number of cells used by a kept triangle; vertex colours from scan.color (when present), vertex normals
 // from scan.normal (when present).

@@ -414,7 +414,7 @@ TEST(Texture, BatchPathsAgreeWithEachOtherAndWithSinglePoints) {
   const int count = static_cast<int>(u.size());
   for (TextureKind kind :
        {TextureKind::kChecker, TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
-    SCOPED_TRACE(TextureName(kind));
+    SCOPED_TRACE(ToString(kind));
     std::vector<uint32_t> baseline(u.size()), avx2(u.size());
     EvaluateTextures(kind, 1.3f, count, u.data(), v.data(), footprint.data(), base.data(), baseline.data(),
                      SimdPath::kScalar);
@@ -451,7 +451,7 @@ TEST(Texture, FootprintFilteringRemovesSubSampleDetailAndKeepsTheMean) {
   for (TextureKind kind : {TextureKind::kGrass, TextureKind::kGravel, TextureKind::kBrick}) {
     const auto [point_std, point_mean] = SampledGreen(kind, 0.0f);
     const auto [filtered_std, filtered_mean] = SampledGreen(kind, 0.1f);
-    SCOPED_TRACE(TextureName(kind));
+    SCOPED_TRACE(ToString(kind));
     EXPECT_GT(point_std, 5.0);                    // point sampling shows the (aliased) detail
     EXPECT_LT(filtered_std, 0.5 * point_std);     // the footprint removes it
     EXPECT_NEAR(filtered_mean, point_mean, 4.0);  // ... and keeps the average colour

@@ -15,6 +15,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -386,35 +387,13 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
 }  // namespace
 
 void ScannerOptions::Check() const {
-  CheckOption(position.allFinite() && rotate_deg.allFinite(),
-              "ScannerOptions: position and rotate_deg must be finite");
+  Validate(*this);
+  CheckOption(position.allFinite() && rotate_deg.allFinite(), "scanner: position and rotate_deg must be finite");
   CheckOption(position.cwiseAbs().maxCoeff() <= kMaxCoordinateM && rotate_deg.cwiseAbs().maxCoeff() <= 1e6,
-              fmt::format("ScannerOptions: position must be within {} m and rotate_deg within 1e6 degrees",
+              fmt::format("scanner: position must be within {} m and rotate_deg within 1e6 degrees",
                           kMaxCoordinateM));
-  CheckOption(
-      max_range_m <= kMaxCoordinateM,
-      fmt::format("ScannerOptions: max_range_m must be <= {} m, got {}", kMaxCoordinateM, max_range_m));
   CheckMemoryBudget(SaturatingBytes(int64_t{columns} * rows, 64),
                     fmt::format("a scan of {} rows x {} columns", rows, columns));
-  CheckOption(
-      azimuth_max_deg > azimuth_min_deg && azimuth_max_deg - azimuth_min_deg <= 360.0,
-      fmt::format("ScannerOptions: azimuth range [{}, {}] must have max > min and span <= 360 degrees",
-                  azimuth_min_deg, azimuth_max_deg));
-  CheckOption(
-      elevation_max_deg > elevation_min_deg && elevation_min_deg >= -90.0 && elevation_max_deg <= 90.0,
-      fmt::format("ScannerOptions: elevation range [{}, {}] must have max > min within [-90, 90]",
-                  elevation_min_deg, elevation_max_deg));
-  CheckOption(columns >= 2 && rows >= 2 && static_cast<int64_t>(columns) * rows <= (int64_t{1} << 28),
-              fmt::format("ScannerOptions: columns ({}) and rows ({}) must be >= 2 and their product <= 2^28",
-                          columns, rows));
-  CheckOption(
-      max_range_m > 0 && min_range_m >= 0 && min_range_m < max_range_m,
-      fmt::format("ScannerOptions: need 0 <= min_range_m ({}) < max_range_m ({})", min_range_m, max_range_m));
-  CheckOption(los_noise_sigma_m >= 0 && orthogonal_noise_sigma_m >= 0,
-              fmt::format("ScannerOptions: noise sigmas must be >= 0, got {} and {}", los_noise_sigma_m,
-                          orthogonal_noise_sigma_m));
-  CheckOption(intensity_falloff_m > 0,
-              fmt::format("ScannerOptions.intensity_falloff_m must be > 0, got {}", intensity_falloff_m));
 }
 
 Eigen::Matrix4d ScannerOptions::WorldFromScanner() const { return ComposeTransform(position, rotate_deg); }

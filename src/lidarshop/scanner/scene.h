@@ -25,6 +25,7 @@
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/texture.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -63,6 +64,8 @@ struct ScannerOptions {
   Eigen::Matrix4d WorldFromScanner() const;
   ScanGrid Grid() const;  // the uniform grid of this scanner (image orientation)
 };
+template <>
+const StructInfo& InfoOf<ScannerOptions>();
 
 struct Material {
   Rgb8 color = Rgb8(180, 180, 180);          // RGB; used where the mesh has no colours of its own

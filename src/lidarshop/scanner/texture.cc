@@ -9,6 +9,7 @@
 #include "lidarshop/scanner/texture_lanes.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/simd.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -94,30 +95,13 @@ void TexturesBaseline(TextureKind kind, float scale, int count, const float* u, 
 }  // namespace
 
 TextureKind ParseTextureKind(const std::string& name, const std::string& what) {
-  if (name == "checker") return TextureKind::kChecker;
-  if (name == "grass") return TextureKind::kGrass;
-  if (name == "gravel") return TextureKind::kGravel;
-  if (name == "brick") return TextureKind::kBrick;
-  if (name == "none") return TextureKind::kNone;
-  ThrowInputError(what, "", "texture",
-                  fmt::format("unknown texture '{}' (checker, grass, gravel, brick)", name));
+  try {
+    return ParseEnum<TextureKind>(name);
+  } catch (const OptionsError& error) {
+    ThrowInputError(what, "", "texture", error.what());
+  }
 }
 
-std::string TextureName(TextureKind kind) {
-  switch (kind) {
-    case TextureKind::kChecker:
-      return "checker";
-    case TextureKind::kGrass:
-      return "grass";
-    case TextureKind::kGravel:
-      return "gravel";
-    case TextureKind::kBrick:
-      return "brick";
-    case TextureKind::kNone:
-      break;
-  }
-  return "none";
-}
 
 Rgb8 DefaultTextureColor(TextureKind kind) {
   switch (kind) {

@@ -18,14 +18,16 @@
 
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/util/simd.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
 enum class TextureKind { kNone, kChecker, kGrass, kGravel, kBrick };
+template <>
+const EnumInfo& EnumInfoOf<TextureKind>();
 
 // "checker", "grass", "gravel", "brick"; throws InputError naming `what` and field 'texture' otherwise.
 TextureKind ParseTextureKind(const std::string& name, const std::string& what);
-std::string TextureName(TextureKind kind);
 // The colour a texture uses when the object gives none.
 Rgb8 DefaultTextureColor(TextureKind kind);
 

@@ -1,5 +1,7 @@
 #include "lidarshop/util/options.h"
 
+#include "lidarshop/util/simd.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -345,6 +347,18 @@ int SetSampleValues(const StructInfo& info, void* object) {
 
 std::string ValueText(const nlohmann::ordered_json& value) {
   return value.is_string() ? value.get<std::string>() : value.dump();
+}
+
+}  // namespace lidarshop
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<SimdPath>() {
+  static const EnumInfo info =
+      MakeEnumInfo<SimdPath>("SIMD path", {{SimdPath::kScalar, "scalar", "baseline x86-64"},
+                                           {SimdPath::kAvx2, "avx2", "AVX2 where the CPU has it"}});
+  return info;
 }
 
 }  // namespace lidarshop

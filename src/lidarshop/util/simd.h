@@ -6,6 +6,8 @@
 // registers elsewhere. Neither target has FMA, so no multiply-add is fused and both round identically.
 #pragma once
 
+#include "lidarshop/util/enum_names.h"
+
 #include <immintrin.h>
 
 #include <cstdint>
@@ -13,6 +15,8 @@
 namespace lidarshop {
 
 enum class SimdPath { kScalar, kAvx2 };
+template <>
+const EnumInfo& EnumInfoOf<SimdPath>();
 
 // kAvx2 when the CPU has it (checked once; safe during static initialization).
 SimdPath BestSimdPath();

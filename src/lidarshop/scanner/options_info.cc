@@ -1,0 +1,143 @@
+// Descriptions of the scanner's options and enums (util/options.h). Not described (geometry and colours, not
+// options): ScannerOptions' position and rotate_deg (scene files give them; Check() keeps checking them),
+// PhotoOptions' background, CarMeshOptions' paint, FacadeMeshOptions' colours.
+#include "lidarshop/scanner/photo.h"
+#include "lidarshop/scanner/primitives.h"
+#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/texture.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<CarStyle>() {
+  static const EnumInfo info =
+      MakeEnumInfo<CarStyle>("car style", {{CarStyle::kSedan, "sedan", "4.6 x 1.8 x 1.45 m"},
+                                           {CarStyle::kHatchback, "hatchback", "4.0 x 1.75 x 1.5 m"},
+                                           {CarStyle::kVan, "van", "van / SUV, 4.9 x 1.95 x 1.95 m"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<TextureKind>() {
+  static const EnumInfo info =
+      MakeEnumInfo<TextureKind>("texture", {{TextureKind::kNone, "none", "plain colour"},
+                                            {TextureKind::kChecker, "checker", "checkerboard"},
+                                            {TextureKind::kGrass, "grass", "grass"},
+                                            {TextureKind::kGravel, "gravel", "gravel"},
+                                            {TextureKind::kBrick, "brick", "brick"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScannerOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScannerOptions> b("ScannerOptions",
+                                    "the synthetic scanner (position and rotation: scene files)");
+    b.Field(&ScannerOptions::azimuth_min_deg, "azimuth_min_deg", "azimuth of the leftmost column, from +y")
+        .Unit("deg");
+    b.Field(&ScannerOptions::azimuth_max_deg, "azimuth_max_deg", "azimuth of the rightmost column")
+        .Unit("deg");
+    b.Field(&ScannerOptions::elevation_min_deg, "elevation_min_deg", "elevation of the bottom row")
+        .Unit("deg")
+        .Range(-90, 90);
+    b.Field(&ScannerOptions::elevation_max_deg, "elevation_max_deg", "elevation of the top row")
+        .Unit("deg")
+        .Range(-90, 90);
+    b.Field(&ScannerOptions::columns, "columns", "strips, left to right").Min(2);
+    b.Field(&ScannerOptions::rows, "rows", "points per strip").Min(2);
+    b.Field(&ScannerOptions::max_range_m, "max_range_m", "farther hits are no return")
+        .Unit("m")
+        .AboveZero()
+        .Max(1e7);
+    b.Field(&ScannerOptions::min_range_m, "min_range_m", "nearer hits are ignored").Unit("m").Min(0);
+    b.Field(&ScannerOptions::los_noise_sigma_m, "los_noise_sigma_m", "Gaussian error along the ray")
+        .Unit("m")
+        .Min(0);
+    b.Field(&ScannerOptions::orthogonal_noise_sigma_m, "orthogonal_noise_sigma_m",
+            "Gaussian error perpendicular to the ray")
+        .Unit("m")
+        .Min(0);
+    b.Field(&ScannerOptions::seed, "seed", "noise seed");
+    b.Field(&ScannerOptions::intensity_falloff_m, "intensity_falloff_m",
+            "range at which intensity falls to 1/e")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&ScannerOptions::filter_textures, "filter_textures",
+            "band-limit textures to each ray's footprint");
+    b.Field(&ScannerOptions::cast_method, "cast_method", "how rays are traced (speed only)");
+    b.Field(&ScannerOptions::simd_path, "simd_path", "SIMD path of the shading (speed only; bit-identical)");
+    b.Check([](const ScannerOptions& o) {
+      if (o.azimuth_max_deg <= o.azimuth_min_deg || o.azimuth_max_deg - o.azimuth_min_deg > 360.0) {
+        throw OptionsFieldError("azimuth_max_deg", "must be above azimuth_min_deg, at most 360 degrees on");
+      }
+      if (o.elevation_max_deg <= o.elevation_min_deg) {
+        throw OptionsFieldError("elevation_max_deg", "must be above elevation_min_deg");
+      }
+      if (int64_t{o.columns} * o.rows > (int64_t{1} << 28)) {
+        throw OptionsFieldError("rows", "columns x rows must be at most 2^28");
+      }
+      if (o.min_range_m >= o.max_range_m) throw OptionsFieldError("min_range_m", "must be below max_range_m");
+    });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PhotoOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PhotoOptions> b("PhotoOptions", "the synthetic camera (background colour: C++ only)");
+    b.Field(&PhotoOptions::samples_per_axis, "samples_per_axis", "rays per pixel = samples^2").Range(1, 8);
+    b.Field(&PhotoOptions::max_range_m, "max_range_m", "farther hits count as background")
+        .Unit("m")
+        .AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanMeshOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScanMeshOptions> b("ScanMeshOptions", "the triangle mesh of a scan's grid");
+    b.Field(&ScanMeshOptions::max_range_jump_ratio, "max_range_jump_ratio",
+            "largest relative range difference of a kept edge")
+        .AboveZero();
+    b.Field(&ScanMeshOptions::world_frame, "world_frame", "vertices in the world frame, not the scanner's");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<CarMeshOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<CarMeshOptions> b("CarMeshOptions", "the procedural car (paint: C++ only)");
+    b.Field(&CarMeshOptions::style, "style", "car style");
+    b.Field(&CarMeshOptions::wheel_segments, "wheel_segments", "facets around each wheel").Min(8);
+    b.Field(&CarMeshOptions::subdivisions, "subdivisions", "each triangle split into 4^n").Range(0, 7);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FacadeMeshOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FacadeMeshOptions> b("FacadeMeshOptions", "the procedural facade (colours: C++ only)");
+    b.Field(&FacadeMeshOptions::width, "width", "along x").Unit("m").Min(2).min_exclusive = true;
+    b.Field(&FacadeMeshOptions::height, "height", "along z").Unit("m").Min(2).min_exclusive = true;
+    b.Field(&FacadeMeshOptions::depth, "depth", "the slab's thickness, along y")
+        .Unit("m")
+        .Min(0.2)
+        .min_exclusive = true;
+    b.Field(&FacadeMeshOptions::floors, "floors", "floors").Range(1, 100);
+    b.Field(&FacadeMeshOptions::windows_per_floor, "windows_per_floor", "windows per floor").Range(1, 200);
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
