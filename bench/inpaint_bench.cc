@@ -142,7 +142,7 @@ class ComparingSearch : public PatchSearch {
 };
 
 void PrintReport() {
-  std::printf("SSD kernel: %s\n\n", WeightedSsd::KernelName());
+  std::printf("SSD kernel: %s\n\n", WeightedSsd().KernelName());
   // Quality against the originals; every method on the same inputs.
   std::printf("| image | method | PSNR in hole (dB) | seconds |\n|---|---|---|---|\n");
   const std::vector<std::pair<std::string, Input>> inputs = {
@@ -249,7 +249,7 @@ void BM_SsdPerCandidate(benchmark::State& state) {
     if (++i == sources.size()) i = 0;
   }
   state.SetItemsProcessed(state.iterations());
-  state.SetLabel(fmt::format("11x11x3, full evaluation, kernel {}", WeightedSsd::KernelName()));
+  state.SetLabel(fmt::format("11x11x3, full evaluation, kernel {}", WeightedSsd().KernelName()));
 }
 BENCHMARK(BM_SsdPerCandidate);
 
@@ -265,7 +265,7 @@ void BM_SsdPerCandidateFullPatch(benchmark::State& state) {
     if (++i == sources.size()) i = 0;
   }
   state.SetItemsProcessed(state.iterations());
-  state.SetLabel(fmt::format("11x11x3 all known, kernel {}", WeightedSsd::KernelName()));
+  state.SetLabel(fmt::format("11x11x3 all known, kernel {}", WeightedSsd().KernelName()));
 }
 BENCHMARK(BM_SsdPerCandidateFullPatch);
 
@@ -297,7 +297,7 @@ void BM_SsdPerCandidateRunOf4(benchmark::State& state) {
   }
   state.SetItemsProcessed(4 * state.iterations());
   state.SetLabel(fmt::format("11x11x3 {}, 4 adjacent candidates per call, full evaluation, kernel {}",
-                             all_known ? "all known" : "half known", WeightedSsd::KernelName()));
+                             all_known ? "all known" : "half known", WeightedSsd().KernelName()));
 }
 BENCHMARK(BM_SsdPerCandidateRunOf4)->Arg(0)->Arg(1);
 
@@ -337,7 +337,7 @@ void BM_SsdFastestBatch(benchmark::State& state) {
   state.SetItemsProcessed(kBatch * state.iterations());
   state.counters["fastest_ns_per_candidate"] = fastest;
   state.SetLabel(fmt::format("11x11x3 {}, {} per call, kernel {}", all_known ? "all known" : "half known",
-                             runs ? "4 adjacent candidates" : "one candidate", WeightedSsd::KernelName()));
+                             runs ? "4 adjacent candidates" : "one candidate", WeightedSsd().KernelName()));
 }
 BENCHMARK(BM_SsdFastestBatch)->Arg(0)->Arg(1)->Arg(2);
 

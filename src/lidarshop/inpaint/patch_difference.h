@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "lidarshop/inpaint/canvas.h"
+#include "lidarshop/util/simd.h"
 
 namespace lidarshop {
 
@@ -37,22 +38,22 @@ class PatchDifference {
 // Weighted sum of squared differences over the target patch's known pixels inside the image:
 //   SSD(p, q) = Σ_{d : p+d known} Σ_k w_k (I_k(p+d) − I_k(q+d))²       (Criminisi et al. 2004, §3 "d(Ψp,
 //   Ψq)")
-// channel_weights: one weight ≥ 0 per channel, or empty for all 1. Evaluated with AVX-512 or AVX2+FMA when
-// the CPU has them (runtime dispatch), on (2R+1)·C contiguous floats per patch row, with early termination
-// checked every few rows. With AVX-512 and (2R+1)·C ≤ 64 (e.g. radius ≤ 10 for RGB) the kernel is unrolled
-// for the row's vector count: per target row the known pixels' values are stored with a lane mask (masked
-// loads of the source, subtract, FMA; the common weight of equal-weight channels is applied once at the end),
-// and EvaluateRun() evaluates four adjacent candidates per pass so they share the target's loads.
+// channel_weights: one weight ≥ 0 per channel, or empty for all 1. Evaluated on (2R+1)·C contiguous floats per
+// patch row in 8-lane vectors (util/simd.h), with early termination checked every second row; EvaluateRun()
+// evaluates four adjacent candidates per pass so that they share the target's loads. `path` chooses the
+// AVX2 or the baseline kernel (AVX2 only if the CPU has it); both sum in one order without FMA, so every
+// evaluation, and so every fill, is bit-identical on either path and any CPU.
 class WeightedSsd : public PatchDifference {
  public:
-  explicit WeightedSsd(std::vector<float> channel_weights = {});
+  explicit WeightedSsd(std::vector<float> channel_weights = {}, SimdPath path = BestSimdPath());
   std::unique_ptr<TargetDifference> ForTarget(const InpaintCanvas& canvas, Pixel target) const override;
 
-  // The instruction set the evaluations use: "avx512", "avx2" or "scalar".
-  static const char* KernelName();
+  // The SIMD path the evaluations take: "avx2" or "baseline".
+  const char* KernelName() const;
 
  private:
   std::vector<float> channel_weights_;
+  bool avx2_;
 };
 
 }  // namespace lidarshop
