@@ -316,7 +316,7 @@ void AddScanRoutes(State& state) {
              RenderOptions options;
              try {
                if (request.has_param("channel"))
-                 options.channel = ParseRenderChannel(request.get_param_value("channel"));
+                 options.channel = ParseEnum<RenderChannel>(request.get_param_value("channel"));
                std::lock_guard lock(document->mutex);
                SendPng(response, RenderScan(document->now.scan, options).image);
              } catch (const OptionsError& error) {

@@ -228,8 +228,9 @@ int RunRender(int argc, char** argv) {
       WriteImage(output, RenderPointView(scan, view));
       return 0;
     }
-    options.channel = ParseRenderChannel(channel);
-    if (!color_map.empty()) options.color_map = ParseColorMap(color_map);
+    options.channel = ParseEnum<RenderChannel>(channel);
+    if (!color_map.empty())
+      options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
     options.Check();
     const ScanFile file = ReadScanFile(input);
     Scan scan = PickScan(file, scan_index, "--scan");

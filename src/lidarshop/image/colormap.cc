@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -29,27 +30,7 @@ std::string FormatTick(double value, double span) {
 
 }  // namespace
 
-ColorMap ParseColorMap(const std::string& name) {
-  if (name == "viridis") return ColorMap::kViridis;
-  if (name == "turbo") return ColorMap::kTurbo;
-  if (name == "magma") return ColorMap::kMagma;
-  if (name == "gray" || name == "grey") return ColorMap::kGray;
-  throw OptionsError(fmt::format("colour map must be viridis, turbo, magma or gray, got '{}'", name));
-}
 
-std::string ColorMapName(ColorMap map) {
-  switch (map) {
-    case ColorMap::kViridis:
-      return "viridis";
-    case ColorMap::kTurbo:
-      return "turbo";
-    case ColorMap::kMagma:
-      return "magma";
-    case ColorMap::kGray:
-      return "gray";
-  }
-  return "viridis";
-}
 
 const std::vector<cv::Vec3b>& ColorMapTable(ColorMap map) {
   static const std::vector<cv::Vec3b> viridis = BuildTable(cv::COLORMAP_VIRIDIS);

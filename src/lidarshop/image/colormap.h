@@ -12,13 +12,15 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/util/options_fwd.h"
+
 namespace lidarshop {
 
 enum class ColorMap { kViridis, kTurbo, kMagma, kGray };
+template <>
+const EnumInfo& EnumInfoOf<ColorMap>();
 
-// "viridis", "turbo", "magma", "gray"; throws OptionsError for anything else.
-ColorMap ParseColorMap(const std::string& name);
-std::string ColorMapName(ColorMap map);
+// Names (util/enum_names.h): "viridis", "turbo", "magma", "gray".
 
 // The 256 RGB colours of `map`, low to high.
 const std::vector<cv::Vec3b>& ColorMapTable(ColorMap map);

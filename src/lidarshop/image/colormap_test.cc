@@ -17,10 +17,10 @@ TEST(ColorMapTest, PerceptualMapsAreMonotoneInLightness) {
     ASSERT_EQ(table.size(), 256u);
     int increases = 0;
     for (int i = 1; i < 256; ++i) {
-      EXPECT_GE(Lightness(table[i]), Lightness(table[i - 1]) - 0.5) << ColorMapName(map) << " at " << i;
+      EXPECT_GE(Lightness(table[i]), Lightness(table[i - 1]) - 0.5) << ToString(map) << " at " << i;
       increases += Lightness(table[i]) > Lightness(table[i - 1]);
     }
-    EXPECT_GT(increases, 200) << ColorMapName(map);
+    EXPECT_GT(increases, 200) << ToString(map);
   }
   // Viridis runs from dark purple to yellow (RGB order).
   const std::vector<cv::Vec3b>& viridis = ColorMapTable(ColorMap::kViridis);
@@ -69,7 +69,7 @@ TEST(ColorMapTest, LegendSitsBesideTheImage) {
   EXPECT_EQ(combined.cols, image.cols + bar.cols);
   EXPECT_EQ(combined.rows, std::max(image.rows, bar.rows));
   EXPECT_EQ(combined.at<cv::Vec3b>(0, 0), cv::Vec3b(7, 7, 7));
-  EXPECT_THROW(ParseColorMap("jet"), OptionsError);
+  EXPECT_THROW(ParseEnum<ColorMap>("jet"), OptionsError);
 }
 
 }  // namespace

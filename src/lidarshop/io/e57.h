@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -71,6 +72,8 @@ struct E57WriteOptions {
   bool write_no_return_directions = true;
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<E57WriteOptions>();
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options);
 // The bytes WriteE57 would write (bench, tests).
 std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOptions& options = {});

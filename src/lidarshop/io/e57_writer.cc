@@ -15,6 +15,7 @@
 #include "lidarshop/io/e57_format.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace e57 {
@@ -351,11 +352,7 @@ void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical
 }  // namespace
 }  // namespace e57
 
-void E57WriteOptions::Check() const {
-  CheckOption(
-      std::isfinite(coordinate_scale_m) && coordinate_scale_m >= 0.0,
-      fmt::format("E57WriteOptions.coordinate_scale_m must be >= 0 (0 = float), got {}", coordinate_scale_m));
-}
+void E57WriteOptions::Check() const { Validate(*this); }
 
 namespace e57 {
 namespace {

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -33,6 +34,8 @@ struct PtxReadOptions {
   // benchmarks of the parser itself.
   bool fit_grid = true;
 };
+template <>
+const StructInfo& InfoOf<PtxReadOptions>();
 
 // Reads every scan of a PTX file.
 std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options = {});

@@ -6,19 +6,10 @@
 #include <fmt/format.h>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-RenderChannel ParseRenderChannel(const std::string& name) {
-  if (name == "range") return RenderChannel::kRange;
-  if (name == "rgb") return RenderChannel::kRgb;
-  if (name == "intensity") return RenderChannel::kIntensity;
-  if (name == "normals") return RenderChannel::kNormals;
-  if (name == "labels") return RenderChannel::kLabels;
-  if (name == "valid") return RenderChannel::kValid;
-  throw OptionsError(
-      fmt::format("channel must be range, rgb, intensity, normals, labels or valid, got '{}'", name));
-}
 
 void RenderOptions::Check() const {
   // NaN means "from the data"; anything else must be a finite value a colour can stand for.

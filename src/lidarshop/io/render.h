@@ -20,13 +20,14 @@
 
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
 enum class RenderChannel { kRange, kRgb, kIntensity, kNormals, kLabels, kValid };
+template <>
+const EnumInfo& EnumInfoOf<RenderChannel>();
 
-// "range", "rgb", "intensity", "normals", "labels", "valid"; throws OptionsError otherwise.
-RenderChannel ParseRenderChannel(const std::string& name);
 
 struct RenderOptions {
   RenderChannel channel = RenderChannel::kRange;

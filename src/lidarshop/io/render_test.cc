@@ -85,7 +85,7 @@ TEST(RenderTest, ValidLabelsNormalsAndMissingChannels) {
   const cv::Vec3f n = normals.at<cv::Vec3f>(2, 1);
   EXPECT_LT(n[1], -0.95f);
   EXPECT_LT(RenderScan(scan, options).image.at<cv::Vec3b>(2, 1)[1], 128);
-  EXPECT_THROW(ParseRenderChannel("depthx"), OptionsError);
+  EXPECT_THROW(ParseEnum<RenderChannel>("depthx"), OptionsError);
 }
 
 }  // namespace

@@ -7,23 +7,15 @@
 #include <Eigen/Geometry>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
 void PointViewOptions::Check() const {
+  Validate(*this);
   CheckOption(
       eye_in_world.allFinite() && target_in_world.allFinite() && (target_in_world - eye_in_world).norm() > 0,
       "PointViewOptions: the eye and the target must be finite and distinct");
-  CheckOption(
-      field_of_view_deg > 0 && field_of_view_deg < 170,
-      fmt::format("PointViewOptions.field_of_view_deg must be in (0, 170), got {}", field_of_view_deg));
-  CheckOption(width_px >= 16 && height_px >= 16 && width_px <= 16384 && height_px <= 16384,
-              fmt::format("PointViewOptions: the picture must be 16..16384 pixels wide and high, got {} x {}",
-                          width_px, height_px));
-  CheckOption(point_size_px >= 1 && point_size_px <= 32,
-              fmt::format("PointViewOptions.point_size_px must be in [1, 32], got {}", point_size_px));
-  CheckOption(synthesized_tint >= 0 && synthesized_tint <= 1,
-              fmt::format("PointViewOptions.synthesized_tint must be in [0, 1], got {}", synthesized_tint));
 }
 
 cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options) {

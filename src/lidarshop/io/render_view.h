@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -20,6 +21,8 @@ struct PointViewOptions {
   double synthesized_tint = 0.0;
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<PointViewOptions>();
 
 // CV_8UC3 RGB, black background. Points take the scan's colour, or grey intensity when it has none. World z
 // is up in the picture.

@@ -14,10 +14,13 @@
 #include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/resection.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
 enum class PairKind { kPixelPoint, kLandmark, kPixelPixel };
+template <>
+const EnumInfo& EnumInfoOf<PairKind>();
 
 struct Correspondences {
   PairKind kind = PairKind::kPixelPoint;

@@ -11,22 +11,11 @@
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
-void RecolorOptions::Check() const {
-  CheckOption(depth_tolerance_m >= 0,
-              fmt::format("RecolorOptions.depth_tolerance_m must be >= 0, got {}", depth_tolerance_m));
-  CheckOption(relative_depth_tolerance >= 0 && relative_depth_tolerance < 1,
-              fmt::format("RecolorOptions.relative_depth_tolerance must be in [0, 1), got {}",
-                          relative_depth_tolerance));
-  CheckOption(silhouette_margin_px >= 0 && silhouette_margin_px <= 50,
-              fmt::format("RecolorOptions.silhouette_margin_px must be 0..50, got {}", silhouette_margin_px));
-  CheckOption(zbuffer_scale > 0 && zbuffer_scale <= 1,
-              fmt::format("RecolorOptions.zbuffer_scale must be in (0, 1], got {}", zbuffer_scale));
-  CheckOption(max_range_jump_ratio > 0,
-              fmt::format("RecolorOptions.max_range_jump_ratio must be > 0, got {}", max_range_jump_ratio));
-}
+void RecolorOptions::Check() const { Validate(*this); }
 
 std::string RecolorResult::Summary() const {
   return fmt::format("{} of {} points recoloured; {} outside the photo, {} hidden from the camera",

@@ -34,10 +34,13 @@
 
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
 enum class VisibilityMethod { kZBuffer, kSegment };
+template <>
+const EnumInfo& EnumInfoOf<VisibilityMethod>();
 
 struct RecolorOptions {
   VisibilityMethod visibility = VisibilityMethod::kZBuffer;
@@ -48,6 +51,8 @@ struct RecolorOptions {
   double max_range_jump_ratio = 0.1;       // scan mesh edges (scanner/scan_mesh.h)
   void Check() const;                      // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<RecolorOptions>();
 
 struct RecolorResult {
   Scan scan;  // a clone of the input with `color` replaced where recolored (created, grey from intensity,

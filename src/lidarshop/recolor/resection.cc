@@ -16,27 +16,14 @@
 #include <unsupported/Eigen/NumericalDiff>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
 void ResectionOptions::Check() const {
+  Validate(*this);
   CheckOption(width_px > 0 && height_px > 0,
-              fmt::format("ResectionOptions: the photo size must be > 0, got {} x {}", width_px, height_px));
-  CheckOption(ransac_threshold_px > 0,
-              fmt::format("ResectionOptions.ransac_threshold_px must be > 0, got {}", ransac_threshold_px));
-  CheckOption(ransac_iterations >= 1,
-              fmt::format("ResectionOptions.ransac_iterations must be >= 1, got {}", ransac_iterations));
-  CheckOption(ransac_confidence > 0 && ransac_confidence < 1,
-              fmt::format("ResectionOptions.ransac_confidence must be in (0, 1), got {}", ransac_confidence));
-  CheckOption(radial_coefficients >= 0 && radial_coefficients <= 3,
-              fmt::format("ResectionOptions.radial_coefficients must be 0..3, got {}", radial_coefficients));
-  CheckOption(min_inliers_for_distortion >= 6,
-              fmt::format("ResectionOptions.min_inliers_for_distortion must be >= 6, got {}",
-                          min_inliers_for_distortion));
-  CheckOption(max_aspect_deviation > 0,
-              fmt::format("ResectionOptions.max_aspect_deviation must be > 0, got {}", max_aspect_deviation));
-  CheckOption(degenerate_ratio > 0 && degenerate_ratio < 1,
-              fmt::format("ResectionOptions.degenerate_ratio must be in (0, 1), got {}", degenerate_ratio));
+              fmt::format("resection: the photo size must be > 0, got {} x {}", width_px, height_px));
 }
 
 std::string ResectionResult::Summary() const {

@@ -29,6 +29,7 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/camera.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -63,6 +64,8 @@ struct ResectionOptions {
   double degenerate_ratio = 1e-3;
   void Check() const;  // throws OptionsError
 };
+template <>
+const StructInfo& InfoOf<ResectionOptions>();
 
 struct ResectionResult {
   PinholeCamera camera;                       // the final camera (refined unless options.refine is false)

@@ -1,0 +1,69 @@
+// Descriptions of the file and picture options (util/options.h). RenderOptions is not described: its colour
+// map is optional and its bounds are NaN for "from the data" (the render command binds them by hand).
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/ptx.h"
+#include "lidarshop/io/render.h"
+#include "lidarshop/io/render_view.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<RenderChannel>() {
+  static const EnumInfo info = MakeEnumInfo<RenderChannel>(
+      "channel", {{RenderChannel::kRange, "range", "metres from the scanner"},
+                  {RenderChannel::kRgb, "rgb", "the scan's colour"},
+                  {RenderChannel::kIntensity, "intensity", "return strength"},
+                  {RenderChannel::kNormals, "normals", "normals as (n + 1) / 2"},
+                  {RenderChannel::kLabels, "labels", "object labels"},
+                  {RenderChannel::kValid, "valid", "white where the ray returned"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PointViewOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PointViewOptions> b("PointViewOptions",
+                                      "points from a second viewpoint (eye, target: C++ only)");
+    b.Field(&PointViewOptions::field_of_view_deg, "field_of_view_deg", "horizontal field of view")
+        .Unit("deg")
+        .AboveZero()
+        .Below(170);
+    b.Field(&PointViewOptions::width_px, "width_px", "picture width").Unit("px").Range(16, 16384);
+    b.Field(&PointViewOptions::height_px, "height_px", "picture height").Unit("px").Range(16, 16384);
+    b.Field(&PointViewOptions::point_size_px, "point_size_px", "side of each drawn point")
+        .Unit("px")
+        .Range(1, 32);
+    b.Field(&PointViewOptions::synthesized_tint, "synthesized_tint", "share of magenta on synthesized points")
+        .Range(0, 1);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PtxReadOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PtxReadOptions> b("PtxReadOptions", "reading PTX");
+    b.Field(&PtxReadOptions::fit_grid, "fit_grid", "fit the angular grid so every cell gets a direction");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<E57WriteOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<E57WriteOptions> b("E57WriteOptions", "writing E57");
+    b.Field(&E57WriteOptions::coordinate_scale_m, "coordinate_scale_m",
+            "0 = float coordinates; > 0 = scaled integers with this step")
+        .Unit("m")
+        .Min(0);
+    b.Field(&E57WriteOptions::write_no_return_directions, "write_no_return_directions",
+            "write cells without a return as invalid points carrying their direction");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

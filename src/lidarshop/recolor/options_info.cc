@@ -1,0 +1,87 @@
+// Descriptions of the recolouring options and enums (util/options.h).
+#include "lidarshop/recolor/correspondences.h"
+#include "lidarshop/recolor/recolor.h"
+#include "lidarshop/recolor/resection.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<VisibilityMethod>() {
+  static const EnumInfo info = MakeEnumInfo<VisibilityMethod>(
+      "visibility method",
+      {{VisibilityMethod::kZBuffer, "zbuffer", "z-buffer of the scan mesh seen by the camera"},
+       {VisibilityMethod::kSegment, "segment", "ray-cast the segment from the camera to each point"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PairKind>() {
+  static const EnumInfo info = MakeEnumInfo<PairKind>(
+      "correspondence kind", {{PairKind::kPixelPoint, "pixel-point", "photo pixel <-> scan point or cell"},
+                              {PairKind::kLandmark, "landmark", "3-D point <-> 3-D point"},
+                              {PairKind::kPixelPixel, "pixel-pixel", "pixel <-> pixel of two images"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ResectionOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<ResectionOptions> b("ResectionOptions", "the camera of a photo from pixel <-> point pairs");
+    b.Field(&ResectionOptions::width_px, "width_px", "the photo's width").Unit("px").Min(0);
+    b.Field(&ResectionOptions::height_px, "height_px", "the photo's height").Unit("px").Min(0);
+    b.Field(&ResectionOptions::ransac_threshold_px, "ransac_threshold_px", "inlier reprojection error")
+        .Unit("px")
+        .AboveZero();
+    b.Field(&ResectionOptions::ransac_iterations, "ransac_iterations", "minimal sets tried at most").Min(1);
+    b.Field(&ResectionOptions::ransac_confidence, "ransac_confidence",
+            "stop once a better set is this unlikely")
+        .AboveZero()
+        .Below(1);
+    b.Field(&ResectionOptions::seed, "seed", "seed of RANSAC's random sets");
+    b.Field(&ResectionOptions::refine, "refine", "refine the DLT camera by Levenberg-Marquardt");
+    b.Field(&ResectionOptions::square_pixels, "square_pixels", "one focal length (fx = fy)");
+    b.Field(&ResectionOptions::max_aspect_deviation, "max_aspect_deviation",
+            "RANSAC skips cameras whose |fx/fy - 1| or skew/fx exceeds this")
+        .AboveZero();
+    b.Field(&ResectionOptions::refine_skew, "refine_skew", "refine the skew");
+    b.Field(&ResectionOptions::radial_coefficients, "radial_coefficients", "radial distortion terms refined")
+        .Range(0, 3);
+    b.Field(&ResectionOptions::refine_tangential, "refine_tangential", "refine p1, p2");
+    b.Field(&ResectionOptions::min_inliers_for_distortion, "min_inliers_for_distortion",
+            "distortion is refined only with this many inliers")
+        .Min(6);
+    b.Field(&ResectionOptions::degenerate_ratio, "degenerate_ratio",
+            "coplanar / collinear below this spread ratio")
+        .AboveZero()
+        .Below(1);
+    // The photo size is required when resecting, but a fresh struct (before the photo is known) is valid.
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RecolorOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RecolorOptions> b("RecolorOptions", "occlusion-aware recolouring");
+    b.Field(&RecolorOptions::visibility, "visibility", "how hidden points are found");
+    b.Field(&RecolorOptions::depth_tolerance_m, "depth_tolerance_m",
+            "a surface this close in front does not hide")
+        .Unit("m")
+        .Min(0);
+    b.Field(&RecolorOptions::relative_depth_tolerance, "relative_depth_tolerance",
+            "fraction of the camera distance added to the tolerance")
+        .Min(0)
+        .Below(1);
+    b.Field(&RecolorOptions::silhouette_margin_px, "silhouette_margin_px", "z-buffer window radius")
+        .Unit("px")
+        .Range(0, 50);
+    b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
+    b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
