@@ -35,10 +35,10 @@ class ServerTest : public ::testing::Test {
     fs::remove_all(base_);
     fs::create_directories(base_ / "root" / "sub");
     fs::create_directories(base_ / "outside");
-    lidarshop::testing::GroundAndBoxOptions scene;
+    lidarshop::test_scenes::GroundAndBoxOptions scene;
     scene.rows = 60;
     scene.columns = 90;
-    scan_ = new Scan(lidarshop::testing::ScanScene(lidarshop::testing::MakeGroundAndBoxScene(scene)));
+    scan_ = new Scan(lidarshop::test_scenes::ScanScene(lidarshop::test_scenes::MakeGroundAndBoxScene(scene)));
     WriteScanFile((base_ / "root" / "sub" / "box.ptx").string(), {*scan_});
     WriteScanFile((base_ / "outside" / "secret.ptx").string(), {*scan_});
     std::ofstream(base_ / "root" / "broken.ptx") << "12\nnot a ptx\n";
@@ -294,9 +294,9 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   EXPECT_EQ(client_->Post(recolor, R"({"pairs": []})", "application/json")->status, 400);  // no photo yet
   EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), "not an image", "image/png")->status, 422);
   // A photo of the same scene from beside the scanner, and pairs of scan cells with their true pixels.
-  lidarshop::testing::GroundAndBoxOptions scene;
+  lidarshop::test_scenes::GroundAndBoxOptions scene;
   const PinholeCamera camera = CameraLookingAt({1.0, 0.5, 1.7}, {0, 8, 0.5}, 320, 240, 60);
-  const Photo photo = RenderPhoto(lidarshop::testing::MakeGroundAndBoxScene(scene), camera);
+  const Photo photo = RenderPhoto(lidarshop::test_scenes::MakeGroundAndBoxScene(scene), camera);
   cv::Mat bgr;
   cv::cvtColor(photo.image, bgr, cv::COLOR_RGB2BGR);
   std::vector<uint8_t> png;

@@ -12,7 +12,7 @@ namespace lidarshop {
 namespace {
 
 TEST(RegionGrowingTest, SmoothRegionsFollowTheObjects) {
-  const Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene());
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeGroundAndBoxScene());
   ASSERT_FALSE(scan.label.empty());
   int regions = 0;
   const cv::Mat labels =
@@ -37,7 +37,7 @@ TEST(RegionGrowingTest, SmoothRegionsFollowTheObjects) {
 }
 
 TEST(RegionGrowingTest, BadSeedAndMissingNormals) {
-  Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene());
+  Scan scan = test_scenes::ScanScene(test_scenes::MakeGroundAndBoxScene());
   EXPECT_THROW(GrowRegion(scan, {-1, 0}, {}, [](cv::Point, cv::Point) { return true; }), InputError);
   scan.normal = cv::Mat();
   EXPECT_THROW(NormalAngleCondition(scan, 10.0), InputError);

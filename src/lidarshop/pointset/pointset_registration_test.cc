@@ -17,9 +17,9 @@ namespace {
 
 // Ground, the test box, and two turned copies of it (planes facing every way, so every axis is constrained).
 SceneDescription ThreeBoxScene() {
-  testing::GroundAndBoxOptions options;
+  test_scenes::GroundAndBoxOptions options;
   options.azimuth_half_deg = 60.0;
-  SceneDescription scene = testing::MakeGroundAndBoxScene(options);
+  SceneDescription scene = test_scenes::MakeGroundAndBoxScene(options);
   const SceneObject box = scene.objects[1];
   for (const auto& [offset, angle] : {std::pair{Eigen::Vector3d(-0.5, 0.5, 0.0), 35.0},
                                       std::pair{Eigen::Vector3d(1.5, -2.0, 0.3), -25.0}}) {
@@ -31,7 +31,7 @@ SceneDescription ThreeBoxScene() {
 }
 
 ScannerOptions Scanner(const SceneDescription& scene, const Eigen::Vector3d& position, double yaw_deg) {
-  ScannerOptions scanner = testing::SmallScanner(scene.scanner, 240, 480);
+  ScannerOptions scanner = test_scenes::SmallScanner(scene.scanner, 240, 480);
   scanner.position = position;
   scanner.rotate_deg = Eigen::Vector3d(0, 0, yaw_deg);
   scanner.los_noise_sigma_m = 0.002;
@@ -45,10 +45,10 @@ double AngleDeg(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
 
 TEST(RegistrationTest, IcpRecoversTheRelativePoseOfTwoScans) {
   const SceneDescription scene = ThreeBoxScene();
-  const Scan fixed = testing::ScanScene(scene, Scanner(scene, {0, 0, 1.5}, 0.0));
+  const Scan fixed = test_scenes::ScanScene(scene, Scanner(scene, {0, 0, 1.5}, 0.0));
   ScannerOptions moving_scanner = Scanner(scene, {0.8, -0.6, 1.6}, 8.0);
   moving_scanner.seed = 2;
-  const Scan moving_true = testing::ScanScene(scene, moving_scanner);
+  const Scan moving_true = test_scenes::ScanScene(scene, moving_scanner);
   ASSERT_GT(fixed.CountValid(), 50000);
   // The initial guess is off by 8 cm and 1.5°.
   Scan moving = moving_true;
@@ -74,8 +74,8 @@ TEST(RegistrationTest, IcpRecoversTheRelativePoseOfTwoScans) {
 
 TEST(RegistrationTest, FpfhRansacThenIcpWithoutAGuess) {
   const SceneDescription scene = ThreeBoxScene();
-  const Scan fixed = testing::ScanScene(scene, Scanner(scene, {0, 0, 1.5}, 0.0));
-  const Scan moving_true = testing::ScanScene(scene, Scanner(scene, {0.8, -0.6, 1.6}, 8.0));
+  const Scan fixed = test_scenes::ScanScene(scene, Scanner(scene, {0, 0, 1.5}, 0.0));
+  const Scan moving_true = test_scenes::ScanScene(scene, Scanner(scene, {0.8, -0.6, 1.6}, 8.0));
   // No usable guess: 1.2 m and 30° off.
   Scan moving = moving_true;
   moving.world_from_scanner = ComposeTransform({1.0, -0.7, 0.1}, {0, 0, 30}) * moving_true.world_from_scanner;

@@ -32,7 +32,7 @@ double Purity(const Scan& scan, const cv::Mat& superpixels) {
 }
 
 TEST(SuperpixelsTest, SuperpixelsFollowTheObjects) {
-  const Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene());
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeGroundAndBoxScene());
   for (SuperpixelMethod method : {SuperpixelMethod::kSlic, SuperpixelMethod::kGraph}) {
     int count = 0;
     const cv::Mat labels = ScanSuperpixels(scan, {.method = method}, &count);

@@ -12,8 +12,8 @@ namespace {
 // A scan and its photo stored in one E57 file as a pinhole entry: recolouring from the entry's own pose and
 // intrinsics gives what the true camera gives.
 TEST(E57Camera, RecoloursFromAStoredPinholeEntry) {
-  const SceneDescription scene = testing::MakeRecolorScene(false, 120, 180);
-  Scan scan = testing::ScanScene(scene);
+  const SceneDescription scene = test_scenes::MakeRecolorScene(false, 120, 180);
+  Scan scan = test_scenes::ScanScene(scene);
   const PinholeCamera camera = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 320, 240, 70);
   E57Image entry;
   entry.name = "beside";

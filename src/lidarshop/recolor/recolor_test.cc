@@ -14,8 +14,8 @@ namespace {
 // The scan of MakeRecolorScene with every colour replaced by a magenta no object has (a badly exposed scanner
 // camera), the true scan and a photo from a camera 1.5 m right of the scanner.
 struct Fixture {
-  SceneDescription scene = testing::MakeRecolorScene();
-  Scan truth = testing::ScanScene(scene);
+  SceneDescription scene = test_scenes::MakeRecolorScene();
+  Scan truth = test_scenes::ScanScene(scene);
   Scan input = Clone(truth);
   PinholeCamera camera = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 800, 600, 75);
   Photo photo;

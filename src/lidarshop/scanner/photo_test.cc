@@ -25,9 +25,9 @@ PinholeCamera CameraBesideScanner() {
 }
 
 TEST(Photo, SeesTheSceneWithTheScannersColours) {
-  testing::GroundAndBoxOptions scene_options;
+  test_scenes::GroundAndBoxOptions scene_options;
   scene_options.ground_texture = false;
-  const SceneDescription scene = testing::MakeGroundAndBoxScene(scene_options);
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene(scene_options);
   const PinholeCamera camera = CameraBesideScanner();
   const Photo photo = RenderPhoto(scene, camera);
   ASSERT_EQ(photo.image.size(), cv::Size(320, 240));
@@ -44,7 +44,7 @@ TEST(Photo, SeesTheSceneWithTheScannersColours) {
   EXPECT_EQ(photo.label.at<int32_t>(ground_row, ground_col), 0);
   EXPECT_NEAR(photo.depth_m.at<float>(ground_row, ground_col), std::sqrt(16 + 1.5 * 1.5), 0.05);
   // The colours are the scan's: compare with the scan cells that see the same labels.
-  const Scan scan = testing::ScanScene(scene);
+  const Scan scan = test_scenes::ScanScene(scene);
   cv::Vec3b scan_box, scan_ground;
   for (int r = 0; r < scan.rows; ++r) {
     for (int c = 0; c < scan.cols; ++c) {
@@ -60,12 +60,12 @@ TEST(Photo, SeesTheSceneWithTheScannersColours) {
 }
 
 TEST(Photo, TexturesMatchTheScanAtTheSamePoints) {
-  const SceneDescription scene = testing::MakeGroundAndBoxScene();  // grass ground, checker box
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene();  // grass ground, checker box
   const PinholeCamera camera = CameraBesideScanner();
   PhotoOptions options;
   options.samples_per_axis = 2;
   const Photo photo = RenderPhoto(scene, camera, options);
-  const Scan scan = testing::ScanScene(scene);
+  const Scan scan = test_scenes::ScanScene(scene);
   // Box cells (checker, 1 m squares) away from the square edges: the photo sees the same colour there.
   int compared = 0, equal = 0;
   for (int r = 0; r < scan.rows; ++r) {
@@ -92,10 +92,10 @@ TEST(Photo, TexturesMatchTheScanAtTheSamePoints) {
 TEST(Photo, RefusesABrokenCamera) {
   PinholeCamera camera = CameraBesideScanner();
   camera.fx_px = 0;
-  EXPECT_THROW(RenderPhoto(testing::MakeGroundAndBoxScene(), camera), InputError);
+  EXPECT_THROW(RenderPhoto(test_scenes::MakeGroundAndBoxScene(), camera), InputError);
   PhotoOptions options;
   options.samples_per_axis = 0;
-  EXPECT_THROW(RenderPhoto(testing::MakeGroundAndBoxScene(), CameraBesideScanner(), options), OptionsError);
+  EXPECT_THROW(RenderPhoto(test_scenes::MakeGroundAndBoxScene(), CameraBesideScanner(), options), OptionsError);
 }
 
 }  // namespace

@@ -14,11 +14,11 @@ namespace lidarshop {
 namespace {
 
 TEST(ScannerIo, PtxRoundTripOfASyntheticScan) {
-  testing::GroundAndBoxOptions options;
+  test_scenes::GroundAndBoxOptions options;
   options.rows = 60;
   options.columns = 90;
   options.los_noise_sigma = 0.005;
-  const Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene(options));
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeGroundAndBoxScene(options));
   const std::string path = (std::filesystem::temp_directory_path() / "scanner_io_test.ptx").string();
   WriteScanFile(path, {scan});
   const ScanFile file = ReadScanFile(path);
@@ -53,13 +53,13 @@ TEST(ScanMesh, JoinsNeighboursAndCutsDepthJumps) {
   options.azimuth_max_deg = 20;
   options.elevation_min_deg = -10;
   options.elevation_max_deg = 10;
-  SceneDescription scene = testing::MakeSingleObjectScene(
+  SceneDescription scene = test_scenes::MakeSingleObjectScene(
       TransformMesh(MakePlaneMesh({100, 100}), ComposeTransform({0, 10, 0}, {90, 0, 0})), 0, options);
   SceneObject panel;
   panel.mesh = TransformMesh(MakePlaneMesh({10, 10}), ComposeTransform({-5, 5, 0}, {90, 0, 0}));
   panel.label = 1;
   scene.objects.push_back(panel);
-  const Scan scan = testing::ScanScene(scene);
+  const Scan scan = test_scenes::ScanScene(scene);
   ASSERT_EQ(scan.CountValid(), scan.num_cells());
   const TriangleMesh mesh = ScanToMesh(scan);
   // Every 2 x 2 block gives 2 triangles except those straddling the step (one column boundary, 39 blocks).

@@ -37,7 +37,7 @@ TEST(Scanner, PlaneRangesAndNormalsAreAnalytic) {
     ScannerOptions options = Scanner(60, 80, -40, 40, -60, -10);
     options.rotate_deg = Eigen::Vector3d(0, 0, yaw);
     const Scan scan =
-        testing::ScanScene(testing::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
+        test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
     ASSERT_EQ(scan.CountValid(), scan.num_cells());
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
@@ -72,7 +72,7 @@ TEST(Scanner, SphereRangesAndNormalsAreAnalytic) {
   const double radius = 1.5;
   const ScannerOptions options = Scanner(120, 120, -5, 17, -10, 12, Eigen::Vector3d::Zero());
   TriangleMesh sphere = TransformMesh(MakeSphereMesh(radius, 256), ComposeTransform(center, {0, 0, 0}));
-  const Scan scan = testing::ScanScene(testing::MakeSingleObjectScene(sphere, 3, options), options);
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(sphere, 3, options), options);
   int checked = 0, misses = 0;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
@@ -111,7 +111,7 @@ TEST(Scanner, TargetAtKnownAnglesLandsInExpectedCell) {
                phi = (-10 + 0.5 * expected_ptx_row) * M_PI / 180;
   const Eigen::Vector3d target = 12.0 * DirectionFromAngles(theta, phi).cast<double>();
   TriangleMesh box = TransformMesh(MakeBoxMesh({0.04, 0.04, 0.04}), ComposeTransform(target, {0, 0, 0}));
-  const Scan scan = testing::ScanScene(testing::MakeSingleObjectScene(box, 5, options), options);
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(box, 5, options), options);
   ASSERT_EQ(scan.CountValid(), 1);  // 4 cm at 12 m is narrower than one 0.5-degree step (10 cm)
   const int expected_row = scan.rows - 1 - expected_ptx_row;
   EXPECT_EQ(scan.label.at<int32_t>(expected_row, expected_col), 5);
@@ -126,7 +126,7 @@ TEST(Scanner, NoiseStatisticsMatchSigmas) {
   options.orthogonal_noise_sigma_m = orthogonal_sigma;
   options.seed = 42;
   TriangleMesh wall = TransformMesh(MakePlaneMesh({100, 100}), ComposeTransform({0, 10, 0}, {90, 0, 0}));
-  const Scan scan = testing::ScanScene(testing::MakeSingleObjectScene(wall, 1, options), options);
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
   ASSERT_EQ(scan.CountValid(), 120000);
   double sum_los = 0, sum_los2 = 0, sum_orthogonal2 = 0, sum_b1 = 0, sum_b2 = 0, max_dot = 0;
   int64_t n = 0;
@@ -156,7 +156,7 @@ TEST(Scanner, NoiseStatisticsMatchSigmas) {
   // Orthogonal noise alone does not move the point along its ray (perpendicular, up to float rounding at 10
   // m).
   options.los_noise_sigma_m = 0;
-  const Scan orthogonal_only = testing::ScanScene(testing::MakeSingleObjectScene(wall, 1, options), options);
+  const Scan orthogonal_only = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
   double max_along = 0, sum_moved2 = 0;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
@@ -173,18 +173,18 @@ TEST(Scanner, NoiseStatisticsMatchSigmas) {
 }
 
 TEST(Scanner, IdenticalWhateverTheThreadCount) {
-  testing::GroundAndBoxOptions box_options;
+  test_scenes::GroundAndBoxOptions box_options;
   box_options.los_noise_sigma = 0.01;
   box_options.orthogonal_noise_sigma = 0.005;
-  const SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene(box_options);
   Scan one, two;
   {
     ThreadLimit limit(1);
-    one = testing::ScanScene(scene);
+    one = test_scenes::ScanScene(scene);
   }
   {
     ThreadLimit limit(2);
-    two = testing::ScanScene(scene);
+    two = test_scenes::ScanScene(scene);
   }
   ASSERT_GT(one.CountValid(), 1000);
   for (auto [a, b] : {std::pair{one.point, two.point},
@@ -200,16 +200,16 @@ TEST(Scanner, IdenticalWhateverTheThreadCount) {
   // Another seed gives other noise.
   SceneDescription other = scene;
   other.scanner.seed = 2;
-  const Scan three = testing::ScanScene(other);
+  const Scan three = test_scenes::ScanScene(other);
   cv::Mat diff;
   cv::absdiff(one.range, three.range, diff);
   EXPECT_GT(cv::countNonZero(diff), one.CountValid() / 2);
 }
 
 TEST(Scanner, ColourIntensityAndLabelsOfTheGroundAndBoxScene) {
-  testing::GroundAndBoxOptions box_options;
+  test_scenes::GroundAndBoxOptions box_options;
   box_options.ground_texture = false;
-  const Scan scan = testing::ScanScene(testing::MakeGroundAndBoxScene(box_options));
+  const Scan scan = test_scenes::ScanScene(test_scenes::MakeGroundAndBoxScene(box_options));
   std::set<int32_t> labels;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
@@ -232,8 +232,8 @@ TEST(Scanner, ColourIntensityAndLabelsOfTheGroundAndBoxScene) {
 }
 
 TEST(Scanner, TexturesAreDeterministicAndVaried) {
-  const SceneDescription scene = testing::MakeGroundAndBoxScene();
-  const Scan a = testing::ScanScene(scene), b = testing::ScanScene(scene);
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene();
+  const Scan a = test_scenes::ScanScene(scene), b = test_scenes::ScanScene(scene);
   cv::Mat diff;
   cv::absdiff(a.color.reshape(1), b.color.reshape(1), diff);
   EXPECT_EQ(cv::countNonZero(diff), 0);
@@ -244,14 +244,14 @@ TEST(Scanner, TexturesAreDeterministicAndVaried) {
 }
 
 TEST(Scanner, FusedPacketPathMatchesTheSingleRayPath) {
-  testing::GroundAndBoxOptions box_options;
+  test_scenes::GroundAndBoxOptions box_options;
   box_options.los_noise_sigma = 0.01;
   box_options.orthogonal_noise_sigma = 0.005;
-  SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  SceneDescription scene = test_scenes::MakeGroundAndBoxScene(box_options);
   ASSERT_EQ(scene.scanner.cast_method, CastMethod::kPacket16);  // the fused cast-and-shade loop
-  const Scan fused = testing::ScanScene(scene);
+  const Scan fused = test_scenes::ScanScene(scene);
   scene.scanner.cast_method = CastMethod::kSingle;  // cast into hit images, then shade
-  const Scan single = testing::ScanScene(scene);
+  const Scan single = test_scenes::ScanScene(scene);
   ASSERT_GT(fused.CountValid(), 1000);
   int64_t label_mismatches = 0, compared = 0;
   for (int row = 0; row < fused.rows; ++row) {
@@ -313,10 +313,10 @@ TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
 // Grids smaller than a band (4 rows) or a SIMD step (8 columns; the smallest grid is 2 x 2), and ragged ones:
 // every cell is shaded, the two SIMD paths agree, and the hits are those of one ray at a time.
 TEST(Scanner, SmallAndRaggedGridsShadeEveryCell) {
-  testing::GroundAndBoxOptions box_options;
+  test_scenes::GroundAndBoxOptions box_options;
   box_options.los_noise_sigma = 0.01;
   box_options.orthogonal_noise_sigma = 0.005;
-  const SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene(box_options);
   const SyntheticScanner scanner(scene);
   for (const auto& [rows, cols] : {std::pair{2, 2}, {2, 9}, {3, 5}, {5, 17}, {4, 8}, {9, 23}}) {
     SCOPED_TRACE(::testing::Message() << rows << " x " << cols);
@@ -464,14 +464,14 @@ TEST(Texture, FootprintFilteringRemovesSubSampleDetailAndKeepsTheMean) {
 }
 
 TEST(Scanner, DistantTexturedGroundDoesNotAlias) {
-  testing::GroundAndBoxOptions box_options;
+  test_scenes::GroundAndBoxOptions box_options;
   box_options.box_center = Eigen::Vector3d(0, -50, 0.5);  // out of view: only ground
-  SceneDescription scene = testing::MakeGroundAndBoxScene(box_options);
+  SceneDescription scene = test_scenes::MakeGroundAndBoxScene(box_options);
   for (auto& object : scene.objects) object.material.texture = TextureKind::kGravel;
   // Mean absolute colour step between horizontal neighbours over the ground rows beyond 10 m.
   auto roughness = [&](bool filter) {
     scene.scanner.filter_textures = filter;
-    const Scan scan = testing::ScanScene(scene);
+    const Scan scan = test_scenes::ScanScene(scene);
     double sum = 0;
     int64_t n = 0;
     for (int row = 0; row < scan.rows; ++row) {
@@ -548,16 +548,16 @@ TEST(SceneFile, TheIssueExampleParses) {
   EXPECT_EQ(scene.objects[1].material.color, Rgb8(200, 40, 40));
   EXPECT_EQ(scene.objects[0].material.texture, TextureKind::kGrass);
   EXPECT_NEAR(scene.objects[4].world_from_object(2, 2), 2.0, 1e-12);  // z scaled by 2, rotated about z
-  const Scan scan = testing::ScanScene(scene, testing::SmallScanner(scene.scanner, 150, 225));
+  const Scan scan = test_scenes::ScanScene(scene, test_scenes::SmallScanner(scene.scanner, 150, 225));
   std::set<int32_t> labels(scan.label.begin<int32_t>(), scan.label.end<int32_t>());
   EXPECT_EQ(labels, (std::set<int32_t>{kNoLabel, 0, 1, 2, 3, 4}));
 }
 
 TEST(SceneFile, BuiltinScenesLoadAndShowEveryObject) {
   for (const std::string name : {"parking_lot", "electric_box", "mailbox"}) {
-    const SceneDescription scene = testing::LoadBuiltinScene(name);
+    const SceneDescription scene = test_scenes::LoadBuiltinScene(name);
     EXPECT_LE(scene.scanner.rows * scene.scanner.columns, 1000 * 600) << name;
-    const Scan scan = testing::ScanScene(scene, testing::SmallScanner(scene.scanner, 280, 480));
+    const Scan scan = test_scenes::ScanScene(scene, test_scenes::SmallScanner(scene.scanner, 280, 480));
     std::set<int32_t> seen(scan.label.begin<int32_t>(), scan.label.end<int32_t>());
     for (const auto& object : scene.objects)
       EXPECT_TRUE(seen.contains(object.label)) << name << " " << object.name;

@@ -6,7 +6,7 @@
 #error "LIDARSHOP_SOURCE_DIR must be defined for lidarshop_testing"
 #endif
 
-namespace lidarshop::testing {
+namespace lidarshop::test_scenes {
 
 SceneDescription MakeGroundAndBoxScene(const GroundAndBoxOptions& options) {
   SceneDescription scene;
@@ -107,4 +107,4 @@ Scan ScanScene(const SceneDescription& scene, const ScannerOptions& scanner) {
   return synthetic.Acquire(scanner);
 }
 
-}  // namespace lidarshop::testing
+}  // namespace lidarshop::test_scenes

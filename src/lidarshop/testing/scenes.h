@@ -14,7 +14,7 @@
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 
-namespace lidarshop::testing {
+namespace lidarshop::test_scenes {
 
 struct GroundAndBoxOptions {
   Eigen::Vector3d box_size = Eigen::Vector3d(1.0, 1.0, 1.0);    // metres, x y z
@@ -58,4 +58,4 @@ ScannerOptions SmallScanner(const ScannerOptions& scanner, int rows, int columns
 Scan ScanScene(const SceneDescription& scene);
 Scan ScanScene(const SceneDescription& scene, const ScannerOptions& scanner);
 
-}  // namespace lidarshop::testing
+}  // namespace lidarshop::test_scenes

@@ -26,9 +26,9 @@ const std::vector<Car> kCars = {{"sedan", 6.5, 10, 120}, {"hatchback", 0, 11, 12
 class ParkingLotTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    const SceneDescription scene = testing::LoadBuiltinScene("parking_lot");
+    const SceneDescription scene = test_scenes::LoadBuiltinScene("parking_lot");
     // The built-in 960 x 560 scan (0.125° steps: ≈ 2.2 cm at 10 m).
-    scans_ = new std::vector<PreparedScan>{PrepareScan(testing::ScanScene(scene))};
+    scans_ = new std::vector<PreparedScan>{PrepareScan(test_scenes::ScanScene(scene))};
     models_ = new std::vector<VerifierModel>;
     for (const Car& car : kCars) {
       CarMeshOptions mesh_options;

@@ -1,5 +1,5 @@
 // recolor_eval: the evidence tables of bench/results/recolor.md. A synthetic scene
-// (testing::MakeRecolorScene) is scanned and photographed (scanner/photo.h) from cameras 1-3 m from the
+// (test_scenes::MakeRecolorScene) is scanned and photographed (scanner/photo.h) from cameras 1-3 m from the
 // scanner; correspondences are drawn from scan points the camera sees, with noise and outliers; three
 // resection methods recover the camera:
 //   thesis  normalized DLT on every pair (no RANSAC, no refinement: the thesis's method)
@@ -91,8 +91,8 @@ int main(int argc, char** argv) {
       "changed, % |\n|---|---|---|---|---|---|\n");
   for (double offset : {1.0, 2.0, 3.0}) {
     Setup s;
-    s.scene = testing::MakeRecolorScene();
-    s.truth = testing::ScanScene(s.scene);
+    s.scene = test_scenes::MakeRecolorScene();
+    s.truth = test_scenes::ScanScene(s.scene);
     s.input = Clone(s.truth);
     s.input.color.setTo(cv::Scalar(250, 0, 250));
     // Beside and a little behind the scanner (at (0, 0, 1.5)), looking at the scene.
