@@ -124,7 +124,8 @@ template <>
 const EnumInfo& EnumInfoOf<SuperpixelMethod>() {
   static const EnumInfo info = MakeEnumInfo<SuperpixelMethod>(
       "superpixel method", {{SuperpixelMethod::kSlic, "slic", "SLIC (OpenCV ximgproc)"},
-                            {SuperpixelMethod::kGraph, "graph", "Felzenszwalb graph segmentation"}});
+                            {SuperpixelMethod::kGraph, "graph", "Felzenszwalb graph segmentation"},
+                            {SuperpixelMethod::kQuickShift, "quickshift", "QuickShift mode seeking"}});
   return info;
 }
 
@@ -141,6 +142,16 @@ const StructInfo& InfoOf<SuperpixelOptions>() {
     b.Field(&SuperpixelOptions::graph_min_cells, "graph_min_cells", "graph: smallest segment")
         .Unit("cells")
         .Min(1);
+    b.Field(&SuperpixelOptions::quickshift_kernel_size, "quickshift_kernel_size",
+            "QuickShift: sigma of the density kernel")
+        .Unit("cells")
+        .AboveZero();
+    b.Field(&SuperpixelOptions::quickshift_max_dist, "quickshift_max_dist",
+            "QuickShift: longest link in the joint space of position and channels")
+        .AboveZero();
+    b.Field(&SuperpixelOptions::quickshift_ratio, "quickshift_ratio",
+            "QuickShift: weight of the colour and range channels against position")
+        .AboveZero();
     b.Field(&SuperpixelOptions::range_weight, "range_weight",
             "weight of the log-range channel against colour")
         .Min(0);

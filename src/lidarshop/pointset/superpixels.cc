@@ -7,6 +7,7 @@
 #include <opencv2/ximgproc/segmentation.hpp>
 #include <opencv2/ximgproc/slic.hpp>
 
+#include "lidarshop/pointset/quickshift.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -47,6 +48,12 @@ cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int*
     slic->enforceLabelConnectivity();
     slic->getLabels(labels);
     if (num_superpixels) *num_superpixels = slic->getNumberOfSuperpixels();
+  } else if (options.method == SuperpixelMethod::kQuickShift) {
+    cv::Mat features;
+    image.convertTo(features, CV_32F, options.quickshift_ratio);
+    const cv::Mat mask = scan.valid.empty() ? cv::Mat() : (scan.valid != 0);
+    labels = QuickShift(features, mask, {options.quickshift_kernel_size, options.quickshift_max_dist},
+                        num_superpixels);
   } else {
     // The graph segmentation takes up to 3 channels of 8 bits or floats; keep the first three.
     if (image.channels() > 3) {

@@ -1,7 +1,8 @@
 // Superpixels on the scan image (OpenCV ximgproc): SLIC (Achanta et al. 2012) and graph-based segmentation
 // (Felzenszwalb and Huttenlocher 2004) over an image of the scan: colour when the scan has one, else
-// intensity, with the range (log, so near and far weigh alike) as an extra channel. QuickShift has no
-// well-kept library in Debian (ximgproc has none; VLFeat is not packaged) and is not provided.
+// intensity, with the range (log, so near and far weigh alike) as an extra channel — and QuickShift (Vedaldi
+// and Soatto 2008, pointset/quickshift.h, written here: no library in Debian has it) over the same channels
+// scaled by `quickshift_ratio`, cells without a return left out.
 #pragma once
 
 #include <cstdint>
@@ -13,7 +14,7 @@
 
 namespace lidarshop {
 
-enum class SuperpixelMethod { kSlic, kGraph };  // "slic", "graph"
+enum class SuperpixelMethod { kSlic, kGraph, kQuickShift };  // "slic", "graph", "quickshift"
 template <>
 const EnumInfo& EnumInfoOf<SuperpixelMethod>();
 
@@ -25,6 +26,10 @@ struct SuperpixelOptions {
   double graph_sigma = 0.5;  // graph: Gaussian smoothing, cells, >= 0
   float graph_k = 300.0f;    // graph: larger = larger segments, > 0
   int graph_min_cells = 50;  // graph: smallest segment, cells, >= 1
+  double quickshift_kernel_size = 3.0;  // QuickShift: σ of the density kernel, cells, > 0
+  double quickshift_max_dist = 10.0;    // QuickShift: longest link in the joint space, > 0
+  double quickshift_ratio = 0.25;       // QuickShift: weight of the [0, 255] channels against position,
+                                        // > 0
   double range_weight =
       1.0;             // weight of the log-range channel against colour (both scaled to [0, 255]), >= 0
   void Check() const;  // throws OptionsError
