@@ -10,7 +10,7 @@ packages=(
   libopencv-dev libopencv-contrib-dev libopenexr-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  libmaxflow-dev libsuitesparse-dev liblzf-dev libpugixml-dev
+  libmaxflow-dev libsuitesparse-dev liblzf-dev libpugixml-dev libcgal-dev
   libcpp-httplib-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed
   nodejs chromium
 )

@@ -1,5 +1,5 @@
 // Descriptions of the point-set options (util/options.h). Not described (geometry, not options): CropOptions'
-// box, polygon and origin, NormalOptions' viewpoint — their Check() keeps checking them.
+// box, polygon and origin, NormalOptions' and SurfaceOptions' viewpoint — their Check() keeps checking them.
 #include "lidarshop/pointset/clustering.h"
 #include "lidarshop/pointset/features.h"
 #include "lidarshop/pointset/filters.h"
@@ -9,6 +9,7 @@
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/superpixels.h"
+#include "lidarshop/pointset/surface.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -259,6 +260,48 @@ const StructInfo& InfoOf<RegionGrowingOptions>() {
     b.Field(&RegionGrowingOptions::min_region_cells, "min_region_cells", "smaller regions get no label")
         .Unit("cells")
         .Min(1);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<SurfaceMethod>() {
+  static const EnumInfo info = MakeEnumInfo<SurfaceMethod>(
+      "surface reconstruction method",
+      {{SurfaceMethod::kPoisson, "poisson", "Poisson reconstruction (CGAL), watertight, needs normals"},
+       {SurfaceMethod::kScaleSpace, "scale-space", "jet smoothing + advancing front (CGAL), interpolating"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SurfaceOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<SurfaceOptions> b("SurfaceOptions", "surface reconstruction from points");
+    b.Field(&SurfaceOptions::method, "method", "reconstruction method");
+    b.Field(&SurfaceOptions::poisson_angle_deg, "poisson_angle_deg", "Poisson: smallest triangle angle")
+        .Unit("deg")
+        .Range(1, 30);
+    b.Field(&SurfaceOptions::poisson_radius_spacings, "poisson_radius_spacings",
+            "Poisson: largest triangle size, in mean point spacings")
+        .AboveZero();
+    b.Field(&SurfaceOptions::poisson_distance_spacings, "poisson_distance_spacings",
+            "Poisson: largest distance to the implicit surface, in mean point spacings")
+        .AboveZero();
+    b.Field(&SurfaceOptions::keep_within_m, "keep_within_m",
+            "drop triangles farther than this from every point; 0 = keep all")
+        .Unit("m")
+        .Min(0);
+    b.Field(&SurfaceOptions::normal_neighbors, "normal_neighbors", "k for estimated normals").Min(3);
+    b.Field(&SurfaceOptions::scale_space_iterations, "scale_space_iterations", "scale-space: smoothing steps")
+        .Min(0);
+    b.Field(&SurfaceOptions::scale_space_neighbors, "scale_space_neighbors",
+            "scale-space: neighbours per jet fit")
+        .Min(6);
+    b.Field(&SurfaceOptions::max_edge_m, "max_edge_m", "scale-space: longest triangle edge; 0 = no limit")
+        .Unit("m")
+        .Min(0);
+    b.Field(&SurfaceOptions::seed, "seed", "CGAL's random choices");
     return b.Build();
   }();
   return info;
