@@ -17,6 +17,7 @@
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/superpixels.h"
+#include "lidarshop/pointset/surface.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::python {
@@ -316,6 +317,32 @@ void BindShapes(py::module_& m) {
       "`normals` (N, 3), a Scan's own, or estimated within normal_radius_m (default radius_m / 2).");
 }
 
+void BindSurfaces(py::module_& m) {
+  m.def(
+      "reconstruct_surface",
+      [](const py::object& points, const py::object& options, const py::object& normals,
+         const py::object& viewpoint, const py::kwargs& kwargs) {
+        PointCloud cloud = CloudOf(points);
+        SurfaceOptions surface_options = OptionsOf<SurfaceOptions>(options, kwargs);
+        if (!normals.is_none()) {
+          const PointCloud given = CloudOf(normals, "normals");
+          if (given.size() != cloud.size()) {
+            throw py::value_error(fmt::format("normals: {} rows for {} points", given.size(), cloud.size()));
+          }
+          cloud.normals = given.points;
+        }
+        if (!viewpoint.is_none()) {
+          surface_options.viewpoint = RowsOf(py::make_tuple(viewpoint), 3, "viewpoint").front().cast<float>();
+        }
+        py::gil_scoped_release release;
+        return ReconstructSurface(cloud, surface_options);
+      },
+      py::arg("points"), py::arg("options") = py::none(), py::kw_only(), py::arg("normals") = py::none(),
+      py::arg("viewpoint") = py::none(),
+      "A TriangleMesh through the points (SurfaceOptions: 'poisson' with oriented normals — given, a Scan's, "
+      "or estimated toward `viewpoint` — or 'scale-space'). docs/points.md.");
+}
+
 void BindScanTools(py::module_& m) {
   m.def(
       "scan_normals",
@@ -422,6 +449,7 @@ void BindPointSets(py::module_& m) {
   BindPointSetResults(m);
   BindFilters(m);
   BindShapes(m);
+  BindSurfaces(m);
   BindScanTools(m);
   BindRegistration(m);
 }

@@ -20,6 +20,7 @@
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/superpixels.h"
+#include "lidarshop/pointset/surface.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
@@ -72,6 +73,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<SuperpixelOptions>(m);
   BindStruct<IcpOptions>(m);
   BindStruct<GlobalAlignOptions>(m);
+  BindStruct<SurfaceOptions>(m);
 }
 
 }  // namespace lidarshop::python

@@ -103,9 +103,10 @@ def test_scan_tools(scan):
     with_normals = lidarshop.scan_normals(scan, window_cells=2)
     up = with_normals.normal[(scan.label == 0) & (scan.valid > 0)]
     assert np.median(up[:, 2]) > 0.98  # the ground faces up (scanner frame = world orientation here)
-    labels, count = lidarshop.superpixels(scan, region_cells=10)
-    assert labels.shape == (scan.rows, scan.cols) and count > 10
-    assert np.all(labels[scan.valid == 0] == -1)
+    for method in ("slic", "graph", "quickshift"):
+        labels, count = lidarshop.superpixels(scan, method=method, region_cells=10)
+        assert labels.shape == (scan.rows, scan.cols) and count > 10, method
+        assert np.all(labels[scan.valid == 0] == -1)
     regions, count = lidarshop.region_growing(scan, 10.0)
     assert regions.shape == (scan.rows, scan.cols) and count >= 3
     # The wall and the ground are separate regions: their largest regions differ.
@@ -158,3 +159,19 @@ def test_global_alignment_then_icp():
     assert coarse.inliers > 10
     fine = lidarshop.icp(fixed, moving, coarse.fixed_from_moving, max_correspondence_m=0.3)
     np.testing.assert_allclose(fine.fixed_from_moving @ motion, np.eye(4), atol=1e-2)
+
+
+def test_surface_reconstruction():
+    rng = np.random.default_rng(6)
+    directions = rng.normal(size=(3000, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    points = (directions * 0.5 + [0, 0, 1]).astype(np.float32)
+    poisson = lidarshop.reconstruct_surface(points, normals=directions)
+    radius = np.linalg.norm(poisson.vertices - [0, 0, 1], axis=1)
+    assert len(poisson.triangles) > 300 and np.abs(radius - 0.5).max() < 0.02
+    inside = lidarshop.reconstruct_surface(points, viewpoint=[0, 0, 1])  # normals estimated, facing the centre
+    assert np.abs(np.linalg.norm(inside.vertices - [0, 0, 1], axis=1) - 0.5).max() < 0.03
+    interpolating = lidarshop.reconstruct_surface(points, method="scale-space")
+    assert np.abs(np.linalg.norm(interpolating.vertices - [0, 0, 1], axis=1) - 0.5).max() < 1e-5
+    with pytest.raises(lidarshop.InputError, match="one plane"):
+        lidarshop.reconstruct_surface(np.column_stack([points[:, :2], np.zeros(3000)]))
