@@ -18,7 +18,7 @@
 
 namespace lidarshop {
 
-using namespace segment_internal;
+using namespace segment_internal;  // NOLINT: the graph and appearance helpers of this module
 
 struct SegmentSession::Impl {
   Scan scan;
