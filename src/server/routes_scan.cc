@@ -223,7 +223,9 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
       return;
     }
     const int id = state.AddDocument(fs::path(path).filename().string(), std::move(file.scans[index]));
-    SendJson(response, DocumentJson(*state.Get(id)));
+    nlohmann::ordered_json reply = DocumentJson(*state.Get(id));
+    reply["warnings"] = file.warnings;  // what the reader left out of the file
+    SendJson(response, reply);
   } catch (const InputError& error) {
     SendError(response, 422, error.what());
   }

@@ -87,6 +87,7 @@ void AddVerifyRoutes(State& state) {
       const std::string name = body->value("model", std::string());
       auto entry = std::make_shared<ModelEntry>();
       entry->name = name;
+      std::vector<std::string> warnings;  // what the mesh reader left out of the file
       if (std::find(kBuiltinModels.begin(), kBuiltinModels.end(), name) != kBuiltinModels.end()) {
         entry->mesh = BuiltinMesh(name);
       } else {
@@ -97,7 +98,9 @@ void AddVerifyRoutes(State& state) {
                                        "server's folders",
                                        name));
         }
-        entry->mesh = ReadMesh(path);
+        MeshFile file = ReadMeshFile(path);
+        entry->mesh = std::move(file.mesh);
+        warnings = std::move(file.warnings);
       }
       entry->model = PrepareModel(entry->mesh);
       Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -low;
@@ -113,7 +116,8 @@ void AddVerifyRoutes(State& state) {
                           {"name", name},
                           {"vertices", entry->mesh.vertices.size()},
                           {"triangles", entry->mesh.triangles.size()},
-                          {"size_m", {size.x(), size.y(), size.z()}}});
+                          {"size_m", {size.x(), size.y(), size.z()}},
+                          {"warnings", warnings}});
     } catch (const OptionsError& error) {
       SendError(response, 400, error.what());
     } catch (const InputError& error) {

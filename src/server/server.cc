@@ -118,10 +118,11 @@ std::string EditorServer::Url() const {
   return fmt::format("http://{}:{}/?token={}", state_->options.host, state_->port, state_->options.token);
 }
 
-int EditorServer::OpenAtStart(const std::string& path) {
+int EditorServer::OpenAtStart(const std::string& path, std::vector<std::string>* warnings) {
   const std::string folder = fs::weakly_canonical(fs::absolute(path)).parent_path().string();
   state_->options.roots.push_back(folder);
   ScanFile file = ReadScanFile(path);
+  if (warnings != nullptr) warnings->insert(warnings->end(), file.warnings.begin(), file.warnings.end());
   if (file.scans.empty()) throw InputError(fmt::format("{}: holds no scan", path));
   return state_->AddDocument(fs::path(path).filename().string(), std::move(file.scans.front()));
 }

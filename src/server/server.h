@@ -51,8 +51,9 @@ class EditorServer {
   const std::string& token() const;
   std::string Url() const;  // http://HOST:PORT/?token=T
 
-  // Opens a scan file at start (`serve SCAN…`); its folder becomes a root. Returns the document id.
-  int OpenAtStart(const std::string& path);
+  // Opens a scan file at start (`serve SCAN…`); its folder becomes a root. Returns the document id; the
+  // reader's warnings go to `warnings` when it is not null.
+  int OpenAtStart(const std::string& path, std::vector<std::string>* warnings = nullptr);
   // Scans a built-in scene and opens it (throws InputError for an unknown name).
   int OpenScene(const std::string& name);
 

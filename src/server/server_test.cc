@@ -42,6 +42,9 @@ class ServerTest : public ::testing::Test {
     WriteScanFile((base_ / "root" / "sub" / "box.ptx").string(), {*scan_});
     WriteScanFile((base_ / "outside" / "secret.ptx").string(), {*scan_});
     std::ofstream(base_ / "root" / "broken.ptx") << "12\nnot a ptx\n";
+    // A mesh whose MTL file is missing: read with a warning.
+    std::ofstream(base_ / "root" / "sub" / "quad.obj")
+        << "mtllib missing.mtl\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4\n";
     fs::create_symlink(base_ / "outside" / "secret.ptx", base_ / "root" / "link.ptx");
     ServerOptions options;
     options.port = 0;
@@ -250,6 +253,19 @@ TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
   const ScanFile file = ReadScanFile(saved.string());
   ASSERT_FALSE(file.scans.empty());
   EXPECT_EQ(file.scans[0].rows, scan_->rows);
+}
+
+TEST_F(ServerTest, ReadersWarningsComeBackInTheReply) {
+  const auto opened = client_->Get(Api("/api/open?path=sub/box.ptx"));
+  ASSERT_EQ(opened->status, 200) << opened->body;
+  ASSERT_TRUE(Json(opened).contains("warnings"));
+  EXPECT_EQ(Json(opened)["warnings"], nlohmann::json::array());  // a PTX file read whole
+  const auto placed = client_->Post(Api("/api/models"), R"({"model": "sub/quad.obj"})", "application/json");
+  ASSERT_EQ(placed->status, 200) << placed->body;
+  const nlohmann::json warnings = Json(placed)["warnings"];
+  ASSERT_EQ(warnings.size(), 1u) << placed->body;
+  EXPECT_NE(warnings[0].get<std::string>().find("quad.obj: "), std::string::npos);
+  EXPECT_NE(warnings[0].get<std::string>().find("missing.mtl"), std::string::npos);
 }
 
 TEST_F(ServerTest, PlaceAndVerifyAModel) {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
 
 namespace lidarshop::cli {
@@ -68,6 +69,13 @@ void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json
 // any), its folder exists and is writable, and it names no input or other output. OptionsError naming `flag`.
 void CheckOutputFile(const std::string& flag, const std::string& path,
                      const std::vector<std::string>& extensions, const std::vector<std::string>& others);
+
+// Prints a reader's warnings on stderr, one line each ("lidarshop: warning: <file>: <what was left out>").
+void PrintWarnings(const std::vector<std::string>& warnings);
+// ReadScanFile, ReadE57 and ReadMeshFile for commands: the reader's warnings are printed (PrintWarnings).
+ScanFile ReadScanFileAndWarn(const std::string& path);
+E57File ReadE57AndWarn(const std::string& path);
+TriangleMesh ReadMeshAndWarn(const std::string& path);
 
 // Scan `index` of `file`; OptionsError naming `flag` (the option the user typed) when out of range.
 const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = "--scan-index");

@@ -128,6 +128,28 @@ void CheckOutputFile(const std::string& flag, const std::string& path,
   }
 }
 
+void PrintWarnings(const std::vector<std::string>& warnings) {
+  for (const std::string& warning : warnings) fmt::print(stderr, "lidarshop: warning: {}\n", warning);
+}
+
+ScanFile ReadScanFileAndWarn(const std::string& path) {
+  ScanFile file = ReadScanFile(path);
+  PrintWarnings(file.warnings);
+  return file;
+}
+
+E57File ReadE57AndWarn(const std::string& path) {
+  E57File file = ReadE57(path);
+  PrintWarnings(file.warnings);
+  return file;
+}
+
+TriangleMesh ReadMeshAndWarn(const std::string& path) {
+  MeshFile file = ReadMeshFile(path);
+  PrintWarnings(file.warnings);
+  return std::move(file.mesh);
+}
+
 const Scan& PickScan(const ScanFile& file, int index, const std::string& flag) {
   if (index < 0 || index >= static_cast<int>(file.scans.size())) {
     throw OptionsError(fmt::format("{} {} is out of range: {} holds {} scan(s), numbered from 0", flag, index,

@@ -64,7 +64,11 @@ SceneDescription LoadDemoScene(const std::string& scene) {
   for (const BuiltinScene& builtin : BuiltinScenes()) {
     if (scene == builtin.name) return ParseScene(builtin.json, fmt::format("built-in scene '{}'", scene), "");
   }
-  if (fs::exists(scene)) return LoadScene(scene);
+  if (fs::exists(scene)) {
+    SceneDescription description = LoadScene(scene);
+    PrintWarnings(description.warnings);
+    return description;
+  }
   std::string names;
   for (const BuiltinScene& builtin : BuiltinScenes()) names += fmt::format(" {}", builtin.name);
   throw InputError(

@@ -106,11 +106,11 @@ int RunInfo(int argc, char** argv) {
     ScanFile file;
     std::vector<E57Image> images;
     if (FileExtension(path) == "e57") {  // read once, keeping the photos
-      E57File e57 = ReadE57(path);
-      file = {path, "e57", std::move(e57.scans)};
+      E57File e57 = ReadE57AndWarn(path);
+      file = {path, "e57", std::move(e57.scans), std::move(e57.warnings)};
       images = std::move(e57.images);
     } else {
-      file = ReadScanFile(path);
+      file = ReadScanFileAndWarn(path);
     }
     nlohmann::json json;
     json["file"] = path;
@@ -142,11 +142,11 @@ int RunConvert(int argc, char** argv) {
     std::vector<E57Image> images;  // E57 -> E57 keeps the photos
     const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
     if (e57_to_e57) {
-      E57File e57 = ReadE57(input);
-      file = {input, "e57", std::move(e57.scans)};
+      E57File e57 = ReadE57AndWarn(input);
+      file = {input, "e57", std::move(e57.scans), std::move(e57.warnings)};
       images = std::move(e57.images);
     } else {
-      file = ReadScanFile(input);
+      file = ReadScanFileAndWarn(input);
     }
     progress->Advance();
     std::vector<Scan> scans = file.scans;
@@ -212,7 +212,7 @@ int RunRender(int argc, char** argv) {
     if (!eye.empty() || !std::isnan(orbit_deg)) {
       if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
       if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
-      const ScanFile file = ReadScanFile(input);
+      const ScanFile file = ReadScanFileAndWarn(input);
       const Scan& scan = PickScan(file, scan_index, "--scan");
       if (!eye.empty()) {
         view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
@@ -232,7 +232,7 @@ int RunRender(int argc, char** argv) {
     if (!color_map.empty())
       options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
     options.Check();
-    const ScanFile file = ReadScanFile(input);
+    const ScanFile file = ReadScanFileAndWarn(input);
     Scan scan = PickScan(file, scan_index, "--scan");
     if (scan.name.empty()) scan.name = input;
     const RenderResult result = RenderScan(scan, options);

@@ -104,7 +104,7 @@ int RunFill(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {scan_path, mask_path, output_path});
         CheckOutputFile("--synthesized-mask", synthesized_mask_path, {"png"},
                         {scan_path, mask_path, output_path, json_path});
-        const ScanFile file = ReadScanFile(scan_path);
+        const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index);
         const cv::Mat hole = ReadMask(mask_path, cv::Size(scan.cols, scan.rows), scan_path);
         auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
@@ -157,7 +157,7 @@ int RunRemove(int argc, char** argv) {
         }
         CheckOutputFile("--mask-out", mask_out_path, {"png"}, {scan_path, strokes_path, output_path});
         CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});
-        const ScanFile file = ReadScanFile(scan_path);
+        const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index);
         const cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill

@@ -47,7 +47,7 @@ struct Gathered {
 Gathered Gather(const std::vector<std::string>& paths) {
   Gathered g;
   for (const std::string& path : paths) {
-    for (const Scan& scan : ReadScanFile(path).scans) {
+    for (const Scan& scan : ReadScanFileAndWarn(path).scans) {
       std::vector<int64_t> cells;
       const PointCloud cloud = ToPointCloud(scan, true, &cells);
       g.cloud = g.cloud.empty() ? cloud : MergeClouds({g.cloud, cloud});
@@ -249,7 +249,7 @@ int RunPoints(int argc, char** argv) {
       if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
       if (FileExtension(output_path) != "ply")
         throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
-      const TriangleMesh mesh = ReadMesh(inputs[0]);
+      const TriangleMesh mesh = ReadMeshAndWarn(inputs[0]);
       if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
       CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
       const Timer timer;
@@ -425,7 +425,7 @@ int RunRegister(int argc, char** argv) {
     if (use_global) global.Check();
     CheckOutputs(output_path, json_path, {fixed_path, moving_path});
     const Timer timer;
-    const ScanFile fixed = ReadScanFile(fixed_path), moving = ReadScanFile(moving_path);
+    const ScanFile fixed = ReadScanFileAndWarn(fixed_path), moving = ReadScanFileAndWarn(moving_path);
     if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
     const ScanRegistration result =
         RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);

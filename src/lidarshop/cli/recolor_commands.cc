@@ -39,7 +39,7 @@ void CheckNotInput(const std::string& output, const std::vector<std::string>& in
   }
 }
 
-Scan ReadOneScan(const std::string& path, int index) { return PickScan(ReadScanFile(path), index); }
+Scan ReadOneScan(const std::string& path, int index) { return PickScan(ReadScanFileAndWarn(path), index); }
 
 // The entry of `images` named `key` or numbered `key`.
 const E57Image& FindImage(const std::vector<E57Image>& images, const std::string& key,
@@ -206,7 +206,7 @@ int RunRecolor(int argc, char** argv) {
     bool have_camera = false;
     if (!image_key.empty()) {
       if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
-      const E57File file = ReadE57(scan_path);
+      const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
       const E57Image& image = FindImage(file.images, image_key, scan_path);
       if (image.image.empty()) ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
       photo = image.image;
@@ -252,7 +252,7 @@ int RunImages(int argc, char** argv) {
   app.add_option("--extract", folder, "folder to write <index>_<name>.png into (created)");
   return RunCommand(app, argc, argv, [&] {
     if (FileExtension(path) != "e57") throw OptionsError(path + " is not an .e57 file");
-    const E57File file = ReadE57(path);
+    const E57File file = ReadE57AndWarn(path);
     nlohmann::ordered_json json;
     json["file"] = path;
     json["images"] = ImagesJson(file.images);
@@ -340,7 +340,9 @@ int RunPhoto(int argc, char** argv) {
       ->capture_default_str();
   return RunCommand(app, argc, argv, [&] {
     CheckNotInput(output, {scene_path, camera_path});
-    const Photo photo = RenderPhoto(LoadScene(scene_path), ReadCameraJson(camera_path), options);
+    const SceneDescription scene = LoadScene(scene_path);
+    PrintWarnings(scene.warnings);
+    const Photo photo = RenderPhoto(scene, ReadCameraJson(camera_path), options);
     WriteImage(output, photo.image);
     return 0;
   });

@@ -58,6 +58,7 @@ int RunScan(int argc, char** argv) {
     Timer total;
     Timer stage;
     SceneDescription scene = LoadScene(scene_path);
+    PrintWarnings(scene.warnings);
     if (app.count("--seed") > 0) scene.scanner.seed = seed;
     if (rows) scene.scanner.rows = *rows;
     if (columns) scene.scanner.columns = *columns;

@@ -73,7 +73,7 @@ int RunSegment(int argc, char** argv) {
       CheckOutputPath(path, used);
       used.push_back(path);
     }
-    const ScanFile file = ReadScanFile(scan_path);
+    const ScanFile file = ReadScanFileAndWarn(scan_path);
     const Scan& scan = PickScan(file, scan_index);
     cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
     SegmentSession session(scan, options);

@@ -68,7 +68,11 @@ int RunServe(int argc, char** argv) {
       throw InputError(fmt::format("no built-in scene '{}'", name));
     };
     server::EditorServer editor(options);
-    for (const std::string& scan : scans) editor.OpenAtStart(scan);
+    for (const std::string& scan : scans) {
+      std::vector<std::string> warnings;
+      editor.OpenAtStart(scan, &warnings);
+      PrintWarnings(warnings);
+    }
     for (const std::string& scene : scenes) editor.OpenScene(scene);
     editor.Bind();
     if (options.web_dir.empty()) {

@@ -25,7 +25,7 @@ namespace {
 std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
   std::vector<PreparedScan> scans;
   for (const std::string& path : paths) {
-    const ScanFile file = ReadScanFile(path);
+    const ScanFile file = ReadScanFileAndWarn(path);
     if (file.scans.empty()) throw InputError(fmt::format("{}: no scan in the file", path));
     for (const Scan& scan : file.scans) scans.push_back(PrepareScan(scan));
   }
@@ -80,7 +80,7 @@ TriangleMesh LoadModel(const std::string& path) {
     options.style = ParseCarStyle(path.substr(prefix.size()), "--model");
     return MakeCarMesh(options);
   }
-  return ReadMesh(path);
+  return ReadMeshAndWarn(path);
 }
 
 struct CommonFlags {

@@ -366,12 +366,37 @@ GridOrientation OrientationOf(const Scan& scan) {
   return o;
 }
 
-// The first returns of one data3D entry; records with returnIndex 1 go to `second` (left 0 x 0 when there are
-// none), later ones are counted in `warnings`. `synthesized_field` is the name of lidarshop's extension field
-// under the prefix the file binds to its namespace ("" when the file does not declare it).
-Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::string& synthesized_field,
-              Scan* second, std::vector<std::string>* warnings) {
-  const pugi::xml_node points = child.child("points");
+// The points CompressedVector of one data3D entry: its prototype's fields and their bytestreams, read after
+// checking that recordCount fits the file.
+struct PointRecords {
+  PointRecords(const Context& context, pugi::xml_node points_node) : ctx(context), points(points_node) {}
+  const Context& ctx;
+  pugi::xml_node points;
+  int64_t count = 0;  // recordCount
+  std::vector<Field> fields;
+  std::unordered_map<std::string, int> field_index;
+  std::vector<std::vector<uint8_t>> streams;  // one per field
+  std::string where;                          // "file: data3D/.../points", for decoding errors
+  bool cartesian = false, spherical = false, structured = false;
+  mutable std::vector<double> buffer;
+
+  const Field* Find(const char* name) const {
+    const auto it = field_index.find(name);
+    return it == field_index.end() ? nullptr : &fields[it->second];
+  }
+  // The `count` values of `field` (not null); valid until the next call.
+  const std::vector<double>& Decode(const Field* field) const {
+    LIDARSHOP_CHECK(field != nullptr);
+    buffer.resize(count);
+    const auto& stream = streams[field - fields.data()];
+    DecodeField(*field, stream.data(), stream.size(), count, buffer.data(), where);
+    return buffer;
+  }
+};
+
+PointRecords ReadPointRecords(const Context& ctx, pugi::xml_node child) {
+  PointRecords records{ctx, child.child("points")};
+  const pugi::xml_node points = records.points;
   if (!points) XmlError(ctx, child, "data3D entry has no 'points'");
   if (TypeOf(points) != "CompressedVector") XmlError(ctx, points, "'points' is not a CompressedVector");
   if (!points.attribute("recordCount")) XmlError(ctx, points, "attribute 'recordCount' is missing");
@@ -379,18 +404,15 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   if (record_count < 0 || record_count > g_max_cells) {
     XmlError(ctx, points, fmt::format("recordCount {} is outside [0, {}]", record_count, g_max_cells));
   }
-  std::vector<Field> fields;
-  CollectFields(ctx, points.child("prototype"), "", &fields);
-  std::unordered_map<std::string, int> field_index;
-  for (size_t i = 0; i < fields.size(); ++i) field_index.emplace(fields[i].name, static_cast<int>(i));
-  auto find = [&](const char* name) -> const Field* {
-    const auto it = field_index.find(name);
-    return it == field_index.end() ? nullptr : &fields[it->second];
-  };
-  const bool cartesian = find("cartesianX") && find("cartesianY") && find("cartesianZ");
-  const bool spherical = find("sphericalRange") && find("sphericalAzimuth") && find("sphericalElevation");
-  const bool structured = find("rowIndex") && find("columnIndex");
-  if (!cartesian && !spherical && record_count > 0) {
+  records.count = record_count;
+  CollectFields(ctx, points.child("prototype"), "", &records.fields);
+  const std::vector<Field>& fields = records.fields;
+  for (size_t i = 0; i < fields.size(); ++i) records.field_index.emplace(fields[i].name, static_cast<int>(i));
+  records.cartesian = records.Find("cartesianX") && records.Find("cartesianY") && records.Find("cartesianZ");
+  records.spherical = records.Find("sphericalRange") && records.Find("sphericalAzimuth") &&
+                      records.Find("sphericalElevation");
+  records.structured = records.Find("rowIndex") && records.Find("columnIndex");
+  if (!records.cartesian && !records.spherical && record_count > 0) {
     XmlError(ctx, points, "prototype has neither cartesianX/Y/Z nor sphericalRange/Azimuth/Elevation");
   }
 
@@ -407,133 +429,163 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
              fmt::format("recordCount {} needs {} bytes of bytestreams, the file has {}", record_count,
                          needed_total, ctx.logical.size()));
   }
-  const std::vector<std::vector<uint8_t>> streams = record_count > 0 || points.attribute("fileOffset")
-                                                        ? ReadBytestreams(ctx, points, needed)
-                                                        : std::vector<std::vector<uint8_t>>(fields.size());
-  const std::string stream_where = fmt::format("{}: {}", ctx.path, ElementPath(points));
-  std::vector<double> buffer;
-  auto decode = [&](const Field* f) -> const std::vector<double>& {
-    LIDARSHOP_CHECK(f != nullptr);
-    buffer.resize(record_count);
-    const auto& s = streams[f - fields.data()];
-    DecodeField(*f, s.data(), s.size(), record_count, buffer.data(), stream_where);
-    return buffer;
-  };
+  records.streams = record_count > 0 || points.attribute("fileOffset")
+                        ? ReadBytestreams(ctx, points, needed)
+                        : std::vector<std::vector<uint8_t>>(fields.size());
+  records.where = fmt::format("{}: {}", ctx.path, ElementPath(points));
+  return records;
+}
 
-  // The grid.
-  std::vector<int64_t> cell(record_count);
+// The grid of a data3D entry: rows x cols and each record's cell (row * cols + col). Structured scans take
+// it from rowIndex / columnIndex (and indexBounds); unstructured ones are one row of records.
+struct RecordGrid {
   int64_t rows = 0, cols = 0;
-  if (structured) {
-    std::vector<int64_t> row(record_count);
-    int64_t max_row = -1, max_col = -1;
-    {
-      const auto& r = decode(find("rowIndex"));
-      for (int64_t i = 0; i < record_count; ++i) {
-        if (!(r[i] >= 0 && r[i] < 2147483647.0)) {
-          XmlError(ctx, points, fmt::format("record {}: rowIndex {} is out of range", i, r[i]));
-        }
-        row[i] = static_cast<int64_t>(r[i]);
-        max_row = std::max(max_row, row[i]);
-      }
-    }
-    {
-      const auto& c = decode(find("columnIndex"));
-      for (int64_t i = 0; i < record_count; ++i) {
-        if (!(c[i] >= 0 && c[i] < 2147483647.0)) {
-          XmlError(ctx, points, fmt::format("record {}: columnIndex {} is out of range", i, c[i]));
-        }
-        cell[i] = static_cast<int64_t>(c[i]);
-        max_col = std::max(max_col, cell[i]);
-      }
-    }
-    const pugi::xml_node bounds = child.child("indexBounds");
-    if (bounds) {
-      max_row = std::max(max_row, BoundedInteger(ctx, bounds.child("rowMaximum"), -1, -1, 2147483646));
-      max_col = std::max(max_col, BoundedInteger(ctx, bounds.child("columnMaximum"), -1, -1, 2147483646));
-    }
-    rows = max_row + 1;
-    cols = max_col + 1;
-    if (rows > 2147483647 || cols > 2147483647 || (rows > 0 && cols > g_max_cells / rows)) {
-      XmlError(ctx, points,
-               fmt::format("grid of {} x {} cells exceeds the limit of {} cells", rows, cols, g_max_cells));
-    }
-    io_internal::CheckGridFromData(rows, cols, static_cast<int64_t>(ctx.logical.size()), ctx.path,
-                                   "data3D points");
-    for (int64_t i = 0; i < record_count; ++i) cell[i] += row[i] * cols;
-  } else {
-    rows = record_count > 0 ? 1 : 0;
-    cols = record_count;
-    for (int64_t i = 0; i < record_count; ++i) cell[i] = i;
+  std::vector<int64_t> cell;  // per record; set to -1 below for records that give the scan nothing
+};
+
+RecordGrid ReadRecordGrid(const Context& ctx, pugi::xml_node child, const PointRecords& records) {
+  const int64_t record_count = records.count;
+  const pugi::xml_node points = records.points;
+  RecordGrid grid;
+  grid.cell.resize(record_count);
+  if (!records.structured) {
+    grid.rows = record_count > 0 ? 1 : 0;
+    grid.cols = record_count;
+    for (int64_t i = 0; i < record_count; ++i) grid.cell[i] = i;
+    return grid;
   }
-
-  const Field* intensity_field = find("intensity");
-  const Field* red = find("colorRed");
-  const Field* green = find("colorGreen");
-  const Field* blue = find("colorBlue");
-  const bool has_color = red && green && blue;
-  Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
-  scan.name = StringValue(child.child("name"));
-  scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
-
-  // Invalid state: 0 = valid point, 1 = direction only, 2 = nothing meaningful.
-  std::vector<uint8_t> state(record_count, 0);
-  const Field* state_field = cartesian ? find("cartesianInvalidState") : find("sphericalInvalidState");
-  if (state_field) {
-    const auto& s = decode(state_field);
-    for (int64_t i = 0; i < record_count; ++i) state[i] = s[i] == 0.0 ? 0 : s[i] == 1.0 ? 1 : 2;
-  }
-
-  // Geometry: decode the three coordinates into floats.
-  std::vector<float> xyz(3 * record_count);
-  if (record_count > 0) {  // cartesian || spherical (checked above)
-    const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
-    if (!cartesian)
-      names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
-    std::vector<double> a[3];
-    for (int k = 0; k < 3; ++k) a[k] = decode(find(names[k]));
+  std::vector<int64_t> row(record_count);
+  int64_t max_row = -1, max_col = -1;
+  {
+    const auto& r = records.Decode(records.Find("rowIndex"));
     for (int64_t i = 0; i < record_count; ++i) {
-      double x = a[0][i], y = a[1][i], z = a[2][i];
-      if (!cartesian) {
-        // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
-        const double r = a[0][i], az = a[1][i], el = a[2][i];
-        if (state[i] == 1 || r == 0.0) {
-          x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
-          if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
-        } else {
-          x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
-        }
+      if (!(r[i] >= 0 && r[i] < 2147483647.0)) {
+        XmlError(ctx, points, fmt::format("record {}: rowIndex {} is out of range", i, r[i]));
       }
-      xyz[3 * i] = static_cast<float>(x), xyz[3 * i + 1] = static_cast<float>(y),
-              xyz[3 * i + 2] = static_cast<float>(z);
+      row[i] = static_cast<int64_t>(r[i]);
+      max_row = std::max(max_row, row[i]);
     }
   }
-  int64_t duplicates = 0;
-  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to `second`, later ones are left
-  // out.
-  std::vector<uint8_t> layer(record_count, 0);
-  if (structured && find("returnIndex") != nullptr) {
-    const auto& v = decode(find("returnIndex"));
-    for (int64_t i = 0; i < record_count; ++i) layer[i] = v[i] <= 0.0 ? 0 : v[i] == 1.0 ? 1 : 2;
-    if (std::find(layer.begin(), layer.end(), 1) != layer.end()) {
-      *second = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
-      second->name = scan.name;
-      second->world_from_scanner = scan.world_from_scanner;
+  {
+    const auto& c = records.Decode(records.Find("columnIndex"));
+    for (int64_t i = 0; i < record_count; ++i) {
+      if (!(c[i] >= 0 && c[i] < 2147483647.0)) {
+        XmlError(ctx, points, fmt::format("record {}: columnIndex {} is out of range", i, c[i]));
+      }
+      grid.cell[i] = static_cast<int64_t>(c[i]);
+      max_col = std::max(max_col, grid.cell[i]);
     }
   }
-  Scan* layers[2] = {&scan, second};
-  int64_t later_returns = 0;
-  std::vector<uint8_t> has_direction(static_cast<size_t>(rows * cols), 0);
+  const pugi::xml_node bounds = child.child("indexBounds");
+  if (bounds) {
+    max_row = std::max(max_row, BoundedInteger(ctx, bounds.child("rowMaximum"), -1, -1, 2147483646));
+    max_col = std::max(max_col, BoundedInteger(ctx, bounds.child("columnMaximum"), -1, -1, 2147483646));
+  }
+  const int64_t rows = max_row + 1, cols = max_col + 1;
+  if (rows > 2147483647 || cols > 2147483647 || (rows > 0 && cols > g_max_cells / rows)) {
+    XmlError(ctx, points,
+             fmt::format("grid of {} x {} cells exceeds the limit of {} cells", rows, cols, g_max_cells));
+  }
+  io_internal::CheckGridFromData(rows, cols, static_cast<int64_t>(ctx.logical.size()), ctx.path,
+                                 "data3D points");
+  for (int64_t i = 0; i < record_count; ++i) grid.cell[i] += row[i] * cols;
+  grid.rows = rows;
+  grid.cols = cols;
+  return grid;
+}
+
+// The invalid state of each record: 0 = valid point, 1 = direction only, 2 = nothing meaningful.
+std::vector<uint8_t> ReadInvalidState(const PointRecords& records) {
+  std::vector<uint8_t> state(records.count, 0);
+  const Field* state_field =
+      records.cartesian ? records.Find("cartesianInvalidState") : records.Find("sphericalInvalidState");
+  if (state_field) {
+    const auto& s = records.Decode(state_field);
+    for (int64_t i = 0; i < records.count; ++i) state[i] = s[i] == 0.0 ? 0 : s[i] == 1.0 ? 1 : 2;
+  }
+  return state;
+}
+
+// The records' coordinates as floats, x y z per record (3 x count); spherical ones converted to cartesian.
+// A spherical record at range 0 or of state 1 gives its unit direction; a "valid" one at range 0 gets state 2.
+std::vector<float> ReadCoordinates(const PointRecords& records, std::vector<uint8_t>* state_in_out) {
+  const int64_t record_count = records.count;
+  std::vector<uint8_t>& state = *state_in_out;
+  std::vector<float> xyz(3 * record_count);
+  if (record_count == 0) return xyz;  // else cartesian || spherical (checked by ReadPointRecords)
+  const bool cartesian = records.cartesian;
+  const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
+  if (!cartesian) names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
+  std::vector<double> a[3];
+  for (int k = 0; k < 3; ++k) a[k] = records.Decode(records.Find(names[k]));
+  for (int64_t i = 0; i < record_count; ++i) {
+    double x = a[0][i], y = a[1][i], z = a[2][i];
+    if (!cartesian) {
+      // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
+      const double r = a[0][i], az = a[1][i], el = a[2][i];
+      if (state[i] == 1 || r == 0.0) {
+        x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
+        if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
+      } else {
+        x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
+      }
+    }
+    xyz[3 * i] = static_cast<float>(x), xyz[3 * i + 1] = static_cast<float>(y),
+            xyz[3 * i + 2] = static_cast<float>(z);
+  }
+  return xyz;
+}
+
+// The layer of each record of a structured scan from its returnIndex: 0 (first return) goes to the scan, 1
+// to the layer behind, 2 (third and later returns) is left out. All 0 without returnIndex.
+std::vector<uint8_t> ReadReturnLayers(const PointRecords& records) {
+  std::vector<uint8_t> layer(records.count, 0);
+  if (records.structured && records.Find("returnIndex") != nullptr) {
+    const auto& v = records.Decode(records.Find("returnIndex"));
+    for (int64_t i = 0; i < records.count; ++i) layer[i] = v[i] <= 0.0 ? 0 : v[i] == 1.0 ? 1 : 2;
+  }
+  return layer;
+}
+
+// What PlaceRecords left out, for the warnings.
+struct PlacedRecords {
+  int64_t duplicates = 0;     // records repeating a return of a cell that already has one
+  int64_t later_returns = 0;  // records with returnIndex >= 2
+  // Per cell: 1 = the direction of a valid point, 2 = a direction the file stored for a no-return cell.
+  std::vector<uint8_t> has_direction;
+};
+
+// Puts the records' points into `scan` (first returns) and `second` (returnIndex 1; a rows x cols scan when
+// any record has it, else untouched). Records that give no cell a point get grid->cell[i] = -1, so that
+// their intensity and colour are skipped. Throws InputError when two records claim one cell of a scan
+// without returnIndex (the grid indices are corrupt).
+PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, const std::vector<float>& xyz,
+                           const std::vector<uint8_t>& state, const std::vector<uint8_t>& layer,
+                           RecordGrid* grid, Scan* scan, Scan* second) {
+  const int64_t record_count = records.count;
+  const int64_t rows = grid->rows, cols = grid->cols;
+  std::vector<int64_t>& cell = grid->cell;
+  PlacedRecords placed;
+  if (std::find(layer.begin(), layer.end(), 1) != layer.end()) {
+    const bool has_color =
+        records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
+    *second = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
+    second->name = scan->name;
+    second->world_from_scanner = scan->world_from_scanner;
+  }
+  placed.has_direction.assign(static_cast<size_t>(rows * cols), 0);
   // Several records of one grid cell are several returns of one ray, which E57 marks with returnIndex.
   // Without it, two records claiming the same rowIndex/columnIndex contradict the grid: the file is corrupt
   // (e.g. zeroed compressed-vector data), and guessing which record to keep would be a silent wrong answer.
-  const bool has_return_index = find("returnIndex") != nullptr;
+  const bool has_return_index = records.Find("returnIndex") != nullptr;
   std::vector<int64_t> first_record_of_cell;
-  if (structured && !has_return_index) first_record_of_cell.assign(static_cast<size_t>(rows * cols), -1);
+  if (records.structured && !has_return_index)
+    first_record_of_cell.assign(static_cast<size_t>(rows * cols), -1);
   for (int64_t i = 0; i < record_count; ++i) {
     const int64_t c = cell[i];
     if (!first_record_of_cell.empty()) {
       if (first_record_of_cell[c] >= 0) {
-        XmlError(ctx, points,
+        XmlError(ctx, records.points,
                  fmt::format("records {} and {} both claim row {}, column {} and the prototype has no "
                              "returnIndex: the grid indices are corrupt",
                              first_record_of_cell[c], i, c / std::max<int64_t>(cols, 1),
@@ -547,139 +599,181 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
     const float range = static_cast<float>(cv::norm(p));
     const bool finite = std::isfinite(range);
     if (layer[i] > 1) {
-      ++later_returns;
+      ++placed.later_returns;
       cell[i] = -1;
       continue;
     }
     if (layer[i] == 1) {
-      // A second return: a point of the layer behind; its ray is the cell's (set from the grid below).
+      // A second return: a point of the layer behind; its ray is the cell's (set from the grid later).
       Scan& behind = *second;
       if (state[i] == 0 && finite && range > 0.0f && behind.valid.at<uint8_t>(r, k) != kValid) {
         behind.valid.at<uint8_t>(r, k) = kValid;
         behind.point.at<cv::Vec3f>(r, k) = p;
         behind.range.at<float>(r, k) = range;
       } else {
-        duplicates += behind.valid.at<uint8_t>(r, k) == kValid;
+        placed.duplicates += behind.valid.at<uint8_t>(r, k) == kValid;
         cell[i] = -1;
       }
       continue;
     }
-    if (scan.valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
-      ++duplicates;
+    if (scan->valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
+      ++placed.duplicates;
       cell[i] = -1;
       continue;
     }
     if (state[i] == 0 && finite && range > 0.0f) {
-      scan.valid.at<uint8_t>(r, k) = kValid;
-      scan.point.at<cv::Vec3f>(r, k) = p;
-      scan.range.at<float>(r, k) = range;
-      scan.direction.at<cv::Vec3f>(r, k) = p / range;
-      has_direction[c] = 1;
+      scan->valid.at<uint8_t>(r, k) = kValid;
+      scan->point.at<cv::Vec3f>(r, k) = p;
+      scan->range.at<float>(r, k) = range;
+      scan->direction.at<cv::Vec3f>(r, k) = p / range;
+      placed.has_direction[c] = 1;
     } else {
       if (state[i] != 2 && finite && range > 0.0f) {
         // Keep a stored unit direction bit for bit (renormalizing would change its last bits).
-        scan.direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
-        has_direction[c] = 2;
+        scan->direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
+        placed.has_direction[c] = 2;
       }
       cell[i] = -1;  // no return: intensity and colour stay at their no-return values
     }
   }
-  if (duplicates > 0) {
+  return placed;
+}
+
+// Intensities of the placed records (grid.cell[i] >= 0), scaled to [0, 1] by intensityLimits (or by the
+// returned values when the file gives none).
+void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords& records,
+                   const RecordGrid& grid, const std::vector<uint8_t>& layer, Scan* const layers[2]) {
+  const Field* intensity_field = records.Find("intensity");
+  if (!intensity_field) return;
+  const std::vector<int64_t>& cell = grid.cell;
+  Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
+                        intensity_field);
+  const auto& v = records.Decode(intensity_field);
+  if (!l.known) {
+    // Float intensities without limits: take them as [0, 1] when they are, else stretch the returned range.
+    double lo = 0, hi = 1;
+    for (int64_t i = 0; i < records.count; ++i) {
+      if (cell[i] < 0 || !std::isfinite(v[i])) continue;
+      lo = std::min(lo, v[i]);
+      hi = std::max(hi, v[i]);
+    }
+    l = {lo, hi, true};
+  }
+  const double span = l.maximum - l.minimum;
+  for (int64_t i = 0; i < records.count; ++i) {
+    if (cell[i] < 0) continue;
+    const double t = span > 0 ? (v[i] - l.minimum) / span : 0.5;
+    layers[layer[i]]->intensity.ptr<float>()[cell[i]] =
+        std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
+  }
+}
+
+// Colours of the placed records, scaled to 0..255 by colorLimits (0..255 when absent). Needs all three of
+// colorRed/Green/Blue.
+void ReadColor(const Context& ctx, pugi::xml_node child, const PointRecords& records, const RecordGrid& grid,
+               const std::vector<uint8_t>& layer, Scan* const layers[2]) {
+  const Field* channel_fields[3] = {records.Find("colorRed"), records.Find("colorGreen"),
+                                    records.Find("colorBlue")};
+  if (!(channel_fields[0] && channel_fields[1] && channel_fields[2])) return;
+  const pugi::xml_node limits = child.child("colorLimits");
+  const char* min_names[3] = {"colorRedMinimum", "colorGreenMinimum", "colorBlueMinimum"};
+  const char* max_names[3] = {"colorRedMaximum", "colorGreenMaximum", "colorBlueMaximum"};
+  for (int ch = 0; ch < 3; ++ch) {
+    Limits l = LimitsFrom(ctx, limits, min_names[ch], max_names[ch], channel_fields[ch]);
+    if (!l.known) l = {0.0, 255.0, true};
+    const double span = l.maximum - l.minimum;
+    const auto& v = records.Decode(channel_fields[ch]);
+    for (int64_t i = 0; i < records.count; ++i) {
+      if (grid.cell[i] < 0) continue;
+      const double t = span > 0 ? (v[i] - l.minimum) / span : 0.0;
+      layers[layer[i]]->color.ptr<uint8_t>()[3 * grid.cell[i] + ch] =
+          std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
+    }
+  }
+}
+
+// lidarshop's extension field (`synthesized_field`, "" when the file does not declare the namespace) into
+// the layers' synthesized channels.
+void ReadSynthesized(const PointRecords& records, const std::string& synthesized_field,
+                     const RecordGrid& grid, const std::vector<uint8_t>& layer, Scan* const layers[2]) {
+  const Field* flag = synthesized_field.empty() ? nullptr : records.Find(synthesized_field.c_str());
+  if (!flag) return;
+  const auto& v = records.Decode(flag);
+  for (int l = 0; l < 2; ++l) {
+    Scan* s = layers[l];
+    if (s != nullptr && s->num_cells() > 0) s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
+  }
+  for (int64_t i = 0; i < records.count; ++i) {
+    if (grid.cell[i] >= 0 && v[i] != 0.0) layers[layer[i]]->synthesized.ptr<uint8_t>()[grid.cell[i]] = kValid;
+  }
+}
+
+// E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turns the
+// grid of a structured scan (and its second layer) into image orientation (row 0 = highest elevation, our
+// azimuth increasing to the right) by the data, then gives no-return cells directions from the fitted
+// angular grid, keeping the directions the file stored (`has_direction` 2).
+void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* second) {
+  Scan* layers[2] = {scan, second};
+  const GridOrientation o = OrientationOf(*scan);
+  if (o.flip_rows || o.flip_cols) {
+    const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
+    for (Scan* s : layers) {
+      if (s == nullptr || s->num_cells() == 0) continue;
+      for (cv::Mat* m :
+           {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized}) {
+        if (!m->empty()) cv::flip(*m, *m, code);
+      }
+    }
+    cv::Mat d(scan->rows, scan->cols, CV_8U, has_direction.data());
+    cv::flip(d, d, code);
+  }
+  if (scan->CountValid() > 0) {
+    const cv::Mat stored = scan->direction.clone();
+    FitGrid(scan);
+    const cv::Vec3f* from = stored.ptr<cv::Vec3f>();
+    cv::Vec3f* to = scan->direction.ptr<cv::Vec3f>();
+    for (int64_t c = 0; c < scan->num_cells(); ++c) {
+      if (has_direction[c] == 2) to[c] = from[c];
+    }
+  }
+  if (second->num_cells() > 0) {
+    second->direction = scan->direction.clone();  // the same rays
+    second->grid = scan->grid;
+  }
+}
+
+// The first returns of one data3D entry; records with returnIndex 1 go to `second` (left 0 x 0 when there are
+// none), later ones are counted in `warnings`. `synthesized_field` is the name of lidarshop's extension field
+// under the prefix the file binds to its namespace ("" when the file does not declare it).
+Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::string& synthesized_field,
+              Scan* second, std::vector<std::string>* warnings) {
+  const PointRecords records = ReadPointRecords(ctx, child);
+  RecordGrid grid = ReadRecordGrid(ctx, child, records);
+  const bool has_color = records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
+  Scan scan = MakeScan(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color);
+  scan.name = StringValue(child.child("name"));
+  scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
+  std::vector<uint8_t> state = ReadInvalidState(records);
+  const std::vector<float> xyz = ReadCoordinates(records, &state);
+  const std::vector<uint8_t> layer = ReadReturnLayers(records);
+  PlacedRecords placed = PlaceRecords(ctx, records, xyz, state, layer, &grid, &scan, second);
+  if (placed.duplicates > 0) {
     warnings->push_back(fmt::format(
         "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
-        ctx.path, index, scan.name, duplicates));
+        ctx.path, index, scan.name, placed.duplicates));
   }
-  if (later_returns > 0) {
+  if (placed.later_returns > 0) {
     warnings->push_back(
         fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
                     "returns) are not kept",
-                    ctx.path, index, scan.name, later_returns));
+                    ctx.path, index, scan.name, placed.later_returns));
   }
-
-  if (intensity_field) {
-    Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
-                          intensity_field);
-    const auto& v = decode(intensity_field);
-    if (!l.known) {
-      // Float intensities without limits: take them as [0, 1] when they are, else stretch the returned range.
-      double lo = 0, hi = 1;
-      for (int64_t i = 0; i < record_count; ++i) {
-        if (cell[i] < 0 || !std::isfinite(v[i])) continue;
-        lo = std::min(lo, v[i]);
-        hi = std::max(hi, v[i]);
-      }
-      l = {lo, hi, true};
-    }
-    const double span = l.maximum - l.minimum;
-    for (int64_t i = 0; i < record_count; ++i) {
-      if (cell[i] < 0) continue;
-      const double t = span > 0 ? (v[i] - l.minimum) / span : 0.5;
-      layers[layer[i]]->intensity.ptr<float>()[cell[i]] =
-          std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
-    }
-  }
-  if (has_color) {
-    const pugi::xml_node limits = child.child("colorLimits");
-    const char* min_names[3] = {"colorRedMinimum", "colorGreenMinimum", "colorBlueMinimum"};
-    const char* max_names[3] = {"colorRedMaximum", "colorGreenMaximum", "colorBlueMaximum"};
-    const Field* channel_fields[3] = {red, green, blue};
-    for (int ch = 0; ch < 3; ++ch) {
-      Limits l = LimitsFrom(ctx, limits, min_names[ch], max_names[ch], channel_fields[ch]);
-      if (!l.known) l = {0.0, 255.0, true};
-      const double span = l.maximum - l.minimum;
-      const auto& v = decode(channel_fields[ch]);
-      for (int64_t i = 0; i < record_count; ++i) {
-        if (cell[i] < 0) continue;
-        const double t = span > 0 ? (v[i] - l.minimum) / span : 0.0;
-        layers[layer[i]]->color.ptr<uint8_t>()[3 * cell[i] + ch] =
-            std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
-      }
-    }
-  }
-
-  if (const Field* flag = synthesized_field.empty() ? nullptr : find(synthesized_field.c_str())) {
-    const auto& v = decode(flag);
-    for (Scan* s : layers) {
-      if (s != nullptr && s->num_cells() > 0)
-        s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
-    }
-    for (int64_t i = 0; i < record_count; ++i) {
-      if (cell[i] >= 0 && v[i] != 0.0) layers[layer[i]]->synthesized.ptr<uint8_t>()[cell[i]] = kValid;
-    }
-  }
-
-  if (structured && scan.num_cells() > 0) {
-    // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turn the
-    // grid into image orientation (row 0 = highest elevation, our azimuth increasing to the right) by the
-    // data.
-    const GridOrientation o = OrientationOf(scan);
-    if (o.flip_rows || o.flip_cols) {
-      const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
-      for (Scan* s : layers) {
-        if (s == nullptr || s->num_cells() == 0) continue;
-        for (cv::Mat* m :
-             {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized}) {
-          if (!m->empty()) cv::flip(*m, *m, code);
-        }
-      }
-      cv::Mat d(static_cast<int>(rows), static_cast<int>(cols), CV_8U, has_direction.data());
-      cv::flip(d, d, code);
-    }
-    // Give no-return cells directions from the fitted angular grid; keep directions the file stored.
-    if (scan.CountValid() > 0) {
-      const cv::Mat stored = scan.direction.clone();
-      FitGrid(&scan);
-      const cv::Vec3f* from = stored.ptr<cv::Vec3f>();
-      cv::Vec3f* to = scan.direction.ptr<cv::Vec3f>();
-      for (int64_t c = 0; c < scan.num_cells(); ++c) {
-        if (has_direction[c] == 2) to[c] = from[c];
-      }
-    }
-    if (second->num_cells() > 0) {
-      second->direction = scan.direction.clone();  // the same rays
-      second->grid = scan.grid;
-    }
-  }
+  Scan* const layers[2] = {&scan, second};
+  ReadIntensity(ctx, child, records, grid, layer, layers);
+  ReadColor(ctx, child, records, grid, layer, layers);
+  ReadSynthesized(records, synthesized_field, grid, layer, layers);
+  if (records.structured && scan.num_cells() > 0)
+    OrientStructuredScan(std::move(placed.has_direction), &scan, second);
   return scan;
 }
 

@@ -3,7 +3,6 @@
 #include <filesystem>
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/io_common.h"
@@ -18,7 +17,7 @@ namespace {
 
 using namespace io_internal;  // NOLINT: the PLY field helpers and TextureToRgb8
 
-TriangleMesh MeshFromPly(const PlyData& ply, const std::string& path) {
+TriangleMesh MeshFromPly(const PlyData& ply, const std::string& path, std::vector<std::string>* warnings) {
   TriangleMesh mesh;
   const PlyElement& vertex = RequireElement(ply, "vertex", path);
   mesh.vertices = Vector3Property(vertex, "x", "y", "z", path, true);
@@ -81,7 +80,7 @@ TriangleMesh MeshFromPly(const PlyData& ply, const std::string& path) {
       mesh.texture = ReadImage((std::filesystem::path(path).parent_path() / name).string());
       mesh.texture = io_internal::TextureToRgb8(mesh.texture);
     } catch (const InputError& error) {
-      spdlog::warn("{} (the mesh is read without its texture)", error.what());
+      warnings->push_back(fmt::format("{}: {} (the mesh is read without its texture)", path, error.what()));
     }
     break;
   }
@@ -91,20 +90,23 @@ TriangleMesh MeshFromPly(const PlyData& ply, const std::string& path) {
 
 }  // namespace
 
-TriangleMesh ReadMesh(const std::string& path) {
+MeshFile ReadMeshFile(const std::string& path) {
   const std::string extension = FileExtension(path);
-  TriangleMesh mesh;
+  MeshFile file;
+  file.path = path;
   if (extension == "obj") {
-    mesh = ReadObj(path);
+    file.mesh = ReadObj(path, &file.warnings);
   } else if (extension == "ply") {
-    mesh = MeshFromPly(ReadPly(path), path);
+    file.mesh = MeshFromPly(ReadPly(path), path, &file.warnings);
   } else {
     ThrowInputError(path, "", "",
                     fmt::format("unknown mesh format '.{}' (lidarshop reads .obj and .ply)", extension));
   }
-  if (mesh.triangles.empty()) ThrowInputError(path, "", "", "the file holds no triangles");
-  return mesh;
+  if (file.mesh.triangles.empty()) ThrowInputError(path, "", "", "the file holds no triangles");
+  return file;
 }
+
+TriangleMesh ReadMesh(const std::string& path) { return ReadMeshFile(path).mesh; }
 
 void WriteMesh(const std::string& path, const TriangleMesh& mesh, bool ascii) {
   if (FileExtension(path) != "ply") {

@@ -3,12 +3,23 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "lidarshop/geometry/mesh.h"
 
 namespace lidarshop {
 
+struct MeshFile {
+  std::string path;
+  TriangleMesh mesh;
+  // What the reader left out of a file it could still read (a missing MTL or texture file, a second
+  // texture), one sentence each, starting with the file's path. The library does not print them.
+  std::vector<std::string> warnings;
+};
+
 // .obj or .ply, by extension. Throws InputError on malformed files (file, line or byte offset, field).
+MeshFile ReadMeshFile(const std::string& path);
+// ReadMeshFile(path).mesh, for callers that have nowhere to show warnings (they are dropped).
 TriangleMesh ReadMesh(const std::string& path);
 
 // .ply (binary little-endian unless `ascii`). Vertex colours, normals and triangle colours are written if

@@ -4,7 +4,6 @@
 #include <map>
 
 #include <fmt/format.h>
-#include <spdlog/spdlog.h>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/io/image_io.h"
@@ -35,12 +34,18 @@ std::string LastToken(std::string_view line) {
   return std::string(space == std::string_view::npos ? line : line.substr(space + 1));
 }
 
-void ReadMtl(const std::string& path, std::map<std::string, Material>* materials) {
+// The materials of the MTL file `path`; a file that cannot be read is a warning of the OBJ file `obj_file`
+// (null `warnings` = dropped).
+void ReadMtl(const std::string& path, const std::string& obj_file, std::map<std::string, Material>* materials,
+             std::vector<std::string>* warnings) {
   std::string text;
   try {
     text = io_internal::ReadFileToString(path);
   } catch (const InputError& error) {
-    spdlog::warn("{} (the mesh is read without its materials)", error.what());
+    if (warnings != nullptr) {
+      warnings->push_back(
+          fmt::format("{}: {} (the mesh is read without its materials)", obj_file, error.what()));
+    }
     return;
   }
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
@@ -74,7 +79,8 @@ int ResolveIndex(int64_t index, size_t count, const TextCursor& cursor, const ch
 
 }  // namespace
 
-TriangleMesh ParseObj(std::string_view text, const std::string& file, const std::string& folder) {
+TriangleMesh ParseObj(std::string_view text, const std::string& file, const std::string& folder,
+                      std::vector<std::string>* warnings) {
   TriangleMesh mesh;
   std::vector<Eigen::Vector3f> normals;
   std::vector<Rgb8> vertex_colors;
@@ -160,7 +166,7 @@ TriangleMesh ParseObj(std::string_view text, const std::string& file, const std:
       }
     } else if (keyword == "mtllib") {
       const std::string_view names = cursor.RestOfLine();
-      ReadMtl((std::filesystem::path(folder) / std::string(names)).string(), &materials);
+      ReadMtl((std::filesystem::path(folder) / std::string(names)).string(), file, &materials, warnings);
     } else if (keyword == "usemtl") {
       const std::string name(cursor.RestOfLine());
       auto found = std::find(material_names.begin(), material_names.end(), name);
@@ -196,11 +202,15 @@ TriangleMesh ParseObj(std::string_view text, const std::string& file, const std:
         mesh.texture = io_internal::TextureToRgb8(mesh.texture);
         textured_material = static_cast<int>(m);
       } catch (const InputError& error) {
-        spdlog::warn("{} (the mesh is read without this texture)", error.what());
+        if (warnings != nullptr) {
+          warnings->push_back(
+              fmt::format("{}: {} (the mesh is read without this texture)", file, error.what()));
+        }
       }
-    } else if (!found->second.texture_path.empty() && textured_material >= 0) {
-      spdlog::warn("{}: material '{}' has a second texture; only one texture per mesh is kept", file,
-                   material_names[m]);
+    } else if (!found->second.texture_path.empty() && textured_material >= 0 && warnings != nullptr) {
+      warnings->push_back(
+          fmt::format("{}: material '{}' has a second texture; only one texture per mesh is kept", file,
+                      material_names[m]));
     }
   }
   if (any_material) {
@@ -228,10 +238,10 @@ TriangleMesh ParseObj(std::string_view text, const std::string& file, const std:
   return mesh;
 }
 
-TriangleMesh ReadObj(const std::string& path) {
+TriangleMesh ReadObj(const std::string& path, std::vector<std::string>* warnings) {
   const std::string text = io_internal::ReadFileToString(path);
   if (text.empty()) ThrowInputError(path, "line 1", "", "the file is empty (no vertices)");
-  return ParseObj(text, path, std::filesystem::path(path).parent_path().string());
+  return ParseObj(text, path, std::filesystem::path(path).parent_path().string(), warnings);
 }
 
 }  // namespace lidarshop

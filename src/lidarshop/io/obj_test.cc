@@ -11,6 +11,8 @@
 namespace lidarshop {
 namespace {
 
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
@@ -58,6 +60,37 @@ TEST(ObjTest, QuadsVertexColoursAndMissingMaterialFile) {
   ASSERT_EQ(mesh.vertex_colors.size(), 4u);
   EXPECT_EQ(mesh.vertex_colors[1], Rgb8(0, 255, 0));
   EXPECT_TRUE(mesh.triangle_colors.empty());
+}
+
+TEST(ObjTest, MissingMaterialAndTextureFilesAreWarningsInTheResult) {
+  // A missing MTL file, and an MTL whose texture is missing: the geometry is read, each left-out file is one
+  // warning starting with the OBJ's path, and nothing is printed.
+  TempFolder folder;
+  WriteText(folder.File("quad.obj"), "mtllib missing.mtl\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4\n");
+  WriteText(folder.File("textured.mtl"), "newmtl wood\nKd 0.5 0.5 0.5\nmap_Kd wood.png\n");
+  WriteText(folder.File("textured.obj"),
+            "mtllib textured.mtl\nv 0 0 0\nv 2 0 0\nv 2 2 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+            "usemtl wood\nf 1/1 2/2 3/3\n");
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const MeshFile quad = ReadMeshFile(folder.File("quad.obj"));
+  const MeshFile textured = ReadMeshFile(folder.File("textured.obj"));
+  const std::string printed =
+      ::testing::internal::GetCapturedStdout() + ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed, "");
+  EXPECT_EQ(quad.mesh.num_triangles(), 2u);
+  ASSERT_EQ(quad.warnings.size(), 1u);
+  EXPECT_THAT(quad.warnings[0], StartsWith(folder.File("quad.obj") + ": "));
+  EXPECT_THAT(quad.warnings[0], HasSubstr("missing.mtl"));
+  EXPECT_THAT(quad.warnings[0], HasSubstr("the mesh is read without its materials"));
+  EXPECT_EQ(textured.mesh.num_triangles(), 1u);
+  EXPECT_TRUE(textured.mesh.texture.empty());
+  ASSERT_EQ(textured.warnings.size(), 1u);
+  EXPECT_THAT(textured.warnings[0], StartsWith(folder.File("textured.obj") + ": "));
+  EXPECT_THAT(textured.warnings[0], HasSubstr("wood.png"));
+  EXPECT_THAT(textured.warnings[0], HasSubstr("the mesh is read without this texture"));
+  // ReadMesh gives the same mesh.
+  EXPECT_EQ(ReadMesh(folder.File("quad.obj")).num_triangles(), 2u);
 }
 
 TEST(ObjTest, SharedMeshesHaveTheirTriangleCounts) {

@@ -239,15 +239,18 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
 
 struct ScanFormat {
   const char* extension;
-  std::vector<Scan> (*read)(const std::string& path);
+  // Reads the scans of a file, adding what it left out to `warnings`.
+  std::vector<Scan> (*read)(const std::string& path, std::vector<std::string>* warnings);
   void (*write)(const std::string& path, const std::vector<Scan>& scans);
 };
 
 const std::vector<ScanFormat>& ScanFormats() {
   static const std::vector<ScanFormat> formats = {
-      {"ptx", [](const std::string& path) { return ReadPtx(path); }, &WritePtx},
-      {"ply", &ReadPlyScans, &WritePlyScans},
-      {"pcd", [](const std::string& path) { return std::vector<Scan>{ReadPcd(path)}; },
+      {"ptx", [](const std::string& path, std::vector<std::string>*) { return ReadPtx(path); }, &WritePtx},
+      {"ply", [](const std::string& path, std::vector<std::string>*) { return ReadPlyScans(path); },
+       &WritePlyScans},
+      {"pcd",
+       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadPcd(path)}; },
        [](const std::string& path, const std::vector<Scan>& scans) {
          if (scans.size() != 1) {
            ThrowInputError(path, "", "",
@@ -255,7 +258,13 @@ const std::vector<ScanFormat>& ScanFormats() {
          }
          WritePcd(path, scans[0]);
        }},
-      {"e57", [](const std::string& path) { return ReadE57(path).scans; }, &WriteE57},
+      {"e57",
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         E57File file = ReadE57(path);
+         warnings->insert(warnings->end(), file.warnings.begin(), file.warnings.end());
+         return std::move(file.scans);
+       },
+       &WriteE57},
   };
   return formats;
 }
@@ -288,7 +297,7 @@ ScanFile ReadScanFile(const std::string& path) {
   file.path = path;
   file.format = format.extension;
   CheckRegularFile(path);  // a FIFO would block the reader, a folder has no bytes to check counts against
-  file.scans = format.read(path);
+  file.scans = format.read(path, &file.warnings);
   for (size_t i = 0; i < file.scans.size(); ++i) {
     CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));
   }

@@ -21,9 +21,14 @@ struct ScanFile {
   std::string path;
   std::string format;       // "ptx", "e57", "ply", "pcd"
   std::vector<Scan> scans;  // several registered scans where the format allows it
+  // What the reader left out or changed while reading a file it could still read, one sentence each,
+  // starting with the file's path (e.g. E57 returns beyond the second). The library does not print them;
+  // the CLI prints them on stderr, the server returns them with the opened document.
+  std::vector<std::string> warnings;
 };
 
-// Reads every scan in `path`. Throws InputError (unknown extension, malformed content).
+// Reads every scan in `path`. Throws InputError (unknown extension, malformed content); what it can read
+// but not keep comes back in ScanFile::warnings.
 ScanFile ReadScanFile(const std::string& path);
 
 // Writes `scans` in the format of `path`'s extension. A format that holds one scan only (PCD) throws

@@ -198,6 +198,36 @@ TEST(ScanLayers, ThirdAndLaterReturnsAreLeftOutAndReported) {
   EXPECT_THAT(file.warnings[0], HasSubstr("shifted.e57: scan 0 ('wall'): 9 records with returnIndex >= 2"));
 }
 
+TEST(ScanLayers, ReadScanFileReturnsTheReaderWarningsAndPrintsNothing) {
+  // The same file as above through ReadScanFile: the E57 reader's warning reaches ScanFile::warnings, naming
+  // the file, and the library writes nothing to stdout or stderr.
+  const Layers layers = MakeLayers();
+  std::vector<uint8_t> logical =
+      e57::LogicalFromPages("x.e57", EncodeE57WithLayer(layers.front, layers.behind));
+  const std::string from = "<returnIndex type=\"Integer\" minimum=\"0\" maximum=\"1\"";
+  const std::string to = "<returnIndex type=\"Integer\" minimum=\"1\" maximum=\"2\"";
+  const auto at = std::search(logical.begin(), logical.end(), from.begin(), from.end());
+  ASSERT_NE(at, logical.end());
+  std::copy(to.begin(), to.end(), at);
+  TempFolder folder;
+  const std::string path = folder.File("shifted.e57");
+  const std::vector<uint8_t> bytes = e57::PagesFromLogical(logical);
+  testing_io::WriteText(path, std::string(bytes.begin(), bytes.end()));
+  ::testing::internal::CaptureStdout();
+  ::testing::internal::CaptureStderr();
+  const ScanFile file = ReadScanFile(path);
+  const std::string printed =
+      ::testing::internal::GetCapturedStdout() + ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed, "");
+  ASSERT_EQ(file.scans.size(), 1u);
+  ASSERT_EQ(file.warnings.size(), 1u);
+  EXPECT_THAT(file.warnings[0], HasSubstr(path + ": scan 0 ('wall'): 9 records with returnIndex >= 2"));
+  // A file the reader keeps whole has none.
+  const std::string clean = folder.File("clean.e57");
+  WriteScanFile(clean, {layers.front});
+  EXPECT_TRUE(ReadScanFile(clean).warnings.empty());
+}
+
 TEST(ScanLayers, PlyAndPcdHoldTheUnionOfThePointsFlagged) {
   const Layers layers = MakeLayers();
   TempFolder folder;

@@ -9,8 +9,8 @@
 #include <fmt/format.h>
 
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 
@@ -230,6 +230,153 @@ struct HitWriter {
   }
 };
 
+// One image cast: the rays of cell (row, col) start at `origin` with the sensor direction of that cell
+// rotated into the scene frame, over [t_near, t_far]; hits go through `writer`. The Cast*Band functions
+// each trace the rows [row0, row1) of one band with one Embree API.
+struct ImageCast {
+  RTCScene scene;
+  const cv::Mat& directions_in_sensor;  // CV_32FC3 rows x cols
+  int rows, cols;
+  Eigen::Vector3f origin;
+  float r00, r01, r02, r10, r11, r12, r20, r21, r22;  // world_from_sensor's rotation
+  float t_near, t_far;
+  const HitWriter& writer;
+
+  ImageCast(RTCScene scene_in, const Eigen::Matrix4d& world_from_sensor, const cv::Mat& directions,
+            float t_near_in, float t_far_in, const HitWriter& writer_in)
+      : scene(scene_in),
+        directions_in_sensor(directions),
+        rows(directions.rows),
+        cols(directions.cols),
+        origin(world_from_sensor.topRightCorner<3, 1>().cast<float>()),
+        t_near(t_near_in),
+        t_far(t_far_in),
+        writer(writer_in) {
+    const Eigen::Matrix3f rotation = world_from_sensor.topLeftCorner<3, 3>().cast<float>();
+    r00 = rotation(0, 0), r01 = rotation(0, 1), r02 = rotation(0, 2);
+    r10 = rotation(1, 0), r11 = rotation(1, 1), r12 = rotation(1, 2);
+    r20 = rotation(2, 0), r21 = rotation(2, 1), r22 = rotation(2, 2);
+  }
+
+  inline __attribute__((always_inline)) Eigen::Vector3f DirectionAt(int row, int col) const {
+    const float* d = directions_in_sensor.ptr<float>(row) + 3 * col;
+    return Eigen::Vector3f(r00 * d[0] + r01 * d[1] + r02 * d[2], r10 * d[0] + r11 * d[1] + r12 * d[2],
+                           r20 * d[0] + r21 * d[1] + r22 * d[2]);
+  }
+};
+
+// One rtcIntersect1 per ray (the reference).
+void CastBandSingle(const ImageCast& cast, RTCIntersectContext* context, int row0, int row1) {
+  RTCRayHit ray_hit;
+  for (int row = row0; row < row1; ++row) {
+    for (int col = 0; col < cast.cols; ++col) {
+      const Eigen::Vector3f d = cast.DirectionAt(row, col);
+      FillRayHit(Ray{cast.origin, d, cast.t_near, cast.t_far}, &ray_hit);
+      rtcIntersect1(cast.scene, context, &ray_hit);
+      cast.writer.Write(row, col, ray_hit.ray.tfar, ray_hit.hit.geomID, ray_hit.hit.primID, ray_hit.hit.Ng_x,
+                        ray_hit.hit.Ng_y, ray_hit.hit.Ng_z, ray_hit.hit.u, ray_hit.hit.v);
+    }
+  }
+}
+
+// The band's rays as one rtcIntersect1M stream, tile by tile; `stream` and `stream_cells` are reused buffers.
+void CastBandStream(const ImageCast& cast, RTCIntersectContext* context, int row0, int row1,
+                    std::vector<RTCRayHit>* stream, std::vector<std::pair<int, int>>* stream_cells) {
+  stream->clear();
+  stream_cells->clear();
+  for (int col0 = 0; col0 < cast.cols; col0 += kTileCols) {
+    for (int row = row0; row < row1; ++row) {
+      for (int col = col0; col < std::min(cast.cols, col0 + kTileCols); ++col) {
+        stream->emplace_back();
+        FillRayHit(Ray{cast.origin, cast.DirectionAt(row, col), cast.t_near, cast.t_far}, &stream->back());
+        stream_cells->emplace_back(row, col);
+      }
+    }
+  }
+  rtcIntersect1M(cast.scene, context, stream->data(), static_cast<unsigned>(stream->size()),
+                 sizeof(RTCRayHit));
+  for (size_t i = 0; i < stream->size(); ++i) {
+    const RTCRayHit& h = (*stream)[i];
+    cast.writer.Write((*stream_cells)[i].first, (*stream_cells)[i].second, h.ray.tfar, h.hit.geomID,
+                      h.hit.primID, h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.hit.u, h.hit.v);
+  }
+}
+
+// 2 x 4 tiles (two rows of a band at a time) as rtcIntersect8 packets.
+void CastBandPacket8(const ImageCast& cast, RTCIntersectContext* context, int row0, int row1) {
+  alignas(32) RTCRayHit8 packet;
+  alignas(32) int valid[8];
+  for (int sub = row0; sub < row1; sub += 2) {
+    for (int col0 = 0; col0 < cast.cols; col0 += 4) {
+      for (int i = 0; i < 8; ++i) {
+        const int row = sub + i / 4, col = col0 + i % 4;
+        const bool inside = row < row1 && col < cast.cols;
+        valid[i] = inside ? -1 : 0;
+        const Eigen::Vector3f d = inside ? cast.DirectionAt(row, col) : Eigen::Vector3f::UnitZ();
+        packet.ray.org_x[i] = cast.origin.x();
+        packet.ray.org_y[i] = cast.origin.y();
+        packet.ray.org_z[i] = cast.origin.z();
+        packet.ray.dir_x[i] = d.x();
+        packet.ray.dir_y[i] = d.y();
+        packet.ray.dir_z[i] = d.z();
+        packet.ray.tnear[i] = cast.t_near;
+        packet.ray.tfar[i] = cast.t_far;
+        packet.ray.mask[i] = 0xFFFFFFFFu;
+        packet.ray.time[i] = 0.0f;
+        packet.ray.flags[i] = 0;
+        packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect8(valid, cast.scene, context, &packet);
+      for (int i = 0; i < 8; ++i) {
+        if (valid[i] == 0) continue;
+        cast.writer.Write(sub + i / 4, col0 + i % 4, packet.ray.tfar[i], packet.hit.geomID[i],
+                          packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
+                          packet.hit.u[i], packet.hit.v[i]);
+      }
+    }
+  }
+}
+
+// kTileRows x kTileCols tiles as rtcIntersect16 packets.
+void CastBandPacket16(const ImageCast& cast, RTCIntersectContext* context, int row0, int row1) {
+  alignas(64) RTCRayHit16 packet;
+  alignas(64) int valid[16];
+  // Fields Embree does not change are set once per band.
+  for (int i = 0; i < 16; ++i) {
+    packet.ray.org_x[i] = cast.origin.x();
+    packet.ray.org_y[i] = cast.origin.y();
+    packet.ray.org_z[i] = cast.origin.z();
+    packet.ray.tnear[i] = cast.t_near;
+    packet.ray.mask[i] = 0xFFFFFFFFu;
+    packet.ray.time[i] = 0.0f;
+    packet.ray.flags[i] = 0;
+  }
+  for (int col0 = 0; col0 < cast.cols; col0 += kTileCols) {
+    const bool full = row0 + kTileRows <= row1 && col0 + kTileCols <= cast.cols;
+    for (int i = 0; i < 16; ++i) {
+      const int row = row0 + i / kTileCols, col = col0 + i % kTileCols;
+      const bool inside = full || (row < row1 && col < cast.cols);
+      valid[i] = inside ? -1 : 0;
+      const Eigen::Vector3f d = inside ? cast.DirectionAt(row, col) : Eigen::Vector3f::UnitZ();
+      packet.ray.dir_x[i] = d.x();
+      packet.ray.dir_y[i] = d.y();
+      packet.ray.dir_z[i] = d.z();
+      packet.ray.tfar[i] = cast.t_far;
+      packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, cast.scene, context, &packet);
+    for (int i = 0; i < 16; ++i) {
+      if (valid[i] == 0) continue;
+      cast.writer.Write(row0 + i / kTileCols, col0 + i % kTileCols, packet.ray.tfar[i], packet.hit.geomID[i],
+                        packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
+                        packet.hit.u[i], packet.hit.v[i]);
+    }
+  }
+}
+
 }  // namespace
 
 RayHitImages RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor,
@@ -255,18 +402,8 @@ void RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor, const cv:
   images.normal.create(rows, cols, CV_32FC3);
   images.barycentric.create(rows, cols, CV_32FC2);
   if (rows == 0 || cols == 0) return;
-  const Eigen::Matrix3f rotation = world_from_sensor.topLeftCorner<3, 3>().cast<float>();
-  const Eigen::Vector3f origin = world_from_sensor.topRightCorner<3, 1>().cast<float>();
   const HitWriter writer(impl_->user_id_of_geometry.data(), images);
-  RTCScene scene = impl_->scene;
-  const float r00 = rotation(0, 0), r01 = rotation(0, 1), r02 = rotation(0, 2);
-  const float r10 = rotation(1, 0), r11 = rotation(1, 1), r12 = rotation(1, 2);
-  const float r20 = rotation(2, 0), r21 = rotation(2, 1), r22 = rotation(2, 2);
-  auto direction_at = [&](int row, int col) __attribute__((always_inline)) {
-    const float* d = directions_in_sensor.ptr<float>(row) + 3 * col;
-    return Eigen::Vector3f(r00 * d[0] + r01 * d[1] + r02 * d[2], r10 * d[0] + r11 * d[1] + r12 * d[2],
-                           r20 * d[0] + r21 * d[1] + r22 * d[2]);
-  };
+  const ImageCast cast(impl_->scene, world_from_sensor, directions_in_sensor, t_near, t_far, writer);
   const int bands = (rows + kTileRows - 1) / kTileRows;
   ParallelForRange(bands, [&](int64_t band_begin, int64_t band_end) {
     RTCIntersectContext context;
@@ -277,106 +414,19 @@ void RaycastScene::CastImage(const Eigen::Matrix4d& world_from_sensor, const cv:
     for (int64_t band = band_begin; band < band_end; ++band) {
       const int row0 = static_cast<int>(band) * kTileRows;
       const int row1 = std::min(rows, row0 + kTileRows);
-      if (method == CastMethod::kSingle) {
-        RTCRayHit ray_hit;
-        for (int row = row0; row < row1; ++row) {
-          for (int col = 0; col < cols; ++col) {
-            const Eigen::Vector3f d = direction_at(row, col);
-            FillRayHit(Ray{origin, d, t_near, t_far}, &ray_hit);
-            rtcIntersect1(scene, &context, &ray_hit);
-            writer.Write(row, col, ray_hit.ray.tfar, ray_hit.hit.geomID, ray_hit.hit.primID, ray_hit.hit.Ng_x,
-                         ray_hit.hit.Ng_y, ray_hit.hit.Ng_z, ray_hit.hit.u, ray_hit.hit.v);
-          }
-        }
-      } else if (method == CastMethod::kStream) {
-        stream.clear();
-        stream_cells.clear();
-        for (int col0 = 0; col0 < cols; col0 += kTileCols) {
-          for (int row = row0; row < row1; ++row) {
-            for (int col = col0; col < std::min(cols, col0 + kTileCols); ++col) {
-              stream.emplace_back();
-              FillRayHit(Ray{origin, direction_at(row, col), t_near, t_far}, &stream.back());
-              stream_cells.emplace_back(row, col);
-            }
-          }
-        }
-        rtcIntersect1M(scene, &context, stream.data(), static_cast<unsigned>(stream.size()),
-                       sizeof(RTCRayHit));
-        for (size_t i = 0; i < stream.size(); ++i) {
-          const RTCRayHit& h = stream[i];
-          writer.Write(stream_cells[i].first, stream_cells[i].second, h.ray.tfar, h.hit.geomID, h.hit.primID,
-                       h.hit.Ng_x, h.hit.Ng_y, h.hit.Ng_z, h.hit.u, h.hit.v);
-        }
-      } else if (method == CastMethod::kPacket8) {
-        // 2 x 4 tiles (two rows of a band at a time).
-        alignas(32) RTCRayHit8 packet;
-        alignas(32) int valid[8];
-        for (int sub = row0; sub < row1; sub += 2) {
-          for (int col0 = 0; col0 < cols; col0 += 4) {
-            for (int i = 0; i < 8; ++i) {
-              const int row = sub + i / 4, col = col0 + i % 4;
-              const bool inside = row < row1 && col < cols;
-              valid[i] = inside ? -1 : 0;
-              const Eigen::Vector3f d = inside ? direction_at(row, col) : Eigen::Vector3f::UnitZ();
-              packet.ray.org_x[i] = origin.x();
-              packet.ray.org_y[i] = origin.y();
-              packet.ray.org_z[i] = origin.z();
-              packet.ray.dir_x[i] = d.x();
-              packet.ray.dir_y[i] = d.y();
-              packet.ray.dir_z[i] = d.z();
-              packet.ray.tnear[i] = t_near;
-              packet.ray.tfar[i] = t_far;
-              packet.ray.mask[i] = 0xFFFFFFFFu;
-              packet.ray.time[i] = 0.0f;
-              packet.ray.flags[i] = 0;
-              packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-              packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
-              packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-            }
-            rtcIntersect8(valid, scene, &context, &packet);
-            for (int i = 0; i < 8; ++i) {
-              if (valid[i] == 0) continue;
-              writer.Write(sub + i / 4, col0 + i % 4, packet.ray.tfar[i], packet.hit.geomID[i],
-                           packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
-                           packet.hit.u[i], packet.hit.v[i]);
-            }
-          }
-        }
-      } else {
-        alignas(64) RTCRayHit16 packet;
-        alignas(64) int valid[16];
-        // Fields Embree does not change are set once per band.
-        for (int i = 0; i < 16; ++i) {
-          packet.ray.org_x[i] = origin.x();
-          packet.ray.org_y[i] = origin.y();
-          packet.ray.org_z[i] = origin.z();
-          packet.ray.tnear[i] = t_near;
-          packet.ray.mask[i] = 0xFFFFFFFFu;
-          packet.ray.time[i] = 0.0f;
-          packet.ray.flags[i] = 0;
-        }
-        for (int col0 = 0; col0 < cols; col0 += kTileCols) {
-          const bool full = row0 + kTileRows <= row1 && col0 + kTileCols <= cols;
-          for (int i = 0; i < 16; ++i) {
-            const int row = row0 + i / kTileCols, col = col0 + i % kTileCols;
-            const bool inside = full || (row < row1 && col < cols);
-            valid[i] = inside ? -1 : 0;
-            const Eigen::Vector3f d = inside ? direction_at(row, col) : Eigen::Vector3f::UnitZ();
-            packet.ray.dir_x[i] = d.x();
-            packet.ray.dir_y[i] = d.y();
-            packet.ray.dir_z[i] = d.z();
-            packet.ray.tfar[i] = t_far;
-            packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-            packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect16(valid, scene, &context, &packet);
-          for (int i = 0; i < 16; ++i) {
-            if (valid[i] == 0) continue;
-            writer.Write(row0 + i / kTileCols, col0 + i % kTileCols, packet.ray.tfar[i], packet.hit.geomID[i],
-                         packet.hit.primID[i], packet.hit.Ng_x[i], packet.hit.Ng_y[i], packet.hit.Ng_z[i],
-                         packet.hit.u[i], packet.hit.v[i]);
-          }
-        }
+      switch (method) {
+        case CastMethod::kSingle:
+          CastBandSingle(cast, &context, row0, row1);
+          break;
+        case CastMethod::kStream:
+          CastBandStream(cast, &context, row0, row1, &stream, &stream_cells);
+          break;
+        case CastMethod::kPacket8:
+          CastBandPacket8(cast, &context, row0, row1);
+          break;
+        case CastMethod::kPacket16:
+          CastBandPacket16(cast, &context, row0, row1);
+          break;
       }
     }
   });

@@ -304,7 +304,7 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
 }
 
 SceneObject ParseObject(const Fields& fields, size_t index, const std::string& base_dir,
-                        int64_t* scene_triangles) {
+                        int64_t* scene_triangles, std::vector<std::string>* warnings) {
   fields.CheckKeys(kObjectKeys);
   SceneObject object;
   object.name = fields.String("name", fmt::format("objects[{}]", index));
@@ -320,7 +320,9 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
       fields.Fail("mesh", fmt::format("mesh file not found: '{}' (paths are relative to the scene file)",
                                       path.string()));
     }
-    object.mesh = ReadMesh(path.string());
+    MeshFile file = ReadMeshFile(path.string());
+    object.mesh = std::move(file.mesh);
+    warnings->insert(warnings->end(), file.warnings.begin(), file.warnings.end());
     if (fields.Has("color")) {
       object.mesh.triangle_colors.clear();
       object.mesh.vertex_colors.clear();
@@ -388,7 +390,8 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
 
 void ScannerOptions::Check() const {
   Validate(*this);
-  CheckOption(position.allFinite() && rotate_deg.allFinite(), "scanner: position and rotate_deg must be finite");
+  CheckOption(position.allFinite() && rotate_deg.allFinite(),
+              "scanner: position and rotate_deg must be finite");
   CheckOption(position.cwiseAbs().maxCoeff() <= kMaxCoordinateM && rotate_deg.cwiseAbs().maxCoeff() <= 1e6,
               fmt::format("scanner: position must be within {} m and rotate_deg within 1e6 degrees",
                           kMaxCoordinateM));
@@ -430,8 +433,8 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   if (!objects.is_array()) top.Fail("objects", fmt::format("expected an array, got {}", TypeName(objects)));
   int64_t scene_triangles = 0;
   for (size_t i = 0; i < objects.size(); ++i) {
-    scene.objects.push_back(
-        ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir, &scene_triangles));
+    scene.objects.push_back(ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir,
+                                        &scene_triangles, &scene.warnings));
   }
   return scene;
 }

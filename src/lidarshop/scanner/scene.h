@@ -86,6 +86,9 @@ struct SceneDescription {
   ScannerOptions scanner;
   std::vector<SceneObject> objects;
   std::string path;  // the file it was read from ("" when built in code)
+  // What the mesh readers left out of the scene's mesh files (io/mesh_io.h MeshFile::warnings), one sentence
+  // each naming the file; not printed by the library.
+  std::vector<std::string> warnings;
 
   int64_t NumTriangles() const;
 };

@@ -68,4 +68,28 @@ std::vector<MethodScores> EvaluateMethods(const Scan& scan, const cv::Mat& truth
   return out;
 }
 
+MaskScores ScoreMask(const cv::Mat& mask, const cv::Mat& truth, const cv::Mat& domain) {
+  LIDARSHOP_CHECK(mask.size() == truth.size() && mask.type() == CV_8U && truth.type() == CV_8U);
+  LIDARSHOP_CHECK(domain.empty() || (domain.size() == mask.size() && domain.type() == CV_8U));
+  MaskScores s;
+  for (int row = 0; row < mask.rows; ++row) {
+    const uint8_t* m = mask.ptr<uint8_t>(row);
+    const uint8_t* t = truth.ptr<uint8_t>(row);
+    const uint8_t* d = domain.empty() ? nullptr : domain.ptr<uint8_t>(row);
+    for (int col = 0; col < mask.cols; ++col) {
+      if (d != nullptr && d[col] == 0) continue;
+      const bool a = m[col] != 0, b = t[col] != 0;
+      s.true_positive += a && b;
+      s.false_positive += a && !b;
+      s.false_negative += !a && b;
+    }
+  }
+  const double tp = double(s.true_positive);
+  s.iou =
+      tp + s.false_positive + s.false_negative > 0 ? tp / (tp + s.false_positive + s.false_negative) : 1.0;
+  s.precision = tp + s.false_positive > 0 ? tp / (tp + s.false_positive) : 1.0;
+  s.recall = tp + s.false_negative > 0 ? tp / (tp + s.false_negative) : 1.0;
+  return s;
+}
+
 }  // namespace lidarshop

@@ -11,11 +11,11 @@
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/footprint_gather.h"
 #include "lidarshop/verify/kernel_grid.h"
-#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -209,6 +209,157 @@ struct Workspace {
   std::vector<uint8_t> status;  // per ray: SceneStatus
 };
 
+// The quantities of a VerifyPose call that do not depend on the scan.
+struct PoseQuery {
+  float allowance = 0, sigma = 0;  // a, σ (metres)
+  float kernel_radius = 0;         // 3σ
+  float inverse_two_sigma_sq = 0;  // 1 / 2σ²
+  float trim = 0;                  // ICP trim distance, metres
+  Eigen::AlignedBox3f near_box;    // the model's box grown by max(3σ, trim), model frame
+  Eigen::AlignedBox3f icp_box;     // the model's box grown by trim
+  // The kernel grid covers the model's box grown by max(3σ, trim); only points inside near_box (the same box)
+  // use it, and only when it was built for these radii.
+  bool use_grid = false;
+};
+
+PoseQuery MakePoseQuery(const VerifierModel& model, const VerifyOptions& options) {
+  PoseQuery q;
+  q.allowance = static_cast<float>(options.allowance_m);
+  q.sigma = static_cast<float>(options.sigma_m);
+  q.kernel_radius = 3.0f * q.sigma;
+  q.inverse_two_sigma_sq = 1.0f / (2.0f * q.sigma * q.sigma);
+  q.trim = static_cast<float>(options.icp_trim_m);
+  const float near_radius = std::max(q.kernel_radius, q.trim);
+  q.near_box = model.bounds_in_model;
+  q.near_box.min().array() -= near_radius;
+  q.near_box.max().array() += near_radius;
+  q.icp_box = model.bounds_in_model;
+  q.icp_box.min().array() -= q.trim;
+  q.icp_box.max().array() += q.trim;
+  const KernelNeighbourGrid& grid = model.kernel_grid;
+  q.use_grid = grid.built() && std::abs(grid.kernel.radius_m - q.kernel_radius) <= 1e-6f * q.kernel_radius &&
+               std::abs(grid.icp.radius_m - q.trim) <= 1e-6f * q.trim;
+  return q;
+}
+
+// The rays of `footprint`'s valid cells that meet the model's box and the scene points inside the near box,
+// model frame (workspace->rays, workspace->near, workspace->near_points). Bands of kBandRows rows, column
+// after column within a band: consecutive rays are neighbouring cells in a small block (coherent Embree
+// packets) and consecutive points stay in the same kernel cells.
+void GatherFootprint(const PreparedScan& prepared, const Footprint& footprint,
+                     const verify_internal::GatherFrame& frame, Workspace* workspace) {
+  static_assert(PreparedScan::kBandRows == 4, "footprint_gather.cc assumes bands of 4 rows");
+  constexpr int kBandRows = PreparedScan::kBandRows;
+  workspace->rays.size = 0;
+  workspace->near.size = 0;
+  verify_internal::ReserveGather(
+      static_cast<size_t>(footprint.num_cells()) + kBandRows * footprint.columns.size(), workspace->rays,
+      workspace->near);
+  for (int band = footprint.row_begin / kBandRows * kBandRows; band < footprint.row_end; band += kBandRows) {
+    // Runs of consecutive footprint columns (one run, or two where the footprint wraps around ±180°).
+    for (size_t first = 0; first < footprint.columns.size();) {
+      size_t last = first;
+      while (last + 1 < footprint.columns.size() &&
+             footprint.columns[last + 1] == footprint.columns[last] + 1) {
+        ++last;
+      }
+      const int first_col = footprint.columns[first];
+      verify_internal::GatherBand(prepared.band_cells.data() + prepared.BandCellIndex(band, first_col), band,
+                                  footprint.row_begin, footprint.row_end, first_col,
+                                  static_cast<int>(last - first + 1), prepared.scan.cols, frame,
+                                  workspace->rays, workspace->near);
+      first = last + 1;
+    }
+  }
+  const size_t num_near = workspace->near.size;
+  workspace->near_points.resize(num_near);
+  for (size_t j = 0; j < num_near; ++j) {
+    workspace->near_points[j] =
+        Eigen::Vector3f(workspace->near.x[j], workspace->near.y[j], workspace->near.z[j]);
+  }
+}
+
+// Confidence: adds Σ_j exp(−d²/2σ²) over the near points j to `sum` (per model point, in the kernel grid's
+// order with the grid, by point index without it), and sets workspace->closest_sq to each near point's
+// squared distance to the nearest model point within 3σ (infinity when there is none). One kernel search
+// serves both: the closest model point within 3σ is the ICP nearest neighbour too.
+void AccumulateKernelSums(const VerifierModel& model, const PoseQuery& q, Workspace* workspace, float* sum) {
+  const size_t num_near = workspace->near_points.size();
+  const float kernel_radius_sq = q.kernel_radius * q.kernel_radius;
+  workspace->closest_sq.assign(num_near, std::numeric_limits<float>::infinity());
+  if (q.use_grid) {
+    verify_internal::AccumulateKernel(model.kernel_grid, workspace->near_points, kernel_radius_sq,
+                                      q.inverse_two_sigma_sq, sum, workspace->closest_sq.data());
+    return;
+  }
+  for (size_t j = 0; j < num_near; ++j) {
+    model.points_in_model.ForEachInRadius(
+        workspace->near_points[j], q.kernel_radius, [&](uint32_t i, float distance_sq) {
+          if (sum[i] < 1.0f) sum[i] += verify_internal::KernelExp(-distance_sq * q.inverse_two_sigma_sq);
+          workspace->closest_sq[j] = std::min(workspace->closest_sq[j], distance_sq);
+        });
+  }
+}
+
+// ICP: the near points inside the ICP box are candidates, those within `trim` of the model inliers. The
+// candidates without a model point within 3σ (not found by AccumulateKernelSums) get a nearest-neighbour
+// search of their own. Adds to the result's counts and to *icp_distance_sum (metres).
+void CountIcpInliers(const VerifierModel& model, const PoseQuery& q, Workspace* workspace,
+                     VerifyResult* result, double* icp_distance_sum) {
+  const size_t num_near = workspace->near_points.size();
+  const float kernel_radius_sq = q.kernel_radius * q.kernel_radius;
+  workspace->far_points.clear();
+  workspace->far_index.clear();
+  for (size_t j = 0; j < num_near; ++j) {
+    if (q.icp_box.contains(workspace->near_points[j]) && !(workspace->closest_sq[j] < kernel_radius_sq)) {
+      workspace->far_points.push_back(workspace->near_points[j]);
+      workspace->far_index.push_back(static_cast<uint32_t>(j));
+    }
+  }
+  workspace->far_closest_sq.resize(workspace->far_points.size());
+  if (q.use_grid) {
+    verify_internal::NearestSquaredDistance(model.kernel_grid, workspace->far_points,
+                                            workspace->far_closest_sq.data());
+  } else {
+    for (size_t f = 0; f < workspace->far_points.size(); ++f) {
+      workspace->far_closest_sq[f] =
+          model.points_in_model.NearestWithin(workspace->far_points[f], q.trim).distance_sq;
+    }
+  }
+  for (size_t f = 0; f < workspace->far_points.size(); ++f) {
+    workspace->closest_sq[workspace->far_index[f]] = workspace->far_closest_sq[f];
+  }
+  for (size_t j = 0; j < num_near; ++j) {
+    if (!q.icp_box.contains(workspace->near_points[j])) continue;
+    ++result->icp_candidates;
+    if (workspace->closest_sq[j] <= q.trim * q.trim) {
+      ++result->icp_inliers;
+      *icp_distance_sum += std::sqrt(workspace->closest_sq[j]);
+    }
+  }
+}
+
+// Consistency: classifies the gathered rays against the posed model (`origin`: the scanner in the model
+// frame) and counts them into `stats`; with `scene_status` (CV_8U, the scan's size), writes each comparable
+// ray's status into its cell.
+void CountRayStatus(const VerifierModel& model, const Eigen::Vector3f& origin, Workspace* workspace,
+                    ScanVerifyStats* stats, cv::Mat* scene_status) {
+  const size_t num_rays = workspace->rays.size;
+  workspace->status.resize(num_rays);
+  ClassifyRays(model.scene_in_model, origin, workspace->rays, workspace->status);
+  stats->rays_cast = static_cast<int64_t>(num_rays);
+  for (size_t k = 0; k < num_rays; ++k) {
+    const uint8_t status = workspace->status[k];
+    if (status == kNotComparable) continue;
+    ++stats->comparable_pairs;
+    if (status == kConsistent) ++stats->consistent_pairs;
+    if (scene_status != nullptr) scene_status->data[workspace->rays.cell[k]] = status;
+  }
+  if (stats->comparable_pairs > 0) {
+    stats->consistency = static_cast<double>(stats->consistent_pairs) / stats->comparable_pairs;
+  }
+}
+
 }  // namespace
 
 void ModelOptions::Check() const {
@@ -353,29 +504,15 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
   thread_local Workspace workspace;
   VerifyResult result;
   const size_t n = model.num_points();
-  const float allowance = static_cast<float>(options.allowance_m);
-  const float sigma = static_cast<float>(options.sigma_m);
-  const float kernel_radius = 3.0f * sigma;
-  const float inverse_two_sigma_sq = 1.0f / (2.0f * sigma * sigma);
-  const float trim = static_cast<float>(options.icp_trim_m);
-  const float near_radius = std::max(kernel_radius, trim);
-  Eigen::AlignedBox3f near_box = model.bounds_in_model;
-  near_box.min().array() -= near_radius;
-  near_box.max().array() += near_radius;
-  Eigen::AlignedBox3f icp_box = model.bounds_in_model;
-  icp_box.min().array() -= trim;
-  icp_box.max().array() += trim;
+  const PoseQuery q = MakePoseQuery(model, options);
   const Eigen::Matrix4d model_from_world = world_from_model.inverse();
   const KernelNeighbourGrid& grid = model.kernel_grid;
-  // The grid covers the model's box grown by max(3σ, trim); only points inside near_box (the same box) use
-  // it.
-  const bool use_grid = grid.built() &&
-                        std::abs(grid.kernel.radius_m - kernel_radius) <= 1e-6f * kernel_radius &&
-                        std::abs(grid.icp.radius_m - trim) <= 1e-6f * trim;
 
   // Σ_j exp(−d²/2σ²) per model point: in the kernel grid's sorted order with the grid (so that its vector
   // loop reads 8 neighbouring sums at once), by point index without it.
-  auto point_of_slot = [&](size_t k) { return use_grid ? grid.kernel.indices[k] : static_cast<uint32_t>(k); };
+  auto point_of_slot = [&](size_t k) {
+    return q.use_grid ? grid.kernel.indices[k] : static_cast<uint32_t>(k);
+  };
   std::vector<float> observed_sum(n, 0.0f);  // over all scans
   std::vector<float> scan_sum;               // the same for one scan (only with several scans)
   double icp_distance_sum = 0.0;
@@ -396,103 +533,14 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     const Eigen::Matrix3f linear = model_from_scanner.topLeftCorner<3, 3>().cast<float>();
     const Eigen::Vector3f origin = model_from_scanner.topRightCorner<3, 1>().cast<float>();
     const Footprint footprint =
-        FindFootprint(prepared, scanner_from_model, near_box, options.footprint_margin_cells);
+        FindFootprint(prepared, scanner_from_model, q.near_box, options.footprint_margin_cells);
     stats.footprint_cells = footprint.num_cells();
-
-    // Bands of kBandRows rows, column after column within a band: consecutive rays are neighbouring cells
-    // in a small block (coherent Embree packets) and consecutive points stay in the same kernel cells.
-    static_assert(PreparedScan::kBandRows == 4, "footprint_gather.cc assumes bands of 4 rows");
-    constexpr int kBandRows = PreparedScan::kBandRows;
-    workspace.rays.size = 0;
-    workspace.near.size = 0;
-    verify_internal::ReserveGather(
-        static_cast<size_t>(footprint.num_cells()) + kBandRows * footprint.columns.size(), workspace.rays,
-        workspace.near);
-    const verify_internal::GatherFrame frame{linear, origin, model.bounds_in_model, near_box, allowance};
-    for (int band = footprint.row_begin / kBandRows * kBandRows; band < footprint.row_end;
-         band += kBandRows) {
-      // Runs of consecutive footprint columns (one run, or two where the footprint wraps around ±180°).
-      for (size_t first = 0; first < footprint.columns.size();) {
-        size_t last = first;
-        while (last + 1 < footprint.columns.size() &&
-               footprint.columns[last + 1] == footprint.columns[last] + 1) {
-          ++last;
-        }
-        const int first_col = footprint.columns[first];
-        verify_internal::GatherBand(prepared.band_cells.data() + prepared.BandCellIndex(band, first_col),
-                                    band, footprint.row_begin, footprint.row_end, first_col,
-                                    static_cast<int>(last - first + 1), scan.cols, frame, workspace.rays,
-                                    workspace.near);
-        first = last + 1;
-      }
-    }
-    const size_t num_rays = workspace.rays.size;
-    const size_t num_near = workspace.near.size;
-    workspace.near_points.resize(num_near);
-    for (size_t j = 0; j < num_near; ++j) {
-      workspace.near_points[j] =
-          Eigen::Vector3f(workspace.near.x[j], workspace.near.y[j], workspace.near.z[j]);
-    }
-
-    // Confidence and ICP: the scene points near the model. One kernel search serves both when a model point
-    // lies within 3σ (the usual case for points on the object): the closest one is the ICP nearest neighbour
-    // too.
-    const float kernel_radius_sq = kernel_radius * kernel_radius;
-    workspace.closest_sq.assign(num_near, std::numeric_limits<float>::infinity());
-    if (use_grid) {
-      verify_internal::AccumulateKernel(grid, workspace.near_points, kernel_radius_sq, inverse_two_sigma_sq,
-                                        sum.data(), workspace.closest_sq.data());
-    } else {
-      for (size_t j = 0; j < num_near; ++j) {
-        model.points_in_model.ForEachInRadius(
-            workspace.near_points[j], kernel_radius, [&](uint32_t i, float distance_sq) {
-              if (sum[i] < 1.0f) sum[i] += verify_internal::KernelExp(-distance_sq * inverse_two_sigma_sq);
-              workspace.closest_sq[j] = std::min(workspace.closest_sq[j], distance_sq);
-            });
-      }
-    }
-    // The ICP candidates without a model point within 3σ need a nearest-neighbour search of their own.
-    workspace.far_points.clear();
-    workspace.far_index.clear();
-    for (size_t j = 0; j < num_near; ++j) {
-      if (icp_box.contains(workspace.near_points[j]) && !(workspace.closest_sq[j] < kernel_radius_sq)) {
-        workspace.far_points.push_back(workspace.near_points[j]);
-        workspace.far_index.push_back(static_cast<uint32_t>(j));
-      }
-    }
-    workspace.far_closest_sq.resize(workspace.far_points.size());
-    if (use_grid) {
-      verify_internal::NearestSquaredDistance(grid, workspace.far_points, workspace.far_closest_sq.data());
-    } else {
-      for (size_t f = 0; f < workspace.far_points.size(); ++f) {
-        workspace.far_closest_sq[f] =
-            model.points_in_model.NearestWithin(workspace.far_points[f], trim).distance_sq;
-      }
-    }
-    for (size_t f = 0; f < workspace.far_points.size(); ++f) {
-      workspace.closest_sq[workspace.far_index[f]] = workspace.far_closest_sq[f];
-    }
-    for (size_t j = 0; j < num_near; ++j) {
-      if (!icp_box.contains(workspace.near_points[j])) continue;
-      ++result.icp_candidates;
-      if (workspace.closest_sq[j] <= trim * trim) {
-        ++result.icp_inliers;
-        icp_distance_sum += std::sqrt(workspace.closest_sq[j]);
-      }
-    }
-    workspace.status.resize(num_rays);
-    ClassifyRays(model.scene_in_model, origin, workspace.rays, workspace.status);
-    stats.rays_cast = static_cast<int64_t>(num_rays);
-    for (size_t k = 0; k < num_rays; ++k) {
-      const uint8_t status = workspace.status[k];
-      if (status == kNotComparable) continue;
-      ++stats.comparable_pairs;
-      if (status == kConsistent) ++stats.consistent_pairs;
-      if (options.keep_details) result.scene_status[s].data[workspace.rays.cell[k]] = status;
-    }
-    if (stats.comparable_pairs > 0) {
-      stats.consistency = static_cast<double>(stats.consistent_pairs) / stats.comparable_pairs;
-    }
+    const verify_internal::GatherFrame frame{linear, origin, model.bounds_in_model, q.near_box, q.allowance};
+    GatherFootprint(prepared, footprint, frame, &workspace);
+    AccumulateKernelSums(model, q, &workspace, sum.data());
+    CountIcpInliers(model, q, &workspace, &result, &icp_distance_sum);
+    CountRayStatus(model, origin, &workspace, &stats,
+                   options.keep_details ? &result.scene_status[s] : nullptr);
     result.comparable_pairs += stats.comparable_pairs;
     result.consistent_pairs += stats.consistent_pairs;
     double confidence = 0.0;

@@ -1,0 +1,338 @@
+// SegmentSession: the two-step method (depth-dominant cut, background inference, colour-dominant cut in a
+// region of interest), its single-cut baselines and incremental refinement (segment.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/segment/appearance.h"
+#include "lidarshop/segment/segment.h"
+#include "lidarshop/segment/segment_graph.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
+#include "lidarshop/util/timer.h"
+
+namespace lidarshop {
+
+using namespace segment_internal;  // NOLINT: the graph and appearance helpers of this module
+
+struct SegmentSession::Impl {
+  Scan scan;
+  SegmentOptions options;
+  Nodes nodes;
+  double features_s = 0;
+  // n-link weights, computed once per step kind when first needed.
+  std::unique_ptr<NLinks> depth_links, color_links, rgbd_links;
+  // The last cut, kept for refinement.
+  Cut last;
+  std::vector<uint8_t> last_hard;
+  SegmentResult last_result;
+  bool ran = false;
+
+  const NLinks& Links(const CutWeights& w, std::unique_ptr<NLinks>* cache, SegmentTimings* t) {
+    if (!*cache) {
+      Timer timer;
+      *cache =
+          std::make_unique<NLinks>(ComputeNLinks(nodes, w, options.eight_connected, options.sigma_scale));
+      t->features_s += timer.Seconds();
+    }
+    return **cache;
+  }
+
+  std::vector<uint8_t> HardFromStrokes(const cv::Mat& strokes, const std::string& what) const {
+    if (strokes.rows != nodes.rows || strokes.cols != nodes.cols || strokes.type() != CV_8U) {
+      ThrowInputError(what, "", "",
+                      fmt::format("stroke labels must be CV_8U {} x {} (the scan's size), got {} x {}",
+                                  nodes.rows, nodes.cols, strokes.rows, strokes.cols));
+    }
+    std::vector<uint8_t> hard(nodes.num(), kFree);
+    const uint8_t* s = strokes.ptr<uint8_t>();
+    for (int i = 0; i < nodes.num(); ++i) {
+      const uint8_t v = s[nodes.cell_of_node[i]];
+      if (v == kStrokeObject)
+        hard[i] = kHardObject;
+      else if (v == kStrokeBackground)
+        hard[i] = kHardBackground;
+    }
+    return hard;
+  }
+
+  // The hard labels of the last graph's nodes: `hard` (per node) mapped to the graph.
+  std::vector<uint8_t> LocalHard(const std::vector<uint8_t>& hard) const {
+    if (last.node_of_local.empty()) return hard;
+    std::vector<uint8_t> local(last.node_of_local.size());
+    for (size_t k = 0; k < local.size(); ++k) local[k] = hard[last.node_of_local[k]];
+    return local;
+  }
+
+  // Whether `mask` (the last cut's) holds a cell on an edge of the last graph's ROI that is not an image
+  // edge: then the object may go on beyond the ROI, which was too small.
+  bool ReachesRoiEdge(const cv::Mat& mask) const {
+    const uint8_t* data = mask.ptr<uint8_t>();
+    for (size_t k = 0; k < last.on_roi_edge.size(); ++k) {
+      if (last.on_roi_edge[k] && data[nodes.cell_of_node[last.node_of_local[k]]] != 0) return true;
+    }
+    return false;
+  }
+
+  // Sets last's node maps to the valid cells of `roi` (an empty rectangle or the whole image = every node).
+  void SetRoi(const cv::Rect& roi) {
+    last.node_of_local.clear();
+    last.local_of_node.clear();
+    last.on_roi_edge.clear();
+    if (roi.empty() || roi == cv::Rect(0, 0, nodes.cols, nodes.rows)) return;
+    last.local_of_node.assign(nodes.num(), -1);
+    for (int row = roi.y; row < roi.y + roi.height; ++row) {
+      for (int col = roi.x; col < roi.x + roi.width; ++col) {
+        const int32_t i = nodes.node_of_cell[static_cast<int64_t>(row) * nodes.cols + col];
+        if (i < 0) continue;
+        last.local_of_node[i] = static_cast<int32_t>(last.node_of_local.size());
+        last.node_of_local.push_back(i);
+        const bool edge = (row == roi.y && row > 0) ||
+                          (row == roi.y + roi.height - 1 && row < nodes.rows - 1) ||
+                          (col == roi.x && col > 0) || (col == roi.x + roi.width - 1 && col < nodes.cols - 1);
+        last.on_roi_edge.push_back(edge ? 1 : 0);
+      }
+    }
+  }
+
+  // One cut with the given weights: models from the hard cells (all of them, also outside the ROI), graph
+  // over the valid cells of `roi` (empty = the whole image), max-flow. Keeps the graph in `last`.
+  cv::Mat RunCut(const CutWeights& w, const NLinks& links, const std::vector<uint8_t>& hard,
+                 SegmentResult* result, const cv::Rect& roi = cv::Rect()) {
+    Timer timer;
+    SetRoi(roi);
+    std::vector<int32_t> object, background;
+    for (int i = 0; i < nodes.num(); ++i) {
+      if (hard[i] == kHardObject)
+        object.push_back(i);
+      else if (hard[i] == kHardBackground)
+        background.push_back(i);
+    }
+    const LogDensities logp = ComputeLogDensities(nodes, object, background, options,
+                                                  last.node_of_local.empty() ? nullptr : &last.node_of_local);
+    result->timings.models_s += timer.Seconds();
+    last.hard_cap = 0;
+    last.links = &links;
+    BuildAndCut(nodes, links, logp, w, LocalHard(hard), &result->timings, &result->flow, &last);
+    last_hard = hard;
+    return MaskFromCut(nodes, last, hard);
+  }
+
+  // Step 3's region of interest around the step-1 object (SegmentOptions::roi_margin_cells); empty = whole.
+  cv::Rect Step3Roi(const cv::Mat& step1) const {
+    if (options.roi_margin_cells <= 0) return cv::Rect();
+    const cv::Rect box = cv::boundingRect(step1);
+    if (box.empty()) return cv::Rect();
+    const int margin =
+        std::max(options.roi_margin_cells,
+                 static_cast<int>(std::ceil(options.roi_margin_fraction * std::max(box.width, box.height))));
+    const int x0 = std::max(0, box.x - margin), y0 = std::max(0, box.y - margin);
+    const int x1 = std::min(nodes.cols, box.x + box.width + margin);
+    const int y1 = std::min(nodes.rows, box.y + box.height + margin);
+    return cv::Rect(x0, y0, x1 - x0, y1 - y0);
+  }
+
+  // Step 2: ring cells whose range differs from every step-1 object cell in their window.
+  cv::Mat InferBackground(const cv::Mat& step1) const {
+    const int r = options.ring_radius_cells;
+    cv::Mat dilated;
+    cv::dilate(step1, dilated, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
+    cv::Mat inferred(nodes.rows, nodes.cols, CV_8U, cv::Scalar(0));
+    ParallelFor(nodes.rows, [&](int64_t row) {
+      const uint8_t* dil = dilated.ptr<uint8_t>(row);
+      const uint8_t* obj = step1.ptr<uint8_t>(row);
+      uint8_t* out = inferred.ptr<uint8_t>(row);
+      for (int col = 0; col < nodes.cols; ++col) {
+        if (dil[col] == 0 || obj[col] != 0) continue;
+        const int32_t p = nodes.node_of_cell[row * nodes.cols + col];
+        if (p < 0) continue;
+        const float range = nodes.raw[p][3];
+        float closest = std::numeric_limits<float>::infinity();
+        for (int dr = -r; dr <= r; ++dr) {
+          const int rr = static_cast<int>(row) + dr;
+          if (rr < 0 || rr >= nodes.rows) continue;
+          const uint8_t* obj_row = step1.ptr<uint8_t>(rr);
+          for (int dc = -r; dc <= r; ++dc) {
+            const int cc = col + dc;
+            if (cc < 0 || cc >= nodes.cols || obj_row[cc] == 0 || dr * dr + dc * dc > r * r) continue;
+            const int32_t q = nodes.node_of_cell[static_cast<int64_t>(rr) * nodes.cols + cc];
+            if (q >= 0) closest = std::min(closest, std::abs(range - nodes.raw[q][3]));
+          }
+        }
+        const double threshold = options.ring_depth_threshold_m +
+                                 options.ring_depth_threshold_fraction * static_cast<double>(range);
+        if (std::isfinite(closest) && closest > threshold) out[col] = 255;
+      }
+    });
+    return inferred;
+  }
+};
+
+SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  options.Check();
+  CheckScan(scan);
+  Timer timer;
+  impl_->scan = scan;
+  impl_->options = options;
+  impl_->nodes = MakeNodes(scan);
+  impl_->features_s = timer.Seconds();
+}
+
+SegmentSession::~SegmentSession() = default;
+SegmentSession::SegmentSession(SegmentSession&&) noexcept = default;
+SegmentSession& SegmentSession::operator=(SegmentSession&&) noexcept = default;
+
+SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
+  Impl& s = *impl_;
+  Timer total;
+  SegmentResult result;
+  result.timings.features_s = s.features_s;
+  s.features_s = 0;  // counted once
+  std::vector<uint8_t> hard = s.HardFromStrokes(strokes, "strokes");
+  const bool has_object = std::count(hard.begin(), hard.end(), kHardObject) > 0;
+  const bool has_background = std::count(hard.begin(), hard.end(), kHardBackground) > 0;
+  if (!has_object) ThrowInputError("strokes", "", "", "no object stroke lies on a cell with a return");
+  if (!has_background)
+    ThrowInputError("strokes", "", "", "no background stroke lies on a cell with a return");
+  const SegmentOptions& o = s.options;
+  switch (o.method) {
+    case SegmentMethod::kDepth:
+      result.mask =
+          s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
+      break;
+    case SegmentMethod::kColor:
+      result.mask =
+          s.RunCut(o.color_step, s.Links(o.color_step, &s.color_links, &result.timings), hard, &result);
+      break;
+    case SegmentMethod::kRgbd:
+      result.mask =
+          s.RunCut(o.rgbd_step, s.Links(o.rgbd_step, &s.rgbd_links, &result.timings), hard, &result);
+      break;
+    case SegmentMethod::kTwoStep: {
+      // Step 1: depth-dominant cut.
+      result.step1_mask =
+          s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
+      // Step 2: background inference on the ring around it.
+      result.inferred_background = s.InferBackground(result.step1_mask);
+      // Step 3: colour-dominant cut seeded with step 1's object and the inferred + stroked background.
+      std::vector<uint8_t> seeds = hard;
+      const uint8_t* step1 = result.step1_mask.ptr<uint8_t>();
+      const uint8_t* inferred = result.inferred_background.ptr<uint8_t>();
+      for (int i = 0; i < s.nodes.num(); ++i) {
+        const int32_t cell = s.nodes.cell_of_node[i];
+        if (hard[i] == kHardBackground) continue;  // the user's word wins
+        if (step1[cell] != 0)
+          seeds[i] = kHardObject;
+        else if (inferred[cell] != 0)
+          seeds[i] = kHardBackground;
+      }
+      const NLinks& color_links = s.Links(o.color_step, &s.color_links, &result.timings);
+      result.mask = s.RunCut(o.color_step, color_links, seeds, &result, s.Step3Roi(result.step1_mask));
+      // The object reached the ROI's edge: the ROI was too small, cut the whole image (the time of both cuts
+      // is counted).
+      if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
+      break;
+    }
+  }
+  result.object_cells = cv::countNonZero(result.mask);
+  result.graph_nodes = s.last.num_local(s.nodes.num());
+  result.timings.total_s = total.Seconds() + result.timings.features_s;
+  s.last_result = result;
+  s.ran = true;
+  return result;
+}
+
+SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
+  Impl& s = *impl_;
+  if (!s.ran) throw std::logic_error("SegmentSession::Refine called before Run");
+  Timer total;
+  const std::vector<uint8_t> extra = s.HardFromStrokes(extra_strokes, "extra strokes");
+  SegmentResult result = s.last_result;
+  result.timings = SegmentTimings();
+  bool any = false, outside = false;
+  for (int i = 0; i < s.nodes.num(); ++i) {
+    if (extra[i] == kFree || extra[i] == s.last_hard[i]) continue;
+    s.last_hard[i] = extra[i];
+    any = true;
+    if (!s.last.local_of_node.empty() && s.last.local_of_node[i] < 0) outside = true;
+  }
+  if (outside) {
+    // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
+    // cell so far.
+    result.flow = 0;
+    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+    result.object_cells = cv::countNonZero(result.mask);
+    result.graph_nodes = s.last.num_local(s.nodes.num());
+    result.timings.total_s = total.Seconds();
+    s.last_result = result;
+    return result;
+  }
+  Graph& g = *s.last.graph;
+  const std::vector<uint8_t> local_hard = s.LocalHard(s.last_hard);
+  const int n = static_cast<int>(local_hard.size());
+  // New t-link capacities: the models re-learnt from all hard cells (options.refine_relearn_models) or only
+  // the new hard cells; the graph gets the differences (BK add_tweights accepts negative changes) and the
+  // changed nodes are marked for the tree-reusing max-flow.
+  std::vector<float> source_cap = s.last.source_cap, sink_cap = s.last.sink_cap;
+  if (any && s.options.refine_relearn_models) {
+    Timer models;
+    std::vector<int32_t> object, background;
+    for (int i = 0; i < s.nodes.num(); ++i) {
+      if (s.last_hard[i] == kHardObject)
+        object.push_back(i);
+      else if (s.last_hard[i] == kHardBackground)
+        background.push_back(i);
+    }
+    const LogDensities logp =
+        ComputeLogDensities(s.nodes, object, background, s.options,
+                            s.last.node_of_local.empty() ? nullptr : &s.last.node_of_local);
+    float hard_cap = s.last.hard_cap;
+    TLinkCapacities(logp, *s.last.weights, local_hard, &hard_cap, &source_cap, &sink_cap);
+    result.timings.models_s = models.Seconds();
+  } else {
+    for (int k = 0; k < n; ++k) {
+      if (local_hard[k] == kHardObject)
+        source_cap[k] = s.last.hard_cap, sink_cap[k] = 0;
+      else if (local_hard[k] == kHardBackground)
+        source_cap[k] = 0, sink_cap[k] = s.last.hard_cap;
+    }
+  }
+  Timer graph_timer;
+  int changed = 0;
+  for (int k = 0; k < n; ++k) {
+    const float ds = source_cap[k] - s.last.source_cap[k], dt = sink_cap[k] - s.last.sink_cap[k];
+    if (ds == 0 && dt == 0) continue;
+    g.add_tweights(k, ds, dt);
+    g.mark_node(k);
+    ++changed;
+  }
+  s.last.source_cap.swap(source_cap);
+  s.last.sink_cap.swap(sink_cap);
+  result.timings.graph_s = graph_timer.Seconds();
+  Timer timer;
+  if (changed > 0) result.flow = g.maxflow(/*reuse_trees=*/true);
+  result.timings.maxflow_s = timer.Seconds();
+  result.mask = MaskFromCut(s.nodes, s.last, s.last_hard);
+  if (s.ReachesRoiEdge(result.mask)) {
+    // The refined object reached the ROI's edge: re-run the cut on the whole image.
+    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+  }
+  result.object_cells = cv::countNonZero(result.mask);
+  result.graph_nodes = s.last.num_local(s.nodes.num());
+  result.timings.total_s = total.Seconds();
+  s.last_result = result;
+  return result;
+}
+
+SegmentResult SegmentObject(const Scan& scan, const cv::Mat& strokes, const SegmentOptions& options) {
+  SegmentSession session(scan, options);
+  return session.Run(strokes);
+}
+
+}  // namespace lidarshop
