@@ -3,11 +3,11 @@
 //   lidarshop points OPERATION IN... -o OUT [options] [--json FILE|-]
 //   lidarshop register FIXED MOVING -o OUT [--max-distance M] [--json FILE|-]
 //
-// Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations
-// that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep
-// every scan's grid: dropped cells become cells without a return, labels and normals go into the scans'
-// channels. Operations that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world
-// frame.
+// Every input scan is taken in the world frame and the operation sees all of them as one cloud.
+// Operations that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or
+// give normals keep every scan's grid: dropped cells become cells without a return, labels and
+// normals go into the scans' channels. Operations that make new points (voxel, merge) write a plain
+// cloud (.ply / .pcd) in the world frame.
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -244,8 +244,8 @@ int RunPoints(int argc, char** argv) {
     if (!box.empty() && box.size() != 6)
       throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
     if (operation == "sample-mesh") {
-      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
-      // normals.
+      // Uniform (area-weighted) samples of a triangle mesh
+      // (pointset/sampling.h), with the triangles' normals.
       if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
       if (FileExtension(output_path) != "ply")
         throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));

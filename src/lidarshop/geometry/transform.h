@@ -1,5 +1,5 @@
-// Rigid and similarity transforms. Names carry frames: `world_from_model` maps model coordinates to world
-// ones.
+// Rigid and similarity transforms. Names carry frames: `world_from_model` maps
+// model coordinates to world ones.
 //
 // Conventions shared by scene files and the CLI: an object is scaled, then rotated, then translated;
 // `rotate_deg` = [x, y, z] rotates about the fixed axes x, then y, then z, i.e. R = Rz * Ry * Rx.
@@ -30,8 +30,8 @@ inline Eigen::Vector3f TransformPoint(const Eigen::Matrix4d& b_from_a, const Eig
       .cast<float>();
 }
 
-// True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is 0 0
-// 0 1.
+// True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is
+// 0 0 0 1.
 bool IsRigid(const Eigen::Matrix4d& transform, double tolerance = 1e-6);
 
 // The largest coordinate or translation (metres) lidarshop accepts: terrestrial scenes span kilometres, so a

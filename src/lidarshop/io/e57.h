@@ -25,8 +25,8 @@ struct E57Image {
   // Additions (E57 engineer):
   int width_px = 0, height_px = 0;  // imageWidth / imageHeight as the XML states them
   std::string decode_error;  // why `image` is empty when its blob does not decode (e.g. a zero-filled blob)
-  // Additions (recolouring, issue 14): the blob exactly as stored, so that E57 -> E57 keeps the photo
-  // bit-exact.
+  // Additions (recolouring, issue 14): the blob exactly as stored, so that E57 ->
+  // E57 keeps the photo bit-exact.
   std::vector<uint8_t> encoded;
   std::string encoding;  // "jpeg" or "png" (the blob's element: jpegImage / pngImage)
 };
@@ -59,8 +59,8 @@ void WriteE57(const std::string& path, const std::vector<Scan>& scans);
 // ---- Additions (E57 engineer)
 // --------------------------------------------------------------------------------
 
-// ReadE57 on the bytes of a file already in memory; `name` is used in error messages (fuzzing, tests,
-// streams).
+// ReadE57 on the bytes of a file already in memory; `name` is used in error
+// messages (fuzzing, tests, streams).
 E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& name);
 
 struct E57WriteOptions {

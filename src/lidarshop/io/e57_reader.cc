@@ -172,8 +172,8 @@ void CollectFields(const Context& ctx, pugi::xml_node node, const std::string& p
   }
 }
 
-// Logical offset of a physical offset found in the XML; rejects offsets outside the file or inside a
-// checksum.
+// Logical offset of a physical offset found in the XML; rejects offsets outside
+// the file or inside a checksum.
 uint64_t LogicalOffset(const Context& ctx, pugi::xml_node node, uint64_t physical) {
   if (physical % kPageSize >= kPagePayload) {
     XmlError(ctx, node, fmt::format("fileOffset {} points into a page checksum", physical));
@@ -297,8 +297,8 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
     pos += length;
   }
   refuse_more_data(pos);
-  // A writer may round each packet's bytestreams up to whole bytes; more than that is records recordCount
-  // does not count.
+  // A writer may round each packet's bytestreams up to whole bytes; more than that is
+  // records recordCount does not count.
   for (size_t i = 0; i < n; ++i) {
     if (streams[i].size() > needed_bytes[i] + static_cast<uint64_t>(packets) + 8) {
       ThrowInputError(ctx.path, where(start), "recordCount",
@@ -508,8 +508,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
     }
   }
   int64_t duplicates = 0;
-  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to `second`, later ones are left
-  // out.
+  // returnIndex of each record in a structured scan: 0 goes to `scan`, 1 to
+  // `second`, later ones are left out.
   std::vector<uint8_t> layer(record_count, 0);
   if (structured && find("returnIndex") != nullptr) {
     const auto& v = decode(find("returnIndex"));
@@ -649,9 +649,9 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   }
 
   if (structured && scan.num_cells() > 0) {
-    // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turn the
-    // grid into image orientation (row 0 = highest elevation, our azimuth increasing to the right) by the
-    // data.
+    // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom
+    // row); turn the grid into image orientation (row 0 = highest elevation, our azimuth
+    // increasing to the right) by the data.
     const GridOrientation o = OrientationOf(scan);
     if (o.flip_rows || o.flip_cols) {
       const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;

@@ -11,8 +11,8 @@ namespace lidarshop {
 // .obj or .ply, by extension. Throws InputError on malformed files (file, line or byte offset, field).
 TriangleMesh ReadMesh(const std::string& path);
 
-// .ply (binary little-endian unless `ascii`). Vertex colours, normals and triangle colours are written if
-// present.
+// .ply (binary little-endian unless `ascii`). Vertex colours, normals and triangle
+// colours are written if present.
 void WriteMesh(const std::string& path, const TriangleMesh& mesh, bool ascii = false);
 
 // .ply points with whatever per-point fields the cloud has (x y z, nx ny nz, red green blue, intensity,

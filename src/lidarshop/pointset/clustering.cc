@@ -96,8 +96,8 @@ KMeansResult KMeans(const PointCloud& cloud, const KMeansOptions& options) {
   const int k = options.clusters;
   std::mt19937_64 random(options.seed);
   auto uniform = [&]() { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-  // k-means++: each next centre drawn with probability proportional to the squared distance to the nearest
-  // one.
+  // k-means++: each next centre drawn with probability proportional to the
+  // squared distance to the nearest one.
   KMeansResult result;
   std::vector<double> nearest_sq(cloud.size(), std::numeric_limits<double>::infinity());
   result.centers.push_back(cloud.points[random() % n].cast<double>());

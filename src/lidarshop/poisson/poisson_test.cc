@@ -131,8 +131,8 @@ TEST_P(PoissonSolverTest, ReconstructsAnImageFromItsOwnGradients) {
 
 TEST_P(PoissonSolverTest, LaplaceFillReproducesHarmonicRamps) {
   // A linear ramp is discrete-harmonic inside the image; at the left/top border the Neumann condition holds
-  // for a ramp along the other axis. So I = 3 y + 7 is reproduced in a hole touching the left border, and I =
-  // 2 x − y everywhere in a hole away from the border.
+  // for a ramp along the other axis. So I = 3 y + 7 is reproduced in a hole touching the left border, and
+  // I = 2 x − y everywhere in a hole away from the border.
   const int rows = 64, cols = 80;
   cv::Mat ramp_y(rows, cols, CV_64F), ramp_xy(rows, cols, CV_64F);
   for (int y = 0; y < rows; ++y) {

@@ -96,8 +96,8 @@ Nodes MakeNodes(const Scan& scan) {
   return nodes;
 }
 
-// Neighbour offsets in the order right, down, down-right, down-left (each edge is stored once, at its
-// upper/left end).
+// Neighbour offsets in the order right, down, down-right, down-left (each edge is
+// stored once, at its upper/left end).
 constexpr int kDirRow[4] = {0, 1, 1, 1};
 constexpr int kDirCol[4] = {1, 0, 1, -1};
 
@@ -114,8 +114,8 @@ NLinks ComputeNLinks(const Nodes& nodes, const CutWeights& w, bool eight_connect
   const int n = nodes.num();
   const float lambda[4] = {float(w.lambda_r), float(w.lambda_g), float(w.lambda_b), float(w.lambda_d)};
   for (int d = 0; d < links.directions; ++d) links.weight[d].assign(n, -1.0f);
-  // Pass 1: weighted squared differences, with per-row partial sums so the σ estimate does not depend on
-  // threads.
+  // Pass 1: weighted squared differences, with per-row partial sums so the σ
+  // estimate does not depend on threads.
   std::vector<double> row_sum(nodes.rows, 0.0);
   std::vector<int64_t> row_count(nodes.rows, 0);
   ParallelFor(nodes.rows, [&](int64_t row) {
@@ -848,8 +848,8 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       }
       const NLinks& color_links = s.Links(o.color_step, &s.color_links, &result.timings);
       result.mask = s.RunCut(o.color_step, color_links, seeds, &result, s.Step3Roi(result.step1_mask));
-      // The object reached the ROI's edge: the ROI was too small, cut the whole image (the time of both cuts
-      // is counted).
+      // The object reached the ROI's edge: the ROI was too small, cut the whole image (the
+      // time of both cuts is counted).
       if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
       break;
     }
@@ -877,8 +877,8 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     if (!s.last.local_of_node.empty() && s.last.local_of_node[i] < 0) outside = true;
   }
   if (outside) {
-    // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
-    // cell so far.
+    // A stroke outside the last cut's region of interest: re-run that cut on the whole
+    // image with every hard cell so far.
     result.flow = 0;
     result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
     result.object_cells = cv::countNonZero(result.mask);

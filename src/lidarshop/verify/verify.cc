@@ -367,8 +367,8 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
   icp_box.max().array() += trim;
   const Eigen::Matrix4d model_from_world = world_from_model.inverse();
   const KernelNeighbourGrid& grid = model.kernel_grid;
-  // The grid covers the model's box grown by max(3σ, trim); only points inside near_box (the same box) use
-  // it.
+  // The grid covers the model's box grown by max(3σ, trim); only points inside
+  // near_box (the same box) use it.
   const bool use_grid = grid.built() &&
                         std::abs(grid.kernel.radius_m - kernel_radius) <= 1e-6f * kernel_radius &&
                         std::abs(grid.icp.radius_m - trim) <= 1e-6f * trim;
@@ -434,9 +434,9 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
           Eigen::Vector3f(workspace.near.x[j], workspace.near.y[j], workspace.near.z[j]);
     }
 
-    // Confidence and ICP: the scene points near the model. One kernel search serves both when a model point
-    // lies within 3σ (the usual case for points on the object): the closest one is the ICP nearest neighbour
-    // too.
+    // Confidence and ICP: the scene points near the model. One kernel search serves both when a
+    // model point lies within 3σ (the usual case for points on the object): the closest one is
+    // the ICP nearest neighbour too.
     const float kernel_radius_sq = kernel_radius * kernel_radius;
     workspace.closest_sq.assign(num_near, std::numeric_limits<float>::infinity());
     if (use_grid) {
