@@ -41,8 +41,8 @@ double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) {
   return max_value;
 }
 
-// Masks exercising the special cases of the issue: a hole touching two image borders, several disconnected
-// holes, isolated pixels, a thin one-pixel line.
+// Masks exercising the special cases of a masked domain: a hole touching two image borders, several
+// disconnected holes, isolated pixels, a thin one-pixel line.
 cv::Mat AwkwardMask(int rows, int cols) {
   cv::Mat mask = cv::Mat::zeros(rows, cols, CV_8U);
   cv::rectangle(mask, cv::Rect(0, 0, cols / 3, rows / 4), 255, cv::FILLED);  // top-left corner
@@ -157,7 +157,7 @@ TEST_P(PoissonSolverTest, LaplaceFillReproducesHarmonicRamps) {
 }
 
 TEST_P(PoissonSolverTest, NonFiniteValuesBesideTheHoleAreRefusedNotSpread) {
-  // One NaN pixel next to the hole used to fill the whole hole with NaN (issue #20); NaN inside the hole or
+  // One NaN pixel next to the hole used to fill the whole hole with NaN; NaN inside the hole or
   // far from it is not read and must not matter.
   const int rows = 40, cols = 50;
   cv::Mat image(rows, cols, CV_32F, cv::Scalar(5.0f));
