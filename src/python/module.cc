@@ -15,6 +15,7 @@
 #include "lidarshop/fill/fill.h"
 #include "lidarshop/fill/fill_metrics.h"
 #include "lidarshop/fill/remove.h"
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/inpaint/acceptance.h"
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/io/image_io.h"
@@ -687,8 +688,15 @@ and scans are prepared once, the poses verified in parallel). Keywords: allowanc
 footprint_margin_cells (VerifyOptions, verify/verify.h; defaults from the library).)doc");
   m.def("pose_from_xyz_yaw", &PoseFromXyzYaw, py::arg("x_m"), py::arg("y_m"), py::arg("z_m"),
         py::arg("yaw_deg"), py::arg("pitch_deg") = 0.0, py::arg("roll_deg") = 0.0,
-        "world_from_model (4 x 4) of an object standing on the ground: translate, then yaw about +z "
-        "(degrees).");
+        "world_from_model (4 x 4) of an object standing on the ground: R = Rz(yaw) Ry(pitch) Rx(roll) "
+        "(degrees; roll about x first, yaw turns +x towards +y), then translate by (x_m, y_m, z_m).");
+  m.def(
+      "rotation_from_euler_degrees",
+      [](const Eigen::Vector3d& rotate_deg) { return RotationFromEulerDegrees(rotate_deg); },
+      py::arg("rotate_deg"),
+      "The 3 x 3 rotation R = Rz(yaw) Ry(pitch) Rx(roll) of rotate_deg = [roll, pitch, yaw] = [x, y, z] "
+      "degrees: the one angle convention of lidarshop (scene files' rotate_deg, pose_from_xyz_yaw, verify "
+      "--pose).");
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/timer.h"
+#include "lidarshop/verify/pose_text.h"
 
 namespace lidarshop::cli {
 namespace {
@@ -203,7 +204,8 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--max-intensity", crop.max_intensity, "crop")->capture_default_str();
   app.add_flag("--invert", crop.invert, "crop: keep the points outside instead");
   app.add_option("--matrix", matrix_text,
-                 "transform: 16 comma-separated numbers, row major, new_world_from_world");
+                 "transform: new_world_from_world as 16 comma-separated numbers (row major), "
+                 "x,y,z,yaw_deg[,pitch_deg,roll_deg] or a pose file (as verify --pose)");
   app.add_flag("--grid", grid, "normals: from the scan grid instead of a KD-tree");
   app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")
       ->capture_default_str();
@@ -239,8 +241,7 @@ int RunPoints(int argc, char** argv) {
       throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
     }
     const std::vector<double> box = ParseNumbers(box_text, "--box"),
-                              polygon = ParseNumbers(polygon_text, "--polygon"),
-                              matrix = ParseNumbers(matrix_text, "--matrix");
+                              polygon = ParseNumbers(polygon_text, "--polygon");
     if (!box.empty() && box.size() != 6)
       throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
     if (operation == "sample-mesh") {
@@ -336,9 +337,9 @@ int RunPoints(int argc, char** argv) {
       }
       summary[operation] = total;
     } else if (operation == "transform") {
-      if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
-      const Eigen::Matrix4d new_from_world =
-          Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
+      if (matrix_text.empty()) throw OptionsError("transform needs --matrix");
+      // The one pose parser (verify/pose_text.h): 16 numbers, x,y,z,yaw_deg[,pitch_deg,roll_deg] or a file.
+      const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(matrix_text, "--matrix");
       for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
     } else if (operation == "normals") {
       normals.neighbors = statistical.neighbors;

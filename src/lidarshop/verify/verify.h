@@ -234,8 +234,10 @@ PointCloud SceneStatusCloud(std::span<const PreparedScan> scans, const VerifyRes
 PointCloud ObservedModelCloud(const VerifierModel& model, const Eigen::Matrix4d& world_from_model,
                               const VerifyResult& result);
 
-// world_from_model of an object standing on the ground: translate (x, y, z), then yaw about +z (degrees, x→y
-// counter-clockwise), pitch about the model's x, roll about its y (R = Rz(yaw) * Rx(pitch) * Ry(roll)).
+// world_from_model of an object standing on the ground: rotation R = Rz(yaw) · Ry(pitch) · Rx(roll) (degrees;
+// roll about x first, then pitch about y, then yaw about z; yaw turns +x towards +y), then translation by
+// (x, y, z) metres. R is geometry/transform.h's RotationFromEulerDegrees({roll, pitch, yaw}), the convention
+// of scene files and every other place that takes angles.
 Eigen::Matrix4d PoseFromXyzYaw(double x_m, double y_m, double z_m, double yaw_deg, double pitch_deg = 0.0,
                                double roll_deg = 0.0);
 
