@@ -23,6 +23,7 @@
 
 #include <fmt/format.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // fields (a list of names) in every instantiation
 
 #include "convert.h"
 #include "lidarshop/util/options.h"

@@ -139,7 +139,7 @@ def test_verify_pose(scan):
                                  allowance_m=0.05)
     assert len(many) == 2
     assert many[1].consistency == floating.consistency and many[1].confidence == floating.confidence
-    with pytest.raises(lidarshop.OptionsError, match="unknown verify option 'sigma'"):
+    with pytest.raises(lidarshop.OptionsError, match="sigma"):
         lidarshop.verify_pose(box, scan, truth, sigma=1)
 
 
@@ -183,3 +183,27 @@ def test_point_set_tools(scan):
     np.testing.assert_array_equal(moved.point, scan.point)
     with pytest.raises(lidarshop.OptionsError):
         lidarshop.transform_scan(scan, np.diag([2.0, 2, 2, 1]))
+
+
+def test_sweep_finds_the_box(scan):
+    box = lidarshop.make_primitive("box", {"size": [1.2, 1.2, 1.2]})
+    options = lidarshop.SweepOptions(x_min_m=-1.5, x_max_m=1.5, y_min_m=3.5, y_max_m=6.5, step_m=0.5, z_m=0.6,
+                                     yaws_deg=[0, 45], min_comparable_pairs=20,
+                                     min_confidence=0.2)
+    result = lidarshop.sweep(box, scan, options, verify_options={"allowance_m": 0.05, "sigma_m": 0.05})
+    assert len(result.xs_m) == 7 and len(result.ys_m) == 7 and list(result.yaws_deg) == [0, 45]
+    assert result.confidence_map.shape == (7, 7)
+    assert len(result.poses["x_m"]) == 7 * 7 * 2
+    assert len(result.detections) >= 1
+    best = result.detections[0]
+    assert abs(best.x_m) < 0.15 and abs(best.y_m - 5) < 0.15, best
+    # The grid pose at the truth gives what verify_pose gives there.
+    index = (list(result.ys_m).index(5.0) * 7 + list(result.xs_m).index(0.0)) * 2
+    alone = lidarshop.verify_pose(box, scan, lidarshop.pose_from_xyz_yaw(0, 5, 0.6, 0), allowance_m=0.05,
+                                  sigma_m=0.05)
+    assert result.poses["confidence"][index] == pytest.approx(alone.confidence, abs=1e-12)
+    picture = result.heat_map("consistency", 0.75)
+    assert picture.ndim == 3 and picture.shape[2] == 3 and picture.dtype == np.uint8
+    assert result.csv().count("\n") >= 98
+    with pytest.raises(lidarshop.OptionsError, match="step_m"):
+        lidarshop.sweep(box, scan, step_m=0)

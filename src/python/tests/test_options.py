@@ -6,9 +6,20 @@ import pytest
 
 import lidarshop
 
-OPTION_CLASSES = [lidarshop.FillOptions, lidarshop.RemoveOptions, lidarshop.SegmentOptions,
-                  lidarshop.InpaintOptions, lidarshop.PoissonOptions, lidarshop.AcceptanceOptions,
-                  lidarshop.CutWeights, lidarshop.MeanTestOptions, lidarshop.HistogramTestOptions]
+# Every generated options class (the classes with from_dict); the list below must all be there.
+OPTION_CLASSES = [getattr(lidarshop, name) for name in dir(lidarshop)
+                  if hasattr(getattr(lidarshop, name), "from_dict") and hasattr(getattr(lidarshop, name), "fields")]
+EXPECTED = {"FillOptions", "RemoveOptions", "SegmentOptions", "InpaintOptions", "PoissonOptions",
+            "AcceptanceOptions", "CutWeights", "MeanTestOptions", "HistogramTestOptions", "ScannerOptions",
+            "VerifyOptions", "ModelOptions", "SweepOptions", "ResectionOptions", "RecolorOptions",
+            "StatisticalOutlierOptions", "RadiusOutlierOptions", "CropOptions", "RansacPlaneOptions",
+            "HoughPlaneOptions", "EuclideanClusterOptions", "KMeansOptions", "NormalOptions",
+            "RegionGrowingOptions", "SuperpixelOptions", "IcpOptions", "GlobalAlignOptions", "PhotoOptions",
+            "PtxReadOptions", "E57WriteOptions", "PointViewOptions"}
+
+
+def test_every_described_struct_is_a_class():
+    assert EXPECTED <= {cls.__name__ for cls in OPTION_CLASSES}
 
 
 def test_keywords_and_attributes():

@@ -1,0 +1,160 @@
+"""The point-set toolbox on clouds whose answer is known: planes, blobs, outliers, rigid motions."""
+import numpy as np
+import pytest
+
+import lidarshop
+from conftest import small_scene
+
+
+def rotation_z(deg):
+    a = np.radians(deg)
+    return np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+
+
+@pytest.fixture
+def plane_with_outliers():
+    """2,000 points on z = 0.5 (1 mm noise) and 20 points far off it."""
+    rng = np.random.default_rng(3)
+    plane = np.column_stack([rng.uniform(-2, 2, 2000), rng.uniform(-2, 2, 2000), 0.5 + rng.normal(0, 0.001, 2000)])
+    outliers = rng.uniform(-2, 2, (20, 3)) + np.array([0, 0, 3])
+    return np.vstack([plane, outliers]).astype(np.float32)
+
+
+def blobs(rng, centers, n=300, sigma=0.05):
+    return np.vstack([rng.normal(c, sigma, (n, 3)) for c in centers]).astype(np.float32)
+
+
+def test_outlier_filters(plane_with_outliers):
+    keep = lidarshop.statistical_outlier_inliers(plane_with_outliers, neighbors=10, std_ratio=2.0)
+    assert keep.dtype == bool and keep.shape == (2020,)
+    assert not keep[2000:].any()  # every far point removed
+    assert keep[:2000].mean() > 0.95
+    keep = lidarshop.radius_outlier_inliers(plane_with_outliers, lidarshop.RadiusOutlierOptions(radius_m=0.2))
+    assert not keep[2000:].any() and keep[:2000].mean() > 0.99
+    with pytest.raises(lidarshop.OptionsError, match="radius_m"):
+        lidarshop.radius_outlier_inliers(plane_with_outliers, radius_m=-1)
+
+
+def test_crop_and_random_sample(plane_with_outliers):
+    keep = lidarshop.crop_inliers(plane_with_outliers, box=[[-1, -1, 0], [1, 1, 1]])
+    inside = np.all((plane_with_outliers >= [-1, -1, 0]) & (plane_with_outliers <= [1, 1, 1]), axis=1)
+    np.testing.assert_array_equal(keep, inside)
+    outside = lidarshop.crop_inliers(plane_with_outliers, invert=True, box=[[-1, -1, 0], [1, 1, 1]])
+    np.testing.assert_array_equal(outside, ~inside)
+    triangle = lidarshop.crop_inliers(plane_with_outliers, polygon=[[0, 0], [2, 0], [0, 2]])
+    x, y = plane_with_outliers[:, 0], plane_with_outliers[:, 1]
+    np.testing.assert_array_equal(triangle, (x > 0) & (y > 0) & (x + y < 2))
+    ranged = lidarshop.crop_inliers(plane_with_outliers, max_range_m=1.0)
+    np.testing.assert_array_equal(ranged, np.linalg.norm(plane_with_outliers.astype(np.float64), axis=1) <= 1.0)
+    sample = lidarshop.random_sample_inliers(plane_with_outliers, 100, seed=4)
+    assert sample.sum() == 100
+    np.testing.assert_array_equal(sample, lidarshop.random_sample_inliers(plane_with_outliers, 100, seed=4))
+    assert (sample != lidarshop.random_sample_inliers(plane_with_outliers, 100, seed=5)).any()
+
+
+def test_planes(plane_with_outliers):
+    fit = lidarshop.fit_plane_ransac(plane_with_outliers, distance_threshold_m=0.01)
+    assert abs(abs(fit.normal[2]) - 1) < 1e-3
+    assert abs(abs(fit.offset_m) - 0.5) < 2e-3
+    assert len(fit.inliers) >= 1990 and fit.inliers.max() < 2000
+    assert fit.rms_m < 0.002
+    assert np.abs(fit.distance(plane_with_outliers[:2000])).max() < 0.01
+    # Two planes: the floor and a wall x = 1.
+    rng = np.random.default_rng(1)
+    wall = np.column_stack([np.full(1500, 1.0), rng.uniform(-2, 2, 1500), rng.uniform(0.6, 3, 1500)])
+    both = np.vstack([plane_with_outliers[:2000], wall]).astype(np.float32)
+    for planes in (lidarshop.detect_planes_ransac(both, max_planes=2, distance_threshold_m=0.01),
+                   lidarshop.detect_planes_hough(both, max_planes=2)):
+        assert len(planes) == 2
+        normals = sorted(np.argmax(np.abs(p.normal)) for p in planes)
+        assert normals == [0, 2], [p.normal for p in planes]
+
+
+def test_clusters_and_kmeans():
+    rng = np.random.default_rng(2)
+    centers = np.array([[0, 0, 0], [3, 0, 0], [0, 4, 1]])
+    points = blobs(rng, centers)
+    clusters = lidarshop.euclidean_clusters(points, radius_m=0.3)
+    assert clusters.num_clusters == 3 and sorted(clusters.sizes) == [300, 300, 300]
+    for i in range(3):
+        assert len(set(clusters.labels[i * 300:(i + 1) * 300])) == 1
+    km = lidarshop.kmeans(points, lidarshop.KMeansOptions(clusters=3, seed=7))
+    found = km.centers[np.argsort(km.centers[:, 0] + 10 * km.centers[:, 1])]
+    np.testing.assert_allclose(found, centers[[0, 1, 2]], atol=0.02)
+    assert km.labels.shape == (900,) and km.inertia_m2 > 0
+    with pytest.raises(lidarshop.OptionsError, match="clusters"):
+        lidarshop.kmeans(points, clusters=0)
+
+
+def test_normals_and_features(plane_with_outliers):
+    points = plane_with_outliers[:2000]
+    normals, curvature = lidarshop.estimate_normals(points, neighbors=15, viewpoint=[0, 0, 5])
+    assert normals.shape == (2000, 3) and curvature.shape == (2000,)
+    assert np.median(normals[:, 2]) > 0.999  # up, toward the viewpoint above
+    assert np.median(curvature) < 0.01
+    features = lidarshop.fpfh(points, 0.4)  # about 60 neighbours each
+    assert features.shape == (2000, 33)
+    np.testing.assert_allclose(features.sum(axis=1), 300, rtol=1e-3)
+    # On a plane every pair has the same angles: each histogram puts its mass in few bins.
+    assert np.median(features.max(axis=1)) > 50
+
+
+def test_scan_tools(scan):
+    with_normals = lidarshop.scan_normals(scan, window_cells=2)
+    up = with_normals.normal[(scan.label == 0) & (scan.valid > 0)]
+    assert np.median(up[:, 2]) > 0.98  # the ground faces up (scanner frame = world orientation here)
+    labels, count = lidarshop.superpixels(scan, region_cells=10)
+    assert labels.shape == (scan.rows, scan.cols) and count > 10
+    assert np.all(labels[scan.valid == 0] == -1)
+    regions, count = lidarshop.region_growing(scan, 10.0)
+    assert regions.shape == (scan.rows, scan.cols) and count >= 3
+    # The wall and the ground are separate regions: their largest regions differ.
+    wall = np.bincount(regions[(scan.label == 1) & (regions >= 0)]).argmax()
+    ground = np.bincount(regions[(scan.label == 0) & (regions >= 0)]).argmax()
+    assert wall != ground
+    # A Scan passed as points means its valid points in the world frame.
+    keep = lidarshop.statistical_outlier_inliers(scan)
+    assert keep.shape == (scan.count_valid(),)
+
+
+def test_icp_and_scan_registration():
+    # The box turned 35 degrees shows two faces: they fix x, which the wall and the ground leave free.
+    scene = small_scene()
+    scene["objects"][2]["rotate_deg"] = [0, 0, 35]
+    scan = lidarshop.scan_scene(scene)
+    fixed = scan.points(world=True)
+    motion = np.eye(4)
+    motion[:3, :3] = rotation_z(2.0)
+    motion[:3, 3] = [0.05, -0.03, 0.02]
+    moving = (fixed.astype(np.float64) @ motion[:3, :3].T + motion[:3, 3]).astype(np.float32)
+    result = lidarshop.icp(fixed, moving, max_correspondence_m=0.3)
+    assert result.converged or result.iterations > 0
+    np.testing.assert_allclose(result.fixed_from_moving @ motion, np.eye(4), atol=5e-3)
+    assert result.fitness > 0.9
+    # Scans: the moving scan's pose is off by a small motion; registration brings it back.
+    moved = lidarshop.transform_scan(scan, motion)
+    registered, icp = lidarshop.register_scans(scan, moved, max_correspondence_m=0.3)
+    np.testing.assert_allclose(registered.world_from_scanner, scan.world_from_scanner, atol=5e-3)
+    assert isinstance(icp, lidarshop.IcpResult)
+
+
+def test_global_alignment_then_icp():
+    """Three boxes seen from all sides, the moving copy turned 60° and shifted: no initial guess needed."""
+    rng = np.random.default_rng(5)
+    faces = []
+    for center, size in [((0, 0, 0.5), (1, 2, 1)), ((3, 1, 0.75), (1.5, 1, 1.5)), ((1, 4, 0.3), (2, 0.6, 0.6))]:
+        for _ in range(3000):
+            p = rng.uniform(-0.5, 0.5, 3)
+            axis = rng.integers(3)
+            p[axis] = rng.choice([-0.5, 0.5])
+            faces.append(np.array(center) + p * np.array(size))
+    fixed = np.array(faces, np.float32)
+    motion = np.eye(4)
+    motion[:3, :3] = rotation_z(60)
+    motion[:3, 3] = [2, -1, 0]
+    moving = (fixed.astype(np.float64) @ motion[:3, :3].T + motion[:3, 3]).astype(np.float32)
+    coarse = lidarshop.align_globally(fixed, moving, voxel_m=0.1, normal_radius_m=0.25, feature_radius_m=0.5,
+                                      seed=3)
+    assert coarse.inliers > 10
+    fine = lidarshop.icp(fixed, moving, coarse.fixed_from_moving, max_correspondence_m=0.3)
+    np.testing.assert_allclose(fine.fixed_from_moving @ motion, np.eye(4), atol=1e-2)
