@@ -11,8 +11,8 @@
 #include "lidarshop/fill/range_gradient.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/timer.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/timer.h"
 
 namespace lidarshop {
 

@@ -28,7 +28,6 @@ enum class RenderChannel { kRange, kRgb, kIntensity, kNormals, kLabels, kValid }
 template <>
 const EnumInfo& EnumInfoOf<RenderChannel>();
 
-
 struct RenderOptions {
   RenderChannel channel = RenderChannel::kRange;
   bool legend = false;                // add a colour scale bar / label swatches to the right

@@ -36,8 +36,8 @@ TEST(Scanner, PlaneRangesAndNormalsAreAnalytic) {
   for (double yaw : {0.0, 30.0}) {
     ScannerOptions options = Scanner(60, 80, -40, 40, -60, -10);
     options.rotate_deg = Eigen::Vector3d(0, 0, yaw);
-    const Scan scan =
-        test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
+    const Scan scan = test_scenes::ScanScene(
+        test_scenes::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
     ASSERT_EQ(scan.CountValid(), scan.num_cells());
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
@@ -156,7 +156,8 @@ TEST(Scanner, NoiseStatisticsMatchSigmas) {
   // Orthogonal noise alone does not move the point along its ray (perpendicular,
   // up to float rounding at 10 m).
   options.los_noise_sigma_m = 0;
-  const Scan orthogonal_only = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
+  const Scan orthogonal_only =
+      test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
   double max_along = 0, sum_moved2 = 0;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {

@@ -388,7 +388,8 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
 
 void ScannerOptions::Check() const {
   Validate(*this);
-  CheckOption(position.allFinite() && rotate_deg.allFinite(), "scanner: position and rotate_deg must be finite");
+  CheckOption(position.allFinite() && rotate_deg.allFinite(),
+              "scanner: position and rotate_deg must be finite");
   CheckOption(position.cwiseAbs().maxCoeff() <= kMaxCoordinateM && rotate_deg.cwiseAbs().maxCoeff() <= 1e6,
               fmt::format("scanner: position must be within {} m and rotate_deg within 1e6 degrees",
                           kMaxCoordinateM));

@@ -13,9 +13,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/timer.h"
-#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 

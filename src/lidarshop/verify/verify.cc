@@ -11,11 +11,11 @@
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/footprint_gather.h"
 #include "lidarshop/verify/kernel_grid.h"
-#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
