@@ -4,7 +4,7 @@ scheduler's overhead per task.
     PYTHONPATH=build/release/python python3 bench/batch_scaling.py [--scans 20] [--work DIR]
 
 The scans are the built-in mailbox scene at half resolution (400 x 250) with different noise seeds; the
-pipeline is the issue's two steps: fill the mailbox's cells (default gradient method), then convert to PLY.
+pipeline has two steps: fill the mailbox's cells (default gradient method), then convert to PLY.
 Each mode starts from an empty output folder; its time includes starting the local cluster.
 """
 import argparse

@@ -35,7 +35,9 @@ int main(int argc, char** argv) {
   const std::string host = host_port.substr(0, host_port.find(':'));
   const int port = std::stoi(host_port.substr(host_port.find(':') + 1));
   const std::string token = url.substr(url.find("token=") + 6);
-  const auto api = [&](const std::string& p) { return p + (p.find('?') == std::string::npos ? "?" : "&") + "token=" + token; };
+  const auto api = [&](const std::string& p) {
+    return p + (p.find('?') == std::string::npos ? "?" : "&") + "token=" + token;
+  };
 
   httplib::Client probe(host, port);
   const auto docs = probe.Get(api("/api/docs"));
@@ -60,14 +62,15 @@ int main(int argc, char** argv) {
       for (int i = 0; std::chrono::steady_clock::now() < deadline; ++i) {
         const auto start = std::chrono::steady_clock::now();
         const bool stroke = i % 2 == 1 && i % 10 != 9;
-        const std::string body = fmt::format(R"({{"background": [[{}, {}]], "radius": 0}})", (k * 7 + i) % rows,
-                                             (k * 13 + i * 3) % cols);
+        const std::string body = fmt::format(R"({{"background": [[{}, {}]], "radius": 0}})",
+                                             (k * 7 + i) % rows, (k * 13 + i * 3) % cols);
         const httplib::Result result =
             i % 50 == 49  ? client.Get(api(fmt::format("/api/docs/{}/points", id)))
             : i % 10 == 9 ? client.Get(api(fmt::format("/api/docs/{}/image.png?channel=range", id)))
             : !stroke     ? client.Get(api(fmt::format("/api/docs/{}", id)))
-                          : client.Post(api(fmt::format("/api/docs/{}/strokes", id)), body, "application/json");
-        mine.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+                      : client.Post(api(fmt::format("/api/docs/{}/strokes", id)), body, "application/json");
+        mine.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         ++requests;
         if (!result || result->status != 200) {
           ++errors;
@@ -87,15 +90,16 @@ int main(int argc, char** argv) {
     return latencies_ms.empty() ? 0.0 : latencies_ms[static_cast<size_t>(q * (latencies_ms.size() - 1))];
   };
   const bool lost = version_after - version_before != strokes_ok.load();
-  nlohmann::ordered_json summary = {{"clients", clients},
-                                    {"seconds", seconds},
-                                    {"requests", requests.load()},
-                                    {"requests_per_s", static_cast<double>(requests) / seconds},
-                                    {"errors", errors.load()},
-                                    {"strokes_acknowledged", strokes_ok.load()},
-                                    {"version_growth", version_after - version_before},
-                                    {"lost_edits", lost},
-                                    {"latency_ms", {{"p50", quantile(0.5)}, {"p99", quantile(0.99)}, {"max", quantile(1.0)}}}};
+  nlohmann::ordered_json summary = {
+      {"clients", clients},
+      {"seconds", seconds},
+      {"requests", requests.load()},
+      {"requests_per_s", static_cast<double>(requests) / seconds},
+      {"errors", errors.load()},
+      {"strokes_acknowledged", strokes_ok.load()},
+      {"version_growth", version_after - version_before},
+      {"lost_edits", lost},
+      {"latency_ms", {{"p50", quantile(0.5)}, {"p99", quantile(0.99)}, {"max", quantile(1.0)}}}};
   fmt::print("{}\n", summary.dump(2));
   return errors == 0 && !lost ? 0 : 1;
 }

@@ -1,8 +1,8 @@
-// Patch-based inpainting: per-candidate SSD cost, the bungee fill with each search, OpenCV's inpainting
-// (Telea, Navier-Stokes, xphoto shift-map and FSR) on the same inputs; before the timings, a quality table
-// (PSNR in the hole against the originals of lettera and trashcan) and the accelerated searches' agreement
-// with the exhaustive one. Pictures: set LIDARSHOP_INPAINT_PICTURES=<folder> to write every method's result
-// there.
+// Patch-based inpainting: per-candidate SSD cost, the bungee fill with each search, OpenCV's
+// inpainting (Telea, Navier-Stokes, xphoto shift-map and FSR) on the same inputs; before the timings,
+// a quality table (PSNR in the hole against the originals of lettera and trashcan) and the accelerated
+// searches' agreement with the exhaustive one. Pictures: set LIDARSHOP_INPAINT_PICTURES=<folder> to
+// write every method's result there.
 //
 //   build/<you>/bench/inpaint_bench --benchmark_min_time=0.2
 #include <algorithm>
@@ -172,8 +172,8 @@ void PrintReport() {
                   result.seconds);
     }
     for (const std::string method : {"telea", "ns", "shiftmap", "fsr_fast", "fsr_best"}) {
-      // FSR_BEST needed 685 s on trashcan (572 x 516) in one run here: left out of the report on large
-      // images.
+      // FSR_BEST needed 685 s on trashcan (572 x 516) in one run here: left out
+      // of the report on large images.
       if (method == "fsr_best" && in.rgb8.total() > 200000 &&
           std::getenv("LIDARSHOP_INPAINT_SLOW") == nullptr) {
         std::printf("| %s | OpenCV %s | (skipped: > 10 min; LIDARSHOP_INPAINT_SLOW=1 runs it) | |\n",

@@ -240,8 +240,8 @@ void WritePictures(const std::string& folder, const std::string& gradient_folder
   std::printf("Laplace fill of f16_mask on f16: %s\n", fill.Summary().c_str());
   if (!gradient_folder.empty()) {
     setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
-    // The gradients are of the BGR image and cv::imwrite writes BGR, so the files hold RGB as lidarshop
-    // expects.
+    // The gradients are of the BGR image and cv::imwrite writes BGR, so the files
+    // hold RGB as lidarshop expects.
     cv::Mat gx, gy;
     gradient.gx.convertTo(gx, CV_32FC3);
     gradient.gy.convertTo(gy, CV_32FC3);

@@ -8,8 +8,7 @@
 //   BM_Textures/<kind>               the procedural textures alone, 1,000,000 points per iteration
 //   BM_ScanMesh                      ScanToMesh of the 1000 x 1000 scan (the optional mesh output)
 //   BM_EmbreeSingle                  a plain loop of rtcIntersect1 per ray over TBB chunks, writing t_hit,
-//   ids,
-//                                    normal and uv (what Open3D's RaycastingScene::CastRays does per ray)
+//                                    ids, normal and uv (as Open3D's RaycastingScene::CastRays does per ray)
 //   BM_EmbreePacket16                rtcIntersect16 over 4 x 4 tiles (coherent flag)
 //   BM_EmbreePacket8                 rtcIntersect8 over 2 x 4 tiles (coherent flag)
 //   BM_EmbreeStream                  rtcIntersect1M over bands of 4 rows in tile order (coherent flag)

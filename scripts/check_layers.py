@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks that the module layering of src/lidarshop is what ARCHITECTURE.md and CMake say (issue 11).
+"""Checks that the module layering of src/lidarshop is what ARCHITECTURE.md and CMake say.
 
 For each module folder src/lidarshop/<m>/ with a `lidarshop_add_module(NAME m DEPS ...)` line it compares
   - the includes of its library sources (*.h, *.cc directly in the folder, not *_test.cc: tests may also use the

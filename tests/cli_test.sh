@@ -57,7 +57,7 @@ json_check() {  # json_check NAME FILE PYTHON_EXPRESSION (on `d`, the parsed JSO
   check "$1" python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); assert ($3), 'expression false'" "$2"
 }
 
-# The issue's scene form, with a mesh from the shared data (paths relative to the scene file).
+# The scene form of docs/scene-format.md, with a mesh from the shared data (paths relative to the scene file).
 mkdir -p "$work/scene/meshes"
 cp "$shared/meshes/beetle.obj" "$work/scene/meshes/car.obj"
 cat >"$work/scene/scene.json" <<'JSON'

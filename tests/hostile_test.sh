@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs every case of tests/hostile/cases.txt (issue #20: hostile input) against the `lidarshop` binary, each
+# Runs every case of tests/hostile/cases.txt (hostile input) against the `lidarshop` binary, each
 # with a time limit and an address-space limit, and classifies the outcome per reader:
 #   clean   — a non-zero exit with one line on stderr (or success where the case allows it)
 #   crash   — killed by a signal, or a sanitizer report

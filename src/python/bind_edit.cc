@@ -210,5 +210,4 @@ Returns a FillResult: .scan (the filled Scan, synthesized cells flagged), .fille
       "boundary elsewhere. Returns a PoissonResult.");
 }
 
-
 }  // namespace lidarshop::python

@@ -39,7 +39,8 @@ PointCloud CloudOf(const py::handle& points, const std::string& what) {
 
 py::array_t<float> PointsArray(const std::vector<Eigen::Vector3f>& points) {
   py::array_t<float> array({static_cast<py::ssize_t>(points.size()), py::ssize_t{3}});
-  if (!points.empty()) std::memcpy(array.mutable_data(), points.data(), points.size() * sizeof(Eigen::Vector3f));
+  if (!points.empty())
+    std::memcpy(array.mutable_data(), points.data(), points.size() * sizeof(Eigen::Vector3f));
   return array;
 }
 
@@ -115,9 +116,10 @@ void BindPointSetResults(py::module_& m) {
           },
           py::arg("points"), "Signed distances of points to the plane, metres, float64 (N,).")
       .def("__repr__", [](const PlaneFit& p) {
-        return fmt::format("<lidarshop.PlaneFit normal ({:.4f}, {:.4f}, {:.4f}), offset {:.4f} m, {} inliers, "
-                           "rms {:.4f} m>",
-                           p.normal.x(), p.normal.y(), p.normal.z(), p.offset_m, p.inliers.size(), p.rms_m);
+        return fmt::format(
+            "<lidarshop.PlaneFit normal ({:.4f}, {:.4f}, {:.4f}), offset {:.4f} m, {} inliers, "
+            "rms {:.4f} m>",
+            p.normal.x(), p.normal.y(), p.normal.z(), p.offset_m, p.inliers.size(), p.rms_m);
       });
   py::class_<ClusterResult>(m, "ClusterResult", "Euclidean clusters: a label per point, -1 = noise.")
       .def_property_readonly(
@@ -187,22 +189,26 @@ void BindFilters(py::module_& m) {
         }
         return BoolArray(keep);
       },
-      "True for points with at least min_neighbors others within radius_m (RadiusOutlierOptions). bool (N,).");
+      "True for points with at least min_neighbors others within radius_m (RadiusOutlierOptions). bool "
+      "(N,).");
   m.def(
       "crop_inliers",
-      [](const py::object& points, const py::object& options, const py::object& box, const py::object& polygon,
-         const py::object& origin, const py::kwargs& kwargs) {
+      [](const py::object& points, const py::object& options, const py::object& box,
+         const py::object& polygon, const py::object& origin, const py::kwargs& kwargs) {
         const PointCloud cloud = CloudOf(points);
         CropOptions crop = OptionsOf<CropOptions>(options, kwargs);
         if (!box.is_none()) {
           const auto corners = RowsOf(box, 3, "box");
-          if (corners.size() != 2) throw py::value_error("box: expected [[x_min, y_min, z_min], [x_max, y_max, z_max]]");
+          if (corners.size() != 2)
+            throw py::value_error("box: expected [[x_min, y_min, z_min], [x_max, y_max, z_max]]");
           crop.box = Eigen::AlignedBox3f(corners[0].cast<float>(), corners[1].cast<float>());
         }
         if (!polygon.is_none()) {
-          for (const Eigen::VectorXd& corner : RowsOf(polygon, 2, "polygon")) crop.polygon.push_back(corner.cast<float>());
+          for (const Eigen::VectorXd& corner : RowsOf(polygon, 2, "polygon"))
+            crop.polygon.push_back(corner.cast<float>());
         }
-        if (!origin.is_none()) crop.origin = RowsOf(py::make_tuple(origin), 3, "origin").front().cast<float>();
+        if (!origin.is_none())
+          crop.origin = RowsOf(py::make_tuple(origin), 3, "origin").front().cast<float>();
         crop.Check();
         return BoolArray(CropInliers(cloud, crop));
       },
@@ -309,10 +315,12 @@ void BindShapes(py::module_& m) {
           features = ComputeFpfh(cloud, radius_m);
         }
         py::array_t<float> array({static_cast<py::ssize_t>(features.size()), py::ssize_t{33}});
-        if (!features.empty()) std::memcpy(array.mutable_data(), features.data(), features.size() * sizeof(Fpfh));
+        if (!features.empty())
+          std::memcpy(array.mutable_data(), features.data(), features.size() * sizeof(Fpfh));
         return array;
       },
-      py::arg("points"), py::arg("radius_m"), py::arg("normals") = py::none(), py::arg("normal_radius_m") = 0.0,
+      py::arg("points"), py::arg("radius_m"), py::arg("normals") = py::none(),
+      py::arg("normal_radius_m") = 0.0,
       "Fast point feature histograms, float32 (N, 33), three 11-bin histograms each summing to 100. Normals: "
       "`normals` (N, 3), a Scan's own, or estimated within normal_radius_m (default radius_m / 2).");
 }
@@ -383,8 +391,8 @@ void BindScanTools(py::module_& m) {
         {
           py::gil_scoped_release release;
           const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
-          labels = SegmentByRegionGrowing(scan, region_options, NormalAngleCondition(with_normals, max_angle_deg),
-                                          &count);
+          labels = SegmentByRegionGrowing(scan, region_options,
+                                          NormalAngleCondition(with_normals, max_angle_deg), &count);
         }
         return py::make_tuple(MatToArray(labels), count);
       },
@@ -397,8 +405,8 @@ void BindScanTools(py::module_& m) {
 void BindRegistration(py::module_& m) {
   m.def(
       "icp",
-      [](const py::object& fixed, const py::object& moving, const py::object& initial, const py::object& options,
-         const py::kwargs& kwargs) {
+      [](const py::object& fixed, const py::object& moving, const py::object& initial,
+         const py::object& options, const py::kwargs& kwargs) {
         const PointCloud fixed_cloud = CloudOf(fixed, "fixed"), moving_cloud = CloudOf(moving, "moving");
         const Eigen::Matrix4d start =
             initial.is_none() ? Eigen::Matrix4d::Identity() : ArrayToMatrix(initial, "initial");
@@ -411,7 +419,8 @@ void BindRegistration(py::module_& m) {
       "IcpResult.");
   m.def(
       "align_globally",
-      [](const py::object& fixed, const py::object& moving, const py::object& options, const py::kwargs& kwargs) {
+      [](const py::object& fixed, const py::object& moving, const py::object& options,
+         const py::kwargs& kwargs) {
         const PointCloud fixed_cloud = CloudOf(fixed, "fixed"), moving_cloud = CloudOf(moving, "moving");
         const GlobalAlignOptions align_options = OptionsOf<GlobalAlignOptions>(options, kwargs);
         py::gil_scoped_release release;
@@ -438,7 +447,8 @@ void BindRegistration(py::module_& m) {
         }
         return py::make_tuple(std::move(result.registered), result.icp);
       },
-      py::arg("fixed"), py::arg("moving"), py::arg("options") = py::none(), py::arg("global_align") = py::none(),
+      py::arg("fixed"), py::arg("moving"), py::arg("options") = py::none(),
+      py::arg("global_align") = py::none(),
       "(registered Scan, IcpResult): `moving` with a corrected world_from_scanner. global_align: True or "
       "GlobalAlignOptions for a coarse alignment first (scans whose poses are far off).");
 }

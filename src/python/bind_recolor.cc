@@ -41,7 +41,8 @@ std::vector<PixelPointPair> PixelPointPairsOf(const py::handle& pixels, const py
   const auto pixel = VectorsOf<2>(pixels, "pixels");
   const auto point = VectorsOf<3>(points, "points");
   if (pixel.size() != point.size()) {
-    throw py::value_error(fmt::format("pixels and points: {} pixels but {} points", pixel.size(), point.size()));
+    throw py::value_error(
+        fmt::format("pixels and points: {} pixels but {} points", pixel.size(), point.size()));
   }
   std::vector<PixelPointPair> pairs(pixel.size());
   for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = {pixel[i], point[i]};
@@ -78,8 +79,8 @@ py::dict CorrespondenceDict(const Correspondences& pairs) {
     result["pixels_a"] = VectorsArrayOf<2>(pixel);
     result["pixels_b"] = VectorsArrayOf<2>(pixel_b);
   }
-  result["image_size_px"] =
-      pairs.width_px > 0 ? py::object(py::make_tuple(pairs.width_px, pairs.height_px)) : py::object(py::none());
+  result["image_size_px"] = pairs.width_px > 0 ? py::object(py::make_tuple(pairs.width_px, pairs.height_px))
+                                               : py::object(py::none());
   return result;
 }
 
@@ -141,9 +142,13 @@ camera files (read_camera / write_camera).)doc");
             for (size_t i = 0; i < pixels.size(); ++i) rays[i] = UnprojectPixel(c, pixels[i]);
             return VectorsArrayOf<3>(rays);
           },
-          py::arg("pixels_px"), "Rays of pixels in the camera frame with z = 1 (depth * ray = point), (N, 3).")
+          py::arg("pixels_px"),
+          "Rays of pixels in the camera frame with z = 1 (depth * ray = point), (N, 3).")
       .def(
-          "to_dict", [](const PinholeCamera& c) { return FromJsonValue(nlohmann::ordered_json::parse(CameraToJson(c))); },
+          "to_dict",
+          [](const PinholeCamera& c) {
+            return FromJsonValue(nlohmann::ordered_json::parse(CameraToJson(c)));
+          },
           "The JSON form of camera files.")
       .def_static(
           "from_dict",
@@ -151,8 +156,9 @@ camera files (read_camera / write_camera).)doc");
           py::arg("dict"), "A camera from its JSON form; raises InputError naming the field.")
       .def("__repr__", [](const PinholeCamera& c) {
         const Eigen::Vector3d center = c.center_in_world();
-        return fmt::format("<lidarshop.PinholeCamera {} x {} px, f {:.1f} px, centre ({:.3f}, {:.3f}, {:.3f}) m>",
-                           c.width_px, c.height_px, c.fx_px, center.x(), center.y(), center.z());
+        return fmt::format(
+            "<lidarshop.PinholeCamera {} x {} px, f {:.1f} px, centre ({:.3f}, {:.3f}, {:.3f}) m>",
+            c.width_px, c.height_px, c.fx_px, center.x(), center.y(), center.z());
       });
   m.def("camera_looking_at", &CameraLookingAt, py::arg("eye"), py::arg("target"), py::arg("width_px"),
         py::arg("height_px"), py::arg("horizontal_fov_deg"),
@@ -167,9 +173,12 @@ camera files (read_camera / write_camera).)doc");
 void BindCorrespondences(py::module_& m) {
   m.def(
       "read_correspondences",
-      [](const std::string& path, const Scan* scan) { return CorrespondenceDict(ReadCorrespondences(path, scan)); },
+      [](const std::string& path, const Scan* scan) {
+        return CorrespondenceDict(ReadCorrespondences(path, scan));
+      },
       py::arg("path"), py::arg("scan") = nullptr,
-      "A correspondence file (docs/recolor.md) as a dict: kind ('pixel-point', 'landmark', 'pixel-pixel') and "
+      "A correspondence file (docs/recolor.md) as a dict: kind ('pixel-point', 'landmark', 'pixel-pixel') "
+      "and "
       "its arrays (pixels/points, source/target or pixels_a/pixels_b) and image_size_px. Pairs given by scan "
       "cell need the scan (their world points come from it).");
   m.def(
@@ -199,7 +208,8 @@ void BindResection(py::module_& m) {
            [](const ResectionResult& r) { return "<lidarshop.ResectionResult " + r.Summary() + ">"; });
   m.def(
       "resection",
-      [](const py::object& pixels, const py::object& points, const py::object& options, const py::kwargs& kwargs) {
+      [](const py::object& pixels, const py::object& points, const py::object& options,
+         const py::kwargs& kwargs) {
         const std::vector<PixelPointPair> pairs = PixelPointPairsOf(pixels, points);
         const ResectionOptions resection_options = OptionsOf<ResectionOptions>(options, kwargs);
         py::gil_scoped_release release;
@@ -250,7 +260,8 @@ void BindAlign(py::module_& m) {
       "target_from_source from >= 3 landmark pairs (N, 3) (Umeyama; a similarity with_scale).");
   const auto photo_pairs = [](const py::object& pixels_a, const py::object& pixels_b) {
     const auto a = VectorsOf<2>(pixels_a, "pixels_a"), b = VectorsOf<2>(pixels_b, "pixels_b");
-    if (a.size() != b.size()) throw py::value_error(fmt::format("pixels_a and pixels_b: {} and {} pixels", a.size(), b.size()));
+    if (a.size() != b.size())
+      throw py::value_error(fmt::format("pixels_a and pixels_b: {} and {} pixels", a.size(), b.size()));
     std::vector<PixelPair> pairs(a.size());
     for (size_t i = 0; i < pairs.size(); ++i) pairs[i] = {a[i], b[i]};
     return pairs;
@@ -282,7 +293,8 @@ void BindRecolorScan(py::module_& m) {
       .def_readonly("outside_image", &RecolorResult::outside_image)
       .def_readonly("hidden", &RecolorResult::hidden)
       .def("summary", &RecolorResult::Summary)
-      .def("__repr__", [](const RecolorResult& r) { return "<lidarshop.RecolorResult " + r.Summary() + ">"; });
+      .def("__repr__",
+           [](const RecolorResult& r) { return "<lidarshop.RecolorResult " + r.Summary() + ">"; });
   m.def(
       "recolor",
       [](const Scan& scan, const py::object& photo, const PinholeCamera& camera, const py::object& options,
@@ -338,7 +350,8 @@ void BindRecolorScan(py::module_& m) {
         return photos;
       },
       py::arg("path"),
-      "The photos stored in an E57 file (images2D): a list of dicts with name, projection, image (RGB or None "
+      "The photos stored in an E57 file (images2D): a list of dicts with name, projection, image (RGB or "
+      "None "
       "when its blob does not decode), world_from_camera, camera (a PinholeCamera for pinhole entries, else "
       "None) and why_no_camera.");
 }

@@ -337,11 +337,12 @@ void BindFiles(py::module_& m) {
         return SynthesizeScan(description);
       },
       py::arg("scene"), py::arg("scanner") = py::none(),
-      "Scans a synthetic scene: a scene file's path, a dict of the scene-file form, or the name of a built-in "
-      "scene (builtin_scenes()). scanner: a ScannerOptions replacing the scene's scanner, or a dict of fields "
+      "Scans a synthetic scene: a scene file's path, a dict of the scene-file form, or the name of a "
+      "built-in "
+      "scene (builtin_scenes()). scanner: a ScannerOptions replacing the scene's scanner, or a dict of "
+      "fields "
       "changed in it ({'rows': 300, 'los_noise_sigma_m': 0.005}). Returns a Scan with colour, intensity, "
       "labels, normals and true ranges.");
 }
-
 
 }  // namespace lidarshop::python

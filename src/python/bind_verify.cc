@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
 
@@ -68,9 +69,10 @@ void BindVerifyResults(py::module_& m) {
       .def_readonly("inlier_fraction", &Detection::inlier_fraction)
       .def_readonly("comparable_pairs", &Detection::comparable_pairs)
       .def("__repr__", [](const Detection& d) {
-        return fmt::format("<lidarshop.Detection x {:.2f} m, y {:.2f} m, yaw {:.1f} deg, consistency {:.3f}, "
-                           "confidence {:.3f}>",
-                           d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);
+        return fmt::format(
+            "<lidarshop.Detection x {:.2f} m, y {:.2f} m, yaw {:.1f} deg, consistency {:.3f}, "
+            "confidence {:.3f}>",
+            d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);
       });
   py::class_<SweepResult>(m, "SweepResult", "Consistency and confidence over a grid of poses on the ground.")
       .def_property_readonly(
@@ -106,7 +108,8 @@ void BindVerifyResults(py::module_& m) {
             return MatToArray(RenderHeatMap(values, r, measure, threshold, cell_px));
           },
           py::arg("measure") = "confidence", py::arg("threshold") = -1.0, py::arg("cell_px") = 0,
-          "The heat map as an RGB picture (uint8 (H, W, 3)) with a colour scale, the threshold marked and the "
+          "The heat map as an RGB picture (uint8 (H, W, 3)) with a colour scale, the threshold marked and "
+          "the "
           "detections ringed.");
 }
 
@@ -162,15 +165,22 @@ and scans are prepared once, the poses verified in parallel). options: a VerifyO
         const Prepared prepared = Prepare(mesh, list, model, verify);
         return Sweep(prepared.model, prepared.scans, sweep_options, verify);
       },
-      py::arg("model"), py::arg("scans"), py::arg("options") = py::none(), py::arg("verify_options") = py::none(),
-      py::arg("model_options") = py::none(),
+      py::arg("model"), py::arg("scans"), py::arg("options") = py::none(),
+      py::arg("verify_options") = py::none(), py::arg("model_options") = py::none(),
       R"doc(Verifies a grid of poses world_from_model = pose_from_xyz_yaw(x, y, z_m, yaw) (SweepOptions: ranges,
 step, yaws, thresholds, local refinement) and returns a SweepResult: heat maps, every pose as columns, and the
 detections passing both thresholds after non-maximum suppression.)doc");
-  m.def("pose_from_xyz_yaw", &PoseFromXyzYaw, py::arg("x_m"), py::arg("y_m"), py::arg("z_m"), py::arg("yaw_deg"),
-        py::arg("pitch_deg") = 0.0, py::arg("roll_deg") = 0.0,
-        "world_from_model (4 x 4) of an object standing on the ground: translate, then yaw about +z "
-        "(degrees).");
+  m.def("pose_from_xyz_yaw", &PoseFromXyzYaw, py::arg("x_m"), py::arg("y_m"), py::arg("z_m"),
+        py::arg("yaw_deg"), py::arg("pitch_deg") = 0.0, py::arg("roll_deg") = 0.0,
+        "world_from_model (4 x 4) of an object standing on the ground: R = Rz(yaw) Ry(pitch) Rx(roll) "
+        "(degrees; roll about x first, yaw turns +x towards +y), then translate by (x_m, y_m, z_m).");
+  m.def(
+      "rotation_from_euler_degrees",
+      [](const Eigen::Vector3d& rotate_deg) { return RotationFromEulerDegrees(rotate_deg); },
+      py::arg("rotate_deg"),
+      "The 3 x 3 rotation R = Rz(yaw) Ry(pitch) Rx(roll) of rotate_deg = [roll, pitch, yaw] = [x, y, z] "
+      "degrees: the one angle convention of lidarshop (scene files' rotate_deg, pose_from_xyz_yaw, verify "
+      "--pose).");
 }
 
 }  // namespace lidarshop::python

@@ -11,6 +11,7 @@
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/verify/pose_text.h"
 #include "lidarshop/verify/verify.h"
 
 namespace lidarshop::server {
@@ -51,14 +52,13 @@ std::string MeshBinary(const TriangleMesh& mesh) {
   return bytes;
 }
 
-double Number(const nlohmann::json& pose, const char* key, double fallback) {
-  if (!pose.contains(key)) return fallback;
-  const nlohmann::json& value = pose.at(key);
-  if (!value.is_number() || !std::isfinite(value.get<double>())) {
-    throw OptionsFieldError(fmt::format("pose.{}", key),
-                            fmt::format("expected a number, got {}", value.dump()));
+// The body's "pose" (verify/pose_text.h PoseFromJson); errors name the key as "pose.<key>".
+Eigen::Matrix4d PoseOfBody(const nlohmann::json& body) {
+  try {
+    return PoseFromJson(body.value("pose", nlohmann::json::object()));
+  } catch (const OptionsFieldError& error) {
+    throw OptionsFieldError("pose." + error.key_path(), error.reason());
   }
-  return value.get<double>();
 }
 
 }  // namespace
@@ -130,39 +130,38 @@ void AddVerifyRoutes(State& state) {
              if (!model) return SendError(response, 404, "no such model");
              response.set_content(MeshBinary(model->mesh), "application/octet-stream");
            });
-  // Consistency and confidence of a model at a pose (x_m, y_m, z_m, yaw_deg; world frame) in an open scan.
-  http.Post(R"(/api/docs/(\d+)/verify)", [&state](const httplib::Request& request,
-                                                  httplib::Response& response) {
-    auto document = state.FindDocument(request, response);
-    if (!document) return;
-    const auto body = BodyJson(request, response);
-    if (!body) return;
-    try {
-      const auto model = state.FindModel(body->value("model", 0));
-      if (!model) return SendError(response, 404, "no such model: POST /api/models first");
-      const nlohmann::json pose = body->value("pose", nlohmann::json::object());
-      const Eigen::Matrix4d world_from_model = PoseFromXyzYaw(
-          Number(pose, "x_m", 0), Number(pose, "y_m", 0), Number(pose, "z_m", 0), Number(pose, "yaw_deg", 0));
-      std::shared_ptr<const PreparedScan> prepared;
-      {
-        std::lock_guard lock(document->mutex);
-        if (!document->prepared || document->prepared_version != document->version) {
-          document->prepared = std::make_shared<PreparedScan>(PrepareScan(document->now.scan));
-          document->prepared_version = document->version;
+  // Consistency and confidence of a model at a pose in an open scan: x_m, y_m, z_m, yaw_deg, pitch_deg,
+  // roll_deg or world_from_model (world frame; PoseOfBody).
+  http.Post(
+      R"(/api/docs/(\d+)/verify)", [&state](const httplib::Request& request, httplib::Response& response) {
+        auto document = state.FindDocument(request, response);
+        if (!document) return;
+        const auto body = BodyJson(request, response);
+        if (!body) return;
+        try {
+          const auto model = state.FindModel(body->value("model", 0));
+          if (!model) return SendError(response, 404, "no such model: POST /api/models first");
+          const Eigen::Matrix4d world_from_model = PoseOfBody(*body);
+          std::shared_ptr<const PreparedScan> prepared;
+          {
+            std::lock_guard lock(document->mutex);
+            if (!document->prepared || document->prepared_version != document->version) {
+              document->prepared = std::make_shared<PreparedScan>(PrepareScan(document->now.scan));
+              document->prepared_version = document->version;
+            }
+            prepared = document->prepared;
+          }
+          const VerifyResult result =
+              VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
+          nlohmann::ordered_json json = ToJson(result);
+          json["summary"] = result.BriefReport();
+          SendJson(response, json);
+        } catch (const OptionsError& error) {
+          SendError(response, 400, error.what());
+        } catch (const InputError& error) {
+          SendError(response, 422, error.what());
         }
-        prepared = document->prepared;
-      }
-      const VerifyResult result =
-          VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
-      nlohmann::ordered_json json = ToJson(result);
-      json["summary"] = result.BriefReport();
-      SendJson(response, json);
-    } catch (const OptionsError& error) {
-      SendError(response, 400, error.what());
-    } catch (const InputError& error) {
-      SendError(response, 422, error.what());
-    }
-  });
+      });
 }
 
 }  // namespace lidarshop::server

@@ -12,11 +12,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/photo.h"
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include "lidarshop/testing/scenes.h"
 // After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
 #include <httplib.h>
@@ -308,7 +308,8 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   const int id = OpenBox();
   const std::string recolor = Api(fmt::format("/api/docs/{}/recolor", id));
   EXPECT_EQ(client_->Post(recolor, R"({"pairs": []})", "application/json")->status, 400);  // no photo yet
-  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), "not an image", "image/png")->status, 422);
+  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), "not an image", "image/png")->status,
+            422);
   // A photo of the same scene from beside the scanner, and pairs of scan cells with their true pixels.
   lidarshop::test_scenes::GroundAndBoxOptions scene;
   const PinholeCamera camera = CameraLookingAt({1.0, 0.5, 1.7}, {0, 8, 0.5}, 320, 240, 60);
@@ -317,8 +318,8 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   cv::cvtColor(photo.image, bgr, cv::COLOR_RGB2BGR);
   std::vector<uint8_t> png;
   cv::imencode(".png", bgr, png);
-  const auto uploaded =
-      client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), std::string(png.begin(), png.end()), "image/png");
+  const auto uploaded = client_->Post(Api(fmt::format("/api/docs/{}/photo", id)),
+                                      std::string(png.begin(), png.end()), "image/png");
   ASSERT_EQ(uploaded->status, 200) << uploaded->body;
   EXPECT_EQ(Json(uploaded)["width_px"], 320);
   nlohmann::json pairs = nlohmann::json::array();
@@ -333,9 +334,11 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
     }
   }
   ASSERT_GE(pairs.size(), 12u);
-  EXPECT_EQ(client_->Post(recolor, R"({"pairs": [{"pixel": [1, 1], "cell": [0, 9999]}]})", "application/json")->status,
+  EXPECT_EQ(client_->Post(recolor, R"({"pairs": [{"pixel": [1, 1], "cell": [0, 9999]}]})", "application/json")
+                ->status,
             400);
-  const auto done = Wait(Json(client_->Post(recolor, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")));
+  const auto done =
+      Wait(Json(client_->Post(recolor, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")));
   ASSERT_EQ(done["state"], "done") << done.dump();
   EXPECT_LT(done["result"]["rms_px"].get<double>(), 1.0) << done.dump();
   EXPECT_GT(done["result"]["recolored_count"].get<int>(), 100) << done.dump();

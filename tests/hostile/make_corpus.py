@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Writes the hostile-input corpus of issue #20 into tests/hostile/corpus/ and its case list cases.txt.
+"""Writes the hostile-input corpus into tests/hostile/corpus/ and its case list cases.txt.
 
 Usage: make_corpus.py LIDARSHOP_BINARY   (run from anywhere; rewrites tests/hostile/corpus and cases.txt)
 

@@ -65,8 +65,9 @@ nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
 // Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty.
 void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json);
 
-// Checks an output before any long work: its extension is one of `extensions` (lower case, no dot; empty =
-// any), its folder exists and is writable, and it names no input or other output. OptionsError naming `flag`.
+// Checks an output before any long work: its extension is one of `extensions` (lower case, no dot;
+// empty = any), its folder exists and is writable, and it names no input or other output. Throws
+// OptionsError naming `flag`.
 void CheckOutputFile(const std::string& flag, const std::string& path,
                      const std::vector<std::string>& extensions, const std::vector<std::string>& others);
 
@@ -85,8 +86,8 @@ const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = 
 // header counts, scene complexity, sample and sweep counts are checked against before any allocation.
 void AddQuietFlag(CLI::App& app, bool* quiet);
 
-// Adds a --seed option storing into *seed: a whole number in [0, 2^63) (CLI11 alone would wrap "-1" to the
-// largest seed).
+// Adds a --seed option storing into *seed: a whole number in [0, 2^63) (CLI11 alone would
+// wrap "-1" to the largest seed).
 void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help);
 
 }  // namespace lidarshop::cli

@@ -93,8 +93,8 @@ json VerifyEntry(const std::string& object, const std::string& pose_name, const 
           {"inlier_fraction", result.inlier_fraction}};
 }
 
-// Objects worth verifying stand up from the ground: flat patches (ground, verges, paths) have no pose to
-// check.
+// Objects worth verifying stand up from the ground: flat patches (ground,
+// verges, paths) have no pose to check.
 bool IsStandingObject(const SceneObject& object) {
   if (object.label == 0 || object.mesh.empty()) return false;
   const Eigen::AlignedBox3f bounds = Bounds(TransformMesh(object.mesh, object.world_from_object));
@@ -224,9 +224,9 @@ json RunSegmentStep(const SceneDescription& scene, const Scan& scan, const std::
           {"seconds", result.timings.total_s}};
 }
 
-// Step 4: remove the cut-out object — fill its cells grown by 2 — and score the fill against the scene scanned
-// again without the object (the scanner's noise is a function of the cell and the seed, so every other cell
-// is the same).
+// Step 4: remove the cut-out object — fill its cells grown by 2 — and score the fill against the scene
+// scanned again without the object (the scanner's noise is a function of the cell and the seed, so
+// every other cell is the same).
 json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::string& object_name,
                    const cv::Mat& object_mask, const fs::path& out_dir, Progress* progress) {
   SceneDescription without = scene;

@@ -3,11 +3,11 @@
 //   lidarshop points OPERATION IN... -o OUT [options] [--json FILE|-]
 //   lidarshop register FIXED MOVING -o OUT [--max-distance M] [--json FILE|-]
 //
-// Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations
-// that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep
-// every scan's grid: dropped cells become cells without a return, labels and normals go into the scans'
-// channels. Operations that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world
-// frame.
+// Every input scan is taken in the world frame and the operation sees all of them as one cloud.
+// Operations that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or
+// give normals keep every scan's grid: dropped cells become cells without a return, labels and
+// normals go into the scans' channels. Operations that make new points (voxel, merge) write a plain
+// cloud (.ply / .pcd) in the world frame.
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -32,6 +32,7 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/timer.h"
+#include "lidarshop/verify/pose_text.h"
 
 namespace lidarshop::cli {
 namespace {
@@ -203,7 +204,8 @@ int RunPoints(int argc, char** argv) {
   app.add_option("--max-intensity", crop.max_intensity, "crop")->capture_default_str();
   app.add_flag("--invert", crop.invert, "crop: keep the points outside instead");
   app.add_option("--matrix", matrix_text,
-                 "transform: 16 comma-separated numbers, row major, new_world_from_world");
+                 "transform: new_world_from_world as 16 comma-separated numbers (row major), "
+                 "x,y,z,yaw_deg[,pitch_deg,roll_deg] or a pose file (as verify --pose)");
   app.add_flag("--grid", grid, "normals: from the scan grid instead of a KD-tree");
   app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")
       ->capture_default_str();
@@ -239,13 +241,12 @@ int RunPoints(int argc, char** argv) {
       throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
     }
     const std::vector<double> box = ParseNumbers(box_text, "--box"),
-                              polygon = ParseNumbers(polygon_text, "--polygon"),
-                              matrix = ParseNumbers(matrix_text, "--matrix");
+                              polygon = ParseNumbers(polygon_text, "--polygon");
     if (!box.empty() && box.size() != 6)
       throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
     if (operation == "sample-mesh") {
-      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
-      // normals.
+      // Uniform (area-weighted) samples of a triangle mesh
+      // (pointset/sampling.h), with the triangles' normals.
       if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
       if (FileExtension(output_path) != "ply")
         throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
@@ -336,9 +337,9 @@ int RunPoints(int argc, char** argv) {
       }
       summary[operation] = total;
     } else if (operation == "transform") {
-      if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
-      const Eigen::Matrix4d new_from_world =
-          Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
+      if (matrix_text.empty()) throw OptionsError("transform needs --matrix");
+      // The one pose parser (verify/pose_text.h): 16 numbers, x,y,z,yaw_deg[,pitch_deg,roll_deg] or a file.
+      const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(matrix_text, "--matrix");
       for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
     } else if (operation == "normals") {
       normals.neighbors = statistical.neighbors;

@@ -51,8 +51,8 @@ cv::Mat ReadFloat(const std::string& path) {
   return result;
 }
 
-// Float results go to .exr / .tif(f) as 32-bit; other formats get `integer_depth` (8- or 16-bit, rounded and
-// saturated).
+// Float results go to .exr / .tif(f) as 32-bit; other formats get `integer_depth` (8- or
+// 16-bit, rounded and saturated).
 void WriteResult(const std::string& path, const cv::Mat& image, int integer_depth) {
   const std::string lower = [&] {
     std::string s = path;

@@ -1,9 +1,9 @@
-// lidarshop scan SCENE.json -o OUT.ptx|.ply [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
-// [--stats]
+// lidarshop scan SCENE.json -o OUT.ptx|.ply [--labels L.png] [--mesh M.ply]
+// [--seed N] [--threads N] [--stats]
 //
-// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) with the synthetic
-// scanner and writes it; --stats prints one JSON object on stdout with the counts and the seconds of each
-// stage.
+// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) with the
+// synthetic scanner and writes it; --stats prints one JSON object on stdout with the counts
+// and the seconds of each stage.
 #include <optional>
 
 #include <fmt/format.h>

@@ -187,8 +187,9 @@ int RunVerify(int argc, char** argv) {
   common.Add(app);
   app.add_option(
          "--pose", pose_text,
-         "world_from_model: a file of 4 rows of 4 numbers, 16 comma-separated numbers (row major), or "
-         "x,y,z,yaw_deg[,pitch_deg,roll_deg] (world frame, metres and degrees)")
+         "world_from_model: a file (4 rows of 4 numbers, or JSON), 16 comma-separated numbers (row major), "
+         "or x,y,z,yaw_deg[,pitch_deg,roll_deg] (world frame, metres and degrees; "
+         "R = Rz(yaw)·Ry(pitch)·Rx(roll))")
       ->required();
   app.add_option("--json", json_path,
                  "write the result as JSON (consistency, confidence, comparable_pairs, "

@@ -11,8 +11,8 @@
 #include "lidarshop/fill/range_gradient.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/timer.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/timer.h"
 
 namespace lidarshop {
 
@@ -157,9 +157,9 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   return Inpaint(JointImage(in, structure), in.hole, inpaint, progress);
 }
 
-// Range in Ω = the hole cells with a return, from the Poisson equation with divergence `divergence` (empty =
-// Laplace); returns the channels of `boundary` solved. Cells of Ω cut off from every known range lose their
-// return.
+// Range in Ω = the hole cells with a return, from the Poisson equation with divergence
+// `divergence` (empty = Laplace); returns the channels of `boundary` solved. Cells of Ω cut off
+// from every known range lose their return.
 cv::Mat SolveInHole(const Inputs& in, const FillOptions& options, HoleValues* values, const cv::Mat& boundary,
                     const cv::Mat& guidance_x, const cv::Mat& guidance_y, const EdgeMasks& cuts,
                     int64_t* unanchored) {

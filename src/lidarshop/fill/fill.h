@@ -1,8 +1,8 @@
 // Hole filling in organized scans: remove an object, or complete the surface hidden behind it (thesis ch. 6).
 //
 // A hole is a set of cells of the scan's ray image (CV_8U rows x cols, image orientation, non-zero = fill
-// this cell; returns already there are replaced). The default method works in the gradient domain (thesis
-// 6.4–6.5):
+// this cell; returns already there are replaced). The default method works in the gradient domain
+// (thesis 6.4–6.5):
 //   1. range gradients: forward differences of the range image, one-sided (backward) where the forward
 //      neighbour is in the hole or has no return, 0 where neither neighbour has a return;
 //   2. patch-based inpainting (inpaint/) of a joint image — colour (or intensity), the two range-gradient

@@ -119,8 +119,8 @@ cv::Mat GuidanceDivergence(const cv::Mat& gx_in, const cv::Mat& gy_in, const cv:
 
 cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const EdgeMasks& cuts) {
   const int rows = domain.rows, cols = domain.cols;
-  // Breadth-first from every domain cell next to an anchor through uncut edges; what is not reached is cut
-  // off.
+  // Breadth-first from every domain cell next to an anchor through uncut edges;
+  // what is not reached is cut off.
   cv::Mat reached(rows, cols, CV_8U, cv::Scalar(0));
   std::deque<cv::Point> queue;
   auto linked = [&](int y, int x, int ny, int nx) {

@@ -4,8 +4,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/progress.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/progress.h"
 
 namespace lidarshop {
 

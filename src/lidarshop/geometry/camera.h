@@ -15,8 +15,8 @@
 //   {"width_px": 1024, "height_px": 768, "fx_px": 800, "fy_px": 800, "cx_px": 512, "cy_px": 384,
 //    "skew_px": 0, "distortion": {"k1": 0, "k2": 0, "k3": 0, "p1": 0, "p2": 0},
 //    "world_from_camera": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]],
-//    "units": {"intrinsics": "pixels", "world_from_camera": "metres", "camera_frame": "x right, y down, z
-//    forward"}}
+//    "units": {"intrinsics": "pixels", "world_from_camera": "metres",
+//              "camera_frame": "x right, y down, z forward"}}
 #pragma once
 
 #include <string>
@@ -43,9 +43,9 @@ struct PinholeCamera {
   void Check(const std::string& what = "camera") const;
 };
 
-// An undistorted camera at `eye` looking at `target` (world z up: the image's y runs down along -z), focal
-// length from the horizontal field of view, principal point at the image centre. For scenes, tests and
-// examples.
+// An undistorted camera at `eye` looking at `target` (world z up: the image's y runs down
+// along -z), focal length from the horizontal field of view, principal point at the image
+// centre. For scenes, tests and examples.
 PinholeCamera CameraLookingAt(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width_px,
                               int height_px, double horizontal_fov_deg);
 

@@ -1,8 +1,13 @@
-// Rigid and similarity transforms. Names carry frames: `world_from_model` maps model coordinates to world
-// ones.
+// Rigid and similarity transforms. Names carry frames: `world_from_model` maps
+// model coordinates to world ones.
 //
-// Conventions shared by scene files and the CLI: an object is scaled, then rotated, then translated;
-// `rotate_deg` = [x, y, z] rotates about the fixed axes x, then y, then z, i.e. R = Rz * Ry * Rx.
+// Conventions shared by scene files, the CLI, the server and the Python module: an object is scaled, then
+// rotated, then translated. Rotations given as angles have ONE convention everywhere
+// (RotationFromEulerDegrees below is the only place where angles become a rotation):
+//   R = Rz(yaw) · Ry(pitch) · Rx(roll)
+// roll about x is applied first, then pitch about y, then yaw about z, all about the fixed axes of the outer
+// frame; positive angles turn counter-clockwise seen from the axis' positive end (yaw turns +x towards +y).
+// `rotate_deg` = [x, y, z] = [roll, pitch, yaw] in degrees.
 #pragma once
 
 #include <string>
@@ -14,7 +19,7 @@
 
 namespace lidarshop {
 
-// R = Rz(z) * Ry(y) * Rx(x), angles in degrees.
+// R = Rz(yaw) · Ry(pitch) · Rx(roll) for rotate_deg = [roll, pitch, yaw] = [x, y, z], degrees.
 Eigen::Matrix3d RotationFromEulerDegrees(const Eigen::Vector3d& rotate_deg);
 
 // 4x4 matrix of translate * rotate * scale (scale per axis).
@@ -30,8 +35,8 @@ inline Eigen::Vector3f TransformPoint(const Eigen::Matrix4d& b_from_a, const Eig
       .cast<float>();
 }
 
-// True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is 0 0
-// 0 1.
+// True when the top-left 3x3 is a rotation (orthonormal, det +1) within `tolerance` and the last row is
+// 0 0 0 1.
 bool IsRigid(const Eigen::Matrix4d& transform, double tolerance = 1e-6);
 
 // The largest coordinate or translation (metres) lidarshop accepts: terrestrial scenes span kilometres, so a

@@ -30,8 +30,6 @@ std::string FormatTick(double value, double span) {
 
 }  // namespace
 
-
-
 const std::vector<cv::Vec3b>& ColorMapTable(ColorMap map) {
   static const std::vector<cv::Vec3b> viridis = BuildTable(cv::COLORMAP_VIRIDIS);
   static const std::vector<cv::Vec3b> turbo = BuildTable(cv::COLORMAP_TURBO);

@@ -25,8 +25,8 @@ const EnumInfo& EnumInfoOf<ColorMap>();
 // The 256 RGB colours of `map`, low to high.
 const std::vector<cv::Vec3b>& ColorMapTable(ColorMap map);
 
-// The values between `min_value` (first colour) and `max_value` (last colour), in `unit` (shown on the
-// legend).
+// The values between `min_value` (first colour) and `max_value` (last colour),
+// in `unit` (shown on the legend).
 struct ColorScale {
   double min_value = 0.0;
   double max_value = 1.0;
@@ -34,9 +34,9 @@ struct ColorScale {
   std::string unit;  // e.g. "m"
 };
 
-// A scale from the `low_fraction` and `high_fraction` quantiles of the finite values of `values` (CV_32F)
-// where `mask` (CV_8U, empty = everywhere) is non-zero; robust to a few stray far points. {0, 1} when nothing
-// is valid.
+// A scale from the `low_fraction` and `high_fraction` quantiles of the finite values of `values`
+// (CV_32F) where `mask` (CV_8U, empty = everywhere) is non-zero; robust to a few stray far
+// points. {0, 1} when nothing is valid.
 ColorScale AutoScale(const cv::Mat& values, const cv::Mat& mask, ColorMap map, const std::string& unit,
                      double low_fraction = 0.01, double high_fraction = 0.99);
 

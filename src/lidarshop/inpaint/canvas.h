@@ -2,9 +2,9 @@
 // acceptance) see it: the image being filled, which pixels are known now, which patch centres may serve as
 // sources, and where every filled pixel was copied from.
 //
-// Pixels are addressed as (row, col) in image orientation. A patch of radius R ("half-width") centred at (r,
-// c) covers rows r-R..r+R and cols c-R..c+R, i.e. (2R+1) x (2R+1) pixels; a target patch may stick out of the
-// image (holes touching the border), a source patch never does.
+// Pixels are addressed as (row, col) in image orientation. A patch of radius R ("half-width") centred at
+// (r, c) covers rows r-R..r+R and cols c-R..c+R, i.e. (2R+1) x (2R+1) pixels; a target patch may stick out of
+// the image (holes touching the border), a source patch never does.
 #pragma once
 
 #include <cstdint>

@@ -8,8 +8,8 @@
 namespace lidarshop {
 
 // Filled pixels coloured by the iteration that filled them (blue = first, red = last, "jet" colour map);
-// known pixels show `background` (any image of the same size: 8-bit or float in [0, 255], 1 or 3 channels)
-// darkened.
+// known pixels show `background`, darkened (any image of the same size: 8-bit or float in [0, 255], 1 or
+// 3 channels).
 cv::Mat RenderFillOrder(const InpaintResult& result, const cv::Mat& background);
 
 // Filled pixels coloured by where they were copied from: red = source column / W, green = source row / H,

@@ -3,8 +3,7 @@
 //
 // Per target, with an acceptance hook:
 //   1. the best `acceptance_candidates` (K) sources of the local window (local_window_radius) in ranked
-//   order;
-//      the first that the acceptance accepts is taken;
+//      order; the first that the acceptance accepts is taken;
 //   2. if none passes, the best K of the configured search over the whole image, in ranked order (with the
 //      exhaustive search, pruned: the scan of the image keeps only candidates no worse than the local K-th
 //      best, which gives exactly the image's top K, since the local K are all at or below that bound);

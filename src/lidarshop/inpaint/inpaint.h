@@ -10,10 +10,10 @@
 //          accepted with the largest margin is filled (thesis ch. 7.2).
 //     copy Ψq*'s pixels into the unknown pixels of Ψp; update the front and the priorities near Ψp
 //
-// Criminisi inpainting is {CriminisiPriority, WeightedSsd, ExhaustiveSearch}. Images are plain multi-channel
-// float images (H x W CV_32FC(C)) with a hole mask (H x W CV_8U, non-zero = hole); the hole may touch the
-// image border. Source patches are (2R+1)² patches entirely inside the image and entirely outside the
-// original hole.
+// Criminisi inpainting is {CriminisiPriority, WeightedSsd, ExhaustiveSearch}. Images are plain
+// multi-channel float images (H x W CV_32FC(C)) with a hole mask (H x W CV_8U, non-zero = hole); the
+// hole may touch the image border. Source patches are (2R+1)² patches entirely inside the image and
+// entirely outside the original hole.
 #pragma once
 
 #include <cstdint>

@@ -81,8 +81,8 @@ TEST(InpaintForward, LookaheadFillsWhatGreedyFillsWrongly) {
   EXPECT_TRUE(out_of_order);
 }
 
-// The same image with a 36 x 32 hole: plain Criminisi copies grass into the brick; acceptance with lookahead
-// does not.
+// The same image with a 36 x 32 hole: plain Criminisi copies grass into the brick;
+// acceptance with lookahead does not.
 TEST(InpaintForward, AcceptanceFillsWhatPlainCriminisiFillsWrongly) {
   cv::Mat hole;
   const cv::Mat truth = BrickOverGrass(40, 90, 20, &hole, cv::Rect(30, 4, 36, 32));

@@ -211,8 +211,8 @@ TEST(InpaintSearch, LocalSearchStaysInItsWindow) {
   }
 }
 
-// PatchMatch is approximate: report how often it finds the exhaustive answer and how much worse it is
-// otherwise.
+// PatchMatch is approximate: report how often it finds the exhaustive answer and
+// how much worse it is otherwise.
 TEST(InpaintSearch, PatchMatchAgreementIsReported) {
   // A structured image (stripes + noise) where good matches exist and can be found by propagation.
   cv::Mat image(96, 128, CV_32FC3);

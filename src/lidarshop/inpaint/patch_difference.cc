@@ -29,8 +29,8 @@ struct PreparedRows {
 // The sum's one order, on every SIMD path (lanes code, util/simd.h; no FMA: the file is compiled with
 // -ffp-contract=off and the AVX2 functions are target("avx2") only). Per candidate, four 8-lane accumulators
 // (block index mod 4, which keeps the dependency chains short) get d² with d = s·√w − t·√w (a product, then
-// a difference); the total is ((a0 + a1) + (a2 + a3)) per lane, then lanes j + (j + 4), then (0 + 2) +
-// (1 + 3).
+// a difference); the total is ((a0 + a1) + (a2 + a3)) per lane, then lanes j + (j + 4), then
+// (0 + 2) + (1 + 3).
 LIDARSHOP_LANES_INLINE float Sum4(const lanes::F8* acc) {
   using F4 = float __attribute__((vector_size(16)));
   const lanes::F8 v = (acc[0] + acc[1]) + (acc[2] + acc[3]);
@@ -38,11 +38,11 @@ LIDARSHOP_LANES_INLINE float Sum4(const lanes::F8* acc) {
   return (x[0] + x[2]) + (x[1] + x[3]);
 }
 
-// N adjacent candidates of a row per pass (source patches candidate_step floats apart): the target's weights
-// and values are loaded once per block for all of them; each candidate's sum is in the order above, so it
-// does not depend on N. Early termination every second row: lanes only grow, so partial sums above the bound
-// prove the full sums are above it too; the pass stops when every candidate is out and returns the partial
-// sums.
+// N adjacent candidates of a row per pass (source patches candidate_step floats apart): the target's
+// weights and values are loaded once per block for all of them; each candidate's sum is in the order
+// above, so it does not depend on N. Early termination every second row: lanes only grow, so partial
+// sums above the bound prove the full sums are above it too; the pass stops when every candidate is
+// out and returns the partial sums.
 template <int N>
 LIDARSHOP_LANES_INLINE void SsdBody(const PreparedRows& p, const float* source_top_left,
                                     int64_t candidate_step, float bound, float* out) {

@@ -1,9 +1,9 @@
 // Patch differences: how unlike a source patch is to the known part of a target patch.
 //
-// The interface is split in two so that the per-target work (gathering the target's known pixels and weights)
-// is done once per query and the per-candidate work is a tight loop: PatchDifference::ForTarget() prepares a
-// TargetDifference, whose Evaluate() is called for each candidate source centre (from several threads at
-// once).
+// The interface is split in two so that the per-target work (gathering the target's known pixels and
+// weights) is done once per query and the per-candidate work is a tight loop:
+// PatchDifference::ForTarget() prepares a TargetDifference, whose Evaluate() is called for each candidate
+// source centre (from several threads at once).
 #pragma once
 
 #include <memory>
@@ -21,8 +21,8 @@ class TargetDifference {
   // once the difference is known to exceed `bound`, any value > bound may be returned. Thread-safe.
   virtual float Evaluate(Pixel source, float bound) const = 0;
   // The same for `count` source centres in a row: (source.row, source.col + i) for i in [0, count), all of
-  // them source centres; out[i] gets what Evaluate() would return for each (bit-identical whenever it is <=
-  // bound; any value > bound otherwise). Implementations may share the target's loads between neighbouring
+  // them source centres; out[i] gets what Evaluate() would return for each (bit-identical whenever it is
+  // <= bound; any value > bound otherwise). Implementations may share the target's loads between neighbouring
   // candidates. The default calls Evaluate() per candidate.
   virtual void EvaluateRun(Pixel source, int count, float bound, float* out) const {
     for (int i = 0; i < count; ++i) out[i] = Evaluate({source.row, source.col + i}, bound);
@@ -36,13 +36,12 @@ class PatchDifference {
 };
 
 // Weighted sum of squared differences over the target patch's known pixels inside the image:
-//   SSD(p, q) = Σ_{d : p+d known} Σ_k w_k (I_k(p+d) − I_k(q+d))²       (Criminisi et al. 2004, §3 "d(Ψp,
-//   Ψq)")
-// channel_weights: one weight ≥ 0 per channel, or empty for all 1. Evaluated on (2R+1)·C contiguous floats per
-// patch row in 8-lane vectors (util/simd.h), with early termination checked every second row; EvaluateRun()
-// evaluates four adjacent candidates per pass so that they share the target's loads. `path` chooses the
-// AVX2 or the baseline kernel (AVX2 only if the CPU has it); both sum in one order without FMA, so every
-// evaluation, and so every fill, is bit-identical on either path and any CPU.
+//   SSD(p, q) = Σ_{d : p+d known} Σ_k w_k (I_k(p+d) − I_k(q+d))²   (d(Ψp, Ψq) of Criminisi et al. 2004, §3)
+// channel_weights: one weight ≥ 0 per channel, or empty for all 1. Evaluated on (2R+1)·C contiguous floats
+// per patch row in 8-lane vectors (util/simd.h), with early termination checked every second row;
+// EvaluateRun() evaluates four adjacent candidates per pass so that they share the target's loads. `path`
+// chooses the AVX2 or the baseline kernel (AVX2 only if the CPU has it); both sum in one order without FMA,
+// so every evaluation, and so every fill, is bit-identical on either path and any CPU.
 class WeightedSsd : public PatchDifference {
  public:
   explicit WeightedSsd(std::vector<float> channel_weights = {}, SimdPath path = BestSimdPath());

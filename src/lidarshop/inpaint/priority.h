@@ -24,11 +24,11 @@ class PatchPriority {
   virtual void Update(const InpaintCanvas& canvas, Pixel target, const std::vector<Pixel>& filled) = 0;
   // Priority of a front pixel.
   virtual double Priority(const InpaintCanvas& canvas, Pixel pixel) const = 0;
-  // Pixels whose priority may change when a pixel at distance d (Chebyshev) is filled: d <=
-  // InfluenceRadius().
+  // Pixels whose priority may change when a pixel at distance d (Chebyshev) is filled:
+  // d <= InfluenceRadius().
   virtual int InfluenceRadius(const InpaintCanvas& canvas) const = 0;
-  // Verifies incrementally kept state against a recomputation from scratch; throws std::logic_error on
-  // mismatch.
+  // Verifies incrementally kept state against a recomputation from scratch;
+  // throws std::logic_error on mismatch.
   virtual void CheckConsistency(const InpaintCanvas& canvas) const {}
 };
 
@@ -86,7 +86,7 @@ struct CriminisiPriorityOptions {
 
 // Criminisi, Pérez, Toyama 2004, eq. 1:  P(p) = C(p) · D(p),  D(p) = |∇I⊥_p · n_p| / α  (+ data_floor).
 // ∇I_p is the largest-magnitude image gradient over the known pixels of Ψp, computed by KnownGradient (which
-// never reads hole pixels); n_p is the unit gradient of the Gaussian-blurred hole mask at p (pointing into
+// never reads hole pixels); n_p is the unit gradient of the Gaussian-blurred hole mask at p (it points into
 // the hole).
 class CriminisiPriority : public PatchPriority {
  public:

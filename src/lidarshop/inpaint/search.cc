@@ -11,8 +11,8 @@ namespace lidarshop {
 
 namespace {
 
-// Keeps the k best candidates seen (by CandidateBefore); Bound() is the k-th best difference (infinity until
-// k).
+// Keeps the k best candidates seen (by CandidateBefore); Bound() is the k-th best
+// difference (infinity until k).
 class TopK {
  public:
   explicit TopK(int k) : k_(k) { best_.reserve(k + 1); }

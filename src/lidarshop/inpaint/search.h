@@ -70,10 +70,10 @@ class LocalSearch : public PatchSearch {
   ExhaustiveSearch exhaustive_;
 };
 
-// Local first, then global: the local window's best k set an early-termination bound (divided by global_gain)
-// for the scan of the whole image, and global candidates are ranked by difference·global_gain against local
-// ones. global_gain = 1 gives exactly the exhaustive answer, only faster; > 1 prefers nearby sources
-// (coherence).
+// Local first, then global: the local window's best k set an early-termination bound (divided by
+// global_gain) for the scan of the whole image, and global candidates are ranked by
+// difference·global_gain against local ones. global_gain = 1 gives exactly the exhaustive answer, only
+// faster; > 1 prefers nearby sources (coherence).
 class TwoStepSearch : public PatchSearch {
  public:
   TwoStepSearch(int window_radius, double global_gain)
@@ -98,14 +98,14 @@ struct PatchMatchOptions {
 };
 
 // PatchMatch (Barnes, Shechtman, Finkelstein, Goldman 2009) adapted to the greedy fill, per query:
-//  * propagation: the offsets of already-filled pixels of the target patch (q came from s(q), so the target
-//  may come
-//    from s(q) − (q − p)) and of the patches filled last, plus ±1-pixel moves of the current best;
+//  * propagation: the offsets of already-filled pixels of the target patch (q came from s(q), so the
+//    target may come from s(q) − (q − p)) and of the patches filled last, plus ±1-pixel moves of the
+//    current best;
 //  * random search: samples around the current best at radii max(H, W)·αⁱ down to 1 pixel;
-//  * `random_samples` uniform draws over the image and `local_samples` draws near the target. The random
-//  stream is seeded from (seed, target); the search runs on one
-//    thread, so the fill is a deterministic function of (inputs, seed). It remembers the offsets of its last
-//    answers: use a fresh object per fill.
+//  * `random_samples` uniform draws over the image and `local_samples` draws near the target.
+// The random stream is seeded from (seed, target); the search runs on one thread, so the fill
+// is a deterministic function of (inputs, seed). It remembers the offsets of its last
+// answers: use a fresh object per fill.
 class PatchMatchSearch : public PatchSearch {
  public:
   explicit PatchMatchSearch(PatchMatchOptions options);

@@ -22,11 +22,9 @@ struct E57Image {
   Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
   // Pinhole intrinsics (metres, as E57 stores them); 0 when absent.
   double focal_length_m = 0, pixel_width_m = 0, pixel_height_m = 0, principal_x_px = 0, principal_y_px = 0;
-  // Additions (E57 engineer):
   int width_px = 0, height_px = 0;  // imageWidth / imageHeight as the XML states them
   std::string decode_error;  // why `image` is empty when its blob does not decode (e.g. a zero-filled blob)
-  // Additions (recolouring, issue 14): the blob exactly as stored, so that E57 -> E57 keeps the photo
-  // bit-exact.
+  // The blob exactly as stored, so that E57 -> E57 keeps the photo bit-exact (recolouring reads it back).
   std::vector<uint8_t> encoded;
   std::string encoding;  // "jpeg" or "png" (the blob's element: jpegImage / pngImage)
 };
@@ -55,9 +53,6 @@ E57File ReadE57(const std::string& path);
 // Writes organized scans with pose, intensity, colour, row/column index and invalid state, and the
 // synthesized channel (when present) as the extension field lidarshop:synthesized; atomic.
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
-
-// ---- Additions (E57 engineer)
-// --------------------------------------------------------------------------------
 
 // ReadE57 on the bytes of a file already in memory; `name` is used in error messages (fuzzing, tests,
 // streams).

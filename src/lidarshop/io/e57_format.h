@@ -99,8 +99,8 @@ int BitsForRange(int64_t minimum, int64_t maximum);
 void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, int64_t count, double* out,
                  const std::string& where);
 
-// Bit-packs raw values (integers already offset by nothing: pass the integer itself, minimum is subtracted
-// here).
+// Bit-packs raw values (integers already offset by nothing: pass the integer
+// itself, minimum is subtracted here).
 class BitWriter {
  public:
   explicit BitWriter(int bits) : bits_(bits) {}

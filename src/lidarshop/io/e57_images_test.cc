@@ -1,4 +1,4 @@
-// images2D written by WriteE57 (recolouring, issue 14): photos survive E57 -> E57 bit-exact.
+// images2D written by WriteE57 (the photos recolouring uses): photos survive E57 -> E57 bit-exact.
 #include <gtest/gtest.h>
 
 #include "lidarshop/io/e57.h"

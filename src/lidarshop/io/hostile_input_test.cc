@@ -1,4 +1,4 @@
-// Hostile input (issue #20) at the reader level: sizes come from the bytes, numbers and poses are checked,
+// Hostile input at the reader level: sizes come from the bytes, numbers and poses are checked,
 // counts must agree with the data, and only regular files are read.
 #include <sys/stat.h>
 

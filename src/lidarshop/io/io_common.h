@@ -23,9 +23,9 @@ constexpr int64_t kCellsPerDataByte = 64;
 void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std::string& file,
                        const std::string& place);
 
-// Checks what a reader produced before any algorithm sees it: the pose is rigid (geometry PoseProblem) and
-// every valid point is within kMaxCoordinateM. Throws InputError naming `file`, `place`, the cell and the
-// field.
+// Checks what a reader produced before any algorithm sees it: the pose is rigid (geometry
+// PoseProblem) and every valid point is within kMaxCoordinateM. Throws InputError naming `file`,
+// `place`, the cell and the field.
 void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place);
 
 // After a reader has filled `valid` and `point`: sets range = |point| and direction = point / range of valid
@@ -37,8 +37,8 @@ void FinishScan(Scan* scan, bool fit_grid);
 // An image as CV_8UC3 RGB (grey and RGBA converted, 16-bit scaled down), for mesh textures.
 cv::Mat TextureToRgb8(const cv::Mat& image);
 
-// `value` as an int32 when it is a whole number in range, else `fallback` (no undefined float-to-int casts on
-// hostile input).
+// `value` as an int32 when it is a whole number in range, else `fallback` (no undefined
+// float-to-int casts on hostile input).
 inline int32_t ToInt32(double value, int32_t fallback = -1) {
   return value >= -2147483648.0 && value <= 2147483647.0 &&
                  value == static_cast<double>(static_cast<int64_t>(value))

@@ -189,8 +189,8 @@ TEST(MalformedInputTest, ImagesAndUnknownFormats) {
               AllOf(HasSubstr("missing.ptx"), HasSubstr("cannot open")));
 }
 
-// Truncations and byte flips of valid files: every reader either succeeds or throws InputError, never
-// anything else.
+// Truncations and byte flips of valid files: every reader either succeeds or throws
+// InputError, never anything else.
 TEST(MalformedInputTest, TruncationsAndByteFlipsNeverCrash) {
   TempFolder folder;
   Scan scan = MakeScan(6, 5, /*with_color=*/true);

@@ -22,8 +22,8 @@ MeshFile ReadMeshFile(const std::string& path);
 // ReadMeshFile(path).mesh, for callers that have nowhere to show warnings (they are dropped).
 TriangleMesh ReadMesh(const std::string& path);
 
-// .ply (binary little-endian unless `ascii`). Vertex colours, normals and triangle colours are written if
-// present.
+// .ply (binary little-endian unless `ascii`). Vertex colours, normals and triangle
+// colours are written if present.
 void WriteMesh(const std::string& path, const TriangleMesh& mesh, bool ascii = false);
 
 // .ply points with whatever per-point fields the cloud has (x y z, nx ny nz, red green blue, intensity,

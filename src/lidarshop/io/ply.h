@@ -3,13 +3,13 @@
 // build meshes, point clouds and scans from them.
 //
 // lidarshop's own conventions inside PLY:
-//   vertex:  x y z, nx ny nz, red green blue (uchar), intensity (float), label (int), synthesized (uchar),
-//            true_range (float); for scans also row, col (int, image orientation) and scan (int, index in the
-//            file)
-//   face:    vertex_indices (list uchar int), red green blue (uchar), texcoord (list uchar float: u v per
-//   corner) comments "lidarshop_scan <index> <rows> <cols> <16 numbers: world_from_scanner, row-major>" for
-//   each scan
-//            (the points themselves are in the world frame), "TextureFile <name>" for a mesh texture.
+//   vertex:   x y z, nx ny nz, red green blue (uchar), intensity (float), label (int), synthesized (uchar),
+//             true_range (float); for scans also row, col (int, image orientation) and scan (int, index in
+//             the file)
+//   face:     vertex_indices (list uchar int), red green blue (uchar), texcoord (list uchar float: u v per
+//             corner)
+//   comments  "lidarshop_scan <index> <rows> <cols> <16 numbers: world_from_scanner, row-major>" for each
+//             scan (the points themselves are in the world frame), "TextureFile <name>" for a mesh texture.
 #pragma once
 
 #include <cstdint>
@@ -49,14 +49,14 @@ struct PlyData {
   const PlyElement* Find(const std::string& name) const;
 };
 
-// Reads every element. Throws InputError naming the file, the line (header, ASCII) or byte offset (binary)
-// and the property; element counts that cannot fit in the rest of the file are refused before anything is
-// allocated.
+// Reads every element. Throws InputError naming the file, the line (header, ASCII) or byte
+// offset (binary) and the property; element counts that cannot fit in the rest of the file are
+// refused before anything is allocated.
 PlyData ReadPly(const std::string& path);
 PlyData ParsePly(const std::string& bytes, const std::string& file);
 
-// Writes `data` in its format (ASCII or binary little-endian; big-endian is written as little-endian).
-// Atomic.
+// Writes `data` in its format (ASCII or binary little-endian; big-endian is
+// written as little-endian). Atomic.
 void WritePly(const std::string& path, const PlyData& data);
 
 }  // namespace lidarshop

@@ -5,9 +5,9 @@
 //   line 2      rows                          (points per strip)
 //   line 3      scanner position              x y z (registered, world frame)
 //   lines 4-6   scanner axes                  the world directions of the scanner's x, y and z axes
-//   lines 7-10  4 x 4 matrix, as Leica prints it: the TRANSPOSE of world_from_scanner, i.e. the first three
-//   printed
-//               rows hold the rotation's columns followed by 0, the fourth printed row is "tx ty tz 1".
+//   lines 7-10  4 x 4 matrix, as Leica prints it: the TRANSPOSE of world_from_scanner, i.e. the first
+//               three printed rows hold the rotation's columns followed by 0, the fourth printed row is
+//               "tx ty tz 1".
 //               (A file that prints the usual layout, translation in the 4th column and "0 0 0 1" last, is
 //               recognised by that last row and read as printed.)
 //   points      "x y z intensity" or "x y z intensity r g b", scanner frame, metres, intensity as printed

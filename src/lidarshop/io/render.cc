@@ -10,7 +10,6 @@
 
 namespace lidarshop {
 
-
 void RenderOptions::Check() const {
   // NaN means "from the data"; anything else must be a finite value a colour can stand for.
   for (const auto& [name, value] : {std::pair{"min_value", min_value}, std::pair{"max_value", max_value}}) {

@@ -1,11 +1,11 @@
 // Pictures of a scan's channels: one pixel per ray, in image orientation (row 0 = top = highest elevation,
 // column = scan column), RGB 8-bit, ready for WriteImage.
 //
-//   range      metres from the scanner, perceptual colour map (viridis by default), scaled to the 1-99 %
-//   quantiles intensity  return strength, grey (or any map) over [0, 1] unless given rgb        the scan's
-//   colour (InputError when the scan has none) normals    the normal channel (synthetic scans), or normals
-//   estimated from the neighbouring points, shown as
-//              (n + 1) / 2 in the scanner frame
+//   range      metres from the scanner, perceptual colour map (viridis by default) over the 1-99 % quantiles
+//   intensity  return strength, grey (or any map) over [0, 1] unless min/max are given
+//   rgb        the scan's colour (InputError when the scan has none)
+//   normals    the normal channel (synthetic scans), or normals estimated from the neighbouring points,
+//              shown as (n + 1) / 2 in the scanner frame
 //   labels     distinct colours per object label (InputError when the scan has none)
 //   valid      white where the ray returned, black elsewhere
 // Cells without a return are black in every channel. With `legend`, a colour scale bar (metric channels) or a
@@ -27,7 +27,6 @@ namespace lidarshop {
 enum class RenderChannel { kRange, kRgb, kIntensity, kNormals, kLabels, kValid };
 template <>
 const EnumInfo& EnumInfoOf<RenderChannel>();
-
 
 struct RenderOptions {
   RenderChannel channel = RenderChannel::kRange;

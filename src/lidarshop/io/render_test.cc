@@ -76,8 +76,8 @@ TEST(RenderTest, ValidLabelsNormalsAndMissingChannels) {
   options.channel = RenderChannel::kRgb;
   EXPECT_THROW(RenderScan(scan, options), InputError);
 
-  // Estimated normals of a sphere around the scanner point back at it: -direction, i.e. (n + 1) / 2 < 0.5 in
-  // y.
+  // Estimated normals of a sphere around the scanner point back at it:
+  // -direction, i.e. (n + 1) / 2 < 0.5 in y.
   options.channel = RenderChannel::kNormals;
   scan.valid.setTo(kValid);
   scan.point = scan.direction * 3.0;

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <Eigen/Geometry>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -85,7 +86,7 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
   const Eigen::Vector3d centre =
       count > 0 ? Eigen::Vector3d(sum / count) : Eigen::Vector3d(scanner + Eigen::Vector3d::UnitY());
   const Eigen::Vector3d arm = scanner - centre;
-  const Eigen::Vector3d turned = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * arm;
+  const Eigen::Vector3d turned = RotationFromEulerDegrees(Eigen::Vector3d(0, 0, angle_deg)) * arm;
   PointViewOptions view;
   view.eye_in_world = centre + turned;
   view.target_in_world = centre;

@@ -23,8 +23,8 @@ using namespace io_internal;  // NOLINT: the PLY field helpers
 
 constexpr char kScanComment[] = "lidarshop_scan ";
 
-// ---- PLY: a scan is its valid points in the world frame plus row/col/scan properties and a pose comment
-// ----
+// ---- PLY: a scan is its valid points in the world frame plus row/col/scan
+// properties and a pose comment ----
 
 // A 1 x N scan of the cloud's points (identity pose; (0, 0, 0) is no return), without a grid.
 Scan ScanFromPointCloud(const PointCloud& cloud) {

@@ -23,8 +23,8 @@ using ::testing::Not;
 using testing_io::TempFolder;
 
 // A 6 x 8 scan before a wall at 5 m with an object at 2 m in the middle 2 x 4 cells, one hole (no return) at
-// (0, 0), colour and a tilted pose. `behind` is the wall filled in behind the object and in the hole (9
-// cells), marked synthesized, intensity 0.25.
+// (0, 0), colour and a tilted pose. `behind` is the wall filled in behind the object and in the hole
+// (9 cells), marked synthesized, intensity 0.25.
 struct Layers {
   Scan front;
   Scan behind;

@@ -1,5 +1,5 @@
-// A cursor over an in-memory text buffer for the hand-rolled ASCII readers (PTX, PLY ascii, OBJ, MTL, PCD
-// ascii).
+// A cursor over an in-memory text buffer for the hand-rolled ASCII readers (PTX,
+// PLY ascii, OBJ, MTL, PCD ascii).
 //
 // Numbers are parsed with std::from_chars (locale independent, no allocation), which is what lets the PTX
 // reader run at hundreds of MB/s. The cursor counts lines so that every error names "file: line N: field 'f':

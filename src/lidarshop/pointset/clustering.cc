@@ -9,8 +9,8 @@
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {
@@ -96,8 +96,8 @@ KMeansResult KMeans(const PointCloud& cloud, const KMeansOptions& options) {
   const int k = options.clusters;
   std::mt19937_64 random(options.seed);
   auto uniform = [&]() { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
-  // k-means++: each next centre drawn with probability proportional to the squared distance to the nearest
-  // one.
+  // k-means++: each next centre drawn with probability proportional to the
+  // squared distance to the nearest one.
   KMeansResult result;
   std::vector<double> nearest_sq(cloud.size(), std::numeric_limits<double>::infinity());
   result.centers.push_back(cloud.points[random() % n].cast<double>());

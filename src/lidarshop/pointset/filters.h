@@ -90,8 +90,8 @@ std::vector<uint8_t> RandomSampleInliers(const PointCloud& cloud, int64_t count,
 // scanner frame). Throws OptionsError when `b_from_world` is not rigid.
 Scan TransformScan(const Scan& scan, const Eigen::Matrix4d& b_from_world);
 
-// All clouds in one; an attribute is kept only when every cloud has it. Throws InputError when none has
-// points.
+// All clouds in one; an attribute is kept only when every cloud has it. Throws
+// InputError when none has points.
 PointCloud MergeClouds(const std::vector<PointCloud>& clouds);
 
 }  // namespace lidarshop

@@ -7,8 +7,8 @@
 
 #include "lidarshop/pointset/filters.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 

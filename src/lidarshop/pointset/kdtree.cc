@@ -32,8 +32,8 @@ NearestResult PointKdTree::Nearest(const Eigen::Vector3f& query) const {
 NearestResult PointKdTree::NearestWithin(const Eigen::Vector3f& query, float max_distance) const {
   NearestResult result;
   if (empty()) return result;
-  // A one-element result set whose worst distance starts at the radius: branches beyond it are pruned at
-  // once.
+  // A one-element result set whose worst distance starts at the radius, so that branches beyond the
+  // radius are pruned at once.
   struct Closest {
     float worst;
     uint32_t index = 0;

@@ -1,5 +1,5 @@
-// A 3-D KD-tree over a list of points (nanoflann), built once and queried many times from any number of
-// threads.
+// A 3-D KD-tree over a list of points (nanoflann), built once and queried many
+// times from any number of threads.
 //
 //   PointKdTree tree(points_in_model);                  // #P points, copied; O(P log P)
 //   NearestResult nearest = tree.Nearest(query);         // closest point and its squared distance
@@ -31,8 +31,8 @@ struct NearestResult {
 class PointKdTree {
  public:
   PointKdTree() = default;
-  // Copies the points and builds the tree. `leaf_size` trades build time against query time (nanoflann's
-  // default is 10).
+  // Copies the points and builds the tree. `leaf_size` trades build time against query
+  // time (nanoflann's default is 10).
   explicit PointKdTree(std::vector<Eigen::Vector3f> points, int leaf_size = 10);
   PointKdTree(PointKdTree&&) noexcept;
   PointKdTree& operator=(PointKdTree&&) noexcept;
@@ -49,8 +49,8 @@ class PointKdTree {
 
   // The closest point to `query`; index -1 when empty.
   NearestResult Nearest(const Eigen::Vector3f& query) const;
-  // The closest point within `max_distance` (index -1 when none); faster than Nearest when most queries are
-  // far.
+  // The closest point within `max_distance` (index -1 when none); faster than
+  // Nearest when most queries are far.
   NearestResult NearestWithin(const Eigen::Vector3f& query, float max_distance) const;
   // The k closest points, nearest first (fewer when the tree is smaller). Indices and squared distances.
   void KNearest(const Eigen::Vector3f& query, int k, std::vector<uint32_t>* indices,

@@ -1,5 +1,5 @@
 // Filters, normals, RANSAC planes and clustering on synthetic clouds whose answer is known: a plane with a
-// known normal plus outliers, well-separated blobs with known membership; and the bad inputs of issue #17.
+// known normal plus outliers, well-separated blobs with known membership; bad inputs get clear errors.
 #include <algorithm>
 #include <random>
 

@@ -17,8 +17,8 @@ bool Joined(const Scan& scan, cv::Point a, cv::Point b, double ratio) {
   return std::abs(ra - rb) <= ratio * std::min(ra, rb);
 }
 
-// Breadth-first front from `seed` over cells whose `labels` are kNoLabel; marks them `label`. Returns the
-// count.
+// Breadth-first front from `seed` over cells whose `labels` are kNoLabel; marks
+// them `label`. Returns the count.
 int64_t Grow(const Scan& scan, cv::Point seed, const RegionGrowingOptions& options,
              const GrowCondition& condition, int32_t label, cv::Mat* labels, std::vector<cv::Point>* cells) {
   cells->clear();

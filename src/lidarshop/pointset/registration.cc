@@ -11,8 +11,8 @@
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {

@@ -11,9 +11,9 @@
 
 namespace lidarshop {
 
-// Points spread uniformly over a mesh's surface (area-weighted choice of triangle, uniform barycentric
-// point), so that a model's points do not follow its triangulation (artist meshes put many small triangles on
-// details).
+// Points spread uniformly over a mesh's surface (area-weighted choice of triangle, uniform
+// barycentric point), so that a model's points do not follow its triangulation (artist meshes put
+// many small triangles on details).
 struct SurfaceSamples {
   std::vector<Eigen::Vector3f> points;   // #S positions, the mesh's frame
   std::vector<Eigen::Vector3f> normals;  // #S unit geometric normals of the sampled triangles
@@ -24,10 +24,10 @@ struct SurfaceSamples {
 // conversion to [0, 1)). Degenerate triangles (zero area) are never sampled. An empty mesh gives no samples.
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int64_t count, uint64_t seed);
 
-// Surface variation (Pauly et al. 2002) of every point: λ0 / (λ0 + λ1 + λ2) of the covariance of its
-// neighbours within `radius` (metres), λ0 the smallest eigenvalue. 0 on a plane, up to 1/3 where the shape is
-// isotropic (corners, edges, fine detail). Points with fewer than 3 neighbours get 1/3. `tree` must hold
-// `points`.
+// Surface variation (Pauly et al. 2002) of every point: λ0 / (λ0 + λ1 + λ2) of the covariance of
+// its neighbours within `radius` (metres), λ0 the smallest eigenvalue. 0 on a plane, up to 1/3
+// where the shape is isotropic (corners, edges, fine detail). Points with fewer than 3 neighbours
+// get 1/3. `tree` must hold `points`.
 std::vector<float> SurfaceVariation(const PointKdTree& tree, float radius);
 
 }  // namespace lidarshop

@@ -126,9 +126,9 @@ void ForRows(const Level& level, int first_colour, int last_colour, Op op) {
       kRowGrain);
 }
 
-// One Gauss–Seidel half sweep over the cells of one colour ((y + x) % 2): x = (b + sum of neighbours) /
-// degree. Cells of one colour only read cells of the other, so rows run in parallel and the result is
-// order-free.
+// One Gauss–Seidel half sweep over the cells of one colour ((y + x) % 2): x = (b + sum of
+// neighbours) / degree. Cells of one colour only read cells of the other, so rows run in
+// parallel and the result is order-free.
 void Sweep(const Level& level, int colour, const float* b, float* x) {
   const int64_t stride = level.stride;
   const uint8_t* degree = level.degree.data();

@@ -6,13 +6,12 @@
 // is treated independently and the output keeps the (float) depth and channel count of the input.
 //
 // Boundary handling (natural / Neumann boundary on the image border: no flux leaves the image):
-//   * gradient samples live on the edges between a pixel and its right / lower neighbour; the last column of
-//   gx
-//     and the last row of gy would be edges leaving the image and are 0;
+//   * gradient samples live on the edges between a pixel and its right / lower neighbour; the last column
+//     of gx and the last row of gy would be edges leaving the image and are 0;
 //   * the divergence ignores edges leaving the image, i.e. it treats gx(y, −1), gx(y, W−1), gy(−1, x) and
 //     gy(H−1, x) as 0 whatever the input holds there;
-//   * so the Laplacian of a pixel sums I(n) − I(p) over its in-image 4-neighbours only (3 at an edge, 2 at a
-//   corner).
+//   * so the Laplacian of a pixel sums I(n) − I(p) over its in-image 4-neighbours only (3 at an edge, 2 at
+//     a corner).
 // This is the discretisation of Pérez, Gangnet, Blake, "Poisson Image Editing", SIGGRAPH 2003, eq. 7–8.
 #pragma once
 

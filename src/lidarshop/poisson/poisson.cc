@@ -11,9 +11,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/poisson/multigrid.h"
-#include "lidarshop/util/options.h"
 #include "lidarshop/poisson/operators.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/timer.h"
 

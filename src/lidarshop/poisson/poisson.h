@@ -1,8 +1,8 @@
 // Poisson image editing on a masked domain (Pérez, Gangnet, Blake, "Poisson Image Editing", SIGGRAPH 2003).
 //
-// The domain Ω is the set of non-zero pixels of an H x W CV_8U mask (the "unknown" pixels, e.g. a hole). For
-// every channel we solve the discrete Poisson equation with Dirichlet values from an image on the pixels
-// around Ω:
+// The domain Ω is the set of non-zero pixels of an H x W CV_8U mask (the "unknown" pixels, e.g. a
+// hole). For every channel we solve the discrete Poisson equation with Dirichlet values, taken from an
+// image, on the pixels around Ω:
 //
 //   for p in Ω:  sum_{n in N(p)} (I(n) − I(p)) = f(p),   I(n) = boundary(n) for n not in Ω,
 //
@@ -20,15 +20,14 @@
 //
 // Solvers:
 //   * direct     supernodal sparse Cholesky (CHOLMOD, SuiteSparse) or Eigen's SimplicialLDLT; exact to
-//   rounding.
+//                rounding.
 //   * multigrid  conjugate gradients preconditioned by one geometric multigrid V-cycle on the masked grid
-//   (MGPCG,
-//                McAdams, Sifakis, Teran, "A parallel multigrid Poisson solver for fluids simulation on large
-//                grids", SCA 2010): red-black Gauss–Seidel smoothing parallel over rows, cell-centred
-//                bilinear prolongation and its transpose as restriction, a coarse cell is unknown only when
-//                none of its 2 x 2 children is a known in-image pixel, and a direct solve on the coarsest
-//                level. Time and memory grow with the bounding box of Ω (plus a 1-pixel ring), not with the
-//                image.
+//                (MGPCG, McAdams, Sifakis, Teran, "A parallel multigrid Poisson solver for fluids simulation
+//                on large grids", SCA 2010): red-black Gauss–Seidel smoothing parallel over rows,
+//                cell-centred bilinear prolongation and its transpose as restriction, a coarse cell is
+//                unknown only if none of its 2 x 2 children is a known in-image pixel, and a direct solve on
+//                the coarsest level. Time and memory grow with the bounding box of Ω (plus a 1-pixel ring),
+//                not with the image.
 //
 // Usage:
 //   PoissonSystem system = PreparePoisson(hole_mask);              // once per mask
@@ -109,23 +108,23 @@ class PoissonSystem {
                                       const PoissonLinks& links);
 };
 
-// Analyses `mask` (H x W, CV_8U, non-zero = unknown; 1- or 3-channel accepted, any non-zero channel counts)
-// and prepares the chosen solver. A mask without unknowns is allowed (solving then copies the boundary
-// image). Throws InputError for an empty or wrong-typed mask, or a mask with no known pixel; OptionsError for
-// bad options.
+// Analyses `mask` (H x W, CV_8U, non-zero = unknown; 1- or 3-channel accepted, any non-zero channel
+// counts) and prepares the chosen solver. A mask without unknowns is allowed (solving then copies
+// the boundary image). Throws InputError for an empty or wrong-typed mask, or a mask with no known
+// pixel; OptionsError for bad options.
 PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options = {});
 
 // Edges left out of the equation, as an edge leaving the image is (natural boundary, no flux):
-//   no_data    H x W CV_8U, non-zero = a pixel with no value at all (e.g. a LiDAR cell without a return): every
-//              edge between Ω and it is left out and its boundary value is never read; pixels of Ω are
+//   no_data    H x W CV_8U, non-zero = a pixel with no value at all (e.g. a LiDAR cell without a return):
+//              every edge between Ω and it is left out and its boundary value is never read; pixels of Ω are
 //              unknowns whatever this mask says;
-//   cut_right  H x W CV_8U, non-zero at (y, x) = the edge between (y, x) and (y, x+1) is left out (e.g. a depth
-//              discontinuity: the two sides are solved apart);
+//   cut_right  H x W CV_8U, non-zero at (y, x) = the edge between (y, x) and (y, x+1) is left out (e.g. a
+//              depth discontinuity: the two sides are solved apart);
 //   cut_down   likewise for the edge between (y, x) and (y+1, x).
-// Empty masks leave nothing out. The divergence given to SolvePoisson must leave those edges out too (guidance
-// 0 on them). Every connected part of Ω must still reach a known pixel with data through linked edges, or the
-// matrix is singular and the factorization throws. With any left-out edge at Ω the direct solver is used (the
-// multigrid hierarchy knows only the image border).
+// Empty masks leave nothing out. The divergence given to SolvePoisson must leave those edges out too
+// (guidance 0 on them). Every connected part of Ω must still reach a known pixel with data through linked
+// edges, or the matrix is singular and the factorization throws. With any left-out edge at Ω the direct
+// solver is used (the multigrid hierarchy knows only the image border).
 struct PoissonLinks {
   cv::Mat no_data, cut_right, cut_down;
 };
@@ -143,9 +142,9 @@ struct PoissonResult {
 };
 
 // Solves the system for every channel:
-//   boundary    H x W x n (any depth; CV_64F stays double, everything else is solved in double and returned
-//   as
-//               CV_32F): Dirichlet values are read from the pixels outside Ω; values inside Ω are ignored;
+//   boundary    H x W x n (any depth; CV_64F stays double, everything else is solved in double and
+//               returned as CV_32F): Dirichlet values are read from the pixels outside Ω; values inside Ω
+//               are ignored;
 //   divergence  H x W x n, f in the equation above, or an empty Mat for f = 0 (Laplace); read only inside Ω.
 // Throws InputError when sizes or channel counts differ from the system's, and std::runtime_error when the
 // multigrid solver does not reach the tolerance within max_iterations.
@@ -171,7 +170,7 @@ PoissonResult SeamlessClone(const cv::Mat& source, const cv::Mat& source_mask, c
 // The two halves of SeamlessClone, for reuse of one prepared system:
 //   CloneMaskInTarget  Ht x Wt CV_8U mask of the pasted region (255 inside);
 //   CloneDivergence    Ht x Wt x n divergence of the source gradients placed at `offset` (0 outside the
-//   region).
+//                      region).
 cv::Mat CloneMaskInTarget(const cv::Mat& source_mask, cv::Size target_size, cv::Point offset);
 cv::Mat CloneDivergence(const cv::Mat& source, const cv::Mat& source_mask, cv::Size target_size,
                         cv::Point offset);

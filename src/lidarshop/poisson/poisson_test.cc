@@ -41,8 +41,8 @@ double MaxAbsDiff(const cv::Mat& a, const cv::Mat& b) {
   return max_value;
 }
 
-// Masks exercising the special cases of the issue: a hole touching two image borders, several disconnected
-// holes, isolated pixels, a thin one-pixel line.
+// Masks exercising the special cases of a masked domain: a hole touching two image borders, several
+// disconnected holes, isolated pixels, a thin one-pixel line.
 cv::Mat AwkwardMask(int rows, int cols) {
   cv::Mat mask = cv::Mat::zeros(rows, cols, CV_8U);
   cv::rectangle(mask, cv::Rect(0, 0, cols / 3, rows / 4), 255, cv::FILLED);  // top-left corner
@@ -131,8 +131,8 @@ TEST_P(PoissonSolverTest, ReconstructsAnImageFromItsOwnGradients) {
 
 TEST_P(PoissonSolverTest, LaplaceFillReproducesHarmonicRamps) {
   // A linear ramp is discrete-harmonic inside the image; at the left/top border the Neumann condition holds
-  // for a ramp along the other axis. So I = 3 y + 7 is reproduced in a hole touching the left border, and I =
-  // 2 x − y everywhere in a hole away from the border.
+  // for a ramp along the other axis. So I = 3 y + 7 is reproduced in a hole touching the left border, and
+  // I = 2 x − y everywhere in a hole away from the border.
   const int rows = 64, cols = 80;
   cv::Mat ramp_y(rows, cols, CV_64F), ramp_xy(rows, cols, CV_64F);
   for (int y = 0; y < rows; ++y) {
@@ -157,7 +157,7 @@ TEST_P(PoissonSolverTest, LaplaceFillReproducesHarmonicRamps) {
 }
 
 TEST_P(PoissonSolverTest, NonFiniteValuesBesideTheHoleAreRefusedNotSpread) {
-  // One NaN pixel next to the hole used to fill the whole hole with NaN (issue #20); NaN inside the hole or
+  // One NaN pixel next to the hole used to fill the whole hole with NaN; NaN inside the hole or
   // far from it is not read and must not matter.
   const int rows = 40, cols = 50;
   cv::Mat image(rows, cols, CV_32F, cv::Scalar(5.0f));

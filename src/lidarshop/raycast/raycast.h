@@ -69,9 +69,9 @@ struct RaycastSceneOptions {
   // 663k-triangle benchmark scene tracing speed differed by less than the run-to-run noise, while the build
   // took 0.34 / 0.78 / 1.70 s (bench/results/scanner.md), so "medium" is the default.
   std::string build_quality = "medium";
-  // RTC_SCENE_FLAG_ROBUST: rays through a shared edge of two triangles do not slip through (without it a ray
-  // along a sphere's equator edge missed the front and hit the back; raycast_test). Costs 0-11 % of casting
-  // speed.
+  // RTC_SCENE_FLAG_ROBUST: rays through a shared edge of two triangles do not slip through
+  // (without it a ray along a sphere's equator edge missed the front and hit the back;
+  // raycast_test). Costs 0-11 % of casting speed.
   bool robust = true;
   bool compact = false;  // RTC_SCENE_FLAG_COMPACT: less memory, slower traversal
   void Check() const;
@@ -87,8 +87,8 @@ class RaycastScene {
   RaycastScene(RaycastScene&&) noexcept;
   RaycastScene& operator=(RaycastScene&&) noexcept;
 
-  // Adds a mesh under `id` (>= 0, unique). Throws before Commit() only. The mesh is copied into Embree's
-  // buffers.
+  // Adds a mesh under `id` (>= 0, unique). Throws before Commit() only. The mesh
+  // is copied into Embree's buffers.
   void AddMesh(const TriangleMesh& mesh, int32_t id);
   // Builds the acceleration structure. Casting before Commit() throws.
   void Commit();

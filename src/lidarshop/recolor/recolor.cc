@@ -10,8 +10,8 @@
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 

@@ -3,16 +3,16 @@
 // A scan point takes the photo's colour (bilinear at its projection) only when
 //   1. it lies in front of the camera and projects inside the photo, and
 //   2. the camera sees it: the segment from the point to the camera centre meets no other surface of the
-//   scan.
+//      scan.
 // Otherwise it keeps its own colour. (The thesis's tool let occluded points take the occluder's colour from
 // the photo; here they never change.)
 //
 // Visibility is decided against the scan's own grid mesh (scanner/scan_mesh.h, world frame, edges across
 // depth jumps dropped) with Embree: one ray per photo pixel (or per pixel of a reduced "z-buffer",
 // `zbuffer_scale`) from the camera centre gives the distance to the first surface of the scan seen through
-// that pixel. A point at distance d from the camera is hidden when that first surface is nearer than d −
-// tolerance, which is the segment test of the thesis with the segment's end moved `tolerance` off the point's
-// own surface (tolerance = depth_tolerance_m + relative_depth_tolerance · d). Two safety margins:
+// that pixel. A point at distance d from the camera is hidden when that first surface is nearer than
+// d − tolerance, which is the segment test of the thesis with the segment's end moved `tolerance` off the
+// point's own surface (tolerance = depth_tolerance_m + relative_depth_tolerance · d). Two safety margins:
 //   - `silhouette_margin_px`: the first-surface distance is the minimum over a (2m + 1)² window of z-buffer
 //     pixels. The scan mesh stops at the last cell of an object, up to one scan step short of its true
 //     silhouette; without a margin, points just behind an occluder's edge see the camera through that gap and

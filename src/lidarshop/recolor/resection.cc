@@ -366,9 +366,9 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
       const std::optional<PinholeCamera> refined =
           Refine(result.camera, Select(pairs, result.inlier), options);
       if (!refined) break;  // too few residuals for the free parameters
-      // Keep the refinement only when it is a camera that explains its inliers within the threshold (LM can
-      // run off from a poor start). Its RMS may exceed the DLT's: fixed skew and square pixels fit the noise
-      // less.
+      // Keep the refinement only when it is a camera that explains its inliers within the
+      // threshold (LM can run off from a poor start). Its RMS may exceed the DLT's: fixed skew and
+      // square pixels fit the noise less.
       if (!(refined->fx_px > 0 && refined->fy_px > 0) ||
           !(RmsOfInliers(*refined, pairs, result.inlier) < options.ransac_threshold_px))
         break;

@@ -6,8 +6,7 @@
 //   2. RANSAC over minimal sets of 6 pairs (seeded: same result on any thread count; the loop is serial),
 //      inliers = pairs whose DLT reprojection error is below `ransac_threshold_px`; the DLT is refitted on
 //      the best set's inliers.
-//   3. P = K [R | t] decomposed by an RQ decomposition (K upper triangular with positive diagonal, R a
-//      rotation).
+//   3. P = K [R | t] decomposed by an RQ decomposition (K upper triangular, positive diagonal; R a rotation).
 //   4. Levenberg–Marquardt on the reprojection error of the inliers over focal length(s), principal point,
 //      optionally skew, radial (k1, k2, k3) and tangential (p1, p2) distortion, rotation (angle-axis) and
 //      translation; inliers are then re-selected with the refined camera and the refinement repeated once.
@@ -33,8 +32,8 @@
 
 namespace lidarshop {
 
-// One correspondence: a photo pixel (continuous coordinates, geometry/camera.h) and the world point seen
-// there.
+// One correspondence: a photo pixel (continuous coordinates, geometry/camera.h)
+// and the world point seen there.
 struct PixelPointPair {
   Eigen::Vector2d pixel_px = Eigen::Vector2d::Zero();
   Eigen::Vector3d point_in_world = Eigen::Vector3d::Zero();

@@ -33,8 +33,8 @@ double Median(std::vector<double>* values) {
 
 double WrapAngle(double angle) { return angle - kTwoPi * std::round(angle / kTwoPi); }
 
-// Weighted pool-adjacent-violators: the non-decreasing sequence closest to `values` in weighted least
-// squares.
+// Weighted pool-adjacent-violators: the non-decreasing sequence closest to
+// `values` in weighted least squares.
 std::vector<double> IsotonicIncreasing(const std::vector<double>& values,
                                        const std::vector<double>& weights) {
   struct Block {

@@ -8,9 +8,9 @@
 namespace lidarshop {
 namespace {
 
-// A scan of a sphere of radius 10 around the scanner on a uniform grid, with orthogonal noise `sigma_rad`
-// (radians) on each point's direction, `hole_fraction` of the cells without a return, and whole empty columns
-// and rows.
+// A scan of a sphere of radius 10 around the scanner on a uniform grid, with orthogonal noise
+// `sigma_rad` (radians) on each point's direction, `hole_fraction` of the cells without a return,
+// and whole empty columns and rows.
 Scan SyntheticScan(const ScanGrid& truth, double sigma_rad, double hole_fraction,
                    const std::vector<int>& empty_cols, const std::vector<int>& empty_rows, uint32_t seed) {
   const int rows = static_cast<int>(truth.elevation_rad.size());
@@ -61,8 +61,8 @@ TEST(GridFitTest, NoiseFreeGridIsRecoveredExactly) {
 }
 
 TEST(GridFitTest, NoisyGridWithHolesAndEmptyLines) {
-  // Step 0.01 rad; noise 1 mrad; 40 % of cells empty; empty columns inside and at both ends, empty rows
-  // likewise.
+  // Step 0.01 rad; noise 1 mrad; 40 % of cells empty; empty columns inside and at
+  // both ends, empty rows likewise.
   const ScanGrid truth = UniformGrid(80, 120, -0.6, 0.59, -0.4, 0.39);
   const double sigma = 0.001;
   Scan scan = SyntheticScan(truth, sigma, 0.4, {0, 1, 50, 51, 52, 119}, {0, 30, 79}, 7);

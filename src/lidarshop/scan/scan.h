@@ -9,11 +9,12 @@
 // (cos φ sin θ, cos φ cos θ, sin φ).
 //
 // Channels (cv::Mat, each rows x cols):
-//   direction   CV_32FC3  unit ray direction in the scanner frame, known for EVERY cell (also without a
-//   return) valid       CV_8U     255 = the ray returned, 0 = no return range       CV_32F    metres from the
-//   scanner origin to the point; 0 where invalid point       CV_32FC3  x y z in the scanner frame, metres; 0
-//   where invalid intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid color
-//   CV_8UC3   R G B (RGB order, not OpenCV's BGR); empty when the scan has no colour
+//   direction   CV_32FC3  unit ray direction (scanner frame), known for EVERY cell, also without a return
+//   valid       CV_8U     255 = the ray returned, 0 = no return
+//   range       CV_32F    metres from the scanner origin to the point; 0 where invalid
+//   point       CV_32FC3  x y z in the scanner frame, metres; 0 where invalid
+//   intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid
+//   color       CV_8UC3   R G B (RGB order, not OpenCV's BGR); empty when the scan has no colour
 // Optional channels (empty when absent):
 //   label       CV_32S    object label (synthetic scans); kNoLabel where invalid
 //   normal      CV_32FC3  unit surface normal in the scanner frame (true normals of synthetic scans)
@@ -91,12 +92,11 @@ Scan Clone(const Scan& scan);
 // The scan with only the cells where `keep_mask` (CV_8U, rows x cols, non-zero = keep) is set: every other
 // cell becomes a cell without a return (valid 0, range 0, point 0, intensity 0.5, colour 0, label kNoLabel,
 // normal 0, true_range 0, synthesized 0) but keeps its direction; grid, pose and name are kept. Used to write
-// a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error on a mask of the wrong
-// size or type.
+// a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error when the mask has the
+// wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);
 
-// A scan with every required channel allocated (no returns, directions zero, intensity 0.5) and no optional
-// ones.
+// A scan with every required channel allocated (no returns, directions zero, intensity 0.5), no optional one.
 Scan MakeScan(int rows, int cols, bool with_color = false);
 
 // Throws std::logic_error when a channel has the wrong size or type (programming error, not input error).
@@ -116,8 +116,7 @@ ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_
 // For real scans: fits per-column azimuth and per-row elevation to the valid points' directions (robust to
 // noise: a median per column/row, then a monotone cleanup; columns or rows without any return are
 // interpolated from their neighbours or extrapolated with the median step), fills `direction` of every cell
-// from the fitted grid and stores the grid and its residual in scan->grid. Valid cells keep their measured
-// points.
+// from the fitted grid and stores the grid and its residual in scan->grid. Valid cells keep their points.
 void FitGrid(Scan* scan);
 
 // Points with all per-point channels, valid cells only, in the scanner frame or (world = true) the world
@@ -138,8 +137,8 @@ cv::Mat LabelImage16(const Scan& scan);
 
 // Puts points back along the rays from a changed range image (CV_32F metres, 0 or NaN = no return). Cells
 // that were valid keep their measured ray (point / |point|); other cells use `direction`. Returns the new
-// scan; all other channels are copied. Cells listed in `mark_synthesized` (CV_8U, non-zero) get synthesized =
-// 255.
+// scan; all other channels are copied. Cells listed in `mark_synthesized` (CV_8U, non-zero) get
+// synthesized = 255.
 Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synthesized = cv::Mat());
 
 }  // namespace lidarshop

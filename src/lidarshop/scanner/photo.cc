@@ -10,8 +10,8 @@
 #include "lidarshop/scanner/shade.h"
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 

@@ -95,7 +95,8 @@ TEST(Photo, RefusesABrokenCamera) {
   EXPECT_THROW(RenderPhoto(test_scenes::MakeGroundAndBoxScene(), camera), InputError);
   PhotoOptions options;
   options.samples_per_axis = 0;
-  EXPECT_THROW(RenderPhoto(test_scenes::MakeGroundAndBoxScene(), CameraBesideScanner(), options), OptionsError);
+  EXPECT_THROW(RenderPhoto(test_scenes::MakeGroundAndBoxScene(), CameraBesideScanner(), options),
+               OptionsError);
 }
 
 }  // namespace

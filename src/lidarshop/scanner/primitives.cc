@@ -30,8 +30,8 @@ class MeshBuilder {
     mesh_.triangles.emplace_back(a, b, c);
     if (with_colors_) mesh_.triangle_colors.push_back(color);
   }
-  // A flat convex polygon (corners in order, either winding), oriented so that its normal points along
-  // `outward`.
+  // A flat convex polygon (corners in order, either winding), oriented so that its
+  // normal points along `outward`.
   void AddPolygon(std::vector<Vector3d> corners, const Vector3d& outward, Rgb8 color) {
     if (corners.size() < 3) return;
     Vector3d normal = Vector3d::Zero();

@@ -1,6 +1,6 @@
-// Procedural meshes for scene descriptions: the analytic primitives (plane, box, sphere, cylinder, cone) and
-// the man-made objects of the built-in scenes (cars, a lamp post, an electric box, a mailbox, a façade, a
-// wall).
+// Procedural meshes for scene descriptions: the analytic primitives (plane, box, sphere,
+// cylinder, cone) and the man-made objects of the built-in scenes (cars, a lamp post, an electric
+// box, a mailbox, a façade, a wall).
 //
 // Frames and units: metres, object frame z up. The analytic primitives are centred at their origin (plane:
 // normal +z, `size` = x, y extents; box: `size` = x, y, z extents; cylinder and cone: axis +z, z in [-h/2,
@@ -60,9 +60,9 @@ TriangleMesh MakeLampPostMesh(double height = 6.0, int segments = 24);
 TriangleMesh MakeElectricBoxMesh(Rgb8 paint = Rgb8(118, 138, 112));
 // A US-style mailbox on a wooden post: box with a rounded top (0.5 m long), a red flag; about 1.25 m high.
 TriangleMesh MakeMailboxMesh(Rgb8 paint = Rgb8(60, 62, 66), int segments = 24);
-// A building façade: a slab of `width` x `height` (x, z) and `depth` (y, behind the front face at y = 0),
-// with `floors` rows of `windows_per_floor` recessed windows (glass set back 0.15 m, dark blue-grey) and a
-// door.
+// A building façade: a slab of `width` x `height` (x, z) and `depth` (y, behind the front face
+// at y = 0), with `floors` rows of `windows_per_floor` recessed windows (glass set back 0.15
+// m, dark blue-grey) and a door.
 struct FacadeMeshOptions {
   double width = 20.0;  // metres along x
   double height = 9.0;  // metres along z

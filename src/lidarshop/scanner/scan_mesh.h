@@ -1,6 +1,6 @@
-// A triangle mesh of an organized scan: adjacent valid cells are joined (two triangles per 2 x 2 block of
-// cells), and edges across depth discontinuities are dropped, so that separate objects do not get joined by
-// long "skirts".
+// A triangle mesh of an organized scan: adjacent valid cells are joined (two triangles per 2 x 2
+// block of cells), and edges across depth discontinuities are dropped, so that separate objects do
+// not get joined by long "skirts".
 //
 // An edge between neighbouring cells a and b is kept when |r_a - r_b| <= max_range_jump_ratio * min(r_a, r_b)
 // (ranges in metres). Triangles face the scanner (counter-clockwise as seen from the scanner origin).

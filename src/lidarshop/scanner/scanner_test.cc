@@ -36,8 +36,8 @@ TEST(Scanner, PlaneRangesAndNormalsAreAnalytic) {
   for (double yaw : {0.0, 30.0}) {
     ScannerOptions options = Scanner(60, 80, -40, 40, -60, -10);
     options.rotate_deg = Eigen::Vector3d(0, 0, yaw);
-    const Scan scan =
-        test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
+    const Scan scan = test_scenes::ScanScene(
+        test_scenes::MakeSingleObjectScene(MakePlaneMesh({400, 400}), 7, options), options);
     ASSERT_EQ(scan.CountValid(), scan.num_cells());
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
@@ -153,10 +153,11 @@ TEST(Scanner, NoiseStatisticsMatchSigmas) {
   // Direction uniform in the perpendicular plane: equal energy along both perpendicular axes.
   EXPECT_NEAR(sum_b1 / sum_b2, 1.0, 0.05);
   (void)max_dot;
-  // Orthogonal noise alone does not move the point along its ray (perpendicular, up to float rounding at 10
-  // m).
+  // Orthogonal noise alone does not move the point along its ray (perpendicular,
+  // up to float rounding at 10 m).
   options.los_noise_sigma_m = 0;
-  const Scan orthogonal_only = test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
+  const Scan orthogonal_only =
+      test_scenes::ScanScene(test_scenes::MakeSingleObjectScene(wall, 1, options), options);
   double max_along = 0, sum_moved2 = 0;
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
@@ -273,10 +274,10 @@ TEST(Scanner, FusedPacketPathMatchesTheSingleRayPath) {
   EXPECT_GT(compared, 1000);
 }
 
-// The two SIMD paths of the shading (scanner/shade.h) give the same scan, bit for bit: the parking lot with
-// noise, procedural textures and curved (per-cell) car bodies, on a grid whose rows and columns are not
-// multiples of the band (4) and of the SIMD width (8). On a CPU without AVX2 both runs take the baseline
-// path.
+// The two SIMD paths of the shading (scanner/shade.h) give the same scan, bit for bit: the
+// parking lot with noise, procedural textures and curved (per-cell) car bodies, on a grid whose
+// rows and columns are not multiples of the band (4) and of the SIMD width (8). On a CPU without
+// AVX2 both runs take the baseline path.
 TEST(Scanner, BaselineAndAvx2ShadingGiveIdenticalScans) {
   SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/scenes/parking_lot.json");
   scene.scanner.rows = 237;

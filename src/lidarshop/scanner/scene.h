@@ -1,18 +1,16 @@
 // Scene descriptions of the synthetic scanner: objects (meshes in their own frame, a pose, a label, a
-// material) and the scanner's settings, read from JSON (docs/scene-format.md has every key, unit and
-// default).
+// material) and the scanner's settings, read from JSON (docs/scene-format.md has every key, unit, default).
 //
 //   {"scanner": {"position": [0, 0, 1.5], "rotate_deg": [0, 0, 0], "azimuth_deg": [-45, 45],
 //                "elevation_deg": [-30, 30], "columns": 900, "rows": 600, "max_range": 100,
 //                "los_noise_sigma": 0.0, "orthogonal_noise_sigma": 0.0, "seed": 1},
 //    "objects": [{"primitive": "plane", "size": [200, 200], "label": 0, "texture": "grass"},
-//                {"mesh": "meshes/car.obj", "scale": 4.2, "rotate_deg": [90, 0, 30], "translate": [0, 15,
-//                0]}]}
+//                {"mesh": "meshes/car.obj", "scale": 4.2, "rotate_deg": [90, 0, 30],
+//                 "translate": [0, 15, 0]}]}
 //
 // Transforms: an object is scaled, then rotated (R = Rz * Ry * Rx of `rotate_deg` = [x, y, z] degrees about
 // fixed axes), then translated; or given as a 4x4 `matrix` (row-major rows). The scanner's `rotate_deg`
-// orients its frame (z up, y forward, x right) in the world the same way; `position` is its origin in the
-// world.
+// orients its frame (z up, y forward, x right) in the world the same way; `position` is its world origin.
 #pragma once
 
 #include <cstdint>

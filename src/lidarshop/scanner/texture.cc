@@ -8,8 +8,8 @@
 
 #include "lidarshop/scanner/texture_lanes.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/simd.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/simd.h"
 
 namespace lidarshop {
 
@@ -101,7 +101,6 @@ TextureKind ParseTextureKind(const std::string& name, const std::string& what) {
     ThrowInputError(what, "", "texture", error.what());
   }
 }
-
 
 Rgb8 DefaultTextureColor(TextureKind kind) {
   switch (kind) {

@@ -17,8 +17,8 @@
 #include <Eigen/Core>
 
 #include "lidarshop/geometry/mesh.h"
-#include "lidarshop/util/simd.h"
 #include "lidarshop/util/options_fwd.h"
+#include "lidarshop/util/simd.h"
 
 namespace lidarshop {
 

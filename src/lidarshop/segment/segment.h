@@ -10,31 +10,27 @@
 //   E(l) = Σ_p D_p(l_p) + γ Σ_{p~q} w_pq [l_p ≠ l_q]
 //   w_pq = exp(−‖I_p − I_q‖² / 2σ²) / dist(p, q),  ‖I_p − I_q‖² = Σ_c λ_c (I_pc − I_qc)²,
 // where I_c are the channels R, G, B, range, each standardized over the valid cells of the image (zero mean,
-// unit standard deviation), λ_c the per-channel weights and σ² = sigma_scale² · mean over all n-links of ‖I_p
-// − I_q‖² (σ estimated from the image; only the ratios of the λ_c matter). dist = 1 for 4-neighbours, √2 for
-// diagonals. D_p(l) = −α_c log P_l(rgb_p) − α_d log P_l(range_p) (+ a constant foreground bias), with the
+// unit standard deviation), λ_c the per-channel weights and σ² = sigma_scale² · mean over all n-links of
+// ‖I_p − I_q‖² (σ estimated from the image; only the ratios of the λ_c matter). dist = 1 for 4-neighbours, √2
+// for diagonals. D_p(l) = −α_c log P_l(rgb_p) − α_d log P_l(range_p) (+ a constant foreground bias), with the
 // foreground and background models learnt from the stroke cells (histograms or Gaussian mixtures, each mixed
 // with a uniform density so that unseen values stay possible; the background model gives the uniform part
 // more weight because the background is "everything else"). Stroke cells are hard constraints.
 //
 // Two-step method (SegmentMethod::kTwoStep):
-//   1. depth-dominant cut (λ_d ≫ λ_rgb, plus a foreground bias): a strict subset of the object — sharp where
-//   the
-//      object stands out in depth, nothing where it meets the ground;
+//   1. depth-dominant cut (λ_d ≫ λ_rgb, plus a foreground bias): a strict subset of the object — sharp
+//      where the object stands out in depth, nothing where it meets the ground;
 //   2. background inference: dilate the step-1 object by `ring_radius_cells`; a valid ring cell becomes
-//   background
-//      where its range differs from the nearest step-1 object cell by more than `ring_depth_threshold_m` (+ a
-//      fraction of the range), so cells at the ground contact stay undecided;
+//      background where its range differs from the nearest step-1 object cell by more than
+//      `ring_depth_threshold_m` (+ a fraction of the range), so cells at the ground contact stay undecided;
 //   3. colour-dominant cut seeded with the step-1 object (hard object) and the inferred background + the
-//   user's
-//      background strokes (hard background); models re-learnt from those seeds.
+//      user's background strokes (hard background); models re-learnt from those seeds.
 // Baselines (single cut, the same machinery): kDepth (step 1's weights alone), kColor (step 3's weights from
 // the strokes alone) and kRgbd (standardized λ = 1/3, 1/3, 1/3, 1).
 //
 // Refinement: SegmentSession keeps the last cut's graph. Refine() with extra strokes turns the stroke cells
 // into hard constraints of that graph and re-runs the max-flow reusing the search trees (BK `reuse_trees`),
-// so the cost is proportional to the change, not to the image. Models, n-links and the step-1 result are
-// kept.
+// so the cost is proportional to the change, not to the image. Models, n-links and the step-1 result stay.
 #pragma once
 
 #include <cstdint>

@@ -3,19 +3,19 @@
 // segment.h).
 //
 // PNG (any size-matched 8-bit RGB or RGBA image, row 0 = top of the scan image): a cell is an OBJECT stroke
-// when it is saturated green (G >= 160, R <= 96, B <= 96) and a BACKGROUND stroke when saturated red (R >=
-// 160, G <= 96, B <= 96); everything else — black, transparent (alpha < 128), or the scan's own picture — is
-// no stroke. Paint on a blank layer when the scan's picture itself has saturated greens or reds.
+// when it is saturated green (G >= 160, R <= 96, B <= 96) and a BACKGROUND stroke when saturated red
+// (R >= 160, G <= 96, B <= 96); everything else — black, transparent (alpha < 128), or the scan's own picture
+// — is no stroke. Paint on a blank layer when the scan's picture itself has saturated greens or reds.
 //
 // JSON polylines in grid coordinates:
 //   {"strokes": [
 //      {"label": "object",     "width": 3, "points": [[col, row], [col, row], ...]},
 //      {"label": "background", "points": [[120, 40], [180, 42]]}
 //   ]}
-// `label` is "object" (alias "foreground") or "background"; `points` holds one or more [col, row] pairs
-// (numbers; col = x to the right, row = y down from the top row), joined by straight segments; `width` is the
-// line thickness in cells (default 1, 1..255). Points must lie inside the image. Later strokes paint over
-// earlier ones.
+// `label` is "object" (alias "foreground") or "background"; `points` holds one or more [col, row]
+// pairs (numbers; col = x to the right, row = y down from the top row), joined by straight segments;
+// `width` is the line thickness in cells (default 1, 1..255). Points must lie inside the image. Later
+// strokes paint over earlier ones.
 #pragma once
 
 #include <string>

@@ -1,9 +1,9 @@
 // Synthetic scenes shared by the tests of every module: small scenes whose truth is known, built in code or
 // read from the built-in data/scenes/*.json, and scanned with the synthetic scanner (scanner/scanner.h).
 //
-//   SceneDescription scene = MakeGroundAndBoxScene();          // ground (label 0) + a box (label 1) at y = 8
-//   m Scan scan = ScanScene(scene);                              // 200 x 300 scan, no noise Scan noisy =
-//   ScanScene(LoadBuiltinScene("mailbox"), SmallScanner(scene.scanner, 120, 200));
+//   SceneDescription scene = MakeGroundAndBoxScene();  // ground (label 0) + a box (label 1) at y = 8 m
+//   Scan scan = ScanScene(scene);                      // 200 x 300 scan, no noise
+//   Scan noisy = ScanScene(LoadBuiltinScene("mailbox"), SmallScanner(scene.scanner, 120, 200));
 #pragma once
 
 #include <string>
@@ -46,8 +46,8 @@ SceneDescription MakeRecolorScene(bool textured = false, int rows = 300, int col
 SceneDescription MakeSingleObjectScene(const TriangleMesh& mesh_in_world, int32_t label,
                                        const ScannerOptions& scanner, Rgb8 color = Rgb8(200, 60, 50));
 
-// The path of a built-in scene: LIDARSHOP_SOURCE_DIR/data/scenes/<name>.json ("parking_lot", "electric_box",
-// "mailbox").
+// The path of a built-in scene: LIDARSHOP_SOURCE_DIR/data/scenes/<name>.json
+// ("parking_lot", "electric_box", "mailbox").
 std::string BuiltinScenePath(const std::string& name);
 SceneDescription LoadBuiltinScene(const std::string& name);
 

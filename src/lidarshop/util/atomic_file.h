@@ -10,9 +10,9 @@
 
 namespace lidarshop {
 
-// Calls `write(stream)` on a binary stream to a temporary file in the target's folder, then renames it to
-// `path`. Throws InputError naming `path` when the folder is not writable or the stream fails; the temporary
-// is removed.
+// Calls `write(stream)` on a binary stream to a temporary file in the target's folder, then renames
+// it to `path`. Throws InputError naming `path` when the folder is not writable or the stream
+// fails; the temporary is removed.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 // For writers that need a path (OpenCV's imwrite, a C library): `write(temporary_path)` must create the file

@@ -5,8 +5,8 @@
 //                   message names the file, the place (line, byte offset, page) and the field, so a user can
 //                   fix the input: "scan.ptx: line 12: field 'x': not a number: 'abc'".
 //  * OptionsError — a parameter is out of its documented range ("VerifyOptions.sigma_m must be > 0, got -1").
-// Broken internal invariants are bugs and use LIDARSHOP_CHECK, which throws std::logic_error with file and
-// line.
+// Broken internal invariants are bugs and use LIDARSHOP_CHECK, which throws
+// std::logic_error with file and line.
 #pragma once
 
 #include <stdexcept>

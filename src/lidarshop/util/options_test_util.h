@@ -28,8 +28,8 @@ void ExpectExactRoundTrip() {
   EXPECT_NO_THROW(Validate(S{})) << info.name << ": the defaults are not valid";
 }
 
-// FromJson({key: value}) throws an OptionsFieldError whose key path is `key` and whose message contains
-// `expected`.
+// FromJson({key: value}) throws an OptionsFieldError whose key path is `key` and
+// whose message contains `expected`.
 template <class S>
 void ExpectRejected(const nlohmann::json& json, const std::string& key_path, const std::string& expected) {
   try {

@@ -21,8 +21,8 @@ const EnumInfo& EnumInfoOf<SimdPath>();
 // kAvx2 when the CPU has it (checked once; safe during static initialization).
 SimdPath BestSimdPath();
 
-// Every lanes function is inlined, so no vector crosses a call: GCC's note on the AVX calling convention does
-// not apply.
+// Every lanes function is inlined, so no vector crosses a call: GCC's note on the AVX
+// calling convention does not apply.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 namespace lanes {

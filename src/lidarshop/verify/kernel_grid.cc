@@ -350,8 +350,8 @@ KernelNeighbourGrid BuildKernelGrid(std::span<const Eigen::Vector3f> points,
 
 namespace {
 
-// Calls group_step(runs, num_runs, group, group_size) for each group of the points that share a cell of
-// `grid`.
+// Calls group_step(runs, num_runs, group, group_size) for each group of the
+// points that share a cell of `grid`.
 template <typename GroupStep>
 void ForEachCellGroup(const PointCellGrid& grid, std::span<const Eigen::Vector3f> points,
                       GroupStep&& group_step) {

@@ -8,9 +8,9 @@
 
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
-#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {

@@ -3,8 +3,8 @@
 //
 // Candidate poses are world_from_model = PoseFromXyzYaw(x, y, z_m, yaw) for x in [x_min, x_max] and y in
 // [y_min, y_max] in steps of step_m, and every yaw of yaws_deg. A detection is a pose with
-//   consistency > min_consistency  and  confidence > min_confidence  and  comparable_pairs >=
-//   min_comparable_pairs,
+//   consistency > min_consistency  and  confidence > min_confidence
+//   and  comparable_pairs >= min_comparable_pairs,
 // kept greedily by decreasing confidence unless a kept detection lies within nms_radius_m (in x, y).
 #pragma once
 

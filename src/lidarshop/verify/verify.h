@@ -5,9 +5,8 @@
 // [0, 1] answer, independently of the method that produced the pose:
 //
 //  * Consistency (eqs. 4.1–4.3) — does the pose make physical sense? For every scene point j whose scanner
-//  ray meets
-//    the posed model, d_m = distance along the ray to the model's first hit, d_s = measured range, a =
-//    allowance:
+//    ray meets the posed model, d_m = distance along the ray to the model's first hit, d_s = measured range,
+//    a = allowance:
 //        consistent_j = [(d_m + a) − d_s ≥ 0]            (the point lies in front of the model or on it)
 //        consistency  = Σ_scans Σ_j consistent_j / Σ_scans #comparable pairs
 //    A ray that returned from *behind* the model went through it: the model cannot be there. Rays without a
@@ -16,17 +15,14 @@
 //
 //  * Confidence (eqs. 4.4–4.5) — how much of the model has been seen? Model point i carries information I_i
 //    (Σ I_i = 1; uniform 1/N, or weighted by shape distinctiveness), observed information O_i starts at 0,
-//    and every scene point j (of every scan: the points of all scans accumulate) within 3σ of model point i
-//    updates
+//    and every scene point j within 3σ of model point i (the points of all scans accumulate) updates it:
 //        O_i ← min(I_i, O_i + I_i · exp(−d_ij² / 2σ²)),      confidence = Σ_i O_i.
-//    The update only adds and clamps, so O_i = I_i · min(1, Σ_j exp(−d_ij²/2σ²)) whatever the order of the
-//    points.
+//    The update only adds and clamps, so O_i = I_i · min(1, Σ_j exp(−d_ij²/2σ²)), in any order of the points.
 //
 //  * Trimmed ICP cost (eq. 4.6, the baseline): mean distance from the scene points near the posed model
-//  (inside its
-//    bounding box grown by the trim distance) to their nearest model point, pairs beyond `icp_trim_m`
-//    excluded; the inlier fraction is the share of those scene points whose nearest model point is within the
-//    trim distance.
+//    (inside its bounding box grown by the trim distance) to their nearest model point, pairs beyond
+//    `icp_trim_m` excluded; the inlier fraction is the share of those scene points whose nearest model point
+//    is within the trim distance.
 //
 // Speed (build once, query many; libigl-style precompute/query split):
 //
@@ -221,8 +217,8 @@ struct VerifyResult {
 template <>
 const StructInfo& InfoOf<VerifyResult>();
 
-// Verifies one pose. `world_from_model` may include a uniform scale; distances stay in scanner (world)
-// metres.
+// Verifies one pose. `world_from_model` may include a uniform scale; distances
+// stay in scanner (world) metres.
 VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan> scans,
                         const Eigen::Matrix4d& world_from_model, const VerifyOptions& options = {});
 
@@ -238,8 +234,10 @@ PointCloud SceneStatusCloud(std::span<const PreparedScan> scans, const VerifyRes
 PointCloud ObservedModelCloud(const VerifierModel& model, const Eigen::Matrix4d& world_from_model,
                               const VerifyResult& result);
 
-// world_from_model of an object standing on the ground: translate (x, y, z), then yaw about +z (degrees, x→y
-// counter-clockwise), pitch about the model's x, roll about its y (R = Rz(yaw) * Rx(pitch) * Ry(roll)).
+// world_from_model of an object standing on the ground: rotation R = Rz(yaw) · Ry(pitch) · Rx(roll) (degrees;
+// roll about x first, then pitch about y, then yaw about z; yaw turns +x towards +y), then translation by
+// (x, y, z) metres. R is geometry/transform.h's RotationFromEulerDegrees({roll, pitch, yaw}), the convention
+// of scene files and every other place that takes angles.
 Eigen::Matrix4d PoseFromXyzYaw(double x_m, double y_m, double z_m, double yaw_deg, double pitch_deg = 0.0,
                                double roll_deg = 0.0);
 

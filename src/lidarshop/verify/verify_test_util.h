@@ -1,8 +1,8 @@
 // Small synthetic scenes for the verify tests and the verify experiment (header only, no gtest).
 //
-// A noise-free synthetic scan is RaycastScene::CastImage over DirectionsFromGrid(UniformGrid(...)): these
-// helpers build boxes, a simple two-box car and such scans, so that the verify module can be tested on its
-// own.
+// A noise-free synthetic scan is RaycastScene::CastImage over
+// DirectionsFromGrid(UniformGrid(...)): these helpers build boxes, a simple two-box car and such
+// scans, so that the verify module can be tested on its own.
 #pragma once
 
 #include <cmath>
@@ -20,8 +20,8 @@ namespace lidarshop::verify_testing {
 
 inline double Radians(double degrees) { return degrees * std::numbers::pi / 180.0; }
 
-// An axis-aligned box [min, max], each face split into `n` x `n` quads (2 n² triangles per face), outward
-// normals.
+// An axis-aligned box [min, max], each face split into `n` x `n` quads (2 n²
+// triangles per face), outward normals.
 inline TriangleMesh MakeBox(const Eigen::Vector3f& min, const Eigen::Vector3f& max, int n = 1) {
   TriangleMesh mesh;
   const Eigen::Vector3f size = max - min;

@@ -99,6 +99,29 @@ def test_inpaint_and_poisson():
         lidarshop.inpaint(grey, hole, patch_radius=0)
 
 
+def test_one_angle_convention():
+    # R = Rz(yaw) Ry(pitch) Rx(roll), roll applied first: the same matrix from both functions and from the
+    # elementary rotations written out here.
+    def rx(a):
+        c, s = np.cos(np.radians(a)), np.sin(np.radians(a))
+        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+    def ry(a):
+        c, s = np.cos(np.radians(a)), np.sin(np.radians(a))
+        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+    def rz(a):
+        c, s = np.cos(np.radians(a)), np.sin(np.radians(a))
+        return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+    yaw, pitch, roll = 35.0, -20.0, 12.0
+    expected = rz(yaw) @ ry(pitch) @ rx(roll)
+    np.testing.assert_allclose(lidarshop.rotation_from_euler_degrees([roll, pitch, yaw]), expected, atol=1e-12)
+    pose = lidarshop.pose_from_xyz_yaw(1, 2, 3, yaw, pitch, roll)
+    np.testing.assert_allclose(pose[:3, :3], expected, atol=1e-12)
+    np.testing.assert_array_equal(pose[:3, 3], [1, 2, 3])
+
+
 def test_verify_pose(scan):
     box = lidarshop.make_primitive("box", {"size": [1.2, 1.2, 1.2]})
     assert box.vertices.shape[1] == 3 and box.triangles.shape[1] == 3

@@ -170,8 +170,8 @@ int main(int argc, char** argv) {
       options.method =
           ParseEnum<FillMethod>(name == "gradient-range" || name == "gradient-plain" ? "gradient" : name);
       if (name == "gradient-range") options.inverse_range = false;
-      // "gradient-plain": without the acceptance tests of inpaint/acceptance.h (the best patch difference
-      // wins).
+      // "gradient-plain": without the acceptance tests of inpaint/acceptance.h
+      // (the best patch difference wins).
       if (name == "gradient-plain") options.acceptance.enabled = false;
       // Patch methods draw random samples: their metrics are the mean over `seeds` fills (the pictures show
       // the first); the other methods are deterministic.

@@ -1,5 +1,5 @@
-// inpaint_eval: quality of the acceptance tests and of forward-looking filling (thesis ch. 7) on images with
-// truth.
+// inpaint_eval: quality of the acceptance tests and of forward-looking filling
+// (thesis ch. 7) on images with truth.
 //
 //   inpaint_eval [--scenes DIR] [--images DIR] [--configs a,b,...] [--lookahead M] [--markdown FILE]
 //                [--pictures DIR] [--skip-trashcan]
