@@ -5,9 +5,9 @@
 
 #include "lidarshop/pointset/quickshift.h"
 #include "lidarshop/pointset/superpixels.h"
-#include "lidarshop/util/parallel.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {

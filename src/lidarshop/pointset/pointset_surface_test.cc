@@ -86,13 +86,14 @@ TEST(SurfaceTest, KeepWithinTrimsTheMembraneOfAnOpenDome) {
     }
   }
   const TriangleMesh closed = ReconstructSurface(dome, {.method = SurfaceMethod::kPoisson});
-  const TriangleMesh trimmed = ReconstructSurface(dome, {.method = SurfaceMethod::kPoisson, .keep_within_m = 0.1});
+  const TriangleMesh trimmed =
+      ReconstructSurface(dome, {.method = SurfaceMethod::kPoisson, .keep_within_m = 0.1});
   ASSERT_GT(trimmed.num_triangles(), 100u);
   EXPECT_LT(trimmed.num_triangles(), closed.num_triangles());
   float lowest_closed = 10, lowest_trimmed = 10;
   for (const Eigen::Vector3f& v : closed.vertices) lowest_closed = std::min(lowest_closed, v.z());
   for (const Eigen::Vector3f& v : trimmed.vertices) lowest_trimmed = std::min(lowest_trimmed, v.z());
-  EXPECT_LT(lowest_closed, 2.9f);   // the membrane reaches below the dome's rim
+  EXPECT_LT(lowest_closed, 2.9f);    // the membrane reaches below the dome's rim
   EXPECT_GT(lowest_trimmed, 2.85f);  // trimmed: only what lies near the points
 }
 

@@ -30,7 +30,8 @@ struct FeatureImage {
 
 }  // namespace
 
-cv::Mat QuickShift(const cv::Mat& features, const cv::Mat& mask, const QuickShiftOptions& options, int* count) {
+cv::Mat QuickShift(const cv::Mat& features, const cv::Mat& mask, const QuickShiftOptions& options,
+                   int* count) {
   if (!(options.kernel_size > 0) || !(options.max_dist > 0)) {
     throw OptionsError("quickshift: kernel_size and max_dist must be > 0");
   }

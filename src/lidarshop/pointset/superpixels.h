@@ -20,12 +20,12 @@ const EnumInfo& EnumInfoOf<SuperpixelMethod>();
 
 struct SuperpixelOptions {
   SuperpixelMethod method = SuperpixelMethod::kSlic;
-  int region_cells = 20;     // SLIC: superpixel side, cells, >= 2
-  float ruler = 10.0f;       // SLIC: compactness, > 0
-  int iterations = 10;       // SLIC iterations, >= 1
-  double graph_sigma = 0.5;  // graph: Gaussian smoothing, cells, >= 0
-  float graph_k = 300.0f;    // graph: larger = larger segments, > 0
-  int graph_min_cells = 50;  // graph: smallest segment, cells, >= 1
+  int region_cells = 20;                // SLIC: superpixel side, cells, >= 2
+  float ruler = 10.0f;                  // SLIC: compactness, > 0
+  int iterations = 10;                  // SLIC iterations, >= 1
+  double graph_sigma = 0.5;             // graph: Gaussian smoothing, cells, >= 0
+  float graph_k = 300.0f;               // graph: larger = larger segments, > 0
+  int graph_min_cells = 50;             // graph: smallest segment, cells, >= 1
   double quickshift_kernel_size = 3.0;  // QuickShift: σ of the density kernel, cells, > 0
   double quickshift_max_dist = 10.0;    // QuickShift: longest link in the joint space, > 0
   double quickshift_ratio = 0.25;       // QuickShift: weight of the [0, 255] channels against position,

@@ -9,7 +9,6 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/Eigenvalues>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Random.h>
 #include <CGAL/Scale_space_reconstruction_3/Advancing_front_mesher.h>
@@ -20,6 +19,7 @@
 #include <CGAL/poisson_surface_reconstruction.h>
 #include <CGAL/property_map.h>
 #include <fmt/format.h>
+#include <Eigen/Eigenvalues>
 
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/pointset/normals.h"
@@ -66,7 +66,8 @@ TriangleMesh PoissonSurface(const PointCloud& cloud, const SurfaceOptions& optio
   for (const auto vertex : mesh.vertices()) {
     const Point& p = mesh.point(vertex);
     index[static_cast<size_t>(vertex)] = static_cast<int>(result.vertices.size());
-    result.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    result.vertices.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
+                                 static_cast<float>(p.z()));
   }
   for (const auto face : mesh.faces()) {
     Eigen::Vector3i triangle;
@@ -150,9 +151,10 @@ void Canonicalize(TriangleMesh* mesh) {
     t = Eigen::Vector3i(new_index[t[0]], new_index[t[1]], new_index[t[2]]);
     while (t[0] > t[1] || t[0] > t[2]) t = Eigen::Vector3i(t[1], t[2], t[0]);
   }
-  std::sort(mesh->triangles.begin(), mesh->triangles.end(), [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
-    return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
-  });
+  std::sort(mesh->triangles.begin(), mesh->triangles.end(),
+            [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+              return std::tie(a[0], a[1], a[2]) < std::tie(b[0], b[1], b[2]);
+            });
   mesh->vertices = std::move(vertices);
 }
 
@@ -162,7 +164,8 @@ void SurfaceOptions::Check() const { Validate(*this); }
 
 TriangleMesh ReconstructSurface(const PointCloud& cloud, const SurfaceOptions& options) {
   options.Check();
-  if (cloud.size() < 10) throw InputError(fmt::format("surface: {} points; at least 10 are needed", cloud.size()));
+  if (cloud.size() < 10)
+    throw InputError(fmt::format("surface: {} points; at least 10 are needed", cloud.size()));
   for (const Eigen::Vector3f& p : cloud.points) {
     if (!p.allFinite()) throw InputError("surface: the cloud has a non-finite point");
   }
@@ -177,7 +180,8 @@ TriangleMesh ReconstructSurface(const PointCloud& cloud, const SurfaceOptions& o
   }
   const Eigen::Vector3d spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues();
   if (spread[0] <= 1e-12 * spread[2]) {
-    throw InputError("surface: the points lie on one plane (or a line); a surface reconstruction needs depth");
+    throw InputError(
+        "surface: the points lie on one plane (or a line); a surface reconstruction needs depth");
   }
   if (!cloud.normals.empty() && cloud.normals.size() != cloud.size()) {
     throw InputError("surface: the cloud's normals do not match its points");

@@ -28,19 +28,19 @@ const EnumInfo& EnumInfoOf<SurfaceMethod>();
 struct SurfaceOptions {
   SurfaceMethod method = SurfaceMethod::kPoisson;
   // Poisson: mesh quality (CGAL's surface mesher criteria, in units of the mean point spacing).
-  double poisson_angle_deg = 20.0;       // smallest triangle angle, degrees, (0, 30]
-  double poisson_radius_spacings = 30.0;  // largest Delaunay ball radius, mean spacings, > 0
+  double poisson_angle_deg = 20.0;           // smallest triangle angle, degrees, (0, 30]
+  double poisson_radius_spacings = 30.0;     // largest Delaunay ball radius, mean spacings, > 0
   double poisson_distance_spacings = 0.375;  // largest distance to the implicit surface, mean spacings, > 0
   // Triangles with a corner farther than this from every input point are dropped (0 = keep all): trims the
   // membrane Poisson closes open scans with, metres, >= 0.
   double keep_within_m = 0.0;
   int normal_neighbors = 18;  // k for normals estimated when the cloud has none, >= 3
   // Scale-space: jet-smoothing iterations (more = smoother, fewer details) and neighbours per fit.
-  int scale_space_iterations = 4;   // >= 0
-  int scale_space_neighbors = 30;   // >= 6
-  double max_edge_m = 0.0;          // advancing front: longest triangle edge, metres (0 = no limit), >= 0
+  int scale_space_iterations = 4;  // >= 0
+  int scale_space_neighbors = 30;  // >= 6
+  double max_edge_m = 0.0;         // advancing front: longest triangle edge, metres (0 = no limit), >= 0
   Eigen::Vector3f viewpoint = Eigen::Vector3f::Zero();  // estimated normals face it (the scanner)
-  uint64_t seed = 1;  // CGAL's random choices (mesher seeds, smoothing samples); the low 32 bits are used
+  uint64_t seed = 1;   // CGAL's random choices (mesher seeds, smoothing samples); the low 32 bits are used
   void Check() const;  // throws OptionsError
 };
 template <>
