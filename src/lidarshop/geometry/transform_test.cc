@@ -49,8 +49,10 @@ TEST(RotationFromEuler, NamedAxesAndOrder) {
 
 TEST(RotationFromEuler, ComposeTransformUsesIt) {
   const Eigen::Matrix4d transform = ComposeTransform({1, 2, 3}, {10, -20, 30}, {2, 2, 2});
-  EXPECT_TRUE(transform.topLeftCorner<3, 3>().isApprox(RotationFromEulerDegrees({10, -20, 30}) * 2.0, 1e-15));
-  EXPECT_EQ(transform.topRightCorner<3, 1>(), Eigen::Vector3d(1, 2, 3));
+  const Eigen::Matrix3d linear = transform.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = transform.topRightCorner<3, 1>();
+  EXPECT_TRUE(linear.isApprox(RotationFromEulerDegrees({10, -20, 30}) * 2.0, 1e-15));
+  EXPECT_EQ(translation, Eigen::Vector3d(1, 2, 3));
 }
 
 }  // namespace
