@@ -505,7 +505,8 @@ exits_with 2 "points: did you mean" "unknown option --std-ration \(did you mean 
 help_shows() {  # help_shows NAME TEXT COMMAND...: --help output holds TEXT
   local name=$1 text=$2
   shift 2
-  if "$@" --help 2>&1 | grep -qF -e "$text"; then
+  "$@" --help >"$work/help.txt" 2>&1
+  if grep -qF -e "$text" "$work/help.txt"; then
     passed=$((passed + 1))
   else
     failed=$((failed + 1))

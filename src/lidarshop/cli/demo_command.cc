@@ -399,7 +399,8 @@ int RunDemoSteps(const DemoSettings& settings) {
   WriteText(out_dir / "index.html", IndexHtml(scene_name, summary));
   WriteJsonOutput(settings.json_path, summary);
   if (!settings.quiet) {
-    fmt::print(stderr, "lidarshop demo: scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)\n",
+    fmt::print(stderr,
+               "lidarshop demo: scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)\n",
                scene_name, scan.rows, scan.cols, scan.CountValid(), out_dir.string());
   }
   return 0;

@@ -147,41 +147,41 @@ int RunConvert(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&] {
-    binder.Validate(e57_options);
-    CheckOutputPath(output, {input});
-    CheckOutputFile("--json", json_path, {}, {input, output});
-    const auto progress = Progress::ForTerminal("convert", 2, quiet);
-    ScanFile file;
-    std::vector<E57Image> images;  // E57 -> E57 keeps the photos
-    const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
-    if (e57_to_e57) {
-      E57File e57 = ReadE57(input);
-      file = {input, "e57", std::move(e57.scans)};
-      images = std::move(e57.images);
-    } else {
-      file = ReadScanFile(input);
-    }
-    progress->Advance();
-    std::vector<Scan> scans = file.scans;
-    if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
-    if (FileExtension(output) == "e57") {
-      WriteE57(output, scans, images, e57_options);
-    } else {
-      WriteScanFile(output, scans);
-    }
-    progress->Advance();
-    progress->Finish();
-    nlohmann::ordered_json json;
-    json["input"] = input;
-    json["output"] = output;
-    json["format"] = FileExtension(output);
-    json["scans"] = scans.size();
-    int64_t returns = 0;
-    for (const Scan& scan : scans) returns += scan.CountValid();
-    json["returns"] = returns;
-    json["images"] = images.size();
-    WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
-    return 0;
+        binder.Validate(e57_options);
+        CheckOutputPath(output, {input});
+        CheckOutputFile("--json", json_path, {}, {input, output});
+        const auto progress = Progress::ForTerminal("convert", 2, quiet);
+        ScanFile file;
+        std::vector<E57Image> images;  // E57 -> E57 keeps the photos
+        const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
+        if (e57_to_e57) {
+          E57File e57 = ReadE57(input);
+          file = {input, "e57", std::move(e57.scans)};
+          images = std::move(e57.images);
+        } else {
+          file = ReadScanFile(input);
+        }
+        progress->Advance();
+        std::vector<Scan> scans = file.scans;
+        if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
+        if (FileExtension(output) == "e57") {
+          WriteE57(output, scans, images, e57_options);
+        } else {
+          WriteScanFile(output, scans);
+        }
+        progress->Advance();
+        progress->Finish();
+        nlohmann::ordered_json json;
+        json["input"] = input;
+        json["output"] = output;
+        json["format"] = FileExtension(output);
+        json["scans"] = scans.size();
+        int64_t returns = 0;
+        for (const Scan& scan : scans) returns += scan.CountValid();
+        json["returns"] = returns;
+        json["images"] = images.size();
+        WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
+        return 0;
       },
       &binder);
 }
@@ -200,13 +200,12 @@ int RunRender(int argc, char** argv) {
   // choices of the described enums.
   const EnumInfo& channels = EnumInfoOf<RenderChannel>();
   const EnumInfo& color_maps = EnumInfoOf<ColorMap>();
-  app.add_option("--channel", channel, "what to draw")
-      ->capture_default_str()
-      ->check(ChoiceOf(channels));
+  app.add_option("--channel", channel, "what to draw")->capture_default_str()->check(ChoiceOf(channels));
   app.add_flag("--legend", options.legend, "add a colour scale bar (or label swatches) to the right");
   app.add_option("--scan", scan_index, "which scan of the file (from 0)")->capture_default_str();
-  app.add_option("--colormap", color_map, "colour map of metric channels (default: viridis for range, gray "
-                                          "for intensity)")
+  app.add_option("--colormap", color_map,
+                 "colour map of metric channels (default: viridis for range, gray "
+                 "for intensity)")
       ->check(ChoiceOf(color_maps, {"grey"}));
   app.add_option("--min", options.min_value,
                  "value of the first colour (metres for range); default: 1 % quantile");
@@ -227,65 +226,67 @@ int RunRender(int argc, char** argv) {
   app.add_option("--around", around_path,
                  "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
   binder.Bind(&view, {.flags = {{"field_of_view_deg", "--fov"},
-                                 {"width_px", "--width"},
-                                 {"height_px", "--height"},
-                                 {"point_size_px", "--point-size"},
-                                 {"synthesized_tint", "--tint-synthesized"}},
-                       .group = "Second viewpoint (--eye / --orbit)"});
+                                {"width_px", "--width"},
+                                {"height_px", "--height"},
+                                {"point_size_px", "--point-size"},
+                                {"synthesized_tint", "--tint-synthesized"}},
+                      .group = "Second viewpoint (--eye / --orbit)"});
   bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
       [&] {
-    binder.Validate(view);
-    CheckOutputPath(output, {input, around_path});
-    CheckOutputFile("--json", json_path, {}, {input, around_path, output});
-    nlohmann::ordered_json json;
-    if (!eye.empty() || !std::isnan(orbit_deg)) {
-      if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
-      if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
-      const ScanFile file = ReadScanFile(input);
-      const Scan& scan = PickScan(file, scan_index, "--scan");
-      if (!eye.empty()) {
-        view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
-        view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
-      } else {
-        const cv::Mat region = around_path.empty()
-                                   ? cv::Mat(scan.valid != 0)
-                                   : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
-        const PointViewOptions side = SideView(scan, region, orbit_deg);
-        view.eye_in_world = side.eye_in_world;
-        view.target_in_world = side.target_in_world;
-      }
-      const cv::Mat picture = RenderPointView(scan, view);
-      WriteImage(output, picture);
-      json["output"] = output;
-      json["width_px"] = picture.cols;
-      json["height_px"] = picture.rows;
-      json["eye_in_world"] = {view.eye_in_world.x(), view.eye_in_world.y(), view.eye_in_world.z()};
-      json["target_in_world"] = {view.target_in_world.x(), view.target_in_world.y(),
-                                 view.target_in_world.z()};
-      WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
-      return 0;
-    }
-    options.channel = ParseEnum<RenderChannel>(channel);
-    if (!color_map.empty())
-      options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
-    options.Check();
-    const ScanFile file = ReadScanFile(input);
-    Scan scan = PickScan(file, scan_index, "--scan");
-    if (scan.name.empty()) scan.name = input;
-    const RenderResult result = RenderScan(scan, options);
-    WriteImage(output, result.image);
-    json["output"] = output;
-    json["channel"] = channel;
-    json["width_px"] = result.image.cols;
-    json["height_px"] = result.image.rows;
-    if (result.scale) {
-      json["scale"] = {{"min", result.scale->min_value}, {"max", result.scale->max_value}, {"unit", result.scale->unit}};
-    }
-    WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
-    return 0;
+        binder.Validate(view);
+        CheckOutputPath(output, {input, around_path});
+        CheckOutputFile("--json", json_path, {}, {input, around_path, output});
+        nlohmann::ordered_json json;
+        if (!eye.empty() || !std::isnan(orbit_deg)) {
+          if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
+          if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
+          const ScanFile file = ReadScanFile(input);
+          const Scan& scan = PickScan(file, scan_index, "--scan");
+          if (!eye.empty()) {
+            view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
+            view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
+          } else {
+            const cv::Mat region = around_path.empty()
+                                       ? cv::Mat(scan.valid != 0)
+                                       : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
+            const PointViewOptions side = SideView(scan, region, orbit_deg);
+            view.eye_in_world = side.eye_in_world;
+            view.target_in_world = side.target_in_world;
+          }
+          const cv::Mat picture = RenderPointView(scan, view);
+          WriteImage(output, picture);
+          json["output"] = output;
+          json["width_px"] = picture.cols;
+          json["height_px"] = picture.rows;
+          json["eye_in_world"] = {view.eye_in_world.x(), view.eye_in_world.y(), view.eye_in_world.z()};
+          json["target_in_world"] = {view.target_in_world.x(), view.target_in_world.y(),
+                                     view.target_in_world.z()};
+          WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+          return 0;
+        }
+        options.channel = ParseEnum<RenderChannel>(channel);
+        if (!color_map.empty())
+          options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
+        options.Check();
+        const ScanFile file = ReadScanFile(input);
+        Scan scan = PickScan(file, scan_index, "--scan");
+        if (scan.name.empty()) scan.name = input;
+        const RenderResult result = RenderScan(scan, options);
+        WriteImage(output, result.image);
+        json["output"] = output;
+        json["channel"] = channel;
+        json["width_px"] = result.image.cols;
+        json["height_px"] = result.image.rows;
+        if (result.scale) {
+          json["scale"] = {{"min", result.scale->min_value},
+                           {"max", result.scale->max_value},
+                           {"unit", result.scale->unit}};
+        }
+        WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+        return 0;
       },
       &binder);
 }

@@ -31,9 +31,9 @@ namespace {
 // The fill options every fill command shares, bound to flags from their description (fill/fill.h).
 // `prefix`: their key path inside the command's options ("fill" in remove).
 void BindFillOptions(OptionBinder& binder, FillOptions* options, const std::string& prefix = "") {
-  binder.Bind(options, {.skip = {"telea_radius_cells"},
-                        .flags = {{"search_window_radius", "--window"}},
-                        .prefix = prefix});
+  binder.Bind(
+      options,
+      {.skip = {"telea_radius_cells"}, .flags = {{"search_window_radius", "--window"}}, .prefix = prefix});
   binder.Bind(options, {.keys = {"acceptance.enabled", "telea_radius_cells"},
                         .flags = {{"acceptance.enabled", "--accept"}},
                         .prefix = prefix});

@@ -134,102 +134,103 @@ int RunInpaint(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&]() {
-    ParseAcceptance(accept, &options);
-    binder.Validate(options);
-    CheckOutputPath(output_path, {image_path, mask_path});
-    CheckOutputFile("--json", json_path, {}, {image_path, mask_path, output_path});
-    if (!resume_dir.empty()) {
-      if ((choose >= 0) == !place.empty())
-        throw OptionsError("--resume needs exactly one of --choose N and --place ROW,COL");
-      const ReviewFolder folder = ReadReviewFolder(resume_dir);
-      options.review_decisions = folder.decisions;
-      Pixel source;
-      if (choose >= 0) {
-        if (choose >= static_cast<int>(folder.candidates.size()))
-          throw OptionsError(
-              fmt::format("--choose {}: the review lists {} candidates", choose, folder.candidates.size()));
-        source = folder.candidates[choose];
-      } else if (std::sscanf(place.c_str(), "%d,%d", &source.row, &source.col) != 2) {
-        throw OptionsError(fmt::format("--place must be ROW,COL, got '{}'", place));
-      }
-      options.review_decisions.push_back({folder.target, source});
-      if (review_dir.empty()) review_dir = resume_dir;
-    } else if (choose >= 0 || !place.empty()) {
-      throw OptionsError("--choose and --place need --resume DIR");
-    }
-    options.stop_for_review = !review_dir.empty();
-    const cv::Mat input = ReadImage(image_path);
-    cv::Mat mask = ReadImage(mask_path);
-    if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
-    if (mask.channels() == 4) cv::cvtColor(mask, mask, cv::COLOR_RGBA2GRAY);
-    if (mask.depth() != CV_8U) ThrowInputError(mask_path, "", "", "the mask must be an 8-bit image");
-    if (mask.size() != input.size()) {
-      ThrowInputError(
-          mask_path, "", "",
-          fmt::format("mask is {}x{} but the image is {}x{}", mask.cols, mask.rows, input.cols, input.rows));
-    }
-    mask = mask > 127;
-    std::string extension = std::filesystem::path(output_path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
-    if ((input.depth() == CV_32F || input.depth() == CV_64F) &&
-        (extension == ".png" || extension == ".jpg" || extension == ".jpeg")) {
-      ThrowInputError(output_path, "", "", "a float image must be written as .exr or .tif");
-    }
-    cv::Mat image;
-    input.convertTo(image, CV_32F);
-    // Data-term scale: the intensity range (255 for 8-bit images).
-    if (input.depth() == CV_8U) {
-      options.alpha = 255.0;
-    } else {
-      double low = 0.0, high = 0.0;
-      cv::minMaxLoc(image.reshape(1), &low, &high);
-      options.alpha = std::max(high - low, 1e-6);
-    }
-    auto progress = Progress::ForTerminal("inpaint", cv::countNonZero(mask), quiet);
-    const InpaintResult result = Inpaint(image, mask, options, progress.get());
-    if (!result.complete) {
-      cv::Mat tentative, canvas;
-      ToDisplay(result.review->tentative_image, input.depth(), &tentative);
-      ToDisplay(result.image, input.depth(), &canvas);
-      WriteReviewFolder(review_dir, *result.review, options.review_decisions, tentative, canvas,
-                        options.patch_radius);
-      fmt::print(stderr,
-                 "stopped for review at iteration {} (target row {}, col {}): {} candidates in {} clusters, "
-                 "see {}/review.json; continue with --resume {} --choose N\n",
-                 result.review->iteration, result.review->target.row, result.review->target.col,
-                 result.review->candidates.size(), result.review->cluster_representative.size(), review_dir,
-                 review_dir);
-      WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
-      return 0;
-    }
-    cv::Mat output;
-    result.image.convertTo(output, input.depth());
-    WriteImage(output_path, output);
-    if (!debug_dir.empty()) {
-      std::filesystem::create_directories(debug_dir);
-      cv::Mat background = result.image;
-      if (input.depth() != CV_8U) cv::normalize(result.image, background, 0, 255, cv::NORM_MINMAX);
-      const std::string dir = debug_dir + "/";
-      WriteImage(dir + "fill_order.png", RenderFillOrder(result, background));
-      WriteImage(dir + "source_map.png", RenderSourceMap(result, background));
-      InpaintResult scaled;
-      scaled.image = background;
-      scaled.steps = result.steps;
-      WriteImage(dir + "source_locations.png", RenderSourceLocations(scaled, options.patch_radius));
-      WriteFileAtomically(dir + "steps.csv", [&](std::ostream& out) {
-        out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels,"
-               "rejected,accepted,margin\n";
-        for (size_t i = 0; i < result.steps.size(); ++i) {
-          const FillStep& s = result.steps[i];
-          out << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col,
-                             s.source.row, s.source.col, s.difference, s.priority, s.filled_pixels,
-                             s.rejected, s.accepted ? 1 : 0, s.margin);
+        ParseAcceptance(accept, &options);
+        binder.Validate(options);
+        CheckOutputPath(output_path, {image_path, mask_path});
+        CheckOutputFile("--json", json_path, {}, {image_path, mask_path, output_path});
+        if (!resume_dir.empty()) {
+          if ((choose >= 0) == !place.empty())
+            throw OptionsError("--resume needs exactly one of --choose N and --place ROW,COL");
+          const ReviewFolder folder = ReadReviewFolder(resume_dir);
+          options.review_decisions = folder.decisions;
+          Pixel source;
+          if (choose >= 0) {
+            if (choose >= static_cast<int>(folder.candidates.size()))
+              throw OptionsError(fmt::format("--choose {}: the review lists {} candidates", choose,
+                                             folder.candidates.size()));
+            source = folder.candidates[choose];
+          } else if (std::sscanf(place.c_str(), "%d,%d", &source.row, &source.col) != 2) {
+            throw OptionsError(fmt::format("--place must be ROW,COL, got '{}'", place));
+          }
+          options.review_decisions.push_back({folder.target, source});
+          if (review_dir.empty()) review_dir = resume_dir;
+        } else if (choose >= 0 || !place.empty()) {
+          throw OptionsError("--choose and --place need --resume DIR");
         }
-      });
-    }
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
-    if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
-    return 0;
+        options.stop_for_review = !review_dir.empty();
+        const cv::Mat input = ReadImage(image_path);
+        cv::Mat mask = ReadImage(mask_path);
+        if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
+        if (mask.channels() == 4) cv::cvtColor(mask, mask, cv::COLOR_RGBA2GRAY);
+        if (mask.depth() != CV_8U) ThrowInputError(mask_path, "", "", "the mask must be an 8-bit image");
+        if (mask.size() != input.size()) {
+          ThrowInputError(mask_path, "", "",
+                          fmt::format("mask is {}x{} but the image is {}x{}", mask.cols, mask.rows,
+                                      input.cols, input.rows));
+        }
+        mask = mask > 127;
+        std::string extension = std::filesystem::path(output_path).extension().string();
+        std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+        if ((input.depth() == CV_32F || input.depth() == CV_64F) &&
+            (extension == ".png" || extension == ".jpg" || extension == ".jpeg")) {
+          ThrowInputError(output_path, "", "", "a float image must be written as .exr or .tif");
+        }
+        cv::Mat image;
+        input.convertTo(image, CV_32F);
+        // Data-term scale: the intensity range (255 for 8-bit images).
+        if (input.depth() == CV_8U) {
+          options.alpha = 255.0;
+        } else {
+          double low = 0.0, high = 0.0;
+          cv::minMaxLoc(image.reshape(1), &low, &high);
+          options.alpha = std::max(high - low, 1e-6);
+        }
+        auto progress = Progress::ForTerminal("inpaint", cv::countNonZero(mask), quiet);
+        const InpaintResult result = Inpaint(image, mask, options, progress.get());
+        if (!result.complete) {
+          cv::Mat tentative, canvas;
+          ToDisplay(result.review->tentative_image, input.depth(), &tentative);
+          ToDisplay(result.image, input.depth(), &canvas);
+          WriteReviewFolder(review_dir, *result.review, options.review_decisions, tentative, canvas,
+                            options.patch_radius);
+          fmt::print(
+              stderr,
+              "stopped for review at iteration {} (target row {}, col {}): {} candidates in {} clusters, "
+              "see {}/review.json; continue with --resume {} --choose N\n",
+              result.review->iteration, result.review->target.row, result.review->target.col,
+              result.review->candidates.size(), result.review->cluster_representative.size(), review_dir,
+              review_dir);
+          WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
+          return 0;
+        }
+        cv::Mat output;
+        result.image.convertTo(output, input.depth());
+        WriteImage(output_path, output);
+        if (!debug_dir.empty()) {
+          std::filesystem::create_directories(debug_dir);
+          cv::Mat background = result.image;
+          if (input.depth() != CV_8U) cv::normalize(result.image, background, 0, 255, cv::NORM_MINMAX);
+          const std::string dir = debug_dir + "/";
+          WriteImage(dir + "fill_order.png", RenderFillOrder(result, background));
+          WriteImage(dir + "source_map.png", RenderSourceMap(result, background));
+          InpaintResult scaled;
+          scaled.image = background;
+          scaled.steps = result.steps;
+          WriteImage(dir + "source_locations.png", RenderSourceLocations(scaled, options.patch_radius));
+          WriteFileAtomically(dir + "steps.csv", [&](std::ostream& out) {
+            out << "iteration,target_row,target_col,source_row,source_col,difference,priority,filled_pixels,"
+                   "rejected,accepted,margin\n";
+            for (size_t i = 0; i < result.steps.size(); ++i) {
+              const FillStep& s = result.steps[i];
+              out << fmt::format("{},{},{},{},{},{},{},{},{},{},{}\n", i, s.target.row, s.target.col,
+                                 s.source.row, s.source.col, s.difference, s.priority, s.filled_pixels,
+                                 s.rejected, s.accepted ? 1 : 0, s.margin);
+            }
+          });
+        }
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
+        if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
+        return 0;
       },
       &binder);
 }

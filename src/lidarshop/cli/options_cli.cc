@@ -145,26 +145,27 @@ CLI::Validator ChoiceOf(const EnumInfo& choices, std::vector<std::string> extra)
 OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
   // Defined before every bound flag: CLI11 runs option callbacks in definition order, so flags override it.
   app_.add_option_function<std::string>(
-         "--options",
-         [this](const std::string& path) {
-           if (root_ == nullptr) throw CLI::ValidationError("--options", "this command has no options struct");
-           try {
-             const std::string text = ReadRegularFile(path);
-             nlohmann::json json;
-             try {
-               json = nlohmann::json::parse(text);
-             } catch (const nlohmann::json::parse_error& error) {
-               throw OptionsError(fmt::format("{}: not JSON: {}", path, error.what()));
-             }
-             StructFromJson(*root_info_, json, root_);
-             given_by_file_.merge_patch(json);
-           } catch (const OptionsFieldError& error) {
-             throw CLI::ValidationError("--options", fmt::format("{}: {}", path, error.what()));
-           } catch (const std::exception& error) {
-             throw CLI::ValidationError("--options", error.what());
-           }
-         },
-         "options as JSON (keys as in --json's \"options\"); flags given too win")
+          "--options",
+          [this](const std::string& path) {
+            if (root_ == nullptr)
+              throw CLI::ValidationError("--options", "this command has no options struct");
+            try {
+              const std::string text = ReadRegularFile(path);
+              nlohmann::json json;
+              try {
+                json = nlohmann::json::parse(text);
+              } catch (const nlohmann::json::parse_error& error) {
+                throw OptionsError(fmt::format("{}: not JSON: {}", path, error.what()));
+              }
+              StructFromJson(*root_info_, json, root_);
+              given_by_file_.merge_patch(json);
+            } catch (const OptionsFieldError& error) {
+              throw CLI::ValidationError("--options", fmt::format("{}: {}", path, error.what()));
+            } catch (const std::exception& error) {
+              throw CLI::ValidationError("--options", error.what());
+            }
+          },
+          "options as JSON (keys as in --json's \"options\"); flags given too win")
       ->type_name("FILE");
 }
 

@@ -87,9 +87,14 @@ namespace {
 // The members of PointsOptions each operation uses.
 const std::map<std::string, std::vector<std::string>>& OptionsOfOperation() {
   static const std::map<std::string, std::vector<std::string>> used = {
-      {"outliers", {"statistical", "radius"}}, {"crop", {"crop"}},          {"normals", {"normals"}},
-      {"planes", {"planes", "hough"}},         {"cluster", {"cluster"}},    {"kmeans", {"kmeans"}},
-      {"mesh", {"mesh"}},                      {"regions", {"regions", "normals"}},
+      {"outliers", {"statistical", "radius"}},
+      {"crop", {"crop"}},
+      {"normals", {"normals"}},
+      {"planes", {"planes", "hough"}},
+      {"cluster", {"cluster"}},
+      {"kmeans", {"kmeans"}},
+      {"mesh", {"mesh"}},
+      {"regions", {"regions", "normals"}},
       {"superpixels", {"superpixels"}}};
   return used;
 }
@@ -295,173 +300,175 @@ int RunPoints(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&]() {
-    if (app.count("--neighbors") > 0) points.normals.neighbors = points.statistical.neighbors;
-    if (app.count("--radius") > 0) points.normals.radius_m = points.cluster.radius_m = points.radius.radius_m;
-    if (app.count("--seed") > 0) points.hough.seed = points.kmeans.seed = points.planes.seed;
-    binder.Validate(points);
-    const uint64_t seed = points.planes.seed;
-    StatisticalOutlierOptions& statistical = points.statistical;
-    RadiusOutlierOptions& radius_outliers = points.radius;
-    CropOptions& crop = points.crop;
-    NormalOptions& normals = points.normals;
-    RansacPlaneOptions& planes = points.planes;
-    HoughPlaneOptions& hough_options = points.hough;
-    EuclideanClusterOptions& clusters = points.cluster;
-    KMeansOptions& kmeans = points.kmeans;
-    ScanMeshOptions& mesh_options = points.mesh;
-    RegionGrowingOptions& region_options = points.regions;
-    SuperpixelOptions& superpixel_options = points.superpixels;
-    CheckOutputs(output_path, json_path, inputs);
-    if (operation == "mesh" && FileExtension(output_path) != "ply") {
-      throw OptionsError(fmt::format("-o {}: mesh writes a triangle mesh, as .ply", output_path));
-    }
-    if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
-      throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
-    }
-    const std::vector<double> box = ParseNumbers(box_text, "--box"),
-                              polygon = ParseNumbers(polygon_text, "--polygon"),
-                              matrix = ParseNumbers(matrix_text, "--matrix");
-    if (!box.empty() && box.size() != 6)
-      throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
-    if (operation == "sample-mesh") {
-      // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
-      // normals.
-      if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
-      if (FileExtension(output_path) != "ply")
-        throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
-      const TriangleMesh mesh = ReadMesh(inputs[0]);
-      if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
-      CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
-      const Timer timer;
-      SurfaceSamples samples = SampleSurface(mesh, count, seed);
-      PointCloud cloud;
-      cloud.points = std::move(samples.points);
-      cloud.normals = std::move(samples.normals);
-      const double seconds = timer.Seconds();
-      WritePointCloud(output_path, cloud);
-      nlohmann::ordered_json summary = {{"operation", operation},
-                                        {"triangles", mesh.num_triangles()},
-                                        {"output_points", cloud.size()},
-                                        {"seconds", seconds}};
-      WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
-      return 0;
-    }
-    const Timer read_timer;
-    const Gathered g = Gather(inputs);
-    nlohmann::ordered_json summary = {{"operation", operation},
-                              {"input_points", g.cloud.size()},
-                              {"scans", g.scans.size()},
-                              {"read_seconds", read_timer.Seconds()}};
-    const Timer timer;  // the operation alone, without reading and writing
-    std::vector<Scan> scans_out;
-    PointCloud cloud_out;
-    bool as_cloud = false;
-    if (operation == "outliers" || operation == "crop" || operation == "sample") {
-      std::vector<uint8_t> keep;
-      if (operation == "outliers" && method == "statistical") {
-        keep = StatisticalOutlierInliers(g.cloud, statistical);
-      } else if (operation == "outliers" && method == "radius") {
-        keep = RadiusOutlierInliers(g.cloud, radius_outliers);
-      } else if (operation == "outliers") {
-        throw OptionsError(fmt::format("--method '{}': expected statistical or radius", method));
-      } else if (operation == "sample") {
-        keep = RandomSampleInliers(g.cloud, count, seed);
-      } else {
-        if (!box.empty())
-          crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
-                                         Eigen::Vector3f(box[3], box[4], box[5]));
-        if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
-        for (size_t i = 0; i + 1 < polygon.size(); i += 2)
-          crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
-        keep = CropInliers(g.cloud, crop);
-      }
-      scans_out = KeepCells(g, keep);
-      summary["output_points"] = std::count(keep.begin(), keep.end(), 1);
-    } else if (operation == "voxel") {
-      cloud_out = VoxelDownsample(g.cloud, voxel_m);
-      as_cloud = true;
-    } else if (operation == "merge") {
-      cloud_out = g.cloud;
-      as_cloud = true;
-    } else if (operation == "mesh") {
-      // The grid mesh of any organized scan, real ones included (scanner/scan_mesh.h).
-      TriangleMesh mesh;
-      for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
-      summary["seconds"] = timer.Seconds();
-      summary["triangles"] = mesh.num_triangles();
-      WriteMesh(output_path, mesh);
-      WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
-      return 0;
-    } else if (operation == "regions" || operation == "superpixels") {
-      // Per scan, over its grid: labels into the scan's label channel.
-      int total = 0;
-      for (const Scan& scan : g.scans) {
-        Scan labelled = scan;
-        int count = 0;
-        if (operation == "regions") {
-          const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
-          labelled.label = SegmentByRegionGrowing(scan, region_options,
-                                                  NormalAngleCondition(with_normals, max_angle_deg), &count);
-        } else {
-          labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
-          labelled.label.setTo(kNoLabel, scan.valid == 0);
+        if (app.count("--neighbors") > 0) points.normals.neighbors = points.statistical.neighbors;
+        if (app.count("--radius") > 0)
+          points.normals.radius_m = points.cluster.radius_m = points.radius.radius_m;
+        if (app.count("--seed") > 0) points.hough.seed = points.kmeans.seed = points.planes.seed;
+        binder.Validate(points);
+        const uint64_t seed = points.planes.seed;
+        StatisticalOutlierOptions& statistical = points.statistical;
+        RadiusOutlierOptions& radius_outliers = points.radius;
+        CropOptions& crop = points.crop;
+        NormalOptions& normals = points.normals;
+        RansacPlaneOptions& planes = points.planes;
+        HoughPlaneOptions& hough_options = points.hough;
+        EuclideanClusterOptions& clusters = points.cluster;
+        KMeansOptions& kmeans = points.kmeans;
+        ScanMeshOptions& mesh_options = points.mesh;
+        RegionGrowingOptions& region_options = points.regions;
+        SuperpixelOptions& superpixel_options = points.superpixels;
+        CheckOutputs(output_path, json_path, inputs);
+        if (operation == "mesh" && FileExtension(output_path) != "ply") {
+          throw OptionsError(fmt::format("-o {}: mesh writes a triangle mesh, as .ply", output_path));
         }
-        total += count;
-        scans_out.push_back(labelled);
-      }
-      summary[operation] = total;
-    } else if (operation == "transform") {
-      if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
-      const Eigen::Matrix4d new_from_world =
-          Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
-      for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
-    } else if (operation == "normals") {
-      if (grid) {
-        for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
-      } else {
-        scans_out = WithNormals(g, EstimateNormals(g.cloud, normals).normals);
-      }
-    } else if (operation == "planes") {
-      hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
-      hough_options.max_planes = planes.max_planes;
-      hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
-      const std::vector<PlaneFit> fits =
-          hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
-      std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
-      summary["planes"] = nlohmann::ordered_json::array();
-      for (size_t p = 0; p < fits.size(); ++p) {
-        for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
-        summary["planes"].push_back({{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
-                                     {"offset_m", fits[p].offset_m},
-                                     {"inliers", fits[p].inliers.size()},
-                                     {"rms_m", fits[p].rms_m}});
-      }
-      scans_out = WithLabels(g, labels);
-    } else if (operation == "cluster") {
-      const ClusterResult result = EuclideanClusters(g.cloud, clusters);
-      summary["clusters"] = result.num_clusters();
-      summary["cluster_sizes"] = result.sizes;
-      scans_out = WithLabels(g, result.labels);
-    } else if (operation == "kmeans") {
-      const KMeansResult result = KMeans(g.cloud, kmeans);
-      summary["inertia_m2"] = result.inertia_m2;
-      summary["iterations"] = result.iterations;
-      scans_out = WithLabels(g, result.labels);
-    } else {
-      throw OptionsError(
-          fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                      "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
-                      operation));
-    }
-    summary["seconds"] = timer.Seconds();
-    if (as_cloud) {
-      WritePointCloud(output_path, cloud_out);
-      summary["output_points"] = cloud_out.size();
-    } else {
-      WriteScanFile(output_path, scans_out);
-    }
-    WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
-    return 0;
+        if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
+          throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
+        }
+        const std::vector<double> box = ParseNumbers(box_text, "--box"),
+                                  polygon = ParseNumbers(polygon_text, "--polygon"),
+                                  matrix = ParseNumbers(matrix_text, "--matrix");
+        if (!box.empty() && box.size() != 6)
+          throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+        if (operation == "sample-mesh") {
+          // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
+          // normals.
+          if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
+          if (FileExtension(output_path) != "ply")
+            throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
+          const TriangleMesh mesh = ReadMesh(inputs[0]);
+          if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
+          CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
+          const Timer timer;
+          SurfaceSamples samples = SampleSurface(mesh, count, seed);
+          PointCloud cloud;
+          cloud.points = std::move(samples.points);
+          cloud.normals = std::move(samples.normals);
+          const double seconds = timer.Seconds();
+          WritePointCloud(output_path, cloud);
+          nlohmann::ordered_json summary = {{"operation", operation},
+                                            {"triangles", mesh.num_triangles()},
+                                            {"output_points", cloud.size()},
+                                            {"seconds", seconds}};
+          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          return 0;
+        }
+        const Timer read_timer;
+        const Gathered g = Gather(inputs);
+        nlohmann::ordered_json summary = {{"operation", operation},
+                                          {"input_points", g.cloud.size()},
+                                          {"scans", g.scans.size()},
+                                          {"read_seconds", read_timer.Seconds()}};
+        const Timer timer;  // the operation alone, without reading and writing
+        std::vector<Scan> scans_out;
+        PointCloud cloud_out;
+        bool as_cloud = false;
+        if (operation == "outliers" || operation == "crop" || operation == "sample") {
+          std::vector<uint8_t> keep;
+          if (operation == "outliers" && method == "statistical") {
+            keep = StatisticalOutlierInliers(g.cloud, statistical);
+          } else if (operation == "outliers" && method == "radius") {
+            keep = RadiusOutlierInliers(g.cloud, radius_outliers);
+          } else if (operation == "outliers") {
+            throw OptionsError(fmt::format("--method '{}': expected statistical or radius", method));
+          } else if (operation == "sample") {
+            keep = RandomSampleInliers(g.cloud, count, seed);
+          } else {
+            if (!box.empty())
+              crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
+                                             Eigen::Vector3f(box[3], box[4], box[5]));
+            if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
+            for (size_t i = 0; i + 1 < polygon.size(); i += 2)
+              crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
+            keep = CropInliers(g.cloud, crop);
+          }
+          scans_out = KeepCells(g, keep);
+          summary["output_points"] = std::count(keep.begin(), keep.end(), 1);
+        } else if (operation == "voxel") {
+          cloud_out = VoxelDownsample(g.cloud, voxel_m);
+          as_cloud = true;
+        } else if (operation == "merge") {
+          cloud_out = g.cloud;
+          as_cloud = true;
+        } else if (operation == "mesh") {
+          // The grid mesh of any organized scan, real ones included (scanner/scan_mesh.h).
+          TriangleMesh mesh;
+          for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
+          summary["seconds"] = timer.Seconds();
+          summary["triangles"] = mesh.num_triangles();
+          WriteMesh(output_path, mesh);
+          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          return 0;
+        } else if (operation == "regions" || operation == "superpixels") {
+          // Per scan, over its grid: labels into the scan's label channel.
+          int total = 0;
+          for (const Scan& scan : g.scans) {
+            Scan labelled = scan;
+            int count = 0;
+            if (operation == "regions") {
+              const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
+              labelled.label = SegmentByRegionGrowing(
+                  scan, region_options, NormalAngleCondition(with_normals, max_angle_deg), &count);
+            } else {
+              labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
+              labelled.label.setTo(kNoLabel, scan.valid == 0);
+            }
+            total += count;
+            scans_out.push_back(labelled);
+          }
+          summary[operation] = total;
+        } else if (operation == "transform") {
+          if (matrix.size() != 16) throw OptionsError("transform needs --matrix with 16 numbers");
+          const Eigen::Matrix4d new_from_world =
+              Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(matrix.data());
+          for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
+        } else if (operation == "normals") {
+          if (grid) {
+            for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
+          } else {
+            scans_out = WithNormals(g, EstimateNormals(g.cloud, normals).normals);
+          }
+        } else if (operation == "planes") {
+          hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
+          hough_options.max_planes = planes.max_planes;
+          hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
+          const std::vector<PlaneFit> fits =
+              hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
+          std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
+          summary["planes"] = nlohmann::ordered_json::array();
+          for (size_t p = 0; p < fits.size(); ++p) {
+            for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
+            summary["planes"].push_back(
+                {{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
+                 {"offset_m", fits[p].offset_m},
+                 {"inliers", fits[p].inliers.size()},
+                 {"rms_m", fits[p].rms_m}});
+          }
+          scans_out = WithLabels(g, labels);
+        } else if (operation == "cluster") {
+          const ClusterResult result = EuclideanClusters(g.cloud, clusters);
+          summary["clusters"] = result.num_clusters();
+          summary["cluster_sizes"] = result.sizes;
+          scans_out = WithLabels(g, result.labels);
+        } else if (operation == "kmeans") {
+          const KMeansResult result = KMeans(g.cloud, kmeans);
+          summary["inertia_m2"] = result.inertia_m2;
+          summary["iterations"] = result.iterations;
+          scans_out = WithLabels(g, result.labels);
+        } else {
+          throw OptionsError(
+              fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
+                          "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
+                          operation));
+        }
+        summary["seconds"] = timer.Seconds();
+        if (as_cloud) {
+          WritePointCloud(output_path, cloud_out);
+          summary["output_points"] = cloud_out.size();
+        } else {
+          WriteScanFile(output_path, scans_out);
+        }
+        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+        return 0;
       },
       &binder);
 }
@@ -496,36 +503,34 @@ int RunRegister(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&]() {
-    binder.Validate(options);
-    if (use_global) {
-      try {
-        Validate(global);
-      } catch (const OptionsFieldError& error) {
-        throw OptionsFieldError("global." + error.key_path(), error.reason());
-      }
-    }
-    CheckOutputs(output_path, json_path, {fixed_path, moving_path});
-    const Timer timer;
-    const ScanFile fixed = ReadScanFile(fixed_path), moving = ReadScanFile(moving_path);
-    if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
-    const ScanRegistration result =
-        RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
-    WriteScanFile(output_path, {result.registered});
-    std::vector<std::vector<double>> rows;
-    for (int r = 0; r < 4; ++r) {
-      rows.push_back({result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
-                      result.registered.world_from_scanner(r, 2),
-                      result.registered.world_from_scanner(r, 3)});
-    }
-    nlohmann::ordered_json json = {{"world_from_scanner", rows},
-                                   {"rms_m", result.icp.rms_m},
-                                   {"fitness", result.icp.fitness},
-                                   {"iterations", result.icp.iterations},
-                                   {"converged", result.icp.converged},
-                                   {"seconds", timer.Seconds()}};
-    if (use_global) json["global_options"] = ToJson(global);
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-    return 0;
+        binder.Validate(options);
+        if (use_global) {
+          try {
+            Validate(global);
+          } catch (const OptionsFieldError& error) {
+            throw OptionsFieldError("global." + error.key_path(), error.reason());
+          }
+        }
+        CheckOutputs(output_path, json_path, {fixed_path, moving_path});
+        const Timer timer;
+        const ScanFile fixed = ReadScanFile(fixed_path), moving = ReadScanFile(moving_path);
+        if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
+        const ScanRegistration result =
+            RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
+        WriteScanFile(output_path, {result.registered});
+        std::vector<std::vector<double>> rows;
+        for (int r = 0; r < 4; ++r) {
+          rows.push_back(
+              {result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
+               result.registered.world_from_scanner(r, 2), result.registered.world_from_scanner(r, 3)});
+        }
+        nlohmann::ordered_json json = {
+            {"world_from_scanner", rows},        {"rms_m", result.icp.rms_m},
+            {"fitness", result.icp.fitness},     {"iterations", result.icp.iterations},
+            {"converged", result.icp.converged}, {"seconds", timer.Seconds()}};
+        if (use_global) json["global_options"] = ToJson(global);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
       },
       &binder);
 }

@@ -97,72 +97,77 @@ int RunPoisson(int argc, char** argv) {
   reconstruct->add_option("--mask", mask_path, "domain to reconstruct (white), same size")->required();
   reconstruct->add_option("-o,--output", output_path, "output image (.exr/.tif float, or .png)")->required();
 
+  for (CLI::App* sub : {fill, clone, reconstruct}) {
+    sub->footer(
+        "Solver options (--solver, --tolerance, ...), --options, --json and --quiet: `lidarshop poisson "
+        "--help`; they may follow the subcommand.");
+  }
   return RunCommand(
       app, argc, argv,
       [&]() {
-    binder.Validate(options);
-    CheckOutputPath(output_path,
-                    {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
-    CheckOutputFile("--json", json_path, {},
-                    {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path,
-                     output_path});
-    PoissonResult result;
-    int unknowns = 0;
-    if (*fill) {
-      const cv::Mat image = ReadImage(image_path);
-      const cv::Mat mask = ReadMask(mask_path, image.size(), image_path);
-      const PoissonSystem system = PreparePoisson(mask, options);
-      unknowns = system.NumUnknowns();
-      cv::Mat input;
-      image.convertTo(input, CV_32F);
-      result = FillLaplace(system, input);
-      WriteResult(output_path, result.image, IntegerDepth(image));
-    } else if (*clone) {
-      const cv::Point offset = ParseOffset(offset_text);
-      const cv::Mat source = ReadImage(source_path);
-      const cv::Mat target = ReadImage(target_path);
-      const cv::Mat mask = ReadMask(mask_path, source.size(), source_path);
-      if (source.channels() != target.channels()) {
-        ThrowInputError(target_path, "", "",
-                        fmt::format("the target has {} channel(s), the source {} has {}", target.channels(),
-                                    source_path, source.channels()));
-      }
-      unknowns = cv::countNonZero(mask);
-      cv::Mat source_float, target_float;
-      source.convertTo(source_float, CV_32F);
-      target.convertTo(target_float, CV_32F);
-      result = SeamlessClone(source_float, mask, target_float, offset, options);
-      WriteResult(output_path, result.image, IntegerDepth(target));
-    } else {
-      const cv::Mat boundary = ReadImage(boundary_path);
-      const cv::Mat gx = ReadFloat(gx_path), gy = ReadFloat(gy_path);
-      for (const auto& [path, field] : {std::pair{gx_path, &gx}, std::pair{gy_path, &gy}}) {
-        if (field->size() != boundary.size() || field->channels() != boundary.channels()) {
-          ThrowInputError(path, "", "",
-                          fmt::format("{}x{} with {} channel(s), but {} is {}x{} with {}", field->cols,
-                                      field->rows, field->channels(), boundary_path, boundary.cols,
-                                      boundary.rows, boundary.channels()));
+        binder.Validate(options);
+        CheckOutputPath(output_path,
+                        {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
+        CheckOutputFile(
+            "--json", json_path, {},
+            {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path, output_path});
+        PoissonResult result;
+        int unknowns = 0;
+        if (*fill) {
+          const cv::Mat image = ReadImage(image_path);
+          const cv::Mat mask = ReadMask(mask_path, image.size(), image_path);
+          const PoissonSystem system = PreparePoisson(mask, options);
+          unknowns = system.NumUnknowns();
+          cv::Mat input;
+          image.convertTo(input, CV_32F);
+          result = FillLaplace(system, input);
+          WriteResult(output_path, result.image, IntegerDepth(image));
+        } else if (*clone) {
+          const cv::Point offset = ParseOffset(offset_text);
+          const cv::Mat source = ReadImage(source_path);
+          const cv::Mat target = ReadImage(target_path);
+          const cv::Mat mask = ReadMask(mask_path, source.size(), source_path);
+          if (source.channels() != target.channels()) {
+            ThrowInputError(target_path, "", "",
+                            fmt::format("the target has {} channel(s), the source {} has {}",
+                                        target.channels(), source_path, source.channels()));
+          }
+          unknowns = cv::countNonZero(mask);
+          cv::Mat source_float, target_float;
+          source.convertTo(source_float, CV_32F);
+          target.convertTo(target_float, CV_32F);
+          result = SeamlessClone(source_float, mask, target_float, offset, options);
+          WriteResult(output_path, result.image, IntegerDepth(target));
+        } else {
+          const cv::Mat boundary = ReadImage(boundary_path);
+          const cv::Mat gx = ReadFloat(gx_path), gy = ReadFloat(gy_path);
+          for (const auto& [path, field] : {std::pair{gx_path, &gx}, std::pair{gy_path, &gy}}) {
+            if (field->size() != boundary.size() || field->channels() != boundary.channels()) {
+              ThrowInputError(path, "", "",
+                              fmt::format("{}x{} with {} channel(s), but {} is {}x{} with {}", field->cols,
+                                          field->rows, field->channels(), boundary_path, boundary.cols,
+                                          boundary.rows, boundary.channels()));
+            }
+          }
+          const cv::Mat mask = ReadMask(mask_path, boundary.size(), boundary_path);
+          const PoissonSystem system = PreparePoisson(mask, options);
+          unknowns = system.NumUnknowns();
+          cv::Mat boundary_float;
+          boundary.convertTo(boundary_float, CV_32F);
+          result = ReconstructFromGradients(system, boundary_float, gx, gy);
+          WriteResult(output_path, result.image, IntegerDepth(boundary));
         }
-      }
-      const cv::Mat mask = ReadMask(mask_path, boundary.size(), boundary_path);
-      const PoissonSystem system = PreparePoisson(mask, options);
-      unknowns = system.NumUnknowns();
-      cv::Mat boundary_float;
-      boundary.convertTo(boundary_float, CV_32F);
-      result = ReconstructFromGradients(system, boundary_float, gx, gy);
-      WriteResult(output_path, result.image, IntegerDepth(boundary));
-    }
-    if (!quiet) fmt::print(stderr, "{} unknowns; {}\n", unknowns, result.Summary());
-    nlohmann::ordered_json json;
-    json["operation"] = *fill ? "fill" : *clone ? "clone" : "reconstruct";
-    json["unknowns"] = unknowns;
-    json["solver"] = ToString(result.solver);
-    json["channels"] = result.channels;
-    json["iterations"] = result.iterations;
-    json["relative_residual"] = result.relative_residual;
-    json["seconds"] = result.seconds;
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-    return 0;
+        if (!quiet) fmt::print(stderr, "{} unknowns; {}\n", unknowns, result.Summary());
+        nlohmann::ordered_json json;
+        json["operation"] = *fill ? "fill" : *clone ? "clone" : "reconstruct";
+        json["unknowns"] = unknowns;
+        json["solver"] = ToString(result.solver);
+        json["channels"] = result.channels;
+        json["iterations"] = result.iterations;
+        json["relative_residual"] = result.relative_residual;
+        json["seconds"] = result.seconds;
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
       },
       &binder);
 }

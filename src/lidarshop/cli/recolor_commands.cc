@@ -149,26 +149,27 @@ int RunResection(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&] {
-    binder.Validate(options);
-    CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
-    CheckOutputFile("--json", json_path, {}, {pairs_path, scan_path, photo_path, intrinsics_path, output});
-    Scan scan;
-    if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
-    const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
-    if (pairs.width_px > 0) options.width_px = pairs.width_px, options.height_px = pairs.height_px;
-    if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
-    if (!photo_path.empty()) {
-      const cv::Mat photo = ReadImage(photo_path);
-      options.width_px = photo.cols, options.height_px = photo.rows;
-    }
-    if (options.width_px <= 0)
-      throw OptionsError("the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " +
-                         pairs_path);
-    const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
-    WriteCameraJson(output, result.camera);
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), ResectionJson(result)));
-    if (json_path != "-") fmt::print(stderr, "resection: {}\n", result.Summary());
-    return 0;
+        binder.Validate(options);
+        CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
+        CheckOutputFile("--json", json_path, {},
+                        {pairs_path, scan_path, photo_path, intrinsics_path, output});
+        Scan scan;
+        if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
+        const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
+        if (pairs.width_px > 0) options.width_px = pairs.width_px, options.height_px = pairs.height_px;
+        if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
+        if (!photo_path.empty()) {
+          const cv::Mat photo = ReadImage(photo_path);
+          options.width_px = photo.cols, options.height_px = photo.rows;
+        }
+        if (options.width_px <= 0)
+          throw OptionsError(
+              "the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " + pairs_path);
+        const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
+        WriteCameraJson(output, result.camera);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ResectionJson(result)));
+        if (json_path != "-") fmt::print(stderr, "resection: {}\n", result.Summary());
+        return 0;
       },
       &binder);
 }
@@ -194,62 +195,65 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
   app.add_option("--scan-index", scan_index, "which scan of the file (from 0)");
   AddJsonOption(app, &json_path);
-  binder.Bind(&options, {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
+  binder.Bind(&options,
+              {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
   AddResectionOptions(app, binder, &resection, &intrinsics_path, "Resection (with --correspondences)");
   return RunCommand(
       app, argc, argv,
       [&] {
-    binder.Validate(options);
-    binder.Validate(resection);
-    CheckOutputFile("--json", json_path, {}, {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
-    if (photo_path.empty() == image_key.empty())
-      throw OptionsError("give exactly one of --photo and --image");
-    CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
-    if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
-    const Scan scan = ReadOneScan(scan_path, scan_index);
-    cv::Mat photo;
-    PinholeCamera camera;
-    bool have_camera = false;
-    nlohmann::ordered_json json;
-    if (!image_key.empty()) {
-      if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
-      const E57File file = ReadE57(scan_path);
-      const E57Image& image = FindImage(file.images, image_key, scan_path);
-      if (image.image.empty()) ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
-      photo = image.image;
-      std::string why;
-      have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
-      if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
-    } else {
-      photo = ReadImage(photo_path);
-      if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
-    }
-    if (!camera_path.empty() && !pairs_path.empty())
-      throw OptionsError("give --camera or --correspondences, not both");
-    if (!camera_path.empty()) {
-      camera = ReadCameraJson(camera_path);
-    } else if (!pairs_path.empty()) {
-      resection.width_px = photo.cols, resection.height_px = photo.rows;
-      const ResectionResult result =
-          RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
-      fmt::print(stderr, "resection: {}\n", result.Summary());
-      json["resection"] = ResectionJson(result);
-      json["resection"]["options"] = ToJson(resection);
-      camera = result.camera;
-    } else if (!have_camera) {
-      throw OptionsError("give --camera or --correspondences");
-    }
-    const RecolorResult result = RecolorScan(scan, photo, camera, options);
-    WriteScanFile(output, {result.scan});
-    if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
-    nlohmann::ordered_json counts;
-    counts["returns"] = result.returns;
-    counts["recolored"] = result.recolored_count;
-    counts["outside_image"] = result.outside_image;
-    counts["hidden"] = result.hidden;
-    if (json.is_object()) counts.update(json);
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
-    return 0;
+        binder.Validate(options);
+        binder.Validate(resection);
+        CheckOutputFile("--json", json_path, {},
+                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
+        if (photo_path.empty() == image_key.empty())
+          throw OptionsError("give exactly one of --photo and --image");
+        CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
+        if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
+        const Scan scan = ReadOneScan(scan_path, scan_index);
+        cv::Mat photo;
+        PinholeCamera camera;
+        bool have_camera = false;
+        nlohmann::ordered_json json;
+        if (!image_key.empty()) {
+          if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
+          const E57File file = ReadE57(scan_path);
+          const E57Image& image = FindImage(file.images, image_key, scan_path);
+          if (image.image.empty())
+            ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
+          photo = image.image;
+          std::string why;
+          have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
+          if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
+        } else {
+          photo = ReadImage(photo_path);
+          if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
+        }
+        if (!camera_path.empty() && !pairs_path.empty())
+          throw OptionsError("give --camera or --correspondences, not both");
+        if (!camera_path.empty()) {
+          camera = ReadCameraJson(camera_path);
+        } else if (!pairs_path.empty()) {
+          resection.width_px = photo.cols, resection.height_px = photo.rows;
+          const ResectionResult result =
+              RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
+          fmt::print(stderr, "resection: {}\n", result.Summary());
+          json["resection"] = ResectionJson(result);
+          json["resection"]["options"] = ToJson(resection);
+          camera = result.camera;
+        } else if (!have_camera) {
+          throw OptionsError("give --camera or --correspondences");
+        }
+        const RecolorResult result = RecolorScan(scan, photo, camera, options);
+        WriteScanFile(output, {result.scan});
+        if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
+        nlohmann::ordered_json counts;
+        counts["returns"] = result.returns;
+        counts["recolored"] = result.recolored_count;
+        counts["outside_image"] = result.outside_image;
+        counts["hidden"] = result.hidden;
+        if (json.is_object()) counts.update(json);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+        return 0;
       },
       &binder);
 }

@@ -44,87 +44,89 @@ int RunScan(int argc, char** argv) {
   app.add_flag("--stats", stats, "= --json -: counts and seconds per stage as one JSON object on stdout");
   app.add_option("--threads", threads, "worker threads (0 = all cores)")->capture_default_str();
   binder.Bind(&scanner_overrides, {.group = "Scanner (default: the scene's \"scanner\")", .overrides = true});
-  binder.Bind(&mesh_options, {.keys = {"max_range_jump_ratio"}, .flags = {{"max_range_jump_ratio", "--mesh-jump"}}});
+  binder.Bind(&mesh_options,
+              {.keys = {"max_range_jump_ratio"}, .flags = {{"max_range_jump_ratio", "--mesh-jump"}}});
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
       [&]() {
-    if (stats && json_path.empty()) json_path = "-";
-    CheckOption(threads >= 0, fmt::format("--threads must be >= 0, got {}", threads));
-    CheckOutputPath(output_path, {scene_path});
-    if (!labels_path.empty()) CheckOutputPath(labels_path, {scene_path, output_path});
-    if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
-    CheckOutputFile("--json", json_path, {}, {scene_path, output_path, labels_path, mesh_path});
-    binder.Validate(mesh_options);
-    const ThreadLimit thread_limit(threads);
-    Timer total;
-    Timer stage;
-    SceneDescription scene = LoadScene(scene_path);
-    StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &scene.scanner);
-    scene.scanner.Check();
-    const double loading_seconds = stage.Seconds();
+        if (stats && json_path.empty()) json_path = "-";
+        CheckOption(threads >= 0, fmt::format("--threads must be >= 0, got {}", threads));
+        CheckOutputPath(output_path, {scene_path});
+        if (!labels_path.empty()) CheckOutputPath(labels_path, {scene_path, output_path});
+        if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
+        CheckOutputFile("--json", json_path, {}, {scene_path, output_path, labels_path, mesh_path});
+        binder.Validate(mesh_options);
+        const ThreadLimit thread_limit(threads);
+        Timer total;
+        Timer stage;
+        SceneDescription scene = LoadScene(scene_path);
+        StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &scene.scanner);
+        scene.scanner.Check();
+        const double loading_seconds = stage.Seconds();
 
-    stage.Restart();
-    const SyntheticScanner scanner(scene);
-    const double building_seconds = stage.Seconds();
+        stage.Restart();
+        const SyntheticScanner scanner(scene);
+        const double building_seconds = stage.Seconds();
 
-    stage.Restart();
-    ScanStats scan_stats;
-    Scan scan;
-    {
-      auto progress = Progress::ForTerminal("scanning", scene.scanner.rows, quiet);
-      scan = scanner.Acquire(scene.scanner, progress.get(), &scan_stats);
-      progress->Finish();
-    }
-    const double scanning_seconds = stage.Seconds();
+        stage.Restart();
+        ScanStats scan_stats;
+        Scan scan;
+        {
+          auto progress = Progress::ForTerminal("scanning", scene.scanner.rows, quiet);
+          scan = scanner.Acquire(scene.scanner, progress.get(), &scan_stats);
+          progress->Finish();
+        }
+        const double scanning_seconds = stage.Seconds();
 
-    stage.Restart();
-    WriteScanFile(output_path, {scan});
-    const double writing_scan_seconds = stage.Seconds();
-    double writing_labels_seconds = 0, meshing_seconds = 0, writing_mesh_seconds = 0;
-    int64_t mesh_triangles = 0;
-    if (!labels_path.empty()) {
-      stage.Restart();
-      WriteImage(labels_path, LabelImage16(scan));
-      writing_labels_seconds = stage.Seconds();
-    }
-    if (!mesh_path.empty()) {
-      stage.Restart();
-      const TriangleMesh mesh = ScanToMesh(scan, mesh_options);
-      mesh_triangles = static_cast<int64_t>(mesh.triangles.size());
-      meshing_seconds = stage.Seconds();
-      stage.Restart();
-      WriteMesh(mesh_path, mesh);
-      writing_mesh_seconds = stage.Seconds();
-    }
-    if (!json_path.empty()) {
-      nlohmann::ordered_json json;
-      json["scene"] = scene_path;
-      json["output"] = output_path;
-      json["objects"] = scene.objects.size();
-      json["triangles"] = scanner.num_triangles();
-      json["rows"] = scan.rows;
-      json["columns"] = scan.cols;
-      json["rays"] = scan_stats.rays;
-      json["returns"] = scan_stats.returns;
-      json["mesh_triangles"] = mesh_triangles;
-      json["threads"] = threads;
-      json["seconds"] = {{"loading", loading_seconds},
-                         {"building", building_seconds},
-                         {"casting", scan_stats.cast_seconds},
-                         {"shading", scan_stats.shade_seconds},
-                         {"scanning", scanning_seconds},
-                         {"meshing", meshing_seconds},
-                         {"writing", writing_scan_seconds + writing_labels_seconds + writing_mesh_seconds},
-                         {"writing_scan", writing_scan_seconds},
-                         {"writing_labels", writing_labels_seconds},
-                         {"writing_mesh", writing_mesh_seconds},
-                         {"total", total.Seconds()}};
-      json["rays_per_second"] = scan_stats.rays / std::max(1e-9, scanning_seconds);
-      if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
-      WriteJsonOutput(json_path, CommandJson(ToJson(scene.scanner), json));
-    }
-    return 0;
+        stage.Restart();
+        WriteScanFile(output_path, {scan});
+        const double writing_scan_seconds = stage.Seconds();
+        double writing_labels_seconds = 0, meshing_seconds = 0, writing_mesh_seconds = 0;
+        int64_t mesh_triangles = 0;
+        if (!labels_path.empty()) {
+          stage.Restart();
+          WriteImage(labels_path, LabelImage16(scan));
+          writing_labels_seconds = stage.Seconds();
+        }
+        if (!mesh_path.empty()) {
+          stage.Restart();
+          const TriangleMesh mesh = ScanToMesh(scan, mesh_options);
+          mesh_triangles = static_cast<int64_t>(mesh.triangles.size());
+          meshing_seconds = stage.Seconds();
+          stage.Restart();
+          WriteMesh(mesh_path, mesh);
+          writing_mesh_seconds = stage.Seconds();
+        }
+        if (!json_path.empty()) {
+          nlohmann::ordered_json json;
+          json["scene"] = scene_path;
+          json["output"] = output_path;
+          json["objects"] = scene.objects.size();
+          json["triangles"] = scanner.num_triangles();
+          json["rows"] = scan.rows;
+          json["columns"] = scan.cols;
+          json["rays"] = scan_stats.rays;
+          json["returns"] = scan_stats.returns;
+          json["mesh_triangles"] = mesh_triangles;
+          json["threads"] = threads;
+          json["seconds"] = {
+              {"loading", loading_seconds},
+              {"building", building_seconds},
+              {"casting", scan_stats.cast_seconds},
+              {"shading", scan_stats.shade_seconds},
+              {"scanning", scanning_seconds},
+              {"meshing", meshing_seconds},
+              {"writing", writing_scan_seconds + writing_labels_seconds + writing_mesh_seconds},
+              {"writing_scan", writing_scan_seconds},
+              {"writing_labels", writing_labels_seconds},
+              {"writing_mesh", writing_mesh_seconds},
+              {"total", total.Seconds()}};
+          json["rays_per_second"] = scan_stats.rays / std::max(1e-9, scanning_seconds);
+          if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
+          WriteJsonOutput(json_path, CommandJson(ToJson(scene.scanner), json));
+        }
+        return 0;
       },
       &binder);
 }

@@ -33,7 +33,8 @@ int RunSegment(int argc, char** argv) {
       "over the "
       "scan's colours; default MASK_overlay.png next to the mask, --overlay none to skip).",
       "segment"};
-  std::string scan_path, strokes_path, mask_path, object_path, rest_path, overlay_path, refine_path, json_path;
+  std::string scan_path, strokes_path, mask_path, object_path, rest_path, overlay_path, refine_path,
+      json_path;
   int scan_index = 0;
   bool quiet = false;
   SegmentOptions options;
@@ -59,41 +60,41 @@ int RunSegment(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&]() {
-    binder.Validate(options);
-    for (const std::string& path : {object_path, rest_path}) {
-      if (!path.empty()) CheckScanFileFormat(path);
-    }
-    std::vector<std::string> used = {scan_path, strokes_path, refine_path};
-    for (const std::string& path : {mask_path, object_path, rest_path, overlay_path, json_path}) {
-      if (path == "-" || path == "none") continue;
-      if (path.empty()) continue;
-      CheckOutputPath(path, used);
-      used.push_back(path);
-    }
-    const ScanFile file = ReadScanFile(scan_path);
-    const Scan& scan = PickScan(file, scan_index);
-    cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
-    SegmentSession session(scan, options);
-    SegmentResult result = session.Run(strokes);
-    if (!quiet) fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());
-    if (!refine_path.empty()) {
-      const cv::Mat extra = ReadStrokes(refine_path, scan.rows, scan.cols);
-      result = session.Refine(extra);
-      strokes.setTo(kStrokeObject, extra == kStrokeObject);
-      strokes.setTo(kStrokeBackground, extra == kStrokeBackground);
-      if (!quiet) fmt::print(stderr, "refined: {}\n", result.Summary());
-    }
-    WriteImage(mask_path, result.mask);
-    if (overlay_path != "none") {
-      WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,
-                 SegmentOverlay(scan, result.mask, strokes));
-    }
-    if (!object_path.empty()) WriteScanFile(object_path, {MaskScan(scan, result.mask)});
-    if (!rest_path.empty()) WriteScanFile(rest_path, {MaskScan(scan, result.mask == 0)});
-    nlohmann::ordered_json json = ToJson(result);
-    json["refined"] = !refine_path.empty();
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-    return 0;
+        binder.Validate(options);
+        for (const std::string& path : {object_path, rest_path}) {
+          if (!path.empty()) CheckScanFileFormat(path);
+        }
+        std::vector<std::string> used = {scan_path, strokes_path, refine_path};
+        for (const std::string& path : {mask_path, object_path, rest_path, overlay_path, json_path}) {
+          if (path == "-" || path == "none") continue;
+          if (path.empty()) continue;
+          CheckOutputPath(path, used);
+          used.push_back(path);
+        }
+        const ScanFile file = ReadScanFile(scan_path);
+        const Scan& scan = PickScan(file, scan_index);
+        cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
+        SegmentSession session(scan, options);
+        SegmentResult result = session.Run(strokes);
+        if (!quiet) fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());
+        if (!refine_path.empty()) {
+          const cv::Mat extra = ReadStrokes(refine_path, scan.rows, scan.cols);
+          result = session.Refine(extra);
+          strokes.setTo(kStrokeObject, extra == kStrokeObject);
+          strokes.setTo(kStrokeBackground, extra == kStrokeBackground);
+          if (!quiet) fmt::print(stderr, "refined: {}\n", result.Summary());
+        }
+        WriteImage(mask_path, result.mask);
+        if (overlay_path != "none") {
+          WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,
+                     SegmentOverlay(scan, result.mask, strokes));
+        }
+        if (!object_path.empty()) WriteScanFile(object_path, {MaskScan(scan, result.mask)});
+        if (!rest_path.empty()) WriteScanFile(rest_path, {MaskScan(scan, result.mask == 0)});
+        nlohmann::ordered_json json = ToJson(result);
+        json["refined"] = !refine_path.empty();
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
       },
       &binder);
 }

@@ -103,8 +103,7 @@ struct CommonFlags {
                                     {"sigma_m", "--sigma"},
                                     {"icp_trim_m", "--icp-trim"},
                                     {"footprint_margin_cells", "--footprint-margin"}}});
-    binder.Bind(&model_options, {.flags = {{"num_surface_samples", "--samples"}},
-                                 .group = "Model points"});
+    binder.Bind(&model_options, {.flags = {{"num_surface_samples", "--samples"}}, .group = "Model points"});
     app.add_flag("--vertices", use_vertices, "= --point-source vertices")->group("Model points");
     app.add_flag("--distinctiveness", distinctiveness, "= --information shape-distinctiveness")
         ->group("Model points");
@@ -190,35 +189,36 @@ int RunVerify(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&] {
-    std::vector<std::string> used = common.scans;
-    used.push_back(common.model);
-    used.push_back(pose_text);
-    for (const std::string& path : {json_path, scene_ply, model_ply}) {
-      if (path.empty() || path == "-") continue;
-      CheckOutputPath(path, used);
-      used.push_back(path);
-    }
-    const Eigen::Matrix4d world_from_model = ParsePose(pose_text);
-    auto progress = Progress::ForTerminal("verify: preparing", 2, common.quiet);
-    VerifierModel model = common.PrepareTheModel(binder);
-    progress->Advance();
-    const std::vector<PreparedScan> scans = LoadScans(common.scans);
-    progress->Advance();
-    progress->Finish();
-    VerifyOptions options = common.verify;
-    options.keep_details = !scene_ply.empty() || !model_ply.empty();
-    const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
-    std::vector<std::string> names;
-    for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
-    if (!common.quiet) fmt::print(stderr, "{}\n", result.BriefReport());
-    nlohmann::ordered_json json = ResultJson(result, names);
-    json["world_from_model"] = MatrixJson(world_from_model);
-    json["model_points"] = model.num_points();
-    json["model_options"] = ToJson(common.model_options);
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-    if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
-    if (!model_ply.empty()) WritePointCloud(model_ply, ObservedModelCloud(model, world_from_model, result));
-    return 0;
+        std::vector<std::string> used = common.scans;
+        used.push_back(common.model);
+        used.push_back(pose_text);
+        for (const std::string& path : {json_path, scene_ply, model_ply}) {
+          if (path.empty() || path == "-") continue;
+          CheckOutputPath(path, used);
+          used.push_back(path);
+        }
+        const Eigen::Matrix4d world_from_model = ParsePose(pose_text);
+        auto progress = Progress::ForTerminal("verify: preparing", 2, common.quiet);
+        VerifierModel model = common.PrepareTheModel(binder);
+        progress->Advance();
+        const std::vector<PreparedScan> scans = LoadScans(common.scans);
+        progress->Advance();
+        progress->Finish();
+        VerifyOptions options = common.verify;
+        options.keep_details = !scene_ply.empty() || !model_ply.empty();
+        const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
+        std::vector<std::string> names;
+        for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
+        if (!common.quiet) fmt::print(stderr, "{}\n", result.BriefReport());
+        nlohmann::ordered_json json = ResultJson(result, names);
+        json["world_from_model"] = MatrixJson(world_from_model);
+        json["model_points"] = model.num_points();
+        json["model_options"] = ToJson(common.model_options);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
+        if (!model_ply.empty())
+          WritePointCloud(model_ply, ObservedModelCloud(model, world_from_model, result));
+        return 0;
       },
       &binder);
 }
@@ -257,71 +257,73 @@ int RunSweep(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&] {
-    if (!x_range.empty()) std::tie(sweep_options.x_min_m, sweep_options.x_max_m) = ParseRange(x_range, "--x-range");
-    if (!y_range.empty()) std::tie(sweep_options.y_min_m, sweep_options.y_max_m) = ParseRange(y_range, "--y-range");
-    if (!yaws.empty()) sweep_options.yaws_deg = ParseYaws(yaws);
-    binder.Validate(sweep_options);
-    CheckOutputFile("--json", json_path, {}, common.scans);
-    VerifierModel model = common.PrepareTheModel(binder);
-    const std::vector<PreparedScan> scans = LoadScans(common.scans);
-    std::filesystem::create_directories(out_dir);
-    const std::filesystem::path out(out_dir);
-    const size_t poses =
-        (static_cast<size_t>(
-             std::floor((sweep_options.x_max_m - sweep_options.x_min_m) / sweep_options.step_m + 1e-9)) +
-         1) *
-        (static_cast<size_t>(
-             std::floor((sweep_options.y_max_m - sweep_options.y_min_m) / sweep_options.step_m + 1e-9)) +
-         1) *
-        sweep_options.yaws_deg.size();
-    auto progress = Progress::ForTerminal("sweep", static_cast<int64_t>(poses), common.quiet);
-    const SweepResult sweep = Sweep(model, scans, sweep_options, common.verify, progress.get());
-    progress->Finish();
-    WriteImage((out / "consistency.png").string(),
-               RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",
-                             sweep_options.min_consistency));
-    WriteImage((out / "confidence.png").string(),
-               RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
-                             sweep_options.min_confidence));
-    WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
-    nlohmann::json json;
-    json["detections"] = nlohmann::json::array();
-    for (const Detection& d : sweep.detections) {
-      json["detections"].push_back({{"x_m", d.x_m},
-                                    {"y_m", d.y_m},
-                                    {"z_m", d.z_m},
-                                    {"yaw_deg", d.yaw_deg},
-                                    {"consistency", d.consistency},
-                                    {"confidence", d.confidence},
-                                    {"comparable_pairs", d.comparable_pairs},
-                                    {"icp_cost", NumberOrNull(d.icp_cost_m)},
-                                    {"inlier_fraction", d.inlier_fraction},
-                                    {"world_from_model", MatrixJson(d.world_from_model)}});
-    }
-    json["thresholds"] = {{"min_consistency", sweep_options.min_consistency},
-                          {"min_confidence", sweep_options.min_confidence},
-                          {"min_comparable_pairs", sweep_options.min_comparable_pairs},
-                          {"nms_radius_m", sweep.nms_radius_m}};
-    json["grid"] = {{"x_count", sweep.xs_m.size()},
-                    {"y_count", sweep.ys_m.size()},
-                    {"yaws_deg", sweep.yaws_deg},
-                    {"poses", sweep.poses.size()},
-                    {"refined_seeds", sweep.refined.size()},
-                    {"refine_evaluations", sweep.refine_evaluations}};
-    WriteText((out / "detections.json").string(), json.dump(2) + "\n");
-    nlohmann::ordered_json result = json;
-    result["verify_options"] = ToJson(common.verify);
-    result["model_options"] = ToJson(common.model_options);
-    WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
-    if (!common.quiet) {
-      fmt::print(stderr, "{} poses, {} refined, {} detection(s):\n", sweep.poses.size(),
-                 sweep.refined.size(), sweep.detections.size());
-      for (const Detection& d : sweep.detections) {
-        fmt::print(stderr, "  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n", d.x_m,
-                   d.y_m, d.yaw_deg, d.consistency, d.confidence);
-      }
-    }
-    return 0;
+        if (!x_range.empty())
+          std::tie(sweep_options.x_min_m, sweep_options.x_max_m) = ParseRange(x_range, "--x-range");
+        if (!y_range.empty())
+          std::tie(sweep_options.y_min_m, sweep_options.y_max_m) = ParseRange(y_range, "--y-range");
+        if (!yaws.empty()) sweep_options.yaws_deg = ParseYaws(yaws);
+        binder.Validate(sweep_options);
+        CheckOutputFile("--json", json_path, {}, common.scans);
+        VerifierModel model = common.PrepareTheModel(binder);
+        const std::vector<PreparedScan> scans = LoadScans(common.scans);
+        std::filesystem::create_directories(out_dir);
+        const std::filesystem::path out(out_dir);
+        const size_t poses =
+            (static_cast<size_t>(
+                 std::floor((sweep_options.x_max_m - sweep_options.x_min_m) / sweep_options.step_m + 1e-9)) +
+             1) *
+            (static_cast<size_t>(
+                 std::floor((sweep_options.y_max_m - sweep_options.y_min_m) / sweep_options.step_m + 1e-9)) +
+             1) *
+            sweep_options.yaws_deg.size();
+        auto progress = Progress::ForTerminal("sweep", static_cast<int64_t>(poses), common.quiet);
+        const SweepResult sweep = Sweep(model, scans, sweep_options, common.verify, progress.get());
+        progress->Finish();
+        WriteImage((out / "consistency.png").string(),
+                   RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",
+                                 sweep_options.min_consistency));
+        WriteImage((out / "confidence.png").string(),
+                   RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
+                                 sweep_options.min_confidence));
+        WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
+        nlohmann::json json;
+        json["detections"] = nlohmann::json::array();
+        for (const Detection& d : sweep.detections) {
+          json["detections"].push_back({{"x_m", d.x_m},
+                                        {"y_m", d.y_m},
+                                        {"z_m", d.z_m},
+                                        {"yaw_deg", d.yaw_deg},
+                                        {"consistency", d.consistency},
+                                        {"confidence", d.confidence},
+                                        {"comparable_pairs", d.comparable_pairs},
+                                        {"icp_cost", NumberOrNull(d.icp_cost_m)},
+                                        {"inlier_fraction", d.inlier_fraction},
+                                        {"world_from_model", MatrixJson(d.world_from_model)}});
+        }
+        json["thresholds"] = {{"min_consistency", sweep_options.min_consistency},
+                              {"min_confidence", sweep_options.min_confidence},
+                              {"min_comparable_pairs", sweep_options.min_comparable_pairs},
+                              {"nms_radius_m", sweep.nms_radius_m}};
+        json["grid"] = {{"x_count", sweep.xs_m.size()},
+                        {"y_count", sweep.ys_m.size()},
+                        {"yaws_deg", sweep.yaws_deg},
+                        {"poses", sweep.poses.size()},
+                        {"refined_seeds", sweep.refined.size()},
+                        {"refine_evaluations", sweep.refine_evaluations}};
+        WriteText((out / "detections.json").string(), json.dump(2) + "\n");
+        nlohmann::ordered_json result = json;
+        result["verify_options"] = ToJson(common.verify);
+        result["model_options"] = ToJson(common.model_options);
+        WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
+        if (!common.quiet) {
+          fmt::print(stderr, "{} poses, {} refined, {} detection(s):\n", sweep.poses.size(),
+                     sweep.refined.size(), sweep.detections.size());
+          for (const Detection& d : sweep.detections) {
+            fmt::print(stderr, "  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n",
+                       d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);
+          }
+        }
+        return 0;
       },
       &binder);
 }
