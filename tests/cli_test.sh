@@ -398,9 +398,132 @@ check "points sample-mesh" "$lidarshop" points sample-mesh "$work/grid_mesh.ply"
 json_check "points sample-mesh summary" "$work/mesh_samples.json" "d['output_points'] == 5000"
 fails_clearly "points: k larger than the cloud" "larger than the cloud" "$lidarshop" points kmeans "$work/scan.ptx" \
   -o "$work/x.ply" --k 100000000
-fails_clearly "points: radius 0" "radius_m: 0(\.0)? is out of range > 0" "$lidarshop" points outliers "$work/scan.ptx" \
-  -o "$work/x.ply" --method radius --radius 0
+exits_with 2 "points: radius 0 names the flag" "--radius: 0(\.0)? is out of range > 0" "$lidarshop" points outliers \
+  "$work/scan.ptx" -o "$work/x.ply" --method radius --radius 0
 fails_clearly "points: unknown operation" "unknown operation" "$lidarshop" points smooth "$work/scan.ptx" -o "$work/x.ply"
+
+# Every command writes its result as one JSON object with --json (- = stdout), its options under "options"
+# where it has library options; summaries for people go to stderr.
+json_stdout() {  # json_stdout NAME KEY COMMAND...: succeeds, and stdout is one JSON object holding KEY
+  local name=$1 key=$2
+  shift 2
+  if "$@" >"$work/last.out" 2>"$work/last.err" && python3 -c "import json,sys; d=json.load(open(sys.argv[1])); \
+assert isinstance(d, dict) and sys.argv[2] in d, 'no key ' + sys.argv[2]" "$work/last.out" "$key" 2>"$work/json.err"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name: expected one JSON object with '$key' on stdout: $*"
+    sed 's/^/  | /' "$work/last.out" "$work/last.err" "$work/json.err" | head -20
+  fi
+}
+json_stdout "scan --json -" returns "$lidarshop" scan "$work/scene/scene.json" -o "$work/j_scan.ptx" --rows 40 \
+  --columns 60 --json - --quiet
+json_stdout "scan --json - has its options" options "$lidarshop" scan "$work/scene/scene.json" -o "$work/j_scan.ptx" \
+  --rows 40 --columns 60 --json - --quiet
+json_stdout "info --json -" scans "$lidarshop" info "$work/scan.ptx" --json -
+json_stdout "convert --json -" returns "$lidarshop" convert "$work/scan.ptx" "$work/j_convert.e57" --json - --quiet
+json_stdout "render --json -" width_px "$lidarshop" render "$work/scan.ptx" -o "$work/j_render.png" --json -
+json_stdout "render --orbit --json -" eye_in_world "$lidarshop" render "$work/scan.ptx" -o "$work/j_orbit.png" \
+  --orbit 20 --width 64 --height 48 --json -
+json_stdout "verify --json -" consistency "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
+  --pose "-2,8,0.6,0" --json - --quiet
+cp "$work/last.out" "$work/j_verify.json"
+json_check "verify --json: the described result and the older keys" "$work/j_verify.json" \
+  "d['icp_cost_m'] == d['icp_cost'] and d['options']['allowance_m'] == 0.1 and 'num_surface_samples' in d['model_options']"
+json_stdout "sweep --json -" detections "$lidarshop" sweep --scan "$work/scan.ptx" --model "$work/box.obj" \
+  --x-range=-3:-1 --y-range 7:9 --step 0.5 --yaws 0 --out "$work/j_sweep" --json - --quiet
+json_stdout "segment --json -" object_cells "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/j_mask.png" --json - --quiet
+json_stdout "inpaint --json -" iterations "$lidarshop" inpaint "$images/lettera/lettera.png" \
+  --mask "$images/lettera/lettera_mask.png" -o "$work/j_lettera.png" --search local --json - --quiet
+json_stdout "poisson --json -" unknowns "$lidarshop" poisson fill "$images/bungee/bungee.png" \
+  --mask "$images/bungee/bungee_mask.png" -o "$work/j_bungee.png" --solver direct --json - --quiet
+json_stdout "fill --json -" synthesized_cells "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" \
+  -o "$work/j_filled.ply" --method laplace --json - --quiet
+json_stdout "remove --json -" cut "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/j_removed.ply" --method laplace --json - --quiet
+json_stdout "resection --json -" rms_px "$lidarshop" resection --correspondences "$work/pairs.json" \
+  -o "$work/j_cam.json" --json -
+json_stdout "recolor --json -" recolored "$lidarshop" recolor "$work/scan.ptx" --photo "$work/photo.png" \
+  --camera "$work/cam.json" -o "$work/j_recolored.ply" --json -
+json_stdout "images --json -" images "$lidarshop" images "$shared/e57/pumpA.e57" --json -
+json_stdout "align --json -" rms_m "$lidarshop" align --correspondences "$work/landmarks.json" -o "$work/j_T.txt" --json -
+json_stdout "photo --json -" scene_pixels "$lidarshop" photo "$work/scene/scene.json" --camera "$work/cam.json" \
+  -o "$work/j_photo.png" --samples 1 --json -
+json_stdout "points --json -" output_points "$lidarshop" points outliers "$work/scan.ptx" -o "$work/j_clean.ptx" --json -
+json_stdout "register --json -" converged "$lidarshop" register "$work/scan.ptx" "$work/moved.ptx" \
+  -o "$work/j_registered.ptx" --json -
+json_stdout "demo --json -" scan "$lidarshop" demo --scene mailbox --out "$work/j_demo" --json - --quiet
+# Older JSON on stdout stays there without --json; --json FILE moves it.
+check "resection --json FILE" "$lidarshop" resection --correspondences "$work/pairs.json" -o "$work/j_cam2.json" \
+  --json "$work/j_resection.json"
+check "resection --json FILE leaves stdout empty" test ! -s "$work/last.out"
+json_check "resection --json FILE" "$work/j_resection.json" "d['inliers'] == 12 and d['options']['ransac_threshold_px'] > 0"
+
+# --options FILE: the command's first options struct, by key; flags win.
+printf '{"method": "depth", "ring_radius_cells": 3}\n' >"$work/segment_options.json"
+check "segment --options" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/j_mask2.png" \
+  --options "$work/segment_options.json" --model histogram --json "$work/j_segment.json" --quiet
+json_check "segment --options reach the options, flags win" "$work/j_segment.json" \
+  "d['options']['method'] == 'depth' and d['options']['ring_radius_cells'] == 3 and d['options']['model'] == 'histogram'"
+printf '{"rows": 30, "seed": 7}\n' >"$work/scanner_options.json"
+check "scan --options overrides the scene's scanner" "$lidarshop" scan "$work/scene/scene.json" -o "$work/j_scan2.ptx" \
+  --options "$work/scanner_options.json" --columns 50 --json "$work/j_scan.json" --quiet
+json_check "scan --options and flags reach the scanner" "$work/j_scan.json" \
+  "d['rows'] == 30 and d['columns'] == 50 and d['options']['seed'] == 7 and d['options']['azimuth_min_deg'] == -45"
+printf '{"sigma_m": 0.07}\n' >"$work/verify_options.json"
+check "verify --options" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" --pose "-2,8,0.6,0" \
+  --options "$work/verify_options.json" --json "$work/j_verify2.json" --quiet
+json_check "verify --options reach the options" "$work/j_verify2.json" "d['options']['sigma_m'] == 0.07"
+printf '{"planes": {"max_planes": 1}}\n' >"$work/points_options.json"
+check "points --options by operation" "$lidarshop" points planes "$work/scan.ptx" -o "$work/j_planes.ply" \
+  --options "$work/points_options.json" --distance 0.02 --json "$work/j_planes.json"
+json_check "points --options reach the operation" "$work/j_planes.json" \
+  "len(d['planes']) == 1 and d['options']['planes']['max_planes'] == 1 and d['options']['planes']['distance_threshold_m'] == 0.02"
+
+# Bad values exit 2 naming the flag the user typed; unknown flags suggest the closest; help shows choices as words.
+exits_with 2 "scan: bad value names the flag" "^lidarshop scan: --rows: 1 is out of range >= 2" \
+  "$lidarshop" scan "$work/scene/scene.json" -o "$work/x.ptx" --rows 1
+exits_with 2 "segment: bad value names the flag" "^lidarshop segment: --ring-threshold: -1(\.0)? is out of range >= 0" \
+  "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/x.png" --ring-threshold -1
+exits_with 2 "segment: bad choice names the flag" "--method: 'two_step' is not a segmentation method.*did you mean 'two-step'" \
+  "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/x.png" --method two_step
+exits_with 2 "verify: bad value names the flag" "^lidarshop verify: --allowance: -1(\.0)? is out of range \[0, 1000\]" \
+  "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" --pose "-2,8,0.6,0" --allowance -1
+exits_with 2 "sweep: cross-field check names the flag" "^lidarshop sweep: --x-range: is below x_min_m" \
+  "$lidarshop" sweep --scan "$work/scan.ptx" --model "$work/box.obj" --x-range 3:1 --out "$work/x_sweep"
+exits_with 2 "recolor: bad value names the flag" "^lidarshop recolor: --zbuffer-scale: 2(\.0)? is out of range" \
+  "$lidarshop" recolor "$work/scan.ptx" --photo "$work/photo.png" --camera "$work/cam.json" -o "$work/x.ply" \
+  --zbuffer-scale 2
+exits_with 2 "inpaint: bad value names the flag" "^lidarshop inpaint: --patch-radius: 0 is out of range \[1, 64\]" \
+  "$lidarshop" inpaint "$images/lettera/lettera.png" --mask "$images/lettera/lettera_mask.png" -o "$work/x.png" \
+  --patch-radius 0
+exits_with 2 "poisson: bad choice names the flag" "--solver: 'cholesky' is not a Poisson solver" \
+  "$lidarshop" poisson fill "$images/bungee/bungee.png" --mask "$images/bungee/bungee_mask.png" -o "$work/x.png" \
+  --solver cholesky
+exits_with 2 "segment: did you mean" "unknown option --ring-treshold \(did you mean --ring-threshold\?\)" \
+  "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" -o "$work/x.png" --ring-treshold 0.2
+exits_with 2 "verify: did you mean" "unknown option --alowance \(did you mean --allowance\?\)" \
+  "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" --pose "-2,8,0.6,0" --alowance 0.1
+exits_with 2 "points: did you mean" "unknown option --std-ration \(did you mean --std-ratio\?\)" \
+  "$lidarshop" points outliers "$work/scan.ptx" -o "$work/x.ply" --std-ration 2
+help_shows() {  # help_shows NAME TEXT COMMAND...: --help output holds TEXT
+  local name=$1 text=$2
+  shift 2
+  "$@" --help >"$work/help.txt" 2>&1
+  if grep -qF -e "$text" "$work/help.txt"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1))
+    echo "FAILED: $name: '$text' not in the help of: $*"
+  fi
+}
+help_shows "inpaint help: fill order as words" "criminisi|onion-peel|random" "$lidarshop" inpaint
+help_shows "segment help: methods as words" "two-step|depth|color|rgbd" "$lidarshop" segment
+help_shows "recolor help: visibility as words" "zbuffer|segment" "$lidarshop" recolor
+help_shows "render help: channels as words" "range|rgb|intensity|normals|labels|valid" "$lidarshop" render
+help_shows "points help: superpixel methods as words" "slic|graph" "$lidarshop" points
+help_shows "verify help: units and ranges" "(m, [0, 1000])" "$lidarshop" verify
 
 # The demo on a small built-in scene.
 check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet

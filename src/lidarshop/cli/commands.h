@@ -58,12 +58,14 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
 // Adds --json FILE ('-' = stdout): where the command's result goes as JSON. Machine output goes only there;
 // summaries for people go to stderr.
 // `names` may add a command's older name for it ("--json,--report").
-void AddJsonOption(CLI::App& app, std::string* path, const std::string& names = "--json");
+// Commands whose JSON went to stdout before --json existed (info, images, resection, recolor, align) start
+// with *path = "-".
+CLI::Option* AddJsonOption(CLI::App& app, std::string* path, const std::string& names = "--json");
 // The JSON form of a command's run: the result's keys, then "options" (what it ran with).
 nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
                                    const nlohmann::ordered_json& result);
-// Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty.
-void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json);
+// Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty. `indent` -1 = one line.
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent = 2);
 
 // Checks an output before any long work: its extension is one of `extensions` (lower case, no dot;
 // empty = any), its folder exists and is writable, and it names no input or other output. Throws

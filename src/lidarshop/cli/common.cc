@@ -96,17 +96,20 @@ nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
   return json;
 }
 
-void AddJsonOption(CLI::App& app, std::string* path, const std::string& names) {
-  app.add_option(names, *path, "write the result as JSON to FILE ('-' = stdout)")->type_name("FILE");
+CLI::Option* AddJsonOption(CLI::App& app, std::string* path, const std::string& names) {
+  CLI::Option* option =
+      app.add_option(names, *path, "write the result as JSON to FILE ('-' = stdout)")->type_name("FILE");
+  if (!path->empty()) option->capture_default_str();
+  return option;
 }
 
-void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json) {
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent) {
   if (path.empty()) return;
   if (path == "-") {
-    std::cout << json.dump(2) << "\n" << std::flush;
+    std::cout << json.dump(indent) << "\n" << std::flush;
     return;
   }
-  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
+  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(indent) << "\n"; });
 }
 
 void CheckOutputFile(const std::string& flag, const std::string& path,

@@ -49,6 +49,7 @@ struct DemoSettings {
   std::string scene = "parking_lot";  // a built-in scene name or a scene file
   std::string out_dir = "out";
   std::string segment_object;  // object name to cut out; "" = the built-in scene's choice
+  std::string json_path;       // --json: summary.json's content here too ("-" = stdout)
   bool quiet = false;
 };
 
@@ -400,8 +401,10 @@ int RunDemoSteps(const DemoSettings& settings) {
   summary["seconds"] = seconds;
   WriteText(out_dir / "summary.json", summary.dump(2) + "\n");
   WriteText(out_dir / "index.html", IndexHtml(scene_name, summary));
+  WriteJsonOutput(settings.json_path, summary);
   if (!settings.quiet) {
-    fmt::print("lidarshop demo: scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)\n",
+    fmt::print(stderr,
+               "lidarshop demo: scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)\n",
                scene_name, scan.rows, scan.cols, scan.CountValid(), out_dir.string());
   }
   return 0;
@@ -422,8 +425,13 @@ int RunDemo(int argc, char** argv) {
   app.add_option("--out", settings.out_dir, "output folder (created if missing)")->capture_default_str();
   app.add_option("--segment-object", settings.segment_object,
                  "name of the scene object to cut out (default: the built-in scene's choice)");
+  AddJsonOption(app, &settings.json_path);
   AddQuietFlag(app, &settings.quiet);
-  return RunCommand(app, argc, argv, [&] { return RunDemoSteps(settings); });
+  return RunCommand(app, argc, argv, [&] {
+    const std::string summary_path = (fs::path(settings.out_dir) / "summary.json").string();
+    CheckOutputFile("--json", settings.json_path, {}, {summary_path});
+    return RunDemoSteps(settings);
+  });
 }
 
 }  // namespace lidarshop::cli

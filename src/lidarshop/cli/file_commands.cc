@@ -6,6 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
+#include "lidarshop/image/colormap.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
@@ -97,12 +99,15 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
-  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd) as one JSON object on stdout.", "info"};
-  std::string path;
+  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd) as one JSON object (on stdout unless --json).",
+               "info"};
+  std::string path, json_path = "-";
   bool compact = false;
   app.add_option("file", path, "scan file")->required();
-  app.add_flag("--compact", compact, "print the JSON on one line");
+  AddJsonOption(app, &json_path);
+  app.add_flag("--compact", compact, "write the JSON on one line");
   return RunCommand(app, argc, argv, [&] {
+    CheckOutputFile("--json", json_path, {}, {path});
     ScanFile file;
     std::vector<E57Image> images;
     if (FileExtension(path) == "e57") {  // read once, keeping the photos
@@ -119,7 +124,7 @@ int RunInfo(int argc, char** argv) {
     for (size_t i = 0; i < file.scans.size(); ++i)
       json["scans"].push_back(ScanJson(file.scans[i], static_cast<int>(i)));
     if (file.format == "e57") json["images"] = ImagesJson(images);
-    fmt::print("{}\n", json.dump(compact ? -1 : 2));
+    WriteJsonOutput(json_path, json, compact ? -1 : 2);
     return 0;
   });
 }
@@ -128,55 +133,80 @@ int RunConvert(int argc, char** argv) {
   CLI::App app{
       "Convert a scan file between .ptx, .e57, .ply and .pcd, keeping the grid where the target can hold it.",
       "convert"};
-  std::string input, output;
+  std::string input, output, json_path;
   int scan_index = -1;
   bool quiet = false;
+  E57WriteOptions e57_options;
+  OptionBinder binder(app);
   app.add_option("input", input, "scan file to read")->required();
   app.add_option("output", output, "scan file to write (format from the extension)")->required();
   app.add_option("--scan", scan_index, "write only scan K (from 0); PCD holds one scan");
+  AddJsonOption(app, &json_path);
+  binder.Bind(&e57_options, {.group = "E57 output"});
   AddQuietFlag(app, &quiet);
-  return RunCommand(app, argc, argv, [&] {
-    CheckOutputPath(output, {input});
-    const auto progress = Progress::ForTerminal("convert", 2, quiet);
-    ScanFile file;
-    std::vector<E57Image> images;  // E57 -> E57 keeps the photos
-    const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
-    if (e57_to_e57) {
-      E57File e57 = ReadE57AndWarn(input);
-      file = {input, "e57", std::move(e57.scans), std::move(e57.warnings)};
-      images = std::move(e57.images);
-    } else {
-      file = ReadScanFileAndWarn(input);
-    }
-    progress->Advance();
-    std::vector<Scan> scans = file.scans;
-    if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
-    if (e57_to_e57) {
-      WriteE57(output, scans, images, E57WriteOptions{});
-    } else {
-      WriteScanFile(output, scans);
-    }
-    progress->Advance();
-    progress->Finish();
-    return 0;
-  });
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(e57_options);
+        CheckOutputPath(output, {input});
+        CheckOutputFile("--json", json_path, {}, {input, output});
+        const auto progress = Progress::ForTerminal("convert", 2, quiet);
+        ScanFile file;
+        std::vector<E57Image> images;  // E57 -> E57 keeps the photos
+        const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
+        if (e57_to_e57) {
+          E57File e57 = ReadE57AndWarn(input);
+          file = {input, "e57", std::move(e57.scans), std::move(e57.warnings)};
+          images = std::move(e57.images);
+        } else {
+          file = ReadScanFileAndWarn(input);
+        }
+        progress->Advance();
+        std::vector<Scan> scans = file.scans;
+        if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
+        if (FileExtension(output) == "e57") {
+          WriteE57(output, scans, images, e57_options);
+        } else {
+          WriteScanFile(output, scans);
+        }
+        progress->Advance();
+        progress->Finish();
+        nlohmann::ordered_json json;
+        json["input"] = input;
+        json["output"] = output;
+        json["format"] = FileExtension(output);
+        json["scans"] = scans.size();
+        int64_t returns = 0;
+        for (const Scan& scan : scans) returns += scan.CountValid();
+        json["returns"] = returns;
+        json["images"] = images.size();
+        WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
+        return 0;
+      },
+      &binder);
 }
 
 int RunRender(int argc, char** argv) {
   CLI::App app{"Render a channel of a scan as a picture: one pixel per ray, row 0 = top (highest elevation).",
                "render"};
-  std::string input, output, channel = "range", color_map;
+  std::string input, output, channel = "range", color_map, json_path;
   int scan_index = 0;
   RenderOptions options;
+  OptionBinder binder(app);
   app.add_option("file", input, "scan file")->required();
   app.add_option("-o,--output", output, "picture to write (.png, .jpg)")->required();
-  app.add_option("--channel", channel, "range | rgb | intensity | normals | labels | valid")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"range", "rgb", "intensity", "normals", "labels", "valid"}));
+  AddJsonOption(app, &json_path);
+  // RenderOptions is not described (an optional colour map, NaN bounds): its flags are bound here, with the
+  // choices of the described enums.
+  const EnumInfo& channels = EnumInfoOf<RenderChannel>();
+  const EnumInfo& color_maps = EnumInfoOf<ColorMap>();
+  app.add_option("--channel", channel, "what to draw")->capture_default_str()->check(ChoiceOf(channels));
   app.add_flag("--legend", options.legend, "add a colour scale bar (or label swatches) to the right");
   app.add_option("--scan", scan_index, "which scan of the file (from 0)")->capture_default_str();
-  app.add_option("--colormap", color_map, "viridis | turbo | magma | gray (metric channels)")
-      ->check(CLI::IsMember({"viridis", "turbo", "magma", "gray"}));
+  app.add_option("--colormap", color_map,
+                 "colour map of metric channels (default: viridis for range, gray "
+                 "for intensity)")
+      ->check(ChoiceOf(color_maps, {"grey"}));
   app.add_option("--min", options.min_value,
                  "value of the first colour (metres for range); default: 1 % quantile");
   app.add_option("--max", options.max_value, "value of the last colour; default: 99 % quantile");
@@ -195,50 +225,70 @@ int RunRender(int argc, char** argv) {
                  "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
   app.add_option("--around", around_path,
                  "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
-  app.add_option("--fov", view.field_of_view_deg, "horizontal field of view of --eye/--orbit, degrees")
-      ->capture_default_str();
-  app.add_option("--width", view.width_px, "picture width of --eye/--orbit, pixels")->capture_default_str();
-  app.add_option("--height", view.height_px, "picture height of --eye/--orbit, pixels")
-      ->capture_default_str();
-  app.add_option("--point-size", view.point_size_px, "drawn point size of --eye/--orbit, pixels")
-      ->capture_default_str();
-  app.add_option("--tint-synthesized", view.synthesized_tint,
-                 "with --eye/--orbit: tint synthesized points magenta by this share (0..1)")
-      ->capture_default_str();
+  binder.Bind(&view, {.flags = {{"field_of_view_deg", "--fov"},
+                                {"width_px", "--width"},
+                                {"height_px", "--height"},
+                                {"point_size_px", "--point-size"},
+                                {"synthesized_tint", "--tint-synthesized"}},
+                      .group = "Second viewpoint (--eye / --orbit)"});
   bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
   AddQuietFlag(app, &quiet);
-  return RunCommand(app, argc, argv, [&] {
-    CheckOutputPath(output, {input, around_path});
-    if (!eye.empty() || !std::isnan(orbit_deg)) {
-      if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
-      if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
-      const ScanFile file = ReadScanFileAndWarn(input);
-      const Scan& scan = PickScan(file, scan_index, "--scan");
-      if (!eye.empty()) {
-        view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
-        view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
-      } else {
-        const cv::Mat region = around_path.empty()
-                                   ? cv::Mat(scan.valid != 0)
-                                   : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
-        const PointViewOptions side = SideView(scan, region, orbit_deg);
-        view.eye_in_world = side.eye_in_world;
-        view.target_in_world = side.target_in_world;
-      }
-      WriteImage(output, RenderPointView(scan, view));
-      return 0;
-    }
-    options.channel = ParseEnum<RenderChannel>(channel);
-    if (!color_map.empty())
-      options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
-    options.Check();
-    const ScanFile file = ReadScanFileAndWarn(input);
-    Scan scan = PickScan(file, scan_index, "--scan");
-    if (scan.name.empty()) scan.name = input;
-    const RenderResult result = RenderScan(scan, options);
-    WriteImage(output, result.image);
-    return 0;
-  });
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(view);
+        CheckOutputPath(output, {input, around_path});
+        CheckOutputFile("--json", json_path, {}, {input, around_path, output});
+        nlohmann::ordered_json json;
+        if (!eye.empty() || !std::isnan(orbit_deg)) {
+          if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
+          if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
+          const ScanFile file = ReadScanFileAndWarn(input);
+          const Scan& scan = PickScan(file, scan_index, "--scan");
+          if (!eye.empty()) {
+            view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
+            view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
+          } else {
+            const cv::Mat region = around_path.empty()
+                                       ? cv::Mat(scan.valid != 0)
+                                       : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
+            const PointViewOptions side = SideView(scan, region, orbit_deg);
+            view.eye_in_world = side.eye_in_world;
+            view.target_in_world = side.target_in_world;
+          }
+          const cv::Mat picture = RenderPointView(scan, view);
+          WriteImage(output, picture);
+          json["output"] = output;
+          json["width_px"] = picture.cols;
+          json["height_px"] = picture.rows;
+          json["eye_in_world"] = {view.eye_in_world.x(), view.eye_in_world.y(), view.eye_in_world.z()};
+          json["target_in_world"] = {view.target_in_world.x(), view.target_in_world.y(),
+                                     view.target_in_world.z()};
+          WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+          return 0;
+        }
+        options.channel = ParseEnum<RenderChannel>(channel);
+        if (!color_map.empty())
+          options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
+        options.Check();
+        const ScanFile file = ReadScanFileAndWarn(input);
+        Scan scan = PickScan(file, scan_index, "--scan");
+        if (scan.name.empty()) scan.name = input;
+        const RenderResult result = RenderScan(scan, options);
+        WriteImage(output, result.image);
+        json["output"] = output;
+        json["channel"] = channel;
+        json["width_px"] = result.image.cols;
+        json["height_px"] = result.image.rows;
+        if (result.scale) {
+          json["scale"] = {{"min", result.scale->min_value},
+                           {"max", result.scale->max_value},
+                           {"unit", result.scale->unit}};
+        }
+        WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+        return 0;
+      },
+      &binder);
 }
 
 }  // namespace lidarshop::cli

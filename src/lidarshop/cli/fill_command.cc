@@ -29,10 +29,14 @@ namespace lidarshop::cli {
 namespace {
 
 // The fill options every fill command shares, bound to flags from their description (fill/fill.h).
-void BindFillOptions(OptionBinder& binder, FillOptions* options) {
-  binder.Bind(options, {.skip = {"telea_radius_cells"}, .flags = {{"search_window_radius", "--window"}}});
+// `prefix`: their key path inside the command's options ("fill" in remove).
+void BindFillOptions(OptionBinder& binder, FillOptions* options, const std::string& prefix = "") {
+  binder.Bind(
+      options,
+      {.skip = {"telea_radius_cells"}, .flags = {{"search_window_radius", "--window"}}, .prefix = prefix});
   binder.Bind(options, {.keys = {"acceptance.enabled", "telea_radius_cells"},
-                        .flags = {{"acceptance.enabled", "--accept"}}});
+                        .flags = {{"acceptance.enabled", "--accept"}},
+                        .prefix = prefix});
 }
 
 // Outputs are checked before the long work: a scan format, a folder that exists, never an input.
@@ -143,7 +147,7 @@ int RunRemove(int argc, char** argv) {
   // --keep-object: E57 holds the fill as a second return, PLY/PCD as extra points flagged synthesized.
   binder.Bind(&remove, {.keys = {"margin_cells", "keep_object", "fill_enclosed_no_return"},
                         .flags = {{"margin_cells", "--margin"}}});
-  BindFillOptions(binder, &remove.fill);
+  BindFillOptions(binder, &remove.fill, "fill");
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,

@@ -128,6 +128,20 @@ nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
   throw OptionsError("a group of options has no flag of its own");
 }
 
+CLI::Validator ChoiceOf(const EnumInfo& choices, std::vector<std::string> extra) {
+  return CLI::Validator(
+      [&choices, extra](std::string& text) -> std::string {
+        if (std::find(extra.begin(), extra.end(), text) != extra.end()) return "";
+        try {
+          choices.Parse(text);
+        } catch (const OptionsError& error) {
+          return error.what();
+        }
+        return "";
+      },
+      choices.NamesText());
+}
+
 OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
   // Defined before every bound flag: CLI11 runs option callbacks in definition order, so flags override it.
   app_.add_option_function<std::string>(
@@ -144,6 +158,7 @@ OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
                 throw OptionsError(fmt::format("{}: not JSON: {}", path, error.what()));
               }
               StructFromJson(*root_info_, json, root_);
+              given_by_file_.merge_patch(json);
             } catch (const OptionsFieldError& error) {
               throw CLI::ValidationError("--options", fmt::format("{}: {}", path, error.what()));
             } catch (const std::exception& error) {
@@ -167,22 +182,24 @@ void OptionBinder::BindStruct(const StructInfo& info, void* object, const BindSe
     void* owner = nullptr;
     const FieldInfo* field = FindPath(info, object, key_path, &owner);
     LIDARSHOP_CHECK(field != nullptr && field->kind != FieldKind::kStruct);
-    BindField(*field, owner, key_path, settings);
+    BindField(*field, owner, key_path, settings, object == root_ || !settings.prefix.empty());
   }
 }
 
 void OptionBinder::BindField(const FieldInfo& field, void* object, const std::string& key_path,
-                             const BindSettings& settings) {
+                             const BindSettings& settings, bool in_root) {
   const auto renamed = settings.flags.find(key_path);
   const std::string names = renamed != settings.flags.end() ? renamed->second : DefaultFlag(key_path);
   const std::string flag = LongName(names);
-  flag_of_key_[key_path] = flag;
+  const std::string full_path = settings.prefix.empty() ? key_path : settings.prefix + "." + key_path;
+  flag_of_key_[full_path] = flag;
   const FieldInfo* info = &field;
-  const auto set = [info, object, flag](const std::string& text) {
+  const auto set = [this, info, object, flag, full_path, in_root](const std::string& text) {
     try {
       const nlohmann::json value = ParseFlagValue(*info, text);
       info->CheckValue(value);
       info->set(object, value);
+      if (in_root) given_by_flag_[full_path] = {info, object};
     } catch (const OptionsError& error) {
       throw CLI::ValidationError(flag, error.what());
     }
@@ -192,15 +209,17 @@ void OptionBinder::BindField(const FieldInfo& field, void* object, const std::st
     // --name sets true, --no-name false: a default of either kind can be turned around.
     const std::string negated = "--no-" + flag.substr(2);
     const bool initially = field.get(object).get<bool>();
+    const bool say_default = !settings.overrides;
     option = app_.add_flag_callback(
-        names, [set] { set("true"); }, HelpText(field) + (initially ? " (the default)" : ""));
+        names, [set] { set("true"); }, HelpText(field) + (initially && say_default ? " (the default)" : ""));
     CLI::Option* off = app_.add_flag_callback(
         negated, [set] { set("false"); },
-        fmt::format("turn {} off{}", flag, initially ? "" : " (the default)"));
+        fmt::format("turn {} off{}", flag, !initially && say_default ? " (the default)" : ""));
     if (!settings.group.empty()) off->group(settings.group);
   } else {
     option = app_.add_option_function<std::string>(names, set, HelpText(field));
-    option->type_name(TypeName(field))->default_str(ValueText(field.get(object)));
+    option->type_name(TypeName(field));
+    if (!settings.overrides) option->default_str(ValueText(field.get(object)));
   }
   if (!settings.group.empty()) option->group(settings.group);
 }
@@ -208,6 +227,20 @@ void OptionBinder::BindField(const FieldInfo& field, void* object, const std::st
 std::string OptionBinder::FlagOf(const std::string& key_path) const {
   const auto found = flag_of_key_.find(key_path);
   return found != flag_of_key_.end() ? found->second : key_path;
+}
+
+nlohmann::json OptionBinder::Given() const {
+  nlohmann::json patch = given_by_file_;
+  for (const auto& [key_path, bound] : given_by_flag_) {
+    nlohmann::json* place = &patch;
+    size_t start = 0;
+    for (size_t dot = key_path.find('.'); dot != std::string::npos; dot = key_path.find('.', start)) {
+      place = &(*place)[key_path.substr(start, dot - start)];
+      start = dot + 1;
+    }
+    (*place)[key_path.substr(start)] = bound.first->get(bound.second);
+  }
+  return patch;
 }
 
 OptionsError OptionBinder::Reworded(const OptionsFieldError& error) const {

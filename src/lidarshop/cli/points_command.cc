@@ -3,12 +3,13 @@
 //   lidarshop points OPERATION IN... -o OUT [options] [--json FILE|-]
 //   lidarshop register FIXED MOVING -o OUT [--max-distance M] [--json FILE|-]
 //
-// Every input scan is taken in the world frame and the operation sees all of them as one cloud.
-// Operations that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or
-// give normals keep every scan's grid: dropped cells become cells without a return, labels and
-// normals go into the scans' channels. Operations that make new points (voxel, merge) write a plain
-// cloud (.ply / .pcd) in the world frame.
+// Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations
+// that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep
+// every scan's grid: dropped cells become cells without a return, labels and normals go into the scans'
+// channels. Operations that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world
+// frame.
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/pointset/clustering.h"
@@ -31,11 +33,81 @@
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/timer.h"
 #include "lidarshop/verify/pose_text.h"
 
 namespace lidarshop::cli {
+
+// The options of every points operation, one member per library struct: `--options FILE` sets them by
+// operation ({"planes": {"max_planes": 3}}), and --json's "options" holds the ones the operation used.
+struct PointsOptions {
+  StatisticalOutlierOptions statistical;
+  RadiusOutlierOptions radius;
+  CropOptions crop;
+  NormalOptions normals;
+  RansacPlaneOptions planes;
+  HoughPlaneOptions hough;
+  EuclideanClusterOptions cluster;
+  KMeansOptions kmeans;
+  ScanMeshOptions mesh;
+  RegionGrowingOptions regions;
+  SuperpixelOptions superpixels;
+};
+
+}  // namespace lidarshop::cli
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<cli::PointsOptions>() {
+  static const StructInfo info = [] {
+    using cli::PointsOptions;
+    StructBuilder<PointsOptions> b("PointsOptions", "the options of the points operations");
+    b.Field(&PointsOptions::statistical, "statistical", "outliers --method statistical");
+    b.Field(&PointsOptions::radius, "radius", "outliers --method radius");
+    b.Field(&PointsOptions::crop, "crop", "crop (box and polygon: --box, --polygon)");
+    b.Field(&PointsOptions::normals, "normals", "normals, and regions' grid normals");
+    b.Field(&PointsOptions::planes, "planes", "planes (RANSAC)");
+    b.Field(&PointsOptions::hough, "hough", "planes --hough");
+    b.Field(&PointsOptions::cluster, "cluster", "cluster");
+    b.Field(&PointsOptions::kmeans, "kmeans", "kmeans");
+    b.Field(&PointsOptions::mesh, "mesh", "mesh");
+    b.Field(&PointsOptions::regions, "regions", "regions");
+    b.Field(&PointsOptions::superpixels, "superpixels", "superpixels");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
+
+namespace lidarshop::cli {
 namespace {
+
+// The members of PointsOptions each operation uses.
+const std::map<std::string, std::vector<std::string>>& OptionsOfOperation() {
+  static const std::map<std::string, std::vector<std::string>> used = {
+      {"outliers", {"statistical", "radius"}},
+      {"crop", {"crop"}},
+      {"normals", {"normals"}},
+      {"planes", {"planes", "hough"}},
+      {"cluster", {"cluster"}},
+      {"kmeans", {"kmeans"}},
+      {"mesh", {"mesh"}},
+      {"regions", {"regions", "normals"}},
+      {"superpixels", {"superpixels"}}};
+  return used;
+}
+
+nlohmann::ordered_json UsedOptions(const PointsOptions& options, const std::string& operation) {
+  const nlohmann::ordered_json all = ToJson(options);
+  nlohmann::ordered_json used = nlohmann::ordered_json::object();
+  const auto found = OptionsOfOperation().find(operation);
+  if (found == OptionsOfOperation().end()) return used;
+  for (const std::string& key : found->second) used[key] = all[key];
+  return used;
+}
 
 // All scans of all inputs as one world-frame cloud, with where each point came from.
 struct Gathered {
@@ -129,15 +201,6 @@ std::vector<double> ParseNumbers(const std::string& text, const std::string& fla
   return numbers;
 }
 
-void WriteSummary(const std::string& path, const nlohmann::json& json) {
-  if (path.empty()) return;
-  if (path == "-") {
-    std::cout << json.dump(2) << "\n";
-  } else {
-    WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(2) << "\n"; });
-  }
-}
-
 void CheckOutputs(const std::string& output, const std::string& json,
                   const std::vector<std::string>& inputs) {
   CheckScanFileFormat(output);
@@ -159,242 +222,257 @@ int RunPoints(int argc, char** argv) {
       "points"};
   std::string operation, output_path, json_path, method = "statistical";
   std::vector<std::string> inputs;
-  StatisticalOutlierOptions statistical;
-  RadiusOutlierOptions radius_outliers;
-  CropOptions crop;
   std::string box_text, polygon_text, matrix_text;
-  NormalOptions normals;
-  bool grid = false;
-  RansacPlaneOptions planes;
-  HoughPlaneOptions hough_options;
-  bool hough = false;
-  EuclideanClusterOptions clusters;
-  KMeansOptions kmeans;
-  double voxel_m = 0.05;
-  ScanMeshOptions mesh_options;
-  RegionGrowingOptions region_options;
-  double max_angle_deg = 10.0;
-  SuperpixelOptions superpixel_options;
-  std::string superpixel_method = "slic";
-  mesh_options.world_frame = true;
+  bool grid = false, hough = false;
+  double voxel_m = 0.05, max_angle_deg = 10.0;
   int64_t count = 100000;
-  uint64_t seed = 1;
+  PointsOptions points;
+  // Flags shared by several operations set the first struct's field and are copied to the others when
+  // given; the others start from the same value, so a flag left out changes nothing.
+  points.mesh.world_frame = true;
+  points.normals.neighbors = points.statistical.neighbors;
+  points.cluster.radius_m = points.radius.radius_m;
+  OptionBinder binder(app);
   app.add_option("operation", operation, "the tool")->required();
   app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd)")->required();
   app.add_option("-o,--output", output_path, "output file; a scan format keeps the grid")->required();
-  app.add_option("--json", json_path, "write a summary as JSON to FILE, or '-' for stdout");
+  AddJsonOption(app, &json_path);
   app.add_option("--method", method, "outliers: statistical | radius")->capture_default_str();
-  app.add_option("--neighbors", statistical.neighbors, "outliers/normals: k nearest")->capture_default_str();
-  app.add_option("--std-ratio", statistical.std_ratio, "statistical outliers: threshold in σ")
-      ->capture_default_str();
-  app.add_option("--radius", radius_outliers.radius_m, "outliers, normals, cluster: radius, metres")
-      ->capture_default_str();
-  app.add_option("--min-neighbors", radius_outliers.min_neighbors, "radius outliers")->capture_default_str();
   app.add_option("--voxel", voxel_m, "voxel: cube side, metres")->capture_default_str();
   app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")
       ->capture_default_str();
-  app.add_option("--seed", seed, "sample, planes, kmeans: seed")->capture_default_str();
   app.add_option("--box", box_text, "crop: xmin,ymin,zmin,xmax,ymax,zmax (world, metres)");
   app.add_option("--polygon", polygon_text, "crop: x1,y1,x2,y2,... (world xy, metres)");
-  app.add_option("--labels", crop.labels, "crop: keep these labels");
-  app.add_option("--min-range", crop.min_range_m, "crop: metres from the world origin")
-      ->capture_default_str();
-  app.add_option("--max-range", crop.max_range_m, "crop: metres (0 = none)")->capture_default_str();
-  app.add_option("--min-intensity", crop.min_intensity, "crop")->capture_default_str();
-  app.add_option("--max-intensity", crop.max_intensity, "crop")->capture_default_str();
-  app.add_flag("--invert", crop.invert, "crop: keep the points outside instead");
   app.add_option("--matrix", matrix_text,
                  "transform: new_world_from_world as 16 comma-separated numbers (row major), "
                  "x,y,z,yaw_deg[,pitch_deg,roll_deg] or a pose file (as verify --pose)");
   app.add_flag("--grid", grid, "normals: from the scan grid instead of a KD-tree");
-  app.add_option("--window", normals.window_cells, "normals --grid: half-width, cells")
-      ->capture_default_str();
-  app.add_option("--distance", planes.distance_threshold_m, "planes: inlier distance, metres")
-      ->capture_default_str();
-  app.add_option("--iterations", planes.max_iterations, "planes: RANSAC hypotheses at most")
-      ->capture_default_str();
   app.add_flag("--hough", hough, "planes: Hough detection (ball accumulator) instead of RANSAC");
-  app.add_option("--angle-step", hough_options.angle_step_deg, "planes --hough: normal resolution, degrees")
-      ->capture_default_str();
-  app.add_option("--planes", planes.max_planes, "planes: how many, sequentially")->capture_default_str();
-  app.add_option("--min-inliers", planes.min_inliers, "planes: stop below this")->capture_default_str();
-  app.add_option("--min-points", clusters.min_points, "cluster: smaller clusters are noise")
-      ->capture_default_str();
-  app.add_option("--mesh-jump", mesh_options.max_range_jump_ratio,
-                 "mesh: drop edges whose ranges differ by more than this fraction of the nearer range")
-      ->capture_default_str();
   app.add_option("--max-angle", max_angle_deg, "regions: largest normal angle between neighbours, degrees")
       ->capture_default_str();
-  app.add_option("--min-cells", region_options.min_region_cells, "regions: smaller regions get no label")
-      ->capture_default_str();
-  app.add_option("--superpixel-method", superpixel_method, "superpixels: slic | graph")
-      ->capture_default_str();
-  app.add_option("--region-cells", superpixel_options.region_cells, "superpixels (slic): side, cells")
-      ->capture_default_str();
-  app.add_option("--k", kmeans.clusters, "kmeans: clusters")->capture_default_str();
-  return RunCommand(app, argc, argv, [&]() {
-    CheckOutputs(output_path, json_path, inputs);
-    if (operation == "mesh" && FileExtension(output_path) != "ply") {
-      throw OptionsError(fmt::format("-o {}: mesh writes a triangle mesh, as .ply", output_path));
-    }
-    if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
-      throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
-    }
-    const std::vector<double> box = ParseNumbers(box_text, "--box"),
-                              polygon = ParseNumbers(polygon_text, "--polygon");
-    if (!box.empty() && box.size() != 6)
-      throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
-    if (operation == "sample-mesh") {
-      // Uniform (area-weighted) samples of a triangle mesh
-      // (pointset/sampling.h), with the triangles' normals.
-      if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
-      if (FileExtension(output_path) != "ply")
-        throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
-      const TriangleMesh mesh = ReadMeshAndWarn(inputs[0]);
-      if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
-      CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
-      const Timer timer;
-      SurfaceSamples samples = SampleSurface(mesh, count, seed);
-      PointCloud cloud;
-      cloud.points = std::move(samples.points);
-      cloud.normals = std::move(samples.normals);
-      const double seconds = timer.Seconds();
-      WritePointCloud(output_path, cloud);
-      WriteSummary(json_path, {{"operation", operation},
-                               {"triangles", mesh.num_triangles()},
-                               {"output_points", cloud.size()},
-                               {"seconds", seconds}});
-      return 0;
-    }
-    const Timer read_timer;
-    const Gathered g = Gather(inputs);
-    nlohmann::json summary = {{"operation", operation},
-                              {"input_points", g.cloud.size()},
-                              {"scans", g.scans.size()},
-                              {"read_seconds", read_timer.Seconds()}};
-    const Timer timer;  // the operation alone, without reading and writing
-    std::vector<Scan> scans_out;
-    PointCloud cloud_out;
-    bool as_cloud = false;
-    if (operation == "outliers" || operation == "crop" || operation == "sample") {
-      std::vector<uint8_t> keep;
-      if (operation == "outliers" && method == "statistical") {
-        keep = StatisticalOutlierInliers(g.cloud, statistical);
-      } else if (operation == "outliers" && method == "radius") {
-        keep = RadiusOutlierInliers(g.cloud, radius_outliers);
-      } else if (operation == "outliers") {
-        throw OptionsError(fmt::format("--method '{}': expected statistical or radius", method));
-      } else if (operation == "sample") {
-        keep = RandomSampleInliers(g.cloud, count, seed);
-      } else {
-        if (!box.empty())
-          crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
-                                         Eigen::Vector3f(box[3], box[4], box[5]));
-        if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
-        for (size_t i = 0; i + 1 < polygon.size(); i += 2)
-          crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
-        keep = CropInliers(g.cloud, crop);
-      }
-      scans_out = KeepCells(g, keep);
-      summary["output_points"] = std::count(keep.begin(), keep.end(), 1);
-    } else if (operation == "voxel") {
-      cloud_out = VoxelDownsample(g.cloud, voxel_m);
-      as_cloud = true;
-    } else if (operation == "merge") {
-      cloud_out = g.cloud;
-      as_cloud = true;
-    } else if (operation == "mesh") {
-      // The grid mesh of any organized scan, real ones included (scanner/scan_mesh.h).
-      TriangleMesh mesh;
-      for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
-      summary["seconds"] = timer.Seconds();
-      summary["triangles"] = mesh.num_triangles();
-      WriteMesh(output_path, mesh);
-      WriteSummary(json_path, summary);
-      return 0;
-    } else if (operation == "regions" || operation == "superpixels") {
-      // Per scan, over its grid: labels into the scan's label channel.
-      int total = 0;
-      for (const Scan& scan : g.scans) {
-        Scan labelled = scan;
-        int count = 0;
-        if (operation == "regions") {
-          const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
-          labelled.label = SegmentByRegionGrowing(scan, region_options,
-                                                  NormalAngleCondition(with_normals, max_angle_deg), &count);
-        } else {
-          if (superpixel_method != "slic" && superpixel_method != "graph") {
-            throw OptionsError(
-                fmt::format("--superpixel-method '{}': expected slic or graph", superpixel_method));
-          }
-          superpixel_options.method =
-              superpixel_method == "slic" ? SuperpixelMethod::kSlic : SuperpixelMethod::kGraph;
-          labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
-          labelled.label.setTo(kNoLabel, scan.valid == 0);
+  binder.Bind(&points, {.keys = {"statistical.neighbors", "statistical.std_ratio", "radius.radius_m",
+                                 "radius.min_neighbors", "planes.seed"},
+                        .flags = {{"statistical.neighbors", "--neighbors"},
+                                  {"statistical.std_ratio", "--std-ratio"},
+                                  {"radius.radius_m", "--radius"},
+                                  {"radius.min_neighbors", "--min-neighbors"},
+                                  {"planes.seed", "--seed"}},
+                        .group = "outliers (--neighbors, --radius also normals and cluster; --seed every "
+                                 "random choice)"});
+  binder.Bind(&points, {.keys = {"crop.labels", "crop.min_range_m", "crop.max_range_m", "crop.min_intensity",
+                                 "crop.max_intensity", "crop.invert"},
+                        .flags = {{"crop.labels", "--labels"},
+                                  {"crop.min_range_m", "--min-range"},
+                                  {"crop.max_range_m", "--max-range"},
+                                  {"crop.min_intensity", "--min-intensity"},
+                                  {"crop.max_intensity", "--max-intensity"},
+                                  {"crop.invert", "--invert"}},
+                        .group = "crop"});
+  binder.Bind(&points, {.keys = {"normals.window_cells", "normals.max_neighbors"},
+                        .flags = {{"normals.window_cells", "--window"}},
+                        .group = "normals"});
+  binder.Bind(&points, {.keys = {"planes.distance_threshold_m", "planes.max_iterations", "planes.confidence",
+                                 "planes.min_inliers", "planes.max_planes", "hough.angle_step_deg",
+                                 "hough.max_voters"},
+                        .flags = {{"planes.distance_threshold_m", "--distance"},
+                                  {"planes.max_iterations", "--iterations"},
+                                  {"planes.min_inliers", "--min-inliers"},
+                                  {"planes.max_planes", "--planes"},
+                                  {"hough.angle_step_deg", "--angle-step"}},
+                        .group = "planes"});
+  binder.Bind(&points, {.keys = {"cluster.min_points", "cluster.max_points", "kmeans.clusters",
+                                 "kmeans.max_iterations", "kmeans.tolerance_m"},
+                        .flags = {{"cluster.min_points", "--min-points"}, {"kmeans.clusters", "--k"}},
+                        .group = "cluster, kmeans"});
+  binder.Bind(&points, {.keys = {"mesh.max_range_jump_ratio", "mesh.world_frame", "regions.min_region_cells",
+                                 "regions.max_range_jump_ratio"},
+                        .flags = {{"mesh.max_range_jump_ratio", "--mesh-jump"},
+                                  {"regions.min_region_cells", "--min-cells"}},
+                        .group = "mesh, regions"});
+  binder.Bind(&points, {.keys = {"superpixels.method", "superpixels.region_cells", "superpixels.ruler",
+                                 "superpixels.iterations", "superpixels.graph_sigma", "superpixels.graph_k",
+                                 "superpixels.graph_min_cells", "superpixels.range_weight",
+                                 "superpixels.quickshift_kernel_size", "superpixels.quickshift_max_dist",
+                                 "superpixels.quickshift_ratio"},
+                        .flags = {{"superpixels.method", "--superpixel-method"},
+                                  {"superpixels.region_cells", "--region-cells"}},
+                        .group = "superpixels"});
+  binder.NameFlag("normals.neighbors", "--neighbors");
+  binder.NameFlag("normals.radius_m", "--radius");
+  binder.NameFlag("cluster.radius_m", "--radius");
+  for (const char* key : {"hough.seed", "kmeans.seed"}) binder.NameFlag(key, "--seed");
+  return RunCommand(
+      app, argc, argv,
+      [&]() {
+        if (app.count("--neighbors") > 0) points.normals.neighbors = points.statistical.neighbors;
+        if (app.count("--radius") > 0)
+          points.normals.radius_m = points.cluster.radius_m = points.radius.radius_m;
+        if (app.count("--seed") > 0) points.hough.seed = points.kmeans.seed = points.planes.seed;
+        binder.Validate(points);
+        const uint64_t seed = points.planes.seed;
+        StatisticalOutlierOptions& statistical = points.statistical;
+        RadiusOutlierOptions& radius_outliers = points.radius;
+        CropOptions& crop = points.crop;
+        NormalOptions& normals = points.normals;
+        RansacPlaneOptions& planes = points.planes;
+        HoughPlaneOptions& hough_options = points.hough;
+        EuclideanClusterOptions& clusters = points.cluster;
+        KMeansOptions& kmeans = points.kmeans;
+        ScanMeshOptions& mesh_options = points.mesh;
+        RegionGrowingOptions& region_options = points.regions;
+        SuperpixelOptions& superpixel_options = points.superpixels;
+        CheckOutputs(output_path, json_path, inputs);
+        if (operation == "mesh" && FileExtension(output_path) != "ply") {
+          throw OptionsError(fmt::format("-o {}: mesh writes a triangle mesh, as .ply", output_path));
         }
-        total += count;
-        scans_out.push_back(labelled);
-      }
-      summary[operation] = total;
-    } else if (operation == "transform") {
-      if (matrix_text.empty()) throw OptionsError("transform needs --matrix");
-      // The one pose parser (verify/pose_text.h): 16 numbers, x,y,z,yaw_deg[,pitch_deg,roll_deg] or a file.
-      const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(matrix_text, "--matrix");
-      for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
-    } else if (operation == "normals") {
-      normals.neighbors = statistical.neighbors;
-      if (app.count("--radius")) normals.radius_m = radius_outliers.radius_m;
-      if (grid) {
-        for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
-      } else {
-        scans_out = WithNormals(g, EstimateNormals(g.cloud, normals).normals);
-      }
-    } else if (operation == "planes") {
-      planes.seed = seed;
-      hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
-      hough_options.max_planes = planes.max_planes;
-      hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
-      hough_options.seed = seed;
-      const std::vector<PlaneFit> fits =
-          hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
-      std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
-      summary["planes"] = nlohmann::json::array();
-      for (size_t p = 0; p < fits.size(); ++p) {
-        for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
-        summary["planes"].push_back({{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
-                                     {"offset_m", fits[p].offset_m},
-                                     {"inliers", fits[p].inliers.size()},
-                                     {"rms_m", fits[p].rms_m}});
-      }
-      scans_out = WithLabels(g, labels);
-    } else if (operation == "cluster") {
-      clusters.radius_m = radius_outliers.radius_m;
-      const ClusterResult result = EuclideanClusters(g.cloud, clusters);
-      summary["clusters"] = result.num_clusters();
-      summary["cluster_sizes"] = result.sizes;
-      scans_out = WithLabels(g, result.labels);
-    } else if (operation == "kmeans") {
-      kmeans.seed = seed;
-      const KMeansResult result = KMeans(g.cloud, kmeans);
-      summary["inertia_m2"] = result.inertia_m2;
-      summary["iterations"] = result.iterations;
-      scans_out = WithLabels(g, result.labels);
-    } else {
-      throw OptionsError(
-          fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                      "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
-                      operation));
-    }
-    summary["seconds"] = timer.Seconds();
-    if (as_cloud) {
-      WritePointCloud(output_path, cloud_out);
-      summary["output_points"] = cloud_out.size();
-    } else {
-      WriteScanFile(output_path, scans_out);
-    }
-    WriteSummary(json_path, summary);
-    return 0;
-  });
+        if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
+          throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
+        }
+        const std::vector<double> box = ParseNumbers(box_text, "--box"),
+                                  polygon = ParseNumbers(polygon_text, "--polygon");
+        if (!box.empty() && box.size() != 6)
+          throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+        if (operation == "sample-mesh") {
+          // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
+          // normals.
+          if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
+          if (FileExtension(output_path) != "ply")
+            throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
+          const TriangleMesh mesh = ReadMeshAndWarn(inputs[0]);
+          if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
+          CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
+          const Timer timer;
+          SurfaceSamples samples = SampleSurface(mesh, count, seed);
+          PointCloud cloud;
+          cloud.points = std::move(samples.points);
+          cloud.normals = std::move(samples.normals);
+          const double seconds = timer.Seconds();
+          WritePointCloud(output_path, cloud);
+          nlohmann::ordered_json summary = {{"operation", operation},
+                                            {"triangles", mesh.num_triangles()},
+                                            {"output_points", cloud.size()},
+                                            {"seconds", seconds}};
+          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          return 0;
+        }
+        const Timer read_timer;
+        const Gathered g = Gather(inputs);
+        nlohmann::ordered_json summary = {{"operation", operation},
+                                          {"input_points", g.cloud.size()},
+                                          {"scans", g.scans.size()},
+                                          {"read_seconds", read_timer.Seconds()}};
+        const Timer timer;  // the operation alone, without reading and writing
+        std::vector<Scan> scans_out;
+        PointCloud cloud_out;
+        bool as_cloud = false;
+        if (operation == "outliers" || operation == "crop" || operation == "sample") {
+          std::vector<uint8_t> keep;
+          if (operation == "outliers" && method == "statistical") {
+            keep = StatisticalOutlierInliers(g.cloud, statistical);
+          } else if (operation == "outliers" && method == "radius") {
+            keep = RadiusOutlierInliers(g.cloud, radius_outliers);
+          } else if (operation == "outliers") {
+            throw OptionsError(fmt::format("--method '{}': expected statistical or radius", method));
+          } else if (operation == "sample") {
+            keep = RandomSampleInliers(g.cloud, count, seed);
+          } else {
+            if (!box.empty())
+              crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
+                                             Eigen::Vector3f(box[3], box[4], box[5]));
+            if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
+            for (size_t i = 0; i + 1 < polygon.size(); i += 2)
+              crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
+            keep = CropInliers(g.cloud, crop);
+          }
+          scans_out = KeepCells(g, keep);
+          summary["output_points"] = std::count(keep.begin(), keep.end(), 1);
+        } else if (operation == "voxel") {
+          cloud_out = VoxelDownsample(g.cloud, voxel_m);
+          as_cloud = true;
+        } else if (operation == "merge") {
+          cloud_out = g.cloud;
+          as_cloud = true;
+        } else if (operation == "mesh") {
+          // The grid mesh of any organized scan, real ones included (scanner/scan_mesh.h).
+          TriangleMesh mesh;
+          for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
+          summary["seconds"] = timer.Seconds();
+          summary["triangles"] = mesh.num_triangles();
+          WriteMesh(output_path, mesh);
+          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          return 0;
+        } else if (operation == "regions" || operation == "superpixels") {
+          // Per scan, over its grid: labels into the scan's label channel.
+          int total = 0;
+          for (const Scan& scan : g.scans) {
+            Scan labelled = scan;
+            int count = 0;
+            if (operation == "regions") {
+              const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
+              labelled.label = SegmentByRegionGrowing(
+                  scan, region_options, NormalAngleCondition(with_normals, max_angle_deg), &count);
+            } else {
+              labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
+              labelled.label.setTo(kNoLabel, scan.valid == 0);
+            }
+            total += count;
+            scans_out.push_back(labelled);
+          }
+          summary[operation] = total;
+        } else if (operation == "transform") {
+          if (matrix_text.empty()) throw OptionsError("transform needs --matrix");
+          const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(matrix_text, "--matrix");
+          for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
+        } else if (operation == "normals") {
+          if (grid) {
+            for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
+          } else {
+            scans_out = WithNormals(g, EstimateNormals(g.cloud, normals).normals);
+          }
+        } else if (operation == "planes") {
+          hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
+          hough_options.max_planes = planes.max_planes;
+          hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
+          const std::vector<PlaneFit> fits =
+              hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
+          std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
+          summary["planes"] = nlohmann::ordered_json::array();
+          for (size_t p = 0; p < fits.size(); ++p) {
+            for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
+            summary["planes"].push_back(
+                {{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
+                 {"offset_m", fits[p].offset_m},
+                 {"inliers", fits[p].inliers.size()},
+                 {"rms_m", fits[p].rms_m}});
+          }
+          scans_out = WithLabels(g, labels);
+        } else if (operation == "cluster") {
+          const ClusterResult result = EuclideanClusters(g.cloud, clusters);
+          summary["clusters"] = result.num_clusters();
+          summary["cluster_sizes"] = result.sizes;
+          scans_out = WithLabels(g, result.labels);
+        } else if (operation == "kmeans") {
+          const KMeansResult result = KMeans(g.cloud, kmeans);
+          summary["inertia_m2"] = result.inertia_m2;
+          summary["iterations"] = result.iterations;
+          scans_out = WithLabels(g, result.labels);
+        } else {
+          throw OptionsError(
+              fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
+                          "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
+                          operation));
+        }
+        summary["seconds"] = timer.Seconds();
+        if (as_cloud) {
+          WritePointCloud(output_path, cloud_out);
+          summary["output_points"] = cloud_out.size();
+        } else {
+          WriteScanFile(output_path, scans_out);
+        }
+        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+        return 0;
+      },
+      &binder);
 }
 
 int RunRegister(int argc, char** argv) {
@@ -406,45 +484,57 @@ int RunRegister(int argc, char** argv) {
   IcpOptions options;
   GlobalAlignOptions global;
   bool use_global = false;
-  app.add_flag("--global", use_global, "no usable pose: align FPFH features by RANSAC first");
-  app.add_option("--voxel", global.voxel_m, "--global: voxel size of the feature clouds, metres")
-      ->capture_default_str();
-  app.add_option("--feature-radius", global.feature_radius_m, "--global: FPFH radius, metres")
-      ->capture_default_str();
-  app.add_option("--seed", global.seed, "--global: RANSAC seed")->capture_default_str();
+  OptionBinder binder(app);
   app.add_option("fixed", fixed_path, "the scan that stays (its first scan)")->required();
   app.add_option("moving", moving_path, "the scan to move (its first scan)")->required();
   app.add_option("-o,--output", output_path, "the moving scan with its new pose")->required();
-  app.add_option("--json", json_path, "write a summary as JSON to FILE, or '-' for stdout");
-  app.add_option("--max-distance", options.max_correspondence_m, "first pairing distance, metres")
-      ->capture_default_str();
-  app.add_option("--min-distance", options.min_correspondence_m, "final pairing distance, metres")
-      ->capture_default_str();
-  app.add_option("--iterations", options.max_iterations, "ICP iterations at most")->capture_default_str();
-  return RunCommand(app, argc, argv, [&]() {
-    options.Check();
-    if (use_global) global.Check();
-    CheckOutputs(output_path, json_path, {fixed_path, moving_path});
-    const Timer timer;
-    const ScanFile fixed = ReadScanFileAndWarn(fixed_path), moving = ReadScanFileAndWarn(moving_path);
-    if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
-    const ScanRegistration result =
-        RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
-    WriteScanFile(output_path, {result.registered});
-    std::vector<std::vector<double>> rows;
-    for (int r = 0; r < 4; ++r) {
-      rows.push_back({result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
-                      result.registered.world_from_scanner(r, 2),
-                      result.registered.world_from_scanner(r, 3)});
-    }
-    WriteSummary(json_path, {{"world_from_scanner", rows},
-                             {"rms_m", result.icp.rms_m},
-                             {"fitness", result.icp.fitness},
-                             {"iterations", result.icp.iterations},
-                             {"converged", result.icp.converged},
-                             {"seconds", timer.Seconds()}});
-    return 0;
-  });
+  AddJsonOption(app, &json_path);
+  binder.Bind(&options, {.flags = {{"max_correspondence_m", "--max-distance"},
+                                   {"min_correspondence_m", "--min-distance"},
+                                   {"max_iterations", "--iterations"}}});
+  app.add_flag("--global", use_global, "no usable pose: align FPFH features by RANSAC first")
+      ->group("Global alignment (--global)");
+  binder.Bind(&global, {.flags = {{"voxel_m", "--voxel"},
+                                  {"feature_radius_m", "--feature-radius"},
+                                  {"normal_radius_m", "--global-normal-radius"},
+                                  {"inlier_distance_m", "--global-inlier-distance"},
+                                  {"max_iterations", "--global-iterations"},
+                                  {"edge_ratio", "--global-edge-ratio"}},
+                        .group = "Global alignment (--global)",
+                        .prefix = "global"});
+  return RunCommand(
+      app, argc, argv,
+      [&]() {
+        binder.Validate(options);
+        if (use_global) {
+          try {
+            Validate(global);
+          } catch (const OptionsFieldError& error) {
+            throw OptionsFieldError("global." + error.key_path(), error.reason());
+          }
+        }
+        CheckOutputs(output_path, json_path, {fixed_path, moving_path});
+        const Timer timer;
+        const ScanFile fixed = ReadScanFileAndWarn(fixed_path), moving = ReadScanFileAndWarn(moving_path);
+        if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
+        const ScanRegistration result =
+            RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
+        WriteScanFile(output_path, {result.registered});
+        std::vector<std::vector<double>> rows;
+        for (int r = 0; r < 4; ++r) {
+          rows.push_back(
+              {result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
+               result.registered.world_from_scanner(r, 2), result.registered.world_from_scanner(r, 3)});
+        }
+        nlohmann::ordered_json json = {
+            {"world_from_scanner", rows},        {"rms_m", result.icp.rms_m},
+            {"fitness", result.icp.fitness},     {"iterations", result.icp.iterations},
+            {"converged", result.icp.converged}, {"seconds", timer.Seconds()}};
+        if (use_global) json["global_options"] = ToJson(global);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
+      },
+      &binder);
 }
 
 }  // namespace lidarshop::cli

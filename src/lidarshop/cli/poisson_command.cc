@@ -8,9 +8,11 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/util/atomic_file.h"
@@ -18,31 +20,6 @@
 
 namespace lidarshop::cli {
 namespace {
-
-struct SolverFlags {
-  std::string solver = "auto";
-  PoissonOptions options;
-};
-
-void AddSolverFlags(CLI::App& command, SolverFlags* flags) {
-  command.add_option("--solver", flags->solver, "auto | direct | multigrid")
-      ->check(CLI::IsMember({"auto", "direct", "multigrid"}))
-      ->capture_default_str();
-  command.add_option("--tolerance", flags->options.tolerance, "multigrid: relative residual to reach")
-      ->capture_default_str();
-  command
-      .add_option("--max-iterations", flags->options.max_iterations, "multigrid: CG iterations per channel")
-      ->capture_default_str();
-}
-
-PoissonOptions Options(const SolverFlags& flags) {
-  PoissonOptions options = flags.options;
-  options.solver = flags.solver == "direct"      ? PoissonSolverKind::kDirect
-                   : flags.solver == "multigrid" ? PoissonSolverKind::kMultigrid
-                                                 : PoissonSolverKind::kAuto;
-  options.Check();
-  return options;
-}
 
 cv::Mat ReadFloat(const std::string& path) {
   const cv::Mat image = ReadImage(path);
@@ -85,21 +62,23 @@ int RunPoisson(int argc, char** argv) {
       "from a gradient field (docs/poisson.md). Masks: white = hole / region.",
       "poisson"};
   app.require_subcommand(1);
-  app.fallthrough();  // --quiet may also follow the subcommand
+  app.fallthrough();  // the options, --json and --quiet may also follow the subcommand
   bool quiet = false;
+  std::string json_path;
+  PoissonOptions options;
+  OptionBinder binder(app);
+  binder.Bind(&options);
+  AddJsonOption(app, &json_path);
   AddQuietFlag(app, &quiet);
 
   std::string image_path, mask_path, output_path;
-  SolverFlags fill_flags;
   CLI::App* fill =
       app.add_subcommand("fill", "fill the masked pixels smoothly from their surroundings (Laplace)");
   fill->add_option("image", image_path, "input image (8/16-bit or float, any channels)")->required();
   fill->add_option("--mask", mask_path, "hole mask (white = hole), same size")->required();
   fill->add_option("-o,--output", output_path, "output image (.png/.jpg 8-bit, .exr/.tif float)")->required();
-  AddSolverFlags(*fill, &fill_flags);
 
   std::string source_path, target_path, offset_text = "0,0";
-  SolverFlags clone_flags;
   CLI::App* clone = app.add_subcommand("clone", "seamlessly clone a masked region of SOURCE into TARGET");
   clone->add_option("source", source_path, "source image")->required();
   clone->add_option("--mask", mask_path, "region of the source to clone (white), source size")->required();
@@ -107,10 +86,8 @@ int RunPoisson(int argc, char** argv) {
   clone->add_option("--offset", offset_text, "X,Y: target pixel where source pixel (0,0) lands")
       ->capture_default_str();
   clone->add_option("-o,--output", output_path, "output image")->required();
-  AddSolverFlags(*clone, &clone_flags);
 
   std::string gx_path, gy_path, boundary_path;
-  SolverFlags reconstruct_flags;
   CLI::App* reconstruct = app.add_subcommand(
       "reconstruct", "solve for the image whose gradients are (GX, GY) in the mask, BOUNDARY around it");
   reconstruct->add_option("--gx", gx_path, "horizontal forward differences I(x+1) - I(x) (float, .exr/.tif)")
@@ -119,63 +96,80 @@ int RunPoisson(int argc, char** argv) {
   reconstruct->add_option("--boundary", boundary_path, "image giving the values around the mask")->required();
   reconstruct->add_option("--mask", mask_path, "domain to reconstruct (white), same size")->required();
   reconstruct->add_option("-o,--output", output_path, "output image (.exr/.tif float, or .png)")->required();
-  AddSolverFlags(*reconstruct, &reconstruct_flags);
 
-  return RunCommand(app, argc, argv, [&]() {
-    CheckOutputPath(output_path,
-                    {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
-    PoissonResult result;
-    int unknowns = 0;
-    if (*fill) {
-      const PoissonOptions options = Options(fill_flags);
-      const cv::Mat image = ReadImage(image_path);
-      const cv::Mat mask = ReadMask(mask_path, image.size(), image_path);
-      const PoissonSystem system = PreparePoisson(mask, options);
-      unknowns = system.NumUnknowns();
-      cv::Mat input;
-      image.convertTo(input, CV_32F);
-      result = FillLaplace(system, input);
-      WriteResult(output_path, result.image, IntegerDepth(image));
-    } else if (*clone) {
-      const PoissonOptions options = Options(clone_flags);
-      const cv::Point offset = ParseOffset(offset_text);
-      const cv::Mat source = ReadImage(source_path);
-      const cv::Mat target = ReadImage(target_path);
-      const cv::Mat mask = ReadMask(mask_path, source.size(), source_path);
-      if (source.channels() != target.channels()) {
-        ThrowInputError(target_path, "", "",
-                        fmt::format("the target has {} channel(s), the source {} has {}", target.channels(),
-                                    source_path, source.channels()));
-      }
-      unknowns = cv::countNonZero(mask);
-      cv::Mat source_float, target_float;
-      source.convertTo(source_float, CV_32F);
-      target.convertTo(target_float, CV_32F);
-      result = SeamlessClone(source_float, mask, target_float, offset, options);
-      WriteResult(output_path, result.image, IntegerDepth(target));
-    } else {
-      const PoissonOptions options = Options(reconstruct_flags);
-      const cv::Mat boundary = ReadImage(boundary_path);
-      const cv::Mat gx = ReadFloat(gx_path), gy = ReadFloat(gy_path);
-      for (const auto& [path, field] : {std::pair{gx_path, &gx}, std::pair{gy_path, &gy}}) {
-        if (field->size() != boundary.size() || field->channels() != boundary.channels()) {
-          ThrowInputError(path, "", "",
-                          fmt::format("{}x{} with {} channel(s), but {} is {}x{} with {}", field->cols,
-                                      field->rows, field->channels(), boundary_path, boundary.cols,
-                                      boundary.rows, boundary.channels()));
+  for (CLI::App* sub : {fill, clone, reconstruct}) {
+    sub->footer(
+        "Solver options (--solver, --tolerance, ...), --options, --json and --quiet: `lidarshop poisson "
+        "--help`; they may follow the subcommand.");
+  }
+  return RunCommand(
+      app, argc, argv,
+      [&]() {
+        binder.Validate(options);
+        CheckOutputPath(output_path,
+                        {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path});
+        CheckOutputFile(
+            "--json", json_path, {},
+            {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path, output_path});
+        PoissonResult result;
+        int unknowns = 0;
+        if (*fill) {
+          const cv::Mat image = ReadImage(image_path);
+          const cv::Mat mask = ReadMask(mask_path, image.size(), image_path);
+          const PoissonSystem system = PreparePoisson(mask, options);
+          unknowns = system.NumUnknowns();
+          cv::Mat input;
+          image.convertTo(input, CV_32F);
+          result = FillLaplace(system, input);
+          WriteResult(output_path, result.image, IntegerDepth(image));
+        } else if (*clone) {
+          const cv::Point offset = ParseOffset(offset_text);
+          const cv::Mat source = ReadImage(source_path);
+          const cv::Mat target = ReadImage(target_path);
+          const cv::Mat mask = ReadMask(mask_path, source.size(), source_path);
+          if (source.channels() != target.channels()) {
+            ThrowInputError(target_path, "", "",
+                            fmt::format("the target has {} channel(s), the source {} has {}",
+                                        target.channels(), source_path, source.channels()));
+          }
+          unknowns = cv::countNonZero(mask);
+          cv::Mat source_float, target_float;
+          source.convertTo(source_float, CV_32F);
+          target.convertTo(target_float, CV_32F);
+          result = SeamlessClone(source_float, mask, target_float, offset, options);
+          WriteResult(output_path, result.image, IntegerDepth(target));
+        } else {
+          const cv::Mat boundary = ReadImage(boundary_path);
+          const cv::Mat gx = ReadFloat(gx_path), gy = ReadFloat(gy_path);
+          for (const auto& [path, field] : {std::pair{gx_path, &gx}, std::pair{gy_path, &gy}}) {
+            if (field->size() != boundary.size() || field->channels() != boundary.channels()) {
+              ThrowInputError(path, "", "",
+                              fmt::format("{}x{} with {} channel(s), but {} is {}x{} with {}", field->cols,
+                                          field->rows, field->channels(), boundary_path, boundary.cols,
+                                          boundary.rows, boundary.channels()));
+            }
+          }
+          const cv::Mat mask = ReadMask(mask_path, boundary.size(), boundary_path);
+          const PoissonSystem system = PreparePoisson(mask, options);
+          unknowns = system.NumUnknowns();
+          cv::Mat boundary_float;
+          boundary.convertTo(boundary_float, CV_32F);
+          result = ReconstructFromGradients(system, boundary_float, gx, gy);
+          WriteResult(output_path, result.image, IntegerDepth(boundary));
         }
-      }
-      const cv::Mat mask = ReadMask(mask_path, boundary.size(), boundary_path);
-      const PoissonSystem system = PreparePoisson(mask, options);
-      unknowns = system.NumUnknowns();
-      cv::Mat boundary_float;
-      boundary.convertTo(boundary_float, CV_32F);
-      result = ReconstructFromGradients(system, boundary_float, gx, gy);
-      WriteResult(output_path, result.image, IntegerDepth(boundary));
-    }
-    if (!quiet) fmt::print(stderr, "{} unknowns; {}\n", unknowns, result.Summary());
-    return 0;
-  });
+        if (!quiet) fmt::print(stderr, "{} unknowns; {}\n", unknowns, result.Summary());
+        nlohmann::ordered_json json;
+        json["operation"] = *fill ? "fill" : *clone ? "clone" : "reconstruct";
+        json["unknowns"] = unknowns;
+        json["solver"] = ToString(result.solver);
+        json["channels"] = result.channels;
+        json["iterations"] = result.iterations;
+        json["relative_residual"] = result.relative_residual;
+        json["seconds"] = result.seconds;
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
+      },
+      &binder);
 }
 
 }  // namespace lidarshop::cli

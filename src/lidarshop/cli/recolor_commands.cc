@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
@@ -83,16 +84,17 @@ nlohmann::ordered_json ResectionJson(const ResectionResult& result) {
   return json;
 }
 
-void AddResectionOptions(CLI::App& app, ResectionOptions* options, std::string* intrinsics_path) {
-  app.add_option("--threshold", options->ransac_threshold_px, "RANSAC inlier threshold, pixels")
-      ->capture_default_str();
-  app.add_option("--iterations", options->ransac_iterations, "most RANSAC sets")->capture_default_str();
-  app.add_option("--seed", options->seed, "RANSAC seed")->capture_default_str();
-  app.add_option("--radial", options->radial_coefficients, "radial distortion terms refined (0-3)")
-      ->capture_default_str();
-  app.add_flag("!--no-refine", options->refine, "keep the DLT camera (no Levenberg-Marquardt)");
+// The photo's size comes from the photo, --size or the correspondence file, not from flags.
+void AddResectionOptions(CLI::App& app, OptionBinder& binder, ResectionOptions* options,
+                         std::string* intrinsics_path, const std::string& group) {
+  binder.Bind(options, {.skip = {"width_px", "height_px"},
+                        .flags = {{"ransac_threshold_px", "--threshold"},
+                                  {"ransac_iterations", "--iterations"},
+                                  {"radial_coefficients", "--radial"}},
+                        .group = group});
   app.add_option("--intrinsics", *intrinsics_path,
-                 "camera JSON whose intrinsics are known: only the pose is estimated (planar targets too)");
+                 "camera JSON whose intrinsics are known: only the pose is estimated (planar targets too)")
+      ->group(group);
 }
 
 }  // namespace
@@ -129,10 +131,11 @@ int RunResection(int argc, char** argv) {
       "Resection: the camera of a photo from pixel <-> point correspondences (normalized DLT, RANSAC, "
       "Levenberg-Marquardt with distortion; docs/recolor.md). Prints the per-pair errors as JSON.",
       "resection"};
-  std::string pairs_path, output, scan_path, photo_path, intrinsics_path;
+  std::string pairs_path, output, scan_path, photo_path, intrinsics_path, json_path = "-";
   std::vector<int> size;
   int scan_index = 0;
   ResectionOptions options;
+  OptionBinder binder(app);
   app.add_option("--correspondences", pairs_path,
                  "C.json: {\"pairs\": [{\"pixel\": [u, v], \"point\": [x, y, z]}]}")
       ->required();
@@ -141,26 +144,34 @@ int RunResection(int argc, char** argv) {
   app.add_option("--scan-index", scan_index, "which scan of --scan (from 0)");
   app.add_option("--photo", photo_path, "the photo (its size goes into the camera)");
   app.add_option("--size", size, "the photo's size: WIDTH HEIGHT (instead of --photo)")->expected(2);
-  AddResectionOptions(app, &options, &intrinsics_path);
-  return RunCommand(app, argc, argv, [&] {
-    CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
-    Scan scan;
-    if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
-    const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
-    options.width_px = pairs.width_px, options.height_px = pairs.height_px;
-    if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
-    if (!photo_path.empty()) {
-      const cv::Mat photo = ReadImage(photo_path);
-      options.width_px = photo.cols, options.height_px = photo.rows;
-    }
-    if (options.width_px <= 0)
-      throw OptionsError("the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " +
-                         pairs_path);
-    const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
-    WriteCameraJson(output, result.camera);
-    fmt::print("{}\n", ResectionJson(result).dump(1));
-    return 0;
-  });
+  AddJsonOption(app, &json_path);
+  AddResectionOptions(app, binder, &options, &intrinsics_path, "");
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(options);
+        CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
+        CheckOutputFile("--json", json_path, {},
+                        {pairs_path, scan_path, photo_path, intrinsics_path, output});
+        Scan scan;
+        if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
+        const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
+        if (pairs.width_px > 0) options.width_px = pairs.width_px, options.height_px = pairs.height_px;
+        if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
+        if (!photo_path.empty()) {
+          const cv::Mat photo = ReadImage(photo_path);
+          options.width_px = photo.cols, options.height_px = photo.rows;
+        }
+        if (options.width_px <= 0)
+          throw OptionsError(
+              "the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " + pairs_path);
+        const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
+        WriteCameraJson(output, result.camera);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ResectionJson(result)));
+        if (json_path != "-") fmt::print(stderr, "resection: {}\n", result.Summary());
+        return 0;
+      },
+      &binder);
 }
 
 int RunRecolor(int argc, char** argv) {
@@ -168,12 +179,12 @@ int RunRecolor(int argc, char** argv) {
       "Recolour a scan from a photo: occlusion-aware projection (thesis 3.2.2.1, docs/recolor.md). Points "
       "the camera does not see keep their colour.",
       "recolor"};
-  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path,
-      visibility = "zbuffer";
+  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path, json_path = "-";
   int scan_index = 0;
   RecolorOptions options;
   ResectionOptions resection;
   std::string intrinsics_path;
+  OptionBinder binder(app);
   app.add_option("scan", scan_path, "scan file to recolour")->required();
   app.add_option("--photo", photo_path, "the photo (.jpg, .png)");
   app.add_option("--image", image_key,
@@ -183,75 +194,81 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
   app.add_option("--scan-index", scan_index, "which scan of the file (from 0)");
-  app.add_option("--visibility", visibility,
-                 "zbuffer (with a silhouette margin) | segment (literal thesis test)")
-      ->check(CLI::IsMember({"zbuffer", "segment"}))
-      ->capture_default_str();
-  app.add_option("--margin", options.silhouette_margin_px, "silhouette margin, z-buffer pixels")
-      ->capture_default_str();
-  app.add_option("--depth-tolerance", options.depth_tolerance_m, "metres")->capture_default_str();
-  app.add_option("--zbuffer-scale", options.zbuffer_scale, "z-buffer size / photo size")
-      ->capture_default_str();
-  AddResectionOptions(app, &resection, &intrinsics_path);
-  return RunCommand(app, argc, argv, [&] {
-    options.visibility = visibility == "segment" ? VisibilityMethod::kSegment : VisibilityMethod::kZBuffer;
-    options.Check();
-    if (photo_path.empty() == image_key.empty())
-      throw OptionsError("give exactly one of --photo and --image");
-    CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
-    if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
-    const Scan scan = ReadOneScan(scan_path, scan_index);
-    cv::Mat photo;
-    PinholeCamera camera;
-    bool have_camera = false;
-    if (!image_key.empty()) {
-      if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
-      const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
-      const E57Image& image = FindImage(file.images, image_key, scan_path);
-      if (image.image.empty()) ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
-      photo = image.image;
-      std::string why;
-      have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
-      if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
-    } else {
-      photo = ReadImage(photo_path);
-      if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
-    }
-    if (!camera_path.empty() && !pairs_path.empty())
-      throw OptionsError("give --camera or --correspondences, not both");
-    if (!camera_path.empty()) {
-      camera = ReadCameraJson(camera_path);
-    } else if (!pairs_path.empty()) {
-      resection.width_px = photo.cols, resection.height_px = photo.rows;
-      const ResectionResult result =
-          RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
-      fmt::print(stderr, "resection: {}\n", result.Summary());
-      camera = result.camera;
-    } else if (!have_camera) {
-      throw OptionsError("give --camera or --correspondences");
-    }
-    const RecolorResult result = RecolorScan(scan, photo, camera, options);
-    WriteScanFile(output, {result.scan});
-    if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
-    nlohmann::ordered_json json;
-    json["returns"] = result.returns;
-    json["recolored"] = result.recolored_count;
-    json["outside_image"] = result.outside_image;
-    json["hidden"] = result.hidden;
-    fmt::print("{}\n", json.dump());
-    return 0;
-  });
+  AddJsonOption(app, &json_path);
+  binder.Bind(&options,
+              {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
+  AddResectionOptions(app, binder, &resection, &intrinsics_path, "Resection (with --correspondences)");
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(options);
+        binder.Validate(resection);
+        CheckOutputFile("--json", json_path, {},
+                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
+        if (photo_path.empty() == image_key.empty())
+          throw OptionsError("give exactly one of --photo and --image");
+        CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
+        if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
+        const Scan scan = ReadOneScan(scan_path, scan_index);
+        cv::Mat photo;
+        PinholeCamera camera;
+        bool have_camera = false;
+        nlohmann::ordered_json json;
+        if (!image_key.empty()) {
+          if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
+          const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
+          const E57Image& image = FindImage(file.images, image_key, scan_path);
+          if (image.image.empty())
+            ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
+          photo = image.image;
+          std::string why;
+          have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
+          if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
+        } else {
+          photo = ReadImage(photo_path);
+          if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
+        }
+        if (!camera_path.empty() && !pairs_path.empty())
+          throw OptionsError("give --camera or --correspondences, not both");
+        if (!camera_path.empty()) {
+          camera = ReadCameraJson(camera_path);
+        } else if (!pairs_path.empty()) {
+          resection.width_px = photo.cols, resection.height_px = photo.rows;
+          const ResectionResult result =
+              RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
+          fmt::print(stderr, "resection: {}\n", result.Summary());
+          json["resection"] = ResectionJson(result);
+          json["resection"]["options"] = ToJson(resection);
+          camera = result.camera;
+        } else if (!have_camera) {
+          throw OptionsError("give --camera or --correspondences");
+        }
+        const RecolorResult result = RecolorScan(scan, photo, camera, options);
+        WriteScanFile(output, {result.scan});
+        if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
+        nlohmann::ordered_json counts;
+        counts["returns"] = result.returns;
+        counts["recolored"] = result.recolored_count;
+        counts["outside_image"] = result.outside_image;
+        counts["hidden"] = result.hidden;
+        if (json.is_object()) counts.update(json);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+        return 0;
+      },
+      &binder);
 }
 
 int RunImages(int argc, char** argv) {
   CLI::App app{
       "List the photos (images2D) of an E57 file as JSON; --extract writes each decoded photo as PNG.",
       "images"};
-  std::string path, folder;
+  std::string path, folder, json_path = "-";
   app.add_option("file", path, "E57 file")->required();
   app.add_option("--extract", folder, "folder to write <index>_<name>.png into (created)");
+  AddJsonOption(app, &json_path);
   return RunCommand(app, argc, argv, [&] {
     if (FileExtension(path) != "e57") throw OptionsError(path + " is not an .e57 file");
+    CheckOutputFile("--json", json_path, {}, {path});
     const E57File file = ReadE57AndWarn(path);
     nlohmann::ordered_json json;
     json["file"] = path;
@@ -271,7 +288,7 @@ int RunImages(int argc, char** argv) {
         json["images"][i]["extracted"] = out;
       }
     }
-    fmt::print("{}\n", json.dump(1));
+    WriteJsonOutput(json_path, json);
     return 0;
   });
 }
@@ -282,11 +299,12 @@ int RunAlign(int argc, char** argv) {
       "scaled 4x4 (Umeyama); photo <-> photo pairs (\"pixel_a\"/\"pixel_b\") a 3x3 homography or "
       "fundamental matrix. Writes the matrix as text rows, prints residuals as JSON.",
       "align"};
-  std::string pairs_path, output, model = "homography";
+  std::string pairs_path, output, model = "homography", json_path = "-";
   bool with_scale = false;
   double threshold_px = 3.0;
   app.add_option("--correspondences", pairs_path, "C.json")->required();
   app.add_option("-o,--output", output, "T.txt to write")->required();
+  AddJsonOption(app, &json_path);
   app.add_flag("--scale", with_scale, "landmarks: allow a uniform scale (similarity)");
   app.add_option("--model", model, "photo pairs: homography | fundamental")
       ->check(CLI::IsMember({"homography", "fundamental"}))
@@ -294,6 +312,7 @@ int RunAlign(int argc, char** argv) {
   app.add_option("--threshold", threshold_px, "photo pairs: RANSAC threshold, pixels")->capture_default_str();
   return RunCommand(app, argc, argv, [&] {
     CheckNotInput(output, {pairs_path});
+    CheckOutputFile("--json", json_path, {}, {pairs_path, output});
     const Correspondences pairs = ReadCorrespondences(pairs_path);
     nlohmann::ordered_json json;
     std::string text;
@@ -322,7 +341,8 @@ int RunAlign(int argc, char** argv) {
       ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
     }
     WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
-    fmt::print("{}\n", json.dump());
+    json["options"] = {{"scale", with_scale}, {"model", model}, {"threshold_px", threshold_px}};
+    WriteJsonOutput(json_path, json);
     return 0;
   });
 }
@@ -331,21 +351,32 @@ int RunPhoto(int argc, char** argv) {
   CLI::App app{
       "The synthetic camera: render what a pinhole camera sees in a scene, with the scanner's colours.",
       "photo"};
-  std::string scene_path, camera_path, output;
+  std::string scene_path, camera_path, output, json_path;
   PhotoOptions options;
+  OptionBinder binder(app);
   app.add_option("scene", scene_path, "scene JSON (docs/scene-format.md)")->required();
   app.add_option("--camera", camera_path, "camera JSON (geometry/camera.h)")->required();
   app.add_option("-o,--output", output, "photo to write (.png, .jpg)")->required();
-  app.add_option("--samples", options.samples_per_axis, "rays per pixel per axis (anti-aliasing)")
-      ->capture_default_str();
-  return RunCommand(app, argc, argv, [&] {
-    CheckNotInput(output, {scene_path, camera_path});
-    const SceneDescription scene = LoadScene(scene_path);
-    PrintWarnings(scene.warnings);
-    const Photo photo = RenderPhoto(scene, ReadCameraJson(camera_path), options);
-    WriteImage(output, photo.image);
-    return 0;
-  });
+  AddJsonOption(app, &json_path);
+  binder.Bind(&options, {.flags = {{"samples_per_axis", "--samples"}}});
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(options);
+        CheckNotInput(output, {scene_path, camera_path});
+        CheckOutputFile("--json", json_path, {}, {scene_path, camera_path, output});
+        const SceneDescription scene = LoadScene(scene_path);
+        PrintWarnings(scene.warnings);
+        const Photo photo = RenderPhoto(scene, ReadCameraJson(camera_path), options);
+        WriteImage(output, photo.image);
+        nlohmann::ordered_json json;
+        json["width_px"] = photo.image.cols;
+        json["height_px"] = photo.image.rows;
+        json["scene_pixels"] = cv::countNonZero(photo.label != kNoLabel);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
+      },
+      &binder);
 }
 
 }  // namespace lidarshop::cli

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
@@ -32,22 +33,16 @@ std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
   return scans;
 }
 
-nlohmann::json NumberOrNull(double value) {
-  return std::isnan(value) ? nlohmann::json() : nlohmann::json(value);
+nlohmann::ordered_json NumberOrNull(double value) {
+  return std::isnan(value) ? nlohmann::ordered_json() : nlohmann::ordered_json(value);
 }
 
-nlohmann::json ResultJson(const VerifyResult& result, const std::vector<std::string>& scan_names) {
-  nlohmann::json json;
-  json["consistency"] = NumberOrNull(result.consistency);
-  json["has_comparable_pairs"] = result.has_comparable_pairs;
-  json["comparable_pairs"] = result.comparable_pairs;
-  json["consistent_pairs"] = result.consistent_pairs;
-  json["confidence"] = result.confidence;
+// The result's described JSON form (VerifyResult), with the older key "icp_cost" (= icp_cost_m) and the
+// per-scan numbers.
+nlohmann::ordered_json ResultJson(const VerifyResult& result, const std::vector<std::string>& scan_names) {
+  nlohmann::ordered_json json = ToJson(result);
   json["icp_cost"] = NumberOrNull(result.icp_cost_m);
-  json["icp_inliers"] = result.icp_inliers;
-  json["icp_candidates"] = result.icp_candidates;
-  json["inlier_fraction"] = result.inlier_fraction;
-  json["per_scan"] = nlohmann::json::array();
+  json["per_scan"] = nlohmann::ordered_json::array();
   for (size_t s = 0; s < result.per_scan.size(); ++s) {
     const ScanVerifyStats& stats = result.per_scan[s];
     json["per_scan"].push_back({{"scan", s < scan_names.size() ? scan_names[s] : std::to_string(s)},
@@ -61,8 +56,8 @@ nlohmann::json ResultJson(const VerifyResult& result, const std::vector<std::str
   return json;
 }
 
-nlohmann::json MatrixJson(const Eigen::Matrix4d& matrix) {
-  nlohmann::json rows = nlohmann::json::array();
+nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
   return rows;
 }
@@ -83,6 +78,8 @@ TriangleMesh LoadModel(const std::string& path) {
   return ReadMeshAndWarn(path);
 }
 
+// The flags verify and sweep share: scans, the model and the options of both sides (VerifyOptions first:
+// `--options FILE` sets it).
 struct CommonFlags {
   std::vector<std::string> scans;
   std::string model;
@@ -92,41 +89,32 @@ struct CommonFlags {
   bool distinctiveness = false;
   bool quiet = false;
 
-  void Add(CLI::App& app) {
+  void Add(CLI::App& app, OptionBinder& binder) {
     app.add_option("--scan", scans, "scan file (.ptx, .e57, .ply, .pcd); repeat for several registered scans")
         ->required();
     app.add_option("--model", model,
                    "model mesh (.obj, .ply) in its own frame, metres; or builtin:sedan|hatchback|van "
                    "(procedural cars)")
         ->required();
-    app.add_option(
-           "--allowance", verify.allowance_m,
-           "mismatch allowance a, metres (consistency: (d_m + a) - d_s >= 0); ~2-3x range noise + model "
-           "error; 0.02 for a 30 cm object")
-        ->capture_default_str();
-    app.add_option(
-           "--sigma", verify.sigma_m,
-           "observation kernel sigma, metres (confidence: neighbours within 3 sigma); ~ the scan's point "
-           "spacing on the object")
-        ->capture_default_str();
-    app.add_option("--icp-trim", verify.icp_trim_m, "trimmed ICP: pairs beyond this are excluded, metres")
-        ->capture_default_str();
-    app.add_option("--samples", model_options.num_surface_samples,
-                   "model points sampled uniformly on the surface (confidence)")
-        ->capture_default_str();
-    AddSeedOption(app, &model_options.seed, "seed of the surface sampling");
-    app.add_flag("--vertices", use_vertices,
-                 "use the mesh vertices as model points instead of surface samples");
-    app.add_flag("--distinctiveness", distinctiveness,
-                 "weight model points by shape distinctiveness (surface variation) instead of uniformly");
+    // allowance_m: ~2-3x the range noise + the model's error (0.02 for a 30 cm object); sigma_m: ~ the
+    // scan's point spacing on the object. keep_details follows --scene-points / --model-points.
+    binder.Bind(&verify, {.skip = {"keep_details"},
+                          .flags = {{"allowance_m", "--allowance"},
+                                    {"sigma_m", "--sigma"},
+                                    {"icp_trim_m", "--icp-trim"},
+                                    {"footprint_margin_cells", "--footprint-margin"}}});
+    binder.Bind(&model_options, {.flags = {{"num_surface_samples", "--samples"}}, .group = "Model points"});
+    app.add_flag("--vertices", use_vertices, "= --point-source vertices")->group("Model points");
+    app.add_flag("--distinctiveness", distinctiveness, "= --information shape-distinctiveness")
+        ->group("Model points");
     AddQuietFlag(app, &quiet);
   }
 
-  VerifierModel PrepareTheModel() {
+  VerifierModel PrepareTheModel(const OptionBinder& binder) {
     if (use_vertices) model_options.point_source = ModelPointSource::kVertices;
     if (distinctiveness) model_options.information = InformationWeighting::kShapeDistinctiveness;
-    model_options.Check();
-    verify.Check();
+    binder.Validate(model_options);
+    binder.Validate(verify);
     return PrepareModel(LoadModel(model), model_options, verify);
   }
 };
@@ -183,58 +171,57 @@ int RunVerify(int argc, char** argv) {
       "number.",
       "verify");
   CommonFlags common;
+  OptionBinder binder(app);
   std::string pose_text, json_path, scene_ply, model_ply;
-  common.Add(app);
+  common.Add(app, binder);
   app.add_option(
          "--pose", pose_text,
          "world_from_model: a file (4 rows of 4 numbers, or JSON), 16 comma-separated numbers (row major), "
          "or x,y,z,yaw_deg[,pitch_deg,roll_deg] (world frame, metres and degrees; "
          "R = Rz(yaw)·Ry(pitch)·Rx(roll))")
       ->required();
-  app.add_option("--json", json_path,
-                 "write the result as JSON (consistency, confidence, comparable_pairs, "
-                 "icp_cost, inlier_fraction, per_scan, ...)");
+  AddJsonOption(app, &json_path);
   app.add_option("--scene-points", scene_ply,
                  "write the scene points (world frame) as PLY: green consistent, red inconsistent, grey not "
                  "comparable (label 1 / 2 / 0)");
   app.add_option(
       "--model-points", model_ply,
       "write the posed model points as PLY coloured by observed information: red unseen -> green seen");
-  return RunCommand(app, argc, argv, [&] {
-    std::vector<std::string> used = common.scans;
-    used.push_back(common.model);
-    used.push_back(pose_text);
-    for (const std::string& path : {json_path, scene_ply, model_ply}) {
-      if (path.empty()) continue;
-      CheckOutputPath(path, used);
-      used.push_back(path);
-    }
-    const Eigen::Matrix4d world_from_model = ParsePose(pose_text);
-    auto progress = Progress::ForTerminal("verify: preparing", 2, common.quiet);
-    VerifierModel model = common.PrepareTheModel();
-    progress->Advance();
-    const std::vector<PreparedScan> scans = LoadScans(common.scans);
-    progress->Advance();
-    progress->Finish();
-    VerifyOptions options = common.verify;
-    options.keep_details = !scene_ply.empty() || !model_ply.empty();
-    const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
-    std::vector<std::string> names;
-    for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
-    fmt::print("{}\n", result.BriefReport());
-    if (!json_path.empty()) {
-      nlohmann::json json = ResultJson(result, names);
-      json["world_from_model"] = MatrixJson(world_from_model);
-      json["options"] = {{"allowance_m", options.allowance_m},
-                         {"sigma_m", options.sigma_m},
-                         {"icp_trim_m", options.icp_trim_m},
-                         {"model_points", model.num_points()}};
-      WriteText(json_path, json.dump(2) + "\n");
-    }
-    if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
-    if (!model_ply.empty()) WritePointCloud(model_ply, ObservedModelCloud(model, world_from_model, result));
-    return 0;
-  });
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        std::vector<std::string> used = common.scans;
+        used.push_back(common.model);
+        used.push_back(pose_text);
+        for (const std::string& path : {json_path, scene_ply, model_ply}) {
+          if (path.empty() || path == "-") continue;
+          CheckOutputPath(path, used);
+          used.push_back(path);
+        }
+        const Eigen::Matrix4d world_from_model = ParsePose(pose_text);
+        auto progress = Progress::ForTerminal("verify: preparing", 2, common.quiet);
+        VerifierModel model = common.PrepareTheModel(binder);
+        progress->Advance();
+        const std::vector<PreparedScan> scans = LoadScans(common.scans);
+        progress->Advance();
+        progress->Finish();
+        VerifyOptions options = common.verify;
+        options.keep_details = !scene_ply.empty() || !model_ply.empty();
+        const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
+        std::vector<std::string> names;
+        for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
+        if (!common.quiet) fmt::print(stderr, "{}\n", result.BriefReport());
+        nlohmann::ordered_json json = ResultJson(result, names);
+        json["world_from_model"] = MatrixJson(world_from_model);
+        json["model_points"] = model.num_points();
+        json["model_options"] = ToJson(common.model_options);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
+        if (!model_ply.empty())
+          WritePointCloud(model_ply, ObservedModelCloud(model, world_from_model, result));
+        return 0;
+      },
+      &binder);
 }
 
 int RunSweep(int argc, char** argv) {
@@ -249,89 +236,97 @@ int RunSweep(int argc, char** argv) {
       "sweep");
   CommonFlags common;
   SweepOptions sweep_options;
-  std::string x_range = "-10:10", y_range = "0:20", yaws = "0:360:15", out_dir;
-  bool no_refine = false;
-  common.Add(app);
-  app.add_option("--x-range", x_range, "MIN:MAX world x of the model origin, metres")->capture_default_str();
-  app.add_option("--y-range", y_range, "MIN:MAX world y of the model origin, metres")->capture_default_str();
-  app.add_option("--step", sweep_options.step_m, "grid step in x and y, metres")->capture_default_str();
-  app.add_option("--z", sweep_options.z_m, "world z of the model origin (the ground for a car), metres")
-      ->capture_default_str();
+  sweep_options.yaws_deg = ParseYaws("0:360:15");  // the command's default: every 15 degrees
+  std::string x_range, y_range, yaws, out_dir, json_path;
+  OptionBinder binder(app);
+  // The sweep's options first: `--options FILE` sets them. The ranges and yaws keep their own syntax.
+  binder.Bind(&sweep_options, {.skip = {"x_min_m", "x_max_m", "y_min_m", "y_max_m", "yaws_deg"},
+                               .flags = {{"step_m", "--step"},
+                                         {"z_m", "--z"},
+                                         {"min_comparable_pairs", "--min-pairs"},
+                                         {"nms_radius_m", "--nms-radius"}}});
+  app.add_option("--x-range", x_range, "MIN:MAX world x of the model origin, metres")->default_str("-10:10");
+  app.add_option("--y-range", y_range, "MIN:MAX world y of the model origin, metres")->default_str("0:20");
   app.add_option("--yaws", yaws, "yaws in degrees: a list '0,90,180' or START:STOP:STEP (STOP excluded)")
-      ->capture_default_str();
-  app.add_option("--min-consistency", sweep_options.min_consistency, "detections need consistency > this")
-      ->capture_default_str();
-  app.add_option("--min-confidence", sweep_options.min_confidence, "detections need confidence > this")
-      ->capture_default_str();
-  app.add_option("--min-pairs", sweep_options.min_comparable_pairs,
-                 "detections need at least this many pairs")
-      ->capture_default_str();
-  app.add_option("--nms-radius", sweep_options.nms_radius_m,
-                 "non-maximum suppression radius, metres (0 = the model's smaller horizontal extent)")
-      ->capture_default_str();
-  app.add_flag("--no-refine", no_refine, "report grid poses only (no local refinement of promising poses)");
+      ->default_str("0:360:15");
+  for (const char* key : {"x_min_m", "x_max_m"}) binder.NameFlag(key, "--x-range");
+  for (const char* key : {"y_min_m", "y_max_m"}) binder.NameFlag(key, "--y-range");
+  binder.NameFlag("yaws_deg", "--yaws");
+  common.Add(app, binder);
   app.add_option("--out", out_dir, "output folder (created)")->required();
-  return RunCommand(app, argc, argv, [&] {
-    std::tie(sweep_options.x_min_m, sweep_options.x_max_m) = ParseRange(x_range, "--x-range");
-    std::tie(sweep_options.y_min_m, sweep_options.y_max_m) = ParseRange(y_range, "--y-range");
-    sweep_options.yaws_deg = ParseYaws(yaws);
-    sweep_options.refine = !no_refine;
-    sweep_options.Check();
-    VerifierModel model = common.PrepareTheModel();
-    const std::vector<PreparedScan> scans = LoadScans(common.scans);
-    std::filesystem::create_directories(out_dir);
-    const std::filesystem::path out(out_dir);
-    const size_t poses =
-        (static_cast<size_t>(
-             std::floor((sweep_options.x_max_m - sweep_options.x_min_m) / sweep_options.step_m + 1e-9)) +
-         1) *
-        (static_cast<size_t>(
-             std::floor((sweep_options.y_max_m - sweep_options.y_min_m) / sweep_options.step_m + 1e-9)) +
-         1) *
-        sweep_options.yaws_deg.size();
-    auto progress = Progress::ForTerminal("sweep", static_cast<int64_t>(poses), common.quiet);
-    const SweepResult sweep = Sweep(model, scans, sweep_options, common.verify, progress.get());
-    progress->Finish();
-    WriteImage((out / "consistency.png").string(),
-               RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",
-                             sweep_options.min_consistency));
-    WriteImage((out / "confidence.png").string(),
-               RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
-                             sweep_options.min_confidence));
-    WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
-    nlohmann::json json;
-    json["detections"] = nlohmann::json::array();
-    for (const Detection& d : sweep.detections) {
-      json["detections"].push_back({{"x_m", d.x_m},
-                                    {"y_m", d.y_m},
-                                    {"z_m", d.z_m},
-                                    {"yaw_deg", d.yaw_deg},
-                                    {"consistency", d.consistency},
-                                    {"confidence", d.confidence},
-                                    {"comparable_pairs", d.comparable_pairs},
-                                    {"icp_cost", NumberOrNull(d.icp_cost_m)},
-                                    {"inlier_fraction", d.inlier_fraction},
-                                    {"world_from_model", MatrixJson(d.world_from_model)}});
-    }
-    json["thresholds"] = {{"min_consistency", sweep_options.min_consistency},
-                          {"min_confidence", sweep_options.min_confidence},
-                          {"min_comparable_pairs", sweep_options.min_comparable_pairs},
-                          {"nms_radius_m", sweep.nms_radius_m}};
-    json["grid"] = {{"x_count", sweep.xs_m.size()},
-                    {"y_count", sweep.ys_m.size()},
-                    {"yaws_deg", sweep.yaws_deg},
-                    {"poses", sweep.poses.size()},
-                    {"refined_seeds", sweep.refined.size()},
-                    {"refine_evaluations", sweep.refine_evaluations}};
-    WriteText((out / "detections.json").string(), json.dump(2) + "\n");
-    fmt::print("{} poses, {} refined, {} detection(s):\n", sweep.poses.size(), sweep.refined.size(),
-               sweep.detections.size());
-    for (const Detection& d : sweep.detections) {
-      fmt::print("  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n", d.x_m, d.y_m,
-                 d.yaw_deg, d.consistency, d.confidence);
-    }
-    return 0;
-  });
+  AddJsonOption(app, &json_path);
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        if (!x_range.empty())
+          std::tie(sweep_options.x_min_m, sweep_options.x_max_m) = ParseRange(x_range, "--x-range");
+        if (!y_range.empty())
+          std::tie(sweep_options.y_min_m, sweep_options.y_max_m) = ParseRange(y_range, "--y-range");
+        if (!yaws.empty()) sweep_options.yaws_deg = ParseYaws(yaws);
+        binder.Validate(sweep_options);
+        CheckOutputFile("--json", json_path, {}, common.scans);
+        VerifierModel model = common.PrepareTheModel(binder);
+        const std::vector<PreparedScan> scans = LoadScans(common.scans);
+        std::filesystem::create_directories(out_dir);
+        const std::filesystem::path out(out_dir);
+        const size_t poses =
+            (static_cast<size_t>(
+                 std::floor((sweep_options.x_max_m - sweep_options.x_min_m) / sweep_options.step_m + 1e-9)) +
+             1) *
+            (static_cast<size_t>(
+                 std::floor((sweep_options.y_max_m - sweep_options.y_min_m) / sweep_options.step_m + 1e-9)) +
+             1) *
+            sweep_options.yaws_deg.size();
+        auto progress = Progress::ForTerminal("sweep", static_cast<int64_t>(poses), common.quiet);
+        const SweepResult sweep = Sweep(model, scans, sweep_options, common.verify, progress.get());
+        progress->Finish();
+        WriteImage((out / "consistency.png").string(),
+                   RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",
+                                 sweep_options.min_consistency));
+        WriteImage((out / "confidence.png").string(),
+                   RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
+                                 sweep_options.min_confidence));
+        WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
+        nlohmann::json json;
+        json["detections"] = nlohmann::json::array();
+        for (const Detection& d : sweep.detections) {
+          json["detections"].push_back({{"x_m", d.x_m},
+                                        {"y_m", d.y_m},
+                                        {"z_m", d.z_m},
+                                        {"yaw_deg", d.yaw_deg},
+                                        {"consistency", d.consistency},
+                                        {"confidence", d.confidence},
+                                        {"comparable_pairs", d.comparable_pairs},
+                                        {"icp_cost", NumberOrNull(d.icp_cost_m)},
+                                        {"inlier_fraction", d.inlier_fraction},
+                                        {"world_from_model", MatrixJson(d.world_from_model)}});
+        }
+        json["thresholds"] = {{"min_consistency", sweep_options.min_consistency},
+                              {"min_confidence", sweep_options.min_confidence},
+                              {"min_comparable_pairs", sweep_options.min_comparable_pairs},
+                              {"nms_radius_m", sweep.nms_radius_m}};
+        json["grid"] = {{"x_count", sweep.xs_m.size()},
+                        {"y_count", sweep.ys_m.size()},
+                        {"yaws_deg", sweep.yaws_deg},
+                        {"poses", sweep.poses.size()},
+                        {"refined_seeds", sweep.refined.size()},
+                        {"refine_evaluations", sweep.refine_evaluations}};
+        WriteText((out / "detections.json").string(), json.dump(2) + "\n");
+        nlohmann::ordered_json result = json;
+        result["verify_options"] = ToJson(common.verify);
+        result["model_options"] = ToJson(common.model_options);
+        WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
+        if (!common.quiet) {
+          fmt::print(stderr, "{} poses, {} refined, {} detection(s):\n", sweep.poses.size(),
+                     sweep.refined.size(), sweep.detections.size());
+          for (const Detection& d : sweep.detections) {
+            fmt::print(stderr, "  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n",
+                       d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);
+          }
+        }
+        return 0;
+      },
+      &binder);
 }
 
 }  // namespace lidarshop::cli
