@@ -6,8 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
@@ -97,7 +99,8 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
-  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd) as one JSON object on stdout.", "info"};
+  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object on stdout.",
+               "info"};
   std::string path;
   bool compact = false;
   app.add_option("file", path, "scan file")->required();
@@ -126,7 +129,8 @@ int RunInfo(int argc, char** argv) {
 
 int RunConvert(int argc, char** argv) {
   CLI::App app{
-      "Convert a scan file between .ptx, .e57, .ply and .pcd, keeping the grid where the target can hold it.",
+      "Convert a scan file between .ptx, .e57, .ply, .pcd, .las, .xyz and .pts, keeping the grid where the "
+      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame).",
       "convert"};
   std::string input, output;
   int scan_index = -1;
@@ -135,8 +139,17 @@ int RunConvert(int argc, char** argv) {
   app.add_option("output", output, "scan file to write (format from the extension)")->required();
   app.add_option("--scan", scan_index, "write only scan K (from 0); PCD holds one scan");
   AddQuietFlag(app, &quiet);
-  return RunCommand(app, argc, argv, [&] {
+  LasWriteOptions las;
+  OptionBinder binder(app);
+  binder.Bind(&las, {.flags = {{"minor_version", "--las-minor-version"},
+                               {"point_format", "--las-point-format"},
+                               {"coordinate_scale_m", "--las-scale"}},
+                     .group = "LAS output"});
+  return RunCommand(
+      app, argc, argv,
+      [&] {
     CheckOutputPath(output, {input});
+    binder.Validate(las);
     const auto progress = Progress::ForTerminal("convert", 2, quiet);
     ScanFile file;
     std::vector<E57Image> images;  // E57 -> E57 keeps the photos
@@ -153,13 +166,16 @@ int RunConvert(int argc, char** argv) {
     if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
     if (e57_to_e57) {
       WriteE57(output, scans, images, E57WriteOptions{});
+    } else if (FileExtension(output) == "las") {
+      WriteLas(output, scans, las);
     } else {
       WriteScanFile(output, scans);
     }
     progress->Advance();
     progress->Finish();
     return 0;
-  });
+      },
+      &binder);
 }
 
 int RunRender(int argc, char** argv) {
