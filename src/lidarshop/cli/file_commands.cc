@@ -99,8 +99,9 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
-  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object on stdout.",
-               "info"};
+  CLI::App app{
+      "Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object on stdout.",
+      "info"};
   std::string path;
   bool compact = false;
   app.add_option("file", path, "scan file")->required();
@@ -148,32 +149,32 @@ int RunConvert(int argc, char** argv) {
   return RunCommand(
       app, argc, argv,
       [&] {
-    CheckOutputPath(output, {input});
-    binder.Validate(las);
-    const auto progress = Progress::ForTerminal("convert", 2, quiet);
-    ScanFile file;
-    std::vector<E57Image> images;  // E57 -> E57 keeps the photos
-    const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
-    if (e57_to_e57) {
-      E57File e57 = ReadE57(input);
-      file = {input, "e57", std::move(e57.scans)};
-      images = std::move(e57.images);
-    } else {
-      file = ReadScanFile(input);
-    }
-    progress->Advance();
-    std::vector<Scan> scans = file.scans;
-    if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
-    if (e57_to_e57) {
-      WriteE57(output, scans, images, E57WriteOptions{});
-    } else if (FileExtension(output) == "las") {
-      WriteLas(output, scans, las);
-    } else {
-      WriteScanFile(output, scans);
-    }
-    progress->Advance();
-    progress->Finish();
-    return 0;
+        CheckOutputPath(output, {input});
+        binder.Validate(las);
+        const auto progress = Progress::ForTerminal("convert", 2, quiet);
+        ScanFile file;
+        std::vector<E57Image> images;  // E57 -> E57 keeps the photos
+        const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
+        if (e57_to_e57) {
+          E57File e57 = ReadE57(input);
+          file = {input, "e57", std::move(e57.scans)};
+          images = std::move(e57.images);
+        } else {
+          file = ReadScanFile(input);
+        }
+        progress->Advance();
+        std::vector<Scan> scans = file.scans;
+        if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
+        if (e57_to_e57) {
+          WriteE57(output, scans, images, E57WriteOptions{});
+        } else if (FileExtension(output) == "las") {
+          WriteLas(output, scans, las);
+        } else {
+          WriteScanFile(output, scans);
+        }
+        progress->Advance();
+        progress->Finish();
+        return 0;
       },
       &binder);
 }
