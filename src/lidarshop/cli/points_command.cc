@@ -179,7 +179,8 @@ int RunPoints(int argc, char** argv) {
   int64_t count = 100000;
   uint64_t seed = 1;
   app.add_option("operation", operation, "the tool")->required();
-  app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts)")->required();
+  app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts)")
+      ->required();
   app.add_option("-o,--output", output_path, "output file; a scan format keeps the grid")->required();
   app.add_option("--json", json_path, "write a summary as JSON to FILE, or '-' for stdout");
   app.add_option("--method", method, "outliers: statistical | radius")->capture_default_str();
