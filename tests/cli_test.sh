@@ -103,12 +103,18 @@ json_check "info keys" "$work/info.json" \
 
 # convert: every format keeps every return.
 valid=$(python3 -c "import json; print(json.load(open('$work/info.json'))['scans'][0]['valid'])")
-for format in e57 ply pcd; do
+for format in e57 ply pcd las xyz pts; do
   check "convert ptx -> $format" "$lidarshop" convert "$work/scan.ptx" "$work/scan.$format" --quiet
   check "info $format" "$lidarshop" info "$work/scan.$format"
   cp "$work/last.out" "$work/info_$format.json"
   json_check "convert to $format keeps the returns" "$work/info_$format.json" "d['scans'][0]['valid'] == $valid"
 done
+check "convert ptx -> LAS 1.2 format 3" "$lidarshop" convert "$work/scan.ptx" "$work/scan12.las" \
+  --las-minor-version 2 --las-point-format 3 --quiet
+check "LAS 1.2 format 3 header" python3 -c "import sys; d=open('$work/scan12.las','rb').read(); sys.exit(not (d[25] == 2 and d[104] == 3))"
+fails_clearly "convert: LAS format 6 needs 1.4" "las-minor-version|las-point-format|1.4" \
+  "$lidarshop" convert "$work/scan.ptx" "$work/bad.las" --las-minor-version 2 --las-point-format 6
+fails_clearly "LAZ is refused" "LAZ is not supported" "$lidarshop" convert "$work/scan.ptx" "$work/scan.laz"
 check "convert e57 -> ptx" "$lidarshop" convert "$work/scan.e57" "$work/back.ptx" --quiet
 check "info back.ptx" "$lidarshop" info "$work/back.ptx"
 cp "$work/last.out" "$work/info_back.json"

@@ -27,7 +27,7 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 cp -r "$here/hostile/corpus" "$work/corpus"
 mkdir -p "$work/scratch"
-for ext in ptx ply pcd e57 json png txt; do mkfifo "$work/fifo.$ext"; done
+for ext in ptx ply pcd e57 las xyz json png txt; do mkfifo "$work/fifo.$ext"; done
 mkfifo "$work/corpus/fifo.obj" "$work/corpus/fifo.mtl"
 # Inputs of the data-safety cases.
 cp "$work/corpus/good.ptx" "$work/scratch/copy.ptx"

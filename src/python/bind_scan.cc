@@ -256,7 +256,8 @@ void BindFiles(py::module_& m) {
         return std::move(file.scans.front());
       },
       py::arg("path"), py::call_guard<py::gil_scoped_release>(),
-      "Reads the first scan of a .ptx, .e57, .ply or .pcd file. Raises InputError naming the file and "
+      "Reads the first scan of a .ptx, .e57, .ply, .pcd, .las, .xyz or .pts file. Raises InputError naming "
+      "the file and "
       "field.");
   m.def(
       "read_scans", [](const std::string& path) { return ReadScanFile(path).scans; }, py::arg("path"),
@@ -275,7 +276,8 @@ void BindFiles(py::module_& m) {
         WriteScanFile(path, list);
       },
       py::arg("scan"), py::arg("path"),
-      "Writes a scan (or a list of scans) in the format of the path's extension (.ptx, .e57, .ply, .pcd), "
+      "Writes a scan (or a list of scans) in the format of the path's extension (.ptx, .e57, .ply, .pcd, "
+      ".las, .xyz, .pts), "
       "atomically.");
   m.def(
       "read_image",

@@ -329,6 +329,51 @@ def main():
     verify('error', '{FIFO}.txt')
     verify('error', ','.join(['1'] * 200))  # 400 characters: "file name too long" must not escape (pose_fuzz)
 
+    # ---- LAS (point format 6, LAS 1.4) and XYZ / PTS
+    def las(count=24, claimed=None, record_length=30, offset_to_points=375, scale=0.001, fmt=6, minor=4, vlrs=0):
+        header = bytearray(375)
+        header[0:4] = b'LASF'
+        header[24], header[25] = 1, minor
+        struct.pack_into('<HIIBH', header, 94, 375, offset_to_points, vlrs, fmt, record_length)
+        struct.pack_into('<ddd', header, 131, scale, scale, scale)
+        struct.pack_into('<Q', header, 247, count if claimed is None else claimed)
+        body = b''.join(struct.pack('<iiiHBBBBhHd', 100 * i - 300, 5000, 10 * i, 1000 * i, 0x11, 0, 0, 0, 0, 0, 0)
+                        for i in range(count))
+        return bytes(header) + body
+    good_las = las()
+    case('las', 'ok', 'info ' + write('good.las', good_las))
+    case('las', 'error', 'info ' + write('count_2p40.las', las(claimed=1 << 40)))
+    case('las', 'error', 'info ' + write('count_short.las', las(claimed=30)))
+    case('las', 'error', 'info ' + write('count_zero.las', las(claimed=0)))
+    case('las', 'error', 'info ' + write('offset_past_end.las', las(offset_to_points=1 << 20)))
+    case('las', 'error', 'info ' + write('offset_in_header.las', las(offset_to_points=100)))
+    case('las', 'error', 'info ' + write('record_too_short.las', las(record_length=20)))
+    case('las', 'error', 'info ' + write('vlrs_past_points.las', las(vlrs=1000)))
+    case('las', 'error', 'info ' + write('scale_zero.las', las(scale=0.0)))
+    case('las', 'error', 'info ' + write('scale_huge.las', las(scale=1e6)))
+    case('las', 'error', 'info ' + write('format_11.las', las(fmt=11)))
+    case('las', 'error', 'info ' + write('laz_bits.las', las(fmt=6 | 0x80)))
+    case('las', 'error', 'info ' + write('version_1_9.las', las(minor=9)))
+    for cut in [0, 3, 100, 374, len(good_las) - 7]:
+        case('las', 'error', 'info ' + write(f'truncated_{cut}.las', good_las[:cut]))
+    las_random = random.Random(16)
+    flips('las', good_las, 10, las_random)
+    case('las', 'error', 'info ' + write('garbage.las', bytes(las_random.randrange(256) for _ in range(600))))
+    case('las', 'error', 'info ' + write('compressed.laz', good_las))
+    case('las', 'error', 'info {FIFO}.las')
+    xyz_points = ''.join(f'{0.1 * i} 5 {0.05 * i} 0.5 10 20 30\n' for i in range(24))
+    case('xyz', 'ok', 'info ' + write('good.xyz', xyz_points))
+    case('xyz', 'ok', 'info ' + write('good.pts', '24\n' + xyz_points))
+    case('xyz', 'error', 'info ' + write('count_huge.pts', '100000000000\n' + xyz_points))
+    case('xyz', 'error', 'info ' + write('count_short.pts', '30\n' + xyz_points))
+    case('xyz', 'error', 'info ' + write('columns_5.xyz', '1 2 3 4 5\n'))
+    case('xyz', 'error', 'info ' + write('columns_differ.xyz', xyz_points + '1 2 3\n'))
+    case('xyz', 'error', 'info ' + write('point_1e38.xyz', xyz_points.replace('0.0 5', '1e38 5', 1)))
+    case('xyz', 'error', 'info ' + write('color_300.xyz', xyz_points.replace('10 20 30', '10 20 300', 1)))
+    case('xyz', 'error', 'info ' + write('garbage.xyz', bytes(las_random.randrange(256) for _ in range(400))))
+    flips('xyz', xyz_points.encode(), 6, las_random)
+    case('xyz', 'error', 'info {FIFO}.xyz')
+
     # ---- options (the options layer: Check() of each command's options)
     L = base_scan
     for args in [f'render {L} -o {{W}}/r.png --min inf',

@@ -10,6 +10,7 @@
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
@@ -99,8 +100,10 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
-  CLI::App app{"Describe a scan file (.ptx, .e57, .ply, .pcd) as one JSON object (on stdout unless --json).",
-               "info"};
+  CLI::App app{
+      "Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object (on stdout "
+      "unless --json).",
+      "info"};
   std::string path, json_path = "-";
   bool compact = false;
   app.add_option("file", path, "scan file")->required();
@@ -131,7 +134,8 @@ int RunInfo(int argc, char** argv) {
 
 int RunConvert(int argc, char** argv) {
   CLI::App app{
-      "Convert a scan file between .ptx, .e57, .ply and .pcd, keeping the grid where the target can hold it.",
+      "Convert a scan file between .ptx, .e57, .ply, .pcd, .las, .xyz and .pts, keeping the grid where the "
+      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame).",
       "convert"};
   std::string input, output, json_path;
   int scan_index = -1;
@@ -144,10 +148,16 @@ int RunConvert(int argc, char** argv) {
   AddJsonOption(app, &json_path);
   binder.Bind(&e57_options, {.group = "E57 output"});
   AddQuietFlag(app, &quiet);
+  LasWriteOptions las;
+  binder.Bind(&las, {.flags = {{"minor_version", "--las-minor-version"},
+                               {"point_format", "--las-point-format"},
+                               {"coordinate_scale_m", "--las-scale"}},
+                     .group = "LAS output"});
   return RunCommand(
       app, argc, argv,
       [&] {
         binder.Validate(e57_options);
+        binder.Validate(las);
         CheckOutputPath(output, {input});
         CheckOutputFile("--json", json_path, {}, {input, output});
         const auto progress = Progress::ForTerminal("convert", 2, quiet);
@@ -166,6 +176,8 @@ int RunConvert(int argc, char** argv) {
         if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
         if (FileExtension(output) == "e57") {
           WriteE57(output, scans, images, e57_options);
+        } else if (FileExtension(output) == "las") {
+          WriteLas(output, scans, las);
         } else {
           WriteScanFile(output, scans);
         }

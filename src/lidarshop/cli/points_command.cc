@@ -234,7 +234,8 @@ int RunPoints(int argc, char** argv) {
   points.cluster.radius_m = points.radius.radius_m;
   OptionBinder binder(app);
   app.add_option("operation", operation, "the tool")->required();
-  app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd)")->required();
+  app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts)")
+      ->required();
   app.add_option("-o,--output", output_path, "output file; a scan format keeps the grid")->required();
   AddJsonOption(app, &json_path);
   app.add_option("--method", method, "outliers: statistical | radius")->capture_default_str();

@@ -35,7 +35,9 @@ int RunScan(int argc, char** argv) {
   ScanMeshOptions mesh_options;
   OptionBinder binder(app);
   app.add_option("scene", scene_path, "scene description (.json, see docs/scene-format.md)")->required();
-  app.add_option("-o,--output", output_path, "output scan: .ptx, .ply, .e57 or .pcd")->required();
+  app.add_option("-o,--output", output_path,
+                 "output scan: .ptx, .ply, .e57, .pcd (or the points alone: .las, .xyz, .pts)")
+      ->required();
   app.add_option(
       "--labels", labels_path,
       "per-ray object labels as a 16-bit single-channel PNG (65535 where the ray returned nothing)");

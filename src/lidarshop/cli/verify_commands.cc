@@ -90,7 +90,9 @@ struct CommonFlags {
   bool quiet = false;
 
   void Add(CLI::App& app, OptionBinder& binder) {
-    app.add_option("--scan", scans, "scan file (.ptx, .e57, .ply, .pcd); repeat for several registered scans")
+    app.add_option(
+           "--scan", scans,
+           "scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts); repeat for several registered scans")
         ->required();
     app.add_option("--model", model,
                    "model mesh (.obj, .ply) in its own frame, metres; or builtin:sedan|hatchback|van "

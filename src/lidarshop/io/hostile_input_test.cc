@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <chrono>
+#include <cstring>
 #include <future>
 
 #include <gmock/gmock.h>
@@ -102,6 +103,42 @@ TEST(HostileInputTest, PcdCountsMustAgreeWithTheData) {
   EXPECT_THAT(ScanError(path), HasSubstr(path));
   WriteText(path, pcd(1 << 20, 1, "0 0 5\n"));
   EXPECT_THAT(ScanError(path), HasSubstr("truncated"));
+}
+
+TEST(HostileInputTest, LasCountsMustAgreeWithTheData) {
+  TempFolder folder;
+  const std::string path = folder.File("cloud.las");
+  // A LAS 1.4 header (375 bytes), point format 6 (30-byte records), two points, scale 1 mm.
+  auto las = [](uint64_t claimed, uint32_t offset_to_points, uint16_t record_length) {
+    std::string bytes(375, '\0');
+    auto put = [&bytes](size_t at, auto value) { std::memcpy(bytes.data() + at, &value, sizeof(value)); };
+    std::memcpy(bytes.data(), "LASF", 4);
+    bytes[24] = 1;
+    bytes[25] = 4;
+    put(94, uint16_t{375});
+    put(96, offset_to_points);
+    bytes[104] = 6;
+    put(105, record_length);
+    for (int axis = 0; axis < 3; ++axis) put(131 + 8 * axis, 0.001);
+    put(247, claimed);
+    for (int i = 0; i < 2; ++i) {
+      std::string record(record_length, '\0');
+      const int32_t xyz[3] = {100 * i, 5000, 0};
+      std::memcpy(record.data(), xyz, sizeof(xyz));
+      bytes += record;
+    }
+    return bytes;
+  };
+  WriteText(path, las(2, 375, 30));
+  ASSERT_EQ(ReadScanFile(path).scans[0].CountValid(), 2);
+  // 2^40 points of 30 bytes claimed by a 435-byte file: refused before anything is allocated.
+  WriteText(path, las(uint64_t{1} << 40, 375, 30));
+  EXPECT_THAT(ScanError(path),
+              AllOf(HasSubstr(path), HasSubstr("Number of Point Records"), HasSubstr("truncated")));
+  WriteText(path, las(2, 1u << 30, 30));
+  EXPECT_THAT(ScanError(path), AllOf(HasSubstr("Offset to Point Data"), HasSubstr("1073741824")));
+  WriteText(path, las(2, 375, 12));
+  EXPECT_THAT(ScanError(path), AllOf(HasSubstr("Point Data Record Length"), HasSubstr("too short")));
 }
 
 TEST(HostileInputTest, OnlyRegularFilesAreRead) {

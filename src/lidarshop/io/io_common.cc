@@ -90,6 +90,13 @@ void FinishScan(Scan* scan, bool fit_grid) {
   if (fit_grid) FitGrid(scan);
 }
 
+Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {
+  if (low.cwiseAbs().maxCoeff() <= kCloudFloatSafeM && high.cwiseAbs().maxCoeff() <= kCloudFloatSafeM) {
+    return Eigen::Vector3d::Zero();
+  }
+  return ((low + high) / 2).array().round().matrix();
+}
+
 cv::Mat TextureToRgb8(const cv::Mat& image) {
   cv::Mat converted;
   if (image.channels() == 4) {

@@ -34,6 +34,13 @@ void CheckScanNumbers(const Scan& scan, const std::string& file, const std::stri
 // directions.
 void FinishScan(Scan* scan, bool fit_grid);
 
+// Unorganized clouds in world coordinates (LAS, XYZ) keep their points as float offsets from an origin that
+// becomes world_from_scanner's translation: (0, 0, 0) when every coordinate of the bounds [low, high] is within
+// kCloudFloatSafeM (float steps of 0.06 mm there), else the centre of the bounds rounded to a metre, so that
+// world coordinates keep 0.1 mm over clouds a few kilometres wide.
+constexpr double kCloudFloatSafeM = 1000.0;
+Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high);
+
 // An image as CV_8UC3 RGB (grey and RGBA converted, 16-bit scaled down), for mesh textures.
 cv::Mat TextureToRgb8(const cv::Mat& image);
 

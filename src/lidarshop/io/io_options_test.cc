@@ -2,6 +2,7 @@
 
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
@@ -13,11 +14,14 @@ TEST(IoOptionsInfo, ExactRoundTrips) {
   ExpectExactRoundTrip<PointViewOptions>();
   ExpectExactRoundTrip<PtxReadOptions>();
   ExpectExactRoundTrip<E57WriteOptions>();
+  ExpectExactRoundTrip<LasWriteOptions>();
 }
 
 TEST(IoOptionsInfo, Errors) {
   ExpectRejected<PointViewOptions>({{"width_px", 8}}, "width_px", "out of range [16, 16384]");
   ExpectRejected<E57WriteOptions>({{"coordinate_scale_m", -1}}, "coordinate_scale_m", "out of range >= 0");
+  ExpectRejected<LasWriteOptions>({{"point_format", 9}}, "point_format", "out of range [-1, 8]");
+  EXPECT_THROW(Validate(LasWriteOptions{.minor_version = 2, .point_format = 7}), OptionsError);
   EXPECT_EQ(ParseEnum<RenderChannel>("normals"), RenderChannel::kNormals);
   EXPECT_EQ(ToString(ColorMap::kMagma), "magma");
   EXPECT_THROW(ParseEnum<RenderChannel>("depth"), OptionsError);

@@ -182,9 +182,9 @@ TEST(MalformedInputTest, ImagesAndUnknownFormats) {
   WriteText(folder.File("bad.png"), Garbage(500, 6));
   EXPECT_THAT(InputErrorOf([&] { ReadImage(folder.File("bad.png")); }), HasSubstr(folder.File("bad.png")));
   EXPECT_THAT(InputErrorOf([&] { ReadImage(folder.File("missing.png")); }), HasSubstr("missing"));
-  WriteText(folder.File("scan.xyz"), "1 2 3\n");
-  EXPECT_THAT(ScanError(folder.File("scan.xyz")),
-              AllOf(HasSubstr("scan.xyz"), HasSubstr("unknown scan format")));
+  WriteText(folder.File("scan.asc"), "1 2 3\n");
+  EXPECT_THAT(ScanError(folder.File("scan.asc")),
+              AllOf(HasSubstr("scan.asc"), HasSubstr("unknown scan format")));
   EXPECT_THAT(ScanError(folder.File("missing.ptx")),
               AllOf(HasSubstr("missing.ptx"), HasSubstr("cannot open")));
 }
@@ -204,7 +204,7 @@ TEST(MalformedInputTest, TruncationsAndByteFlipsNeverCrash) {
     }
   }
   std::vector<std::string> paths;
-  for (const char* name : {"good.ptx", "good.ply", "good.pcd"}) {
+  for (const char* name : {"good.ptx", "good.ply", "good.pcd", "good.las", "good.xyz", "good.pts"}) {
     paths.push_back(folder.File(name));
     WriteScanFile(paths.back(), {scan});
   }

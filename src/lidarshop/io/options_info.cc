@@ -1,9 +1,13 @@
 // Descriptions of the file and picture options (util/options.h). RenderOptions is not described: its colour
 // map is optional and its bounds are NaN for "from the data" (the render command binds them by hand).
+#include <fmt/format.h>
+
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
+#include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -61,6 +65,34 @@ const StructInfo& InfoOf<E57WriteOptions>() {
         .Min(0);
     b.Field(&E57WriteOptions::write_no_return_directions, "write_no_return_directions",
             "write cells without a return as invalid points carrying their direction");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<LasWriteOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<LasWriteOptions> b("LasWriteOptions", "writing LAS");
+    b.Field(&LasWriteOptions::minor_version, "minor_version",
+            "LAS 1.x: 4 (LAS 1.4) or 2 (LAS 1.2, formats 0-3)")
+        .Range(2, 4);
+    b.Field(&LasWriteOptions::point_format, "point_format",
+            "point data record format 0-3 or 6-8; -1 = 7 (1.4) or 2 (1.2) with colour, else 6 or 0")
+        .Range(-1, 8);
+    b.Field(&LasWriteOptions::coordinate_scale_m, "coordinate_scale_m", "step of the stored coordinates")
+        .Unit("m")
+        .AboveZero()
+        .Max(1);
+    b.Check([](const LasWriteOptions& o) {
+      CheckOption(
+          o.minor_version == 2 || o.minor_version == 4,
+          fmt::format("minor_version: {} is not written; 4 (LAS 1.4) or 2 (LAS 1.2)", o.minor_version));
+      CheckOption(o.point_format != 4 && o.point_format != 5,
+                  fmt::format("point_format: {} (waveform) is not written; 0-3 or 6-8", o.point_format));
+      CheckOption(o.point_format < 6 || o.minor_version == 4,
+                  fmt::format("point_format: {} needs LAS 1.4 (minor_version 4)", o.point_format));
+    });
     return b.Build();
   }();
   return info;

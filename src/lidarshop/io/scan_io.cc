@@ -9,10 +9,12 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/io_common.h"
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/pcd.h"
 #include "lidarshop/io/ply.h"
 #include "lidarshop/io/ply_fields.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/xyz.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 
@@ -265,6 +267,30 @@ const std::vector<ScanFormat>& ScanFormats() {
          return std::move(file.scans);
        },
        &WriteE57},
+      {"las",
+       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadLas(path)}; },
+       [](const std::string& path, const std::vector<Scan>& scans) { WriteLas(path, scans); }},
+      {"laz",
+       [](const std::string& path, std::vector<std::string>*) -> std::vector<Scan> {
+         ThrowInputError(path, "", "", LazNotSupportedMessage());
+       },
+       [](const std::string& path, const std::vector<Scan>&) {
+         ThrowInputError(path, "", "", LazNotSupportedMessage());
+       }},
+      {"xyz",
+       [](const std::string& path, std::vector<std::string>*) {
+         return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz)};
+       },
+       [](const std::string& path, const std::vector<Scan>& scans) {
+         WritePointList(path, scans, PointListKind::kXyz);
+       }},
+      {"pts",
+       [](const std::string& path, std::vector<std::string>*) {
+         return std::vector<Scan>{ReadPointList(path, PointListKind::kPts)};
+       },
+       [](const std::string& path, const std::vector<Scan>& scans) {
+         WritePointList(path, scans, PointListKind::kPts);
+       }},
   };
   return formats;
 }
@@ -274,9 +300,10 @@ const ScanFormat& FormatFor(const std::string& path) {
   for (const ScanFormat& format : ScanFormats()) {
     if (extension == format.extension) return format;
   }
-  ThrowInputError(path, "", "",
-                  fmt::format("unknown scan format '{}' (lidarshop reads .ptx, .e57, .ply and .pcd)",
-                              extension.empty() ? std::string("no extension") : "." + extension));
+  ThrowInputError(
+      path, "", "",
+      fmt::format("unknown scan format '{}' (lidarshop reads .ptx, .e57, .ply, .pcd, .las, .xyz and .pts)",
+                  extension.empty() ? std::string("no extension") : "." + extension));
 }
 
 }  // namespace
@@ -325,6 +352,11 @@ void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& 
   if (extension == "ptx") {
     ThrowInputError(path, "", "", "PTX cannot hold two returns per cell; write E57, PLY or PCD");
   }
+  if (extension == "xyz" || extension == "pts") {
+    ThrowInputError(
+        path, "", "",
+        "XYZ and PTS cannot mark the synthesized layer behind the object; write E57, PLY, PCD or LAS");
+  }
   if (extension == "e57") {
     WriteE57WithLayer(path, front, behind);
     return;
@@ -332,6 +364,11 @@ void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& 
   // Points of both layers, world frame, the layer behind flagged synthesized.
   Scan flagged = behind;
   flagged.synthesized = cv::Mat(behind.rows, behind.cols, CV_8U, cv::Scalar(kValid));
+  if (extension == "las") {
+    // One cloud: the union of both layers' points, the layer behind with the synthetic flag.
+    WriteLas(path, {front, flagged});
+    return;
+  }
   if (extension == "ply") {
     // Two scans of one grid: plain PLY readers see the union of the points, lidarshop gets both layers back.
     WritePlyScans(path, {front, flagged});

@@ -5,6 +5,11 @@
 //   .ply  points with colour/normal/label/synthesized fields   read + write (a scan becomes its valid points;
 //         the grid is kept in element properties `row`/`col` when written by lidarshop)
 //   .pcd  PCL, organized clouds (ascii, binary, binary_compressed) read + write
+//   .las  ASPRS LAS 1.0-1.4, point formats 0-10 read; 1.4/1.2 formats 0-3, 6-8 written (io/las.h): one
+//         unorganized cloud in the world frame (several scans are written as one cloud, point source ID =
+//         scan index); .laz is refused ("LAZ is not supported: ...")
+//   .xyz  ASCII "x y z [intensity] [r g b]", world frame, one cloud           read + write (io/xyz.h)
+//   .pts  Leica PTS: a point count line, then as .xyz                        read + write
 //
 // Readers reject malformed input with an InputError naming the file, the line or byte offset and the field;
 // they refuse before allocating when a header claims more cells than memory allows. Writers are atomic.
@@ -19,7 +24,7 @@ namespace lidarshop {
 
 struct ScanFile {
   std::string path;
-  std::string format;       // "ptx", "e57", "ply", "pcd"
+  std::string format;       // "ptx", "e57", "ply", "pcd", "las", "xyz", "pts"
   std::vector<Scan> scans;  // several registered scans where the format allows it
   // What the reader left out or changed while reading a file it could still read, one sentence each,
   // starting with the file's path (e.g. E57 returns beyond the second). The library does not print them;
@@ -45,7 +50,9 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 //         PLY reader sees the union of both layers' points with the `synthesized` field
 //   .pcd  one unorganized cloud (HEIGHT 1, world frame) of both layers' valid points, `synthesized` 0 for
 //         measured points of `front` (or its own flags) and 1 for `behind`
+//   .las  one cloud of both layers' valid points (world frame), the layer behind with the synthetic flag
 //   .ptx  InputError: "PTX cannot hold two returns per cell; write E57, PLY or PCD"
+//   .xyz .pts  InputError: they cannot mark synthesized points
 // Throws InputError naming `path` when the layers differ in size or pose. Atomic.
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind);
 

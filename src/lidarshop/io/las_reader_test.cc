@@ -1,0 +1,287 @@
+// LAS reading: every point format read from files built here byte by byte from the specification's tables
+// (independent of las_format.h and of the writer), and the header checks of hostile and LAZ files.
+#include "lidarshop/io/las.h"
+
+#include <cstring>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <Eigen/Geometry>
+
+#include "lidarshop/io/io_test_util.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using testing::AllOf;
+using testing::HasSubstr;
+using testing_io::InputErrorOf;
+using testing_io::TempFolder;
+
+// ---- A LAS file built by hand (ASPRS LAS 1.4 R15, tables 3 and 7-16), independent of las_format.h ----
+
+struct HandPoint {
+  int32_t x = 0, y = 0, z = 0;  // in scale steps
+  uint16_t intensity = 0;
+  uint8_t classification = 0;
+  bool synthetic = false;
+  uint16_t rgb[3] = {0, 0, 0};
+};
+
+struct HandLas {
+  int minor = 4;
+  int format = 6;
+  int extra_bytes = 0;  // after each record
+  double scale = 0.001;
+  double offset[3] = {100, 200, 0};
+  std::vector<HandPoint> points;
+  std::string vlr;  // one variable length record's payload, or none
+};
+
+template <typename T>
+void Put(std::string* bytes, size_t at, T value) {
+  if (bytes->size() < at + sizeof(T)) bytes->resize(at + sizeof(T), '\0');
+  std::memcpy(bytes->data() + at, &value, sizeof(T));
+}
+
+std::string Build(const HandLas& las) {
+  const int base[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  const int record = base[las.format] + las.extra_bytes;
+  const int header = las.minor >= 4 ? 375 : las.minor == 3 ? 235 : 227;
+  const int vlr_bytes = las.vlr.empty() ? 0 : 54 + static_cast<int>(las.vlr.size());
+  std::string b(header, '\0');
+  std::memcpy(b.data(), "LASF", 4);
+  b[24] = 1;
+  b[25] = static_cast<char>(las.minor);
+  Put<uint16_t>(&b, 94, header);
+  Put<uint32_t>(&b, 96, header + vlr_bytes);
+  Put<uint32_t>(&b, 100, las.vlr.empty() ? 0 : 1);
+  b[104] = static_cast<char>(las.format);
+  Put<uint16_t>(&b, 105, record);
+  if (las.format < 6) Put<uint32_t>(&b, 107, las.points.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    Put<double>(&b, 131 + 8 * axis, las.scale);
+    Put<double>(&b, 155 + 8 * axis, las.offset[axis]);
+  }
+  if (las.minor >= 4) Put<uint64_t>(&b, 247, las.points.size());
+  if (!las.vlr.empty()) {
+    std::string v(54, '\0');
+    std::memcpy(v.data() + 2, "lidarshop_test", 14);
+    Put<uint16_t>(&v, 18, 7);
+    Put<uint16_t>(&v, 52, las.vlr.size());
+    b += v + las.vlr;
+  }
+  const bool legacy = las.format <= 5;
+  const int rgb_at = las.format == 2 ? 20 : (las.format == 3 || las.format == 5) ? 28 : 30;
+  const bool has_rgb = las.format == 2 || las.format == 3 || las.format == 5 || las.format == 7 ||
+                       las.format == 8 || las.format == 10;
+  for (const HandPoint& p : las.points) {
+    const size_t at = b.size();
+    b.resize(at + record, '\0');
+    Put<int32_t>(&b, at, p.x);
+    Put<int32_t>(&b, at + 4, p.y);
+    Put<int32_t>(&b, at + 8, p.z);
+    Put<uint16_t>(&b, at + 12, p.intensity);
+    if (legacy) {
+      b[at + 14] = 1 | (1 << 3);
+      b[at + 15] = static_cast<char>((p.classification & 31) | (p.synthetic ? 32 : 0));
+      if (las.format == 1 || las.format == 3) Put<double>(&b, at + 20, 12345.5);  // GPS time
+    } else {
+      b[at + 14] = 1 | (1 << 4);
+      b[at + 15] = p.synthetic ? 1 : 0;
+      b[at + 16] = static_cast<char>(p.classification);
+      Put<double>(&b, at + 22, 12345.5);
+    }
+    if (has_rgb) {
+      for (int c = 0; c < 3; ++c) Put<uint16_t>(&b, at + rgb_at + 2 * c, p.rgb[c]);
+    }
+    for (int i = 0; i < las.extra_bytes; ++i) b[at + base[las.format] + i] = '\x7f';
+  }
+  return b;
+}
+
+// Three points: (100.001, 200.002, 0.003), (101, 199, -1.5), (100, 200.5, 2) with scale 1 mm.
+HandLas ThreePoints(int minor, int format) {
+  HandLas las;
+  las.minor = minor;
+  las.format = format;
+  HandPoint a{1, 2, 3, 65535, 2, false, {65535, 0, 32896}};
+  HandPoint b{1000, -1000, -1500, 0, 6, true, {257, 514, 771}};
+  HandPoint c{0, 500, 2000, 32768, 0, false, {0, 65535, 0}};
+  las.points = {a, b, c};
+  return las;
+}
+
+Eigen::Vector3d WorldPoint(const Scan& scan, int row, int col) {
+  const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+  return scan.world_from_scanner.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) +
+         scan.world_from_scanner.topRightCorner<3, 1>();
+}
+
+Scan ReadBytes(const TempFolder& folder, const std::string& bytes, const std::string& name = "hand.las") {
+  const std::string path = folder.File(name);
+  testing_io::WriteText(path, bytes);
+  return ReadScanFile(path).scans.at(0);
+}
+
+TEST(LasTest, EveryPointFormatReads) {
+  TempFolder folder;
+  const std::pair<int, int> versions_formats[] = {{0, 0}, {1, 1}, {2, 2}, {2, 3}, {3, 4}, {3, 5}, {4, 0},
+                                                  {4, 3}, {4, 6}, {4, 7}, {4, 8}, {4, 9}, {4, 10}};
+  for (const auto& [minor, format] : versions_formats) {
+    SCOPED_TRACE(fmt::format("LAS 1.{} format {}", minor, format));
+    const Scan scan = ReadBytes(folder, Build(ThreePoints(minor, format)));
+    ASSERT_EQ(scan.rows, 1);
+    ASSERT_EQ(scan.cols, 3);
+    EXPECT_EQ(scan.CountValid(), 3);
+    EXPECT_TRUE(scan.world_from_scanner.isIdentity());  // within 1 km: no origin shift
+    EXPECT_LT((WorldPoint(scan, 0, 0) - Eigen::Vector3d(100.001, 200.002, 0.003)).norm(), 1e-5);
+    EXPECT_LT((WorldPoint(scan, 0, 1) - Eigen::Vector3d(101, 199, -1.5)).norm(), 1e-5);
+    EXPECT_LT((WorldPoint(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
+    EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 0), 1.0f);
+    EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 1), 0.0f);
+    EXPECT_NEAR(scan.intensity.at<float>(0, 2), 0.5f, 1e-4);
+    ASSERT_FALSE(scan.label.empty());
+    EXPECT_EQ(scan.label.at<int32_t>(0, 0), 2);
+    EXPECT_EQ(scan.label.at<int32_t>(0, 1), 6);
+    EXPECT_EQ(scan.label.at<int32_t>(0, 2), 0);
+    ASSERT_FALSE(scan.synthesized.empty());
+    EXPECT_EQ(scan.synthesized.at<uint8_t>(0, 0), 0);
+    EXPECT_EQ(scan.synthesized.at<uint8_t>(0, 1), kValid);
+    const bool rgb = format == 2 || format == 3 || format == 5 || format == 7 || format == 8 || format == 10;
+    ASSERT_EQ(scan.has_color(), rgb);
+    if (rgb) {
+      EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 0), cv::Vec3b(255, 0, 128));  // 16-bit / 257
+      EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 1), cv::Vec3b(1, 2, 3));
+      EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 2), cv::Vec3b(0, 255, 0));
+    }
+  }
+}
+
+TEST(LasTest, ExtraBytesAndRecordsAreSkipped) {
+  TempFolder folder;
+  HandLas las = ThreePoints(4, 7);
+  las.extra_bytes = 5;
+  las.vlr = std::string(40, 'v');
+  const Scan scan = ReadBytes(folder, Build(las));
+  ASSERT_EQ(scan.CountValid(), 3);
+  EXPECT_LT((WorldPoint(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
+  EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 1), cv::Vec3b(1, 2, 3));
+}
+
+TEST(LasTest, ChannelsTheFileDoesNotHoldAreAbsent) {
+  TempFolder folder;
+  HandLas las = ThreePoints(4, 7);
+  for (HandPoint& p : las.points) p = HandPoint{p.x, p.y, p.z, 0, 0, false, {p.rgb[0], 0, 0}};
+  // Colour written as 8-bit values in the 16-bit fields: taken as they are.
+  las.points[0].rgb[0] = 200;
+  las.points[1].rgb[0] = 7;
+  const Scan scan = ReadBytes(folder, Build(las));
+  EXPECT_TRUE(scan.label.empty());
+  EXPECT_TRUE(scan.synthesized.empty());
+  EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 0), 0.5f);  // no intensity: the no-information value
+  EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 0), cv::Vec3b(200, 0, 0));
+  EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 1), cv::Vec3b(7, 0, 0));
+}
+
+TEST(LasTest, FarCoordinatesKeepTenthsOfMillimetres) {
+  TempFolder folder;
+  HandLas las = ThreePoints(4, 6);
+  las.scale = 0.0001;
+  las.offset[0] = 512345;
+  las.offset[1] = 5412345;
+  las.offset[2] = 310;
+  const Scan scan = ReadBytes(folder, Build(las));
+  EXPECT_FALSE((scan.world_from_scanner.topRightCorner<3, 1>().isZero()));
+  EXPECT_LT((WorldPoint(scan, 0, 0) - Eigen::Vector3d(512345.0001, 5412345.0002, 310.0003)).norm(), 2e-5);
+  EXPECT_LT((WorldPoint(scan, 0, 1) - Eigen::Vector3d(512345.1, 5412344.9, 309.85)).norm(), 2e-5);
+}
+
+// ---- Hostile and unsupported files ----
+
+TEST(LasTest, HostileHeadersAreRefusedBeforeAllocating) {
+  TempFolder folder;
+  const std::string path = folder.File("bad.las");
+  auto error_for = [&](const std::string& bytes) {
+    testing_io::WriteText(path, bytes);
+    return InputErrorOf([&] { ReadScanFile(path); });
+  };
+  const std::string good = Build(ThreePoints(4, 6));
+  ASSERT_EQ(error_for(good), "");
+  auto with = [&](size_t at, auto value) {
+    std::string bytes = good;
+    Put(&bytes, at, value);
+    return bytes;
+  };
+  // More points than the file holds (the 64-bit count of LAS 1.4): refused, nothing allocated.
+  EXPECT_THAT(error_for(with(247, uint64_t{1} << 40)),
+              AllOf(HasSubstr(path), HasSubstr("header byte 247"), HasSubstr("Number of Point Records"),
+                    HasSubstr("truncated")));
+  EXPECT_THAT(error_for(with(247, uint64_t{4})), HasSubstr("truncated"));
+  EXPECT_THAT(error_for(good.substr(0, good.size() - 1)), HasSubstr("truncated"));
+  HandLas legacy = ThreePoints(2, 1);
+  std::string legacy_bytes = Build(legacy);
+  Put<uint32_t>(&legacy_bytes, 107, 0xFFFFFFFFu);
+  EXPECT_THAT(error_for(legacy_bytes), AllOf(HasSubstr("header byte 107"), HasSubstr("4294967295 points")));
+  EXPECT_THAT(error_for(with(247, uint64_t{0})), HasSubstr("no points"));
+  // Offset to the point data past the end, or inside the header.
+  EXPECT_THAT(error_for(with(96, uint32_t{100000})),
+              AllOf(HasSubstr("header byte 96"), HasSubstr("Offset to Point Data"), HasSubstr("100000")));
+  EXPECT_THAT(error_for(with(96, uint32_t{300})), HasSubstr("Offset to Point Data"));
+  // Record length too short for the format.
+  EXPECT_THAT(error_for(with(105, uint16_t{20})),
+              AllOf(HasSubstr("header byte 105"), HasSubstr("Point Data Record Length"),
+                    HasSubstr("too short for point format 6 (30 bytes)")));
+  EXPECT_THAT(error_for(with(104, uint8_t{11})), HasSubstr("11 does not exist"));
+  EXPECT_THAT(error_for(with(94, uint16_t{200})), HasSubstr("Header Size"));
+  EXPECT_THAT(error_for(with(25, uint8_t{5})), HasSubstr("LAS 1.5 is not read"));
+  EXPECT_THAT(error_for(with(131, 0.0)),
+              AllOf(HasSubstr("X Scale Factor"), HasSubstr("not a coordinate step")));
+  EXPECT_THAT(error_for(with(163, std::nan(""))), HasSubstr("Y Offset"));
+  EXPECT_THAT(error_for(with(171, 1e300)), HasSubstr("Z Offset"));
+  EXPECT_THAT(error_for(with(107, uint32_t{2})), HasSubstr("the legacy count says 2"));
+  EXPECT_THAT(error_for(with(100, uint32_t{1})),
+              AllOf(HasSubstr("Number of Variable Length Records"), HasSubstr("does not fit")));
+  EXPECT_THAT(error_for(good.substr(0, 200)), AllOf(HasSubstr(path), HasSubstr("truncated")));
+  EXPECT_THAT(error_for("PK\x03\x04 not a las file at all"), HasSubstr("not a LAS file"));
+  EXPECT_THAT(error_for(""), HasSubstr("empty"));
+  // A coordinate beyond 10^7 m.
+  HandLas far = ThreePoints(4, 6);
+  far.scale = 1e6;
+  EXPECT_THAT(error_for(Build(far)),
+              AllOf(HasSubstr("point 1 (byte 405)"), HasSubstr("field 'X'"), HasSubstr("within")));
+  HandLas with_vlr = ThreePoints(4, 6);
+  with_vlr.vlr = "abc";
+  std::string vlr_bytes = Build(with_vlr);
+  Put<uint16_t>(&vlr_bytes, 375 + 52, 5000);
+  EXPECT_THAT(error_for(vlr_bytes), AllOf(HasSubstr("VLR Record Length After Header"), HasSubstr("past")));
+}
+
+TEST(LasTest, LazIsRefusedWithTheReason) {
+  TempFolder folder;
+  const std::string laz = folder.File("x.laz");
+  testing_io::WriteText(laz, Build(ThreePoints(4, 6)));
+  EXPECT_THAT(InputErrorOf([&] { ReadScanFile(laz); }),
+              AllOf(HasSubstr(laz), HasSubstr("LAZ is not supported")));
+  EXPECT_THAT(InputErrorOf([&] { WriteScanFile(laz, {ReadBytes(folder, Build(ThreePoints(4, 6)))}); }),
+              HasSubstr("LAZ is not supported"));
+  // LASzip marks compressed point formats with bits 7 and 6, and adds its VLR.
+  std::string bytes = Build(ThreePoints(4, 6));
+  bytes[104] = static_cast<char>(6 | 0x80);
+  EXPECT_THAT(InputErrorOf([&] { ReadBytes(folder, bytes); }), HasSubstr("LAZ is not supported"));
+  HandLas with_vlr = ThreePoints(4, 6);
+  with_vlr.vlr = std::string(34, '\0');
+  bytes = Build(with_vlr);
+  std::memcpy(bytes.data() + 375 + 2, "laszip encoded\0\0", 16);
+  Put<uint16_t>(&bytes, 375 + 18, 22204);
+  EXPECT_THAT(InputErrorOf([&] { ReadBytes(folder, bytes); }),
+              AllOf(HasSubstr("byte 375"), HasSubstr("LAZ is not supported")));
+}
+
+}  // namespace
+}  // namespace lidarshop

@@ -1,0 +1,209 @@
+#include "lidarshop/io/xyz.h"
+
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "lidarshop/geometry/transform.h"
+#include "lidarshop/io/io_common.h"
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/text_cursor.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+using io_internal::TextCursor;
+
+// The shortest point line, "0 0 0\n": bounds a PTS count by the bytes that follow it.
+constexpr int64_t kShortestLineBytes = 6;
+
+// Blank-separated tokens on the line starting at `p`.
+int CountTokens(const char* p, const char* end) {
+  int tokens = 0;
+  bool inside = false;
+  for (; p < end && *p != '\n'; ++p) {
+    const bool blank = TextCursor::IsSpace(*p);
+    if (!blank && !inside) ++tokens;
+    inside = !blank;
+  }
+  return tokens;
+}
+
+struct PointList {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> intensities;  // empty without an intensity column
+  std::vector<cv::Vec3b> colors;    // empty without colour columns
+};
+
+PointList ParseLines(const std::string& bytes, const std::string& file, PointListKind kind) {
+  PointList list;
+  TextCursor cursor(bytes, file);
+  int columns = 0;
+  int64_t block_left = 0, block_size = 0, block_line = 0;
+  const char* end = bytes.data() + bytes.size();
+  for (;;) {
+    cursor.SkipEmptyLines();
+    if (cursor.AtEnd()) break;
+    cursor.SkipBlanks();
+    const std::string_view rest(cursor.position(), std::min<int64_t>(cursor.remaining(), 2));
+    if (kind == PointListKind::kXyz && (rest.substr(0, 1) == "#" || rest == "//")) {
+      cursor.NextLine();
+      continue;
+    }
+    if (kind == PointListKind::kPts && block_left == 0) {
+      block_line = cursor.line();
+      block_size = cursor.Int("point count");
+      if (block_size <= 0)
+        cursor.Fail("point count", fmt::format("{} is not a number of points", block_size));
+      cursor.EndLine("the point count");
+      if (block_size > cursor.remaining() / kShortestLineBytes + 1) {
+        ThrowInputError(file, fmt::format("line {}", block_line), "point count",
+                        fmt::format("truncated: {} points claimed, only {} bytes follow", block_size,
+                                    cursor.remaining()));
+      }
+      block_left = block_size;
+      continue;
+    }
+    if (columns == 0) {
+      columns = CountTokens(cursor.position(), end);
+      if (columns != 3 && columns != 4 && columns != 6 && columns != 7) {
+        cursor.Fail("columns",
+                    fmt::format("{} numbers on the first point line; expected x y z [intensity] [r g "
+                                "b] (3, 4, 6 or 7)",
+                                columns));
+      }
+    }
+    Eigen::Vector3d p;
+    p.x() = cursor.Double("x");
+    p.y() = cursor.Double("y");
+    p.z() = cursor.Double("z");
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(std::abs(p[axis]) <= kMaxCoordinateM)) {
+        cursor.Fail(std::string(1, "xyz"[axis]),
+                    fmt::format("{} is not a coordinate within {} m", p[axis], kMaxCoordinateM));
+      }
+    }
+    list.points.push_back(p);
+    if (columns == 4 || columns == 7) list.intensities.push_back(cursor.Double("intensity"));
+    if (columns >= 6) {
+      cv::Vec3b color;
+      for (int c = 0; c < 3; ++c) {
+        const char* name = c == 0 ? "red" : c == 1 ? "green" : "blue";
+        const int64_t value = cursor.Int(name);
+        if (value < 0 || value > 255) cursor.Fail(name, fmt::format("{} is not in 0-255", value));
+        color[c] = static_cast<uint8_t>(value);
+      }
+      list.colors.push_back(color);
+    }
+    if (!cursor.AtEndOfLine()) {
+      cursor.Fail("columns", fmt::format("more than the {} numbers of the first point line", columns));
+    }
+    cursor.NextLine();
+    if (kind == PointListKind::kPts) --block_left;
+  }
+  if (block_left > 0) {
+    ThrowInputError(
+        file, fmt::format("line {}", block_line), "point count",
+        fmt::format("truncated: {} points claimed, found {}", block_size, block_size - block_left));
+  }
+  if (list.points.empty()) ThrowInputError(file, "", "", "no points");
+  return list;
+}
+
+// Intensities as [0, 1] (see xyz.h).
+void NormalizeIntensities(std::vector<double>* intensities, PointListKind kind) {
+  const auto [lowest, highest] = std::minmax_element(intensities->begin(), intensities->end());
+  double low = std::min(0.0, *lowest), high = std::max(1.0, *highest);
+  if (kind == PointListKind::kPts && *lowest >= -2048 && *highest <= 2047) low = -2048, high = 2047;
+  for (double& value : *intensities) value = (value - low) / (high - low);
+}
+
+}  // namespace
+
+Scan ParsePointList(const std::string& bytes, const std::string& file, PointListKind kind) {
+  if (bytes.empty()) ThrowInputError(file, "line 1", "", "the file is empty");
+  // Every point takes a line: the line count bounds what the lists and the scan may take.
+  const int64_t lines = std::count(bytes.begin(), bytes.end(), '\n') + 1;
+  io_internal::CheckScanSize(1, std::min<int64_t>(lines, kMaxScanCells + 1), file, "lines");
+  PointList list = ParseLines(bytes, file, kind);
+  const int count = static_cast<int>(list.points.size());
+  if (!list.intensities.empty()) NormalizeIntensities(&list.intensities, kind);
+
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (const Eigen::Vector3d& p : list.points) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  const Eigen::Vector3d origin = io_internal::CloudOrigin(low, high);
+  Scan scan = MakeScan(1, count, !list.colors.empty());
+  scan.world_from_scanner.topRightCorner<3, 1>() = origin;
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3f p = (list.points[i] - origin).cast<float>();
+    if (p.isZero()) continue;  // no ray from the origin
+    scan.valid.at<uint8_t>(0, i) = kValid;
+    scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
+    if (!list.intensities.empty()) scan.intensity.at<float>(0, i) = static_cast<float>(list.intensities[i]);
+    if (!list.colors.empty()) scan.color.at<cv::Vec3b>(0, i) = list.colors[i];
+  }
+  io_internal::FinishScan(&scan, /*fit_grid=*/false);
+  return scan;
+}
+
+Scan ReadPointList(const std::string& path, PointListKind kind) {
+  return ParsePointList(io_internal::ReadFileToString(path), path, kind);
+}
+
+void WritePointList(const std::string& path, const std::vector<Scan>& scans, PointListKind kind) {
+  int64_t count = 0, synthesized = 0;
+  bool color = false;
+  for (const Scan& scan : scans) {
+    CheckScan(scan);
+    count += scan.CountValid();
+    color |= scan.has_color();
+    if (!scan.synthesized.empty()) synthesized += cv::countNonZero(scan.synthesized & scan.valid);
+  }
+  const char* name = kind == PointListKind::kPts ? "PTS" : "XYZ";
+  if (synthesized > 0) {
+    ThrowInputError(
+        path, "", "synthesized",
+        fmt::format("{} cannot mark synthesized points ({} of them); write .las, .ply, .pcd or .e57", name,
+                    synthesized));
+  }
+  if (count == 0) ThrowInputError(path, "", "", "no point with a return to write");
+  std::string out;
+  out.reserve(static_cast<size_t>(count) * (color ? 56 : 44));
+  auto sink = std::back_inserter(out);
+  if (kind == PointListKind::kPts) fmt::format_to(sink, "{}\n", count);
+  for (const Scan& scan : scans) {
+    const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+    const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 0; col < scan.cols; ++col) {
+        if (!scan.valid.at<uint8_t>(row, col)) continue;
+        const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+        const Eigen::Vector3d world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+        fmt::format_to(sink, "{:.5f} {:.5f} {:.5f} ", world.x(), world.y(), world.z());
+        const float intensity = scan.intensity.at<float>(row, col);
+        if (kind == PointListKind::kPts) {
+          fmt::format_to(sink, "{}", std::lround(std::clamp(intensity, 0.0f, 1.0f) * 4095.0f) - 2048);
+        } else {
+          io_internal::AppendNumber(&out, intensity);
+        }
+        if (color) {
+          const cv::Vec3b c = scan.has_color() ? scan.color.at<cv::Vec3b>(row, col) : cv::Vec3b(0, 0, 0);
+          fmt::format_to(sink, " {} {} {}", c[0], c[1], c[2]);
+        }
+        out += '\n';
+      }
+    }
+  }
+  WriteFileAtomically(path, [&](std::ostream& stream) { stream.write(out.data(), out.size()); });
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,38 @@
+// ASCII point lists: XYZ (`.xyz`) and Leica PTS (`.pts`), one point per line, world coordinates:
+//
+//   x y z [intensity] [r g b]      3, 4, 6 or 7 numbers, separated by blanks (the first data line decides;
+//                                  every line must have as many)
+//
+// PTS starts with a line holding the number of points that follow; several such blocks may follow each other
+// (Leica writes one per scan) and are read as one cloud. Lines starting with '#' or '//' are comments (XYZ
+// only); empty lines are skipped.
+//
+// Reading gives one 1 x N scan in file order, points kept as float offsets from an origin
+// (io_common.h CloudOrigin: (0, 0, 0) for clouds within 1 km, so UTM coordinates keep 0.1 mm). A point exactly
+// at that origin has no ray and is left out. Intensity: PTS uses Leica's integer range -2048..2047, read as
+// (i + 2048) / 4095 (a PTS file with values outside that range is read as XYZ); XYZ intensities are kept when all lie in [0, 1], else mapped linearly from
+// [min(0, lowest), max(1, highest)] to [0, 1] (0-255 files become i / 255). Without an intensity column the
+// scan has the no-information intensity 0.5. Colour is 0-255 per channel. Errors name the file, the line and
+// the column.
+//
+// Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm), then the intensity (XYZ:
+// the shortest decimal that reads back to the same float; PTS: round(i * 4095) - 2048) and, when a scan has
+// colour, r g b (0 0 0 for a scan without). These formats cannot mark synthesized points, so a scan with any
+// synthesized valid point is refused (write LAS, PLY, PCD or E57). Atomic.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+enum class PointListKind { kXyz, kPts };
+
+Scan ReadPointList(const std::string& path, PointListKind kind);
+Scan ParsePointList(const std::string& bytes, const std::string& file, PointListKind kind);
+
+void WritePointList(const std::string& path, const std::vector<Scan>& scans, PointListKind kind);
+
+}  // namespace lidarshop
