@@ -62,8 +62,9 @@ void Commit(Document& document, Snapshot next, int undo_depth);
 nlohmann::ordered_json JobJson(const Job& job);
 // Starts `run` on the document as a job of `kind`; answers 202 with the job's JSON, or 503 (and returns null)
 // when too many are queued.
-std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document, const std::string& kind,
-                              std::function<nlohmann::ordered_json(Progress&)> run, httplib::Response& response);
+std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document,
+                              const std::string& kind, std::function<nlohmann::ordered_json(Progress&)> run,
+                              httplib::Response& response);
 
 // A POST route on a document: finds it (404), parses the body as a JSON object (400), then runs `handler`;
 // OptionsError becomes 400 and InputError 422, each with its one-line message.

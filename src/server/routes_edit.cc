@@ -198,8 +198,9 @@ nlohmann::ordered_json JobJson(const Job& job) {
   return json;
 }
 
-std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document, const std::string& kind,
-                              std::function<nlohmann::ordered_json(Progress&)> run, httplib::Response& response) {
+std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document,
+                              const std::string& kind, std::function<nlohmann::ordered_json(Progress&)> run,
+                              httplib::Response& response) {
   auto job = std::make_shared<Job>();
   job->id = state.runner->NextId();
   job->document = document->id;

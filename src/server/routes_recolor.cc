@@ -34,10 +34,11 @@ cv::Mat* PhotoSlot(Document& document, const httplib::Request& request, httplib:
 Correspondences ParsePairs(const nlohmann::json& body, PairKind kind, const Scan* scan) {
   if (!body.contains("pairs") || !body["pairs"].is_array() || body["pairs"].size() > 10000)
     throw OptionsFieldError("pairs", "expected a list of at most 10000 pairs");
-  Correspondences pairs = ParseCorrespondences(nlohmann::json{{"pairs", body["pairs"]}}.dump(), "pairs", scan);
+  Correspondences pairs =
+      ParseCorrespondences(nlohmann::json{{"pairs", body["pairs"]}}.dump(), "pairs", scan);
   if (pairs.size() > 0 && pairs.kind != kind) {
-    throw OptionsFieldError("pairs", fmt::format("{} pairs here; expected {} pairs", ToString(pairs.kind),
-                                                 ToString(kind)));
+    throw OptionsFieldError(
+        "pairs", fmt::format("{} pairs here; expected {} pairs", ToString(pairs.kind), ToString(kind)));
   }
   return pairs;
 }
@@ -184,7 +185,8 @@ void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohma
   if (model != "homography" && model != "fundamental")
     throw OptionsFieldError("model", "expected \"homography\" or \"fundamental\"");
   const double threshold_px = body.value("threshold_px", 3.0);
-  if (!(threshold_px > 0 && threshold_px <= 1000)) throw OptionsFieldError("threshold_px", "out of range (0, 1000]");
+  if (!(threshold_px > 0 && threshold_px <= 1000))
+    throw OptionsFieldError("threshold_px", "out of range (0, 1000]");
   std::lock_guard lock(document->mutex);
   if (document->photo.empty() || document->photo_b.empty())
     return SendError(response, 400, "upload both photos first (POST .../photo and .../photo?slot=b)");

@@ -76,57 +76,58 @@ std::shared_ptr<Job> FillingJob(State& state, const std::shared_ptr<Document>& d
   job->document = document->id;
   job->kind = "review";
   job->run = [document, review, start, undo_depth](Progress& progress) {
-        // Whatever ends the job (a review point, the end, an error, a cancel), the session is idle after it;
-        // an error or a cancel closes the review.
-        auto finish = [&](bool keep) {
-          std::lock_guard lock(document->mutex);
-          review->job = nullptr;
-          if (!keep && document->review == review) document->review = nullptr;
-        };
-        bool complete = false;
-        try {
-          progress.Restart("inpaint", 1);
-          if (!review->session) {
-            review->session = std::make_unique<InpaintSession>(ChannelImage(start.scan, review->channel),
-                                                               review->hole, review->options);
-          }
-          review->session->SetProgress(&progress);
-          complete = review->session->Run();
-          review->session->SetProgress(nullptr);
-        } catch (...) {
-          if (review->session) review->session->SetProgress(nullptr);
-          finish(false);
-          throw;
-        }
-        if (!complete) {
-          const InpaintReview& pending = *review->session->pending_review();
-          nlohmann::ordered_json json = {{"state", "review"},
-                                         {"review_point", pending.review_point},
-                                         {"target", {pending.target.row, pending.target.col}},
-                                         {"candidates", pending.candidates.size()},
-                                         {"clusters", pending.cluster_representative.size()}};
-          finish(true);
-          return json;
-        }
-        const InpaintResult result = review->session->Result();
-        std::lock_guard lock(document->mutex);
-        review->job = nullptr;
-        if (document->review == review) document->review = nullptr;
-        Snapshot next = document->now;
-        next.scan = WithChannel(document->now.scan, review->channel, result.image, review->hole);
-        Commit(*document, std::move(next), undo_depth);
-        return nlohmann::ordered_json{{"state", "done"},
-                                      {"channel", review->channel},
-                                      {"decisions", DecisionsToJson(review->session->decisions())},
-                                      {"summary", result.Summary()},
-                                      {"version", document->version}};
+    // Whatever ends the job (a review point, the end, an error, a cancel), the session is idle after it;
+    // an error or a cancel closes the review.
+    auto finish = [&](bool keep) {
+      std::lock_guard lock(document->mutex);
+      review->job = nullptr;
+      if (!keep && document->review == review) document->review = nullptr;
+    };
+    bool complete = false;
+    try {
+      progress.Restart("inpaint", 1);
+      if (!review->session) {
+        review->session = std::make_unique<InpaintSession>(ChannelImage(start.scan, review->channel),
+                                                           review->hole, review->options);
+      }
+      review->session->SetProgress(&progress);
+      complete = review->session->Run();
+      review->session->SetProgress(nullptr);
+    } catch (...) {
+      if (review->session) review->session->SetProgress(nullptr);
+      finish(false);
+      throw;
+    }
+    if (!complete) {
+      const InpaintReview& pending = *review->session->pending_review();
+      nlohmann::ordered_json json = {{"state", "review"},
+                                     {"review_point", pending.review_point},
+                                     {"target", {pending.target.row, pending.target.col}},
+                                     {"candidates", pending.candidates.size()},
+                                     {"clusters", pending.cluster_representative.size()}};
+      finish(true);
+      return json;
+    }
+    const InpaintResult result = review->session->Result();
+    std::lock_guard lock(document->mutex);
+    review->job = nullptr;
+    if (document->review == review) document->review = nullptr;
+    Snapshot next = document->now;
+    next.scan = WithChannel(document->now.scan, review->channel, result.image, review->hole);
+    Commit(*document, std::move(next), undo_depth);
+    return nlohmann::ordered_json{{"state", "done"},
+                                  {"channel", review->channel},
+                                  {"decisions", DecisionsToJson(review->session->decisions())},
+                                  {"summary", result.Summary()},
+                                  {"version", document->version}};
   };
   return job;
 }
 
 // Submits the review's job (answers 202), or closes the review and answers 503.
-void Submit(State& state, const std::shared_ptr<Document>& document, const std::shared_ptr<ReviewSession>& review,
-            const std::shared_ptr<Job>& job, httplib::Response& response) {
+void Submit(State& state, const std::shared_ptr<Document>& document,
+            const std::shared_ptr<ReviewSession>& review, const std::shared_ptr<Job>& job,
+            httplib::Response& response) {
   if (state.runner->Submit(job)) return SendJson(response, JobJson(*job), 202);
   std::lock_guard lock(document->mutex);
   review->job = nullptr;
@@ -209,17 +210,20 @@ void Decide(State& state, const std::shared_ptr<Document>& document, const nlohm
       source = pending->candidates[index.get<size_t>()].source;
     } else {
       const nlohmann::json& cell = body.at("source");
-      if (!cell.is_array() || cell.size() != 2 || !cell[0].is_number_integer() || !cell[1].is_number_integer())
-        throw OptionsFieldError("source", fmt::format("expected [row, col] whole numbers, got {}", cell.dump()));
+      if (!cell.is_array() || cell.size() != 2 || !cell[0].is_number_integer() ||
+          !cell[1].is_number_integer())
+        throw OptionsFieldError("source",
+                                fmt::format("expected [row, col] whole numbers, got {}", cell.dump()));
       source = {cell[0].get<int>(), cell[1].get<int>()};
     }
     try {
       review->session->Decide(source);
     } catch (const InputError& error) {
       // A hand-placed patch that is not wholly known, or outside the scan: the user's mistake, not the file's.
-      throw OptionsFieldError("source", fmt::format("({}, {}) is not the centre of a patch wholly outside the "
-                                                    "hole and inside the scan ({})",
-                                                    source.row, source.col, error.what()));
+      throw OptionsFieldError("source",
+                              fmt::format("({}, {}) is not the centre of a patch wholly outside the "
+                                          "hole and inside the scan ({})",
+                                          source.row, source.col, error.what()));
     }
     review->job = FillingJob(state, document, review, document->now);
     job = review->job;
@@ -251,20 +255,20 @@ void AddReviewRoutes(State& state) {
            });
   // The pixels: the fill so far (`canvas`, candidates are cut from it) or with the best candidate pasted
   // (`tentative`), 8-bit, the ray image's size and orientation.
-  http.Get(R"(/api/docs/(\d+)/inpaint/review/image.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             const std::string layer =
-                 request.has_param("layer") ? request.get_param_value("layer") : std::string("canvas");
-             if (layer != "canvas" && layer != "tentative")
-               return SendError(response, 400, fmt::format("layer '{}': expected canvas or tentative", layer));
-             std::lock_guard lock(document->mutex);
-             auto review = IdleReview(*document, response);
-             if (!review) return;
-             SendPng(response, Display(layer == "tentative" ? review->session->pending_review()->tentative_image
-                                                            : review->session->Result().image));
-           });
+  http.Get(R"(/api/docs/(\d+)/inpaint/review/image.png)", [&state](const httplib::Request& request,
+                                                                   httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    const std::string layer =
+        request.has_param("layer") ? request.get_param_value("layer") : std::string("canvas");
+    if (layer != "canvas" && layer != "tentative")
+      return SendError(response, 400, fmt::format("layer '{}': expected canvas or tentative", layer));
+    std::lock_guard lock(document->mutex);
+    auto review = IdleReview(*document, response);
+    if (!review) return;
+    SendPng(response, Display(layer == "tentative" ? review->session->pending_review()->tentative_image
+                                                   : review->session->Result().image));
+  });
   http.Delete(R"(/api/docs/(\d+)/inpaint/review)",
               [&state](const httplib::Request& request, httplib::Response& response) {
                 auto document = state.FindDocument(request, response);

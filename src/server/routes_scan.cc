@@ -234,7 +234,8 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
   const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
   const std::vector<std::string> formats = SupportedScanWriteExtensions();
   if (std::find(formats.begin(), formats.end(), format) == formats.end()) {
-    SendError(response, 400, fmt::format("format '{}': expected one of {}", format, fmt::join(formats, ", ")));
+    SendError(response, 400,
+              fmt::format("format '{}': expected one of {}", format, fmt::join(formats, ", ")));
     return;
   }
   const fs::path folder = fs::temp_directory_path() / fmt::format("lidarshop-save-{}", getpid());

@@ -12,11 +12,11 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/photo.h"
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include "lidarshop/testing/scenes.h"
 // After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
 #include <httplib.h>
@@ -305,7 +305,8 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   const int id = OpenBox();
   const std::string recolor = Api(fmt::format("/api/docs/{}/recolor", id));
   EXPECT_EQ(client_->Post(recolor, R"({"pairs": []})", "application/json")->status, 400);  // no photo yet
-  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), "not an image", "image/png")->status, 422);
+  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), "not an image", "image/png")->status,
+            422);
   // A photo of the same scene from beside the scanner, and pairs of scan cells with their true pixels.
   lidarshop::test_scenes::GroundAndBoxOptions scene;
   const PinholeCamera camera = CameraLookingAt({1.0, 0.5, 1.7}, {0, 8, 0.5}, 320, 240, 60);
@@ -314,8 +315,8 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   cv::cvtColor(photo.image, bgr, cv::COLOR_RGB2BGR);
   std::vector<uint8_t> png;
   cv::imencode(".png", bgr, png);
-  const auto uploaded =
-      client_->Post(Api(fmt::format("/api/docs/{}/photo", id)), std::string(png.begin(), png.end()), "image/png");
+  const auto uploaded = client_->Post(Api(fmt::format("/api/docs/{}/photo", id)),
+                                      std::string(png.begin(), png.end()), "image/png");
   ASSERT_EQ(uploaded->status, 200) << uploaded->body;
   EXPECT_EQ(Json(uploaded)["width_px"], 320);
   nlohmann::json pairs = nlohmann::json::array();
@@ -330,9 +331,11 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
     }
   }
   ASSERT_GE(pairs.size(), 12u);
-  EXPECT_EQ(client_->Post(recolor, R"({"pairs": [{"pixel": [1, 1], "cell": [0, 9999]}]})", "application/json")->status,
+  EXPECT_EQ(client_->Post(recolor, R"({"pairs": [{"pixel": [1, 1], "cell": [0, 9999]}]})", "application/json")
+                ->status,
             400);
-  const auto done = Wait(Json(client_->Post(recolor, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")));
+  const auto done =
+      Wait(Json(client_->Post(recolor, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")));
   ASSERT_EQ(done["state"], "done") << done.dump();
   EXPECT_LT(done["result"]["rms_px"].get<double>(), 1.0) << done.dump();
   EXPECT_GT(done["result"]["recolored_count"].get<int>(), 100) << done.dump();
@@ -347,7 +350,8 @@ TEST_F(ServerTest, SaveOffersTheLibrarysWriteFormats) {
   }
   const int id = OpenBox();
   for (const auto& format : formats["write"]) {
-    const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format={}", id, format.get<std::string>())));
+    const auto saved =
+        client_->Get(Api(fmt::format("/api/docs/{}/save?format={}", id, format.get<std::string>())));
     EXPECT_EQ(saved->status, 200) << format;
     EXPECT_GT(saved->body.size(), 1000u) << format;
   }
@@ -364,7 +368,8 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
   const int id = OpenBox();
   const std::string review = Api(fmt::format("/api/docs/{}/inpaint/review", id));
   const std::string decide = Api(fmt::format("/api/docs/{}/inpaint/review/decide", id));
-  EXPECT_EQ(client_->Post(fmt::format("/api/docs/{}/inpaint/review", id), "{}", "application/json")->status, 401);
+  EXPECT_EQ(client_->Post(fmt::format("/api/docs/{}/inpaint/review", id), "{}", "application/json")->status,
+            401);
   const auto no_hole = client_->Post(review, "{}", "application/json");
   EXPECT_EQ(no_hole->status, 400);
   EXPECT_NE(Json(no_hole)["error"].get<std::string>().find("paint a hole first"), std::string::npos);
@@ -397,11 +402,14 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
   EXPECT_FALSE(first["review"]["candidates"][0]["test"].get<std::string>().empty());
   EXPECT_GE(first["review"]["clusters"].size(), 1u);
   const int target_row = first["review"]["target"][0], target_col = first["review"]["target"][1];
-  EXPECT_TRUE(target_row >= 38 && target_row <= 57 && target_col >= 8 && target_col <= 32) << first["review"]["target"];
+  EXPECT_TRUE(target_row >= 38 && target_row <= 57 && target_col >= 8 && target_col <= 32)
+      << first["review"]["target"];
   for (const char* layer : {"canvas", "tentative"}) {
-    const auto png = client_->Get(Api(fmt::format("/api/docs/{}/inpaint/review/image.png?layer={}", id, layer)));
+    const auto png =
+        client_->Get(Api(fmt::format("/api/docs/{}/inpaint/review/image.png?layer={}", id, layer)));
     ASSERT_EQ(png->status, 200) << layer;
-    const cv::Mat image = cv::imdecode(std::vector<uint8_t>(png->body.begin(), png->body.end()), cv::IMREAD_COLOR);
+    const cv::Mat image =
+        cv::imdecode(std::vector<uint8_t>(png->body.begin(), png->body.end()), cv::IMREAD_COLOR);
     EXPECT_EQ(image.rows, scan_->rows);
     EXPECT_EQ(image.cols, scan_->cols);
   }
@@ -409,12 +417,14 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
 
   // Bad decisions: 400 with a message, and the review stays where it was.
   EXPECT_EQ(client_->Post(decide, R"({"candidate": 30})", "application/json")->status, 400);
-  EXPECT_EQ(client_->Post(decide, R"({"candidate": 1, "source": [10, 60]})", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(decide, R"({"candidate": 1, "source": [10, 60]})", "application/json")->status,
+            400);
   const auto outside = client_->Post(decide, R"({"source": [0, 0]})", "application/json");
   EXPECT_EQ(outside->status, 400);
   EXPECT_NE(Json(outside)["error"].get<std::string>().find("(0, 0) is not the centre"), std::string::npos)
       << outside->body;
-  EXPECT_EQ(client_->Post(decide, R"({"source": [45, 20]})", "application/json")->status, 400);  // in the hole
+  EXPECT_EQ(client_->Post(decide, R"({"source": [45, 20]})", "application/json")->status,
+            400);  // in the hole
   EXPECT_EQ(Json(client_->Get(review))["review"]["review_point"], 0);
 
   // Accept candidate 2: the fill goes on to the next review point with that decision recorded.
@@ -439,8 +449,8 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
   // Without acceptance nothing stops: the fill runs to its end and is one undoable edit of the colours in the
   // hole; every other cell keeps its colour.
   const Scan before = ReadScanFile((base_ / "root" / "sub" / "box.ptx").string()).scans[0];
-  const auto finished = Wait(Json(client_->Post(
-      review, R"({"options": {"acceptance": {"enabled": false}}})", "application/json")));
+  const auto finished = Wait(
+      Json(client_->Post(review, R"({"options": {"acceptance": {"enabled": false}}})", "application/json")));
   ASSERT_EQ(finished["state"], "done") << finished.dump();
   ASSERT_EQ(finished["result"]["state"], "done") << finished.dump();
   EXPECT_EQ(finished["result"]["version"].get<int64_t>(), version + 1);
@@ -478,17 +488,22 @@ TEST_F(ServerTest, LandmarksRegisterOneScanToAnother) {
   ASSERT_GE(pairs.size(), 6u);
   const std::string align = Api(fmt::format("/api/docs/{}/align", moved));
   EXPECT_EQ(client_->Post(align, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")->status, 400);
-  EXPECT_EQ(client_->Post(align, nlohmann::json{{"target", moved}, {"pairs", pairs}}.dump(), "application/json")->status,
-            400);
-  EXPECT_EQ(client_->Post(align, nlohmann::json{{"target", 9999}, {"pairs", pairs}}.dump(), "application/json")->status,
-            404);
+  EXPECT_EQ(
+      client_->Post(align, nlohmann::json{{"target", moved}, {"pairs", pairs}}.dump(), "application/json")
+          ->status,
+      400);
+  EXPECT_EQ(
+      client_->Post(align, nlohmann::json{{"target", 9999}, {"pairs", pairs}}.dump(), "application/json")
+          ->status,
+      404);
   EXPECT_EQ(client_
                 ->Post(align, nlohmann::json{{"target", box}, {"pairs", pairs}, {"with_scale", true}}.dump(),
                        "application/json")
                 ->status,
             400);
   const nlohmann::json two = nlohmann::json::array({pairs[0], pairs[1]});
-  EXPECT_EQ(client_->Post(align, nlohmann::json{{"target", box}, {"pairs", two}}.dump(), "application/json")->status,
+  EXPECT_EQ(client_->Post(align, nlohmann::json{{"target", box}, {"pairs", two}}.dump(), "application/json")
+                ->status,
             400);
   const auto sky = client_->Post(
       align, nlohmann::json{{"target", box}, {"pairs", {{{"cell", {0, 0}}, {"target_cell", {0, 0}}}}}}.dump(),
@@ -501,18 +516,21 @@ TEST_F(ServerTest, LandmarksRegisterOneScanToAnother) {
   ASSERT_EQ(similarity->status, 200) << similarity->body;
   EXPECT_NEAR(Json(similarity)["scale"].get<double>(), 1.0, 1e-6);
   EXPECT_FALSE(Json(similarity)["applied"]);
-  const auto fitted = client_->Post(align, nlohmann::json{{"target", box}, {"pairs", pairs}}.dump(), "application/json");
+  const auto fitted =
+      client_->Post(align, nlohmann::json{{"target", box}, {"pairs", pairs}}.dump(), "application/json");
   ASSERT_EQ(fitted->status, 200) << fitted->body;
   EXPECT_LT(Json(fitted)["rms_m"].get<double>(), 1e-4);
   // The moved scan's pose is the box scan's again: T undid the move.
-  const auto pose = Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
+  const auto pose =
+      Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
   for (int k = 0; k < 16; ++k)
     EXPECT_NEAR(pose[k].get<double>(), scan_->world_from_scanner.data()[k], 1e-4) << k;
   const Eigen::Matrix4d expected_t = MovedPose().inverse();
   const auto t = Json(fitted)["target_from_source_column_major"];
   for (int k = 0; k < 16; ++k) EXPECT_NEAR(t[k].get<double>(), expected_t.data()[k], 1e-4) << k;
   ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", moved)), "", "application/json")->status, 200);
-  const auto undone = Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
+  const auto undone =
+      Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
   const Eigen::Matrix4d moved_pose = MovedPose() * scan_->world_from_scanner;
   for (int k = 0; k < 16; ++k) EXPECT_NEAR(undone[k].get<double>(), moved_pose.data()[k], 1e-6) << k;
 }
@@ -541,8 +559,8 @@ TEST_F(ServerTest, PhotoPairsGiveAHomography) {
   for (double x = -3; x <= 3; x += 1.5) {
     for (double y = 5; y <= 12; y += 2.5) {
       Eigen::Vector2d pa, pb;
-      if (!ProjectWorldPoint(a, {x, y, 0}, &pa) || !InsideImage(a, pa) || !ProjectWorldPoint(b, {x, y, 0}, &pb) ||
-          !InsideImage(b, pb))
+      if (!ProjectWorldPoint(a, {x, y, 0}, &pa) || !InsideImage(a, pa) ||
+          !ProjectWorldPoint(b, {x, y, 0}, &pb) || !InsideImage(b, pb))
         continue;
       pairs.push_back({{"pixel_a", {pa.x(), pa.y()}}, {"pixel_b", {pb.x(), pb.y()}}});
     }
@@ -571,19 +589,21 @@ TEST_F(ServerTest, PhotoPairsGiveAHomography) {
       match, nlohmann::json{{"pairs", general}, {"model", "fundamental"}}.dump(), "application/json");
   ASSERT_EQ(fundamental->status, 200) << fundamental->body;
   EXPECT_LT(Json(fundamental)["rms_px"].get<double>(), 0.1) << fundamental->body;
-  EXPECT_EQ(client_->Post(match, nlohmann::json{{"pairs", pairs}, {"model", "affine"}}.dump(), "application/json")
-                ->status,
-            400);
+  EXPECT_EQ(
+      client_->Post(match, nlohmann::json{{"pairs", pairs}, {"model", "affine"}}.dump(), "application/json")
+          ->status,
+      400);
   const nlohmann::json three = nlohmann::json::array({pairs[0], pairs[1], pairs[2]});
   EXPECT_EQ(client_->Post(match, nlohmann::json{{"pairs", three}}.dump(), "application/json")->status, 400);
-  const auto outside = client_->Post(
-      match, R"({"pairs": [{"pixel_a": [1, 1], "pixel_b": [500, 1]}])", "application/json");
+  const auto outside =
+      client_->Post(match, R"({"pairs": [{"pixel_a": [1, 1], "pixel_b": [500, 1]}])", "application/json");
   EXPECT_EQ(outside->status, 400);
   EXPECT_NE(Json(outside)["error"].get<std::string>().find("outside the 300 x 200 photo"), std::string::npos)
       << outside->body;
   // The kinds do not mix across routes: photo pairs are not resection pairs.
-  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/recolor", id)), nlohmann::json{{"pairs", pairs}}.dump(),
-                          "application/json")
+  EXPECT_EQ(client_
+                ->Post(Api(fmt::format("/api/docs/{}/recolor", id)), nlohmann::json{{"pairs", pairs}}.dump(),
+                       "application/json")
                 ->status,
             400);
 }

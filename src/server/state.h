@@ -70,7 +70,7 @@ struct Document {
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
   cv::Mat photo;                    // CV_8UC3 RGB: the photo to recolour from (empty = none)
-  cv::Mat photo_b;  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
+  cv::Mat photo_b;                  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
   std::shared_ptr<ReviewSession> review;  // the inpainting review in progress (null = none)
   int64_t prepared_version = -1;
   std::mutex mutex;  // guards every field above

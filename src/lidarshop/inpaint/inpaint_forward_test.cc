@@ -208,7 +208,8 @@ TEST(InpaintForward, SessionStretchesReportToTheirOwnProgress) {
     }
     EXPECT_EQ(members, review.candidates.size());
     session.Decide(review.candidates[1].source);  // the decision's pixels count towards no stretch
-    filled += w * w - cv::countNonZero(review.known(cv::Rect(review.target.col - R, review.target.row - R, w, w)));
+    filled +=
+        w * w - cv::countNonZero(review.known(cv::Rect(review.target.col - R, review.target.row - R, w, w)));
     ASSERT_LT(++stops, 50);
   }
   EXPECT_GT(stops, 0);

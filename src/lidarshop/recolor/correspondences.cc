@@ -33,8 +33,9 @@ Eigen::Vector3d CellPoint(const Scan* scan, const Eigen::Vector2d& cell, const s
   if (!scan) ThrowInputError(what, place, "cell", "scan cells need a scan (--scan SCAN)");
   const int row = static_cast<int>(cell.x()), col = static_cast<int>(cell.y());
   if (row != cell.x() || col != cell.y())
-    ThrowInputError(what, place, "cell", fmt::format("[{}, {}] is not a cell of the {} x {} scan", cell.x(),
-                                                     cell.y(), scan->rows, scan->cols));
+    ThrowInputError(what, place, "cell",
+                    fmt::format("[{}, {}] is not a cell of the {} x {} scan", cell.x(), cell.y(), scan->rows,
+                                scan->cols));
   return WorldPointOfCell(*scan, row, col, what, place);
 }
 
@@ -92,8 +93,9 @@ Correspondences ParseCorrespondences(const std::string& json_text, const std::st
 Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col, const std::string& what,
                                  const std::string& place) {
   if (row < 0 || col < 0 || row >= scan.rows || col >= scan.cols)
-    ThrowInputError(what, place, "cell",
-                    fmt::format("[{}, {}] is not a cell of the {} x {} scan", row, col, scan.rows, scan.cols));
+    ThrowInputError(
+        what, place, "cell",
+        fmt::format("[{}, {}] is not a cell of the {} x {} scan", row, col, scan.rows, scan.cols));
   if (!scan.valid.at<uint8_t>(row, col))
     ThrowInputError(what, place, "cell", fmt::format("[{}, {}] has no return", row, col));
   const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
