@@ -221,6 +221,10 @@ void AddRecolorRoutes(State& state) {
             [&state](const httplib::Request& request, httplib::Response& response) {
               auto document = state.FindDocument(request, response);
               if (!document) return;
+              {
+                std::lock_guard lock(document->mutex);
+                if (!PhotoSlot(*document, request, response)) return;  // 400 for an unknown slot
+              }
               const std::vector<uint8_t> bytes(request.body.begin(), request.body.end());
               cv::Mat decoded;
               try {

@@ -111,7 +111,8 @@ std::shared_ptr<Job> FillingJob(State& state, const std::shared_ptr<Document>& d
     const InpaintResult result = review->session->Result();
     std::lock_guard lock(document->mutex);
     review->job = nullptr;
-    if (document->review == review) document->review = nullptr;
+    if (document->review != review) return nlohmann::ordered_json{{"state", "stopped"}};  // dropped meanwhile
+    document->review = nullptr;
     Snapshot next = document->now;
     next.scan = WithChannel(document->now.scan, review->channel, result.image, review->hole);
     Commit(*document, std::move(next), undo_depth);
@@ -135,13 +136,24 @@ void Submit(State& state, const std::shared_ptr<Document>& document,
   SendError(response, 503, "too many operations queued; try again");
 }
 
+// Whether a job is filling the review (queued or running). A job cancelled before it ran never cleared its
+// mark: that review is over.
+bool Filling(const ReviewSession& review) {
+  if (!review.job) return false;
+  const JobState job = review.job->state;
+  return job == JobState::kQueued || job == JobState::kRunning || job == JobState::kDone;
+}
+
 // The document's review when it is idle; nullptr after answering 404 (none) or 409 (a job is filling).
 std::shared_ptr<ReviewSession> IdleReview(Document& document, httplib::Response& response) {
+  if (document.review && !Filling(*document.review)) {
+    if (document.review->job) document.review = nullptr;  // its job was cancelled or failed before running
+  }
   if (!document.review) {
     SendError(response, 404, "no review in progress: start one (POST .../inpaint/review)");
     return nullptr;
   }
-  if (document.review->job) {
+  if (Filling(*document.review)) {
     SendError(response, 409,
               fmt::format("the review is filling (job {}); wait for it to stop", document.review->job->id));
     return nullptr;
@@ -165,7 +177,7 @@ void Start(State& state, const std::shared_ptr<Document>& document, const nlohma
   Snapshot start;
   {
     std::lock_guard lock(document->mutex);
-    if (document->review && document->review->job)
+    if (document->review && Filling(*document->review))
       return SendError(response, 409, "a review is filling on this scan; cancel it or wait");
     start = document->now;
     const cv::Mat& mask = which == "painted" ? start.hole : start.object_mask;

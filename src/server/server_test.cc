@@ -357,7 +357,10 @@ TEST_F(ServerTest, SaveOffersTheLibrarysWriteFormats) {
   }
   const auto refused = client_->Get(Api(fmt::format("/api/docs/{}/save?format=xyz", id)));
   EXPECT_EQ(refused->status, 400);
-  EXPECT_NE(Json(refused)["error"].get<std::string>().find("expected one of e57"), std::string::npos)
+  // The message lists the library's formats (whatever they are when a writer is added).
+  EXPECT_NE(Json(refused)["error"].get<std::string>().find(
+                fmt::format("expected one of {}", formats["write"][0].get<std::string>())),
+            std::string::npos)
       << refused->body;
   EXPECT_EQ(client_->Get("/api/formats")->status, 401);
 }
@@ -465,7 +468,8 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
   cv::Mat changed;
   cv::Mat difference;
   cv::absdiff(after.color, before.color, difference);
-  cv::reduce((difference > 0).reshape(1, before.rows * before.cols), changed, 1, cv::REDUCE_MAX);
+  const cv::Mat differs = difference > 0;
+  cv::reduce(differs.reshape(1, before.rows * before.cols), changed, 1, cv::REDUCE_MAX);
   changed = changed.reshape(1, before.rows);
   EXPECT_GT(cv::countNonZero(changed & hole), 20);
   EXPECT_EQ(cv::countNonZero(changed & ~hole), 0);
@@ -596,7 +600,7 @@ TEST_F(ServerTest, PhotoPairsGiveAHomography) {
   const nlohmann::json three = nlohmann::json::array({pairs[0], pairs[1], pairs[2]});
   EXPECT_EQ(client_->Post(match, nlohmann::json{{"pairs", three}}.dump(), "application/json")->status, 400);
   const auto outside =
-      client_->Post(match, R"({"pairs": [{"pixel_a": [1, 1], "pixel_b": [500, 1]}])", "application/json");
+      client_->Post(match, R"({"pairs": [{"pixel_a": [1, 1], "pixel_b": [500, 1]}]})", "application/json");
   EXPECT_EQ(outside->status, 400);
   EXPECT_NE(Json(outside)["error"].get<std::string>().find("outside the 300 x 200 photo"), std::string::npos)
       << outside->body;
