@@ -52,6 +52,26 @@ void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, i
 // The request body as a JSON object; nullopt after answering 400.
 std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response);
 
+// The PNG of an 8-bit RGB (3 channels) or grey image as the answer.
+void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
+
+// Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
+// Caller holds document.mutex.
+void Commit(Document& document, Snapshot next, int undo_depth);
+// A job's JSON form (GET /api/jobs/ID).
+nlohmann::ordered_json JobJson(const Job& job);
+// Starts `run` on the document as a job of `kind`; answers 202 with the job's JSON, or 503 (and returns null)
+// when too many are queued.
+std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document,
+                              const std::string& kind, std::function<nlohmann::ordered_json(Progress&)> run,
+                              httplib::Response& response);
+
+// A POST route on a document: finds it (404), parses the body as a JSON object (400), then runs `handler`;
+// OptionsError becomes 400 and InputError 422, each with its one-line message.
+using DocumentHandler =
+    std::function<void(State&, const std::shared_ptr<Document>&, const nlohmann::json&, httplib::Response&)>;
+void PostDocument(State& state, const std::string& pattern, DocumentHandler handler);
+
 // A path given by a client, resolved against the roots: the canonical path when it lies inside one (after
 // following symlinks), else empty. `..` components are refused before any lookup.
 std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::string& requested);
@@ -60,6 +80,7 @@ std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::
 void AddScanRoutes(State& state);     // routes_scan.cc: open, list, pictures, points, save
 void AddEditRoutes(State& state);     // routes_edit.cc: strokes, segment, remove, fill, undo, jobs
 void AddVerifyRoutes(State& state);   // routes_verify.cc: models, pose verification
-void AddRecolorRoutes(State& state);  // routes_recolor.cc: photo, resection, recolouring
+void AddRecolorRoutes(State& state);  // routes_recolor.cc: photos, the three kinds of correspondences
+void AddReviewRoutes(State& state);   // routes_review.cc: inpainting with the patch review
 
 }  // namespace lidarshop::server

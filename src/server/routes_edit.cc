@@ -14,15 +14,6 @@ namespace lidarshop::server {
 
 namespace {
 
-// Replaces the document's state with `next`, keeping the old one for undo. Caller holds document.mutex.
-void Commit(Document& document, Snapshot next, int undo_depth) {
-  document.undo.push_back(std::move(document.now));
-  if (static_cast<int>(document.undo.size()) > undo_depth) document.undo.erase(document.undo.begin());
-  document.redo.clear();
-  document.now = std::move(next);
-  ++document.version;
-}
-
 // Cells [[row, col], ...] of `json[key]` painted with `value` as discs of `radius` into `strokes`.
 void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int radius, cv::Mat& strokes) {
   if (!json.contains(key)) return;
@@ -52,35 +43,6 @@ void FillPolygon(const nlohmann::json& json, const char* key, cv::Mat& mask) {
   for (const auto& cell : json.at(key)) polygon.emplace_back(cell[1].get<int>(), cell[0].get<int>());
   if (polygon.size() < 3) throw OptionsFieldError(key, "a lasso needs at least 3 cells");
   cv::fillPoly(mask, std::vector<std::vector<cv::Point>>{polygon}, cv::Scalar(255));
-}
-
-nlohmann::ordered_json JobJson(const Job& job) {
-  nlohmann::ordered_json json = {{"id", job.id},
-                                 {"kind", job.kind},
-                                 {"document", job.document},
-                                 {"state", ToString(job.state.load())},
-                                 {"label", job.progress.label()},
-                                 {"done", job.progress.done()},
-                                 {"total", job.progress.total()}};
-  std::lock_guard lock(const_cast<std::mutex&>(job.mutex));
-  if (!job.error.empty()) json["error"] = job.error;
-  if (!job.result.is_null()) json["result"] = job.result;
-  return json;
-}
-
-// Starts `run` on the document as a job and answers 202 with the job's JSON (503 when too many are queued).
-void StartJob(State& state, const std::shared_ptr<Document>& document, const std::string& kind,
-              std::function<nlohmann::ordered_json(Progress&)> run, httplib::Response& response) {
-  auto job = std::make_shared<Job>();
-  job->id = state.runner->NextId();
-  job->document = document->id;
-  job->kind = kind;
-  job->run = std::move(run);
-  if (!state.runner->Submit(job)) {
-    SendError(response, 503, "too many operations queued; try again");
-    return;
-  }
-  SendJson(response, JobJson(*job), 202);
 }
 
 template <class Options>
@@ -212,9 +174,47 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
       response);
 }
 
+}  // namespace
+
+void Commit(Document& document, Snapshot next, int undo_depth) {
+  document.undo.push_back(std::move(document.now));
+  if (static_cast<int>(document.undo.size()) > undo_depth) document.undo.erase(document.undo.begin());
+  document.redo.clear();
+  document.now = std::move(next);
+  ++document.version;
+}
+
+nlohmann::ordered_json JobJson(const Job& job) {
+  nlohmann::ordered_json json = {{"id", job.id},
+                                 {"kind", job.kind},
+                                 {"document", job.document},
+                                 {"state", ToString(job.state.load())},
+                                 {"label", job.progress.label()},
+                                 {"done", job.progress.done()},
+                                 {"total", job.progress.total()}};
+  std::lock_guard lock(const_cast<std::mutex&>(job.mutex));
+  if (!job.error.empty()) json["error"] = job.error;
+  if (!job.result.is_null()) json["result"] = job.result;
+  return json;
+}
+
+std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document,
+                              const std::string& kind, std::function<nlohmann::ordered_json(Progress&)> run,
+                              httplib::Response& response) {
+  auto job = std::make_shared<Job>();
+  job->id = state.runner->NextId();
+  job->document = document->id;
+  job->kind = kind;
+  job->run = std::move(run);
+  if (!state.runner->Submit(job)) {
+    SendError(response, 503, "too many operations queued; try again");
+    return nullptr;
+  }
+  SendJson(response, JobJson(*job), 202);
+  return job;
+}
+
 // Wraps a document route: finds the document, parses the body, answers 400 for option errors.
-using DocumentHandler =
-    std::function<void(State&, const std::shared_ptr<Document>&, const nlohmann::json&, httplib::Response&)>;
 void PostDocument(State& state, const std::string& pattern, DocumentHandler handler) {
   state.http.Post(pattern, [&state, handler](const httplib::Request& request, httplib::Response& response) {
     auto document = state.FindDocument(request, response);
@@ -230,8 +230,6 @@ void PostDocument(State& state, const std::string& pattern, DocumentHandler hand
     }
   });
 }
-
-}  // namespace
 
 void AddEditRoutes(State& state) {
   PostDocument(

@@ -1,10 +1,16 @@
-// Routes that recolour a scan from a photo (recolor/, thesis 3.2): upload the photo, pick pixel <-> cell pairs,
-// resection the camera and project the photo's colours onto the points it sees (docs/api.md).
+// Routes for the three kinds of correspondences of the thesis's selection tool (3.2.1, recolor/; docs/api.md):
+//   photo <-> scan   pixel <-> cell or point: resection, then occlusion-aware recolouring (an edit)
+//   scan <-> scan    landmark cells in two open scans: a rigid transform (Umeyama) that registers this scan
+//                    to the other (an edit of its pose), or a similarity reported only
+//   photo <-> photo  pixel pairs between the photo and a second one: a homography or fundamental matrix
+//                    with per-pair errors (the scan does not change)
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/recolor/align.h"
+#include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
 #include "lidarshop/util/error.h"
@@ -14,91 +20,63 @@ namespace lidarshop::server {
 
 namespace {
 
-// One pair {"pixel": [x, y], "cell": [row, col]} as a pixel and the cell's point in the world frame.
-PixelPointPair PairOf(const nlohmann::json& pair, const Scan& scan, const cv::Mat& photo, size_t index) {
-  const std::string key = fmt::format("pairs[{}]", index);
-  if (!pair.is_object() || !pair.contains("pixel") || !pair.contains("cell") || pair["pixel"].size() != 2 ||
-      pair["cell"].size() != 2 || !pair["pixel"][0].is_number() || !pair["pixel"][1].is_number() ||
-      !pair["cell"][0].is_number_integer() || !pair["cell"][1].is_number_integer()) {
-    throw OptionsFieldError(key, "expected {\"pixel\": [x, y], \"cell\": [row, col]}");
-  }
-  const double x = pair["pixel"][0], y = pair["pixel"][1];
-  const int row = pair["cell"][0], col = pair["cell"][1];
-  if (!(x >= 0 && y >= 0 && x < photo.cols && y < photo.rows)) {
-    throw OptionsFieldError(
-        key, fmt::format("pixel ({}, {}) is outside the {} x {} photo", x, y, photo.cols, photo.rows));
-  }
-  if (row < 0 || col < 0 || row >= scan.rows || col >= scan.cols || scan.valid.at<uint8_t>(row, col) == 0) {
-    throw OptionsFieldError(key, fmt::format("cell [{}, {}] has no return", row, col));
-  }
-  const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
-  const Eigen::Vector4d world = scan.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1.0);
-  return {Eigen::Vector2d(x, y), world.head<3>()};
+// ?slot=a (the photo to recolour from, the default) or ?slot=b (the second photo of photo <-> photo pairs).
+cv::Mat* PhotoSlot(Document& document, const httplib::Request& request, httplib::Response& response) {
+  const std::string slot = request.has_param("slot") ? request.get_param_value("slot") : std::string("a");
+  if (slot == "a") return &document.photo;
+  if (slot == "b") return &document.photo_b;
+  SendError(response, 400, fmt::format("slot '{}': expected a or b", slot));
+  return nullptr;
 }
 
-}  // namespace
+// The pairs of `body` through the library's correspondence parser (recolor/correspondences.h): every pair
+// names its kind by its keys; all must be of `kind`.
+Correspondences ParsePairs(const nlohmann::json& body, PairKind kind, const Scan* scan) {
+  if (!body.contains("pairs") || !body["pairs"].is_array() || body["pairs"].size() > 10000)
+    throw OptionsFieldError("pairs", "expected a list of at most 10000 pairs");
+  Correspondences pairs =
+      ParseCorrespondences(nlohmann::json{{"pairs", body["pairs"]}}.dump(), "pairs", scan);
+  if (pairs.size() > 0 && pairs.kind != kind) {
+    throw OptionsFieldError(
+        "pairs", fmt::format("{} pairs here; expected {} pairs", ToString(pairs.kind), ToString(kind)));
+  }
+  return pairs;
+}
 
-void AddRecolorRoutes(State& state) {
-  httplib::Server& http = state.http;
-  // The photo as the request body (PNG or JPEG bytes); kept with the document.
-  http.Post(R"(/api/docs/(\d+)/photo)",
-            [&state](const httplib::Request& request, httplib::Response& response) {
-              auto document = state.FindDocument(request, response);
-              if (!document) return;
-              const std::vector<uint8_t> bytes(request.body.begin(), request.body.end());
-              cv::Mat decoded;
-              try {
-                decoded = cv::imdecode(bytes, cv::IMREAD_COLOR);
-              } catch (const cv::Exception& error) {
-                return SendError(response, 422, fmt::format("the photo does not decode: {}", error.err));
-              }
-              if (decoded.empty()) return SendError(response, 422, "the photo is not a PNG or JPEG image");
-              cv::Mat rgb;
-              cv::cvtColor(decoded, rgb, cv::COLOR_BGR2RGB);
-              std::lock_guard lock(document->mutex);
-              document->photo = rgb;
-              SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
-            });
-  http.Get(R"(/api/docs/(\d+)/photo.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             std::lock_guard lock(document->mutex);
-             if (document->photo.empty()) return SendError(response, 404, "no photo uploaded for this scan");
-             cv::Mat bgr;
-             cv::cvtColor(document->photo, bgr, cv::COLOR_RGB2BGR);
-             std::vector<uint8_t> png;
-             cv::imencode(".png", bgr, png);
-             response.set_content(std::string(png.begin(), png.end()), "image/png");
-           });
-  // Resection from the pairs, then occlusion-aware recolouring; an undoable edit (a job).
-  http.Post(R"(/api/docs/(\d+)/recolor)", [&state](const httplib::Request& request,
-                                                   httplib::Response& response) {
-    auto document = state.FindDocument(request, response);
-    if (!document) return;
-    const auto body = BodyJson(request, response);
-    if (!body) return;
+void CheckInside(const Eigen::Vector2d& pixel, const cv::Mat& photo, const std::string& key) {
+  if (!(pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() < photo.cols && pixel.y() < photo.rows)) {
+    throw OptionsFieldError(key, fmt::format("pixel ({}, {}) is outside the {} x {} photo", pixel.x(),
+                                             pixel.y(), photo.cols, photo.rows));
+  }
+}
+
+// Photo <-> scan: resection from the pairs, then occlusion-aware recolouring; an undoable edit (a job).
+void Recolor(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+             httplib::Response& response) {
+  std::vector<PixelPointPair> pairs;
+  ResectionOptions resection;
+  {
+    std::lock_guard lock(document->mutex);
+    if (document->photo.empty()) return SendError(response, 400, "upload a photo first (POST .../photo)");
     try {
-      std::vector<PixelPointPair> pairs;
-      ResectionOptions resection;
-      {
-        std::lock_guard lock(document->mutex);
-        if (document->photo.empty()) return SendError(response, 400, "upload a photo first (POST .../photo)");
-        const nlohmann::json list = body->value("pairs", nlohmann::json::array());
-        if (!list.is_array() || list.size() > 10000)
-          throw OptionsFieldError("pairs", "expected a list of pairs");
-        for (size_t i = 0; i < list.size(); ++i)
-          pairs.push_back(PairOf(list[i], document->now.scan, document->photo, i));
-        resection.width_px = document->photo.cols;
-        resection.height_px = document->photo.rows;
-      }
-      CheckResectionInput(pairs, resection.degenerate_ratio, "pairs");
-      const int undo_depth = state.options.undo_depth;
-      auto job = std::make_shared<Job>();
-      job->id = state.runner->NextId();
-      job->document = document->id;
-      job->kind = "recolor";
-      job->run = [document, pairs, resection, undo_depth](Progress& progress) {
+      pairs = ParsePairs(body, PairKind::kPixelPoint, &document->now.scan).pixel_point;
+    } catch (const InputError& error) {
+      throw OptionsError(error.what());  // a bad cell or pair is the request's fault: 400
+    }
+    for (size_t i = 0; i < pairs.size(); ++i)
+      CheckInside(pairs[i].pixel_px, document->photo, fmt::format("pairs[{}]", i));
+    resection.width_px = document->photo.cols;
+    resection.height_px = document->photo.rows;
+  }
+  try {
+    CheckResectionInput(pairs, resection.degenerate_ratio, "pairs");
+  } catch (const InputError& error) {
+    throw OptionsError(error.what());  // pairs that cannot determine a camera
+  }
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "recolor",
+      [document, pairs, resection, undo_depth](Progress& progress) {
         Snapshot start;
         cv::Mat photo;
         {
@@ -114,32 +92,168 @@ void AddRecolorRoutes(State& state) {
         std::lock_guard lock(document->mutex);
         Snapshot next = document->now;
         next.scan = recolored.scan;
-        document->undo.push_back(std::move(document->now));
-        if (static_cast<int>(document->undo.size()) > undo_depth)
-          document->undo.erase(document->undo.begin());
-        document->redo.clear();
-        document->now = std::move(next);
-        ++document->version;
+        Commit(*document, std::move(next), undo_depth);
         return nlohmann::ordered_json{{"inliers", camera.num_inliers},
                                       {"pairs", pairs.size()},
                                       {"rms_px", camera.rms_px},
                                       {"reprojection_error_px", camera.reprojection_error_px},
+                                      {"inlier", camera.inlier},
                                       {"recolored_count", recolored.recolored_count},
                                       {"hidden", recolored.hidden},
                                       {"outside_image", recolored.outside_image},
                                       {"summary", camera.Summary() + "; " + recolored.Summary()},
                                       {"version", document->version}};
-      };
-      if (!state.runner->Submit(job))
-        return SendError(response, 503, "too many operations queued; try again");
-      SendJson(response,
-               {{"id", job->id}, {"kind", job->kind}, {"document", job->document}, {"state", "queued"}}, 202);
-    } catch (const OptionsError& error) {
-      SendError(response, 400, error.what());
-    } catch (const InputError& error) {
-      SendError(response, 400, error.what());  // pairs that cannot determine a camera
+      },
+      response);
+}
+
+// A cell [row, col] of `pair[key]`, whole numbers.
+std::pair<int, int> CellOf(const nlohmann::json& pair, const char* key, const std::string& place) {
+  const auto it = pair.find(key);
+  if (it == pair.end() || !it->is_array() || it->size() != 2 || !(*it)[0].is_number_integer() ||
+      !(*it)[1].is_number_integer()) {
+    throw OptionsFieldError(place + "." + key, "expected [row, col] whole numbers");
+  }
+  return {(*it)[0].get<int>(), (*it)[1].get<int>()};
+}
+
+// Scan <-> scan: landmark cells in this scan and in another open one; Umeyama's fit. With "apply" (default)
+// and no scale, this scan's pose becomes target_from_source · world_from_scanner: it is registered to the
+// other (an undoable edit).
+void Align(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+           httplib::Response& response) {
+  if (!body.contains("target") || !body["target"].is_number_integer())
+    throw OptionsFieldError("target", "expected the id of another open scan");
+  const int target_id = body["target"].get<int>();
+  if (target_id == document->id) throw OptionsFieldError("target", "align to another open scan, not itself");
+  std::shared_ptr<Document> target;
+  {
+    std::lock_guard lock(state.documents_mutex);
+    const auto found = state.documents.find(target_id);
+    if (found != state.documents.end()) target = found->second;
+  }
+  if (!target) return SendError(response, 404, fmt::format("no open scan {}", target_id));
+  const bool with_scale = body.value("with_scale", false);
+  const bool apply = body.value("apply", true);
+  if (with_scale && apply)
+    throw OptionsFieldError("apply", "a scaled transform cannot be a scanner pose; send \"apply\": false");
+  const nlohmann::json list = body.value("pairs", nlohmann::json::array());
+  if (!list.is_array() || list.size() > 10000) throw OptionsFieldError("pairs", "expected a list of pairs");
+  std::vector<PointPair> pairs(list.size());
+  try {
+    {
+      std::lock_guard lock(target->mutex);
+      for (size_t i = 0; i < list.size(); ++i) {
+        const std::string place = fmt::format("pairs[{}]", i);
+        const auto [row, col] = CellOf(list[i], "target_cell", place);
+        pairs[i].target = WorldPointOfCell(target->now.scan, row, col, "target scan", place);
+      }
     }
-  });
+    std::lock_guard lock(document->mutex);
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string place = fmt::format("pairs[{}]", i);
+      const auto [row, col] = CellOf(list[i], "cell", place);
+      pairs[i].source = WorldPointOfCell(document->now.scan, row, col, "this scan", place);
+    }
+    const LandmarkAlignment fit = AlignLandmarks(pairs, with_scale, "pairs");
+    const Eigen::Matrix4d& t = fit.target_from_source;
+    nlohmann::ordered_json json = {
+        {"model", with_scale ? "similarity" : "rigid"},
+        {"target_from_source_column_major", std::vector<double>(t.data(), t.data() + 16)},
+        {"scale", fit.scale},
+        {"rms_m", fit.rms_m},
+        {"residual_m", fit.residual_m},
+        {"applied", apply}};
+    if (apply) {
+      Snapshot next = document->now;
+      next.scan.world_from_scanner = t * document->now.scan.world_from_scanner;
+      next.behind.world_from_scanner = next.scan.world_from_scanner;  // the second layer shares the pose
+      Commit(*document, std::move(next), state.options.undo_depth);
+    }
+    json["version"] = document->version;
+    SendJson(response, json);
+  } catch (const InputError& error) {
+    throw OptionsError(error.what());  // cells without a return, too few or collinear landmarks
+  }
+}
+
+// Photo <-> photo: pixel_a in the photo, pixel_b in the second photo; a homography (>= 4 pairs) or a
+// fundamental matrix (>= 8) by RANSAC, answered at once.
+void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+                 httplib::Response& response) {
+  const std::string model = body.value("model", std::string("homography"));
+  if (model != "homography" && model != "fundamental")
+    throw OptionsFieldError("model", "expected \"homography\" or \"fundamental\"");
+  const double threshold_px = body.value("threshold_px", 3.0);
+  if (!(threshold_px > 0 && threshold_px <= 1000))
+    throw OptionsFieldError("threshold_px", "out of range (0, 1000]");
+  std::lock_guard lock(document->mutex);
+  if (document->photo.empty() || document->photo_b.empty())
+    return SendError(response, 400, "upload both photos first (POST .../photo and .../photo?slot=b)");
+  try {
+    const Correspondences pairs = ParsePairs(body, PairKind::kPixelPixel, nullptr);
+    for (size_t i = 0; i < pairs.pixel_pixel.size(); ++i) {
+      CheckInside(pairs.pixel_pixel[i].pixel_a, document->photo, fmt::format("pairs[{}].pixel_a", i));
+      CheckInside(pairs.pixel_pixel[i].pixel_b, document->photo_b, fmt::format("pairs[{}].pixel_b", i));
+    }
+    const PhotoPairModel fit = model == "fundamental"
+                                   ? EstimateFundamental(pairs.pixel_pixel, threshold_px, "pairs")
+                                   : EstimateHomography(pairs.pixel_pixel, threshold_px, "pairs");
+    std::vector<double> rows;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) rows.push_back(fit.matrix(r, c));
+    SendJson(response, {{"model", model},
+                        {"matrix_row_major", rows},
+                        {"rms_px", fit.rms_px},
+                        {"error_px", fit.error_px},
+                        {"inlier", fit.inlier}});
+  } catch (const InputError& error) {
+    throw OptionsError(error.what());  // too few pairs, no model found
+  }
+}
+
+}  // namespace
+
+void AddRecolorRoutes(State& state) {
+  httplib::Server& http = state.http;
+  // A photo as the request body (PNG or JPEG bytes); kept with the document.
+  http.Post(R"(/api/docs/(\d+)/photo)",
+            [&state](const httplib::Request& request, httplib::Response& response) {
+              auto document = state.FindDocument(request, response);
+              if (!document) return;
+              {
+                std::lock_guard lock(document->mutex);
+                if (!PhotoSlot(*document, request, response)) return;  // 400 for an unknown slot
+              }
+              const std::vector<uint8_t> bytes(request.body.begin(), request.body.end());
+              cv::Mat decoded;
+              try {
+                decoded = cv::imdecode(bytes, cv::IMREAD_COLOR);
+              } catch (const cv::Exception& error) {
+                return SendError(response, 422, fmt::format("the photo does not decode: {}", error.err));
+              }
+              if (decoded.empty()) return SendError(response, 422, "the photo is not a PNG or JPEG image");
+              cv::Mat rgb;
+              cv::cvtColor(decoded, rgb, cv::COLOR_BGR2RGB);
+              std::lock_guard lock(document->mutex);
+              cv::Mat* slot = PhotoSlot(*document, request, response);
+              if (!slot) return;
+              *slot = rgb;
+              SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
+            });
+  http.Get(R"(/api/docs/(\d+)/photo.png)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             auto document = state.FindDocument(request, response);
+             if (!document) return;
+             std::lock_guard lock(document->mutex);
+             const cv::Mat* slot = PhotoSlot(*document, request, response);
+             if (!slot) return;
+             if (slot->empty()) return SendError(response, 404, "no photo uploaded there for this scan");
+             SendPng(response, *slot);
+           });
+  PostDocument(state, R"(/api/docs/(\d+)/recolor)", Recolor);
+  PostDocument(state, R"(/api/docs/(\d+)/align)", Align);
+  PostDocument(state, R"(/api/docs/(\d+)/photo-match)", MatchPhotos);
 }
 
 }  // namespace lidarshop::server

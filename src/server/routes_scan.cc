@@ -9,6 +9,7 @@
 #include <map>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -67,6 +68,14 @@ std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::
     }
   }
   return "";
+}
+
+void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
+  cv::Mat out = rgb_or_gray;
+  if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  std::vector<uint8_t> png;
+  cv::imencode(".png", out, png);
+  response.set_content(std::string(png.begin(), png.end()), "image/png");
 }
 
 int State::AddDocument(std::string name, Scan scan) {
@@ -141,14 +150,6 @@ nlohmann::ordered_json DocumentJson(Document& document) {
       {"version", document.version},
       {"can_undo", !document.undo.empty()},
       {"can_redo", !document.redo.empty()}};
-}
-
-void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
-  cv::Mat out = rgb_or_gray;
-  if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
-  std::vector<uint8_t> png;
-  cv::imencode(".png", out, png);
-  response.set_content(std::string(png.begin(), png.end()), "image/png");
 }
 
 // The points of a scan as typed arrays (docs/api.md "Points"): header, xyz float32 (scanner frame), cell index
@@ -233,8 +234,10 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
 
 void Save(Document& document, const httplib::Request& request, httplib::Response& response) {
   const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
-  if (format != "e57" && format != "ptx" && format != "ply" && format != "pcd") {
-    SendError(response, 400, fmt::format("format '{}': expected e57, ptx, ply or pcd", format));
+  const std::vector<std::string> formats = SupportedScanWriteExtensions();
+  if (std::find(formats.begin(), formats.end(), format) == formats.end()) {
+    SendError(response, 400,
+              fmt::format("format '{}': expected one of {}", format, fmt::join(formats, ", ")));
     return;
   }
   const fs::path folder = fs::temp_directory_path() / fmt::format("lidarshop-save-{}", getpid());
@@ -268,12 +271,17 @@ void AddScanRoutes(State& state) {
   http.Get("/api/health", [](const httplib::Request&, httplib::Response& response) {
     SendJson(response, {{"ok", true}});
   });
+  // The scan formats the library reads and writes (the open and save dialogs offer these).
+  http.Get("/api/formats", [](const httplib::Request&, httplib::Response& response) {
+    SendJson(response, {{"read", SupportedScanReadExtensions()}, {"write", SupportedScanWriteExtensions()}});
+  });
   http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
     SendJson(response, {{"scenes", state.options.builtin_scenes}});
   });
   // The file dialog: scan files under the roots (at most 2000, two folders deep).
   http.Get("/api/files", [&state](const httplib::Request&, httplib::Response& response) {
     nlohmann::ordered_json files = nlohmann::ordered_json::array();
+    const std::vector<std::string> readable = SupportedScanReadExtensions();
     for (const std::string& root : state.options.roots) {
       std::error_code error;
       for (auto it = fs::recursive_directory_iterator(root, error);
@@ -281,7 +289,7 @@ void AddScanRoutes(State& state) {
         if (it.depth() > 1) it.disable_recursion_pending();
         if (!it->is_regular_file()) continue;
         const std::string extension = FileExtension(it->path().string());
-        if (extension != "ptx" && extension != "e57" && extension != "ply" && extension != "pcd") continue;
+        if (std::find(readable.begin(), readable.end(), extension) == readable.end()) continue;
         files.push_back({{"path", it->path().string()}, {"bytes", it->file_size()}});
         if (files.size() >= 2000) break;
       }

@@ -80,6 +80,7 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
   AddEditRoutes(*state_);
   AddVerifyRoutes(*state_);
   AddRecolorRoutes(*state_);
+  AddReviewRoutes(*state_);
   if (!state_->options.web_dir.empty()) {
     if (!http.set_mount_point("/", state_->options.web_dir)) {
       throw InputError(

@@ -41,6 +41,11 @@ class ServerTest : public ::testing::Test {
     scan_ = new Scan(lidarshop::test_scenes::ScanScene(lidarshop::test_scenes::MakeGroundAndBoxScene(scene)));
     WriteScanFile((base_ / "root" / "sub" / "box.ptx").string(), {*scan_});
     WriteScanFile((base_ / "outside" / "secret.ptx").string(), {*scan_});
+    // The same scan with its pose moved (2 m along x, 1 m along y, turned 20 degrees about z): registering
+    // it to the box's scan with landmarks must bring the pose back.
+    Scan moved = *scan_;
+    moved.world_from_scanner = MovedPose() * scan_->world_from_scanner;
+    WriteScanFile((base_ / "root" / "sub" / "moved.ptx").string(), {moved});
     std::ofstream(base_ / "root" / "broken.ptx") << "12\nnot a ptx\n";
     // A mesh whose MTL file is missing: read with a warning.
     std::ofstream(base_ / "root" / "sub" / "quad.obj")
@@ -72,6 +77,14 @@ class ServerTest : public ::testing::Test {
     fs::remove_all(base_);
   }
 
+  static Eigen::Matrix4d MovedPose() {
+    Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+    const double angle = 20.0 * M_PI / 180.0;
+    pose.topLeftCorner<2, 2>() << std::cos(angle), -std::sin(angle), std::sin(angle), std::cos(angle);
+    pose(0, 3) = 2.0;
+    pose(1, 3) = 1.0;
+    return pose;
+  }
   static std::string Api(const std::string& path) {
     return path + (path.find('?') == std::string::npos ? "?" : "&") + "token=secret-token";
   }
@@ -132,7 +145,7 @@ TEST_F(ServerTest, FilesOnlyUnderTheRoots) {
   EXPECT_EQ(broken->status, 422);
   EXPECT_NE(Json(broken)["error"].get<std::string>().find("broken.ptx"), std::string::npos);
   const auto files = Json(client_->Get(Api("/api/files")));
-  EXPECT_EQ(files["files"].size(), 3u);  // box.ptx, broken.ptx, link.ptx (listed; opening the link fails)
+  EXPECT_EQ(files["files"].size(), 4u);  // box, moved, broken, link (listed; opening the link fails)
   const auto opened = client_->Get(Api("/api/open?path=" + (base_ / "root" / "sub" / "box.ptx").string()));
   ASSERT_EQ(opened->status, 200);
   EXPECT_EQ(Json(opened)["rows"], 60);
@@ -343,6 +356,276 @@ TEST_F(ServerTest, RecolourFromAPhotoWithPickedPairs) {
   EXPECT_LT(done["result"]["rms_px"].get<double>(), 1.0) << done.dump();
   EXPECT_GT(done["result"]["recolored_count"].get<int>(), 100) << done.dump();
   EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/photo.png", id)))->status, 200);
+}
+
+TEST_F(ServerTest, SaveOffersTheLibrarysWriteFormats) {
+  const auto formats = Json(client_->Get(Api("/api/formats")));
+  for (const char* format : {"e57", "ptx", "ply", "pcd"}) {
+    EXPECT_NE(std::find(formats["write"].begin(), formats["write"].end(), format), formats["write"].end());
+    EXPECT_NE(std::find(formats["read"].begin(), formats["read"].end(), format), formats["read"].end());
+  }
+  const int id = OpenBox();
+  for (const auto& format : formats["write"]) {
+    const auto saved =
+        client_->Get(Api(fmt::format("/api/docs/{}/save?format={}", id, format.get<std::string>())));
+    EXPECT_EQ(saved->status, 200) << format;
+    EXPECT_GT(saved->body.size(), 1000u) << format;
+  }
+  const auto refused = client_->Get(Api(fmt::format("/api/docs/{}/save?format=xyz", id)));
+  EXPECT_EQ(refused->status, 400);
+  // The message lists the library's formats (whatever they are when a writer is added).
+  EXPECT_NE(Json(refused)["error"].get<std::string>().find(
+                fmt::format("expected one of {}", formats["write"][0].get<std::string>())),
+            std::string::npos)
+      << refused->body;
+  EXPECT_EQ(client_->Get("/api/formats")->status, 401);
+}
+
+// The patch review: strict acceptance makes every target a review point; accept a listed candidate, place one
+// by hand, close; then a fill without acceptance runs to the end and becomes one undoable colour edit.
+TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
+  const int id = OpenBox();
+  const std::string review = Api(fmt::format("/api/docs/{}/inpaint/review", id));
+  const std::string decide = Api(fmt::format("/api/docs/{}/inpaint/review/decide", id));
+  EXPECT_EQ(client_->Post(fmt::format("/api/docs/{}/inpaint/review", id), "{}", "application/json")->status,
+            401);
+  const auto no_hole = client_->Post(review, "{}", "application/json");
+  EXPECT_EQ(no_hole->status, 400);
+  EXPECT_NE(Json(no_hole)["error"].get<std::string>().find("paint a hole first"), std::string::npos);
+  EXPECT_EQ(client_->Get(review)->status, 404);  // none started
+  ASSERT_EQ(client_
+                ->Post(Api(fmt::format("/api/docs/{}/strokes", id)),
+                       R"({"hole_polygon": [[40, 10], [40, 30], [55, 30], [55, 10]]})", "application/json")
+                ->status,
+            200);
+  EXPECT_EQ(client_->Post(review, R"({"channel": "range"})", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(review, R"({"options": {"patch_radiuss": 4}})", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(review, R"({"options": {"patch_radius": 0}})", "application/json")->status, 400);
+  const std::string strict =
+      R"({"options": {"review_candidates": 30, "acceptance": {"auto_accept_hole_fraction": 0,
+          "representative": {"enabled": true, "max_difference": 1e-6}}}})";
+  const auto started = client_->Post(review, strict, "application/json");
+  ASSERT_EQ(started->status, 202) << started->body;
+  EXPECT_EQ(Json(started)["kind"], "review");
+  const auto stopped = Wait(Json(started));
+  ASSERT_EQ(stopped["state"], "done") << stopped.dump();
+  ASSERT_EQ(stopped["result"]["state"], "review") << stopped.dump();
+  const auto pending = client_->Get(review);
+  ASSERT_EQ(pending->status, 200) << pending->body;
+  const auto first = Json(pending);
+  EXPECT_EQ(first["channel"], "color");
+  EXPECT_EQ(first["review"]["review_point"], 0);
+  EXPECT_EQ(first["review"]["patch_radius"], 4);
+  ASSERT_EQ(first["review"]["candidates"].size(), 30u);
+  EXPECT_FALSE(first["review"]["candidates"][0]["accepted"]);
+  EXPECT_FALSE(first["review"]["candidates"][0]["test"].get<std::string>().empty());
+  EXPECT_GE(first["review"]["clusters"].size(), 1u);
+  const int target_row = first["review"]["target"][0], target_col = first["review"]["target"][1];
+  EXPECT_TRUE(target_row >= 38 && target_row <= 57 && target_col >= 8 && target_col <= 32)
+      << first["review"]["target"];
+  for (const char* layer : {"canvas", "tentative"}) {
+    const auto png =
+        client_->Get(Api(fmt::format("/api/docs/{}/inpaint/review/image.png?layer={}", id, layer)));
+    ASSERT_EQ(png->status, 200) << layer;
+    const cv::Mat image =
+        cv::imdecode(std::vector<uint8_t>(png->body.begin(), png->body.end()), cv::IMREAD_COLOR);
+    EXPECT_EQ(image.rows, scan_->rows);
+    EXPECT_EQ(image.cols, scan_->cols);
+  }
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/inpaint/review/image.png?layer=x", id)))->status, 400);
+
+  // Bad decisions: 400 with a message, and the review stays where it was.
+  EXPECT_EQ(client_->Post(decide, R"({"candidate": 30})", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(decide, R"({"candidate": 1, "source": [10, 60]})", "application/json")->status,
+            400);
+  const auto outside = client_->Post(decide, R"({"source": [0, 0]})", "application/json");
+  EXPECT_EQ(outside->status, 400);
+  EXPECT_NE(Json(outside)["error"].get<std::string>().find("(0, 0) is not the centre"), std::string::npos)
+      << outside->body;
+  EXPECT_EQ(client_->Post(decide, R"({"source": [45, 20]})", "application/json")->status,
+            400);  // in the hole
+  EXPECT_EQ(Json(client_->Get(review))["review"]["review_point"], 0);
+
+  // Accept candidate 2: the fill goes on to the next review point with that decision recorded.
+  const auto accepted = Wait(Json(client_->Post(decide, R"({"candidate": 2})", "application/json")));
+  ASSERT_EQ(accepted["result"]["state"], "review") << accepted.dump();
+  const auto second = Json(client_->Get(review));
+  EXPECT_EQ(second["review"]["review_point"], 1);
+  ASSERT_EQ(second["decisions"].size(), 1u);
+  EXPECT_EQ(second["decisions"][0]["source"], first["review"]["candidates"][2]["source"]);
+  // Place by hand: the centre of a patch the user clicked, anywhere wholly outside the hole.
+  const auto placed = Wait(Json(client_->Post(decide, R"({"source": [30, 60]})", "application/json")));
+  ASSERT_EQ(placed["result"]["state"], "review") << placed.dump();
+  const auto third = Json(client_->Get(review));
+  ASSERT_EQ(third["decisions"].size(), 2u);
+  EXPECT_EQ(third["decisions"][1]["source"], nlohmann::json::array({30, 60}));
+  const int64_t version = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"];
+  ASSERT_EQ(client_->Delete(review)->status, 200);
+  EXPECT_EQ(client_->Get(review)->status, 404);
+  EXPECT_EQ(client_->Post(decide, R"({"candidate": 0})", "application/json")->status, 404);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["version"], version);  // nothing applied
+
+  // Without acceptance nothing stops: the fill runs to its end and is one undoable edit of the colours in the
+  // hole; every other cell keeps its colour.
+  const Scan before = ReadScanFile((base_ / "root" / "sub" / "box.ptx").string()).scans[0];
+  const auto finished = Wait(
+      Json(client_->Post(review, R"({"options": {"acceptance": {"enabled": false}}})", "application/json")));
+  ASSERT_EQ(finished["state"], "done") << finished.dump();
+  ASSERT_EQ(finished["result"]["state"], "done") << finished.dump();
+  EXPECT_EQ(finished["result"]["version"].get<int64_t>(), version + 1);
+  EXPECT_EQ(client_->Get(review)->status, 404);
+  const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format=ply", id)));
+  ASSERT_EQ(saved->status, 200);
+  const fs::path file = base_ / "reviewed.ply";
+  std::ofstream(file, std::ios::binary) << saved->body;
+  const Scan after = ReadScanFile(file.string()).scans[0];
+  cv::Mat hole = cv::Mat::zeros(before.rows, before.cols, CV_8U);
+  cv::fillPoly(hole, std::vector<std::vector<cv::Point>>{{{10, 40}, {30, 40}, {30, 55}, {10, 55}}}, 255);
+  cv::Mat changed;
+  cv::Mat difference;
+  cv::absdiff(after.color, before.color, difference);
+  const cv::Mat differs = difference > 0;
+  cv::reduce(differs.reshape(1, before.rows * before.cols), changed, 1, cv::REDUCE_MAX);
+  changed = changed.reshape(1, before.rows);
+  EXPECT_GT(cv::countNonZero(changed & hole), 20);
+  EXPECT_EQ(cv::countNonZero(changed & ~hole), 0);
+  EXPECT_EQ(after.CountValid(), before.CountValid());  // the points did not move or appear
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+}
+
+TEST_F(ServerTest, LandmarksRegisterOneScanToAnother) {
+  const int box = OpenBox();
+  const auto opened = client_->Get(Api("/api/open?path=sub/moved.ptx"));
+  ASSERT_EQ(opened->status, 200);
+  const int moved = Json(opened)["id"];
+  nlohmann::json pairs = nlohmann::json::array();
+  for (int r = 20; r < scan_->rows; r += 9) {
+    for (int c = 3; c < scan_->cols; c += 17) {
+      if (scan_->valid.at<uint8_t>(r, c) == 0) continue;
+      pairs.push_back({{"cell", {r, c}}, {"target_cell", {r, c}}});
+    }
+  }
+  ASSERT_GE(pairs.size(), 6u);
+  const std::string align = Api(fmt::format("/api/docs/{}/align", moved));
+  EXPECT_EQ(client_->Post(align, nlohmann::json{{"pairs", pairs}}.dump(), "application/json")->status, 400);
+  EXPECT_EQ(
+      client_->Post(align, nlohmann::json{{"target", moved}, {"pairs", pairs}}.dump(), "application/json")
+          ->status,
+      400);
+  EXPECT_EQ(
+      client_->Post(align, nlohmann::json{{"target", 9999}, {"pairs", pairs}}.dump(), "application/json")
+          ->status,
+      404);
+  EXPECT_EQ(client_
+                ->Post(align, nlohmann::json{{"target", box}, {"pairs", pairs}, {"with_scale", true}}.dump(),
+                       "application/json")
+                ->status,
+            400);
+  const nlohmann::json two = nlohmann::json::array({pairs[0], pairs[1]});
+  EXPECT_EQ(client_->Post(align, nlohmann::json{{"target", box}, {"pairs", two}}.dump(), "application/json")
+                ->status,
+            400);
+  const auto sky = client_->Post(
+      align, nlohmann::json{{"target", box}, {"pairs", {{{"cell", {0, 0}}, {"target_cell", {0, 0}}}}}}.dump(),
+      "application/json");
+  EXPECT_EQ(sky->status, 400);
+  EXPECT_NE(Json(sky)["error"].get<std::string>().find("has no return"), std::string::npos) << sky->body;
+  const auto similarity = client_->Post(
+      align, nlohmann::json{{"target", box}, {"pairs", pairs}, {"with_scale", true}, {"apply", false}}.dump(),
+      "application/json");
+  ASSERT_EQ(similarity->status, 200) << similarity->body;
+  EXPECT_NEAR(Json(similarity)["scale"].get<double>(), 1.0, 1e-6);
+  EXPECT_FALSE(Json(similarity)["applied"]);
+  const auto fitted =
+      client_->Post(align, nlohmann::json{{"target", box}, {"pairs", pairs}}.dump(), "application/json");
+  ASSERT_EQ(fitted->status, 200) << fitted->body;
+  EXPECT_LT(Json(fitted)["rms_m"].get<double>(), 1e-4);
+  // The moved scan's pose is the box scan's again: T undid the move.
+  const auto pose =
+      Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
+  for (int k = 0; k < 16; ++k)
+    EXPECT_NEAR(pose[k].get<double>(), scan_->world_from_scanner.data()[k], 1e-4) << k;
+  const Eigen::Matrix4d expected_t = MovedPose().inverse();
+  const auto t = Json(fitted)["target_from_source_column_major"];
+  for (int k = 0; k < 16; ++k) EXPECT_NEAR(t[k].get<double>(), expected_t.data()[k], 1e-4) << k;
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", moved)), "", "application/json")->status, 200);
+  const auto undone =
+      Json(client_->Get(Api(fmt::format("/api/docs/{}", moved))))["world_from_scanner_column_major"];
+  const Eigen::Matrix4d moved_pose = MovedPose() * scan_->world_from_scanner;
+  for (int k = 0; k < 16; ++k) EXPECT_NEAR(undone[k].get<double>(), moved_pose.data()[k], 1e-6) << k;
+}
+
+// Photo <-> photo: ground points (z = 0) seen by two cameras are related by a homography.
+TEST_F(ServerTest, PhotoPairsGiveAHomography) {
+  const int id = OpenBox();
+  const std::string match = Api(fmt::format("/api/docs/{}/photo-match", id));
+  EXPECT_EQ(client_->Post(match, R"({"pairs": []})", "application/json")->status, 400);  // no photos yet
+  lidarshop::test_scenes::GroundAndBoxOptions scene;
+  const PinholeCamera a = CameraLookingAt({1.0, 0.5, 1.7}, {0, 8, 0.5}, 320, 240, 60);
+  const PinholeCamera b = CameraLookingAt({-1.5, 1.0, 2.0}, {0.5, 9, 0.3}, 300, 200, 55);
+  for (const auto& [camera, slot] : {std::pair{a, "a"}, std::pair{b, "b"}}) {
+    const Photo photo = RenderPhoto(lidarshop::test_scenes::MakeGroundAndBoxScene(scene), camera);
+    cv::Mat bgr;
+    cv::cvtColor(photo.image, bgr, cv::COLOR_RGB2BGR);
+    std::vector<uint8_t> png;
+    cv::imencode(".png", bgr, png);
+    const auto uploaded = client_->Post(Api(fmt::format("/api/docs/{}/photo?slot={}", id, slot)),
+                                        std::string(png.begin(), png.end()), "image/png");
+    ASSERT_EQ(uploaded->status, 200) << uploaded->body;
+  }
+  EXPECT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/photo?slot=c", id)), "x", "image/png")->status, 400);
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/photo.png?slot=b", id)))->status, 200);
+  nlohmann::json pairs = nlohmann::json::array();
+  for (double x = -3; x <= 3; x += 1.5) {
+    for (double y = 5; y <= 12; y += 2.5) {
+      Eigen::Vector2d pa, pb;
+      if (!ProjectWorldPoint(a, {x, y, 0}, &pa) || !InsideImage(a, pa) ||
+          !ProjectWorldPoint(b, {x, y, 0}, &pb) || !InsideImage(b, pb))
+        continue;
+      pairs.push_back({{"pixel_a", {pa.x(), pa.y()}}, {"pixel_b", {pb.x(), pb.y()}}});
+    }
+  }
+  ASSERT_GE(pairs.size(), 8u);
+  const auto fitted = client_->Post(match, nlohmann::json{{"pairs", pairs}}.dump(), "application/json");
+  ASSERT_EQ(fitted->status, 200) << fitted->body;
+  EXPECT_LT(Json(fitted)["rms_px"].get<double>(), 0.1) << fitted->body;
+  EXPECT_EQ(Json(fitted)["error_px"].size(), pairs.size());
+  EXPECT_EQ(Json(fitted)["matrix_row_major"].size(), 9u);
+  // Points off one plane: a fundamental matrix (a homography would not fit them).
+  nlohmann::json general = nlohmann::json::array();
+  int k = 0;
+  for (double x = -3; x <= 3; x += 1.0) {
+    for (double y = 5; y <= 12; y += 1.5) {
+      const Eigen::Vector3d point(x, y, 0.4 * (k++ % 5));
+      Eigen::Vector2d pa, pb;
+      if (!ProjectWorldPoint(a, point, &pa) || !InsideImage(a, pa) || !ProjectWorldPoint(b, point, &pb) ||
+          !InsideImage(b, pb))
+        continue;
+      general.push_back({{"pixel_a", {pa.x(), pa.y()}}, {"pixel_b", {pb.x(), pb.y()}}});
+    }
+  }
+  ASSERT_GE(general.size(), 15u);
+  const auto fundamental = client_->Post(
+      match, nlohmann::json{{"pairs", general}, {"model", "fundamental"}}.dump(), "application/json");
+  ASSERT_EQ(fundamental->status, 200) << fundamental->body;
+  EXPECT_LT(Json(fundamental)["rms_px"].get<double>(), 0.1) << fundamental->body;
+  EXPECT_EQ(
+      client_->Post(match, nlohmann::json{{"pairs", pairs}, {"model", "affine"}}.dump(), "application/json")
+          ->status,
+      400);
+  const nlohmann::json three = nlohmann::json::array({pairs[0], pairs[1], pairs[2]});
+  EXPECT_EQ(client_->Post(match, nlohmann::json{{"pairs", three}}.dump(), "application/json")->status, 400);
+  const auto outside =
+      client_->Post(match, R"({"pairs": [{"pixel_a": [1, 1], "pixel_b": [500, 1]}]})", "application/json");
+  EXPECT_EQ(outside->status, 400);
+  EXPECT_NE(Json(outside)["error"].get<std::string>().find("outside the 300 x 200 photo"), std::string::npos)
+      << outside->body;
+  // The kinds do not mix across routes: photo pairs are not resection pairs.
+  EXPECT_EQ(client_
+                ->Post(Api(fmt::format("/api/docs/{}/recolor", id)), nlohmann::json{{"pairs", pairs}}.dump(),
+                       "application/json")
+                ->status,
+            400);
 }
 
 TEST_F(ServerTest, ConcurrentEditsAreNotLost) {

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
+#include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/progress.h"
@@ -45,6 +46,20 @@ struct SegmentCut {
   const uint8_t* scan_data = nullptr;  // the scan it was built on (its range buffer)
 };
 
+struct Job;
+
+// An inpainting review in progress on a document (inpaint/inpaint_session.h): the scan's colour (or
+// intensity) ray image inpainted in a hole, stopping where no candidate passes the acceptance tests so that
+// the user decides. The finished fill becomes one undoable edit of that channel.
+struct ReviewSession {
+  std::unique_ptr<InpaintSession> session;  // null until the first job has built it
+  InpaintOptions options;
+  std::string channel;  // "color" or "intensity": what the fill is written back to
+  cv::Mat hole;         // CV_8U 255 = the cells inpainted
+  // The job filling now (null = none): while it runs the session is its alone. Guarded by Document::mutex.
+  std::shared_ptr<Job> job;
+};
+
 struct Document {
   int id = 0;
   std::string name;  // file name or built-in scene name
@@ -53,9 +68,10 @@ struct Document {
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
-  std::shared_ptr<SegmentCut> cut;
-  cv::Mat
-      photo;  // CV_8UC3 RGB: the photo to recolour from (empty = none)  // the last segmentation's session (null = none yet)
+  std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
+  cv::Mat photo;                    // CV_8UC3 RGB: the photo to recolour from (empty = none)
+  cv::Mat photo_b;                  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
+  std::shared_ptr<ReviewSession> review;  // the inpainting review in progress (null = none)
   int64_t prepared_version = -1;
   std::mutex mutex;  // guards every field above
 };

@@ -1,6 +1,7 @@
 // End to end in a real browser: Debian's chromium driven by playwright-core against `lidarshop serve`.
 // Opens the built-in parking lot, paints strokes on the hatchback, segments, removes it, orbits, saves as E57
-// and checks the saved file with `lidarshop info`. Screenshots of each step go to ARTEFACTS (and to
+// and checks the saved file with `lidarshop info`; then reviews an inpainting of the facade's colours (accepts a
+// candidate, places a patch by hand) and registers a second copy of the scan to the first with landmarks. Screenshots of each step go to ARTEFACTS (and to
 // docs/results/editor/ with --docs).
 //
 //   node e2e/editor.mjs LIDARSHOP_BINARY ARTEFACTS_DIR [--docs]
@@ -139,6 +140,66 @@ try {
   const info = JSON.parse(execFileSync(binary, ['info', saved], { encoding: 'utf8' }));
   const scan = info.scans[0];
   if (!scan.channels.includes('synthesized')) fail(`the saved E57 has no synthesized channel: ${scan.channels}`);
+  // The patch review: a lasso on the facade, strict acceptance so that the fill stops at once; accept the best
+  // group's patch, then place one by hand.
+  const facade = labels.labels.find((entry) => entry.label === 1);
+  if (!facade) fail('no facade in the labels');
+  const [fr, fc] = facade.center;
+  await page.click('#brush-lasso');
+  await drag([[fr - 6, fc - 10], [fr - 6, fc + 10], [fr + 6, fc + 10], [fr + 6, fc - 10], [fr - 6, fc - 10]]);
+  await page.waitForFunction(() => window.lidarshop.current().hole_cells > 100, null, { timeout: 30000 });
+  await page.fill('#review-options', JSON.stringify({ review_candidates: 40, acceptance: { auto_accept_hole_fraction: 0, representative: { enabled: true, max_difference: 1e-6 } } }));
+  await page.click('#review-fill');
+  await waitForStatus(/^review: no patch passes/, 'review fill', 120000);
+  const first = await page.evaluate(() => window.lidarshop.review());
+  const tiles = await page.locator('.review-tile').count();
+  if (first.review.candidates.length !== 40 || tiles < 1 || tiles !== first.review.clusters.length)
+    fail(`review: ${first.review.candidates.length} candidates, ${tiles} tiles for ${first.review.clusters.length} clusters`);
+  await shot('review');
+  const chosen = Number(await page.locator('.review-tile').nth(Math.min(1, tiles - 1)).getAttribute('data-candidate'));
+  await page.locator('.review-tile').nth(Math.min(1, tiles - 1)).click();
+  await page.waitForFunction(() => window.lidarshop.review()?.review.review_point === 1, null, { timeout: 60000 });
+  const second = await page.evaluate(() => window.lidarshop.review());
+  if (JSON.stringify(second.decisions[0].source) !== JSON.stringify(first.review.candidates[chosen].source))
+    fail(`accepted candidate ${chosen} but the decision was ${JSON.stringify(second.decisions[0])}`);
+  await page.click('#review-place');
+  const source = await screen(fr - 20, fc);
+  await page.mouse.click(canvas.x + source.x, canvas.y + source.y);
+  await page.waitForFunction(() => window.lidarshop.review()?.review.review_point === 2, null, { timeout: 60000 });
+  const third = await page.evaluate(() => window.lidarshop.review());
+  if (JSON.stringify(third.decisions[1].source) !== JSON.stringify([fr - 20, fc]))
+    fail(`placed by hand at ${[fr - 20, fc]} but the decision was ${JSON.stringify(third.decisions[1])}`);
+  await shot('review_placed');
+  await page.click('#review-stop');
+  await waitForStatus(/^review stopped/, 'stop review');
+
+  // Landmarks (scan <-> scan): a second copy of the scan registered to the first; the same cells in both give
+  // the identity with no residual.
+  await page.click('#open-scene');
+  await page.waitForFunction((id) => window.lidarshop.current()?.id !== id, doc.id, { timeout: 120000 });
+  const copy = await page.evaluate(() => window.lidarshop.current());
+  await page.selectOption('#pair-mode', 'scan-scan');
+  await page.waitForFunction(() => document.getElementById('align-target').options.length > 0, null, { timeout: 30000 });
+  await page.selectOption('#align-target', String(doc.id));
+  await page.waitForFunction((id) => window.lidarshop.pairs().shownTarget === id, doc.id, { timeout: 30000 });
+  await page.click('#brush-none');
+  const pointsBuffer = await (await fetch(new URL(`/api/docs/${doc.id}/points?token=${token}`, url))).arrayBuffer();
+  const count = new DataView(pointsBuffer).getUint32(4, true);
+  const cells = new Uint32Array(pointsBuffer, 16 + 12 * count, count);
+  const target = await page.locator('#target-ray').boundingBox();
+  for (const fraction of [0.15, 0.35, 0.55, 0.75, 0.9]) {
+    const cell = cells[Math.floor(fraction * count)];
+    const [row, col] = [Math.floor(cell / copy.cols), cell % copy.cols];
+    const here = await screen(row, col);
+    await page.mouse.click(canvas.x + here.x, canvas.y + here.y);
+    const there = await page.evaluate(([r, c]) => window.lidarshop.pairs().targetView.screenOf({ row: r, col: c }), [row, col]);
+    await page.mouse.click(target.x + there.x, target.y + there.y);
+  }
+  await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+  await page.click('#recolor');
+  await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
+  await shot('landmarks');
+
   console.log(`e2e: passed (car ${car.cells} cells, segmented ${segmented.object_cells}, synthesized ${removed.synthesized_cells}, saved ${saved})`);
 } finally {
   await browser.close();

@@ -141,6 +141,11 @@ export class Api {
     return json as T;
   }
 
+  async delete(path: string): Promise<void> {
+    const response = await fetch(this.url(path), { method: 'DELETE' });
+    if (!response.ok) throw new ApiError(response.status, (await response.json().catch(() => ({}))).error ?? `${response.status}`);
+  }
+
   async mesh(id: number): Promise<MeshData> {
     const response = await fetch(this.url(`/api/models/${id}/mesh`));
     if (!response.ok) throw new ApiError(response.status, `mesh: ${response.status}`);

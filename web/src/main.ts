@@ -1,7 +1,10 @@
 // The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
 import { Api, ApiError, DocumentInfo, JobInfo, MeshData, inverseRigid, multiply, poseMatrix } from './api';
 import { PointColouring, PointView } from './pointview';
-import { Brush, RayView } from './rayview';
+import { PairsPanel } from './pairsui';
+import { Brush, RayView, loadImage } from './rayview';
+import { PendingReview, ReviewChoice, decisionBody } from './review';
+import { ReviewPanel } from './reviewpanel';
 import { Cell, toCellList } from './strokes';
 
 const api = Api.fromLocation(window.location);
@@ -16,8 +19,13 @@ let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
 const strokeKinds = new Set<Brush>();  // brushes used on the open scan since its last cut was reset
 
+let pending: PendingReview | null = null; // the patch review shown (null = none)
+let placingByHand = false; // the next pick in the ray image is a review's source patch
+
 // For end-to-end tests: where a cell is on screen, and what is open.
-(window as unknown as Record<string, unknown>).lidarshop = { rayView, pointView, current: () => doc, verify: () => verify() };
+(window as unknown as Record<string, unknown>).lidarshop = {
+  rayView, pointView, current: () => doc, verify: () => verify(), review: () => pending, pairs: () => pairsPanel,
+};
 
 async function refresh(keepView: boolean) {
   if (!doc) return;
@@ -41,15 +49,22 @@ async function open(params: Record<string, string>) {
     doc = await api.json<DocumentInfo>('/api/open', params);
     rayView.clearStrokes();
     strokeKinds.clear();
+    pending = null;
+    reviewPanel.hide();
     await refresh(false);
+    if (pairsPanel.pairs.mode === 'scan-scan') await pairsPanel.listTargets();
   } catch (error) {
     status(`open failed: ${(error as Error).message}`);
   }
 }
 
-// Runs an operation as a job; shows the progress bar once it has taken half a second, with cancel.
-async function runJob(path: string, body: unknown, what: string) {
-  if (!doc) return status('open a scan first');
+// Runs an operation as a job; shows the progress bar once it has taken half a second, with cancel. Resolves
+// with the job's last state (null when it could not start); `refreshAfter` reloads the scan when it is done.
+async function runJob(path: string, body: unknown, what: string, refreshAfter = true): Promise<JobInfo | null> {
+  if (!doc) {
+    status('open a scan first');
+    return null;
+  }
   const started = Date.now();
   try {
     runningJob = await api.json<JobInfo>(path, {}, body);
@@ -64,14 +79,16 @@ async function runJob(path: string, body: unknown, what: string) {
     element('progress').hidden = true;
     runningJob = null;
     if (finished.state === 'done') {
-      await refresh(true);
+      if (refreshAfter) await refresh(true);
       status(`${what} done. ${element('status').textContent}`);
     } else {
       status(`${what} ${finished.state}${finished.error ? `: ${finished.error}` : ''}`);
     }
+    return finished;
   } catch (error) {
     element('progress').hidden = true;
     status(`${what} failed: ${error instanceof ApiError ? error.message : String(error)}`);
+    return null;
   }
 }
 
@@ -94,8 +111,13 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
 };
 rayView.onPick = (cell) => {
   if (!doc) return;
+  if (placingByHand) {
+    setPlacing(false);
+    reviewStep(`/api/docs/${doc.id}/inpaint/review/decide`, { source: [cell.row, cell.col] }, 'place patch');
+    return;
+  }
   picked = cell;
-  addPairForCell(cell);
+  pairsPanel.pickCell(cell);
   rayView.pick(cell);
   pointView.highlight(cell.row * doc.cols + cell.col);
   status(`cell row ${cell.row}, column ${cell.col}`);
@@ -103,6 +125,7 @@ rayView.onPick = (cell) => {
 pointView.onPick = (index) => {
   if (!doc) return;
   picked = { row: Math.floor(index / doc.cols), col: index % doc.cols };
+  pairsPanel.pickCell(picked);
   rayView.pick({ row: Math.floor(index / doc.cols), col: index % doc.cols });
 };
 
@@ -200,65 +223,85 @@ element('place').addEventListener('click', async () => {
   }
 });
 
-// Recolouring (thesis 3.2): click a pixel in the photo, then the same spot in the ray image (Pick tool); six or
-// more pairs give the camera; the photo's colours then go to the points it sees.
-const photoCanvas = element<HTMLCanvasElement>('photo');
-let photo: HTMLImageElement | null = null;
-let pendingPixel: [number, number] | null = null;
-const pairs: { pixel: [number, number]; cell: [number, number] }[] = [];
-function drawPhoto() {
-  const context = photoCanvas.getContext('2d');
-  if (!context || !photo) return;
-  photoCanvas.width = photoCanvas.clientWidth;
-  photoCanvas.height = photoCanvas.clientHeight;
-  const scale = Math.min(photoCanvas.width / photo.width, photoCanvas.height / photo.height);
-  context.drawImage(photo, 0, 0, photo.width * scale, photo.height * scale);
-  context.fillStyle = '#ff0';
-  for (const pair of pairs) context.fillRect(pair.pixel[0] * scale - 3, pair.pixel[1] * scale - 3, 6, 6);
-  if (pendingPixel) {
-    context.strokeStyle = '#0ff';
-    context.strokeRect(pendingPixel[0] * scale - 5, pendingPixel[1] * scale - 5, 10, 10);
+// Correspondences of the three kinds (pairsui.ts).
+const pairsPanel = new PairsPanel({ api, doc: () => doc, status, runJob, refresh: () => refresh(true) });
+
+// The patch review of the inpainting (thesis 7.1 "User action"): the fill stops where no patch passes the
+// acceptance tests; the panel shows the candidates grouped, a click accepts one, or a pick places one by hand.
+const reviewPanel = new ReviewPanel(element('review-panel'), element<HTMLCanvasElement>('review-target'),
+                                    element('review-tiles'), element('review-caption'));
+let reviewImages = 0; // a counter in the image URLs: each stop's pictures are new
+function setPlacing(on: boolean) {
+  placingByHand = on;
+  document.body.classList.toggle('placing', on);
+  element('review-place').classList.toggle('active', on);
+  if (on) element('brush-none').click();
+}
+async function reviewStep(path: string, body: unknown, what: string) {
+  const finished = await runJob(path, body, what, false);
+  const result = finished?.result as { state?: string } | undefined;
+  if (finished?.state === 'done' && result?.state === 'review') return showReview();
+  pending = null;
+  reviewPanel.hide();
+  setPlacing(false);
+  if (finished?.state === 'done') {
+    await refresh(true);
+    status(`review done: the fill is one edit (undo takes it back). ${element('status').textContent}`);
   }
-  photoCanvas.dataset.scale = String(scale);
 }
-photoCanvas.addEventListener('click', (event) => {
-  if (!photo) return;
-  const scale = Number(photoCanvas.dataset.scale);
-  const pixel: [number, number] = [event.offsetX / scale, event.offsetY / scale];
-  if (pixel[0] >= photo.width || pixel[1] >= photo.height) return;
-  pendingPixel = pixel;
-  drawPhoto();
-  status(`photo pixel (${pixel[0].toFixed(1)}, ${pixel[1].toFixed(1)}): now pick the same spot in the ray image`);
-});
-function addPairForCell(cell: { row: number; col: number }) {
-  if (!pendingPixel) return;
-  pairs.push({ pixel: pendingPixel, cell: [cell.row, cell.col] });
-  pendingPixel = null;
-  element('pairs').textContent = `${pairs.length} pairs`;
-  drawPhoto();
-}
-element<HTMLInputElement>('photo-file').addEventListener('change', async (event) => {
-  const file = (event.target as HTMLInputElement).files?.[0];
-  if (!file || !doc) return;
+async function showReview() {
+  if (!doc) return;
   try {
-    await fetch(api.url(`/api/docs/${doc.id}/photo`), { method: 'POST', body: file, headers: { 'Content-Type': file.type } })
-      .then(async (response) => { if (!response.ok) throw new Error((await response.json()).error); });
-    photo = new Image();
-    photo.onload = drawPhoto;
-    photo.src = api.url(`/api/docs/${doc.id}/photo.png`, { v: Date.now() });
-    element('photo-panel').hidden = false;
-    pairs.length = 0;
-    element('pairs').textContent = '0 pairs';
-    status('photo loaded: click a pixel in it, then the same spot in the ray image (Pick tool)');
+    pending = await api.json<PendingReview>(`/api/docs/${doc.id}/inpaint/review`);
+    const v = ++reviewImages;
+    const [canvas, tentative] = await Promise.all(['canvas', 'tentative'].map((layer) =>
+      loadImage(api.url(`/api/docs/${doc!.id}/inpaint/review/image.png`, { layer, v }))));
+    reviewPanel.show(pending, canvas, tentative);
+    const [row, col] = pending.review.target;
+    rayView.pick({ row, col });
+    status(`review: no patch passes at row ${row}, column ${col}; accept a group's patch or place one by hand`);
   } catch (error) {
-    status(`photo: ${(error as Error).message}`);
+    status(`review: ${(error as Error).message}`);
   }
+}
+reviewPanel.onAccept = (candidate) => {
+  if (!doc) return;
+  const choice: ReviewChoice = { candidate };
+  reviewStep(`/api/docs/${doc.id}/inpaint/review/decide`, decisionBody(choice), `accept candidate ${candidate}`);
+};
+element('review-fill').addEventListener('click', () => {
+  if (!doc) return status('open a scan first');
+  let options: unknown = undefined;
+  const text = element<HTMLInputElement>('review-options').value.trim();
+  try {
+    if (text) options = JSON.parse(text);
+  } catch {
+    return status('review options: not JSON');
+  }
+  reviewStep(`/api/docs/${doc.id}/inpaint/review`, options === undefined ? { hole: 'painted' } : { hole: 'painted', options }, 'review fill');
 });
-element('recolor').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/recolor`, { pairs }, 'recolour'));
+element('review-place').addEventListener('click', () => {
+  setPlacing(!placingByHand);
+  if (placingByHand) status('click the centre of the source patch in the ray image');
+});
+element('review-stop').addEventListener('click', async () => {
+  if (!doc) return;
+  try {
+    await api.delete(`/api/docs/${doc.id}/inpaint/review`);
+  } catch (error) {
+    status(`stop review: ${(error as Error).message}`);
+  }
+  pending = null;
+  reviewPanel.hide();
+  setPlacing(false);
+  status('review stopped; the scan is as it was');
+});
 
 async function start() {
   try {
     const { scenes } = await api.json<{ scenes: string[] }>('/api/scenes');
+    const formats = await api.json<{ write: string[] }>('/api/formats');
+    element('format').replaceChildren(...formats.write.map((name) => new Option(name, name)));
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
     const { files } = await api.json<{ files: { path: string }[] }>('/api/files');
     element('file').replaceChildren(...files.map((file) => new Option(file.path.split('/').pop()!, file.path)));

@@ -36,8 +36,8 @@ export class RayView {
 
   async show(imageUrl: string, maskUrl: string | null, holeUrl: string | null, rows: number, cols: number, aspect: number,
              keepView: boolean) {
-    const [image, mask, hole] = await Promise.all([load(imageUrl), maskUrl ? load(maskUrl) : Promise.resolve(null),
-                                                   holeUrl ? load(holeUrl) : Promise.resolve(null)]);
+    const [image, mask, hole] = await Promise.all([loadImage(imageUrl), maskUrl ? loadImage(maskUrl) : Promise.resolve(null),
+                                                   holeUrl ? loadImage(holeUrl) : Promise.resolve(null)]);
     this.holeMask = hole;
     const sizeChanged = rows !== this.rows || cols !== this.cols;
     this.image = image;
@@ -141,7 +141,7 @@ export class RayView {
   }
 }
 
-function load(url: string): Promise<HTMLImageElement> {
+export function loadImage(url: string): Promise<HTMLImageElement> {
   return new Promise((resolve, reject) => {
     const image = new Image();
     image.onload = () => resolve(image);

@@ -18,8 +18,6 @@ using nlohmann::json;
 
 namespace {
 
-json PixelJson(Pixel p) { return json::array({p.row, p.col}); }
-
 Pixel JsonPixel(const json& j, const std::string& file, const std::string& field) {
   if (!j.is_array() || j.size() != 2 || !j[0].is_number_integer() || !j[1].is_number_integer())
     ThrowInputError(file, "", field, "expected [row, col]");
@@ -32,36 +30,9 @@ void WriteReviewFolder(const std::string& dir, const InpaintReview& review,
                        const std::vector<ReviewDecision>& decisions, const cv::Mat& tentative_display,
                        const cv::Mat& canvas_display, int patch_radius) {
   std::filesystem::create_directories(dir);
-  json doc;
-  doc["decisions"] = json::array();
-  for (const ReviewDecision& d : decisions)
-    doc["decisions"].push_back({{"target", PixelJson(d.target)}, {"source", PixelJson(d.source)}});
-  json r;
-  r["review_point"] = review.review_point;
-  r["iteration"] = review.iteration;
-  r["target"] = PixelJson(review.target);
-  r["patch_radius"] = patch_radius;
-  r["candidates"] = json::array();
-  for (size_t i = 0; i < review.candidates.size(); ++i) {
-    const AcceptanceVerdict& v = review.verdicts[i];
-    r["candidates"].push_back({{"index", i},
-                               {"source", PixelJson(review.candidates[i].source)},
-                               {"difference", review.candidates[i].difference},
-                               {"cluster", review.cluster[i]},
-                               {"accepted", v.accepted},
-                               {"test", v.test},
-                               {"value", v.value},
-                               {"threshold", v.threshold}});
-  }
-  r["clusters"] = json::array();
-  for (size_t c = 0; c < review.cluster_representative.size(); ++c) {
-    json members = json::array();
-    for (size_t i = 0; i < review.cluster.size(); ++i)
-      if (review.cluster[i] == static_cast<int>(c)) members.push_back(i);
-    r["clusters"].push_back(
-        {{"index", c}, {"representative", review.cluster_representative[c]}, {"members", members}});
-  }
-  doc["review"] = r;
+  nlohmann::ordered_json doc;
+  doc["decisions"] = DecisionsToJson(decisions);
+  doc["review"] = ReviewToJson(review, patch_radius);
   WriteFileAtomically(dir + "/review.json", [&](std::ostream& out) { out << doc.dump(1) << "\n"; });
 
   const int R = patch_radius, w = 2 * R + 1;

@@ -6,6 +6,7 @@
 #include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
+#include "lidarshop/util/progress.h"
 
 namespace lidarshop {
 namespace {
@@ -174,6 +175,47 @@ TEST(InpaintForward, SessionDecisionsEqualReplay) {
   const InpaintResult replayed = Inpaint(truth, hole, replay);
   EXPECT_EQ(cv::norm(replayed.image, result.image, cv::NORM_INF), 0.0);
   EXPECT_EQ(replayed.steps.size(), result.steps.size());
+}
+
+// Each stretch between review points reports to the progress it is given (the editor runs each as a job);
+// the review's JSON form lists every candidate once, in its cluster.
+TEST(InpaintForward, SessionStretchesReportToTheirOwnProgress) {
+  cv::Mat hole;
+  const cv::Mat truth = BrickOverGrass(40, 90, 20, &hole, cv::Rect(30, 8, 28, 24));
+  const InpaintOptions options = ReviewOptions();
+  const int R = options.patch_radius;
+  InpaintSession session(truth, hole, options);
+  int stops = 0, filled = 0;
+  bool complete = false;
+  while (!complete) {
+    Progress progress("stretch", 1, false);
+    session.SetProgress(&progress);
+    EXPECT_EQ(progress.total(), cv::countNonZero(hole) - filled);
+    complete = session.Run();
+    filled += static_cast<int>(progress.done());
+    session.SetProgress(nullptr);
+    if (complete) break;
+    const InpaintReview& review = *session.pending_review();
+    const nlohmann::ordered_json json = ReviewToJson(review, R);
+    EXPECT_EQ(json["target"][0], review.target.row);
+    EXPECT_EQ(json["patch_radius"], R);
+    ASSERT_EQ(json["candidates"].size(), review.candidates.size());
+    EXPECT_FALSE(json["candidates"][0]["accepted"]);
+    size_t members = 0;
+    for (const auto& cluster : json["clusters"]) {
+      members += cluster["members"].size();
+      EXPECT_EQ(cluster["members"][0], cluster["representative"]);
+    }
+    EXPECT_EQ(members, review.candidates.size());
+    // The decision's pixels count towards no stretch.
+    const int before = cv::countNonZero(session.Result().fill_iteration >= 0);
+    session.Decide(review.candidates[1].source);
+    filled += cv::countNonZero(session.Result().fill_iteration >= 0) - before;
+    ASSERT_LT(++stops, 50);
+  }
+  EXPECT_GT(stops, 0);
+  EXPECT_EQ(filled, cv::countNonZero(hole));
+  EXPECT_EQ(DecisionsToJson(session.decisions()).size(), static_cast<size_t>(stops));
 }
 
 TEST(InpaintForward, SameResultForAnyThreadCountWithSeed) {

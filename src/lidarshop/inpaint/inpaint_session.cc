@@ -168,6 +168,11 @@ void InpaintSession::Decide(Pixel source) {
   ++s.review_points;
 }
 
+void InpaintSession::SetProgress(Progress* progress) {
+  state_->progress = progress;
+  if (progress) progress->Restart("inpaint", state_->remaining);
+}
+
 const std::vector<ReviewDecision>& InpaintSession::decisions() const { return state_->decisions; }
 
 InpaintResult InpaintSession::Result() const {

@@ -41,6 +41,10 @@ class InpaintSession {
   // Copies the source patch centred at `source` (a source centre) into the pending review's target; Run()
   // then continues. Throws InputError when nothing is pending or `source` is not a source centre.
   void Decide(Pixel source);
+  // Reports the next Run() and Decide() to `progress` (nullptr = silent) instead of the one given at
+  // construction, restarted at the hole pixels still to fill: a caller that runs each stretch between two
+  // review points as its own operation (the editor's jobs) gives each its own progress and cancel.
+  void SetProgress(Progress* progress);
   // Every decision applied so far, review point by review point.
   const std::vector<ReviewDecision>& decisions() const;
   // The fill as it stands (partial when stopped: complete = false and review set).

@@ -91,4 +91,47 @@ InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<
   return review;
 }
 
+namespace {
+
+nlohmann::ordered_json PixelJson(Pixel p) { return nlohmann::ordered_json::array({p.row, p.col}); }
+
+}  // namespace
+
+nlohmann::ordered_json ReviewToJson(const InpaintReview& review, int patch_radius) {
+  nlohmann::ordered_json json;
+  json["review_point"] = review.review_point;
+  json["iteration"] = review.iteration;
+  json["target"] = PixelJson(review.target);
+  json["patch_radius"] = patch_radius;
+  json["candidates"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < review.candidates.size(); ++i) {
+    const AcceptanceVerdict verdict = i < review.verdicts.size() ? review.verdicts[i] : AcceptanceVerdict{};
+    json["candidates"].push_back({{"index", i},
+                                  {"source", PixelJson(review.candidates[i].source)},
+                                  {"difference", review.candidates[i].difference},
+                                  {"cluster", review.cluster[i]},
+                                  {"accepted", verdict.accepted},
+                                  {"test", verdict.test},
+                                  {"value", verdict.value},
+                                  {"threshold", verdict.threshold},
+                                  {"margin", verdict.margin}});
+  }
+  json["clusters"] = nlohmann::ordered_json::array();
+  for (size_t c = 0; c < review.cluster_representative.size(); ++c) {
+    nlohmann::ordered_json members = nlohmann::ordered_json::array();
+    for (size_t i = 0; i < review.cluster.size(); ++i)
+      if (review.cluster[i] == static_cast<int>(c)) members.push_back(i);
+    json["clusters"].push_back(
+        {{"index", c}, {"representative", review.cluster_representative[c]}, {"members", members}});
+  }
+  return json;
+}
+
+nlohmann::ordered_json DecisionsToJson(const std::vector<ReviewDecision>& decisions) {
+  nlohmann::ordered_json json = nlohmann::ordered_json::array();
+  for (const ReviewDecision& d : decisions)
+    json.push_back({{"target", PixelJson(d.target)}, {"source", PixelJson(d.source)}});
+  return json;
+}
+
 }  // namespace lidarshop

@@ -12,6 +12,7 @@
 
 #include <vector>
 
+#include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
 #include "lidarshop/inpaint/acceptance.h"
@@ -52,5 +53,14 @@ std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
 InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<SourceCandidate> candidates,
                          const PatchAcceptance* acceptance, double cluster_max_rms,
                          const std::vector<float>& channel_weights);
+
+// The JSON form of a review, shared by `inpaint --review` (review.json) and the editor's API (docs/api.md):
+//   {"review_point", "iteration", "target": [r, c], "patch_radius",
+//    "candidates": [{"index", "source": [r, c], "difference", "cluster", "accepted", "test", "value",
+//                    "threshold", "margin"}, ...],                       (best first)
+//    "clusters": [{"index", "representative", "members": [candidate indices]}, ...]}
+nlohmann::ordered_json ReviewToJson(const InpaintReview& review, int patch_radius);
+// [{"target": [r, c], "source": [r, c]}, ...]
+nlohmann::ordered_json DecisionsToJson(const std::vector<ReviewDecision>& decisions);
 
 }  // namespace lidarshop

@@ -318,6 +318,20 @@ std::string FileExtension(const std::string& path) {
 
 void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
 
+std::vector<std::string> SupportedScanReadExtensions() {
+  std::vector<std::string> extensions;
+  for (const ScanFormat& format : ScanFormats())
+    if (format.read) extensions.push_back(format.extension);
+  return extensions;
+}
+
+std::vector<std::string> SupportedScanWriteExtensions() {
+  std::vector<std::string> extensions;
+  for (const ScanFormat& format : ScanFormats())
+    if (format.write) extensions.push_back(format.extension);
+  return extensions;
+}
+
 ScanFile ReadScanFile(const std::string& path) {
   const ScanFormat& format = FormatFor(path);
   ScanFile file;

@@ -60,6 +60,11 @@ void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& 
 // extension; lets a command refuse an output path before its work.
 void CheckScanFileFormat(const std::string& path);
 
+// The extensions (lower case, no dot) of the scan formats ReadScanFile reads and WriteScanFile writes, in the
+// table's order: what a file dialog offers. A format added to the table appears here by itself.
+std::vector<std::string> SupportedScanReadExtensions();
+std::vector<std::string> SupportedScanWriteExtensions();
+
 // The lower-case extension without the dot ("ptx"), or "" when none.
 std::string FileExtension(const std::string& path);
 

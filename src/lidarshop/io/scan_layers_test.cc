@@ -1,5 +1,5 @@
 // The synthesized flag in E57 (lidarshop's extension field) and scans written with a second layer behind them
-// (WriteScanWithLayer: E57 second returns, PLY two scans, PCD one cloud, PTX refused).
+// (WriteScanWithLayer: E57 second returns, PLY two scans, PCD one cloud, PTX refused); the lists of formats.
 #include <algorithm>
 #include <filesystem>
 #include <string>
@@ -292,6 +292,26 @@ TEST(ScanLayers, PtxAndMismatchedLayersAreRefused) {
   moved.world_from_scanner(0, 3) += 1.0;
   EXPECT_THROW(WriteScanWithLayer(folder.File("kept.pcd"), layers.front, moved), InputError);
   EXPECT_FALSE(std::filesystem::exists(folder.File("kept.pcd")));
+}
+
+// The lists a file dialog offers are the table's: every listed write format writes a scan that reads back,
+// and an extension not listed is refused.
+TEST(ScanFormats, EveryListedWriteFormatWritesAndReadsBack) {
+  const std::vector<std::string> write = SupportedScanWriteExtensions();
+  const std::vector<std::string> read = SupportedScanReadExtensions();
+  for (const char* expected : {"ptx", "e57", "ply", "pcd"}) {
+    EXPECT_THAT(write, ::testing::Contains(expected));
+    EXPECT_THAT(read, ::testing::Contains(expected));
+  }
+  const Layers layers = MakeLayers();
+  TempFolder folder;
+  for (const std::string& extension : write) {
+    const std::string path = folder.File("scan." + extension);
+    WriteScanFile(path, {layers.front});
+    EXPECT_EQ(ReadScanFile(path).scans.at(0).CountValid(), layers.front.CountValid()) << extension;
+  }
+  EXPECT_THAT(write, Not(::testing::Contains("xyz")));
+  EXPECT_THROW(WriteScanFile(folder.File("scan.xyz"), {layers.front}), InputError);
 }
 
 }  // namespace

@@ -32,14 +32,11 @@ Eigen::Vector3d CellPoint(const Scan* scan, const Eigen::Vector2d& cell, const s
                           const std::string& place) {
   if (!scan) ThrowInputError(what, place, "cell", "scan cells need a scan (--scan SCAN)");
   const int row = static_cast<int>(cell.x()), col = static_cast<int>(cell.y());
-  if (row != cell.x() || col != cell.y() || row < 0 || col < 0 || row >= scan->rows || col >= scan->cols)
+  if (row != cell.x() || col != cell.y())
     ThrowInputError(what, place, "cell",
                     fmt::format("[{}, {}] is not a cell of the {} x {} scan", cell.x(), cell.y(), scan->rows,
                                 scan->cols));
-  if (!scan->valid.at<uint8_t>(row, col))
-    ThrowInputError(what, place, "cell", fmt::format("[{}, {}] has no return", row, col));
-  const cv::Vec3f p = scan->point.at<cv::Vec3f>(row, col);
-  return (scan->world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1)).head<3>();
+  return WorldPointOfCell(*scan, row, col, what, place);
 }
 
 }  // namespace
@@ -91,6 +88,18 @@ Correspondences ParseCorrespondences(const std::string& json_text, const std::st
       ThrowInputError(what, place, "", "mixes kinds of pairs (pixel/point, source/target, pixel_a/pixel_b)");
   }
   return result;
+}
+
+Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col, const std::string& what,
+                                 const std::string& place) {
+  if (row < 0 || col < 0 || row >= scan.rows || col >= scan.cols)
+    ThrowInputError(
+        what, place, "cell",
+        fmt::format("[{}, {}] is not a cell of the {} x {} scan", row, col, scan.rows, scan.cols));
+  if (!scan.valid.at<uint8_t>(row, col))
+    ThrowInputError(what, place, "cell", fmt::format("[{}, {}] has no return", row, col));
+  const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
+  return (scan.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1)).head<3>();
 }
 
 Correspondences ReadCorrespondences(const std::string& path, const Scan* scan) {

@@ -37,6 +37,11 @@ Correspondences ParseCorrespondences(const std::string& json_text, const std::st
                                      const Scan* scan = nullptr);
 Correspondences ReadCorrespondences(const std::string& path, const Scan* scan = nullptr);
 
+// The world point (metres) of the scan's cell (row, col), image orientation. Throws InputError naming `what`,
+// `place` and the field "cell" for a cell outside the scan or without a return.
+Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col, const std::string& what,
+                                 const std::string& place);
+
 // The JSON text of pixel <-> point pairs (what `resection` reads back).
 std::string PixelPointPairsToJson(const std::vector<PixelPointPair>& pairs, int width_px = 0,
                                   int height_px = 0);
