@@ -318,17 +318,20 @@ std::string FileExtension(const std::string& path) {
 
 void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
 
+// LAZ is in the table only to be refused with its reason (io/las.h), not offered.
+static bool IsRefusedFormat(const ScanFormat& format) { return std::string(format.extension) == "laz"; }
+
 std::vector<std::string> SupportedScanReadExtensions() {
   std::vector<std::string> extensions;
   for (const ScanFormat& format : ScanFormats())
-    if (format.read) extensions.push_back(format.extension);
+    if (format.read && !IsRefusedFormat(format)) extensions.push_back(format.extension);
   return extensions;
 }
 
 std::vector<std::string> SupportedScanWriteExtensions() {
   std::vector<std::string> extensions;
   for (const ScanFormat& format : ScanFormats())
-    if (format.write) extensions.push_back(format.extension);
+    if (format.write && !IsRefusedFormat(format)) extensions.push_back(format.extension);
   return extensions;
 }
 
