@@ -1,6 +1,6 @@
 // End to end in a real browser: Debian's chromium driven by playwright-core against `lidarshop serve`.
 // Opens the built-in parking lot, paints strokes on the hatchback, segments, removes it, orbits, saves as E57
-// and checks the saved file with `lidarshop info`; then reviews an inpainting of the facade's colours (accepts a
+// and checks the saved file with `lidarshop info`; then reviews an inpainting of the verge's colours (accepts a
 // candidate, places a patch by hand) and registers a second copy of the scan to the first with landmarks. Screenshots of each step go to ARTEFACTS (and to
 // docs/results/editor/ with --docs).
 //
@@ -140,11 +140,11 @@ try {
   const info = JSON.parse(execFileSync(binary, ['info', saved], { encoding: 'utf8' }));
   const scan = info.scans[0];
   if (!scan.channels.includes('synthesized')) fail(`the saved E57 has no synthesized channel: ${scan.channels}`);
-  // The patch review: a lasso on the facade, strict acceptance so that the fill stops at once; accept the best
-  // group's patch, then place one by hand.
-  const facade = labels.labels.find((entry) => entry.label === 1);
-  if (!facade) fail('no facade in the labels');
-  const [fr, fc] = facade.center;
+  // The patch review: a lasso on the grass verge before the facade (texture: identical patches are rare),
+  // strict acceptance so that the fill stops at once; accept a group's patch, then place one by hand.
+  const verge = labels.labels.find((entry) => entry.label === 6);
+  if (!verge) fail('no verge in the labels');
+  const [fr, fc] = verge.center;
   await page.click('#brush-lasso');
   await drag([[fr - 6, fc - 10], [fr - 6, fc + 10], [fr + 6, fc + 10], [fr + 6, fc - 10], [fr - 6, fc - 10]]);
   await page.waitForFunction(() => window.lidarshop.current().hole_cells > 100, null, { timeout: 30000 });
