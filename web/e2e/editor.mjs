@@ -187,15 +187,21 @@ try {
   const count = new DataView(pointsBuffer).getUint32(4, true);
   const cells = new Uint32Array(pointsBuffer, 16 + 12 * count, count);
   const target = await page.locator('#target-ray').boundingBox();
+  const ray = await page.locator('#ray').boundingBox(); // the ray panel shares the row with the other scan now
   for (const fraction of [0.15, 0.35, 0.55, 0.75, 0.9]) {
     const cell = cells[Math.floor(fraction * count)];
     const [row, col] = [Math.floor(cell / copy.cols), cell % copy.cols];
     const here = await screen(row, col);
-    await page.mouse.click(canvas.x + here.x, canvas.y + here.y);
+    await page.mouse.click(ray.x + here.x, ray.y + here.y);
     const there = await page.evaluate(([r, c]) => window.lidarshop.pairs().targetView.screenOf({ row: r, col: c }), [row, col]);
     await page.mouse.click(target.x + there.x, target.y + there.y);
   }
-  await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+  try {
+    await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+  } catch {
+    await shot('landmarks_failed');
+    fail(`landmarks: ${await page.locator('#pairs').textContent()} picked; status '${await statusText()}'`);
+  }
   await page.click('#recolor');
   await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
   await shot('landmarks');
