@@ -115,6 +115,7 @@ std::shared_ptr<Job> FillingJob(State& state, const std::shared_ptr<Document>& d
     document->review = nullptr;
     Snapshot next = document->now;
     next.scan = WithChannel(document->now.scan, review->channel, result.image, review->hole);
+    if (review->painted) next.hole = cv::Mat();
     Commit(*document, std::move(next), undo_depth);
     return nlohmann::ordered_json{{"state", "done"},
                                   {"channel", review->channel},
@@ -185,7 +186,8 @@ void Start(State& state, const std::shared_ptr<Document>& document, const nlohma
       throw OptionsFieldError("hole", which == "painted" ? "paint a hole first (hole brush or lasso)"
                                                          : "segment an object first");
     }
-    review->hole = which == "painted" ? (mask != 0) : GrowHole(mask, margin);
+    review->painted = which == "painted";
+    review->hole = review->painted ? (mask != 0) : GrowHole(mask, margin);
     const Scan& scan = start.scan;
     review->channel = body.value("channel", std::string(scan.has_color() ? "color" : "intensity"));
     if (review->channel != "color" && review->channel != "intensity")

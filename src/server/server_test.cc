@@ -474,6 +474,7 @@ TEST_F(ServerTest, InpaintingReviewAcceptPlaceAndFinish) {
   ASSERT_EQ(finished["result"]["state"], "done") << finished.dump();
   EXPECT_EQ(finished["result"]["version"].get<int64_t>(), version + 1);
   EXPECT_EQ(client_->Get(review)->status, 404);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["hole_cells"], 0);  // the hole is filled
   const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format=ply", id)));
   ASSERT_EQ(saved->status, 200);
   const fs::path file = base_ / "reviewed.ply";

@@ -56,6 +56,7 @@ struct ReviewSession {
   InpaintOptions options;
   std::string channel;  // "color" or "intensity": what the fill is written back to
   cv::Mat hole;         // CV_8U 255 = the cells inpainted
+  bool painted = true;  // the hole is the painted one (cleared when the fill is applied, as by fill)
   // The job filling now (null = none): while it runs the session is its alone. Guarded by Document::mutex.
   std::shared_ptr<Job> job;
 };

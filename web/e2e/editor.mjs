@@ -1,6 +1,6 @@
 // End to end in a real browser: Debian's chromium driven by playwright-core against `lidarshop serve`.
 // Opens the built-in parking lot, paints strokes on the hatchback, segments, removes it, orbits, saves as E57
-// and checks the saved file with `lidarshop info`; then reviews an inpainting of the facade's colours (accepts a
+// and checks the saved file with `lidarshop info`; then reviews an inpainting of the verge's colours (accepts a
 // candidate, places a patch by hand) and registers a second copy of the scan to the first with landmarks. Screenshots of each step go to ARTEFACTS (and to
 // docs/results/editor/ with --docs).
 //
@@ -140,11 +140,11 @@ try {
   const info = JSON.parse(execFileSync(binary, ['info', saved], { encoding: 'utf8' }));
   const scan = info.scans[0];
   if (!scan.channels.includes('synthesized')) fail(`the saved E57 has no synthesized channel: ${scan.channels}`);
-  // The patch review: a lasso on the facade, strict acceptance so that the fill stops at once; accept the best
-  // group's patch, then place one by hand.
-  const facade = labels.labels.find((entry) => entry.label === 1);
-  if (!facade) fail('no facade in the labels');
-  const [fr, fc] = facade.center;
+  // The patch review: a lasso on the grass verge before the facade (texture: identical patches are rare),
+  // strict acceptance so that the fill stops at once; accept a group's patch, then place one by hand.
+  const verge = labels.labels.find((entry) => entry.label === 6);
+  if (!verge) fail('no verge in the labels');
+  const [fr, fc] = verge.center;
   await page.click('#brush-lasso');
   await drag([[fr - 6, fc - 10], [fr - 6, fc + 10], [fr + 6, fc + 10], [fr + 6, fc - 10], [fr - 6, fc - 10]]);
   await page.waitForFunction(() => window.lidarshop.current().hole_cells > 100, null, { timeout: 30000 });
@@ -187,15 +187,21 @@ try {
   const count = new DataView(pointsBuffer).getUint32(4, true);
   const cells = new Uint32Array(pointsBuffer, 16 + 12 * count, count);
   const target = await page.locator('#target-ray').boundingBox();
+  const ray = await page.locator('#ray').boundingBox(); // the ray panel shares the row with the other scan now
   for (const fraction of [0.15, 0.35, 0.55, 0.75, 0.9]) {
     const cell = cells[Math.floor(fraction * count)];
     const [row, col] = [Math.floor(cell / copy.cols), cell % copy.cols];
     const here = await screen(row, col);
-    await page.mouse.click(canvas.x + here.x, canvas.y + here.y);
+    await page.mouse.click(ray.x + here.x, ray.y + here.y);
     const there = await page.evaluate(([r, c]) => window.lidarshop.pairs().targetView.screenOf({ row: r, col: c }), [row, col]);
     await page.mouse.click(target.x + there.x, target.y + there.y);
   }
-  await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+  try {
+    await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+  } catch {
+    await shot('landmarks_failed');
+    fail(`landmarks: ${await page.locator('#pairs').textContent()} picked; status '${await statusText()}'`);
+  }
   await page.click('#recolor');
   await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
   await shot('landmarks');

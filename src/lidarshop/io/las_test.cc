@@ -190,6 +190,24 @@ TEST(LasTest, SeveralScansAreOneCloud) {
   EXPECT_EQ(source_last, 1);
 }
 
+TEST(LasTest, ALayerBehindIsOneCloudWithTheSyntheticFlag) {
+  TempFolder folder;
+  Scan front = SyntheticScan();
+  front.synthesized.release();
+  Scan behind = Clone(front);
+  behind.valid.setTo(0);
+  behind.valid(cv::Rect(5, 10, 30, 8)).setTo(kValid);
+  const std::string path = folder.File("layers.las");
+  WriteScanWithLayer(path, front, behind);
+  const Scan back = ReadScanFile(path).scans[0];
+  ASSERT_EQ(back.cols, front.CountValid() + behind.CountValid());
+  ASSERT_FALSE(back.synthesized.empty());
+  EXPECT_EQ(cv::countNonZero(back.synthesized), behind.CountValid());
+  EXPECT_EQ(cv::countNonZero(back.synthesized(cv::Rect(0, 0, static_cast<int>(front.CountValid()), 1))), 0);
+  EXPECT_THAT(InputErrorOf([&] { WriteScanWithLayer(folder.File("layers.xyz"), front, behind); }),
+              HasSubstr("cannot mark"));
+}
+
 TEST(LasTest, WriterErrors) {
   TempFolder folder;
   Scan scan = SyntheticScan();

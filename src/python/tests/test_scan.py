@@ -94,6 +94,21 @@ def test_write_read_round_trip(scan, tmp_path, extension):
         np.testing.assert_array_equal(back.color[valid], scan.color[valid])
 
 
+@pytest.mark.parametrize("extension", ["las", "xyz", "pts"])
+def test_point_formats_keep_the_world_points(scan, tmp_path, extension):
+    path = tmp_path / f"box.{extension}"
+    lidarshop.write_scan(scan, str(path))
+    back = lidarshop.read_scan(str(path))
+    valid = scan.valid > 0
+    assert (back.rows, back.cols) == (1, int(valid.sum()))  # the points alone, in row-major order
+
+    def world(s, mask):
+        return s.point[mask] @ s.world_from_scanner[:3, :3].T + s.world_from_scanner[:3, 3]
+
+    np.testing.assert_allclose(world(back, back.valid > 0), world(scan, valid), atol=1e-4)
+    np.testing.assert_array_equal(back.color[0], scan.color[valid])
+
+
 def test_bad_files_raise_input_error(tmp_path):
     bad = tmp_path / "bad.ptx"
     bad.write_text("12\nnot a number\n")
@@ -104,7 +119,7 @@ def test_bad_files_raise_input_error(tmp_path):
     with pytest.raises(OSError):  # ... and an OSError
         lidarshop.read_scan(str(tmp_path / "missing.e57"))
     with pytest.raises(lidarshop.InputError, match="unknown scan format"):
-        lidarshop.write_scan(lidarshop.Scan(2, 2), str(tmp_path / "scan.xyz"))
+        lidarshop.write_scan(lidarshop.Scan(2, 2), str(tmp_path / "scan.asc"))
 
 
 def test_builtin_scenes_and_dict_scenes():
