@@ -640,13 +640,8 @@ PointCloud ObservedModelCloud(const VerifierModel& model, const Eigen::Matrix4d&
 
 Eigen::Matrix4d PoseFromXyzYaw(double x_m, double y_m, double z_m, double yaw_deg, double pitch_deg,
                                double roll_deg) {
-  const double to_rad = kPi / 180.0;
-  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(yaw_deg * to_rad, Eigen::Vector3d::UnitZ()) *
-                                    Eigen::AngleAxisd(pitch_deg * to_rad, Eigen::Vector3d::UnitX()) *
-                                    Eigen::AngleAxisd(roll_deg * to_rad, Eigen::Vector3d::UnitY()))
-                                       .toRotationMatrix();
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
-  pose.topLeftCorner<3, 3>() = rotation;
+  pose.topLeftCorner<3, 3>() = RotationFromEulerDegrees(Eigen::Vector3d(roll_deg, pitch_deg, yaw_deg));
   pose.topRightCorner<3, 1>() = Eigen::Vector3d(x_m, y_m, z_m);
   return pose;
 }
