@@ -22,7 +22,7 @@ const std::vector<Command>& Commands() {
       {"demo", lidarshop::cli::RunDemo, "run the main job on a built-in scene, results in ./out/"},
       {"scan", lidarshop::cli::RunScan, "synthesize a scan of a scene description (JSON)"},
       {"info", lidarshop::cli::RunInfo, "describe a scan file as JSON"},
-      {"convert", lidarshop::cli::RunConvert, "convert between PTX, E57, PLY and PCD"},
+      {"convert", lidarshop::cli::RunConvert, "convert between PTX, E57, PLY, PCD, LAS, XYZ and PTS"},
       {"render", lidarshop::cli::RunRender, "render a channel of a scan as a picture"},
       {"verify", lidarshop::cli::RunVerify, "consistency and confidence of an object pose"},
       {"sweep", lidarshop::cli::RunSweep, "verification heat maps over candidate poses"},
