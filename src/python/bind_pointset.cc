@@ -44,15 +44,6 @@ py::array_t<float> PointsArray(const std::vector<Eigen::Vector3f>& points) {
   return array;
 }
 
-py::array_t<double> VectorsArray(const std::vector<Eigen::Vector3d>& vectors) {
-  py::array_t<double> array({static_cast<py::ssize_t>(vectors.size()), py::ssize_t{3}});
-  auto view = array.mutable_unchecked<2>();
-  for (size_t i = 0; i < vectors.size(); ++i) {
-    for (int k = 0; k < 3; ++k) view(i, k) = vectors[i][k];
-  }
-  return array;
-}
-
 std::vector<Eigen::VectorXd> RowsOf(const py::handle& values, int k, const std::string& what) {
   const py::array_t<double, py::array::c_style | py::array::forcecast> array =
       py::module_::import("numpy").attr("asarray")(values, "float64");
@@ -67,6 +58,18 @@ std::vector<Eigen::VectorXd> RowsOf(const py::handle& values, int k, const std::
   return rows;
 }
 
+Eigen::Vector3f Vector3Of(const py::handle& value, const std::string& what) {
+  return RowsOf(py::make_tuple(value), 3, what).front().cast<float>();
+}
+
+void SetNormals(const py::handle& normals, PointCloud* cloud) {
+  const PointCloud given = CloudOf(normals, "normals");
+  if (given.size() != cloud->size()) {
+    throw py::value_error(fmt::format("normals: {} rows for {} points", given.size(), cloud->size()));
+  }
+  cloud->normals = given.points;
+}
+
 py::array BoolArray(const std::vector<uint8_t>& flags) {
   py::array_t<bool> array(static_cast<py::ssize_t>(flags.size()));
   bool* out = array.mutable_data();
@@ -75,13 +78,6 @@ py::array BoolArray(const std::vector<uint8_t>& flags) {
 }
 
 namespace {
-
-template <class T>
-py::array_t<T> VectorArray(const std::vector<T>& values) {
-  py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
-  if (!values.empty()) std::memcpy(array.mutable_data(), values.data(), values.size() * sizeof(T));
-  return array;
-}
 
 // A per-point tool: fn(cloud, options) for a cloud of `points` and options from an object, a dict or keywords.
 template <class Options, class Fn>
@@ -131,7 +127,7 @@ void BindPointSetResults(py::module_& m) {
       .def_property_readonly(
           "labels", [](const KMeansResult& r) { return VectorArray(r.labels); }, "int32 (N,)")
       .def_property_readonly(
-          "centers", [](const KMeansResult& r) { return VectorsArray(r.centers); }, "float64 (k, 3)")
+          "centers", [](const KMeansResult& r) { return VectorsArray<3>(r.centers); }, "float64 (k, 3)")
       .def_readonly("inertia_m2", &KMeansResult::inertia_m2)
       .def_readonly("iterations", &KMeansResult::iterations);
   py::class_<IcpResult>(m, "IcpResult", "Point-to-plane ICP.")
@@ -207,8 +203,7 @@ void BindFilters(py::module_& m) {
           for (const Eigen::VectorXd& corner : RowsOf(polygon, 2, "polygon"))
             crop.polygon.push_back(corner.cast<float>());
         }
-        if (!origin.is_none())
-          crop.origin = RowsOf(py::make_tuple(origin), 3, "origin").front().cast<float>();
+        if (!origin.is_none()) crop.origin = Vector3Of(origin, "origin");
         crop.Check();
         return BoolArray(CropInliers(cloud, crop));
       },
@@ -280,7 +275,7 @@ void BindShapes(py::module_& m) {
         const PointCloud cloud = CloudOf(points);
         NormalOptions normal_options = OptionsOf<NormalOptions>(options, kwargs);
         if (!viewpoint.is_none()) {
-          normal_options.viewpoint = RowsOf(py::make_tuple(viewpoint), 3, "viewpoint").front().cast<float>();
+          normal_options.viewpoint = Vector3Of(viewpoint, "viewpoint");
         }
         NormalResult result;
         {
@@ -297,13 +292,7 @@ void BindShapes(py::module_& m) {
       [](const py::object& points, double radius_m, const py::object& normals, double normal_radius_m) {
         PointCloud cloud = CloudOf(points);
         if (!(radius_m > 0)) throw OptionsError(fmt::format("radius_m: {} is out of range > 0", radius_m));
-        if (!normals.is_none()) {
-          const PointCloud given = CloudOf(normals, "normals");
-          if (given.size() != cloud.size()) {
-            throw py::value_error(fmt::format("normals: {} rows for {} points", given.size(), cloud.size()));
-          }
-          cloud.normals = given.points;
-        }
+        if (!normals.is_none()) SetNormals(normals, &cloud);
         std::vector<Fpfh> features;
         {
           py::gil_scoped_release release;
@@ -332,15 +321,9 @@ void BindSurfaces(py::module_& m) {
          const py::object& viewpoint, const py::kwargs& kwargs) {
         PointCloud cloud = CloudOf(points);
         SurfaceOptions surface_options = OptionsOf<SurfaceOptions>(options, kwargs);
-        if (!normals.is_none()) {
-          const PointCloud given = CloudOf(normals, "normals");
-          if (given.size() != cloud.size()) {
-            throw py::value_error(fmt::format("normals: {} rows for {} points", given.size(), cloud.size()));
-          }
-          cloud.normals = given.points;
-        }
+        if (!normals.is_none()) SetNormals(normals, &cloud);
         if (!viewpoint.is_none()) {
-          surface_options.viewpoint = RowsOf(py::make_tuple(viewpoint), 3, "viewpoint").front().cast<float>();
+          surface_options.viewpoint = Vector3Of(viewpoint, "viewpoint");
         }
         py::gil_scoped_release release;
         return ReconstructSurface(cloud, surface_options);
@@ -370,7 +353,6 @@ void BindScanTools(py::module_& m) {
         {
           py::gil_scoped_release release;
           labels = ScanSuperpixels(scan, superpixel_options, &count);
-          labels.setTo(kNoLabel, scan.valid == 0);
         }
         return py::make_tuple(MatToArray(labels), count);
       },

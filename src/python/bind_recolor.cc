@@ -20,23 +20,6 @@
 namespace lidarshop::python {
 namespace {
 
-// float64 (N, 2) / (N, 3) -> Eigen vectors; ValueError naming `what` on another shape.
-template <int K>
-std::vector<Eigen::Matrix<double, K, 1>> VectorsOf(const py::handle& values, const std::string& what) {
-  const std::vector<Eigen::VectorXd> rows = RowsOf(values, K, what);
-  return std::vector<Eigen::Matrix<double, K, 1>>(rows.begin(), rows.end());
-}
-
-template <int K>
-py::array_t<double> VectorsArrayOf(const std::vector<Eigen::Matrix<double, K, 1>>& vectors) {
-  py::array_t<double> array({static_cast<py::ssize_t>(vectors.size()), py::ssize_t{K}});
-  auto view = array.mutable_unchecked<2>();
-  for (size_t i = 0; i < vectors.size(); ++i) {
-    for (int k = 0; k < K; ++k) view(i, k) = vectors[i][k];
-  }
-  return array;
-}
-
 std::vector<PixelPointPair> PixelPointPairsOf(const py::handle& pixels, const py::handle& points) {
   const auto pixel = VectorsOf<2>(pixels, "pixels");
   const auto point = VectorsOf<3>(points, "points");
@@ -49,8 +32,6 @@ std::vector<PixelPointPair> PixelPointPairsOf(const py::handle& pixels, const py
   return pairs;
 }
 
-py::array_t<double> Array(const std::vector<double>& values) { return py::array_t<double>(py::cast(values)); }
-
 // A correspondence file's content as a dict of arrays.
 py::dict CorrespondenceDict(const Correspondences& pairs) {
   std::vector<Eigen::Vector2d> pixel, pixel_b;
@@ -62,22 +43,22 @@ py::dict CorrespondenceDict(const Correspondences& pairs) {
       pixel.push_back(p.pixel_px);
       point.push_back(p.point_in_world);
     }
-    result["pixels"] = VectorsArrayOf<2>(pixel);
-    result["points"] = VectorsArrayOf<3>(point);
+    result["pixels"] = VectorsArray<2>(pixel);
+    result["points"] = VectorsArray<3>(point);
   } else if (pairs.kind == PairKind::kLandmark) {
     for (const PointPair& p : pairs.landmarks) {
       source.push_back(p.source);
       point.push_back(p.target);
     }
-    result["source"] = VectorsArrayOf<3>(source);
-    result["target"] = VectorsArrayOf<3>(point);
+    result["source"] = VectorsArray<3>(source);
+    result["target"] = VectorsArray<3>(point);
   } else {
     for (const PixelPair& p : pairs.pixel_pixel) {
       pixel.push_back(p.pixel_a);
       pixel_b.push_back(p.pixel_b);
     }
-    result["pixels_a"] = VectorsArrayOf<2>(pixel);
-    result["pixels_b"] = VectorsArrayOf<2>(pixel_b);
+    result["pixels_a"] = VectorsArray<2>(pixel);
+    result["pixels_b"] = VectorsArray<2>(pixel_b);
   }
   result["image_size_px"] = pairs.width_px > 0 ? py::object(py::make_tuple(pairs.width_px, pairs.height_px))
                                                : py::object(py::none());
@@ -131,7 +112,7 @@ camera files (read_camera / write_camera).)doc");
             for (size_t i = 0; i < points.size(); ++i) {
               if (!ProjectWorldPoint(c, points[i], &pixels[i])) pixels[i].setConstant(std::nan(""));
             }
-            return VectorsArrayOf<2>(pixels);
+            return VectorsArray<2>(pixels);
           },
           py::arg("points_in_world"), "Pixels of world points, float64 (N, 2); NaN behind the camera.")
       .def(
@@ -140,7 +121,7 @@ camera files (read_camera / write_camera).)doc");
             const auto pixels = VectorsOf<2>(pixels_px, "pixels_px");
             std::vector<Eigen::Vector3d> rays(pixels.size());
             for (size_t i = 0; i < pixels.size(); ++i) rays[i] = UnprojectPixel(c, pixels[i]);
-            return VectorsArrayOf<3>(rays);
+            return VectorsArray<3>(rays);
           },
           py::arg("pixels_px"),
           "Rays of pixels in the camera frame with z = 1 (depth * ray = point), (N, 3).")
@@ -195,7 +176,8 @@ void BindResection(py::module_& m) {
       .def_readonly("camera", &ResectionResult::camera)
       .def_readonly("projection", &ResectionResult::projection, "P (3 x 4) of the DLT on the inliers")
       .def_property_readonly(
-          "reprojection_error_px", [](const ResectionResult& r) { return Array(r.reprojection_error_px); },
+          "reprojection_error_px",
+          [](const ResectionResult& r) { return VectorArray(r.reprojection_error_px); },
           "per pair, with `camera`")
       .def_property_readonly(
           "inlier", [](const ResectionResult& r) { return BoolArray(r.inlier); }, "bool per pair")
@@ -236,12 +218,13 @@ void BindAlign(py::module_& m) {
       .def_readonly("target_from_source", &LandmarkAlignment::target_from_source)
       .def_readonly("scale", &LandmarkAlignment::scale)
       .def_property_readonly(
-          "residual_m", [](const LandmarkAlignment& a) { return Array(a.residual_m); }, "per pair, metres")
+          "residual_m", [](const LandmarkAlignment& a) { return VectorArray(a.residual_m); },
+          "per pair, metres")
       .def_readonly("rms_m", &LandmarkAlignment::rms_m);
   py::class_<PhotoPairModel>(m, "PhotoPairModel", "A homography or fundamental matrix between two photos.")
       .def_readonly("matrix", &PhotoPairModel::matrix)
       .def_property_readonly(
-          "error_px", [](const PhotoPairModel& p) { return Array(p.error_px); }, "per pair, pixels")
+          "error_px", [](const PhotoPairModel& p) { return VectorArray(p.error_px); }, "per pair, pixels")
       .def_property_readonly(
           "inlier", [](const PhotoPairModel& p) { return BoolArray(p.inlier); }, "bool per pair")
       .def_readonly("rms_px", &PhotoPairModel::rms_px);

@@ -3,6 +3,7 @@
 // option classes of options_py.h.
 #pragma once
 
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -71,9 +72,36 @@ int ImageDepth(const py::handle& image);
 PointCloud CloudOf(const py::handle& points, const std::string& what = "points");
 // float32 (N, 3).
 py::array_t<float> PointsArray(const std::vector<Eigen::Vector3f>& points);
-py::array_t<double> VectorsArray(const std::vector<Eigen::Vector3d>& vectors);
 // (N, k) float64 of an array-like with `k` columns; ValueError naming `what` otherwise.
 std::vector<Eigen::VectorXd> RowsOf(const py::handle& array, int k, const std::string& what);
+// One 3-vector (a list or array of 3 numbers) as float; ValueError naming `what` otherwise.
+Eigen::Vector3f Vector3Of(const py::handle& value, const std::string& what);
+// Normals (N, 3) for the N points of `cloud` (ValueError naming the counts when they differ).
+void SetNormals(const py::handle& normals, PointCloud* cloud);
+
+// A 1-D numpy array (a copy) of a vector of numbers.
+template <class T>
+py::array_t<T> VectorArray(const std::vector<T>& values) {
+  py::array_t<T> array(static_cast<py::ssize_t>(values.size()));
+  if (!values.empty()) std::memcpy(array.mutable_data(), values.data(), values.size() * sizeof(T));
+  return array;
+}
+
+// (N, K) float64 of fixed-size vectors, and back.
+template <int K>
+py::array_t<double> VectorsArray(const std::vector<Eigen::Matrix<double, K, 1>>& vectors) {
+  py::array_t<double> array({static_cast<py::ssize_t>(vectors.size()), py::ssize_t{K}});
+  auto view = array.mutable_unchecked<2>();
+  for (size_t i = 0; i < vectors.size(); ++i) {
+    for (int k = 0; k < K; ++k) view(i, k) = vectors[i][k];
+  }
+  return array;
+}
+template <int K>
+std::vector<Eigen::Matrix<double, K, 1>> VectorsOf(const py::handle& values, const std::string& what) {
+  const std::vector<Eigen::VectorXd> rows = RowsOf(values, K, what);
+  return std::vector<Eigen::Matrix<double, K, 1>>(rows.begin(), rows.end());
+}
 // Flags as a bool numpy array (N,).
 py::array BoolArray(const std::vector<uint8_t>& flags);
 

@@ -414,7 +414,6 @@ int RunPoints(int argc, char** argv) {
                   scan, region_options, NormalAngleCondition(with_normals, max_angle_deg), &count);
             } else {
               labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
-              labelled.label.setTo(kNoLabel, scan.valid == 0);
             }
             total += count;
             scans_out.push_back(labelled);

@@ -117,12 +117,6 @@ HandLas ThreePoints(int minor, int format) {
   return las;
 }
 
-Eigen::Vector3d WorldPoint(const Scan& scan, int row, int col) {
-  const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-  return scan.world_from_scanner.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) +
-         scan.world_from_scanner.topRightCorner<3, 1>();
-}
-
 Scan ReadBytes(const TempFolder& folder, const std::string& bytes, const std::string& name = "hand.las") {
   const std::string path = folder.File(name);
   testing_io::WriteText(path, bytes);
@@ -140,9 +134,9 @@ TEST(LasTest, EveryPointFormatReads) {
     ASSERT_EQ(scan.cols, 3);
     EXPECT_EQ(scan.CountValid(), 3);
     EXPECT_TRUE(scan.world_from_scanner.isIdentity());  // within 1 km: no origin shift
-    EXPECT_LT((WorldPoint(scan, 0, 0) - Eigen::Vector3d(100.001, 200.002, 0.003)).norm(), 1e-5);
-    EXPECT_LT((WorldPoint(scan, 0, 1) - Eigen::Vector3d(101, 199, -1.5)).norm(), 1e-5);
-    EXPECT_LT((WorldPoint(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
+    EXPECT_LT((WorldPointOfCell(scan, 0, 0) - Eigen::Vector3d(100.001, 200.002, 0.003)).norm(), 1e-5);
+    EXPECT_LT((WorldPointOfCell(scan, 0, 1) - Eigen::Vector3d(101, 199, -1.5)).norm(), 1e-5);
+    EXPECT_LT((WorldPointOfCell(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
     EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 0), 1.0f);
     EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 1), 0.0f);
     EXPECT_NEAR(scan.intensity.at<float>(0, 2), 0.5f, 1e-4);
@@ -170,7 +164,7 @@ TEST(LasTest, ExtraBytesAndRecordsAreSkipped) {
   las.vlr = std::string(40, 'v');
   const Scan scan = ReadBytes(folder, Build(las));
   ASSERT_EQ(scan.CountValid(), 3);
-  EXPECT_LT((WorldPoint(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 2) - Eigen::Vector3d(100, 200.5, 2)).norm(), 1e-5);
   EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 1), cv::Vec3b(1, 2, 3));
 }
 
@@ -198,8 +192,9 @@ TEST(LasTest, FarCoordinatesKeepTenthsOfMillimetres) {
   las.offset[2] = 310;
   const Scan scan = ReadBytes(folder, Build(las));
   EXPECT_FALSE((scan.world_from_scanner.topRightCorner<3, 1>().isZero()));
-  EXPECT_LT((WorldPoint(scan, 0, 0) - Eigen::Vector3d(512345.0001, 5412345.0002, 310.0003)).norm(), 2e-5);
-  EXPECT_LT((WorldPoint(scan, 0, 1) - Eigen::Vector3d(512345.1, 5412344.9, 309.85)).norm(), 2e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 0) - Eigen::Vector3d(512345.0001, 5412345.0002, 310.0003)).norm(),
+            2e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 1) - Eigen::Vector3d(512345.1, 5412344.9, 309.85)).norm(), 2e-5);
 }
 
 // ---- Hostile and unsupported files ----
@@ -270,6 +265,10 @@ TEST(LasTest, LazIsRefusedWithTheReason) {
               AllOf(HasSubstr(laz), HasSubstr("LAZ is not supported")));
   EXPECT_THAT(InputErrorOf([&] { WriteScanFile(laz, {ReadBytes(folder, Build(ThreePoints(4, 6)))}); }),
               HasSubstr("LAZ is not supported"));
+  // An output path is checked before any work: a .laz output is refused up front, and not offered.
+  EXPECT_THAT(InputErrorOf([&] { CheckScanFileFormat(folder.File("out.laz")); }),
+              HasSubstr("LAZ is not supported"));
+  EXPECT_THAT(SupportedScanWriteExtensions(), testing::Not(testing::Contains("laz")));
   // LASzip marks compressed point formats with bits 7 and 6, and adds its VLR.
   std::string bytes = Build(ThreePoints(4, 6));
   bytes[104] = static_cast<char>(6 | 0x80);

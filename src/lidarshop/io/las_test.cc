@@ -25,12 +25,6 @@ using testing::HasSubstr;
 using testing_io::InputErrorOf;
 using testing_io::TempFolder;
 
-Eigen::Vector3d WorldPoint(const Scan& scan, int row, int col) {
-  const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-  return scan.world_from_scanner.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) +
-         scan.world_from_scanner.topRightCorner<3, 1>();
-}
-
 // ---- Round trips through the writer ----
 
 Scan SyntheticScan() {
@@ -60,8 +54,8 @@ void ExpectSamePoints(const Scan& original, const Scan& back, bool color, bool l
   for (int row = 0; row < original.rows; ++row) {
     for (int col = 0; col < original.cols; ++col) {
       if (!original.valid.at<uint8_t>(row, col)) continue;
-      worst =
-          std::max(worst, (WorldPoint(original, row, col) - WorldPoint(back, 0, i)).cwiseAbs().maxCoeff());
+      worst = std::max(
+          worst, (WorldPointOfCell(original, row, col) - WorldPointOfCell(back, 0, i)).cwiseAbs().maxCoeff());
       EXPECT_NEAR(back.intensity.at<float>(0, i), original.intensity.at<float>(row, col), intensity_step)
           << i;
       if (color) {
@@ -133,7 +127,7 @@ TEST(LasTest, HeaderFields) {
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
       if (!scan.valid.at<uint8_t>(row, col)) continue;
-      const Eigen::Vector3d p = WorldPoint(scan, row, col);
+      const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
       for (int axis = 0; axis < 3; ++axis) low[axis] = std::min(low[axis], p[axis]);
     }
   }

@@ -75,13 +75,10 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (const Scan& scan : scans) {
-    const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
-    const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
-        const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-        world.push_back(rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation);
+        world.push_back(WorldPointOfCell(scan, row, col));
         low = low.cwiseMin(world.back());
         high = high.cwiseMax(world.back());
       }

@@ -184,7 +184,7 @@ TEST(MalformedInputTest, ImagesAndUnknownFormats) {
   EXPECT_THAT(InputErrorOf([&] { ReadImage(folder.File("missing.png")); }), HasSubstr("missing"));
   WriteText(folder.File("scan.asc"), "1 2 3\n");
   EXPECT_THAT(ScanError(folder.File("scan.asc")),
-              AllOf(HasSubstr("scan.asc"), HasSubstr("unknown scan format")));
+              AllOf(HasSubstr("scan.asc"), HasSubstr("unknown scan format"), HasSubstr(".las")));
   EXPECT_THAT(ScanError(folder.File("missing.ptx")),
               AllOf(HasSubstr("missing.ptx"), HasSubstr("cannot open")));
 }

@@ -244,6 +244,8 @@ struct ScanFormat {
   // Reads the scans of a file, adding what it left out to `warnings`.
   std::vector<Scan> (*read)(const std::string& path, std::vector<std::string>* warnings);
   void (*write)(const std::string& path, const std::vector<Scan>& scans);
+  // A format known only to be refused (LAZ): neither read nor write is set, this says why.
+  std::string (*refusal)() = nullptr;
 };
 
 const std::vector<ScanFormat>& ScanFormats() {
@@ -270,13 +272,7 @@ const std::vector<ScanFormat>& ScanFormats() {
       {"las",
        [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadLas(path)}; },
        [](const std::string& path, const std::vector<Scan>& scans) { WriteLas(path, scans); }},
-      {"laz",
-       [](const std::string& path, std::vector<std::string>*) -> std::vector<Scan> {
-         ThrowInputError(path, "", "", LazNotSupportedMessage());
-       },
-       [](const std::string& path, const std::vector<Scan>&) {
-         ThrowInputError(path, "", "", LazNotSupportedMessage());
-       }},
+      {"laz", nullptr, nullptr, &LazNotSupportedMessage},
       {"xyz",
        [](const std::string& path, std::vector<std::string>*) {
          return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz)};
@@ -298,12 +294,17 @@ const std::vector<ScanFormat>& ScanFormats() {
 const ScanFormat& FormatFor(const std::string& path) {
   const std::string extension = FileExtension(path);
   for (const ScanFormat& format : ScanFormats()) {
-    if (extension == format.extension) return format;
+    if (extension != format.extension) continue;
+    if (format.refusal != nullptr) ThrowInputError(path, "", "", format.refusal());
+    return format;
   }
-  ThrowInputError(
-      path, "", "",
-      fmt::format("unknown scan format '{}' (lidarshop reads .ptx, .e57, .ply, .pcd, .las, .xyz and .pts)",
-                  extension.empty() ? std::string("no extension") : "." + extension));
+  std::string known;
+  for (const ScanFormat& format : ScanFormats()) {
+    if (format.read != nullptr) known += fmt::format("{}.{}", known.empty() ? "" : " ", format.extension);
+  }
+  ThrowInputError(path, "", "",
+                  fmt::format("unknown scan format '{}' (lidarshop reads {})",
+                              extension.empty() ? std::string("no extension") : "." + extension, known));
 }
 
 }  // namespace
@@ -318,20 +319,17 @@ std::string FileExtension(const std::string& path) {
 
 void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
 
-// LAZ is in the table only to be refused with its reason (io/las.h), not offered.
-static bool IsRefusedFormat(const ScanFormat& format) { return std::string(format.extension) == "laz"; }
-
 std::vector<std::string> SupportedScanReadExtensions() {
   std::vector<std::string> extensions;
   for (const ScanFormat& format : ScanFormats())
-    if (format.read && !IsRefusedFormat(format)) extensions.push_back(format.extension);
+    if (format.read) extensions.push_back(format.extension);
   return extensions;
 }
 
 std::vector<std::string> SupportedScanWriteExtensions() {
   std::vector<std::string> extensions;
   for (const ScanFormat& format : ScanFormats())
-    if (format.write && !IsRefusedFormat(format)) extensions.push_back(format.extension);
+    if (format.write) extensions.push_back(format.extension);
   return extensions;
 }
 

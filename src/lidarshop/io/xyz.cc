@@ -181,13 +181,10 @@ void WritePointList(const std::string& path, const std::vector<Scan>& scans, Poi
   auto sink = std::back_inserter(out);
   if (kind == PointListKind::kPts) fmt::format_to(sink, "{}\n", count);
   for (const Scan& scan : scans) {
-    const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
-    const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
-        const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-        const Eigen::Vector3d world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+        const Eigen::Vector3d world = WorldPointOfCell(scan, row, col);
         fmt::format_to(sink, "{:.5f} {:.5f} {:.5f} ", world.x(), world.y(), world.z());
         const float intensity = scan.intensity.at<float>(row, col);
         if (kind == PointListKind::kPts) {

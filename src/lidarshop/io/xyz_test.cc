@@ -20,12 +20,6 @@ using testing_io::InputErrorOf;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
-Eigen::Vector3d WorldPoint(const Scan& scan, int row, int col) {
-  const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-  return scan.world_from_scanner.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) +
-         scan.world_from_scanner.topRightCorner<3, 1>();
-}
-
 Scan SyntheticScan() {
   test_scenes::GroundAndBoxOptions options;
   options.rows = 40;
@@ -49,8 +43,8 @@ double CompareClouds(const Scan& original, const Scan& back, double intensity_st
   for (int row = 0; row < original.rows; ++row) {
     for (int col = 0; col < original.cols; ++col) {
       if (!original.valid.at<uint8_t>(row, col) || i >= back.cols) continue;
-      worst =
-          std::max(worst, (WorldPoint(original, row, col) - WorldPoint(back, 0, i)).cwiseAbs().maxCoeff());
+      worst = std::max(
+          worst, (WorldPointOfCell(original, row, col) - WorldPointOfCell(back, 0, i)).cwiseAbs().maxCoeff());
       EXPECT_NEAR(back.intensity.at<float>(0, i), original.intensity.at<float>(row, col), intensity_step)
           << i;
       if (original.has_color()) {
@@ -113,8 +107,9 @@ TEST(XyzTest, ColumnsAndIntensityRanges) {
   // UTM coordinates keep their tenths of millimetres (float alone would keep half metres).
   WriteText(path, "512345.1234 5412345.5678 310.0001\n512346.0001 5412344.9999 311.5\n");
   scan = ReadScanFile(path).scans[0];
-  EXPECT_LT((WorldPoint(scan, 0, 0) - Eigen::Vector3d(512345.1234, 5412345.5678, 310.0001)).norm(), 2e-5);
-  EXPECT_LT((WorldPoint(scan, 0, 1) - Eigen::Vector3d(512346.0001, 5412344.9999, 311.5)).norm(), 2e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 0) - Eigen::Vector3d(512345.1234, 5412345.5678, 310.0001)).norm(),
+            2e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 1) - Eigen::Vector3d(512346.0001, 5412344.9999, 311.5)).norm(), 2e-5);
 }
 
 TEST(XyzTest, MalformedLinesNameFileLineAndColumn) {

@@ -104,6 +104,9 @@ TEST(SurfaceTest, BadInputIsRefused) {
   PointCloud nan = Sphere(100, true);
   nan.points[3].x() = std::nanf("");
   EXPECT_THROW(ReconstructSurface(nan), InputError);
+  PointCloud mismatched = Sphere(100, true);
+  mismatched.normals.pop_back();
+  EXPECT_THROW(ReconstructSurface(mismatched), InputError);
   EXPECT_THROW(ReconstructSurface(Sphere(100, true), {.poisson_angle_deg = 0}), OptionsError);
   // Exactly on one plane: refused (a 3-D triangulation of it has no cells), not a crash.
   PointCloud flat;

@@ -70,6 +70,7 @@ cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int*
       *num_superpixels = static_cast<int>(high) + 1;
     }
   }
+  if (!scan.valid.empty()) labels.setTo(kNoLabel, scan.valid == 0);
   return labels;
 }
 

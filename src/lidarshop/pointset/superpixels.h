@@ -37,8 +37,9 @@ struct SuperpixelOptions {
 template <>
 const StructInfo& InfoOf<SuperpixelOptions>();
 
-// CV_32S rows x cols superpixel labels 0, 1, … (cells without a return included: their range channel is 0).
-// `num_superpixels` (optional) receives the count. Deterministic (neither method draws random numbers).
+// CV_32S rows x cols superpixel labels 0, 1, …, kNoLabel for cells without a return (SLIC and graph see them,
+// with range 0; QuickShift leaves them out). `num_superpixels` (optional) receives the count. Deterministic
+// (no method draws random numbers).
 cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int* num_superpixels = nullptr);
 
 }  // namespace lidarshop

@@ -98,8 +98,7 @@ Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col, const std::
         fmt::format("[{}, {}] is not a cell of the {} x {} scan", row, col, scan.rows, scan.cols));
   if (!scan.valid.at<uint8_t>(row, col))
     ThrowInputError(what, place, "cell", fmt::format("[{}, {}] has no return", row, col));
-  const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
-  return (scan.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1)).head<3>();
+  return WorldPointOfCell(scan, row, col);
 }
 
 Correspondences ReadCorrespondences(const std::string& path, const Scan* scan) {

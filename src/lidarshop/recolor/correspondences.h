@@ -37,7 +37,7 @@ Correspondences ParseCorrespondences(const std::string& json_text, const std::st
                                      const Scan* scan = nullptr);
 Correspondences ReadCorrespondences(const std::string& path, const Scan* scan = nullptr);
 
-// The world point (metres) of the scan's cell (row, col), image orientation. Throws InputError naming `what`,
+// WorldPointOfCell (scan/scan.h), checked: the cell (row, col), image orientation. Throws InputError naming `what`,
 // `place` and the field "cell" for a cell outside the scan or without a return.
 Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col, const std::string& what,
                                  const std::string& place);

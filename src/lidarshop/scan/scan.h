@@ -119,6 +119,14 @@ ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_
 // from the fitted grid and stores the grid and its residual in scan->grid. Valid cells keep their points.
 void FitGrid(Scan* scan);
 
+// The point of one cell in the world frame, in double precision (world_from_scanner applied to the float
+// point): what writers of world coordinates and correspondences by cell need.
+inline Eigen::Vector3d WorldPointOfCell(const Scan& scan, int row, int col) {
+  const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+  return scan.world_from_scanner.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) +
+         scan.world_from_scanner.topRightCorner<3, 1>();
+}
+
 // Points with all per-point channels, valid cells only, in the scanner frame or (world = true) the world
 // frame. `cell_index` (optional) receives row * cols + col of each point.
 PointCloud ToPointCloud(const Scan& scan, bool world = false, std::vector<int64_t>* cell_index = nullptr);

@@ -207,3 +207,5 @@ def test_sweep_finds_the_box(scan):
     assert result.csv().count("\n") >= 98
     with pytest.raises(lidarshop.OptionsError, match="step_m"):
         lidarshop.sweep(box, scan, step_m=0)
+    with pytest.raises(lidarshop.OptionsError, match="consistency\\|confidence"):
+        result.heat_map("consistancy")

@@ -97,6 +97,8 @@ def test_normals_and_features(plane_with_outliers):
     np.testing.assert_allclose(features.sum(axis=1), 300, rtol=1e-3)
     # On a plane every pair has the same angles: each histogram puts its mass in few bins.
     assert np.median(features.max(axis=1)) > 50
+    with pytest.raises(ValueError, match="normals: 10 rows for 2000 points"):
+        lidarshop.fpfh(points, 0.4, normals=np.zeros((10, 3)))
 
 
 def test_scan_tools(scan):
