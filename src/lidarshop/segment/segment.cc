@@ -59,17 +59,33 @@ cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& str
   picture.setTo(cv::Scalar(30, 30, 50), scan.valid == 0);
   if (!mask.empty()) {
     LIDARSHOP_CHECK(mask.size() == picture.size() && mask.type() == CV_8U);
+    // The colour is chosen against the object and a band around it: the outline lies on both.
+    cv::Mat surroundings;
+    cv::dilate(mask, surroundings, cv::Mat(), cv::Point(-1, -1), 5);
+    const cv::Vec3b overlay_rgb = ContrastingOverlayColor(picture, surroundings);
+    const cv::Scalar overlay(overlay_rgb[0], overlay_rgb[1], overlay_rgb[2]);
     cv::Mat tinted;
-    cv::addWeighted(picture, 0.6, cv::Mat(picture.size(), CV_8UC3, cv::Scalar(255, 220, 0)), 0.4, 0, tinted);
+    cv::addWeighted(picture, 0.6, cv::Mat(picture.size(), CV_8UC3, overlay), 0.4, 0, tinted);
     tinted.copyTo(picture, mask);
     cv::Mat eroded;
     cv::erode(mask, eroded, cv::Mat());
-    picture.setTo(cv::Scalar(255, 255, 0), mask & ~eroded);
+    picture.setTo(overlay, mask & ~eroded);
   }
   if (!strokes.empty()) {
     LIDARSHOP_CHECK(strokes.size() == picture.size() && strokes.type() == CV_8U);
-    picture.setTo(cv::Scalar(0, 255, 0), strokes == kStrokeObject);
-    picture.setTo(cv::Scalar(255, 0, 0), strokes == kStrokeBackground);
+    const int radius = OverlayStrokeRadius(picture.size());
+    const cv::Mat disc =
+        cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+    for (const auto& [kind, colour] : {std::pair{kStrokeBackground, cv::Scalar(255, 0, 0)},
+                                       std::pair{kStrokeObject, cv::Scalar(0, 255, 0)}}) {
+      cv::Mat wide, rim;
+      cv::dilate(strokes == kind, wide, disc);
+      if (radius > 1) {  // a dark rim keeps a thick stroke readable on any background
+        cv::dilate(wide, rim, cv::Mat());
+        picture.setTo(cv::Scalar(0, 0, 0), rim);
+      }
+      picture.setTo(colour, wide);
+    }
   }
   return picture;
 }

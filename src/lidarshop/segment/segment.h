@@ -186,8 +186,17 @@ MaskScores ScoreMask(const cv::Mat& mask, const cv::Mat& truth, const cv::Mat& d
 cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterations = 5,
                            int probable_radius_cells = 0);
 
-// The overlay picture: the scan's colour (or intensity as grey), object cells tinted, the mask outline in
-// yellow, object strokes green and background strokes red. CV_8UC3 RGB.
+// The overlay picture: the scan's colour (or intensity as grey), object cells tinted and outlined in the
+// colour of ContrastingOverlayColor (yellow on most outdoor scenes, another on yellowish ones), object strokes
+// green and background strokes red, both widened to OverlayStrokeRadius and rimmed in black. CV_8UC3 RGB.
 cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes);
+
+// The overlay colour for `picture_rgb` (CV_8UC3): of a fixed list of saturated colours and white (yellow
+// first), the first one at least 40 CIELAB units from the colours in `region` (CV_8U; empty = the whole
+// picture), else the farthest; distances are taken at the 10th percentile so a few pixels cannot decide.
+cv::Vec3b ContrastingOverlayColor(const cv::Mat& picture_rgb, const cv::Mat& region = cv::Mat());
+
+// Radius in pixels of the strokes drawn on an overlay of this size (1 up to 800 pixels across).
+int OverlayStrokeRadius(cv::Size picture_size);
 
 }  // namespace lidarshop
