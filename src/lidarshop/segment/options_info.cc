@@ -99,6 +99,9 @@ const StructInfo& InfoOf<SegmentOptions>() {
         .Below(1);
     b.Field(&SegmentOptions::refine_relearn_models, "refine_relearn_models",
             "refinement re-learns the appearance models from every hard cell");
+    b.Field(&SegmentOptions::refine_monotone, "refine_monotone",
+            "a refinement with only background strokes only removes cells, one with only object strokes only "
+            "adds");
     return b.Build();
   }();
   return info;

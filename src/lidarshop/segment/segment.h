@@ -122,6 +122,10 @@ struct SegmentOptions {
   // and update every t-link (true), or only turn the new stroke cells into hard constraints (false, cheaper,
   // but an object stroke on a missed part then adds little more than the stroke itself).
   bool refine_relearn_models = true;
+  // Refine(): strokes say only what they say. A refinement whose new strokes are all background can only
+  // remove cells from the mask, one whose strokes are all object can only add cells (re-learnt models must
+  // not make a correct background stroke grow the object elsewhere). Mixed strokes take the new cut as is.
+  bool refine_monotone = true;
 
   void Check() const;  // throws OptionsFieldError naming the field
 };

@@ -255,18 +255,28 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   const std::vector<uint8_t> extra = s.HardFromStrokes(extra_strokes, "extra strokes");
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
-  bool any = false, outside = false;
+  bool any = false, outside = false, object_strokes = false, background_strokes = false;
   for (int i = 0; i < s.nodes.num(); ++i) {
     if (extra[i] == kFree || extra[i] == s.last_hard[i]) continue;
     s.last_hard[i] = extra[i];
     any = true;
+    (extra[i] == kHardObject ? object_strokes : background_strokes) = true;
     if (!s.last.local_of_node.empty() && s.last.local_of_node[i] < 0) outside = true;
   }
+  const cv::Mat previous_mask = s.last_result.mask;
+  const auto keep_monotone = [&](cv::Mat* mask) {
+    if (!s.options.refine_monotone || previous_mask.empty() || object_strokes == background_strokes) return;
+    if (background_strokes)
+      *mask &= previous_mask;  // the stroke cells themselves are background in the new cut already
+    else
+      *mask |= previous_mask;
+  };
   if (outside) {
     // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
     // cell so far.
     result.flow = 0;
     result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+    keep_monotone(&result.mask);
     result.object_cells = cv::countNonZero(result.mask);
     result.graph_nodes = s.last.num_local(s.nodes.num());
     result.timings.total_s = total.Seconds();
@@ -323,6 +333,7 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     // The refined object reached the ROI's edge: re-run the cut on the whole image.
     result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
   }
+  keep_monotone(&result.mask);
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
   result.timings.total_s = total.Seconds();

@@ -146,6 +146,8 @@ TEST(SegmentTest, RefineAddsHardConstraintsIncrementally) {
   const SegmentResult refined = session.Refine(extra);
   EXPECT_EQ(cv::countNonZero(refined.mask & (extra == kStrokeBackground)), 0);
   EXPECT_LT(refined.object_cells, first.object_cells);
+  // Background strokes only remove cells (refine_monotone).
+  EXPECT_EQ(cv::countNonZero(refined.mask & ~first.mask), 0);
   // The band cuts the box: what is below it is no longer connected to the object stroke.
   EXPECT_EQ(cv::countNonZero(refined.mask(cv::Rect(box.x, band_row + 2, box.width, 1))), 0);
   // Refine before Run is a programming error.
@@ -199,6 +201,8 @@ TEST(SegmentTest, RefineOutsideTheRegionOfInterestReRunsOnTheWholeImage) {
   const SegmentResult refined = session.Refine(inside);
   EXPECT_EQ(refined.graph_nodes, first.graph_nodes);
   EXPECT_EQ(cv::countNonZero((inside == kStrokeObject) & (refined.mask == 0) & (scan.valid != 0)), 0);
+  // Object strokes only add cells (refine_monotone), on the incremental path and on the whole-image re-run.
+  EXPECT_EQ(cv::countNonZero(first.mask & ~refined.mask), 0);
   // An object stroke on the wall far from the box (a second object): outside the ROI, so the cut is re-run on
   // the whole image and the stroke cells become object.
   cv::Mat far(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
@@ -212,6 +216,7 @@ TEST(SegmentTest, RefineOutsideTheRegionOfInterestReRunsOnTheWholeImage) {
   const SegmentResult again = session.Refine(far);
   EXPECT_EQ(again.graph_nodes, scan.CountValid());
   EXPECT_EQ(cv::countNonZero((far == kStrokeObject) & (again.mask == 0)), 0);
+  EXPECT_EQ(cv::countNonZero(refined.mask & ~again.mask), 0);
   EXPECT_GT(ScoreMask(again.mask & TruthMask(scan), TruthMask(scan), scan.valid).iou, 0.9);
 }
 
