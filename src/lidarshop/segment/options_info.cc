@@ -102,6 +102,8 @@ const StructInfo& InfoOf<SegmentOptions>() {
     b.Field(&SegmentOptions::refine_monotone, "refine_monotone",
             "a refinement with only background strokes only removes cells, one with only object strokes only "
             "adds");
+    b.Field(&SegmentOptions::include_enclosed_no_return, "include_enclosed_no_return",
+            "cells without a return enclosed by the object join the mask");
     return b.Build();
   }();
   return info;

@@ -126,6 +126,9 @@ struct SegmentOptions {
   // remove cells from the mask, one whose strokes are all object can only add cells (re-learnt models must
   // not make a correct background stroke grow the object elsewhere). Mixed strokes take the new cut as is.
   bool refine_monotone = true;
+  // Cells without a return enclosed by the object (dark hair, black tyres, windows: no echo, but inside the
+  // object's outline) join the mask, so a cut-out has no holes and a fill covers them too.
+  bool include_enclosed_no_return = true;
 
   void Check() const;  // throws OptionsFieldError naming the field
 };
@@ -137,7 +140,7 @@ struct SegmentTimings {
 };
 
 struct SegmentResult {
-  cv::Mat mask;                 // CV_8U 255 = object, rows x cols; 0 where invalid
+  cv::Mat mask;                 // CV_8U 255 = object, rows x cols; 0 where invalid unless enclosed (below)
   cv::Mat step1_mask;           // two-step only: the depth-dominant cut, CV_8U 255/0 (else empty)
   cv::Mat inferred_background;  // two-step only: ring cells marked background in step 2, CV_8U 255/0
   int64_t object_cells = 0;
@@ -189,6 +192,10 @@ MaskScores ScoreMask(const cv::Mat& mask, const cv::Mat& truth, const cv::Mat& d
 // only (grabCut has no depth). Returns CV_8U 255/0.
 cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterations = 5,
                            int probable_radius_cells = 0);
+
+// Cells without a return (valid == 0) enclosed by `mask`: the 4-connected components of no-return cells that
+// touch neither the image border nor a cell with a return outside the mask. CV_8U 255/0.
+cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
 
 // The overlay picture: the scan's colour (or intensity as grey), object cells tinted and outlined in the
 // colour of ContrastingOverlayColor (yellow on most outdoor scenes, another on yellowish ones), object strokes

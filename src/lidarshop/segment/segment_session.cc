@@ -240,6 +240,7 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       break;
     }
   }
+  if (o.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
   result.timings.total_s = total.Seconds() + result.timings.features_s;
@@ -277,6 +278,7 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     result.flow = 0;
     result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
     keep_monotone(&result.mask);
+    if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
     result.object_cells = cv::countNonZero(result.mask);
     result.graph_nodes = s.last.num_local(s.nodes.num());
     result.timings.total_s = total.Seconds();
@@ -334,6 +336,7 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
   }
   keep_monotone(&result.mask);
+  if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
   result.timings.total_s = total.Seconds();

@@ -220,6 +220,40 @@ TEST(SegmentTest, RefineOutsideTheRegionOfInterestReRunsOnTheWholeImage) {
   EXPECT_GT(ScoreMask(again.mask & TruthMask(scan), TruthMask(scan), scan.valid).iou, 0.9);
 }
 
+TEST(SegmentTest, EnclosedNoReturnCellsOnlyInsideTheOutline) {
+  cv::Mat mask = cv::Mat::zeros(12, 12, CV_8U), valid(12, 12, CV_8U, cv::Scalar(1));
+  mask(cv::Rect(2, 2, 6, 6)).setTo(255);
+  valid(cv::Rect(4, 4, 2, 2)).setTo(0);   // a window inside the object
+  valid(cv::Rect(7, 7, 3, 1)).setTo(0);   // on the object's edge, reaching the background
+  valid(cv::Rect(0, 10, 3, 2)).setTo(0);  // at the image border
+  mask.setTo(0, valid == 0);
+  const cv::Mat enclosed = EnclosedNoReturnCells(mask, valid);
+  EXPECT_EQ(cv::countNonZero(enclosed), 4);
+  EXPECT_EQ(cv::countNonZero(enclosed(cv::Rect(4, 4, 2, 2))), 4);
+}
+
+TEST(SegmentTest, NoReturnCellsInsideTheObjectJoinTheMask) {
+  Scan scan = MakeBoxOnGround(120, 160, cv::Vec3b(40, 60, 200), 9);
+  const cv::Rect box = cv::boundingRect(TruthMask(scan));
+  // Black tyres: a patch of the box without returns, away from the box's outline and from the strokes.
+  const cv::Rect hole(box.x + box.width / 2 + 2, box.y + box.height / 4, 3, 3);
+  scan = MaskScan(scan, [&] {
+    cv::Mat keep(scan.rows, scan.cols, CV_8U, cv::Scalar(255));
+    keep(hole).setTo(0);
+    return keep;
+  }());
+  const cv::Mat strokes = MakeStrokes(scan);
+  ASSERT_EQ(cv::countNonZero(strokes(hole)), 0);
+  SegmentOptions options;
+  const SegmentResult with = SegmentObject(scan, strokes, options);
+  options.include_enclosed_no_return = false;
+  const SegmentResult without = SegmentObject(scan, strokes, options);
+  EXPECT_EQ(cv::countNonZero(without.mask(hole)), 0);
+  EXPECT_EQ(cv::countNonZero(with.mask(hole)), hole.area());
+  EXPECT_EQ(cv::countNonZero(with.mask & (scan.valid != 0)), without.object_cells);
+  EXPECT_EQ(with.object_cells, without.object_cells + hole.area());
+}
+
 TEST(SegmentTest, BadStrokesAndOptionsAreRejected) {
   const Scan scan = MakeBoxOnGround(60, 80, cv::Vec3b(118, 138, 112), 7);
   cv::Mat only_object(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
