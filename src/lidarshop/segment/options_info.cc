@@ -52,6 +52,42 @@ const StructInfo& InfoOf<CutWeights>() {
 }
 
 template <>
+const StructInfo& InfoOf<WholeObjectOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<WholeObjectOptions> b("WholeObjectOptions",
+                                        "growth of the cut into parts continuous in depth and orientation");
+    b.Field(&WholeObjectOptions::jump_cells, "jump_cells",
+            "depth continuity: largest range step, in cell spacings at the cell's range")
+        .AboveZero();
+    b.Field(&WholeObjectOptions::min_jump_m, "min_jump_m", "floor of the depth-continuity threshold")
+        .Unit("m")
+        .Min(0);
+    b.Field(&WholeObjectOptions::max_crease_deg, "max_crease_deg",
+            "largest angle between neighbouring normals inside one object")
+        .Unit("deg")
+        .AboveZero()
+        .Max(180);
+    b.Field(&WholeObjectOptions::normal_window_cells, "normal_window_cells",
+            "half-width of the grid window of the normals")
+        .Unit("cells")
+        .Min(1);
+    b.Field(&WholeObjectOptions::max_growth, "max_growth",
+            "growth larger than this times the object's cells is a leak and is dropped")
+        .Min(0);
+    b.Field(&WholeObjectOptions::support_band_cells, "support_band_cells",
+            "support planes are fitted to the cells this far around the cut")
+        .Unit("cells")
+        .Min(1);
+    b.Field(&WholeObjectOptions::support_distance_m, "support_distance_m",
+            "cells this close to a support plane and parallel to it are support, never object")
+        .Unit("m")
+        .AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<SegmentOptions>() {
   static const StructInfo info = [] {
     StructBuilder<SegmentOptions> b("SegmentOptions", "two-step RGB + depth graph cuts");
@@ -102,6 +138,9 @@ const StructInfo& InfoOf<SegmentOptions>() {
     b.Field(&SegmentOptions::refine_monotone, "refine_monotone",
             "a refinement with only background strokes only removes cells, one with only object strokes only "
             "adds");
+    b.Field(&SegmentOptions::grow_whole_object, "grow_whole_object",
+            "two-step: parts continuous in depth and orientation with the cut join it");
+    b.Field(&SegmentOptions::whole_object, "whole_object", "the whole-object growth");
     b.Field(&SegmentOptions::include_enclosed_no_return, "include_enclosed_no_return",
             "cells without a return enclosed by the object join the mask");
     return b.Build();

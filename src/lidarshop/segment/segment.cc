@@ -12,6 +12,8 @@ void CutWeights::Check() const { Validate(*this); }
 
 void SegmentOptions::Check() const { Validate(*this); }
 
+void WholeObjectOptions::Check() const { Validate(*this); }
+
 std::string SegmentResult::Summary() const {
   return fmt::format(
       "{} object cells, flow {:.1f}, {:.3f} s (features {:.3f}, models {:.3f}, graph {:.3f}, "

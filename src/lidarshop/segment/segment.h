@@ -77,6 +77,23 @@ struct CutWeights {
 template <>
 const StructInfo& InfoOf<CutWeights>();
 
+// Whole-object growth: cells joined to the mask through grid edges that are continuous in depth (a jump under
+// jump_cells cell spacings at that range, at least min_jump_m) and in orientation (grid normals within
+// max_crease_deg), so parts of another colour join while the support surface, which meets the object at a
+// crease, does not. Growth that would add more than max_growth × the object's cells is a leak: none is added.
+struct WholeObjectOptions {
+  double jump_cells = 6.0;           // depth continuity, in cell spacings at the cell's range (dimensionless)
+  double min_jump_m = 0.01;          // floor of the depth-continuity threshold, metres
+  double max_crease_deg = 45.0;      // largest angle between neighbouring normals inside one object, degrees
+  int normal_window_cells = 2;       // half-width of the grid window of the normals, cells
+  double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
+  int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
+  double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
+  void Check() const;                // throws OptionsFieldError naming the field
+};
+template <>
+const StructInfo& InfoOf<WholeObjectOptions>();
+
 struct SegmentOptions {
   SegmentMethod method = SegmentMethod::kTwoStep;
   AppearanceModel model = AppearanceModel::kGmm;  // measured better than histograms (segment.md)
@@ -129,6 +146,9 @@ struct SegmentOptions {
   // Cells without a return enclosed by the object (dark hair, black tyres, windows: no echo, but inside the
   // object's outline) join the mask, so a cut-out has no holes and a fill covers them too.
   bool include_enclosed_no_return = true;
+  // Two-step: parts continuous in depth and orientation with the cut join it (GrowWholeObject).
+  bool grow_whole_object = true;
+  WholeObjectOptions whole_object;
 
   void Check() const;  // throws OptionsFieldError naming the field
 };
@@ -192,6 +212,9 @@ MaskScores ScoreMask(const cv::Mat& mask, const cv::Mat& truth, const cv::Mat& d
 // only (grabCut has no depth). Returns CV_8U 255/0.
 cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterations = 5,
                            int probable_radius_cells = 0);
+
+cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
+                        const WholeObjectOptions& options = WholeObjectOptions());
 
 // Cells without a return (valid == 0) enclosed by `mask`: the 4-connected components of no-return cells that
 // touch neither the image border nor a cell with a return outside the mask. CV_8U 255/0.

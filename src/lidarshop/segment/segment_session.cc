@@ -237,6 +237,12 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       // The object reached the ROI's edge: the ROI was too small, cut the whole image (the time of both cuts
       // is counted).
       if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
+      if (o.grow_whole_object) {
+        cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+        for (int i = 0; i < s.nodes.num(); ++i)
+          if (hard[i] == kHardBackground) barrier.data[s.nodes.cell_of_node[i]] = 255;
+        result.mask = GrowWholeObject(s.scan, result.mask, barrier, o.whole_object);
+      }
       break;
     }
   }

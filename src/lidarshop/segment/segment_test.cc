@@ -254,6 +254,29 @@ TEST(SegmentTest, NoReturnCellsInsideTheObjectJoinTheMask) {
   EXPECT_EQ(with.object_cells, without.object_cells + hole.area());
 }
 
+TEST(SegmentTest, WholeObjectGrowthJoinsAPartOfAnotherColourButNotTheGround) {
+  // A blue box whose lower half is painted the grass's colour: one object in depth, two in colour.
+  Scan scan = Clone(MakeBoxOnGround(140, 180, cv::Vec3b(40, 60, 200), 11));
+  const cv::Mat truth = TruthMask(scan);
+  const cv::Rect box = cv::boundingRect(truth);
+  const cv::Rect lower(box.x, box.y + box.height / 2, box.width, box.height - box.height / 2);
+  scan.color(lower).setTo(cv::Scalar(74, 112, 42), truth(lower));
+  cv::Mat strokes(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const int stroke_row = box.y + box.height / 4;
+  cv::line(strokes, cv::Point(box.x + box.width / 3, stroke_row),
+           cv::Point(box.x + 2 * box.width / 3, stroke_row), cv::Scalar(kStrokeObject), 1);
+  cv::line(strokes, cv::Point(2, scan.rows - 3), cv::Point(20, scan.rows - 3), cv::Scalar(kStrokeBackground),
+           1);
+  SegmentOptions options;
+  options.grow_whole_object = false;
+  const MaskScores without = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  options.grow_whole_object = true;
+  const MaskScores with = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  EXPECT_LT(without.iou, 0.8);      // the colour cut keeps to the blue half
+  EXPECT_GT(with.iou, 0.95);        // growth joins the green half...
+  EXPECT_GT(with.precision, 0.98);  // ...and stops at the ground it stands on
+}
+
 TEST(SegmentTest, BadStrokesAndOptionsAreRejected) {
   const Scan scan = MakeBoxOnGround(60, 80, cv::Vec3b(118, 138, 112), 7);
   cv::Mat only_object(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));

@@ -14,6 +14,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 #include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/scanner/scanner.h"
@@ -53,11 +54,19 @@ int main(int argc, char** argv) {
   app.add_option("--ring-threshold", options.ring_depth_threshold_m);
   app.add_option("--background-uniform", options.background_uniform);
   app.add_option("--sigma-scale", options.sigma_scale);
+  app.add_option("--grow-jump-cells", options.whole_object.jump_cells,
+                 "whole-object growth: depth continuity, cells");
+  app.add_option("--grow-crease-deg", options.whole_object.max_crease_deg,
+                 "whole-object growth: largest crease, degrees");
+  app.add_option("--grow-max", options.whole_object.max_growth,
+                 "whole-object growth: at most this times the cut");
+  app.add_flag("!--no-grow", options.grow_whole_object, "no whole-object growth");
   bool eight = false;
   std::string dump_dir;
   app.add_option("--dump", dump_dir, "write overlays (step 1 + inferred background, final, grabCut) here");
   app.add_flag("--eight", eight);
   CLI11_PARSE(app, argc, argv);
+  if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
   options.depth_step.lambda_g = options.depth_step.lambda_b = options.depth_step.lambda_r;
   options.depth_step.median_sigma = options.depth_step.median_sigma || depth_median;
   options.color_step.median_sigma = options.color_step.median_sigma || color_median;
@@ -96,7 +105,7 @@ int main(int argc, char** argv) {
       std::map<std::string, std::vector<double>> iou;
       for (int seed = 1; seed <= seeds; ++seed) {
         const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, static_cast<uint64_t>(seed) * 7919 + 1);
-        if (!dump_dir.empty() && seed == 1) {
+        if (!dump_dir.empty()) {
           const std::string stem = std::filesystem::path(path).stem().string();
           SegmentOptions o = options;
           o.method = SegmentMethod::kTwoStep;
@@ -107,9 +116,17 @@ int main(int argc, char** argv) {
           cv::hconcat(step1, SegmentOverlay(scan, r.mask, strokes), row1);
           cv::hconcat(SegmentOverlay(scan, truth, strokes),
                       SegmentOverlay(scan, GrabCutFromStrokes(scan, strokes), strokes), row2);
+          // Third row: the two-step errors, missed object cells red and extra cells blue, enlarged 2x.
+          cv::Mat errors(scan.rows, scan.cols, CV_8UC3, cv::Scalar(60, 60, 60));
+          errors.setTo(cv::Scalar(200, 200, 200), truth & r.mask);
+          errors.setTo(cv::Scalar(255, 0, 0), truth & ~r.mask);
+          errors.setTo(cv::Scalar(0, 80, 255), r.mask & ~truth & (scan.valid != 0));
+          cv::Mat row3;
+          cv::resize(errors, row3, row1.size(), 0, 0, cv::INTER_NEAREST);
           cv::Mat both;
-          cv::vconcat(row1, row2, both);
-          WriteImage(dump_dir + "/" + stem + ".png", both);
+          cv::vconcat(std::vector<cv::Mat>{row1, row2, row3}, both);
+          WriteImage(dump_dir + "/" + stem + (seed == 1 ? "" : "_seed" + std::to_string(seed)) + ".png",
+                     both);
         }
         for (const MethodScores& s :
              EvaluateMethods(scan, truth, strokes, options, m == models.front() ? grabcut_iterations : 0)) {
