@@ -138,6 +138,12 @@ const StructInfo& InfoOf<SegmentOptions>() {
     b.Field(&SegmentOptions::refine_monotone, "refine_monotone",
             "a refinement with only background strokes only removes cells, one with only object strokes only "
             "adds");
+    b.Field(&SegmentOptions::scale_to_data, "scale_to_data",
+            "scale the metric lengths by the ray spacing measured at the object strokes");
+    b.Field(&SegmentOptions::reference_spacing_m, "reference_spacing_m",
+            "ray spacing at the object the metric lengths are given for")
+        .Unit("m")
+        .AboveZero();
     b.Field(&SegmentOptions::grow_whole_object, "grow_whole_object",
             "two-step: parts continuous in depth and orientation with the cut join it");
     b.Field(&SegmentOptions::whole_object, "whole_object", "the whole-object growth");
@@ -173,6 +179,11 @@ const StructInfo& InfoOf<SegmentResult>() {
     b.Field(&SegmentResult::object_cells, "object_cells", "cells of the object").Unit("cells");
     b.Field(&SegmentResult::graph_nodes, "graph_nodes", "nodes of the last cut's graph");
     b.Field(&SegmentResult::flow, "flow", "value of the last max-flow");
+    b.Field(&SegmentResult::ray_spacing_m, "ray_spacing_m",
+            "spacing of neighbouring rays at the object strokes")
+        .Unit("m");
+    b.Field(&SegmentResult::length_scale, "length_scale",
+            "factor applied to the metric lengths (scale_to_data)");
     b.Field(&SegmentResult::timings, "timings", "wall seconds per stage");
     return b.Build();
   }();

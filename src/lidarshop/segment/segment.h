@@ -125,6 +125,14 @@ struct SegmentOptions {
   int roi_margin_cells = 50;          // cells (>= 0; 0 disables the ROI)
   double roi_margin_fraction = 0.25;  // of the box's larger side (dimensionless, >= 0)
 
+  // Scale to the data: the metric lengths above and below (ring_depth_threshold_m, depth_bin_m,
+  // depth_smoothing_m) are given for a ray spacing of reference_spacing_m at the object (terrestrial scans of
+  // objects metres away) and multiplied by min(1, measured spacing / reference_spacing_m), the spacing being
+  // the object strokes' median range × RayAngleAt the strokes: finer scans (a table top at 1 m) get finer
+  // lengths, coarser ones keep them. false = the lengths as given.
+  bool scale_to_data = true;
+  double reference_spacing_m = 0.0125;  // metres between neighbouring rays the lengths are given for (> 0)
+
   // Appearance models.
   int color_bins = 16;              // histogram bins per colour channel (2..64)
   double depth_bin_m = 0.05;        // histogram bin width of the range, metres (> 0)
@@ -164,8 +172,10 @@ struct SegmentResult {
   cv::Mat step1_mask;           // two-step only: the depth-dominant cut, CV_8U 255/0 (else empty)
   cv::Mat inferred_background;  // two-step only: ring cells marked background in step 2, CV_8U 255/0
   int64_t object_cells = 0;
-  int64_t graph_nodes = 0;  // nodes of the last cut's graph (two-step: step 3's region of interest)
-  double flow = 0;          // value of the last max-flow (the minimum energy, up to constants)
+  int64_t graph_nodes = 0;   // nodes of the last cut's graph (two-step: step 3's region of interest)
+  double ray_spacing_m = 0;  // measured spacing of neighbouring rays at the object strokes, metres (0: none)
+  double length_scale = 1;   // factor applied to the metric lengths (scale_to_data), dimensionless
+  double flow = 0;           // value of the last max-flow (the minimum energy, up to constants)
   SegmentTimings timings;
   std::string Summary() const;  // one line
 };
@@ -215,6 +225,11 @@ cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterati
 
 cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
                         const WholeObjectOptions& options = WholeObjectOptions());
+
+// The angle between neighbouring rays near `cells` (CV_8U, rows x cols), radians: the median of the distances
+// between the points of neighbouring cells over their range (pairs across depth edges are left out). 0 when no
+// pair is found. With a range it gives the scan's own length scale at an object: what "continuous" means there.
+double RayAngleAt(const Scan& scan, const cv::Mat& cells);
 
 // Cells without a return (valid == 0) enclosed by `mask`: the 4-connected components of no-return cells that
 // touch neither the image border nor a cell with a return outside the mask. CV_8U 255/0.

@@ -22,7 +22,8 @@ using namespace segment_internal;  // NOLINT: the graph and appearance helpers o
 
 struct SegmentSession::Impl {
   Scan scan;
-  SegmentOptions options;
+  SegmentOptions given;    // as the caller gave them
+  SegmentOptions options;  // in force: `given` with the metric lengths scaled to the data at Run()
   Nodes nodes;
   double features_s = 0;
   // n-link weights, computed once per step kind when first needed.
@@ -179,7 +180,7 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
   CheckScan(scan);
   Timer timer;
   impl_->scan = scan;
-  impl_->options = options;
+  impl_->given = impl_->options = options;
   impl_->nodes = MakeNodes(scan);
   impl_->features_s = timer.Seconds();
 }
@@ -200,6 +201,30 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
   if (!has_object) ThrowInputError("strokes", "", "", "no object stroke lies on a cell with a return");
   if (!has_background)
     ThrowInputError("strokes", "", "", "no background stroke lies on a cell with a return");
+  s.options = s.given;
+  if (s.given.scale_to_data) {
+    // The object strokes' median range times the ray angle measured around them.
+    cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+    std::vector<float> ranges;
+    for (int i = 0; i < s.nodes.num(); ++i) {
+      if (hard[i] != kHardObject) continue;
+      object_cells.data[s.nodes.cell_of_node[i]] = 255;
+      ranges.push_back(s.scan.range.at<float>(s.nodes.cell_of_node[i] / s.scan.cols,
+                                              s.nodes.cell_of_node[i] % s.scan.cols));
+    }
+    std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+    result.ray_spacing_m = ranges[ranges.size() / 2] * RayAngleAt(s.scan, object_cells);
+    if (result.ray_spacing_m > 0) {
+      // Scaled down only: a finer scan (a table top at 1 m) resolves depth steps and range bins the outdoor
+      // lengths would merge, while a coarser one (a facade at 40 m) keeps them — the range noise of a
+      // terrestrial scanner grows far more slowly than the ray spacing (measured: scaling up as well lost the
+      // van before its facade, IoU 0.997 -> 0.811).
+      result.length_scale = std::min(1.0, result.ray_spacing_m / s.given.reference_spacing_m);
+      s.options.ring_depth_threshold_m *= result.length_scale;
+      s.options.depth_bin_m *= result.length_scale;
+      s.options.depth_smoothing_m *= result.length_scale;
+    }
+  }
   const SegmentOptions& o = s.options;
   switch (o.method) {
     case SegmentMethod::kDepth:
