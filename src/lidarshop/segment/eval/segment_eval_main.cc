@@ -54,7 +54,8 @@ int main(int argc, char** argv) {
   app.add_option("--ring-threshold", options.ring_depth_threshold_m);
   app.add_option("--background-uniform", options.background_uniform);
   app.add_option("--sigma-scale", options.sigma_scale);
-  app.add_option("--reference-spacing", options.reference_spacing_m, "scale_to_data: reference ray spacing, m");
+  app.add_option("--reference-spacing", options.reference_spacing_m,
+                 "scale_to_data: reference ray spacing, m");
   app.add_flag("!--no-scale", options.scale_to_data, "no scaling of the metric lengths to the data");
   app.add_option("--grow-jump-cells", options.whole_object.jump_cells,
                  "whole-object growth: depth continuity, cells");
@@ -104,7 +105,6 @@ int main(int argc, char** argv) {
       const SceneDescription scene = LoadScene(path);
       const Scan scan = SynthesizeScan(scene);
       const cv::Mat truth = (scan.label == 1) & (scan.valid != 0);
-      if (getenv("SPACING")) { std::vector<float> rr; for (int r = 0; r < scan.rows; ++r) for (int c = 0; c < scan.cols; ++c) if (truth.at<uint8_t>(r, c)) rr.push_back(scan.range.at<float>(r, c)); std::nth_element(rr.begin(), rr.begin() + rr.size() / 2, rr.end()); const double a = RayAngleAt(scan, truth); fmt::print(stderr, "{} angle {:.5f} range {:.2f} spacing {:.4f}\n", path, a, rr[rr.size() / 2], a * rr[rr.size() / 2]); }
       std::map<std::string, std::vector<double>> iou;
       for (int seed = 1; seed <= seeds; ++seed) {
         const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, static_cast<uint64_t>(seed) * 7919 + 1);
