@@ -125,11 +125,12 @@ struct SegmentOptions {
   int roi_margin_cells = 50;          // cells (>= 0; 0 disables the ROI)
   double roi_margin_fraction = 0.25;  // of the box's larger side (dimensionless, >= 0)
 
-  // Scale to the data: the metric lengths above and below (ring_depth_threshold_m, depth_bin_m,
-  // depth_smoothing_m) are given for a ray spacing of reference_spacing_m at the object (terrestrial scans of
-  // objects metres away) and multiplied by min(1, measured spacing / reference_spacing_m), the spacing being
-  // the object strokes' median range × RayAngleAt the strokes: finer scans (a table top at 1 m) get finer
-  // lengths, coarser ones keep them. false = the lengths as given.
+  // Scale to the data: the range-model lengths below (depth_bin_m, depth_smoothing_m) are given for a ray
+  // spacing of reference_spacing_m at the object (terrestrial scans of objects metres away) and multiplied by
+  // min(1, measured spacing / reference_spacing_m), the spacing being the object strokes' median range ×
+  // RayAngleAt the strokes: finer scans (a table top at 1 m) get finer bins, coarser ones keep them. The ring
+  // threshold is not scaled: it is the size of a physical step between parts (an overhang), not of the
+  // sampling. false = the lengths as given.
   bool scale_to_data = true;
   double reference_spacing_m = 0.0125;  // metres between neighbouring rays the lengths are given for (> 0)
 

@@ -70,7 +70,7 @@ TEST(SegmentRealTest, MugWithDefaultOptions) {
   const MaskScores grabcut = ScoreMask(GrabCutFromStrokes(scan, strokes, 5, 20), truth, scan.valid);
   std::printf("mug, grabCut (5 iterations, probable zone 20 cells): IoU %.3f\n", grabcut.iou);
   EXPECT_LT(result.length_scale, 0.2);
-  EXPECT_GT(scores.iou, 0.65);  // measured 0.706: the shadowed table at the base leaks in (precision 0.73)
+  EXPECT_GT(scores.iou, 0.65);  // measured 0.722: the shadowed table at the base leaks in (precision 0.74)
   EXPECT_GT(scores.recall, 0.9);
   EXPECT_LT(unscaled_scores.iou, 0.5);
 }

@@ -220,7 +220,6 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       // terrestrial scanner grows far more slowly than the ray spacing (measured: scaling up as well lost the
       // van before its facade, IoU 0.997 -> 0.811).
       result.length_scale = std::min(1.0, result.ray_spacing_m / s.given.reference_spacing_m);
-      s.options.ring_depth_threshold_m *= result.length_scale;
       s.options.depth_bin_m *= result.length_scale;
       s.options.depth_smoothing_m *= result.length_scale;
     }
