@@ -1,6 +1,6 @@
 // The evaluation set's claims, as a test: on data/segment_eval (one stroke seed, grabCut left to segment_eval
 // for time), the two-step cut beats the depth-only, colour-only and single-step RGB+D cuts on mean IoU, and
-// its step 1 is nearly background-free (mean precision >= 0.99).
+// its step 1 is nearly background-free (precision >= 0.98) wherever no neighbour touches the object.
 #include <map>
 
 #include <gtest/gtest.h>
@@ -12,10 +12,11 @@ namespace lidarshop {
 namespace {
 
 TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
-  const char* scenes[] = {"car_gravel",       "electric_box_grass", "electric_box_wall", "hatchback_grass",
-                          "mailbox_gravel",   "mailbox_lawn",       "sign_on_post",      "trash_can_grass",
-                          "trash_can_gravel", "van_facade"};
-  std::map<std::string, double> iou, precision;
+  const char* scenes[] = {"bench_paving",    "car_gravel",      "electric_box_grass", "electric_box_wall",
+                          "hatchback_grass", "mailbox_gravel",  "mailbox_lawn",       "sign_on_post",
+                          "table_mug",       "trash_can_grass", "trash_can_gravel",   "two_people",
+                          "van_facade"};
+  std::map<std::string, double> iou, precision, step1_precision;
   int runs = 0;
   for (const char* name : scenes) {
     const Scan scan =
@@ -26,8 +27,17 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
          EvaluateMethods(scan, truth, strokes, SegmentOptions(), /*grabcut_iterations=*/0)) {
       iou[s.method] += s.scores.iou;
       precision[s.method] += s.scores.precision;
+      if (s.method == "step-1") step1_precision[name] = s.scores.precision;
     }
     ++runs;
+  }
+  // Step 1 stops at depth edges: nearly background-free, except where a neighbour touches the object at the
+  // same range (two_people: both people, precision ~0.5 — the open weakness of #15).
+  for (const auto& [name, value] : step1_precision) {
+    if (name == "two_people")
+      EXPECT_LT(value, 0.7) << "step 1 separates touching neighbours now: update the test and the docs";
+    else
+      EXPECT_GE(value, 0.98) << name;
   }
   for (auto& [method, value] : iou) {
     value /= runs;
@@ -37,8 +47,9 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
   EXPECT_GT(iou["two-step"], iou["depth"]);
   EXPECT_GT(iou["two-step"], iou["color"]);
   EXPECT_GT(iou["two-step"], iou["rgbd"]);
-  EXPECT_GE(precision["step-1"], 0.99);
-  EXPECT_GT(iou["two-step"], 0.85);
+  // Measured 0.943 (3 seeds; two_people, touching neighbours at one range, 0.500): whole-object growth
+  // lifted the ten outdoor scenes from 0.940 to 0.976.
+  EXPECT_GT(iou["two-step"], 0.92);
 }
 
 }  // namespace
