@@ -37,10 +37,6 @@ struct RemoveResult {
 template <>
 const StructInfo& InfoOf<RemoveResult>();
 
-// The cells without a return (`valid` == 0) that `mask` (CV_8U) encloses: not reachable from the image border
-// through cells outside the mask. CV_8U 255/0.
-cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
-
 // Throws InputError for strokes of another size or without object / background cells (as SegmentObject).
 RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options = {},
                           Progress* progress = nullptr);

@@ -232,8 +232,8 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
 // pair is found. With a range it gives the scan's own length scale at an object: what "continuous" means there.
 double RayAngleAt(const Scan& scan, const cv::Mat& cells);
 
-// Cells without a return (valid == 0) enclosed by `mask`: the 4-connected components of no-return cells that
-// touch neither the image border nor a cell with a return outside the mask. CV_8U 255/0.
+// Cells without a return (valid == 0) enclosed by `mask`: not reachable from the image border through cells
+// outside the mask (4-connected). CV_8U 255/0.
 cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
 
 // The overlay picture: the scan's colour (or intensity as grey), object cells tinted and outlined in the
