@@ -90,19 +90,27 @@ TEST_P(VerifyScaleTest, ScaleInThePoseEqualsThePreScaledMesh) {
     ExpectSameMeasures(option, reference);
   }
 
-  // The measures are those of metres: the true pose passes, the offset one fails, whichever way.
+  // The measures are those of metres: the true pose passes, the offset one fails, whichever way (with σ in
+  // model units the millimetre model saw nothing and the tenths model everything).
+  const VerifyResult truth = VerifyPose(pre_scaled, scans_, world_from_object_);
+  EXPECT_GT(truth.consistency, 0.95);
+  EXPECT_GT(truth.confidence, 0.2);  // one side and one end of a car (0.28)
+  EXPECT_LT(truth.confidence, 0.5);
+  EXPECT_LT(truth.icp_cost_m, 0.04);  // noise-free; the ground under the sill is within the trim distance
+  const VerifyResult wrong = VerifyPose(pre_scaled, scans_, offset);
+  EXPECT_LT(wrong.consistency, 0.5);
+  EXPECT_LT(wrong.confidence, 0.7 * truth.confidence);
+  EXPECT_GT(wrong.icp_cost_m, 2 * truth.icp_cost_m);
   for (const VerifyResult& result :
        {VerifyPose(in_units, scans_, WithScale(world_from_object_, metres_per_unit)),
         VerifyPose(by_option, scans_, world_from_object_)}) {
+    EXPECT_NEAR(result.confidence, truth.confidence, 2e-4);
     EXPECT_GT(result.consistency, 0.95);
-    EXPECT_GT(result.confidence, 0.2);  // one side and one end of a car
-    EXPECT_LT(result.confidence, 0.5);
-    EXPECT_LT(result.icp_cost_m, 0.01);  // noise-free scan on the model's surface
   }
   for (const VerifyResult& result : {VerifyPose(in_units, scans_, WithScale(offset, metres_per_unit)),
                                      VerifyPose(by_option, scans_, offset)}) {
     EXPECT_LT(result.consistency, 0.5);
-    EXPECT_LT(result.confidence, 0.1);
+    EXPECT_LT(result.confidence, 0.7 * truth.confidence);
   }
 }
 
