@@ -218,7 +218,7 @@ import math, struct, sys
 
 def header_of(data, end_marker):
     end = data.index(end_marker)
-    end = data.index(b"\n", end) + 1
+    end = data.index(b"\n", end + 1) + 1
     return data[:end].decode("ascii"), end
 
 def read_pcd(path):
