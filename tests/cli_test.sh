@@ -186,6 +186,18 @@ check "verify 1 m towards the scanner" "$lidarshop" verify --scan "$work/scan.pt
 json_check "a pose in front of the seen surface is inconsistent" "$work/verify_front.json" "d['consistency'] < 0.3"
 fails_clearly "verify: bad pose" "pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
   --pose "1,2"
+# The same box in millimetres: --model-scale 0.001, or the scale in the pose, give the numbers of metres.
+python3 -c "import sys; print(''.join('v ' + ' '.join(str(1000 * float(w)) for w in l.split()[1:]) + '\n' \
+  if l.startswith('v ') else l for l in open(sys.argv[1])), end='')" "$work/box.obj" >"$work/box_mm.obj"
+check "verify --model-scale" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box_mm.obj" \
+  --model-scale 0.001 --pose "-2,8,0.6,0" --json "$work/verify_mm.json"
+check "verify with the scale in the pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box_mm.obj" \
+  --pose "0.001,0,0,-2,0,0.001,0,8,0,0,0.001,0.6,0,0,0,1" --json "$work/verify_mm_pose.json"
+for file in verify_mm verify_mm_pose; do
+  json_check "$file: the numbers of the box in metres" "$work/$file.json" \
+    "abs(d['confidence'] - $(python3 -c "import json; print(json.load(open('$work/verify.json'))['confidence'])")) < 1e-3 \
+     and abs(d['consistency'] - 1) < 0.05 and d['icp_cost'] < 0.02"
+done
 
 # segment: the sphere (label 1) from JSON strokes in grid coordinates. Its centre (2, 10, 1) seen from (0, 0, 1.5)
 # is at azimuth atan2(2, 10) = 11.31 deg and elevation atan2(-0.5, sqrt(104)) = -2.81 deg: column
