@@ -186,6 +186,18 @@ check "verify 1 m towards the scanner" "$lidarshop" verify --scan "$work/scan.pt
 json_check "a pose in front of the seen surface is inconsistent" "$work/verify_front.json" "d['consistency'] < 0.3"
 fails_clearly "verify: bad pose" "pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box.obj" \
   --pose "1,2"
+# The same box in millimetres: --model-scale 0.001, or the scale in the pose, give the numbers of metres.
+python3 -c "import sys; print(''.join('v ' + ' '.join(str(1000 * float(w)) for w in l.split()[1:]) + '\n' \
+  if l.startswith('v ') else l for l in open(sys.argv[1])), end='')" "$work/box.obj" >"$work/box_mm.obj"
+check "verify --model-scale" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box_mm.obj" \
+  --model-scale 0.001 --pose "-2,8,0.6,0" --json "$work/verify_mm.json"
+check "verify with the scale in the pose" "$lidarshop" verify --scan "$work/scan.ptx" --model "$work/box_mm.obj" \
+  --pose "0.001,0,0,-2,0,0.001,0,8,0,0,0.001,0.6,0,0,0,1" --json "$work/verify_mm_pose.json"
+for file in verify_mm verify_mm_pose; do
+  json_check "$file: the numbers of the box in metres" "$work/$file.json" \
+    "abs(d['confidence'] - $(python3 -c "import json; print(json.load(open('$work/verify.json'))['confidence'])")) < 1e-3 \
+     and abs(d['consistency'] - 1) < 0.05 and d['icp_cost'] < 0.02"
+done
 
 # segment: the sphere (label 1) from JSON strokes in grid coordinates. Its centre (2, 10, 1) seen from (0, 0, 1.5)
 # is at azimuth atan2(2, 10) = 11.31 deg and elevation atan2(-0.5, sqrt(104)) = -2.81 deg: column
@@ -210,6 +222,92 @@ object_valid=$(python3 -c "import json; print(json.load(open('$work/info_object.
 json_check "segment --rest holds the other returns" "$work/info_rest.json" \
   "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and \
    d['scans'][0]['valid'] + $object_valid == $valid and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+# Every point output is in the world frame (docs/file-formats.md): the cut-out written as PCD and PLY lies on the
+# scan's own world points (scan.xyz from convert), and the headers say so. Read here without lidarshop, as a tool
+# that ignores VIEWPOINT and comments would.
+cat >"$work/frame_check.py" <<'PY'
+import math, struct, sys
+
+def header_of(data, end_marker):
+    end = data.index(end_marker)
+    end = data.index(b"\n", end + 1) + 1
+    return data[:end].decode("ascii"), end
+
+def read_pcd(path):
+    data = open(path, "rb").read()
+    header, start = header_of(data, b"\nDATA ")
+    assert "\n# frame world\n" in header and "\nVIEWPOINT 0 0 0 1 0 0 0\n" in header, header
+    keys = {line.split()[0]: line.split()[1:] for line in header.splitlines() if line and line[0] != "#"}
+    assert keys["DATA"] == ["binary"]
+    codes = {("F", "4"): "f", ("F", "8"): "d", ("U", "1"): "B", ("I", "4"): "i", ("U", "4"): "I"}
+    fmt = "<" + "".join(codes[t, s] for t, s in zip(keys["TYPE"], keys["SIZE"]))
+    size = struct.calcsize(fmt)
+    count = int(keys["POINTS"][0])
+    names = keys["FIELDS"]
+    points = []
+    for i in range(count):
+        record = struct.unpack_from(fmt, data, start + i * size)
+        x, y, z = (record[names.index(n)] for n in "xyz")
+        if not math.isnan(x):
+            points.append((x, y, z))
+    return points
+
+def read_ply(path):
+    data = open(path, "rb").read()
+    header, start = header_of(data, b"end_header")
+    assert "\ncomment frame world\n" in header and "binary_little_endian" in header, header
+    codes = {"float": "f", "double": "d", "uchar": "B", "int": "i", "uint": "I", "char": "b", "short": "h",
+             "ushort": "H"}
+    fmt, names, count, in_vertex = "<", [], 0, False
+    for line in header.splitlines():
+        words = line.split()
+        if words[:2] == ["element", "vertex"]:
+            count, in_vertex = int(words[2]), True
+        elif words[:1] == ["element"]:
+            in_vertex = False
+        elif words[:1] == ["property"] and in_vertex:
+            fmt += codes[words[1]]
+            names.append(words[2])
+    size = struct.calcsize(fmt)
+    return [tuple(struct.unpack_from(fmt, data, start + i * size)[names.index(n)] for n in "xyz")
+            for i in range(count)]
+
+scan = {}
+for line in open(sys.argv[1]):
+    words = line.split()
+    if len(words) >= 3:
+        p = tuple(float(w) for w in words[:3])
+        scan.setdefault(tuple(round(c * 100) for c in p), []).append(p)
+
+def on_scan(p):
+    key = [round(c * 100) for c in p]
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                for q in scan.get((key[0] + dx, key[1] + dy, key[2] + dz), []):
+                    if max(abs(a - b) for a, b in zip(p, q)) < 1e-4:
+                        return True
+    return False
+
+for path in sys.argv[2:]:
+    points = read_pcd(path) if path.endswith(".pcd") else read_ply(path)
+    assert len(points) > 50, (path, len(points))
+    missing = sum(not on_scan(p) for p in points)
+    assert missing == 0, f"{path}: {missing} of {len(points)} points are not on the scan's world points"
+    mean_z = sum(p[2] for p in points) / len(points)
+    assert "object" not in path or 0.5 < mean_z < 1.5, f"{path}: mean z {mean_z}: the sphere's centre is 1 m up in the world"
+PY
+check "segment --object as PCD and PLY" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/mask_frames.png" --overlay none --object "$work/object.pcd" --rest "$work/rest.pcd" --quiet
+check "segment --object as PLY" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" \
+  -o "$work/mask_frames.png" --overlay none --object "$work/object.ply" --quiet
+check "segment outputs lie on the scan's world points" python3 "$work/frame_check.py" "$work/scan.xyz" \
+  "$work/object.pcd" "$work/object.ply" "$work/scan.pcd" "$work/scan.ply"
+check "PCD round trip keeps the pose" "$lidarshop" info "$work/object.pcd"
+cp "$work/last.out" "$work/info_object_pcd.json"
+json_check "segment --object .pcd reads back with its grid and pose" "$work/info_object_pcd.json" \
+  "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and d['scans'][0]['valid'] == $object_valid and \
+   abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-9"
 fails_clearly "segment: --object needs a scan format" "unknown scan format" "$lidarshop" segment "$work/scan.ptx" \
   --strokes "$work/strokes.json" -o "$work/mask3.png" --object "$work/object.txt" --quiet
 fails_clearly "segment: strokes of the wrong size" "stroke" "$lidarshop" segment "$work/scan.ptx" \

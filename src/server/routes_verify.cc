@@ -102,7 +102,12 @@ void AddVerifyRoutes(State& state) {
         entry->mesh = std::move(file.mesh);
         warnings = std::move(file.warnings);
       }
-      entry->model = PrepareModel(entry->mesh);
+      // "options": ModelOptions (e.g. {"model_scale": 0.001} for a mesh in millimetres); the mesh the
+      // browser gets is the scaled one, the frame the measures use.
+      const ModelOptions model_options =
+          body->contains("options") ? FromJson<ModelOptions>(body->at("options")) : ModelOptions{};
+      entry->model = PrepareModel(entry->mesh, model_options);
+      entry->mesh = entry->model.mesh_in_model;
       Eigen::Vector3f low = Eigen::Vector3f::Constant(INFINITY), high = -low;
       for (const Eigen::Vector3f& v : entry->mesh.vertices) {
         low = low.cwiseMin(v);

@@ -293,6 +293,16 @@ TEST_F(ServerTest, PlaceAndVerifyAModel) {
   uint32_t header[4];
   std::memcpy(header, mesh->body.data(), sizeof(header));
   EXPECT_EQ(mesh->body.size(), 16 + header[1] * 12 + header[2] * 12);
+  // A model in other units: "options" takes ModelOptions (here the sedan in decimetres ÷ 10).
+  const auto small = client_->Post(
+      Api("/api/models"), R"({"model": "car:sedan", "options": {"model_scale": 0.1}})", "application/json");
+  ASSERT_EQ(small->status, 200) << small->body;
+  EXPECT_NEAR(Json(small)["size_m"][1].get<double>(), 0.46, 0.025);
+  EXPECT_EQ(client_
+                ->Post(Api("/api/models"), R"({"model": "car:sedan", "options": {"model_scale": -1}})",
+                       "application/json")
+                ->status,
+            400);
   EXPECT_EQ(client_->Post(Api("/api/models"), R"({"model": "car:limo"})", "application/json")->status, 403);
   EXPECT_EQ(client_->Post(Api("/api/models"), R"({"model": "/etc/passwd"})", "application/json")->status,
             403);

@@ -94,6 +94,34 @@ json VerifyEntry(const std::string& object, const std::string& pose_name, const 
           {"inlier_fraction", result.inlier_fraction}};
 }
 
+// A scene object as a verification model: its mesh, ModelOptions and world_from_model. A scene's uniform
+// "scale" becomes ModelOptions::model_scale (the measures stay in metres and the neighbour grids apply); any
+// other linear part (per-axis scale, a mirror, a sheared "matrix") is baked into the mesh, leaving the pose a
+// translation.
+struct ObjectModel {
+  TriangleMesh mesh;
+  ModelOptions options;
+  Eigen::Matrix4d world_from_model = Eigen::Matrix4d::Identity();
+};
+
+ObjectModel ObjectAsModel(const SceneObject& object) {
+  ObjectModel model;
+  const Eigen::Matrix4d& pose = object.world_from_object;
+  if (PoseProblem(pose, /*allow_uniform_scale=*/true).empty()) {
+    const double scale = std::cbrt(pose.topLeftCorner<3, 3>().determinant());
+    model.mesh = object.mesh;
+    model.options.model_scale = scale;
+    model.world_from_model = pose;
+    model.world_from_model.topLeftCorner<3, 3>() /= scale;
+  } else {
+    Eigen::Matrix4d linear = Eigen::Matrix4d::Identity();
+    linear.topLeftCorner<3, 3>() = pose.topLeftCorner<3, 3>();
+    model.mesh = TransformMesh(object.mesh, linear);
+    model.world_from_model.topRightCorner<3, 1>() = pose.topRightCorner<3, 1>();
+  }
+  return model;
+}
+
 // Objects worth verifying stand up from the ground: flat patches (ground,
 // verges, paths) have no pose to check.
 bool IsStandingObject(const SceneObject& object) {
@@ -112,7 +140,8 @@ json RunVerifyStep(const SceneDescription& scene, const Scan& scan, const fs::pa
   json entries = json::array();
   for (const SceneObject& object : scene.objects) {
     if (!IsStandingObject(object)) continue;
-    const VerifierModel model = PrepareModel(object.mesh, ModelOptions{}, options);
+    const ObjectModel object_model = ObjectAsModel(object);
+    const VerifierModel model = PrepareModel(object_model.mesh, object_model.options, options);
     const Eigen::Vector3d center =
         object.world_from_object.topLeftCorner<3, 3>() * Bounds(object.mesh).center().cast<double>() +
         object.world_from_object.topRightCorner<3, 1>();
@@ -120,15 +149,15 @@ json RunVerifyStep(const SceneDescription& scene, const Scan& scan, const fs::pa
     towards_scanner.z() = 0;
     towards_scanner.normalize();
     const std::vector<std::pair<std::string, Eigen::Matrix4d>> poses = {
-        {"true", object.world_from_object},
+        {"true", object_model.world_from_model},
         {"1 m towards the scanner",
          [&] {
-           Eigen::Matrix4d pose = object.world_from_object;
+           Eigen::Matrix4d pose = object_model.world_from_model;
            pose.topRightCorner<3, 1>() += towards_scanner;
            return pose;
          }()},
         {"1 m away from the scanner", [&] {
-           Eigen::Matrix4d pose = object.world_from_object;
+           Eigen::Matrix4d pose = object_model.world_from_model;
            pose.topRightCorner<3, 1>() -= towards_scanner;
            return pose;
          }()}};
@@ -174,7 +203,9 @@ json RunSweepStep(const SceneDescription& scene, const Scan& scan, const DemoSwe
   }
   const std::vector<PreparedScan> scans = {PrepareScan(scan)};
   const VerifyOptions verify_options;
-  const VerifierModel model = PrepareModel(model_object->mesh, ModelOptions{}, verify_options);
+  // The sweep's poses are x, y, yaw of the model's origin: the object's scale goes into the model.
+  const ObjectModel object_model = ObjectAsModel(*model_object);
+  const VerifierModel model = PrepareModel(object_model.mesh, object_model.options, verify_options);
   const SweepResult sweep = Sweep(model, scans, demo_sweep.options, verify_options, progress);
   WriteImage((out_dir / "sweep_consistency.png").string(),
              RenderHeatMap(sweep.consistency_map, sweep, "consistency (best over yaws)",

@@ -173,6 +173,7 @@ void WritePointCloud(const std::string& path, const PointCloud& cloud, bool asci
   PlyData ply;
   ply.format = ascii ? PlyData::Format::kAscii : PlyData::Format::kBinaryLittleEndian;
   ply.comments.push_back("written by lidarshop");
+  ply.comments.push_back("frame world");
   ply.elements.push_back(VertexElementFromCloud(cloud, /*double_positions=*/false));
   WritePly(path, ply);
 }

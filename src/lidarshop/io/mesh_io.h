@@ -27,7 +27,8 @@ TriangleMesh ReadMesh(const std::string& path);
 void WriteMesh(const std::string& path, const TriangleMesh& mesh, bool ascii = false);
 
 // .ply points with whatever per-point fields the cloud has (x y z, nx ny nz, red green blue, intensity,
-// label, synthesized).
+// label, synthesized). Every point lidarshop writes is in the world frame: the header says so ("comment frame
+// world"), and callers give world-frame clouds.
 PointCloud ReadPointCloud(const std::string& path);
 void WritePointCloud(const std::string& path, const PointCloud& cloud, bool ascii = false);
 

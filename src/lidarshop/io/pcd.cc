@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <liblzf/lzf.h>
 #include <Eigen/Geometry>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/text_cursor.h"
@@ -33,6 +35,10 @@ struct PcdHeader {
   std::vector<PcdField> fields;
   int64_t width = 0, height = 0, points = -1;
   double viewpoint[7] = {0, 0, 0, 1, 0, 0, 0};
+  // From lidarshop's comment "# lidarshop_scan world_from_scanner <16 numbers, row major>": the points are
+  // world coordinates (in the VIEWPOINT frame, identity when lidarshop wrote them) of a scan in this pose.
+  bool has_scanner_pose = false;
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
   std::string data;
   int64_t point_size = 0;
   size_t data_offset = 0;
@@ -45,6 +51,8 @@ struct PcdHeader {
     return -1;
   }
 };
+
+constexpr std::string_view kPoseComment = "lidarshop_scan world_from_scanner";
 
 // The optical frame of an organized cloud from the scanner frame: (x, y, z)_camera = (x, -z, y)_scanner.
 Eigen::Matrix4d CameraFromScanner() {
@@ -66,7 +74,20 @@ PcdHeader ParseHeader(const std::string& bytes, const std::string& file) {
     if (cursor.AtEnd()) cursor.Fail("DATA", "missing: the header never ends (truncated or not a PCD file)");
     if (cursor.offset() > (1 << 16)) cursor.Fail("header", "longer than 64 KiB: not a PCD file");
     const std::string_view keyword = cursor.Token();
-    if (keyword.empty() || keyword[0] == '#') {
+    if (!keyword.empty() && keyword[0] == '#') {
+      const std::string_view comment = cursor.RestOfLine();
+      if (keyword == "#" && comment.substr(0, kPoseComment.size()) == kPoseComment) {
+        TextCursor numbers(comment.substr(kPoseComment.size()), file, cursor.line());
+        for (int i = 0; i < 16; ++i) header.world_from_scanner(i / 4, i % 4) = numbers.Double(kPoseComment);
+        if (!numbers.AtEndOfLine()) numbers.Fail(kPoseComment, "more than 16 numbers");
+        const std::string problem = PoseProblem(header.world_from_scanner, /*allow_uniform_scale=*/false);
+        if (!problem.empty()) numbers.Fail(kPoseComment, fmt::format("the pose {}", problem));
+        header.has_scanner_pose = true;
+      }
+      cursor.NextLine();
+      continue;
+    }
+    if (keyword.empty()) {
       cursor.NextLine();
       continue;
     }
@@ -331,6 +352,28 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
   if (normals) scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
   if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  const double* v = header.viewpoint;
+  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
+  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
+  if (rotation.norm() < 1e-9)
+    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
+  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
+  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
+  // The file's coordinates are in the VIEWPOINT frame: world = viewpoint · file. lidarshop's own files say
+  // in a comment which scan pose they hold (the points are world coordinates); a foreign organized cloud is
+  // a camera image in the optical frame, a foreign unorganized one a cloud in the viewpoint's frame.
+  Eigen::Matrix4d scanner_from_file = Eigen::Matrix4d::Identity();
+  if (header.has_scanner_pose) {
+    scan.world_from_scanner = header.world_from_scanner;
+    scanner_from_file = header.world_from_scanner.inverse() * viewpoint;
+  } else if (organized) {
+    scan.world_from_scanner = viewpoint * CameraFromScanner();
+    scanner_from_file = CameraFromScanner().inverse();  // (x, y, z) → (x, z, −y), exactly
+  } else {
+    scan.world_from_scanner = viewpoint;
+  }
+  const Eigen::Matrix3d rotate = scanner_from_file.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = scanner_from_file.topRightCorner<3, 1>();
   const auto& f = header.fields;
   for (int row = 0; row < rows; ++row) {
     for (int col = 0; col < cols; ++col) {
@@ -341,7 +384,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || (x == 0 && y == 0 && z == 0))
         continue;
       scan.valid.at<uint8_t>(row, col) = kValid;
-      scan.point.at<cv::Vec3f>(row, col) = organized ? cv::Vec3f(x, z, -y) : cv::Vec3f(x, y, z);
+      const Eigen::Vector3f p = (rotate * Eigen::Vector3d(x, y, z) + shift).cast<float>();
+      scan.point.at<cv::Vec3f>(row, col) = cv::Vec3f(p.x(), p.y(), p.z());
       if (fcolor >= 0) {
         const uint32_t bits = PackedColor(record + f[fcolor].offset, f[fcolor]);
         scan.color.at<cv::Vec3b>(row, col) = cv::Vec3b((bits >> 16) & 0xff, (bits >> 8) & 0xff, bits & 0xff);
@@ -359,7 +403,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
         const double ny = LoadValue(record + f[fny].offset, f[fny]);
         const double nz = LoadValue(record + f[fnz].offset, f[fnz]);
         if (std::isfinite(nx) && std::isfinite(ny) && std::isfinite(nz)) {
-          scan.normal.at<cv::Vec3f>(row, col) = organized ? cv::Vec3f(nx, nz, -ny) : cv::Vec3f(nx, ny, nz);
+          const Eigen::Vector3f n = (rotate * Eigen::Vector3d(nx, ny, nz)).cast<float>();
+          scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
         }
       }
       if (fsynth >= 0 && LoadValue(record + f[fsynth].offset, f[fsynth]) != 0) {
@@ -368,14 +413,6 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       if (ftrue >= 0) scan.true_range.at<float>(row, col) = LoadValue(record + f[ftrue].offset, f[ftrue]);
     }
   }
-  const double* v = header.viewpoint;
-  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
-  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
-  if (rotation.norm() < 1e-9)
-    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
-  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
-  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
-  scan.world_from_scanner = organized ? Eigen::Matrix4d(viewpoint * CameraFromScanner()) : viewpoint;
   io_internal::FinishScan(&scan, /*fit_grid=*/organized);
   return scan;
 }
@@ -384,14 +421,13 @@ Scan ReadPcd(const std::string& path) { return ParsePcd(io_internal::ReadFileToS
 
 void WritePcd(const std::string& path, const Scan& scan) {
   CheckScan(scan);
-  const bool organized = scan.rows > 1;
-  const Eigen::Matrix4d camera_from_scanner = organized ? CameraFromScanner() : Eigen::Matrix4d::Identity();
-  const Eigen::Matrix3d rotate = camera_from_scanner.topLeftCorner<3, 3>();
-  const Eigen::Matrix4d viewpoint = scan.world_from_scanner * camera_from_scanner.inverse();
-  Eigen::Quaterniond rotation(Eigen::Matrix3d(viewpoint.topLeftCorner<3, 3>()));
-  rotation.normalize();
+  const Eigen::Matrix4d& world_from_scanner = scan.world_from_scanner;
+  const Eigen::Matrix3d rotate = world_from_scanner.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = world_from_scanner.topRightCorner<3, 1>();
+  // Far from the origin (georeferenced scans) floats would lose millimetres: doubles then, as in PLY.
+  const bool far = shift.norm() > 1e4;
 
-  std::string fields = "x y z", sizes = "4 4 4", types = "F F F", counts = "1 1 1";
+  std::string fields = "x y z", sizes = far ? "8 8 8" : "4 4 4", types = "F F F", counts = "1 1 1";
   auto add = [&](const char* name, const char* size, const char* type) {
     fields += std::string(" ") + name;
     sizes += std::string(" ") + size;
@@ -408,13 +444,16 @@ void WritePcd(const std::string& path, const Scan& scan) {
   }
   if (!scan.synthesized.empty()) add("synthesized", "1", "U");
   if (!scan.true_range.empty()) add("true_range", "4", "F");
-  const Eigen::Vector3d t = viewpoint.topRightCorner<3, 1>();
+  std::string pose;
+  for (int i = 0; i < 16; ++i) {
+    pose += ' ';
+    io_internal::AppendNumber(&pose, world_from_scanner(i / 4, i % 4));
+  }
   std::string out = fmt::format(
-      "# .PCD v0.7 - Point Cloud Data file format (written by lidarshop)\nVERSION 0.7\nFIELDS {}\nSIZE "
-      "{}\nTYPE "
-      "{}\nCOUNT {}\nWIDTH {}\nHEIGHT {}\nVIEWPOINT {} {} {} {} {} {} {}\nPOINTS {}\nDATA binary\n",
-      fields, sizes, types, counts, scan.cols, scan.rows, t.x(), t.y(), t.z(), rotation.w(), rotation.x(),
-      rotation.y(), rotation.z(), scan.num_cells());
+      "# .PCD v0.7 - Point Cloud Data file format (written by lidarshop)\n# frame world\n# {}{}\n"
+      "VERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {}\nHEIGHT {}\nVIEWPOINT 0 0 0 1 0 0 0\n"
+      "POINTS {}\nDATA binary\n",
+      kPoseComment, pose, fields, sizes, types, counts, scan.cols, scan.rows, scan.num_cells());
   auto put = [&out](auto value) { out.append(reinterpret_cast<const char*>(&value), sizeof(value)); };
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int row = 0; row < scan.rows; ++row) {
@@ -422,14 +461,10 @@ void WritePcd(const std::string& path, const Scan& scan) {
       const bool valid = scan.valid.at<uint8_t>(row, col) != 0;
       if (valid) {
         const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-        const Eigen::Vector3f q = (rotate * Eigen::Vector3d(p[0], p[1], p[2])).cast<float>();
-        put(q.x());
-        put(q.y());
-        put(q.z());
+        const Eigen::Vector3d world = rotate * Eigen::Vector3d(p[0], p[1], p[2]) + shift;
+        for (int i = 0; i < 3; ++i) far ? put(world[i]) : put(static_cast<float>(world[i]));
       } else {
-        put(nan);
-        put(nan);
-        put(nan);
+        for (int i = 0; i < 3; ++i) far ? put(static_cast<double>(nan)) : put(nan);
       }
       if (scan.has_color()) {
         const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);

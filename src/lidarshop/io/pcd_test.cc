@@ -1,7 +1,10 @@
 #include "lidarshop/io/pcd.h"
 
+#include <cmath>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+#include <Eigen/Geometry>
 
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
@@ -63,6 +66,108 @@ TEST(PcdTest, ReadsAscii) {
   // World coordinates are the file's.
   const PointCloud world = ToPointCloud(scan, /*world=*/true);
   EXPECT_TRUE(world.points[0].isApprox(Eigen::Vector3f(-0.1f, -0.1f, 1)));
+}
+
+// A 3 x 4 scan with returns, normals and colour in a pose turned 30° about z, lifted 1.5 m and moved by
+// `offset` metres.
+Scan PosedScan(const Eigen::Vector3d& offset) {
+  Scan scan = MakeScan(3, 4, /*with_color=*/true);
+  scan.grid = UniformGrid(3, 4, -0.3, 0.3, -0.2, 0.1);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  scan.normal = cv::Mat(3, 4, CV_32FC3, cv::Scalar::all(0));
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      if (r == 1 && c == 2) continue;  // one cell without a return
+      const float range = 5.0f + 0.3f * c + 0.1f * r;
+      scan.valid.at<uint8_t>(r, c) = kValid;
+      scan.range.at<float>(r, c) = range;
+      scan.point.at<cv::Vec3f>(r, c) = scan.direction.at<cv::Vec3f>(r, c) * range;
+      scan.normal.at<cv::Vec3f>(r, c) = cv::Vec3f(0, -1, 0);
+      scan.color.at<cv::Vec3b>(r, c) = cv::Vec3b(10 * r, 20 * c, 7);
+    }
+  }
+  Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
+  pose.topLeftCorner<3, 3>() = Eigen::AngleAxisd(M_PI / 6, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  pose.topRightCorner<3, 1>() = offset + Eigen::Vector3d(0, 0, 1.5);
+  scan.world_from_scanner = pose;
+  return scan;
+}
+
+// The file without lidarshop's comments: what a tool that ignores VIEWPOINT and comments sees.
+std::string WithoutComments(const std::string& bytes) {
+  std::string out;
+  size_t start = 0;
+  while (start < bytes.size()) {
+    const size_t end = bytes.find('\n', start);
+    const std::string line = bytes.substr(start, end - start + 1);
+    if (line.rfind("# frame", 0) != 0 && line.rfind("# lidarshop_scan", 0) != 0) out += line;
+    if (line.rfind("DATA", 0) == 0) return out + bytes.substr(end + 1);
+    start = end + 1;
+  }
+  return out;
+}
+
+TEST(PcdTest, WritesWorldCoordinatesAndReadsTheScanBack) {
+  TempFolder folder;
+  const Scan scan = PosedScan(Eigen::Vector3d(12, -3, 0));
+  WritePcd(folder.File("posed.pcd"), scan);
+  const std::string bytes = testing_io::ReadText(folder.File("posed.pcd"));
+  const std::string header = bytes.substr(0, bytes.find("DATA binary"));
+  EXPECT_THAT(header, ::testing::HasSubstr("\n# frame world\n"));
+  EXPECT_THAT(header, ::testing::HasSubstr("\n# lidarshop_scan world_from_scanner "));
+  EXPECT_THAT(header, ::testing::HasSubstr("\nVIEWPOINT 0 0 0 1 0 0 0\n"));
+  EXPECT_THAT(header, ::testing::HasSubstr("\nWIDTH 4\nHEIGHT 3\n"));
+
+  // Round trip: grid, scanner-frame points, normals and the pose come back.
+  const Scan back = ReadPcd(folder.File("posed.pcd"));
+  ASSERT_EQ(back.rows, 3);
+  ASSERT_EQ(back.cols, 4);
+  EXPECT_TRUE(back.world_from_scanner.isApprox(scan.world_from_scanner, 1e-15));
+  EXPECT_EQ(cv::norm(back.valid, scan.valid, cv::NORM_INF), 0.0);
+  EXPECT_LT(cv::norm(back.point, scan.point, cv::NORM_INF), 1e-5);
+  EXPECT_LT(cv::norm(back.normal, scan.normal, cv::NORM_INF), 1e-6);
+  EXPECT_EQ(cv::norm(back.color, scan.color, cv::NORM_INF), 0.0);
+  EXPECT_LT(cv::norm(back.direction, scan.direction, cv::NORM_INF), 1e-5);
+
+  // The coordinates in the file are the world's: read without the comments (as Open3D does, ignoring
+  // VIEWPOINT) the world points are the scan's.
+  const Scan foreign = ParsePcd(WithoutComments(bytes), "foreign.pcd");
+  const PointCloud expected = ToPointCloud(scan, /*world=*/true);
+  const PointCloud seen = ToPointCloud(foreign, /*world=*/true);
+  ASSERT_EQ(seen.size(), expected.size());
+  for (size_t i = 0; i < seen.size(); ++i) {
+    EXPECT_LT((seen.points[i] - expected.points[i]).norm(), 1e-5f) << i;
+  }
+  EXPECT_GT(seen.points[0].z(), 1.5);  // world z of the top row: the scanner stands 1.5 m up
+}
+
+TEST(PcdTest, FarScansKeepMillimetresInDoubles) {
+  TempFolder folder;
+  const Scan scan = PosedScan(Eigen::Vector3d(500000, 4000000, 100));  // UTM-like coordinates
+  WritePcd(folder.File("far.pcd"), scan);
+  EXPECT_THAT(testing_io::ReadText(folder.File("far.pcd")), ::testing::HasSubstr("\nSIZE 8 8 8 "));
+  const Scan back = ReadPcd(folder.File("far.pcd"));
+  EXPECT_TRUE(back.world_from_scanner.isApprox(scan.world_from_scanner, 1e-15));
+  EXPECT_LT(cv::norm(back.point, scan.point, cv::NORM_INF), 1e-5);
+}
+
+TEST(PcdTest, ABadPoseCommentIsRefused) {
+  const std::string body =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\n"
+      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n";
+  EXPECT_THAT(testing_io::InputErrorOf([&] {
+                ParsePcd("# lidarshop_scan world_from_scanner 1 0 0 0 0 1 0 0 0 0 1 0\n" + body, "short.pcd");
+              }),
+              ::testing::HasSubstr("lidarshop_scan world_from_scanner"));
+  EXPECT_THAT(testing_io::InputErrorOf([&] {
+                ParsePcd("# lidarshop_scan world_from_scanner 2 0 0 0 0 2 0 0 0 0 2 0 0 0 0 1\n" + body,
+                         "scaled.pcd");
+              }),
+              ::testing::HasSubstr("scaled"));
+  // A pose that is a rotation and a translation is taken: the point comes back in the scanner frame.
+  const Scan scan = ParsePcd(
+      "# lidarshop_scan world_from_scanner 1 0 0 10 0 1 0 0 0 0 1 1.5 0 0 0 1\n" + body, "posed.pcd");
+  EXPECT_EQ(scan.point.at<cv::Vec3f>(0, 0), cv::Vec3f(-9, 2, 1.5f));
 }
 
 TEST(PcdTest, SeveralScansAreRefused) {

@@ -8,8 +8,9 @@
 //             the file)
 //   face:     vertex_indices (list uchar int), red green blue (uchar), texcoord (list uchar float: u v per
 //             corner)
-//   comments  "lidarshop_scan <index> <rows> <cols> <16 numbers: world_from_scanner, row-major>" for each
-//             scan (the points themselves are in the world frame), "TextureFile <name>" for a mesh texture.
+//   comments  "frame world" (every point lidarshop writes is in the world frame), "lidarshop_scan <index>
+//             <rows> <cols> <16 numbers: world_from_scanner, row-major>" for each scan (the points themselves
+//             are in the world frame), "TextureFile <name>" for a mesh texture.
 #pragma once
 
 #include <cstdint>

@@ -101,6 +101,7 @@ TEST(PlyTest, PointCloudRoundTrip) {
     const std::string path = folder.File(ascii ? "a.ply" : "b.ply");
     WritePointCloud(path, cloud, ascii);
     const PointCloud back = ReadPointCloud(path);
+    EXPECT_THAT(ReadPly(path).comments, ::testing::Contains("frame world"));
     EXPECT_EQ(back.points, cloud.points);
     EXPECT_EQ(back.normals, cloud.normals);
     EXPECT_EQ(back.colors, cloud.colors);
@@ -139,6 +140,7 @@ TEST(PlyTest, ScansKeepTheirGridPoseAndChannels) {
   scans[1].world_from_scanner(0, 3) = 10.0;
   scans[1].world_from_scanner(2, 3) = -1.0;
   WriteScanFile(folder.File("scans.ply"), scans);
+  EXPECT_THAT(ReadPly(folder.File("scans.ply")).comments, ::testing::Contains("frame world"));
   const ScanFile file = ReadScanFile(folder.File("scans.ply"));
   ASSERT_EQ(file.scans.size(), 2u);
   for (int k = 0; k < 2; ++k) {

@@ -153,6 +153,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
 void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   PlyData ply;
   ply.comments.push_back("written by lidarshop: points in the world frame; row/col in image orientation");
+  ply.comments.push_back("frame world");
   int64_t total = 0;
   bool color = false, label = false, normal = false, synthesized = false, true_range = false, far = false;
   for (size_t k = 0; k < scans.size(); ++k) {

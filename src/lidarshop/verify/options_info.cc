@@ -27,6 +27,9 @@ template <>
 const StructInfo& InfoOf<ModelOptions>() {
   static const StructInfo info = [] {
     StructBuilder<ModelOptions> b("ModelOptions", "the model side of verification");
+    b.Field(&ModelOptions::model_scale, "model_scale",
+            "metres per mesh unit: the mesh is scaled by this first (0.001 for a mesh in millimetres)")
+        .Range(1e-6, 1e6);
     b.Field(&ModelOptions::point_source, "point_source", "where the model points come from");
     b.Field(&ModelOptions::num_surface_samples, "num_surface_samples", "model points (surface samples)")
         .Range(1, static_cast<double>(ModelOptions::kMaxSurfaceSamples));

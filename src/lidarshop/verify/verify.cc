@@ -209,12 +209,15 @@ struct Workspace {
   std::vector<uint8_t> status;  // per ray: SceneStatus
 };
 
-// The quantities of a VerifyPose call that do not depend on the scan.
+// The quantities of a VerifyPose call that do not depend on the scan. Lengths in the model frame are in
+// model units: metres divided by the pose's scale (world metres = model units · metres_per_unit).
 struct PoseQuery {
-  float allowance = 0, sigma = 0;  // a, σ (metres)
-  float kernel_radius = 0;         // 3σ
-  float inverse_two_sigma_sq = 0;  // 1 / 2σ²
-  float trim = 0;                  // ICP trim distance, metres
+  double metres_per_unit = 1.0;    // the uniform scale s of world_from_model
+  float allowance = 0;             // a, metres: applied along the rays, whose parameter stays in metres
+  float sigma = 0;                 // σ, model units
+  float kernel_radius = 0;         // 3σ, model units
+  float inverse_two_sigma_sq = 0;  // 1 / 2σ², per model unit²
+  float trim = 0;                  // ICP trim distance, model units
   Eigen::AlignedBox3f near_box;    // the model's box grown by max(3σ, trim), model frame
   Eigen::AlignedBox3f icp_box;     // the model's box grown by trim
   // The kernel grid covers the model's box grown by max(3σ, trim); only points inside near_box (the same box)
@@ -222,13 +225,14 @@ struct PoseQuery {
   bool use_grid = false;
 };
 
-PoseQuery MakePoseQuery(const VerifierModel& model, const VerifyOptions& options) {
+PoseQuery MakePoseQuery(const VerifierModel& model, const VerifyOptions& options, double metres_per_unit) {
   PoseQuery q;
+  q.metres_per_unit = metres_per_unit;
   q.allowance = static_cast<float>(options.allowance_m);
-  q.sigma = static_cast<float>(options.sigma_m);
+  q.sigma = static_cast<float>(options.sigma_m / metres_per_unit);
   q.kernel_radius = 3.0f * q.sigma;
   q.inverse_two_sigma_sq = 1.0f / (2.0f * q.sigma * q.sigma);
-  q.trim = static_cast<float>(options.icp_trim_m);
+  q.trim = static_cast<float>(options.icp_trim_m / metres_per_unit);
   const float near_radius = std::max(q.kernel_radius, q.trim);
   q.near_box = model.bounds_in_model;
   q.near_box.min().array() -= near_radius;
@@ -303,7 +307,7 @@ void AccumulateKernelSums(const VerifierModel& model, const PoseQuery& q, Worksp
 
 // ICP: the near points inside the ICP box are candidates, those within `trim` of the model inliers. The
 // candidates without a model point within 3σ (not found by AccumulateKernelSums) get a nearest-neighbour
-// search of their own. Adds to the result's counts and to *icp_distance_sum (metres).
+// search of their own. Adds to the result's counts and to *icp_distance_sum (model units).
 void CountIcpInliers(const VerifierModel& model, const PoseQuery& q, Workspace* workspace,
                      VerifyResult* result, double* icp_distance_sum) {
   const size_t num_near = workspace->near_points.size();
@@ -383,22 +387,28 @@ VerifierModel PrepareModel(const TriangleMesh& mesh_in_model, const ModelOptions
   if (mesh_in_model.empty()) throw InputError("verification model: the mesh has no triangles");
   VerifierModel model;
   model.mesh_in_model = mesh_in_model;
-  model.surface_area_m2 = SurfaceArea(mesh_in_model);
+  if (options.model_scale != 1.0) {
+    for (Eigen::Vector3f& vertex : model.mesh_in_model.vertices) {
+      vertex = (vertex.cast<double>() * options.model_scale).cast<float>();
+    }
+    ValidateMesh(model.mesh_in_model, "verification model (scaled by model_scale)");
+  }
+  model.surface_area_m2 = SurfaceArea(model.mesh_in_model);
   if (!(model.surface_area_m2 > 0)) throw InputError("verification model: the mesh has no surface area");
-  model.bounds_in_model = Bounds(mesh_in_model);
+  model.bounds_in_model = Bounds(model.mesh_in_model);
   // Built once and cast millions of times: the slowest, best BVH pays for itself.
   RaycastSceneOptions raycast_options;
   raycast_options.build_quality = "high";
   raycast_options.robust = false;  // ~8 % faster; a ray grazing an edge decides nothing here
   model.scene_in_model = RaycastScene(raycast_options);
-  model.scene_in_model.AddMesh(mesh_in_model, 0);
+  model.scene_in_model.AddMesh(model.mesh_in_model, 0);
   model.scene_in_model.Commit();
 
   std::vector<Eigen::Vector3f> points;
   if (options.point_source == ModelPointSource::kVertices) {
-    points = mesh_in_model.vertices;
+    points = model.mesh_in_model.vertices;
   } else {
-    points = SampleSurface(mesh_in_model, options.num_surface_samples, options.seed).points;
+    points = SampleSurface(model.mesh_in_model, options.num_surface_samples, options.seed).points;
   }
   model.points_in_model = PointKdTree(std::move(points));
   const size_t n = model.points_in_model.size();
@@ -501,10 +511,15 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
                         const Eigen::Matrix4d& world_from_model, const VerifyOptions& options) {
   LIDARSHOP_CHECK(model.scene_in_model.committed());
   options.Check();
+  const std::string pose_problem = PoseProblem(world_from_model, /*allow_uniform_scale=*/true);
+  if (!pose_problem.empty()) {
+    throw std::invalid_argument(fmt::format("VerifyPose: world_from_model {}", pose_problem));
+  }
   thread_local Workspace workspace;
   VerifyResult result;
   const size_t n = model.num_points();
-  const PoseQuery q = MakePoseQuery(model, options);
+  const PoseQuery q =
+      MakePoseQuery(model, options, std::cbrt(world_from_model.topLeftCorner<3, 3>().determinant()));
   const Eigen::Matrix4d model_from_world = world_from_model.inverse();
   const KernelNeighbourGrid& grid = model.kernel_grid;
 
@@ -564,7 +579,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     if (options.keep_details) result.observed_information[i] = observed;
   }
   result.confidence = std::min(1.0, confidence);
-  if (result.icp_inliers > 0) result.icp_cost_m = icp_distance_sum / result.icp_inliers;
+  if (result.icp_inliers > 0) result.icp_cost_m = q.metres_per_unit * icp_distance_sum / result.icp_inliers;
   if (result.icp_candidates > 0) {
     result.inlier_fraction = static_cast<double>(result.icp_inliers) / result.icp_candidates;
   }

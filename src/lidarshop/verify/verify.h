@@ -78,6 +78,10 @@ template <>
 const EnumInfo& EnumInfoOf<InformationWeighting>();  // "uniform", "shape-distinctiveness"
 
 struct ModelOptions {
+  // Metres per unit of the mesh: PrepareModel scales the mesh by it before anything else, so that the model
+  // frame is in metres (0.001 for a mesh in millimetres, 0.0254 for inches). Equivalent to a uniform scale in
+  // world_from_model (same numbers), but faster: the neighbour grids are built for σ and the trim in metres.
+  double model_scale = 1.0;
   ModelPointSource point_source = ModelPointSource::kSurfaceSamples;
   static constexpr int64_t kMaxSurfaceSamples = int64_t{1} << 27;
   int64_t num_surface_samples =
@@ -124,7 +128,7 @@ struct KernelNeighbourGrid {
   bool built() const { return kernel.radius_m > 0; }
 };
 
-// The model side, built once (model frame = the mesh's own coordinates).
+// The model side, built once (model frame = the mesh's own coordinates times ModelOptions::model_scale).
 struct VerifierModel {
   TriangleMesh mesh_in_model;
   RaycastScene scene_in_model;          // Embree scene of mesh_in_model, committed
@@ -217,8 +221,13 @@ struct VerifyResult {
 template <>
 const StructInfo& InfoOf<VerifyResult>();
 
-// Verifies one pose. `world_from_model` may include a uniform scale; distances
-// stay in scanner (world) metres.
+// Verifies one pose. `world_from_model` is a rotation times one uniform scale s plus a translation
+// (geometry/transform.h PoseProblem; std::invalid_argument otherwise). Every distance of the measures stays
+// in world metres whatever s is: the allowance along the rays, σ and the trim distance (divided by s in the
+// model frame) and the ICP cost (multiplied back). A scale in the pose and the mesh pre-scaled by s
+// (ModelOptions::model_scale) give the same numbers; with s ≠ 1 the kernel grid built for σ does not apply
+// and the KD-tree answers (same results, slower).
+
 VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan> scans,
                         const Eigen::Matrix4d& world_from_model, const VerifyOptions& options = {});
 

@@ -141,6 +141,16 @@ def test_verify_pose(scan):
     assert many[1].consistency == floating.consistency and many[1].confidence == floating.confidence
     with pytest.raises(lidarshop.OptionsError, match="sigma"):
         lidarshop.verify_pose(box, scan, truth, sigma=1)
+    # A model in millimetres: model_scale, or the scale in the pose, gives the numbers of the model in metres.
+    box_mm = lidarshop.make_primitive("box", {"size": [1200.0, 1200.0, 1200.0]})
+    by_option = lidarshop.verify_pose(box_mm, scan, truth, allowance_m=0.05, sigma_m=0.05,
+                                      model_options={"model_scale": 0.001})
+    scaled_pose = truth.copy()
+    scaled_pose[:3, :3] *= 0.001
+    in_pose = lidarshop.verify_pose(box_mm, scan, scaled_pose, allowance_m=0.05, sigma_m=0.05)
+    for result in (by_option, in_pose):
+        assert result.consistency == pytest.approx(right.consistency, abs=1e-3)
+        assert result.confidence == pytest.approx(right.confidence, abs=1e-3)
 
 
 def test_long_calls_release_the_gil(scan):
