@@ -127,8 +127,10 @@ std::shared_ptr<Job> FillingJob(State& state, const std::shared_ptr<Document>& d
 }
 
 // Submits the review's job (answers 202), or closes the review and answers 503.
+// `job` by value: callers pass review->job, which the worker clears when the job ends — possibly before
+// this thread has answered with the job's JSON.
 void Submit(State& state, const std::shared_ptr<Document>& document,
-            const std::shared_ptr<ReviewSession>& review, const std::shared_ptr<Job>& job,
+            const std::shared_ptr<ReviewSession>& review, std::shared_ptr<Job> job,
             httplib::Response& response) {
   if (state.runner->Submit(job)) return SendJson(response, JobJson(*job), 202);
   std::lock_guard lock(document->mutex);
