@@ -25,14 +25,22 @@ SweepConfidenceBound::SweepConfidenceBound(const VerifierModel& model, std::span
   const auto points = model.points_in_model.points();
   LIDARSHOP_CHECK(!points.empty());
   double reach_xy = 0.0, z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  // Lowest first: the ground reaches them, so a block that cannot be skipped usually stops early; and
+  // neighbours in z share a window of slabs (cache).
+  std::vector<uint32_t> order(points.size());
+  for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return points[a].z() < points[b].z(); });
   points_in_model_.reserve(points.size());
-  for (const Eigen::Vector3f& p : points) {
+  information_.reserve(points.size());
+  for (uint32_t i : order) {
+    const Eigen::Vector3f& p = points[i];
     points_in_model_.push_back(p.cast<double>());
+    information_.push_back(model.information[i]);
     reach_xy = std::max(reach_xy, std::hypot(double{p.x()}, double{p.y()}));
     z_lo = std::min(z_lo, double{p.z()});
     z_hi = std::max(z_hi, double{p.z()});
   }
-  information_.assign(model.information.begin(), model.information.end());
 
   // Columns of about σ square (finer would not tighten a bound whose kernel is 3σ; coarser when the region
   // is large) and slabs of σ / 5: a car's sills and tyres lie within centimetres of 3σ above the ground, so
@@ -122,24 +130,50 @@ SweepConfidenceBound::SweepConfidenceBound(const VerifierModel& model, std::span
     }
     window_distance_[k] = floored;
   });
+  window_of_point_.resize(points_in_model_.size());
+  for (size_t i = 0; i < points_in_model_.size(); ++i) {
+    const cv::Mat& distance = window_distance_[first_slab_[i]];
+    window_of_point_[i] = distance.empty() ? nullptr : distance.data;
+  }
+  yaws_deg_ = options.yaws_deg;
+  rotated_cells_.resize(yaws_deg_.size());
+  for (size_t k = 0; k < yaws_deg_.size(); ++k) rotated_cells_[k] = RotatedCells(yaws_deg_[k]);
+}
+
+std::vector<Eigen::Vector2d> SweepConfidenceBound::RotatedCells(double yaw_deg) const {
+  const Eigen::Matrix2d rotation = PoseFromXyzYaw(0.0, 0.0, 0.0, yaw_deg).topLeftCorner<2, 2>();
+  std::vector<Eigen::Vector2d> cells(points_in_model_.size());
+  for (size_t i = 0; i < cells.size(); ++i) cells[i] = rotation * points_in_model_[i].head<2>() / cell_m_;
+  return cells;
 }
 
 double SweepConfidenceBound::UpperBound(double x_m, double y_m, double yaw_deg, double radius_m,
                                         double stop_above) const {
-  const Eigen::Matrix4d pose = PoseFromXyzYaw(x_m, y_m, 0.0, yaw_deg);
-  const Eigen::Matrix2d rotation = pose.topLeftCorner<2, 2>();
+  std::vector<Eigen::Vector2d> computed;
+  const std::vector<Eigen::Vector2d>* rotated = nullptr;
+  for (size_t k = 0; k < yaws_deg_.size() && rotated == nullptr; ++k) {
+    if (yaws_deg_[k] == yaw_deg) rotated = &rotated_cells_[k];
+  }
+  if (rotated == nullptr) {
+    computed = RotatedCells(yaw_deg);
+    rotated = &computed;
+  }
   const double reach_m = radius_m * (1.0 + kRelativeMargin) + kAbsoluteMargin + kernel_m_;
-  // Occupied cells D apart hold points at least (D − √2 − 1) cells apart (see the header).
-  const float reach_cells = static_cast<float>(reach_m / cell_m_ + std::sqrt(2.0) + 1.0);
+  // Occupied cells D apart hold points at least (D − √2 − 1) cells apart (see the header); D is stored
+  // rounded down, so compare with the whole cells below the reach.
+  const double reach_cells = reach_m / cell_m_ + std::sqrt(2.0) + 1.0;
+  const uint8_t limit = static_cast<uint8_t>(std::min(255.0, std::floor(reach_cells)));
+  const bool all_near = reach_cells >= 255.0;
+  // The model points' cell coordinates are (rotated + centre) in cells from the grid's corner.
+  const double cx = (x_m - x0_m_) / cell_m_, cy = (y_m - y0_m_) / cell_m_;
   double bound = 0.0;
-  for (size_t i = 0; i < points_in_model_.size(); ++i) {
-    const Eigen::Vector2d p = rotation * points_in_model_[i].head<2>() + Eigen::Vector2d(x_m, y_m);
-    const double fx = std::floor((p.x() - x0_m_) / cell_m_), fy = std::floor((p.y() - y0_m_) / cell_m_);
+  for (size_t i = 0; i < rotated->size(); ++i) {
+    const double fx = std::floor((*rotated)[i].x() + cx), fy = std::floor((*rotated)[i].y() + cy);
     bool near = true;  // outside the grid (not expected): counted
     if (fx >= 0 && fx < nx_ && fy >= 0 && fy < ny_) {
-      const cv::Mat& distance = window_distance_[first_slab_[i]];
-      near = !distance.empty() &&
-             distance.at<uint8_t>(static_cast<int>(fy), static_cast<int>(fx)) <= reach_cells;
+      const uint8_t* distance = window_of_point_[i];
+      near = distance != nullptr &&
+             (all_near || distance[static_cast<size_t>(fy) * nx_ + static_cast<size_t>(fx)] <= limit);
     }
     if (near) {
       bound += information_[i];

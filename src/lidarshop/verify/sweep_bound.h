@@ -64,6 +64,11 @@ class SweepConfidenceBound {
   std::vector<Eigen::Vector3d> points_in_model_;
   std::vector<double> information_;
   std::vector<int> first_slab_;
+  std::vector<const uint8_t*> window_of_point_;  // window_distance_[first_slab_[i]].data, or nullptr
+  // Per yaw of the sweep: the model points' x, y rotated by it, in cells (the rest computed when asked).
+  std::vector<double> yaws_deg_;
+  std::vector<std::vector<Eigen::Vector2d>> rotated_cells_;
+  std::vector<Eigen::Vector2d> RotatedCells(double yaw_deg) const;
 };
 
 }  // namespace lidarshop::verify_internal
