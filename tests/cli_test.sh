@@ -536,6 +536,16 @@ json_check "verify --json: the described result and the older keys" "$work/j_ver
   "d['icp_cost_m'] == d['icp_cost'] and d['options']['allowance_m'] == 0.1 and 'num_surface_samples' in d['model_options']"
 json_stdout "sweep --json -" detections "$lidarshop" sweep --scan "$work/scan.ptx" --model "$work/box.obj" \
   --x-range=-3:-1 --y-range 7:9 --step 0.5 --yaws 0 --out "$work/j_sweep" --json - --quiet
+cp "$work/last.out" "$work/j_sweep.json"
+json_stdout "sweep --search full --json -" detections "$lidarshop" sweep --scan "$work/scan.ptx" \
+  --model "$work/box.obj" --x-range=-3:-1 --y-range 7:9 --step 0.5 --yaws 0 --out "$work/j_sweep_full" \
+  --search full --json - --quiet
+cp "$work/last.out" "$work/j_sweep_full.json"
+json_check "sweep --json: the search and the poses it verified" "$work/j_sweep.json" \
+  "d['grid']['search'] == 'coarse-to-fine' and 0 < d['grid']['evaluated_poses'] <= d['grid']['poses'] == 25"
+json_check "sweep --search full: every pose verified, the same detections" "$work/j_sweep_full.json" \
+  "d['grid']['search'] == 'full' and d['grid']['evaluated_poses'] == 25 and \
+d['detections'] == json.load(open('$work/j_sweep.json'))['detections']"
 json_stdout "segment --json -" object_cells "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.json" \
   -o "$work/j_mask.png" --json - --quiet
 json_stdout "inpaint --json -" iterations "$lidarshop" inpaint "$images/lettera/lettera.png" \

@@ -45,6 +45,8 @@ py::dict PoseColumns(const std::vector<SweepPose>& poses) {
       column([](const SweepPose& p) { return static_cast<double>(p.result.comparable_pairs); });
   columns["icp_cost_m"] = column([](const SweepPose& p) { return p.result.icp_cost_m; });
   columns["inlier_fraction"] = column([](const SweepPose& p) { return p.result.inlier_fraction; });
+  columns["evaluated"] = column([](const SweepPose& p) { return p.evaluated ? 1.0 : 0.0; });
+  columns["confidence_bound"] = column([](const SweepPose& p) { return p.confidence_bound; });
   return columns;
 }
 
@@ -83,21 +85,28 @@ void BindVerifyResults(py::module_& m) {
           "yaws_deg", [](const SweepResult& r) { return py::array(py::cast(r.yaws_deg)); }, "degrees")
       .def_property_readonly(
           "consistency_map", [](const SweepResult& r) { return MatToArray(r.consistency_map); },
-          "float32 (#y, #x): the best over yaws; row 0 = the largest y; NaN = nothing comparable")
+          "float32 (#y, #x): the best over the verified yaws; row 0 = the largest y; NaN = nothing "
+          "comparable "
+          "or nothing verified")
       .def_property_readonly(
           "confidence_map", [](const SweepResult& r) { return MatToArray(r.confidence_map); },
-          "float32 (#y, #x): the best over yaws; row 0 = the largest y")
+          "float32 (#y, #x): the best over the verified yaws; row 0 = the largest y; NaN = nothing verified")
+      .def_property_readonly(
+          "evaluated_map", [](const SweepResult& r) { return MatToArray(r.evaluated_map); },
+          "uint8 (#y, #x): yaws verified at each position (coarse-to-fine skips poses that cannot pass)")
+      .def_readonly("evaluated_poses", &SweepResult::evaluated_poses, "grid poses verified")
       .def_property_readonly(
           "poses", [](const SweepResult& r) { return PoseColumns(r.poses); },
           "every grid pose as columns (dict of float64 arrays: x_m, y_m, yaw_deg, consistency, confidence, "
-          "comparable_pairs, icp_cost_m, inlier_fraction), index (iy * #x + ix) * #yaws + iyaw")
+          "comparable_pairs, icp_cost_m, inlier_fraction, evaluated (0 = skipped by coarse-to-fine: its "
+          "confidence is at most confidence_bound), confidence_bound), index (iy * #x + ix) * #yaws + iyaw")
       .def_property_readonly(
           "refined", [](const SweepResult& r) { return PoseColumns(r.refined); },
           "the poses of the local refinement, as columns")
       .def_readonly("detections", &SweepResult::detections, "by decreasing confidence")
       .def_readonly("refine_evaluations", &SweepResult::refine_evaluations)
       .def_readonly("nms_radius_m", &SweepResult::nms_radius_m)
-      .def("csv", &SweepCsv, "One line per grid pose (x_m,y_m,yaw_deg,consistency,confidence,...).")
+      .def("csv", &SweepCsv, "One line per verified pose (x_m,y_m,yaw_deg,consistency,confidence,...).")
       .def(
           "heat_map",
           [](const SweepResult& r, const std::string& measure, double threshold, int cell_px) {
@@ -108,9 +117,8 @@ void BindVerifyResults(py::module_& m) {
             return MatToArray(RenderHeatMap(values, r, measure, threshold, cell_px));
           },
           py::arg("measure") = "confidence", py::arg("threshold") = -1.0, py::arg("cell_px") = 0,
-          "The heat map as an RGB picture (uint8 (H, W, 3)) with a colour scale, the threshold marked and "
-          "the "
-          "detections ringed.");
+          "The heat map as an RGB picture (uint8 (H, W, 3)) with a colour scale, the threshold marked, the "
+          "detections ringed, axes in metres, the scanners (magenta) and the scene points underneath.");
 }
 
 }  // namespace

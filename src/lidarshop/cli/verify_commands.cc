@@ -14,6 +14,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/enum_names.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/pose_text.h"
@@ -234,7 +235,10 @@ int RunSweep(int argc, char** argv) {
       "refinement and non-maximum suppression.\n"
       "Outputs in --out: consistency.png, confidence.png (best value over yaws per position, north up, rings "
       "at "
-      "detections), sweep.csv, detections.json.",
+      "detections, axes in metres, the scanner and the scene points), sweep.csv (the verified poses), "
+      "detections.json.\n"
+      "--search coarse-to-fine (default) verifies only the blocks of poses whose confidence bound can still "
+      "pass and gives the same detections as --search full.",
       "sweep");
   CommonFlags common;
   SweepOptions sweep_options;
@@ -312,15 +316,18 @@ int RunSweep(int argc, char** argv) {
                         {"yaws_deg", sweep.yaws_deg},
                         {"poses", sweep.poses.size()},
                         {"refined_seeds", sweep.refined.size()},
-                        {"refine_evaluations", sweep.refine_evaluations}};
+                        {"refine_evaluations", sweep.refine_evaluations},
+                        {"search", ToString(sweep_options.search)},
+                        {"evaluated_poses", sweep.evaluated_poses},
+                        {"bound_evaluations", sweep.bound_evaluations}};
         WriteText((out / "detections.json").string(), json.dump(2) + "\n");
         nlohmann::ordered_json result = json;
         result["verify_options"] = ToJson(common.verify);
         result["model_options"] = ToJson(common.model_options);
         WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
         if (!common.quiet) {
-          fmt::print(stderr, "{} poses, {} refined, {} detection(s):\n", sweep.poses.size(),
-                     sweep.refined.size(), sweep.detections.size());
+          fmt::print(stderr, "{} poses ({} verified), {} refined, {} detection(s):\n", sweep.poses.size(),
+                     sweep.evaluated_poses, sweep.refined.size(), sweep.detections.size());
           for (const Detection& d : sweep.detections) {
             fmt::print(stderr, "  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n",
                        d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);

@@ -24,6 +24,15 @@ const EnumInfo& EnumInfoOf<InformationWeighting>() {
 }
 
 template <>
+const EnumInfo& EnumInfoOf<SweepSearch>() {
+  static const EnumInfo info = MakeEnumInfo<SweepSearch>(
+      "sweep search", {{SweepSearch::kFull, "full", "verify every grid pose"},
+                       {SweepSearch::kCoarseToFine, "coarse-to-fine",
+                        "verify only the poses whose confidence bound can pass (same detections)"}});
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<ModelOptions>() {
   static const StructInfo info = [] {
     StructBuilder<ModelOptions> b("ModelOptions", "the model side of verification");
@@ -108,6 +117,11 @@ const StructInfo& InfoOf<SweepOptions>() {
     b.Field(&SweepOptions::refine_min_yaw_deg, "refine_min_yaw_deg", "smallest refinement yaw step")
         .Unit("deg")
         .AboveZero();
+    b.Field(&SweepOptions::search, "search",
+            "full: every grid pose; coarse-to-fine: skip blocks whose confidence bound cannot pass");
+    b.Field(&SweepOptions::coarse_block, "coarse_block",
+            "grid positions along x and y of the coarsest blocks (coarse-to-fine)")
+        .Range(1, 4096);
     b.Check([](const SweepOptions& o) {
       if (o.x_max_m < o.x_min_m) throw OptionsFieldError("x_max_m", "is below x_min_m");
       if (o.y_max_m < o.y_min_m) throw OptionsFieldError("y_max_m", "is below y_min_m");

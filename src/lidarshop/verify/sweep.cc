@@ -11,6 +11,7 @@
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
+#include "lidarshop/verify/sweep_bound.h"
 
 namespace lidarshop {
 namespace {
@@ -98,6 +99,128 @@ void RefineSeeds(const VerifierModel& model, std::span<const PreparedScan> scans
   for (int64_t e : evaluations) sweep->refine_evaluations += e;
 }
 
+// The confidence threshold a grid pose must pass to matter: as a detection, or as a refinement seed.
+double PassThreshold(const SweepOptions& options) {
+  return options.refine ? std::min(options.min_confidence, options.refine_min_confidence)
+                        : options.min_confidence;
+}
+
+// The coarse-to-fine search (sweep.h, sweep_bound.h): per yaw, blocks of coarse_block x coarse_block grid
+// positions; a block whose confidence bound cannot pass is skipped (its poses keep evaluated = false and the
+// bound), others split into quarters down to single positions, which are verified. Appends the indices of
+// the poses to verify (in index order) and returns the number of bounds computed.
+int64_t SelectByConfidenceBound(const VerifierModel& model, std::span<const PreparedScan> scans,
+                                const SweepOptions& options, double sigma_m, SweepResult* sweep,
+                                std::vector<size_t>* to_verify, Progress* progress) {
+  const int nx = static_cast<int>(sweep->xs_m.size()), ny = static_cast<int>(sweep->ys_m.size());
+  const int nyaw = static_cast<int>(sweep->yaws_deg.size());
+  const int block = std::max(1, options.coarse_block);
+  struct Block {
+    int x0, x1, y0, y1;  // grid positions [x0, x1) x [y0, y1)
+    double RadiusM(const SweepResult& s) const {
+      return 0.5 * std::hypot(s.xs_m[x1 - 1] - s.xs_m[x0], s.ys_m[y1 - 1] - s.ys_m[y0]);
+    }
+  };
+  std::vector<std::pair<int, Block>> roots;  // (yaw index, block)
+  for (int iyaw = 0; iyaw < nyaw; ++iyaw) {
+    for (int y0 = 0; y0 < ny; y0 += block) {
+      for (int x0 = 0; x0 < nx; x0 += block) {
+        roots.push_back({iyaw, Block{x0, std::min(nx, x0 + block), y0, std::min(ny, y0 + block)}});
+      }
+    }
+  }
+  double max_radius = 0.0;
+  for (const auto& root : roots) max_radius = std::max(max_radius, root.second.RadiusM(*sweep));
+  const verify_internal::SweepConfidenceBound bound(model, scans, options, sigma_m, max_radius);
+  const double threshold = PassThreshold(options);
+  // A bound is summed in another order than verify's confidence: a relative 1e-9 covers the rounding.
+  const double stop_above = threshold - 1e-9;
+
+  std::vector<uint8_t> verify_pose(sweep->poses.size(), 0);
+  std::vector<int64_t> bounds_per_root(roots.size(), 0);
+  ParallelFor(static_cast<int64_t>(roots.size()), [&](int64_t k) {
+    const int iyaw = roots[k].first;
+    const double yaw = sweep->yaws_deg[iyaw];
+    std::vector<Block> stack = {roots[k].second};
+    while (!stack.empty()) {
+      const Block b = stack.back();
+      stack.pop_back();
+      const double cx = 0.5 * (sweep->xs_m[b.x0] + sweep->xs_m[b.x1 - 1]);
+      const double cy = 0.5 * (sweep->ys_m[b.y0] + sweep->ys_m[b.y1 - 1]);
+      const double upper = bound.UpperBound(cx, cy, yaw, b.RadiusM(*sweep), stop_above);
+      ++bounds_per_root[k];
+      const bool single = b.x1 - b.x0 == 1 && b.y1 - b.y0 == 1;
+      if (upper <= stop_above || single) {
+        const bool skip = upper <= stop_above;
+        for (int iy = b.y0; iy < b.y1; ++iy) {
+          for (int ix = b.x0; ix < b.x1; ++ix) {
+            const size_t p = (static_cast<size_t>(iy) * nx + ix) * nyaw + iyaw;
+            verify_pose[p] = skip ? 0 : 1;
+            SweepPose& pose = sweep->poses[p];  // each pose belongs to one block: no race
+            pose.evaluated = !skip;
+            pose.confidence_bound = skip ? upper : 1.0;
+          }
+        }
+        Advance(progress, static_cast<int64_t>(b.x1 - b.x0) * (b.y1 - b.y0));
+        continue;
+      }
+      const int xm = b.x1 - b.x0 > 1 ? (b.x0 + b.x1) / 2 : b.x1;
+      const int ym = b.y1 - b.y0 > 1 ? (b.y0 + b.y1) / 2 : b.y1;
+      for (const Block child : {Block{b.x0, xm, b.y0, ym}, Block{xm, b.x1, b.y0, ym},
+                                Block{b.x0, xm, ym, b.y1}, Block{xm, b.x1, ym, b.y1}}) {
+        if (child.x1 > child.x0 && child.y1 > child.y0) stack.push_back(child);
+      }
+    }
+  });
+  for (size_t p = 0; p < verify_pose.size(); ++p) {
+    if (verify_pose[p] != 0) to_verify->push_back(p);
+  }
+  int64_t total = 0;
+  for (int64_t n : bounds_per_root) total += n;
+  return total;
+}
+
+// The scanners' positions and the scene points a model on the ground could touch, for the heat maps.
+void CollectPictureContext(const VerifierModel& model, std::span<const PreparedScan> scans,
+                           const SweepOptions& options, SweepResult* sweep) {
+  const double half_x = 0.5 * (sweep->xs_m.size() > 1 ? sweep->xs_m[1] - sweep->xs_m[0] : options.step_m);
+  const double x_lo = sweep->xs_m.front() - half_x, x_hi = sweep->xs_m.back() + half_x;
+  const double y_lo = sweep->ys_m.front() - half_x, y_hi = sweep->ys_m.back() + half_x;
+  // Above the ground (20 cm: noise and gravel) and below the model's top.
+  const double z_lo = options.z_m + std::max(0.2, double{model.bounds_in_model.min().z()});
+  const double z_hi = options.z_m + std::max(0.4, double{model.bounds_in_model.max().z()});
+  constexpr double kThinM = 0.02;
+  const int64_t columns = static_cast<int64_t>(std::ceil((x_hi - x_lo) / kThinM)) + 1;
+  std::vector<int64_t> seen;
+  for (const PreparedScan& prepared : scans) {
+    const Eigen::Vector3d origin = prepared.world_from_scanner.topRightCorner<3, 1>();
+    sweep->scanner_xy_m.emplace_back(origin.x(), origin.y());
+    const Scan& scan = prepared.scan;
+    for (int r = 0; r < scan.rows; ++r) {
+      for (int c = 0; c < scan.cols; ++c) {
+        if (scan.valid.at<uint8_t>(r, c) == 0 || !(scan.range.at<float>(r, c) > 0)) continue;
+        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3d q =
+            (prepared.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1.0)).head<3>();
+        if (!(q.z() > z_lo && q.z() < z_hi && q.x() >= x_lo && q.x() < x_hi && q.y() >= y_lo &&
+              q.y() < y_hi)) {
+          continue;
+        }
+        seen.push_back(static_cast<int64_t>((q.y() - y_lo) / kThinM) * columns +
+                       static_cast<int64_t>((q.x() - x_lo) / kThinM));
+      }
+    }
+  }
+  std::sort(seen.begin(), seen.end());
+  seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+  sweep->scene_xy_m.reserve(seen.size());
+  for (int64_t key : seen) {
+    sweep->scene_xy_m.emplace_back(
+        static_cast<float>(x_lo + (static_cast<double>(key % columns) + 0.5) * kThinM),
+        static_cast<float>(y_lo + (static_cast<double>(key / columns) + 0.5) * kThinM));
+  }
+}
+
 }  // namespace
 
 void SweepOptions::Check() const {
@@ -174,26 +297,54 @@ SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scan
   }
   VerifyOptions options = verify_options;
   options.keep_details = false;
-  std::vector<VerifyResult> results = VerifyPoses(model, scans, poses, options, progress);
-  for (size_t p = 0; p < results.size(); ++p) sweep.poses[p].result = std::move(results[p]);
+  std::vector<size_t> to_verify;  // indices into sweep.poses
+  if (sweep_options.search == SweepSearch::kCoarseToFine) {
+    if (progress != nullptr) progress->Restart("sweep: bounds", static_cast<int64_t>(sweep.poses.size()));
+    sweep.bound_evaluations = SelectByConfidenceBound(model, scans, sweep_options, verify_options.sigma_m,
+                                                      &sweep, &to_verify, progress);
+    if (progress != nullptr) progress->Restart("sweep", static_cast<int64_t>(to_verify.size()));
+  } else {
+    to_verify.resize(sweep.poses.size());
+    for (size_t p = 0; p < to_verify.size(); ++p) to_verify[p] = p;
+  }
+  std::vector<Eigen::Matrix4d> chosen;
+  chosen.reserve(to_verify.size());
+  for (size_t p : to_verify) chosen.push_back(poses[p]);
+  poses.clear();
+  poses.shrink_to_fit();
+  std::vector<VerifyResult> results = VerifyPoses(model, scans, chosen, options, progress);
+  for (size_t k = 0; k < results.size(); ++k) {
+    SweepPose& pose = sweep.poses[to_verify[k]];
+    pose.result = std::move(results[k]);
+    pose.evaluated = true;
+    pose.confidence_bound = 1.0;
+  }
+  sweep.evaluated_poses = static_cast<int64_t>(to_verify.size());
 
-  sweep.consistency_map = cv::Mat(static_cast<int>(ny), static_cast<int>(nx), CV_32F,
-                                  cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
-  sweep.confidence_map = cv::Mat(static_cast<int>(ny), static_cast<int>(nx), CV_32F, cv::Scalar(0.0f));
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  sweep.consistency_map = cv::Mat(static_cast<int>(ny), static_cast<int>(nx), CV_32F, cv::Scalar(nan));
+  sweep.confidence_map = cv::Mat(static_cast<int>(ny), static_cast<int>(nx), CV_32F, cv::Scalar(nan));
+  sweep.evaluated_map = cv::Mat::zeros(static_cast<int>(ny), static_cast<int>(nx), CV_8U);
   for (size_t iy = 0; iy < ny; ++iy) {
     const int row = static_cast<int>(ny - 1 - iy);  // north up
     for (size_t ix = 0; ix < nx; ++ix) {
       float& consistency = sweep.consistency_map.at<float>(row, static_cast<int>(ix));
       float& confidence = sweep.confidence_map.at<float>(row, static_cast<int>(ix));
+      uint8_t& evaluated = sweep.evaluated_map.at<uint8_t>(row, static_cast<int>(ix));
       for (size_t iyaw = 0; iyaw < nyaw; ++iyaw) {
-        const VerifyResult& r = sweep.poses[(iy * nx + ix) * nyaw + iyaw].result;
+        const SweepPose& pose = sweep.poses[(iy * nx + ix) * nyaw + iyaw];
+        if (!pose.evaluated) continue;
+        evaluated = static_cast<uint8_t>(std::min<size_t>(255, evaluated + 1));
+        const VerifyResult& r = pose.result;
         if (r.has_comparable_pairs && (std::isnan(consistency) || r.consistency > consistency)) {
           consistency = static_cast<float>(r.consistency);
         }
-        confidence = std::max(confidence, static_cast<float>(r.confidence));
+        if (std::isnan(confidence) || r.confidence > confidence)
+          confidence = static_cast<float>(r.confidence);
       }
     }
   }
+  CollectPictureContext(model, scans, sweep_options, &sweep);
   sweep.nms_radius_m = sweep_options.nms_radius_m;
   if (sweep.nms_radius_m <= 0) {
     const Eigen::Vector3f size = model.bounds_in_model.sizes();
@@ -206,87 +357,10 @@ SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scan
   return sweep;
 }
 
-cv::Mat RenderHeatMap(const cv::Mat& values, const SweepResult& sweep, const std::string& title,
-                      double threshold, int cell_px) {
-  LIDARSHOP_CHECK(values.type() == CV_32F);
-  const int rows = values.rows, cols = values.cols;
-  if (cell_px <= 0) cell_px = std::clamp(600 / std::max(1, std::max(rows, cols)), 1, 40);
-  const int map_w = cols * cell_px, map_h = rows * cell_px;
-  const int margin = 10, top = 36, bottom = 40, bar_w = 24, bar_gap = 16, label_w = 50;
-  const int width = margin + map_w + bar_gap + bar_w + label_w + margin;
-  const int height = top + std::max(map_h, 120) + bottom;
-  cv::Mat canvas(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
-
-  // Colours: 8-bit levels through viridis (OpenCV returns BGR; flipped to RGB at the end).
-  cv::Mat levels(rows, cols, CV_8U), nan_mask(rows, cols, CV_8U);
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const float v = values.at<float>(r, c);
-      nan_mask.at<uint8_t>(r, c) = std::isnan(v) ? 255 : 0;
-      levels.at<uint8_t>(r, c) =
-          std::isnan(v) ? 0 : static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255));
-    }
-  }
-  cv::Mat colored;
-  cv::applyColorMap(levels, colored, cv::COLORMAP_VIRIDIS);
-  colored.setTo(cv::Scalar(150, 150, 150), nan_mask);
-  cv::Mat scaled;
-  cv::resize(colored, scaled, cv::Size(map_w, map_h), 0, 0, cv::INTER_NEAREST);
-  scaled.copyTo(canvas(cv::Rect(margin, top, map_w, map_h)));
-
-  // Detections as rings.
-  if (!sweep.xs_m.empty() && !sweep.ys_m.empty()) {
-    const double step_x = sweep.xs_m.size() > 1 ? sweep.xs_m[1] - sweep.xs_m[0] : 1.0;
-    const double step_y = sweep.ys_m.size() > 1 ? sweep.ys_m[1] - sweep.ys_m[0] : 1.0;
-    for (const Detection& d : sweep.detections) {
-      const double fx = (d.x_m - sweep.xs_m.front()) / step_x + 0.5;
-      const double fy = (sweep.ys_m.back() - d.y_m) / step_y + 0.5;
-      const cv::Point centre(margin + static_cast<int>(fx * cell_px), top + static_cast<int>(fy * cell_px));
-      cv::circle(canvas, centre, std::max(6, 2 * cell_px), cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
-      cv::circle(canvas, centre, std::max(6, 2 * cell_px) + 2, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    }
-  }
-
-  // Colour scale.
-  const int bar_x = margin + map_w + bar_gap;
-  const int bar_h = std::max(map_h, 120);
-  for (int y = 0; y < bar_h; ++y) {
-    cv::Mat level(1, 1, CV_8U,
-                  cv::Scalar(static_cast<int>(std::lround(255.0 * (bar_h - 1 - y) / (bar_h - 1)))));
-    cv::Mat color;
-    cv::applyColorMap(level, color, cv::COLORMAP_VIRIDIS);
-    const cv::Vec3b bgr = color.at<cv::Vec3b>(0, 0);
-    cv::line(canvas, cv::Point(bar_x, top + y), cv::Point(bar_x + bar_w - 1, top + y),
-             cv::Scalar(bgr[0], bgr[1], bgr[2]));
-  }
-  cv::rectangle(canvas, cv::Rect(bar_x, top, bar_w, bar_h), cv::Scalar(0, 0, 0), 1);
-  for (int tick = 0; tick <= 4; ++tick) {
-    const int y = top + static_cast<int>(std::lround((bar_h - 1) * (1.0 - tick / 4.0)));
-    cv::line(canvas, cv::Point(bar_x + bar_w, y), cv::Point(bar_x + bar_w + 4, y), cv::Scalar(0, 0, 0));
-    cv::putText(canvas, fmt::format("{:.2f}", tick / 4.0), cv::Point(bar_x + bar_w + 6, y + 4),
-                cv::FONT_HERSHEY_SIMPLEX, 0.38, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-  }
-  if (threshold >= 0 && threshold <= 1) {
-    const int y = top + static_cast<int>(std::lround((bar_h - 1) * (1.0 - threshold)));
-    cv::line(canvas, cv::Point(bar_x - 4, y), cv::Point(bar_x + bar_w + 4, y), cv::Scalar(0, 0, 255), 2);
-  }
-  cv::putText(canvas, title, cv::Point(margin, 24), cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1,
-              cv::LINE_AA);
-  if (!sweep.xs_m.empty() && !sweep.ys_m.empty()) {
-    cv::putText(canvas,
-                fmt::format("x {:.1f}..{:.1f} m (right), y {:.1f}..{:.1f} m (up); grey = no comparable pair",
-                            sweep.xs_m.front(), sweep.xs_m.back(), sweep.ys_m.front(), sweep.ys_m.back()),
-                cv::Point(margin, top + bar_h + 24), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar(0, 0, 0), 1,
-                cv::LINE_AA);
-  }
-  cv::Mat rgb;
-  cv::cvtColor(canvas, rgb, cv::COLOR_BGR2RGB);
-  return rgb;
-}
-
 std::string SweepCsv(const SweepResult& sweep) {
   std::string csv = "x_m,y_m,yaw_deg,consistency,confidence,comparable_pairs,icp_cost_m,inlier_fraction\n";
   for (const SweepPose& pose : sweep.poses) {
+    if (!pose.evaluated) continue;
     const VerifyResult& r = pose.result;
     csv += fmt::format("{:.4f},{:.4f},{:.3f},{},{:.6f},{},{},{:.6f}\n", pose.x_m, pose.y_m, pose.yaw_deg,
                        Field(r.consistency), r.confidence, r.comparable_pairs, Field(r.icp_cost_m),

@@ -6,6 +6,14 @@
 //   consistency > min_consistency  and  confidence > min_confidence
 //   and  comparable_pairs >= min_comparable_pairs,
 // kept greedily by decreasing confidence unless a kept detection lies within nms_radius_m (in x, y).
+//
+// Search (SweepOptions::search): `kFull` verifies every grid pose; `kCoarseToFine` (default) first bounds
+// the confidence of whole blocks of grid poses from above (sweep_bound.h: the model's points may move by at
+// most the block's radius, so a model point can only be observed where scene points lie within 3σ of the
+// block's swept positions) and verifies only the poses of blocks whose bound can still pass, splitting
+// blocks into quarters down to single poses. A skipped pose provably has confidence ≤ its block's bound ≤
+// the confidence threshold of detections and of refinement seeds, so both searches give the same
+// detections, the same refinement seeds and the same refined poses (sweep_search_test).
 #pragma once
 
 #include <string>
@@ -17,6 +25,13 @@
 #include "lidarshop/verify/verify.h"
 
 namespace lidarshop {
+
+enum class SweepSearch {
+  kFull,          // verify every grid pose
+  kCoarseToFine,  // verify only the grid poses whose confidence bound can still pass (same detections)
+};
+template <>
+const EnumInfo& EnumInfoOf<SweepSearch>();  // "full", "coarse-to-fine"
 
 struct SweepOptions {
   double x_min_m = -10.0, x_max_m = 10.0;  // metres, world x range of the model origin (inclusive)
@@ -42,6 +57,8 @@ struct SweepOptions {
   int refine_max_seeds = 64;
   double refine_min_step_m = 0.02;  // metres
   double refine_min_yaw_deg = 0.5;  // degrees
+  SweepSearch search = SweepSearch::kCoarseToFine;
+  int coarse_block = 16;  // grid positions along x and y of the coarsest blocks of the coarse-to-fine search
 
   void Check() const;  // throws OptionsError
 };
@@ -58,16 +75,28 @@ struct Detection {
 struct SweepPose {
   double x_m = 0, y_m = 0, yaw_deg = 0;
   VerifyResult result;  // without details
+  // False: skipped by the coarse-to-fine search, which proved confidence ≤ confidence_bound (≤ the
+  // thresholds); `result` is then empty (no comparable pair, confidence 0).
+  bool evaluated = true;
+  double confidence_bound = 1.0;  // an upper bound of the confidence (1 when evaluated)
 };
 
 struct SweepResult {
   std::vector<double> xs_m, ys_m, yaws_deg;  // the grid: #X, #Y, #yaws
   std::vector<SweepPose> poses;              // #Y * #X * #yaws, index (iy * #X + ix) * #yaws + iyaw
   // Heat maps, CV_32F, #Y rows x #X cols, row 0 = the largest y (north up), column 0 = the smallest x: the
-  // best value over yaws at each position (each map maximised on its own). NaN where no yaw had a comparable
-  // pair (consistency) or never (confidence is always defined).
+  // best value over the evaluated yaws at each position (each map maximised on its own). NaN where no yaw
+  // had a comparable pair (consistency) or where no yaw was evaluated (both; coarse-to-fine only).
   cv::Mat consistency_map;
   cv::Mat confidence_map;
+  cv::Mat evaluated_map;          // CV_8U, same layout: how many yaws were verified at each position
+  int64_t evaluated_poses = 0;    // grid poses verified (all of them with SweepSearch::kFull)
+  int64_t bound_evaluations = 0;  // blocks whose confidence was bounded (coarse-to-fine)
+  // For the heat maps' pictures: the scanners' positions (world x, y, metres) and the scene points that a
+  // model on the ground could touch (world z within the model's height above z_m, the ground left out),
+  // projected onto the ground plane (x, y, metres), at most one per 2 cm square.
+  std::vector<Eigen::Vector2d> scanner_xy_m;
+  std::vector<Eigen::Vector2f> scene_xy_m;
   std::vector<Detection> detections;  // by decreasing confidence
   std::vector<SweepPose> refined;     // the refined poses (empty without refinement)
   int64_t refine_evaluations = 0;     // poses verified during refinement
@@ -82,14 +111,28 @@ SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scan
 std::vector<Detection> SelectDetections(std::span<const SweepPose> poses, const SweepOptions& options,
                                         double nms_radius_m, double z_m);
 
+// Where RenderHeatMap puts things: the map's rectangle in the picture and the pixel of a world position.
+struct HeatMapLayout {
+  cv::Rect map;                           // the heat map's cells, pixels
+  int cell_px = 0;                        // pixels per grid cell
+  double x0_m = 0, y1_m = 0, step_m = 1;  // x of column 0's centre, y of row 0's centre, metres per cell
+  cv::Point2d PixelOf(double x_m, double y_m) const;  // picture pixel (x right, y down) of world (x, y)
+};
+HeatMapLayout HeatMapLayoutOf(const cv::Mat& values, const SweepResult& sweep, int cell_px = 0);
+
+// RGB colour of the scanner marks in heat-map pictures (magenta: in no colour map, ring or scale).
+inline const cv::Vec3b kHeatMapScannerRgb(255, 0, 255);
+
 // A heat map as an RGB picture: each cell a square of `cell_px` pixels (0 = automatic, about 600 px across),
-// viridis colours for [0, 1], grey where NaN, a colour scale with ticks at 0, 0.25, …, 1 and a mark at
-// `threshold` (< 0 = none), the title and the x/y ranges written on it, and a white ring at each detection.
+// viridis colours for [0, 1], grey where NaN, pale where no pose was verified (coarse-to-fine), the scene
+// points (SweepResult::scene_xy_m) darkening the cells they fall in, x and y axes with ticks and labels in
+// metres, a magenta mark at each scanner inside the map, a colour scale with ticks at 0, 0.25, …, 1 and a
+// mark at `threshold` (< 0 = none), the title, and a white ring at each detection.
 cv::Mat RenderHeatMap(const cv::Mat& values, const SweepResult& sweep, const std::string& title,
                       double threshold, int cell_px = 0);
 
-// One line per pose: x_m,y_m,yaw_deg,consistency,confidence,comparable_pairs,icp_cost_m,inlier_fraction
-// (empty fields where NaN).
+// One line per verified pose (every grid pose with SweepSearch::kFull):
+// x_m,y_m,yaw_deg,consistency,confidence,comparable_pairs,icp_cost_m,inlier_fraction (empty fields where NaN).
 std::string SweepCsv(const SweepResult& sweep);
 
 }  // namespace lidarshop

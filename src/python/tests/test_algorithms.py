@@ -197,9 +197,9 @@ def test_point_set_tools(scan):
 
 def test_sweep_finds_the_box(scan):
     box = lidarshop.make_primitive("box", {"size": [1.2, 1.2, 1.2]})
-    options = lidarshop.SweepOptions(x_min_m=-1.5, x_max_m=1.5, y_min_m=3.5, y_max_m=6.5, step_m=0.5, z_m=0.6,
-                                     yaws_deg=[0, 45], min_comparable_pairs=20,
-                                     min_confidence=0.2)
+    grid = dict(x_min_m=-1.5, x_max_m=1.5, y_min_m=3.5, y_max_m=6.5, step_m=0.5, z_m=0.6, yaws_deg=[0, 45],
+                min_comparable_pairs=20, min_confidence=0.2)
+    options = lidarshop.SweepOptions(**grid)
     result = lidarshop.sweep(box, scan, options, verify_options={"allowance_m": 0.05, "sigma_m": 0.05})
     assert len(result.xs_m) == 7 and len(result.ys_m) == 7 and list(result.yaws_deg) == [0, 45]
     assert result.confidence_map.shape == (7, 7)
@@ -214,7 +214,16 @@ def test_sweep_finds_the_box(scan):
     assert result.poses["confidence"][index] == pytest.approx(alone.confidence, abs=1e-12)
     picture = result.heat_map("consistency", 0.75)
     assert picture.ndim == 3 and picture.shape[2] == 3 and picture.dtype == np.uint8
-    assert result.csv().count("\n") >= 98
+    # The coarse-to-fine search (the default) verifies only the poses that can pass; the CSV lists those.
+    assert result.csv().count("\n") == 1 + int(result.poses["evaluated"].sum())
+    assert result.evaluated_poses == int(result.poses["evaluated"].sum())
+    skipped = result.poses["evaluated"] == 0
+    assert np.all(result.poses["confidence_bound"][skipped] <= 0.2)
+    full = lidarshop.sweep(box, scan, lidarshop.SweepOptions(**grid, search="full"),
+                           verify_options={"allowance_m": 0.05, "sigma_m": 0.05})
+    assert full.evaluated_poses == 98 and full.csv().count("\n") == 99
+    assert [(d.x_m, d.y_m, d.yaw_deg, d.confidence) for d in full.detections] == \
+        [(d.x_m, d.y_m, d.yaw_deg, d.confidence) for d in result.detections]
     with pytest.raises(lidarshop.OptionsError, match="step_m"):
         lidarshop.sweep(box, scan, step_m=0)
     with pytest.raises(lidarshop.OptionsError, match="consistency\\|confidence"):
