@@ -24,6 +24,9 @@ namespace {
 
 using namespace io_internal;  // NOLINT: the PLY field helpers
 
+// PLY's `curvature` where it is unknown: NaN would be refused by PLY readers that check numbers (ours does).
+constexpr double kNoCurvature = -1.0;
+
 constexpr char kScanComment[] = "lidarshop_scan ";
 
 // ---- PLY: a scan is its valid points in the world frame plus row/col/scan
@@ -149,7 +152,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     if (!cloud.synthesized.empty())
       scan.synthesized.at<uint8_t>(row, col) = cloud.synthesized[i] ? kValid : 0;
     if (true_range_property != nullptr) scan.true_range.at<float>(row, col) = true_range_property->values[i];
-    if (curvature_property != nullptr) scan.curvature.at<float>(row, col) = curvature_property->values[i];
+    if (curvature_property != nullptr && curvature_property->values[i] >= 0.0)  // < 0: unknown (kNoCurvature)
+      scan.curvature.at<float>(row, col) = curvature_property->values[i];
   }
   for (Scan& scan : scans) FinishScan(&scan, /*fit_grid=*/true);
   return scans;
@@ -211,7 +215,10 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
           ny.push_back(n.y());
           nz.push_back(n.z());
         }
-        if (curvature) curv.push_back(scan.curvature.empty() ? NAN : scan.curvature.at<float>(row, col));
+        if (curvature) {
+          const float value = scan.curvature.empty() ? NAN : scan.curvature.at<float>(row, col);
+          curv.push_back(std::isnan(value) ? kNoCurvature : value);
+        }
         if (label) labels.push_back(scan.label.empty() ? kNoLabel : scan.label.at<int32_t>(row, col));
         if (synthesized)
           synth.push_back(!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
