@@ -1,22 +1,58 @@
 #!/usr/bin/python3
-"""Side by side: lidarshop `points` against Open3D (Debian python3-open3d 0.16) on one 1 M-point cloud.
+"""Side by side: lidarshop `points` against Open3D (Debian python3-open3d 0.16) and PCL 1.13 on one 1 M-point
+cloud.
 
-Usage: /usr/bin/python3 bench/pointset_peers.py LIDARSHOP_BINARY WORK_DIR [POINTS]
+Usage: /usr/bin/python3 bench/pointset_peers.py LIDARSHOP_BINARY WORK_DIR [POINTS] [--pcl build/release/bench/pcl_peers]
 Prints a markdown table: seconds of each tool (lidarshop: the operation alone, from its --json summary, without
-reading and writing; Open3D: the call alone) and how well the answers agree. The cloud: a 40 m x 40 m ground
-(5 mm noise), four boxes, 3 % uniform outliers, seeded.
+reading and writing; Open3D: the call alone; PCL: the calls alone, timed inside bench/pcl_peers.cc) and how well
+the answers agree. The cloud: a 40 m x 40 m ground (5 mm noise), four boxes, 3 % uniform outliers, seeded.
+Poisson runs on a closed surface instead (a torus, POINTS / 20 points, at most 50 k, 1 mm noise, exact normals):
+the scene is open and Poisson closes every surface; the agreement is each mesh's distance to the true torus.
+Without --pcl (PCL not installed: bench/pcl_peers is built only when CMake finds PCL) the PCL column is left out.
 """
+import argparse
 import json
 import subprocess
-import sys
 import time
 
 import numpy as np
 import open3d as o3d
 
-lidarshop, work = sys.argv[1], sys.argv[2]
-count = int(sys.argv[3]) if len(sys.argv) > 3 else 1_000_000
+parser = argparse.ArgumentParser()
+parser.add_argument("lidarshop")
+parser.add_argument("work")
+parser.add_argument("points", type=int, nargs="?", default=1_000_000)
+parser.add_argument("--pcl", help="bench/pcl_peers (built when CMake finds PCL)")
+args = parser.parse_args()
+lidarshop, work, count = args.lidarshop, args.work, args.points
 rng = np.random.default_rng(17)
+TORUS_R, TORUS_r = 2.0, 0.7
+
+
+def make_torus(n):
+    """n points on a torus (uniform by area, by rejection), 1 mm noise along the exact outward normals."""
+    u, v = [], []
+    while len(u) < n:
+        a, b = rng.uniform(0, 2 * np.pi, 2 * n), rng.uniform(0, 2 * np.pi, 2 * n)
+        keep = rng.uniform(0, 1, 2 * n) < (TORUS_R + TORUS_r * np.cos(b)) / (TORUS_R + TORUS_r)
+        u.extend(a[keep])
+        v.extend(b[keep])
+    u, v = np.array(u[:n]), np.array(v[:n])
+    normal = np.c_[np.cos(v) * np.cos(u), np.cos(v) * np.sin(u), np.sin(v)]
+    centre = np.c_[TORUS_R * np.cos(u), TORUS_R * np.sin(u), np.zeros(n)]
+    points = centre + (TORUS_r + rng.normal(0, 0.001, n))[:, None] * normal
+    return points.astype(np.float32), normal.astype(np.float32)
+
+
+def torus_distance(vertices):
+    """|distance| of each vertex to the true torus, metres."""
+    v = np.asarray(vertices, dtype=np.float64)
+    return np.abs(np.hypot(np.hypot(v[:, 0], v[:, 1]) - TORUS_R, v[:, 2]) - TORUS_r)
+
+
+def distance_text(vertices, triangles):
+    d = torus_distance(vertices)
+    return f"{triangles} triangles, median {np.median(d) * 1000:.2f} mm, 99 % {np.percentile(d, 99) * 1000:.2f} mm"
 
 
 def make_cloud(n):
@@ -80,8 +116,23 @@ points = make_cloud(count)
 cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points.astype(np.float64)))
 path = f"{work}/cloud.ply"
 o3d.io.write_point_cloud(path, o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points.astype(np.float64))))
-points = xyz(read_ply(path))  # exactly what both tools read
-rows = []
+points = xyz(read_ply(path))  # exactly what every tool reads
+points.tofile(f"{work}/points.f32")
+torus_points, torus_normals = make_torus(min(50_000, count // 20))
+torus_path = f"{work}/torus.ply"
+torus = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(torus_points.astype(np.float64)))
+torus.normals = o3d.utility.Vector3dVector(torus_normals.astype(np.float64))
+o3d.io.write_point_cloud(torus_path, torus)
+torus_read = read_ply(torus_path)
+np.c_[xyz(torus_read), torus_read["nx"], torus_read["ny"], torus_read["nz"]].astype(np.float32).tofile(
+    f"{work}/torus.f32")
+pcl = {}
+if args.pcl:
+    out = subprocess.run([args.pcl, f"{work}/points.f32", work, f"{work}/torus.f32"], check=True,
+                         capture_output=True, text=True)
+    pcl = json.loads(out.stdout)
+    assert pcl["points"] == len(points)
+rows = []  # (tool, lidarshop s, Open3D s, PCL s, agreement)
 
 # Normals from the 20 nearest points.
 t = time.perf_counter()
@@ -91,9 +142,18 @@ summary = run(["normals", path, "-o", f"{work}/normals.ply", "--neighbors", "20"
 ours = read_ply(f"{work}/normals.ply")
 ours_n = np.c_[ours["nx"], ours["ny"], ours["nz"]]
 o3d_n = np.asarray(cloud.normals)
-angle = np.degrees(np.arccos(np.clip(np.abs(np.sum(ours_n * o3d_n, axis=1)), 0, 1)))
-rows.append(("normals (k = 20)", summary["seconds"], o3d_s,
-             f"angle to Open3D's: median {np.median(angle):.2g}°, {np.mean(angle < 1) * 100:.2f} % under 1°"))
+
+
+def angle_text(a, b, name):
+    angle = np.degrees(np.arccos(np.clip(np.abs(np.sum(a * b, axis=1)), 0, 1)))
+    return f"to {name}'s: median {np.median(angle):.2g}°, {np.mean(angle < 1) * 100:.2f} % under 1°"
+
+
+agreement = "ours " + angle_text(ours_n, o3d_n, "Open3D")
+if pcl:
+    pcl_n = np.fromfile(f"{work}/pcl_normals.f32", dtype=np.float32).reshape(-1, 3)
+    agreement += "; ours " + angle_text(ours_n, pcl_n, "PCL")
+rows.append(("normals (k = 20)", summary["seconds"], o3d_s, pcl.get("normals_s"), agreement))
 
 # Statistical outlier removal, k = 20, 2 σ.
 t = time.perf_counter()
@@ -102,8 +162,12 @@ o3d_s = time.perf_counter() - t
 summary = run(["outliers", path, "-o", f"{work}/clean.ply", "--neighbors", "20", "--std-ratio", "2"])
 ours_kept = key_set(xyz(read_ply(f"{work}/clean.ply")))
 o3d_kept = key_set(points[np.asarray(kept)])
-rows.append(("statistical outliers (k = 20, 2 σ)", summary["seconds"], o3d_s,
-             f"kept {len(ours_kept)} vs {len(o3d_kept)}; Jaccard of the kept sets {jaccard(ours_kept, o3d_kept):.4f}"))
+agreement = (f"kept {len(ours_kept)} / {len(o3d_kept)}" + (f" / {pcl['kept']}" if pcl else "") +
+             f"; Jaccard ours–Open3D {jaccard(ours_kept, o3d_kept):.4f}")
+if pcl:
+    pcl_kept = key_set(points[np.fromfile(f"{work}/pcl_kept.i32", dtype=np.int32)])
+    agreement += f", ours–PCL {jaccard(ours_kept, pcl_kept):.4f}, Open3D–PCL {jaccard(o3d_kept, pcl_kept):.4f}"
+rows.append(("statistical outliers (k = 20, 2 σ)", summary["seconds"], o3d_s, pcl.get("outliers_s"), agreement))
 
 # RANSAC plane, 1 cm, 1000 hypotheses.
 t = time.perf_counter()
@@ -114,36 +178,60 @@ ours = read_ply(f"{work}/planes.ply")
 ours_in = key_set(xyz(ours)[ours["label"] == 0])
 o3d_in = key_set(points[np.asarray(inliers)])
 n_ours = np.array(summary["planes"][0]["normal"])
-plane_angle = np.degrees(np.arccos(min(1.0, abs(np.dot(n_ours, np.array(plane[:3]) / np.linalg.norm(plane[:3]))))))
-rows.append(("RANSAC plane (1 cm, ≤ 1000 hypotheses)", summary["seconds"], o3d_s,
-             f"normal angle {plane_angle:.3f}°; inliers {len(ours_in)} vs {len(o3d_in)}, Jaccard "
-             f"{jaccard(ours_in, o3d_in):.4f}"))
+
+
+def plane_angle(a, b):
+    a, b = np.array(a[:3]) / np.linalg.norm(a[:3]), np.array(b[:3]) / np.linalg.norm(b[:3])
+    return np.degrees(np.arccos(min(1.0, abs(np.dot(a, b)))))
+
+
+agreement = (f"normal angle to Open3D's {plane_angle(n_ours, plane):.3f}°" +
+             (f", to PCL's {plane_angle(n_ours, pcl['plane']):.3f}°" if pcl else "") +
+             f"; inliers {len(ours_in)} / {len(o3d_in)}" + (f" / {pcl['plane_inliers']}" if pcl else "") +
+             f", Jaccard ours–Open3D {jaccard(ours_in, o3d_in):.4f}")
+if pcl:
+    pcl_in = key_set(points[np.fromfile(f"{work}/pcl_plane.i32", dtype=np.int32)])
+    agreement += f", ours–PCL {jaccard(ours_in, pcl_in):.4f}"
+rows.append(("RANSAC plane (1 cm, ≤ 1000 hypotheses)", summary["seconds"], o3d_s, pcl.get("plane_s"), agreement))
 
 # Euclidean clustering (ours) vs DBSCAN with min_points 1 (the same connected components).
 t = time.perf_counter()
 labels = np.asarray(cloud.cluster_dbscan(eps=0.1, min_points=1))
 o3d_s = time.perf_counter() - t
 summary = run(["cluster", path, "-o", f"{work}/clusters.ply", "--radius", "0.1"])
-rows.append(("Euclidean clustering / DBSCAN min 1 (r = 10 cm)", summary["seconds"], o3d_s,
-             f"{summary['clusters']} clusters vs {labels.max() + 1}; largest {summary['cluster_sizes'][0]} vs "
-             f"{np.bincount(labels[labels >= 0]).max()}"))
+rows.append(("Euclidean clustering (Open3D: DBSCAN min 1; r = 10 cm)", summary["seconds"], o3d_s,
+             pcl.get("cluster_s"),
+             f"clusters {summary['clusters']} / {labels.max() + 1}" + (f" / {pcl['clusters']}" if pcl else "") +
+             f"; largest {summary['cluster_sizes'][0]} / {np.bincount(labels[labels >= 0]).max()}" +
+             (f" / {pcl['largest_cluster']}" if pcl else "")))
 
 # Voxel subsampling, 5 cm.
 t = time.perf_counter()
 down = cloud.voxel_down_sample(0.05)
 o3d_s = time.perf_counter() - t
 summary = run(["voxel", path, "-o", f"{work}/voxel.ply", "--voxel", "0.05"])
-rows.append(("voxel subsampling (5 cm)", summary["seconds"], o3d_s,
-             f"{summary['output_points']} vs {len(down.points)} points"))
+agreement = f"{summary['output_points']} / {len(down.points)}" + (f" / {pcl['voxels']}" if pcl else "") + " points"
+if pcl:  # PCL's grid is aligned to multiples of the leaf size: numpy counts the same occupied voxels
+    agreement += f" (numpy, PCL's grid: {len(np.unique(np.floor(points / np.float32(0.05)).astype(np.int64), axis=0))})"
+rows.append(("voxel subsampling (5 cm)", summary["seconds"], o3d_s, pcl.get("voxel_s"), agreement))
 
-# Poisson reconstruction: Open3D only (lidarshop has none yet).
+# Poisson reconstruction on the torus with its exact normals: lidarshop (CGAL, Delaunay refinement), Open3D
+# (Kazhdan's PoissonRecon, depth 8), PCL (its older copy of PoissonRecon, depth 8).
 t = time.perf_counter()
-o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(cloud, depth=8)
-rows.append(("Poisson reconstruction (depth 8)", None, time.perf_counter() - t, "not in lidarshop yet"))
+o3d_mesh, _ = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(torus, depth=8)
+o3d_s = time.perf_counter() - t
+summary = run(["mesh", torus_path, "-o", f"{work}/torus_mesh.ply", "--method", "poisson"])
+assert summary["normals"] == "input"
+agreement = ("distance to the torus: ours " + distance_text(xyz(read_ply(f"{work}/torus_mesh.ply")), summary["triangles"]) +
+             "; Open3D " + distance_text(np.asarray(o3d_mesh.vertices), len(o3d_mesh.triangles)))
+if pcl:
+    agreement += "; PCL " + distance_text(
+        np.fromfile(f"{work}/pcl_poisson_vertices.f32", dtype=np.float32).reshape(-1, 3), pcl["poisson_triangles"])
+rows.append((f"Poisson reconstruction ({len(torus_points) // 1000} k-point torus, depth 8)", summary["seconds"], o3d_s,
+             pcl.get("poisson_s"), agreement))
 
 print(f"{len(points)} points\n")
-print("| tool | lidarshop s | Open3D 0.16 s | agreement |")
-print("|---|---|---|---|")
-for name, ours_s, o3d_s, agreement in rows:
-    ours_text = "—" if ours_s is None else f"{ours_s:.3f}"
-    print(f"| {name} | {ours_text} | {o3d_s:.3f} | {agreement} |")
+print("| tool | lidarshop s | Open3D 0.16 s |" + (" PCL 1.13 s |" if pcl else "") + " agreement |")
+print("|---|---|---|" + ("---|" if pcl else "") + "---|")
+for name, ours_s, o3d_s, pcl_s, agreement in rows:
+    print(f"| {name} | {ours_s:.3f} | {o3d_s:.3f} |" + (f" {pcl_s:.3f} |" if pcl else "") + f" {agreement} |")

@@ -343,7 +343,8 @@ void BindScanTools(py::module_& m) {
         return WithGridNormals(scan, normal_options);
       },
       py::arg("scan"), py::arg("options") = py::none(),
-      "The scan with its `normal` channel estimated on the grid (window_cells around each cell).");
+      "The scan with its `normal` and `curvature` channels estimated on the grid (window_cells around each "
+      "cell).");
   m.def(
       "superpixels",
       [](const Scan& scan, const py::object& options, const py::kwargs& kwargs) {

@@ -80,6 +80,8 @@ const ChannelSpec kChannels[] = {
      "object label (synthetic scans), -1 where none; int32 (rows, cols) or None"},
     {"normal", &Scan::normal, CV_32F, 3, false,
      "unit surface normal, scanner frame; float32 (rows, cols, 3) or None"},
+    {"curvature", &Scan::curvature, CV_32F, 1, false,
+     "surface variation of the normal's neighbourhood in [0, 1/3], NaN where unknown; float32 or None"},
     {"true_range", &Scan::true_range, CV_32F, 1, false,
      "noise-free range (synthetic scans), metres; float32 or None"},
     {"synthesized", &Scan::synthesized, CV_8U, 1, false,

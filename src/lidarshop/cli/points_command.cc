@@ -8,6 +8,7 @@
 // every scan's grid: dropped cells become cells without a return, labels and normals go into the scans'
 // channels. Operations that make new points (voxel, merge) write a plain cloud (.ply / .pcd) in the world
 // frame.
+#include <cmath>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
@@ -30,6 +32,7 @@
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/pointset/superpixels.h"
+#include "lidarshop/pointset/surface.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -51,6 +54,7 @@ struct PointsOptions {
   EuclideanClusterOptions cluster;
   KMeansOptions kmeans;
   ScanMeshOptions mesh;
+  SurfaceOptions surface;
   RegionGrowingOptions regions;
   SuperpixelOptions superpixels;
 };
@@ -72,7 +76,8 @@ const StructInfo& InfoOf<cli::PointsOptions>() {
     b.Field(&PointsOptions::hough, "hough", "planes --hough");
     b.Field(&PointsOptions::cluster, "cluster", "cluster");
     b.Field(&PointsOptions::kmeans, "kmeans", "kmeans");
-    b.Field(&PointsOptions::mesh, "mesh", "mesh");
+    b.Field(&PointsOptions::mesh, "mesh", "mesh (--method grid)");
+    b.Field(&PointsOptions::surface, "surface", "mesh --method poisson | scale-space");
     b.Field(&PointsOptions::regions, "regions", "regions");
     b.Field(&PointsOptions::superpixels, "superpixels", "superpixels");
     return b.Build();
@@ -94,15 +99,22 @@ const std::map<std::string, std::vector<std::string>>& OptionsOfOperation() {
       {"planes", {"planes", "hough"}},
       {"cluster", {"cluster"}},
       {"kmeans", {"kmeans"}},
-      {"mesh", {"mesh"}},
+      {"mesh", {"mesh", "surface"}},
       {"regions", {"regions", "normals"}},
       {"superpixels", {"superpixels"}}};
   return used;
 }
 
-nlohmann::ordered_json UsedOptions(const PointsOptions& options, const std::string& operation) {
+// `mesh_method`: "grid" uses "mesh", a surface reconstruction "surface".
+nlohmann::ordered_json UsedOptions(const PointsOptions& options, const std::string& operation,
+                                   const std::string& mesh_method = "grid") {
   const nlohmann::ordered_json all = ToJson(options);
   nlohmann::ordered_json used = nlohmann::ordered_json::object();
+  if (operation == "mesh") {
+    const std::string key = mesh_method == "grid" ? "mesh" : "surface";
+    used[key] = all[key];
+    return used;
+  }
   const auto found = OptionsOfOperation().find(operation);
   if (found == OptionsOfOperation().end()) return used;
   for (const std::string& key : found->second) used[key] = all[key];
@@ -163,12 +175,15 @@ std::vector<Scan> WithLabels(const Gathered& g, const std::vector<int32_t>& labe
   return out;
 }
 
-// World-frame normals into each scan's normal channel (scanner frame), facing that scan's scanner.
-std::vector<Scan> WithNormals(const Gathered& g, const std::vector<Eigen::Vector3f>& normals_in_world) {
+// World-frame normals into each scan's normal channel (scanner frame), facing that scan's scanner, and
+// their curvature into the curvature channel (NaN where a point had too few neighbours).
+std::vector<Scan> WithNormals(const Gathered& g, const NormalResult& result) {
+  const std::vector<Eigen::Vector3f>& normals_in_world = result.normals;
   std::vector<Scan> out;
   for (const Scan& scan : g.scans) {
     Scan with = scan;
     with.normal = cv::Mat(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
+    with.curvature = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN));
     out.push_back(with);
   }
   for (size_t i = 0; i < normals_in_world.size(); ++i) {
@@ -180,8 +195,27 @@ std::vector<Scan> WithNormals(const Gathered& g, const std::vector<Eigen::Vector
     const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
     if (n.dot(Eigen::Vector3f(p[0], p[1], p[2])) > 0.0f) n = -n;
     scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
+    if (normals_in_world[i].squaredNorm() > 0.0f) scan.curvature.at<float>(row, col) = result.curvature[i];
   }
   return out;
+}
+
+// The gathered cloud with normals for a Poisson reconstruction: its own when every scan has them, else
+// estimated from the `neighbors` nearest points, each turned toward the scanner of the scan it came from
+// (several scans see a surface from several sides; one viewpoint would flip some of them).
+PointCloud WithOrientedNormals(const Gathered& g, int neighbors, bool* estimated) {
+  PointCloud cloud = g.cloud;
+  *estimated = cloud.normals.size() != cloud.size();
+  if (!*estimated) return cloud;
+  NormalOptions options;
+  options.neighbors = neighbors;
+  cloud.normals = EstimateNormals(cloud, options).normals;
+  for (size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f scanner_in_world =
+        g.scans[g.scan_of_point[i]].world_from_scanner.topRightCorner<3, 1>().cast<float>();
+    if (cloud.normals[i].dot(scanner_in_world - cloud.points[i]) < 0.0f) cloud.normals[i] = -cloud.normals[i];
+  }
+  return cloud;
 }
 
 // "1,2.5,-3" as numbers; "" as none.
@@ -220,7 +254,7 @@ int RunPoints(int argc, char** argv) {
       "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels | sample-mesh "
       "(IN = a triangle mesh). Scans keep their grid where the operation allows.",
       "points"};
-  std::string operation, output_path, json_path, method = "statistical";
+  std::string operation, output_path, json_path, method;
   std::vector<std::string> inputs;
   std::string box_text, polygon_text, matrix_text;
   bool grid = false, hough = false;
@@ -232,13 +266,16 @@ int RunPoints(int argc, char** argv) {
   points.mesh.world_frame = true;
   points.normals.neighbors = points.statistical.neighbors;
   points.cluster.radius_m = points.radius.radius_m;
+  points.surface.normal_neighbors = points.statistical.neighbors;
   OptionBinder binder(app);
   app.add_option("operation", operation, "the tool")->required();
   app.add_option("inputs", inputs, "scan or cloud files (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts)")
       ->required();
   app.add_option("-o,--output", output_path, "output file; a scan format keeps the grid")->required();
   AddJsonOption(app, &json_path);
-  app.add_option("--method", method, "outliers: statistical | radius")->capture_default_str();
+  app.add_option("--method", method,
+                 "outliers: statistical (default) | radius; mesh: grid (default: the scans' grid mesh) | "
+                 "poisson | scale-space (surface reconstruction)");
   app.add_option("--voxel", voxel_m, "voxel: cube side, metres")->capture_default_str();
   app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")
       ->capture_default_str();
@@ -285,11 +322,23 @@ int RunPoints(int argc, char** argv) {
                                  "kmeans.max_iterations", "kmeans.tolerance_m"},
                         .flags = {{"cluster.min_points", "--min-points"}, {"kmeans.clusters", "--k"}},
                         .group = "cluster, kmeans"});
-  binder.Bind(&points, {.keys = {"mesh.max_range_jump_ratio", "mesh.world_frame", "regions.min_region_cells",
-                                 "regions.max_range_jump_ratio"},
+  binder.Bind(&points, {.keys = {"mesh.max_range_jump_ratio", "mesh.max_edge_m", "mesh.world_frame",
+                                 "regions.min_region_cells", "regions.max_range_jump_ratio"},
                         .flags = {{"mesh.max_range_jump_ratio", "--mesh-jump"},
+                                  {"mesh.max_edge_m", "--max-edge"},
                                   {"regions.min_region_cells", "--min-cells"}},
-                        .group = "mesh, regions"});
+                        .group = "mesh, regions (--max-edge also mesh --method scale-space)"});
+  binder.Bind(&points,
+              {.keys = {"surface.poisson_angle_deg", "surface.poisson_radius_spacings",
+                        "surface.poisson_distance_spacings", "surface.keep_within_m",
+                        "surface.scale_space_iterations", "surface.scale_space_neighbors"},
+               .flags = {{"surface.poisson_angle_deg", "--poisson-angle"},
+                         {"surface.poisson_radius_spacings", "--poisson-radius"},
+                         {"surface.poisson_distance_spacings", "--poisson-distance"},
+                         {"surface.keep_within_m", "--keep-within"},
+                         {"surface.scale_space_iterations", "--smoothing-steps"},
+                         {"surface.scale_space_neighbors", "--smoothing-neighbors"}},
+               .group = "mesh --method poisson | scale-space (--neighbors: k of estimated normals)"});
   binder.Bind(&points, {.keys = {"superpixels.method", "superpixels.region_cells", "superpixels.ruler",
                                  "superpixels.iterations", "superpixels.graph_sigma", "superpixels.graph_k",
                                  "superpixels.graph_min_cells", "superpixels.range_weight",
@@ -301,14 +350,26 @@ int RunPoints(int argc, char** argv) {
   binder.NameFlag("normals.neighbors", "--neighbors");
   binder.NameFlag("normals.radius_m", "--radius");
   binder.NameFlag("cluster.radius_m", "--radius");
-  for (const char* key : {"hough.seed", "kmeans.seed"}) binder.NameFlag(key, "--seed");
+  binder.NameFlag("surface.normal_neighbors", "--neighbors");
+  binder.NameFlag("surface.max_edge_m", "--max-edge");
+  for (const char* key : {"hough.seed", "kmeans.seed", "surface.seed"}) binder.NameFlag(key, "--seed");
   return RunCommand(
       app, argc, argv,
       [&]() {
-        if (app.count("--neighbors") > 0) points.normals.neighbors = points.statistical.neighbors;
+        if (app.count("--neighbors") > 0)
+          points.normals.neighbors = points.surface.normal_neighbors = points.statistical.neighbors;
+        if (app.count("--max-edge") > 0) points.surface.max_edge_m = points.mesh.max_edge_m;
         if (app.count("--radius") > 0)
           points.normals.radius_m = points.cluster.radius_m = points.radius.radius_m;
-        if (app.count("--seed") > 0) points.hough.seed = points.kmeans.seed = points.planes.seed;
+        if (app.count("--seed") > 0)
+          points.hough.seed = points.kmeans.seed = points.surface.seed = points.planes.seed;
+        const std::string mesh_method = method.empty() ? "grid" : method;
+        if (operation == "mesh" && mesh_method != "grid") {
+          if (mesh_method != "poisson" && mesh_method != "scale-space")
+            throw OptionsError(
+                fmt::format("--method '{}': mesh takes grid, poisson or scale-space", mesh_method));
+          points.surface.method = ParseEnum<SurfaceMethod>(mesh_method);
+        }
         binder.Validate(points);
         const uint64_t seed = points.planes.seed;
         StatisticalOutlierOptions& statistical = points.statistical;
@@ -368,7 +429,7 @@ int RunPoints(int argc, char** argv) {
         bool as_cloud = false;
         if (operation == "outliers" || operation == "crop" || operation == "sample") {
           std::vector<uint8_t> keep;
-          if (operation == "outliers" && method == "statistical") {
+          if (operation == "outliers" && (method.empty() || method == "statistical")) {
             keep = StatisticalOutlierInliers(g.cloud, statistical);
           } else if (operation == "outliers" && method == "radius") {
             keep = RadiusOutlierInliers(g.cloud, radius_outliers);
@@ -394,13 +455,31 @@ int RunPoints(int argc, char** argv) {
           cloud_out = g.cloud;
           as_cloud = true;
         } else if (operation == "mesh") {
-          // The grid mesh of any organized scan, real ones included (scanner/scan_mesh.h).
+          // grid: the grid mesh of any organized scan, real ones included (scanner/scan_mesh.h); otherwise a
+          // surface reconstructed from all the points in the world frame (pointset/surface.h).
           TriangleMesh mesh;
-          for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
+          summary["method"] = mesh_method;
+          if (mesh_method == "grid") {
+            for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
+            if (mesh.empty()) {
+              throw InputError(
+                  fmt::format("{}: the grid mesh has no triangles (no two neighbouring cells are joined; a "
+                              "plain cloud has no grid): use --method poisson or scale-space",
+                              fmt::join(inputs, ", ")));
+            }
+          } else if (points.surface.method == SurfaceMethod::kPoisson) {
+            bool estimated = false;
+            const PointCloud cloud = WithOrientedNormals(g, points.surface.normal_neighbors, &estimated);
+            summary["normals"] = estimated ? "estimated" : "input";
+            mesh = ReconstructSurface(cloud, points.surface);
+          } else {
+            mesh = ReconstructSurface(g.cloud, points.surface);
+          }
           summary["seconds"] = timer.Seconds();
+          summary["vertices"] = mesh.num_vertices();
           summary["triangles"] = mesh.num_triangles();
           WriteMesh(output_path, mesh);
-          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation, mesh_method), summary));
           return 0;
         } else if (operation == "regions" || operation == "superpixels") {
           // Per scan, over its grid: labels into the scan's label channel.
@@ -427,7 +506,7 @@ int RunPoints(int argc, char** argv) {
           if (grid) {
             for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
           } else {
-            scans_out = WithNormals(g, EstimateNormals(g.cloud, normals).normals);
+            scans_out = WithNormals(g, EstimateNormals(g.cloud, normals));
           }
         } else if (operation == "planes") {
           hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell

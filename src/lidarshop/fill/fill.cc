@@ -397,6 +397,7 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
       }
       if (!out.true_range.empty()) out.true_range.at<float>(y, x) = 0.0f;  // no truth for a synthesized point
       if (!out.normal.empty()) out.normal.at<cv::Vec3f>(y, x) = cv::Vec3f(0, 0, 0);
+      if (!out.curvature.empty()) out.curvature.at<float>(y, x) = NAN;  // the filled surface's is unknown
       if (keep) {
         result->filled.at<uint8_t>(y, x) = 255;
         ++result->synthesized_cells;

@@ -344,12 +344,14 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
   const int fintensity = header.Find("intensity");
   const int flabel = header.Find("label");
   const int fnx = header.Find("normal_x"), fny = header.Find("normal_y"), fnz = header.Find("normal_z");
+  const int fcurvature = header.Find("curvature");
   const int fsynth = header.Find("synthesized");
   const int ftrue = header.Find("true_range");
   Scan scan = MakeScan(rows, cols, fcolor >= 0);
   if (flabel >= 0) scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
   const bool normals = fnx >= 0 && fny >= 0 && fnz >= 0;
   if (normals) scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  if (fcurvature >= 0) scan.curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
   if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
   const double* v = header.viewpoint;
@@ -407,6 +409,10 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
           scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
         }
       }
+      if (fcurvature >= 0) {
+        scan.curvature.at<float>(row, col) =
+            static_cast<float>(LoadValue(record + f[fcurvature].offset, f[fcurvature]));
+      }
       if (fsynth >= 0 && LoadValue(record + f[fsynth].offset, f[fsynth]) != 0) {
         scan.synthesized.at<uint8_t>(row, col) = kValid;
       }
@@ -442,6 +448,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
     add("normal_y", "4", "F");
     add("normal_z", "4", "F");
   }
+  if (!scan.curvature.empty()) add("curvature", "4", "F");  // PCL's PointNormal field
   if (!scan.synthesized.empty()) add("synthesized", "1", "U");
   if (!scan.true_range.empty()) add("true_range", "4", "F");
   std::string pose;
@@ -480,6 +487,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
         put(m.y());
         put(m.z());
       }
+      if (!scan.curvature.empty()) put(valid ? scan.curvature.at<float>(row, col) : nan);
       if (!scan.synthesized.empty())
         put(static_cast<uint8_t>(scan.synthesized.at<uint8_t>(row, col) ? 1 : 0));
       if (!scan.true_range.empty()) put(scan.true_range.at<float>(row, col));

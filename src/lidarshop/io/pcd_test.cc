@@ -13,6 +13,7 @@
 namespace lidarshop {
 namespace {
 
+using testing_io::ReadText;
 using testing_io::TempFolder;
 
 TEST(PcdTest, ReadsTheSharedBinaryCompressedCloudAsAScan) {
@@ -50,6 +51,34 @@ TEST(PcdTest, RoundTripKeepsTheScan) {
   EXPECT_LT(cv::norm(back.point, scan.point, cv::NORM_INF), 1e-6);
   EXPECT_EQ(cv::norm(back.color, scan.color, cv::NORM_INF), 0.0);
   EXPECT_TRUE(back.world_from_scanner.isApprox(scan.world_from_scanner, 1e-9));
+}
+
+TEST(PcdTest, CurvatureFieldRoundTrips) {
+  TempFolder folder;
+  Scan scan = ReadPcd(LIDARSHOP_SHARED_DATA_DIR "/rgbd/table_scene_mug_stereo_textured.pcd");
+  scan.curvature = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN));
+  for (int row = 0; row < scan.rows; row += 7) {
+    for (int col = 0; col < scan.cols; col += 3)
+      scan.curvature.at<float>(row, col) = 1e-4f * (row % 100 + col);
+  }
+  WritePcd(folder.File("curvature.pcd"), scan);
+  EXPECT_THAT(ReadText(folder.File("curvature.pcd")).substr(0, 400), testing::HasSubstr(" curvature"));
+  const Scan back = ReadPcd(folder.File("curvature.pcd"));
+  ASSERT_EQ(back.curvature.type(), CV_32F);
+  int64_t known = 0;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      const float want = scan.valid.at<uint8_t>(row, col) ? scan.curvature.at<float>(row, col) : NAN;
+      const float got = back.curvature.at<float>(row, col);
+      if (std::isnan(want)) {
+        ASSERT_TRUE(std::isnan(got)) << row << " " << col;
+      } else {
+        ASSERT_EQ(got, want) << row << " " << col;
+        ++known;
+      }
+    }
+  }
+  EXPECT_GT(known, 1000);
 }
 
 TEST(PcdTest, ReadsAscii) {

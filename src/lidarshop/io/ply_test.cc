@@ -1,5 +1,6 @@
 #include "lidarshop/io/ply.h"
 
+#include <cmath>
 #include <cstring>
 
 #include <gmock/gmock.h>
@@ -117,6 +118,7 @@ Scan SmallScan(double azimuth_offset) {
       DirectionsFromGrid(UniformGrid(4, 5, -0.2 + azimuth_offset, 0.2 + azimuth_offset, -0.1, 0.2));
   scan.label = cv::Mat(4, 5, CV_32S, cv::Scalar(kNoLabel));
   scan.synthesized = cv::Mat(4, 5, CV_8U, cv::Scalar(0));
+  scan.curvature = cv::Mat(4, 5, CV_32F, cv::Scalar(NAN));
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 5; ++col) {
       if ((row + col) % 3 == 0) continue;  // no return
@@ -129,6 +131,7 @@ Scan SmallScan(double azimuth_offset) {
       scan.color.at<cv::Vec3b>(row, col) = cv::Vec3b(row * 10, col * 10, 99);
       scan.label.at<int32_t>(row, col) = row;
       scan.synthesized.at<uint8_t>(row, col) = col == 2 ? 255 : 0;
+      if (col != 4) scan.curvature.at<float>(row, col) = 0.01f * (row + col);  // NaN = unknown in column 4
     }
   }
   return scan;
@@ -154,6 +157,20 @@ TEST(PlyTest, ScansKeepTheirGridPoseAndChannels) {
     EXPECT_EQ(cv::norm(back.label, scans[k].label, cv::NORM_INF), 0.0);
     EXPECT_EQ(cv::norm(back.synthesized, scans[k].synthesized, cv::NORM_INF), 0.0);
     EXPECT_LT(cv::norm(back.intensity, scans[k].intensity, cv::NORM_INF), 1e-7);
+    // The curvature field: the values where known, NaN where unknown or without a return.
+    ASSERT_EQ(back.curvature.type(), CV_32F);
+    for (int row = 0; row < 4; ++row) {
+      for (int col = 0; col < 5; ++col) {
+        const float want =
+            scans[k].valid.at<uint8_t>(row, col) ? scans[k].curvature.at<float>(row, col) : NAN;
+        const float got = back.curvature.at<float>(row, col);
+        if (std::isnan(want)) {
+          EXPECT_TRUE(std::isnan(got)) << row << " " << col;
+        } else {
+          EXPECT_FLOAT_EQ(got, want);
+        }
+      }
+    }
     // The fitted grid gives every cell, also the empty ones, its direction back.
     EXPECT_LT(cv::norm(back.direction, scans[k].direction, cv::NORM_INF), 1e-5);
   }

@@ -1,6 +1,7 @@
 #include "lidarshop/io/scan_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -22,6 +23,9 @@ namespace lidarshop {
 namespace {
 
 using namespace io_internal;  // NOLINT: the PLY field helpers
+
+// PLY's `curvature` where it is unknown: NaN would be refused by PLY readers that check numbers (ours does).
+constexpr double kNoCurvature = -1.0;
 
 constexpr char kScanComment[] = "lidarshop_scan ";
 
@@ -89,6 +93,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
   const PlyProperty* col_property = FindScalar(vertex, {"col"});
   const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
   const PlyProperty* true_range_property = FindScalar(vertex, {"true_range"});
+  const PlyProperty* curvature_property = FindScalar(vertex, {"curvature"});
 
   if (headers.empty() || row_property == nullptr || col_property == nullptr) {
     // A plain point cloud: one 1 x N scan, every point a return, in the identity pose.
@@ -107,6 +112,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
     if (true_range_property != nullptr)
       scan.true_range = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
+    if (curvature_property != nullptr)
+      scan.curvature = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN));
     scanner_from_world.push_back(header.world_from_scanner.inverse());
     scans.push_back(std::move(scan));
   }
@@ -145,6 +152,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     if (!cloud.synthesized.empty())
       scan.synthesized.at<uint8_t>(row, col) = cloud.synthesized[i] ? kValid : 0;
     if (true_range_property != nullptr) scan.true_range.at<float>(row, col) = true_range_property->values[i];
+    if (curvature_property != nullptr && curvature_property->values[i] >= 0.0)  // < 0: unknown (kNoCurvature)
+      scan.curvature.at<float>(row, col) = curvature_property->values[i];
   }
   for (Scan& scan : scans) FinishScan(&scan, /*fit_grid=*/true);
   return scans;
@@ -155,7 +164,8 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   ply.comments.push_back("written by lidarshop: points in the world frame; row/col in image orientation");
   ply.comments.push_back("frame world");
   int64_t total = 0;
-  bool color = false, label = false, normal = false, synthesized = false, true_range = false, far = false;
+  bool color = false, label = false, normal = false, curvature = false, synthesized = false,
+       true_range = false, far = false;
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
     CheckScan(scan);
@@ -166,12 +176,13 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     color |= scan.has_color();
     label |= !scan.label.empty();
     normal |= !scan.normal.empty();
+    curvature |= !scan.curvature.empty();
     synthesized |= !scan.synthesized.empty();
     true_range |= !scan.true_range.empty();
     far |= scan.world_from_scanner.topRightCorner<3, 1>().norm() > 1e4;  // floats would lose millimetres
   }
-  std::vector<double> x, y, z, nx, ny, nz, red, green, blue, intensity, labels, synth, truth, rows, cols,
-      index;
+  std::vector<double> x, y, z, nx, ny, nz, curv, red, green, blue, intensity, labels, synth, truth, rows,
+      cols, index;
   for (std::vector<double>* column : {&x, &y, &z, &intensity, &rows, &cols, &index}) column->reserve(total);
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
@@ -205,6 +216,10 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
           ny.push_back(n.y());
           nz.push_back(n.z());
         }
+        if (curvature) {
+          const float value = scan.curvature.empty() ? NAN : scan.curvature.at<float>(row, col);
+          curv.push_back(std::isnan(value) ? kNoCurvature : value);
+        }
         if (label) labels.push_back(scan.label.empty() ? kNoLabel : scan.label.at<int32_t>(row, col));
         if (synthesized)
           synth.push_back(!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
@@ -222,6 +237,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     AddScalarProperty(&vertex, "ny", PlyType::kFloat32, std::move(ny));
     AddScalarProperty(&vertex, "nz", PlyType::kFloat32, std::move(nz));
   }
+  if (curvature) AddScalarProperty(&vertex, "curvature", PlyType::kFloat32, std::move(curv));
   if (color) {
     AddScalarProperty(&vertex, "red", PlyType::kUInt8, std::move(red));
     AddScalarProperty(&vertex, "green", PlyType::kUInt8, std::move(green));

@@ -114,8 +114,10 @@ GridNormalResult EstimateGridNormals(const Scan& scan, const NormalOptions& opti
 }
 
 Scan WithGridNormals(const Scan& scan, const NormalOptions& options) {
+  GridNormalResult result = EstimateGridNormals(scan, options);
   Scan out = scan;
-  out.normal = EstimateGridNormals(scan, options).normal;
+  out.normal = result.normal;
+  out.curvature = result.curvature;
   return out;
 }
 

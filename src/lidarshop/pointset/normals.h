@@ -48,7 +48,7 @@ struct GridNormalResult {
 };
 GridNormalResult EstimateGridNormals(const Scan& scan, const NormalOptions& options);
 
-// The scan with its `normal` channel replaced by the grid normals.
+// The scan with its `normal` and `curvature` channels replaced by the grid normals and their curvature.
 Scan WithGridNormals(const Scan& scan, const NormalOptions& options);
 
 }  // namespace lidarshop

@@ -1,6 +1,7 @@
 // Filters, normals, RANSAC planes and clustering on synthetic clouds whose answer is known: a plane with a
 // known normal plus outliers, well-separated blobs with known membership; bad inputs get clear errors.
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -107,6 +108,44 @@ TEST(NormalsTest, PlaneNormalsFaceTheViewpointAndCurvatureIsZero) {
       EXPECT_LT(result.curvature[i], 1e-5f);
     }
   }
+}
+
+// Surface variation on a sphere of radius r over a ball neighbourhood of radius R: the neighbours fill a
+// cap of height h = R² / (2r) whose covariance has λ0 = r²η²/12 along the normal and λ1 = λ2 = r²(η − η²/3)/2
+// across it (η = h / r, cos θ uniform over the cap), so λ0 / (λ0 + λ1 + λ2) = η / (12 − 3η) ≈ R² / (24 r²).
+TEST(NormalsTest, SphereCurvatureIsTheCapsSurfaceVariation) {
+  const double r = 1.0, R = 0.2;
+  const Eigen::Vector3f centre(3, -2, 1);
+  PointCloud sphere;  // a Fibonacci lattice: nearly uniform, so every neighbourhood is close to the ideal cap
+  const int count = 20000;
+  for (int i = 0; i < count; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / count, phi = M_PI * (1.0 + std::sqrt(5.0)) * (i + 0.5);
+    const double rho = std::sqrt(1.0 - z * z);
+    sphere.points.push_back(centre +
+                            (r * Eigen::Vector3d(rho * std::cos(phi), rho * std::sin(phi), z)).cast<float>());
+  }
+  NormalOptions options;
+  options.radius_m = R;
+  options.max_neighbors = 0;  // every point within R
+  options.viewpoint = centre;
+  const NormalResult result = EstimateNormals(sphere, options);
+  const double eta = R * R / (2.0 * r * r), expected = eta / (12.0 - 3.0 * eta);
+  std::vector<float> sorted = result.curvature;
+  std::nth_element(sorted.begin(), sorted.begin() + count / 2, sorted.end());
+  EXPECT_NEAR(sorted[count / 2], expected, 0.01 * expected);
+  for (int i = 0; i < count; ++i) {
+    ASSERT_NEAR(result.curvature[i], expected, 0.06 * expected) << i;
+    // Toward the centre (the viewpoint) and radial.
+    const Eigen::Vector3f inward = (centre - sphere.points[i]).normalized();
+    ASSERT_GT(result.normals[i].dot(inward), 0.999f) << i;
+  }
+  // A plane of the same sampling has none (PlaneNormalsFaceTheViewpointAndCurvatureIsZero), a smaller sphere more.
+  PointCloud small = sphere;
+  for (Eigen::Vector3f& p : small.points) p = centre + 0.5f * (p - centre);
+  std::vector<float> smaller = EstimateNormals(small, options).curvature;
+  const double eta_small = R * R / (2.0 * 0.5 * 0.5), expected_small = eta_small / (12.0 - 3.0 * eta_small);
+  std::nth_element(smaller.begin(), smaller.begin() + count / 2, smaller.end());
+  EXPECT_NEAR(smaller[count / 2], expected_small, 0.02 * expected_small);
 }
 
 TEST(NormalsTest, SameNormalsOnOneThreadAndOnAll) {

@@ -18,8 +18,9 @@ int64_t Scan::CountValid() const { return valid.empty() ? 0 : cv::countNonZero(v
 
 Scan Clone(const Scan& scan) {
   Scan copy = scan;
-  for (cv::Mat* channel : {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity,
-                           &copy.color, &copy.label, &copy.normal, &copy.true_range, &copy.synthesized}) {
+  for (cv::Mat* channel :
+       {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity, &copy.color, &copy.label,
+        &copy.normal, &copy.curvature, &copy.true_range, &copy.synthesized}) {
     *channel = channel->clone();
   }
   return copy;
@@ -40,6 +41,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   if (!masked.color.empty()) masked.color.setTo(cv::Scalar::all(0), drop);
   if (!masked.label.empty()) masked.label.setTo(kNoLabel, drop);
   if (!masked.normal.empty()) masked.normal.setTo(cv::Scalar::all(0), drop);
+  if (!masked.curvature.empty()) masked.curvature.setTo(NAN, drop);
   if (!masked.true_range.empty()) masked.true_range.setTo(0, drop);
   if (!masked.synthesized.empty()) masked.synthesized.setTo(0, drop);
   return masked;
@@ -79,6 +81,7 @@ void CheckScan(const Scan& scan) {
   check(scan.color, CV_8UC3, "color", false);
   check(scan.label, CV_32S, "label", false);
   check(scan.normal, CV_32FC3, "normal", false);
+  check(scan.curvature, CV_32F, "curvature", false);
   check(scan.true_range, CV_32F, "true_range", false);
   check(scan.synthesized, CV_8U, "synthesized", false);
 }
@@ -88,6 +91,7 @@ std::vector<std::string> ChannelNames(const Scan& scan) {
   if (!scan.color.empty()) names.push_back("rgb");
   if (!scan.label.empty()) names.push_back("label");
   if (!scan.normal.empty()) names.push_back("normal");
+  if (!scan.curvature.empty()) names.push_back("curvature");
   if (!scan.true_range.empty()) names.push_back("true_range");
   if (!scan.synthesized.empty()) names.push_back("synthesized");
   return names;

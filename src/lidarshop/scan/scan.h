@@ -18,6 +18,8 @@
 // Optional channels (empty when absent):
 //   label       CV_32S    object label (synthetic scans); kNoLabel where invalid
 //   normal      CV_32FC3  unit surface normal in the scanner frame (true normals of synthetic scans)
+//   curvature   CV_32F    surface variation λ0 / (λ0 + λ1 + λ2) in [0, 1/3] of the neighbourhood the normal
+//                         came from (pointset/normals.h); NaN where invalid or unknown
 //   true_range  CV_32F    noise-free range (synthetic scans), 0 where invalid
 //   synthesized CV_8U     255 = created by lidarshop (e.g. hole filling), 0 = measured
 //
@@ -75,6 +77,7 @@ struct Scan {
 
   cv::Mat label;
   cv::Mat normal;
+  cv::Mat curvature;
   cv::Mat true_range;
   cv::Mat synthesized;
 
@@ -91,7 +94,7 @@ Scan Clone(const Scan& scan);
 
 // The scan with only the cells where `keep_mask` (CV_8U, rows x cols, non-zero = keep) is set: every other
 // cell becomes a cell without a return (valid 0, range 0, point 0, intensity 0.5, colour 0, label kNoLabel,
-// normal 0, true_range 0, synthesized 0) but keeps its direction; grid, pose and name are kept. Used to write
+// normal 0, curvature NaN, true_range 0, synthesized 0) but keeps its direction; grid, pose and name are kept. Used to write
 // a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error when the mask has the
 // wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);

@@ -17,11 +17,15 @@ TriangleMesh ScanToMesh(const Scan& scan, const ScanMeshOptions& options) {
   CheckScan(scan);
   const int rows = scan.rows, cols = scan.cols;
   const float ratio = static_cast<float>(options.max_range_jump_ratio);
+  const float max_edge_sq = static_cast<float>(options.max_edge_m * options.max_edge_m);
   auto valid = [&](int r, int c) { return scan.valid.at<uint8_t>(r, c) != 0; };
   auto range = [&](int r, int c) { return scan.range.at<float>(r, c); };
   auto joined = [&](int r0, int c0, int r1, int c1) {
     const float a = range(r0, c0), b = range(r1, c1);
-    return std::abs(a - b) <= ratio * std::min(a, b);
+    if (std::abs(a - b) > ratio * std::min(a, b)) return false;
+    if (max_edge_sq <= 0.0f) return true;
+    const cv::Vec3f d = scan.point.at<cv::Vec3f>(r0, c0) - scan.point.at<cv::Vec3f>(r1, c1);
+    return d.dot(d) <= max_edge_sq;
   };
   // Triangles over cell indices first, then compact the vertices that are used.
   std::vector<Eigen::Vector3i> cell_triangles;

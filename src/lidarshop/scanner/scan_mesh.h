@@ -3,7 +3,7 @@
 // not get joined by long "skirts".
 //
 // An edge between neighbouring cells a and b is kept when |r_a - r_b| <= max_range_jump_ratio * min(r_a, r_b)
-// (ranges in metres). Triangles face the scanner (counter-clockwise as seen from the scanner origin).
+// (ranges in metres) and, when max_edge_m > 0, |p_a - p_b| <= max_edge_m. Triangles face the scanner (counter-clockwise as seen from the scanner origin).
 #pragma once
 
 #include "lidarshop/geometry/mesh.h"
@@ -17,6 +17,9 @@ struct ScanMeshOptions {
   // down to about 6 degrees of grazing incidence at 0.1-degree steps and cuts the edge of an object 10 % in
   // front of its background.
   double max_range_jump_ratio = 0.1;
+  // Longest kept edge between the two cells' points, metres (0 = no limit): cuts grazing surfaces and far
+  // returns where neighbouring rays are far apart, which the relative jump alone keeps.
+  double max_edge_m = 0.0;
   bool world_frame = false;  // vertices in the world frame (world_from_scanner) instead of the scanner frame
   void Check() const;        // throws OptionsError
 };

@@ -1,4 +1,5 @@
 // The synthetic scanner's outputs through files, and the scan mesh.
+#include <algorithm>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -77,6 +78,29 @@ TEST(ScanMesh, JoinsNeighboursAndCutsDepthJumps) {
   ScanMeshOptions bad;
   bad.max_range_jump_ratio = 0;
   EXPECT_THROW(ScanToMesh(scan, bad), OptionsError);
+  bad = ScanMeshOptions();
+  bad.max_edge_m = -1;
+  EXPECT_THROW(ScanToMesh(scan, bad), OptionsError);
+
+  // An edge-length limit between the shortest and the longest edge keeps some triangles, none with a longer edge.
+  float longest = 0.0f, shortest = 1e9f;
+  for (const auto& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const float length = (mesh.vertices[t[k]] - mesh.vertices[t[(k + 1) % 3]]).norm();
+      longest = std::max(longest, length);
+      shortest = std::min(shortest, length);
+    }
+  }
+  ScanMeshOptions limited;
+  limited.max_edge_m = 0.5 * (shortest + longest);
+  const TriangleMesh cut = ScanToMesh(scan, limited);
+  EXPECT_GT(cut.triangles.size(), 0u);
+  EXPECT_LT(cut.triangles.size(), mesh.triangles.size());
+  for (const auto& t : cut.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_LE((cut.vertices[t[k]] - cut.vertices[t[(k + 1) % 3]]).norm(), limited.max_edge_m + 1e-6);
+    }
+  }
 }
 
 }  // namespace

@@ -105,6 +105,10 @@ def test_scan_tools(scan):
     with_normals = lidarshop.scan_normals(scan, window_cells=2)
     up = with_normals.normal[(scan.label == 0) & (scan.valid > 0)]
     assert np.median(up[:, 2]) > 0.98  # the ground faces up (scanner frame = world orientation here)
+    # The curvature channel beside it: ~0 on the flat ground, NaN where the ray returned nothing.
+    assert with_normals.curvature.dtype == np.float32 and scan.curvature is None
+    assert np.nanmedian(with_normals.curvature[(scan.label == 0) & (scan.valid > 0)]) < 1e-3
+    assert np.all(np.isnan(with_normals.curvature[scan.valid == 0]))
     for method in ("slic", "graph", "quickshift"):
         labels, count = lidarshop.superpixels(scan, method=method, region_cells=10)
         assert labels.shape == (scan.rows, scan.cols) and count > 10, method
