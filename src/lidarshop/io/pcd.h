@@ -8,7 +8,8 @@
 // becomes a 1 x N scan whose points are taken as they are (pose = VIEWPOINT).
 //
 // Fields read: x y z (required), rgb/rgba (packed 0xAARRGGBB, TYPE F or U), intensity, label, normal_x/y/z,
-// synthesized, true_range; other fields are skipped. NaN (or 0 0 0) coordinates mark a missing return.
+// synthesized, true_range; other fields are skipped. NaN (or 0 0 0) coordinates mark a missing return. A file
+// without an `intensity` field gives a scan without intensity (Scan::intensity empty), not an invented one.
 #pragma once
 
 #include <string>
@@ -20,7 +21,7 @@ namespace lidarshop {
 Scan ReadPcd(const std::string& path);
 Scan ParsePcd(const std::string& bytes, const std::string& file);
 
-// Binary PCD with x y z, rgb (when the scan has colour), intensity, label, normal_x/y/z, synthesized,
+// Binary PCD with x y z, then each channel the scan has: rgb, intensity, label, normal_x/y/z, synthesized,
 // true_range; missing returns are NaN. Atomic.
 void WritePcd(const std::string& path, const Scan& scan);
 

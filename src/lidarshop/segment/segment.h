@@ -1,7 +1,8 @@
 // Cutting an object out of a scan from a few strokes: graph cuts on the RGB+D image (two-step RGB + depth).
 //
 // The scan is treated as an RGB+D image (scan/scan.h RgbdImage: R, G, B in [0, 1] and range in metres; scans
-// without colour use the intensity as grey). Every valid cell is a node of a grid graph; cells without a
+// without colour use the intensity as grey; scans with neither have constant R, G, B, so only the depth
+// separates). Every valid cell is a node of a grid graph; cells without a
 // return are NOT nodes (they are never "depth 0"): they have no n-links, are never part of the object and
 // split the grid where they lie. The minimum cut comes from the Boykov–Kolmogorov max-flow (Debian
 // libmaxflow, the reference implementation).
@@ -186,7 +187,7 @@ MaskScores ScoreMask(const cv::Mat& mask, const cv::Mat& truth, const cv::Mat& d
 cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterations = 5,
                            int probable_radius_cells = 0);
 
-// The overlay picture: the scan's colour (or intensity as grey), object cells tinted, the mask outline in
+// The overlay picture: the scan's colour (or intensity as grey, or plain grey 128), object cells tinted, the mask outline in
 // yellow, object strokes green and background strokes red. CV_8UC3 RGB.
 cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes);
 
