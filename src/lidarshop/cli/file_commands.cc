@@ -138,7 +138,10 @@ int RunInfo(int argc, char** argv) {
 int RunConvert(int argc, char** argv) {
   CLI::App app{
       "Convert a scan file between .ptx, .e57, .ply, .pcd, .las, .xyz and .pts, keeping the grid where the "
-      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame).",
+      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame). Prints one warning for "
+      "each "
+      "thing the target cannot hold (labels, normals, photos, second returns, ...) and one line of what it "
+      "wrote (not with --quiet).",
       "convert"};
   std::string input, output, json_path;
   int scan_index = -1;
