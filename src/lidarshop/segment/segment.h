@@ -26,6 +26,8 @@
 //      `ring_depth_threshold_m` (+ a fraction of the range), so cells at the ground contact stay undecided;
 //   3. colour-dominant cut seeded with the step-1 object (hard object) and the inferred background + the
 //      user's background strokes (hard background); models re-learnt from those seeds.
+// A scan with neither colour nor intensity (a PCD or E57 of bare points) stops after step 2: the mask is step
+// 1's depth cut; kColor then throws InputError (it needs colour or intensity).
 // Baselines (single cut, the same machinery): kDepth (step 1's weights alone), kColor (step 3's weights from
 // the strokes alone) and kRgbd (standardized λ = 1/3, 1/3, 1/3, 1).
 //
