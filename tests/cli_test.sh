@@ -550,26 +550,33 @@ done
 
 # convert says what the target cannot hold (one warning line each) and what it wrote (one line).
 check "convert to PTX without intensity" "$lidarshop" convert "$work/plain.pcd" "$work/plain.ptx"
+cp "$work/last.err" "$work/plain_ptx.err"
 check "PTX: the convention intensity is a warning" \
-  grep -q "^lidarshop: warning: .*plain.ptx: the input has no intensity, but PTX requires an intensity column: written as 0.5" "$work/last.err"
+  grep -q "^lidarshop: warning: .*plain.ptx: the input has no intensity, but PTX requires an intensity column: written as 0.5" "$work/plain_ptx.err"
 check "convert prints what it wrote" \
-  grep -qx "wrote .*plain.ptx: 1 scan, 3 points, channels xyz intensity=0.5" "$work/last.err"
+  grep -qx "wrote .*plain.ptx: 1 scan, 3 points, channels xyz intensity=0.5" "$work/plain_ptx.err"
 check "convert labels to PTX" "$lidarshop" convert "$work/scan_labels.ply" "$work/labels.ptx" --json "$work/labels_convert.json"
+cp "$work/last.err" "$work/labels_ptx.err"
 check "PTX drops labels and normals, one line each" sh -c \
-  "grep -c '^lidarshop: warning: .*labels.ptx: labels are not written' '$work/last.err' | grep -qx 1 && \
-   grep -q '^lidarshop: warning: .*labels.ptx: normals are not written' '$work/last.err'"
+  "grep -c '^lidarshop: warning: .*labels.ptx: labels are not written' '$work/labels_ptx.err' | grep -qx 1 && \
+   grep -q '^lidarshop: warning: .*labels.ptx: normals are not written' '$work/labels_ptx.err'"
 json_check "convert --json lists channels and what was dropped" "$work/labels_convert.json" \
   "d['channels'][:3] == ['xyz', 'intensity', 'rgb'] and any('labels are not written' in x for x in d['dropped'])"
 check "convert labels to LAS" "$lidarshop" convert "$work/scan_labels.ply" "$work/labels.las"
+cp "$work/last.err" "$work/labels_las.err"
 check "LAS: labels become classification, the grid is dropped" sh -c \
-  "grep -q 'wrote .*labels.las: 1 scan, [0-9,]* points, channels xyz intensity rgb label→classification' '$work/last.err' && \
-   grep -q 'warning: .*labels.las: the grid (120 rows x 180 columns) and the scanner pose are not kept' '$work/last.err'"
+  "grep -q 'wrote .*labels.las: 1 scan, [0-9,]* points, channels xyz intensity rgb label→classification' '$work/labels_las.err' && \
+   grep -q 'warning: .*labels.las: the grid (120 rows x 180 columns) and the scanner pose are not kept' '$work/labels_las.err'"
 check "E57 -> E57 keeps the second returns" "$lidarshop" convert "$work/two_layers.e57" "$work/two_layers_copy.e57"
-check "no second returns dropped E57 -> E57" sh -c "! grep -q 'second returns' '$work/last.err'"
+cp "$work/last.err" "$work/e57_copy.err"
+check "no second returns dropped E57 -> E57" sh -c "grep -q 'wrote .*two_layers_copy.e57' '$work/e57_copy.err' && \
+  ! grep -q 'second returns' '$work/e57_copy.err'"
 check "the copy still has them (PLY drops them)" "$lidarshop" convert "$work/two_layers_copy.e57" "$work/x2.ply"
-check "PLY says it drops the second returns" grep -q "x2.ply: the second returns of 1 scan are not written" "$work/last.err"
+cp "$work/last.err" "$work/x2.err"
+check "PLY says it drops the second returns" grep -q "x2.ply: the second returns of 1 scan are not written" "$work/x2.err"
 check "pumpA to PLY drops the photo" "$lidarshop" convert "$shared/e57/pumpA.e57" "$work/pumpA.ply"
-check "the photo is one warning" grep -q "pumpA.ply: 1 image (E57 images2D) not written" "$work/last.err"
+cp "$work/last.err" "$work/pumpA_ply.err"
+check "the photo is one warning" grep -q "pumpA.ply: 1 image (E57 images2D) not written" "$work/pumpA_ply.err"
 check "E57 scaled-integer precision" "$lidarshop" convert "$work/scan.ptx" "$work/scaled.e57" \
   --e57-precision-m 0.0001 --json "$work/scaled.json" --quiet
 json_check "the precision is in the options" "$work/scaled.json" "d['options']['coordinate_scale_m'] == 0.0001"
