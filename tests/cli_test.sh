@@ -639,6 +639,61 @@ help_shows "render help: channels as words" "range|rgb|intensity|normals|labels|
 help_shows "points help: superpixel methods as words" "slic|graph" "$lidarshop" points
 help_shows "verify help: units and ranges" "(m, [0, 1000])" "$lidarshop" verify
 
+# A channel the file does not hold is absent: a PCD of bare points has no intensity, and says so.
+printf '# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\nDATA ascii\n1 2 3\n2 3 4\n3 4 5\n' \
+  >"$work/plain.pcd"
+check "info of a PCD without intensity" sh -c "'$lidarshop' info '$work/plain.pcd' >'$work/plain.json'"
+json_check "no intensity channel is invented" "$work/plain.json" \
+  "'intensity' not in d['scans'][0]['channels'] and 'intensity' not in d['scans'][0] and 'xyz' in d['scans'][0]['channels']"
+fails_clearly "render intensity of a scan without it" "plain.pcd has no intensity channel; it has: xyz$" \
+  "$lidarshop" render "$work/plain.pcd" -o "$work/x.png" --channel intensity
+check "convert the PCD to PCD" "$lidarshop" convert "$work/plain.pcd" "$work/plain_copy.pcd" --quiet
+check "the copy has no intensity field" grep -qa "^FIELDS x y z$" "$work/plain_copy.pcd"
+for format in ply e57 las xyz; do
+  check "convert the PCD to $format" "$lidarshop" convert "$work/plain.pcd" "$work/plain.$format" --quiet
+  check "info plain.$format" sh -c "'$lidarshop' info '$work/plain.$format' >'$work/plain_$format.json'"
+  json_check "$format: still no intensity" "$work/plain_$format.json" \
+    "'intensity' not in d['scans'][0]['channels'] and d['scans'][0]['valid'] == 3"
+done
+
+# convert says what the target cannot hold (one warning line each) and what it wrote (one line).
+check "convert to PTX without intensity" "$lidarshop" convert "$work/plain.pcd" "$work/plain.ptx"
+cp "$work/last.err" "$work/plain_ptx.err"
+check "PTX: the convention intensity is a warning" \
+  grep -q "^lidarshop: warning: .*plain.ptx: the input has no intensity, but PTX requires an intensity column: written as 0.5" "$work/plain_ptx.err"
+check "convert prints what it wrote" \
+  grep -qx "wrote .*plain.ptx: 1 scan, 3 points, channels xyz intensity=0.5" "$work/plain_ptx.err"
+check "convert labels to PTX" "$lidarshop" convert "$work/scan_labels.ply" "$work/labels.ptx" --json "$work/labels_convert.json"
+cp "$work/last.err" "$work/labels_ptx.err"
+check "PTX drops labels and normals, one line each" sh -c \
+  "grep -c '^lidarshop: warning: .*labels.ptx: labels are not written' '$work/labels_ptx.err' | grep -qx 1 && \
+   grep -q '^lidarshop: warning: .*labels.ptx: normals are not written' '$work/labels_ptx.err'"
+json_check "convert --json lists channels and what was dropped" "$work/labels_convert.json" \
+  "d['channels'][:3] == ['xyz', 'intensity', 'rgb'] and any('labels are not written' in x for x in d['dropped'])"
+check "convert labels to LAS" "$lidarshop" convert "$work/scan_labels.ply" "$work/labels.las"
+cp "$work/last.err" "$work/labels_las.err"
+check "LAS: labels become classification, the grid is dropped" sh -c \
+  "grep -q 'wrote .*labels.las: 1 scan, [0-9,]* points, channels xyz intensity rgb label→classification' '$work/labels_las.err' && \
+   grep -q 'warning: .*labels.las: the grid (120 rows x 180 columns) and the scanner pose are not kept' '$work/labels_las.err'"
+check "E57 -> E57 keeps the second returns" "$lidarshop" convert "$work/two_layers.e57" "$work/two_layers_copy.e57"
+cp "$work/last.err" "$work/e57_copy.err"
+check "no second returns dropped E57 -> E57" sh -c "grep -q 'wrote .*two_layers_copy.e57' '$work/e57_copy.err' && \
+  ! grep -q 'second returns' '$work/e57_copy.err'"
+check "the copy still has them (PLY drops them)" "$lidarshop" convert "$work/two_layers_copy.e57" "$work/x2.ply"
+cp "$work/last.err" "$work/x2.err"
+check "PLY says it drops the second returns" grep -q "x2.ply: the second returns of 1 scan are not written" "$work/x2.err"
+check "pumpA to PLY drops the photo" "$lidarshop" convert "$shared/e57/pumpA.e57" "$work/pumpA.ply"
+cp "$work/last.err" "$work/pumpA_ply.err"
+check "the photo is one warning" grep -q "pumpA.ply: 1 image (E57 images2D) not written" "$work/pumpA_ply.err"
+check "E57 scaled-integer precision" "$lidarshop" convert "$work/scan.ptx" "$work/scaled.e57" \
+  --e57-precision-m 0.0001 --json "$work/scaled.json" --quiet
+json_check "the precision is in the options" "$work/scaled.json" "d['options']['coordinate_scale_m'] == 0.0001"
+check "the E57 stores scaled integers" python3 -c \
+  "import sys; sys.exit(b'ScaledInteger' not in open('$work/scaled.e57', 'rb').read())"
+check "the old flag still works" "$lidarshop" convert "$work/scan.ptx" "$work/scaled2.e57" --coordinate-scale-m 0.001 --quiet
+fails_clearly "a negative precision is refused" "e57-precision-m" \
+  "$lidarshop" convert "$work/scan.ptx" "$work/bad.e57" --e57-precision-m -1
+
 # The demo on a small built-in scene.
 check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet
 json_check "demo summary" "$work/demo/summary.json" "d['scene'] == 'mailbox' and d['scan']['valid'] > 0"

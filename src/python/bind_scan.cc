@@ -73,7 +73,8 @@ const ChannelSpec kChannels[] = {
     {"range", &Scan::range, CV_32F, 1, true,
      "metres from the scanner origin, 0 where invalid; float32 (rows, cols)"},
     {"point", &Scan::point, CV_32F, 3, true, "x y z in the scanner frame, metres; float32 (rows, cols, 3)"},
-    {"intensity", &Scan::intensity, CV_32F, 1, true, "return strength in [0, 1]; float32 (rows, cols)"},
+    {"intensity", &Scan::intensity, CV_32F, 1, false,
+     "return strength in [0, 1]; float32 (rows, cols), None when the scan has no intensity"},
     {"color", &Scan::color, CV_8U, 3, false,
      "R G B; uint8 (rows, cols, 3), None when the scan has no colour"},
     {"label", &Scan::label, CV_32S, 1, false,
@@ -98,12 +99,13 @@ Every channel is a numpy array of the grid's shape in image orientation (row 0 =
 column = azimuth increasing to the right). Reading a channel gives a view of the scan's memory, no copy:
 writing into the array changes the scan. Assigning an array replaces the channel (a copy, converted to the
 channel's dtype; the shape must match). Optional channels are None when absent and can be set to None.)doc");
-  scan.def(py::init([](int rows, int cols, bool with_color) {
+  scan.def(py::init([](int rows, int cols, bool with_color, bool with_intensity) {
              if (rows <= 0 || cols <= 0) throw py::value_error("Scan: rows and cols must be > 0");
-             return MakeScan(rows, cols, with_color);
+             return MakeScan(rows, cols, with_color, with_intensity);
            }),
-           py::arg("rows"), py::arg("cols"), py::arg("with_color") = false,
-           "A scan with every required channel allocated and no returns.");
+           py::arg("rows"), py::arg("cols"), py::arg("with_color") = false, py::arg("with_intensity") = true,
+           "A scan with every required channel allocated and no returns; intensity (0.5) unless "
+           "with_intensity=False, colour when with_color.");
   scan.def_readonly("rows", &Scan::rows);
   scan.def_readonly("cols", &Scan::cols);
   scan.def_readwrite("name", &Scan::name);
@@ -142,6 +144,7 @@ channel's dtype; the shape must match). Optional channels are None when absent a
       "elevation_rad", [](const Scan& s) { return py::array(py::cast(s.grid.elevation_rad)); },
       "elevation of each image row, radians, decreasing downwards");
   scan.def_property_readonly("has_color", &Scan::has_color);
+  scan.def_property_readonly("has_intensity", &Scan::has_intensity);
   scan.def_property_readonly("num_cells", &Scan::num_cells);
   scan.def("count_valid", &Scan::CountValid, "Cells with a return.");
   scan.def("channel_names", &ChannelNames, "Names of the channels present.");

@@ -95,7 +95,7 @@ export class PairsPanel {
     const api = this.context.api;
     this.targetDoc = await api.json<DocumentInfo>(`/api/docs/${id}`);
     const d = this.targetDoc;
-    const channel = d.channels.includes('color') ? 'rgb' : 'intensity';
+    const channel = d.channels.includes('color') ? 'rgb' : d.channels.includes('intensity') ? 'intensity' : 'range';
     const aspect = d.azimuth_step_deg > 0 ? d.elevation_step_deg / d.azimuth_step_deg : 1;
     await this.targetView.show(api.url(`/api/docs/${id}/image.png`, { channel, v: d.version }), null, null, d.rows, d.cols, aspect, false);
     this.shownTarget = id;

@@ -14,6 +14,7 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
@@ -56,9 +57,11 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
       min_range = std::min(min_range, range);
       max_range = std::max(max_range, range);
       sum_range += range;
-      const double intensity = scan.intensity.at<float>(row, col);
-      min_intensity = std::min(min_intensity, intensity);
-      max_intensity = std::max(max_intensity, intensity);
+      if (scan.has_intensity()) {
+        const double intensity = scan.intensity.at<float>(row, col);
+        min_intensity = std::min(min_intensity, intensity);
+        max_intensity = std::max(max_intensity, intensity);
+      }
       ++count;
     }
   }
@@ -67,7 +70,7 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
                       {"min", {world_bounds.min().x(), world_bounds.min().y(), world_bounds.min().z()}},
                       {"max", {world_bounds.max().x(), world_bounds.max().y(), world_bounds.max().z()}}};
     json["range_m"] = {{"min", min_range}, {"max", max_range}, {"mean", sum_range / count}};
-    json["intensity"] = {{"min", min_intensity}, {"max", max_intensity}};
+    if (scan.has_intensity()) json["intensity"] = {{"min", min_intensity}, {"max", max_intensity}};
   } else {
     json["bounds"] = nullptr;
   }
@@ -135,7 +138,10 @@ int RunInfo(int argc, char** argv) {
 int RunConvert(int argc, char** argv) {
   CLI::App app{
       "Convert a scan file between .ptx, .e57, .ply, .pcd, .las, .xyz and .pts, keeping the grid where the "
-      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame).",
+      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame). Prints one warning for "
+      "each "
+      "thing the target cannot hold (labels, normals, photos, second returns, ...) and one line of what it "
+      "wrote (not with --quiet).",
       "convert"};
   std::string input, output, json_path;
   int scan_index = -1;
@@ -146,7 +152,9 @@ int RunConvert(int argc, char** argv) {
   app.add_option("output", output, "scan file to write (format from the extension)")->required();
   app.add_option("--scan", scan_index, "write only scan K (from 0); PCD holds one scan");
   AddJsonOption(app, &json_path);
-  binder.Bind(&e57_options, {.group = "E57 output"});
+  // --e57-precision-m names the scaled-integer step; --coordinate-scale-m stays (an earlier contract).
+  binder.Bind(&e57_options, {.flags = {{"coordinate_scale_m", "--coordinate-scale-m,--e57-precision-m"}},
+                             .group = "E57 output"});
   AddQuietFlag(app, &quiet);
   LasWriteOptions las;
   binder.Bind(&las, {.flags = {{"minor_version", "--las-minor-version"},
@@ -162,10 +170,11 @@ int RunConvert(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {input, output});
         const auto progress = Progress::ForTerminal("convert", 2, quiet);
         ScanFile file;
-        std::vector<E57Image> images;  // E57 -> E57 keeps the photos
-        const bool e57_to_e57 = FileExtension(input) == "e57" && FileExtension(output) == "e57";
-        if (e57_to_e57) {
+        std::vector<E57Image> images;         // E57 -> E57 keeps the photos
+        std::vector<Scan> second_returns;     // E57 input: one per scan, 0 x 0 = none
+        if (FileExtension(input) == "e57") {  // photos and second returns, to keep or to report
           E57File e57 = ReadE57AndWarn(input);
+          second_returns = std::move(e57.second_returns);
           file = {input, "e57", std::move(e57.scans), std::move(e57.warnings)};
           images = std::move(e57.images);
         } else {
@@ -173,9 +182,22 @@ int RunConvert(int argc, char** argv) {
         }
         progress->Advance();
         std::vector<Scan> scans = file.scans;
-        if (scan_index >= 0) scans = {PickScan(file, scan_index, "--scan")};
-        if (FileExtension(output) == "e57") {
-          WriteE57(output, scans, images, e57_options);
+        if (scan_index >= 0) {
+          scans = {PickScan(file, scan_index, "--scan")};
+          if (!second_returns.empty()) second_returns = {second_returns[scan_index]};
+        }
+        const bool to_e57 = FileExtension(output) == "e57";
+        size_t scans_with_second_returns = 0;
+        for (const Scan& second : second_returns) scans_with_second_returns += second.CountValid() > 0;
+        // E57 -> E57 keeps the second returns; every other target drops them (and says so).
+        const ScanWritePlan plan =
+            PlanScanWrite(output, scans, images.size(), to_e57 ? 0 : scans_with_second_returns);
+        if (to_e57) {
+          E57File out;
+          out.scans = scans;
+          out.second_returns = second_returns;
+          out.images = images;
+          WriteE57(output, out, e57_options);
         } else if (FileExtension(output) == "las") {
           WriteLas(output, scans, las);
         } else {
@@ -183,6 +205,10 @@ int RunConvert(int argc, char** argv) {
         }
         progress->Advance();
         progress->Finish();
+        // After a successful write: what the target could not hold, one line each, then what it holds.
+        PrintWarnings(plan.dropped);
+        const size_t images_written = to_e57 ? images.size() : 0;
+        if (!quiet) fmt::print(stderr, "{}\n", WrittenSummary(output, scans, images_written, plan));
         nlohmann::ordered_json json;
         json["input"] = input;
         json["output"] = output;
@@ -191,7 +217,9 @@ int RunConvert(int argc, char** argv) {
         int64_t returns = 0;
         for (const Scan& scan : scans) returns += scan.CountValid();
         json["returns"] = returns;
-        json["images"] = images.size();
+        json["images"] = images_written;
+        json["channels"] = plan.channels;
+        json["dropped"] = plan.dropped;
         WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
         return 0;
       },
@@ -285,7 +313,8 @@ int RunRender(int argc, char** argv) {
         options.Check();
         const ScanFile file = ReadScanFileAndWarn(input);
         Scan scan = PickScan(file, scan_index, "--scan");
-        if (scan.name.empty()) scan.name = input;
+        // Errors about the scan's channels name the file (and the scan, when the file names it).
+        scan.name = scan.name.empty() ? input : fmt::format("{} (scan '{}')", input, scan.name);
         const RenderResult result = RenderScan(scan, options);
         WriteImage(output, result.image);
         json["output"] = output;

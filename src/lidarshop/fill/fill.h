@@ -63,7 +63,8 @@ struct FillOptions {
   // With acceptance: search the local window exhaustively first, then the whole scan (true), or offer the
   // configured search's best candidates only (false, faster).
   bool acceptance_local_first = true;
-  // Channel weights of the patch difference. Colour is in grey levels (0..255, or intensity × 255); a range
+  // Channel weights of the patch difference. Colour is in grey levels (0..255, or intensity × 255; a scan with
+  // neither colour nor intensity has a constant colour channel, so only the range gradients guide); a range
   // gradient g becomes 255 · asinh(g / s) / asinh(1) with s its 90th percentile over the known cells (range
   // channel of depth-patch: s = its 5–95 % spread), linear near 0 and logarithmic for steep ground and jumps.
   double color_weight = 1.0;     // per colour channel (>= 0)

@@ -176,6 +176,23 @@ TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
   }
 }
 
+TEST(FillScan, EveryMethodRunsOnAScanWithoutIntensityOrColourAndInventsNone) {
+  // A PCD or E57 without intensity (and here without colour): the fill has only the range to go by.
+  Case c = MakeCase(kWallScene, 1);
+  c.scan.intensity = cv::Mat();
+  c.scan.color = cv::Mat();
+  for (FillMethod method :
+       {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+    FillOptions options;
+    options.method = method;
+    const FillResult result = FillScan(c.scan, c.hole, options);
+    EXPECT_FALSE(result.scan.has_intensity()) << ToString(method);
+    EXPECT_FALSE(result.scan.has_color()) << ToString(method);
+    const FillMetrics m = MeasureFill(result.scan, c.truth, c.hole);
+    EXPECT_GT(m.return_accuracy, 0.9) << ToString(method);
+  }
+}
+
 TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
   const Case c = MakeCase(kWallScene, 2);
   FillOptions options;

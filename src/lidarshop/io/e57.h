@@ -50,7 +50,8 @@ constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 // Throws InputError naming the file, the page or byte offset and what is wrong (bad CRC, truncated, bad XML).
 E57File ReadE57(const std::string& path);
 
-// Writes organized scans with pose, intensity, colour, row/column index and invalid state, and the
+// Writes organized scans with pose, intensity and colour (each when the scan has it), row/column index and
+// invalid state, and the
 // synthesized channel (when present) as the extension field lidarshop:synthesized; atomic.
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
 
@@ -91,5 +92,10 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector
                                const E57WriteOptions& options);
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,
               const E57WriteOptions& options);
+// A whole file as ReadE57 gave it (E57 -> E57): scans, the second returns of each (returnIndex 1; a second
+// layer's `synthesized` flags are kept, a layer without the channel is written as measured) and photos.
+// Throws std::logic_error when a second layer differs from its scan in size.
+std::vector<uint8_t> EncodeE57(const E57File& file, const E57WriteOptions& options);
+void WriteE57(const std::string& path, const E57File& file, const E57WriteOptions& options);
 
 }  // namespace lidarshop

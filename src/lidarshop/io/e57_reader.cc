@@ -569,7 +569,8 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
   if (std::find(layer.begin(), layer.end(), 1) != layer.end()) {
     const bool has_color =
         records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
-    *second = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color);
+    *second = MakeScan(static_cast<int>(rows), static_cast<int>(cols), has_color,
+                       /*with_intensity=*/records.Find("intensity") != nullptr);
     second->name = scan->name;
     second->world_from_scanner = scan->world_from_scanner;
   }
@@ -750,7 +751,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   const PointRecords records = ReadPointRecords(ctx, child);
   RecordGrid grid = ReadRecordGrid(ctx, child, records);
   const bool has_color = records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
-  Scan scan = MakeScan(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color);
+  Scan scan = MakeScan(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color,
+                       /*with_intensity=*/records.Find("intensity") != nullptr);
   scan.name = StringValue(child.child("name"));
   scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
   std::vector<uint8_t> state = ReadInvalidState(records);

@@ -87,6 +87,7 @@ TEST(E57Reader, BunnyFloatIsUnstructured) {
   EXPECT_EQ(s.cols, 30571);  // recordCount
   EXPECT_GT(s.CountValid(), 0);
   EXPECT_FALSE(s.has_color());
+  EXPECT_FALSE(s.has_intensity());  // the file has no intensity field: none is invented
   ExpectInsideBounds(s, {-0.094689, 0.040011, -0.061873}, {0.061009, 0.187321, 0.058799}, 1e-6);
 }
 
@@ -151,6 +152,8 @@ TEST(E57Reader, TinyCartesianFloatRgb) {
   EXPECT_EQ(s.num_cells(), 2090);
   EXPECT_EQ(s.CountValid(), 2090);
   ASSERT_TRUE(s.has_color());
+  EXPECT_FALSE(s.has_intensity());
+  EXPECT_THAT(ChannelNames(s), ::testing::Not(::testing::Contains("intensity")));
   ExpectInsideBounds(s, {-9.77952957, 4.5138793, 295.524689}, {-6.77423811, 7.51546049, 298.532166}, 1e-4);
   // colorLimits 0..255 over 8-bit fields: colours are not all black.
   EXPECT_GT(cv::sum(s.color)[0], 0.0);

@@ -154,13 +154,16 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     }
     streams.push_back(std::move(s));
   }
-  {
+  if (scan.has_intensity()) {  // no intensity field for a scan without intensity
     Stream s;
     s.field.name = "intensity";
     s.field.type = Field::Type::kFloat;
     s.field.bits = 32;
     BitWriter w(32);
-    for (int64_t i = 0; i < n; ++i) w.PutFloat(layer_of(i).intensity.ptr<float>()[records[i].cell]);
+    for (int64_t i = 0; i < n; ++i) {
+      const Scan& from = layer_of(i);  // a layer without intensity gets the no-information value
+      w.PutFloat(from.has_intensity() ? from.intensity.ptr<float>()[records[i].cell] : 0.5f);
+    }
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
   }
@@ -219,13 +222,19 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   }
   const bool write_synthesized = behind != nullptr || !scan.synthesized.empty();
   if (write_synthesized) {
-    // The second layer is synthesized by definition; the front scan says per cell.
+    // The front scan says per cell; the second layer too when it has the channel, else it is synthesized by
+    // definition (the layer behind a kept object).
     Stream s;
     s.field = IntegerField(kSynthesizedField, 0, 1);
     BitWriter w(s.field.bits);
     const uint8_t* flags = scan.synthesized.empty() ? nullptr : scan.synthesized.ptr<uint8_t>();
+    const uint8_t* behind_flags =
+        behind == nullptr || behind->synthesized.empty() ? nullptr : behind->synthesized.ptr<uint8_t>();
     for (int64_t i = 0; i < n; ++i) {
-      w.PutInteger(records[i].layer == 1 || (flags != nullptr && flags[records[i].cell] != 0) ? 1 : 0, 0);
+      const int64_t c = records[i].cell;
+      const bool synthesized = records[i].layer == 1 ? (behind_flags == nullptr || behind_flags[c] != 0)
+                                                     : (flags != nullptr && flags[c] != 0);
+      w.PutInteger(synthesized ? 1 : 0, 0);
     }
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
@@ -262,7 +271,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     AddFloat(b, "zMinimum", lo[2]);
     AddFloat(b, "zMaximum", hi[2]);
   }
-  {
+  if (scan.has_intensity()) {
     pugi::xml_node l = AddTyped(child, "intensityLimits", "Structure");
     AddFloat(l, "intensityMinimum", 0.0);
     AddFloat(l, "intensityMaximum", 1.0);
@@ -357,8 +366,9 @@ void E57WriteOptions::Check() const { Validate(*this); }
 namespace e57 {
 namespace {
 
-// The file of `scans` and `image_list`; `behind_first` (may be null) is a second layer of scans[0].
-std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_first,
+// The file of `scans` and `image_list`; `behind` (may be null, else one per scan, 0 x 0 = none) holds the
+// second layer of each scan.
+std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
                             const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
   options.Check();
   std::vector<uint8_t> logical(kHeaderSize, 0);
@@ -376,8 +386,9 @@ std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const Scan* behind_f
   data3d.append_attribute("allowHeterogeneousChildren") = "1";
   bool extension = false;
   for (size_t i = 0; i < scans.size(); ++i) {
-    extension |=
-        AppendScan(scans[i], i == 0 ? behind_first : nullptr, static_cast<int>(i), options, &logical, data3d);
+    const Scan* layer = behind != nullptr ? (*behind)[i] : nullptr;
+    if (layer != nullptr && layer->num_cells() == 0) layer = nullptr;
+    extension |= AppendScan(scans[i], layer, static_cast<int>(i), options, &logical, data3d);
   }
   // E2807 declares extensions by an XML namespace on e57Root; readers that do not know it skip its fields.
   if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
@@ -427,7 +438,10 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector
 
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
                                         const E57WriteOptions& options) {
-  return e57::Encode({front}, &behind, {}, options);
+  Scan synthesized_layer = behind;            // shares the buffers
+  synthesized_layer.synthesized = cv::Mat();  // every second return is synthesized here (the contract)
+  const std::vector<const Scan*> layers = {&synthesized_layer};
+  return e57::Encode({front}, &layers, {}, options);
 }
 
 void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
@@ -444,6 +458,27 @@ void WriteE57(const std::string& path, const std::vector<Scan>& scans) { WriteE5
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,
               const E57WriteOptions& options) {
   e57::WriteBytes(path, EncodeE57(scans, images, options));
+}
+
+std::vector<uint8_t> EncodeE57(const E57File& file, const E57WriteOptions& options) {
+  std::vector<Scan> seconds(file.scans.size());  // share the file's buffers
+  std::vector<const Scan*> layers(file.scans.size(), nullptr);
+  for (size_t i = 0; i < file.scans.size() && i < file.second_returns.size(); ++i) {
+    Scan& second = seconds[i] = file.second_returns[i];
+    if (second.num_cells() == 0) continue;
+    if (second.rows != file.scans[i].rows || second.cols != file.scans[i].cols) {
+      throw std::logic_error("EncodeE57: a scan's second returns differ from it in size");
+    }
+    // A file without lidarshop's flag measured its second returns.
+    if (second.synthesized.empty())
+      second.synthesized = cv::Mat(second.rows, second.cols, CV_8U, cv::Scalar(0));
+    layers[i] = &second;
+  }
+  return e57::Encode(file.scans, &layers, file.images, options);
+}
+
+void WriteE57(const std::string& path, const E57File& file, const E57WriteOptions& options) {
+  e57::WriteBytes(path, EncodeE57(file, options));
 }
 
 }  // namespace lidarshop

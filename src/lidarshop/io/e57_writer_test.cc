@@ -240,6 +240,65 @@ TEST(E57Writer, SeveralScansAndUnstructuredRoundTrip) {
   std::filesystem::remove(path);
 }
 
+TEST(E57Writer, AScanWithoutIntensityWritesNoIntensityField) {
+  Scan scan = SyntheticScan(12, 17, 5, true);
+  scan.intensity = cv::Mat();
+  const std::vector<uint8_t> bytes = EncodeE57({scan});
+  const std::string path = TempPath("no_intensity.e57");
+  {
+    std::ofstream out(path, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  const std::vector<uint8_t> logical = e57::LogicalFromPages(path, bytes);
+  const std::string text(logical.begin(), logical.end());
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("intensity")));
+  const E57File f = ReadE57Bytes(bytes, "no_intensity.e57");
+  ASSERT_EQ(f.scans.size(), 1u);
+  EXPECT_FALSE(f.scans[0].has_intensity());
+  EXPECT_THAT(ChannelNames(f.scans[0]), ::testing::Not(::testing::Contains("intensity")));
+  EXPECT_EQ(f.scans[0].CountValid(), scan.CountValid());
+  std::filesystem::remove(path);
+}
+
+TEST(E57Writer, AWholeFileKeepsSecondReturnsAndTheirFlags) {
+  // E57 -> E57: second returns of a measured file stay measured; a lidarshop layer keeps its flags.
+  const Scan front = SyntheticScan(10, 14, 6, false);
+  Scan second = MakeScan(front.rows, front.cols);
+  second.world_from_scanner = front.world_from_scanner;
+  second.direction = front.direction.clone();
+  for (int c = 0; c < front.cols; c += 3) {
+    if (!front.valid.at<uint8_t>(4, c)) continue;
+    const cv::Vec3f p = front.point.at<cv::Vec3f>(4, c) * 1.5f;
+    second.valid.at<uint8_t>(4, c) = kValid;
+    second.point.at<cv::Vec3f>(4, c) = p;
+    second.range.at<float>(4, c) = static_cast<float>(cv::norm(p));
+    second.intensity.at<float>(4, c) = 0.125f;
+  }
+  ASSERT_GT(second.CountValid(), 0);
+  E57File file;
+  file.scans = {front, SyntheticScan(5, 6, 7, true)};
+  file.second_returns = {second, Scan()};  // the second scan has none
+  const E57File back = ReadE57Bytes(EncodeE57(file, {}), "two_layers.e57");
+  ASSERT_EQ(back.scans.size(), 2u);
+  ASSERT_EQ(back.second_returns.size(), 2u);
+  EXPECT_EQ(back.second_returns[0].CountValid(), second.CountValid());
+  EXPECT_EQ(back.second_returns[1].num_cells(), 0);
+  EXPECT_EQ(back.scans[0].CountValid(), front.CountValid());
+  const Scan& layer = back.second_returns[0];
+  ASSERT_FALSE(layer.synthesized.empty());
+  EXPECT_EQ(cv::countNonZero(layer.synthesized), 0);  // measured, not synthesized
+  for (int c = 0; c < front.cols; ++c) {
+    if (!second.valid.at<uint8_t>(4, c)) continue;
+    EXPECT_EQ(layer.point.at<cv::Vec3f>(4, c), second.point.at<cv::Vec3f>(4, c));
+    EXPECT_EQ(layer.intensity.at<float>(4, c), 0.125f);
+  }
+  // A layer flagged synthesized stays synthesized.
+  file.second_returns[0].synthesized = second.valid.clone();
+  const E57File flagged = ReadE57Bytes(EncodeE57(file, {}), "flagged.e57");
+  EXPECT_EQ(cv::countNonZero(flagged.second_returns[0].synthesized & flagged.second_returns[0].valid),
+            second.CountValid());
+}
+
 TEST(E57Reader, TurnsBottomUpAndMirroredGridsIntoImageOrientation) {
   // A file whose rowIndex 0 is the bottom row (like pumpA) and whose columns run against our azimuth.
   const Scan scan = SyntheticScan(30, 50, 11, true);

@@ -71,7 +71,7 @@ void FinishScan(Scan* scan, bool fit_grid) {
     cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
     float* range = scan->range.ptr<float>(row);
     cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
-    float* intensity = scan->intensity.ptr<float>(row);
+    float* intensity = scan->intensity.empty() ? nullptr : scan->intensity.ptr<float>(row);
     cv::Vec3b* color = scan->color.empty() ? nullptr : scan->color.ptr<cv::Vec3b>(row);
     for (int col = 0; col < scan->cols; ++col) {
       if (valid[col]) {
@@ -81,7 +81,7 @@ void FinishScan(Scan* scan, bool fit_grid) {
       } else {
         point[col] = cv::Vec3f(0, 0, 0);
         range[col] = 0;
-        intensity[col] = 0.5f;
+        if (intensity != nullptr) intensity[col] = 0.5f;
         direction[col] = cv::Vec3f(0, 0, 0);
         if (color != nullptr) color[col] = cv::Vec3b(0, 0, 0);
       }

@@ -29,7 +29,7 @@ void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std
 void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place);
 
 // After a reader has filled `valid` and `point`: sets range = |point| and direction = point / range of valid
-// cells, clears invalid cells (point 0, range 0, intensity 0.5, colour 0) and, when `fit_grid`, fits the
+// cells, clears invalid cells (point 0, range 0, intensity 0.5 when present, colour 0) and, when `fit_grid`, fits the
 // angular grid so that every cell gets a direction (FitGrid). A scan without any return keeps zero
 // directions.
 void FinishScan(Scan* scan, bool fit_grid);

@@ -9,8 +9,8 @@
 //               precision at 1 km is 0.06 mm). A point exactly at that origin has no ray and is left out,
 //               as in PLY and PCD.
 //   intensity   intensity / 65535 (the specification normalizes intensity to 16 bits) when some point has a
-//               non-zero intensity; a file whose intensities are all 0 holds none, and the scan keeps the
-//               no-information value 0.5, as readers of files without intensity do
+//               non-zero intensity; a file whose intensities are all 0 holds none (LAS: 0 = not recorded),
+//               and the scan has no intensity channel
 //   color       formats 2, 3, 7, 8: RGB / 257 rounded; files that put 8-bit values in the 16-bit fields (every
 //               value <= 255, a common writer mistake) are taken as 8-bit
 //   label       the classification value (0-31 in formats 0-3, 0-255 in 6-8) when some point's is non-zero
@@ -26,7 +26,7 @@
 //   coordinates scale `coordinate_scale_m` (default 0.1 mm), offset = floor of the minimum per axis, so a
 //               coordinate is within half a step of its double value; an extent that does not fit int32
 //               steps is refused with the step to use instead
-//   intensity   round(clamp(intensity, 0, 1) * 65535)
+//   intensity   round(clamp(intensity, 0, 1) * 65535); 0 (not recorded) for a scan without intensity
 //   colour      R * 257 (255 -> 65535) in formats 2, 3, 7, 8; scans without colour are written black there
 //   class       the label clamped to 0..31 (formats 0-3) or 0..255 (6-8); a larger label becomes the largest
 //               class, a point without a label (kNoLabel) class 0 ("created, never classified"), which

@@ -208,13 +208,14 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
   // 16-bit colour is divided by 257 (65535 -> 255); files with 8-bit values in the 16-bit fields are kept.
   const bool eight_bit_color = max_rgb <= 255;
 
-  Scan scan = MakeScan(1, static_cast<int>(count), rgb);
+  // Intensity is optional in LAS (0 = not recorded): a file whose intensities are all 0 has none.
+  Scan scan = MakeScan(1, static_cast<int>(count), rgb, /*with_intensity=*/any_intensity);
   scan.world_from_scanner.topRightCorner<3, 1>() = origin;
   if (any_label) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
   if (any_synthetic) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
   uint8_t* valid = scan.valid.ptr<uint8_t>(0);
   cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(0);
-  float* intensity = scan.intensity.ptr<float>(0);
+  float* intensity = any_intensity ? scan.intensity.ptr<float>(0) : nullptr;
   for (int64_t i = 0; i < count; ++i) {
     const char* p = record(i);
     const cv::Vec3f relative(static_cast<float>(coordinate(p, 0) - origin.x()),

@@ -178,7 +178,7 @@ TEST(LasTest, ChannelsTheFileDoesNotHoldAreAbsent) {
   const Scan scan = ReadBytes(folder, Build(las));
   EXPECT_TRUE(scan.label.empty());
   EXPECT_TRUE(scan.synthesized.empty());
-  EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 0), 0.5f);  // no intensity: the no-information value
+  EXPECT_FALSE(scan.has_intensity());  // all intensities 0 = not recorded: no channel
   EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 0), cv::Vec3b(200, 0, 0));
   EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 1), cv::Vec3b(7, 0, 0));
 }

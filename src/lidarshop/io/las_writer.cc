@@ -156,7 +156,9 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
           stored_low[axis] = std::min(stored_low[axis], stored);
           stored_high[axis] = std::max(stored_high[axis], stored);
         }
-        const double intensity = std::clamp<double>(scan.intensity.at<float>(row, col), 0.0, 1.0);
+        // A scan without intensity writes 0, LAS's "not recorded", which reads back as no intensity.
+        const double intensity =
+            scan.has_intensity() ? std::clamp<double>(scan.intensity.at<float>(row, col), 0.0, 1.0) : 0.0;
         las::Store<uint16_t>(out + las::point::kIntensity,
                              static_cast<uint16_t>(std::lround(intensity * 65535)));
         int label = 0;

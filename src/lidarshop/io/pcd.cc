@@ -347,7 +347,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
   const int fcurvature = header.Find("curvature");
   const int fsynth = header.Find("synthesized");
   const int ftrue = header.Find("true_range");
-  Scan scan = MakeScan(rows, cols, fcolor >= 0);
+  Scan scan = MakeScan(rows, cols, fcolor >= 0, /*with_intensity=*/fintensity >= 0);
   if (flabel >= 0) scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
   const bool normals = fnx >= 0 && fny >= 0 && fnz >= 0;
   if (normals) scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
@@ -441,7 +441,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
     counts += " 1";
   };
   if (scan.has_color()) add("rgb", "4", "F");
-  add("intensity", "4", "F");
+  if (scan.has_intensity()) add("intensity", "4", "F");
   if (!scan.label.empty()) add("label", "4", "I");
   if (!scan.normal.empty()) {
     add("normal_x", "4", "F");
@@ -478,7 +478,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
         const uint32_t bits = (uint32_t{255} << 24) | (uint32_t{c[0]} << 16) | (uint32_t{c[1]} << 8) | c[2];
         put(std::bit_cast<float>(bits));
       }
-      put(scan.intensity.at<float>(row, col));
+      if (scan.has_intensity()) put(scan.intensity.at<float>(row, col));
       if (!scan.label.empty()) put(static_cast<int32_t>(scan.label.at<int32_t>(row, col)));
       if (!scan.normal.empty()) {
         const cv::Vec3f& n = scan.normal.at<cv::Vec3f>(row, col);

@@ -15,7 +15,8 @@
 // are (pose = VIEWPOINT). Either way the world coordinates are those of the file.
 //
 // Fields read: x y z (required), rgb/rgba (packed 0xAARRGGBB, TYPE F or U), intensity, label, normal_x/y/z,
-// synthesized, true_range; other fields are skipped. NaN (or 0 0 0) coordinates mark a missing return.
+// synthesized, true_range; other fields are skipped. NaN (or 0 0 0) coordinates mark a missing return. A file
+// without an `intensity` field gives a scan without intensity (Scan::intensity empty), not an invented one.
 #pragma once
 
 #include <string>
@@ -27,9 +28,9 @@ namespace lidarshop {
 Scan ReadPcd(const std::string& path);
 Scan ParsePcd(const std::string& bytes, const std::string& file);
 
-// Binary PCD with x y z (world frame; float, or double when the scanner is over 10 km from the origin), rgb
-// (when the scan has colour), intensity, label, normal_x/y/z (world frame), synthesized, true_range; missing
-// returns are NaN; VIEWPOINT identity and the two comments above. Atomic.
+// Binary PCD with x y z (world frame; float, or double when the scanner is over 10 km from the origin), then
+// each channel the scan has: rgb, intensity, label, normal_x/y/z (world frame), curvature, synthesized,
+// true_range; missing returns are NaN; VIEWPOINT identity and the two comments above. Atomic.
 void WritePcd(const std::string& path, const Scan& scan);
 
 }  // namespace lidarshop

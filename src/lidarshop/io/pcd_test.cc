@@ -81,6 +81,28 @@ TEST(PcdTest, CurvatureFieldRoundTrips) {
   EXPECT_GT(known, 1000);
 }
 
+TEST(PcdTest, AFileWithoutIntensityHasNoIntensityChannelAndWritesNone) {
+  // The shared cloud's fields are x y z rgb: no intensity may be invented on reading or writing.
+  TempFolder folder;
+  const Scan scan = ReadPcd(LIDARSHOP_SHARED_DATA_DIR "/rgbd/table_scene_mug_stereo_textured.pcd");
+  EXPECT_FALSE(scan.has_intensity());
+  EXPECT_THAT(ChannelNames(scan), testing::Not(testing::Contains("intensity")));
+  EXPECT_THAT(ChannelNames(scan), testing::Contains("rgb"));
+  WritePcd(folder.File("copy.pcd"), scan);
+  const std::string written = testing_io::ReadText(folder.File("copy.pcd"));
+  const std::string fields = written.substr(
+      written.find("FIELDS"), written.find('\n', written.find("FIELDS")) - written.find("FIELDS"));
+  EXPECT_EQ(fields, "FIELDS x y z rgb");
+  EXPECT_FALSE(ReadPcd(folder.File("copy.pcd")).has_intensity());
+  // A scan with intensity keeps it.
+  Scan with = scan;
+  with.intensity = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0.25));
+  WritePcd(folder.File("with.pcd"), with);
+  const Scan back = ReadPcd(folder.File("with.pcd"));
+  ASSERT_TRUE(back.has_intensity());
+  EXPECT_FLOAT_EQ(back.intensity.at<float>(240, 320), back.valid.at<uint8_t>(240, 320) ? 0.25f : 0.5f);
+}
+
 TEST(PcdTest, ReadsAscii) {
   const std::string text =
       "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 2\n"

@@ -193,7 +193,9 @@ std::string FormatPtx(const std::vector<Scan>& scans) {
         out += ' ';
         AppendNumber(&out, point[2]);
         out += ' ';
-        AppendNumber(&out, scan.intensity.ptr<float>(row)[col]);
+        // PTX has no way to leave the intensity column out: a scan without intensity gets the format's
+        // no-information value 0.5 (convert warns that the PTX holds it; ReadPtx reads it back as intensity).
+        AppendNumber(&out, scan.has_intensity() ? scan.intensity.ptr<float>(row)[col] : 0.5f);
         if (color) {
           const cv::Vec3b& rgb = scan.color.ptr<cv::Vec3b>(row)[col];
           for (int channel = 0; channel < 3; ++channel) {

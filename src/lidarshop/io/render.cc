@@ -4,6 +4,7 @@
 #include <set>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -68,6 +69,15 @@ RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
       metric(scan.range, ColorMap::kViridis, "m", false);
       break;
     case RenderChannel::kIntensity: {
+      if (!scan.has_intensity()) {
+        // Name what there is instead (leaving out range, valid and direction, which every scan has).
+        std::vector<std::string> present;
+        for (const std::string& name : ChannelNames(scan)) {
+          if (name != "range" && name != "valid" && name != "direction") present.push_back(name);
+        }
+        throw InputError(fmt::format("{} has no intensity channel; it has: {}",
+                                     scan.name.empty() ? "the scan" : scan.name, fmt::join(present, ", ")));
+      }
       double low = 0, high = 0;
       cv::minMaxLoc(scan.intensity, &low, &high, nullptr, nullptr, scan.valid);
       // PTX intensities are in [0, 1]; other scales (integer counts) get automatic limits.

@@ -2,7 +2,8 @@
 // column = scan column), RGB 8-bit, ready for WriteImage.
 //
 //   range      metres from the scanner, perceptual colour map (viridis by default) over the 1-99 % quantiles
-//   intensity  return strength, grey (or any map) over [0, 1] unless min/max are given
+//   intensity  return strength, grey (or any map) over [0, 1] unless min/max are given; a scan without
+//              intensity throws InputError "NAME has no intensity channel; it has: xyz, rgb"
 //   rgb        the scan's colour (InputError when the scan has none)
 //   normals    the normal channel (synthetic scans), or normals estimated from the neighbouring points,
 //              shown as (n + 1) / 2 in the scanner frame

@@ -88,5 +88,23 @@ TEST(RenderTest, ValidLabelsNormalsAndMissingChannels) {
   EXPECT_THROW(ParseEnum<RenderChannel>("depthx"), OptionsError);
 }
 
+TEST(RenderTest, IntensityOfAScanWithoutItNamesWhatTheScanHas) {
+  Scan scan = BrightTopScan();
+  scan.intensity = cv::Mat();
+  scan.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(9));
+  scan.name = "cloud.pcd";
+  RenderOptions options;
+  options.channel = RenderChannel::kIntensity;
+  try {
+    RenderScan(scan, options);
+    FAIL() << "rendered an intensity the scan does not have";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "cloud.pcd has no intensity channel; it has: xyz, rgb");
+  }
+  // Every other channel still renders.
+  options.channel = RenderChannel::kRange;
+  EXPECT_EQ(RenderScan(scan, options).image.size(), cv::Size(3, 4));
+}
+
 }  // namespace
 }  // namespace lidarshop

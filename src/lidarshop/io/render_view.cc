@@ -12,6 +12,9 @@
 
 namespace lidarshop {
 
+// Grey of points when the scan has neither colour nor intensity.
+constexpr uint8_t kPlainGrey = 200;
+
 void PointViewOptions::Check() const {
   Validate(*this);
   CheckOption(
@@ -45,9 +48,11 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options) {
       cv::Vec3b color;
       if (scan.has_color()) {
         color = scan.color.at<cv::Vec3b>(y, x);
-      } else {
+      } else if (scan.has_intensity()) {
         const auto grey = cv::saturate_cast<uint8_t>(255.0f * scan.intensity.at<float>(y, x));
         color = cv::Vec3b(grey, grey, grey);
+      } else {
+        color = cv::Vec3b(kPlainGrey, kPlainGrey, kPlainGrey);
       }
       if (options.synthesized_tint > 0 && !scan.synthesized.empty() && scan.synthesized.at<uint8_t>(y, x)) {
         const double t = options.synthesized_tint;

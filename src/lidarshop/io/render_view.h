@@ -24,7 +24,8 @@ struct PointViewOptions {
 template <>
 const StructInfo& InfoOf<PointViewOptions>();
 
-// CV_8UC3 RGB, black background. Points take the scan's colour, or grey intensity when it has none. World z
+// CV_8UC3 RGB, black background. Points take the scan's colour, or grey intensity when it has none, or a plain
+// light grey (200) when it has neither. World z
 // is up in the picture.
 cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 

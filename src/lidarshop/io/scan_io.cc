@@ -34,7 +34,7 @@ constexpr char kScanComment[] = "lidarshop_scan ";
 
 // A 1 x N scan of the cloud's points (identity pose; (0, 0, 0) is no return), without a grid.
 Scan ScanFromPointCloud(const PointCloud& cloud) {
-  Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty());
+  Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty(), !cloud.intensities.empty());
   if (!cloud.labels.empty()) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
   if (!cloud.normals.empty()) scan.normal = cv::Mat(1, scan.cols, CV_32FC3, cv::Scalar::all(0));
   if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
@@ -105,7 +105,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
   std::vector<Scan> scans;
   std::vector<Eigen::Matrix4d> scanner_from_world;
   for (const PlyScanHeader& header : headers) {
-    Scan scan = MakeScan(static_cast<int>(header.rows), static_cast<int>(header.cols), !cloud.colors.empty());
+    Scan scan = MakeScan(static_cast<int>(header.rows), static_cast<int>(header.cols), !cloud.colors.empty(),
+                         !cloud.intensities.empty());
     scan.world_from_scanner = header.world_from_scanner;
     if (!cloud.labels.empty()) scan.label = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
     if (!cloud.normals.empty()) scan.normal = cv::Mat(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
@@ -165,7 +166,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   ply.comments.push_back("frame world");
   int64_t total = 0;
   bool color = false, label = false, normal = false, curvature = false, synthesized = false,
-       true_range = false, far = false;
+       true_range = false, far = false, any_intensity = false;
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
     CheckScan(scan);
@@ -174,6 +175,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     ply.comments.push_back(comment);
     total += scan.CountValid();
     color |= scan.has_color();
+    any_intensity |= scan.has_intensity();
     label |= !scan.label.empty();
     normal |= !scan.normal.empty();
     curvature |= !scan.curvature.empty();
@@ -196,7 +198,9 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
         x.push_back(world.x());
         y.push_back(world.y());
         z.push_back(world.z());
-        intensity.push_back(scan.intensity.at<float>(row, col));
+        // A scan without intensity among scans with it gets the PTX no-information value 0.5.
+        if (any_intensity)
+          intensity.push_back(scan.has_intensity() ? scan.intensity.at<float>(row, col) : 0.5);
         rows.push_back(row);
         cols.push_back(col);
         index.push_back(static_cast<double>(k));
@@ -243,7 +247,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     AddScalarProperty(&vertex, "green", PlyType::kUInt8, std::move(green));
     AddScalarProperty(&vertex, "blue", PlyType::kUInt8, std::move(blue));
   }
-  AddScalarProperty(&vertex, "intensity", PlyType::kFloat32, std::move(intensity));
+  if (any_intensity) AddScalarProperty(&vertex, "intensity", PlyType::kFloat32, std::move(intensity));
   if (label) AddScalarProperty(&vertex, "label", PlyType::kInt32, std::move(labels));
   if (synthesized) AddScalarProperty(&vertex, "synthesized", PlyType::kUInt8, std::move(synth));
   if (true_range) AddScalarProperty(&vertex, "true_range", PlyType::kFloat32, std::move(truth));
@@ -420,8 +424,8 @@ void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& 
   append_optional(cloud.colors, more.colors);
   append_optional(cloud.normals, more.normals);
   append_optional(cloud.labels, more.labels);
+  append_optional(cloud.intensities, more.intensities);
   append(cloud.points, more.points);
-  append(cloud.intensities, more.intensities);
   append(cloud.synthesized, more.synthesized);
   if (cloud.points.empty()) ThrowInputError(path, "", "", "neither layer has a return to write");
   WritePcd(path, ScanFromPointCloud(cloud));

@@ -141,7 +141,7 @@ Scan ParsePointList(const std::string& bytes, const std::string& file, PointList
     high = high.cwiseMax(p);
   }
   const Eigen::Vector3d origin = io_internal::CloudOrigin(low, high);
-  Scan scan = MakeScan(1, count, !list.colors.empty());
+  Scan scan = MakeScan(1, count, !list.colors.empty(), /*with_intensity=*/!list.intensities.empty());
   scan.world_from_scanner.topRightCorner<3, 1>() = origin;
   for (int i = 0; i < count; ++i) {
     const Eigen::Vector3f p = (list.points[i] - origin).cast<float>();
@@ -161,11 +161,12 @@ Scan ReadPointList(const std::string& path, PointListKind kind) {
 
 void WritePointList(const std::string& path, const std::vector<Scan>& scans, PointListKind kind) {
   int64_t count = 0, synthesized = 0;
-  bool color = false;
+  bool color = false, intensity = false;
   for (const Scan& scan : scans) {
     CheckScan(scan);
     count += scan.CountValid();
     color |= scan.has_color();
+    intensity |= scan.has_intensity();
     if (!scan.synthesized.empty()) synthesized += cv::countNonZero(scan.synthesized & scan.valid);
   }
   const char* name = kind == PointListKind::kPts ? "PTS" : "XYZ";
@@ -185,12 +186,16 @@ void WritePointList(const std::string& path, const std::vector<Scan>& scans, Poi
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
         const Eigen::Vector3d world = WorldPointOfCell(scan, row, col);
-        fmt::format_to(sink, "{:.5f} {:.5f} {:.5f} ", world.x(), world.y(), world.z());
-        const float intensity = scan.intensity.at<float>(row, col);
-        if (kind == PointListKind::kPts) {
-          fmt::format_to(sink, "{}", std::lround(std::clamp(intensity, 0.0f, 1.0f) * 4095.0f) - 2048);
-        } else {
-          io_internal::AppendNumber(&out, intensity);
+        fmt::format_to(sink, "{:.5f} {:.5f} {:.5f}", world.x(), world.y(), world.z());
+        if (intensity) {
+          // A scan without intensity among scans with it gets the no-information value 0.5.
+          const float value = scan.has_intensity() ? scan.intensity.at<float>(row, col) : 0.5f;
+          out += ' ';
+          if (kind == PointListKind::kPts) {
+            fmt::format_to(sink, "{}", std::lround(std::clamp(value, 0.0f, 1.0f) * 4095.0f) - 2048);
+          } else {
+            io_internal::AppendNumber(&out, value);
+          }
         }
         if (color) {
           const cv::Vec3b c = scan.has_color() ? scan.color.at<cv::Vec3b>(row, col) : cv::Vec3b(0, 0, 0);

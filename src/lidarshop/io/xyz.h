@@ -12,11 +12,12 @@
 // at that origin has no ray and is left out. Intensity: PTS uses Leica's integer range -2048..2047, read as
 // (i + 2048) / 4095 (a PTS file with values outside that range is read as XYZ); XYZ intensities are kept when all lie in [0, 1], else mapped linearly from
 // [min(0, lowest), max(1, highest)] to [0, 1] (0-255 files become i / 255). Without an intensity column the
-// scan has the no-information intensity 0.5. Colour is 0-255 per channel. Errors name the file, the line and
+// scan has no intensity channel. Colour is 0-255 per channel. Errors name the file, the line and
 // the column.
 //
-// Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm), then the intensity (XYZ:
-// the shortest decimal that reads back to the same float; PTS: round(i * 4095) - 2048) and, when a scan has
+// Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm), then, when a scan has
+// intensity, the intensity (XYZ: the shortest decimal that reads back to the same float; PTS:
+// round(i * 4095) - 2048; 0.5 for a scan without among scans with) and, when a scan has
 // colour, r g b (0 0 0 for a scan without). These formats cannot mark synthesized points, so a scan with any
 // synthesized valid point is refused (write LAS, PLY, PCD or E57). Atomic.
 #pragma once

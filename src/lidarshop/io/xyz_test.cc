@@ -82,7 +82,7 @@ TEST(XyzTest, ColumnsAndIntensityRanges) {
   Scan scan = ReadScanFile(path).scans[0];
   ASSERT_EQ(scan.cols, 2);
   EXPECT_FALSE(scan.has_color());
-  EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 1), 0.5f);  // no intensity column
+  EXPECT_FALSE(scan.has_intensity());  // no intensity column: no channel
   EXPECT_EQ(scan.point.at<cv::Vec3f>(0, 1), cv::Vec3f(4, 5, 6));
 
   WriteText(path, "1 2 3 0 10 20 30\n4 5 6 255 40 50 60\n7 8 9 51 0 0 0\n");  // 0-255 intensities
@@ -95,6 +95,7 @@ TEST(XyzTest, ColumnsAndIntensityRanges) {
   WriteText(path, "1 2 3 10 20 30\n");  // 6 columns: colour, no intensity
   scan = ReadScanFile(path).scans[0];
   EXPECT_EQ(scan.color.at<cv::Vec3b>(0, 0), cv::Vec3b(10, 20, 30));
+  EXPECT_FALSE(scan.has_intensity());
 
   const std::string pts = folder.File("hand.pts");
   WriteText(pts, "2\n1 2 3 -2048\n4 5 6 2047\n1\n7 8 9 0\n");  // two blocks, Leica's intensity range

@@ -24,10 +24,15 @@ cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int*
     cv::Mat color;
     scan.color.convertTo(color, CV_32FC3);
     cv::split(color, channels);
-  } else {
+  } else if (scan.has_intensity()) {
     cv::Mat intensity;
     scan.intensity.convertTo(intensity, CV_32F, 255.0);
     channels.push_back(intensity);
+  }  // neither: the range alone
+  if (channels.empty() && !(options.range_weight > 0.0 && scan.CountValid() > 0)) {
+    throw InputError(
+        "superpixels: the scan has neither colour nor intensity, and the range is not used (range_weight 0 "
+        "or no return): nothing to group by");
   }
   if (options.range_weight > 0.0 && scan.CountValid() > 0) {
     cv::Mat log_range;

@@ -1,6 +1,7 @@
 // Superpixels on the scan image (OpenCV ximgproc): SLIC (Achanta et al. 2012) and graph-based segmentation
 // (Felzenszwalb and Huttenlocher 2004) over an image of the scan: colour when the scan has one, else
-// intensity, with the range (log, so near and far weigh alike) as an extra channel — and QuickShift (Vedaldi
+// intensity when it has that, with the range (log, so near and far weigh alike) as an extra channel (the only
+// one for a scan with neither; InputError when range_weight is then 0) — and QuickShift (Vedaldi
 // and Soatto 2008, pointset/quickshift.h, written here: no library in Debian has it) over the same channels
 // scaled by `quickshift_ratio`, cells without a return left out.
 #pragma once

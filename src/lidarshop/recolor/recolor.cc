@@ -108,7 +108,9 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
   RecolorResult result;
   result.scan = Clone(scan);
   Scan& out = result.scan;
-  if (!out.has_color()) {
+  if (!out.has_color() && !out.has_intensity()) {
+    out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));  // black where not recoloured
+  } else if (!out.has_color()) {
     out.color.create(scan.rows, scan.cols, CV_8UC3);
     for (int r = 0; r < scan.rows; ++r) {
       for (int c = 0; c < scan.cols; ++c) {

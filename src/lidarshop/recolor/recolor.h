@@ -56,7 +56,7 @@ const StructInfo& InfoOf<RecolorOptions>();
 
 struct RecolorResult {
   Scan scan;  // a clone of the input with `color` replaced where recolored (created, grey from intensity,
-              // when the input had no colour)
+              // or black without intensity, when the input had no colour)
   cv::Mat recolored;            // CV_8U rows x cols: 255 = the point took the photo's colour
   int64_t returns = 0;          // valid cells
   int64_t recolored_count = 0;  // valid cells that took the photo's colour

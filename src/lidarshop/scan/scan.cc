@@ -37,7 +37,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   masked.valid.setTo(0, drop);
   masked.range.setTo(0, drop);
   masked.point.setTo(cv::Scalar::all(0), drop);
-  masked.intensity.setTo(0.5, drop);
+  if (!masked.intensity.empty()) masked.intensity.setTo(0.5, drop);
   if (!masked.color.empty()) masked.color.setTo(cv::Scalar::all(0), drop);
   if (!masked.label.empty()) masked.label.setTo(kNoLabel, drop);
   if (!masked.normal.empty()) masked.normal.setTo(cv::Scalar::all(0), drop);
@@ -47,7 +47,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   return masked;
 }
 
-Scan MakeScan(int rows, int cols, bool with_color) {
+Scan MakeScan(int rows, int cols, bool with_color, bool with_intensity) {
   if (rows < 0 || cols < 0) throw std::logic_error("MakeScan: negative size");
   Scan scan;
   scan.rows = rows;
@@ -56,7 +56,7 @@ Scan MakeScan(int rows, int cols, bool with_color) {
   scan.valid = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   scan.range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
   scan.point = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
-  scan.intensity = cv::Mat(rows, cols, CV_32F, cv::Scalar(0.5));
+  if (with_intensity) scan.intensity = cv::Mat(rows, cols, CV_32F, cv::Scalar(0.5));
   if (with_color) scan.color = cv::Mat(rows, cols, CV_8UC3, cv::Scalar::all(0));
   return scan;
 }
@@ -77,7 +77,7 @@ void CheckScan(const Scan& scan) {
   check(scan.valid, CV_8U, "valid", true);
   check(scan.range, CV_32F, "range", true);
   check(scan.point, CV_32FC3, "point", true);
-  check(scan.intensity, CV_32F, "intensity", true);
+  check(scan.intensity, CV_32F, "intensity", false);
   check(scan.color, CV_8UC3, "color", false);
   check(scan.label, CV_32S, "label", false);
   check(scan.normal, CV_32FC3, "normal", false);
@@ -87,7 +87,10 @@ void CheckScan(const Scan& scan) {
 }
 
 std::vector<std::string> ChannelNames(const Scan& scan) {
-  std::vector<std::string> names = {"xyz", "range", "intensity", "valid", "direction"};
+  std::vector<std::string> names = {"xyz", "range"};
+  if (!scan.intensity.empty()) names.push_back("intensity");
+  names.push_back("valid");
+  names.push_back("direction");
   if (!scan.color.empty()) names.push_back("rgb");
   if (!scan.label.empty()) names.push_back("label");
   if (!scan.normal.empty()) names.push_back("normal");
@@ -144,7 +147,7 @@ PointCloud ToPointCloud(const Scan& scan, bool world, std::vector<int64_t>* cell
       Eigen::Vector3f point(p[0], p[1], p[2]);
       if (world) point = rotation * point + translation;
       cloud.points.push_back(point);
-      cloud.intensities.push_back(scan.intensity.at<float>(row, col));
+      if (!scan.intensity.empty()) cloud.intensities.push_back(scan.intensity.at<float>(row, col));
       if (!scan.color.empty()) {
         const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
         cloud.colors.emplace_back(c[0], c[1], c[2]);
@@ -184,7 +187,7 @@ cv::Mat RgbdImage(const Scan& scan) {
       if (!scan.color.empty()) {
         const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
         out = cv::Vec4f(c[0] / 255.f, c[1] / 255.f, c[2] / 255.f, 0.f);
-      } else {
+      } else if (!scan.intensity.empty()) {
         const float gray = scan.intensity.at<float>(row, col);
         out = cv::Vec4f(gray, gray, gray, 0.f);
       }
@@ -219,7 +222,7 @@ Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synth
   result.valid = scan.valid.clone();
   result.range = range.clone();
   result.point = scan.point.clone();
-  result.intensity = scan.intensity.clone();
+  result.intensity = scan.intensity.clone();  // empty stays empty
   if (!mark_synthesized.empty() && result.synthesized.empty()) {
     result.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
   } else if (!result.synthesized.empty()) {

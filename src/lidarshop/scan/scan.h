@@ -13,9 +13,10 @@
 //   valid       CV_8U     255 = the ray returned, 0 = no return
 //   range       CV_32F    metres from the scanner origin to the point; 0 where invalid
 //   point       CV_32FC3  x y z in the scanner frame, metres; 0 where invalid
-//   intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid
+// Optional channels (empty when absent: a channel the file does not hold is never invented):
+//   intensity   CV_32F    return strength in [0, 1] (PTX convention); 0.5 where invalid; empty when the source
+//                         holds no intensity (a PCD without an `intensity` field, an E57 without intensity)
 //   color       CV_8UC3   R G B (RGB order, not OpenCV's BGR); empty when the scan has no colour
-// Optional channels (empty when absent):
 //   label       CV_32S    object label (synthetic scans); kNoLabel where invalid
 //   normal      CV_32FC3  unit surface normal in the scanner frame (true normals of synthetic scans)
 //   curvature   CV_32F    surface variation λ0 / (λ0 + λ1 + λ2) in [0, 1/3] of the neighbourhood the normal
@@ -84,6 +85,7 @@ struct Scan {
   ScanGrid grid;  // empty vectors when the scan has no known grid
 
   bool has_color() const { return !color.empty(); }
+  bool has_intensity() const { return !intensity.empty(); }
   int64_t num_cells() const { return static_cast<int64_t>(rows) * cols; }
   int64_t CountValid() const;
 };
@@ -99,13 +101,15 @@ Scan Clone(const Scan& scan);
 // wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);
 
-// A scan with every required channel allocated (no returns, directions zero, intensity 0.5), no optional one.
-Scan MakeScan(int rows, int cols, bool with_color = false);
+// A scan with every required channel allocated (no returns, directions zero), intensity (0.5 everywhere) unless
+// `with_intensity` is false, colour (0) when `with_color`, no other optional channel.
+Scan MakeScan(int rows, int cols, bool with_color = false, bool with_intensity = true);
 
 // Throws std::logic_error when a channel has the wrong size or type (programming error, not input error).
 void CheckScan(const Scan& scan);
 
-// Names of the channels present, e.g. {"xyz", "intensity", "rgb", "label"}.
+// Names of the channels present, e.g. {"xyz", "range", "intensity", "valid", "direction", "rgb", "label"};
+// "intensity" only when the scan has it.
 std::vector<std::string> ChannelNames(const Scan& scan);
 
 // Directions for every cell from a regular grid (azimuth per column, elevation per image row).
@@ -137,7 +141,8 @@ PointCloud ToPointCloud(const Scan& scan, bool world = false, std::vector<int64_
 // Image views. All CV_32F unless stated; invalid cells are 0 (range) or NaN where said.
 cv::Mat RangeImage(const Scan& scan);  // CV_32F metres
 cv::Mat DepthImage(const Scan& scan);  // CV_32F, y in the scanner frame (forward distance)
-cv::Mat RgbdImage(const Scan& scan);   // CV_32FC4: R, G, B in [0,1], range in metres
+cv::Mat RgbdImage(const Scan& scan);   // CV_32FC4: R, G, B in [0,1] (grey intensity without colour, 0
+                                       // without either), range in metres
 cv::Mat ValidMask(const Scan& scan);   // CV_8U 255/0 (a copy of scan.valid)
 
 // The label image of the file convention (`--labels L.png`): CV_16U, pixel = the object's label,

@@ -48,6 +48,35 @@ TEST(ScanTest, WithRangeKeepsRaysAndMarksSynthesized) {
   EXPECT_EQ(scan.CountValid(), 1);  // the input is untouched
 }
 
+TEST(ScanTest, IntensityIsAnOptionalChannel) {
+  Scan scan = MakeScan(2, 3, /*with_color=*/false, /*with_intensity=*/false);
+  EXPECT_FALSE(scan.has_intensity());
+  EXPECT_NO_THROW(CheckScan(scan));
+  EXPECT_EQ(ChannelNames(scan), (std::vector<std::string>{"xyz", "range", "valid", "direction"}));
+  scan.valid.at<uint8_t>(0, 1) = kValid;
+  scan.point.at<cv::Vec3f>(0, 1) = cv::Vec3f(0, 2, 0);
+  scan.range.at<float>(0, 1) = 2;
+  const PointCloud cloud = ToPointCloud(scan);
+  ASSERT_EQ(cloud.size(), 1u);
+  EXPECT_TRUE(cloud.intensities.empty());  // not invented
+  EXPECT_EQ(RgbdImage(scan).at<cv::Vec4f>(0, 1), cv::Vec4f(0, 0, 0, 2));
+  const Scan masked = MaskScan(scan, cv::Mat(2, 3, CV_8U, cv::Scalar(0)));
+  EXPECT_FALSE(masked.has_intensity());
+  EXPECT_EQ(masked.CountValid(), 0);
+  EXPECT_FALSE(Clone(scan).has_intensity());
+  EXPECT_FALSE(WithRange(scan, scan.range).has_intensity());
+  // The default keeps the intensity channel (0.5, the no-information value) for scanners that measure it.
+  const Scan with = MakeScan(2, 3);
+  ASSERT_TRUE(with.has_intensity());
+  EXPECT_EQ(with.intensity.at<float>(1, 2), 0.5f);
+  EXPECT_EQ(ChannelNames(with),
+            (std::vector<std::string>{"xyz", "range", "intensity", "valid", "direction"}));
+  // A wrongly typed intensity is still a programming error.
+  Scan bad = with;
+  bad.intensity = cv::Mat(2, 3, CV_8U, cv::Scalar(0));
+  EXPECT_THROW(CheckScan(bad), std::logic_error);
+}
+
 TEST(ScanTest, MaskScanClearsDroppedCellsAndKeepsDirections) {
   Scan scan = MakeScan(2, 2, /*with_color=*/true);
   scan.direction = DirectionsFromGrid(UniformGrid(2, 2, -0.1, 0.1, -0.1, 0.1));

@@ -25,8 +25,8 @@ std::string SegmentResult::Summary() const {
 namespace {
 cv::Mat ColorPicture(const Scan& scan) {
   if (scan.has_color()) return scan.color.clone();
-  cv::Mat grey;
-  scan.intensity.convertTo(grey, CV_8U, 255.0);
+  cv::Mat grey(scan.rows, scan.cols, CV_8U, cv::Scalar(128));  // neither colour nor intensity: plain grey
+  if (scan.has_intensity()) scan.intensity.convertTo(grey, CV_8U, 255.0);
   cv::Mat rgb;
   cv::cvtColor(grey, rgb, cv::COLOR_GRAY2RGB);
   return rgb;

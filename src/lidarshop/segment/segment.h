@@ -1,7 +1,8 @@
 // Cutting an object out of a scan from a few strokes: graph cuts on the RGB+D image (two-step RGB + depth).
 //
 // The scan is treated as an RGB+D image (scan/scan.h RgbdImage: R, G, B in [0, 1] and range in metres; scans
-// without colour use the intensity as grey). Every valid cell is a node of a grid graph; cells without a
+// without colour use the intensity as grey; scans with neither have constant R, G, B, so only the depth
+// separates). Every valid cell is a node of a grid graph; cells without a
 // return are NOT nodes (they are never "depth 0"): they have no n-links, are never part of the object and
 // split the grid where they lie. The minimum cut comes from the Boykov–Kolmogorov max-flow (Debian
 // libmaxflow, the reference implementation).
@@ -25,6 +26,8 @@
 //      `ring_depth_threshold_m` (+ a fraction of the range), so cells at the ground contact stay undecided;
 //   3. colour-dominant cut seeded with the step-1 object (hard object) and the inferred background + the
 //      user's background strokes (hard background); models re-learnt from those seeds.
+// A scan with neither colour nor intensity (a PCD or E57 of bare points) stops after step 2: the mask is step
+// 1's depth cut; kColor then throws InputError (it needs colour or intensity).
 // Baselines (single cut, the same machinery): kDepth (step 1's weights alone), kColor (step 3's weights from
 // the strokes alone) and kRgbd (standardized λ = 1/3, 1/3, 1/3, 1).
 //
@@ -236,7 +239,7 @@ double RayAngleAt(const Scan& scan, const cv::Mat& cells);
 // outside the mask (4-connected). CV_8U 255/0.
 cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
 
-// The overlay picture: the scan's colour (or intensity as grey), object cells tinted and outlined in the
+// The overlay picture: the scan's colour (or intensity as grey, or plain grey 128), object cells tinted and outlined in the
 // colour of ContrastingOverlayColor (yellow on most outdoor scenes, another on yellowish ones), object strokes
 // green and background strokes red, both widened to OverlayStrokeRadius and rimmed in black. CV_8UC3 RGB.
 cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes);

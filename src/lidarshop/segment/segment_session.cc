@@ -25,6 +25,8 @@ struct SegmentSession::Impl {
   SegmentOptions given;    // as the caller gave them
   SegmentOptions options;  // in force: `given` with the metric lengths scaled to the data at Run()
   Nodes nodes;
+  // Colour or intensity to tell the object by; without either the colour terms are constant.
+  bool has_appearance = false;
   double features_s = 0;
   // n-link weights, computed once per step kind when first needed.
   std::unique_ptr<NLinks> depth_links, color_links, rgbd_links;
@@ -182,6 +184,7 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
   impl_->scan = scan;
   impl_->given = impl_->options = options;
   impl_->nodes = MakeNodes(scan);
+  impl_->has_appearance = scan.has_color() || scan.has_intensity();
   impl_->features_s = timer.Seconds();
 }
 
@@ -231,6 +234,11 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
           s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
       break;
     case SegmentMethod::kColor:
+      if (!s.has_appearance) {
+        throw InputError(
+            "segment: the color method needs colour or intensity, and the scan has neither; use the depth or "
+            "two-step method");
+      }
       result.mask =
           s.RunCut(o.color_step, s.Links(o.color_step, &s.color_links, &result.timings), hard, &result);
       break;
@@ -244,6 +252,12 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
           s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
       // Step 2: background inference on the ring around it.
       result.inferred_background = s.InferBackground(result.step1_mask);
+      if (!s.has_appearance) {
+        // Neither colour nor intensity: step 3 would have nothing to tell the object by and floods the
+        // ring. The depth cut is the answer.
+        result.mask = result.step1_mask.clone();
+        break;
+      }
       // Step 3: colour-dominant cut seeded with step 1's object and the inferred + stroked background.
       std::vector<uint8_t> seeds = hard;
       const uint8_t* step1 = result.step1_mask.ptr<uint8_t>();

@@ -305,6 +305,29 @@ TEST(SegmentTest, ScoreMaskCounts) {
   EXPECT_DOUBLE_EQ(s.precision, 0.5);
 }
 
+TEST(SegmentTest, AScanWithoutColourOrIntensityIsCutByDepth) {
+  // A PCD or E57 that holds only points: the colour terms are constant, the depth still separates the box.
+  Scan scan = MakeBoxOnGround(160, 200, cv::Vec3b(118, 138, 112), 3);
+  scan.color = cv::Mat();
+  scan.intensity = cv::Mat();
+  const cv::Mat strokes = MakeStrokes(scan);
+  const SegmentResult result = SegmentObject(scan, strokes, SegmentOptions());
+  const MaskScores step1 = ScoreMask(result.step1_mask, TruthMask(scan), scan.valid);
+  const MaskScores final_scores = ScoreMask(result.mask, TruthMask(scan), scan.valid);
+  EXPECT_GE(step1.precision, 0.99);
+  // Step 3 has nothing to go by: the depth cut is the answer (not a flood of the ring).
+  EXPECT_EQ(cv::norm(result.mask, result.step1_mask, cv::NORM_INF), 0.0);
+  EXPECT_GE(final_scores.precision, 0.99);
+  EXPECT_GT(final_scores.iou, 0.5) << "recall " << final_scores.recall;
+  SegmentOptions color;
+  color.method = SegmentMethod::kColor;
+  EXPECT_THROW(SegmentObject(scan, strokes, color), InputError);
+  // The baseline and the overlay run too (plain grey under the tint).
+  EXPECT_EQ(GrabCutFromStrokes(scan, strokes, 2).type(), CV_8U);
+  const cv::Mat overlay = SegmentOverlay(scan, result.mask, strokes);
+  EXPECT_EQ(overlay.size(), cv::Size(scan.cols, scan.rows));
+}
+
 TEST(SegmentTest, GrabCutBaselineAndOverlayRun) {
   const Scan scan = MakeBoxOnGround(80, 100, cv::Vec3b(40, 60, 200), 8);
   const cv::Mat strokes = MakeStrokes(scan);

@@ -80,6 +80,25 @@ def test_new_scan():
     assert scan.range.shape == (4, 5) and scan.color.shape == (4, 5, 3) and scan.count_valid() == 0
 
 
+def test_intensity_is_none_when_the_file_has_none(tmp_path):
+    path = tmp_path / "plain.pcd"
+    path.write_text("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\n"
+                    "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\nDATA ascii\n1 2 3\n2 3 4\n")
+    scan = lidarshop.read_scan(str(path))
+    assert scan.intensity is None and not scan.has_intensity
+    assert "intensity" not in scan.channel_names()
+    assert scan.count_valid() == 2
+    lidarshop.write_scan(scan, str(tmp_path / "copy.ply"))
+    assert lidarshop.read_scan(str(tmp_path / "copy.ply")).intensity is None
+    # Setting an intensity adds the channel; None removes it again.
+    scan.intensity = np.full((scan.rows, scan.cols), 0.25)
+    assert scan.has_intensity and scan.intensity.dtype == np.float32
+    scan.intensity = None
+    assert scan.intensity is None
+    assert lidarshop.Scan(2, 3, with_intensity=False).intensity is None
+    assert lidarshop.Scan(2, 3).intensity.shape == (2, 3)
+
+
 @pytest.mark.parametrize("extension", ["ptx", "e57", "pcd", "ply"])
 def test_write_read_round_trip(scan, tmp_path, extension):
     path = tmp_path / f"box.{extension}"

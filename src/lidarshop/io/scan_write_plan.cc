@@ -1,0 +1,142 @@
+#include "lidarshop/io/scan_write_plan.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+// The name of a channel in the target format: nullptr = not held, "" = the same name, else the target's name.
+struct FormatHolds {
+  const char* extension;
+  const char* name;
+  bool grid;  // rows x cols and the scanner pose
+  bool intensity_required;
+  const char* intensity;
+  const char* color;
+  const char* label;
+  const char* normal;
+  const char* true_range;
+  const char* synthesized;
+  bool images;
+};
+
+// The table of the header; keep it in step with the writers.
+const FormatHolds kFormats[] = {
+    {"ptx", "PTX", true, true, "", "", nullptr, nullptr, nullptr, nullptr, false},
+    {"e57", "E57", true, false, "", "", nullptr, nullptr, nullptr, "lidarshop:synthesized", true},
+    {"ply", "PLY", true, false, "", "", "", "", "", "", false},
+    {"pcd", "PCD", true, false, "", "", "", "", "", "", false},
+    {"las", "LAS", false, false, "", "", "classification", nullptr, nullptr, "synthetic", false},
+    {"xyz", "XYZ", false, false, "", "", nullptr, nullptr, nullptr, nullptr, false},
+    {"pts", "PTS", false, false, "", "", nullptr, nullptr, nullptr, nullptr, false},
+};
+
+const FormatHolds& HoldsFor(const std::string& path) {
+  CheckScanFileFormat(path);  // the reader's own message for unknown or refused extensions
+  const std::string extension = FileExtension(path);
+  for (const FormatHolds& holds : kFormats) {
+    if (extension == holds.extension) return holds;
+  }
+  ThrowInputError(path, "", "", fmt::format("lidarshop does not write '.{}' scans", extension));
+}
+
+}  // namespace
+
+ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& scans, size_t images,
+                            size_t scans_with_second_returns) {
+  const FormatHolds& holds = HoldsFor(path);
+  auto any = [&](auto has) { return std::any_of(scans.begin(), scans.end(), has); };
+  ScanWritePlan plan;
+  plan.channels.push_back("xyz");
+
+  if (!holds.grid) {
+    const auto organized =
+        std::find_if(scans.begin(), scans.end(), [](const Scan& scan) { return scan.rows > 1; });
+    if (organized != scans.end()) {
+      plan.dropped.push_back(fmt::format(
+          "{}: the grid ({} rows x {} columns) and the scanner pose are not kept: {} holds an unorganized "
+          "cloud of points in the world frame",
+          path, organized->rows, organized->cols, holds.name));
+    }
+  }
+
+  const bool has_intensity = any([](const Scan& s) { return s.has_intensity(); });
+  if (has_intensity) {
+    plan.channels.push_back("intensity");
+  } else if (holds.intensity_required && !scans.empty()) {
+    plan.channels.push_back("intensity=0.5");
+    plan.dropped.push_back(fmt::format(
+        "{}: the input has no intensity, but {} requires an intensity column: written as 0.5, the format's "
+        "no-information value",
+        path, holds.name));
+  }
+
+  // The optional channels: written (under the target's name) or dropped with a sentence.
+  struct Optional {
+    bool present;
+    const char* channel;  // our name
+    const char* plural;   // in the sentence
+    const char* target;   // FormatHolds entry
+  };
+  const Optional optional[] = {
+      {any([](const Scan& s) { return s.has_color(); }), "rgb", "colours", holds.color},
+      {any([](const Scan& s) { return !s.label.empty(); }), "label", "labels", holds.label},
+      {any([](const Scan& s) { return !s.normal.empty(); }), "normal", "normals", holds.normal},
+      {any([](const Scan& s) { return !s.true_range.empty(); }), "true_range", "true ranges",
+       holds.true_range},
+      {any([](const Scan& s) { return !s.synthesized.empty(); }), "synthesized", "synthesized flags",
+       holds.synthesized},
+  };
+  for (const Optional& channel : optional) {
+    if (!channel.present) continue;
+    if (channel.target == nullptr) {
+      plan.dropped.push_back(fmt::format("{}: {} are not written ({} has no {} field)", path, channel.plural,
+                                         holds.name, channel.channel));
+    } else if (channel.target[0] == '\0') {
+      plan.channels.push_back(channel.channel);
+    } else {
+      plan.channels.push_back(fmt::format("{}→{}", channel.channel, channel.target));
+    }
+  }
+
+  if (images > 0 && !holds.images) {
+    plan.dropped.push_back(fmt::format("{}: {} image{} (E57 images2D) not written: {} holds no photos", path,
+                                       images, images == 1 ? "" : "s", holds.name));
+  }
+  if (scans_with_second_returns > 0) {
+    plan.dropped.push_back(
+        fmt::format("{}: the second returns of {} scan{} are not written (only first returns are converted)",
+                    path, scans_with_second_returns, scans_with_second_returns == 1 ? "" : "s"));
+  }
+  return plan;
+}
+
+std::string WithThousandsSeparators(int64_t value) {
+  const std::string digits = std::to_string(value < 0 ? -value : value);
+  std::string out;
+  for (size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out += ',';
+    out += digits[i];
+  }
+  return value < 0 ? "-" + out : out;
+}
+
+std::string WrittenSummary(const std::string& path, const std::vector<Scan>& scans, size_t images_written,
+                           const ScanWritePlan& plan) {
+  int64_t points = 0;
+  for (const Scan& scan : scans) points += scan.CountValid();
+  std::string images;
+  if (images_written > 0)
+    images = fmt::format(", {} image{}", images_written, images_written == 1 ? "" : "s");
+  return fmt::format("wrote {}: {} scan{}, {} point{}{}, channels {}", path, scans.size(),
+                     scans.size() == 1 ? "" : "s", WithThousandsSeparators(points), points == 1 ? "" : "s",
+                     images, fmt::join(plan.channels, " "));
+}
+
+}  // namespace lidarshop

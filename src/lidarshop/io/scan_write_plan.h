@@ -1,0 +1,47 @@
+// What writing scans to a file keeps and what it drops, by the target format (the extension): what `convert`
+// says before and after it writes, so that nothing is lost silently.
+//
+// What each writer holds (see the format headers):
+//   format     grid  scans    pose  intensity  colour  label           normal  true_range  synthesized   photos
+//   .ptx       yes   several  yes   required*  yes     -               -       -           -             -
+//   .e57       yes   several  yes   yes        yes     -               -       -           extension     yes
+//   .ply       yes   several  yes   yes        yes     yes             yes     yes         yes           -
+//   .pcd       yes   one      yes   yes        yes     yes             yes     yes         yes           -
+//   .las       -     merged   -     yes        yes     classification  -       -           synthetic     -
+//   .xyz .pts  -     merged   -     yes        yes     -               -       -           refused       -
+// * PTX has no way to leave the intensity column out: a scan without intensity is written with the PTX
+//   no-information value 0.5, and the plan says so. Second returns (E57 returnIndex 1) are kept only by
+//   WriteE57 of a whole E57File; a caller that writes them that way passes 0 scans with second returns.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+struct ScanWritePlan {
+  // The channels written, in the target's words where it renames them: {"xyz", "intensity", "rgb",
+  // "label→classification"}.
+  std::vector<std::string> channels;
+  // What the target cannot hold (or holds only by convention), one sentence each starting with the output
+  // path, e.g. "out.ptx: labels are not written (PTX has no label field)".
+  std::vector<std::string> dropped;
+};
+
+// The plan for writing `scans` to `path` (its extension decides; InputError for an unknown one), with
+// `images` photos (E57 images2D) and `scans_with_second_returns` scans that have second returns in the input.
+ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& scans, size_t images,
+                            size_t scans_with_second_returns);
+
+// One line of what was written: "wrote out.las: 1 scan, 1,234,567 points, channels xyz intensity rgb
+// label→classification" (plus ", 2 images" when `images_written` > 0).
+std::string WrittenSummary(const std::string& path, const std::vector<Scan>& scans, size_t images_written,
+                           const ScanWritePlan& plan);
+
+// 1234567 -> "1,234,567".
+std::string WithThousandsSeparators(int64_t value);
+
+}  // namespace lidarshop
