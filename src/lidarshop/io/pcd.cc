@@ -10,10 +10,12 @@
 #include <Eigen/Geometry>
 
 #include "lidarshop/io/io_common.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
@@ -212,6 +214,18 @@ uint32_t PackedColor(const char* p, const PcdField& field) {
   return bits;
 }
 
+// The scan's pose: VIEWPOINT, turned from the optical frame for an organized cloud.
+Eigen::Matrix4d WorldFromScanner(const PcdHeader& header, const std::string& file) {
+  const double* v = header.viewpoint;
+  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
+  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
+  if (rotation.norm() < 1e-9)
+    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
+  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
+  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return header.height > 1 ? Eigen::Matrix4d(viewpoint * CameraFromScanner()) : viewpoint;
+}
+
 }  // namespace
 
 Scan ParsePcd(const std::string& bytes, const std::string& file) {
@@ -368,19 +382,38 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       if (ftrue >= 0) scan.true_range.at<float>(row, col) = LoadValue(record + f[ftrue].offset, f[ftrue]);
     }
   }
-  const double* v = header.viewpoint;
-  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
-  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
-  if (rotation.norm() < 1e-9)
-    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
-  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
-  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
-  scan.world_from_scanner = organized ? Eigen::Matrix4d(viewpoint * CameraFromScanner()) : viewpoint;
+  scan.world_from_scanner = WorldFromScanner(header, file);
   io_internal::FinishScan(&scan, /*fit_grid=*/organized);
   return scan;
 }
 
 Scan ReadPcd(const std::string& path) { return ParsePcd(io_internal::ReadFileToString(path), path); }
+
+ScanFileHeader io_internal::ReadPcdHeader(const std::string& path) {
+  const int64_t file_bytes = CheckRegularFile(path);
+  if (file_bytes == 0) ThrowInputError(path, "byte 0", "", "the file is empty");
+  // ParseHeader refuses a header longer than 64 KiB: a little more holds any header it accepts.
+  const PcdHeader header = ParseHeader(io_internal::ReadFilePrefix(path, (1 << 16) + 4096), path);
+  ScanFileHeader file;
+  file.format_version = "PCD DATA " + header.data;
+  ScanHeader scan;
+  scan.organized = header.height > 1;
+  scan.rows = header.height;
+  scan.cols = header.width;
+  scan.points = header.points;
+  scan.world_from_scanner = WorldFromScanner(header, path);
+  scan.channels = {"xyz", "range"};
+  if (header.Find("intensity") >= 0) scan.channels.push_back("intensity");
+  scan.channels.insert(scan.channels.end(), {"valid", "direction"});
+  if (header.Find("rgba") >= 0 || header.Find("rgb") >= 0) scan.channels.push_back("rgb");
+  if (header.Find("label") >= 0) scan.channels.push_back("label");
+  if (header.Find("normal_x") >= 0 && header.Find("normal_y") >= 0 && header.Find("normal_z") >= 0)
+    scan.channels.push_back("normal");
+  if (header.Find("true_range") >= 0) scan.channels.push_back("true_range");
+  if (header.Find("synthesized") >= 0) scan.channels.push_back("synthesized");
+  file.scans.push_back(scan);
+  return file;
+}
 
 void WritePcd(const std::string& path, const Scan& scan) {
   CheckScan(scan);
