@@ -100,15 +100,34 @@ nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
   return json;
 }
 
-// Every floating-point number of `json` to 12 significant digits, and |x| < 1e-12 to 0: 1.5 instead of
-// 1.5000000000000002, 0 instead of 6.1e-17, while UTM coordinates keep 10 micrometres.
-void RoundNumbers(nlohmann::ordered_json* json) {
+// Numbers as people read them, by what they are (the key that holds them): statistics of float32 points and
+// angles in degrees to 1e-6 (micrometres, microdegrees), residuals in radians to 6 significant digits,
+// everything else to 12 significant digits and |x| < 1e-12 to 0 (1.5, not 1.5000000000000002; UTM
+// coordinates keep 10 micrometres).
+double Significant(double value, int digits) {
+  return std::abs(value) < 1e-12 ? 0.0 : std::stod(fmt::format("{:.{}g}", value, digits));
+}
+
+void RoundNumbers(nlohmann::ordered_json* json, const std::string& key = "") {
+  auto ends_with = [&](const char* suffix) {
+    const std::string s(suffix);
+    return key.size() >= s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0;
+  };
   if (json->is_number_float()) {
     const double value = json->get<double>();
-    if (std::isfinite(value))
-      *json = std::abs(value) < 1e-12 ? 0.0 : std::stod(fmt::format("{:.12g}", value));
-  } else if (json->is_structured()) {
-    for (auto& child : *json) RoundNumbers(&child);
+    if (!std::isfinite(value)) return;
+    if (ends_with("_rad")) {
+      *json = Significant(value, 6);
+    } else if (key == "min" || key == "max" || key == "mean" || ends_with("_deg")) {
+      const double rounded = std::round(value * 1e6) / 1e6;
+      *json = rounded == 0.0 ? 0.0 : rounded;
+    } else {
+      *json = Significant(value, 12);
+    }
+  } else if (json->is_object()) {
+    for (auto it = json->begin(); it != json->end(); ++it) RoundNumbers(&it.value(), it.key());
+  } else if (json->is_array()) {
+    for (auto& child : *json) RoundNumbers(&child, key);
   }
 }
 
