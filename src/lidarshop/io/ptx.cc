@@ -189,6 +189,16 @@ std::vector<ScanHeader> io_internal::ReadPtxHeaders(const std::string& path) {
     ~Unmap() { ::munmap(data, size); }
   } unmap{mapped, static_cast<size_t>(size)};
   ::madvise(mapped, static_cast<size_t>(size), MADV_SEQUENTIAL);
+  // Pages already skipped leave the process (they stay in the page cache): the memory stays flat.
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  uintptr_t dropped = reinterpret_cast<uintptr_t>(mapped);
+  auto drop_behind = [&](const char* position) {
+    const uintptr_t until = reinterpret_cast<uintptr_t>(position) / page * page;
+    if (until > dropped) {
+      ::madvise(reinterpret_cast<void*>(dropped), until - dropped, MADV_DONTNEED);
+      dropped = until;
+    }
+  };
   TextCursor cursor(std::string_view(static_cast<const char*>(mapped), static_cast<size_t>(size)), path);
   std::vector<ScanHeader> scans;
   cursor.SkipEmptyLines();
@@ -210,6 +220,7 @@ std::vector<ScanHeader> io_internal::ReadPtxHeaders(const std::string& path) {
     if (fields == 7) scan.channels.push_back("rgb");
     const int64_t total = head.rows * head.cols;
     for (int64_t done = 0; done < total; ++done) {
+      if ((done & 0xFFFFF) == 0) drop_behind(cursor.position());
       cursor.SkipEmptyLines();
       if (cursor.AtEnd()) {
         cursor.Fail("",
