@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every reader with libFuzzer + AddressSanitizer + UBSan (clang 14 from scripts/setup.sh):
 #   scripts/fuzz.sh [SECONDS_PER_READER=300] [READER...]     readers: ptx ply pcd las xyz pts e57 obj scene strokes
-#   mask pose
+#   mask pose header
 # Configures build/fuzz (the whole library instrumented, LIDARSHOP_BUILD_FUZZ=ON), replays the regression
 # inputs of data/fuzz_regressions/<reader>_*, seeds each target with the repository's files of its format
 # (tests/hostile/corpus, data/, the shared E57 files) and runs it for the given time. Prints one line per
@@ -13,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-300}
 shift || true
 readers=("$@")
-[[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd las xyz pts e57 obj scene strokes mask pose)
+[[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd las xyz pts e57 obj scene strokes mask pose header)
 shared=${LIDARSHOP_SHARED_DATA_DIR:-$PWD/../shared/data}
 build=build/fuzz
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd .. && pwd)} CCACHE_NOHASHDIR=true
@@ -52,6 +52,18 @@ for reader in "${readers[@]}"; do
       [[ -f $f && $(stat -c %s "$f") -le 4194304 ]] || continue
       python3 -c 'import sys; d=open(sys.argv[1],"rb").read(); open(sys.argv[2],"wb").write(b"".join(d[i:i+1020] for i in range(0,len(d),1024)))' \
         "$f" "$corpus/shared_$(basename "$f").logical"
+    done
+  fi
+  if [[ $reader == header ]]; then
+    # The header target's first byte picks the format (0 ptx, 1 ply, 2 pcd, 3 las, 4 e57 as a logical stream).
+    for f in tests/hostile/corpus/*.{ptx,ply,pcd,las} "$shared"/e57/*.e57; do
+      [[ -f $f && $(stat -c %s "$f") -le 4194304 ]] || continue
+      python3 -c 'import sys
+kinds = {"ptx": 0, "ply": 1, "pcd": 2, "las": 3, "e57": 4}
+ext = sys.argv[1].rsplit(".", 1)[1]
+d = open(sys.argv[1], "rb").read()
+if ext == "e57": d = b"".join(d[i:i + 1020] for i in range(0, len(d), 1024))
+open(sys.argv[2], "wb").write(bytes([kinds[ext]]) + d[:65535])' "$f" "$corpus/$(basename "$f").seed"
     done
   fi
   regressions=(data/fuzz_regressions/"${reader}"_*)

@@ -91,11 +91,39 @@ check "scan prints the mesh reader's warning" \
   grep -qE "^lidarshop: warning: .*scene/meshes/car\.obj: .*VWBugMesh002\.mtl.*without its materials" "$work/scan.err"
 check "scan is quiet when stderr is not a terminal" test "$(grep -vc '^lidarshop: warning: ' "$work/scan.err")" -eq 0
 fails_clearly "scan: missing scene" "no_such_scene.json" "$lidarshop" scan "$work/no_such_scene.json" -o "$work/x.ptx"
+# A built-in scene by name, as `demo --scene NAME`; an unknown name lists the built-in ones.
+check "scan a built-in scene by name" sh -c "'$lidarshop' scan parking_lot -o '$work/parking.ply' --rows 30 \
+  --columns 60 --json - --quiet >'$work/parking.json'"
+json_check "the built-in scene was scanned" "$work/parking.json" \
+  "d['rows'] == 30 and d['columns'] == 60 and d['objects'] > 3 and d['returns'] > 0"
+fails_clearly "scan: an unknown scene name lists the built-in ones" "no_such_scene.*parking_lot.*" \
+  "$lidarshop" scan no_such_scene -o "$work/x.ptx"
+# The scene example of docs/scene-format.md runs as the document says: saved in the repository's top folder
+# (here: beside a link to its data/ folder), its mesh path names a mesh of the repository.
+repo=$(cd "$(dirname "$0")/.." && pwd)
+mkdir -p "$work/doc_example"
+ln -s "$repo/data" "$work/doc_example/data"
+check "extract the scene example of docs/scene-format.md" python3 -c 'import re, sys
+fence = chr(96) * 3
+text = open(sys.argv[1]).read()
+open(sys.argv[2], "w").write(re.search(fence + "json\n(.*?)" + fence, text, re.S).group(1))' \
+  "$repo/docs/scene-format.md" "$work/doc_example/example.json"
+check "the documented scene example scans" sh -c "'$lidarshop' scan '$work/doc_example/example.json' \
+  -o '$work/doc_example/example.ply' --json - --quiet >'$work/doc_example.json'"
+json_check "the documented example has its four objects, the mesh among them" "$work/doc_example.json" \
+  "d['objects'] == 4 and d['returns'] > 0"
 
-# info: the keys scripts rely on.
+# info: the header alone by default, in reading order; --stats reads the points (the keys scripts rely on).
 check "info" "$lidarshop" info "$work/scan.ptx"
+cp "$work/last.out" "$work/info_header.json"
+json_check "info header keys" "$work/info_header.json" \
+  "list(d)[:4] == ['file', 'format', 'format_version', 'size_bytes'] and d['size_bytes'] > 0 and \
+   d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and d['scans'][0]['organized'] and \
+   d['scans'][0]['points'] == 120 * 180 and 'intensity' in d['scans'][0]['channels'] and \
+   'valid' not in d['scans'][0] and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
+check "info --stats" "$lidarshop" info "$work/scan.ptx" --stats
 cp "$work/last.out" "$work/info.json"
-json_check "info keys" "$work/info.json" \
+json_check "info --stats keys" "$work/info.json" \
   "d['format'] == 'ptx' and d['file'].endswith('scan.ptx') and len(d['scans']) == 1 and \
    all(k in d['scans'][0] for k in ('rows', 'cols', 'valid', 'bounds', 'world_from_scanner', 'channels')) and \
    d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and 0 < d['scans'][0]['valid'] <= 120 * 180 and \
@@ -105,7 +133,7 @@ json_check "info keys" "$work/info.json" \
 valid=$(python3 -c "import json; print(json.load(open('$work/info.json'))['scans'][0]['valid'])")
 for format in e57 ply pcd las xyz pts; do
   check "convert ptx -> $format" "$lidarshop" convert "$work/scan.ptx" "$work/scan.$format" --quiet
-  check "info $format" "$lidarshop" info "$work/scan.$format"
+  check "info $format" "$lidarshop" info --stats "$work/scan.$format"
   cp "$work/last.out" "$work/info_$format.json"
   json_check "convert to $format keeps the returns" "$work/info_$format.json" "d['scans'][0]['valid'] == $valid"
 done
@@ -116,7 +144,7 @@ fails_clearly "convert: LAS format 6 needs 1.4" "las-minor-version|las-point-for
   "$lidarshop" convert "$work/scan.ptx" "$work/bad.las" --las-minor-version 2 --las-point-format 6
 fails_clearly "LAZ is refused" "LAZ is not supported" "$lidarshop" convert "$work/scan.ptx" "$work/scan.laz"
 check "convert e57 -> ptx" "$lidarshop" convert "$work/scan.e57" "$work/back.ptx" --quiet
-check "info back.ptx" "$lidarshop" info "$work/back.ptx"
+check "info back.ptx" "$lidarshop" info --stats "$work/back.ptx"
 cp "$work/last.out" "$work/info_back.json"
 json_check "ptx -> e57 -> ptx keeps the grid" "$work/info_back.json" \
   "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and d['scans'][0]['valid'] == $valid"
@@ -142,13 +170,28 @@ check "no partial output" test ! -e "$work/out.ply"
 check "input untouched" test "$before" = "$(md5sum <"$work/truncated.ptx")"
 printf 'garbage\n' >"$work/garbage.e57"
 fails_clearly "garbage e57" "garbage.e57" "$lidarshop" info "$work/garbage.e57"
-fails_clearly "corrupt e57 names the page" "page [0-9]+" "$lidarshop" info "$shared/e57/corrupt_crc.e57"
+fails_clearly "corrupt e57 names the page" "page [0-9]+" "$lidarshop" info --stats "$shared/e57/corrupt_crc.e57"
 
 # Real data: the E57 scan and the organized RGB-D cloud.
-check "info pumpA" "$lidarshop" info "$shared/e57/pumpA.e57"
+check "info pumpA (header)" "$lidarshop" info "$shared/e57/pumpA.e57"
+cp "$work/last.out" "$work/pump_header.json"
+json_check "pumpA header: grid, records, photo, guid" "$work/pump_header.json" \
+  "d['scans'][0]['rows'] * d['scans'][0]['cols'] == 1074 * 345 and d['scans'][0]['points'] == 155201 and \
+   d['guid'] == '{4F947749-517F-49D1-9AD9-A899110EFFDD}' and d['created_utc'].startswith('2011-08-03') and \
+   d['images'][0]['width_px'] == 3072 and d['images'][0]['representation'] == 'visual' and \
+   d['images'][0]['encoding'] == 'jpeg' and d['size_bytes'] == $(stat -c %s "$shared/e57/pumpA.e57")"
+check "info pumpA --stats" "$lidarshop" info --stats "$shared/e57/pumpA.e57"
 cp "$work/last.out" "$work/pump.json"
 json_check "pumpA grid and counts" "$work/pump.json" \
   "d['scans'][0]['rows'] * d['scans'][0]['cols'] == 1074 * 345 and d['scans'][0]['valid'] == 155201"
+# read_error.e57 (docs/e57.md): the header describes it, reading its points refuses its corrupt grid indices.
+check "info read_error.e57 (header)" sh -c "'$lidarshop' info '$shared/e57/read_error.e57' >'$work/read_error.json'"
+json_check "read_error.e57: one organized scan of 2,651 spherical records, grid unknown" "$work/read_error.json" \
+  "d['scans'][0]['points'] == 2651 and d['scans'][0]['organized'] and d['scans'][0]['rows'] is None and \
+   d['scans'][0]['coordinates'] == 'spherical'"
+exits_with 1 "read_error.e57: its points are refused as documented" \
+  "read_error.e57: XML section: field 'e57Root/data3D/vectorChild/points': records 0 and 1 both claim row 0, column 0" \
+  "$lidarshop" info --stats "$shared/e57/read_error.e57"
 check "render pumpA" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump.png" --channel rgb
 check "info mug pcd" "$lidarshop" info "$shared/rgbd/table_scene_mug_stereo_textured.pcd"
 
@@ -211,9 +254,9 @@ check "segment" "$lidarshop" segment "$work/scan.ptx" --strokes "$work/strokes.j
 check "segment wrote mask, overlay and scans" test -s "$work/mask.png" -a -s "$work/mask_overlay.png" \
   -a -s "$work/object.e57" -a -s "$work/rest.ply"
 # --object and --rest are organized scans of the input's grid and pose that split its returns between them.
-check "info object.e57" "$lidarshop" info "$work/object.e57"
+check "info object.e57" "$lidarshop" info --stats "$work/object.e57"
 cp "$work/last.out" "$work/info_object.json"
-check "info rest.ply" "$lidarshop" info "$work/rest.ply"
+check "info rest.ply" "$lidarshop" info --stats "$work/rest.ply"
 cp "$work/last.out" "$work/info_rest.json"
 json_check "segment --object keeps the grid and pose" "$work/info_object.json" \
   "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and 0 < d['scans'][0]['valid'] < $valid and \
@@ -389,7 +432,7 @@ check "remove --keep-object into E57 (second returns)" "$lidarshop" remove "$wor
   --strokes "$work/strokes.json" -o "$work/two_layers.e57" --keep-object --quiet
 check "remove --keep-object into PLY" "$lidarshop" remove "$work/scan.ptx" --strokes "$work/strokes.json" \
   -o "$work/two_layers.ply" --keep-object --quiet
-check "info on the two-layer PLY" sh -c "'$lidarshop' info '$work/two_layers.ply' > '$work/two_layers.json'"
+check "info on the two-layer PLY" sh -c "'$lidarshop' info --stats '$work/two_layers.ply' > '$work/two_layers.json'"
 json_check "the PLY holds the scan and the layer behind the object" "$work/two_layers.json" \
   "len(d['scans']) == 2 and d['scans'][1]['valid'] > 0"
 fails_clearly "fill: mask of another size" "mask" "$lidarshop" fill "$work/scan.ptx" \
@@ -457,8 +500,12 @@ check "images of the copy" sh -c "'$lidarshop' images '$work/pumpA_copy.e57' >'$
 json_check "the copy holds the photo" "$work/images_copy.json" \
   "len(d['images']) == 1 and d['images'][0]['decoded'] and d['images'][0]['width_px'] == 3072"
 check "info lists E57 images" sh -c "'$lidarshop' info '$shared/e57/tiny_pc_and_images.e57' >'$work/info_images.json'"
+json_check "four images, their kinds, the scan of one" "$work/info_images.json" \
+  "[i['representation'] for i in d['images']] == ['visual', 'spherical', 'pinhole', 'cylindrical'] and \
+   d['images'][1]['scan'] == 0 and d['images'][1]['e57']['sensor_vendor'] == 'vendor'"
+check "info --stats decodes E57 images" sh -c "'$lidarshop' info --stats '$shared/e57/tiny_pc_and_images.e57' >'$work/info_images.json'"
 json_check "four images, two decoded" "$work/info_images.json" \
-  "len(d['images']) == 4 and sum(i['decoded'] for i in d['images']) == 2"
+  "len(d['images']) == 4 and sum(i['decoded'] for i in d['images']) == 2 and d['images'][1]['scan'] == 0"
 cat >"$work/landmarks.json" <<'JSON'
 {"pairs": [{"source": [0, 0, 0], "target": [1, 2, 3]}, {"source": [1, 0, 0], "target": [2, 2, 3]},
            {"source": [0, 1, 0], "target": [1, 3, 3]}, {"source": [0, 0, 1], "target": [1, 2, 4]}]}

@@ -10,6 +10,7 @@
 #include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
@@ -264,6 +265,22 @@ void BindFiles(py::module_& m) {
       "Reads the first scan of a .ptx, .e57, .ply, .pcd, .las, .xyz or .pts file. Raises InputError naming "
       "the file and "
       "field.");
+  m.def(
+      "read_scan_header",
+      [](const std::string& path) {
+        nlohmann::ordered_json json;
+        {
+          py::gil_scoped_release release;
+          json = ToJson(ReadScanHeader(path));
+        }
+        return FromJsonValue(json);
+      },
+      py::arg("path"),
+      "What a scan file says about itself, without reading its points (as `lidarshop info`, "
+      "docs/file-formats.md): "
+      "a dict with format, size_bytes, scans (organized, rows, cols, points, channels, world_from_scanner, "
+      "E57 "
+      "metadata) and E57 images.");
   m.def(
       "read_scans", [](const std::string& path) { return ReadScanFile(path).scans; }, py::arg("path"),
       py::call_guard<py::gil_scoped_release>(), "Reads every scan of a file (E57 and PTX hold several).");

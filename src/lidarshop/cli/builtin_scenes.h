@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "lidarshop/scanner/scene.h"
+
 namespace lidarshop::cli {
 
 struct BuiltinScene {
@@ -12,5 +14,12 @@ struct BuiltinScene {
 };
 
 const std::vector<BuiltinScene>& BuiltinScenes();
+
+// `scene` as `scan` and `demo` take it: the name of a built-in scene, else a scene JSON file (its warnings
+// printed). Throws InputError listing the built-in names when it is neither. builtin_scenes.cc.
+SceneDescription LoadSceneOrBuiltin(const std::string& scene);
+
+// " parking_lot electric_box ...": the built-in names, for help texts and errors.
+std::string BuiltinSceneNames();
 
 }  // namespace lidarshop::cli

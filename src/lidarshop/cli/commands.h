@@ -65,7 +65,11 @@ CLI::Option* AddJsonOption(CLI::App& app, std::string* path, const std::string& 
 nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
                                    const nlohmann::ordered_json& result);
 // Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty. `indent` -1 = one line.
-void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent = 2);
+// `inline_arrays`: arrays of numbers and strings on one line ("[1, 0, 0, 0]"), for output people read.
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent = 2,
+                     bool inline_arrays = false);
+// `json` indented by `indent`, arrays of scalars on one line.
+std::string DumpWithInlineArrays(const nlohmann::ordered_json& json, int indent, int depth = 0);
 
 // Checks an output before any long work: its extension is one of `extensions` (lower case, no dot;
 // empty = any), its folder exists and is writable, and it names no input or other output. Throws

@@ -1,5 +1,6 @@
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <exception>
 #include <filesystem>
@@ -103,13 +104,40 @@ CLI::Option* AddJsonOption(CLI::App& app, std::string* path, const std::string& 
   return option;
 }
 
-void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent) {
+std::string DumpWithInlineArrays(const nlohmann::ordered_json& json, int indent, int depth) {
+  const bool scalar_array = json.is_array() && std::none_of(json.begin(), json.end(), [](const auto& item) {
+                              return item.is_structured();
+                            });
+  if (!json.is_structured() || json.empty() || indent < 0) return json.dump(indent);
+  std::string out;
+  if (scalar_array) {
+    out = "[";
+    for (size_t i = 0; i < json.size(); ++i) out += (i ? ", " : "") + json[i].dump();
+    return out + "]";
+  }
+  const std::string inner(static_cast<size_t>(indent * (depth + 1)), ' ');
+  out = json.is_object() ? "{\n" : "[\n";
+  bool first = true;
+  for (auto it = json.begin(); it != json.end(); ++it) {
+    out += first ? "" : ",\n";
+    first = false;
+    out += inner;
+    if (json.is_object()) out += nlohmann::ordered_json(it.key()).dump() + ": ";
+    out += DumpWithInlineArrays(it.value(), indent, depth + 1);
+  }
+  out += "\n" + std::string(static_cast<size_t>(indent * depth), ' ') + (json.is_object() ? "}" : "]");
+  return out;
+}
+
+void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json, int indent,
+                     bool inline_arrays) {
   if (path.empty()) return;
+  const std::string text = inline_arrays ? DumpWithInlineArrays(json, indent) : json.dump(indent);
   if (path == "-") {
-    std::cout << json.dump(indent) << "\n" << std::flush;
+    std::cout << text << "\n" << std::flush;
     return;
   }
-  WriteFileAtomically(path, [&](std::ostream& out) { out << json.dump(indent) << "\n"; });
+  WriteFileAtomically(path, [&](std::ostream& out) { out << text << "\n"; });
 }
 
 void CheckOutputFile(const std::string& flag, const std::string& path,

@@ -61,21 +61,6 @@ std::string DefaultSegmentObject(const std::string& scene_name) {
   return found == objects.end() ? std::string() : found->second;
 }
 
-SceneDescription LoadDemoScene(const std::string& scene) {
-  for (const BuiltinScene& builtin : BuiltinScenes()) {
-    if (scene == builtin.name) return ParseScene(builtin.json, fmt::format("built-in scene '{}'", scene), "");
-  }
-  if (fs::exists(scene)) {
-    SceneDescription description = LoadScene(scene);
-    PrintWarnings(description.warnings);
-    return description;
-  }
-  std::string names;
-  for (const BuiltinScene& builtin : BuiltinScenes()) names += fmt::format(" {}", builtin.name);
-  throw InputError(
-      fmt::format("'{}' is neither a built-in scene (one of:{}) nor a scene file", scene, names));
-}
-
 std::string SceneName(const std::string& scene) { return fs::path(scene).stem().string(); }
 
 void WriteText(const fs::path& path, const std::string& text) {
@@ -366,7 +351,7 @@ int RunDemoSteps(const DemoSettings& settings) {
   auto progress = Progress::ForTerminal("demo: loading", 1, settings.quiet);
 
   Timer timer;
-  const SceneDescription scene = LoadDemoScene(settings.scene);
+  const SceneDescription scene = LoadSceneOrBuiltin(settings.scene);
   const SyntheticScanner scanner(scene);
   seconds["load"] = timer.Seconds();
 

@@ -1,4 +1,5 @@
 // lidarshop info | convert | render: describe, convert and picture scan files.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -13,10 +14,12 @@
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 #include "lidarshop/util/progress.h"
 
 namespace lidarshop::cli {
@@ -24,14 +27,14 @@ namespace {
 
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
-nlohmann::json MatrixJson(const Eigen::Matrix4d& matrix) {
-  nlohmann::json rows = nlohmann::json::array();
+nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
   return rows;
 }
 
-nlohmann::json ScanJson(const Scan& scan, int index) {
-  nlohmann::json json;
+nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
+  nlohmann::ordered_json json;
   json["index"] = index;
   if (!scan.name.empty()) json["name"] = scan.name;
   json["rows"] = scan.rows;
@@ -75,7 +78,7 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
     json["bounds"] = nullptr;
   }
 
-  nlohmann::json grid;
+  nlohmann::ordered_json grid;
   grid["fitted"] = scan.grid.fitted;
   grid["known"] = !scan.grid.azimuth_rad.empty();
   if (!scan.grid.azimuth_rad.empty() && !scan.grid.elevation_rad.empty()) {
@@ -100,37 +103,115 @@ nlohmann::json ScanJson(const Scan& scan, int index) {
   return json;
 }
 
+// Numbers as people read them, by what they are (the key that holds them): statistics of float32 points and
+// angles in degrees to 1e-6 (micrometres, microdegrees), residuals in radians to 6 significant digits,
+// everything else to 12 significant digits and |x| < 1e-12 to 0 (1.5, not 1.5000000000000002; UTM
+// coordinates keep 10 micrometres).
+double Significant(double value, int digits) {
+  return std::abs(value) < 1e-12 ? 0.0 : std::stod(fmt::format("{:.{}g}", value, digits));
+}
+
+void RoundNumbers(nlohmann::ordered_json* json, const std::string& key = "") {
+  auto ends_with = [&](const char* suffix) {
+    const std::string s(suffix);
+    return key.size() >= s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0;
+  };
+  if (json->is_number_float()) {
+    const double value = json->get<double>();
+    if (!std::isfinite(value)) return;
+    if (ends_with("_rad")) {
+      *json = Significant(value, 6);
+    } else if (key == "min" || key == "max" || key == "mean" || ends_with("_deg")) {
+      const double rounded = std::round(value * 1e6) / 1e6;
+      *json = rounded == 0.0 ? 0.0 : rounded;
+    } else {
+      *json = Significant(value, 12);
+    }
+  } else if (json->is_object()) {
+    for (auto it = json->begin(); it != json->end(); ++it) RoundNumbers(&it.value(), it.key());
+  } else if (json->is_array()) {
+    for (auto& child : *json) RoundNumbers(&child, key);
+  }
+}
+
+// Adds the keys of `from` to `into`: a key `into` has keeps its place and takes the new value, unless it is
+// listed in `keep`.
+void MergeInto(const nlohmann::ordered_json& from, nlohmann::ordered_json* into,
+               const std::vector<std::string>& keep = {}) {
+  for (const auto& [key, value] : from.items()) {
+    if (into->contains(key) && std::find(keep.begin(), keep.end(), key) != keep.end()) continue;
+    (*into)[key] = value;
+  }
+}
+
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
   CLI::App app{
-      "Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object (on stdout "
-      "unless --json).",
+      "Describe a scan file (.ptx, .e57, .ply, .pcd, .las, .xyz, .pts) as one JSON object (on stdout unless "
+      "--json): format, size, scans (organized or not, rows x cols, points, channels, pose, E57 sensor and "
+      "dates), E57 images. Reads the headers only (XYZ/PTS have none: they are read whole); --stats reads "
+      "the "
+      "points too.",
       "info"};
   std::string path, json_path = "-";
-  bool compact = false;
+  bool compact = false, stats = false;
   app.add_option("file", path, "scan file")->required();
   AddJsonOption(app, &json_path);
   app.add_flag("--compact", compact, "write the JSON on one line");
+  app.add_flag("--stats", stats,
+               "also read every point: per scan the valid returns, world bounds, range and intensity "
+               "statistics and the angular grid; whether each E57 image decodes");
   return RunCommand(app, argc, argv, [&] {
     CheckOutputFile("--json", json_path, {}, {path});
+    const std::string format = FileExtension(path);
+    const bool headerless = format == "xyz" || format == "pts";
+    ScanFileHeader header;
+    if (!stats || !headerless) {
+      header = ReadScanHeader(path);
+      if (!stats) PrintWarnings(header.warnings);
+    }
+    if (!stats) {
+      nlohmann::ordered_json json = ToJson(header);
+      RoundNumbers(&json);
+      WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
+      return 0;
+    }
     ScanFile file;
     std::vector<E57Image> images;
-    if (FileExtension(path) == "e57") {  // read once, keeping the photos
+    if (format == "e57") {  // read once, keeping the photos
       E57File e57 = ReadE57AndWarn(path);
       file = {path, "e57", std::move(e57.scans), std::move(e57.warnings)};
       images = std::move(e57.images);
     } else {
       file = ReadScanFileAndWarn(path);
     }
-    nlohmann::json json;
-    json["file"] = path;
-    json["format"] = file.format;
-    json["scans"] = nlohmann::json::array();
-    for (size_t i = 0; i < file.scans.size(); ++i)
-      json["scans"].push_back(ScanJson(file.scans[i], static_cast<int>(i)));
-    if (file.format == "e57") json["images"] = ImagesJson(images);
-    WriteJsonOutput(json_path, json, compact ? -1 : 2);
+    if (headerless) {
+      header.path = path;
+      header.format = format;
+      header.format_version = format == "pts" ? "PTS" : "XYZ";
+      header.file_size_bytes = CheckRegularFile(path);
+      for (const Scan& scan : file.scans) header.scans.push_back(ScanHeaderOf(scan));
+    }
+    nlohmann::ordered_json json = ToJson(header);
+    // The points decide what the header could not (an E57 grid without indexBounds): the full read's
+    // rows, cols and channels win; the header's pose, names and metadata stay.
+    auto& scans = json["scans"];
+    for (size_t i = 0; i < file.scans.size(); ++i) {
+      if (i >= scans.size()) scans.push_back(ToJson(ScanHeaderOf(file.scans[i]), static_cast<int>(i)));
+      MergeInto(ScanJson(file.scans[i], static_cast<int>(i)), &scans[i],
+                {"index", "name", "world_from_scanner"});
+    }
+    if (format == "e57") {
+      const nlohmann::ordered_json decoded = ImagesJson(images);
+      auto& list = json["images"];
+      for (size_t i = 0; i < decoded.size(); ++i) {
+        if (i >= list.size()) list.push_back(nlohmann::ordered_json::object());
+        MergeInto(decoded[i], &list[i], {"index", "name", "world_from_camera"});
+      }
+    }
+    RoundNumbers(&json);
+    WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
     return 0;
   });
 }

@@ -1,12 +1,13 @@
-// lidarshop scan SCENE.json -o OUT.ptx|.ply [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
+// lidarshop scan SCENE.json|BUILTIN -o OUT.ptx|.ply [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
 // [--json FILE|-] [--stats]
 //
-// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) with the synthetic
-// scanner and writes it; --json writes one JSON object with the counts and the seconds of each stage
+// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) or of a built-in scene
+// (parking_lot, ...: the scenes of `demo --scene`) with the synthetic scanner and writes it; --json writes one JSON object with the counts and the seconds of each stage
 // (--stats = --json -). Scanner flags (--rows, --seed, ...) override the scene's "scanner" entries.
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
@@ -34,7 +35,10 @@ int RunScan(int argc, char** argv) {
   ScannerOptions scanner_overrides;
   ScanMeshOptions mesh_options;
   OptionBinder binder(app);
-  app.add_option("scene", scene_path, "scene description (.json, see docs/scene-format.md)")->required();
+  app.add_option(
+         "scene", scene_path,
+         "scene description (.json, see docs/scene-format.md) or a built-in scene:" + BuiltinSceneNames())
+      ->required();
   app.add_option("-o,--output", output_path,
                  "output scan: .ptx, .ply, .e57, .pcd (or the points alone: .las, .xyz, .pts)")
       ->required();
@@ -62,8 +66,7 @@ int RunScan(int argc, char** argv) {
         const ThreadLimit thread_limit(threads);
         Timer total;
         Timer stage;
-        SceneDescription scene = LoadScene(scene_path);
-        PrintWarnings(scene.warnings);
+        SceneDescription scene = LoadSceneOrBuiltin(scene_path);
         StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &scene.scanner);
         scene.scanner.Check();
         const double loading_seconds = stage.Seconds();

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <fstream>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -16,6 +17,28 @@
 namespace lidarshop::io_internal {
 
 std::string ReadFileToString(const std::string& path) { return ReadRegularFile(path); }
+
+std::string ReadFilePrefix(const std::string& path, int64_t max_bytes) {
+  const int64_t size = CheckRegularFile(path);
+  return ReadFileRange(path, 0, std::min(size, max_bytes), "the file's start");
+}
+
+std::string ReadFileRange(const std::string& path, int64_t offset, int64_t size, const std::string& what) {
+  const int64_t file_size = CheckRegularFile(path);
+  if (offset < 0 || size < 0 || offset > file_size || size > file_size - offset) {
+    ThrowInputError(path, fmt::format("byte offset {}", offset), what,
+                    fmt::format("truncated: {} bytes at byte {} run past the end of the file ({} bytes)",
+                                size, offset, file_size));
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
+  std::string bytes(static_cast<size_t>(size), '\0');
+  in.seekg(offset);
+  if (size > 0 && !in.read(bytes.data(), size)) {
+    ThrowInputError(path, fmt::format("byte offset {}", offset), what, "read failed");
+  }
+  return bytes;
+}
 
 void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const std::string& place) {
   if (rows <= 0 || cols <= 0) {

@@ -11,6 +11,10 @@ namespace lidarshop::io_internal {
 // Reads a whole regular file (util/input_file.h: FIFOs, devices and folders are refused without opening
 // them). Throws InputError naming the file when it cannot be read.
 std::string ReadFileToString(const std::string& path);
+// The first `max_bytes` bytes of the regular file `path` (all of it when shorter), for header readers.
+std::string ReadFilePrefix(const std::string& path, int64_t max_bytes);
+// `size` bytes at `offset` of `path`; throws InputError naming `what` when the file is shorter.
+std::string ReadFileRange(const std::string& path, int64_t offset, int64_t size, const std::string& what);
 
 // Throws InputError naming `file` and `place` when rows x cols is negative, more than kMaxScanCells, or more
 // than the memory budget (util/memory_budget.h) holds, before anything is allocated.

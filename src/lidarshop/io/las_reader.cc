@@ -8,8 +8,10 @@
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/las_format.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
@@ -30,8 +32,10 @@ struct LasHeader {
   ThrowInputError(file, fmt::format("header byte {}", byte), field, message);
 }
 
-LasHeader ParseHeader(const std::string& bytes, const std::string& file) {
-  const int64_t size = static_cast<int64_t>(bytes.size());
+// `bytes` holds the file or (header readers) its start up to the point data; `file_size` is the whole
+// file's size (-1: bytes.size()).
+LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t file_size = -1) {
+  const int64_t size = file_size < 0 ? static_cast<int64_t>(bytes.size()) : file_size;
   if (size == 0) ThrowInputError(file, "byte 0", "", "the file is empty");
   const char* h = bytes.data();
   if (size < 4 || std::memcmp(h, "LASF", 4) != 0) {
@@ -240,5 +244,41 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
 }
 
 Scan ReadLas(const std::string& path) { return ParseLas(io_internal::ReadFileToString(path), path); }
+
+ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
+  const int64_t file_size = CheckRegularFile(path);
+  std::string bytes = io_internal::ReadFilePrefix(path, las::kHeaderSize14);
+  if (static_cast<int64_t>(bytes.size()) >= las::kHeaderSize12) {
+    // The header and the variable length records up to the point data (both sizes checked by ParseHeader).
+    const int64_t needed =
+        std::max<int64_t>(las::Load<uint32_t>(bytes.data() + las::header::kOffsetToPointData),
+                          las::Load<uint16_t>(bytes.data() + las::header::kHeaderSize));
+    if (needed > static_cast<int64_t>(bytes.size()) && needed <= file_size)
+      bytes = io_internal::ReadFilePrefix(path, needed);
+  }
+  const LasHeader header = ParseHeader(bytes, path, file_size);
+  io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
+  ScanFileHeader file;
+  file.format_version = fmt::format("LAS 1.{} point format {}", header.minor_version, header.format);
+  ScanHeader scan;
+  scan.rows = 1;
+  scan.cols = header.count;
+  scan.points = header.count;
+  // The reader's origin from the header's bounds (max x, min x, max y, ...), as it takes it from the points.
+  const char* h = bytes.data();
+  Eigen::Vector3d low, high;
+  for (int axis = 0; axis < 3; ++axis) {
+    high[axis] = las::Load<double>(h + las::header::kMaxX + 16 * axis);
+    low[axis] = las::Load<double>(h + las::header::kMaxX + 16 * axis + 8);
+  }
+  if (low.allFinite() && high.allFinite() && (low.array() <= high.array()).all() &&
+      (low.array().abs() <= kMaxCoordinateM).all() && (high.array().abs() <= kMaxCoordinateM).all()) {
+    scan.world_from_scanner.topRightCorner<3, 1>() = io_internal::CloudOrigin(low, high);
+  }
+  scan.channels = {"xyz", "range", "intensity", "valid", "direction"};
+  if (las::HasRgb(header.format)) scan.channels.push_back("rgb");
+  file.scans.push_back(scan);
+  return file;
+}
 
 }  // namespace lidarshop

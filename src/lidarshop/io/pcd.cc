@@ -12,10 +12,12 @@
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_common.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
@@ -233,6 +235,26 @@ uint32_t PackedColor(const char* p, const PcdField& field) {
   return bits;
 }
 
+// VIEWPOINT as a matrix: the frame the file's coordinates are in.
+Eigen::Matrix4d Viewpoint(const PcdHeader& header, const std::string& file) {
+  const double* v = header.viewpoint;
+  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
+  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
+  if (rotation.norm() < 1e-9)
+    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
+  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
+  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
+  return viewpoint;
+}
+
+// The scan's pose: the one lidarshop's comment names (its points are world coordinates), else VIEWPOINT,
+// turned from the optical frame for a foreign organized cloud (a camera image).
+Eigen::Matrix4d WorldFromScanner(const PcdHeader& header, const std::string& file) {
+  if (header.has_scanner_pose) return header.world_from_scanner;
+  const Eigen::Matrix4d viewpoint = Viewpoint(header, file);
+  return header.height > 1 ? Eigen::Matrix4d(viewpoint * CameraFromScanner()) : viewpoint;
+}
+
 }  // namespace
 
 Scan ParsePcd(const std::string& bytes, const std::string& file) {
@@ -354,26 +376,15 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
   if (fcurvature >= 0) scan.curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
   if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
-  const double* v = header.viewpoint;
-  Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
-  const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
-  if (rotation.norm() < 1e-9)
-    ThrowInputError(file, "header", "VIEWPOINT", "the orientation quaternion is zero");
-  viewpoint.topLeftCorner<3, 3>() = rotation.normalized().toRotationMatrix();
-  viewpoint.topRightCorner<3, 1>() = Eigen::Vector3d(v[0], v[1], v[2]);
   // The file's coordinates are in the VIEWPOINT frame: world = viewpoint · file. lidarshop's own files say
   // in a comment which scan pose they hold (the points are world coordinates); a foreign organized cloud is
   // a camera image in the optical frame, a foreign unorganized one a cloud in the viewpoint's frame.
+  scan.world_from_scanner = WorldFromScanner(header, file);
   Eigen::Matrix4d scanner_from_file = Eigen::Matrix4d::Identity();
-  if (header.has_scanner_pose) {
-    scan.world_from_scanner = header.world_from_scanner;
-    scanner_from_file = header.world_from_scanner.inverse() * viewpoint;
-  } else if (organized) {
-    scan.world_from_scanner = viewpoint * CameraFromScanner();
+  if (header.has_scanner_pose)
+    scanner_from_file = header.world_from_scanner.inverse() * Viewpoint(header, file);
+  else if (organized)
     scanner_from_file = CameraFromScanner().inverse();  // (x, y, z) → (x, z, −y), exactly
-  } else {
-    scan.world_from_scanner = viewpoint;
-  }
   const Eigen::Matrix3d rotate = scanner_from_file.topLeftCorner<3, 3>();
   const Eigen::Vector3d shift = scanner_from_file.topRightCorner<3, 1>();
   const auto& f = header.fields;
@@ -424,6 +435,33 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
 }
 
 Scan ReadPcd(const std::string& path) { return ParsePcd(io_internal::ReadFileToString(path), path); }
+
+ScanFileHeader io_internal::ReadPcdHeader(const std::string& path) {
+  const int64_t file_bytes = CheckRegularFile(path);
+  if (file_bytes == 0) ThrowInputError(path, "byte 0", "", "the file is empty");
+  // ParseHeader refuses a header longer than 64 KiB: a little more holds any header it accepts.
+  const PcdHeader header = ParseHeader(io_internal::ReadFilePrefix(path, (1 << 16) + 4096), path);
+  ScanFileHeader file;
+  file.format_version = "PCD DATA " + header.data;
+  ScanHeader scan;
+  scan.organized = header.height > 1;
+  scan.rows = header.height;
+  scan.cols = header.width;
+  scan.points = header.points;
+  scan.world_from_scanner = WorldFromScanner(header, path);
+  scan.channels = {"xyz", "range"};
+  if (header.Find("intensity") >= 0) scan.channels.push_back("intensity");
+  scan.channels.insert(scan.channels.end(), {"valid", "direction"});
+  if (header.Find("rgba") >= 0 || header.Find("rgb") >= 0) scan.channels.push_back("rgb");
+  if (header.Find("label") >= 0) scan.channels.push_back("label");
+  if (header.Find("normal_x") >= 0 && header.Find("normal_y") >= 0 && header.Find("normal_z") >= 0)
+    scan.channels.push_back("normal");
+  if (header.Find("curvature") >= 0) scan.channels.push_back("curvature");
+  if (header.Find("true_range") >= 0) scan.channels.push_back("true_range");
+  if (header.Find("synthesized") >= 0) scan.channels.push_back("synthesized");
+  file.scans.push_back(scan);
+  return file;
+}
 
 void WritePcd(const std::string& path, const Scan& scan) {
   CheckScan(scan);

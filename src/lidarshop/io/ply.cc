@@ -9,6 +9,7 @@
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace {
@@ -351,6 +352,22 @@ PlyData ParsePly(const std::string& bytes, const std::string& file) {
 }
 
 PlyData ReadPly(const std::string& path) { return ParsePly(io_internal::ReadFileToString(path), path); }
+
+PlyData ReadPlyHeader(const std::string& path, int64_t* data_bytes) {
+  constexpr int64_t kMaxHeaderBytes = 1 << 20;
+  const int64_t file_bytes = CheckRegularFile(path);
+  const std::string prefix = io_internal::ReadFilePrefix(path, kMaxHeaderBytes);
+  if (prefix.compare(0, 3, "ply") == 0 && prefix.find("end_header") == std::string::npos &&
+      file_bytes > kMaxHeaderBytes) {
+    ThrowInputError(path, "header", "end_header",
+                    fmt::format("missing in the first {} bytes: not a PLY header", kMaxHeaderBytes));
+  }
+  size_t data_offset = 0;
+  int64_t data_line = 0;
+  PlyData data = ParseHeader(prefix, path, &data_offset, &data_line);
+  if (data_bytes != nullptr) *data_bytes = file_bytes - static_cast<int64_t>(data_offset);
+  return data;
+}
 
 void WritePly(const std::string& path, const PlyData& data) {
   const bool ascii = data.format == PlyData::Format::kAscii;

@@ -55,6 +55,9 @@ struct PlyData {
 // refused before anything is allocated.
 PlyData ReadPly(const std::string& path);
 PlyData ParsePly(const std::string& bytes, const std::string& file);
+// The header alone (elements with their counts and properties, comments; no values), read from the start of
+// the file; `data_bytes` (optional) gets the number of bytes after the header. Throws InputError as ReadPly.
+PlyData ReadPlyHeader(const std::string& path, int64_t* data_bytes = nullptr);
 
 // Writes `data` in its format (ASCII or binary little-endian; big-endian is
 // written as little-endian). Atomic.

@@ -1,12 +1,18 @@
 #include "lidarshop/io/ptx.h"
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "lidarshop/io/io_common.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 namespace {
@@ -54,7 +60,13 @@ int64_t ReadCount(TextCursor* cursor, const char* what, int scan_index) {
   return count;
 }
 
-Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& options) {
+// A scan's 10 header lines: its size and pose.
+struct PtxScanHead {
+  int64_t rows = 0, cols = 0;
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
+};
+
+PtxScanHead ParseScanHead(TextCursor* cursor, int scan_index) {
   const std::string place = fmt::format("scan {}", scan_index + 1);
   const int64_t header_line = cursor->line();
   const int64_t cols = ReadCount(cursor, "columns", scan_index);
@@ -86,13 +98,24 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
   // 0 1" as its last row and a translation in the last column: take it as printed.
   const bool usual_layout = printed[3][0] == 0 && printed[3][1] == 0 && printed[3][2] == 0 &&
                             (printed[0][3] != 0 || printed[1][3] != 0 || printed[2][3] != 0);
-  Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols));
-  scan.world_from_scanner = usual_layout ? matrix : Eigen::Matrix4d(matrix.transpose());
-  const Eigen::RowVector4d last_row = scan.world_from_scanner.row(3);
+  PtxScanHead head;
+  head.rows = rows;
+  head.cols = cols;
+  head.world_from_scanner = usual_layout ? matrix : Eigen::Matrix4d(matrix.transpose());
+  const Eigen::RowVector4d last_row = head.world_from_scanner.row(3);
   if (!last_row.isApprox(Eigen::RowVector4d(0, 0, 0, 1), 1e-9)) {
     ThrowInputError(cursor->file(), fmt::format("line {}: {}", cursor->line() - 1, place), "matrix",
                     "not an affine transform: the printed 4th column (Leica layout) must be 0 0 0 1");
   }
+  return head;
+}
+
+Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& options) {
+  const std::string place = fmt::format("scan {}", scan_index + 1);
+  const PtxScanHead head = ParseScanHead(cursor, scan_index);
+  const int64_t rows = head.rows, cols = head.cols;
+  Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols));
+  scan.world_from_scanner = head.world_from_scanner;
 
   const int64_t total = rows * cols;
   int64_t done = 0;
@@ -146,6 +169,67 @@ std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const
   if (cursor.AtEnd()) ThrowInputError(file, "line 1", "columns", "the file is empty");
   while (!cursor.AtEnd()) {
     scans.push_back(ParseOneScan(&cursor, static_cast<int>(scans.size()), options));
+    cursor.SkipEmptyLines();
+  }
+  return scans;
+}
+
+std::vector<ScanHeader> io_internal::ReadPtxHeaders(const std::string& path) {
+  const int64_t size = CheckRegularFile(path);
+  if (size == 0) ThrowInputError(path, "line 1", "columns", "the file is empty");
+  // Mapped, not read: the point lines are only skipped, so a large file costs page cache, not memory.
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) ThrowInputError(path, "", "", "cannot open for reading");
+  void* mapped = ::mmap(nullptr, static_cast<size_t>(size), PROT_READ, MAP_PRIVATE, fd, 0);
+  ::close(fd);
+  if (mapped == MAP_FAILED) ThrowInputError(path, "", "", "cannot map the file for reading");
+  struct Unmap {
+    void* data;
+    size_t size;
+    ~Unmap() { ::munmap(data, size); }
+  } unmap{mapped, static_cast<size_t>(size)};
+  ::madvise(mapped, static_cast<size_t>(size), MADV_SEQUENTIAL);
+  // Pages already skipped leave the process (they stay in the page cache): the memory stays flat.
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  uintptr_t dropped = reinterpret_cast<uintptr_t>(mapped);
+  auto drop_behind = [&](const char* position) {
+    const uintptr_t until = reinterpret_cast<uintptr_t>(position) / page * page;
+    if (until > dropped) {
+      ::madvise(reinterpret_cast<void*>(dropped), until - dropped, MADV_DONTNEED);
+      dropped = until;
+    }
+  };
+  TextCursor cursor(std::string_view(static_cast<const char*>(mapped), static_cast<size_t>(size)), path);
+  std::vector<ScanHeader> scans;
+  cursor.SkipEmptyLines();
+  if (cursor.AtEnd()) ThrowInputError(path, "line 1", "columns", "the file is empty");
+  while (!cursor.AtEnd()) {
+    const int scan_index = static_cast<int>(scans.size());
+    const PtxScanHead head = ParseScanHead(&cursor, scan_index);
+    ScanHeader scan;
+    scan.organized = true;
+    scan.rows = head.rows;
+    scan.cols = head.cols;
+    scan.points = head.rows * head.cols;
+    scan.world_from_scanner = head.world_from_scanner;
+    scan.channels = {"xyz", "range", "intensity", "valid", "direction"};
+    // The first point line says whether the scan has colour (7 fields) or not (4).
+    cursor.SkipEmptyLines();
+    int fields = 0;
+    for (TextCursor line = cursor; !line.AtEndOfLine(); ++fields) line.Token();
+    if (fields == 7) scan.channels.push_back("rgb");
+    const int64_t total = head.rows * head.cols;
+    for (int64_t done = 0; done < total; ++done) {
+      if ((done & 0xFFFFF) == 0) drop_behind(cursor.position());
+      cursor.SkipEmptyLines();
+      if (cursor.AtEnd()) {
+        cursor.Fail("",
+                    fmt::format("truncated: scan {} expects {} point lines ({} columns x {} rows), found {}",
+                                scan_index + 1, total, head.cols, head.rows, done));
+      }
+      cursor.NextLine();
+    }
+    scans.push_back(std::move(scan));
     cursor.SkipEmptyLines();
   }
   return scans;

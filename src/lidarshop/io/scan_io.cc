@@ -15,6 +15,7 @@
 #include "lidarshop/io/ply.h"
 #include "lidarshop/io/ply_fields.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/xyz.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
@@ -258,6 +259,58 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   WritePly(path, ply);
 }
 
+// The scans of a PLY file as its header describes them: lidarshop's scan comments give the grids and poses
+// (organized when the vertices have row/col), else one cloud of `vertex` points.
+ScanFileHeader PlyFileHeader(const std::string& path) {
+  int64_t data_bytes = 0;
+  const PlyData ply = ReadPlyHeader(path, &data_bytes);
+  const PlyElement& vertex = RequireElement(ply, "vertex", path);
+  ScanFileHeader file;
+  file.format_version = ply.format == PlyData::Format::kAscii             ? "PLY ascii"
+                        : ply.format == PlyData::Format::kBinaryBigEndian ? "PLY binary_big_endian"
+                                                                          : "PLY binary_little_endian";
+  std::vector<std::string> channels = {"xyz", "range"};
+  if (FindScalar(vertex, {"intensity", "scalar_intensity", "scalar_Intensity"}))
+    channels.push_back("intensity");
+  channels.insert(channels.end(), {"valid", "direction"});
+  if (FindScalar(vertex, {"red", "r", "diffuse_red"}) &&
+      FindScalar(vertex, {"green", "g", "diffuse_green"}) &&
+      FindScalar(vertex, {"blue", "b", "diffuse_blue"})) {
+    channels.push_back("rgb");
+  }
+  if (FindScalar(vertex, {"label", "scalar_label", "class", "classification"})) channels.push_back("label");
+  if (FindScalar(vertex, {"nx"}) && FindScalar(vertex, {"ny"}) && FindScalar(vertex, {"nz"}))
+    channels.push_back("normal");
+  const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path, CheckRegularFile(path));
+  const bool organized = !headers.empty() && FindScalar(vertex, {"row"}) && FindScalar(vertex, {"col"});
+  if (FindScalar(vertex, {"curvature"})) channels.push_back("curvature");
+  if (organized && FindScalar(vertex, {"true_range"})) channels.push_back("true_range");
+  if (FindScalar(vertex, {"synthesized"})) channels.push_back("synthesized");
+  if (!organized) {
+    if (vertex.count == 0) ThrowInputError(path, "header", "element vertex", "no points");
+    CheckScanSize(1, vertex.count, path, "header");
+    ScanHeader scan;
+    scan.rows = 1;
+    scan.cols = vertex.count;
+    scan.points = vertex.count;
+    scan.channels = channels;
+    file.scans.push_back(scan);
+  }
+  for (const PlyScanHeader& header : headers) {
+    if (!organized) break;
+    ScanHeader scan;
+    scan.organized = true;
+    scan.rows = header.rows;
+    scan.cols = header.cols;
+    // The vertices of several scans are told apart by their `scan` property: only the total is in the header.
+    scan.points = headers.size() == 1 ? vertex.count : -1;
+    scan.world_from_scanner = header.world_from_scanner;
+    scan.channels = channels;
+    file.scans.push_back(scan);
+  }
+  return file;
+}
+
 // ---- The table ----
 
 struct ScanFormat {
@@ -329,6 +382,8 @@ const ScanFormat& FormatFor(const std::string& path) {
 }
 
 }  // namespace
+
+ScanFileHeader io_internal::ReadPlyScanHeader(const std::string& path) { return PlyFileHeader(path); }
 
 std::string FileExtension(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();

@@ -128,6 +128,18 @@ def test_point_formats_keep_the_world_points(scan, tmp_path, extension):
     np.testing.assert_array_equal(back.color[0], scan.color[valid])
 
 
+def test_read_scan_header_agrees_with_the_scan(scan, tmp_path):
+    path = str(tmp_path / "scan.e57")
+    lidarshop.write_scan(scan, path)
+    header = lidarshop.read_scan_header(path)
+    assert header["format"] == "e57"
+    assert list(header)[:2] == ["file", "format"]
+    entry = header["scans"][0]
+    assert (entry["rows"], entry["cols"]) == (scan.rows, scan.cols)
+    assert entry["organized"] is True
+    assert "valid" not in entry  # the points are not read
+
+
 def test_bad_files_raise_input_error(tmp_path):
     bad = tmp_path / "bad.ptx"
     bad.write_text("12\nnot a number\n")

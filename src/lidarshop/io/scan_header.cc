@@ -1,0 +1,165 @@
+#include "lidarshop/io/scan_header.h"
+
+#include <cmath>
+#include <ctime>
+
+#include <fmt/format.h>
+
+#include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+
+namespace lidarshop {
+namespace {
+
+// Numbers as people read them: poses to the nanometre, which also drops the 1e-17 noise of a rotation
+// (1.0000000000000002 prints as 1).
+double Rounded(double value, double step = 1e-9) {
+  if (!std::isfinite(value)) return value;
+  const double rounded = std::round(value / step) * step;
+  return rounded == 0.0 ? 0.0 : rounded;  // no -0
+}
+
+nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back(
+        {Rounded(matrix(r, 0)), Rounded(matrix(r, 1)), Rounded(matrix(r, 2)), Rounded(matrix(r, 3))});
+  }
+  return rows;
+}
+
+// The E57 metadata keys the entry has (none when the file says nothing).
+nlohmann::ordered_json MetadataJson(const E57Metadata& m) {
+  nlohmann::ordered_json json = nlohmann::ordered_json::object();
+  auto put = [&](const char* key, const std::string& value) {
+    if (!value.empty()) json[key] = value;
+  };
+  put("guid", m.guid);
+  put("description", m.description);
+  put("sensor_vendor", m.sensor_vendor);
+  put("sensor_model", m.sensor_model);
+  put("sensor_serial_number", m.sensor_serial_number);
+  put("sensor_hardware_version", m.sensor_hardware_version);
+  put("sensor_software_version", m.sensor_software_version);
+  put("sensor_firmware_version", m.sensor_firmware_version);
+  put("acquisition_start_utc", m.acquisition_start_utc);
+  if (std::isfinite(m.acquisition_start_gps_s)) json["acquisition_start_gps_s"] = m.acquisition_start_gps_s;
+  put("acquisition_end_utc", m.acquisition_end_utc);
+  if (std::isfinite(m.acquisition_end_gps_s)) json["acquisition_end_gps_s"] = m.acquisition_end_gps_s;
+  return json;
+}
+
+}  // namespace
+
+std::string UtcFromGpsSeconds(double gps_seconds) {
+  if (!std::isfinite(gps_seconds) || gps_seconds < 0 || gps_seconds > 1e11) return "";
+  // GPS time runs ahead of UTC by the leap seconds inserted since 1980-01-06 (the GPS epoch); each entry is
+  // the GPS second at which one more applies (IERS Bulletin C; none since 2017-01-01).
+  static const double kLeapGpsSeconds[] = {
+      46828801,  78364802,  109900803, 173059204, 252028805, 315187206, 346723207,  393984008,  425520009,
+      457056010, 504489611, 551750412, 599184013, 820108814, 914803215, 1025136016, 1119744017, 1167264018};
+  int leap = 0;
+  for (double at : kLeapGpsSeconds) leap += gps_seconds >= at ? 1 : 0;
+  constexpr double kUnixAtGpsEpoch = 315964800;  // 1980-01-06T00:00:00Z
+  const std::time_t unix_seconds = static_cast<std::time_t>(std::floor(gps_seconds + kUnixAtGpsEpoch - leap));
+  std::tm utc{};
+  if (gmtime_r(&unix_seconds, &utc) == nullptr) return "";
+  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}Z", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday,
+                     utc.tm_hour, utc.tm_min, utc.tm_sec);
+}
+
+ScanHeader ScanHeaderOf(const Scan& scan) {
+  ScanHeader header;
+  header.name = scan.name;
+  header.organized = scan.rows > 1;
+  header.rows = scan.rows;
+  header.cols = scan.cols;
+  header.points = scan.num_cells();
+  header.world_from_scanner = scan.world_from_scanner;
+  header.channels = ChannelNames(scan);
+  return header;
+}
+
+ScanFileHeader ReadScanHeader(const std::string& path) {
+  CheckScanFileFormat(path);  // unknown extensions and LAZ are refused as ReadScanFile refuses them
+  ScanFileHeader file;
+  const std::string format = FileExtension(path);
+  const int64_t size = CheckRegularFile(path);
+  if (format == "e57") {
+    file = io_internal::ReadE57Header(path);
+  } else if (format == "ply") {
+    file = io_internal::ReadPlyScanHeader(path);
+  } else if (format == "pcd") {
+    file = io_internal::ReadPcdHeader(path);
+  } else if (format == "las") {
+    file = io_internal::ReadLasHeader(path);
+  } else if (format == "ptx") {
+    file.scans = io_internal::ReadPtxHeaders(path);
+    file.format_version = "PTX";
+  } else {
+    // XYZ and PTS have no header: what they hold is known only once read.
+    ScanFile scans = ReadScanFile(path);
+    for (const Scan& scan : scans.scans) file.scans.push_back(ScanHeaderOf(scan));
+    file.warnings = std::move(scans.warnings);
+    file.format_version = format == "pts" ? "PTS" : "XYZ";
+  }
+  file.path = path;
+  file.format = format;
+  file.file_size_bytes = size;
+  return file;
+}
+
+nlohmann::ordered_json ToJson(const ScanHeader& scan, int index) {
+  nlohmann::ordered_json json;
+  json["index"] = index;
+  if (!scan.name.empty()) json["name"] = scan.name;
+  json["organized"] = scan.organized;
+  auto known = [](int64_t value) { return value >= 0 ? nlohmann::ordered_json(value) : nullptr; };
+  json["rows"] = known(scan.rows);
+  json["cols"] = known(scan.cols);
+  json["cells"] = scan.rows >= 0 && scan.cols >= 0 ? nlohmann::ordered_json(scan.rows * scan.cols) : nullptr;
+  json["points"] = known(scan.points);
+  json["channels"] = scan.channels;
+  if (!scan.coordinates.empty()) json["coordinates"] = scan.coordinates;
+  json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
+  const nlohmann::ordered_json metadata = MetadataJson(scan.e57);
+  if (!metadata.empty()) json["e57"] = metadata;
+  return json;
+}
+
+nlohmann::ordered_json ToJson(const ScanFileHeader& header) {
+  nlohmann::ordered_json json;
+  json["file"] = header.path;
+  json["format"] = header.format;
+  if (!header.format_version.empty()) json["format_version"] = header.format_version;
+  json["size_bytes"] = header.file_size_bytes;
+  if (!header.guid.empty()) json["guid"] = header.guid;
+  if (!header.creation_utc.empty()) json["created_utc"] = header.creation_utc;
+  json["scans"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < header.scans.size(); ++i)
+    json["scans"].push_back(ToJson(header.scans[i], static_cast<int>(i)));
+  if (header.format == "e57") {
+    json["images"] = nlohmann::ordered_json::array();
+    for (size_t i = 0; i < header.images.size(); ++i) {
+      const ScanImageHeader& image = header.images[i];
+      nlohmann::ordered_json entry;
+      entry["index"] = i;
+      entry["name"] = image.name;
+      entry["representation"] = image.projection;
+      entry["width_px"] = image.width_px;
+      entry["height_px"] = image.height_px;
+      entry["encoding"] = image.encoding;
+      entry["encoded_bytes"] = image.encoded_bytes;
+      entry["scan"] = image.scan_index >= 0 ? nlohmann::ordered_json(image.scan_index) : nullptr;
+      entry["world_from_camera"] = MatrixJson(image.world_from_camera);
+      const nlohmann::ordered_json metadata = MetadataJson(image.e57);
+      if (!metadata.empty()) entry["e57"] = metadata;
+      json["images"].push_back(entry);
+    }
+  }
+  if (!header.warnings.empty()) json["warnings"] = header.warnings;
+  return json;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,112 @@
+// What a scan file says about itself without reading its points: the E57 XML section, the PTX scan headers,
+// the PLY / PCD / LAS headers. `lidarshop info` prints it (its --stats reads the points as well), the server
+// and the Python module can ask it before deciding to load a file.
+//
+// Per format, what comes from where (nothing else is read):
+//   .e57  the 48-byte file header and the XML section (its pages' CRCs checked): data3D entries (name, guid,
+//         sensor, acquisition dates, pose, recordCount, indexBounds for rows x cols, the prototype's fields
+//         as channels), images2D entries (name, size, kind, the scan they belong to) and the root's guid.
+//         An organized scan whose XML has no indexBounds has rows = cols = -1 (unknown without the points).
+//   .ptx  each scan's 10 header lines (columns, rows, pose) and its first point line (4 or 7 fields: colour);
+//         the point lines are skipped, not parsed, to find the next scan.
+//   .ply  the header up to end_header: the vertex count, the properties (channels), lidarshop's
+//         "lidarshop_scan" comments (grid and pose of each scan).
+//   .pcd  the header up to DATA: FIELDS (channels), WIDTH x HEIGHT, VIEWPOINT (pose as the reader makes it).
+//   .las  the public header block and the VLRs: point count, point format (colour), bounds.
+//   .xyz .pts  no header: the whole file is read (as ReadScanFile does).
+// Channels are named as ChannelNames (scan/scan.h) names them; a channel is listed only when the header
+// declares it ("intensity" only with a PCD/PLY intensity field, an E57 prototype's intensity, a PTX file (its
+// fourth column) or a LAS file (every LAS point format has one)). Values decide a few channels the full
+// reader adds (a LAS file whose classes are all 0 has no labels once read): the header lists what the file
+// can hold.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+// Sensor and acquisition facts of an E57 data3D or images2D entry; empty strings where the file says nothing.
+struct E57Metadata {
+  std::string guid;
+  std::string description;
+  std::string sensor_vendor, sensor_model, sensor_serial_number;
+  std::string sensor_hardware_version, sensor_software_version, sensor_firmware_version;
+  // Acquisition times as the file stores them (GPS seconds since 1980-01-06 00:00 UTC) and as UTC text
+  // ("2011-06-14T16:07:02Z", leap seconds applied); NaN / "" when absent.
+  double acquisition_start_gps_s = std::numeric_limits<double>::quiet_NaN();
+  double acquisition_end_gps_s = std::numeric_limits<double>::quiet_NaN();
+  std::string acquisition_start_utc, acquisition_end_utc;
+};
+
+// One scan of a file as its header describes it.
+struct ScanHeader {
+  std::string name;        // E57 data3D name, else ""
+  bool organized = false;  // a grid of rays (PTX, E57 rowIndex/columnIndex, lidarshop PLY, PCD HEIGHT > 1)
+  int64_t rows = -1, cols = -1;  // the grid (an unorganized cloud: 1 x points); -1 when unknown
+  int64_t points = -1;           // records the file stores for this scan (rows x cols for PTX and organized
+                                 // PCD, E57 recordCount, LAS/PLY point count); -1 when unknown
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
+  std::vector<std::string> channels;  // as ChannelNames names them
+  std::string coordinates;            // E57: "cartesian" or "spherical"; else ""
+  E57Metadata e57;                    // E57 only
+};
+
+// One images2D entry of an E57 file.
+struct ScanImageHeader {
+  std::string name;
+  std::string projection;  // "pinhole", "spherical", "cylindrical" or "visual"
+  std::string encoding;    // "jpeg" or "png"
+  int width_px = 0, height_px = 0;
+  int64_t encoded_bytes = 0;  // the blob's length
+  int scan_index = -1;        // the data3D entry whose guid associatedData3DGuid names; -1 when none
+  Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
+  E57Metadata e57;
+};
+
+struct ScanFileHeader {
+  std::string path;
+  std::string format;  // "ptx", "e57", "ply", "pcd", "las", "xyz", "pts"
+  int64_t file_size_bytes = 0;
+  std::string format_version;  // "E57 1.0", "PCD 0.7", "LAS 1.4 point format 7", "PLY binary_little_endian"
+  std::string guid;            // E57 root guid
+  std::string creation_utc;    // E57 creationDateTime as UTC text, "" when absent
+  std::vector<ScanHeader> scans;
+  std::vector<ScanImageHeader> images;  // E57 images2D
+  std::vector<std::string> warnings;    // as ScanFile::warnings
+};
+
+// Reads what `path` says about itself (see the table above), chosen by extension. Throws InputError naming
+// the file, the place and the field when the header is malformed or truncated, as the full reader would.
+ScanFileHeader ReadScanHeader(const std::string& path);
+
+// The header of scans already read (what ReadScanFile gives), for formats without a header and for tests:
+// rows, cols, points = cells, channels = ChannelNames.
+ScanHeader ScanHeaderOf(const Scan& scan);
+
+// The header as JSON, keys in reading order: file, format, format_version, size_bytes, guid, created,
+// scans [{index, name, organized, rows, cols, points, channels, world_from_scanner, e57 metadata}],
+// images [...]. Numbers keep their precision; the CLI prints it.
+nlohmann::ordered_json ToJson(const ScanFileHeader& header);
+nlohmann::ordered_json ToJson(const ScanHeader& scan, int index);
+
+// GPS seconds (since 1980-01-06T00:00:00Z, no leap seconds) as UTC text "YYYY-MM-DDThh:mm:ssZ"
+// (fractions of a second dropped), leap seconds up to 2017 applied; "" when not finite or before 1980.
+std::string UtcFromGpsSeconds(double gps_seconds);
+
+namespace io_internal {
+// The per-format header readers behind ReadScanHeader (each in its format's .cc).
+std::vector<ScanHeader> ReadPtxHeaders(const std::string& path);
+ScanFileHeader ReadE57Header(const std::string& path);
+ScanFileHeader ReadPlyScanHeader(const std::string& path);
+ScanFileHeader ReadPcdHeader(const std::string& path);
+ScanFileHeader ReadLasHeader(const std::string& path);
+}  // namespace io_internal
+
+}  // namespace lidarshop
