@@ -9,9 +9,9 @@
 //   sphere  the points projected from the scanner position (world_from_scanner's origin) onto a grid of
 //           square angular cells, azimuth increasing to the right, elevation up; the nearest point of each
 //           cell is kept. Azimuths start after the widest empty sector, so a cloud behind the scanner is not
-//           cut in two. Automatic size: about one cell per point over the angular bounding box
+//           cut in two. Automatic size: about three points a cell over the angular bounding box
 //   top     orthographic from above in the world frame: world x to the right, world y up, the highest point
-//           of each cell kept
+//           of each cell kept (automatic size as for sphere)
 //   front   orthographic from the front in the world frame: world x to the right, world z up, looking along
 //           world +y, the point with the smallest y of each cell kept
 //   auto    grid for organized scans, sphere for unorganized clouds (IsUnorganized)
