@@ -114,8 +114,8 @@ RenderResult FinishPicture(const Scan& cells, RenderResult colored, cv::Size siz
                            const RenderOptions& options) {
   colored.image = ResampleNearest(colored.image, size);
   const cv::Mat valid = ResampleNearest(cells.valid, size);
-  const bool any_no_return =
-      options.channel != RenderChannel::kValid && static_cast<size_t>(cv::countNonZero(valid)) < valid.total();
+  const bool any_no_return = options.channel != RenderChannel::kValid &&
+                             static_cast<size_t>(cv::countNonZero(valid)) < valid.total();
   if (any_no_return) PaintNoReturn(&colored.image, valid);
   if (!options.legend) return colored;
   cv::Mat legend;
