@@ -18,6 +18,8 @@ constexpr double kDegPerRad = 180.0 / M_PI;
 // Automatic projection sizes: about this many points a cell over the bounding box. Points fall on cells
 // unevenly (a Poisson-like spread leaves e^-3 = 5 % of a surface's cells empty at 3, 37 % at 1).
 constexpr double kPointsPerCell = 3.0;
+// Orthographic windows: these quantiles of the points on each axis.
+constexpr double kWindowLow = 0.005, kWindowHigh = 0.995, kWindowMargin = 0.25;
 
 double Median(std::vector<double>* values) {
   if (values->empty()) return 0.0;
@@ -201,6 +203,30 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
     }
   }
   if (projected.empty()) ThrowNothingToProject(scan, view);
+  // The window holds the 0.5-99.5 % quantiles on each axis and a quarter of their span around them (never
+  // more than the points' extent): a few far stray points (a terrestrial scan's distant ground rings) would
+  // otherwise shrink everything else to a corner, while the top of a thin post stays in. Points outside are
+  // left out.
+  auto quantile = [&](double fraction, bool along_u) {
+    std::vector<double> values;
+    values.reserve(projected.size());
+    for (const ProjectedPoint& p : projected) values.push_back(along_u ? p.u : p.v);
+    const size_t index =
+        std::min(values.size() - 1, static_cast<size_t>(fraction * (values.size() - 1) + 0.5));
+    std::nth_element(values.begin(), values.begin() + index, values.end());
+    return values[index];
+  };
+  const double u_low = quantile(kWindowLow, true), u_high = quantile(kWindowHigh, true);
+  const double v_low = quantile(kWindowLow, false), v_high = quantile(kWindowHigh, false);
+  const double u_margin = kWindowMargin * (u_high - u_low), v_margin = kWindowMargin * (v_high - v_low);
+  u_min = std::max(u_min, u_low - u_margin);
+  u_max = std::min(u_max, u_high + u_margin);
+  v_min = std::max(v_min, v_low - v_margin);
+  v_max = std::min(v_max, v_high + v_margin);
+  const int64_t all_points = static_cast<int64_t>(projected.size());
+  std::erase_if(projected, [&](const ProjectedPoint& p) {
+    return p.u < u_min || p.u > u_max || p.v < v_min || p.v > v_max;
+  });
   const double floor_m = 1e-3;
   const double u_span = std::max(u_max - u_min, floor_m), v_span = std::max(v_max - v_min, floor_m);
   const double step = std::sqrt(u_span * v_span * kPointsPerCell / static_cast<double>(projected.size()));
@@ -213,7 +239,7 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
   PictureLayout layout;
   layout.view = view;
   layout.cells = EmptyCells(scan, size);
-  layout.points = static_cast<int64_t>(projected.size());
+  layout.points = all_points;
   layout.points_kept = FillCells(scan, projected, &layout.cells);
   layout.picture_size = size;
   layout.pixel_width = step_across;

@@ -11,7 +11,9 @@
 //           cell is kept. Azimuths start after the widest empty sector, so a cloud behind the scanner is not
 //           cut in two. Automatic size: about three points a cell over the angular bounding box
 //   top     orthographic from above in the world frame: world x to the right, world y up, the highest point
-//           of each cell kept (automatic size as for sphere)
+//           of each cell kept (automatic size as for sphere). The window holds the 0.5-99.5 % quantiles of
+//           the points on each axis widened by a quarter of their span (at most the points' extent), so that
+//           a scan's few far stray points do not shrink the rest to a corner
 //   front   orthographic from the front in the world frame: world x to the right, world z up, looking along
 //           world +y, the point with the smallest y of each cell kept
 //   auto    grid for organized scans, sphere for unorganized clouds (IsUnorganized)

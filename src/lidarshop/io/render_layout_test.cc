@@ -138,9 +138,9 @@ TEST(RenderLayoutTest, SphereStartsAfterTheWidestEmptySector) {
 }
 
 TEST(RenderLayoutTest, OrthographicTopAndFrontViews) {
-  // A flat square 4 m x 2 m on the ground (z = 0) and a 1 m post at (1, 1): from above the post's top hides
-  // the ground under it.
-  Scan cloud = MakeScan(1, 41 * 21 + 1);
+  // A flat square 4 m x 2 m on the ground (z = 0), a 1 m post at (1, 1) (20 points: 2 %) and a stray point
+  // 50 m away: from above the post's top hides the ground under it, the stray point is left out.
+  Scan cloud = MakeScan(1, 41 * 21 + 21);
   int i = 0;
   auto add = [&](float x, float y, float z, float intensity) {
     cloud.valid.at<uint8_t>(0, i) = kValid;
@@ -154,7 +154,8 @@ TEST(RenderLayoutTest, OrthographicTopAndFrontViews) {
       add(-2.0f + 0.1f * a, 0.1f * b, 0.0f, 0.1f);
     }
   }
-  add(1.0f, 1.0f, 1.0f, 0.9f);
+  for (int k = 1; k <= 20; ++k) add(1.0f, 1.0f, 0.05f * k, 0.9f);
+  add(50.0f, 1.0f, 0.0f, 0.1f);
   cloud.world_from_scanner(2, 3) = 1.5;  // the scanner 1.5 m up: world z = 1.5 + scanner z
 
   PictureLayoutOptions top;
@@ -164,9 +165,13 @@ TEST(RenderLayoutTest, OrthographicTopAndFrontViews) {
   const PictureLayout layout = LayOutPicture(cloud, top);
   EXPECT_EQ(layout.pixel_unit, "m");
   EXPECT_EQ(layout.picture_size, cv::Size(41, 21));
-  // World x = 1 m is column 30, world y = 1 m is row 10 (y up); the post's top is kept there.
-  EXPECT_FLOAT_EQ(layout.cells.point.at<cv::Vec3f>(10, 30)[2], 1.0f);
-  EXPECT_FLOAT_EQ(layout.cells.intensity.at<float>(10, 30), 0.9f);
+  // The window: x from -2 m to the 99.5 % quantile (2 m) plus a quarter of the span, 3 m, not 50 m: the stray
+  // point is left out.
+  EXPECT_NEAR(layout.pixel_width * 41, 5.0, 1e-6);
+  EXPECT_EQ(layout.points, 41 * 21 + 21);
+  // World x = 1 m is column 24 (3 m of 5 m), world y = 1 m is row 10 (y up); the post's top is kept there.
+  EXPECT_FLOAT_EQ(layout.cells.point.at<cv::Vec3f>(10, 24)[2], 1.0f);
+  EXPECT_FLOAT_EQ(layout.cells.intensity.at<float>(10, 24), 0.9f);
 
   PictureLayoutOptions front = top;
   front.view = PictureView::kFront;
