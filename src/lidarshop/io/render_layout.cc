@@ -340,7 +340,7 @@ std::string PictureLayout::Describe() const {
     case PictureView::kFront:
       return fmt::format(
           "{} points projected orthographically ({} view, world frame): {} pixels of {}; {} "
-          "points shown, {} hidden behind nearer ones",
+          "points shown, {} hidden behind nearer ones or outside the window",
           points, ToString(view), size, pixel, points_kept, points - points_kept);
     case PictureView::kAuto:
     case PictureView::kGrid:
