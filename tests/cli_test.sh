@@ -193,6 +193,74 @@ exits_with 1 "read_error.e57: its points are refused as documented" \
   "read_error.e57: XML section: field 'e57Root/data3D/vectorChild/points': records 0 and 1 both claim row 0, column 0" \
   "$lidarshop" info --stats "$shared/e57/read_error.e57"
 check "render pumpA" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump.png" --channel rgb
+
+# render: square angular pixels. pumpA's rays are 0.250 deg across and 0.0675 deg down (345 x 1074): the
+# picture is 3.7 times as wide as one pixel per ray, its aspect the scan's angular aspect (86 deg x 72.5 deg).
+picture_size() {  # picture_size FILE.png: "width height" from the PNG header
+  python3 -c "import struct,sys; d=open(sys.argv[1],'rb').read(24); print(*struct.unpack('>II', d[16:24]))" "$1"
+}
+check "render pumpA --json" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump_range.png" --json "$work/pump_range.json"
+json_check "render pumpA: square angular pixels" "$work/pump_range.json" \
+  "d['layout']['view'] == 'grid' and abs(d['layout']['pixel_width'] - d['layout']['pixel_height']) < 0.001 and \
+   abs(d['width_px'] / d['height_px'] - (345 * 0.2498) / (1074 * 0.06754)) < 0.01 and d['height_px'] == 1074"
+check "render pumpA: the picture has the size --json says" test "$(picture_size "$work/pump_range.png")" = "1276 1074"
+check "render --aspect native: one pixel per ray" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump_native.png" \
+  --aspect native --quiet
+check "render --aspect native size" test "$(picture_size "$work/pump_native.png")" = "345 1074"
+check "render --width keeps the aspect" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump_w.png" --width 638 --quiet
+check "render --width size" test "$(picture_size "$work/pump_w.png")" = "638 537"
+check "render --width --height" "$lidarshop" render "$shared/e57/pumpA.e57" -o "$work/pump_wh.png" --width 300 \
+  --height 100 --quiet
+check "render --width --height size" test "$(picture_size "$work/pump_wh.png")" = "300 100"
+fails_clearly "render --width below 16" "width" "$lidarshop" render "$work/scan.ptx" -o "$work/x.png" --width 8
+
+# render: an unorganized cloud (an E57 without row/column) is projected onto a spherical grid, and says so.
+check "render an unorganized E57" "$lidarshop" render "$shared/e57/bunnyFloat.e57" -o "$work/bunny.png" \
+  --json "$work/bunny.json"
+cp "$work/last.err" "$work/bunny.err"
+check "render says it projected the cloud" grep -q "^lidarshop render: unorganized cloud of 30571 points projected onto a spherical grid" "$work/bunny.err"
+json_check "render of a cloud is not N x 1" "$work/bunny.json" \
+  "d['layout']['view'] == 'sphere' and d['width_px'] > 50 and d['height_px'] > 50 and \
+   d['layout']['points'] == 30571 and 0 < d['layout']['points_kept'] <= 30571"
+check "render --view top" "$lidarshop" render "$shared/e57/bunnyFloat.e57" -o "$work/bunny_top.png" --view top \
+  --channel normals --legend --json "$work/bunny_top.json" --quiet
+cp "$work/last.err" "$work/bunny_top.err"
+check "render --quiet says nothing" test ! -s "$work/bunny_top.err"
+json_check "render --view top is orthographic in metres" "$work/bunny_top.json" \
+  "d['layout']['view'] == 'top' and d['layout']['pixel_unit'] == 'm'"
+python3 - "$work/cloud.pcd" <<'PY'
+import math, sys
+# An unorganized cloud as Open3D writes it (HEIGHT 1): a wall 6 m ahead seen over 60 x 20 degrees.
+points = [(6 * math.cos(math.radians(e)) * math.sin(math.radians(a)), 6 * math.cos(math.radians(e)) * math.cos(math.radians(a)),
+           6 * math.sin(math.radians(e))) for a in range(-30, 31) for e in range(-10, 11)]
+with open(sys.argv[1], "w") as f:
+    f.write("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n")
+    f.write(f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(points)}\nDATA ascii\n")
+    f.writelines(f"{x:.5f} {y:.5f} {z:.5f}\n" for x, y, z in points)
+PY
+check "render an unorganized PCD" "$lidarshop" render "$work/cloud.pcd" -o "$work/cloud.png" \
+  --json "$work/cloud.json" --quiet
+json_check "render of a PCD cloud is projected" "$work/cloud.json" \
+  "d['layout']['view'] == 'sphere' and d['height_px'] > 10 and abs(d['width_px'] / d['height_px'] - 3) < 0.3"
+
+# render: float pictures hold the values (the C++ test checks them value by value).
+for extension in exr tif; do
+  check "render range .$extension" "$lidarshop" render "$work/scan.ptx" -o "$work/range.$extension" --json \
+    "$work/range_$extension.json" --quiet
+  json_check "render range .$extension is float metres" "$work/range_$extension.json" "'metres' in d['values']"
+done
+check "range.exr is OpenEXR" python3 -c "import sys; sys.exit(open('$work/range.exr','rb').read(4) != b'\x76\x2f\x31\x01')"
+fails_clearly "render rgb as .exr" "range, intensity or normals" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --channel rgb
+fails_clearly "render --legend as .exr" "legend" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --legend
+
+# Label legends name the scene's objects; scan --labels writes the colour picture beside the raw one.
+check "scan wrote the colour labels beside the raw ones" test -s "$work/labels_color.png"
+check "render labels with the scene's names" "$lidarshop" render "$work/scan_labels.ply" -o "$work/named.png" \
+  --channel labels --legend --scene "$work/scene/scene.json" --quiet
+check "render labels without names" "$lidarshop" render "$work/scan_labels.ply" -o "$work/unnamed.png" \
+  --channel labels --legend --quiet
+check "names widen the label legend" test "$(picture_size "$work/named.png" | cut -d' ' -f1)" -gt \
+  "$(picture_size "$work/unnamed.png" | cut -d' ' -f1)"
 check "info mug pcd" "$lidarshop" info "$shared/rgbd/table_scene_mug_stereo_textured.pcd"
 
 # verify: the box (label 2) at its true pose, and 1 m towards the scanner.
@@ -744,6 +812,16 @@ fails_clearly "a negative precision is refused" "e57-precision-m" \
 # The demo on a small built-in scene.
 check "demo" "$lidarshop" demo --scene mailbox --out "$work/demo" --quiet
 json_check "demo summary" "$work/demo/summary.json" "d['scene'] == 'mailbox' and d['scan']['valid'] > 0"
+# The page links every file the demo wrote and shows every picture.
+for file in "$work"/demo/*; do
+  name=$(basename "$file")
+  [ "$name" = index.html ] && continue
+  check "demo index links $name" grep -qF "href=\"$name\"" "$work/demo/index.html"
+  case "$name" in *.png) check "demo index shows $name" grep -qF "src=\"$name\"" "$work/demo/index.html" ;; esac
+done
+check "demo wrote a second viewpoint and float range" test -s "$work/demo/top_view.png" -a -s "$work/demo/range.exr"
+check "demo index explains the verification thresholds" grep -qE "passes above 0\.75.*passes above 0\.30" "$work/demo/index.html"
+check "demo index colours pass and fail" grep -qE "<td>(pass|fail)</td>" "$work/demo/index.html"
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

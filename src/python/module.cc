@@ -10,6 +10,7 @@
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/pointset/clustering.h"
 #include "lidarshop/pointset/features.h"
@@ -53,6 +54,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<PtxReadOptions>(m);
   BindStruct<E57WriteOptions>(m);
   BindStruct<PointViewOptions>(m);
+  BindStruct<PictureLayoutOptions>(m);
   // Verification
   BindStruct<ModelOptions>(m);
   BindStruct<VerifyOptions>(m);

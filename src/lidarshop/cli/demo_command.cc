@@ -1,6 +1,7 @@
 // `lidarshop demo`: the main job on a built-in scene, end to end, with every result in one folder.
 //
-//   1. scan      synthesize the scene (ground truth included): scan.ptx, scan.e57, labels.png, pictures
+//   1. scan      synthesize the scene (ground truth included): scan.ptx, scan.e57, labels.png, pictures of
+//                every channel, range.exr, top_view.png (a second viewpoint)
 //   2. verify    every standing object at its true pose, and at wrong poses, against the scan: verify.json;
 //                in the parking lot, a sweep of one car's model over the lot: sweep_*.png, sweep.csv
 //   3. segment   cut one object out from two automatic strokes, compared with the true labels: segment_*.png
@@ -25,6 +26,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
+#include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/scanner.h"
@@ -66,6 +68,9 @@ std::string SceneName(const std::string& scene) { return fs::path(scene).stem().
 void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& stream) { stream << text; });
 }
+
+constexpr const char* kPassColor = "#d8f0d8";
+constexpr const char* kFailColor = "#f6d5d5";
 
 json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
@@ -256,7 +261,8 @@ json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::s
   WriteScanFile((out_dir / "removed.e57").string(), {fill.scan});
   RenderOptions range;
   range.channel = RenderChannel::kRange;
-  WriteImage((out_dir / "remove_range.png").string(), RenderScan(fill.scan, range).image);
+  range.legend = true;
+  WriteImage((out_dir / "remove_range.png").string(), RenderPicture(fill.scan, range, {}).image);
   PointViewOptions view = SideView(truth, hole, 35.0);
   view.width_px = 540;
   view.height_px = 360;
@@ -277,6 +283,89 @@ json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::s
           {"seconds", fill.timings.total_s}};
 }
 
+// Step 1's pictures: every channel with its legend (square angular pixels), the range as float metres, and
+// the points from above (a second viewpoint: what the ray picture cannot show, distances on the ground).
+void WriteScanPictures(const SceneDescription& scene, const Scan& scan, const fs::path& out_dir) {
+  const std::vector<std::pair<std::string, RenderChannel>> views = {{"rgb", RenderChannel::kRgb},
+                                                                    {"range", RenderChannel::kRange},
+                                                                    {"intensity", RenderChannel::kIntensity},
+                                                                    {"labels_view", RenderChannel::kLabels},
+                                                                    {"normals", RenderChannel::kNormals}};
+  for (const auto& [name, channel] : views) {
+    RenderOptions options;
+    options.channel = channel;
+    options.legend = channel != RenderChannel::kRgb;
+    options.label_names = ObjectNamesByLabel(scene);
+    WriteImage((out_dir / (name + ".png")).string(), RenderPicture(scan, options, {}).image);
+  }
+  PictureLayoutOptions native;
+  native.aspect = PixelAspect::kNative;
+  WriteImage((out_dir / "range.exr").string(), RenderValues(scan, RenderChannel::kRange, native).values);
+  // From above, the points around the standing objects (2 m around their footprints): the far ground's sparse
+  // rings would leave the objects a few pixels in the middle.
+  Eigen::AlignedBox3d around;
+  for (const SceneObject& object : scene.objects) {
+    if (IsStandingObject(object)) around.extend(Bounds(MeshInWorld(object)).cast<double>());
+  }
+  cv::Mat near_objects(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  if (!around.isEmpty()) {
+    for (int row = 0; row < scan.rows; ++row) {
+      for (int col = 0; col < scan.cols; ++col) {
+        const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
+        const bool inside = p.x() > around.min().x() - 2 && p.x() < around.max().x() + 2 &&
+                            p.y() > around.min().y() - 2 && p.y() < around.max().y() + 2;
+        if (scan.valid.at<uint8_t>(row, col) && inside) near_objects.at<uint8_t>(row, col) = 255;
+      }
+    }
+  }
+  const Scan shown = cv::countNonZero(near_objects) > 0 ? MaskScan(scan, near_objects) : scan;
+  RenderOptions top_colors;
+  top_colors.channel = RenderChannel::kRgb;
+  PictureLayoutOptions top;
+  top.view = PictureView::kTop;
+  top.max_side_px = 900;
+  WriteImage((out_dir / "top_view.png").string(), RenderPicture(shown, top_colors, top).image);
+}
+
+// Every file the demo writes (index.html aside), with what it holds; the index links them all.
+std::vector<std::pair<std::string, std::string>> DemoFiles(const json& summary) {
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"scan.ptx", "the synthetic scan, Leica PTX (ASCII)"},
+      {"scan.e57", "the synthetic scan, E57"},
+      {"labels.png",
+       "true object label of every ray, raw 16-bit PNG (65535 = no return); labels_view.png is "
+       "its colour picture"},
+      {"rgb.png", "the scan's colour"},
+      {"range.png", "range in metres"},
+      {"range.exr", "range in metres as 32-bit floats, one pixel per ray, NaN = no return"},
+      {"intensity.png", "return intensity"},
+      {"labels_view.png", "object labels in colour, with the objects' names"},
+      {"normals.png", "surface normals, with the key of their colours"},
+      {"top_view.png", "the points around the objects seen from above (orthographic, world x right, y up)"},
+      {"verify.json", "the verification table as JSON"}};
+  if (summary.contains("sweep")) {
+    files.insert(files.end(),
+                 {{"sweep_consistency.png", "sweep: best consistency over headings, per position"},
+                  {"sweep_confidence.png", "sweep: best confidence over headings, per position"},
+                  {"sweep.csv", "sweep: every pose evaluated"}});
+  }
+  if (summary.contains("segment")) {
+    files.insert(files.end(), {{"segment_overlay.png", "segmentation: the cut over the scan's colour"},
+                               {"segment_mask.png", "segmentation: the object's cells (white)"},
+                               {"segment_strokes.png", "segmentation: the automatic strokes"}});
+  }
+  if (summary.contains("remove")) {
+    files.insert(files.end(),
+                 {{"removed.e57", "the scan with the object removed and the hole filled"},
+                  {"remove_range.png", "range after the removal"},
+                  {"remove_view_scan.png", "35° aside: the scan with the object"},
+                  {"remove_view_truth.png", "35° aside: the scene scanned without the object"},
+                  {"remove_view_filled.png", "35° aside: the fill (synthesized points magenta)"}});
+  }
+  files.push_back({"summary.json", "every number of this page"});
+  return files;
+}
+
 std::string IndexHtml(const std::string& scene_name, const json& summary) {
   std::string html = fmt::format(
       "<!doctype html><html><head><meta charset=\"utf-8\"><title>lidarshop demo: {0}</title>"
@@ -284,21 +373,63 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
       "image-rendering:pixelated;border:1px solid #ccc}}td,th{{padding:2px 8px;text-align:right}}"
       "pre{{background:#f4f4f4;padding:1em}}</style></head><body><h1>lidarshop demo: {0}</h1>",
       scene_name);
+  auto figure = [](const std::string& file, const std::string& caption, const std::string& width = "") {
+    return fmt::format(
+        "<figure style=\"display:inline-block;margin:4px;vertical-align:top{}\"><a href=\"{}\">"
+        "<img src=\"{}\"></a><figcaption>{}</figcaption></figure>",
+        width.empty() ? "" : ";width:" + width, file, file, caption);
+  };
   html +=
-      "<h2>1. The synthetic scan</h2><p>Colour, range (metres) and the true object labels, one pixel per ray "
-      "(row 0 = highest elevation).</p><img src=\"rgb.png\"><img src=\"range.png\"><img "
-      "src=\"labels_view.png\">";
+      "<h2>1. The synthetic scan</h2><p>Every channel of the scan as a picture: azimuth to the right, "
+      "elevation "
+      "up (row 0 = highest ray), square angular pixels. Cells where the ray returned nothing are a magenta / "
+      "pink checker, a colour no colour map uses. The raw label image (16-bit, one object label per ray) "
+      "looks "
+      "black in a browser; its colour version has the objects' names.</p>";
+  html += figure("rgb.png", "colour") + figure("range.png", "range (m)") +
+          figure("intensity.png", "intensity") + figure("labels_view.png", "object labels") +
+          figure("normals.png", "surface normals (scanner frame)") +
+          figure("labels.png", "raw 16-bit labels (<a href=\"labels.png\">labels.png</a>)");
   html +=
-      "<h2>2. Verification</h2><table><tr><th>object</th><th>pose</th><th>consistency</th>"
-      "<th>confidence</th><th>ICP cost (m)</th></tr>";
+      "<h3>A second viewpoint</h3><p>The points within 2 m of the standing objects seen from straight above "
+      "(orthographic, world x to the right, world y up, the highest point of each cell shown): where the ray "
+      "picture shows directions, this shows distances on the ground and the shadows behind objects.</p>" +
+      figure("top_view.png", "top view");
+  const SweepOptions thresholds;
+  html += fmt::format(
+      "<h2>2. Verification</h2><p>Every standing object at its true pose and at two wrong ones, checked "
+      "against the scan. <b>Consistency</b>: of the rays that meet the posed model, the share whose measured "
+      "point is not behind the model (a ray that returned from behind the model went through it): it passes "
+      "above {:.2f}; &mdash; means no ray met the model. <b>Confidence</b>: the share of the model's surface "
+      "the scan has seen: it passes above {:.2f} (one side of a car reaches about 0.3). A pose passes when "
+      "both pass: <span style=\"background:{}\">&nbsp;green row&nbsp;</span> = pass, <span "
+      "style=\"background:{}\">&nbsp;red row&nbsp;</span> = fail, and the failing measure in bold red. "
+      "Expect "
+      "the true poses to pass, the pose 1 m towards the scanner to fail consistency (it stands in front of "
+      "what the scanner saw) and the pose 1 m away to fail confidence (hidden in the object's shadow, "
+      "nothing "
+      "contradicts it but nothing supports it). The <b>ICP cost</b> (mean distance from the scan points near "
+      "the model to the model, metres) is the usual score, shown for comparison: it cannot tell these "
+      "apart.</p><table><tr><th>object</th><th>pose</th><th>consistency</th><th>confidence</th><th>ICP cost "
+      "(m)</th><th>verdict</th></tr>",
+      thresholds.min_consistency, thresholds.min_confidence, kPassColor, kFailColor);
   for (const json& entry : summary["verify"]) {
     auto format_number = [](const json& value) {
       return value.is_null() ? std::string("—") : fmt::format("{:.3f}", value.get<double>());
     };
-    html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>",
-                        entry["object"].get<std::string>(), entry["pose"].get<std::string>(),
-                        format_number(entry["consistency"]), format_number(entry["confidence"]),
-                        format_number(entry["icp_cost"]));
+    const bool consistent =
+        !entry["consistency"].is_null() && entry["consistency"].get<double>() > thresholds.min_consistency;
+    const bool confident = entry["confidence"].get<double>() > thresholds.min_confidence;
+    auto cell = [](const std::string& text, bool pass) {
+      return pass ? fmt::format("<td>{}</td>", text)
+                  : fmt::format("<td style=\"color:#b00000;font-weight:bold\">{}</td>", text);
+    };
+    html +=
+        fmt::format("<tr style=\"background:{}\"><td>{}</td><td>{}</td>{}{}<td>{}</td><td>{}</td></tr>",
+                    consistent && confident ? kPassColor : kFailColor, entry["object"].get<std::string>(),
+                    entry["pose"].get<std::string>(), cell(format_number(entry["consistency"]), consistent),
+                    cell(format_number(entry["confidence"]), confident), format_number(entry["icp_cost"]),
+                    consistent && confident ? "pass" : "fail");
   }
   html += "</table>";
   if (summary.contains("sweep")) {
@@ -318,7 +449,8 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
     html += fmt::format(
         "<h2>3. Segmentation</h2><p>Object '{}' cut out from two automatic strokes (green object, red "
         "background): IoU {:.3f}, precision {:.3f}, recall {:.3f} against the true labels.</p>"
-        "<img src=\"segment_overlay.png\">",
+        "<img src=\"segment_overlay.png\"><br><img src=\"segment_strokes.png\" width=\"49%\"> <img "
+        "src=\"segment_mask.png\" width=\"49%\"><br>The strokes (left) and the cut (right, white = object).",
         segment["object"].get<std::string>(), segment["iou"].get<double>(),
         segment["precision"].get<double>(), segment["recall"].get<double>());
   }
@@ -338,6 +470,14 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
         100 * remove["floating_points"].get<double>(), 100 * remove["return_accuracy"].get<double>(),
         remove["color_psnr_db"].get<double>(), remove["seconds"].get<double>());
   }
+  html += "<h2>Files</h2><p>Everything in this folder:</p><table>";
+  for (const auto& [file, what] : DemoFiles(summary)) {
+    html += fmt::format(
+        "<tr><td style=\"text-align:left\"><a href=\"{0}\">{0}</a></td><td "
+        "style=\"text-align:left\">{1}</td></tr>",
+        file, what);
+  }
+  html += "</table>";
   html += fmt::format("<h2>Summary</h2><pre>{}</pre></body></html>\n", summary.dump(2));
   return html;
 }
@@ -371,16 +511,7 @@ int RunDemoSteps(const DemoSettings& settings) {
   WriteScanFile((out_dir / "scan.e57").string(), {scan});
   progress->Advance();
   WriteImage((out_dir / "labels.png").string(), LabelImage16(scan));
-  const std::vector<std::pair<std::string, RenderChannel>> views = {{"rgb", RenderChannel::kRgb},
-                                                                    {"range", RenderChannel::kRange},
-                                                                    {"intensity", RenderChannel::kIntensity},
-                                                                    {"labels_view", RenderChannel::kLabels}};
-  for (const auto& [name, channel] : views) {
-    RenderOptions options;
-    options.channel = channel;
-    options.legend = channel == RenderChannel::kRange || channel == RenderChannel::kLabels;
-    WriteImage((out_dir / (name + ".png")).string(), RenderScan(scan, options).image);
-  }
+  WriteScanPictures(scene, scan, out_dir);
   progress->Advance(2);
   seconds["write"] = timer.Seconds();
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/image/colormap.h"
@@ -13,10 +14,12 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/render.h"
+#include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
+#include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
@@ -307,22 +310,61 @@ int RunConvert(int argc, char** argv) {
       &binder);
 }
 
+// The object names of a scene file or a built-in scene, by label, for the labels legend.
+std::map<int32_t, std::string> SceneLabelNames(const std::string& scene) {
+  for (const BuiltinScene& builtin : BuiltinScenes()) {
+    if (scene == builtin.name) {
+      return ObjectNamesByLabel(ParseScene(builtin.json, fmt::format("built-in scene '{}'", scene), ""));
+    }
+  }
+  return ObjectNamesByLabel(LoadScene(scene));
+}
+
+bool IsFloatPicture(const std::string& path) {
+  const std::string extension = FileExtension(path);
+  return extension == "exr" || extension == "tif" || extension == "tiff";
+}
+
+nlohmann::ordered_json LayoutJson(const PictureLayout& layout) {
+  nlohmann::ordered_json json;
+  json["view"] = ToString(layout.view);
+  json["description"] = layout.Describe();
+  json["pixel_width"] = layout.pixel_width;
+  json["pixel_height"] = layout.pixel_height;
+  json["pixel_unit"] = layout.pixel_unit;
+  json["source_rows"] = layout.cells.rows;
+  json["source_cols"] = layout.cells.cols;
+  if (layout.view != PictureView::kGrid) {
+    json["points"] = layout.points;
+    json["points_kept"] = layout.points_kept;
+  }
+  return json;
+}
+
 int RunRender(int argc, char** argv) {
-  CLI::App app{"Render a channel of a scan as a picture: one pixel per ray, row 0 = top (highest elevation).",
-               "render"};
-  std::string input, output, channel = "range", color_map, json_path;
-  int scan_index = 0;
+  CLI::App app{
+      "Render a channel of a scan as a picture, row 0 = top (highest elevation): square angular pixels by "
+      "default (--aspect native: one pixel per ray); an unorganized cloud is projected onto a spherical grid "
+      "around the scanner (--view top|front: orthographic). .exr / .tif write the values as 32-bit floats.",
+      "render"};
+  std::string input, output, channel = "range", color_map, json_path, scene_names;
+  int scan_index = 0, width_px = 0, height_px = 0;
   RenderOptions options;
+  PictureLayoutOptions layout_options;
   OptionBinder binder(app);
   app.add_option("file", input, "scan file")->required();
-  app.add_option("-o,--output", output, "picture to write (.png, .jpg)")->required();
+  app.add_option("-o,--output", output,
+                 "picture to write: .png, .jpg (colours); .exr, .tif (range in metres, intensity or normals "
+                 "as 32-bit floats, NaN where no return)")
+      ->required();
   AddJsonOption(app, &json_path);
   // RenderOptions is not described (an optional colour map, NaN bounds): its flags are bound here, with the
   // choices of the described enums.
   const EnumInfo& channels = EnumInfoOf<RenderChannel>();
   const EnumInfo& color_maps = EnumInfoOf<ColorMap>();
   app.add_option("--channel", channel, "what to draw")->capture_default_str()->check(ChoiceOf(channels));
-  app.add_flag("--legend", options.legend, "add a colour scale bar (or label swatches) to the right");
+  app.add_flag("--legend", options.legend,
+               "add a colour scale bar, label swatches with names, or the normals key to the right");
   app.add_option("--scan", scan_index, "which scan of the file (from 0)")->capture_default_str();
   app.add_option("--colormap", color_map,
                  "colour map of metric channels (default: viridis for range, gray "
@@ -331,6 +373,16 @@ int RunRender(int argc, char** argv) {
   app.add_option("--min", options.min_value,
                  "value of the first colour (metres for range); default: 1 % quantile");
   app.add_option("--max", options.max_value, "value of the last colour; default: 99 % quantile");
+  app.add_option("--scene", scene_names,
+                 "a scene file or built-in scene whose object names label the labels legend");
+  // Picture size: the ray picture's and the second viewpoint's.
+  app.add_option("--width", width_px,
+                 "picture width in pixels (default: automatic; second viewpoint: 640); with only --width or "
+                 "--height the other keeps the aspect")
+      ->check(CLI::Range(16, 16384));
+  app.add_option("--height", height_px,
+                 "picture height in pixels (default: automatic; second viewpoint: 480)")
+      ->check(CLI::Range(16, 16384));
   // A second viewpoint: the points seen by a pinhole camera (colours, or grey intensity).
   std::vector<double> eye, target;
   double orbit_deg = std::numeric_limits<double>::quiet_NaN();
@@ -346,18 +398,23 @@ int RunRender(int argc, char** argv) {
                  "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
   app.add_option("--around", around_path,
                  "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
-  binder.Bind(&view, {.flags = {{"field_of_view_deg", "--fov"},
-                                {"width_px", "--width"},
-                                {"height_px", "--height"},
+  binder.Bind(&view, {.keys = {"field_of_view_deg", "point_size_px", "synthesized_tint"},
+                      .flags = {{"field_of_view_deg", "--fov"},
                                 {"point_size_px", "--point-size"},
                                 {"synthesized_tint", "--tint-synthesized"}},
                       .group = "Second viewpoint (--eye / --orbit)"});
-  bool quiet = false;  // rendering shows no progress; accepted like every other command's --quiet
+  binder.NameFlag("width_px", "--width");
+  binder.NameFlag("height_px", "--height");
+  binder.Bind(&layout_options, {.keys = {"view", "aspect"}, .group = "Picture layout"});
+  bool quiet = false;
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
       [&] {
+        if (width_px > 0) view.width_px = layout_options.width_px = width_px;
+        if (height_px > 0) view.height_px = layout_options.height_px = height_px;
         binder.Validate(view);
+        binder.Validate(layout_options);
         CheckOutputPath(output, {input, around_path});
         CheckOutputFile("--json", json_path, {}, {input, around_path, output});
         nlohmann::ordered_json json;
@@ -392,21 +449,44 @@ int RunRender(int argc, char** argv) {
         if (!color_map.empty())
           options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
         options.Check();
+        const bool float_picture = IsFloatPicture(output);
+        if (float_picture && options.legend) {
+          throw OptionsError(fmt::format("--legend draws on 8-bit pictures; {} holds float values", output));
+        }
+        if (float_picture && !HasFloatValues(options.channel)) {
+          throw OptionsError(fmt::format(
+              "{}: float pictures hold range, intensity or normals, not {}; write a .png", output, channel));
+        }
+        if (!scene_names.empty()) options.label_names = SceneLabelNames(scene_names);
         const ScanFile file = ReadScanFileAndWarn(input);
         Scan scan = PickScan(file, scan_index, "--scan");
         // Errors about the scan's channels name the file (and the scan, when the file names it).
         scan.name = scan.name.empty() ? input : fmt::format("{} (scan '{}')", input, scan.name);
-        const RenderResult result = RenderScan(scan, options);
-        WriteImage(output, result.image);
         json["output"] = output;
         json["channel"] = channel;
-        json["width_px"] = result.image.cols;
-        json["height_px"] = result.image.rows;
-        if (result.scale) {
-          json["scale"] = {{"min", result.scale->min_value},
-                           {"max", result.scale->max_value},
-                           {"unit", result.scale->unit}};
+        PictureLayout layout;
+        if (float_picture) {
+          ValuesResult values = RenderValues(scan, options.channel, layout_options);
+          WriteImage(output, values.values);
+          json["width_px"] = values.values.cols;
+          json["height_px"] = values.values.rows;
+          json["values"] = options.channel == RenderChannel::kRange ? "float32 metres, NaN = no return"
+                                                                    : "float32, NaN = no return";
+          layout = std::move(values.layout);
+        } else {
+          PictureResult result = RenderPicture(scan, options, layout_options);
+          WriteImage(output, result.image);
+          json["width_px"] = result.image.cols;
+          json["height_px"] = result.image.rows;
+          if (result.scale) {
+            json["scale"] = {{"min", result.scale->min_value},
+                             {"max", result.scale->max_value},
+                             {"unit", result.scale->unit}};
+          }
+          layout = std::move(result.layout);
         }
+        json["layout"] = LayoutJson(layout);
+        if (!quiet) fmt::print(stderr, "lidarshop render: {}\n", layout.Describe());
         WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
         return 0;
       },

@@ -4,6 +4,8 @@
 // Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) or of a built-in scene
 // (parking_lot, ...: the scenes of `demo --scene`) with the synthetic scanner and writes it; --json writes one JSON object with the counts and the seconds of each stage
 // (--stats = --json -). Scanner flags (--rows, --seed, ...) override the scene's "scanner" entries.
+#include <filesystem>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -12,6 +14,7 @@
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
+#include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/scan_mesh.h"
@@ -24,6 +27,15 @@
 #include "lidarshop/util/timer.h"
 
 namespace lidarshop::cli {
+namespace {
+
+// L.png -> L_color.png, beside the raw label image.
+std::string ColorLabelsPath(const std::string& labels_path) {
+  const std::filesystem::path path(labels_path);
+  return (path.parent_path() / (path.stem().string() + "_color.png")).string();
+}
+
+}  // namespace
 
 int RunScan(int argc, char** argv) {
   CLI::App app("Synthesize an organized scan of a scene description (JSON) with the synthetic scanner.",
@@ -44,7 +56,8 @@ int RunScan(int argc, char** argv) {
       ->required();
   app.add_option(
       "--labels", labels_path,
-      "per-ray object labels as a 16-bit single-channel PNG (65535 where the ray returned nothing)");
+      "per-ray object labels as a 16-bit single-channel PNG (65535 where the ray returned nothing); their "
+      "colour picture with the objects' names goes beside it (L.png -> L_color.png)");
   app.add_option("--mesh", mesh_path, "triangle mesh of the scan (.ply): adjacent returns joined");
   AddJsonOption(app, &json_path);
   app.add_flag("--stats", stats, "= --json -: counts and seconds per stage as one JSON object on stdout");
@@ -60,6 +73,8 @@ int RunScan(int argc, char** argv) {
         CheckOption(threads >= 0, fmt::format("--threads must be >= 0, got {}", threads));
         CheckOutputPath(output_path, {scene_path});
         if (!labels_path.empty()) CheckOutputPath(labels_path, {scene_path, output_path});
+        const std::string labels_color_path = labels_path.empty() ? "" : ColorLabelsPath(labels_path);
+        if (!labels_path.empty()) CheckOutputPath(labels_color_path, {scene_path, output_path, labels_path});
         if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
         CheckOutputFile("--json", json_path, {}, {scene_path, output_path, labels_path, mesh_path});
         binder.Validate(mesh_options);
@@ -93,6 +108,12 @@ int RunScan(int argc, char** argv) {
         if (!labels_path.empty()) {
           stage.Restart();
           WriteImage(labels_path, LabelImage16(scan));
+          // One pixel per ray like the raw image, so the two overlay; the legend names the objects.
+          RenderOptions colors;
+          colors.channel = RenderChannel::kLabels;
+          colors.legend = true;
+          colors.label_names = ObjectNamesByLabel(scene);
+          WriteImage(labels_color_path, RenderScan(scan, colors).image);
           writing_labels_seconds = stage.Seconds();
         }
         if (!mesh_path.empty()) {
@@ -108,6 +129,10 @@ int RunScan(int argc, char** argv) {
           nlohmann::ordered_json json;
           json["scene"] = scene_path;
           json["output"] = output_path;
+          if (!labels_path.empty()) {
+            json["labels"] = labels_path;
+            json["labels_color"] = labels_color_path;
+          }
           json["objects"] = scene.objects.size();
           json["triangles"] = scanner.num_triangles();
           json["rows"] = scan.rows;

@@ -167,19 +167,63 @@ cv::Mat ColorLabels(const cv::Mat& labels, const cv::Mat& mask) {
   return image;
 }
 
-cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height) {
+cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height,
+                    const std::map<int32_t, std::string>& names) {
   const int row_height = 18;
   const int needed = static_cast<int>(labels.size()) * row_height + 16;
-  cv::Mat legend(std::max(height, needed), 110, CV_8UC3, cv::Scalar::all(255));
+  std::vector<std::string> texts;
+  int width = 110;
+  for (const int32_t label : labels) {
+    std::string text = label < 0 ? std::string("none") : fmt::format("label {}", label);
+    const auto name = names.find(label);
+    if (name != names.end() && !name->second.empty()) {
+      text = label < 0 ? name->second : fmt::format("{}  {}", label, name->second);
+    }
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
+    width = std::max(width, 28 + size.width + 8);
+    texts.push_back(std::move(text));
+  }
+  cv::Mat legend(std::max(height, needed), width, CV_8UC3, cv::Scalar::all(255));
   for (size_t i = 0; i < labels.size(); ++i) {
     const int y = 8 + static_cast<int>(i) * row_height;
     const cv::Vec3b color = LabelColor(labels[i]);
     cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar(color[0], color[1], color[2]), cv::FILLED);
     cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar::all(0));
-    cv::putText(legend, labels[i] < 0 ? std::string("none") : fmt::format("label {}", labels[i]),
-                cv::Point(28, y + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1, cv::LINE_AA);
+    cv::putText(legend, texts[i], cv::Point(28, y + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1,
+                cv::LINE_AA);
   }
   return legend;
+}
+
+void PaintNoReturn(cv::Mat* image, const cv::Mat& valid) {
+  LIDARSHOP_CHECK(image->type() == CV_8UC3 && valid.type() == CV_8U && valid.size() == image->size());
+  for (int row = 0; row < image->rows; ++row) {
+    const uint8_t* v = valid.ptr<uint8_t>(row);
+    cv::Vec3b* out = image->ptr<cv::Vec3b>(row);
+    for (int col = 0; col < image->cols; ++col) {
+      if (!v[col]) out[col] = NoReturnColor(row, col);
+    }
+  }
+}
+
+cv::Mat NoReturnKey(int width) {
+  cv::Mat key(26, std::max(width, 110), CV_8UC3, cv::Scalar::all(255));
+  for (int row = 6; row < 22; ++row) {
+    for (int col = 8; col < 24; ++col) key.at<cv::Vec3b>(row, col) = NoReturnColor(row - 6, col - 8);
+  }
+  cv::rectangle(key, cv::Rect(7, 5, 18, 18), cv::Scalar::all(0));
+  cv::putText(key, "no return", cv::Point(30, 18), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1,
+              cv::LINE_AA);
+  return key;
+}
+
+cv::Mat StackLegends(const cv::Mat& top, const cv::Mat& bottom) {
+  LIDARSHOP_CHECK(top.type() == CV_8UC3 && bottom.type() == CV_8UC3);
+  cv::Mat combined(top.rows + bottom.rows, std::max(top.cols, bottom.cols), CV_8UC3, cv::Scalar::all(255));
+  top.copyTo(combined(cv::Rect(0, 0, top.cols, top.rows)));
+  bottom.copyTo(combined(cv::Rect(0, top.rows, bottom.cols, bottom.rows)));
+  return combined;
 }
 
 cv::Mat BesideLegend(const cv::Mat& image, const cv::Mat& legend) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -55,8 +56,27 @@ cv::Vec3b LabelColor(int32_t label, const cv::Vec3b& negative_color = cv::Vec3b(
 // Colours a CV_32S label image; cells where `mask` (CV_8U, empty = everywhere) is zero get black.
 cv::Mat ColorLabels(const cv::Mat& labels, const cv::Mat& mask);
 
-// A legend of label swatches with their numbers (CV_8UC3 RGB, `height` rows at least).
-cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height);
+// A legend of label swatches with their numbers (CV_8UC3 RGB, `height` rows at least), and the object's name
+// where `names` has one ("3  hatchback"); the legend widens to fit the longest line.
+cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height,
+                    const std::map<int32_t, std::string>& names = {});
+
+// Cells without a return are drawn as a checker of two colours that no colour map, label colour or normal
+// colour takes (magenta and light pink, both at least 50 RGB units from every entry of every map), in squares
+// of kNoReturnCheckerPx pixels: a picture never shows "nothing" as a value.
+inline const cv::Vec3b kNoReturnColorA(255, 0, 255);
+inline const cv::Vec3b kNoReturnColorB(255, 180, 255);
+constexpr int kNoReturnCheckerPx = 4;
+inline cv::Vec3b NoReturnColor(int row, int col) {
+  return ((row / kNoReturnCheckerPx + col / kNoReturnCheckerPx) % 2 == 0) ? kNoReturnColorA : kNoReturnColorB;
+}
+// Paints the no-return checker on `image` (CV_8UC3) where `valid` (CV_8U, same size) is zero.
+void PaintNoReturn(cv::Mat* image, const cv::Mat& valid);
+// A small key for the checker: a swatch and the words "no return" (CV_8UC3, `width` columns, white ground).
+cv::Mat NoReturnKey(int width);
+
+// `top` above `bottom` (CV_8UC3), padded with white to the wider width.
+cv::Mat StackLegends(const cv::Mat& top, const cv::Mat& bottom);
 
 // `image` (CV_8UC3) with `legend` to its right, both padded with white to the taller height.
 cv::Mat BesideLegend(const cv::Mat& image, const cv::Mat& legend);

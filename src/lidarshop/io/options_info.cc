@@ -6,6 +6,7 @@
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/render.h"
+#include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -21,6 +22,47 @@ const EnumInfo& EnumInfoOf<RenderChannel>() {
                   {RenderChannel::kNormals, "normals", "normals as (n + 1) / 2"},
                   {RenderChannel::kLabels, "labels", "object labels"},
                   {RenderChannel::kValid, "valid", "white where the ray returned"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PictureView>() {
+  static const EnumInfo info = MakeEnumInfo<PictureView>(
+      "view", {{PictureView::kAuto, "auto", "the ray grid of organized scans, a spherical grid for clouds"},
+               {PictureView::kGrid, "grid", "the scan's own ray grid"},
+               {PictureView::kSphere, "sphere", "points projected onto a spherical grid around the scanner"},
+               {PictureView::kTop, "top", "orthographic from above (world x right, y up)"},
+               {PictureView::kFront, "front", "orthographic from the front (world x right, z up)"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PixelAspect>() {
+  static const EnumInfo info = MakeEnumInfo<PixelAspect>(
+      "aspect", {{PixelAspect::kSquare, "square", "square angular pixels (the finer native step)"},
+                 {PixelAspect::kNative, "native", "one pixel per ray"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PictureLayoutOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PictureLayoutOptions> b("PictureLayoutOptions",
+                                          "where the pixels of a scan picture come from");
+    b.Field(&PictureLayoutOptions::view, "view", "grid, spherical or orthographic layout");
+    b.Field(&PictureLayoutOptions::aspect, "aspect", "grid view: square angular pixels or one pixel per ray");
+    b.Field(&PictureLayoutOptions::width_px, "width_px",
+            "picture width; 0 = automatic (with only one size given the other keeps the aspect)")
+        .Unit("px")
+        .Range(0, 16384);
+    b.Field(&PictureLayoutOptions::height_px, "height_px", "picture height; 0 = automatic")
+        .Unit("px")
+        .Range(0, 16384);
+    b.Field(&PictureLayoutOptions::max_side_px, "max_side_px", "automatic sizes: the longer side at most")
+        .Unit("px")
+        .Range(16, 16384);
+    return b.Build();
+  }();
   return info;
 }
 

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -50,14 +51,20 @@ cv::Mat EstimateGridNormals(const Scan& scan) {
   return normals;
 }
 
-RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
-  options.Check();
-  CheckScan(scan);
+namespace {
+
+cv::Vec3b NormalColor(const cv::Vec3f& n) {
+  cv::Vec3b out;
+  for (int k = 0; k < 3; ++k) out[k] = cv::saturate_cast<uint8_t>((n[k] + 1.0f) * 127.5f);
+  return out;
+}
+
+// The cells' colours, one pixel per cell, no-return cells left black (painted after resampling).
+RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
   RenderResult result;
-  auto metric = [&](const cv::Mat& values, ColorMap default_map, const std::string& unit, bool unit_range) {
+  auto metric = [&](const cv::Mat& values, ColorMap default_map, const std::string& unit) {
     const ColorMap map = options.color_map.value_or(default_map);
-    ColorScale scale =
-        unit_range ? ColorScale{0.0, 1.0, map, unit} : AutoScale(values, scan.valid, map, unit);
+    ColorScale scale = AutoScale(values, scan.valid, map, unit);  // 1-99 % quantiles
     if (!std::isnan(options.min_value)) scale.min_value = options.min_value;
     if (!std::isnan(options.max_value)) scale.max_value = options.max_value;
     if (scale.max_value <= scale.min_value) scale.max_value = scale.min_value + 1e-6;
@@ -66,9 +73,9 @@ RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
   };
   switch (options.channel) {
     case RenderChannel::kRange:
-      metric(scan.range, ColorMap::kViridis, "m", false);
+      metric(scan.range, ColorMap::kViridis, "m");
       break;
-    case RenderChannel::kIntensity: {
+    case RenderChannel::kIntensity:
       if (!scan.has_intensity()) {
         // Name what there is instead (leaving out range, valid and direction, which every scan has).
         std::vector<std::string> present;
@@ -78,12 +85,8 @@ RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
         throw InputError(fmt::format("{} has no intensity channel; it has: {}",
                                      scan.name.empty() ? "the scan" : scan.name, fmt::join(present, ", ")));
       }
-      double low = 0, high = 0;
-      cv::minMaxLoc(scan.intensity, &low, &high, nullptr, nullptr, scan.valid);
-      // PTX intensities are in [0, 1]; other scales (integer counts) get automatic limits.
-      metric(scan.intensity, ColorMap::kGray, "", low >= 0 && high <= 1);
+      metric(scan.intensity, ColorMap::kGray, "");
       break;
-    }
     case RenderChannel::kRgb:
       if (!scan.has_color()) ThrowInputError(scan.name, "", "rgb", "the scan has no colour channel");
       result.image = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
@@ -96,8 +99,7 @@ RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
         for (int col = 0; col < scan.cols; ++col) {
           const cv::Vec3f& n = normals.at<cv::Vec3f>(row, col);
           if (!scan.valid.at<uint8_t>(row, col) || n == cv::Vec3f(0, 0, 0)) continue;
-          cv::Vec3b& out = result.image.at<cv::Vec3b>(row, col);
-          for (int k = 0; k < 3; ++k) out[k] = cv::saturate_cast<uint8_t>((n[k] + 1.0f) * 127.5f);
+          result.image.at<cv::Vec3b>(row, col) = NormalColor(n);
         }
       }
       break;
@@ -111,22 +113,118 @@ RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
       result.image.setTo(cv::Scalar::all(255), scan.valid);
       break;
   }
-  if (options.legend) {
-    if (result.scale) {
-      result.image = BesideLegend(result.image, ColorScaleBar(*result.scale, scan.rows));
-    } else if (options.channel == RenderChannel::kLabels) {
-      std::set<int32_t> present;
-      for (int row = 0; row < scan.rows; ++row) {
-        for (int col = 0; col < scan.cols; ++col) {
-          if (scan.valid.at<uint8_t>(row, col)) present.insert(scan.label.at<int32_t>(row, col));
-        }
+  return result;
+}
+
+// The coloured cells resampled to `size`, the no-return checker, and the legend.
+RenderResult FinishPicture(const Scan& cells, RenderResult colored, cv::Size size,
+                           const RenderOptions& options) {
+  colored.image = ResampleNearest(colored.image, size);
+  const cv::Mat valid = ResampleNearest(cells.valid, size);
+  const bool any_no_return = options.channel != RenderChannel::kValid &&
+                             static_cast<size_t>(cv::countNonZero(valid)) < valid.total();
+  if (any_no_return) PaintNoReturn(&colored.image, valid);
+  if (!options.legend) return colored;
+  cv::Mat legend;
+  if (colored.scale) {
+    legend = ColorScaleBar(*colored.scale, size.height);
+  } else if (options.channel == RenderChannel::kLabels) {
+    std::set<int32_t> present;
+    for (int row = 0; row < cells.rows; ++row) {
+      for (int col = 0; col < cells.cols; ++col) {
+        if (cells.valid.at<uint8_t>(row, col)) present.insert(cells.label.at<int32_t>(row, col));
       }
-      std::vector<int32_t> shown(present.begin(), present.end());
-      if (shown.size() > 40) shown.resize(40);  // a legend, not a catalogue
-      result.image = BesideLegend(result.image, LabelLegend(shown, scan.rows));
+    }
+    std::vector<int32_t> shown(present.begin(), present.end());
+    if (shown.size() > 40) shown.resize(40);  // a legend, not a catalogue
+    legend = LabelLegend(shown, size.height, options.label_names);
+  } else if (options.channel == RenderChannel::kNormals) {
+    legend = NormalsKey(std::min(size.height, 160));
+  }
+  if (legend.empty()) return colored;
+  if (any_no_return) legend = StackLegends(legend, NoReturnKey(legend.cols));
+  colored.image = BesideLegend(colored.image, legend);
+  return colored;
+}
+
+}  // namespace
+
+RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
+  options.Check();
+  CheckScan(scan);
+  return FinishPicture(scan, ColorCells(scan, options), cv::Size(scan.cols, scan.rows), options);
+}
+
+PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
+                            const PictureLayoutOptions& layout_options) {
+  options.Check();
+  PictureLayout layout = LayOutPicture(scan, layout_options);
+  RenderResult colored =
+      FinishPicture(layout.cells, ColorCells(layout.cells, options), layout.picture_size, options);
+  return {std::move(colored.image), std::move(colored.scale), std::move(layout)};
+}
+
+bool HasFloatValues(RenderChannel channel) {
+  return channel == RenderChannel::kRange || channel == RenderChannel::kIntensity ||
+         channel == RenderChannel::kNormals;
+}
+
+cv::Mat ChannelValues(const Scan& scan, RenderChannel channel) {
+  CheckScan(scan);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  cv::Mat values;
+  switch (channel) {
+    case RenderChannel::kRange:
+      values = scan.range.clone();
+      break;
+    case RenderChannel::kIntensity:
+      if (scan.intensity.empty()) {
+        ThrowInputError(scan.name, "", "intensity", "the scan has no intensity channel");
+      }
+      values = scan.intensity.clone();
+      break;
+    case RenderChannel::kNormals:
+      values = scan.normal.empty() ? EstimateGridNormals(scan) : scan.normal.clone();
+      break;
+    case RenderChannel::kRgb:
+    case RenderChannel::kLabels:
+    case RenderChannel::kValid:
+      throw OptionsError(fmt::format(
+          "float pictures (.exr, .tif) hold range, intensity or normals, not {}; write {} as .png",
+          ToString(channel), ToString(channel)));
+  }
+  values.setTo(cv::Scalar::all(nan), scan.valid == 0);
+  return values;
+}
+
+ValuesResult RenderValues(const Scan& scan, RenderChannel channel,
+                          const PictureLayoutOptions& layout_options) {
+  PictureLayout layout = LayOutPicture(scan, layout_options);
+  cv::Mat values = ResampleNearest(ChannelValues(layout.cells, channel), layout.picture_size);
+  return {std::move(values), std::move(layout)};
+}
+
+cv::Mat NormalsKey(int height) {
+  height = std::max(height, 100);
+  const int text_rows = 30, radius = (height - text_rows - 8) / 2, width = std::max(2 * radius + 16, 110);
+  cv::Mat key(height, width, CV_8UC3, cv::Scalar::all(255));
+  const int centre_col = width / 2, centre_row = 4 + radius;
+  for (int row = centre_row - radius; row <= centre_row + radius; ++row) {
+    for (int col = centre_col - radius; col <= centre_col + radius; ++col) {
+      const double x = static_cast<double>(col - centre_col) / radius;
+      const double z = static_cast<double>(centre_row - row) / radius;
+      if (x * x + z * z > 1.0) continue;
+      // A normal facing the viewer: the scanner looks along +y, so the surfaces it sees face -y.
+      const cv::Vec3f n(static_cast<float>(x), static_cast<float>(-std::sqrt(1.0 - x * x - z * z)),
+                        static_cast<float>(z));
+      key.at<cv::Vec3b>(row, col) = NormalColor(n);
     }
   }
-  return result;
+  cv::putText(key, "x right, z up", cv::Point(6, height - text_rows + 10), cv::FONT_HERSHEY_SIMPLEX, 0.35,
+              cv::Scalar::all(0), 1, cv::LINE_AA);
+  cv::putText(key, "centre: facing scanner", cv::Point(6, height - text_rows + 24), cv::FONT_HERSHEY_SIMPLEX,
+              0.35, cv::Scalar::all(0), 1, cv::LINE_AA);
+  return key;
 }
 
 }  // namespace lidarshop

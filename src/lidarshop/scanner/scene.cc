@@ -461,4 +461,13 @@ TriangleMesh MakePrimitive(const std::string& primitive, const std::string& para
   return MakePrimitiveMesh(primitive, fields, &color_used, &triangles);
 }
 
+std::map<int32_t, std::string> ObjectNamesByLabel(const SceneDescription& scene) {
+  std::map<int32_t, std::string> names;
+  for (const SceneObject& object : scene.objects) {
+    std::string& name = names[object.label];
+    name += (name.empty() ? "" : ", ") + object.name;
+  }
+  return names;
+}
+
 }  // namespace lidarshop

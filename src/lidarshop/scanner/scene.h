@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,10 @@ SceneDescription LoadScene(const std::string& path);
 // Parses JSON text; `what` names the source in errors, mesh paths are relative to `base_dir`.
 SceneDescription ParseScene(const std::string& json_text, const std::string& what,
                             const std::string& base_dir);
+
+// The objects' names by label, for legends (RenderOptions::label_names); objects sharing a label are joined
+// with ", ".
+std::map<int32_t, std::string> ObjectNamesByLabel(const SceneDescription& scene);
 
 // The mesh of one object of a scene in world coordinates (vertex normals transformed along).
 TriangleMesh MeshInWorld(const SceneObject& object);

@@ -15,7 +15,7 @@ EXPECTED = {"FillOptions", "RemoveOptions", "SegmentOptions", "InpaintOptions", 
             "StatisticalOutlierOptions", "RadiusOutlierOptions", "CropOptions", "RansacPlaneOptions",
             "HoughPlaneOptions", "EuclideanClusterOptions", "KMeansOptions", "NormalOptions",
             "RegionGrowingOptions", "SuperpixelOptions", "IcpOptions", "GlobalAlignOptions", "PhotoOptions",
-            "PtxReadOptions", "E57WriteOptions", "PointViewOptions"}
+            "PtxReadOptions", "E57WriteOptions", "PointViewOptions", "PictureLayoutOptions"}
 
 
 def test_every_described_struct_is_a_class():

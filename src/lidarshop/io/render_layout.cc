@@ -1,0 +1,371 @@
+#include "lidarshop/io/render_layout.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+// Automatic projection sizes: about this many points a cell over the bounding box. Points fall on cells
+// unevenly (a Poisson-like spread leaves e^-3 = 5 % of a surface's cells empty at 3, 37 % at 1).
+constexpr double kPointsPerCell = 3.0;
+// Orthographic windows: these quantiles of the points on each axis.
+constexpr double kWindowLow = 0.005, kWindowHigh = 0.995, kWindowMargin = 0.25;
+
+double Median(std::vector<double>* values) {
+  if (values->empty()) return 0.0;
+  const auto middle = values->begin() + values->size() / 2;
+  std::nth_element(values->begin(), middle, values->end());
+  return *middle;
+}
+
+// Picture size from a natural size (width, height in pixels, fractional) and the options: automatic sizes
+// are capped to max_side_px; one given side keeps the aspect; two given sides are taken as they are.
+cv::Size PictureSize(double natural_width, double natural_height, const PictureLayoutOptions& options) {
+  natural_width = std::max(natural_width, 1.0);
+  natural_height = std::max(natural_height, 1.0);
+  double width = natural_width, height = natural_height;
+  if (options.width_px > 0 && options.height_px > 0) {
+    return cv::Size(options.width_px, options.height_px);
+  } else if (options.width_px > 0) {
+    width = options.width_px;
+    height = natural_height * width / natural_width;
+  } else if (options.height_px > 0) {
+    height = options.height_px;
+    width = natural_width * height / natural_height;
+  } else {
+    const double longer = std::max(width, height);
+    if (longer > options.max_side_px) {
+      width *= options.max_side_px / longer;
+      height *= options.max_side_px / longer;
+    }
+  }
+  return cv::Size(std::max(1, static_cast<int>(std::lround(width))),
+                  std::max(1, static_cast<int>(std::lround(height))));
+}
+
+// A picture coordinate of every valid point (u to the right, v up), its depth (smaller = nearer, kept) and
+// its cell; the projection keeps the nearest point of every picture cell.
+struct ProjectedPoint {
+  double u, v, depth;
+  int row, col;
+};
+
+// Fills an organized cells scan of `size` from the projected points: each cell takes the channels of its
+// nearest point. Returns the number of points kept.
+int64_t FillCells(const Scan& scan, const std::vector<ProjectedPoint>& projected, Scan* cells) {
+  cv::Mat depth(cells->rows, cells->cols, CV_64F, cv::Scalar(std::numeric_limits<double>::infinity()));
+  cv::Mat source(cells->rows, cells->cols, CV_32SC2, cv::Scalar::all(-1));
+  for (const ProjectedPoint& p : projected) {
+    const int col = std::clamp(static_cast<int>(std::floor(p.u)), 0, cells->cols - 1);
+    const int row = std::clamp(static_cast<int>(std::floor(p.v)), 0, cells->rows - 1);
+    double& best = depth.at<double>(row, col);
+    if (p.depth < best) {
+      best = p.depth;
+      source.at<cv::Vec2i>(row, col) = cv::Vec2i(p.row, p.col);
+    }
+  }
+  int64_t kept = 0;
+  for (int row = 0; row < cells->rows; ++row) {
+    for (int col = 0; col < cells->cols; ++col) {
+      const cv::Vec2i from = source.at<cv::Vec2i>(row, col);
+      if (from[0] < 0) continue;
+      ++kept;
+      const int r = from[0], c = from[1];
+      cells->valid.at<uint8_t>(row, col) = kValid;
+      cells->range.at<float>(row, col) = scan.range.at<float>(r, c);
+      cells->point.at<cv::Vec3f>(row, col) = scan.point.at<cv::Vec3f>(r, c);
+      if (!scan.intensity.empty()) cells->intensity.at<float>(row, col) = scan.intensity.at<float>(r, c);
+      if (scan.has_color()) cells->color.at<cv::Vec3b>(row, col) = scan.color.at<cv::Vec3b>(r, c);
+      if (!scan.label.empty()) cells->label.at<int32_t>(row, col) = scan.label.at<int32_t>(r, c);
+      if (!scan.normal.empty()) cells->normal.at<cv::Vec3f>(row, col) = scan.normal.at<cv::Vec3f>(r, c);
+      if (!scan.synthesized.empty()) {
+        cells->synthesized.at<uint8_t>(row, col) = scan.synthesized.at<uint8_t>(r, c);
+      }
+      // Orthographic cells have no ray grid: their direction is the point's own.
+      if (cells->grid.azimuth_rad.empty()) {
+        const cv::Vec3f p = cells->point.at<cv::Vec3f>(row, col);
+        const float norm = static_cast<float>(cv::norm(p));
+        if (norm > 0) cells->direction.at<cv::Vec3f>(row, col) = p / norm;
+      }
+    }
+  }
+  return kept;
+}
+
+Scan EmptyCells(const Scan& scan, cv::Size size) {
+  Scan cells = MakeScan(size.height, size.width, scan.has_color());
+  cells.world_from_scanner = scan.world_from_scanner;
+  cells.name = scan.name;
+  if (scan.intensity.empty()) cells.intensity.release();
+  if (!scan.label.empty()) cells.label = cv::Mat(size, CV_32S, cv::Scalar(kNoLabel));
+  if (!scan.normal.empty()) cells.normal = cv::Mat(size, CV_32FC3, cv::Scalar::all(0));
+  if (!scan.synthesized.empty()) cells.synthesized = cv::Mat(size, CV_8U, cv::Scalar(0));
+  return cells;
+}
+
+void ThrowNothingToProject(const Scan& scan, PictureView view) {
+  ThrowInputError(scan.name, "", "",
+                  fmt::format("no point with a return to project for the {} view", ToString(view)));
+}
+
+PictureLayout LayOutSphere(const Scan& scan, const PictureLayoutOptions& options) {
+  struct Angles {
+    double azimuth, elevation;
+    int row, col;
+  };
+  std::vector<Angles> angles;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col) || scan.range.at<float>(row, col) <= 0) continue;
+      const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
+      angles.push_back({std::atan2(p[0], p[1]), std::atan2(p[2], std::hypot(p[0], p[1])), row, col});
+    }
+  }
+  if (angles.empty()) ThrowNothingToProject(scan, PictureView::kSphere);
+  // The azimuth window starts after the widest empty sector (the wrap-around sector included).
+  std::vector<double> azimuths;
+  azimuths.reserve(angles.size());
+  for (const Angles& a : angles) azimuths.push_back(a.azimuth);
+  std::sort(azimuths.begin(), azimuths.end());
+  double widest_gap = azimuths.front() + 2 * M_PI - azimuths.back(), start = azimuths.front();
+  for (size_t i = 1; i < azimuths.size(); ++i) {
+    if (azimuths[i] - azimuths[i - 1] > widest_gap) {
+      widest_gap = azimuths[i] - azimuths[i - 1];
+      start = azimuths[i];
+    }
+  }
+  auto unwrapped = [&](double azimuth) { return azimuth < start ? azimuth + 2 * M_PI : azimuth; };
+  double azimuth_span = 0, elevation_min = M_PI, elevation_max = -M_PI;
+  for (const Angles& a : angles) {
+    azimuth_span = std::max(azimuth_span, unwrapped(a.azimuth) - start);
+    elevation_min = std::min(elevation_min, a.elevation);
+    elevation_max = std::max(elevation_max, a.elevation);
+  }
+  // A little room so that the extreme points fall inside the last cells, and no zero spans.
+  const double floor_rad = 1e-4;
+  azimuth_span = std::max(azimuth_span, floor_rad);
+  const double elevation_span = std::max(elevation_max - elevation_min, floor_rad);
+  const double step =
+      std::sqrt(azimuth_span * elevation_span * kPointsPerCell / static_cast<double>(angles.size()));
+  const cv::Size size = PictureSize(azimuth_span / step, elevation_span / step, options);
+  const double step_across = azimuth_span / size.width, step_down = elevation_span / size.height;
+
+  PictureLayout layout;
+  layout.view = PictureView::kSphere;
+  layout.cells = EmptyCells(scan, size);
+  ScanGrid& grid = layout.cells.grid;
+  for (int col = 0; col < size.width; ++col) grid.azimuth_rad.push_back(start + (col + 0.5) * step_across);
+  for (int row = 0; row < size.height; ++row) {
+    grid.elevation_rad.push_back(elevation_min + elevation_span - (row + 0.5) * step_down);
+  }
+  layout.cells.direction = DirectionsFromGrid(grid);
+  std::vector<ProjectedPoint> projected;
+  projected.reserve(angles.size());
+  for (const Angles& a : angles) {
+    projected.push_back({(unwrapped(a.azimuth) - start) / step_across,
+                         (elevation_min + elevation_span - a.elevation) / step_down,
+                         scan.range.at<float>(a.row, a.col), a.row, a.col});
+  }
+  layout.points = static_cast<int64_t>(projected.size());
+  layout.points_kept = FillCells(scan, projected, &layout.cells);
+  layout.picture_size = size;
+  layout.pixel_width = step_across * kDegPerRad;
+  layout.pixel_height = step_down * kDegPerRad;
+  layout.pixel_unit = "deg";
+  return layout;
+}
+
+PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const PictureLayoutOptions& options) {
+  // u to the right, v up, depth: smaller is nearer to the viewer.
+  std::vector<ProjectedPoint> projected;
+  double u_min = INFINITY, u_max = -INFINITY, v_min = INFINITY, v_max = -INFINITY;
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
+      const ProjectedPoint point = view == PictureView::kTop ? ProjectedPoint{p.x(), p.y(), -p.z(), row, col}
+                                                             : ProjectedPoint{p.x(), p.z(), p.y(), row, col};
+      u_min = std::min(u_min, point.u);
+      u_max = std::max(u_max, point.u);
+      v_min = std::min(v_min, point.v);
+      v_max = std::max(v_max, point.v);
+      projected.push_back(point);
+    }
+  }
+  if (projected.empty()) ThrowNothingToProject(scan, view);
+  // The window holds the 0.5-99.5 % quantiles on each axis and a quarter of their span around them (never
+  // more than the points' extent): a few far stray points (a terrestrial scan's distant ground rings) would
+  // otherwise shrink everything else to a corner, while the top of a thin post stays in. Points outside are
+  // left out.
+  auto quantile = [&](double fraction, bool along_u) {
+    std::vector<double> values;
+    values.reserve(projected.size());
+    for (const ProjectedPoint& p : projected) values.push_back(along_u ? p.u : p.v);
+    const size_t index =
+        std::min(values.size() - 1, static_cast<size_t>(fraction * (values.size() - 1) + 0.5));
+    std::nth_element(values.begin(), values.begin() + index, values.end());
+    return values[index];
+  };
+  const double u_low = quantile(kWindowLow, true), u_high = quantile(kWindowHigh, true);
+  const double v_low = quantile(kWindowLow, false), v_high = quantile(kWindowHigh, false);
+  const double u_margin = kWindowMargin * (u_high - u_low), v_margin = kWindowMargin * (v_high - v_low);
+  u_min = std::max(u_min, u_low - u_margin);
+  u_max = std::min(u_max, u_high + u_margin);
+  v_min = std::max(v_min, v_low - v_margin);
+  v_max = std::min(v_max, v_high + v_margin);
+  const int64_t all_points = static_cast<int64_t>(projected.size());
+  std::erase_if(projected, [&](const ProjectedPoint& p) {
+    return p.u < u_min || p.u > u_max || p.v < v_min || p.v > v_max;
+  });
+  const double floor_m = 1e-3;
+  const double u_span = std::max(u_max - u_min, floor_m), v_span = std::max(v_max - v_min, floor_m);
+  const double step = std::sqrt(u_span * v_span * kPointsPerCell / static_cast<double>(projected.size()));
+  const cv::Size size = PictureSize(u_span / step, v_span / step, options);
+  const double step_across = u_span / size.width, step_down = v_span / size.height;
+  for (ProjectedPoint& p : projected) {
+    p.u = (p.u - u_min) / step_across;
+    p.v = (v_min + v_span - p.v) / step_down;
+  }
+  PictureLayout layout;
+  layout.view = view;
+  layout.cells = EmptyCells(scan, size);
+  layout.points = all_points;
+  layout.points_kept = FillCells(scan, projected, &layout.cells);
+  layout.picture_size = size;
+  layout.pixel_width = step_across;
+  layout.pixel_height = step_down;
+  layout.pixel_unit = "m";
+  return layout;
+}
+
+PictureLayout LayOutGrid(const Scan& scan, const PictureLayoutOptions& options) {
+  PictureLayout layout;
+  layout.view = PictureView::kGrid;
+  layout.cells = scan;
+  const cv::Vec2d steps = NativeStepsRad(scan);
+  double natural_width = scan.cols, natural_height = scan.rows;
+  if (options.aspect == PixelAspect::kSquare && steps[0] > 0 && steps[1] > 0) {
+    // The finer step becomes the pixel: nothing is lost, the coarser direction repeats pixels.
+    const double pixel = std::min(steps[0], steps[1]);
+    natural_width = scan.cols * steps[0] / pixel;
+    natural_height = scan.rows * steps[1] / pixel;
+  }
+  const bool one_per_ray = options.aspect == PixelAspect::kNative && options.width_px == 0 &&
+                           options.height_px == 0;  // native: never capped
+  layout.picture_size = one_per_ray ? cv::Size(std::max(scan.cols, 1), std::max(scan.rows, 1))
+                                    : PictureSize(natural_width, natural_height, options);
+  layout.pixel_width = steps[0] * scan.cols / layout.picture_size.width * kDegPerRad;
+  layout.pixel_height = steps[1] * scan.rows / layout.picture_size.height * kDegPerRad;
+  layout.pixel_unit = "deg";
+  return layout;
+}
+
+}  // namespace
+
+void PictureLayoutOptions::Check() const { Validate(*this); }
+
+bool IsUnorganized(const Scan& scan) {
+  return (scan.rows == 1 || scan.cols == 1) && scan.num_cells() > 1 && scan.grid.azimuth_rad.empty();
+}
+
+cv::Vec2d NativeStepsRad(const Scan& scan) {
+  const ScanGrid& grid = scan.grid;
+  if (static_cast<int>(grid.azimuth_rad.size()) == scan.cols &&
+      static_cast<int>(grid.elevation_rad.size()) == scan.rows && scan.cols > 1 && scan.rows > 1) {
+    return {std::abs(grid.azimuth_rad.back() - grid.azimuth_rad.front()) / (scan.cols - 1),
+            std::abs(grid.elevation_rad.front() - grid.elevation_rad.back()) / (scan.rows - 1)};
+  }
+  // No grid: the median angle between neighbouring rays that both returned.
+  std::vector<double> across, down;
+  auto direction = [&](int row, int col) {
+    const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+    return Eigen::Vector3f(d[0], d[1], d[2]);
+  };
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      if (col + 1 < scan.cols && scan.valid.at<uint8_t>(row, col + 1)) {
+        double step = std::abs(AzimuthOf(direction(row, col + 1)) - AzimuthOf(direction(row, col)));
+        if (step > M_PI) step = 2 * M_PI - step;
+        across.push_back(step);
+      }
+      if (row + 1 < scan.rows && scan.valid.at<uint8_t>(row + 1, col)) {
+        down.push_back(std::abs(ElevationOf(direction(row, col)) - ElevationOf(direction(row + 1, col))));
+      }
+    }
+  }
+  return {Median(&across), Median(&down)};
+}
+
+PictureLayout LayOutPicture(const Scan& scan, const PictureLayoutOptions& options) {
+  options.Check();
+  CheckScan(scan);
+  PictureView view = options.view;
+  if (view == PictureView::kAuto) view = IsUnorganized(scan) ? PictureView::kSphere : PictureView::kGrid;
+  switch (view) {
+    case PictureView::kSphere:
+      return LayOutSphere(scan, options);
+    case PictureView::kTop:
+    case PictureView::kFront:
+      return LayOutOrthographic(scan, view, options);
+    case PictureView::kAuto:
+    case PictureView::kGrid:
+      break;
+  }
+  return LayOutGrid(scan, options);
+}
+
+std::string PictureLayout::Describe() const {
+  const std::string size = fmt::format("{} x {}", picture_size.width, picture_size.height);
+  const std::string pixel = pixel_unit == "deg"
+                                ? fmt::format("{:.4g}° x {:.4g}°", pixel_width, pixel_height)
+                                : fmt::format("{:.4g} m x {:.4g} m", pixel_width, pixel_height);
+  switch (view) {
+    case PictureView::kSphere:
+      return fmt::format(
+          "unorganized cloud of {} points projected onto a spherical grid around the scanner position: {} "
+          "pixels of {}; {} points shown, {} hidden behind nearer ones",
+          points, size, pixel, points_kept, points - points_kept);
+    case PictureView::kTop:
+    case PictureView::kFront:
+      return fmt::format(
+          "{} points projected orthographically ({} view, world frame): {} pixels of {}; {} "
+          "points shown, {} hidden behind nearer ones or outside the window",
+          points, ToString(view), size, pixel, points_kept, points - points_kept);
+    case PictureView::kAuto:
+    case PictureView::kGrid:
+      break;
+  }
+  return fmt::format("{} x {} rays shown as {} pixels of {}", cells.cols, cells.rows, size, pixel);
+}
+
+cv::Mat ResampleNearest(const cv::Mat& image, cv::Size size) {
+  if (image.size() == size) return image;
+  cv::Mat resampled(size, image.type());
+  const size_t element = image.elemSize();
+  std::vector<int> source_col(size.width);
+  for (int col = 0; col < size.width; ++col) {
+    source_col[col] = std::min(image.cols - 1, static_cast<int>((col + 0.5) * image.cols / size.width));
+  }
+  for (int row = 0; row < size.height; ++row) {
+    const int source_row = std::min(image.rows - 1, static_cast<int>((row + 0.5) * image.rows / size.height));
+    const uint8_t* in = image.ptr<uint8_t>(source_row);
+    uint8_t* out = resampled.ptr<uint8_t>(row);
+    for (int col = 0; col < size.width; ++col) {
+      std::memcpy(out + col * element, in + source_col[col] * element, element);
+    }
+  }
+  return resampled;
+}
+
+}  // namespace lidarshop
