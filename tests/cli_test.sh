@@ -414,7 +414,7 @@ check "segment --object as PLY" "$lidarshop" segment "$work/scan.ptx" --strokes 
   -o "$work/mask_frames.png" --overlay none --object "$work/object.ply" --quiet
 check "segment outputs lie on the scan's world points" python3 "$work/frame_check.py" "$work/scan.xyz" \
   "$work/object.pcd" "$work/object.ply" "$work/scan.pcd" "$work/scan.ply"
-check "PCD round trip keeps the pose" "$lidarshop" info "$work/object.pcd"
+check "PCD round trip keeps the pose" "$lidarshop" info --stats "$work/object.pcd"
 cp "$work/last.out" "$work/info_object_pcd.json"
 json_check "segment --object .pcd reads back with its grid and pose" "$work/info_object_pcd.json" \
   "d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and d['scans'][0]['valid'] == $object_valid and \
@@ -766,7 +766,7 @@ check "convert the PCD to PCD" "$lidarshop" convert "$work/plain.pcd" "$work/pla
 check "the copy has no intensity field" grep -qa "^FIELDS x y z$" "$work/plain_copy.pcd"
 for format in ply e57 las xyz; do
   check "convert the PCD to $format" "$lidarshop" convert "$work/plain.pcd" "$work/plain.$format" --quiet
-  check "info plain.$format" sh -c "'$lidarshop' info '$work/plain.$format' >'$work/plain_$format.json'"
+  check "info plain.$format" sh -c "'$lidarshop' info --stats '$work/plain.$format' >'$work/plain_$format.json'"
   json_check "$format: still no intensity" "$work/plain_$format.json" \
     "'intensity' not in d['scans'][0]['channels'] and d['scans'][0]['valid'] == 3"
 done
