@@ -433,12 +433,12 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
     html += fmt::format(
         "<h3>Sweep</h3><p>The {} model at {} candidate poses over the lot (0.5 m grid, three headings, then "
         "local "
-        "refinement); white rings mark the {} detection(s) that pass consistency &gt; 0.75 and confidence "
-        "&gt; "
-        "0.3. The true position is ({:.2f}, {:.2f}).</p><img src=\"sweep_consistency.png\" width=\"49%\">"
-        "<img src=\"sweep_confidence.png\" width=\"49%\">",
+        "refinement); white rings mark the {} detection(s) that pass consistency &gt; {:.2f} and confidence "
+        "&gt; {:.2f}. The true position is ({:.2f}, {:.2f}).</p><img src=\"sweep_consistency.png\" "
+        "width=\"49%\"><img src=\"sweep_confidence.png\" width=\"49%\">",
         sweep["model"].get<std::string>(), sweep["poses"].get<size_t>(), sweep["detections"].size(),
-        sweep["true_position"][0].get<double>(), sweep["true_position"][1].get<double>());
+        thresholds.min_consistency, thresholds.min_confidence, sweep["true_position"][0].get<double>(),
+        sweep["true_position"][1].get<double>());
   }
   if (summary.contains("segment")) {
     const json& segment = summary["segment"];
