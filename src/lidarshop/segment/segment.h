@@ -151,9 +151,10 @@ struct SegmentOptions {
   // and update every t-link (true), or only turn the new stroke cells into hard constraints (false, cheaper,
   // but an object stroke on a missed part then adds little more than the stroke itself).
   bool refine_relearn_models = true;
-  // Refine(): strokes say only what they say. A refinement whose new strokes are all background can only
-  // remove cells from the mask, one whose strokes are all object can only add cells (re-learnt models must
-  // not make a correct background stroke grow the object elsewhere). Mixed strokes take the new cut as is.
+  // Refine(): strokes say only what they say. A refinement whose new strokes are all background only removes
+  // the parts of the mask its strokes touch (8-connected parts of the dropped cells holding a stroke cell), one
+  // whose strokes are all object only adds cells (re-learnt models must not make a correct stroke change the
+  // object elsewhere). Mixed strokes take the new cut as is.
   bool refine_monotone = true;
   // Cells without a return enclosed by the object (dark hair, black tyres, windows: no echo, but inside the
   // object's outline) join the mask, so a cut-out has no holes and a fill covers them too.

@@ -1,5 +1,6 @@
 #include "lidarshop/segment/segment_eval.h"
 
+#include <algorithm>
 #include <random>
 
 #include <opencv2/imgproc.hpp>
@@ -65,6 +66,64 @@ std::vector<MethodScores> EvaluateMethods(const Scan& scan, const cv::Mat& truth
     const cv::Mat mask = GrabCutFromStrokes(scan, strokes, grabcut_iterations);
     out.push_back({"grabcut", ScoreMask(mask, truth, scan.valid), timer.Seconds()});
   }
+  return out;
+}
+
+namespace {
+
+// A stroke of up to `length` cells of the largest 4-connected component of `part`, along its middle row,
+// starting at the component's cell nearest its centroid. Returns false when `part` is empty.
+bool StrokeOnLargestPart(const cv::Mat& part, uint8_t kind, int length, cv::Mat* strokes) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(part, labels, stats, centroids, 4, CV_32S);
+  int largest = 0;
+  for (int k = 1; k < count; ++k)
+    if (largest == 0 || stats.at<int>(k, cv::CC_STAT_AREA) > stats.at<int>(largest, cv::CC_STAT_AREA))
+      largest = k;
+  if (largest == 0) return false;
+  const int row = std::clamp(cvRound(centroids.at<double>(largest, 1)), 0, part.rows - 1);
+  int start = -1;
+  double best = 0;
+  for (int col = 0; col < part.cols; ++col) {
+    if (labels.at<int32_t>(row, col) != largest) continue;
+    const double distance = std::abs(col - centroids.at<double>(largest, 0));
+    if (start < 0 || distance < best) start = col, best = distance;
+  }
+  if (start < 0) {  // the middle row misses the component (a ring): its first cell
+    std::vector<cv::Point> cells;
+    cv::findNonZero(labels == largest, cells);
+    strokes->at<uint8_t>(cells.front()) = kind;
+    return true;
+  }
+  for (int col = start; col < std::min(part.cols, start + length) && labels.at<int32_t>(row, col) == largest;
+       ++col)
+    strokes->at<uint8_t>(row, col) = kind;
+  return true;
+}
+
+}  // namespace
+
+RefinementScores EvaluateRefinement(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes,
+                                    const SegmentOptions& options, int stroke_length_cells) {
+  SegmentOptions o = options;
+  o.method = SegmentMethod::kTwoStep;
+  SegmentSession session(scan, o);
+  const SegmentResult first = session.Run(strokes);
+  RefinementScores out;
+  out.before = ScoreMask(first.mask, truth, scan.valid);
+  const cv::Mat valid = scan.valid != 0, object = truth != 0;
+  cv::Mat extra(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  if (StrokeOnLargestPart(object & ~first.mask & valid, kStrokeObject, stroke_length_cells, &extra)) {
+    out.stroke = "object";
+  } else if (StrokeOnLargestPart(first.mask & ~object & valid, kStrokeBackground, stroke_length_cells,
+                                 &extra)) {
+    out.stroke = "background";
+  } else {
+    out.stroke = "none";
+    out.after = out.before;
+    return out;
+  }
+  out.after = ScoreMask(session.Refine(extra).mask, truth, scan.valid);
   return out;
 }
 

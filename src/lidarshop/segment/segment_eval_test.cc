@@ -52,5 +52,26 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
   EXPECT_GT(iou["two-step"], 0.92);
 }
 
+// #15: a correct refinement stroke never lowers IoU by more than 0.01 (one stroke per scene, on the largest
+// missed part or else the largest wrongly taken part).
+TEST(SegmentEvalTest, ACorrectRefinementNeverLowersIoU) {
+  const char* scenes[] = {"bench_paving",    "car_gravel",      "electric_box_grass", "electric_box_wall",
+                          "hatchback_grass", "mailbox_gravel",  "mailbox_lawn",       "sign_on_post",
+                          "table_mug",       "trash_can_grass", "trash_can_gravel",   "two_people",
+                          "van_facade"};
+  int refined = 0;
+  for (const char* name : scenes) {
+    const Scan scan =
+        SynthesizeScan(LoadScene(std::string(LIDARSHOP_SOURCE_DIR "/data/segment_eval/") + name + ".json"));
+    const cv::Mat truth = (scan.label == 1) & (scan.valid != 0);
+    const RefinementScores r =
+        EvaluateRefinement(scan, truth, MakeEvalStrokes(truth, scan.valid, 7920), SegmentOptions());
+    std::printf("%-20s %-10s IoU %.3f -> %.3f\n", name, r.stroke.c_str(), r.before.iou, r.after.iou);
+    EXPECT_GE(r.after.iou, r.before.iou - 0.01) << name;
+    refined += r.stroke != "none";
+  }
+  EXPECT_GT(refined, 6);
+}
+
 }  // namespace
 }  // namespace lidarshop

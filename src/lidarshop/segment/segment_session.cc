@@ -311,10 +311,23 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   const cv::Mat previous_mask = s.last_result.mask;
   const auto keep_monotone = [&](cv::Mat* mask) {
     if (!s.options.refine_monotone || previous_mask.empty() || object_strokes == background_strokes) return;
-    if (background_strokes)
-      *mask &= previous_mask;  // the stroke cells themselves are background in the new cut already
-    else
+    if (object_strokes) {
       *mask |= previous_mask;
+      return;
+    }
+    // Background strokes remove what they touch: of the cells the new cut drops, only the 8-connected parts
+    // that hold a new stroke cell leave (re-learnt models must not take away object parts elsewhere).
+    *mask &= previous_mask;
+    cv::Mat dropped = previous_mask & ~*mask, part;
+    const int count = cv::connectedComponents(dropped, part, 8, CV_32S);
+    std::vector<uint8_t> touched(static_cast<size_t>(count), 0);
+    for (int i = 0; i < s.nodes.num(); ++i) {
+      if (extra[i] != kHardBackground) continue;
+      touched[static_cast<size_t>(reinterpret_cast<const int32_t*>(part.data)[s.nodes.cell_of_node[i]])] = 1;
+    }
+    const int32_t* label = reinterpret_cast<const int32_t*>(part.data);
+    for (int64_t cell = 0; cell < static_cast<int64_t>(part.total()); ++cell)
+      if (label[cell] != 0 && !touched[static_cast<size_t>(label[cell])]) mask->data[cell] = 255;
   };
   if (outside) {
     // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
