@@ -9,18 +9,8 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 passed=0
 failed=0
-
-check() {  # check NAME COMMAND...: the command must succeed
-  local name=$1
-  shift
-  if "$@" >"$work/last.out" 2>"$work/last.err"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAILED: $name: $*"
-    sed 's/^/  | /' "$work/last.out" "$work/last.err" | head -20
-  fi
-}
+# shellcheck source=check_lib.sh
+source "$(dirname "$0")/check_lib.sh"
 
 exits_with() {  # exits_with CODE NAME PATTERN COMMAND...: that exit code and one line on stderr matching PATTERN
   local code=$1 name=$2 pattern=$3
@@ -34,27 +24,6 @@ exits_with() {  # exits_with CODE NAME PATTERN COMMAND...: that exit code and on
     echo "FAILED: $name: expected exit $code and one line matching '$pattern', got exit $status:"
     sed 's/^/  | /' "$work/last.err" | head -10
   fi
-}
-
-fails_clearly() {  # fails_clearly NAME PATTERN COMMAND...: non-zero exit, one line on stderr matching PATTERN
-  local name=$1 pattern=$2
-  shift 2
-  if "$@" >"$work/last.out" 2>"$work/last.err"; then
-    failed=$((failed + 1))
-    echo "FAILED: $name: succeeded but should have failed: $*"
-    return
-  fi
-  if [ "$(wc -l <"$work/last.err")" -eq 1 ] && grep -qE -e "$pattern" "$work/last.err"; then
-    passed=$((passed + 1))
-  else
-    failed=$((failed + 1))
-    echo "FAILED: $name: expected one line matching '$pattern' on stderr, got:"
-    sed 's/^/  | /' "$work/last.err" | head -10
-  fi
-}
-
-json_check() {  # json_check NAME FILE PYTHON_EXPRESSION (on `d`, the parsed JSON)
-  check "$1" python3 -c "import json,sys,math; d=json.load(open(sys.argv[1])); assert ($3), 'expression false'" "$2"
 }
 
 # The scene form of docs/scene-format.md, with a mesh from the shared data (paths relative to the scene file).

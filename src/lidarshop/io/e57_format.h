@@ -39,6 +39,10 @@ extern int64_t g_max_cells;
 // CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing-by-8.
 uint32_t Crc32c(const uint8_t* data, size_t size);
 
+// Checks one physical page's stored CRC against its payload; throws InputError naming `path`, the page index
+// and its byte offset on a mismatch.
+void CheckPageCrc(const std::string& path, const uint8_t* page, uint64_t page_index);
+
 inline uint64_t LogicalFromPhysical(uint64_t physical) {
   return physical / kPageSize * kPagePayload + physical % kPageSize;
 }

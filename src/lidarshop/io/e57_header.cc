@@ -138,14 +138,7 @@ std::string ReadLogical(const std::string& path, uint64_t logical_begin, uint64_
   logical.reserve((last_page - first_page + 1) * kPagePayload);
   for (uint64_t p = first_page; p <= last_page; ++p) {
     const auto* page = reinterpret_cast<const uint8_t*>(pages.data() + (p - first_page) * kPageSize);
-    const uint32_t stored = (uint32_t{page[1020]} << 24) | (uint32_t{page[1021]} << 16) |
-                            (uint32_t{page[1022]} << 8) | uint32_t{page[1023]};
-    const uint32_t computed = Crc32c(page, kPagePayload);
-    if (stored != computed) {
-      ThrowInputError(path, fmt::format("page {} (byte offset {})", p, p * kPageSize), "CRC-32C",
-                      fmt::format("checksum mismatch: stored 0x{:08x}, computed 0x{:08x} (corrupt page)",
-                                  stored, computed));
-    }
+    CheckPageCrc(path, page, p);
     logical.append(reinterpret_cast<const char*>(page), kPagePayload);
   }
   return logical.substr(logical_begin - first_page * kPagePayload, size);

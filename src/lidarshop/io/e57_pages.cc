@@ -28,6 +28,18 @@ const CrcTables& Tables() {
 
 }  // namespace
 
+void CheckPageCrc(const std::string& path, const uint8_t* page, uint64_t page_index) {
+  const uint32_t stored = (uint32_t{page[1020]} << 24) | (uint32_t{page[1021]} << 16) |
+                          (uint32_t{page[1022]} << 8) | uint32_t{page[1023]};
+  const uint32_t computed = Crc32c(page, kPagePayload);
+  if (stored != computed) {
+    ThrowInputError(path, fmt::format("page {} (byte offset {})", page_index, page_index * kPageSize),
+                    "CRC-32C",
+                    fmt::format("checksum mismatch: stored 0x{:08x}, computed 0x{:08x} (corrupt page)",
+                                stored, computed));
+  }
+}
+
 uint32_t Crc32c(const uint8_t* data, size_t size) {
   const auto& t = Tables().t;
   uint32_t crc = 0xFFFFFFFFu;
@@ -53,14 +65,7 @@ std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector
   std::vector<uint8_t> logical(pages * kPagePayload);
   for (size_t p = 0; p < pages; ++p) {
     const uint8_t* page = physical.data() + p * kPageSize;
-    const uint32_t stored = (uint32_t{page[1020]} << 24) | (uint32_t{page[1021]} << 16) |
-                            (uint32_t{page[1022]} << 8) | uint32_t{page[1023]};
-    const uint32_t computed = Crc32c(page, kPagePayload);
-    if (stored != computed) {
-      ThrowInputError(path, fmt::format("page {} (byte offset {})", p, p * kPageSize), "CRC-32C",
-                      fmt::format("checksum mismatch: stored 0x{:08x}, computed 0x{:08x} (corrupt page)",
-                                  stored, computed));
-    }
+    CheckPageCrc(path, page, p);
     std::memcpy(logical.data() + p * kPagePayload, page, kPagePayload);
   }
   return logical;
