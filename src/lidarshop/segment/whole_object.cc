@@ -37,12 +37,13 @@ Scan CropView(const Scan& scan, const cv::Rect& rect) {
   return view;
 }
 
-// Cells of `cells_mask` whose point lies within distance_m of the plane.
-int CountOnPlane(const Scan& scan, const cv::Mat& cells_mask, const PlaneFit& plane, double distance_m) {
+// Cells of `cells_mask` (all inside `box`, its bounding box) whose point lies within distance_m of the plane.
+int CountOnPlane(const Scan& scan, const cv::Mat& cells_mask, const cv::Rect& box, const PlaneFit& plane,
+                 double distance_m) {
   int count = 0;
-  for (int r = 0; r < scan.rows; ++r) {
+  for (int r = box.y; r < box.y + box.height; ++r) {
     const uint8_t* in = cells_mask.ptr<uint8_t>(r);
-    for (int c = 0; c < scan.cols; ++c) {
+    for (int c = box.x; c < box.x + box.width; ++c) {
       if (!in[c] || !scan.valid.at<uint8_t>(r, c)) continue;
       const cv::Vec3f& p = scan.point.at<cv::Vec3f>(r, c);
       count += std::abs(plane.Distance(Eigen::Vector3f(p[0], p[1], p[2]))) <= distance_m;
@@ -82,7 +83,7 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
     for (uint32_t i : plane.inliers) outside_box += !box.contains(cells[i]);
     if (4 * outside_box < plane.inliers.size()) continue;
     // A plane through much of the cut itself is a face of the object (its other half in another colour).
-    if (5 * CountOnPlane(scan, mask, plane, options.support_distance_m) > object_cells) continue;
+    if (5 * CountOnPlane(scan, mask, box, plane, options.support_distance_m) > object_cells) continue;
     const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
                                  static_cast<float>(plane.normal.z()));
     // Every cell of the region on that plane and facing its way, not only the band's.
