@@ -34,8 +34,8 @@ void BindFillOptions(OptionBinder& binder, FillOptions* options, const std::stri
   binder.Bind(
       options,
       {.skip = {"telea_radius_cells"}, .flags = {{"search_window_radius", "--window"}}, .prefix = prefix});
-  binder.Bind(options, {.keys = {"acceptance.enabled", "telea_radius_cells"},
-                        .flags = {{"acceptance.enabled", "--accept"}},
+  binder.Bind(options, {.keys = {"acceptance.enabled", "planes.enabled", "telea_radius_cells"},
+                        .flags = {{"acceptance.enabled", "--accept"}, {"planes.enabled", "--planes"}},
                         .prefix = prefix});
 }
 

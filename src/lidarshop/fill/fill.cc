@@ -30,10 +30,11 @@ std::string FillResult::Summary() const {
   return fmt::format(
       "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s "
       "(gradients "
-      "{:.2f}, inpaint {:.2f}, poisson {:.2f}, placement {:.2f})",
+      "{:.2f}, inpaint {:.2f}, poisson {:.2f}, planes {:.2f}, placement {:.2f})",
       hole_cells, synthesized_cells, no_return_cells,
       unanchored_cells ? fmt::format(" ({} cut off from every known range)", unanchored_cells) : "", patches,
-      timings.total_s, timings.gradients_s, timings.inpaint_s, timings.poisson_s, timings.placement_s);
+      timings.total_s, timings.gradients_s, timings.inpaint_s, timings.poisson_s, timings.planes_s,
+      timings.placement_s);
 }
 
 cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
@@ -243,6 +244,12 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
     }
   }
   result->timings.poisson_s = timer.Seconds();
+
+  timer.Restart();
+  result->plane_cells =
+      fill_internal::SnapToPlanes(in.range, in.known_valid, in.scan->direction, in.hole, values->has_return,
+                                  patches.source_pixel, options.planes, options.seed, &values->range);
+  result->timings.planes_s = timer.Seconds();
 }
 
 void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* progress, HoleValues* values,

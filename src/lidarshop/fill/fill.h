@@ -13,7 +13,9 @@
 //      the known ranges around the hole as Dirichlet boundary (poisson/); cells without a return are no-flux
 //      boundaries (edges to them are left out), not zero-range Dirichlet values, and copied depth jumps cut
 //      the system (FillOptions::depth_jump_ratio);
-//   4. every new point is placed along its own cell's ray (`direction`) at the reconstructed range — never on
+//   4. the reconstructed ranges are moved onto the planes seen around the hole where the reconstruction says
+//      a cell lies on one (fill/surface_planes.h: the crease hidden behind a car);
+//   5. every new point is placed along its own cell's ray (`direction`) at the reconstructed range — never on
 //      a height field — and flagged in `synthesized`.
 // Baselines in the same code path (the same return decision where they make none of their own):
 //   laplace      membrane fill ∇²r = 0 of range, colour and intensity (thesis eq. 6.5);
@@ -29,6 +31,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/fill/surface_planes.h"
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scan/scan.h"
@@ -83,6 +86,7 @@ struct FillOptions {
   // Telea baseline.
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
   PoissonOptions poisson;           // range reconstruction (and the laplace baseline)
+  FillPlaneOptions planes;          // gradient method: reconstructed ranges onto the planes around the hole
   uint64_t seed = 0;                // random choices of the patch fill (ties are broken by position)
   void Check() const;               // throws OptionsFieldError naming the field
 };
@@ -90,7 +94,8 @@ template <>
 const StructInfo& InfoOf<FillOptions>();
 
 struct FillTimings {
-  double gradients_s = 0, inpaint_s = 0, poisson_s = 0, placement_s = 0, total_s = 0;  // wall seconds
+  double gradients_s = 0, inpaint_s = 0, poisson_s = 0, planes_s = 0, placement_s = 0,
+         total_s = 0;  // wall seconds
 };
 
 struct FillResult {
@@ -101,6 +106,7 @@ struct FillResult {
   int64_t synthesized_cells = 0;  // hole cells given a return
   int64_t no_return_cells = 0;    // hole cells left without a return (sky, beyond range)
   int64_t unanchored_cells = 0;   // cells decided "return" but cut off from every known range (left empty)
+  int64_t plane_cells = 0;        // synthesized cells placed on a plane seen around the hole
   int patches = 0;                // patches copied (patch methods)
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:

@@ -159,6 +159,22 @@ TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
   EXPECT_EQ(gradient.synthesized_cells + gradient.no_return_cells, gradient.hole_cells);
 }
 
+TEST(FillScan, ThePlanesAroundTheHoleTakeTheDriftOutOfTheReconstruction) {
+  const Case c = MakeCase(kWallScene, 2);
+  FillOptions options;
+  const FillResult with_planes = FillScan(c.scan, c.hole, options);
+  options.planes.enabled = false;
+  const FillResult without = FillScan(c.scan, c.hole, options);
+  EXPECT_GT(with_planes.plane_cells, with_planes.synthesized_cells / 2);
+  EXPECT_EQ(without.plane_cells, 0);
+  const FillMetrics on = MeasureFill(with_planes.scan, c.truth, c.hole);
+  const FillMetrics off = MeasureFill(without.scan, c.truth, c.hole);
+  EXPECT_LT(on.range_rmse_mm, off.range_rmse_mm)
+      << "planes " << on.range_rmse_mm << " none " << off.range_rmse_mm;
+  EXPECT_LE(on.floating_share, off.floating_share);
+  EXPECT_GT(on.within_share, off.within_share);
+}
+
 TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
   const Case c = MakeCase(kSkyScene, 1);
   int sky = 0;

@@ -58,6 +58,7 @@ const StructInfo& InfoOf<FillOptions>() {
         .Unit("cells")
         .AboveZero();
     b.Field(&FillOptions::poisson, "poisson", "range reconstruction");
+    b.Field(&FillOptions::planes, "planes", "gradient method: ranges onto the planes seen around the hole");
     b.Field(&FillOptions::seed, "seed", "seed of the patch fill's random choices");
     b.Check([](const FillOptions& o) {
       if (o.search_window_radius < o.patch_radius) {
@@ -68,6 +69,48 @@ const StructInfo& InfoOf<FillOptions>() {
         throw OptionsFieldError("color_weight", "one of the colour, gradient and return weights must be > 0");
       }
     });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FillPlaneOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillPlaneOptions> b(
+        "FillPlaneOptions", "filled ranges onto the planes seen around the hole (fill/surface_planes.h)");
+    b.Field(&FillPlaneOptions::enabled, "enabled",
+            "move reconstructed ranges onto the planes around the hole");
+    b.Field(&FillPlaneOptions::band_cells, "band_cells",
+            "band around each part of the hole searched for planes; 0 = a quarter of its diameter (8..80)")
+        .Unit("cells")
+        .Range(0, 1000);
+    b.Field(&FillPlaneOptions::inlier_m, "inlier_m", "RANSAC inlier distance at range 0")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&FillPlaneOptions::inlier_per_m, "inlier_per_m",
+            "inlier distance added per metre of the band's median range")
+        .Unit("m/m")
+        .Min(0);
+    b.Field(&FillPlaneOptions::max_planes, "max_planes", "planes per part of the hole").Range(1, 20);
+    b.Field(&FillPlaneOptions::min_share, "min_share", "least share of the band's cells a kept plane holds")
+        .Range(1e-4, 0.999);
+    b.Field(&FillPlaneOptions::tolerance, "tolerance",
+            "a plane is a cell's candidate when its ray intersection is within this fraction of the "
+            "reconstructed range")
+        .Range(1e-4, 0.999);
+    b.Field(&FillPlaneOptions::agreement_m, "agreement_m",
+            "the patch source's plane is preferred when within this of the reconstruction")
+        .Unit("m")
+        .Min(0);
+    b.Field(&FillPlaneOptions::agreement_per_m, "agreement_per_m",
+            "added to agreement_m per metre from the hole's border")
+        .Unit("m/m")
+        .Min(0);
+    b.Field(&FillPlaneOptions::relief_m, "relief_m",
+            "largest offset from a plane copied from the patch source")
+        .Unit("m")
+        .Min(0);
     return b.Build();
   }();
   return info;
@@ -126,6 +169,7 @@ const StructInfo& InfoOf<FillTimings>() {
     b.Field(&FillTimings::gradients_s, "gradients_s", "range gradients and the joint image").Unit("s");
     b.Field(&FillTimings::inpaint_s, "inpaint_s", "patch fill").Unit("s");
     b.Field(&FillTimings::poisson_s, "poisson_s", "range reconstruction").Unit("s");
+    b.Field(&FillTimings::planes_s, "planes_s", "planes around the hole and ranges onto them").Unit("s");
     b.Field(&FillTimings::placement_s, "placement_s", "points along their rays").Unit("s");
     b.Field(&FillTimings::total_s, "total_s", "everything").Unit("s");
     return b.Build();
@@ -144,6 +188,8 @@ const StructInfo& InfoOf<FillResult>() {
         .Unit("cells");
     b.Field(&FillResult::unanchored_cells, "unanchored_cells",
             "cells decided 'return' but cut off from every known range (left empty)")
+        .Unit("cells");
+    b.Field(&FillResult::plane_cells, "plane_cells", "synthesized cells placed on a plane around the hole")
         .Unit("cells");
     b.Field(&FillResult::patches, "patches", "patches copied");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");

@@ -1,0 +1,332 @@
+#include "lidarshop/fill/surface_planes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/pointset/normals.h"
+#include "lidarshop/pointset/planes.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+void FillPlaneOptions::Check() const { Validate(*this); }
+
+namespace fill_internal {
+namespace {
+
+// n · x + offset_m = 0 with offset_m > 0: the scanner (the origin) is on the positive side.
+struct SeenPlane {
+  Eigen::Vector3d normal;
+  double offset_m = 0;
+  std::vector<Eigen::Vector3f> seen;  // its inliers in the band
+  double SignedDistance(const Eigen::Vector3f& x) const { return normal.dot(x.cast<double>()) + offset_m; }
+};
+
+// cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
+constexpr float kAgreeingNormal = 0.985f;
+
+enum class Meeting { kNone, kConcave, kConvex };
+
+// The known cells of the scan: ranges (0 without a return), which are usable, and the rays.
+struct KnownCells {
+  const cv::Mat& range;      // CV_32F
+  const cv::Mat& valid;      // CV_8U, outside the hole with a return
+  const cv::Mat& direction;  // CV_32FC3
+  bool Usable(int y, int x) const {
+    return y >= 0 && x >= 0 && y < range.rows && x < range.cols && valid.at<uint8_t>(y, x);
+  }
+  Eigen::Vector3f PointAt(int y, int x) const {
+    const cv::Vec3f d = direction.at<cv::Vec3f>(y, x);
+    const float r = range.at<float>(y, x);
+    return {d[0] * r, d[1] * r, d[2] * r};
+  }
+};
+
+// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
+constexpr double kFacingNormal = 0.906;
+
+// The unit normal at a known cell from its known neighbours two cells away on each side (a wider base than
+// one cell, so that range noise tilts it by a few degrees only); false where they are missing.
+bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
+  constexpr int kReach = 2;
+  auto end = [&](int dy, int dx, Eigen::Vector3f* p) {
+    for (int step = kReach; step >= 0; --step) {
+      if (known.Usable(y + dy * step, x + dx * step)) {
+        *p = known.PointAt(y + dy * step, x + dx * step);
+        return true;
+      }
+    }
+    return false;
+  };
+  Eigen::Vector3f left, right, up, down;
+  if (!end(0, -1, &left) || !end(0, 1, &right) || !end(-1, 0, &up) || !end(1, 0, &down)) return false;
+  const Eigen::Vector3f n = (right - left).cross(down - up);
+  if (n.norm() <= 0) return false;
+  *normal = n.normalized();
+  return true;
+}
+
+// The mean angle between neighbouring rays in `box`, radians.
+double MeanRaySpacing(const cv::Mat& direction, const cv::Rect& box) {
+  double sum = 0;
+  int count = 0;
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      const cv::Vec3f d = direction.at<cv::Vec3f>(y, x);
+      if (x + 1 < direction.cols) {
+        sum +=
+            std::acos(std::clamp(static_cast<double>(d.dot(direction.at<cv::Vec3f>(y, x + 1))), -1.0, 1.0));
+        ++count;
+      }
+      if (y + 1 < direction.rows) {
+        sum +=
+            std::acos(std::clamp(static_cast<double>(d.dot(direction.at<cv::Vec3f>(y + 1, x))), -1.0, 1.0));
+        ++count;
+      }
+    }
+  }
+  return count ? sum / count : 0.0;
+}
+
+// How two planes meet, from where their seen parts lie relative to each other. Nearly parallel planes (a
+// road and a pavement) do not meet; nor do planes whose parts lie on mixed sides (a wall end before a facade).
+Meeting HowTheyMeet(const SeenPlane& a, const SeenPlane& b, double threshold_m) {
+  if (std::abs(a.normal.dot(b.normal)) > std::cos(20.0 * M_PI / 180.0)) return Meeting::kNone;
+  auto sides = [threshold_m](const SeenPlane& from, const SeenPlane& to, double* front, double* behind) {
+    int in_front = 0, in_behind = 0;
+    for (const Eigen::Vector3f& p : from.seen) {
+      const double d = to.SignedDistance(p);
+      in_front += d > threshold_m;
+      in_behind += d < -threshold_m;
+    }
+    const int total = std::max(in_front + in_behind, 1);
+    *front = static_cast<double>(in_front) / total;
+    *behind = static_cast<double>(in_behind) / total;
+    return in_front + in_behind;
+  };
+  double front_a = 0, behind_a = 0, front_b = 0, behind_b = 0;
+  if (sides(a, b, &front_a, &behind_a) < 20 || sides(b, a, &front_b, &behind_b) < 20) return Meeting::kNone;
+  if (front_a >= 0.9 && front_b >= 0.9) return Meeting::kConcave;
+  if (behind_a >= 0.9 && behind_b >= 0.9) return Meeting::kConvex;
+  return Meeting::kNone;
+}
+
+// Planes among the known cells in a band around one part of the hole (`part`, CV_8U over the whole scan,
+// `box` its bounding box).
+std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part, const cv::Rect& box,
+                                  int part_cells, const FillPlaneOptions& options, uint64_t seed,
+                                  double* threshold_m) {
+  int band = options.band_cells;
+  if (band <= 0) {
+    const double diameter = 2.0 * std::sqrt(part_cells / M_PI);
+    band = std::clamp(static_cast<int>(std::lround(diameter / 4.0)), 8, 80);
+  }
+  const cv::Rect roi = cv::Rect(box.x - band, box.y - band, box.width + 2 * band, box.height + 2 * band) &
+                       cv::Rect(0, 0, known.range.cols, known.range.rows);
+  cv::Mat near_part;
+  cv::dilate(part(roi), near_part,
+             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
+  near_part &= known.valid(roi);
+  std::vector<cv::Point> cells;
+  cv::findNonZero(near_part, cells);
+  // Distance of every band cell from the part: a plane seen only on the hole's rim is what the cut left of
+  // the object itself (its face, missed by a cell or two), not a surface that runs on behind it.
+  cv::Mat from_part;
+  cv::distanceTransform(part(roi) == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  if (cells.size() < 50) return {};
+  // Grid normals of the band (a view of the known cells only), to tell a plane the cells lie on from one that
+  // only runs through them (the plane through the nosings of a flight of steps).
+  Scan band_view;
+  band_view.rows = roi.height;
+  band_view.cols = roi.width;
+  band_view.valid = known.valid(roi);
+  band_view.point = cv::Mat(roi.size(), CV_32FC3, cv::Scalar::all(0));
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      if (!band_view.valid.at<uint8_t>(y, x)) continue;
+      const Eigen::Vector3f p = known.PointAt(y + roi.y, x + roi.x);
+      band_view.point.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+    }
+  }
+  NormalOptions normal_options;
+  normal_options.window_cells = 2;
+  const cv::Mat normal = EstimateGridNormals(band_view, normal_options).normal;
+  PointCloud cloud;
+  std::vector<float> ranges;
+  cloud.points.reserve(cells.size());
+  ranges.reserve(cells.size());
+  for (const cv::Point& c : cells) {
+    cloud.points.push_back(known.PointAt(c.y + roi.y, c.x + roi.x));
+    ranges.push_back(known.range.at<float>(c.y + roi.y, c.x + roi.x));
+  }
+  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+  *threshold_m = options.inlier_m + options.inlier_per_m * ranges[ranges.size() / 2];
+
+  RansacPlaneOptions ransac;
+  ransac.distance_threshold_m = *threshold_m;
+  ransac.max_planes = options.max_planes;
+  ransac.min_inliers = std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size())));
+  ransac.seed = seed;
+  std::vector<SeenPlane> planes;
+  for (const PlaneFit& fit : DetectPlanesRansac(cloud, ransac)) {
+    SeenPlane plane;
+    plane.normal = fit.normal;
+    plane.offset_m = fit.offset_m;
+    if (std::abs(plane.offset_m) < 1e-6) continue;  // a plane through the scanner is seen edge-on
+    if (plane.offset_m < 0) {
+      plane.normal = -plane.normal;
+      plane.offset_m = -plane.offset_m;
+    }
+    plane.seen.reserve(fit.inliers.size());
+    const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
+                                 static_cast<float>(plane.normal.z()));
+    size_t outer = 0;
+    for (uint32_t i : fit.inliers) {
+      if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
+      plane.seen.push_back(cloud.points[i]);
+      outer += from_part.at<float>(cells[i]) > 0.5f * band;
+    }
+    if (2 * plane.seen.size() < fit.inliers.size()) continue;  // most cells face elsewhere: not a surface
+    if (4 * outer < plane.seen.size()) continue;               // only on the rim
+    planes.push_back(std::move(plane));
+  }
+  return planes;
+}
+
+// The planes of one part of the hole, how each pair meets, and the part's ray spacing.
+struct PartPlanes {
+  std::vector<SeenPlane> planes;
+  std::vector<Meeting> meeting;  // planes² (row-major)
+  double spacing_rad = 0;
+  Meeting At(size_t a, size_t b) const { return meeting[a * planes.size() + b]; }
+};
+
+PartPlanes FindPartPlanes(const KnownCells& known, const cv::Mat& part_mask, const cv::Rect& box,
+                          int part_cells, const FillPlaneOptions& options, uint64_t seed) {
+  PartPlanes part;
+  double threshold_m = 0;
+  part.planes = BandPlanes(known, part_mask, box, part_cells, options, seed, &threshold_m);
+  const size_t n = part.planes.size();
+  part.meeting.assign(n * n, Meeting::kNone);
+  for (size_t a = 0; a < n; ++a)
+    for (size_t b = a + 1; b < n; ++b)
+      part.meeting[a * n + b] = part.meeting[b * n + a] =
+          HowTheyMeet(part.planes[a], part.planes[b], threshold_m);
+  part.spacing_rad = MeanRaySpacing(known.direction, box);
+  return part;
+}
+
+// The plane a source cell lies on, facing its way, within relief_m (the nearest), and its signed offset from
+// it; −1 when none.
+int SourcePlane(const PartPlanes& part, const KnownCells& known, const cv::Vec2i& from, double relief_m,
+                double* offset_m) {
+  Eigen::Vector3f normal;
+  if (from[0] < 0 || !known.valid.at<uint8_t>(from[0], from[1]) ||
+      !CellNormal(known, from[0], from[1], &normal)) {
+    return -1;
+  }
+  const Eigen::Vector3f q = known.PointAt(from[0], from[1]);
+  int best = -1;
+  for (size_t k = 0; k < part.planes.size(); ++k) {
+    const double d = part.planes[k].SignedDistance(q);
+    if (std::abs(d) > relief_m || std::abs(normal.cast<double>().dot(part.planes[k].normal)) < kFacingNormal)
+      continue;
+    if (best < 0 || std::abs(d) < std::abs(*offset_m)) {
+      best = static_cast<int>(k);
+      *offset_m = d;
+    }
+  }
+  return best;
+}
+
+// The range of a hole cell (ray `dir`, reconstructed range `r`, copied from `from`) on the planes of its
+// part; 0 = keep the reconstruction.
+double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Vec2i& from,
+                     const cv::Vec3f& dir, double r, double agreement_m, const FillPlaneOptions& options) {
+  double source_offset = 0;
+  const int source_plane = SourcePlane(part, known, from, options.relief_m, &source_offset);
+  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  const size_t n = part.planes.size();
+  std::vector<double> along(n, 0.0);
+  std::vector<char> candidate(n, 0);
+  int best = -1;
+  for (size_t k = 0; k < n; ++k) {
+    const double facing = part.planes[k].normal.dot(ray);
+    if (std::abs(facing) < 1e-6) continue;
+    const double offset = static_cast<int>(k) == source_plane ? source_offset : 0.0;
+    along[k] = (offset - part.planes[k].offset_m) / facing;
+    if (!(along[k] > 0) || std::abs(along[k] - r) > options.tolerance * r) continue;
+    candidate[k] = 1;
+    if (best < 0 || std::abs(along[k] - r) < std::abs(along[static_cast<size_t>(best)] - r))
+      best = static_cast<int>(k);
+  }
+  if (best < 0) return 0;
+  // The source's own surface, when it is a candidate: of two parallel planes a few centimetres apart (a facade
+  // and its window recesses) the reconstruction cannot tell which, the patch can. A cell copied from no plane
+  // goes only onto a plane the reconstruction already agrees with.
+  if (source_plane >= 0 && candidate[static_cast<size_t>(source_plane)]) {
+    best = source_plane;
+  } else if (std::abs(along[static_cast<size_t>(best)] - r) > agreement_m) {
+    return 0;
+  }
+  // The order of the surroundings: the nearer of two planes meeting concavely, the farther of two meeting
+  // convexly (bounded: three planes could send it round).
+  for (size_t round = 0; round < n; ++round) {
+    size_t next = static_cast<size_t>(best);
+    for (size_t k = 0; k < n; ++k) {
+      if (!candidate[k]) continue;
+      const Meeting m = part.At(static_cast<size_t>(best), k);
+      if ((m == Meeting::kConcave && along[k] < along[next]) ||
+          (m == Meeting::kConvex && along[k] > along[next]))
+        next = k;
+    }
+    if (static_cast<int>(next) == best) break;
+    best = static_cast<int>(next);
+  }
+  return along[static_cast<size_t>(best)];
+}
+
+}  // namespace
+
+int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv::Mat& direction,
+                     const cv::Mat& hole, const cv::Mat& has_return, const cv::Mat& source,
+                     const FillPlaneOptions& options, uint64_t seed, cv::Mat* hole_range) {
+  if (!options.enabled) return 0;
+  const KnownCells known{range, known_valid, direction};
+  cv::Mat part_id, stats, centroids;
+  const int part_count = cv::connectedComponentsWithStats(hole != 0, part_id, stats, centroids, 8, CV_32S);
+  cv::Mat to_border;
+  cv::distanceTransform(hole != 0, to_border, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  int64_t moved = 0;
+  for (int id = 1; id < part_count; ++id) {
+    const cv::Rect box(stats.at<int>(id, cv::CC_STAT_LEFT), stats.at<int>(id, cv::CC_STAT_TOP),
+                       stats.at<int>(id, cv::CC_STAT_WIDTH), stats.at<int>(id, cv::CC_STAT_HEIGHT));
+    const PartPlanes part = FindPartPlanes(known, part_id == id, box, stats.at<int>(id, cv::CC_STAT_AREA),
+                                           options, seed + static_cast<uint64_t>(id));
+    if (part.planes.empty()) continue;
+    for (int y = box.y; y < box.y + box.height; ++y) {
+      for (int x = box.x; x < box.x + box.width; ++x) {
+        if (part_id.at<int32_t>(y, x) != id || !has_return.at<uint8_t>(y, x)) continue;
+        float& r = hole_range->at<float>(y, x);
+        if (!(r > 0.0f) || !std::isfinite(r)) continue;
+        // The reconstruction drifts with the distance it has travelled from the known ranges.
+        const double travelled_m = to_border.at<float>(y, x) * part.spacing_rad * r;
+        const cv::Vec2i from = source.empty() ? cv::Vec2i(-1, -1) : source.at<cv::Vec2i>(y, x);
+        const double placed =
+            RangeOnPlanes(part, known, from, direction.at<cv::Vec3f>(y, x), r,
+                          options.agreement_m + options.agreement_per_m * travelled_m, options);
+        if (placed <= 0) continue;
+        r = static_cast<float>(placed);
+        ++moved;
+      }
+    }
+  }
+  return moved;
+}
+
+}  // namespace fill_internal
+}  // namespace lidarshop

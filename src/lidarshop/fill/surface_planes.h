@@ -1,0 +1,67 @@
+// Planes around a hole, and the fill's ranges placed on them (the hidden crease behind a car).
+//
+// The Poisson reconstruction of the copied gradients drifts over a large hole: behind a van the facade and
+// the ground come out right near the hole's border, but the hidden wall–ground crease ends up tens of
+// centimetres off, and the points there float. Man-made surroundings are mostly planes, and the planes seen
+// around the hole continue behind the object. So, after the Poisson step, each filled cell is moved onto the
+// plane that the reconstruction says it is on:
+//   1. planes are found by sequential RANSAC among the known cells in a band around each connected part of
+//      the hole (pointset/planes.h);
+//   2. a cell's candidates are the planes the reconstructed point lies near (within a tolerance that grows
+//      with the cell's distance from the hole's border); with none, the cell keeps the reconstructed range;
+//   3. among candidates, the plane of the cell's patch source when it is one (else the one nearest the
+//      reconstruction), then the order the surroundings show: two planes
+//      whose seen parts each lie in front of the other meet in a concave crease (a wall standing on the
+//      ground: the ray stops at the nearer), two whose parts each lie behind the other in a convex edge (a
+//      kerb's top and face: the ray passes the nearer plane's extension and stops at the farther);
+//   4. relief is copied, not flattened: when the cell's patch source lies within `relief_m` of the plane
+//      (a window recess, a brick course), the cell is placed at the same signed distance from it.
+// A plane is unbounded, which is wrong beyond a wall's end; the tolerance around the reconstruction, which
+// already knows where the wall ends (its depth jump is copied and cut), keeps the plane out there.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/util/options_fwd.h"
+
+namespace lidarshop {
+
+struct FillPlaneOptions {
+  bool enabled = true;  // false = the reconstructed ranges as they are
+  // Width of the band of known cells around each part of the hole in which planes are sought; 0 = a quarter of
+  // the part's equivalent diameter (2·sqrt(cells/π)/4), at least 8 and at most 80 cells.
+  int band_cells = 0;
+  // RANSAC inlier distance: inlier_m + inlier_per_m × the band's median range (range noise and the scanner's
+  // footprint grow with range).
+  double inlier_m = 0.02;       // metres, > 0
+  double inlier_per_m = 0.002;  // metres per metre of range, >= 0
+  int max_planes = 6;           // planes per part of the hole, >= 1
+  // A plane is kept when it holds at least this share of the band's cells (and at least 50 cells).
+  double min_share = 0.05;  // (0, 1)
+  // A plane is a candidate for a cell when its intersection with the cell's ray is within this fraction of the
+  // reconstructed range (the reconstruction of a car-sized hole drifts by a tenth of the range).
+  double tolerance = 0.2;  // (0, 1)
+  // The patch source's plane is preferred over the one nearest the reconstruction only when it lies within
+  // agreement_m + agreement_per_m × t of the reconstruction, t the cell's distance from the hole's border
+  // (cells × ray spacing × range, metres): near the border the known ranges pin the reconstruction down.
+  double agreement_m = 0.05;     // metres, >= 0
+  double agreement_per_m = 1.0;  // metres per metre from the border, >= 0
+  double relief_m = 0.3;  // largest copied offset from a plane, metres, >= 0 (0 = flatten onto the plane)
+  void Check() const;     // throws OptionsFieldError naming the field
+};
+template <>
+const StructInfo& InfoOf<FillPlaneOptions>();
+
+namespace fill_internal {
+
+// Moves the ranges of the hole cells with a return (`has_return`, CV_8U) onto the planes around the hole, as
+// described above. `range` (CV_32F, the scan's ranges outside the hole, 0 without a return) and `known_valid`
+// (CV_8U) describe the known cells; `direction` is the scan's CV_32FC3 unit ray directions; `source`
+// (CV_32SC2, may be empty) the cell each hole cell was copied from; `hole_range` (CV_32F) holds the
+// reconstructed ranges and is updated. Returns the number of cells moved.
+int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv::Mat& direction,
+                     const cv::Mat& hole, const cv::Mat& has_return, const cv::Mat& source,
+                     const FillPlaneOptions& options, uint64_t seed, cv::Mat* hole_range);
+
+}  // namespace fill_internal
+}  // namespace lidarshop
