@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -29,6 +30,59 @@ float TruthRange(const Scan& truth, int y, int x) {
   return truth.range.at<float>(y, x);
 }
 
+// The truth's noise-free point of a cell (its own ray at the true range).
+Eigen::Vector3f TruePointAt(const Scan& truth, int y, int x) {
+  if (truth.direction.empty()) return PointAt(truth, y, x);
+  const cv::Vec3f d = truth.direction.at<cv::Vec3f>(y, x) * TruthRange(truth, y, x);
+  return {d[0], d[1], d[2]};
+}
+
+// Distance from p to the triangle abc (the closest point by Voronoi regions, Ericson 2005, 5.1.5).
+double PointTriangleDistance(const Eigen::Vector3f& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+                             const Eigen::Vector3f& c) {
+  const Eigen::Vector3f ab = b - a, ac = c - a, ap = p - a;
+  const float d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (p - a).norm();
+  const Eigen::Vector3f bp = p - b;
+  const float d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (p - b).norm();
+  const float vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + ab * (d1 / (d1 - d3)))).norm();
+  const Eigen::Vector3f cp = p - c;
+  const float d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (p - c).norm();
+  const float vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + ac * (d2 / (d2 - d6)))).norm();
+  const float va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))))).norm();
+  const float denom = 1.0f / (va + vb + vc);
+  return (p - (a + ab * (vb * denom) + ac * (vc * denom))).norm();
+}
+
+// Distance from p to the truth's surface around cell (y, x): the triangles of the truth's grid within
+// `reach` cells, leaving out those across a depth jump (a silhouette is no surface). At grazing incidence
+// the rows of a far ground lie a metre apart, so the nearest truth *point* can be far from a point lying on
+// the true surface between them; this measures to the surface itself. Infinity when there is none.
+double LocalSurfaceDistance(const Scan& truth, int y, int x, const Eigen::Vector3f& p, int reach) {
+  constexpr float kJumpRatio = 1.2f;
+  double best = std::numeric_limits<double>::infinity();
+  for (int qy = y - reach; qy < y + reach; ++qy) {
+    for (int qx = x - reach; qx < x + reach; ++qx) {
+      if (!Valid(truth, qy, qx) || !Valid(truth, qy, qx + 1) || !Valid(truth, qy + 1, qx) ||
+          !Valid(truth, qy + 1, qx + 1))
+        continue;
+      const float r[4] = {TruthRange(truth, qy, qx), TruthRange(truth, qy, qx + 1),
+                          TruthRange(truth, qy + 1, qx), TruthRange(truth, qy + 1, qx + 1)};
+      if (*std::max_element(r, r + 4) > kJumpRatio * *std::min_element(r, r + 4)) continue;
+      const Eigen::Vector3f a = TruePointAt(truth, qy, qx), b = TruePointAt(truth, qy, qx + 1),
+                            c = TruePointAt(truth, qy + 1, qx), d = TruePointAt(truth, qy + 1, qx + 1);
+      best = std::min({best, PointTriangleDistance(p, a, b, d), PointTriangleDistance(p, a, d, c)});
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& hole_in,
@@ -51,6 +105,7 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
     }
   }
   const PointKdTree tree(std::move(truth_points));
+  constexpr int kSurfaceReach = 2;  // cells: the truth's triangles around a filled cell's own ray
 
   double sum_sq = 0, sum_abs = 0, color_sq = 0, normal_deg = 0;
   int64_t within = 0, same_return = 0, synthesized = 0, floating = 0, normals = 0, color_values = 0;
@@ -69,9 +124,10 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
       if (f == t) ++same_return;
       if (f) {
         ++synthesized;
-        const NearestResult nearest =
-            tree.NearestWithin(PointAt(filled, y, x), static_cast<float>(options.floating_m));
-        if (!nearest.found()) ++floating;
+        const Eigen::Vector3f p = PointAt(filled, y, x);
+        const NearestResult nearest = tree.NearestWithin(p, static_cast<float>(options.floating_m));
+        if (!nearest.found() && LocalSurfaceDistance(truth, y, x, p, kSurfaceReach) > options.floating_m)
+          ++floating;
       }
       if (!f || !t) continue;
       ++m.compared_cells;

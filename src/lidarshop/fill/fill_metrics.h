@@ -13,8 +13,10 @@
 namespace lidarshop {
 
 struct FillMetricsOptions {
-  double within_m = 0.02;        // "within" tolerance of the range error, metres (the 20 mm of the share)
-  double floating_m = 0.10;      // a filled point farther than this from every truth point floats, metres
+  double within_m = 0.02;  // "within" tolerance of the range error, metres (the 20 mm of the share)
+  // A filled point farther than this from the true surface floats, metres: from every truth point and from the
+  // truth grid's triangles around its own cell (far ground at grazing incidence is sampled a metre apart).
+  double floating_m = 0.10;
   int normal_window_radius = 2;  // plane-fit window of the filled points' normals, cells (5 x 5)
   int seam_band_cells = 8;       // width of the band outside the hole where the reference jump is measured
 };
