@@ -2,20 +2,22 @@
 //
 // The Poisson reconstruction of the copied gradients drifts over a large hole: behind a van the facade and
 // the ground come out right near the hole's border, but the hidden wall–ground crease ends up tens of
-// centimetres off, and the points there float. Man-made surroundings are mostly planes, and the planes seen
-// around the hole continue behind the object. So, after the Poisson step, each filled cell is moved onto the
-// plane that the reconstruction says it is on:
+// centimetres off, and the points there float. Built surroundings are mostly planes, and the planes seen
+// around the hole continue behind the object. So, after the Poisson step, each filled cell is moved onto one:
 //   1. planes are found by sequential RANSAC among the known cells in a band around each connected part of
-//      the hole (pointset/planes.h);
-//   2. a cell's candidates are the planes the reconstructed point lies near (within a tolerance that grows
-//      with the cell's distance from the hole's border); with none, the cell keeps the reconstructed range;
-//   3. among candidates, the plane of the cell's patch source when it is one (else the one nearest the
-//      reconstruction), then the order the surroundings show: two planes
-//      whose seen parts each lie in front of the other meet in a concave crease (a wall standing on the
-//      ground: the ray stops at the nearer), two whose parts each lie behind the other in a convex edge (a
-//      kerb's top and face: the ray passes the nearer plane's extension and stops at the farther);
-//   4. relief is copied, not flattened: when the cell's patch source lies within `relief_m` of the plane
-//      (a window recess, a brick course), the cell is placed at the same signed distance from it.
+//      the hole (pointset/planes.h), kept when most of their inliers' grid normals agree with them (not the
+//      plane through a staircase's nosings) and a quarter of them lie in the band's outer half (not what the
+//      cut left of the object itself on the hole's rim);
+//   2. a cell's candidates are the planes whose intersection with its ray lies within `tolerance` × the
+//      reconstructed range; with none, the cell keeps the reconstructed range;
+//   3. the cell goes onto the plane its patch source lies on (facing its way, within `relief_m`), at the
+//      source's signed distance from it — relief is copied, not flattened (a window recess stays a recess);
+//      a cell copied from no plane goes onto the nearest candidate only when the reconstruction agrees with it
+//      (`agreement_m`, growing with the distance from the hole's border);
+//   4. then the order the surroundings show: two planes whose seen parts each lie in front of the other meet
+//      in a concave crease (a wall standing on the ground: the ray stops at the nearer), two whose parts each
+//      lie behind the other in a convex edge (a kerb's top and face: the ray passes the nearer plane's
+//      extension and stops at the farther).
 // A plane is unbounded, which is wrong beyond a wall's end; the tolerance around the reconstruction, which
 // already knows where the wall ends (its depth jump is copied and cut), keeps the plane out there.
 #pragma once
