@@ -77,6 +77,11 @@ const StructInfo& InfoOf<RecolorOptions>() {
     b.Field(&RecolorOptions::silhouette_margin_px, "silhouette_margin_px", "z-buffer window radius")
         .Unit("px")
         .Range(0, 50);
+    b.Field(&RecolorOptions::silhouette_skirts, "silhouette_skirts",
+            "grow every occluder of the scan mesh by one scan cell");
+    b.Field(&RecolorOptions::skirt_depth_m, "skirt_depth_m", "skirt walls behind each occluder edge")
+        .Unit("m")
+        .Min(0);
     b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
     b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
     return b.Build();

@@ -135,19 +135,37 @@ int main(int argc, char** argv) {
                    hidden_sum / seeds, hidden_worst);
       }
     }
-    // Visibility with the true camera: the z-buffer with its margin, without, and the literal segment test.
-    for (int variant = 0; variant < 5; ++variant) {
+    // Visibility with the true camera: the default (skirts with walls, 1 px margin) and its parts, the literal
+    // segment test, and the visibility test before the skirts (2 px margin).
+    struct Variant {
+      const char* name;
+      VisibilityMethod method;
+      bool skirts;
+      double depth_m;
+      int margin_px;
+    };
+    const Variant variants[] = {
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (default)", VisibilityMethod::kZBuffer,
+         true, 0.25, 1},
+        {"true camera, z-buffer + skirt caps only (no walls) + 1 px margin", VisibilityMethod::kZBuffer, true,
+         0.0, 1},
+        {"true camera, z-buffer + skirts (0.25 m walls), no margin", VisibilityMethod::kZBuffer, true, 0.25,
+         0},
+        {"true camera, segment test + skirts (0.25 m walls)", VisibilityMethod::kSegment, true, 0.25, 0},
+        {"true camera, literal segment test (no skirts)", VisibilityMethod::kSegment, false, 0.0, 0},
+        {"true camera, z-buffer + 2 px margin, no skirts (the previous default)", VisibilityMethod::kZBuffer,
+         false, 0.0, 2},
+        {"true camera, z-buffer, no skirts, no margin", VisibilityMethod::kZBuffer, false, 0.0, 0},
+    };
+    for (const Variant& variant : variants) {
       RecolorOptions options;
-      if (variant == 1) options.silhouette_margin_px = 0;
-      if (variant == 2) options.visibility = VisibilityMethod::kSegment;
-      if (variant == 3) options.silhouette_margin_px = 3;
-      if (variant == 4) options.silhouette_margin_px = 4;
+      options.visibility = variant.method;
+      options.silhouette_skirts = variant.skirts;
+      options.skirt_depth_m = variant.depth_m;
+      options.silhouette_margin_px = variant.margin_px;
       const RecolorResult result = RecolorScan(s.input, s.photo.image, s.camera, options);
       const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input, result.scan, s.camera);
-      const char* names[] = {"true camera, z-buffer + 2 px margin (default)",
-                             "true camera, z-buffer, no margin", "true camera, literal segment test",
-                             "true camera, z-buffer + 3 px margin", "true camera, z-buffer + 4 px margin"};
-      fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, names[variant],
+      fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, variant.name,
                  score.visible_correct_percent(), score.hidden_changed_percent(), score.hidden_changed,
                  score.hidden);
     }
