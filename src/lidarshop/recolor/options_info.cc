@@ -34,6 +34,10 @@ const StructInfo& InfoOf<ResectionOptions>() {
         .Unit("px")
         .AboveZero();
     b.Field(&ResectionOptions::ransac_iterations, "ransac_iterations", "minimal sets tried at most").Min(1);
+    b.Field(&ResectionOptions::ransac_min_iterations, "ransac_min_iterations", "minimal sets tried at least")
+        .Min(1);
+    b.Field(&ResectionOptions::local_optimization, "local_optimization",
+            "refit every best-so-far set on its inliers (DLT + LM) and score it after (LO-RANSAC)");
     b.Field(&ResectionOptions::ransac_confidence, "ransac_confidence",
             "stop once a better set is this unlikely")
         .AboveZero()
@@ -51,6 +55,9 @@ const StructInfo& InfoOf<ResectionOptions>() {
     b.Field(&ResectionOptions::min_inliers_for_distortion, "min_inliers_for_distortion",
             "distortion is refined only with this many inliers")
         .Min(6);
+    b.Field(&ResectionOptions::min_inliers_for_principal_point, "min_inliers_for_principal_point",
+            "below this many inliers the principal point stays at the photo's centre")
+        .Min(0);
     b.Field(&ResectionOptions::degenerate_ratio, "degenerate_ratio",
             "coplanar / collinear below this spread ratio")
         .AboveZero()

@@ -136,8 +136,13 @@ struct ReprojectionFunctor {
   }
 };
 
+// Levenberg–Marquardt over the pose and the intrinsics the inlier count supports: the focal length(s)
+// always; the principal point from `min_inliers_for_principal_point` inliers (else the photo's centre);
+// distortion from `min_inliers_for_distortion`.
 std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vector<PixelPointPair>& pairs,
                                     const ResectionOptions& options) {
+  const int count = static_cast<int>(pairs.size());
+  const bool free_principal_point = count >= options.min_inliers_for_principal_point;
   ReprojectionFunctor functor;
   functor.pairs = pairs;
   functor.fixed = ToParameters(start);
@@ -145,11 +150,17 @@ std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vecto
   functor.width_px = options.width_px;
   functor.height_px = options.height_px;
   if (options.square_pixels) functor.fixed[0] = functor.fixed[1] = 0.5 * (start.fx_px + start.fy_px);
-  if (!options.refine_skew) functor.fixed[4] = 0;
-  functor.free = {0, 2, 3};
+  if (!options.refine_skew || !free_principal_point) functor.fixed[4] = 0;
+  functor.free = {0};
+  if (free_principal_point) {
+    functor.free.insert(functor.free.end(), {2, 3});
+  } else {
+    functor.fixed[2] = 0.5 * options.width_px;
+    functor.fixed[3] = 0.5 * options.height_px;
+  }
   if (!options.square_pixels) functor.free.push_back(1);
-  if (options.refine_skew) functor.free.push_back(4);
-  if (static_cast<int>(pairs.size()) >= options.min_inliers_for_distortion) {
+  if (options.refine_skew && free_principal_point) functor.free.push_back(4);
+  if (count >= options.min_inliers_for_distortion) {
     for (int k = 0; k < options.radial_coefficients; ++k) functor.free.push_back(5 + k);
     if (options.refine_tangential) functor.free.insert(functor.free.end(), {8, 9});
   }
@@ -292,16 +303,59 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
   options.Check();
   CheckResectionInput(pairs, options.degenerate_ratio, what);
   const int n = static_cast<int>(pairs.size());
+  const double t2 = options.ransac_threshold_px * options.ransac_threshold_px;
   ResectionResult result;
+
+  // MSAC: every pair costs its squared error, capped at the threshold's square; `inliers` gets the pairs
+  // within the threshold.
+  const auto score_camera = [&](const auto& error_of, std::vector<uint8_t>* inliers) {
+    double score = 0;
+    inliers->assign(n, 0);
+    for (int i = 0; i < n; ++i) {
+      const double e = error_of(pairs[i]);
+      (*inliers)[i] = e * e < t2;
+      score += std::min(e * e, t2);
+    }
+    return score;
+  };
+  const auto count_of = [](const std::vector<uint8_t>& inliers) {
+    return static_cast<int>(std::count(inliers.begin(), inliers.end(), 1));
+  };
+  // Local optimization (LO-RANSAC): the DLT on a set's inliers, Levenberg–Marquardt with the intrinsics the
+  // inlier count supports (Refine), inliers re-selected with the refined camera, twice; scored after.
+  struct Candidate {
+    PinholeCamera camera;
+    std::vector<uint8_t> inliers;
+    double score = std::numeric_limits<double>::infinity();
+  };
+  const auto optimize = [&](std::vector<uint8_t> inliers) {
+    Candidate out;
+    out.camera =
+        CameraFromProjection(NormalizedDlt(Select(pairs, inliers)), options.width_px, options.height_px);
+    out.score = score_camera([&](const PixelPointPair& pair) { return ReprojectionError(out.camera, pair); },
+                             &out.inliers);
+    if (!options.refine) return out;
+    for (int round = 0; round < 2 && count_of(inliers) >= 6; ++round) {
+      const std::optional<PinholeCamera> refined = Refine(out.camera, Select(pairs, inliers), options);
+      if (!refined || !(refined->fx_px > 0 && refined->fy_px > 0)) break;
+      std::vector<uint8_t> next;
+      const double score =
+          score_camera([&](const PixelPointPair& pair) { return ReprojectionError(*refined, pair); }, &next);
+      if (!(score < out.score) && round > 0) break;
+      if (score < out.score || round == 0) out = {*refined, next, score};
+      if (next == inliers) break;
+      inliers = next;
+    }
+    return out;
+  };
 
   // RANSAC over minimal sets of 6 (serial, seeded).
   std::mt19937_64 rng(options.seed);
   std::vector<int> order(n);
-  std::vector<uint8_t> best_inliers(n, 1);
-  int best_count = -1;
-  double best_score = std::numeric_limits<double>::infinity();
+  Candidate best;
+  int best_set_count = -1;                      // inliers of the best minimal set, for the adaptive bound
+  std::vector<std::vector<uint8_t>> optimized;  // inlier sets already locally optimized
   int iterations_needed = options.ransac_iterations;
-  const double t2 = options.ransac_threshold_px * options.ransac_threshold_px;
   std::vector<PixelPointPair> sample(6);
   std::vector<Eigen::Vector3d> sample_points(6);
   for (int iteration = 0; iteration < iterations_needed; ++iteration) {
@@ -323,44 +377,46 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
           std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0))
         continue;
     }
-    std::vector<uint8_t> inliers(n, 0);
-    int count = 0;
-    double score = 0;
-    for (int i = 0; i < n; ++i) {
-      const bool in_front = (p.row(2) * pairs[i].point_in_world.homogeneous()) > 0;
-      const double e = in_front ? ProjectionError(p, pairs[i]) : std::numeric_limits<double>::infinity();
-      inliers[i] = e * e < t2;
-      count += inliers[i];
-      score += std::min(e * e, t2);  // MSAC: ties in count go to the tighter fit
+    std::vector<uint8_t> inliers;
+    const double score = score_camera(
+        [&](const PixelPointPair& pair) {
+          const bool in_front = (p.row(2) * pair.point_in_world.homogeneous()) > 0;
+          return in_front ? ProjectionError(p, pair) : std::numeric_limits<double>::infinity();
+        },
+        &inliers);
+    const int count = count_of(inliers);
+    if (count < 6 || count < best_set_count) continue;
+    Candidate candidate{CameraFromProjection(p, options.width_px, options.height_px), inliers, score};
+    if (options.local_optimization) {
+      if (std::find(optimized.begin(), optimized.end(), inliers) != optimized.end()) continue;
+      optimized.push_back(inliers);
+      candidate = optimize(inliers);
     }
-    if (count > best_count || (count == best_count && score < best_score)) {
-      best_count = count;
-      best_score = score;
-      best_inliers = inliers;
-      const double w = static_cast<double>(count) / n;
-      const double miss = 1.0 - std::pow(w, 6);
-      if (miss >= 1) {
-        // No information yet: keep the iteration budget.
-      } else if (miss <= 0) {
-        iterations_needed = iteration + 1;
-      } else {
-        const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
-        iterations_needed = static_cast<int>(std::min<double>(options.ransac_iterations, std::ceil(needed)));
-      }
+    if (!(candidate.score < best.score)) continue;
+    best = std::move(candidate);
+    best_set_count = std::max(best_set_count, count);
+    const double w = static_cast<double>(std::max(count, count_of(best.inliers))) / n;
+    const double miss = 1.0 - std::pow(w, 6);
+    if (miss <= 0) {
+      iterations_needed = std::min(iterations_needed, std::max(iteration + 1, options.ransac_min_iterations));
+    } else if (miss < 1) {
+      const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
+      iterations_needed = static_cast<int>(std::min<double>(
+          options.ransac_iterations, std::max<double>(options.ransac_min_iterations, std::ceil(needed))));
     }
   }
-  if (best_count < 6)
+  if (count_of(best.inliers) < 6)
     ThrowInputError(what, "", "pairs",
                     fmt::format("no 6 pairs agree on a camera within {} px (best set: {} inliers)",
-                                options.ransac_threshold_px, std::max(best_count, 0)));
+                                options.ransac_threshold_px, std::max(count_of(best.inliers), 0)));
 
-  // DLT on the inliers, decomposed; then LM, re-selection and LM again.
-  result.projection = NormalizedDlt(Select(pairs, best_inliers));
+  // The DLT on the inliers (reported), then LM, re-selection and LM again from the best camera.
+  result.projection = NormalizedDlt(Select(pairs, best.inliers));
   const PinholeCamera dlt_camera =
       CameraFromProjection(result.projection, options.width_px, options.height_px);
-  result.dlt_rms_px = RmsOfInliers(dlt_camera, pairs, best_inliers);
-  result.camera = dlt_camera;
-  result.inlier = best_inliers;
+  result.dlt_rms_px = RmsOfInliers(dlt_camera, pairs, best.inliers);
+  result.camera = options.local_optimization ? best.camera : dlt_camera;
+  result.inlier = best.inliers;
   if (options.refine) {
     for (int round = 0; round < 2; ++round) {
       const std::optional<PinholeCamera> refined =

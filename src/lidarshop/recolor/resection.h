@@ -40,9 +40,14 @@ struct PixelPointPair {
 };
 
 struct ResectionOptions {
-  int width_px = 0, height_px = 0;    // the photo's size (stored in the camera); required, > 0
-  double ransac_threshold_px = 4.0;   // a pair is an inlier when its reprojection error is below this, pixels
-  int ransac_iterations = 2000;       // most minimal sets tried (fewer when the confidence is reached)
+  int width_px = 0, height_px = 0;   // the photo's size (stored in the camera); required, > 0
+  double ransac_threshold_px = 4.0;  // a pair is an inlier when its reprojection error is below this, pixels
+  int ransac_iterations = 2000;      // most minimal sets tried (fewer when the confidence is reached)
+  int ransac_min_iterations = 100;   // fewest minimal sets tried, whatever the adaptive bound says
+  // LO-RANSAC: a minimal set whose inliers are as many as the best set's is refitted on them (DLT, then
+  // Levenberg–Marquardt with the intrinsics the count supports, inliers re-selected) and scored (MSAC) after
+  // that refinement: a wrong set that happens to collect many pairs loses to the right one.
+  bool local_optimization = true;
   double ransac_confidence = 0.9999;  // stop once a better set is this unlikely
   uint64_t seed = 1;                  // RANSAC's random sets
   bool refine = true;                 // false = the (RANSAC) DLT camera without Levenberg–Marquardt
@@ -58,6 +63,10 @@ struct ResectionOptions {
   bool refine_tangential = false;  // refine p1, p2
   // Distortion is refined only with at least this many inliers (fewer pairs would fit the noise).
   int min_inliers_for_distortion = 16;
+  // Below this many inliers the principal point stays at the photo's centre and the skew at 0 (only the focal
+  // length and the pose are refined): with 8 inliers of 0.35 px noise a free principal point wandered 30 px
+  // and doubled the error (bench/results/recolor.md).
+  int min_inliers_for_principal_point = 12;
   // Points count as coplanar (or collinear) when the smallest spread of their centred coordinates is below
   // this fraction of the largest; same for collinear pixels.
   double degenerate_ratio = 1e-3;
