@@ -37,7 +37,7 @@ const StructInfo& InfoOf<ResectionOptions>() {
     b.Field(&ResectionOptions::ransac_min_iterations, "ransac_min_iterations", "minimal sets tried at least")
         .Min(1);
     b.Field(&ResectionOptions::local_optimization, "local_optimization",
-            "refit every best-so-far set on its inliers (DLT + LM) and score it after (LO-RANSAC)");
+            "refit every set with as many inliers as the best on them (DLT + LM), score it after (LO-RANSAC)");
     b.Field(&ResectionOptions::ransac_confidence, "ransac_confidence",
             "stop once a better set is this unlikely")
         .AboveZero()

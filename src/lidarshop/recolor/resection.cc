@@ -177,6 +177,56 @@ std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vecto
   return FromParameters(functor.Full(x), options.width_px, options.height_px);
 }
 
+// The camera of a minimal set under the intrinsics prior (square pixels, principal point at the photo's centre,
+// no skew): for sets whose DLT is no plausible camera (near-planar sets leave the DLT's intrinsics undetermined;
+// the prior's focal length and pose stay determined). Poses from EPnP for a few fields of view, each refined by
+// Levenberg–Marquardt over the focal length and the pose; the one that fits the set best.
+std::optional<PinholeCamera> PriorCamera(const std::vector<PixelPointPair>& sample,
+                                         const ResectionOptions& options) {
+  ResectionOptions prior = options;
+  prior.min_inliers_for_principal_point = std::numeric_limits<int>::max();
+  prior.min_inliers_for_distortion = std::numeric_limits<int>::max();
+  prior.square_pixels = true;
+  std::vector<cv::Point3d> object_points;
+  std::vector<cv::Point2d> image_points;
+  for (const PixelPointPair& pair : sample) {
+    object_points.emplace_back(pair.point_in_world.x(), pair.point_in_world.y(), pair.point_in_world.z());
+    image_points.emplace_back(pair.pixel_px.x() - 0.5, pair.pixel_px.y() - 0.5);
+  }
+  std::optional<PinholeCamera> best;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (const double fov_deg : {30.0, 50.0, 70.0, 90.0}) {
+    PinholeCamera camera;
+    camera.width_px = options.width_px;
+    camera.height_px = options.height_px;
+    camera.fx_px = camera.fy_px = 0.5 * options.width_px / std::tan(0.5 * fov_deg * M_PI / 180.0);
+    camera.cx_px = 0.5 * options.width_px;
+    camera.cy_px = 0.5 * options.height_px;
+    const cv::Matx33d k(camera.fx_px, 0, camera.cx_px - 0.5, 0, camera.fy_px, camera.cy_px - 0.5, 0, 0, 1);
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(object_points, image_points, k, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_EPNP))
+      continue;
+    cv::Matx33d rotation;
+    cv::Rodrigues(rvec, rotation);
+    Eigen::Matrix3d r;
+    cv::cv2eigen(cv::Mat(rotation), r);
+    const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    if (!r.allFinite() || !t.allFinite()) continue;
+    camera.world_from_camera.setIdentity();
+    camera.world_from_camera.topLeftCorner<3, 3>() = r.transpose();
+    camera.world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
+    const std::optional<PinholeCamera> refined = Refine(camera, sample, prior);
+    if (!refined || !(refined->fx_px > 0)) continue;
+    double sum = 0;
+    for (const PixelPointPair& pair : sample) sum += std::pow(ReprojectionError(*refined, pair), 2);
+    if (sum < best_sum) {
+      best_sum = sum;
+      best = refined;
+    }
+  }
+  return best;
+}
+
 double RmsOfInliers(const PinholeCamera& camera, std::span<const PixelPointPair> pairs,
                     const std::vector<uint8_t>& inlier) {
   double sum = 0;
@@ -328,21 +378,28 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
     std::vector<uint8_t> inliers;
     double score = std::numeric_limits<double>::infinity();
   };
-  const auto optimize = [&](std::vector<uint8_t> inliers) {
+  const auto optimize = [&](const Candidate& start) {
+    std::vector<uint8_t> inliers = start.inliers;
     Candidate out;
     out.camera =
         CameraFromProjection(NormalizedDlt(Select(pairs, inliers)), options.width_px, options.height_px);
     out.score = score_camera([&](const PixelPointPair& pair) { return ReprojectionError(out.camera, pair); },
                              &out.inliers);
+    if (!(out.score < start.score)) out = start;  // e.g. near-planar inliers: the DLT is no camera
     if (!options.refine) return out;
+    // With refinement, candidates are refined cameras only: a set whose refinement fails is no candidate.
+    out.score = std::numeric_limits<double>::infinity();
     for (int round = 0; round < 2 && count_of(inliers) >= 6; ++round) {
       const std::optional<PinholeCamera> refined = Refine(out.camera, Select(pairs, inliers), options);
       if (!refined || !(refined->fx_px > 0 && refined->fy_px > 0)) break;
       std::vector<uint8_t> next;
       const double score =
           score_camera([&](const PixelPointPair& pair) { return ReprojectionError(*refined, pair); }, &next);
+      if (!std::isfinite(score) || count_of(next) < 6) break;
+      // The first refinement is taken even when the DLT scored lower: candidates are compared under the
+      // model the inlier count supports, not with the DLT's free intrinsics.
       if (!(score < out.score) && round > 0) break;
-      if (score < out.score || round == 0) out = {*refined, next, score};
+      out = {*refined, next, score};
       if (next == inliers) break;
       inliers = next;
     }
@@ -353,7 +410,11 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
   std::mt19937_64 rng(options.seed);
   std::vector<int> order(n);
   Candidate best;
-  int best_set_count = -1;                      // inliers of the best minimal set, for the adaptive bound
+  // The best minimal set so far (most inliers, then lowest MSAC score). With local optimization every set
+  // with as many inliers as the refined best is refitted (once per distinct inlier set): with few pairs a
+  // wrong set can hold the best minimal score, and only its refitted rivals show it.
+  int best_set_count = -1;
+  double best_set_score = std::numeric_limits<double>::infinity();
   std::vector<std::vector<uint8_t>> optimized;  // inlier sets already locally optimized
   int iterations_needed = options.ransac_iterations;
   std::vector<PixelPointPair> sample(6);
@@ -370,31 +431,52 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
     if (spread[2] <= options.degenerate_ratio * spread[0]) continue;  // a planar set: no camera
     Matrix34d p = NormalizedDlt(sample);
     if (p.leftCols<3>().determinant() < 0) p = -p;  // then (P X)_z > 0 in front of the camera
+    std::optional<PinholeCamera> prior_camera;      // set when the DLT is no plausible camera
     if (options.square_pixels) {
-      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one.
+      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one —
+      // or a near-planar set whose intrinsics the DLT cannot fix: with local optimization, such a set gets
+      // the camera of the intrinsics prior instead.
       const Eigen::Matrix3d k = DecomposeProjection(p).K;
       if (std::abs(k(0, 0) / k(1, 1) - 1) > options.max_aspect_deviation ||
-          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0))
-        continue;
+          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0)) {
+        if (!options.local_optimization) continue;
+        prior_camera = PriorCamera(sample, options);
+        if (!prior_camera) continue;
+      }
     }
     std::vector<uint8_t> inliers;
-    const double score = score_camera(
-        [&](const PixelPointPair& pair) {
-          const bool in_front = (p.row(2) * pair.point_in_world.homogeneous()) > 0;
-          return in_front ? ProjectionError(p, pair) : std::numeric_limits<double>::infinity();
-        },
-        &inliers);
+    const double score =
+        prior_camera
+            ? score_camera([&](const PixelPointPair& pair) { return ReprojectionError(*prior_camera, pair); },
+                           &inliers)
+            : score_camera(
+                  [&](const PixelPointPair& pair) {
+                    const bool in_front = (p.row(2) * pair.point_in_world.homogeneous()) > 0;
+                    return in_front ? ProjectionError(p, pair) : std::numeric_limits<double>::infinity();
+                  },
+                  &inliers);
     const int count = count_of(inliers);
-    if (count < 6 || count < best_set_count) continue;
-    Candidate candidate{CameraFromProjection(p, options.width_px, options.height_px), inliers, score};
+    // With local optimization the bar is the refined best's inlier count (a wrong minimal set may collect
+    // more pairs than any right one before refinement).
+    if (count < 6 || count < (options.local_optimization ? count_of(best.inliers) : best_set_count)) continue;
+    const bool better_set = count > best_set_count || (count == best_set_count && score < best_set_score);
+    if (better_set) {
+      best_set_count = count;
+      best_set_score = score;
+    }
+    Candidate candidate{
+        prior_camera ? *prior_camera : CameraFromProjection(p, options.width_px, options.height_px), inliers,
+        score};
     if (options.local_optimization) {
       if (std::find(optimized.begin(), optimized.end(), inliers) != optimized.end()) continue;
       optimized.push_back(inliers);
-      candidate = optimize(inliers);
+      candidate = optimize(candidate);
+      // Compared after refinement.
+      if (count_of(candidate.inliers) < 6 || !(candidate.score < best.score)) continue;
+    } else if (!better_set) {
+      continue;
     }
-    if (!(candidate.score < best.score)) continue;
     best = std::move(candidate);
-    best_set_count = std::max(best_set_count, count);
     const double w = static_cast<double>(std::max(count, count_of(best.inliers))) / n;
     const double miss = 1.0 - std::pow(w, 6);
     if (miss <= 0) {

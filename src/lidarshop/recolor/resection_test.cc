@@ -163,6 +163,26 @@ TEST(Resection, TheOldSettingsKeptAnOutlierOnTheWorstDraw) {
   EXPECT_LT(RmsReprojectionError(Resection(pairs, lo).camera, exact), 0.5);
 }
 
+TEST(Resection, NearPlanarDrawsGetTheCameraOfTheIntrinsicsPrior) {
+  // The 1 m draw with seed 11: no minimal DLT of these 10 pairs is a plausible camera (the points nearly lie on
+  // one plane), so RANSAC without local optimization finds no set; the prior's camera (square pixels, principal
+  // point at the centre, f and pose from EPnP + LM) does.
+  const SceneDescription scene = test_scenes::MakeRecolorScene();
+  const Scan scan = test_scenes::ScanScene(scene);
+  const PinholeCamera truth = CameraLookingAt(
+      Eigen::Vector3d(0, 0, 1.5) + 1.0 * Eigen::Vector3d(0.8, -0.6, 0.05), {0, 10, 1.0}, 800, 600, 70);
+  std::vector<PixelPointPair> exact;
+  const std::vector<PixelPointPair> pairs =
+      DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 1110, &exact);
+  ResectionOptions options = Options(truth);
+  options.seed = 11;
+  const ResectionResult result = Resection(pairs, options);
+  EXPECT_EQ(result.num_inliers, 8);
+  EXPECT_LT(RmsReprojectionError(result.camera, exact), 1.0);
+  options.local_optimization = false;
+  EXPECT_THROW(Resection(pairs, options), InputError);
+}
+
 TEST(Resection, SameSeedSameCamera) {
   const PinholeCamera truth = TrueCamera();
   const std::vector<PixelPointPair> pairs = MakePairs(truth, 25, 0.5, 0.2, 9);
