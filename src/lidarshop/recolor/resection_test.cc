@@ -91,9 +91,9 @@ TEST(Resection, RansacAndRefinementMeetTheTargetWithNoiseAndOutliers) {
       const ResectionResult result = Resection(pairs, Options(truth));
       // The outliers (the first 20 %) are found, every other pair is kept.
       for (int i = 0; i < count; ++i) EXPECT_EQ(result.inlier[i], i >= std::round(0.2 * count) ? 1 : 0) << i;
-      // Single draws of the noise can exceed 0.5 px (10 pairs = 8 inliers: 16 residuals for 7 unknowns, the principal
-      // point held at the centre although this camera has it 3 px off); the
-      // mean over draws stays under 0.5 px.
+      // Single draws of the noise can exceed 0.5 px (10 pairs = 8 inliers: 16 residuals for 7 unknowns, the
+      // principal point held at the centre although this camera has it 3 px off); the mean over draws stays
+      // under 0.5 px.
       const double rms_true = Rms(result.camera, exact);
       sum_rms += rms_true;
       EXPECT_LT(rms_true, 0.75) << count << " pairs, seed " << seed;
