@@ -34,6 +34,11 @@ const StructInfo& InfoOf<ResectionOptions>() {
         .Unit("px")
         .AboveZero();
     b.Field(&ResectionOptions::ransac_iterations, "ransac_iterations", "minimal sets tried at most").Min(1);
+    b.Field(&ResectionOptions::ransac_min_iterations, "ransac_min_iterations", "minimal sets tried at least")
+        .Min(1);
+    b.Field(
+        &ResectionOptions::local_optimization, "local_optimization",
+        "refit every set with as many inliers as the best on them (DLT + LM), score it after (LO-RANSAC)");
     b.Field(&ResectionOptions::ransac_confidence, "ransac_confidence",
             "stop once a better set is this unlikely")
         .AboveZero()
@@ -51,6 +56,9 @@ const StructInfo& InfoOf<ResectionOptions>() {
     b.Field(&ResectionOptions::min_inliers_for_distortion, "min_inliers_for_distortion",
             "distortion is refined only with this many inliers")
         .Min(6);
+    b.Field(&ResectionOptions::min_inliers_for_principal_point, "min_inliers_for_principal_point",
+            "below this many inliers the principal point stays at the photo's centre")
+        .Min(0);
     b.Field(&ResectionOptions::degenerate_ratio, "degenerate_ratio",
             "coplanar / collinear below this spread ratio")
         .AboveZero()
@@ -77,6 +85,11 @@ const StructInfo& InfoOf<RecolorOptions>() {
     b.Field(&RecolorOptions::silhouette_margin_px, "silhouette_margin_px", "z-buffer window radius")
         .Unit("px")
         .Range(0, 50);
+    b.Field(&RecolorOptions::silhouette_skirts, "silhouette_skirts",
+            "grow every occluder of the scan mesh by one scan cell");
+    b.Field(&RecolorOptions::skirt_depth_m, "skirt_depth_m", "skirt walls behind each occluder edge")
+        .Unit("m")
+        .Min(0);
     b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
     b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
     return b.Build();

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/silhouette_skirt.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -71,7 +72,9 @@ cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, d
         distance.at<float>(row0 + r, c) = hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
         const cv::Vec3f n = hits.normal.at<cv::Vec3f>(r, c);
         const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
-        back_facing->at<uint8_t>(row0 + r, c) = w.dot(Eigen::Vector3f(n[0], n[1], n[2])) > 0 ? 255 : 0;
+        // Skirts (geometry 1) are no surface of the scan: only the scan mesh's own back faces count.
+        back_facing->at<uint8_t>(row0 + r, c) =
+            hits.geometry_id.at<int32_t>(r, c) == 0 && w.dot(Eigen::Vector3f(n[0], n[1], n[2])) > 0 ? 255 : 0;
       }
     }
   }
@@ -126,6 +129,13 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
   mesh_options.world_frame = true;
   RaycastScene raycast;
   raycast.AddMesh(ScanToMesh(scan, mesh_options), 0);
+  if (options.silhouette_skirts) {
+    SilhouetteSkirtOptions skirt_options;
+    skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
+    skirt_options.depth_m = options.skirt_depth_m;
+    const TriangleMesh skirts = SilhouetteSkirts(scan, skirt_options);
+    if (!skirts.empty()) raycast.AddMesh(skirts, 1);
+  }
   raycast.Commit();
 
   const Eigen::Vector3d center = camera.center_in_world();

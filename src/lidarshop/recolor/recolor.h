@@ -12,11 +12,15 @@
 // `zbuffer_scale`) from the camera centre gives the distance to the first surface of the scan seen through
 // that pixel. A point at distance d from the camera is hidden when that first surface is nearer than
 // d − tolerance, which is the segment test of the thesis with the segment's end moved `tolerance` off the
-// point's own surface (tolerance = depth_tolerance_m + relative_depth_tolerance · d). Two safety margins:
+// point's own surface (tolerance = depth_tolerance_m + relative_depth_tolerance · d). Safety margins:
+//   - silhouette skirts (`silhouette_skirts`, recolor/silhouette_skirt.h): the scan mesh stops at the last
+//     cell of an object, up to one scan step (angular spacing × the object's range) short of its true
+//     silhouette; the skirt grows every occluder by exactly that step, and walls `skirt_depth_m` deep behind
+//     the edge stand for the occluder's sides that the scanner never saw. Without them, points just behind an
+//     occluder's edge see the camera through the gap and take the occluder's colour (bench/results/recolor.md
+//     measures it).
 //   - `silhouette_margin_px`: the first-surface distance is the minimum over a (2m + 1)² window of z-buffer
-//     pixels. The scan mesh stops at the last cell of an object, up to one scan step short of its true
-//     silhouette; without a margin, points just behind an occluder's edge see the camera through that gap and
-//     take the occluder's colour (bench/results/recolor.md measures it).
+//     pixels: the z-buffer samples the mesh at pixel centres, a point may project up to 0.71 px away.
 //   - the window's own depth slope: on surfaces seen at a grazing angle the window minimum is nearer than the
 //     point by (margin · slope); that much is added to the tolerance, with the slope taken one-sided (the
 //     smaller of the forward and backward differences), so that a depth jump does not count as slope.
@@ -24,7 +28,7 @@
 // faces the scanner, so the camera then sees the side of that surface the scanner never saw (a camera facing
 // the scanner across an object sees the object's other side, whose colour is not the scanned side's).
 // `VisibilityMethod::kSegment` instead casts the exact segment of every point (Embree occlusion rays, no
-// margin): the literal thesis test, kept as the reference of the evaluation.
+// pixel margin; skirts when `silhouette_skirts`): without skirts, the literal thesis test.
 #pragma once
 
 #include <cstdint>
@@ -46,10 +50,21 @@ struct RecolorOptions {
   VisibilityMethod visibility = VisibilityMethod::kZBuffer;
   double depth_tolerance_m = 0.03;  // metres: a surface this close in front of a point does not hide it
   double relative_depth_tolerance = 0.01;  // fraction of the camera distance added to the tolerance
-  int silhouette_margin_px = 2;            // z-buffer window radius (z-buffer pixels), 0 = no margin
-  double zbuffer_scale = 1.0;              // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
-  double max_range_jump_ratio = 0.1;       // scan mesh edges (scanner/scan_mesh.h)
-  void Check() const;                      // throws OptionsError
+  // z-buffer window radius (z-buffer pixels), 0 = no margin: the z-buffer samples the scan mesh at pixel
+  // centres, a point's projection lies up to 0.71 px from its pixel's centre; 1 covers that sampling.
+  int silhouette_margin_px = 1;
+  // Grow every occluder of the scan mesh by one scan cell at its own range (recolor/silhouette_skirt.h): the
+  // scan's own angular spacing decides how far a silhouette may reach, not a photo-pixel margin.
+  bool silhouette_skirts = true;
+  // Skirt walls this far behind each occluder's edge, metres (0 = caps only): faces the scanner never saw
+  // (an occluder's sides inside its shadow) that a camera beside the scanner looks at. A prior on how deep
+  // occluders are, which no scan can measure: with the 3 m camera of bench/results/recolor.md, caps alone
+  // let 29 hidden points past the 0.5 m deep pillar's unseen side, 0.25 m walls none (at 0.14 % of the
+  // visible points); deeper walls hide more of what the camera sees beside occluders.
+  double skirt_depth_m = 0.25;
+  double zbuffer_scale = 1.0;         // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
+  double max_range_jump_ratio = 0.1;  // scan mesh edges (scanner/scan_mesh.h)
+  void Check() const;                 // throws OptionsError
 };
 template <>
 const StructInfo& InfoOf<RecolorOptions>();

@@ -1,6 +1,8 @@
 #include "lidarshop/recolor/recolor_eval.h"
 
+#include <cmath>
 #include <cstdlib>
+#include <random>
 #include <vector>
 
 #include <fmt/format.h>
@@ -64,6 +66,44 @@ RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, cons
     score.visible_correct += close;
   }
   return score;
+}
+
+std::vector<PixelPointPair> DrawCorrespondences(const Scan& scan, const PinholeCamera& camera,
+                                                const cv::Mat& photo_depth_m, int count, double noise_px,
+                                                double outlier_fraction, uint64_t seed,
+                                                std::vector<PixelPointPair>* exact) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss(0, noise_px / std::sqrt(2.0));
+  std::uniform_real_distribution<double> unit(0, 1);
+  std::vector<PixelPointPair> pairs;
+  const int outlier_count = static_cast<int>(std::round(outlier_fraction * count));
+  while (static_cast<int>(pairs.size()) < count) {
+    const int r = static_cast<int>(unit(rng) * scan.rows), c = static_cast<int>(unit(rng) * scan.cols);
+    if (!scan.valid.at<uint8_t>(r, c)) continue;
+    const Eigen::Vector3d world = WorldPointOfCell(scan, r, c);
+    Eigen::Vector2d pixel;
+    if (!ProjectWorldPoint(camera, world, &pixel) || !InsideImage(camera, pixel)) continue;
+    const int pr = static_cast<int>(pixel.y()), pc = static_cast<int>(pixel.x());
+    if (std::abs(photo_depth_m.at<float>(pr, pc) - (world - camera.center_in_world()).norm()) > 0.02)
+      continue;  // hidden
+    if (exact) exact->push_back({pixel, world});
+    PixelPointPair noisy{pixel + Eigen::Vector2d(gauss(rng), gauss(rng)), world};
+    if (static_cast<int>(pairs.size()) < outlier_count) {
+      const double angle = 2 * M_PI * unit(rng), length = 20 + 180 * unit(rng);
+      noisy.pixel_px += length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    }
+    pairs.push_back(noisy);
+  }
+  return pairs;
+}
+
+double RmsReprojectionError(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs) {
+  double sum = 0;
+  for (const PixelPointPair& pair : pairs) {
+    const double e = ReprojectionError(camera, pair);
+    sum += std::isfinite(e) ? e * e : 1e12;
+  }
+  return pairs.empty() ? 0.0 : std::sqrt(sum / pairs.size());
 }
 
 }  // namespace lidarshop

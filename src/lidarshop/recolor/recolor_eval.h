@@ -6,7 +6,10 @@
 #include <cstdint>
 #include <string>
 
+#include <vector>
+
 #include "lidarshop/geometry/camera.h"
+#include "lidarshop/recolor/resection.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scanner/scene.h"
 
@@ -30,5 +33,18 @@ struct RecolorScore {
 RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, const Scan& input,
                           const Scan& output, const PinholeCamera& camera, int max_level_difference = 10,
                           double visibility_tolerance_m = 0.005);
+
+// `count` correspondences of scan points the camera sees (a user clicks points seen in both): a valid cell
+// drawn at random whose projection lies inside the photo and whose distance from the camera matches the
+// photo's depth there (within 2 cm). Pixels get Gaussian noise of RMS length `noise_px` (σ = noise / √2 per
+// axis); the first round(outlier_fraction · count) pairs are moved 20–200 px in a random direction.
+// `exact` (optional) receives the noise-free pairs. Deterministic in `seed`.
+std::vector<PixelPointPair> DrawCorrespondences(const Scan& scan, const PinholeCamera& camera,
+                                                const cv::Mat& photo_depth_m, int count, double noise_px,
+                                                double outlier_fraction, uint64_t seed,
+                                                std::vector<PixelPointPair>* exact = nullptr);
+
+// RMS reprojection error of `pairs` with `camera`, pixels (a point behind the camera counts 10^6 px).
+double RmsReprojectionError(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs);
 
 }  // namespace lidarshop

@@ -136,8 +136,13 @@ struct ReprojectionFunctor {
   }
 };
 
+// Levenberg–Marquardt over the pose and the intrinsics the inlier count supports: the focal length(s)
+// always; the principal point from `min_inliers_for_principal_point` inliers (else the photo's centre);
+// distortion from `min_inliers_for_distortion`.
 std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vector<PixelPointPair>& pairs,
                                     const ResectionOptions& options) {
+  const int count = static_cast<int>(pairs.size());
+  const bool free_principal_point = count >= options.min_inliers_for_principal_point;
   ReprojectionFunctor functor;
   functor.pairs = pairs;
   functor.fixed = ToParameters(start);
@@ -145,11 +150,17 @@ std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vecto
   functor.width_px = options.width_px;
   functor.height_px = options.height_px;
   if (options.square_pixels) functor.fixed[0] = functor.fixed[1] = 0.5 * (start.fx_px + start.fy_px);
-  if (!options.refine_skew) functor.fixed[4] = 0;
-  functor.free = {0, 2, 3};
+  if (!options.refine_skew || !free_principal_point) functor.fixed[4] = 0;
+  functor.free = {0};
+  if (free_principal_point) {
+    functor.free.insert(functor.free.end(), {2, 3});
+  } else {
+    functor.fixed[2] = 0.5 * options.width_px;
+    functor.fixed[3] = 0.5 * options.height_px;
+  }
   if (!options.square_pixels) functor.free.push_back(1);
-  if (options.refine_skew) functor.free.push_back(4);
-  if (static_cast<int>(pairs.size()) >= options.min_inliers_for_distortion) {
+  if (options.refine_skew && free_principal_point) functor.free.push_back(4);
+  if (count >= options.min_inliers_for_distortion) {
     for (int k = 0; k < options.radial_coefficients; ++k) functor.free.push_back(5 + k);
     if (options.refine_tangential) functor.free.insert(functor.free.end(), {8, 9});
   }
@@ -164,6 +175,56 @@ std::optional<PinholeCamera> Refine(const PinholeCamera& start, const std::vecto
   solver.parameters.ftol = 1e-12;
   solver.minimize(x);
   return FromParameters(functor.Full(x), options.width_px, options.height_px);
+}
+
+// The camera of a minimal set under the intrinsics prior (square pixels, principal point at the photo's centre,
+// no skew): for sets whose DLT is no plausible camera (near-planar sets leave the DLT's intrinsics undetermined;
+// the prior's focal length and pose stay determined). Poses from EPnP for a few fields of view, each refined by
+// Levenberg–Marquardt over the focal length and the pose; the one that fits the set best.
+std::optional<PinholeCamera> PriorCamera(const std::vector<PixelPointPair>& sample,
+                                         const ResectionOptions& options) {
+  ResectionOptions prior = options;
+  prior.min_inliers_for_principal_point = std::numeric_limits<int>::max();
+  prior.min_inliers_for_distortion = std::numeric_limits<int>::max();
+  prior.square_pixels = true;
+  std::vector<cv::Point3d> object_points;
+  std::vector<cv::Point2d> image_points;
+  for (const PixelPointPair& pair : sample) {
+    object_points.emplace_back(pair.point_in_world.x(), pair.point_in_world.y(), pair.point_in_world.z());
+    image_points.emplace_back(pair.pixel_px.x() - 0.5, pair.pixel_px.y() - 0.5);
+  }
+  std::optional<PinholeCamera> best;
+  double best_sum = std::numeric_limits<double>::infinity();
+  for (const double fov_deg : {30.0, 50.0, 70.0, 90.0}) {
+    PinholeCamera camera;
+    camera.width_px = options.width_px;
+    camera.height_px = options.height_px;
+    camera.fx_px = camera.fy_px = 0.5 * options.width_px / std::tan(0.5 * fov_deg * M_PI / 180.0);
+    camera.cx_px = 0.5 * options.width_px;
+    camera.cy_px = 0.5 * options.height_px;
+    const cv::Matx33d k(camera.fx_px, 0, camera.cx_px - 0.5, 0, camera.fy_px, camera.cy_px - 0.5, 0, 0, 1);
+    cv::Mat rvec, tvec;
+    if (!cv::solvePnP(object_points, image_points, k, cv::noArray(), rvec, tvec, false, cv::SOLVEPNP_EPNP))
+      continue;
+    cv::Matx33d rotation;
+    cv::Rodrigues(rvec, rotation);
+    Eigen::Matrix3d r;
+    cv::cv2eigen(cv::Mat(rotation), r);
+    const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+    if (!r.allFinite() || !t.allFinite()) continue;
+    camera.world_from_camera.setIdentity();
+    camera.world_from_camera.topLeftCorner<3, 3>() = r.transpose();
+    camera.world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
+    const std::optional<PinholeCamera> refined = Refine(camera, sample, prior);
+    if (!refined || !(refined->fx_px > 0)) continue;
+    double sum = 0;
+    for (const PixelPointPair& pair : sample) sum += std::pow(ReprojectionError(*refined, pair), 2);
+    if (sum < best_sum) {
+      best_sum = sum;
+      best = refined;
+    }
+  }
+  return best;
 }
 
 double RmsOfInliers(const PinholeCamera& camera, std::span<const PixelPointPair> pairs,
@@ -292,16 +353,70 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
   options.Check();
   CheckResectionInput(pairs, options.degenerate_ratio, what);
   const int n = static_cast<int>(pairs.size());
+  const double t2 = options.ransac_threshold_px * options.ransac_threshold_px;
   ResectionResult result;
+
+  // MSAC: every pair costs its squared error, capped at the threshold's square; `inliers` gets the pairs
+  // within the threshold.
+  const auto score_camera = [&](const auto& error_of, std::vector<uint8_t>* inliers) {
+    double score = 0;
+    inliers->assign(n, 0);
+    for (int i = 0; i < n; ++i) {
+      const double e = error_of(pairs[i]);
+      (*inliers)[i] = e * e < t2;
+      score += std::min(e * e, t2);
+    }
+    return score;
+  };
+  const auto count_of = [](const std::vector<uint8_t>& inliers) {
+    return static_cast<int>(std::count(inliers.begin(), inliers.end(), 1));
+  };
+  // Local optimization (LO-RANSAC): the DLT on a set's inliers, Levenberg–Marquardt with the intrinsics the
+  // inlier count supports (Refine), inliers re-selected with the refined camera, twice; scored after.
+  struct Candidate {
+    PinholeCamera camera;
+    std::vector<uint8_t> inliers;
+    double score = std::numeric_limits<double>::infinity();
+  };
+  const auto optimize = [&](const Candidate& start) {
+    std::vector<uint8_t> inliers = start.inliers;
+    Candidate out;
+    out.camera =
+        CameraFromProjection(NormalizedDlt(Select(pairs, inliers)), options.width_px, options.height_px);
+    out.score = score_camera([&](const PixelPointPair& pair) { return ReprojectionError(out.camera, pair); },
+                             &out.inliers);
+    if (!(out.score < start.score)) out = start;  // e.g. near-planar inliers: the DLT is no camera
+    if (!options.refine) return out;
+    // With refinement, candidates are refined cameras only: a set whose refinement fails is no candidate.
+    out.score = std::numeric_limits<double>::infinity();
+    for (int round = 0; round < 2 && count_of(inliers) >= 6; ++round) {
+      const std::optional<PinholeCamera> refined = Refine(out.camera, Select(pairs, inliers), options);
+      if (!refined || !(refined->fx_px > 0 && refined->fy_px > 0)) break;
+      std::vector<uint8_t> next;
+      const double score =
+          score_camera([&](const PixelPointPair& pair) { return ReprojectionError(*refined, pair); }, &next);
+      if (!std::isfinite(score) || count_of(next) < 6) break;
+      // The first refinement is taken even when the DLT scored lower: candidates are compared under the
+      // model the inlier count supports, not with the DLT's free intrinsics.
+      if (!(score < out.score) && round > 0) break;
+      out = {*refined, next, score};
+      if (next == inliers) break;
+      inliers = next;
+    }
+    return out;
+  };
 
   // RANSAC over minimal sets of 6 (serial, seeded).
   std::mt19937_64 rng(options.seed);
   std::vector<int> order(n);
-  std::vector<uint8_t> best_inliers(n, 1);
-  int best_count = -1;
-  double best_score = std::numeric_limits<double>::infinity();
+  Candidate best;
+  // The best minimal set so far (most inliers, then lowest MSAC score). With local optimization every set
+  // with as many inliers as the refined best is refitted (once per distinct inlier set): with few pairs a
+  // wrong set can hold the best minimal score, and only its refitted rivals show it.
+  int best_set_count = -1;
+  double best_set_score = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<uint8_t>> optimized;  // inlier sets already locally optimized
   int iterations_needed = options.ransac_iterations;
-  const double t2 = options.ransac_threshold_px * options.ransac_threshold_px;
   std::vector<PixelPointPair> sample(6);
   std::vector<Eigen::Vector3d> sample_points(6);
   for (int iteration = 0; iteration < iterations_needed; ++iteration) {
@@ -316,51 +431,74 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
     if (spread[2] <= options.degenerate_ratio * spread[0]) continue;  // a planar set: no camera
     Matrix34d p = NormalizedDlt(sample);
     if (p.leftCols<3>().determinant() < 0) p = -p;  // then (P X)_z > 0 in front of the camera
+    std::optional<PinholeCamera> prior_camera;      // set when the DLT is no plausible camera
     if (options.square_pixels) {
-      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one.
+      // A minimal set fits nearly any 6 pairs; a camera far from square pixels and zero skew is a wrong one —
+      // or a near-planar set whose intrinsics the DLT cannot fix: with local optimization, such a set gets
+      // the camera of the intrinsics prior instead.
       const Eigen::Matrix3d k = DecomposeProjection(p).K;
       if (std::abs(k(0, 0) / k(1, 1) - 1) > options.max_aspect_deviation ||
-          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0))
-        continue;
-    }
-    std::vector<uint8_t> inliers(n, 0);
-    int count = 0;
-    double score = 0;
-    for (int i = 0; i < n; ++i) {
-      const bool in_front = (p.row(2) * pairs[i].point_in_world.homogeneous()) > 0;
-      const double e = in_front ? ProjectionError(p, pairs[i]) : std::numeric_limits<double>::infinity();
-      inliers[i] = e * e < t2;
-      count += inliers[i];
-      score += std::min(e * e, t2);  // MSAC: ties in count go to the tighter fit
-    }
-    if (count > best_count || (count == best_count && score < best_score)) {
-      best_count = count;
-      best_score = score;
-      best_inliers = inliers;
-      const double w = static_cast<double>(count) / n;
-      const double miss = 1.0 - std::pow(w, 6);
-      if (miss >= 1) {
-        // No information yet: keep the iteration budget.
-      } else if (miss <= 0) {
-        iterations_needed = iteration + 1;
-      } else {
-        const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
-        iterations_needed = static_cast<int>(std::min<double>(options.ransac_iterations, std::ceil(needed)));
+          std::abs(k(0, 1)) > options.max_aspect_deviation * k(0, 0)) {
+        if (!options.local_optimization) continue;
+        prior_camera = PriorCamera(sample, options);
+        if (!prior_camera) continue;
       }
     }
+    std::vector<uint8_t> inliers;
+    const double score =
+        prior_camera
+            ? score_camera([&](const PixelPointPair& pair) { return ReprojectionError(*prior_camera, pair); },
+                           &inliers)
+            : score_camera(
+                  [&](const PixelPointPair& pair) {
+                    const bool in_front = (p.row(2) * pair.point_in_world.homogeneous()) > 0;
+                    return in_front ? ProjectionError(p, pair) : std::numeric_limits<double>::infinity();
+                  },
+                  &inliers);
+    const int count = count_of(inliers);
+    // With local optimization the bar is the refined best's inlier count (a wrong minimal set may collect
+    // more pairs than any right one before refinement).
+    if (count < 6 || count < (options.local_optimization ? count_of(best.inliers) : best_set_count)) continue;
+    const bool better_set = count > best_set_count || (count == best_set_count && score < best_set_score);
+    if (better_set) {
+      best_set_count = count;
+      best_set_score = score;
+    }
+    Candidate candidate{
+        prior_camera ? *prior_camera : CameraFromProjection(p, options.width_px, options.height_px), inliers,
+        score};
+    if (options.local_optimization) {
+      if (std::find(optimized.begin(), optimized.end(), inliers) != optimized.end()) continue;
+      optimized.push_back(inliers);
+      candidate = optimize(candidate);
+      // Compared after refinement.
+      if (count_of(candidate.inliers) < 6 || !(candidate.score < best.score)) continue;
+    } else if (!better_set) {
+      continue;
+    }
+    best = std::move(candidate);
+    const double w = static_cast<double>(std::max(count, count_of(best.inliers))) / n;
+    const double miss = 1.0 - std::pow(w, 6);
+    if (miss <= 0) {
+      iterations_needed = std::min(iterations_needed, std::max(iteration + 1, options.ransac_min_iterations));
+    } else if (miss < 1) {
+      const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
+      iterations_needed = static_cast<int>(std::min<double>(
+          options.ransac_iterations, std::max<double>(options.ransac_min_iterations, std::ceil(needed))));
+    }
   }
-  if (best_count < 6)
+  if (count_of(best.inliers) < 6)
     ThrowInputError(what, "", "pairs",
                     fmt::format("no 6 pairs agree on a camera within {} px (best set: {} inliers)",
-                                options.ransac_threshold_px, std::max(best_count, 0)));
+                                options.ransac_threshold_px, std::max(count_of(best.inliers), 0)));
 
-  // DLT on the inliers, decomposed; then LM, re-selection and LM again.
-  result.projection = NormalizedDlt(Select(pairs, best_inliers));
+  // The DLT on the inliers (reported), then LM, re-selection and LM again from the best camera.
+  result.projection = NormalizedDlt(Select(pairs, best.inliers));
   const PinholeCamera dlt_camera =
       CameraFromProjection(result.projection, options.width_px, options.height_px);
-  result.dlt_rms_px = RmsOfInliers(dlt_camera, pairs, best_inliers);
-  result.camera = dlt_camera;
-  result.inlier = best_inliers;
+  result.dlt_rms_px = RmsOfInliers(dlt_camera, pairs, best.inliers);
+  result.camera = options.local_optimization ? best.camera : dlt_camera;
+  result.inlier = best.inliers;
   if (options.refine) {
     for (int round = 0; round < 2; ++round) {
       const std::optional<PinholeCamera> refined =

@@ -4,12 +4,22 @@
 //      distance √2, points to zero mean and mean distance √3; the 2N x 12 system A p = 0 solved by the SVD
 //      (the right singular vector of the smallest singular value), then denormalized.
 //   2. RANSAC over minimal sets of 6 pairs (seeded: same result on any thread count; the loop is serial),
-//      inliers = pairs whose DLT reprojection error is below `ransac_threshold_px`; the DLT is refitted on
-//      the best set's inliers.
+//      inliers = pairs whose DLT reprojection error is below `ransac_threshold_px`. Locally optimized
+//      (LO-RANSAC, Chum et al. 2003): each set with at least as many inliers as the best so far (each
+//      distinct inlier set once) is refitted on its inliers (DLT, then step 4, inliers re-selected) and the sets are
+//      compared by the MSAC score of the refined camera. A minimal DLT on 6 noisy pairs is unstable, and with
+//      few pairs a wrong set (an outlier among them) can collect as many pairs as the right one; refined, it
+//      explains them worse. A set whose DLT is no plausible camera (far from square pixels and zero
+//      skew: an outlier among the 6, or points near one plane, which leave the DLT's intrinsics undetermined)
+//      is skipped without local optimization; with it, the set gets the camera of the intrinsics prior
+//      (square pixels, principal point at the centre: EPnP for a few fields of view, then LM over f and
+//      the pose). At least `ransac_min_iterations` sets, then the adaptive bound.
 //   3. P = K [R | t] decomposed by an RQ decomposition (K upper triangular, positive diagonal; R a rotation).
 //   4. Levenberg–Marquardt on the reprojection error of the inliers over focal length(s), principal point,
 //      optionally skew, radial (k1, k2, k3) and tangential (p1, p2) distortion, rotation (angle-axis) and
 //      translation; inliers are then re-selected with the refined camera and the refinement repeated once.
+//      The intrinsics freed follow the inlier count: below `min_inliers_for_principal_point` the principal
+//      point stays at the photo's centre (and skew at 0), below `min_inliers_for_distortion` no distortion.
 //      The solver is Eigen's unsupported LevenbergMarquardt (MINPACK lmdif) with forward-difference
 //      Jacobians: a 16-parameter problem with at most a few hundred residuals needs no sparse solver, and it
 //      keeps lidarshop free of a new dependency (Ceres is not in the base image) while letting us free or
@@ -40,9 +50,14 @@ struct PixelPointPair {
 };
 
 struct ResectionOptions {
-  int width_px = 0, height_px = 0;    // the photo's size (stored in the camera); required, > 0
-  double ransac_threshold_px = 4.0;   // a pair is an inlier when its reprojection error is below this, pixels
-  int ransac_iterations = 2000;       // most minimal sets tried (fewer when the confidence is reached)
+  int width_px = 0, height_px = 0;   // the photo's size (stored in the camera); required, > 0
+  double ransac_threshold_px = 4.0;  // a pair is an inlier when its reprojection error is below this, pixels
+  int ransac_iterations = 2000;      // most minimal sets tried (fewer when the confidence is reached)
+  int ransac_min_iterations = 100;   // fewest minimal sets tried, whatever the adaptive bound says
+  // LO-RANSAC: a minimal set with at least as many inliers as the best set is refitted on them (DLT, then
+  // Levenberg–Marquardt with the intrinsics the count supports, inliers re-selected) and scored (MSAC) after
+  // that refinement: a wrong set that happens to collect many pairs loses to the right one.
+  bool local_optimization = true;
   double ransac_confidence = 0.9999;  // stop once a better set is this unlikely
   uint64_t seed = 1;                  // RANSAC's random sets
   bool refine = true;                 // false = the (RANSAC) DLT camera without Levenberg–Marquardt
@@ -58,6 +73,10 @@ struct ResectionOptions {
   bool refine_tangential = false;  // refine p1, p2
   // Distortion is refined only with at least this many inliers (fewer pairs would fit the noise).
   int min_inliers_for_distortion = 16;
+  // Below this many inliers the principal point stays at the photo's centre and the skew at 0 (only the focal
+  // length and the pose are refined): with 8 inliers of 0.35 px noise a free principal point wandered 30 px
+  // and doubled the error (bench/results/recolor.md).
+  int min_inliers_for_principal_point = 12;
   // Points count as coplanar (or collinear) when the smallest spread of their centred coordinates is below
   // this fraction of the largest; same for collinear pixels.
   double degenerate_ratio = 1e-3;

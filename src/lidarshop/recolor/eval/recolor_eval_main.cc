@@ -31,46 +31,6 @@ struct Setup {
   Photo photo;
 };
 
-// Pairs from valid scan points inside the photo (visible or not: a user may click a point the scanner saw;
-// here only points the camera sees, as a user would). noise_px = RMS length of the pixel error.
-std::vector<PixelPointPair> DrawPairs(const Setup& s, int count, double noise_px, double outliers,
-                                      uint64_t seed, std::vector<PixelPointPair>* exact) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> gauss(0, noise_px / std::sqrt(2.0));
-  std::uniform_real_distribution<double> unit(0, 1);
-  std::vector<PixelPointPair> pairs;
-  int outlier_count = static_cast<int>(std::round(outliers * count));
-  while (static_cast<int>(pairs.size()) < count) {
-    const int r = static_cast<int>(unit(rng) * s.truth.rows), c = static_cast<int>(unit(rng) * s.truth.cols);
-    if (!s.truth.valid.at<uint8_t>(r, c)) continue;
-    const cv::Vec3f p = s.truth.point.at<cv::Vec3f>(r, c);
-    const Eigen::Vector3d world =
-        (s.truth.world_from_scanner * Eigen::Vector4d(p[0], p[1], p[2], 1)).head<3>();
-    Eigen::Vector2d pixel;
-    if (!ProjectWorldPoint(s.camera, world, &pixel) || !InsideImage(s.camera, pixel)) continue;
-    const int pr = static_cast<int>(pixel.y()), pc = static_cast<int>(pixel.x());
-    if (std::abs(s.photo.depth_m.at<float>(pr, pc) - (world - s.camera.center_in_world()).norm()) > 0.02)
-      continue;  // hidden
-    exact->push_back({pixel, world});
-    PixelPointPair noisy{pixel + Eigen::Vector2d(gauss(rng), gauss(rng)), world};
-    if (static_cast<int>(pairs.size()) < outlier_count) {
-      const double angle = 2 * M_PI * unit(rng), length = 20 + 180 * unit(rng);
-      noisy.pixel_px += length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
-    }
-    pairs.push_back(noisy);
-  }
-  return pairs;
-}
-
-double TrueRms(const PinholeCamera& camera, const std::vector<PixelPointPair>& exact) {
-  double sum = 0;
-  for (const PixelPointPair& pair : exact) {
-    const double e = ReprojectionError(camera, pair);
-    sum += std::isfinite(e) ? e * e : 1e12;
-  }
-  return std::sqrt(sum / exact.size());
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -106,8 +66,8 @@ int main(int argc, char** argv) {
                hidden_worst = 0;
         for (int seed = 1; seed <= seeds; ++seed) {
           std::vector<PixelPointPair> exact;
-          const std::vector<PixelPointPair> pairs =
-              DrawPairs(s, count, noise_px, outliers, 100 * seed + count, &exact);
+          const std::vector<PixelPointPair> pairs = DrawCorrespondences(
+              s.truth, s.camera, s.photo.depth_m, count, noise_px, outliers, 100 * seed + count, &exact);
           ResectionOptions options;
           options.width_px = s.camera.width_px;
           options.height_px = s.camera.height_px;
@@ -120,7 +80,7 @@ int main(int argc, char** argv) {
           } else {
             camera = ResectWithIntrinsics(pairs, s.camera, options).camera;
           }
-          const double rms = TrueRms(camera, exact);
+          const double rms = RmsReprojectionError(camera, exact);
           const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input,
                                                   RecolorScan(s.input, s.photo.image, camera).scan, s.camera);
           rms_sum += rms;
@@ -135,19 +95,37 @@ int main(int argc, char** argv) {
                    hidden_sum / seeds, hidden_worst);
       }
     }
-    // Visibility with the true camera: the z-buffer with its margin, without, and the literal segment test.
-    for (int variant = 0; variant < 5; ++variant) {
+    // Visibility with the true camera: the default (skirts with walls, 1 px margin) and its parts, the literal
+    // segment test, and the visibility test before the skirts (2 px margin).
+    struct Variant {
+      const char* name;
+      VisibilityMethod method;
+      bool skirts;
+      double depth_m;
+      int margin_px;
+    };
+    const Variant variants[] = {
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (default)", VisibilityMethod::kZBuffer,
+         true, 0.25, 1},
+        {"true camera, z-buffer + skirt caps only (no walls) + 1 px margin", VisibilityMethod::kZBuffer, true,
+         0.0, 1},
+        {"true camera, z-buffer + skirts (0.25 m walls), no margin", VisibilityMethod::kZBuffer, true, 0.25,
+         0},
+        {"true camera, segment test + skirts (0.25 m walls)", VisibilityMethod::kSegment, true, 0.25, 0},
+        {"true camera, literal segment test (no skirts)", VisibilityMethod::kSegment, false, 0.0, 0},
+        {"true camera, z-buffer + 2 px margin, no skirts (the previous default)", VisibilityMethod::kZBuffer,
+         false, 0.0, 2},
+        {"true camera, z-buffer, no skirts, no margin", VisibilityMethod::kZBuffer, false, 0.0, 0},
+    };
+    for (const Variant& variant : variants) {
       RecolorOptions options;
-      if (variant == 1) options.silhouette_margin_px = 0;
-      if (variant == 2) options.visibility = VisibilityMethod::kSegment;
-      if (variant == 3) options.silhouette_margin_px = 3;
-      if (variant == 4) options.silhouette_margin_px = 4;
+      options.visibility = variant.method;
+      options.silhouette_skirts = variant.skirts;
+      options.skirt_depth_m = variant.depth_m;
+      options.silhouette_margin_px = variant.margin_px;
       const RecolorResult result = RecolorScan(s.input, s.photo.image, s.camera, options);
       const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input, result.scan, s.camera);
-      const char* names[] = {"true camera, z-buffer + 2 px margin (default)",
-                             "true camera, z-buffer, no margin", "true camera, literal segment test",
-                             "true camera, z-buffer + 3 px margin", "true camera, z-buffer + 4 px margin"};
-      fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, names[variant],
+      fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, variant.name,
                  score.visible_correct_percent(), score.hidden_changed_percent(), score.hidden_changed,
                  score.hidden);
     }
