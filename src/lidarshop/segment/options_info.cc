@@ -82,6 +82,20 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "cells this close to a support plane and parallel to it are support, never object")
         .Unit("m")
         .AboveZero();
+    b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
+            "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
+    b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",
+            "both flanks of a crevice between touching bodies rise at least this steeply")
+        .Unit("deg")
+        .AboveZero()
+        .Max(89);
+    b.Field(&WholeObjectOptions::crevice_baseline_cells, "crevice_baseline_cells",
+            "the rise of a crevice's flanks is measured over this many cells")
+        .Unit("cells")
+        .Range(1, 32);
+    b.Field(&WholeObjectOptions::neighbour_min_fraction, "neighbour_min_fraction",
+            "smaller parts, as a fraction of the stroked parts' cells, stay with the object")
+        .Min(0);
     return b.Build();
   }();
   return info;
