@@ -82,6 +82,8 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "cells this close to a support plane and parallel to it are support, never object")
         .Unit("m")
         .AboveZero();
+    b.Field(&WholeObjectOptions::join_overhangs, "join_overhangs",
+            "a part in front of the object held by nothing else visible joins it");
     b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
             "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
     b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",

@@ -92,6 +92,10 @@ struct WholeObjectOptions {
   double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
   int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
   double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
+  // Overhangs: a part in front of the object across a depth step, joined to nothing else in depth (every other
+  // boundary a step down to something farther or no return), rests on the object and joins it (a mailbox on
+  // its post, with the stroke on the post).
+  bool join_overhangs = true;
   // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
   // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
   // and the growth does not enter them.

@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
                  "touching neighbours: the flanks' rise is measured over this many cells");
   app.add_option("--neighbour-fraction", options.whole_object.neighbour_min_fraction,
                  "touching neighbours: smallest part dropped, times the stroked parts' cells");
+  app.add_flag("!--no-overhangs", options.whole_object.join_overhangs, "no joining of overhanging parts");
   app.add_flag("!--no-separate", options.whole_object.separate_touching,
                "no separation of touching neighbours");
   bool eight = false;
