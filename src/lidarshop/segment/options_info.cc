@@ -82,6 +82,11 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "cells this close to a support plane and parallel to it are support, never object")
         .Unit("m")
         .AboveZero();
+    b.Field(&WholeObjectOptions::support_max_tilt_deg, "support_max_tilt_deg",
+            "a cell near a support plane is support when its normal is within this angle of the plane's")
+        .Unit("deg")
+        .AboveZero()
+        .Max(90);
     b.Field(&WholeObjectOptions::join_overhangs, "join_overhangs",
             "a part in front of the object held by nothing else visible joins it");
     b.Field(&WholeObjectOptions::separate_touching, "separate_touching",

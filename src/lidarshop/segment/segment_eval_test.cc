@@ -42,8 +42,9 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
   EXPECT_GT(iou["two-step"], iou["depth"]);
   EXPECT_GT(iou["two-step"], iou["color"]);
   EXPECT_GT(iou["two-step"], iou["rgbd"]);
-  // Measured 0.996 over 3 seeds: 0.943 before touching neighbours were separated (two_people 0.500 -> 0.999)
-  // and overhanging parts joined (mailbox_gravel 0.884 -> 0.998, mailbox_lawn 0.897 -> 0.973).
+  // Measured 0.997 over 3 seeds: 0.943 before touching neighbours were separated (two_people 0.500 -> 0.999),
+  // overhanging parts joined (mailbox_gravel 0.884 -> 0.998, mailbox_lawn 0.897 -> 0.973) and support cells
+  // allowed a 75° normal tilt (0.996 -> 0.997).
   EXPECT_GT(iou["two-step"], 0.97);
 }
 
@@ -65,7 +66,7 @@ TEST(SegmentEvalTest, ACorrectRefinementNeverLowersIoU) {
     EXPECT_GE(r.after.iou, r.before.iou - 0.01) << name;
     refined += r.stroke != "none";
   }
-  EXPECT_GT(refined, 6);
+  EXPECT_GT(refined, 10);  // an exact cut gets a background stroke away from the object
 }
 
 }  // namespace

@@ -77,7 +77,7 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
   ransac.min_inliers = static_cast<int>(cells.size() / 5);
   const cv::Rect box = cv::boundingRect(mask);
   const int object_cells = cv::countNonZero(mask);
-  const float cos_max = static_cast<float>(std::cos(options.max_crease_deg * M_PI / 180.0));
+  const float cos_max = static_cast<float>(std::cos(options.support_max_tilt_deg * M_PI / 180.0));
   for (const PlaneFit& plane : DetectPlanesRansac(cloud, ransac)) {
     size_t outside_box = 0;
     for (uint32_t i : plane.inliers) outside_box += !box.contains(cells[i]);

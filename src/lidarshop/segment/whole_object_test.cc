@@ -123,5 +123,15 @@ TEST(WholeObjectTest, APartInFrontThatStandsOnTheGroundDoesNotJoin) {
   EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
 }
 
+TEST(WholeObjectTest, GrowthFromAWholeObjectAddsNoSupportAlongItsFoot) {
+  // A crate standing on the ground, seen slightly from the side (so its foot is an outline on the ground with
+  // corners): the ground cells along the foot have normals that mix in the crate's faces.
+  const Block crate = {{-0.55, 4.6, -1.5}, {0.15, 5.2, -0.9}, cv::Vec3b(40, 60, 170), 1};
+  const Scan scan = MakeBlocks({crate}, 7);
+  const cv::Mat truth = scan.label == 1;
+  const cv::Mat grown = GrowWholeObject(scan, truth, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(grown & ~truth), 0);  // 10 cells with support_max_tilt_deg = 45
+}
+
 }  // namespace
 }  // namespace lidarshop

@@ -70,6 +70,8 @@ int main(int argc, char** argv) {
                  "touching neighbours: the flanks' rise is measured over this many cells");
   app.add_option("--neighbour-fraction", options.whole_object.neighbour_min_fraction,
                  "touching neighbours: smallest part dropped, times the stroked parts' cells");
+  app.add_option("--support-tilt-deg", options.whole_object.support_max_tilt_deg,
+                 "whole-object growth: largest tilt of a support cell's normal, degrees");
   app.add_flag("!--no-overhangs", options.whole_object.join_overhangs, "no joining of overhanging parts");
   app.add_flag("!--no-separate", options.whole_object.separate_touching,
                "no separation of touching neighbours");
