@@ -94,7 +94,7 @@ struct WholeObjectOptions {
   double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
   // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
   // the support's cells along the object's foot mix in the object's side.
-  double support_max_tilt_deg = 75.0;
+  double support_max_tilt_deg = 60.0;
   // Overhangs: a part in front of the object across a depth step, joined to nothing else in depth (every other
   // boundary a step down to something farther or no return), rests on the object and joins it (a mailbox on
   // its post, with the stroke on the post).
