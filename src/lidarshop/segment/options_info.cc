@@ -89,6 +89,10 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
         .Max(90);
     b.Field(&WholeObjectOptions::join_overhangs, "join_overhangs",
             "a part in front of the object held by nothing else visible joins it");
+    b.Field(&WholeObjectOptions::overhang_max_contact, "overhang_max_contact",
+            "an overhang meets the object along at most this fraction of its outline")
+        .Min(0)
+        .Max(1);
     b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
             "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
     b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",

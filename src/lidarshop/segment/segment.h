@@ -99,6 +99,7 @@ struct WholeObjectOptions {
   // boundary a step down to something farther or no return), rests on the object and joins it (a mailbox on
   // its post, with the stroke on the post).
   bool join_overhangs = true;
+  double overhang_max_contact = 0.5;  // ... and meeting the object along at most this fraction of its outline
   // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
   // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
   // and the growth does not enter them.

@@ -106,11 +106,13 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
 // whose every other boundary is a step down to something farther or a cell without a return. Nothing visible
 // holds such a part but the object, so it rests on the object. A part that meets anything else in depth (the
 // ground it stands on runs on), a barrier or the scan's edge, that has more than max_cells cells, or that lies
-// behind the object where they meet, is not one. The seeds are the cells next to `grown` within `region`.
+// behind the object where they meet, is not one; nor is a part that meets the object along more than
+// max_contact_fraction of its outline (the object around it: an occluder, not a part). The seeds are the cells next to `grown` within `region`.
 // Returns the cells of the first such part found (empty: none).
 template <typename JumpAt, typename Free>
 std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, const cv::Rect& region,
-                                       size_t max_cells, const JumpAt& jump_at, const Free& free) {
+                                       size_t max_cells, double max_contact_fraction, const JumpAt& jump_at,
+                                       const Free& free) {
   const cv::Rect image(0, 0, scan.cols, scan.rows);
   constexpr int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
   constexpr uint8_t kInPart = 1, kRejected = 2;
@@ -126,6 +128,7 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
         std::vector<cv::Point> part = {seed};
         visited.at<uint8_t>(seed) = kInPart;
         bool held_elsewhere = false;
+        int contact_edges = 0, outline_edges = 0;  // the part's outline, and where it meets the object
         for (size_t i = 0; i < part.size() && !held_elsewhere; ++i) {
           const cv::Point p = part[i];
           const float range_p = scan.range.at<float>(p);
@@ -136,13 +139,16 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
               held_elsewhere = true;  // it runs on beyond the scan
               continue;
             }
-            if (!scan.valid.at<uint8_t>(q) || visited.at<uint8_t>(q) == kInPart) continue;
+            if (visited.at<uint8_t>(q) == kInPart) continue;
+            ++outline_edges;
+            if (!scan.valid.at<uint8_t>(q)) continue;
             if (visited.at<uint8_t>(q) == kRejected) {
               held_elsewhere = true;  // the rest of a part already turned down
               continue;
             }
             const float range_q = scan.range.at<float>(q);
             if (grown.at<uint8_t>(q)) {
+              ++contact_edges;
               held_elsewhere = range_q < range_p - jump_m;  // behind the object there
               continue;
             }
@@ -151,12 +157,15 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
               held_elsewhere = true;  // occluded by something else, or against a barrier
               continue;
             }
+            --outline_edges;  // not outline: the part goes on
             visited.at<uint8_t>(q) = kInPart;
             part.push_back(q);
             held_elsewhere = part.size() > max_cells;  // too large to be a part: it runs on
           }
         }
-        if (!held_elsewhere) return part;
+        // Something in front of the object, the object all around it (a leaf before a car door), is not held
+        // by it: a part that rests on the object meets it along a side.
+        if (!held_elsewhere && contact_edges <= max_contact_fraction * outline_edges) return part;
         for (const cv::Point& p : part) visited.at<uint8_t>(p) = kRejected;
       }
     }
@@ -249,8 +258,9 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   // Overhanging parts are closed by depth steps on every side, so they cannot leak: they join even when the
   // growth above did (each one closed in depth, so growth from it would add nothing).
   while (options.join_overhangs) {
-    const std::vector<cv::Point> overhang = OverhangingPart(
-        scan, grown, region, static_cast<size_t>(std::max(0, max_added - added)), jump_at, free);
+    const std::vector<cv::Point> overhang =
+        OverhangingPart(scan, grown, region, static_cast<size_t>(std::max(0, max_added - added)),
+                        options.overhang_max_contact, jump_at, free);
     if (overhang.empty()) break;
     added += static_cast<int>(overhang.size());
     for (const cv::Point& cell : overhang) grown.at<uint8_t>(cell) = 255;

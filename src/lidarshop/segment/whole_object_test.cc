@@ -123,6 +123,23 @@ TEST(WholeObjectTest, APartInFrontThatStandsOnTheGroundDoesNotJoin) {
   EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
 }
 
+TEST(WholeObjectTest, APlateInFrontOfTheObjectWithTheObjectAllAroundItDoesNotJoin) {
+  // A wide board on the ground (the object) and a small plate hanging 0.3 m in front of its middle: in front,
+  // held by nothing visible, but the object lies all around it: an occluder, not a part. Lifted to the board's
+  // top edge, so that it meets the board along one side only, it joins.
+  const Block board = {{-0.8, 5.0, -1.5}, {0.8, 5.1, -0.7}, cv::Vec3b(40, 60, 170), 1};
+  const Block plate = {{-0.1, 4.7, -1.2}, {0.1, 4.72, -1.0}, cv::Vec3b(200, 30, 30), 2};
+  const Scan scan = MakeBlocks({board, plate}, 11);
+  const cv::Mat grown = GrowWholeObject(scan, scan.label == 1, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(grown & (scan.label == 2)), 0);  // all of it with overhang_max_contact = 1
+  Block on_top = plate;
+  on_top.lo[2] = -0.72;
+  on_top.hi[2] = -0.42;
+  const Scan lifted = MakeBlocks({board, on_top}, 11);
+  const cv::Mat lifted_grown = GrowWholeObject(lifted, lifted.label == 1, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
+}
+
 TEST(WholeObjectTest, GrowthFromAWholeObjectAddsNoSupportAlongItsFoot) {
   // A crate standing on the ground, seen slightly from the side (so its foot is an outline on the ground with
   // corners): the ground cells along the foot have normals that mix in the crate's faces.
