@@ -82,6 +82,31 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "cells this close to a support plane and parallel to it are support, never object")
         .Unit("m")
         .AboveZero();
+    b.Field(&WholeObjectOptions::support_max_tilt_deg, "support_max_tilt_deg",
+            "a cell near a support plane is support when its normal is within this angle of the plane's")
+        .Unit("deg")
+        .AboveZero()
+        .Max(90);
+    b.Field(&WholeObjectOptions::join_overhangs, "join_overhangs",
+            "a part in front of the object held by nothing else visible joins it");
+    b.Field(&WholeObjectOptions::overhang_max_contact, "overhang_max_contact",
+            "an overhang meets the object along at most this fraction of its outline")
+        .Min(0)
+        .Max(1);
+    b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
+            "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
+    b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",
+            "both flanks of a crevice between touching bodies rise at least this steeply")
+        .Unit("deg")
+        .AboveZero()
+        .Max(89);
+    b.Field(&WholeObjectOptions::crevice_baseline_cells, "crevice_baseline_cells",
+            "the rise of a crevice's flanks is measured over this many cells")
+        .Unit("cells")
+        .Range(1, 32);
+    b.Field(&WholeObjectOptions::neighbour_min_fraction, "neighbour_min_fraction",
+            "smaller parts, as a fraction of the stroked parts' cells, stay with the object")
+        .Min(0);
     return b.Build();
   }();
   return info;

@@ -92,7 +92,22 @@ struct WholeObjectOptions {
   double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
   int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
   double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
-  void Check() const;                // throws OptionsFieldError naming the field
+  // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
+  // the support's cells along the object's foot mix in the object's side.
+  double support_max_tilt_deg = 60.0;
+  // Overhangs: a part in front of the object across a depth step, joined to nothing else in depth (every other
+  // boundary a step down to something farther or no return), rests on the object and joins it (a mailbox on
+  // its post, with the stroke on the post).
+  bool join_overhangs = true;
+  double overhang_max_contact = 0.5;  // ... and meeting the object along at most this fraction of its outline
+  // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
+  // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
+  // and the growth does not enter them.
+  bool separate_touching = true;
+  double crevice_flank_deg = 60.0;       // both flanks of a crevice rise at least this steeply, degrees
+  int crevice_baseline_cells = 3;        // the flanks' rise is measured over this many cells
+  double neighbour_min_fraction = 0.25;  // smaller parts (× the stroked parts' cells) stay with the object
+  void Check() const;                    // throws OptionsFieldError naming the field
 };
 template <>
 const StructInfo& InfoOf<WholeObjectOptions>();
@@ -230,6 +245,18 @@ cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterati
 
 cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
                         const WholeObjectOptions& options = WholeObjectOptions());
+
+// Crevices between touching bodies in `region` of the scan: grid edges between valid cells where the range
+// rises towards the edge from both sides, each flank at least crevice_flank_deg steep (a rise of
+// tan(crevice_flank_deg) cell spacings per cell, measured over crevice_baseline_cells). CV_8U of the region's
+// size: bit 0 = the edge to the right neighbour, bit 1 = the edge to the neighbour below.
+cv::Mat CreviceEdges(const Scan& scan, const cv::Rect& region, const WholeObjectOptions& options);
+
+// The touching neighbours in `mask` (CV_8U): its 4-connected parts, not joined across crevices, that hold no
+// cell of `object_cells` (the object strokes) and have at least neighbour_min_fraction × the cells of the parts
+// that do. CV_8U 255/0.
+cv::Mat TouchingNeighbours(const Scan& scan, const cv::Mat& mask, const cv::Mat& object_cells,
+                           const WholeObjectOptions& options = WholeObjectOptions());
 
 // The angle between neighbouring rays near `cells` (CV_8U, rows x cols), radians: the median of the distances
 // between the points of neighbouring cells over their range (pairs across depth edges are left out). 0 when no

@@ -101,6 +101,13 @@ bool StrokeOnLargestPart(const cv::Mat& part, uint8_t kind, int length, cv::Mat*
   return true;
 }
 
+// The object and the cells within 12 cells of it (the evaluation strokes' background margin).
+cv::Mat AroundObject(const cv::Mat& object) {
+  cv::Mat around;
+  cv::dilate(object, around, cv::Mat(), cv::Point(-1, -1), EvalStrokeOptions().background_margin_cells);
+  return around;
+}
+
 }  // namespace
 
 RefinementScores EvaluateRefinement(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes,
@@ -118,6 +125,9 @@ RefinementScores EvaluateRefinement(const Scan& scan, const cv::Mat& truth, cons
   } else if (StrokeOnLargestPart(first.mask & ~object & valid, kStrokeBackground, stroke_length_cells,
                                  &extra)) {
     out.stroke = "background";
+  } else if (StrokeOnLargestPart(valid & ~AroundObject(object), kStrokeBackground, stroke_length_cells,
+                                 &extra)) {
+    out.stroke = "background";  // nothing wrong: a correct stroke on the background away from the object
   } else {
     out.stroke = "none";
     out.after = out.before;

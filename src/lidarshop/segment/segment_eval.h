@@ -41,9 +41,9 @@ std::vector<MethodScores> EvaluateMethods(const Scan& scan, const cv::Mat& truth
                                           const SegmentOptions& options, int grabcut_iterations = 5);
 
 // One correct refinement after a two-step cut: an object stroke on the largest missed part of `truth`, or, when
-// nothing is missed, a background stroke on the largest wrongly taken part, or else on a background cell far
-// from the object. The stroke marks only cells of that part (it is correct by construction), up to
-// `stroke_length_cells` cells along the part's middle row.
+// nothing is missed, a background stroke on the largest wrongly taken part, or else (the cut is exact) on the
+// largest part of the background more than background_margin_cells from the object. The stroke marks only cells
+// of that part (it is correct by construction), up to `stroke_length_cells` cells along the part's middle row.
 struct RefinementScores {
   MaskScores before, after;
   std::string stroke;  // "object", "background" or "none" (no room for a stroke)

@@ -1,6 +1,6 @@
 // The evaluation set's claims, as a test: on data/segment_eval (one stroke seed, grabCut left to segment_eval
 // for time), the two-step cut beats the depth-only, colour-only and single-step RGB+D cuts on mean IoU, and
-// its step 1 is nearly background-free (precision >= 0.98) wherever no neighbour touches the object.
+// its step 1 is nearly background-free (precision >= 0.98), touching neighbours included.
 #include <map>
 
 #include <gtest/gtest.h>
@@ -31,14 +31,9 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
     }
     ++runs;
   }
-  // Step 1 stops at depth edges: nearly background-free, except where a neighbour touches the object at the
-  // same range (two_people: both people, precision ~0.5 — the open weakness of #15).
-  for (const auto& [name, value] : step1_precision) {
-    if (name == "two_people")
-      EXPECT_LT(value, 0.7) << "step 1 separates touching neighbours now: update the test and the docs";
-    else
-      EXPECT_GE(value, 0.98) << name;
-  }
+  // Step 1 stops at depth edges and at the crevice where a neighbour touches the object at the same range
+  // (two_people: ~0.5 before TouchingNeighbours): nearly background-free everywhere.
+  for (const auto& [name, value] : step1_precision) EXPECT_GE(value, 0.98) << name;
   for (auto& [method, value] : iou) {
     value /= runs;
     precision[method] /= runs;
@@ -47,9 +42,10 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
   EXPECT_GT(iou["two-step"], iou["depth"]);
   EXPECT_GT(iou["two-step"], iou["color"]);
   EXPECT_GT(iou["two-step"], iou["rgbd"]);
-  // Measured 0.943 (3 seeds; two_people, touching neighbours at one range, 0.500): whole-object growth
-  // lifted the ten outdoor scenes from 0.940 to 0.976.
-  EXPECT_GT(iou["two-step"], 0.92);
+  // Measured 0.997 over 3 seeds: 0.943 before touching neighbours were separated (two_people 0.500 -> 0.999),
+  // overhanging parts joined (mailbox_gravel 0.884 -> 0.998, mailbox_lawn 0.897 -> 0.973) and support cells
+  // allowed a 60° normal tilt (0.996 -> 0.997).
+  EXPECT_GT(iou["two-step"], 0.97);
 }
 
 // #15: a correct refinement stroke never lowers IoU by more than 0.01 (one stroke per scene, on the largest
@@ -70,7 +66,7 @@ TEST(SegmentEvalTest, ACorrectRefinementNeverLowersIoU) {
     EXPECT_GE(r.after.iou, r.before.iou - 0.01) << name;
     refined += r.stroke != "none";
   }
-  EXPECT_GT(refined, 6);
+  EXPECT_GT(refined, 10);  // an exact cut gets a background stroke away from the object
 }
 
 }  // namespace

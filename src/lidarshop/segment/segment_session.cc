@@ -250,8 +250,18 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       // Step 1: depth-dominant cut.
       result.step1_mask =
           s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
+      // A neighbour touching the object at the same range joins the depth cut; it is background from here on.
+      cv::Mat neighbours;
+      if (o.whole_object.separate_touching) {
+        cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+        for (int i = 0; i < s.nodes.num(); ++i)
+          if (hard[i] == kHardObject) object_cells.data[s.nodes.cell_of_node[i]] = 255;
+        neighbours = TouchingNeighbours(s.scan, result.step1_mask, object_cells, o.whole_object);
+        result.step1_mask.setTo(0, neighbours);
+      }
       // Step 2: background inference on the ring around it.
       result.inferred_background = s.InferBackground(result.step1_mask);
+      if (!neighbours.empty()) result.inferred_background |= neighbours;
       if (!s.has_appearance) {
         // Neither colour nor intensity: step 3 would have nothing to tell the object by and floods the
         // ring. The depth cut is the answer.
@@ -279,6 +289,7 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
         cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
         for (int i = 0; i < s.nodes.num(); ++i)
           if (hard[i] == kHardBackground) barrier.data[s.nodes.cell_of_node[i]] = 255;
+        if (!neighbours.empty()) barrier |= neighbours;
         result.mask = GrowWholeObject(s.scan, result.mask, barrier, o.whole_object);
       }
       break;

@@ -77,7 +77,7 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
   ransac.min_inliers = static_cast<int>(cells.size() / 5);
   const cv::Rect box = cv::boundingRect(mask);
   const int object_cells = cv::countNonZero(mask);
-  const float cos_max = static_cast<float>(std::cos(options.max_crease_deg * M_PI / 180.0));
+  const float cos_max = static_cast<float>(std::cos(options.support_max_tilt_deg * M_PI / 180.0));
   for (const PlaneFit& plane : DetectPlanesRansac(cloud, ransac)) {
     size_t outside_box = 0;
     for (uint32_t i : plane.inliers) outside_box += !box.contains(cells[i]);
@@ -99,6 +99,78 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
     }
   }
   return support;
+}
+
+// An overhanging part: cells in front of the object across a depth step (a mailbox on its post, seen from the
+// post), joined to each other in depth (orientation aside: a flag at right angles to the box is the box's),
+// whose every other boundary is a step down to something farther or a cell without a return. Nothing visible
+// holds such a part but the object, so it rests on the object. A part that meets anything else in depth (the
+// ground it stands on runs on), a barrier or the scan's edge, that has more than max_cells cells, or that lies
+// behind the object where they meet, is not one; nor is a part that meets the object along more than
+// max_contact_fraction of its outline (the object around it: an occluder, not a part). The seeds are the cells next to `grown` within `region`.
+// Returns the cells of the first such part found (empty: none).
+template <typename JumpAt, typename Free>
+std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, const cv::Rect& region,
+                                       size_t max_cells, double max_contact_fraction, const JumpAt& jump_at,
+                                       const Free& free) {
+  const cv::Rect image(0, 0, scan.cols, scan.rows);
+  constexpr int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
+  constexpr uint8_t kInPart = 1, kRejected = 2;
+  cv::Mat visited = cv::Mat::zeros(grown.size(), CV_8U);
+  for (int r = region.y; r < region.y + region.height; ++r) {
+    for (int c = region.x; c < region.x + region.width; ++c) {
+      const cv::Point a(c, r);
+      if (!grown.at<uint8_t>(a) || !scan.valid.at<uint8_t>(a)) continue;
+      for (int k = 0; k < 4; ++k) {
+        const cv::Point seed(c + kDc[k], r + kDr[k]);
+        if (!image.contains(seed) || !free(grown, seed) || visited.at<uint8_t>(seed)) continue;
+        if (scan.range.at<float>(seed) >= scan.range.at<float>(a) - jump_at(a)) continue;
+        std::vector<cv::Point> part = {seed};
+        visited.at<uint8_t>(seed) = kInPart;
+        bool held_elsewhere = false;
+        int contact_edges = 0, outline_edges = 0;  // the part's outline, and where it meets the object
+        for (size_t i = 0; i < part.size() && !held_elsewhere; ++i) {
+          const cv::Point p = part[i];
+          const float range_p = scan.range.at<float>(p);
+          const double jump_m = jump_at(p);
+          for (int j = 0; j < 4 && !held_elsewhere; ++j) {
+            const cv::Point q(p.x + kDc[j], p.y + kDr[j]);
+            if (!image.contains(q)) {
+              held_elsewhere = true;  // it runs on beyond the scan
+              continue;
+            }
+            if (visited.at<uint8_t>(q) == kInPart) continue;
+            ++outline_edges;
+            if (!scan.valid.at<uint8_t>(q)) continue;
+            if (visited.at<uint8_t>(q) == kRejected) {
+              held_elsewhere = true;  // the rest of a part already turned down
+              continue;
+            }
+            const float range_q = scan.range.at<float>(q);
+            if (grown.at<uint8_t>(q)) {
+              ++contact_edges;
+              held_elsewhere = range_q < range_p - jump_m;  // behind the object there
+              continue;
+            }
+            if (range_q > range_p + jump_m) continue;  // a step down to something farther
+            if (range_q < range_p - jump_m || !free(grown, q)) {
+              held_elsewhere = true;  // occluded by something else, or against a barrier
+              continue;
+            }
+            --outline_edges;  // not outline: the part goes on
+            visited.at<uint8_t>(q) = kInPart;
+            part.push_back(q);
+            held_elsewhere = part.size() > max_cells;  // too large to be a part: it runs on
+          }
+        }
+        // Something in front of the object, the object all around it (a leaf before a car door), is not held
+        // by it: a part that rests on the object meets it along a side.
+        if (!held_elsewhere && contact_edges <= max_contact_fraction * outline_edges) return part;
+        for (const cv::Point& p : part) visited.at<uint8_t>(p) = kRejected;
+      }
+    }
+  }
+  return {};
 }
 
 }  // namespace
@@ -135,6 +207,22 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
 
   const cv::Mat support = SupportCells(scan, mask, region, normal, options);
   const float cos_max = static_cast<float>(std::cos(options.max_crease_deg * M_PI / 180.0));
+  // A jump of more than this many cell spacings at this range is a depth edge (a surface seen at up to
+  // ~80° incidence still stays under it), with a floor for range noise.
+  const auto jump_at = [&](cv::Point a) {
+    return std::max(options.min_jump_m, options.jump_cells * scan.range.at<float>(a) * cell_angle);
+  };
+  // A cell an overhang may take: valid, not yet object and not barred (it may lie beyond the region: its size
+  // is bounded by the growth's budget instead). (Support planes do not
+  // matter there: a part on a support surface runs on in depth across it to the region's edge, and the front
+  // face of an overhanging box wider than the cut is easily taken for a support plane.)
+  const auto free = [&](const cv::Mat& grown, cv::Point b) {
+    return !grown.at<uint8_t>(b) && scan.valid.at<uint8_t>(b) && (barrier.empty() || !barrier.at<uint8_t>(b));
+  };
+  // A cell growth may enter: free and not support.
+  const auto open = [&](const cv::Mat& grown, cv::Point b) {
+    return free(grown, b) && !support.at<uint8_t>(b);
+  };
   cv::Mat grown = mask.clone();
   std::deque<cv::Point> front;
   for (int r = region.y; r < region.y + region.height; ++r)
@@ -149,21 +237,33 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
     const float range_a = scan.range.at<float>(a);
     const cv::Vec3f normal_a = normal.at<cv::Vec3f>(a - region.tl());
     if (!scan.valid.at<uint8_t>(a) || normal_a == cv::Vec3f()) continue;
-    // A jump of more than this many cell spacings at this range is a depth edge (a surface seen at up to
-    // ~80° incidence still stays under it), with a floor for range noise.
-    const double jump_m = std::max(options.min_jump_m, options.jump_cells * range_a * cell_angle);
+    const double jump_m = jump_at(a);
     for (int k = 0; k < 4; ++k) {
       const cv::Point b(a.x + kDc[k], a.y + kDr[k]);
-      if (!region.contains(b) || grown.at<uint8_t>(b) || !scan.valid.at<uint8_t>(b)) continue;
-      if ((!barrier.empty() && barrier.at<uint8_t>(b)) || support.at<uint8_t>(b)) continue;
+      if (!open(grown, b)) continue;
       if (std::abs(scan.range.at<float>(b) - range_a) > jump_m) continue;
       const cv::Vec3f normal_b = normal.at<cv::Vec3f>(b - region.tl());
       if (normal_b == cv::Vec3f() || normal_a.dot(normal_b) < cos_max) continue;
       grown.at<uint8_t>(b) = 255;
       front.push_back(b);
       // A growth this large is a leak into the surroundings, not a missing part: keep the cut as it was.
-      if (++added > max_added) return mask.clone();
+      if (++added > max_added) {
+        grown = mask.clone();
+        front.clear();
+        added = 0;
+        break;
+      }
     }
+  }
+  // Overhanging parts are closed by depth steps on every side, so they cannot leak: they join even when the
+  // growth above did (each one closed in depth, so growth from it would add nothing).
+  while (options.join_overhangs) {
+    const std::vector<cv::Point> overhang =
+        OverhangingPart(scan, grown, region, static_cast<size_t>(std::max(0, max_added - added)),
+                        options.overhang_max_contact, jump_at, free);
+    if (overhang.empty()) break;
+    added += static_cast<int>(overhang.size());
+    for (const cv::Point& cell : overhang) grown.at<uint8_t>(cell) = 255;
   }
   return grown;
 }

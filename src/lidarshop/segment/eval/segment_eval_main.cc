@@ -64,6 +64,17 @@ int main(int argc, char** argv) {
   app.add_option("--grow-max", options.whole_object.max_growth,
                  "whole-object growth: at most this times the cut");
   app.add_flag("!--no-grow", options.grow_whole_object, "no whole-object growth");
+  app.add_option("--crevice-flank-deg", options.whole_object.crevice_flank_deg,
+                 "touching neighbours: steepness of a crevice's flanks, degrees");
+  app.add_option("--crevice-baseline", options.whole_object.crevice_baseline_cells,
+                 "touching neighbours: the flanks' rise is measured over this many cells");
+  app.add_option("--neighbour-fraction", options.whole_object.neighbour_min_fraction,
+                 "touching neighbours: smallest part dropped, times the stroked parts' cells");
+  app.add_option("--support-tilt-deg", options.whole_object.support_max_tilt_deg,
+                 "whole-object growth: largest tilt of a support cell's normal, degrees");
+  app.add_flag("!--no-overhangs", options.whole_object.join_overhangs, "no joining of overhanging parts");
+  app.add_flag("!--no-separate", options.whole_object.separate_touching,
+               "no separation of touching neighbours");
   bool eight = false;
   std::string dump_dir;
   app.add_option("--dump", dump_dir, "write overlays (step 1 + inferred background, final, grabCut) here");

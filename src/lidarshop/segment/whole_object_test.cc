@@ -1,0 +1,154 @@
+// Whole-object growth across an overhang: a part in front of the object that nothing else visible holds.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/segment/segment.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Block {
+  cv::Vec3d lo, hi;  // axis-aligned box corners, metres (scanner at the origin, z up)
+  cv::Vec3b rgb;
+  int label;
+};
+
+// Distance along `d` to the box (slab method), infinity when missed.
+double HitBlock(const cv::Vec3f& d, const Block& block) {
+  double t_near = 0, t_far = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d[i]) < 1e-12) {
+      if (0 < block.lo[i] || 0 > block.hi[i]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double t0 = block.lo[i] / d[i], t1 = block.hi[i] / d[i];
+    if (t0 > t1) std::swap(t0, t1);
+    t_near = std::max(t_near, t0);
+    t_far = std::min(t_far, t1);
+  }
+  return t_near <= t_far ? t_near : std::numeric_limits<double>::infinity();
+}
+
+// Blocks on a grey ground plane 1.5 m below the scanner, a beige wall at y = 12 m behind them.
+Scan MakeBlocks(const std::vector<Block>& blocks, uint64_t seed) {
+  const int rows = 240, cols = 240;
+  Scan scan = MakeScan(rows, cols, /*with_color=*/true);
+  scan.grid = UniformGrid(rows, cols, -12 * kPi / 180, 12 * kPi / 180, -22 * kPi / 180, 8 * kPi / 180);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) {
+      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+      double t = 12.0 / d[1];
+      int label = 0;
+      cv::Vec3b rgb(210, 198, 176);
+      if (d[2] < 0 && -1.5 / d[2] < t) {
+        t = -1.5 / d[2];
+        rgb = cv::Vec3b(120, 120, 116);
+      }
+      for (const Block& block : blocks) {
+        const double hit = HitBlock(d, block);
+        if (hit >= t) continue;
+        t = hit;
+        label = block.label;
+        rgb = block.rgb;
+      }
+      const double g = noise(rng);
+      const double range = t + 0.003 * noise(rng);
+      scan.valid.at<uint8_t>(row, col) = kValid;
+      scan.range.at<float>(row, col) = static_cast<float>(range);
+      scan.point.at<cv::Vec3f>(row, col) = d * static_cast<float>(range);
+      scan.color.at<cv::Vec3b>(row, col) =
+          cv::Vec3b(cv::saturate_cast<uint8_t>(rgb[0] + 5 * g), cv::saturate_cast<uint8_t>(rgb[1] + 5 * g),
+                    cv::saturate_cast<uint8_t>(rgb[2] + 5 * g));
+      scan.label.at<int32_t>(row, col) = label;
+    }
+  }
+  return scan;
+}
+
+// A brown post 0.4 m tall with a blue box on top that overhangs it by 0.2 m towards the scanner. (Tops are kept
+// 0.9 m or more below the scanner: a face seen at over ~80° incidence steps by more than the growth's depth
+// continuity from row to row.)
+const Block kPost = {{-0.05, 4.95, -1.5}, {0.05, 5.05, -1.1}, cv::Vec3b(112, 82, 52), 1};
+const Block kBoxOnPost = {{-0.15, 4.75, -1.1}, {0.15, 5.25, -0.9}, cv::Vec3b(40, 60, 170), 1};
+
+// A short vertical object stroke on the post (the middle of the object's cells 3/4 of the way down) and a background stroke on the ground to the left.
+cv::Mat StrokeOnPost(const Scan& scan) {
+  cv::Mat strokes(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+  // The post's column: the middle of the label-1 cells in the row 3/4 down the object.
+  const cv::Rect object = cv::boundingRect(scan.label == 1);
+  const int row = object.y + 3 * object.height / 4;
+  std::vector<int> cols;
+  for (int c = 0; c < scan.cols; ++c)
+    if (scan.label.at<int32_t>(row, c) == 1) cols.push_back(c);
+  const int middle = cols[cols.size() / 2];
+  cv::line(strokes, cv::Point(middle, row - 8), cv::Point(middle, row + 8), cv::Scalar(kStrokeObject), 2);
+  cv::line(strokes, cv::Point(5, scan.rows - 8), cv::Point(30, scan.rows - 8), cv::Scalar(kStrokeBackground),
+           2);
+  return strokes;
+}
+
+TEST(WholeObjectTest, ABoxOverhangingItsPostJoinsAStrokeOnThePost) {
+  const Scan scan = MakeBlocks({kPost, kBoxOnPost}, 3);
+  const cv::Mat truth = scan.label == 1;
+  const cv::Mat strokes = StrokeOnPost(scan);
+  SegmentOptions options;
+  options.whole_object.join_overhangs = false;
+  const MaskScores without = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  options.whole_object.join_overhangs = true;
+  const MaskScores with = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  EXPECT_LT(without.iou, 0.7);  // the post alone: the box is another colour and a depth step away
+  EXPECT_GT(with.iou, 0.95) << "precision " << with.precision << " recall " << with.recall;
+}
+
+TEST(WholeObjectTest, APartInFrontThatStandsOnTheGroundDoesNotJoin) {
+  // A crate on the ground in front of the post's foot: in front of the object, but the ground holds it.
+  const Block crate = {{-0.25, 4.4, -1.5}, {0.25, 4.7, -1.25}, cv::Vec3b(40, 60, 170), 2};
+  const Scan scan = MakeBlocks({kPost, crate}, 5);
+  const cv::Mat post = scan.label == 1;
+  const cv::Mat grown = GrowWholeObject(scan, post, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(grown & (scan.label == 2)), 0);
+  // A smaller crate held off the ground (nothing visible holds it but the post) joins.
+  const Block floating = {{-0.12, 4.4, -1.35}, {0.12, 4.7, -1.25}, cv::Vec3b(40, 60, 170), 2};
+  const Scan lifted = MakeBlocks({kPost, floating}, 5);
+  const cv::Mat lifted_grown = GrowWholeObject(lifted, lifted.label == 1, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
+}
+
+TEST(WholeObjectTest, APlateInFrontOfTheObjectWithTheObjectAllAroundItDoesNotJoin) {
+  // A wide board on the ground (the object) and a small plate hanging 0.3 m in front of its middle: in front,
+  // held by nothing visible, but the object lies all around it: an occluder, not a part. Lifted to the board's
+  // top edge, so that it meets the board along one side only, it joins.
+  const Block board = {{-0.8, 5.0, -1.5}, {0.8, 5.1, -0.7}, cv::Vec3b(40, 60, 170), 1};
+  const Block plate = {{-0.1, 4.7, -1.2}, {0.1, 4.72, -1.0}, cv::Vec3b(200, 30, 30), 2};
+  const Scan scan = MakeBlocks({board, plate}, 11);
+  const cv::Mat grown = GrowWholeObject(scan, scan.label == 1, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(grown & (scan.label == 2)), 0);  // all of it with overhang_max_contact = 1
+  Block on_top = plate;
+  on_top.lo[2] = -0.72;
+  on_top.hi[2] = -0.42;
+  const Scan lifted = MakeBlocks({board, on_top}, 11);
+  const cv::Mat lifted_grown = GrowWholeObject(lifted, lifted.label == 1, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
+}
+
+TEST(WholeObjectTest, GrowthFromAWholeObjectAddsNoSupportAlongItsFoot) {
+  // A crate standing on the ground, seen slightly from the side (so its foot is an outline on the ground with
+  // corners): the ground cells along the foot have normals that mix in the crate's faces.
+  const Block crate = {{-0.55, 4.6, -1.5}, {0.15, 5.2, -0.9}, cv::Vec3b(40, 60, 170), 1};
+  const Scan scan = MakeBlocks({crate}, 7);
+  const cv::Mat truth = scan.label == 1;
+  const cv::Mat grown = GrowWholeObject(scan, truth, cv::Mat());
+  EXPECT_EQ(cv::countNonZero(grown & ~truth), 0);  // 10 cells with support_max_tilt_deg = 45
+}
+
+}  // namespace
+}  // namespace lidarshop
