@@ -375,7 +375,8 @@ void BM_SsdFillShape(benchmark::State& state) {
   }
   state.SetItemsProcessed(kBatch * state.iterations());
   state.counters["fastest_ns_per_candidate"] = fastest;
-  state.SetLabel(fmt::format("9x9x6 half known, 4 adjacent candidates per call, kernel {}", ssd.KernelName()));
+  state.SetLabel(
+      fmt::format("9x9x6 half known, 4 adjacent candidates per call, kernel {}", ssd.KernelName()));
 }
 BENCHMARK(BM_SsdFillShape)->Arg(0)->Arg(1)->Arg(2);
 

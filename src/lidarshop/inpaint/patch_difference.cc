@@ -95,8 +95,8 @@ LIDARSHOP_LANES_INLINE float Sum16(const F16* pair) {
 
 template <int N>
 __attribute__((target("avx512f"), flatten)) void SsdAvx512(const PreparedRows& p,
-                                                          const float* source_top_left,
-                                                          int64_t candidate_step, float bound, float* out) {
+                                                           const float* source_top_left,
+                                                           int64_t candidate_step, float bound, float* out) {
   F16 acc[N][2];
   for (int c = 0; c < N; ++c)
     for (int a = 0; a < 2; ++a) acc[c][a] = F16{} * 0.0f;
