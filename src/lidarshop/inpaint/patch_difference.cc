@@ -77,6 +77,52 @@ __attribute__((target("avx2"), flatten)) void SsdAvx2(const PreparedRows& p, con
                                                       int64_t candidate_step, float bound, float* out) {
   SsdBody<N>(p, source_top_left, candidate_step, bound, out);
 }
+// The same sums with 16-lane vectors: one 16-float load covers blocks 2m and 2m + 1, whose lanes go to the
+// 8-lane accumulators 2m mod 4 and (2m + 1) mod 4, so pair[m & 1] holds accumulators (0, 1) or (2, 3) in its
+// low and high halves and every lane adds the same terms in the same order as SsdBody. A span with an odd
+// number of blocks reads one block past it: its weights and targets are the stored zero padding, so those
+// lanes add d² = (s·0 − 0)² = +0, which leaves a sum of squares unchanged. The canvas's padding covers the
+// source floats read past the last patch row.
+using F16 = float __attribute__((vector_size(64)));
+
+LIDARSHOP_LANES_INLINE float Sum16(const F16* pair) {
+  const lanes::F8 acc[4] = {__builtin_shufflevector(pair[0], pair[0], 0, 1, 2, 3, 4, 5, 6, 7),
+                            __builtin_shufflevector(pair[0], pair[0], 8, 9, 10, 11, 12, 13, 14, 15),
+                            __builtin_shufflevector(pair[1], pair[1], 0, 1, 2, 3, 4, 5, 6, 7),
+                            __builtin_shufflevector(pair[1], pair[1], 8, 9, 10, 11, 12, 13, 14, 15)};
+  return Sum4(acc);
+}
+
+template <int N>
+__attribute__((target("avx512f"), flatten)) void SsdAvx512(const PreparedRows& p,
+                                                           const float* source_top_left,
+                                                           int64_t candidate_step, float bound, float* out) {
+  F16 acc[N][2];
+  for (int c = 0; c < N; ++c)
+    for (int a = 0; a < 2; ++a) acc[c][a] = F16{} * 0.0f;
+  const size_t n = p.spans.size();
+  for (size_t i = 0; i < n; ++i) {
+    const RowSpan& span = p.spans[i];
+    const float* s = source_top_left + span.source_offset;
+    const float* sw = p.sqrt_weight.data() + span.stored_offset;
+    const float* tw = p.target_times_sqrt_weight.data() + span.stored_offset;
+    const int pairs = (span.blocks8 + 1) / 2;
+    for (int m = 0; m < pairs; ++m) {
+      const F16 w = lanes::Load<F16>(sw + 16 * m), t = lanes::Load<F16>(tw + 16 * m);
+      for (int c = 0; c < N; ++c) {
+        const F16 d = lanes::Load<F16>(s + c * candidate_step + 16 * m) * w - t;
+        acc[c][m & 1] += d * d;
+      }
+    }
+    if ((i & 1) && i + 1 < n) {
+      bool all_out = true;
+      for (int c = 0; c < N && all_out; ++c) all_out = Sum16(acc[c]) > bound;
+      if (all_out) break;
+    }
+  }
+  for (int c = 0; c < N; ++c) out[c] = Sum16(acc[c]);
+}
+
 template <int N>
 void SsdBaseline(const PreparedRows& p, const float* source_top_left, int64_t candidate_step, float bound,
                  float* out) {
@@ -86,8 +132,8 @@ void SsdBaseline(const PreparedRows& p, const float* source_top_left, int64_t ca
 class WeightedSsdTarget : public TargetDifference {
  public:
   WeightedSsdTarget(const InpaintCanvas& canvas, Pixel target, const std::vector<float>& channel_weights,
-                    bool avx2)
-      : canvas_(canvas), avx2_(avx2) {
+                    SsdKernel kernel)
+      : canvas_(canvas), kernel_(kernel) {
     const int R = canvas.patch_radius(), C = canvas.channels(), side = 2 * R + 1;
     const int row_floats = side * C;
     const int padded = (row_floats + 7) / 8 * 8;
@@ -133,10 +179,16 @@ class WeightedSsdTarget : public TargetDifference {
     const int R = canvas_.patch_radius();
     const float* top_left = canvas_.PixelData(source.row - R, source.col - R);
     float out;
-    if (avx2_) {
-      SsdAvx2<1>(prepared_, top_left, 0, bound, &out);
-    } else {
-      SsdBaseline<1>(prepared_, top_left, 0, bound, &out);
+    switch (kernel_) {
+      case SsdKernel::kAvx512:
+        SsdAvx512<1>(prepared_, top_left, 0, bound, &out);
+        break;
+      case SsdKernel::kAvx2:
+        SsdAvx2<1>(prepared_, top_left, 0, bound, &out);
+        break;
+      case SsdKernel::kBaseline:
+        SsdBaseline<1>(prepared_, top_left, 0, bound, &out);
+        break;
     }
     return out;
   }
@@ -148,7 +200,11 @@ class WeightedSsdTarget : public TargetDifference {
     const int R = canvas_.patch_radius(), C = canvas_.channels();
     auto top_left = [&](int i) { return canvas_.PixelData(source.row - R, source.col + i - R); };
     int i = 0;
-    if (avx2_) {
+    if (kernel_ == SsdKernel::kAvx512) {
+      for (; i + 4 <= count; i += 4) SsdAvx512<4>(prepared_, top_left(i), C, bound, out + i);
+      for (; i + 2 <= count; i += 2) SsdAvx512<2>(prepared_, top_left(i), C, bound, out + i);
+      for (; i < count; ++i) SsdAvx512<1>(prepared_, top_left(i), C, bound, out + i);
+    } else if (kernel_ == SsdKernel::kAvx2) {
       for (; i + 4 <= count; i += 4) SsdAvx2<4>(prepared_, top_left(i), C, bound, out + i);
       for (; i + 2 <= count; i += 2) SsdAvx2<2>(prepared_, top_left(i), C, bound, out + i);
       for (; i < count; ++i) SsdAvx2<1>(prepared_, top_left(i), C, bound, out + i);
@@ -161,15 +217,26 @@ class WeightedSsdTarget : public TargetDifference {
 
  private:
   const InpaintCanvas& canvas_;
-  const bool avx2_;
+  const SsdKernel kernel_;
   PreparedRows prepared_;
 };
 
 }  // namespace
 
+SsdKernel BestSsdKernel() {
+  static const SsdKernel best = [] {
+    if (BestSimdPath() != SimdPath::kAvx2) return SsdKernel::kBaseline;
+    return __builtin_cpu_supports("avx512f") ? SsdKernel::kAvx512 : SsdKernel::kAvx2;
+  }();
+  return best;
+}
+
 WeightedSsd::WeightedSsd(std::vector<float> channel_weights, SimdPath path)
-    : channel_weights_(std::move(channel_weights)),
-      avx2_(path == SimdPath::kAvx2 && BestSimdPath() == SimdPath::kAvx2) {
+    : WeightedSsd(std::move(channel_weights),
+                  path == SimdPath::kAvx2 ? SsdKernel::kAvx512 : SsdKernel::kBaseline) {}
+
+WeightedSsd::WeightedSsd(std::vector<float> channel_weights, SsdKernel kernel)
+    : channel_weights_(std::move(channel_weights)), kernel_(std::min(kernel, BestSsdKernel())) {
   for (float w : channel_weights_)
     CheckOption(std::isfinite(w) && w >= 0.0f, "WeightedSsd: channel weights must be >= 0");
 }
@@ -179,9 +246,19 @@ std::unique_ptr<TargetDifference> WeightedSsd::ForTarget(const InpaintCanvas& ca
     throw OptionsError(fmt::format("WeightedSsd: {} channel weights for an image of {} channels",
                                    channel_weights_.size(), canvas.channels()));
   }
-  return std::make_unique<WeightedSsdTarget>(canvas, target, channel_weights_, avx2_);
+  return std::make_unique<WeightedSsdTarget>(canvas, target, channel_weights_, kernel_);
 }
 
-const char* WeightedSsd::KernelName() const { return avx2_ ? "avx2" : "baseline"; }
+const char* WeightedSsd::KernelName() const {
+  switch (kernel_) {
+    case SsdKernel::kAvx512:
+      return "avx512";
+    case SsdKernel::kAvx2:
+      return "avx2";
+    case SsdKernel::kBaseline:
+      break;
+  }
+  return "baseline";
+}
 
 }  // namespace lidarshop

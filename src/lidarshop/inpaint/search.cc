@@ -40,6 +40,18 @@ uint64_t SplitMix64(uint64_t& state) {
   return z ^ (z >> 31);
 }
 
+// The i-th row of [row_begin, row_end) counted from its middle outwards (middle, middle + 1, middle − 1,
+// middle + 2, ...; then the rest of the longer side): windows are centred on the target, and nearby sources
+// are the likeliest good ones, so scanning them first tightens the early-termination bound sooner.
+int RowFromMiddle(int row_begin, int row_end, int i) {
+  const int middle = row_begin + (row_end - row_begin) / 2;
+  const int below = row_end - middle - 1, above = middle - row_begin;  // rows after / before the middle
+  const int paired = std::min(below, above);
+  if (i <= 2 * paired) return i % 2 == 1 ? middle + (i + 1) / 2 : middle - i / 2;
+  const int rest = i - 2 * paired;  // beyond the shorter side: continue on the longer one
+  return below > above ? middle + paired + rest : middle - paired - rest;
+}
+
 int UniformInt(uint64_t& state, int n) {
   return static_cast<int>((SplitMix64(state) >> 11) % static_cast<uint64_t>(n));
 }
@@ -62,13 +74,25 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& ca
   if (row_end <= row_begin) return {};
   std::mutex merge_mutex;
   TopK merged(count);
+  // The least count-th best difference of any chunk so far. Every chunk's count-th best is >= the count-th
+  // best of the whole range (a chunk is a subset of it), so no candidate of the answer is ever above this
+  // bound: sharing it between the chunks (and threads) keeps the answer exact while the scan of each chunk
+  // prunes against the best bound found anywhere, as one sequential scan would. Only how early a rejected
+  // candidate stops depends on the timing, never which candidates are kept.
+  std::atomic<float> shared_bound{bound};
+  auto tighten = [&](float chunk_bound) {
+    float now = shared_bound.load(std::memory_order_relaxed);
+    while (chunk_bound < now &&
+           !shared_bound.compare_exchange_weak(now, chunk_bound, std::memory_order_relaxed)) {
+    }
+  };
   ParallelForRange(
       row_end - row_begin,
       [&](int64_t begin, int64_t end) {
         TopK local(count);
         int64_t evaluated = 0;
         for (int64_t i = begin; i < end; ++i) {
-          const int r = row_begin + static_cast<int>(i);
+          const int r = RowFromMiddle(row_begin, row_end, static_cast<int>(i));
           const std::vector<int>& cols = cols_by_row[r];
           auto first = std::lower_bound(cols.begin(), cols.end(), col_begin);
           auto last = std::lower_bound(first, cols.end(), col_end);
@@ -80,10 +104,12 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& ca
           for (auto it = first; it != last;) {
             int run = 1;
             while (run < kRun && it + run != last && *(it + run) == *it + run) ++run;
-            difference.EvaluateRun({r, *it}, run, std::min(bound, local.Bound()), d);
+            difference.EvaluateRun({r, *it}, run,
+                                   std::min(shared_bound.load(std::memory_order_relaxed), local.Bound()), d);
             for (int k = 0; k < run; ++k) {
-              const float limit = std::min(bound, local.Bound());
-              if (d[k] <= limit) local.Offer({{r, *it + k}, d[k]});
+              if (d[k] > std::min(shared_bound.load(std::memory_order_relaxed), local.Bound())) continue;
+              local.Offer({{r, *it + k}, d[k]});
+              tighten(local.Bound());
             }
             evaluated += run;
             it += run;

@@ -41,8 +41,10 @@ class PatchSearch {
   std::atomic<int64_t> evaluations_{0};
 };
 
-// Every source centre of the image. Parallel over source rows (each chunk keeps its own top-k with its own
-// early termination bound; the merge is exact), so the answer is the same for any number of threads.
+// Every source centre of the image. Parallel over source rows, scanned from the middle of the range outwards
+// (nearby sources first); each chunk keeps its own top-k and the chunks share one early-termination bound, the
+// least k-th best of any chunk so far (>= the k-th best of the whole range, so no answer is ever pruned; the
+// merge is exact), so the answer is the same for any number of threads and scheduling.
 class ExhaustiveSearch : public PatchSearch {
  public:
   std::vector<SourceCandidate> Find(const InpaintCanvas& canvas, const TargetDifference& difference,
