@@ -78,6 +78,8 @@ void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance) {
   }
   state.counters["inpaint_s"] = result.timings.inpaint_s;
   state.counters["poisson_s"] = result.timings.poisson_s;
+  state.counters["planes_s"] = result.timings.planes_s;
+  state.counters["plane_cells"] = static_cast<double>(result.plane_cells);
   state.counters["total_s"] = result.timings.total_s;
 }
 
