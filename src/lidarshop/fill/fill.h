@@ -60,7 +60,7 @@ struct FillOptions {
   int patchmatch_iterations = 4;       // PatchMatch: propagation + random-search rounds per query (>= 1)
   // Patch acceptance tests (inpaint/acceptance.h, thesis 7.1), the combined set by default: a patch is copied
   // only when what it brings agrees with the target's known part (measured on data/fill_eval: mean range RMSE
-  // over the non-planar scenes 105 mm with them, 264 mm without; bench/results/fill.md). `enabled = false`
+  // over the non-planar scenes 24 mm with them, 195 mm without; bench/results/fill.md). `enabled = false`
   // trusts the best patch difference alone.
   AcceptanceOptions acceptance = AcceptanceOptions::Combined();
   // With acceptance: search the local window exhaustively first, then the whole scan (true), or offer the
