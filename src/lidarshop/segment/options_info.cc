@@ -87,6 +87,8 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
         .Unit("deg")
         .AboveZero()
         .Max(90);
+    b.Field(&WholeObjectOptions::free_support_seeds, "free_support_seeds",
+            "step 3 does not force step 1's cells on a support plane into the object");
     b.Field(&WholeObjectOptions::join_overhangs, "join_overhangs",
             "a part in front of the object held by nothing else visible joins it");
     b.Field(&WholeObjectOptions::overhang_max_contact, "overhang_max_contact",

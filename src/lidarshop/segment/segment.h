@@ -95,6 +95,10 @@ struct WholeObjectOptions {
   // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
   // the support's cells along the object's foot mix in the object's side.
   double support_max_tilt_deg = 60.0;
+  // Step 3 takes step 1's cells as hard object seeds, except those on a support plane (SupportSurfaceCells):
+  // a few ground cells the depth cut took at the object's foot are left to the colour cut instead of being
+  // forced into the object.
+  bool free_support_seeds = true;
   // Overhangs: a part in front of the object across a depth step, joined to nothing else in depth (every other
   // boundary a step down to something farther or no return), rests on the object and joins it (a mailbox on
   // its post, with the stroke on the post).
@@ -245,6 +249,11 @@ cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterati
 
 cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
                         const WholeObjectOptions& options = WholeObjectOptions());
+
+// The cells of `mask` and around it that lie on a surface the object stands on or against (the support planes
+// of GrowWholeObject: the ground, a table, a wall), facing its way. CV_8U 255/0.
+cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask,
+                            const WholeObjectOptions& options = WholeObjectOptions());
 
 // Crevices between touching bodies in `region` of the scan: grid edges between valid cells where the range
 // rises towards the edge from both sides, each flank at least crevice_flank_deg steep (a rise of

@@ -270,7 +270,11 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       }
       // Step 3: colour-dominant cut seeded with step 1's object and the inferred + stroked background.
       std::vector<uint8_t> seeds = hard;
-      const uint8_t* step1 = result.step1_mask.ptr<uint8_t>();
+      // Step 1's cells on a support plane (ground the depth cut took at the object's foot) are left free.
+      cv::Mat step1_seeds = result.step1_mask;
+      if (o.whole_object.free_support_seeds)
+        step1_seeds = result.step1_mask & ~SupportSurfaceCells(s.scan, result.step1_mask, o.whole_object);
+      const uint8_t* step1 = step1_seeds.ptr<uint8_t>();
       const uint8_t* inferred = result.inferred_background.ptr<uint8_t>();
       for (int i = 0; i < s.nodes.num(); ++i) {
         const int32_t cell = s.nodes.cell_of_node[i];

@@ -56,7 +56,7 @@ int CountOnPlane(const Scan& scan, const cv::Mat& cells_mask, const cv::Rect& bo
 // in a band around the object, kept when a quarter of their band cells lie outside the object's bounding box
 // (a face of a missed part lies within it; the ground, a table or a wall runs beyond it).
 cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& region, const cv::Mat& normal,
-                     const WholeObjectOptions& options) {
+                     const WholeObjectOptions& options, bool include_mask = false) {
   cv::Mat band;
   cv::dilate(mask, band, cv::Mat(), cv::Point(-1, -1), options.support_band_cells);
   band &= ~mask;
@@ -89,7 +89,7 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
     // Every cell of the region on that plane and facing its way, not only the band's.
     for (int r = region.y; r < region.y + region.height; ++r) {
       for (int c = region.x; c < region.x + region.width; ++c) {
-        if (!scan.valid.at<uint8_t>(r, c) || mask.at<uint8_t>(r, c)) continue;
+        if (!scan.valid.at<uint8_t>(r, c) || (!include_mask && mask.at<uint8_t>(r, c))) continue;
         const cv::Vec3f& p = scan.point.at<cv::Vec3f>(r, c);
         if (std::abs(plane.Distance(Eigen::Vector3f(p[0], p[1], p[2]))) > options.support_distance_m)
           continue;
@@ -173,21 +173,22 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
   return {};
 }
 
-}  // namespace
+// The object's box, the region around it that growth may reach, and the grid normals there.
+struct ObjectFrame {
+  cv::Rect box, region;
+  double cell_angle = 0;
+  cv::Mat normal;  // CV_32FC3 of the region's size
+};
 
-cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
-                        const WholeObjectOptions& options) {
-  LIDARSHOP_CHECK(mask.type() == CV_8U && mask.size() == cv::Size(scan.cols, scan.rows));
-  LIDARSHOP_CHECK(barrier.empty() || (barrier.type() == CV_8U && barrier.size() == mask.size()));
-  const int object_cells = cv::countNonZero(mask);
-  if (object_cells == 0) return mask.clone();
+// False when the mask holds no cell with a return.
+bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options, ObjectFrame* frame) {
   // Work on the object's box grown by as much again on every side: growth beyond it is a leak anyway.
-  const cv::Rect box = cv::boundingRect(mask);
+  frame->box = cv::boundingRect(mask);
+  const cv::Rect& box = frame->box;
   const int margin = std::max(box.width, box.height);
-  const cv::Rect region =
-      cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
-      cv::Rect(0, 0, scan.cols, scan.rows);
-  const double cell_angle = MeanCellAngle(scan);
+  frame->region = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
+                  cv::Rect(0, 0, scan.cols, scan.rows);
+  frame->cell_angle = MeanCellAngle(scan);
   // Normals from the window's cells near the centre only: a window across a depth edge would tilt the
   // normals of the background cells along the object's outline, and growth would crawl along that ring.
   std::vector<float> object_ranges;
@@ -195,16 +196,40 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
     for (int c = box.x; c < box.x + box.width; ++c)
       if (mask.at<uint8_t>(r, c) && scan.valid.at<uint8_t>(r, c))
         object_ranges.push_back(scan.range.at<float>(r, c));
-  if (object_ranges.empty()) return mask.clone();
+  if (object_ranges.empty()) return false;
   std::nth_element(object_ranges.begin(), object_ranges.begin() + object_ranges.size() / 2,
                    object_ranges.end());
   const double median_range_m = object_ranges[object_ranges.size() / 2];
   NormalOptions normal_options;
   normal_options.window_cells = options.normal_window_cells;
-  normal_options.radius_m =
-      std::max(options.min_jump_m, 3.0 * (2 * options.normal_window_cells + 1) * median_range_m * cell_angle);
-  const cv::Mat normal = EstimateGridNormals(CropView(scan, region), normal_options).normal;
+  normal_options.radius_m = std::max(
+      options.min_jump_m, 3.0 * (2 * options.normal_window_cells + 1) * median_range_m * frame->cell_angle);
+  frame->normal = EstimateGridNormals(CropView(scan, frame->region), normal_options).normal;
+  return true;
+}
 
+}  // namespace
+
+cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options) {
+  LIDARSHOP_CHECK(mask.type() == CV_8U && mask.size() == cv::Size(scan.cols, scan.rows));
+  ObjectFrame frame;
+  if (cv::countNonZero(mask) == 0 || !FrameOf(scan, mask, options, &frame))
+    return cv::Mat::zeros(mask.size(), CV_8U);
+  return SupportCells(scan, mask, frame.region, frame.normal, options, /*include_mask=*/true);
+}
+
+cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
+                        const WholeObjectOptions& options) {
+  LIDARSHOP_CHECK(mask.type() == CV_8U && mask.size() == cv::Size(scan.cols, scan.rows));
+  LIDARSHOP_CHECK(barrier.empty() || (barrier.type() == CV_8U && barrier.size() == mask.size()));
+  const int object_cells = cv::countNonZero(mask);
+  if (object_cells == 0) return mask.clone();
+  ObjectFrame frame;
+  if (!FrameOf(scan, mask, options, &frame)) return mask.clone();
+  const cv::Rect& box = frame.box;
+  const cv::Rect& region = frame.region;
+  const double cell_angle = frame.cell_angle;
+  const cv::Mat& normal = frame.normal;
   const cv::Mat support = SupportCells(scan, mask, region, normal, options);
   const float cos_max = static_cast<float>(std::cos(options.max_crease_deg * M_PI / 180.0));
   // A jump of more than this many cell spacings at this range is a depth edge (a surface seen at up to

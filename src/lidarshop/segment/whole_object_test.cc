@@ -150,5 +150,31 @@ TEST(WholeObjectTest, GrowthFromAWholeObjectAddsNoSupportAlongItsFoot) {
   EXPECT_EQ(cv::countNonZero(grown & ~truth), 0);  // 10 cells with support_max_tilt_deg = 45
 }
 
+TEST(WholeObjectTest, SupportSurfaceCellsAreTheGroundTheCutTookAtTheFootNotTheObject) {
+  // What step 1 hands step 3 when the depth cut took a fringe of ground at the crate's foot: the fringe is
+  // support (left free for the colour cut), the crate is not.
+  const Block crate = {{-0.55, 4.6, -1.5}, {0.15, 5.2, -0.9}, cv::Vec3b(40, 60, 170), 1};
+  const Scan scan = MakeBlocks({crate}, 7);
+  const cv::Mat truth = scan.label == 1;
+  cv::Mat fringe;
+  cv::dilate(truth, fringe, cv::getStructuringElement(cv::MORPH_RECT, {5, 5}));
+  fringe &= ~truth;
+  fringe &= scan.label == 0;  // the ground only, not the wall
+  const cv::Rect box = cv::boundingRect(truth);
+  fringe(cv::Rect(0, 0, scan.cols, box.y + box.height / 2)) = 0;  // along the foot
+  ASSERT_GT(cv::countNonZero(fringe), 20);
+  const cv::Mat support = SupportSurfaceCells(scan, truth | fringe);
+  EXPECT_GT(cv::countNonZero(support & fringe), cv::countNonZero(fringe) * 3 / 4)
+      << cv::countNonZero(support & fringe) << " of " << cv::countNonZero(fringe);
+  // Of the crate, only cells within a few centimetres of the ground can be taken for it (its lowest row, whose
+  // normals mix in the ground's).
+  int crate_support_above_foot = 0;
+  for (int r = 0; r < scan.rows; ++r)
+    for (int c = 0; c < scan.cols; ++c)
+      crate_support_above_foot += support.at<uint8_t>(r, c) && truth.at<uint8_t>(r, c) &&
+                                  scan.point.at<cv::Vec3f>(r, c)[2] > -1.5f + 0.05f;
+  EXPECT_EQ(crate_support_above_foot, 0);
+}
+
 }  // namespace
 }  // namespace lidarshop
