@@ -180,12 +180,13 @@ struct ObjectFrame {
   cv::Mat normal;  // CV_32FC3 of the region's size
 };
 
-// False when the mask holds no cell with a return.
-bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options, ObjectFrame* frame) {
-  // Work on the object's box grown by as much again on every side: growth beyond it is a leak anyway.
+// `margin` cells around the mask's box make the region (-1 = the box's own size again on every side: growth
+// beyond that is a leak anyway). False when the mask holds no cell with a return.
+bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options, int margin,
+             ObjectFrame* frame) {
   frame->box = cv::boundingRect(mask);
   const cv::Rect& box = frame->box;
-  const int margin = std::max(box.width, box.height);
+  if (margin < 0) margin = std::max(box.width, box.height);
   frame->region = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
                   cv::Rect(0, 0, scan.cols, scan.rows);
   frame->cell_angle = MeanCellAngle(scan);
@@ -213,7 +214,9 @@ bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& op
 cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options) {
   LIDARSHOP_CHECK(mask.type() == CV_8U && mask.size() == cv::Size(scan.cols, scan.rows));
   ObjectFrame frame;
-  if (cv::countNonZero(mask) == 0 || !FrameOf(scan, mask, options, &frame))
+  // Only the support band and the normals' window around the mask matter here.
+  const int margin = options.support_band_cells + options.normal_window_cells + 1;
+  if (cv::countNonZero(mask) == 0 || !FrameOf(scan, mask, options, margin, &frame))
     return cv::Mat::zeros(mask.size(), CV_8U);
   return SupportCells(scan, mask, frame.region, frame.normal, options, /*include_mask=*/true);
 }
@@ -225,7 +228,7 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const int object_cells = cv::countNonZero(mask);
   if (object_cells == 0) return mask.clone();
   ObjectFrame frame;
-  if (!FrameOf(scan, mask, options, &frame)) return mask.clone();
+  if (!FrameOf(scan, mask, options, /*margin=*/-1, &frame)) return mask.clone();
   const cv::Rect& box = frame.box;
   const cv::Rect& region = frame.region;
   const double cell_angle = frame.cell_angle;
