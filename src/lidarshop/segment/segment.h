@@ -94,7 +94,7 @@ struct WholeObjectOptions {
   double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
   // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
   // the support's cells along the object's foot mix in the object's side.
-  double support_max_tilt_deg = 60.0;
+  double support_max_tilt_deg = 75.0;
   // Step 3 takes step 1's cells as hard object seeds, except those on a support plane (SupportSurfaceCells):
   // a few ground cells the depth cut took at the object's foot are left to the colour cut instead of being
   // forced into the object.

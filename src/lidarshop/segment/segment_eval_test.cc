@@ -63,7 +63,7 @@ TEST(SegmentEvalTest, TwoStepBeatsTheBaselinesAndStepOneIsClean) {
   EXPECT_GT(iou["two-step"], iou["rgbd"]);
   // Measured 0.997 over 3 seeds: 0.943 before touching neighbours were separated (two_people 0.500 -> 0.999),
   // overhanging parts joined (mailbox_gravel 0.884 -> 0.998, mailbox_lawn 0.897 -> 0.973) and support cells
-  // allowed a 60° normal tilt (0.996 -> 0.997).
+  // allowed a 60° normal tilt (0.996 -> 0.997); 0.998 with free support seeds and a 75° tilt.
   EXPECT_GT(iou["two-step"], 0.97);
 }
 
