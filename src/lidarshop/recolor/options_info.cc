@@ -36,9 +36,11 @@ const StructInfo& InfoOf<ResectionOptions>() {
     b.Field(&ResectionOptions::ransac_iterations, "ransac_iterations", "minimal sets tried at most").Min(1);
     b.Field(&ResectionOptions::ransac_min_iterations, "ransac_min_iterations", "minimal sets tried at least")
         .Min(1);
-    b.Field(
-        &ResectionOptions::local_optimization, "local_optimization",
-        "refit every set with as many inliers as the best on them (DLT + LM), score it after (LO-RANSAC)");
+    b.Field(&ResectionOptions::local_optimization, "local_optimization",
+            "refit every set with as many inliers as the best (or a lower MSAC score) on them (DLT + LM), "
+            "score it "
+            "after (LO-RANSAC); then trade inliers for the pairs just outside the threshold while the score "
+            "drops");
     b.Field(&ResectionOptions::ransac_confidence, "ransac_confidence",
             "stop once a better set is this unlikely")
         .AboveZero()

@@ -457,8 +457,13 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
                   &inliers);
     const int count = count_of(inliers);
     // With local optimization the bar is the refined best's inlier count (a wrong minimal set may collect
-    // more pairs than any right one before refinement).
-    if (count < 6 || count < (options.local_optimization ? count_of(best.inliers) : best_set_count)) continue;
+    // more pairs than any right one before refinement) or its MSAC score: a camera bent to absorb an outlier
+    // keeps one pair more than the right one, all of them loosely (with 10 pairs: 9 pairs at 1-3.5 px against
+    // 8 at 0.5 px), and only the score tells them apart.
+    if (count < 6) continue;
+    if (options.local_optimization ? count < count_of(best.inliers) && !(score < best.score)
+                                   : count < best_set_count)
+      continue;
     const bool better_set = count > best_set_count || (count == best_set_count && score < best_set_score);
     if (better_set) {
       best_set_count = count;
@@ -485,6 +490,37 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
       const double needed = std::log(1.0 - options.ransac_confidence) / std::log(miss);
       iterations_needed = static_cast<int>(std::min<double>(
           options.ransac_iterations, std::max<double>(options.ransac_min_iterations, std::ceil(needed))));
+    }
+  }
+  // Swap search: an outlier can also be absorbed by trading it for a right pair (the camera bends to fit the
+  // outlier exactly and pushes one right pair just past the threshold: as many inliers, as tight; with 10 pairs
+  // both cameras fit 8 pairs at 0.5 px, and a pair left out alone leaves 7 too weak to bring the right one
+  // back). Each inlier is traded in turn for each of the (at most 3) nearest pairs just outside the threshold
+  // (below 3 thresholds) and the set refitted from the refined best (`optimize`, inliers re-selected); the
+  // lowest MSAC score wins; repeated until no trade lowers it. At most 3 x inliers refits per round.
+  if (options.local_optimization && options.refine && count_of(best.inliers) >= 6) {
+    for (int round = 0, improved = 1; improved && round < n; ++round) {
+      improved = 0;
+      std::vector<std::pair<double, int>> outside;  // (error, pair) of the pairs just outside the threshold
+      for (int j = 0; j < n; ++j) {
+        const double e = ReprojectionError(best.camera, pairs[j]);
+        if (!best.inliers[j] && e < 3 * options.ransac_threshold_px) outside.emplace_back(e, j);
+      }
+      std::sort(outside.begin(), outside.end());
+      outside.resize(std::min<size_t>(outside.size(), 3));
+      Candidate next = best;
+      for (const auto& [error, j] : outside) {
+        for (int i = 0; i < n; ++i) {
+          if (!best.inliers[i]) continue;
+          Candidate start = best;
+          start.inliers[i] = 0;
+          start.inliers[j] = 1;
+          Candidate traded = optimize(start);
+          if (count_of(traded.inliers) >= 6 && traded.score < next.score)
+            next = std::move(traded), improved = 1;
+        }
+      }
+      if (improved) best = std::move(next);
     }
   }
   if (count_of(best.inliers) < 6)

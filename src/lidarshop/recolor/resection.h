@@ -13,7 +13,11 @@
 //      skew: an outlier among the 6, or points near one plane, which leave the DLT's intrinsics undetermined)
 //      is skipped without local optimization; with it, the set gets the camera of the intrinsics prior
 //      (square pixels, principal point at the centre: EPnP for a few fields of view, then LM over f and
-//      the pose). At least `ransac_min_iterations` sets, then the adaptive bound.
+//      the pose). At least `ransac_min_iterations` sets, then the adaptive bound. A set is also locally
+//      optimized when its MSAC score beats the best's (a camera bent to absorb an outlier keeps one pair more
+//      than the right one, loosely). Then a swap search: each inlier traded for each of the (at most 3)
+//      nearest pairs just outside the threshold, refitted, the lowest MSAC score kept, until none lowers it
+//      (an outlier fitted exactly can push a right pair out: as many inliers, as tight).
 //   3. P = K [R | t] decomposed by an RQ decomposition (K upper triangular, positive diagonal; R a rotation).
 //   4. Levenberg–Marquardt on the reprojection error of the inliers over focal length(s), principal point,
 //      optionally skew, radial (k1, k2, k3) and tangential (p1, p2) distortion, rotation (angle-axis) and
@@ -54,9 +58,10 @@ struct ResectionOptions {
   double ransac_threshold_px = 4.0;  // a pair is an inlier when its reprojection error is below this, pixels
   int ransac_iterations = 2000;      // most minimal sets tried (fewer when the confidence is reached)
   int ransac_min_iterations = 100;   // fewest minimal sets tried, whatever the adaptive bound says
-  // LO-RANSAC: a minimal set with at least as many inliers as the best set is refitted on them (DLT, then
-  // Levenberg–Marquardt with the intrinsics the count supports, inliers re-selected) and scored (MSAC) after
-  // that refinement: a wrong set that happens to collect many pairs loses to the right one.
+  // LO-RANSAC: a minimal set with at least as many inliers as the best set (or a lower MSAC score) is
+  // refitted on them (DLT, then Levenberg–Marquardt with the intrinsics the count supports, inliers
+  // re-selected) and scored (MSAC) after that refinement: a wrong set that happens to collect many pairs loses
+  // to the right one. Also turns on the swap search after RANSAC (needs `refine`).
   bool local_optimization = true;
   double ransac_confidence = 0.9999;  // stop once a better set is this unlikely
   uint64_t seed = 1;                  // RANSAC's random sets

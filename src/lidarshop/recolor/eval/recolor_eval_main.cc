@@ -37,7 +37,13 @@ int main(int argc, char** argv) {
   CLI::App app{"recolor_eval: resection and recolouring against synthetic truth (bench/results/recolor.md)"};
   int seeds = 5;
   double noise_px = 0.5, outliers = 0.2;
-  app.add_option("--seeds", seeds, "draws per configuration");
+  bool resection_only = false, per_draw = false;
+  app.add_option("--seeds,--draws", seeds, "draws per configuration (seeds 1..N)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--resection-only", resection_only,
+               "only the RMS on true pairs: no recolouring, no true-camera rows (fast, for many draws)");
+  app.add_flag("--per-draw", per_draw,
+               "also print every draw of \"ours\" (offset, pairs, seed, inliers, RMS)");
   app.add_option("--noise", noise_px, "RMS pixel noise of the correspondences");
   app.add_option("--outliers", outliers, "fraction of outlier pairs");
   CLI11_PARSE(app, argc, argv);
@@ -73,28 +79,42 @@ int main(int argc, char** argv) {
           options.height_px = s.camera.height_px;
           options.seed = seed;
           PinholeCamera camera;
+          std::string
+              inlier_flags;  // "ours": 1 = inlier, per pair (the first round(outliers · count) are outliers)
           if (method == 0) {
             camera = CameraFromProjection(NormalizedDlt(pairs), options.width_px, options.height_px);
           } else if (method == 1) {
-            camera = Resection(pairs, options).camera;
+            const ResectionResult result = Resection(pairs, options);
+            camera = result.camera;
+            for (uint8_t inlier : result.inlier) inlier_flags += inlier ? '1' : '0';
           } else {
             camera = ResectWithIntrinsics(pairs, s.camera, options).camera;
           }
           const double rms = RmsReprojectionError(camera, exact);
-          const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input,
-                                                  RecolorScan(s.input, s.photo.image, camera).scan, s.camera);
           rms_sum += rms;
           rms_worst = std::max(rms_worst, rms);
+          if (per_draw && method == 1)
+            fmt::print("  draw: {:.0f} m, {} pairs, seed {}: inliers {}, RMS on true pairs {:.3f} px\n",
+                       offset, count, seed, inlier_flags, rms);
+          if (resection_only) continue;
+          const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input,
+                                                  RecolorScan(s.input, s.photo.image, camera).scan, s.camera);
           correct_sum += score.visible_correct_percent();
           correct_worst = std::min(correct_worst, score.visible_correct_percent());
           hidden_sum += score.hidden_changed_percent();
           hidden_worst = std::max(hidden_worst, score.hidden_changed_percent());
+        }
+        if (resection_only) {
+          fmt::print("| {:.0f} m | {} | {} | {:.3f} ({:.3f}) | - | - |\n", offset, count, names[method],
+                     rms_sum / seeds, rms_worst);
+          continue;
         }
         fmt::print("| {:.0f} m | {} | {} | {:.3f} ({:.3f}) | {:.2f} ({:.2f}) | {:.3f} ({:.3f}) |\n", offset,
                    count, names[method], rms_sum / seeds, rms_worst, correct_sum / seeds, correct_worst,
                    hidden_sum / seeds, hidden_worst);
       }
     }
+    if (resection_only) continue;
     // Visibility with the true camera: the default (skirts with walls, 1 px margin) and its parts, the literal
     // segment test, and the visibility test before the skirts (2 px margin).
     struct Variant {
