@@ -250,8 +250,9 @@ cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterati
 cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
                         const WholeObjectOptions& options = WholeObjectOptions());
 
-// The cells of `mask` and around it that lie on a surface the object stands on or against (the support planes
-// of GrowWholeObject: the ground, a table, a wall), facing its way. CV_8U 255/0.
+// The cells of `mask` within 4 cells of its outline that lie on a surface the object stands on or against (the
+// support planes of GrowWholeObject: the ground, a table, a wall), facing its way: a fringe of support a cut
+// took. CV_8U 255/0.
 cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask,
                             const WholeObjectOptions& options = WholeObjectOptions());
 

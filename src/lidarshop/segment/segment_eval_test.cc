@@ -14,8 +14,8 @@ namespace {
 TEST(SegmentEvalTest, GroundTheDepthCutTookAtTheFootIsLeftToTheColourCut) {
   // electric_box_wall: step 1 takes a fringe of the ground at the box's foot; as hard object seeds those cells
   // stayed in the final mask (IoU 0.990 over the eval's seeds), left free the colour cut drops them.
-  const Scan scan =
-      SynthesizeScan(LoadScene(std::string(LIDARSHOP_SOURCE_DIR "/data/segment_eval/electric_box_wall.json")));
+  const Scan scan = SynthesizeScan(
+      LoadScene(std::string(LIDARSHOP_SOURCE_DIR "/data/segment_eval/electric_box_wall.json")));
   const cv::Mat truth = (scan.label == 1) & (scan.valid != 0);
   double gain = 0;
   for (uint64_t seed : {7920u, 7921u, 7922u}) {

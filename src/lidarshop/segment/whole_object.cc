@@ -55,8 +55,9 @@ int CountOnPlane(const Scan& scan, const cv::Mat& cells_mask, const cv::Rect& bo
 // Cells on the surfaces the object stands on or against: planes found by RANSAC among the cells with a return
 // in a band around the object, kept when a quarter of their band cells lie outside the object's bounding box
 // (a face of a missed part lies within it; the ground, a table or a wall runs beyond it).
+// `classify` (CV_8U, may be empty = every cell of the region outside the mask): the cells to classify.
 cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& region, const cv::Mat& normal,
-                     const WholeObjectOptions& options, bool include_mask = false) {
+                     const WholeObjectOptions& options, const cv::Mat& classify = cv::Mat()) {
   cv::Mat band;
   cv::dilate(mask, band, cv::Mat(), cv::Point(-1, -1), options.support_band_cells);
   band &= ~mask;
@@ -89,7 +90,8 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
     // Every cell of the region on that plane and facing its way, not only the band's.
     for (int r = region.y; r < region.y + region.height; ++r) {
       for (int c = region.x; c < region.x + region.width; ++c) {
-        if (!scan.valid.at<uint8_t>(r, c) || (!include_mask && mask.at<uint8_t>(r, c))) continue;
+        if (!scan.valid.at<uint8_t>(r, c)) continue;
+        if (classify.empty() ? mask.at<uint8_t>(r, c) != 0 : !classify.at<uint8_t>(r, c)) continue;
         const cv::Vec3f& p = scan.point.at<cv::Vec3f>(r, c);
         if (std::abs(plane.Distance(Eigen::Vector3f(p[0], p[1], p[2]))) > options.support_distance_m)
           continue;
@@ -173,6 +175,9 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
   return {};
 }
 
+// How deep into a cut a fringe of its support can reach, cells.
+constexpr int kFringeCells = 4;
+
 // The object's box, the region around it that growth may reach, and the grid normals there.
 struct ObjectFrame {
   cv::Rect box, region;
@@ -182,8 +187,9 @@ struct ObjectFrame {
 
 // `margin` cells around the mask's box make the region (-1 = the box's own size again on every side: growth
 // beyond that is a leak anyway). False when the mask holds no cell with a return.
+// `normals_at` (CV_8U over the scan, may be empty): where the normals are needed; elsewhere they are left 0.
 bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options, int margin,
-             ObjectFrame* frame) {
+             const cv::Mat& normals_at, ObjectFrame* frame) {
   frame->box = cv::boundingRect(mask);
   const cv::Rect& box = frame->box;
   if (margin < 0) margin = std::max(box.width, box.height);
@@ -205,7 +211,18 @@ bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& op
   normal_options.window_cells = options.normal_window_cells;
   normal_options.radius_m = std::max(
       options.min_jump_m, 3.0 * (2 * options.normal_window_cells + 1) * median_range_m * frame->cell_angle);
-  frame->normal = EstimateGridNormals(CropView(scan, frame->region), normal_options).normal;
+  Scan view = CropView(scan, frame->region);
+  if (!normals_at.empty()) {
+    // A cell's normal reads the cells of its window only: the rest can be left out, exactly.
+    cv::Mat needed;
+    const int size = 2 * options.normal_window_cells + 1;
+    cv::dilate(normals_at(frame->region), needed, cv::getStructuringElement(cv::MORPH_RECT, {size, size}));
+    // (A new matrix: assigning an expression to the view's header would write into the scan's own buffer.)
+    cv::Mat restricted;
+    cv::bitwise_and(view.valid, needed, restricted);
+    view.valid = restricted;
+  }
+  frame->normal = EstimateGridNormals(view, normal_options).normal;
   return true;
 }
 
@@ -213,12 +230,16 @@ bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& op
 
 cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options) {
   LIDARSHOP_CHECK(mask.type() == CV_8U && mask.size() == cv::Size(scan.cols, scan.rows));
-  ObjectFrame frame;
+  if (cv::countNonZero(mask) == 0) return cv::Mat::zeros(mask.size(), CV_8U);
+  // The mask's cells near its outline: a fringe of support the cut took lies there, not inside.
+  cv::Mat inner;
+  cv::erode(mask, inner, cv::Mat(), cv::Point(-1, -1), kFringeCells, cv::BORDER_CONSTANT, 0);
+  const cv::Mat fringe = mask & ~inner;
   // Only the support band and the normals' window around the mask matter here.
   const int margin = options.support_band_cells + options.normal_window_cells + 1;
-  if (cv::countNonZero(mask) == 0 || !FrameOf(scan, mask, options, margin, &frame))
-    return cv::Mat::zeros(mask.size(), CV_8U);
-  return SupportCells(scan, mask, frame.region, frame.normal, options, /*include_mask=*/true);
+  ObjectFrame frame;
+  if (!FrameOf(scan, mask, options, margin, fringe, &frame)) return cv::Mat::zeros(mask.size(), CV_8U);
+  return SupportCells(scan, mask, frame.region, frame.normal, options, fringe);
 }
 
 cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& barrier,
@@ -228,7 +249,7 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const int object_cells = cv::countNonZero(mask);
   if (object_cells == 0) return mask.clone();
   ObjectFrame frame;
-  if (!FrameOf(scan, mask, options, /*margin=*/-1, &frame)) return mask.clone();
+  if (!FrameOf(scan, mask, options, /*margin=*/-1, cv::Mat(), &frame)) return mask.clone();
   const cv::Rect& box = frame.box;
   const cv::Rect& region = frame.region;
   const double cell_angle = frame.cell_angle;
