@@ -1,15 +1,13 @@
 #include <cmath>
-#include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/segment/segment.h"
+#include "lidarshop/testing/analytic_scan.h"
 
 namespace lidarshop {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct Pillar {
   double x, y, radius;  // axis position and radius, metres (the axis is vertical, z from -1.5 to 0)
@@ -20,46 +18,24 @@ struct Pillar {
 // A hand-made scan (analytic ray casting): vertical pillars 1.5 m tall standing on a grey ground plane 1.5 m
 // below the scanner, a beige wall at y = 15 m behind them.
 Scan MakePillars(const std::vector<Pillar>& pillars, uint64_t seed) {
-  const int rows = 180, cols = 360;
-  Scan scan = MakeScan(rows, cols, /*with_color=*/true);
-  scan.grid = UniformGrid(rows, cols, -14 * kPi / 180, 14 * kPi / 180, -24 * kPi / 180, 8 * kPi / 180);
-  scan.direction = DirectionsFromGrid(scan.grid);
-  scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < cols; ++col) {
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
-      double t = 15.0 / d[1];  // the wall
-      int label = 0;
-      cv::Vec3b rgb(210, 198, 176);
-      if (d[2] < 0 && -1.5 / d[2] < t) {
-        t = -1.5 / d[2];
-        rgb = cv::Vec3b(130, 130, 126);
-      }
-      for (const Pillar& pillar : pillars) {
-        const double a = d[0] * d[0] + d[1] * d[1], b = -2 * (d[0] * pillar.x + d[1] * pillar.y),
-                     c = pillar.x * pillar.x + pillar.y * pillar.y - pillar.radius * pillar.radius;
-        const double discriminant = b * b - 4 * a * c;
-        if (discriminant < 0) continue;
-        const double hit = (-b - std::sqrt(discriminant)) / (2 * a);
-        if (hit >= t || hit * d[2] < -1.5 || hit * d[2] > 0) continue;
-        t = hit;
-        label = pillar.label;
-        rgb = pillar.rgb;
-      }
-      const double g = noise(rng);
-      const double range = t + 0.004 * noise(rng);
-      scan.valid.at<uint8_t>(row, col) = kValid;
-      scan.range.at<float>(row, col) = static_cast<float>(range);
-      scan.point.at<cv::Vec3f>(row, col) = d * static_cast<float>(range);
-      scan.color.at<cv::Vec3b>(row, col) =
-          cv::Vec3b(cv::saturate_cast<uint8_t>(rgb[0] + 5 * g), cv::saturate_cast<uint8_t>(rgb[1] + 5 * g),
-                    cv::saturate_cast<uint8_t>(rgb[2] + 5 * g));
-      scan.label.at<int32_t>(row, col) = label;
-    }
-  }
-  return scan;
+  const test_scenes::AnalyticGrid grid{180, 360, -14, 14, -24, 8};
+  return test_scenes::MakeAnalyticScan(
+      grid,
+      [&](const cv::Vec3f& d) {
+        test_scenes::RayHit h{15.0 / d[1], cv::Vec3b(210, 198, 176), 0};  // the wall
+        if (d[2] < 0 && -1.5 / d[2] < h.range_m) h = {-1.5 / d[2], cv::Vec3b(130, 130, 126), 0};
+        for (const Pillar& pillar : pillars) {
+          const double a = d[0] * d[0] + d[1] * d[1], b = -2 * (d[0] * pillar.x + d[1] * pillar.y),
+                       c = pillar.x * pillar.x + pillar.y * pillar.y - pillar.radius * pillar.radius;
+          const double discriminant = b * b - 4 * a * c;
+          if (discriminant < 0) continue;
+          const double t = (-b - std::sqrt(discriminant)) / (2 * a);
+          if (t >= h.range_m || t * d[2] < -1.5 || t * d[2] > 0) continue;
+          h = {t, pillar.rgb, pillar.label};
+        }
+        return h;
+      },
+      0.004, seed);
 }
 
 // A short object stroke across the middle of label 1, a background stroke on the ground to the left.

@@ -1,16 +1,14 @@
 // Whole-object growth across an overhang: a part in front of the object that nothing else visible holds.
 #include <cmath>
-#include <random>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/segment/segment.h"
+#include "lidarshop/testing/analytic_scan.h"
 
 namespace lidarshop {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 struct Block {
   cv::Vec3d lo, hi;  // axis-aligned box corners, metres (scanner at the origin, z up)
@@ -36,42 +34,19 @@ double HitBlock(const cv::Vec3f& d, const Block& block) {
 
 // Blocks on a grey ground plane 1.5 m below the scanner, a beige wall at y = 12 m behind them.
 Scan MakeBlocks(const std::vector<Block>& blocks, uint64_t seed) {
-  const int rows = 240, cols = 240;
-  Scan scan = MakeScan(rows, cols, /*with_color=*/true);
-  scan.grid = UniformGrid(rows, cols, -12 * kPi / 180, 12 * kPi / 180, -22 * kPi / 180, 8 * kPi / 180);
-  scan.direction = DirectionsFromGrid(scan.grid);
-  scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> noise(0.0, 1.0);
-  for (int row = 0; row < rows; ++row) {
-    for (int col = 0; col < cols; ++col) {
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
-      double t = 12.0 / d[1];
-      int label = 0;
-      cv::Vec3b rgb(210, 198, 176);
-      if (d[2] < 0 && -1.5 / d[2] < t) {
-        t = -1.5 / d[2];
-        rgb = cv::Vec3b(120, 120, 116);
-      }
-      for (const Block& block : blocks) {
-        const double hit = HitBlock(d, block);
-        if (hit >= t) continue;
-        t = hit;
-        label = block.label;
-        rgb = block.rgb;
-      }
-      const double g = noise(rng);
-      const double range = t + 0.003 * noise(rng);
-      scan.valid.at<uint8_t>(row, col) = kValid;
-      scan.range.at<float>(row, col) = static_cast<float>(range);
-      scan.point.at<cv::Vec3f>(row, col) = d * static_cast<float>(range);
-      scan.color.at<cv::Vec3b>(row, col) =
-          cv::Vec3b(cv::saturate_cast<uint8_t>(rgb[0] + 5 * g), cv::saturate_cast<uint8_t>(rgb[1] + 5 * g),
-                    cv::saturate_cast<uint8_t>(rgb[2] + 5 * g));
-      scan.label.at<int32_t>(row, col) = label;
-    }
-  }
-  return scan;
+  const test_scenes::AnalyticGrid grid{240, 240, -12, 12, -22, 8};
+  return test_scenes::MakeAnalyticScan(
+      grid,
+      [&](const cv::Vec3f& d) {
+        test_scenes::RayHit h{12.0 / d[1], cv::Vec3b(210, 198, 176), 0};  // the wall
+        if (d[2] < 0 && -1.5 / d[2] < h.range_m) h = {-1.5 / d[2], cv::Vec3b(120, 120, 116), 0};
+        for (const Block& block : blocks) {
+          const double t = HitBlock(d, block);
+          if (t < h.range_m) h = {t, block.rgb, block.label};
+        }
+        return h;
+      },
+      0.003, seed);
 }
 
 // A brown post 0.4 m tall with a blue box on top that overhangs it by 0.2 m towards the scanner. (Tops are kept
