@@ -30,12 +30,6 @@ namespace {
 
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
-nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
-  return rows;
-}
-
 nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
   nlohmann::ordered_json json;
   json["index"] = index;

@@ -11,6 +11,7 @@
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/atomic_file.h"
@@ -55,12 +56,6 @@ nlohmann::ordered_json ResultJson(const VerifyResult& result, const std::vector<
                                 {"rays_cast", stats.rays_cast}});
   }
   return json;
-}
-
-nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
-  return rows;
 }
 
 void WriteText(const std::string& path, const std::string& text) {

@@ -115,11 +115,11 @@ Meeting HowTheyMeet(const SeenPlane& a, const SeenPlane& b, double threshold_m) 
   return Meeting::kNone;
 }
 
-// Planes among the known cells in a band around one part of the hole (`part`, CV_8U over the whole scan,
-// `box` its bounding box).
-std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part, const cv::Rect& box,
-                                  int part_cells, const FillPlaneOptions& options, uint64_t seed,
-                                  double* threshold_m) {
+// Planes among the known cells in a band around one part of the hole (the cells of `part_id` (CV_32S
+// connected-component labels over the scan) equal to `id`, `box` its bounding box).
+std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_id, int id,
+                                  const cv::Rect& box, int part_cells, const FillPlaneOptions& options,
+                                  uint64_t seed, double* threshold_m) {
   int band = options.band_cells;
   if (band <= 0) {
     const double diameter = 2.0 * std::sqrt(part_cells / M_PI);
@@ -127,16 +127,17 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part, 
   }
   const cv::Rect roi = cv::Rect(box.x - band, box.y - band, box.width + 2 * band, box.height + 2 * band) &
                        cv::Rect(0, 0, known.range.cols, known.range.rows);
+  // The part over the band's box only: a hole of many small parts must not cost the whole scan per part.
+  const cv::Mat part = part_id(roi) == id;
   cv::Mat near_part;
-  cv::dilate(part(roi), near_part,
-             cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
+  cv::dilate(part, near_part, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
   near_part &= known.valid(roi);
   std::vector<cv::Point> cells;
   cv::findNonZero(near_part, cells);
   // Distance of every band cell from the part: a plane seen only on the hole's rim is what the cut left of
   // the object itself (its face, missed by a cell or two), not a surface that runs on behind it.
   cv::Mat from_part;
-  cv::distanceTransform(part(roi) == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  cv::distanceTransform(part == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
   if (cells.size() < 50) return {};
   // Grid normals of the band (a view of the known cells only), to tell a plane the cells lie on from one that
   // only runs through them (the plane through the nosings of a flight of steps).
@@ -205,11 +206,11 @@ struct PartPlanes {
   Meeting At(size_t a, size_t b) const { return meeting[a * planes.size() + b]; }
 };
 
-PartPlanes FindPartPlanes(const KnownCells& known, const cv::Mat& part_mask, const cv::Rect& box,
+PartPlanes FindPartPlanes(const KnownCells& known, const cv::Mat& part_id, int id, const cv::Rect& box,
                           int part_cells, const FillPlaneOptions& options, uint64_t seed) {
   PartPlanes part;
   double threshold_m = 0;
-  part.planes = BandPlanes(known, part_mask, box, part_cells, options, seed, &threshold_m);
+  part.planes = BandPlanes(known, part_id, id, box, part_cells, options, seed, &threshold_m);
   const size_t n = part.planes.size();
   part.meeting.assign(n * n, Meeting::kNone);
   for (size_t a = 0; a < n; ++a)
@@ -305,7 +306,7 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
   for (int id = 1; id < part_count; ++id) {
     const cv::Rect box(stats.at<int>(id, cv::CC_STAT_LEFT), stats.at<int>(id, cv::CC_STAT_TOP),
                        stats.at<int>(id, cv::CC_STAT_WIDTH), stats.at<int>(id, cv::CC_STAT_HEIGHT));
-    const PartPlanes part = FindPartPlanes(known, part_id == id, box, stats.at<int>(id, cv::CC_STAT_AREA),
+    const PartPlanes part = FindPartPlanes(known, part_id, id, box, stats.at<int>(id, cv::CC_STAT_AREA),
                                            options, seed + static_cast<uint64_t>(id));
     if (part.planes.empty()) continue;
     for (int y = box.y; y < box.y + box.height; ++y) {

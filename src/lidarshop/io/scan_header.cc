@@ -20,15 +20,6 @@ double Rounded(double value, double step = 1e-9) {
   return rounded == 0.0 ? 0.0 : rounded;  // no -0
 }
 
-nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (int r = 0; r < 4; ++r) {
-    rows.push_back(
-        {Rounded(matrix(r, 0)), Rounded(matrix(r, 1)), Rounded(matrix(r, 2)), Rounded(matrix(r, 3))});
-  }
-  return rows;
-}
-
 // The E57 metadata keys the entry has (none when the file says nothing).
 nlohmann::ordered_json MetadataJson(const E57Metadata& m) {
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
@@ -160,6 +151,15 @@ nlohmann::ordered_json ToJson(const ScanFileHeader& header) {
   }
   if (!header.warnings.empty()) json["warnings"] = header.warnings;
   return json;
+}
+
+nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back(
+        {Rounded(matrix(r, 0)), Rounded(matrix(r, 1)), Rounded(matrix(r, 2)), Rounded(matrix(r, 3))});
+  }
+  return rows;
 }
 
 }  // namespace lidarshop

@@ -96,6 +96,10 @@ ScanHeader ScanHeaderOf(const Scan& scan);
 nlohmann::ordered_json ToJson(const ScanFileHeader& header);
 nlohmann::ordered_json ToJson(const ScanHeader& scan, int index);
 
+// A 4 x 4 pose (world_from_scanner, world_from_model, ...) as four JSON rows, every entry rounded to 1e-9 (a
+// nanometre: it also drops a rotation's 1e-17 noise, so 1.0000000000000002 prints as 1).
+nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix);
+
 // GPS seconds (since 1980-01-06T00:00:00Z, no leap seconds) as UTC text "YYYY-MM-DDThh:mm:ssZ"
 // (fractions of a second dropped), leap seconds up to 2017 applied; "" when not finite or before 1980.
 std::string UtcFromGpsSeconds(double gps_seconds);

@@ -97,6 +97,11 @@ std::vector<PixelPointPair> DrawCorrespondences(const Scan& scan, const PinholeC
   return pairs;
 }
 
+PinholeCamera EvaluationCamera(double offset_m) {
+  const Eigen::Vector3d eye = Eigen::Vector3d(0, 0, 1.5) + offset_m * Eigen::Vector3d(0.8, -0.6, 0.05);
+  return CameraLookingAt(eye, {0, 10, 1.0}, 800, 600, 70);
+}
+
 double RmsReprojectionError(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs) {
   double sum = 0;
   for (const PixelPointPair& pair : pairs) {

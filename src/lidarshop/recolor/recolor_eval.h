@@ -44,6 +44,10 @@ std::vector<PixelPointPair> DrawCorrespondences(const Scan& scan, const PinholeC
                                                 double outlier_fraction, uint64_t seed,
                                                 std::vector<PixelPointPair>* exact = nullptr);
 
+// The evaluation's camera (bench/results/recolor.md): `offset_m` beside and a little behind the scanner at
+// (0, 0, 1.5) — along (0.8, −0.6, 0.05) — looking at (0, 10, 1), 800 x 600 px, 70° horizontal field.
+PinholeCamera EvaluationCamera(double offset_m);
+
 // RMS reprojection error of `pairs` with `camera`, pixels (a point behind the camera counts 10^6 px).
 double RmsReprojectionError(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs);
 

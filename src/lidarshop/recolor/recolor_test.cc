@@ -64,8 +64,7 @@ TEST(Recolor, WithoutSkirtsTheScanMeshLeaksAtSilhouettes) {
 // pillar the scanner never saw.
 TEST(Recolor, NoHiddenPointChangesWithACameraThreeMetresFromTheScanner) {
   Fixture f;
-  f.camera = CameraLookingAt(Eigen::Vector3d(0, 0, 1.5) + 3.0 * Eigen::Vector3d(0.8, -0.6, 0.05),
-                             {0, 10, 1.0}, 800, 600, 70);
+  f.camera = EvaluationCamera(3.0);
   f.photo = RenderPhoto(f.scene, f.camera);
   const auto score = [&](const RecolorOptions& options) {
     return ScoreRecolor(f.scene, f.truth, f.input,

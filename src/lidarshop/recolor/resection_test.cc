@@ -55,12 +55,6 @@ std::vector<PixelPointPair> MakePairs(const PinholeCamera& camera, int count, do
   return pairs;
 }
 
-double Rms(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs) {
-  double sum = 0;
-  for (const PixelPointPair& pair : pairs) sum += std::pow(ReprojectionError(camera, pair), 2);
-  return std::sqrt(sum / pairs.size());
-}
-
 ResectionOptions Options(const PinholeCamera& camera) {
   ResectionOptions options;
   options.width_px = camera.width_px;
@@ -78,7 +72,7 @@ TEST(Resection, DltIsExactWithoutNoiseAndDecomposesIntoTheTrueCamera) {
   EXPECT_NEAR(camera.cy_px, truth.cy_px, 1e-5);
   EXPECT_NEAR(camera.skew_px, 0, 1e-5);
   EXPECT_LT((camera.world_from_camera - truth.world_from_camera).norm(), 1e-7);
-  EXPECT_LT(Rms(camera, pairs), 1e-6);
+  EXPECT_LT(RmsReprojectionError(camera, pairs), 1e-6);
 }
 
 TEST(Resection, RansacAndRefinementMeetTheTargetWithNoiseAndOutliers) {
@@ -94,7 +88,7 @@ TEST(Resection, RansacAndRefinementMeetTheTargetWithNoiseAndOutliers) {
       // Single draws of the noise can exceed 0.5 px (10 pairs = 8 inliers: 16 residuals for 7 unknowns, the
       // principal point held at the centre although this camera has it 3 px off); the mean over draws stays
       // under 0.5 px.
-      const double rms_true = Rms(result.camera, exact);
+      const double rms_true = RmsReprojectionError(result.camera, exact);
       sum_rms += rms_true;
       EXPECT_LT(rms_true, 0.75) << count << " pairs, seed " << seed;
       EXPECT_LT(result.rms_px, 1.0);
@@ -111,8 +105,7 @@ TEST(Resection, TenPairsWithTwoOutliersStayUnderHalfAPixel) {
   const SceneDescription scene = test_scenes::MakeRecolorScene();
   const Scan scan = test_scenes::ScanScene(scene);
   for (double offset : {1.0, 3.0}) {
-    const PinholeCamera truth = CameraLookingAt(
-        Eigen::Vector3d(0, 0, 1.5) + offset * Eigen::Vector3d(0.8, -0.6, 0.05), {0, 10, 1.0}, 800, 600, 70);
+    const PinholeCamera truth = EvaluationCamera(offset);
     const cv::Mat depth = RenderPhoto(scene, truth).depth_m;
     double sum_rms = 0;
     for (int seed = 1; seed <= 5; ++seed) {
@@ -141,8 +134,7 @@ TEST(Resection, TheOldSettingsKeptAnOutlierOnTheWorstDraw) {
   // collected 8 pairs, one of them an outlier: 22 px on the true pairs.
   const SceneDescription scene = test_scenes::MakeRecolorScene();
   const Scan scan = test_scenes::ScanScene(scene);
-  const PinholeCamera truth = CameraLookingAt(
-      Eigen::Vector3d(0, 0, 1.5) + 3.0 * Eigen::Vector3d(0.8, -0.6, 0.05), {0, 10, 1.0}, 800, 600, 70);
+  const PinholeCamera truth = EvaluationCamera(3.0);
   std::vector<PixelPointPair> exact;
   const std::vector<PixelPointPair> pairs =
       DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 310, &exact);
@@ -173,8 +165,7 @@ TEST(Resection, AnAbsorbedOutlierLosesToTheRightSet) {
   const SceneDescription scene = test_scenes::MakeRecolorScene();
   const Scan scan = test_scenes::ScanScene(scene);
   for (double offset : {1.0, 3.0}) {
-    const PinholeCamera truth = CameraLookingAt(
-        Eigen::Vector3d(0, 0, 1.5) + offset * Eigen::Vector3d(0.8, -0.6, 0.05), {0, 10, 1.0}, 800, 600, 70);
+    const PinholeCamera truth = EvaluationCamera(offset);
     std::vector<PixelPointPair> exact;
     const std::vector<PixelPointPair> pairs =
         DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 2110, &exact);
@@ -192,8 +183,7 @@ TEST(Resection, NearPlanarDrawsGetTheCameraOfTheIntrinsicsPrior) {
   // point at the centre, f and pose from EPnP + LM) does.
   const SceneDescription scene = test_scenes::MakeRecolorScene();
   const Scan scan = test_scenes::ScanScene(scene);
-  const PinholeCamera truth = CameraLookingAt(
-      Eigen::Vector3d(0, 0, 1.5) + 1.0 * Eigen::Vector3d(0.8, -0.6, 0.05), {0, 10, 1.0}, 800, 600, 70);
+  const PinholeCamera truth = EvaluationCamera(1.0);
   std::vector<PixelPointPair> exact;
   const std::vector<PixelPointPair> pairs =
       DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 1110, &exact);

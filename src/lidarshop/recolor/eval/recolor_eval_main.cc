@@ -61,9 +61,7 @@ int main(int argc, char** argv) {
     s.truth = test_scenes::ScanScene(s.scene);
     s.input = Clone(s.truth);
     s.input.color.setTo(cv::Scalar(250, 0, 250));
-    // Beside and a little behind the scanner (at (0, 0, 1.5)), looking at the scene.
-    const Eigen::Vector3d eye = Eigen::Vector3d(0, 0, 1.5) + offset * Eigen::Vector3d(0.8, -0.6, 0.05);
-    s.camera = CameraLookingAt(eye, {0, 10, 1.0}, 800, 600, 70);
+    s.camera = EvaluationCamera(offset);
     s.photo = RenderPhoto(s.scene, s.camera);
     for (int count : {10, 20, 40}) {
       const char* names[] = {"thesis DLT", "ours (RANSAC + LM)", "OpenCV PnP, true K"};
