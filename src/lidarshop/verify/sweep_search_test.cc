@@ -23,6 +23,16 @@ using verify_testing::LabeledMesh;
 using verify_testing::MakeBox;
 using verify_testing::MakeCar;
 
+// Sweep options over x in [x_min, x_max] and y in [y_min, y_max], metres; the rest default.
+SweepOptions Area(double x_min_m, double x_max_m, double y_min_m, double y_max_m) {
+  SweepOptions options;
+  options.x_min_m = x_min_m;
+  options.x_max_m = x_max_m;
+  options.y_min_m = y_min_m;
+  options.y_max_m = y_max_m;
+  return options;
+}
+
 // Two two-box cars, a wall and the ground, scanned noise-free from (0, 0, 1.6) over 120° x 60° at 0.2°.
 std::vector<PreparedScan> SyntheticLot() {
   std::vector<LabeledMesh> meshes;
@@ -108,11 +118,7 @@ void ExpectSameAsFullGrid(const VerifierModel& model, std::span<const PreparedSc
 TEST(SweepSearch, SyntheticLotSameDetectionsAsFullGrid) {
   const std::vector<PreparedScan> scans = SyntheticLot();
   const VerifierModel model = PrepareModel(MakeCar());
-  SweepOptions options;
-  options.x_min_m = -7;
-  options.x_max_m = 7;
-  options.y_min_m = 5;
-  options.y_max_m = 14;
+  SweepOptions options = Area(-7, 7, 5, 14);
   options.step_m = 0.25;
   options.yaws_deg = {0, 30, 60, 90, 120, 150};
   // One view of a two-box car shows about a fifth of it.
@@ -127,11 +133,7 @@ TEST(SweepSearch, ParkingLotSameDetectionsAsFullGrid) {
   mesh_options.style = ParseCarStyle("sedan", "test");
   const VerifierModel model = PrepareModel(MakeCarMesh(mesh_options));
   // The default grid's x range, its near half in y (the cars stand at y 10–11 m), every 0.5 m and 30°.
-  SweepOptions options;
-  options.x_min_m = -10;
-  options.x_max_m = 10;
-  options.y_min_m = 2;
-  options.y_max_m = 14;
+  SweepOptions options = Area(-10, 10, 2, 14);
   options.step_m = 0.5;
   options.yaws_deg = {0, 30, 60, 90, 120, 150};
   ExpectSameAsFullGrid(model, scans, options, 1);
@@ -141,11 +143,7 @@ TEST(SweepSearch, ParkingLotSameDetectionsAsFullGrid) {
 TEST(SweepSearch, BoundIsAboveEveryPoseOfTheBlock) {
   const std::vector<PreparedScan> scans = SyntheticLot();
   const VerifierModel model = PrepareModel(MakeCar());
-  SweepOptions options;
-  options.x_min_m = -7;
-  options.x_max_m = 7;
-  options.y_min_m = 5;
-  options.y_max_m = 14;
+  SweepOptions options = Area(-7, 7, 5, 14);
   const verify_internal::SweepConfidenceBound bound(model, scans, options, VerifyOptions().sigma_m, 2.0);
   std::mt19937 random(7);
   std::uniform_real_distribution<double> x(-7, 7), y(5, 14), yaw(0, 360), unit(0, 1);
@@ -173,11 +171,7 @@ TEST(SweepSearch, BoundIsAboveEveryPoseOfTheBlock) {
 TEST(SweepSearch, FullSearchVerifiesEveryPose) {
   const std::vector<PreparedScan> scans = SyntheticLot();
   const VerifierModel model = PrepareModel(MakeCar());
-  SweepOptions options;
-  options.x_min_m = -1;
-  options.x_max_m = 1;
-  options.y_min_m = 2;
-  options.y_max_m = 3;
+  SweepOptions options = Area(-1, 1, 2, 3);
   options.step_m = 0.5;
   options.yaws_deg = {0, 90};
   options.search = SweepSearch::kFull;
@@ -241,11 +235,7 @@ TEST(SweepHeatMap, AxesScannerAndPoints) {
 TEST(SweepHeatMap, SweepCollectsScannerAndScenePoints) {
   const std::vector<PreparedScan> scans = SyntheticLot();
   const VerifierModel model = PrepareModel(MakeCar());
-  SweepOptions options;
-  options.x_min_m = -5;
-  options.x_max_m = 5;
-  options.y_min_m = 8;
-  options.y_max_m = 12;
+  SweepOptions options = Area(-5, 5, 8, 12);
   options.step_m = 1;
   options.yaws_deg = {0};
   const SweepResult sweep = Sweep(model, scans, options, VerifyOptions());
