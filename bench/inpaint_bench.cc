@@ -301,6 +301,36 @@ void BM_SsdPerCandidateRunOf4(benchmark::State& state) {
 }
 BENCHMARK(BM_SsdPerCandidateRunOf4)->Arg(0)->Arg(1);
 
+// Times batches of 1024 candidates from `starts` (four adjacent per call when `runs`, else one) and reports
+// the fastest batch as fastest_ns_per_candidate.
+void TimeFastestBatch(benchmark::State& state, const TargetDifference& prepared,
+                      const std::vector<Pixel>& starts, bool runs) {
+  constexpr int kBatch = 1024;
+  const float inf = std::numeric_limits<float>::infinity();
+  float out[4];
+  size_t i = 0;
+  double fastest = inf;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (runs) {
+      for (int b = 0; b < kBatch; b += 4) {
+        prepared.EvaluateRun(starts[i], 4, inf, out);
+        benchmark::DoNotOptimize(out);
+        if (++i == starts.size()) i = 0;
+      }
+    } else {
+      for (int b = 0; b < kBatch; ++b) {
+        benchmark::DoNotOptimize(prepared.Evaluate(starts[i], inf));
+        if (++i == starts.size()) i = 0;
+      }
+    }
+    const auto t1 = std::chrono::steady_clock::now();
+    fastest = std::min(fastest, std::chrono::duration<double, std::nano>(t1 - t0).count() / kBatch);
+  }
+  state.SetItemsProcessed(kBatch * state.iterations());
+  state.counters["fastest_ns_per_candidate"] = fastest;
+}
+
 // The same kernels timed robustly against the shared machine's load: each iteration times one batch of 1024
 // candidates (steady_clock, about 10-30 us, shorter than a scheduler time slice) and the counter
 // fastest_ns_per_candidate is the fastest batch seen. Arg 0: one candidate per call, half-known target; 1:
@@ -311,31 +341,7 @@ void BM_SsdFastestBatch(benchmark::State& state) {
   const InpaintCanvas canvas(ToFloat(Bungee().rgb8), all_known ? no_hole : Bungee().mask, 5);
   const Pixel target = all_known ? Pixel{150, 100} : FrontTarget(canvas);
   const auto prepared = WeightedSsd().ForTarget(canvas, target);
-  const std::vector<Pixel> starts = RunStarts(canvas);
-  constexpr int kBatch = 1024;
-  const float inf = std::numeric_limits<float>::infinity();
-  float out[4];
-  size_t i = 0;
-  double fastest = inf;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    if (runs) {
-      for (int b = 0; b < kBatch; b += 4) {
-        prepared->EvaluateRun(starts[i], 4, inf, out);
-        benchmark::DoNotOptimize(out);
-        if (++i == starts.size()) i = 0;
-      }
-    } else {
-      for (int b = 0; b < kBatch; ++b) {
-        benchmark::DoNotOptimize(prepared->Evaluate(starts[i], inf));
-        if (++i == starts.size()) i = 0;
-      }
-    }
-    const auto t1 = std::chrono::steady_clock::now();
-    fastest = std::min(fastest, std::chrono::duration<double, std::nano>(t1 - t0).count() / kBatch);
-  }
-  state.SetItemsProcessed(kBatch * state.iterations());
-  state.counters["fastest_ns_per_candidate"] = fastest;
+  TimeFastestBatch(state, *prepared, RunStarts(canvas), runs);
   state.SetLabel(fmt::format("11x11x3 {}, {} per call, kernel {}", all_known ? "all known" : "half known",
                              runs ? "4 adjacent candidates" : "one candidate", WeightedSsd().KernelName()));
 }
@@ -357,24 +363,7 @@ void BM_SsdFillShape(benchmark::State& state) {
   const Pixel target = FrontTarget(canvas);
   const WeightedSsd ssd({}, kernel);
   const auto prepared = ssd.ForTarget(canvas, target);
-  const std::vector<Pixel> starts = RunStarts(canvas);
-  constexpr int kBatch = 1024;
-  const float inf = std::numeric_limits<float>::infinity();
-  float out[4];
-  size_t i = 0;
-  double fastest = inf;
-  for (auto _ : state) {
-    const auto t0 = std::chrono::steady_clock::now();
-    for (int b = 0; b < kBatch; b += 4) {
-      prepared->EvaluateRun(starts[i], 4, inf, out);
-      benchmark::DoNotOptimize(out);
-      if (++i == starts.size()) i = 0;
-    }
-    const auto t1 = std::chrono::steady_clock::now();
-    fastest = std::min(fastest, std::chrono::duration<double, std::nano>(t1 - t0).count() / kBatch);
-  }
-  state.SetItemsProcessed(kBatch * state.iterations());
-  state.counters["fastest_ns_per_candidate"] = fastest;
+  TimeFastestBatch(state, *prepared, RunStarts(canvas), /*runs=*/true);
   state.SetLabel(
       fmt::format("9x9x6 half known, 4 adjacent candidates per call, kernel {}", ssd.KernelName()));
 }
