@@ -1,6 +1,7 @@
 #include "lidarshop/fill/surface_planes.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -9,6 +10,7 @@
 
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
+#include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -25,6 +27,8 @@ struct SeenPlane {
   std::vector<Eigen::Vector3f> seen;  // its inliers in the band
   double SignedDistance(const Eigen::Vector3f& x) const { return normal.dot(x.cast<double>()) + offset_m; }
 };
+
+constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
 
 // cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
 constexpr float kAgreeingNormal = 0.985f;
@@ -252,8 +256,10 @@ double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::
   const int source_plane = SourcePlane(part, known, from, options.relief_m, &source_offset);
   const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
   const size_t n = part.planes.size();
-  std::vector<double> along(n, 0.0);
-  std::vector<char> candidate(n, 0);
+  // No allocation per cell: FillPlaneOptions::max_planes is at most kMaxPlanes (checked with the options).
+  LIDARSHOP_CHECK(n <= kMaxPlanes);
+  std::array<double, kMaxPlanes> along{};
+  std::array<char, kMaxPlanes> candidate{};
   int best = -1;
   for (size_t k = 0; k < n; ++k) {
     const double facing = part.planes[k].normal.dot(ray);
