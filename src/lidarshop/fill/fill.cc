@@ -106,6 +106,30 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
   }
 }
 
+// Hole cells whose nearest known cells to the left and to the right in the same row both lack a return
+// (CV_8U 255). A scan's rows are elevations: the sky over a lamp post, or the band beyond the far end of the
+// ground, runs along the rows, so a cell between two no-return cells of its row has none either, whatever a
+// patch copied from elsewhere says.
+cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
+  cv::Mat between = cv::Mat::zeros(hole.size(), CV_8U);
+  for (int y = 0; y < hole.rows; ++y) {
+    const uint8_t* in_hole = hole.ptr<uint8_t>(y);
+    const uint8_t* valid = known_valid.ptr<uint8_t>(y);
+    for (int x = 0; x < hole.cols;) {
+      if (!in_hole[x]) {
+        ++x;
+        continue;
+      }
+      int end = x;
+      while (end < hole.cols && in_hole[end]) ++end;  // the run [x, end) of hole cells
+      if (x > 0 && end < hole.cols && !valid[x - 1] && !valid[end])
+        between.row(y).colRange(x, end).setTo(255);
+      x = end;
+    }
+  }
+  return between;
+}
+
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
 // has-return channel; zero in the hole.
 cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
@@ -207,6 +231,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);
+  values->has_return.setTo(0, NoReturnOnBothSides(in.hole, in.known_valid));
 
   // The guidance field: known gradients outside, the copied ones inside; depth jumps are copied along and cut
   // the Poisson system there, so that surfaces at different distances are not joined by a membrane.
@@ -266,6 +291,7 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);  // copies the range as it is: the method under test
+  values->has_return.setTo(0, NoReturnOnBothSides(in.hole, in.known_valid));
   result->unanchored_cells = 0;
 }
 

@@ -96,6 +96,7 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
   const cv::Mat hole = hole_in != 0;
   FillMetrics m;
   m.hole_cells = cv::countNonZero(hole);
+  m.floating_cells = cv::Mat::zeros(hole.size(), CV_8U);
   if (m.hole_cells == 0) return m;
 
   std::vector<Eigen::Vector3f> truth_points;
@@ -126,8 +127,10 @@ FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& ho
         ++synthesized;
         const Eigen::Vector3f p = PointAt(filled, y, x);
         const NearestResult nearest = tree.NearestWithin(p, static_cast<float>(options.floating_m));
-        if (!nearest.found() && LocalSurfaceDistance(truth, y, x, p, kSurfaceReach) > options.floating_m)
+        if (!nearest.found() && LocalSurfaceDistance(truth, y, x, p, kSurfaceReach) > options.floating_m) {
           ++floating;
+          m.floating_cells.at<uint8_t>(y, x) = 255;
+        }
       }
       if (!f || !t) continue;
       ++m.compared_cells;

@@ -35,6 +35,7 @@ struct FillMetrics {
   double floating_share = 0;    // share of synthesized points farther than floating_m from the truth
   double return_accuracy = 0;   // share of hole cells whose return / no-return matches the truth
   double color_psnr_db = 0;     // RGB PSNR over compared cells (0 when a scan has no colour)
+  cv::Mat floating_cells;       // CV_8U rows x cols, 255 = a synthesized point counted as floating
 };
 
 // `filled` and `truth` share the grid; `hole` is CV_8U non-zero. Throws InputError on mismatched sizes.

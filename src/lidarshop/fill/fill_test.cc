@@ -192,6 +192,42 @@ TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
   }
 }
 
+// The ground ends 20 m out and the scan's top rows look past its end: a box tall enough to reach the top row
+// leaves a hole whose upper rows have no return on either side of it in their row, and must stay without one
+// (a patch copied from lower down would bring ground).
+TEST(FillScan, RowsWithoutAReturnOnBothSidesOfTheHoleStayWithoutOne) {
+  const Case c = MakeCase(R"({
+    "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-35, 35], "elevation_deg": [-25, -2], "columns": 200,
+                "rows": 100, "max_range": 60, "seed": 7},
+    "objects": [
+      {"primitive": "plane", "size": [40, 20], "translate": [0, 10, 0], "label": 0, "texture": "gravel",
+       "color": [120, 118, 112]},
+      {"primitive": "box", "size": [3.0, 0.8, 2.0], "translate": [0.3, 5, 1.0], "label": 1, "color": [40, 60, 200]}
+    ]
+  })",
+                          2);
+  // Hole cells whose nearest known cells left and right in the row both lack a return.
+  cv::Mat between = cv::Mat::zeros(c.hole.size(), CV_8U);
+  for (int y = 0; y < c.hole.rows; ++y)
+    for (int x = 0; x < c.hole.cols; ++x) {
+      if (!c.hole.at<uint8_t>(y, x)) continue;
+      int left = x, right = x;
+      while (left >= 0 && c.hole.at<uint8_t>(y, left)) --left;
+      while (right < c.hole.cols && c.hole.at<uint8_t>(y, right)) ++right;
+      between.at<uint8_t>(y, x) = left >= 0 && right < c.hole.cols && !c.scan.valid.at<uint8_t>(y, left) &&
+                                  !c.scan.valid.at<uint8_t>(y, right);
+    }
+  ASSERT_GT(cv::countNonZero(between), 40);
+  ASSERT_GT(cv::countNonZero(c.hole.row(0)), 0);  // the hole reaches the scan's top row
+  for (FillMethod method : {FillMethod::kGradient, FillMethod::kDepthPatch}) {
+    FillOptions options;
+    options.method = method;
+    const FillResult result = FillScan(c.scan, c.hole, options);
+    EXPECT_EQ(cv::countNonZero(result.scan.valid & between), 0) << ToString(method);
+    EXPECT_GT(MeasureFill(result.scan, c.truth, c.hole).return_accuracy, 0.975) << ToString(method);
+  }
+}
+
 TEST(FillScan, EveryMethodRunsOnAScanWithoutIntensityOrColourAndInventsNone) {
   // A PCD or E57 without intensity (and here without colour): the fill has only the range to go by.
   Case c = MakeCase(kWallScene, 1);

@@ -63,7 +63,7 @@ TargetDecision TargetChooser::Compute(Pixel target) {
   ++global_searches_;
   if (search_is_exhaustive_ && static_cast<int>(local.size()) == count) {
     std::vector<SourceCandidate> all = exhaustive_.FindBelow(
-        canvas_, *difference, count, local.back().difference, 0, canvas_.rows(), 0, canvas_.cols());
+        canvas_, *difference, target, count, local.back().difference, 0, canvas_.rows(), 0, canvas_.cols());
     all.insert(all.end(), local.begin(), local.end());
     MergeCandidates(all, count);
     decision.candidates = std::move(all);

@@ -127,6 +127,33 @@ TEST(InpaintFill, CriminisiContinuesAStraightEdgeExactly) {
   EXPECT_EQ(wrong_side, 0);
 }
 
+// A hole touching the border is filled from patches at the same distance from that border: the image's top
+// two rows are a band of their own (a scan's sky above the last ground row), and a source patch that had to lie
+// wholly inside the image could only bring rows from at least a patch radius further down.
+TEST(InpaintFill, BorderRowsAreFilledFromBorderRows) {
+  const int rows = 60, cols = 90;
+  cv::Mat image(rows, cols, CV_32FC1);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) image.at<float>(r, c) = r < 2 ? 0.0f : 100.0f + 20.0f * ((r + c) % 3);
+  cv::Mat mask = cv::Mat::zeros(rows, cols, CV_8U);
+  cv::rectangle(mask, cv::Rect(30, 0, 30, 20), cv::Scalar(255), cv::FILLED);  // touches the top border
+  for (const auto search : {InpaintSearchKind::kExhaustive, InpaintSearchKind::kLocal,
+                            InpaintSearchKind::kTwoStep, InpaintSearchKind::kPatchMatch}) {
+    InpaintOptions options;
+    options.patch_radius = 4;
+    options.search = search;
+    options.check_bookkeeping = true;
+    const InpaintResult result = Inpaint(image, mask, options);
+    ExpectCompleteAndUntouched(image, mask, result);
+    int wrong = 0;
+    for (int r = 0; r < 20; ++r)
+      for (int c = 30; c < 60; ++c) wrong += (result.image.at<float>(r, c) == 0.0f) != (r < 2) ? 1 : 0;
+    EXPECT_EQ(wrong, 0) << "search " << static_cast<int>(search);
+    // Every copied pixel came from the same row (the band structure is periodic only along the rows).
+    for (int c = 30; c < 60; ++c) EXPECT_EQ(result.source_pixel.at<cv::Vec2i>(0, c)[0], 0);
+  }
+}
+
 TEST(InpaintFill, OnionPeelFillsFromTheRimInwards) {
   const cv::Mat image = TexturedImage(60, 60, 2);
   cv::Mat mask = cv::Mat::zeros(60, 60, CV_8U);

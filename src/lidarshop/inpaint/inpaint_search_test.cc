@@ -95,6 +95,9 @@ TEST(InpaintSearch, EvaluateRunMatchesEvaluate) {
           for (int r = 0; r < canvas.rows(); r += 7) {
             const auto& cols = canvas.source_cols_by_row()[r];
             for (size_t i = 0; i + 6 <= cols.size() && cols[i + 5] == cols[i] + 5; i += 11) {
+              if (!canvas.SourceFits(front[f], {r, cols[i]}) ||
+                  !canvas.SourceFits(front[f], {r, cols[i] + 5}))
+                continue;
               float run[6];
               prepared->EvaluateRun({r, cols[i]}, 6, std::numeric_limits<float>::infinity(), run);
               for (int k = 0; k < 6; ++k) {
@@ -207,9 +210,9 @@ TEST(InpaintSearch, PrunedScanEqualsFullRanking) {
       ThreadLimit limit(threads);
       ExhaustiveSearch search;
       const auto near = search.FindNear(canvas, *prepared, target, count, radius);
-      const auto below = search.FindBelow(canvas, *prepared, count, std::numeric_limits<float>::infinity(),
-                                          target.row - radius, target.row + radius + 1, target.col - radius,
-                                          target.col + radius + 1);
+      const auto below = search.FindBelow(
+          canvas, *prepared, target, count, std::numeric_limits<float>::infinity(), target.row - radius,
+          target.row + radius + 1, target.col - radius, target.col + radius + 1);
       for (const auto* found : {&near, &below}) {
         ASSERT_EQ(found->size(), all.size()) << "threads " << threads;
         for (int k = 0; k < count; ++k) {

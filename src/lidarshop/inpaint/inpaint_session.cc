@@ -62,7 +62,7 @@ struct InpaintSession::State {
 
   SourceCandidate Checked(const ReviewDecision& made, Pixel target) const {
     if (!(made.target == target) || !canvas.Inside(made.source.row, made.source.col) ||
-        !canvas.IsSource(made.source.row, made.source.col)) {
+        !canvas.IsSource(made.source.row, made.source.col) || !canvas.SourceFits(target, made.source)) {
       ThrowInputError("", "", fmt::format("review decision {}", review_points),
                       fmt::format("decision for target ({}, {}) with source ({}, {}) does not fit this fill "
                                   "(target ({}, {}); the source must be a source centre)",

@@ -18,6 +18,7 @@ std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
     std::vector<double> sum(5 * C, 0.0), count(4, 0.0), square(C, 0.0), all(C, 0.0);
     for (int dr = -R; dr <= R; ++dr)
       for (int dc = -R; dc <= R; ++dc) {
+        if (!canvas.Inside(s.row + dr, s.col + dc)) continue;  // a source at the border (canvas.h)
         const int q = (dr > 0 ? 2 : 0) + (dc > 0 ? 1 : 0);
         const float* p = canvas.PixelData(s.row + dr, s.col + dc);
         count[q] += 1.0;
@@ -28,9 +29,9 @@ std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
           square[k] += v * v;
         }
       }
-    const double n = (2.0 * R + 1) * (2.0 * R + 1);
+    const double n = count[0] + count[1] + count[2] + count[3];
     for (int q = 0; q < 4; ++q)
-      for (int k = 0; k < C; ++k) sum[q * C + k] = std::sqrt(w[k]) * sum[q * C + k] / count[q];
+      for (int k = 0; k < C; ++k) sum[q * C + k] = std::sqrt(w[k]) * sum[q * C + k] / std::max(count[q], 1.0);
     for (int k = 0; k < C; ++k) {
       const double mean = all[k] / n;
       sum[4 * C + k] = std::sqrt(w[k] * std::max(0.0, square[k] / n - mean * mean));

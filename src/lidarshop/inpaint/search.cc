@@ -65,12 +65,15 @@ bool CandidateBefore(const SourceCandidate& a, const SourceCandidate& b) {
 }
 
 std::vector<SourceCandidate> ExhaustiveSearch::FindBelow(const InpaintCanvas& canvas,
-                                                         const TargetDifference& difference, int count,
-                                                         float bound, int row_begin, int row_end,
+                                                         const TargetDifference& difference, Pixel target,
+                                                         int count, float bound, int row_begin, int row_end,
                                                          int col_begin, int col_end) {
   const auto& cols_by_row = canvas.source_cols_by_row();
-  row_begin = std::max(row_begin, 0);
-  row_end = std::min(row_end, canvas.rows());
+  const cv::Rect fits = canvas.SourceBox(target);
+  row_begin = std::max(row_begin, fits.y);
+  row_end = std::min(row_end, fits.y + fits.height);
+  col_begin = std::max(col_begin, fits.x);
+  col_end = std::min(col_end, fits.x + fits.width);
   if (row_end <= row_begin) return {};
   std::mutex merge_mutex;
   TopK merged(count);
@@ -139,10 +142,10 @@ std::vector<SourceCandidate> ExhaustiveSearch::FindNear(const InpaintCanvas& can
   // termination bound from its first candidate on. Exact: the scan keeps every candidate <= that bound.
   const float inf = std::numeric_limits<float>::infinity();
   const int w = 2 * canvas.patch_radius() + 1;
-  auto nearby = FindBelow(canvas, difference, count, inf, target.row - w, target.row + w + 1, target.col - w,
-                          target.col + w + 1);
+  auto nearby = FindBelow(canvas, difference, target, count, inf, target.row - w, target.row + w + 1,
+                          target.col - w, target.col + w + 1);
   const float bound = static_cast<int>(nearby.size()) == count ? nearby.back().difference : inf;
-  auto all = FindBelow(canvas, difference, count, bound, target.row - radius, target.row + radius + 1,
+  auto all = FindBelow(canvas, difference, target, count, bound, target.row - radius, target.row + radius + 1,
                        target.col - radius, target.col + radius + 1);
   // Merge (the scan re-finds the nearby ones that are good enough; keep each source once).
   all.insert(all.end(), nearby.begin(), nearby.end());
@@ -159,8 +162,9 @@ std::vector<SourceCandidate> ExhaustiveSearch::Find(const InpaintCanvas& canvas,
 std::vector<SourceCandidate> LocalSearch::Find(const InpaintCanvas& canvas,
                                                const TargetDifference& difference, Pixel target, int count) {
   const int w = window_radius_;
-  auto result = exhaustive_.FindBelow(canvas, difference, count, std::numeric_limits<float>::infinity(),
-                                      target.row - w, target.row + w + 1, target.col - w, target.col + w + 1);
+  auto result =
+      exhaustive_.FindBelow(canvas, difference, target, count, std::numeric_limits<float>::infinity(),
+                            target.row - w, target.row + w + 1, target.col - w, target.col + w + 1);
   if (result.empty()) result = exhaustive_.Find(canvas, difference, target, count);
   evaluations_ = exhaustive_.evaluations();
   return result;
@@ -171,13 +175,13 @@ std::vector<SourceCandidate> TwoStepSearch::Find(const InpaintCanvas& canvas,
                                                  int count) {
   const int w = window_radius_;
   const float inf = std::numeric_limits<float>::infinity();
-  auto local = exhaustive_.FindBelow(canvas, difference, count, inf, target.row - w, target.row + w + 1,
-                                     target.col - w, target.col + w + 1);
+  auto local = exhaustive_.FindBelow(canvas, difference, target, count, inf, target.row - w,
+                                     target.row + w + 1, target.col - w, target.col + w + 1);
   const float local_bound = static_cast<int>(local.size()) == count ? local.back().difference : inf;
   // A global candidate must satisfy difference·gain <= local bound to enter the merged top-k.
   auto global =
-      exhaustive_.FindBelow(canvas, difference, count, static_cast<float>(local_bound / global_gain_), 0,
-                            canvas.rows(), 0, canvas.cols());
+      exhaustive_.FindBelow(canvas, difference, target, count, static_cast<float>(local_bound / global_gain_),
+                            0, canvas.rows(), 0, canvas.cols());
   evaluations_ = exhaustive_.evaluations();
   // Rank: local candidates by their difference, global ones (not inside the window) by difference·gain.
   auto in_window = [&](Pixel p) {
@@ -222,7 +226,7 @@ std::vector<SourceCandidate> PatchMatchSearch::Find(const InpaintCanvas& canvas,
   std::unordered_set<int64_t> seen;
   int64_t evaluated = 0;
   auto offer = [&](int r, int c) {
-    if (!canvas.Inside(r, c) || !canvas.IsSource(r, c)) return;
+    if (!canvas.Inside(r, c) || !canvas.IsSource(r, c) || !canvas.SourceFits(target, {r, c})) return;
     if (!seen.insert(canvas.Index(r, c)).second) return;
     const float bound = top.Bound();
     const float d = difference.Evaluate({r, c}, bound);

@@ -53,10 +53,12 @@ class ExhaustiveSearch : public PatchSearch {
   // around it is scanned first and its count-th best bounds the scan of the rest (exact).
   std::vector<SourceCandidate> FindNear(const InpaintCanvas& canvas, const TargetDifference& difference,
                                         Pixel target, int count, int radius);
-  // The same, with an initial early-termination bound: candidates with difference > bound may be left out.
+  // The best `count` of the source centres in rows [row_begin, row_end) and cols [col_begin, col_end) that fit
+  // the target (InpaintCanvas::SourceBox), with an initial early-termination bound: candidates with
+  // difference > bound may be left out.
   std::vector<SourceCandidate> FindBelow(const InpaintCanvas& canvas, const TargetDifference& difference,
-                                         int count, float bound, int row_begin, int row_end, int col_begin,
-                                         int col_end);
+                                         Pixel target, int count, float bound, int row_begin, int row_end,
+                                         int col_begin, int col_end);
 };
 
 // Source centres within a (2·window_radius+1)² window around the target; falls back to the whole image when

@@ -10,6 +10,7 @@
 // images and a second-viewpoint rendering per scene.
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <set>
 #include <sstream>
@@ -24,8 +25,10 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
+#include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/options.h"
 
 using namespace lidarshop;
 
@@ -109,10 +112,25 @@ int main(int argc, char** argv) {
   app.add_option("--pm-samples", base.patchmatch_random_samples)->capture_default_str();
   app.add_option("--accept-local-first", base.acceptance_local_first)->capture_default_str();
   app.add_option("--pm-iterations", base.patchmatch_iterations)->capture_default_str();
+  std::string dump_dir;
+  app.add_option("--dump", dump_dir,
+                 "write each scene's scan, truth and hole, and per method the first seed's fill and its "
+                 "floating cells, here (PLY, PNG)");
+  std::string options_path;
+  app.add_option(
+         "--options", options_path,
+         "FillOptions as JSON (keys as in `lidarshop fill --options`), applied before the flags above")
+      ->check(CLI::ExistingFile);
   std::string priority = "criminisi", search;  // empty search = FillOptions' default
   app.add_option("--priority", priority, "criminisi | onion-peel | random")->capture_default_str();
   app.add_option("--search", search, "local | two-step | exhaustive | patchmatch (default: FillOptions')");
   CLI11_PARSE(app, argc, argv);
+  if (!options_path.empty()) {
+    // The flags given explicitly win over the file: parse again onto the file's options.
+    std::ifstream file(options_path);
+    base = FromJson<FillOptions>(nlohmann::json::parse(file), FillOptions{});
+    CLI11_PARSE(app, argc, argv);
+  }
   base.priority = priority == "onion-peel" ? InpaintPriorityKind::kOnionPeel
                   : priority == "random"   ? InpaintPriorityKind::kRandom
                                            : InpaintPriorityKind::kCriminisi;
@@ -132,6 +150,7 @@ int main(int argc, char** argv) {
   }
   std::sort(scene_paths.begin(), scene_paths.end());
   if (!pictures_dir.empty()) std::filesystem::create_directories(pictures_dir);
+  if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
 
   std::string report;
   auto emit = [&](const std::string& text) {
@@ -156,6 +175,11 @@ int main(int argc, char** argv) {
     std::erase_if(without.objects, [](const SceneObject& object) { return object.label == 1; });
     const Scan truth = SynthesizeScan(without);
     const cv::Mat hole = GrowHole((with_object.label == 1) & (with_object.valid != 0), margin);
+    if (!dump_dir.empty()) {
+      WriteScanFile(fmt::format("{}/{}_scan.ply", dump_dir, stem), {with_object});
+      WriteScanFile(fmt::format("{}/{}_truth.ply", dump_dir, stem), {truth});
+      WriteImage(fmt::format("{}/{}_hole.png", dump_dir, stem), hole);
+    }
     emit(fmt::format("\n#### {} ({} x {} cells, hole {} cells{})\n\n", stem, with_object.cols,
                      with_object.rows, cv::countNonZero(hole),
                      planar.count(stem) ? ", planar behind the object" : ""));
@@ -199,6 +223,10 @@ int main(int argc, char** argv) {
         m.floating_share += one.floating_share / runs;
         m.return_accuracy += one.return_accuracy / runs;
         m.color_psnr_db += one.color_psnr_db / runs;
+        if (k == 0 && !dump_dir.empty()) {
+          WriteScanFile(fmt::format("{}/{}_{}.ply", dump_dir, stem, name), {run.scan});
+          WriteImage(fmt::format("{}/{}_{}_floating.png", dump_dir, stem, name), one.floating_cells);
+        }
         if (k == 0) result = std::move(run);
       }
       result.timings.total_s = seconds;
