@@ -45,11 +45,12 @@ const Problem& GetProblem(int kind) {
   return cache.emplace(kind, std::move(problem)).first->second;
 }
 
-void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance) {
+void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance, bool offsets = false) {
   const Problem& problem = GetProblem(static_cast<int>(state.range(0)));
   FillOptions options;
   options.method = method;
   options.acceptance.enabled = acceptance;
+  options.offset_completion = offsets;
   FillResult result;
   for (auto _ : state) {
     result = FillScan(problem.scan, problem.hole, options);
@@ -80,11 +81,18 @@ void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance) {
   state.counters["poisson_s"] = result.timings.poisson_s;
   state.counters["planes_s"] = result.timings.planes_s;
   state.counters["plane_cells"] = static_cast<double>(result.plane_cells);
+  if (offsets) state.counters["offset_cells"] = static_cast<double>(result.offset_cells);
   state.counters["total_s"] = result.timings.total_s;
 }
 
 // The default (acceptance tests on), the same without them, and the baselines.
 BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient, true)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+// Opt-in: shifted copies at the dominant patch offsets first (inpaint/offset_completion.h).
+BENCHMARK_CAPTURE(BM_FillScan, gradient_offsets, FillMethod::kGradient, true, true)
     ->Arg(0)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)

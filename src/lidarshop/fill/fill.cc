@@ -9,6 +9,7 @@
 #include <opencv2/photo.hpp>
 
 #include "lidarshop/fill/range_gradient.h"
+#include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -130,6 +131,35 @@ cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
   return between;
 }
 
+// Cuts at the seams between two copies: an edge of the hole whose two cells were not copied from two
+// neighbouring cells (or a known cell next to a copied one) is cut where the cells they show lie at depths more
+// than `ratio` apart, as a depth jump of the scan itself would be. Shifted copies of a wall's top edge that land
+// a row apart otherwise leave a gap in the copied jump, through which the Poisson step joins the wall to the
+// facade behind it.
+void SeamCuts(const Inputs& in, const cv::Mat& source, double ratio, EdgeMasks* cuts) {
+  if (ratio <= 0) return;
+  const cv::Mat& hole = in.hole;
+  auto shown = [&](int y, int x) {  // the cell a cell shows: itself when known, its source when copied
+    return hole.at<uint8_t>(y, x) ? source.at<cv::Vec2i>(y, x) : cv::Vec2i(y, x);
+  };
+  auto seam_jump = [&](int y, int x, int ny, int nx, cv::Vec2i step) {
+    const cv::Vec2i a = shown(y, x), b = shown(ny, nx);
+    if (a[0] < 0 || b[0] < 0 || b == a + step) return false;  // one copy: its own edge decides
+    const float ra = in.range.at<float>(a[0], a[1]), rb = in.range.at<float>(b[0], b[1]);
+    return ra > 0 && rb > 0 && std::abs(ra - rb) > ratio * std::min(ra, rb);
+  };
+  for (int y = 0; y < hole.rows; ++y) {
+    for (int x = 0; x < hole.cols; ++x) {
+      if (x + 1 < hole.cols && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y, x + 1)) &&
+          seam_jump(y, x, y, x + 1, {0, 1}))
+        cuts->right.at<uint8_t>(y, x) = 255;
+      if (y + 1 < hole.rows && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y + 1, x)) &&
+          seam_jump(y, x, y + 1, x, {1, 0}))
+        cuts->down.at<uint8_t>(y, x) = 255;
+    }
+  }
+}
+
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
 // has-return channel; zero in the hole.
 cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
@@ -160,7 +190,7 @@ cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
 }
 
 InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure, const FillOptions& options,
-                        Progress* progress) {
+                        Progress* progress, int64_t* offset_cells) {
   InpaintOptions inpaint;
   inpaint.patch_radius = options.patch_radius;
   // The exact search is the two-step one with the local window as its first bound: the same best patch,
@@ -179,7 +209,41 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   for (size_t k = 0; k < structure.size(); ++k)
     inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
   inpaint.channel_weights.push_back(static_cast<float>(options.return_weight));
-  return Inpaint(JointImage(in, structure), in.hole, inpaint, progress);
+  const cv::Mat joint = JointImage(in, structure);
+  if (!options.offset_completion) return Inpaint(joint, in.hole, inpaint, progress);
+
+  OffsetCompletionOptions offsets;
+  offsets.patch_radius = options.patch_radius;
+  offsets.channel_weights = inpaint.channel_weights;
+  const OffsetCompletionResult completed = CompleteByOffsets(joint, in.hole, offsets);
+  *offset_cells = cv::countNonZero(completed.label >= 0);
+  // What no offset could fill goes to the greedy fill, which may copy from the completed cells: its sources
+  // are followed back to cells outside the hole.
+  const cv::Mat rest = (in.hole != 0) & (completed.label < 0);
+  cv::Mat image = joint.clone();
+  const int channels = joint.channels();
+  for (int y = 0; y < joint.rows; ++y) {
+    for (int x = 0; x < joint.cols; ++x) {
+      const cv::Vec2i s = completed.source_pixel.at<cv::Vec2i>(y, x);
+      if (s[0] < 0) continue;
+      std::copy_n(joint.ptr<float>(s[0]) + s[1] * channels, channels, image.ptr<float>(y) + x * channels);
+    }
+  }
+  InpaintResult result;
+  if (cv::countNonZero(rest) > 0) {
+    result = Inpaint(image, rest, inpaint, progress);
+    for (auto it = result.source_pixel.begin<cv::Vec2i>(); it != result.source_pixel.end<cv::Vec2i>(); ++it) {
+      if ((*it)[0] >= 0 && completed.source_pixel.at<cv::Vec2i>((*it)[0], (*it)[1])[0] >= 0)
+        *it = completed.source_pixel.at<cv::Vec2i>((*it)[0], (*it)[1]);
+    }
+  } else {
+    result.image = image;
+    result.source_pixel = cv::Mat(joint.size(), CV_32SC2, cv::Scalar(-1, -1));
+    result.fill_iteration = cv::Mat(joint.size(), CV_32S, cv::Scalar(-1));
+  }
+  completed.source_pixel.copyTo(result.source_pixel, completed.label >= 0);
+  result.fill_iteration.setTo(0, completed.label >= 0);
+  return result;
 }
 
 // Range in Ω = the hole cells with a return, from the Poisson equation with divergence
@@ -225,7 +289,8 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
 
   timer.Restart();
   const InpaintResult patches =
-      PatchFill(in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress);
+      PatchFill(in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress,
+                &result->offset_cells);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;
@@ -250,6 +315,9 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
       cuts.down.at<uint8_t>(y, x) = known_jumps.down.at<uint8_t>(s[0], s[1]);
     }
   }
+  // Shifted copies meet at seams that no source edge describes (the greedy fill's patches overlap the cells
+  // already filled, and its copies of one surface may come from different distances: no seam cuts there).
+  if (options.offset_completion) SeamCuts(in, patches.source_pixel, options.depth_jump_ratio, &cuts);
   cv::magnitude(gradient.gx, gradient.gy, result->gradient_magnitude_before);
   result->gradient_magnitude_before.setTo(0, in.hole);
   cv::magnitude(gx, gy, result->gradient_magnitude_after);
@@ -285,7 +353,8 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   const double high = AbsQuantile(in.range, in.known_valid, 0.95, low + 1e-3);
   cv::Mat shifted;
   in.range.convertTo(shifted, CV_32F, 1.0, -low);
-  const InpaintResult patches = PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress);
+  const InpaintResult patches =
+      PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress, &result->offset_cells);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;

@@ -85,10 +85,14 @@ struct FillOptions {
   double depth_jump_ratio = 0.2;
   // Telea baseline.
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
-  PoissonOptions poisson;           // range reconstruction (and the laplace baseline)
-  FillPlaneOptions planes;          // gradient method: reconstructed ranges onto the planes around the hole
-  uint64_t seed = 0;                // random choices of the patch fill (ties are broken by position)
-  void Check() const;               // throws OptionsFieldError naming the field
+  // Patch methods: complete the hole by shifted copies of the scan at its dominant patch offsets
+  // (inpaint/offset_completion.h: a facade's window pitch brings whole windows) before the greedy patch fill,
+  // which then fills only what no offset could.
+  bool offset_completion = false;
+  PoissonOptions poisson;   // range reconstruction (and the laplace baseline)
+  FillPlaneOptions planes;  // gradient method: reconstructed ranges onto the planes around the hole
+  uint64_t seed = 0;        // random choices of the patch fill (ties are broken by position)
+  void Check() const;       // throws OptionsFieldError naming the field
 };
 template <>
 const StructInfo& InfoOf<FillOptions>();
@@ -107,6 +111,7 @@ struct FillResult {
   int64_t no_return_cells = 0;    // hole cells left without a return (sky, beyond range)
   int64_t unanchored_cells = 0;   // cells decided "return" but cut off from every known range (left empty)
   int64_t plane_cells = 0;        // synthesized cells placed on a plane seen around the hole
+  int64_t offset_cells = 0;       // hole cells copied by offset completion (FillOptions::offset_completion)
   int patches = 0;                // patches copied (patch methods)
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:

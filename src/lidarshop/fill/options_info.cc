@@ -47,6 +47,8 @@ const StructInfo& InfoOf<FillOptions>() {
         .Min(0);
     b.Field(&FillOptions::return_weight, "return_weight", "patch difference weight of the has-return channel")
         .Min(0);
+    b.Field(&FillOptions::offset_completion, "offset_completion",
+            "complete the hole by shifted copies at the scan's dominant patch offsets first");
     b.Field(&FillOptions::inverse_range, "inverse_range",
             "copy the gradients of 1/range (slowly varying on planes)");
     b.Field(
@@ -190,6 +192,8 @@ const StructInfo& InfoOf<FillResult>() {
             "cells decided 'return' but cut off from every known range (left empty)")
         .Unit("cells");
     b.Field(&FillResult::plane_cells, "plane_cells", "synthesized cells placed on a plane around the hole")
+        .Unit("cells");
+    b.Field(&FillResult::offset_cells, "offset_cells", "hole cells copied by offset completion")
         .Unit("cells");
     b.Field(&FillResult::patches, "patches", "patches copied");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
