@@ -107,59 +107,6 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
   }
 }
 
-// Hole cells whose nearest known cells to the left and to the right in the same row both lack a return
-// (CV_8U 255). A scan's rows are elevations: the sky over a lamp post, or the band beyond the far end of the
-// ground, runs along the rows, so a cell between two no-return cells of its row has none either, whatever a
-// patch copied from elsewhere says.
-cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
-  cv::Mat between = cv::Mat::zeros(hole.size(), CV_8U);
-  for (int y = 0; y < hole.rows; ++y) {
-    const uint8_t* in_hole = hole.ptr<uint8_t>(y);
-    const uint8_t* valid = known_valid.ptr<uint8_t>(y);
-    for (int x = 0; x < hole.cols;) {
-      if (!in_hole[x]) {
-        ++x;
-        continue;
-      }
-      int end = x;
-      while (end < hole.cols && in_hole[end]) ++end;  // the run [x, end) of hole cells
-      if (x > 0 && end < hole.cols && !valid[x - 1] && !valid[end])
-        between.row(y).colRange(x, end).setTo(255);
-      x = end;
-    }
-  }
-  return between;
-}
-
-// Cuts at the seams between two copies: an edge of the hole whose two cells were not copied from two
-// neighbouring cells (or a known cell next to a copied one) is cut where the cells they show lie at depths more
-// than `ratio` apart, as a depth jump of the scan itself would be. Shifted copies of a wall's top edge that land
-// a row apart otherwise leave a gap in the copied jump, through which the Poisson step joins the wall to the
-// facade behind it.
-void SeamCuts(const Inputs& in, const cv::Mat& source, double ratio, EdgeMasks* cuts) {
-  if (ratio <= 0) return;
-  const cv::Mat& hole = in.hole;
-  auto shown = [&](int y, int x) {  // the cell a cell shows: itself when known, its source when copied
-    return hole.at<uint8_t>(y, x) ? source.at<cv::Vec2i>(y, x) : cv::Vec2i(y, x);
-  };
-  auto seam_jump = [&](int y, int x, int ny, int nx, cv::Vec2i step) {
-    const cv::Vec2i a = shown(y, x), b = shown(ny, nx);
-    if (a[0] < 0 || b[0] < 0 || b == a + step) return false;  // one copy: its own edge decides
-    const float ra = in.range.at<float>(a[0], a[1]), rb = in.range.at<float>(b[0], b[1]);
-    return ra > 0 && rb > 0 && std::abs(ra - rb) > ratio * std::min(ra, rb);
-  };
-  for (int y = 0; y < hole.rows; ++y) {
-    for (int x = 0; x < hole.cols; ++x) {
-      if (x + 1 < hole.cols && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y, x + 1)) &&
-          seam_jump(y, x, y, x + 1, {0, 1}))
-        cuts->right.at<uint8_t>(y, x) = 255;
-      if (y + 1 < hole.rows && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y + 1, x)) &&
-          seam_jump(y, x, y + 1, x, {1, 0}))
-        cuts->down.at<uint8_t>(y, x) = 255;
-    }
-  }
-}
-
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
 // has-return channel; zero in the hole.
 cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
@@ -296,7 +243,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);
-  values->has_return.setTo(0, NoReturnOnBothSides(in.hole, in.known_valid));
+  values->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
 
   // The guidance field: known gradients outside, the copied ones inside; depth jumps are copied along and cut
   // the Poisson system there, so that surfaces at different distances are not joined by a membrane.
@@ -317,7 +264,8 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   }
   // Shifted copies meet at seams that no source edge describes (the greedy fill's patches overlap the cells
   // already filled, and its copies of one surface may come from different distances: no seam cuts there).
-  if (options.offset_completion) SeamCuts(in, patches.source_pixel, options.depth_jump_ratio, &cuts);
+  if (options.offset_completion)
+    fill_internal::SeamCuts(in.range, in.hole, patches.source_pixel, options.depth_jump_ratio, &cuts);
   cv::magnitude(gradient.gx, gradient.gy, result->gradient_magnitude_before);
   result->gradient_magnitude_before.setTo(0, in.hole);
   cv::magnitude(gx, gy, result->gradient_magnitude_after);
@@ -360,7 +308,7 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);  // copies the range as it is: the method under test
-  values->has_return.setTo(0, NoReturnOnBothSides(in.hole, in.known_valid));
+  values->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
   result->unanchored_cells = 0;
 }
 

@@ -13,9 +13,12 @@
 namespace lidarshop {
 namespace {
 
+using fill_internal::EdgeMasks;
 using fill_internal::GuidanceDivergence;
 using fill_internal::NearestKnownCell;
+using fill_internal::NoReturnOnBothSides;
 using fill_internal::OneSidedRangeGradient;
+using fill_internal::SeamCuts;
 using fill_internal::UnanchoredCells;
 
 // A box in front of a wall that meets textured ground: non-planar behind the box. Label 1 = the box.
@@ -81,6 +84,43 @@ TEST(RangeGradient, NearestKnownCellAndUnanchoredParts) {
   EXPECT_EQ(cv::countNonZero(UnanchoredCells(hole, anchor)), 9);
   anchor.at<uint8_t>(0, 2) = 255;
   EXPECT_EQ(cv::countNonZero(UnanchoredCells(hole, anchor)), 0);
+}
+
+TEST(RangeGradient, NoReturnOnBothSidesOfAHoleRun) {
+  // Row 0: no return | hole | no return -> marked. Row 1: return on the left -> not. Row 2: the run touches the
+  // image's right side -> not.
+  cv::Mat hole = cv::Mat::zeros(3, 8, CV_8U), valid = cv::Mat::zeros(3, 8, CV_8U);
+  hole.row(0).colRange(2, 5).setTo(255);
+  hole.row(1).colRange(2, 5).setTo(255);
+  valid.at<uint8_t>(1, 1) = 255;
+  hole.row(2).colRange(5, 8).setTo(255);
+  const cv::Mat between = NoReturnOnBothSides(hole, valid);
+  EXPECT_EQ(cv::countNonZero(between.row(0)), 3);
+  EXPECT_EQ(cv::countNonZero(between.row(1)), 0);
+  EXPECT_EQ(cv::countNonZero(between.row(2)), 0);
+}
+
+TEST(RangeGradient, SeamsBetweenCopiesAtDifferentDepthsAreCut) {
+  // Known: a wall at 5 m (cols 0..3) and a facade at 20 m (cols 4..7) in row 0, the hole in row 1 copies row 0
+  // shifted by one column at col 5 (a seam) and unshifted elsewhere.
+  cv::Mat range(2, 8, CV_32F, cv::Scalar(0));
+  for (int x = 0; x < 8; ++x) range.at<float>(0, x) = x < 4 ? 5.0f : 20.0f;
+  cv::Mat hole = cv::Mat::zeros(2, 8, CV_8U);
+  hole.row(1).setTo(255);
+  cv::Mat source(2, 8, CV_32SC2, cv::Scalar(-1, -1));
+  for (int x = 0; x < 8; ++x) source.at<cv::Vec2i>(1, x) = cv::Vec2i(0, x == 5 ? 3 : x);
+  EdgeMasks cuts{cv::Mat::zeros(2, 8, CV_8U), cv::Mat::zeros(2, 8, CV_8U)};
+  SeamCuts(range, hole, source, 0.2, &cuts);
+  // (1,4)-(1,5): shows (0,4) at 20 m and (0,3) at 5 m, not neighbours -> cut; (1,5)-(1,6) likewise.
+  EXPECT_TRUE(cuts.right.at<uint8_t>(1, 4));
+  EXPECT_TRUE(cuts.right.at<uint8_t>(1, 5));
+  // (1,3)-(1,4) shows two neighbouring cells: their own edge decides, not the seam rule.
+  EXPECT_FALSE(cuts.right.at<uint8_t>(1, 3));
+  // Down edges from the known row: (0,5) at 20 m over (1,5) showing 5 m -> cut; (0,2) over (1,2) showing itself
+  // one row up is a copy of the same depth -> not.
+  EXPECT_TRUE(cuts.down.at<uint8_t>(0, 5));
+  EXPECT_FALSE(cuts.down.at<uint8_t>(0, 2));
+  EXPECT_EQ(cv::countNonZero(cuts.right) + cv::countNonZero(cuts.down), 3);
 }
 
 TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {

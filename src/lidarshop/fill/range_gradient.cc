@@ -170,4 +170,57 @@ double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile,
   return std::max(floor, static_cast<double>(magnitudes[k]));
 }
 
+// Hole cells whose nearest known cells to the left and to the right in the same row both lack a return
+// (CV_8U 255). A scan's rows are elevations: the sky over a lamp post, or the band beyond the far end of the
+// ground, runs along the rows, so a cell between two no-return cells of its row has none either, whatever a
+// patch copied from elsewhere says.
+cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
+  cv::Mat between = cv::Mat::zeros(hole.size(), CV_8U);
+  for (int y = 0; y < hole.rows; ++y) {
+    const uint8_t* in_hole = hole.ptr<uint8_t>(y);
+    const uint8_t* valid = known_valid.ptr<uint8_t>(y);
+    for (int x = 0; x < hole.cols;) {
+      if (!in_hole[x]) {
+        ++x;
+        continue;
+      }
+      int end = x;
+      while (end < hole.cols && in_hole[end]) ++end;  // the run [x, end) of hole cells
+      if (x > 0 && end < hole.cols && !valid[x - 1] && !valid[end])
+        between.row(y).colRange(x, end).setTo(255);
+      x = end;
+    }
+  }
+  return between;
+}
+
+// Cuts at the seams between two copies: an edge of the hole whose two cells were not copied from two
+// neighbouring cells (or a known cell next to a copied one) is cut where the cells they show lie at depths more
+// than `ratio` apart, as a depth jump of the scan itself would be. Shifted copies of a wall's top edge that land
+// a row apart otherwise leave a gap in the copied jump, through which the Poisson step joins the wall to the
+// facade behind it.
+void SeamCuts(const cv::Mat& range, const cv::Mat& hole, const cv::Mat& source, double ratio,
+              EdgeMasks* cuts) {
+  if (ratio <= 0) return;
+  auto shown = [&](int y, int x) {  // the cell a cell shows: itself when known, its source when copied
+    return hole.at<uint8_t>(y, x) ? source.at<cv::Vec2i>(y, x) : cv::Vec2i(y, x);
+  };
+  auto seam_jump = [&](int y, int x, int ny, int nx, cv::Vec2i step) {
+    const cv::Vec2i a = shown(y, x), b = shown(ny, nx);
+    if (a[0] < 0 || b[0] < 0 || b == a + step) return false;  // one copy: its own edge decides
+    const float ra = range.at<float>(a[0], a[1]), rb = range.at<float>(b[0], b[1]);
+    return ra > 0 && rb > 0 && std::abs(ra - rb) > ratio * std::min(ra, rb);
+  };
+  for (int y = 0; y < hole.rows; ++y) {
+    for (int x = 0; x < hole.cols; ++x) {
+      if (x + 1 < hole.cols && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y, x + 1)) &&
+          seam_jump(y, x, y, x + 1, {0, 1}))
+        cuts->right.at<uint8_t>(y, x) = 255;
+      if (y + 1 < hole.rows && (hole.at<uint8_t>(y, x) || hole.at<uint8_t>(y + 1, x)) &&
+          seam_jump(y, x, y + 1, x, {1, 0}))
+        cuts->down.at<uint8_t>(y, x) = 255;
+    }
+  }
+}
+
 }  // namespace lidarshop::fill_internal

@@ -43,4 +43,14 @@ cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const Edge
 // when there are none or the quantile is smaller.
 double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile, double floor);
 
+// Hole cells (`hole` CV_8U non-zero) whose nearest known cells to the left and to the right in the same row both
+// lack a return (`known_valid` CV_8U zero): CV_8U 255. A hole run touching the image's side is never marked.
+cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid);
+
+// Adds to `cuts` the seams between copies: an edge touching the hole whose two cells do not show two neighbouring
+// cells (`source` CV_32SC2 gives the cell each hole cell shows; a known cell shows itself) is cut where the
+// ranges (`range` CV_32F, 0 = no return) of the cells they show differ by more than `ratio` times the nearer.
+void SeamCuts(const cv::Mat& range, const cv::Mat& hole, const cv::Mat& source, double ratio,
+              EdgeMasks* cuts);
+
 }  // namespace lidarshop::fill_internal
