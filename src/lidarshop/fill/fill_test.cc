@@ -354,18 +354,49 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
   border(cv::Rect(0, c.scan.rows - 20, 30, 20)) = 255;
   for (FillMethod method :
        {FillMethod::kGradient, FillMethod::kLaplace, FillMethod::kDepthPatch, FillMethod::kTelea}) {
+    for (bool offsets : {false, true}) {
+      if (offsets && method != FillMethod::kGradient && method != FillMethod::kDepthPatch) continue;
+      FillOptions options;
+      options.method = method;
+      options.offset_completion = offsets;
+      const FillResult result = FillScan(grey, border, options);
+      const FillMetrics m = MeasureFill(result.scan, c.truth, border);
+      const std::string what = ToString(method) + (offsets ? " with offsets" : "");
+      EXPECT_GT(result.synthesized_cells, 500) << what;
+      double low = 0, high = 0;
+      cv::minMaxLoc(result.scan.range, &low, &high, nullptr, nullptr, border & (result.scan.valid != 0));
+      EXPECT_GT(low, 0.5) << what;  // finite, in front of the scanner
+      EXPECT_LT(high, 40.0) << what;
+      // The membrane and fast marching flatten the ground against the image border (no flux there); the
+      // gradient fill continues its slope.
+      if (method == FillMethod::kGradient) EXPECT_LT(m.range_rmse_mm, 100.0) << what;
+    }
+  }
+  // Offset completion on a tiny scan (fewer known patches than the statistics want) and on a hole that leaves a
+  // band of 12 known columns: a fill; a hole that leaves one column: the same clear error as without offsets.
+  {
     FillOptions options;
-    options.method = method;
-    const FillResult result = FillScan(grey, border, options);
-    const FillMetrics m = MeasureFill(result.scan, c.truth, border);
-    EXPECT_GT(result.synthesized_cells, 500) << ToString(method);
-    double low = 0, high = 0;
-    cv::minMaxLoc(result.scan.range, &low, &high, nullptr, nullptr, border & (result.scan.valid != 0));
-    EXPECT_GT(low, 0.5) << ToString(method);  // finite, in front of the scanner
-    EXPECT_LT(high, 40.0) << ToString(method);
-    // The membrane and fast marching flatten the ground against the image border (no flux there); the
-    // gradient fill continues its slope.
-    if (method == FillMethod::kGradient) EXPECT_LT(m.range_rmse_mm, 100.0);
+    options.offset_completion = true;
+    cv::Mat most(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(255));
+    most.colRange(c.scan.cols / 2, c.scan.cols / 2 + 12).setTo(0);
+    const FillResult result = FillScan(c.scan, most, options);
+    EXPECT_EQ(result.synthesized_cells + result.no_return_cells, result.hole_cells);
+    EXPECT_GT(result.synthesized_cells, 0);
+    cv::Mat one_column(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(255));
+    one_column.col(c.scan.cols / 2).setTo(0);
+    EXPECT_THROW(FillScan(c.scan, one_column, options), InputError);
+    EXPECT_THROW(FillScan(c.scan, one_column, FillOptions{}), InputError);
+    const cv::Rect corner(0, 0, 20, 16);
+    Scan tiny = c.scan;
+    for (cv::Mat* m : {&tiny.range, &tiny.point, &tiny.direction, &tiny.valid, &tiny.color, &tiny.intensity,
+                       &tiny.label, &tiny.normal, &tiny.curvature, &tiny.true_range, &tiny.synthesized})
+      if (!m->empty()) *m = (*m)(corner).clone();
+    tiny.rows = corner.height;
+    tiny.cols = corner.width;
+    cv::Mat small_hole = cv::Mat::zeros(corner.size(), CV_8U);
+    small_hole(cv::Rect(8, 6, 3, 3)).setTo(255);
+    const FillResult small = FillScan(tiny, small_hole, options);
+    EXPECT_EQ(small.hole_cells, 9);
   }
   FillOptions bad;
   bad.patch_radius = 0;
