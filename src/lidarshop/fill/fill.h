@@ -117,7 +117,8 @@ struct FillResult {
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole
   cv::Mat gradient_magnitude_after;   // |∇r| of the guidance after inpainting
-  cv::Mat fill_order;                 // CV_32S: patch iteration that filled each cell, −1 = known
+  // CV_32S: patch iteration that filled each cell (0 also for the cells of offset completion), −1 = known.
+  cv::Mat fill_order;
   cv::Mat source_cell;  // CV_32SC2: (row, col) each hole cell was copied from, (−1, −1) = known
   FillTimings timings;
   std::string Summary() const;  // one line

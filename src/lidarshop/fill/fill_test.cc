@@ -163,6 +163,11 @@ TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
   EXPECT_LT(g.floating_share, 0.02);
   EXPECT_LT(g.floating_share, l.floating_share / 4);
   EXPECT_GT(g.return_accuracy, 0.97);
+  // The floating-cell map is the share's cells, inside the hole only.
+  EXPECT_EQ(cv::countNonZero(l.floating_cells),
+            std::lround(l.floating_share * static_cast<double>(laplace.synthesized_cells)));
+  EXPECT_GT(cv::countNonZero(l.floating_cells), 0);
+  EXPECT_EQ(cv::countNonZero(l.floating_cells & (c.hole == 0)), 0);
 
   // Outside the hole: a bit-exact copy of every channel.
   const cv::Mat outside = c.hole == 0;
@@ -397,6 +402,7 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
     small_hole(cv::Rect(8, 6, 3, 3)).setTo(255);
     const FillResult small = FillScan(tiny, small_hole, options);
     EXPECT_EQ(small.hole_cells, 9);
+    EXPECT_EQ(small.synthesized_cells + small.no_return_cells, 9);
   }
   FillOptions bad;
   bad.patch_radius = 0;

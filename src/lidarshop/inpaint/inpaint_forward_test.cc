@@ -141,9 +141,16 @@ TEST(InpaintForward, ReviewAndResumeEqualsAnUninterruptedFill) {
   int reviewed = 0;
   for (const FillStep& step : uninterrupted.steps) reviewed += step.review_point >= 0;
   EXPECT_EQ(reviewed, stops);
-  // Choosing differently changes the result; a hand-placed source must be a source centre.
+  // Choosing differently changes the result; a hand-placed source must be a source centre (not in the hole)
+  // that fits the target: (0, 0) is a source centre (its patch's part inside the image is known) but sticks out
+  // of the image where the target's patch does not.
   once.review_decisions.back().source = once.review_decisions[0].source;
   EXPECT_GT(cv::norm(Inpaint(truth, hole, once).image, result.image, cv::NORM_INF), 0.0);
+  once.review_decisions.back().source = {20, 40};
+  EXPECT_THROW(Inpaint(truth, hole, once), InputError);
+  const InpaintCanvas canvas(truth, hole, once.patch_radius);
+  ASSERT_TRUE(canvas.IsSource(0, 0));
+  ASSERT_FALSE(canvas.SourceFits(once.review_decisions.back().target, {0, 0}));
   once.review_decisions.back().source = {0, 0};
   EXPECT_THROW(Inpaint(truth, hole, once), InputError);
 }

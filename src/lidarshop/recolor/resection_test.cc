@@ -1,6 +1,7 @@
 #include "lidarshop/recolor/resection.h"
 
 #include <cmath>
+#include <map>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -62,6 +63,30 @@ ResectionOptions Options(const PinholeCamera& camera) {
   return options;
 }
 
+// Draws of bench/results/recolor.md's 10-pair rows: 8 right pairs and 2 outliers (0.5 px noise) from the scan
+// of MakeRecolorScene, seen by the evaluation camera `offset_m` from the scanner; `exact` the noise-free pairs.
+struct TenPairDraw {
+  PinholeCamera truth;
+  std::vector<PixelPointPair> pairs, exact;
+};
+class RecolorSceneDraws {
+ public:
+  RecolorSceneDraws() : scene_(test_scenes::MakeRecolorScene()), scan_(test_scenes::ScanScene(scene_)) {}
+  TenPairDraw Draw(double offset_m, uint64_t draw_seed) {
+    TenPairDraw draw;
+    draw.truth = EvaluationCamera(offset_m);
+    auto [depth, fresh] = depth_m_.try_emplace(offset_m);  // one rendering per camera
+    if (fresh) depth->second = RenderPhoto(scene_, draw.truth).depth_m;
+    draw.pairs = DrawCorrespondences(scan_, draw.truth, depth->second, 10, 0.5, 0.2, draw_seed, &draw.exact);
+    return draw;
+  }
+
+ private:
+  SceneDescription scene_;
+  Scan scan_;
+  std::map<double, cv::Mat> depth_m_;
+};
+
 TEST(Resection, DltIsExactWithoutNoiseAndDecomposesIntoTheTrueCamera) {
   const PinholeCamera truth = TrueCamera();
   const std::vector<PixelPointPair> pairs = MakePairs(truth, 8, 0.0, 0.0, 3);
@@ -102,22 +127,17 @@ TEST(Resection, RansacAndRefinementMeetTheTargetWithNoiseAndOutliers) {
 // MakeRecolorScene seen by a camera 1 and 3 m from the scanner. Before LO-RANSAC and the principal-point
 // prior the 3 m draw with seed 3 kept an outlier (22 px) and the 1 m rows averaged 0.71 px.
 TEST(Resection, TenPairsWithTwoOutliersStayUnderHalfAPixel) {
-  const SceneDescription scene = test_scenes::MakeRecolorScene();
-  const Scan scan = test_scenes::ScanScene(scene);
+  RecolorSceneDraws draws;
   for (double offset : {1.0, 3.0}) {
-    const PinholeCamera truth = EvaluationCamera(offset);
-    const cv::Mat depth = RenderPhoto(scene, truth).depth_m;
     double sum_rms = 0;
     for (int seed = 1; seed <= 5; ++seed) {
-      std::vector<PixelPointPair> exact;
-      const std::vector<PixelPointPair> pairs =
-          DrawCorrespondences(scan, truth, depth, 10, 0.5, 0.2, 100 * seed + 10, &exact);
-      ResectionOptions options = Options(truth);
+      const TenPairDraw draw = draws.Draw(offset, 100 * seed + 10);
+      ResectionOptions options = Options(draw.truth);
       options.seed = seed;
-      const ResectionResult result = Resection(pairs, options);
+      const ResectionResult result = Resection(draw.pairs, options);
       for (int i = 0; i < 10; ++i)
         EXPECT_EQ(result.inlier[i], i >= 2 ? 1 : 0) << offset << " m, seed " << seed;
-      const double rms = RmsReprojectionError(result.camera, exact);
+      const double rms = RmsReprojectionError(result.camera, draw.exact);
       EXPECT_LT(rms, 0.75) << offset << " m, seed " << seed;
       sum_rms += rms;
       // Eight inliers do not support a free principal point: it stays at the centre.
@@ -132,13 +152,10 @@ TEST(Resection, TheOldSettingsKeptAnOutlierOnTheWorstDraw) {
   // The 3 m draw with seed 3 of bench/results/recolor.md. Before this change (no local optimization, the
   // adaptive bound alone: 31 sets, the principal point free with 8 inliers) RANSAC kept the first set that
   // collected 8 pairs, one of them an outlier: 22 px on the true pairs.
-  const SceneDescription scene = test_scenes::MakeRecolorScene();
-  const Scan scan = test_scenes::ScanScene(scene);
-  const PinholeCamera truth = EvaluationCamera(3.0);
-  std::vector<PixelPointPair> exact;
-  const std::vector<PixelPointPair> pairs =
-      DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 310, &exact);
-  ResectionOptions options = Options(truth);
+  const TenPairDraw draw = RecolorSceneDraws().Draw(3.0, 310);
+  const std::vector<PixelPointPair>& pairs = draw.pairs;
+  const std::vector<PixelPointPair>& exact = draw.exact;
+  ResectionOptions options = Options(draw.truth);
   options.seed = 3;
   const ResectionResult ours = Resection(pairs, options);
   EXPECT_LT(RmsReprojectionError(ours.camera, exact), 0.5);
@@ -162,18 +179,14 @@ TEST(Resection, AnAbsorbedOutlierLosesToTheRightSet) {
   // included) against 8 at 0.5 px; the right sets had fewer inliers and were never refitted: 6.4 px on the true
   // pairs. Now a set is also refitted when its MSAC score beats the best's. 3 m, seed 21: the outlier traded for
   // a right pair (5.6 px), 8 pairs as tight as the right 8: 6.7 px. Now the swap search trades it back.
-  const SceneDescription scene = test_scenes::MakeRecolorScene();
-  const Scan scan = test_scenes::ScanScene(scene);
+  RecolorSceneDraws draws;
   for (double offset : {1.0, 3.0}) {
-    const PinholeCamera truth = EvaluationCamera(offset);
-    std::vector<PixelPointPair> exact;
-    const std::vector<PixelPointPair> pairs =
-        DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 2110, &exact);
-    ResectionOptions options = Options(truth);
+    const TenPairDraw draw = draws.Draw(offset, 2110);
+    ResectionOptions options = Options(draw.truth);
     options.seed = 21;
-    const ResectionResult result = Resection(pairs, options);
+    const ResectionResult result = Resection(draw.pairs, options);
     for (int i = 0; i < 10; ++i) EXPECT_EQ(result.inlier[i], i >= 2 ? 1 : 0) << offset << " m, pair " << i;
-    EXPECT_LT(RmsReprojectionError(result.camera, exact), 0.75) << offset << " m";
+    EXPECT_LT(RmsReprojectionError(result.camera, draw.exact), 0.75) << offset << " m";
   }
 }
 
@@ -181,19 +194,14 @@ TEST(Resection, NearPlanarDrawsGetTheCameraOfTheIntrinsicsPrior) {
   // The 1 m draw with seed 11: no minimal DLT of these 10 pairs is a plausible camera (the points nearly lie on
   // one plane), so RANSAC without local optimization finds no set; the prior's camera (square pixels, principal
   // point at the centre, f and pose from EPnP + LM) does.
-  const SceneDescription scene = test_scenes::MakeRecolorScene();
-  const Scan scan = test_scenes::ScanScene(scene);
-  const PinholeCamera truth = EvaluationCamera(1.0);
-  std::vector<PixelPointPair> exact;
-  const std::vector<PixelPointPair> pairs =
-      DrawCorrespondences(scan, truth, RenderPhoto(scene, truth).depth_m, 10, 0.5, 0.2, 1110, &exact);
-  ResectionOptions options = Options(truth);
+  const TenPairDraw draw = RecolorSceneDraws().Draw(1.0, 1110);
+  ResectionOptions options = Options(draw.truth);
   options.seed = 11;
-  const ResectionResult result = Resection(pairs, options);
+  const ResectionResult result = Resection(draw.pairs, options);
   EXPECT_EQ(result.num_inliers, 8);
-  EXPECT_LT(RmsReprojectionError(result.camera, exact), 1.0);
+  EXPECT_LT(RmsReprojectionError(result.camera, draw.exact), 1.0);
   options.local_optimization = false;
-  EXPECT_THROW(Resection(pairs, options), InputError);
+  EXPECT_THROW(Resection(draw.pairs, options), InputError);
 }
 
 TEST(Resection, SameSeedSameCamera) {

@@ -22,8 +22,7 @@ Scan MakePillars(const std::vector<Pillar>& pillars, uint64_t seed) {
   return test_scenes::MakeAnalyticScan(
       grid,
       [&](const cv::Vec3f& d) {
-        test_scenes::RayHit h{15.0 / d[1], cv::Vec3b(210, 198, 176), 0};  // the wall
-        if (d[2] < 0 && -1.5 / d[2] < h.range_m) h = {-1.5 / d[2], cv::Vec3b(130, 130, 126), 0};
+        test_scenes::RayHit h = test_scenes::WallAndGround(d, 15.0, cv::Vec3b(130, 130, 126));
         for (const Pillar& pillar : pillars) {
           const double a = d[0] * d[0] + d[1] * d[1], b = -2 * (d[0] * pillar.x + d[1] * pillar.y),
                        c = pillar.x * pillar.x + pillar.y * pillar.y - pillar.radius * pillar.radius;
@@ -82,16 +81,28 @@ TEST(NeighboursTest, CrevicesRunAlongTheContactOfTouchingBodiesOnly) {
   EXPECT_GT(rows_with_crevice, 0.8 * pair.height);
 }
 
-TEST(NeighboursTest, APillarTouchingTheStrokedOneIsANeighbourNotAPart) {
-  const Scan scan = MakePillars(kTouchingPair, 5);
+// The label-1 pillar cut from StrokeOnLabelOne's strokes without and with the separation of touching
+// neighbours, scored against its true cells.
+struct WithoutAndWith {
+  MaskScores without, with;
+  SegmentResult result;  // with the separation
+};
+WithoutAndWith SegmentWithoutAndWithSeparation(const Scan& scan) {
   const cv::Mat truth = scan.label == 1;
   const cv::Mat strokes = StrokeOnLabelOne(scan);
   SegmentOptions options;
   options.whole_object.separate_touching = false;
-  const MaskScores without = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  WithoutAndWith out;
+  out.without = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
   options.whole_object.separate_touching = true;
-  const SegmentResult result = SegmentObject(scan, strokes, options);
-  const MaskScores with = ScoreMask(result.mask, truth, scan.valid);
+  out.result = SegmentObject(scan, strokes, options);
+  out.with = ScoreMask(out.result.mask, truth, scan.valid);
+  return out;
+}
+
+TEST(NeighboursTest, APillarTouchingTheStrokedOneIsANeighbourNotAPart) {
+  const Scan scan = MakePillars(kTouchingPair, 5);
+  const auto [without, with, result] = SegmentWithoutAndWithSeparation(scan);
   EXPECT_LT(without.iou, 0.7);  // the depth cut takes both pillars, and the colour cut keeps them
   EXPECT_GT(with.iou, 0.95) << "precision " << with.precision << " recall " << with.recall;
   // The neighbour is inferred background, so no later step takes it back.
@@ -105,13 +116,7 @@ TEST(NeighboursTest, APairSeenObliquelyIsStillSeparated) {
   std::vector<Pillar> pair = kTouchingPair;
   for (Pillar& pillar : pair) pillar.x += 0.8;
   const Scan scan = MakePillars(pair, 9);
-  const cv::Mat truth = scan.label == 1;
-  const cv::Mat strokes = StrokeOnLabelOne(scan);
-  SegmentOptions options;
-  options.whole_object.separate_touching = false;
-  const MaskScores without = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
-  options.whole_object.separate_touching = true;
-  const MaskScores with = ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid);
+  const auto [without, with, result] = SegmentWithoutAndWithSeparation(scan);
   EXPECT_LT(without.iou, 0.7);
   EXPECT_GT(with.iou, 0.95) << "precision " << with.precision << " recall " << with.recall;
 }

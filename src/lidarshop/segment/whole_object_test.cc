@@ -38,8 +38,7 @@ Scan MakeBlocks(const std::vector<Block>& blocks, uint64_t seed) {
   return test_scenes::MakeAnalyticScan(
       grid,
       [&](const cv::Vec3f& d) {
-        test_scenes::RayHit h{12.0 / d[1], cv::Vec3b(210, 198, 176), 0};  // the wall
-        if (d[2] < 0 && -1.5 / d[2] < h.range_m) h = {-1.5 / d[2], cv::Vec3b(120, 120, 116), 0};
+        test_scenes::RayHit h = test_scenes::WallAndGround(d, 12.0, cv::Vec3b(120, 120, 116));
         for (const Block& block : blocks) {
           const double t = HitBlock(d, block);
           if (t < h.range_m) h = {t, block.rgb, block.label};

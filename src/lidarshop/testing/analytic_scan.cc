@@ -4,6 +4,12 @@
 
 namespace lidarshop::test_scenes {
 
+RayHit WallAndGround(const cv::Vec3f& d, double wall_y_m, const cv::Vec3b& ground_rgb) {
+  RayHit hit{wall_y_m / d[1], cv::Vec3b(210, 198, 176), 0};
+  if (d[2] < 0 && -1.5 / d[2] < hit.range_m) hit = {-1.5 / d[2], ground_rgb, 0};
+  return hit;
+}
+
 Scan MakeAnalyticScan(const AnalyticGrid& grid, const std::function<RayHit(const cv::Vec3f&)>& hit,
                       double range_noise_m, uint64_t seed) {
   constexpr double kDegree = 3.14159265358979323846 / 180.0;

@@ -18,6 +18,10 @@ struct RayHit {
   int label = 0;
 };
 
+// The backdrop of the segment tests: a beige wall across y = wall_y_m and a ground plane 1.5 m below the scanner
+// (`ground_rgb`), whichever the ray meets first; label 0.
+RayHit WallAndGround(const cv::Vec3f& direction, double wall_y_m, const cv::Vec3b& ground_rgb);
+
 struct AnalyticGrid {
   int rows = 0, cols = 0;
   double azimuth_min_deg = 0, azimuth_max_deg = 0, elevation_min_deg = 0, elevation_max_deg = 0;

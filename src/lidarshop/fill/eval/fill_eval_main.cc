@@ -124,24 +124,23 @@ int main(int argc, char** argv) {
          "--options", options_path,
          "FillOptions as JSON (keys as in `lidarshop fill --options`), applied before the flags above")
       ->check(CLI::ExistingFile);
-  std::string priority = "criminisi", search;  // empty search = FillOptions' default
-  app.add_option("--priority", priority, "criminisi | onion-peel | random")->capture_default_str();
+  std::string priority, search;  // empty: FillOptions' default (or the --options file's)
+  app.add_option("--priority", priority, "criminisi | onion-peel | random (default: FillOptions')");
   app.add_option("--search", search, "local | two-step | exhaustive | patchmatch (default: FillOptions')");
   CLI11_PARSE(app, argc, argv);
-  if (!options_path.empty()) {
-    // The flags given explicitly win over the file: parse again onto the file's options.
-    std::ifstream file(options_path);
-    base = FromJson<FillOptions>(nlohmann::json::parse(file), FillOptions{});
-    CLI11_PARSE(app, argc, argv);
-  }
-  base.priority = priority == "onion-peel" ? InpaintPriorityKind::kOnionPeel
-                  : priority == "random"   ? InpaintPriorityKind::kRandom
-                                           : InpaintPriorityKind::kCriminisi;
-  if (!search.empty()) {
-    base.search = search == "two-step"     ? InpaintSearchKind::kTwoStep
-                  : search == "exhaustive" ? InpaintSearchKind::kExhaustive
-                  : search == "local"      ? InpaintSearchKind::kLocal
-                                           : InpaintSearchKind::kPatchMatch;
+  try {
+    if (!options_path.empty()) {
+      // The flags given explicitly win over the file: parse again onto the file's options.
+      std::ifstream file(options_path);
+      base = FromJson<FillOptions>(nlohmann::json::parse(file), FillOptions{});
+      CLI11_PARSE(app, argc, argv);
+    }
+    if (!priority.empty()) base.priority = ParseEnum<InpaintPriorityKind>(priority);
+    if (!search.empty()) base.search = ParseEnum<InpaintSearchKind>(search);
+    base.Check();
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "fill_eval: {}\n", error.what());
+    return 2;
   }
   const std::vector<std::string> methods = SplitList(methods_text);
   const std::vector<std::string> planar_list = SplitList(planar_text);
