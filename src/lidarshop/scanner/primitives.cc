@@ -379,14 +379,22 @@ TriangleMesh MakeFacadeMesh(const FacadeMeshOptions& options) {
   xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
   std::sort(zs.begin(), zs.end());
   zs.erase(std::unique(zs.begin(), zs.end()), zs.end());
+  // Each opening marks the grid cells it spans (found by binary search): a facade of 100 floors of 150
+  // windows must not test every cell against every opening (minutes).
+  const size_t grid_columns = xs.size() - 1;
+  std::vector<char> open_cell(grid_columns * (zs.size() - 1), 0);
+  auto grid_index = [](const std::vector<double>& edges, double value) {
+    return static_cast<size_t>(std::lower_bound(edges.begin(), edges.end(), value) - edges.begin());
+  };
+  for (const auto& o : openings) {
+    for (size_t j = grid_index(zs, o.z0); j < grid_index(zs, o.z1); ++j) {
+      for (size_t i = grid_index(xs, o.x0); i < grid_index(xs, o.x1); ++i) open_cell[j * grid_columns + i] = 1;
+    }
+  }
   const Vector3d front(0, -1, 0);
   for (size_t i = 0; i + 1 < xs.size(); ++i) {
     for (size_t j = 0; j + 1 < zs.size(); ++j) {
-      const double cx = (xs[i] + xs[i + 1]) / 2, cz = (zs[j] + zs[j + 1]) / 2;
-      const bool inside = std::any_of(openings.begin(), openings.end(), [&](const Opening& o) {
-        return cx > o.x0 && cx < o.x1 && cz > o.z0 && cz < o.z1;
-      });
-      if (inside) continue;
+      if (open_cell[j * grid_columns + i]) continue;
       builder.AddQuad(Vector3d(xs[i], 0, zs[j]), Vector3d(xs[i + 1], 0, zs[j]),
                       Vector3d(xs[i + 1], 0, zs[j + 1]), Vector3d(xs[i], 0, zs[j + 1]), front, options.wall);
     }

@@ -584,6 +584,28 @@ TEST(Primitives, CarsHaveRealSizesAndCanBeRefined) {
   EXPECT_NEAR(SurfaceArea(car), SurfaceArea(MakeCarMesh(CarMeshOptions())), 1e-3 * SurfaceArea(car));
 }
 
+TEST(Primitives, FacadeFrontHasOneHolePerOpening) {
+  // The front face (y = 0) is the slab minus every window (1.5 m wide, at most 1.7 m high) and the door
+  // (1.3 x 2.3 m): its area tells whether each opening was cut once, and only there.
+  auto front_area = [](const TriangleMesh& mesh) {
+    double area = 0;
+    for (const auto& t : mesh.triangles) {
+      const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(), b = mesh.vertices[t[1]].cast<double>(),
+                            c = mesh.vertices[t[2]].cast<double>();
+      if (a.y() == 0 && b.y() == 0 && c.y() == 0) area += (b - a).cross(c - a).norm() / 2;
+    }
+    return area;
+  };
+  FacadeMeshOptions small;  // 20 x 9 m, 3 floors of 6: windows 1.5 x 1.5 m
+  EXPECT_NEAR(front_area(MakeFacadeMesh(small)), 20.0 * 9.0 - 17 * 1.5 * 1.5 - 1.3 * 2.3, 1e-3);
+  FacadeMeshOptions tall;  // 15,000 openings: cut in well under a second, not minutes
+  tall.width = 1000;
+  tall.height = 400;
+  tall.floors = 100;
+  tall.windows_per_floor = 150;
+  EXPECT_NEAR(front_area(MakeFacadeMesh(tall)), 1000.0 * 400.0 - 14999 * 1.5 * 1.7 - 1.3 * 2.3, 1.0);
+}
+
 TEST(Primitives, ClosedPrimitivesHaveConsistentOutwardWinding) {
   // For a closed mesh with outward counter-clockwise faces, the divergence theorem gives the positive volume.
   auto volume = [](const TriangleMesh& mesh) {
