@@ -388,7 +388,8 @@ TriangleMesh MakeFacadeMesh(const FacadeMeshOptions& options) {
   };
   for (const auto& o : openings) {
     for (size_t j = grid_index(zs, o.z0); j < grid_index(zs, o.z1); ++j) {
-      for (size_t i = grid_index(xs, o.x0); i < grid_index(xs, o.x1); ++i) open_cell[j * grid_columns + i] = 1;
+      for (size_t i = grid_index(xs, o.x0); i < grid_index(xs, o.x1); ++i)
+        open_cell[j * grid_columns + i] = 1;
     }
   }
   const Vector3d front(0, -1, 0);
