@@ -45,12 +45,14 @@ const Problem& GetProblem(int kind) {
   return cache.emplace(kind, std::move(problem)).first->second;
 }
 
-void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance, bool offsets = false) {
+void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance, bool offsets = false,
+                 InpaintSearchKind search = FillOptions().search) {
   const Problem& problem = GetProblem(static_cast<int>(state.range(0)));
   FillOptions options;
   options.method = method;
   options.acceptance.enabled = acceptance;
   options.offset_completion = offsets;
+  options.search = search;
   FillResult result;
   for (auto _ : state) {
     result = FillScan(problem.scan, problem.hole, options);
@@ -93,6 +95,13 @@ BENCHMARK_CAPTURE(BM_FillScan, gradient, FillMethod::kGradient, true)
     ->UseRealTime();
 // Opt-in: shifted copies at the dominant patch offsets first (inpaint/offset_completion.h).
 BENCHMARK_CAPTURE(BM_FillScan, gradient_offsets, FillMethod::kGradient, true, true)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+// The exact search (two-step: the local window bounds the scan-wide search).
+BENCHMARK_CAPTURE(BM_FillScan, gradient_exhaustive, FillMethod::kGradient, true, false,
+                  InpaintSearchKind::kExhaustive)
     ->Arg(0)
     ->Arg(1)
     ->Unit(benchmark::kMillisecond)

@@ -137,13 +137,17 @@ cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
 }
 
 InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure, const FillOptions& options,
-                        Progress* progress, int64_t* offset_cells) {
+                        Progress* progress, FillResult* result_counts) {
   InpaintOptions inpaint;
   inpaint.patch_radius = options.patch_radius;
   // The exact search is the two-step one with the local window as its first bound: the same best patch,
   // found sooner.
-  inpaint.search =
-      options.search == InpaintSearchKind::kExhaustive ? InpaintSearchKind::kTwoStep : options.search;
+  const double cost = static_cast<double>(cv::countNonZero(in.hole)) * static_cast<double>(in.hole.total());
+  const bool exact =
+      options.search == InpaintSearchKind::kExhaustive ||
+      (options.search == InpaintSearchKind::kPatchMatch && cost <= options.exact_search_max_cost);
+  inpaint.search = exact ? InpaintSearchKind::kTwoStep : options.search;
+  result_counts->exact_search = exact;
   inpaint.priority = options.priority;
   inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
   inpaint.patchmatch_iterations = options.patchmatch_iterations;
@@ -159,11 +163,10 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   const cv::Mat joint = JointImage(in, structure);
   if (!options.offset_completion) return Inpaint(joint, in.hole, inpaint, progress);
 
-  OffsetCompletionOptions offsets;
-  offsets.patch_radius = options.patch_radius;
-  offsets.channel_weights = inpaint.channel_weights;
+  OffsetCompletionOptions offsets = options.offsets;
+  if (offsets.channel_weights.empty()) offsets.channel_weights = inpaint.channel_weights;
   const OffsetCompletionResult completed = CompleteByOffsets(joint, in.hole, offsets);
-  *offset_cells = cv::countNonZero(completed.label >= 0);
+  result_counts->offset_cells = cv::countNonZero(completed.label >= 0);
   // What no offset could fill goes to the greedy fill, which may copy from the completed cells: its sources
   // are followed back to cells outside the hole.
   const cv::Mat rest = (in.hole != 0) & (completed.label < 0);
@@ -235,9 +238,8 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->timings.gradients_s = timer.Seconds();
 
   timer.Restart();
-  const InpaintResult patches =
-      PatchFill(in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress,
-                &result->offset_cells);
+  const InpaintResult patches = PatchFill(
+      in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress, result);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;
@@ -302,7 +304,7 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   cv::Mat shifted;
   in.range.convertTo(shifted, CV_32F, 1.0, -low);
   const InpaintResult patches =
-      PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress, &result->offset_cells);
+      PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress, result);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;

@@ -33,6 +33,7 @@
 
 #include "lidarshop/fill/surface_planes.h"
 #include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/options_fwd.h"
@@ -51,10 +52,16 @@ struct FillOptions {
   // Patch fill (gradient and depth-patch).
   int patch_radius = 4;  // cells; patches are (2r+1)² (9 x 9: with 6 channels one AVX-512 row per patch row)
   InpaintPriorityKind priority = InpaintPriorityKind::kCriminisi;  // fill order
-  // PatchMatch: random samples over the whole scan plus samples near the target; measured best on
-  // data/fill_eval (a surface hidden behind a large object is found far away, e.g. a facade above a car).
-  // kExhaustive runs the two-step search with the local window as its first bound (the same patches).
+  // PatchMatch: random samples over the whole scan plus samples near the target (a surface hidden behind a
+  // large object is found far away, e.g. a facade above a car). kExhaustive runs the two-step search with the
+  // local window as its first bound (the same patches).
   InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
+  // With PatchMatch: the exact search instead when its cost, hole cells x scan cells, is at most this. A
+  // 20,000-cell hole in a 480 x 320 scan (3e9) takes about 0.5 s exact; a 100,000-cell hole in a 1000 x 1000
+  // scan (1e11) 8 to 15 s, where PatchMatch takes 1.5 s. Measured on data/fill_eval (bench/results/fill.md):
+  // mean range RMSE over the non-planar scenes 24.5 mm exact, 81.0 mm PatchMatch, whose local-first candidates
+  // let the ground climb into a facade behind a van. 0 = always PatchMatch.
+  double exact_search_max_cost = 1e10;
   int search_window_radius = 50;       // cells; local window (local search; PatchMatch's near samples)
   int patchmatch_random_samples = 48;  // PatchMatch: uniform draws over the scan per query (>= 1)
   int patchmatch_iterations = 4;       // PatchMatch: propagation + random-search rounds per query (>= 1)
@@ -87,8 +94,12 @@ struct FillOptions {
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
   // Patch methods: complete the hole by shifted copies of the scan at its dominant patch offsets
   // (inpaint/offset_completion.h: a facade's window pitch brings whole windows) before the greedy patch fill,
-  // which then fills only what no offset could.
+  // which then fills only what no offset could. Opt-in: measured on data/fill_eval (bench/results/fill.md) it
+  // completes windows the greedy fill garbles (facade_van_windows: 0.9 % floating points against 23 %), but on a
+  // small scan its offsets can shift the horizon (tests/cli_test.sh's sphere: the ground behind it left empty).
   bool offset_completion = false;
+  // Its parameters; empty channel_weights = the fill's (colour, gradient and has-return weights above).
+  OffsetCompletionOptions offsets;
   PoissonOptions poisson;   // range reconstruction (and the laplace baseline)
   FillPlaneOptions planes;  // gradient method: reconstructed ranges onto the planes around the hole
   uint64_t seed = 0;        // random choices of the patch fill (ties are broken by position)
@@ -113,6 +124,7 @@ struct FillResult {
   int64_t plane_cells = 0;        // synthesized cells placed on a plane seen around the hole
   int64_t offset_cells = 0;       // hole cells copied by offset completion (FillOptions::offset_completion)
   int patches = 0;                // patches copied (patch methods)
+  bool exact_search = false;      // the patch search was the exact one (FillOptions::exact_search_max_cost)
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole

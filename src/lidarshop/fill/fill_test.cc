@@ -243,6 +243,32 @@ TEST(FillScan, OffsetCompletionFillsBehindTheBox) {
   options.method = FillMethod::kGradient;
   const FillResult again = FillScan(c.scan, c.hole, options);
   EXPECT_EQ(cv::countNonZero(again.scan.range != offsets.scan.range), 0);
+  // Its own options reach it: one label copies fewer cells, a weight list of the wrong length is refused.
+  options.offsets.labels = 1;
+  EXPECT_LT(FillScan(c.scan, c.hole, options).offset_cells, offsets.offset_cells);
+  options.offsets = {};
+  options.offsets.channel_weights = {1.0f};
+  EXPECT_THROW(FillScan(c.scan, c.hole, options), OptionsError);
+}
+
+// PatchMatch gives way to the exact search where that is affordable (FillOptions::exact_search_max_cost): the
+// same fill as asking for it, and PatchMatch's own with a budget of 0.
+TEST(FillScan, SmallHolesGetTheExactSearch) {
+  const Case c = MakeCase(kWallScene, 2);
+  FillOptions options;
+  const FillResult automatic = FillScan(c.scan, c.hole, options);
+  EXPECT_TRUE(automatic.exact_search);
+  options.search = InpaintSearchKind::kExhaustive;
+  const FillResult exact = FillScan(c.scan, c.hole, options);
+  EXPECT_TRUE(exact.exact_search);
+  EXPECT_EQ(cv::countNonZero(automatic.scan.range != exact.scan.range), 0);
+  options.search = InpaintSearchKind::kPatchMatch;
+  options.exact_search_max_cost = 0;
+  const FillResult patchmatch = FillScan(c.scan, c.hole, options);
+  EXPECT_FALSE(patchmatch.exact_search);
+  // PatchMatch compares a few hundred sources per patch, the exact search every one the local bound admits.
+  EXPECT_LT(patchmatch.candidates_evaluated / std::max(1, patchmatch.patches),
+            automatic.candidates_evaluated / std::max(1, automatic.patches));
 }
 
 TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {

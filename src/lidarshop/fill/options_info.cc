@@ -27,6 +27,10 @@ const StructInfo& InfoOf<FillOptions>() {
         .Range(1, 15);
     b.Field(&FillOptions::priority, "priority", "fill order of the patch methods");
     b.Field(&FillOptions::search, "search", "source search of the patch methods");
+    b.Field(&FillOptions::exact_search_max_cost, "exact_search_max_cost",
+            "with patchmatch: the exact search when hole cells x scan cells is at most this; 0 = never")
+        .Unit("cells x cells")
+        .Min(0);
     b.Field(&FillOptions::search_window_radius, "search_window_radius",
             "half-width of the local source search (and PatchMatch's near samples)")
         .Unit("cells")
@@ -49,6 +53,8 @@ const StructInfo& InfoOf<FillOptions>() {
         .Min(0);
     b.Field(&FillOptions::offset_completion, "offset_completion",
             "complete the hole by shifted copies at the scan's dominant patch offsets first");
+    b.Field(&FillOptions::offsets, "offsets",
+            "offset completion's parameters (empty channel_weights = the fill's weights)");
     b.Field(&FillOptions::inverse_range, "inverse_range",
             "copy the gradients of 1/range (slowly varying on planes)");
     b.Field(
@@ -196,6 +202,7 @@ const StructInfo& InfoOf<FillResult>() {
     b.Field(&FillResult::offset_cells, "offset_cells", "hole cells copied by offset completion")
         .Unit("cells");
     b.Field(&FillResult::patches, "patches", "patches copied");
+    b.Field(&FillResult::exact_search, "exact_search", "the patch search was the exact one");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
     b.Field(&FillResult::timings, "timings", "wall seconds per step");
     return b.Build();

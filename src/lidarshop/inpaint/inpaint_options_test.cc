@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/util/options_test_util.h"
 
 namespace lidarshop {
@@ -12,6 +13,7 @@ TEST(InpaintOptionsInfo, ExactRoundTrips) {
   ExpectExactRoundTrip<RepresentativeTestOptions>();
   ExpectExactRoundTrip<HistogramTestOptions>();
   ExpectExactRoundTrip<SmoothTextureTestOptions>();
+  ExpectExactRoundTrip<OffsetCompletionOptions>();
 }
 
 TEST(InpaintOptionsInfo, Errors) {
@@ -19,6 +21,8 @@ TEST(InpaintOptionsInfo, Errors) {
   ExpectRejected<InpaintOptions>({{"search", "patch-match"}}, "search", "did you mean 'patchmatch'");
   ExpectRejected<InpaintOptions>({{"acceptance", {{"histogram", {{"bins", 1}}}}}},
                                  "acceptance.histogram.bins", "out of range [2, 256]");
+  ExpectRejected<OffsetCompletionOptions>({{"labels", 0}}, "labels", "out of range [1, 1000]");
+  ExpectRejected<OffsetCompletionOptions>({{"channel_weights", {1.0, -1.0}}}, "channel_weights", ">= 0");
   EXPECT_EQ(ToString(InpaintSearchKind::kTwoStep), "two-step");
   EXPECT_EQ(ToString(HistogramMetric::kEarthMovers), "emd");
 }

@@ -30,6 +30,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/util/options_fwd.h"
+
 namespace lidarshop {
 
 struct OffsetCompletionOptions {
@@ -40,10 +42,12 @@ struct OffsetCompletionOptions {
   int descriptor_dims = 12;            // principal components of a patch's values (>= 2)
   int min_offset = 8;                  // offsets shorter than this (Chebyshev) are not counted, pixels (>= 1)
   int labels = 60;                     // dominant offsets kept, K (>= 1)
-  int sweeps = 3;                      // expansion sweeps over all labels (>= 1)
+  int sweeps = 2;                      // expansion sweeps over all labels (>= 1)
   std::vector<float> channel_weights;  // one weight >= 0 per channel, or empty for all 1
-  void Check() const;                  // throws OptionsError naming the field
+  void Check() const;                  // throws OptionsFieldError naming the field
 };
+template <>
+const StructInfo& InfoOf<OffsetCompletionOptions>();
 
 struct OffsetCompletionResult {
   std::vector<cv::Point> offsets;  // the K dominant offsets (dx = cols, dy = rows), most votes first

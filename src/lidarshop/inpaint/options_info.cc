@@ -1,5 +1,6 @@
 // Descriptions of the inpainting options and enums (util/options.h): names, units, ranges, docs.
 #include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -194,6 +195,38 @@ const StructInfo& InfoOf<InpaintOptions>() {
         .Min(0);
     b.Field(&InpaintOptions::check_bookkeeping, "check_bookkeeping",
             "verify the incremental front after every fill (slow; for tests)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<OffsetCompletionOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<OffsetCompletionOptions> b(
+        "OffsetCompletionOptions",
+        "completion by shifted copies at the dominant patch offsets (He & Sun 2012)");
+    b.Field(&OffsetCompletionOptions::patch_radius, "patch_radius",
+            "half-width of the patches described for the offset statistics")
+        .Unit("px")
+        .Range(1, 32);
+    b.Field(&OffsetCompletionOptions::sample_step, "sample_step",
+            "grid step of the described known patches (raised to stay within max_samples)")
+        .Unit("px")
+        .Min(1);
+    b.Field(&OffsetCompletionOptions::max_samples, "max_samples", "described patches at most").Min(100);
+    b.Field(&OffsetCompletionOptions::descriptor_dims, "descriptor_dims",
+            "principal components describing a patch")
+        .Range(2, 64);
+    b.Field(&OffsetCompletionOptions::min_offset, "min_offset", "shorter offsets are not counted (Chebyshev)")
+        .Unit("px")
+        .Min(1);
+    b.Field(&OffsetCompletionOptions::labels, "labels", "dominant offsets kept (the labels)").Range(1, 1000);
+    b.Field(&OffsetCompletionOptions::sweeps, "sweeps", "alpha-expansion sweeps over all labels")
+        .Range(1, 100);
+    b.Field(&OffsetCompletionOptions::channel_weights, "channel_weights",
+            "per-channel weights of the seam costs; empty = all 1")
+        .Min(0);
     return b.Build();
   }();
   return info;

@@ -83,17 +83,18 @@ cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
 int main(int argc, char** argv) {
   CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
-  std::string
-      methods_text =
-          "gradient,gradient-noplanes,gradient-plain,gradient-range,gradient-offsets,laplace,depth-patch,"
-          "telea",
-      markdown_path, pictures_dir;
+  std::string methods_text =
+                  "gradient,gradient-patchmatch,gradient-noplanes,gradient-plain,gradient-range,gradient-"
+                  "offsets,laplace,"
+                  "depth-patch,telea",
+              markdown_path, pictures_dir;
   std::string planar_text = "textured_ground";
   int margin = 2, seeds = 3;
   FillOptions base;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the objects to remove)");
   app.add_option("--methods", methods_text,
-                 "comma-separated fill methods (gradient-noplanes: the reconstruction left off the planes; "
+                 "comma-separated fill methods (gradient-patchmatch: PatchMatch whatever the hole's size; "
+                 "gradient-noplanes: the reconstruction left off the planes; "
                  "gradient-plain: no acceptance tests; gradient-range: also on the range; gradient-offsets: "
                  "shifted copies at the dominant patch offsets first)")
       ->capture_default_str();
@@ -195,12 +196,15 @@ int main(int argc, char** argv) {
       FillOptions options = base;
       // "gradient-range": the thesis's variant, range gradients matched and copied (no inverse range).
       const bool variant = name == "gradient-range" || name == "gradient-plain" ||
-                           name == "gradient-noplanes" || name == "gradient-offsets";
+                           name == "gradient-noplanes" || name == "gradient-offsets" ||
+                           name == "gradient-patchmatch";
       options.method = ParseEnum<FillMethod>(variant ? "gradient" : name);
       // "gradient-noplanes": the Poisson reconstruction as it is (fill/surface_planes.h off).
       if (name == "gradient-noplanes") options.planes.enabled = false;
       // "gradient-offsets": shifted copies at the dominant patch offsets first (inpaint/offset_completion.h).
       if (name == "gradient-offsets") options.offset_completion = true;
+      // "gradient-patchmatch": the approximate search even where the exact one is affordable.
+      if (name == "gradient-patchmatch") options.exact_search_max_cost = 0;
       if (name == "gradient-range") options.inverse_range = false;
       // "gradient-plain": without the acceptance tests of inpaint/acceptance.h
       // (the best patch difference wins).
