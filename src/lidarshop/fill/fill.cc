@@ -9,6 +9,7 @@
 #include <opencv2/photo.hpp>
 
 #include "lidarshop/fill/range_gradient.h"
+#include "lidarshop/fill/return_acceptance.h"
 #include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/util/error.h"
@@ -161,7 +162,17 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
     inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
   inpaint.channel_weights.push_back(static_cast<float>(options.return_weight));
   const cv::Mat joint = JointImage(in, structure);
-  if (!options.offset_completion) return Inpaint(joint, in.hole, inpaint, progress);
+  // The acceptance tests, and no sky brought into a patch whose known cells all returned
+  // (fill/return_acceptance.h); the has-return channel is the joint image's last.
+  auto strategies = [&] {
+    InpaintStrategies chosen;
+    if (inpaint.acceptance.enabled) {
+      chosen.acceptance = std::make_unique<fill_internal::ReturnConsistentAcceptance>(
+          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1);
+    }
+    return chosen;
+  };
+  if (!options.offset_completion) return Inpaint(joint, in.hole, inpaint, strategies(), progress);
 
   OffsetCompletionOptions offsets = options.offsets;
   if (offsets.channel_weights.empty()) offsets.channel_weights = inpaint.channel_weights;
@@ -181,7 +192,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   }
   InpaintResult result;
   if (cv::countNonZero(rest) > 0) {
-    result = Inpaint(image, rest, inpaint, progress);
+    result = Inpaint(image, rest, inpaint, strategies(), progress);
     for (auto it = result.source_pixel.begin<cv::Vec2i>(); it != result.source_pixel.end<cv::Vec2i>(); ++it) {
       if ((*it)[0] >= 0 && completed.source_pixel.at<cv::Vec2i>((*it)[0], (*it)[1])[0] >= 0)
         *it = completed.source_pixel.at<cv::Vec2i>((*it)[0], (*it)[1]);

@@ -30,6 +30,9 @@ struct AcceptanceVerdict {
   double margin = 1.0;
   std::string test;  // the test that decided (the failing one, or the one with the least margin)
   double value = 0.0, threshold = 0.0;
+  // A rejection no fallback overrides: when no candidate passes, the fill copies the best candidate that was
+  // not rejected outright (e.g. one that would bring sky into a wall, fill/return_acceptance.h).
+  bool hard = false;
   std::string Explain() const;  // e.g. "rejected by mean: 0.31 > 0.15"
 };
 

@@ -248,6 +248,44 @@ TEST(InpaintFill, AcceptanceHookRejectsCandidates) {
   EXPECT_GT(rejected, 0);
 }
 
+// Every candidate fails; those from the right half outright (AcceptanceVerdict::hard). The fallback copies the
+// best candidate that was not rejected outright, looking past the offered candidates when all of them were.
+class RejectAllRightHalfOutright : public PatchAcceptance {
+ public:
+  bool Accept(const InpaintCanvas& canvas, Pixel target, const SourceCandidate& candidate) const override {
+    return Judge(canvas, target, candidate).accepted;
+  }
+  AcceptanceVerdict Judge(const InpaintCanvas& canvas, Pixel,
+                          const SourceCandidate& candidate) const override {
+    AcceptanceVerdict verdict;
+    verdict.accepted = false;
+    verdict.margin = -1.0;
+    verdict.hard = candidate.source.col >= canvas.cols() / 2;
+    return verdict;
+  }
+};
+
+TEST(InpaintFill, FallbacksSkipCandidatesRejectedOutright) {
+  // The hole lies in the left half; its exact original, the best candidate, in the right one.
+  cv::Mat half = TexturedImage(60, 40, 6), image;
+  cv::hconcat(half, half, image);
+  cv::Mat mask = cv::Mat::zeros(60, 80, CV_8U);
+  cv::circle(mask, {20, 30}, 6, cv::Scalar(255), cv::FILLED);
+  InpaintOptions options;
+  options.patch_radius = 3;
+  options.search = InpaintSearchKind::kExhaustive;
+  InpaintStrategies strategies;
+  strategies.acceptance = std::make_unique<RejectAllRightHalfOutright>();
+  const InpaintResult result = Inpaint(image, mask, options, std::move(strategies));
+  EXPECT_EQ(result.acceptance_fallbacks, result.iterations);
+  for (const FillStep& step : result.steps) EXPECT_LT(step.source.col, 40);
+  // Without acceptance the best candidates come from the right half.
+  const InpaintResult plain = Inpaint(image, mask, options);
+  int right = 0;
+  for (const FillStep& step : plain.steps) right += step.source.col >= 40;
+  EXPECT_GT(right, 0);
+}
+
 TEST(InpaintFill, SingleChannelAndWeightedChannels) {
   cv::Mat image = TexturedImage(40, 50, 7), gray;
   cv::cvtColor(image, gray, cv::COLOR_RGB2GRAY);

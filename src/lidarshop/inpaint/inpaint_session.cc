@@ -60,6 +60,21 @@ struct InpaintSession::State {
     Advance(progress, step.filled_pixels);
   }
 
+  // When no candidate passes: the best candidate not rejected outright (AcceptanceVerdict::hard), among the
+  // decision's and then among the search's best `review_candidates`; the best one when all are.
+  SourceCandidate Fallback(const TargetDecision& decision) const {
+    auto soft = [&](const SourceCandidate& c) {
+      return !strategies.acceptance->Judge(canvas, decision.target, c).hard;
+    };
+    for (const SourceCandidate& c : decision.candidates)
+      if (soft(c)) return c;
+    const auto difference = strategies.difference->ForTarget(canvas, decision.target);
+    for (const SourceCandidate& c :
+         strategies.search->Find(canvas, *difference, decision.target, options.review_candidates))
+      if (soft(c)) return c;
+    return decision.candidates.front();
+  }
+
   SourceCandidate Checked(const ReviewDecision& made, Pixel target) const {
     if (!(made.target == target) || !canvas.Inside(made.source.row, made.source.col) ||
         !canvas.IsSource(made.source.row, made.source.col) || !canvas.SourceFits(target, made.source)) {
@@ -141,7 +156,7 @@ bool InpaintSession::Run() {
       return false;
     } else {
       ++s.result.acceptance_fallbacks;
-      s.Fill(decision, decision.candidates.front(), -1);
+      s.Fill(decision, s.Fallback(decision), -1);
     }
     ++s.review_points;
   }
