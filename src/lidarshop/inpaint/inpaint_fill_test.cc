@@ -227,12 +227,20 @@ class RejectRightHalf : public PatchAcceptance {
   }
 };
 
-TEST(InpaintFill, AcceptanceHookRejectsCandidates) {
-  // The right half is a copy of the left one, so the hole's exact original is the best candidate: rejected.
-  cv::Mat half = TexturedImage(60, 40, 6), image;
-  cv::hconcat(half, half, image);
+// A textured image whose right half repeats its left one, and a hole in the left half: the hole's exact
+// original, the best candidate everywhere, lies in the right half.
+struct TwoHalves {
+  cv::Mat image;
   cv::Mat mask = cv::Mat::zeros(60, 80, CV_8U);
-  cv::circle(mask, {20, 30}, 6, cv::Scalar(255), cv::FILLED);
+  TwoHalves() {
+    const cv::Mat half = TexturedImage(60, 40, 6);
+    cv::hconcat(half, half, image);
+    cv::circle(mask, {20, 30}, 6, cv::Scalar(255), cv::FILLED);
+  }
+};
+
+TEST(InpaintFill, AcceptanceHookRejectsCandidates) {
+  const auto [image, mask] = TwoHalves();
   InpaintOptions options;
   options.patch_radius = 3;
   options.acceptance_candidates = 400;
@@ -266,11 +274,7 @@ class RejectAllRightHalfOutright : public PatchAcceptance {
 };
 
 TEST(InpaintFill, FallbacksSkipCandidatesRejectedOutright) {
-  // The hole lies in the left half; its exact original, the best candidate, in the right one.
-  cv::Mat half = TexturedImage(60, 40, 6), image;
-  cv::hconcat(half, half, image);
-  cv::Mat mask = cv::Mat::zeros(60, 80, CV_8U);
-  cv::circle(mask, {20, 30}, 6, cv::Scalar(255), cv::FILLED);
+  const auto [image, mask] = TwoHalves();
   InpaintOptions options;
   options.patch_radius = 3;
   options.search = InpaintSearchKind::kExhaustive;
