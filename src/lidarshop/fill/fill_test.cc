@@ -98,6 +98,17 @@ TEST(RangeGradient, NoReturnOnBothSidesOfAHoleRun) {
   EXPECT_EQ(cv::countNonZero(between.row(0)), 3);
   EXPECT_EQ(cv::countNonZero(between.row(1)), 0);
   EXPECT_EQ(cv::countNonZero(between.row(2)), 0);
+
+  // Dropouts inside a surface (no-return cells enclosed by returns) do not count; the same row reaching the
+  // border through no-return cells does.
+  cv::Mat inner_hole = cv::Mat::zeros(3, 16, CV_8U), inner_valid = cv::Mat(3, 16, CV_8U, cv::Scalar(255));
+  inner_hole.row(1).colRange(6, 10).setTo(255);
+  inner_valid.row(1).colRange(4, 6).setTo(0);
+  inner_valid.row(1).colRange(10, 12).setTo(0);
+  EXPECT_EQ(cv::countNonZero(NoReturnOnBothSides(inner_hole, inner_valid)), 0);
+  inner_valid.row(1).colRange(0, 6).setTo(0);
+  inner_valid.row(1).colRange(10, 16).setTo(0);
+  EXPECT_EQ(cv::countNonZero(NoReturnOnBothSides(inner_hole, inner_valid)), 4);
 }
 
 TEST(RangeGradient, SeamsBetweenCopiesAtDifferentDepthsAreCut) {

@@ -175,10 +175,21 @@ double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile,
 // ground, runs along the rows, so a cell between two no-return cells of its row has none either, whatever a
 // patch copied from elsewhere says.
 cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
+  // The known cells without a return that are connected to the image's border (sky, beyond range).
+  const cv::Mat no_return = (known_valid == 0) & (hole == 0);
+  cv::Mat component;
+  const int components = cv::connectedComponents(no_return, component, 8, CV_32S);
+  std::vector<uint8_t> open(static_cast<size_t>(components), 0);
+  for (int y = 0; y < hole.rows; ++y) {
+    const int32_t* row = component.ptr<int32_t>(y);
+    const bool edge_row = y == 0 || y == hole.rows - 1;
+    for (int x = 0; x < hole.cols; ++x)
+      if (row[x] > 0 && (edge_row || x == 0 || x == hole.cols - 1)) open[static_cast<size_t>(row[x])] = 1;
+  }
+  auto open_sky = [&](int y, int x) { return open[static_cast<size_t>(component.at<int32_t>(y, x))] != 0; };
   cv::Mat between = cv::Mat::zeros(hole.size(), CV_8U);
   for (int y = 0; y < hole.rows; ++y) {
     const uint8_t* in_hole = hole.ptr<uint8_t>(y);
-    const uint8_t* valid = known_valid.ptr<uint8_t>(y);
     for (int x = 0; x < hole.cols;) {
       if (!in_hole[x]) {
         ++x;
@@ -186,7 +197,7 @@ cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
       }
       int end = x;
       while (end < hole.cols && in_hole[end]) ++end;  // the run [x, end) of hole cells
-      if (x > 0 && end < hole.cols && !valid[x - 1] && !valid[end])
+      if (x > 0 && end < hole.cols && open_sky(y, x - 1) && open_sky(y, end))
         between.row(y).colRange(x, end).setTo(255);
       x = end;
     }

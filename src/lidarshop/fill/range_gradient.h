@@ -44,7 +44,11 @@ cv::Mat UnanchoredCells(const cv::Mat& domain, const cv::Mat& anchor, const Edge
 double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile, double floor);
 
 // Hole cells (`hole` CV_8U non-zero) whose nearest known cells to the left and to the right in the same row both
-// lack a return (`known_valid` CV_8U zero): CV_8U 255. A hole run touching the image's side is never marked.
+// lack a return (`known_valid` CV_8U zero) and belong to regions without a return that reach the image's border
+// (8-connected): CV_8U 255. The sky beside a lamp post and the band beyond the far end of the ground qualify; a
+// stereo cloud's dropouts and an object's own occlusion shadow beside a table-top hole do not (the mug of the
+// shared RGB-D cloud: bars of 136–164 cells across the table left empty). A hole run touching the image's side is
+// never marked.
 cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid);
 
 // Adds to `cuts` the seams between copies: an edge touching the hole whose two cells do not show two neighbouring
