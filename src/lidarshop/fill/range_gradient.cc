@@ -173,7 +173,8 @@ double AbsQuantile(const cv::Mat& values, const cv::Mat& where, double quantile,
 // Hole cells whose nearest known cells to the left and to the right in the same row both lack a return
 // (CV_8U 255). A scan's rows are elevations: the sky over a lamp post, or the band beyond the far end of the
 // ground, runs along the rows, so a cell between two no-return cells of its row has none either, whatever a
-// patch copied from elsewhere says.
+// patch copied from elsewhere says. Only no-return regions that reach the image's border count: dropouts and
+// occlusion shadows inside a surface are enclosed by returns, and the surface continues behind the object.
 cv::Mat NoReturnOnBothSides(const cv::Mat& hole, const cv::Mat& known_valid) {
   // The known cells without a return that are connected to the image's border (sky, beyond range).
   const cv::Mat no_return = (known_valid == 0) & (hole == 0);

@@ -63,6 +63,7 @@ struct InpaintSession::State {
   // When no candidate passes: the best candidate not rejected outright (AcceptanceVerdict::hard), among the
   // decision's and then among the search's best `review_candidates`; the best one when all are.
   SourceCandidate Fallback(const TargetDecision& decision) const {
+    if (!strategies.acceptance) return decision.candidates.front();
     auto soft = [&](const SourceCandidate& c) {
       return !strategies.acceptance->Judge(canvas, decision.target, c).hard;
     };

@@ -84,10 +84,9 @@ int main(int argc, char** argv) {
   CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
   std::string methods_text =
-                  "gradient,gradient-patchmatch,gradient-noplanes,gradient-plain,gradient-range,gradient-"
-                  "offsets,laplace,"
-                  "depth-patch,telea",
-              markdown_path, pictures_dir;
+      "gradient,gradient-patchmatch,gradient-noplanes,gradient-plain,gradient-range,gradient-offsets,"
+      "laplace,depth-patch,telea";
+  std::string markdown_path, pictures_dir;
   std::string planar_text = "textured_ground";
   int margin = 2, seeds = 3;
   FillOptions base;
