@@ -84,7 +84,8 @@ cv::Mat Guide(const Scan& scan) {
   return guide;
 }
 
-// Copies the attributes of each hole cell's source cell (patch methods).
+// Copies the attributes of each hole cell's source cell (patch methods); the row rule of range_gradient.h then
+// takes the return from cells between two no-return regions of their row.
 void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
   const Scan& scan = *in.scan;
   out->source = source;
@@ -106,6 +107,7 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
       if (!out->label.empty()) out->label.at<int32_t>(y, x) = scan.label.at<int32_t>(s[0], s[1]);
     }
   }
+  out->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
 }
 
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
@@ -143,7 +145,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   inpaint.patch_radius = options.patch_radius;
   // The exact search is the two-step one with the local window as its first bound: the same best patch,
   // found sooner.
-  const double cost = static_cast<double>(cv::countNonZero(in.hole)) * static_cast<double>(in.hole.total());
+  const double cost = static_cast<double>(result_counts->hole_cells) * static_cast<double>(in.hole.total());
   const bool exact =
       options.search == InpaintSearchKind::kExhaustive ||
       (options.search == InpaintSearchKind::kPatchMatch && cost <= options.exact_search_max_cost);
@@ -256,7 +258,6 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);
-  values->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
 
   // The guidance field: known gradients outside, the copied ones inside; depth jumps are copied along and cut
   // the Poisson system there, so that surfaces at different distances are not joined by a membrane.
@@ -321,7 +322,6 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
   CopyFromSources(in, patches.source_pixel, values);  // copies the range as it is: the method under test
-  values->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
   result->unanchored_cells = 0;
 }
 

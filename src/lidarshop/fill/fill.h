@@ -58,7 +58,7 @@ struct FillOptions {
   InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
   // With PatchMatch: the exact search instead when its cost, hole cells x scan cells, is at most this. A
   // 20,000-cell hole in a 480 x 320 scan (3e9) takes about 0.5 s exact; a 100,000-cell hole in a 1000 x 1000
-  // scan (1e11) 8 to 15 s, where PatchMatch takes 1.5 s. Measured on data/fill_eval (bench/results/fill.md):
+  // scan (1e11) 8 to 16 s, where PatchMatch takes 1.5 s. Measured on data/fill_eval (bench/results/fill.md):
   // mean range RMSE over the non-planar scenes 24.5 mm exact, 81.0 mm PatchMatch, whose local-first candidates
   // let the ground climb into a facade behind a van. 0 = always PatchMatch.
   double exact_search_max_cost = 1e10;

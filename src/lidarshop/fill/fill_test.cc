@@ -277,7 +277,7 @@ TEST(FillScan, SmallHolesGetTheExactSearch) {
   options.exact_search_max_cost = 0;
   const FillResult patchmatch = FillScan(c.scan, c.hole, options);
   EXPECT_FALSE(patchmatch.exact_search);
-  // PatchMatch compares a few hundred sources per patch, the exact search every one the local bound admits.
+  // PatchMatch compares fewer sources per patch than the exact search, which scans every one its bound admits.
   EXPECT_LT(patchmatch.candidates_evaluated / std::max(1, patchmatch.patches),
             automatic.candidates_evaluated / std::max(1, automatic.patches));
 }
