@@ -80,6 +80,8 @@ void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance, bo
     state.counters["inpaint_us_per_patch"] = 1e6 * result.timings.inpaint_s / result.patches;
   }
   state.counters["inpaint_s"] = result.timings.inpaint_s;
+  state.counters["lattice_s"] = result.timings.lattice_s;
+  state.counters["lattice_cells"] = static_cast<double>(result.lattice_cells);
   state.counters["poisson_s"] = result.timings.poisson_s;
   state.counters["planes_s"] = result.timings.planes_s;
   state.counters["plane_cells"] = static_cast<double>(result.plane_cells);

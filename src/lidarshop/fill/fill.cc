@@ -32,11 +32,11 @@ std::string FillResult::Summary() const {
   return fmt::format(
       "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s "
       "(gradients "
-      "{:.2f}, inpaint {:.2f}, poisson {:.2f}, planes {:.2f}, placement {:.2f})",
+      "{:.2f}, inpaint {:.2f}, lattice {:.2f}, poisson {:.2f}, planes {:.2f}, placement {:.2f})",
       hole_cells, synthesized_cells, no_return_cells,
       unanchored_cells ? fmt::format(" ({} cut off from every known range)", unanchored_cells) : "", patches,
-      timings.total_s, timings.gradients_s, timings.inpaint_s, timings.poisson_s, timings.planes_s,
-      timings.placement_s);
+      timings.total_s, timings.gradients_s, timings.inpaint_s, timings.lattice_s, timings.poisson_s,
+      timings.planes_s, timings.placement_s);
 }
 
 cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
@@ -257,7 +257,19 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;
   result->fill_order = patches.fill_iteration;
-  CopyFromSources(in, patches.source_pixel, values);
+  cv::Mat source = patches.source_pixel, relief_range;
+  if (options.lattice.enabled) {
+    timer.Restart();
+    source = source.clone();
+    const fill_internal::FacadeLatticeReport lattice = fill_internal::RefineSourcesByLattice(
+        in.range, in.known_valid, in.scan->direction, in.guide, in.hole, in.scan->grid, options.planes,
+        options.lattice, options.seed, &source, &relief_range);
+    result->lattice_cells = lattice.cells;
+    result->lattice_pitches_m = lattice.pitches_m;
+    result->lattice_storeys_m = lattice.floors_m;
+    result->timings.lattice_s = timer.Seconds();
+  }
+  CopyFromSources(in, source, values);
 
   // The guidance field: known gradients outside, the copied ones inside; depth jumps are copied along and cut
   // the Poisson system there, so that surfaces at different distances are not joined by a membrane.
@@ -268,7 +280,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   for (int y = 0; y < in.hole.rows; ++y) {
     for (int x = 0; x < in.hole.cols; ++x) {
       if (!in.hole.at<uint8_t>(y, x)) continue;
-      const cv::Vec2i s = patches.source_pixel.at<cv::Vec2i>(y, x);
+      const cv::Vec2i s = source.at<cv::Vec2i>(y, x);
       if (s[0] < 0) continue;
       gx.at<float>(y, x) = gradient.gx.at<float>(s[0], s[1]);
       gy.at<float>(y, x) = gradient.gy.at<float>(s[0], s[1]);
@@ -276,10 +288,30 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
       cuts.down.at<uint8_t>(y, x) = known_jumps.down.at<uint8_t>(s[0], s[1]);
     }
   }
+  // Between two cells placed on a facade's lattice, the difference of their relief ranges (facade_lattice.h).
+  if (!relief_range.empty()) {
+    auto value = [&](int y, int x) {
+      const float r = relief_range.at<float>(y, x);
+      return options.inverse_range ? 1.0f / r : r;
+    };
+    for (int y = 0; y < in.hole.rows; ++y) {
+      for (int x = 0; x < in.hole.cols; ++x) {
+        if (!(relief_range.at<float>(y, x) > 0)) continue;
+        if (x + 1 < in.hole.cols && relief_range.at<float>(y, x + 1) > 0) {
+          gx.at<float>(y, x) = value(y, x + 1) - value(y, x);
+          cuts.right.at<uint8_t>(y, x) = 0;
+        }
+        if (y + 1 < in.hole.rows && relief_range.at<float>(y + 1, x) > 0) {
+          gy.at<float>(y, x) = value(y + 1, x) - value(y, x);
+          cuts.down.at<uint8_t>(y, x) = 0;
+        }
+      }
+    }
+  }
   // Shifted copies meet at seams that no source edge describes (the greedy fill's patches overlap the cells
   // already filled, and its copies of one surface may come from different distances: no seam cuts there).
   if (options.offset_completion)
-    fill_internal::SeamCuts(in.range, in.hole, patches.source_pixel, options.depth_jump_ratio, &cuts);
+    fill_internal::SeamCuts(in.range, in.hole, source, options.depth_jump_ratio, &cuts);
   cv::magnitude(gradient.gx, gradient.gy, result->gradient_magnitude_before);
   result->gradient_magnitude_before.setTo(0, in.hole);
   cv::magnitude(gx, gy, result->gradient_magnitude_after);
@@ -303,7 +335,23 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   timer.Restart();
   result->plane_cells =
       fill_internal::SnapToPlanes(in.range, in.known_valid, in.scan->direction, in.hole, values->has_return,
-                                  patches.source_pixel, options.planes, options.seed, &values->range);
+                                  source, options.planes, options.seed, &values->range);
+  // The lattice's cells stand on their facade, refitted over a storey and several pitches of it, at their
+  // source's relief; the planes of the band around the hole are tilted by what a narrow band cannot pin down,
+  // and a source a pitch away would carry that tilt (a degree is 0.07 m at four metres).
+  // Only where the reconstruction agrees (FillPlaneOptions::tolerance): a cell the patch fill gave the facade's
+  // colour at the foot of a wall standing in front of it stays with the reconstruction's range.
+  if (!relief_range.empty()) {
+    for (int y = 0; y < relief_range.rows; ++y) {
+      for (int x = 0; x < relief_range.cols; ++x) {
+        const float lattice = relief_range.at<float>(y, x);
+        float& r = values->range.at<float>(y, x);
+        if (lattice > 0 && values->has_return.at<uint8_t>(y, x) &&
+            std::abs(lattice - r) <= options.planes.tolerance * r)
+          r = lattice;
+      }
+    }
+  }
   result->timings.planes_s = timer.Seconds();
 }
 

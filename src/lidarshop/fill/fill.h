@@ -31,6 +31,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/fill/facade_lattice.h"
 #include "lidarshop/fill/surface_planes.h"
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/inpaint/offset_completion.h"
@@ -101,6 +102,10 @@ struct FillOptions {
   bool offset_completion = false;
   // Its parameters; empty channel_weights = the fill's (colour, gradient and has-return weights above).
   OffsetCompletionOptions offsets;
+  // Gradient method: the hole cells the patch fill copied from a repeating upright plane (a facade's window
+  // rows) are copied instead from the cells one or more pitches along it (fill/facade_lattice.h), so that a
+  // hidden window ends at its sill and a wall stays a wall.
+  FacadeLatticeOptions lattice;
   PoissonOptions poisson;   // range reconstruction (and the laplace baseline)
   FillPlaneOptions planes;  // gradient method: reconstructed ranges onto the planes around the hole
   uint64_t seed = 0;        // random choices of the patch fill (ties are broken by position)
@@ -110,7 +115,7 @@ template <>
 const StructInfo& InfoOf<FillOptions>();
 
 struct FillTimings {
-  double gradients_s = 0, inpaint_s = 0, poisson_s = 0, planes_s = 0, placement_s = 0,
+  double gradients_s = 0, inpaint_s = 0, lattice_s = 0, poisson_s = 0, planes_s = 0, placement_s = 0,
          total_s = 0;  // wall seconds
 };
 
@@ -124,8 +129,12 @@ struct FillResult {
   int64_t unanchored_cells = 0;   // cells decided "return" but cut off from every known range (left empty)
   int64_t plane_cells = 0;        // synthesized cells placed on a plane seen around the hole
   int64_t offset_cells = 0;       // hole cells copied by offset completion (FillOptions::offset_completion)
-  int patches = 0;                // patches copied (patch methods)
-  bool exact_search = false;      // the patch search was the exact one (FillOptions::exact_search_max_cost)
+  int64_t lattice_cells = 0;      // hole cells copied along a facade's pitch (FillOptions::lattice)
+  // The repeating facades found, one entry per facade and part of the hole: the pitch along it and the storey
+  // height up it, metres (0 = does not repeat that way).
+  std::vector<double> lattice_pitches_m, lattice_storeys_m;
+  int patches = 0;            // patches copied (patch methods)
+  bool exact_search = false;  // the patch search was the exact one (FillOptions::exact_search_max_cost)
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole

@@ -66,6 +66,8 @@ const StructInfo& InfoOf<FillOptions>() {
         .Unit("cells")
         .AboveZero();
     b.Field(&FillOptions::poisson, "poisson", "range reconstruction");
+    b.Field(&FillOptions::lattice, "lattice",
+            "gradient method: cells copied from a repeating facade taken one or more pitches along it");
     b.Field(&FillOptions::planes, "planes", "gradient method: ranges onto the planes seen around the hole");
     b.Field(&FillOptions::seed, "seed", "seed of the patch fill's random choices");
     b.Check([](const FillOptions& o) {
@@ -125,6 +127,36 @@ const StructInfo& InfoOf<FillPlaneOptions>() {
 }
 
 template <>
+const StructInfo& InfoOf<FacadeLatticeOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FacadeLatticeOptions> b("FacadeLatticeOptions",
+                                          "copies along a repeating facade's pitch (fill/facade_lattice.h)");
+    b.Field(&FacadeLatticeOptions::enabled, "enabled",
+            "copy the cells filled from a repeating upright plane one or more pitches along it");
+    b.Field(&FacadeLatticeOptions::min_period_m, "min_period_m", "shortest pitch sought")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&FacadeLatticeOptions::max_period_m, "max_period_m", "longest pitch sought (> min_period_m)")
+        .Unit("m")
+        .AboveZero();
+    b.Field(
+         &FacadeLatticeOptions::min_score, "min_score",
+         "a plane repeats when its best shift scores this (1 = identical copies, 0 = no better than chance)")
+        .Range(1e-3, 1.0);
+    b.Field(&FacadeLatticeOptions::max_translates, "max_translates", "pitches tried on each side")
+        .Range(1, 100);
+    b.Field(&FacadeLatticeOptions::relief_m, "relief_m",
+            "a cell lies on a plane within this distance (window recesses)")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&FacadeLatticeOptions::max_samples, "max_samples", "known cells compared per shift at most")
+        .Min(100);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<RemoveOptions>() {
   static const StructInfo info = [] {
     StructBuilder<RemoveOptions> b("RemoveOptions", "remove an object: cut it out, fill behind it");
@@ -176,6 +208,7 @@ const StructInfo& InfoOf<FillTimings>() {
     StructBuilder<FillTimings> b("FillTimings", "wall seconds per step");
     b.Field(&FillTimings::gradients_s, "gradients_s", "range gradients and the joint image").Unit("s");
     b.Field(&FillTimings::inpaint_s, "inpaint_s", "patch fill").Unit("s");
+    b.Field(&FillTimings::lattice_s, "lattice_s", "copies along a repeating facade").Unit("s");
     b.Field(&FillTimings::poisson_s, "poisson_s", "range reconstruction").Unit("s");
     b.Field(&FillTimings::planes_s, "planes_s", "planes around the hole and ranges onto them").Unit("s");
     b.Field(&FillTimings::placement_s, "placement_s", "points along their rays").Unit("s");
@@ -203,6 +236,11 @@ const StructInfo& InfoOf<FillResult>() {
         .Unit("cells");
     b.Field(&FillResult::patches, "patches", "patches copied");
     b.Field(&FillResult::exact_search, "exact_search", "the patch search was the exact one");
+    b.Field(&FillResult::lattice_cells, "lattice_cells", "hole cells copied along a facade's pitch");
+    b.Field(&FillResult::lattice_pitches_m, "lattice_pitches_m", "pitch of each repeating facade (0 = none)")
+        .Unit("m");
+    b.Field(&FillResult::lattice_storeys_m, "lattice_storeys_m", "storey height of each (0 = none)")
+        .Unit("m");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
     b.Field(&FillResult::timings, "timings", "wall seconds per step");
     return b.Build();

@@ -20,59 +20,15 @@ void FillPlaneOptions::Check() const { Validate(*this); }
 namespace fill_internal {
 namespace {
 
-// n · x + offset_m = 0 with offset_m > 0: the scanner (the origin) is on the positive side.
-struct SeenPlane {
-  Eigen::Vector3d normal;
-  double offset_m = 0;
-  std::vector<Eigen::Vector3f> seen;  // its inliers in the band
-  double SignedDistance(const Eigen::Vector3f& x) const { return normal.dot(x.cast<double>()) + offset_m; }
-};
-
 constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
+
+// cos 8°: planes this parallel, within relief_m of each other, are one surface and its relief.
+constexpr double kParallelCos = 0.99;
 
 // cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
 constexpr float kAgreeingNormal = 0.985f;
 
 enum class Meeting { kNone, kConcave, kConvex };
-
-// The known cells of the scan: ranges (0 without a return), which are usable, and the rays.
-struct KnownCells {
-  const cv::Mat& range;      // CV_32F
-  const cv::Mat& valid;      // CV_8U, outside the hole with a return
-  const cv::Mat& direction;  // CV_32FC3
-  bool Usable(int y, int x) const {
-    return y >= 0 && x >= 0 && y < range.rows && x < range.cols && valid.at<uint8_t>(y, x);
-  }
-  Eigen::Vector3f PointAt(int y, int x) const {
-    const cv::Vec3f d = direction.at<cv::Vec3f>(y, x);
-    const float r = range.at<float>(y, x);
-    return {d[0] * r, d[1] * r, d[2] * r};
-  }
-};
-
-// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
-constexpr double kFacingNormal = 0.906;
-
-// The unit normal at a known cell from its known neighbours two cells away on each side (a wider base than
-// one cell, so that range noise tilts it by a few degrees only); false where they are missing.
-bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
-  constexpr int kReach = 2;
-  auto end = [&](int dy, int dx, Eigen::Vector3f* p) {
-    for (int step = kReach; step >= 0; --step) {
-      if (known.Usable(y + dy * step, x + dx * step)) {
-        *p = known.PointAt(y + dy * step, x + dx * step);
-        return true;
-      }
-    }
-    return false;
-  };
-  Eigen::Vector3f left, right, up, down;
-  if (!end(0, -1, &left) || !end(0, 1, &right) || !end(-1, 0, &up) || !end(1, 0, &down)) return false;
-  const Eigen::Vector3f n = (right - left).cross(down - up);
-  if (n.norm() <= 0) return false;
-  *normal = n.normalized();
-  return true;
-}
 
 // The mean angle between neighbouring rays in `box`, radians.
 double MeanRaySpacing(const cv::Mat& direction, const cv::Rect& box) {
@@ -117,89 +73,6 @@ Meeting HowTheyMeet(const SeenPlane& a, const SeenPlane& b, double threshold_m) 
   if (front_a >= 0.9 && front_b >= 0.9) return Meeting::kConcave;
   if (behind_a >= 0.9 && behind_b >= 0.9) return Meeting::kConvex;
   return Meeting::kNone;
-}
-
-// Planes among the known cells in a band around one part of the hole (the cells of `part_id` (CV_32S
-// connected-component labels over the scan) equal to `id`, `box` its bounding box).
-std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_id, int id,
-                                  const cv::Rect& box, int part_cells, const FillPlaneOptions& options,
-                                  uint64_t seed, double* threshold_m) {
-  int band = options.band_cells;
-  if (band <= 0) {
-    const double diameter = 2.0 * std::sqrt(part_cells / M_PI);
-    band = std::clamp(static_cast<int>(std::lround(diameter / 4.0)), 8, 80);
-  }
-  const cv::Rect roi = cv::Rect(box.x - band, box.y - band, box.width + 2 * band, box.height + 2 * band) &
-                       cv::Rect(0, 0, known.range.cols, known.range.rows);
-  // The part over the band's box only: a hole of many small parts must not cost the whole scan per part.
-  const cv::Mat part = part_id(roi) == id;
-  cv::Mat near_part;
-  cv::dilate(part, near_part, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
-  near_part &= known.valid(roi);
-  std::vector<cv::Point> cells;
-  cv::findNonZero(near_part, cells);
-  // Distance of every band cell from the part: a plane seen only on the hole's rim is what the cut left of
-  // the object itself (its face, missed by a cell or two), not a surface that runs on behind it.
-  cv::Mat from_part;
-  cv::distanceTransform(part == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  if (cells.size() < 50) return {};
-  // Grid normals of the band (a view of the known cells only), to tell a plane the cells lie on from one that
-  // only runs through them (the plane through the nosings of a flight of steps).
-  Scan band_view;
-  band_view.rows = roi.height;
-  band_view.cols = roi.width;
-  band_view.valid = known.valid(roi);
-  band_view.point = cv::Mat(roi.size(), CV_32FC3, cv::Scalar::all(0));
-  for (int y = 0; y < roi.height; ++y) {
-    for (int x = 0; x < roi.width; ++x) {
-      if (!band_view.valid.at<uint8_t>(y, x)) continue;
-      const Eigen::Vector3f p = known.PointAt(y + roi.y, x + roi.x);
-      band_view.point.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
-    }
-  }
-  NormalOptions normal_options;
-  normal_options.window_cells = 2;
-  const cv::Mat normal = EstimateGridNormals(band_view, normal_options).normal;
-  PointCloud cloud;
-  std::vector<float> ranges;
-  cloud.points.reserve(cells.size());
-  ranges.reserve(cells.size());
-  for (const cv::Point& c : cells) {
-    cloud.points.push_back(known.PointAt(c.y + roi.y, c.x + roi.x));
-    ranges.push_back(known.range.at<float>(c.y + roi.y, c.x + roi.x));
-  }
-  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-  *threshold_m = options.inlier_m + options.inlier_per_m * ranges[ranges.size() / 2];
-
-  RansacPlaneOptions ransac;
-  ransac.distance_threshold_m = *threshold_m;
-  ransac.max_planes = options.max_planes;
-  ransac.min_inliers = std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size())));
-  ransac.seed = seed;
-  std::vector<SeenPlane> planes;
-  for (const PlaneFit& fit : DetectPlanesRansac(cloud, ransac)) {
-    SeenPlane plane;
-    plane.normal = fit.normal;
-    plane.offset_m = fit.offset_m;
-    if (std::abs(plane.offset_m) < 1e-6) continue;  // a plane through the scanner is seen edge-on
-    if (plane.offset_m < 0) {
-      plane.normal = -plane.normal;
-      plane.offset_m = -plane.offset_m;
-    }
-    plane.seen.reserve(fit.inliers.size());
-    const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
-                                 static_cast<float>(plane.normal.z()));
-    size_t outer = 0;
-    for (uint32_t i : fit.inliers) {
-      if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
-      plane.seen.push_back(cloud.points[i]);
-      outer += from_part.at<float>(cells[i]) > 0.5f * band;
-    }
-    if (2 * plane.seen.size() < fit.inliers.size()) continue;  // most cells face elsewhere: not a surface
-    if (4 * outer < plane.seen.size()) continue;               // only on the rim
-    planes.push_back(std::move(plane));
-  }
-  return planes;
 }
 
 // The planes of one part of the hole, how each pair meets, and the part's ray spacing.
@@ -298,6 +171,114 @@ double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::
 }
 
 }  // namespace
+
+bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
+  constexpr int kReach = 2;
+  auto end = [&](int dy, int dx, Eigen::Vector3f* p) {
+    for (int step = kReach; step >= 0; --step) {
+      if (known.Usable(y + dy * step, x + dx * step)) {
+        *p = known.PointAt(y + dy * step, x + dx * step);
+        return true;
+      }
+    }
+    return false;
+  };
+  Eigen::Vector3f left, right, up, down;
+  if (!end(0, -1, &left) || !end(0, 1, &right) || !end(-1, 0, &up) || !end(1, 0, &down)) return false;
+  const Eigen::Vector3f n = (right - left).cross(down - up);
+  if (n.norm() <= 0) return false;
+  *normal = n.normalized();
+  return true;
+}
+
+std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_id, int id,
+                                  const cv::Rect& box, int part_cells, const FillPlaneOptions& options,
+                                  uint64_t seed, double* threshold_m) {
+  int band = options.band_cells;
+  if (band <= 0) {
+    const double diameter = 2.0 * std::sqrt(part_cells / M_PI);
+    band = std::clamp(static_cast<int>(std::lround(diameter / 4.0)), 8, 80);
+  }
+  const cv::Rect roi = cv::Rect(box.x - band, box.y - band, box.width + 2 * band, box.height + 2 * band) &
+                       cv::Rect(0, 0, known.range.cols, known.range.rows);
+  // The part over the band's box only: a hole of many small parts must not cost the whole scan per part.
+  const cv::Mat part = part_id(roi) == id;
+  cv::Mat near_part;
+  cv::dilate(part, near_part, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
+  near_part &= known.valid(roi);
+  std::vector<cv::Point> cells;
+  cv::findNonZero(near_part, cells);
+  // Distance of every band cell from the part: a plane seen only on the hole's rim is what the cut left of
+  // the object itself (its face, missed by a cell or two), not a surface that runs on behind it.
+  cv::Mat from_part;
+  cv::distanceTransform(part == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+  if (cells.size() < 50) return {};
+  // Grid normals of the band (a view of the known cells only), to tell a plane the cells lie on from one that
+  // only runs through them (the plane through the nosings of a flight of steps).
+  Scan band_view;
+  band_view.rows = roi.height;
+  band_view.cols = roi.width;
+  band_view.valid = known.valid(roi);
+  band_view.point = cv::Mat(roi.size(), CV_32FC3, cv::Scalar::all(0));
+  for (int y = 0; y < roi.height; ++y) {
+    for (int x = 0; x < roi.width; ++x) {
+      if (!band_view.valid.at<uint8_t>(y, x)) continue;
+      const Eigen::Vector3f p = known.PointAt(y + roi.y, x + roi.x);
+      band_view.point.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+    }
+  }
+  NormalOptions normal_options;
+  normal_options.window_cells = 2;
+  const cv::Mat normal = EstimateGridNormals(band_view, normal_options).normal;
+  PointCloud cloud;
+  std::vector<float> ranges;
+  cloud.points.reserve(cells.size());
+  ranges.reserve(cells.size());
+  for (const cv::Point& c : cells) {
+    cloud.points.push_back(known.PointAt(c.y + roi.y, c.x + roi.x));
+    ranges.push_back(known.range.at<float>(c.y + roi.y, c.x + roi.x));
+  }
+  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+  *threshold_m = options.inlier_m + options.inlier_per_m * ranges[ranges.size() / 2];
+
+  RansacPlaneOptions ransac;
+  ransac.distance_threshold_m = *threshold_m;
+  ransac.max_planes = options.max_planes;
+  ransac.min_inliers = std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size())));
+  ransac.seed = seed;
+  std::vector<SeenPlane> planes;
+  for (const PlaneFit& fit : DetectPlanesRansac(cloud, ransac)) {
+    SeenPlane plane;
+    plane.normal = fit.normal;
+    plane.offset_m = fit.offset_m;
+    if (std::abs(plane.offset_m) < 1e-6) continue;  // a plane through the scanner is seen edge-on
+    if (plane.offset_m < 0) {
+      plane.normal = -plane.normal;
+      plane.offset_m = -plane.offset_m;
+    }
+    plane.seen.reserve(fit.inliers.size());
+    const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
+                                 static_cast<float>(plane.normal.z()));
+    size_t outer = 0;
+    for (uint32_t i : fit.inliers) {
+      if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
+      plane.seen.push_back(cloud.points[i]);
+      outer += from_part.at<float>(cells[i]) > 0.5f * band;
+    }
+    if (2 * plane.seen.size() < fit.inliers.size()) continue;  // most cells face elsewhere: not a surface
+    if (4 * outer < plane.seen.size()) continue;               // only on the rim
+    // A facade's window panes are a plane of their own a little behind it; they are the facade's relief (a
+    // copied pane lands at its offset from the facade), not a surface a cell copied from no plane may snap to.
+    const bool relief_of_earlier = std::any_of(planes.begin(), planes.end(), [&](const SeenPlane& earlier) {
+      return std::abs(plane.normal.z()) < kUprightNormalZ &&
+             earlier.normal.dot(plane.normal) > kParallelCos &&
+             std::abs(earlier.offset_m - plane.offset_m) <= options.relief_m;
+    });
+    if (relief_of_earlier) continue;
+    planes.push_back(std::move(plane));
+  }
+  return planes;
+}
 
 int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv::Mat& direction,
                      const cv::Mat& hole, const cv::Mat& has_return, const cv::Mat& source,

@@ -22,6 +22,9 @@
 // already knows where the wall ends (its depth jump is copied and cut), keeps the plane out there.
 #pragma once
 
+#include <vector>
+
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "lidarshop/util/options_fwd.h"
@@ -55,6 +58,47 @@ template <>
 const StructInfo& InfoOf<FillPlaneOptions>();
 
 namespace fill_internal {
+
+// The known cells of the scan: ranges (0 without a return), which are usable, and the rays.
+struct KnownCells {
+  const cv::Mat& range;      // CV_32F
+  const cv::Mat& valid;      // CV_8U, outside the hole with a return
+  const cv::Mat& direction;  // CV_32FC3
+  bool Usable(int y, int x) const {
+    return y >= 0 && x >= 0 && y < range.rows && x < range.cols && valid.at<uint8_t>(y, x);
+  }
+  Eigen::Vector3f PointAt(int y, int x) const {
+    const cv::Vec3f d = direction.at<cv::Vec3f>(y, x);
+    const float r = range.at<float>(y, x);
+    return {d[0] * r, d[1] * r, d[2] * r};
+  }
+};
+
+// n · x + offset_m = 0 with offset_m > 0: the scanner (the origin) is on the positive side.
+struct SeenPlane {
+  Eigen::Vector3d normal;
+  double offset_m = 0;
+  std::vector<Eigen::Vector3f> seen;  // its inliers in the band
+  double SignedDistance(const Eigen::Vector3f& x) const { return normal.dot(x.cast<double>()) + offset_m; }
+};
+
+// The unit normal at a known cell from its known neighbours two cells away on each side (a wider base than
+// one cell, so that range noise tilts it by a few degrees only); false where they are missing.
+bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal);
+
+// cos 60°: a plane whose normal is within 30° of the horizontal stands upright (a wall, a facade).
+constexpr double kUprightNormalZ = 0.5;
+
+// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
+constexpr double kFacingNormal = 0.906;
+
+// Step 1 above: the planes among the known cells in a band around one part of the hole (the cells of
+// `part_id` (CV_32S connected-component labels over the scan) equal to `id`, `box` its bounding box, of
+// `part_cells` cells); `threshold_m` receives the RANSAC inlier distance used. An upright plane parallel to an
+// earlier one and within relief_m of it (a facade's panes) is left out.
+std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_id, int id,
+                                  const cv::Rect& box, int part_cells, const FillPlaneOptions& options,
+                                  uint64_t seed, double* threshold_m);
 
 // Moves the ranges of the hole cells with a return (`has_return`, CV_8U) onto the planes around the hole, as
 // described above. `range` (CV_32F, the scan's ranges outside the hole, 0 without a return) and `known_valid`

@@ -84,15 +84,16 @@ int main(int argc, char** argv) {
   CLI::App app{"Hole-filling quality against ground truth on the synthetic evaluation scenes"};
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/fill_eval";
   std::string methods_text =
-      "gradient,gradient-patchmatch,gradient-noplanes,gradient-plain,gradient-range,gradient-offsets,"
-      "laplace,depth-patch,telea";
+      "gradient,gradient-nolattice,gradient-patchmatch,gradient-noplanes,gradient-plain,gradient-range,"
+      "gradient-offsets,laplace,depth-patch,telea";
   std::string markdown_path, pictures_dir;
   std::string planar_text = "textured_ground";
   int margin = 2, seeds = 3;
   FillOptions base;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the objects to remove)");
   app.add_option("--methods", methods_text,
-                 "comma-separated fill methods (gradient-patchmatch: PatchMatch whatever the hole's size; "
+                 "comma-separated fill methods (gradient-nolattice: no copies along a repeating facade; "
+                 "gradient-patchmatch: PatchMatch whatever the hole's size; "
                  "gradient-noplanes: the reconstruction left off the planes; "
                  "gradient-plain: no acceptance tests; gradient-range: also on the range; gradient-offsets: "
                  "shifted copies at the dominant patch offsets first)")
@@ -196,10 +197,12 @@ int main(int argc, char** argv) {
       // "gradient-range": the thesis's variant, range gradients matched and copied (no inverse range).
       const bool variant = name == "gradient-range" || name == "gradient-plain" ||
                            name == "gradient-noplanes" || name == "gradient-offsets" ||
-                           name == "gradient-patchmatch";
+                           name == "gradient-patchmatch" || name == "gradient-nolattice";
       options.method = ParseEnum<FillMethod>(variant ? "gradient" : name);
       // "gradient-noplanes": the Poisson reconstruction as it is (fill/surface_planes.h off).
       if (name == "gradient-noplanes") options.planes.enabled = false;
+      // "gradient-nolattice": the patch fill's sources as they are (fill/facade_lattice.h off).
+      if (name == "gradient-nolattice") options.lattice.enabled = false;
       // "gradient-offsets": shifted copies at the dominant patch offsets first (inpaint/offset_completion.h).
       if (name == "gradient-offsets") options.offset_completion = true;
       // "gradient-patchmatch": the approximate search even where the exact one is affordable.
