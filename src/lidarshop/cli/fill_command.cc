@@ -34,9 +34,12 @@ void BindFillOptions(OptionBinder& binder, FillOptions* options, const std::stri
   binder.Bind(
       options,
       {.skip = {"telea_radius_cells"}, .flags = {{"search_window_radius", "--window"}}, .prefix = prefix});
-  binder.Bind(options, {.keys = {"acceptance.enabled", "planes.enabled", "telea_radius_cells"},
-                        .flags = {{"acceptance.enabled", "--accept"}, {"planes.enabled", "--planes"}},
-                        .prefix = prefix});
+  binder.Bind(options,
+              {.keys = {"acceptance.enabled", "planes.enabled", "lattice.enabled", "telea_radius_cells"},
+               .flags = {{"acceptance.enabled", "--accept"},
+                         {"planes.enabled", "--planes"},
+                         {"lattice.enabled", "--lattice"}},
+               .prefix = prefix});
 }
 
 // Outputs are checked before the long work: a scan format, a folder that exists, never an input.

@@ -29,13 +29,13 @@ constexpr float kLevelNormalZ = 0.8f;
 // The pitch is sought at the best shift divided by 2 .. kMaxDivisor, within ±kDivisorReach of it.
 constexpr int kMaxDivisor = 4;
 constexpr double kDivisorReach = 0.05;
-// A known cell differs from its translates' agreement by more than this (grey levels, RMS over the features)
-// is an exception to the lattice.
+// A known cell that differs from what its translates agree on by more than this (grey levels, RMS over the
+// features) is an exception to the lattice.
 constexpr double kExceptionGrey = 20.0;
 // The coarse grid of shifts, metres.
 constexpr double kCoarseStepM = 0.05;
-// How far a pitch's score rises above the lowest score at shorter shifts (the score is 1 − a normalized
-// squared difference: 0.5 is a quarter of the features' variance).
+// How far a pitch's score rises above the lowest score at shorter shifts (the score is 1 − mean squared
+// difference / (2 · variance): a rise of 0.5 is a fall of the difference by the features' variance).
 constexpr double kMinProminence = 0.5;
 // Known cells of a plane's region that make a pitch worth seeking.
 constexpr size_t kMinRegionCells = 100;
@@ -43,7 +43,7 @@ constexpr size_t kMinRegionCells = 100;
 constexpr size_t kMaxRefitPoints = 20000;
 // An exception is wider than this, metres (frame bars are not; doors and shop windows are).
 constexpr double kExceptionReachM = 0.25;
-// Shifts compared when picking among the first valid ones (two agree against a third).
+// Translates that vote, per axis (the nearest valid ones).
 constexpr size_t kVoters = 5;
 
 double WrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
@@ -116,7 +116,7 @@ class AngularGrid {
   double azimuth_step_ = 0, elevation_step_ = 0;
 };
 
-// A plane with an in-plane horizontal axis u and the cells' features on it.
+// A plane and its axes: u along its horizontal, v up it.
 struct PlaneFrame {
   Eigen::Vector3d normal, u_axis, v_axis, origin;  // u along the plane's horizontal, v up it
   double offset_m = 0;

@@ -30,11 +30,12 @@ void FillOptions::Check() const { Validate(*this); }
 
 std::string FillResult::Summary() const {
   return fmt::format(
-      "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches; {:.2f} s "
+      "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches{}; {:.2f} s "
       "(gradients "
       "{:.2f}, inpaint {:.2f}, lattice {:.2f}, poisson {:.2f}, planes {:.2f}, placement {:.2f})",
       hole_cells, synthesized_cells, no_return_cells,
       unanchored_cells ? fmt::format(" ({} cut off from every known range)", unanchored_cells) : "", patches,
+      lattice_cells ? fmt::format(", {} cells copied along a facade's pitch", lattice_cells) : "",
       timings.total_s, timings.gradients_s, timings.inpaint_s, timings.lattice_s, timings.poisson_s,
       timings.planes_s, timings.placement_s);
 }
