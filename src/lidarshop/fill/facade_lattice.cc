@@ -89,7 +89,9 @@ class AngularGrid {
   bool CellOf(const Eigen::Vector3d& p, int* row, int* col) const {
     const double r = p.norm();
     if (!(r > 0)) return false;
-    const double azimuth = azimuth_.front() + WrapAngle(std::atan2(p.x(), p.y()) - azimuth_.front());
+    // In [first column, first column + 2π): a full turn's seam lies just left of the first column.
+    const double azimuth =
+        azimuth_.front() + M_PI + WrapAngle(std::atan2(p.x(), p.y()) - azimuth_.front() - M_PI);
     const double elevation = std::asin(std::clamp(p.z() / r, -1.0, 1.0));
     const int c = Nearest(azimuth_, azimuth, 0.5 * azimuth_step_, false);
     const int y = Nearest(elevation_, elevation, 0.5 * elevation_step_, true);

@@ -121,6 +121,36 @@ TEST(FacadeLattice, ADoorCutByTheHoleRunsOnDownBehindIt) {
   EXPECT_GT(door_colored, 0.9 * door_cells);
 }
 
+TEST(FacadeLattice, AFullTurnScanRepeatsAcrossItsSeam) {
+  // The facade behind the scanner: the image's seam (azimuth ±180°) runs through it and through the hole.
+  const std::string json = R"({
+  "scanner": {"position": [0, 0, 1.6], "azimuth_deg": [-180, 180], "elevation_deg": [-22, 25], "columns": 1200,
+              "rows": 200, "max_range": 60, "los_noise_sigma": 0.004, "seed": 11},
+  "objects": [
+    {"primitive": "plane", "size": [80, 80], "translate": [0, 0, 0], "label": 0, "color": [120, 118, 112]},
+    {"primitive": "facade", "size": [32, 0.5, 10], "floors": 3, "windows_per_floor": 8, "translate": [0, -12, 0],
+     "rotate_deg": [0, 0, 180], "label": 2, "color": [214, 200, 178]},
+    {"primitive": "car", "style": "van", "color": [180, 40, 40], "rotate_deg": [0, 0, 90],
+     "translate": [-1.0, -8.5, 0], "label": 1}
+  ]
+})";
+  const SceneDescription scene = ParseScene(json, "full turn", ".");
+  SceneDescription without = scene;
+  std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
+  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  c.hole = GrowHole((c.scan.label == 1) & (c.scan.valid != 0), 2);
+  ASSERT_GT(cv::countNonZero(c.hole.colRange(0, 10)), 0);  // the hole reaches across the seam
+  ASSERT_GT(cv::countNonZero(c.hole.colRange(c.hole.cols - 10, c.hole.cols)), 0);
+  cv::Mat source = NearestKnownCell(c.hole);
+  const FacadeLatticeReport report = Refine(c, {}, &source);
+  // One facade for each of the hole's two parts, either side of the seam.
+  ASSERT_EQ(report.pitches_m.size(), 2u);
+  for (const double pitch : report.pitches_m) EXPECT_NEAR(pitch, 4.0, 0.1);
+  FillOptions without_lattice;
+  without_lattice.lattice.enabled = false;
+  EXPECT_LT(FloatingPercent(c, {}), 0.5 * FloatingPercent(c, without_lattice));
+}
+
 TEST(FacadeLattice, APlainWallDoesNotRepeat) {
   const std::string json = R"({
   "scanner": {"position": [0, 0, 1.6], "azimuth_deg": [-30, 30], "elevation_deg": [-20, 20], "columns": 160,

@@ -338,10 +338,10 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
       fill_internal::SnapToPlanes(in.range, in.known_valid, in.scan->direction, in.hole, values->has_return,
                                   source, options.planes, options.seed, &values->range);
   // The lattice's cells stand on their facade, refitted over a storey and several pitches of it, at their
-  // source's relief; the planes of the band around the hole are tilted by what a narrow band cannot pin down,
-  // and a source a pitch away would carry that tilt (a degree is 0.07 m at four metres).
-  // Only where the reconstruction agrees (FillPlaneOptions::tolerance): a cell the patch fill gave the facade's
-  // colour at the foot of a wall standing in front of it stays with the reconstruction's range.
+  // source's relief: the planes of the band around the hole keep a tilt a narrow band cannot pin down, which a
+  // source a pitch away would carry (a degree is 0.07 m at four metres). Only where the reconstruction agrees
+  // (FillPlaneOptions::tolerance): a cell the patch fill gave the facade's colour at the foot of a wall standing
+  // in front of it keeps the reconstruction's range.
   if (!relief_range.empty()) {
     for (int y = 0; y < relief_range.rows; ++y) {
       for (int x = 0; x < relief_range.cols; ++x) {

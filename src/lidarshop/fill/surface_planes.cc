@@ -22,6 +22,9 @@ namespace {
 
 constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
 
+// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
+constexpr double kFacingNormal = 0.906;
+
 // cos 8°: planes this parallel, within relief_m of each other, are one surface and its relief.
 constexpr double kParallelCos = 0.99;
 

@@ -89,9 +89,6 @@ bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal);
 // cos 60°: a plane whose normal is within 30° of the horizontal stands upright (a wall, a facade).
 constexpr double kUprightNormalZ = 0.5;
 
-// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
-constexpr double kFacingNormal = 0.906;
-
 // Step 1 above: the planes among the known cells in a band around one part of the hole (the cells of
 // `part_id` (CV_32S connected-component labels over the scan) equal to `id`, `box` its bounding box, of
 // `part_cells` cells); `threshold_m` receives the RANSAC inlier distance used. An upright plane parallel to an
