@@ -14,12 +14,7 @@
 
 namespace lidarshop {
 
-void FacadeLatticeOptions::Check() const {
-  Validate(*this);
-  if (max_period_m <= min_period_m) {
-    throw OptionsFieldError("max_period_m", "must be greater than min_period_m");
-  }
-}
+void FacadeLatticeOptions::Check() const { Validate(*this); }
 
 namespace fill_internal {
 namespace {
@@ -43,32 +38,21 @@ constexpr size_t kMinRegionCells = 100;
 constexpr size_t kMaxRefitPoints = 20000;
 // An exception is wider than this, metres (frame bars are not; doors and shop windows are).
 constexpr double kExceptionReachM = 0.25;
+// Colour (at most 3 channels) and relief.
+constexpr int kMaxFeatures = 4;
 // Translates that vote, per axis (the nearest valid ones).
 constexpr size_t kVoters = 5;
-
-double WrapAngle(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 // The scan's angular grid, for finding the cell whose ray passes through a point.
 class AngularGrid {
  public:
-  // False when no monotonic grid can be had.
-  bool Init(const ScanGrid& grid, const cv::Mat& direction) {
-    const int rows = direction.rows, cols = direction.cols;
-    if (static_cast<int>(grid.azimuth_rad.size()) == cols &&
-        static_cast<int>(grid.elevation_rad.size()) == rows) {
-      azimuth_ = grid.azimuth_rad;
-      elevation_ = grid.elevation_rad;
-    } else {
-      azimuth_.resize(static_cast<size_t>(cols));
-      elevation_.resize(static_cast<size_t>(rows));
-      auto angle_of = [&](int y, int x, bool azimuth) {
-        const cv::Vec3f d = direction.at<cv::Vec3f>(y, x);
-        const Eigen::Vector3f v(d[0], d[1], d[2]);
-        return azimuth ? AzimuthOf(v) : ElevationOf(v);
-      };
-      for (int x = 0; x < cols; ++x) azimuth_[static_cast<size_t>(x)] = angle_of(rows / 2, x, true);
-      for (int y = 0; y < rows; ++y) elevation_[static_cast<size_t>(y)] = angle_of(y, cols / 2, false);
-    }
+  // False when the grid does not match the scan or is not monotonic.
+  bool Init(const ScanGrid& grid, int rows, int cols) {
+    if (static_cast<int>(grid.azimuth_rad.size()) != cols ||
+        static_cast<int>(grid.elevation_rad.size()) != rows)
+      return false;
+    azimuth_ = grid.azimuth_rad;
+    elevation_ = grid.elevation_rad;
     // Azimuths unwrapped from the first column (a full turn may cross ±π).
     for (size_t i = 1; i < azimuth_.size(); ++i)
       azimuth_[i] = azimuth_[i - 1] + WrapAngle(azimuth_[i] - azimuth_[i - 1]);
@@ -89,9 +73,10 @@ class AngularGrid {
   bool CellOf(const Eigen::Vector3d& p, int* row, int* col) const {
     const double r = p.norm();
     if (!(r > 0)) return false;
-    // In [first column, first column + 2π): a full turn's seam lies just left of the first column.
-    const double azimuth =
-        azimuth_.front() + M_PI + WrapAngle(std::atan2(p.x(), p.y()) - azimuth_.front() - M_PI);
+    // In [first column, first column + 2π): a full turn's seam lies just left of the first column; a point
+    // less than half a column left of it belongs to the first column.
+    double azimuth = azimuth_.front() + M_PI + WrapAngle(std::atan2(p.x(), p.y()) - azimuth_.front() - M_PI);
+    if (azimuth > azimuth_.back() + 0.5 * azimuth_step_) azimuth -= 2.0 * M_PI;
     const double elevation = std::asin(std::clamp(p.z() / r, -1.0, 1.0));
     const int c = Nearest(azimuth_, azimuth, 0.5 * azimuth_step_, false);
     const int y = Nearest(elevation_, elevation, 0.5 * elevation_step_, true);
@@ -182,13 +167,18 @@ struct Context {
     out[channels] = static_cast<float>(255.0 * plane.SignedDistance(Point(y, x)) / options.relief_m);
   }
   int feature_count() const { return guide.channels() + 1; }
-  double Difference(const PlaneFrame& plane, int y0, int x0, int y1, int x1) const {
-    float a[8], b[8];
-    Features(plane, y0, x0, a);
-    Features(plane, y1, x1, b);
+  // Squared difference of the features `a` and those of cell (y, x).
+  double Difference(const PlaneFrame& plane, const float* a, int y, int x) const {
+    float b[kMaxFeatures];
+    Features(plane, y, x, b);
     double sum = 0;
     for (int k = 0; k < feature_count(); ++k) sum += (double{a[k]} - b[k]) * (double{a[k]} - b[k]);
     return sum;
+  }
+  double Difference(const PlaneFrame& plane, int y0, int x0, int y1, int x1) const {
+    float a[kMaxFeatures];
+    Features(plane, y0, x0, a);
+    return Difference(plane, a, y1, x1);
   }
   // The cell seeing the point of the plane at `point` + `shift`, when it is on the plane.
   bool Shifted(const PlaneFrame& plane, const Eigen::Vector3d& point, const Eigen::Vector3d& shift, int* y,
@@ -253,22 +243,21 @@ double PlanePitch(const Context& ctx, const PlaneFrame& plane, const Eigen::Vect
   std::vector<cv::Point> samples;
   for (size_t i = 0; i < cells.size(); i += every) samples.push_back(cells[i]);
 
-  // Variance of the features over the samples.
+  // The samples' features (the same for every shift) and their variance.
   const int nf = ctx.feature_count();
-  std::vector<double> mean(static_cast<size_t>(nf), 0.0);
-  std::vector<float> f(static_cast<size_t>(nf));
-  std::vector<double> ranges;
-  for (const cv::Point& s : samples) {
-    ctx.Features(plane, s.y, s.x, f.data());
-    for (int k = 0; k < nf; ++k) mean[static_cast<size_t>(k)] += f[static_cast<size_t>(k)];
-    ranges.push_back(ctx.known.range.at<float>(s.y, s.x));
+  std::vector<float> features(samples.size() * static_cast<size_t>(nf));
+  std::vector<double> mean(static_cast<size_t>(nf), 0.0), ranges;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    float* f = features.data() + i * static_cast<size_t>(nf);
+    ctx.Features(plane, samples[i].y, samples[i].x, f);
+    for (int k = 0; k < nf; ++k) mean[static_cast<size_t>(k)] += f[k];
+    ranges.push_back(ctx.known.range.at<float>(samples[i].y, samples[i].x));
   }
   for (double& m : mean) m /= static_cast<double>(samples.size());
   double variance = 0;
-  for (const cv::Point& s : samples) {
-    ctx.Features(plane, s.y, s.x, f.data());
-    for (int k = 0; k < nf; ++k)
-      variance += std::pow(f[static_cast<size_t>(k)] - mean[static_cast<size_t>(k)], 2);
+  for (size_t i = 0; i < features.size(); ++i) {
+    const double d = features[i] - mean[i % static_cast<size_t>(nf)];
+    variance += d * d;
   }
   variance /= static_cast<double>(samples.size());
   if (variance < 1.0) return 0;  // a plain wall: any shift copies the same
@@ -290,7 +279,7 @@ double PlanePitch(const Context& ctx, const PlaneFrame& plane, const Eigen::Vect
     for (size_t s = 0; s < samples.size(); ++s) {
       int y = 0, x = 0;
       if (!ctx.Shifted(plane, on_plane[s], shift * axis, &y, &x)) continue;
-      sum += ctx.Difference(plane, samples[s].y, samples[s].x, y, x);
+      sum += ctx.Difference(plane, features.data() + s * static_cast<size_t>(nf), y, x);
       ++pairs;
     }
     if (pairs < 50 || 4 * pairs < samples.size()) return -std::numeric_limits<double>::infinity();
@@ -347,9 +336,9 @@ double PlanePitch(const Context& ctx, const PlaneFrame& plane, const Eigen::Vect
 // The cells that see `point` shifted by ±1 .. ±max_translates pitches along u and storeys along v (pitches 0 =
 // no repetition along that axis), kVoters at most per axis, nearest first.
 std::vector<cv::Vec2i> Translates(const Context& ctx, const PlaneFrame& plane, const Eigen::Vector3d& point,
-                                  double pitch_m, double floor_m) {
+                                  double pitch_m, double storey_m) {
   std::vector<cv::Vec2i> found;
-  for (const auto& [axis, step_m] : {std::pair(plane.u_axis, pitch_m), std::pair(plane.v_axis, floor_m)}) {
+  for (const auto& [axis, step_m] : {std::pair(plane.u_axis, pitch_m), std::pair(plane.v_axis, storey_m)}) {
     if (step_m <= 0) continue;
     const size_t before = found.size();
     for (int k = 1; k <= ctx.options.max_translates && found.size() - before < kVoters; ++k)
@@ -377,10 +366,10 @@ size_t Medoid(const Context& ctx, const PlaneFrame& plane, const std::vector<cv:
 
 // A known cell on the plane that differs from what its translates agree on, and from the cells around that
 // one (a pitch lands a cell or two off on thin frame bars).
-bool Exceptional(const Context& ctx, const PlaneFrame& plane, int y, int x, double pitch_m, double floor_m) {
+bool Exceptional(const Context& ctx, const PlaneFrame& plane, int y, int x, double pitch_m, double storey_m) {
   const Eigen::Vector3d p = ctx.Point(y, x);
   const std::vector<cv::Vec2i> translates =
-      Translates(ctx, plane, p - plane.SignedDistance(p) * plane.normal, pitch_m, floor_m);
+      Translates(ctx, plane, p - plane.SignedDistance(p) * plane.normal, pitch_m, storey_m);
   if (translates.empty()) return false;
   const cv::Vec2i rule = translates[Medoid(ctx, plane, translates)];
   const double limit = kExceptionGrey * kExceptionGrey * ctx.feature_count();
@@ -409,7 +398,7 @@ bool RimAbove(const Context& ctx, const PlaneFrame& plane, const Eigen::Vector3d
 // loop that reads it.
 class RimExceptions {
  public:
-  RimExceptions(const Context& ctx, const PlaneFrame& plane, double pitch_m, double floor_m) {
+  RimExceptions(const Context& ctx, const PlaneFrame& plane, double pitch_m, double storey_m) {
     exceptional_ = cv::Mat(ctx.hole.size(), CV_8S, cv::Scalar(-1));
     std::vector<cv::Point> rims;
     for (int y = 0; y + 1 < ctx.hole.rows; ++y)
@@ -419,7 +408,7 @@ class RimExceptions {
     std::vector<int8_t> answer(rims.size(), 0);
     ParallelFor(static_cast<int64_t>(rims.size()), [&](int64_t i) {
       const cv::Point r = rims[static_cast<size_t>(i)];
-      answer[static_cast<size_t>(i)] = Exceptional(ctx, plane, r.y, r.x, pitch_m, floor_m) ? 1 : 0;
+      answer[static_cast<size_t>(i)] = Exceptional(ctx, plane, r.y, r.x, pitch_m, storey_m) ? 1 : 0;
     });
     for (size_t i = 0; i < rims.size(); ++i) exceptional_.at<int8_t>(rims[i]) = answer[i];
   }
@@ -444,19 +433,19 @@ bool ExceptionAbove(const Context& ctx, const PlaneFrame& plane, const RimExcept
 }
 
 // Step 3 of the header for one periodic plane (pitches 0 = no repetition along that axis).
-int64_t CopyAlongLattice(const Context& ctx, const PlaneFrame& plane, double pitch_m, double floor_m,
+int64_t CopyAlongLattice(const Context& ctx, const PlaneFrame& plane, double pitch_m, double storey_m,
                          const std::vector<cv::Point>& targets, cv::Mat* source, cv::Mat* relief_range) {
   int64_t copied = 0;
   std::vector<cv::Vec2i> chosen(targets.size(), cv::Vec2i(-1, -1));
   std::vector<float> range(targets.size(), 0.0f);
-  const RimExceptions exceptions(ctx, plane, pitch_m, floor_m);
+  const RimExceptions exceptions(ctx, plane, pitch_m, storey_m);
   ParallelFor(static_cast<int64_t>(targets.size()), [&](int64_t i) {
     const cv::Point t = targets[static_cast<size_t>(i)];
     Eigen::Vector3d point;
     if (!RayPoint(ctx.known.direction, plane, t.y, t.x, &point)) return;
     cv::Vec2i from;
     if (!ExceptionAbove(ctx, plane, exceptions, point, &from)) {
-      std::vector<cv::Vec2i> found = Translates(ctx, plane, point, pitch_m, floor_m);
+      std::vector<cv::Vec2i> found = Translates(ctx, plane, point, pitch_m, storey_m);
       if (found.empty()) return;
       // The patch fill's own choice votes too (last, so that it wins no tie): a shift that lands on the one
       // door of a facade, with only the wall one pitch further to vote against it, is outvoted.
@@ -493,7 +482,7 @@ FacadeLatticeReport RefineSourcesByLattice(const cv::Mat& range, const cv::Mat& 
   *relief_range = cv::Mat::zeros(hole.size(), CV_32F);
   if (!options.enabled || source->empty()) return report;
   AngularGrid angular;
-  if (!angular.Init(grid, direction)) return report;
+  if (!angular.Init(grid, hole.rows, hole.cols)) return report;
   const KnownCells known{range, known_valid, direction};
   Context ctx{known, guide, hole, angular, options, cv::Mat(hole.size(), CV_32S, cv::Scalar(-1))};
   for (int x = 0; x < hole.cols; ++x) {
@@ -542,13 +531,13 @@ FacadeLatticeReport RefineSourcesByLattice(const cv::Mat& range, const cv::Mat& 
       find_targets(plane);
       if (targets.empty()) continue;
       const std::vector<cv::Point> region = RegionCells(ctx, plane, target_points);
-      double score = 0, floor_score = 0;
+      double score = 0, storey_score = 0;
       const double pitch = PlanePitch(ctx, plane, plane.u_axis, region, &score);
-      const double floor = PlanePitch(ctx, plane, plane.v_axis, region, &floor_score);
-      if (pitch <= 0 && floor <= 0) continue;
+      const double storey = PlanePitch(ctx, plane, plane.v_axis, region, &storey_score);
+      if (pitch <= 0 && storey <= 0) continue;
       report.pitches_m.push_back(pitch);
-      report.floors_m.push_back(floor);
-      report.cells += CopyAlongLattice(ctx, plane, pitch, floor, targets, source, relief_range);
+      report.storeys_m.push_back(storey);
+      report.cells += CopyAlongLattice(ctx, plane, pitch, storey, targets, source, relief_range);
     }
   }
   return report;

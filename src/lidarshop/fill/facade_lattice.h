@@ -58,7 +58,7 @@ namespace fill_internal {
 struct FacadeLatticeReport {
   // Per repeating plane and part of the hole: the pitch along the plane's horizontal and the one up it (a
   // storey), metres, 0 where it does not repeat.
-  std::vector<double> pitches_m, floors_m;
+  std::vector<double> pitches_m, storeys_m;
   int64_t cells = 0;  // hole cells whose source the lattice changed
 };
 
@@ -67,8 +67,8 @@ struct FacadeLatticeReport {
 // decided (changed or kept), the range of step 5, 0 elsewhere: copied range gradients come from cells a pitch
 // or a storey away, whose rays meet the plane at other angles, and would drift over a storey's height, where
 // these ranges do not. `range`, `known_valid` and `direction` as for SnapToPlanes; `guide` CV_32FC(1 or 3) the
-// fill's colour or intensity (grey levels); `grid` the scan's angular grid (when empty, one is read off the
-// ray directions; a grid that is not monotonic turns the lattice off).
+// fill's colour or intensity (grey levels); `grid` the scan's angular grid (GridOf in scan/scan.h; one that
+// does not match the scan's size or is not monotonic turns the lattice off).
 FacadeLatticeReport RefineSourcesByLattice(const cv::Mat& range, const cv::Mat& known_valid,
                                            const cv::Mat& direction, const cv::Mat& guide,
                                            const cv::Mat& hole, const ScanGrid& grid,

@@ -70,7 +70,7 @@ TEST(FacadeLattice, FindsTheBayPitchAndTheStoreyAndCopiesAlongThem) {
   const FacadeLatticeReport report = Refine(c, {}, &source);
   ASSERT_EQ(report.pitches_m.size(), 1u);
   EXPECT_NEAR(report.pitches_m[0], 4.0, 0.08);
-  EXPECT_NEAR(report.floors_m[0], 10.0 / 3, 0.08);
+  EXPECT_NEAR(report.storeys_m[0], 10.0 / 3, 0.08);
   EXPECT_GT(report.cells, 500);
   // Sources changed only in the hole, and only to known cells.
   for (int y = 0; y < source.rows; ++y) {
@@ -82,6 +82,18 @@ TEST(FacadeLattice, FindsTheBayPitchAndTheStoreyAndCopiesAlongThem) {
         EXPECT_TRUE(c.scan.valid.at<uint8_t>(s[0], s[1]) && !c.hole.at<uint8_t>(s[0], s[1]));
       }
     }
+  }
+  // A grid that does not match the scan, or is not monotonic: nothing changes.
+  for (const bool reversed : {false, true}) {
+    Case odd = c;
+    if (reversed) {
+      std::reverse(odd.scan.grid.azimuth_rad.begin(), odd.scan.grid.azimuth_rad.end());
+    } else {
+      odd.scan.grid.azimuth_rad.pop_back();
+    }
+    cv::Mat unchanged = before.clone();
+    EXPECT_EQ(Refine(odd, {}, &unchanged).cells, 0);
+    EXPECT_EQ(cv::norm(unchanged.reshape(1), before.reshape(1), cv::NORM_INF), 0.0);
   }
   // Off: nothing changes.
   FacadeLatticeOptions off;

@@ -263,11 +263,11 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
     timer.Restart();
     source = source.clone();
     const fill_internal::FacadeLatticeReport lattice = fill_internal::RefineSourcesByLattice(
-        in.range, in.known_valid, in.scan->direction, in.guide, in.hole, in.scan->grid, options.planes,
+        in.range, in.known_valid, in.scan->direction, in.guide, in.hole, GridOf(*in.scan), options.planes,
         options.lattice, options.seed, &source, &relief_range);
     result->lattice_cells = lattice.cells;
     result->lattice_pitches_m = lattice.pitches_m;
-    result->lattice_storeys_m = lattice.floors_m;
+    result->lattice_storeys_m = lattice.storeys_m;
     result->timings.lattice_s = timer.Seconds();
   }
   CopyFromSources(in, source, values);

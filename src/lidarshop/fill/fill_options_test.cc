@@ -20,6 +20,8 @@ TEST(FillOptionsInfo, Errors) {
   ExpectRejected<FillOptions>({{"method", "magic"}}, "method", "gradient|laplace|depth-patch|telea");
   ExpectRejected<FillOptions>({{"exact_search_max_cost", -1}}, "exact_search_max_cost", "out of range >= 0");
   ExpectRejected<FillOptions>({{"offsets", {{"sweeps", 0}}}}, "offsets.sweeps", "out of range [1, 100]");
+  ExpectRejected<FillOptions>({{"lattice", {{"max_period_m", 0.5}}}}, "lattice.max_period_m",
+                              "must be greater than min_period_m");
   ExpectRejected<RemoveOptions>({{"fill", {{"poisson", {{"max_levels", 0}}}}}}, "fill.poisson.max_levels",
                                 "out of range >= 1");
   ExpectRejected<RemoveOptions>({{"segment", {{"gmm_components", 33}}}}, "segment.gmm_components",

@@ -151,6 +151,10 @@ const StructInfo& InfoOf<FacadeLatticeOptions>() {
         .AboveZero();
     b.Field(&FacadeLatticeOptions::max_samples, "max_samples", "known cells compared per shift at most")
         .Min(100);
+    b.Check([](const FacadeLatticeOptions& o) {
+      if (o.max_period_m <= o.min_period_m)
+        throw OptionsFieldError("max_period_m", "must be greater than min_period_m");
+    });
     return b.Build();
   }();
   return info;

@@ -31,8 +31,6 @@ double Median(std::vector<double>* values) {
   return median;
 }
 
-double WrapAngle(double angle) { return angle - kTwoPi * std::round(angle / kTwoPi); }
-
 // Weighted pool-adjacent-violators: the non-decreasing sequence closest to
 // `values` in weighted least squares.
 std::vector<double> IsotonicIncreasing(const std::vector<double>& values,

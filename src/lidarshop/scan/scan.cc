@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -12,6 +14,53 @@ double ElevationOf(const Eigen::Vector3f& direction) {
   const double norm = direction.norm();
   if (norm == 0) return 0.0;
   return std::asin(std::clamp(direction.z() / norm, -1.0, 1.0));
+}
+
+double WrapAngle(double angle_rad) {
+  double wrapped = std::fmod(angle_rad + M_PI, 2.0 * M_PI);
+  if (wrapped < 0) wrapped += 2.0 * M_PI;
+  return wrapped - M_PI;
+}
+
+ScanGrid GridOf(const Scan& scan) {
+  if (static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
+      static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
+    return scan.grid;
+  }
+  // The k-th cell out from the middle of `count`: middle, middle - 1, middle + 1, ... (wrapping).
+  auto outward = [](int k, int count) {
+    return (count / 2 + (k % 2 == 0 ? k / 2 : -(k + 1) / 2) + count) % count;
+  };
+  auto direction_at = [&](int r, int c) {
+    const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, c);
+    return Eigen::Vector3f(d[0], d[1], d[2]);
+  };
+  ScanGrid grid;
+  grid.azimuth_rad.resize(static_cast<size_t>(scan.cols));
+  for (int c = 0; c < scan.cols; ++c) {
+    bool found = false;
+    for (int k = 0; k < scan.rows && !found; ++k) {
+      const Eigen::Vector3f d = direction_at(outward(k, scan.rows), c);
+      if (d.squaredNorm() > 0) {
+        grid.azimuth_rad[static_cast<size_t>(c)] = AzimuthOf(d);
+        found = true;
+      }
+    }
+    if (!found) throw InputError(fmt::format("scan '{}': column {} has no ray direction", scan.name, c));
+  }
+  grid.elevation_rad.resize(static_cast<size_t>(scan.rows));
+  for (int r = 0; r < scan.rows; ++r) {
+    bool found = false;
+    for (int k = 0; k < scan.cols && !found; ++k) {
+      const Eigen::Vector3f d = direction_at(r, outward(k, scan.cols));
+      if (d.squaredNorm() > 0) {
+        grid.elevation_rad[static_cast<size_t>(r)] = ElevationOf(d);
+        found = true;
+      }
+    }
+    if (!found) throw InputError(fmt::format("scan '{}': row {} has no ray direction", scan.name, r));
+  }
+  return grid;
 }
 
 int64_t Scan::CountValid() const { return valid.empty() ? 0 : cv::countNonZero(valid); }

@@ -51,6 +51,8 @@ inline Eigen::Vector3f DirectionFromAngles(double azimuth_rad, double elevation_
 // θ = atan2(x, y) in [-π, π]; φ = asin(z / |d|).
 double AzimuthOf(const Eigen::Vector3f& direction);
 double ElevationOf(const Eigen::Vector3f& direction);
+// The angle plus a whole number of turns that lies in [-π, π), radians.
+double WrapAngle(double angle_rad);
 
 // The angular grid of a scan: one azimuth per column and one elevation per image row (row 0 = top = highest).
 struct ScanGrid {
@@ -89,6 +91,12 @@ struct Scan {
   int64_t num_cells() const { return static_cast<int64_t>(rows) * cols; }
   int64_t CountValid() const;
 };
+
+// The scan's angular grid: `scan.grid` when it has an entry per column and row, else read off the ray
+// directions (a column's azimuth from the cell with a direction nearest the middle row, a row's elevation
+// from the cell nearest the middle column; fitted = false). Throws InputError naming the scan and the column
+// or row that has no ray direction at all.
+ScanGrid GridOf(const Scan& scan);
 
 // Copying a Scan shares the pixel buffers (cv::Mat semantics); Clone() copies every channel. A function that
 // changes a channel of a scan it was given must clone first: inputs are never modified.

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarshop/util/error.h"
+
 namespace lidarshop {
 namespace {
 
@@ -24,6 +26,37 @@ TEST(ScanTest, UniformGridPutsHighestElevationInRowZero) {
   const cv::Mat directions = DirectionsFromGrid(grid);
   EXPECT_GT(directions.at<cv::Vec3f>(0, 0)[2], 0.0f);
   EXPECT_LT(directions.at<cv::Vec3f>(2, 0)[0], 0.0f);
+}
+
+TEST(ScanTest, WrapAngleAndTheGridReadOffTheDirections) {
+  EXPECT_NEAR(WrapAngle(3 * M_PI / 2), -M_PI / 2, 1e-12);
+  EXPECT_NEAR(WrapAngle(-3 * M_PI / 2), M_PI / 2, 1e-12);
+  EXPECT_DOUBLE_EQ(WrapAngle(M_PI), -M_PI);  // [-π, π)
+  EXPECT_DOUBLE_EQ(WrapAngle(0.25), 0.25);
+  Scan scan = MakeScan(3, 4);
+  const ScanGrid grid = UniformGrid(3, 4, -0.5, 0.5, -0.2, 0.2);
+  scan.direction = DirectionsFromGrid(grid);
+  scan.grid = grid;
+  EXPECT_EQ(GridOf(scan).azimuth_rad, grid.azimuth_rad);  // the scan's own grid when it matches
+  scan.grid = {};
+  // The middle row has no direction in column 1: that column's azimuth comes from the next row out.
+  scan.direction.at<cv::Vec3f>(1, 1) = cv::Vec3f(0, 0, 0);
+  const ScanGrid read = GridOf(scan);
+  ASSERT_EQ(read.azimuth_rad.size(), 4u);
+  ASSERT_EQ(read.elevation_rad.size(), 3u);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(read.azimuth_rad[c], grid.azimuth_rad[c], 1e-6);
+  for (int r = 0; r < 3; ++r) EXPECT_NEAR(read.elevation_rad[r], grid.elevation_rad[r], 1e-6);
+  EXPECT_FALSE(read.fitted);
+  // A column without any direction.
+  for (int r = 0; r < 3; ++r) scan.direction.at<cv::Vec3f>(r, 2) = cv::Vec3f(0, 0, 0);
+  scan.name = "s";
+  try {
+    GridOf(scan);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("scan 's': column 2 has no ray direction"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST(ScanTest, WithRangeKeepsRaysAndMarksSynthesized) {

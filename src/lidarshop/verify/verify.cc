@@ -22,12 +22,6 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-double WrapAngle(double angle) {
-  angle = std::fmod(angle + kPi, 2.0 * kPi);
-  if (angle < 0) angle += 2.0 * kPi;
-  return angle - kPi;
-}
-
 // Slab test of the line origin + t * direction against a box; returns the parameter interval [t0, t1] (t0 >
 // t1 when the line misses).
 std::pair<float, float> LineBoxInterval(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
@@ -453,44 +447,10 @@ PreparedScan PrepareScan(const Scan& scan) {
       prepared.band_cells[prepared.BandCellIndex(r, c)] = Eigen::Vector4f(p[0], p[1], p[2], range);
     }
   }
-  const bool grid_matches = static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
-                            static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows;
-  if (grid_matches) {
-    prepared.column_azimuth_rad = scan.grid.azimuth_rad;
-    prepared.row_elevation_rad = scan.grid.elevation_rad;
-  } else {
-    // From the direction channel: the middle row for azimuths, the middle column for elevations (falling back
-    // to any cell with a direction).
-    auto direction_at = [&](int r, int c) {
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, c);
-      return Eigen::Vector3f(d[0], d[1], d[2]);
-    };
-    prepared.column_azimuth_rad.resize(scan.cols);
-    for (int c = 0; c < scan.cols; ++c) {
-      bool found = false;
-      for (int k = 0; k < scan.rows && !found; ++k) {
-        const int r = (scan.rows / 2 + (k % 2 == 0 ? k / 2 : -(k + 1) / 2) + scan.rows) % scan.rows;
-        const Eigen::Vector3f d = direction_at(r, c);
-        if (d.squaredNorm() > 0) {
-          prepared.column_azimuth_rad[c] = AzimuthOf(d);
-          found = true;
-        }
-      }
-      if (!found) throw InputError(fmt::format("scan '{}': column {} has no ray direction", scan.name, c));
-    }
-    prepared.row_elevation_rad.resize(scan.rows);
-    for (int r = 0; r < scan.rows; ++r) {
-      bool found = false;
-      for (int k = 0; k < scan.cols && !found; ++k) {
-        const int c = (scan.cols / 2 + (k % 2 == 0 ? k / 2 : -(k + 1) / 2) + scan.cols) % scan.cols;
-        const Eigen::Vector3f d = direction_at(r, c);
-        if (d.squaredNorm() > 0) {
-          prepared.row_elevation_rad[r] = ElevationOf(d);
-          found = true;
-        }
-      }
-      if (!found) throw InputError(fmt::format("scan '{}': row {} has no ray direction", scan.name, r));
-    }
+  {
+    ScanGrid grid = GridOf(scan);
+    prepared.column_azimuth_rad = std::move(grid.azimuth_rad);
+    prepared.row_elevation_rad = std::move(grid.elevation_rad);
   }
   for (int c = 1; c < scan.cols; ++c) {
     prepared.azimuth_step_rad =
