@@ -446,7 +446,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
     const Eigen::Matrix4d preferred =
         header.has_scanner_pose ? header.world_from_scanner : Viewpoint(header, file);
     scan = io_internal::UnorganizedScan(world, valid, with_color, fintensity >= 0, preferred);
-    if (warnings != nullptr && !header.has_scanner_pose &&
+    // Worth a word only when the file gives a sensor pose (an identity VIEWPOINT is PCL's "unknown").
+    if (warnings != nullptr && !header.has_scanner_pose && !preferred.isIdentity() &&
         !scan.world_from_scanner.topRightCorner<3, 1>().isApprox(preferred.topRightCorner<3, 1>())) {
       warnings->push_back(
           fmt::format("{}: the points lie more than {} m from the VIEWPOINT position; the scan's origin is "

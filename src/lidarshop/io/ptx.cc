@@ -8,6 +8,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <Eigen/SVD>
 
 #include "lidarshop/geometry/transform.h"
 
@@ -72,7 +73,8 @@ struct PtxScanHead {
   Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
   // What takes the file's scanner-frame points into the pose's scanner frame: identity for a rigid transform,
   // else R^T · A (A the transform's 3 x 3, R its rotation), which applies the scale to the points.
-  bool scaled = false;
+  bool apply_linear = false;  // scanner_from_file is not the identity
+  bool scaled = false;        // ... and more than the rounding of a printed rotation: a warning
   Eigen::Matrix3d scanner_from_file = Eigen::Matrix3d::Identity();
   double scale = 1.0;  // det(A)^(1/3)
 };
@@ -118,18 +120,25 @@ PtxScanHead ParseScanHead(TextCursor* cursor, int scan_index) {
     ThrowInputError(cursor->file(), fmt::format("line {}: {}", cursor->line() - 1, place), "matrix",
                     "not an affine transform: the printed 4th column (Leica layout) must be 0 0 0 1");
   }
-  if (PoseProblem(head.world_from_scanner, /*allow_uniform_scale=*/false).empty()) return head;
-  // Not a rigid motion. A transform that scales the scanner's axes (orthogonal columns, each scaled by
-  // 1e-3 to 1e3, no mirror: PDAL applies the whole matrix to the points) is applied to the points; the pose
-  // keeps its rotation (the columns normalised, the polar decomposition A = R · S) and position. Anything else
+  // A rotation printed to a few decimals is not quite orthonormal (E57 and other writers refuse such a pose):
+  // the pose takes its nearest rotation R (polar decomposition A = R · S, by SVD) and the points S · p, so the
+  // world coordinates stay the transform's. A transform that scales the scanner's axes (PDAL applies the whole
+  // matrix to the points; each scale within [1e-3, 1e3]) is read the same way, with a warning. Anything else
   // (shear, mirror, a singular or absurd matrix) stays as printed and is refused by CheckScanNumbers.
   const Eigen::Matrix3d linear = head.world_from_scanner.topLeftCorner<3, 3>();
-  if (!linear.allFinite() || !(linear.determinant() > 0)) return head;
-  const Eigen::Vector3d scales = linear.colwise().norm().transpose();
-  if (!(scales.minCoeff() >= 1e-3 && scales.maxCoeff() <= 1e3)) return head;
-  const Eigen::Matrix3d rotation = linear * scales.cwiseInverse().asDiagonal();
-  if (!(rotation.transpose() * rotation).isApprox(Eigen::Matrix3d::Identity(), 1e-4)) return head;
-  head.scaled = true;
+  if (IsRigid(head.world_from_scanner, 1e-12)) return head;
+  const bool rigid = PoseProblem(head.world_from_scanner, /*allow_uniform_scale=*/false).empty();
+  if (!rigid) {
+    if (!linear.allFinite() || !(linear.determinant() > 0)) return head;
+    const Eigen::Vector3d scales = linear.colwise().norm().transpose();
+    if (!(scales.minCoeff() >= 1e-3 && scales.maxCoeff() <= 1e3)) return head;
+    const Eigen::Matrix3d normalized = linear * scales.cwiseInverse().asDiagonal();
+    if (!(normalized.transpose() * normalized).isApprox(Eigen::Matrix3d::Identity(), 1e-4)) return head;
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  head.apply_linear = true;
+  head.scaled = !rigid;
   head.scale = std::cbrt(linear.determinant());
   head.scanner_from_file = rotation.transpose() * linear;
   head.world_from_scanner.topLeftCorner<3, 3>() = rotation;
@@ -219,7 +228,7 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
       }
       cursor->NextLine();
       if (valid) {
-        if (head.scaled) point = head.scanner_from_file * point;
+        if (head.apply_linear) point = head.scanner_from_file * point;
         low = low.cwiseMin(point);
         high = high.cwiseMax(point);
         const Eigen::Vector3f rounded = point.cast<float>();

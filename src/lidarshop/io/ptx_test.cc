@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
@@ -188,6 +189,8 @@ TEST(PtxTest, ReadsTheInteropFilesInWorldCoordinates) {
   const ScanFile complex = ReadScanFile(dir + "complex-transform.ptx");
   EXPECT_TRUE(complex.warnings.empty());
   ASSERT_EQ(complex.scans.size(), 1u);
+  // The printed rotation is orthonormal to 1e-5 only: the pose is its nearest rotation (E57 can store it).
+  EXPECT_TRUE(IsRigid(complex.scans[0].world_from_scanner, 1e-12));
   EXPECT_EQ(complex.scans[0].CountValid(), 4);
   EXPECT_LT((WorldPointOfCell(complex.scans[0], 1, 0) -
              Eigen::Vector3d(-3.0344073807900003, -3.173781036324, -1.823750041614))
