@@ -92,6 +92,8 @@ std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::stri
 std::vector<Scan> ReadPlyScans(const std::string& path, std::vector<std::string>* warnings) {
   const PlyData ply = ReadPly(path);
   const PlyElement& vertex = RequireElement(ply, "vertex", path);
+  // The positions as the file stores them (doubles when the writer needed them): the cloud's floats would
+  // lose half metres 5,000 km out before the pose takes them back to the scanner frame.
   const std::vector<Eigen::Vector3d> positions = VertexPositions(vertex, path, warnings);
   const PointCloud cloud = PointCloudFromPly(ply, path, /*require_positions=*/false);
   const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path, CheckRegularFile(path));
@@ -354,7 +356,9 @@ const std::vector<ScanFormat>& ScanFormats() {
        },
        &WriteE57},
       {"las",
-       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadLas(path)}; },
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadLas(path, warnings)};
+       },
        [](const std::string& path, const std::vector<Scan>& scans) { WriteLas(path, scans); }},
       {"laz", nullptr, nullptr, &LazNotSupportedMessage},
       {"xyz",
