@@ -32,9 +32,6 @@ namespace {
 struct Context {
   const std::string& path;
   const std::vector<uint8_t>& logical;
-  // The records of the data3D entries read so far: every scan of a file is kept at once, so their records are
-  // bounded together.
-  mutable int64_t records_so_far = 0;
 };
 
 // What the reader holds per record while it places a scan's records (coordinates, state, layer, cell and
@@ -415,13 +412,6 @@ PointRecords ReadPointRecords(const Context& ctx, pugi::xml_node child) {
     XmlError(ctx, points, fmt::format("recordCount {} is outside [0, {}]", record_count, g_max_cells));
   }
   records.count = record_count;
-  // A field whose minimum equals its maximum takes no bits, so the bytestreams below do not bound the count:
-  // the records of all scans are bounded by the file's bytes, as the structured grids are, and by the budget.
-  ctx.records_so_far += record_count;
-  io_internal::CheckCellsFromData(ctx.records_so_far, io_internal::kScanBytesPerCell + kReaderBytesPerRecord,
-                                  static_cast<int64_t>(ctx.logical.size()), ctx.path,
-                                  "XML section: " + ElementPath(points),
-                                  "recordCount (records of all scans)");
   CollectFields(ctx, points.child("prototype"), "", &records.fields);
   const std::vector<Field>& fields = records.fields;
   for (size_t i = 0; i < fields.size(); ++i) records.field_index.emplace(fields[i].name, static_cast<int>(i));
@@ -921,6 +911,19 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
       synthesized_field = std::string(name.substr(6)) + ":" + kSynthesizedLocalName;
     }
   }
+  // A field whose minimum equals its maximum takes no bits, so the bytestreams do not bound recordCount: the
+  // records of all scans (kept at once) are bounded together by the file's bytes, as the structured grids
+  // are, and by the budget, before any is read.
+  int64_t all_records = 0;
+  for (pugi::xml_node child : root.child("data3D").children()) {
+    const pugi::xml_attribute count = child.child("points").attribute("recordCount");
+    if (child.type() != pugi::node_element || !count) continue;
+    all_records +=
+        std::clamp<int64_t>(ParseInt(ctx, child.child("points"), count.value()), 0, kMaxScanCells + 1);
+  }
+  io_internal::CheckCellsFromData(all_records, io_internal::kScanBytesPerCell + kReaderBytesPerRecord,
+                                  static_cast<int64_t>(logical.size()), path, "XML section: data3D",
+                                  "recordCount (records of all scans)");
   E57File file;
   int index = 0;
   for (pugi::xml_node child : root.child("data3D").children()) {

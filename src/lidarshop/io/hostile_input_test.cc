@@ -218,9 +218,9 @@ TEST(HostileInputTest, E57RecordsOfNoBitsAreBoundedByTheBytes) {
   EXPECT_EQ(small.scans[0].CountValid(), 24);
   EXPECT_THAT(E57Error(ZeroBitE57({{"a", int64_t{1} << 24}})),
               AllOf(HasSubstr("zero_bits.e57"), HasSubstr("16777216 cells from")));
-  // Eight scans, each within the limit: refused together, at the second.
+  // Eight scans, each within the limit: refused together, before any is read.
   EXPECT_THAT(E57Error(ZeroBitE57(std::vector<std::pair<std::string, int64_t>>(8, {"a", int64_t{1} << 22}))),
-              AllOf(HasSubstr("8388608 cells from"), HasSubstr("records of all scans")));
+              AllOf(HasSubstr("33554432 cells from"), HasSubstr("records of all scans")));
 }
 
 // E57's XML is UTF-8: a Latin-1 scan name is refused naming the file and the byte.
