@@ -309,16 +309,16 @@ ImageHeader ReadImageHeader(const uint8_t* data, size_t size, const std::string&
 
 void CheckImageHeader(const ImageHeader& header, const std::string& what, cv::Size expected,
                       const std::string& expected_what) {
+  if (!expected.empty() && (header.width != expected.width || header.height != expected.height)) {
+    ThrowInputError(what, "", "",
+                    fmt::format("the image is {}x{} but {} is {}x{}", header.width, header.height,
+                                expected_what, expected.width, expected.height));
+  }
   if (header.width > kMaxImagePixels || header.height > kMaxImagePixels ||
       header.width * header.height > kMaxImagePixels) {
     ThrowInputError(what, "header", header.format,
                     fmt::format("an image of {} x {} pixels: more than the {} pixels lidarshop decodes",
                                 header.width, header.height, kMaxImagePixels));
-  }
-  if (!expected.empty() && (header.width != expected.width || header.height != expected.height)) {
-    ThrowInputError(what, "", "",
-                    fmt::format("the image is {}x{} but {} is {}x{}", header.width, header.height,
-                                expected_what, expected.width, expected.height));
   }
   CheckMemoryBudget(header.DecodedBytes(),
                     fmt::format("{}: a {} x {} {} image", what, header.width, header.height, header.format));
