@@ -486,6 +486,12 @@ def main():
     at = broken.index(b'IDAT') + 8
     broken[at:at + 6] = b'\xff' * 6
     fill('error', write('mask_bad_idat.png', bytes(broken)))
+    subprocess.run([lidarshop, 'render', os.path.join(CORPUS, 'good.ptx'), '--channel', 'valid', '-o', os.path.join(CORPUS, 'good_valid.jpg')], check=True)
+    jpeg = bytearray(open(os.path.join(CORPUS, 'good_valid.jpg'), 'rb').read())
+    os.remove(os.path.join(CORPUS, 'good_valid.jpg'))
+    at = jpeg.index(b'\xff\xda')
+    jpeg[at + 20:at + 24] = b'\xff\xd0\xff\xd5'  # restart markers out of order: libjpeg warns, then decodes
+    fill('any', write('mask_corrupt_data.jpg', bytes(jpeg[:-10]) + b'\xff\xd9'))
     # Amplification: a PCD claiming 1.2 GB of LZF data in 172 bytes; 100,000 one-point PTX scans in 7 MB.
     case('budget', 'error@300M', 'info ' + write('lzf_1g.pcd', pcd(100000000, 1, 100000000, data='binary_compressed', body='').encode()
                                                           + struct.pack('<II', 20, 1200000000) + b'\0' * 20))
