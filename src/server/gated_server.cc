@@ -91,6 +91,10 @@ struct GatedServer::Connection {
   int requests = 0;
   Clock::time_point last_activity;              // accepted, or the last request done
   std::optional<Clock::time_point> first_byte;  // of the request under way
+  // Refused: the answer is sent and the client's rest is read and dropped until then, so that a client still
+  // sending its body gets to read the answer instead of a reset.
+  std::optional<Clock::time_point> lingering_until;
+  uint64_t dropped_bytes = 0;
 };
 
 namespace {
@@ -277,6 +281,14 @@ void GatedServer::Refuse(int fd, int status, const std::string& message) {
   shutdown(fd, SHUT_WR);
 }
 
+void GatedServer::Linger(Connection& connection, int status, const std::string& message) {
+  Refuse(connection.fd, status, message);
+  connection.lingering_until = Clock::now() + Seconds(options_.linger_s);
+  connection.first_byte.reset();
+  connection.buffer.clear();
+  connection.buffer.shrink_to_fit();
+}
+
 void GatedServer::Close(int fd) {
   epoll_ctl(epoll_fd_, EPOLL_CTL_DEL, fd, nullptr);
   shutdown(fd, SHUT_RDWR);
@@ -298,6 +310,11 @@ void GatedServer::Admit(int fd) {
       if (oldest == nullptr || other->last_activity < oldest->last_activity) oldest = other.get();
     }
     if (oldest == nullptr) {
+      // What the newcomer sent already is read first: closing a socket with unread bytes resets it, and the
+      // client would see the reset instead of the answer.
+      char chunk[16384];
+      while (recv(fd, chunk, sizeof(chunk), 0) > 0) {
+      }
       Refuse(fd, 503, "too many connections; retry later");
       ::close(fd);
       return;
@@ -322,16 +339,26 @@ void GatedServer::Admit(int fd) {
 void GatedServer::ReadInto(Connection& connection) {
   const int fd = connection.fd;
   char chunk[16384];
+  if (connection.lingering_until) {
+    for (;;) {
+      const ssize_t n = recv(fd, chunk, sizeof(chunk), 0);
+      if (n > 0 && (connection.dropped_bytes += static_cast<uint64_t>(n)) <= options_.max_linger_bytes)
+        continue;
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) return;
+      Close(fd);  // the client is done (or sends too much)
+      return;
+    }
+  }
   for (;;) {
     if (connection.header_bytes == 0) {
       if (connection.buffer.find("\r\n\r\n") != std::string::npos) {
-        if (!CheckHeaders(connection)) return;  // answered and closed
+        if (!CheckHeaders(connection)) return;  // answered (lingering)
         continue;
       }
       if (connection.buffer.size() > options_.max_header_bytes) {
-        Refuse(fd, 431,
+        Linger(connection, 431,
                fmt::format("the request line and headers exceed {} bytes", options_.max_header_bytes));
-        Close(fd);
         return;
       }
     } else if (connection.body_bytes > options_.gate_body_bytes ||
@@ -358,8 +385,8 @@ bool GatedServer::CheckHeaders(Connection& connection) {
   std::string& buffer = connection.buffer;
   const size_t end = buffer.find("\r\n\r\n");
   if (end > options_.max_header_bytes) {
-    Refuse(fd, 431, fmt::format("the request line and headers exceed {} bytes", options_.max_header_bytes));
-    Close(fd);
+    Linger(connection, 431,
+           fmt::format("the request line and headers exceed {} bytes", options_.max_header_bytes));
     return false;
   }
   int lengths = 0;
@@ -405,8 +432,7 @@ bool GatedServer::CheckHeaders(Connection& connection) {
     }
   }
   if (!problem.empty()) {
-    Refuse(fd, status, problem);
-    Close(fd);
+    Linger(connection, status, problem);
     return false;
   }
   if (lengths == 0) {
@@ -480,19 +506,23 @@ void GatedServer::GateLoop() {
     // Deadlines: a request whose headers are late gets 408; an idle connection is closed.
     const Clock::time_point now = Clock::now();
     std::vector<int> late, idle;
+    std::vector<int> lingered;
     for (const auto& [fd, connection] : connections_) {
       if (connection->busy) continue;
-      if (connection->first_byte) {
+      if (connection->lingering_until) {
+        if (now > *connection->lingering_until) lingered.push_back(fd);
+      } else if (connection->first_byte) {
         if (now - *connection->first_byte > Seconds(options_.header_timeout_s)) late.push_back(fd);
       } else if (now - connection->last_activity > Seconds(options_.idle_timeout_s)) {
         idle.push_back(fd);
       }
     }
     for (int fd : late) {
-      Refuse(fd, 408, fmt::format("the request's headers took longer than {} s", options_.header_timeout_s));
-      Close(fd);
+      Linger(*connections_.at(fd), 408,
+             fmt::format("the request's headers took longer than {} s", options_.header_timeout_s));
     }
     for (int fd : idle) Close(fd);
+    for (int fd : lingered) Close(fd);
   }
 }
 

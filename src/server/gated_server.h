@@ -48,6 +48,8 @@ struct GateOptions {
   size_t max_header_bytes = 32 << 10;  // request line and headers together
   int64_t max_body_bytes = int64_t{64} << 20;  // Content-Length above this gets 413
   int max_requests_per_connection = 1000;
+  double linger_s = 2;  // after a refusal, how long the client's rest is read and dropped
+  uint64_t max_linger_bytes = uint64_t{64} << 20;  // ... and how much of it at most
 };
 
 class GatedServer : public httplib::Server {
@@ -83,7 +85,11 @@ class GatedServer : public httplib::Server {
   void Dispatch(Connection& connection);
   void Serve(Connection& connection);
   void Close(int fd);
+  // Sends a one-line JSON error and ends the sending side.
   void Refuse(int fd, int status, const std::string& message);
+  // Refuse, then keep the connection for a moment, dropping what the client still sends (a body it was
+  // sending when the answer came), so that it reads the answer instead of a reset.
+  void Linger(Connection& connection, int status, const std::string& message);
   void Wake();
 
   GateOptions options_;
