@@ -291,6 +291,39 @@ def check_file(lidarshop, rel, path, out_dir):
     return row
 
 
+def hostile_variants(rel, path, out_dir):
+    """Damaged copies of a valid file (cut in half, 16 bytes flipped with a fixed seed, the first 64 bytes
+    zeroed): `info --stats` either reads them or refuses them with exit 1 and one line naming the file —
+    never a crash, a hang or a second line from a library."""
+    data = open(path, "rb").read()
+    rng = np.random.default_rng(sum(rel.encode()))  # a fixed seed per file
+    flipped = bytearray(data)
+    for at in rng.integers(0, len(data), size=16):
+        flipped[at] ^= 0xFF
+    zeroed = bytes(64) + data[64:]
+    problems = []
+    base = os.path.basename(rel)
+    for name, variant in (("half", data[:len(data) // 2]), ("flipped", bytes(flipped)), ("zeroed", zeroed)):
+        variant_path = os.path.join(out_dir, f"{name}_{base}")
+        with open(variant_path, "wb") as f:
+            f.write(variant)
+        try:
+            result = run(["prlimit", "--as=4000000000", "--", LIDARSHOP, "info", "--stats", "--max-memory",
+                          "1G", "--json", os.devnull, variant_path])
+        except subprocess.TimeoutExpired:
+            problems.append(f"{name}: hang")
+            continue
+        errors = [line for line in result.stderr.splitlines() if "warning" not in line]
+        if result.returncode not in (0, 1):
+            problems.append(f"{name}: exit {result.returncode}")
+        elif result.returncode == 1 and (len(errors) != 1 or variant_path not in errors[0]):
+            problems.append(f"{name}: the error is not one line naming the file: {errors[:2]}")
+    return problems
+
+
+LIDARSHOP = None
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("lidarshop")
@@ -298,6 +331,8 @@ def main():
     parser.add_argument("--table")
     parser.add_argument("--only", help="a substring of the files to run")
     args = parser.parse_args()
+    global LIDARSHOP
+    LIDARSHOP = args.lidarshop
     root = os.path.join(args.data, "interop")
     if not os.path.isdir(root):
         print(f"interop_test: {root} is missing (the shared data must lie beside the checkout)")
@@ -308,6 +343,12 @@ def main():
     with tempfile.TemporaryDirectory() as out_dir:
         for rel in files:
             row = check_file(args.lidarshop, rel, os.path.join(root, rel), out_dir)
+            damaged = hostile_variants(rel, os.path.join(root, rel), out_dir)
+            if damaged:
+                row["result"] = "FAIL: damaged copies: " + "; ".join(damaged) if row["result"] == "ok" \
+                    else row["result"] + "; damaged copies: " + "; ".join(damaged)
+            else:
+                row["notes"].append("3 damaged copies read or refused cleanly")
             rows.append(row)
             print(f"{rel}: {row['result']}" + (f" ({'; '.join(row['notes'])})" if row["notes"] else ""),
                   flush=True)
