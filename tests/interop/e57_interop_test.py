@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""E57 checked by a decoder that is not lidarshop's (tests/e57_decode.py, written from ASTM E2807).
+"""E57 checked by a decoder that is not lidarshop's (tests/interop/e57_decode.py, written from ASTM E2807).
 
 usage: e57_interop_test.py LIDARSHOP SHARED_DATA_DIR [TABLE.md]
 
