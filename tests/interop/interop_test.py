@@ -14,6 +14,7 @@ import argparse
 import os
 import re
 import struct
+import xml.etree.ElementTree as ET
 import subprocess
 import sys
 import tempfile
@@ -78,7 +79,12 @@ def promised_points(rel, path):
     if ext == "las":
         return read_las(path)["count"]
     if ext == "e57":
-        return sum(int(n) for n in re.findall(r'recordCount="(\d+)"', e57_xml(path)))
+        # The recordCount of each data3D entry's `points` only: other CompressedVectors (libE57Format's
+        # pointGroupingSchemes groups, extensions) hold no points.
+        root = ET.fromstring(e57_xml(path))
+        ns = "{http://www.astm.org/COMMIT/E57/2010-e57-v1.0}"
+        return sum(int(entry.find(ns + "points").get("recordCount"))
+                   for entry in root.iterfind(f"{ns}data3D/{ns}vectorChild"))
     if ext in ("xyz", "pts"):
         return len(text_points(path, ext))
     if ext == "ply":
