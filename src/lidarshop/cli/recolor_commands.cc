@@ -260,11 +260,14 @@ int RunRecolor(int argc, char** argv) {
 
 int RunImages(int argc, char** argv) {
   CLI::App app{
-      "List the photos (images2D) of an E57 file as JSON; --extract writes each decoded photo as PNG.",
+      "List the photos (images2D) of an E57 file as JSON; --extract writes each photo's stored bytes as they "
+      "are (JPEG or PNG, EXIF kept).",
       "images"};
   std::string path, folder, json_path = "-";
   app.add_option("file", path, "E57 file")->required();
-  app.add_option("--extract", folder, "folder to write <index>_<name>.png into (created)");
+  app.add_option("--extract", folder,
+                 "folder to write <index>_<name>.jpg / .png into (created): the stored blob, byte for byte; "
+                 "a blob that does not decode is not written");
   AddJsonOption(app, &json_path);
   return RunCommand(app, argc, argv, [&] {
     if (FileExtension(path) != "e57") throw OptionsError(path + " is not an .e57 file");
@@ -277,14 +280,22 @@ int RunImages(int argc, char** argv) {
       std::filesystem::create_directories(folder);
       for (size_t i = 0; i < file.images.size(); ++i) {
         const E57Image& image = file.images[i];
-        if (image.image.empty()) continue;
+        // The stored bytes (re-encoding would lose the JPEG's EXIF, where the camera's focal length lives,
+        // and grow it ~6x as PNG); a blob that does not decode (e.g. zero-filled) is not a photo.
+        if (image.image.empty() || image.encoded.empty()) continue;
         std::string name = image.name;
         for (char& c : name) {
           if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
         }
         const std::string out =
-            (std::filesystem::path(folder) / fmt::format("{:02}_{}.png", i, name)).string();
-        WriteImage(out, image.image);
+            (std::filesystem::path(folder) /
+             fmt::format("{:02}_{}.{}", i, name, image.encoding == "jpeg" ? "jpg" : "png"))
+                .string();
+        CheckOutputPath(out, {path, json_path == "-" ? "" : json_path});
+        WriteFileAtomically(out, [&](std::ostream& stream) {
+          stream.write(reinterpret_cast<const char*>(image.encoded.data()),
+                       static_cast<std::streamsize>(image.encoded.size()));
+        });
         json["images"][i]["extracted"] = out;
       }
     }

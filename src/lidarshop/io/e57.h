@@ -42,17 +42,22 @@ struct E57File {
 };
 
 // lidarshop's E57 extension (E2807: extensions are XML namespaces declared on e57Root). Declared as
-// xmlns:lidarshop="http://lidarshop.dev/e57/1.0" when a file uses it; its one field is the points prototype's
-// `lidarshop:synthesized` (Integer 0..1, 1 = created by lidarshop), read back into Scan::synthesized
-// (255 / 0). Readers that do not know the namespace skip the field (libE57Format does).
+// xmlns:lidarshop="http://lidarshop.dev/e57/1.0" when a file uses it; its fields are
+// - the points prototype's `lidarshop:synthesized` (Integer 0..1, 1 = created by lidarshop), read back into
+//   Scan::synthesized (255 / 0);
+// - `lidarshop:noReturnDirections` under a data3D entry: a Structure whose `points` CompressedVector holds
+//   one record per cell without a return (rowIndex, columnIndex, the unit ray as single-float
+//   cartesianX/Y/Z), read back into those cells' Scan::direction bit for bit.
+// Readers that do not know the namespace skip them (libE57Format does).
 constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 
 // Throws InputError naming the file, the page or byte offset and what is wrong (bad CRC, truncated, bad XML).
 E57File ReadE57(const std::string& path);
 
 // Writes organized scans with pose, intensity and colour (each when the scan has it), row/column index and
-// invalid state, and the
-// synthesized channel (when present) as the extension field lidarshop:synthesized; atomic.
+// invalid state, and the synthesized channel (when present) as the extension field lidarshop:synthesized;
+// atomic. Cells without a return get no record in `points` (as scanners' own files): every reader counts and
+// shows the scan's returns only. Their rays go to lidarshop:noReturnDirections (see E57WriteOptions).
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);
 
 // ReadE57 on the bytes of a file already in memory; `name` is used in error messages (fuzzing, tests,
@@ -63,8 +68,12 @@ struct E57WriteOptions {
   // Coordinates: 0 = IEEE single floats (bit-exact round trip of the float32 points); > 0 = ScaledInteger
   // with this step in metres (e.g. 1e-4 = 0.1 mm), using the fewest bits that hold the scan's extent.
   double coordinate_scale_m = 0.0;
-  // Cells without a return but with a direction are written as cartesianInvalidState = 1 (the xyz is the unit
-  // direction), so directions survive a round trip exactly; false writes valid cells only (smaller files).
+  // Cells without a return are never records of `points` (a reader that ignores cartesianInvalidState would
+  // show their rays as points). true: their directions (rays) are written in lidarshop's extension
+  // `lidarshop:noReturnDirections`, so that they survive a round trip bit for bit; false: not at all (smaller
+  // files; the reader then gives them the fitted grid's directions). Files written by lidarshop before the
+  // extension carried these rays as `points` records of cartesianInvalidState 1 at unit distance; ReadE57
+  // still reads them so.
   bool write_no_return_directions = true;
   void Check() const;  // throws OptionsError
 };
@@ -77,7 +86,8 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const E57WriteOpt
 // One scan with a second layer behind it (`remove --keep-object`: the kept object in front, the filled
 // background behind). `front` and `behind` share the grid (rows x cols, directions) and pose; `behind` holds
 // returns only in some cells. Every record of `front` is written as by WriteE57 with returnIndex 0, plus one
-// record per valid `behind` cell with the same rowIndex/columnIndex and returnIndex 1; returnCount is 2 on
+// record per valid `behind` cell with the same rowIndex/columnIndex and returnIndex 1 (after a front record
+// at zero coordinates with cartesianInvalidState 2 where the front has no return); returnCount is 2 on
 // both records of such a cell, else 1; the `lidarshop:synthesized` field is 1 on every second return and
 // follows front.synthesized on the others. ReadE57 gives the layers back as scans[0] and second_returns[0].
 // Throws std::logic_error when the layers differ in size (check first: WriteScanWithLayer does). Atomic.

@@ -31,6 +31,10 @@ constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a c
 constexpr char kExtensionXmlns[] = "xmlns:lidarshop";
 constexpr char kSynthesizedField[] = "lidarshop:synthesized";
 constexpr char kSynthesizedLocalName[] = "synthesized";
+// The rays of a scan's cells without a return (e57.h): a Structure under the data3D entry holding a `points`
+// CompressedVector of rowIndex, columnIndex and the unit ray as cartesianX/Y/Z.
+constexpr char kNoReturnDirectionsField[] = "lidarshop:noReturnDirections";
+constexpr char kNoReturnDirectionsLocalName[] = "noReturnDirections";
 
 // The largest record count or grid (cells) a file may claim; kMaxScanCells unless lowered (the fuzzer does,
 // to keep its memory bounded). Not thread-safe to change while reading.

@@ -647,6 +647,55 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
   return placed;
 }
 
+// lidarshop's extension `<prefix>:noReturnDirections` of a data3D entry (`field_name`, "" when the file
+// does not declare the namespace): the rays of the cells without a return, as rowIndex / columnIndex and a
+// unit vector in cartesianX/Y/Z. Sets them bit for bit (`has_direction` 2). Files written before it carried
+// these rays as records of state 1 instead (PlaceRecords reads those).
+void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std::string& field_name,
+                            const RecordGrid& grid, Scan* scan, std::vector<uint8_t>* has_direction) {
+  const pugi::xml_node extension = field_name.empty() ? pugi::xml_node() : child.child(field_name.c_str());
+  if (!extension) return;
+  const PointRecords records = ReadPointRecords(ctx, extension);
+  if (records.count == 0) return;
+  if (!records.structured || !records.cartesian) {
+    XmlError(ctx, records.points, "needs rowIndex, columnIndex and cartesianX/Y/Z");
+  }
+  std::vector<int64_t> cells(records.count);
+  for (const char* name : {"rowIndex", "columnIndex"}) {
+    const int64_t bound = name[0] == 'r' ? grid.rows : grid.cols;
+    const auto& v = records.Decode(records.Find(name));
+    for (int64_t i = 0; i < records.count; ++i) {
+      if (!(v[i] >= 0 && v[i] < static_cast<double>(bound))) {
+        XmlError(ctx, records.points,
+                 fmt::format("record {}: {} {} is outside the scan's {} x {} grid", i, name, v[i], grid.rows,
+                             grid.cols));
+      }
+      cells[i] =
+          name[0] == 'r' ? static_cast<int64_t>(v[i]) * grid.cols : cells[i] + static_cast<int64_t>(v[i]);
+    }
+  }
+  cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>();
+  const uint8_t* valid = scan->valid.ptr<uint8_t>();
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto& v = records.Decode(records.Find(axis == 0   ? "cartesianX"
+                                                : axis == 1 ? "cartesianY"
+                                                            : "cartesianZ"));
+    for (int64_t i = 0; i < records.count; ++i) direction[cells[i]][axis] = static_cast<float>(v[i]);
+  }
+  for (int64_t i = 0; i < records.count; ++i) {
+    cv::Vec3f& d = direction[cells[i]];
+    const float norm = static_cast<float>(cv::norm(d));
+    if (valid[cells[i]] || !(std::isfinite(norm) && norm > 0.0f)) {
+      XmlError(
+          ctx, records.points,
+          fmt::format("record {} (row {}, column {}): {}", i, cells[i] / grid.cols, cells[i] % grid.cols,
+                      valid[cells[i]] ? "the cell has a return" : "the direction is zero or not finite"));
+    }
+    if (!(std::abs(norm - 1.0f) < 1e-6f)) d /= norm;  // a stored unit vector is kept bit for bit
+    (*has_direction)[cells[i]] = 2;
+  }
+}
+
 // Intensities of the placed records (grid.cell[i] >= 0), scaled to [0, 1] by intensityLimits (or by the
 // returned values when the file gives none).
 void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords& records,
@@ -751,10 +800,13 @@ void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* 
 }
 
 // The first returns of one data3D entry; records with returnIndex 1 go to `second` (left 0 x 0 when there are
-// none), later ones are counted in `warnings`. `synthesized_field` is the name of lidarshop's extension field
-// under the prefix the file binds to its namespace ("" when the file does not declare it).
-Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::string& synthesized_field,
+// none), later ones are counted in `warnings`. `extension_prefix` is the prefix the file binds to lidarshop's
+// namespace ("" when the file does not declare it): its fields are `<prefix>:synthesized` and
+// `<prefix>:noReturnDirections`.
+Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::string& extension_prefix,
               Scan* second, std::vector<std::string>* warnings) {
+  const std::string synthesized_field =
+      extension_prefix.empty() ? "" : extension_prefix + ":" + kSynthesizedLocalName;
   const PointRecords records = ReadPointRecords(ctx, child);
   RecordGrid grid = ReadRecordGrid(ctx, child, records);
   const bool has_color = records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
@@ -766,6 +818,9 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   const std::vector<float> xyz = ReadCoordinates(records, &state);
   const std::vector<uint8_t> layer = ReadReturnLayers(records);
   PlacedRecords placed = PlaceRecords(ctx, records, xyz, state, layer, &grid, &scan, second);
+  ReadNoReturnDirections(
+      ctx, child, extension_prefix.empty() ? "" : extension_prefix + ":" + kNoReturnDirectionsLocalName, grid,
+      &scan, &placed.has_direction);
   if (placed.duplicates > 0) {
     warnings->push_back(fmt::format(
         "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
@@ -903,12 +958,12 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
   const pugi::xml_node root = doc.child("e57Root");
   if (!root) ThrowInputError(path, "XML section", "e57Root", "missing: not an E57 file");
 
-  // lidarshop's extension field, under whatever prefix the file binds to its namespace.
-  std::string synthesized_field;
+  // lidarshop's extension fields, under whatever prefix the file binds to its namespace.
+  std::string extension_prefix;
   for (const pugi::xml_attribute attribute : root.attributes()) {
     const std::string_view name = attribute.name();
     if (name.rfind("xmlns:", 0) == 0 && std::string_view(attribute.value()) == kLidarshopE57Namespace) {
-      synthesized_field = std::string(name.substr(6)) + ":" + kSynthesizedLocalName;
+      extension_prefix = std::string(name.substr(6));
     }
   }
   // A field whose minimum equals its maximum takes no bits, so the bytestreams do not bound recordCount: the
@@ -929,7 +984,7 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
   for (pugi::xml_node child : root.child("data3D").children()) {
     if (child.type() != pugi::node_element) continue;
     Scan second;
-    file.scans.push_back(ReadScan(ctx, child, index++, synthesized_field, &second, &file.warnings));
+    file.scans.push_back(ReadScan(ctx, child, index++, extension_prefix, &second, &file.warnings));
     file.second_returns.push_back(std::move(second));
   }
   ImageCache image_cache;

@@ -66,15 +66,53 @@ void AddPrototypeField(pugi::xml_node prototype, const Field& f) {
 // One record of a compressed vector: a cell of the front scan (layer 0) or of the layer behind it (layer 1).
 struct Record {
   int64_t cell = 0;   // row * cols + col, image orientation
-  uint8_t state = 0;  // cartesianInvalidState: 0 = a return, 1 = direction only
+  uint8_t state = 0;  // cartesianInvalidState: 0 = a return, 2 = no return (zero coordinates)
   uint8_t layer = 0;  // returnIndex
 };
 
-// Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
-// become second returns. Returns whether the lidarshop extension field was written.
 // The E57 pose (unit quaternion with w >= 0, translation) of `transform` under `parent`.
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
 
+// lidarshop's extension element `lidarshop:noReturnDirections` under a data3D entry (`child`): a Structure
+// holding a `points` CompressedVector of one record per cell without a return (`cells`, row-major image
+// order): rowIndex, columnIndex as in the scan's points, and the cell's unit ray as cartesianX/Y/Z in single
+// floats (bit-exact). Readers that do not know the namespace skip it.
+void AppendNoReturnDirections(const Scan& scan, const std::vector<int64_t>& cells,
+                              std::vector<uint8_t>* logical, pugi::xml_node child) {
+  const int64_t m = static_cast<int64_t>(cells.size());
+  std::vector<Stream> streams(5);
+  streams[0].field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
+  streams[1].field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
+  BitWriter wr(streams[0].field.bits), wc(streams[1].field.bits);
+  for (int64_t c : cells) {
+    wr.PutInteger(c / scan.cols, 0);
+    wc.PutInteger(c % scan.cols, 0);
+  }
+  streams[0].bytes = wr.Finish();
+  streams[1].bytes = wc.Finish();
+  const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
+  const cv::Vec3f* direction = scan.direction.ptr<cv::Vec3f>();
+  for (int axis = 0; axis < 3; ++axis) {
+    Stream& s = streams[2 + axis];
+    s.field.name = axis_names[axis];
+    s.field.type = Field::Type::kFloat;
+    s.field.bits = 32;
+    BitWriter w(32);
+    for (int64_t c : cells) w.PutFloat(direction[c][axis]);
+    s.bytes = w.Finish();
+  }
+  const uint64_t offset = AppendCompressedVector(streams, m, logical);
+  pugi::xml_node extension = AddTyped(child, kNoReturnDirectionsField, "Structure");
+  pugi::xml_node points = AddTyped(extension, "points", "CompressedVector");
+  points.append_attribute("fileOffset") = std::to_string(offset).c_str();
+  points.append_attribute("recordCount") = std::to_string(m).c_str();
+  pugi::xml_node prototype = AddTyped(points, "prototype", "Structure");
+  for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
+  AddTyped(points, "codecs", "Vector").append_attribute("allowHeterogeneousChildren") = "1";
+}
+
+// Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
+// become second returns. Returns whether lidarshop's extension (namespace) is used.
 bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteOptions& options,
                 std::vector<uint8_t>* logical, pugi::xml_node data3d) {
   CheckScan(scan);
@@ -88,27 +126,31 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     CheckScan(*behind);
     LIDARSHOP_CHECK(behind->rows == scan.rows && behind->cols == scan.cols);
   }
-  // The records: valid cells, (optionally) no-return cells that have a direction, and after each cell its
-  // second return from `behind`.
+  // The records: the valid cells and after each cell its second return from `behind`. A cell without a
+  // return has no record (as scanners write them: readers that ignore cartesianInvalidState see no junk),
+  // except before a second return, where a record at zero coordinates with cartesianInvalidState 2 keeps
+  // the cell's first return index. The rays of no-return cells go to lidarshop's extension (below).
   std::vector<Record> records;
-  records.reserve(static_cast<size_t>(scan.num_cells()));
+  records.reserve(static_cast<size_t>(scan.CountValid()));
+  std::vector<int64_t> direction_cells;  // no-return cells with a direction, row-major
   const uint8_t* behind_valid = behind != nullptr ? behind->valid.ptr<uint8_t>() : nullptr;
   for (int64_t c = 0; c < scan.num_cells(); ++c) {
     const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
+    const bool has_second = behind_valid != nullptr && behind_valid[c];
     if (scan.valid.at<uint8_t>(r, k)) {
       records.push_back({c, 0, 0});
-    } else if (options.write_no_return_directions) {
+    } else {
       const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
-      if (d.dot(d) > 0.0f && std::isfinite(d.dot(d))) records.push_back({c, 1, 0});
+      if (options.write_no_return_directions && d.dot(d) > 0.0f && std::isfinite(d.dot(d)))
+        direction_cells.push_back(c);
+      if (has_second) records.push_back({c, 2, 0});
     }
-    if (behind_valid != nullptr && behind_valid[c]) records.push_back({c, 0, 1});
+    if (has_second) records.push_back({c, 0, 1});
   }
   const int64_t n = static_cast<int64_t>(records.size());
   auto layer_of = [&](int64_t i) -> const Scan& { return records[i].layer == 0 ? scan : *behind; };
   auto xyz_of = [&](int64_t i, int axis) {
-    const int64_t c = records[i].cell;
-    const Scan& s = layer_of(i);
-    return records[i].state == 0 ? s.point.ptr<cv::Vec3f>()[c][axis] : s.direction.ptr<cv::Vec3f>()[c][axis];
+    return records[i].state == 0 ? layer_of(i).point.ptr<cv::Vec3f>()[records[i].cell][axis] : 0.0f;
   };
 
   std::vector<Stream> streams;
@@ -196,10 +238,10 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     streams.push_back(std::move(col));
   }
   {
-    const bool any_direction_only =
+    const bool any_invalid =
         std::any_of(records.begin(), records.end(), [](const Record& r) { return r.state != 0; });
     Stream s;
-    s.field = IntegerField("cartesianInvalidState", 0, any_direction_only ? 2 : 0);
+    s.field = IntegerField("cartesianInvalidState", 0, any_invalid ? 2 : 0);
     BitWriter w(s.field.bits);
     for (int64_t i = 0; i < n; ++i) w.PutInteger(records[i].state, 0);
     s.bytes = w.Finish();
@@ -292,6 +334,10 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
   pugi::xml_node codecs = AddTyped(points, "codecs", "Vector");
   codecs.append_attribute("allowHeterogeneousChildren") = "1";
+  if (!direction_cells.empty()) {
+    AppendNoReturnDirections(scan, direction_cells, logical, child);
+    return true;
+  }
   return write_synthesized;
 }
 

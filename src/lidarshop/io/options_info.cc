@@ -106,7 +106,7 @@ const StructInfo& InfoOf<E57WriteOptions>() {
         .Unit("m")
         .Min(0);
     b.Field(&E57WriteOptions::write_no_return_directions, "write_no_return_directions",
-            "write cells without a return as invalid points carrying their direction");
+            "keep the directions of cells without a return (in lidarshop's E57 extension; never as points)");
     return b.Build();
   }();
   return info;

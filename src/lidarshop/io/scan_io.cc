@@ -444,7 +444,18 @@ ScanFile ReadScanFile(const std::string& path) {
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
   const ScanFormat& format = FormatFor(path);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
-  format.write(path, scans);
+  if (format.extension == "e57" ||
+      std::none_of(scans.begin(), scans.end(), [](const Scan& s) { return s.num_cells() == 0; })) {
+    format.write(path, scans);
+    return;
+  }
+  // PTX, PLY and PCD have no empty scan (0 x 0 is not a size their readers take); LAS, XYZ and PTS hold points.
+  std::vector<Scan> kept;
+  for (const Scan& scan : scans) {
+    if (scan.num_cells() > 0) kept.push_back(scan);
+  }
+  if (kept.empty()) ThrowInputError(path, "", "", "no point to write: every scan of the input is empty");
+  format.write(path, kept);
 }
 
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind) {

@@ -41,7 +41,9 @@ struct ScanFile {
 ScanFile ReadScanFile(const std::string& path);
 
 // Writes `scans` in the format of `path`'s extension. A format that holds one scan only (PCD) throws
-// InputError when given several. Atomic.
+// InputError when given several. Scans of 0 cells (an E57 data3D entry of 0 records) are written to E57 only:
+// the other formats leave them out, and throw InputError ("no point to write") when no scan is left, rather
+// than write a file that no reader (ours included) takes as a scan. Atomic.
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 
 // Writes `front` with a second layer `behind` it (`remove --keep-object`: the kept object in front, the
