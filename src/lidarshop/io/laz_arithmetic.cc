@@ -31,37 +31,39 @@ SymbolModel::SymbolModel(uint32_t symbols) : symbols_(symbols), last_symbol_(sym
     while (symbols > (1u << (table_bits + 2))) ++table_bits;
     table_size_ = 1u << table_bits;
     table_shift_ = kSymbolLengthShift - table_bits;
-    decoder_table_.assign(table_size_ + 2, 0);
   }
-  distribution_.assign(symbols, 0);
-  symbol_count_.assign(symbols, 1);
+  storage_.assign(2 * symbols + (table_size_ != 0 ? table_size_ + 2 : 0), 0);
+  std::fill_n(symbol_count(), symbols, 1u);
   update_cycle_ = symbols;
   Update();
   symbols_until_update_ = update_cycle_ = (symbols + 6) >> 1;
 }
 
 void SymbolModel::Update() {
+  uint32_t* const dist = distribution();
+  uint32_t* const counts = symbol_count();
+  uint32_t* const table = decoder_table();
   if ((total_count_ += update_cycle_) > kSymbolMaxCount) {
     total_count_ = 0;
-    for (uint32_t& count : symbol_count_) total_count_ += (count = (count + 1) >> 1);
+    for (uint32_t k = 0; k < symbols_; ++k) total_count_ += (counts[k] = (counts[k] + 1) >> 1);
   }
   const uint32_t scale = 0x80000000u / total_count_;
   uint32_t sum = 0;
   if (table_size_ == 0) {
     for (uint32_t k = 0; k < symbols_; ++k) {
-      distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
-      sum += symbol_count_[k];
+      dist[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+      sum += counts[k];
     }
   } else {
     uint32_t s = 0;
     for (uint32_t k = 0; k < symbols_; ++k) {
-      distribution_[k] = (scale * sum) >> (31 - kSymbolLengthShift);
-      sum += symbol_count_[k];
-      const uint32_t w = distribution_[k] >> table_shift_;
-      while (s < w) decoder_table_[++s] = k - 1;
+      dist[k] = (scale * sum) >> (31 - kSymbolLengthShift);
+      sum += counts[k];
+      const uint32_t w = dist[k] >> table_shift_;
+      while (s < w) table[++s] = k - 1;
     }
-    decoder_table_[0] = 0;
-    while (s <= table_size_) decoder_table_[++s] = symbols_ - 1;
+    table[0] = 0;
+    while (s <= table_size_) table[++s] = symbols_ - 1;
   }
   update_cycle_ = std::min((5 * update_cycle_) >> 2, (symbols_ + 6) << 3);
   symbols_until_update_ = update_cycle_;
@@ -100,25 +102,25 @@ uint32_t ArithmeticDecoder::DecodeSymbol(SymbolModel& model) {
     // The decoder table narrows the search to the symbols of the value's slice.
     const uint32_t dv = value_ / (length_ >>= kSymbolLengthShift);
     const uint32_t t = std::min(dv >> model.table_shift_, model.table_size_);
-    symbol = model.decoder_table_[t];
-    uint32_t n = model.decoder_table_[t + 1] + 1;
+    symbol = model.decoder_table()[t];
+    uint32_t n = model.decoder_table()[t + 1] + 1;
     while (n > symbol + 1) {
       const uint32_t k = (symbol + n) >> 1;
-      if (model.distribution_[k] > dv) {
+      if (model.distribution()[k] > dv) {
         n = k;
       } else {
         symbol = k;
       }
     }
-    x = model.distribution_[symbol] * length_;
-    if (symbol != model.last_symbol_) y = model.distribution_[symbol + 1] * length_;
+    x = model.distribution()[symbol] * length_;
+    if (symbol != model.last_symbol_) y = model.distribution()[symbol + 1] * length_;
   } else {
     x = symbol = 0;
     length_ >>= kSymbolLengthShift;
     uint32_t n = model.symbols_;
     uint32_t k = n >> 1;
     do {
-      const uint32_t z = length_ * model.distribution_[k];
+      const uint32_t z = length_ * model.distribution()[k];
       if (z > value_) {
         n = k;
         y = z;
@@ -132,7 +134,7 @@ uint32_t ArithmeticDecoder::DecodeSymbol(SymbolModel& model) {
   value_ -= x;
   length_ = y - x;
   if (length_ < kMinLength) Renormalize();
-  ++model.symbol_count_[symbol];
+  ++model.symbol_count()[symbol];
   if (--model.symbols_until_update_ == 0) model.Update();
   return symbol;
 }
@@ -167,15 +169,16 @@ IntegerDecompressor::IntegerDecompressor(ArithmeticDecoder& decoder, uint32_t bi
     corr_min_ = INT32_MIN;
   }
   k_models_.assign(contexts, SymbolModel(corr_bits_ + 1));
-  correctors_.reserve(corr_bits_);
-  for (uint32_t i = 1; i <= corr_bits_; ++i) correctors_.emplace_back(1u << std::min(i, bits_high_));
+  correctors_.resize(corr_bits_);
 }
 
 int32_t IntegerDecompressor::ReadCorrector(SymbolModel& k_model) {
   k_ = decoder_->DecodeSymbol(k_model);
   if (k_ == 0) return static_cast<int32_t>(decoder_->DecodeBit(corrector_0_));
   if (k_ >= 32) return corr_min_;
-  int64_t c = decoder_->DecodeSymbol(correctors_[k_ - 1]);
+  std::optional<SymbolModel>& model = correctors_[k_ - 1];
+  if (!model) model.emplace(1u << std::min(k_, bits_high_));
+  int64_t c = decoder_->DecodeSymbol(*model);
   if (k_ > bits_high_) {
     const uint32_t low_bits = k_ - bits_high_;
     c = (c << low_bits) | decoder_->ReadBits(low_bits);

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -50,9 +51,12 @@ class SymbolModel {
   uint32_t total_count_ = 0;
   uint32_t update_cycle_;
   uint32_t symbols_until_update_ = 0;
-  std::vector<uint32_t> distribution_;  // cumulative probabilities, in 1/32768
-  std::vector<uint32_t> symbol_count_;
-  std::vector<uint32_t> decoder_table_;  // table_size_ + 2 entries: first symbol of each 1/table_size_ slice
+  // One allocation (models are made per chunk): the cumulative probabilities in 1/32768 (symbols_), the
+  // counts (symbols_), then the decoder table (table_size_ + 2: the first symbol of each slice).
+  std::vector<uint32_t> storage_;
+  uint32_t* distribution() { return storage_.data(); }
+  uint32_t* symbol_count() { return storage_.data() + symbols_; }
+  uint32_t* decoder_table() { return storage_.data() + 2 * symbols_; }
 };
 
 class ArithmeticDecoder {
@@ -104,9 +108,11 @@ class IntegerDecompressor {
   int32_t corr_min_;
   uint32_t bits_high_;
   uint32_t k_ = 0;
-  std::vector<SymbolModel> k_models_;    // one per context
-  BitModel corrector_0_;                 // k = 0: the corrector is 0 or 1
-  std::vector<SymbolModel> correctors_;  // k = 1 .. corr_bits_ at index k - 1
+  std::vector<SymbolModel> k_models_;  // one per context
+  BitModel corrector_0_;               // k = 0: the corrector is 0 or 1
+  // k = 1 .. corr_bits_ at index k - 1, made on first use (a fresh model is the same whenever it is made;
+  // making all 32 of a 32-bit decompressor up front dominated chunks of a few points, as COPC has).
+  std::vector<std::optional<SymbolModel>> correctors_;
 };
 
 // The median of the last five values, kept incrementally as LASzip does (its exact update order matters: the
