@@ -16,10 +16,12 @@
 //   label       the classification value (0-31 in formats 0-3, 0-255 in 6-8) when some point's is non-zero
 //   synthesized the "synthetic" bit (255) when some point has it
 // GPS time, return numbers, scan angle, user data, point source ID, NIR and VLRs are not kept.
-// LAZ (LASzip-compressed LAS: the point format byte's bit 7, or a .laz file) is refused: "LAZ is not
-// supported: ..." — no LASzip library is packaged for lidarshop's platform, and LASzip's arithmetic coder is
-// beyond a hand-written reader. Every header field is checked against the file size before anything is
-// allocated; errors name the file, the byte offset or header, the field and the value.
+// LAZ (LASzip-compressed LAS: the point format byte's bits 7-6 and a "laszip encoded" VLR) is read the same
+// way: the points are decompressed by io/laz.h (written from the LAZ specification, as no LASzip library is
+// packaged for lidarshop's platform: point formats 0-3 and 6-8 with extra bytes, LASzip 1.0-3.x and COPC
+// files; wave packets are refused) into the records an uncompressed file holds. Every header field is
+// checked against the file size before anything is allocated; errors name the file, the byte offset or
+// header (LAZ: the chunk and point), the field and the value.
 //
 // Writing: the valid points of every scan in the world frame (world_from_scanner applied), one record each,
 // point source ID = the scan's index in the file; return 1 of 1; GPS time 0 (scans have no time channel).
@@ -72,7 +74,7 @@ void WriteLas(const std::string& path, const std::vector<Scan>& scans, const Las
 std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,
                       const std::string& file);
 
-// The message of the InputError for a LAZ file ("LAZ is not supported: ...").
-std::string LazNotSupportedMessage();
+// The message of the InputError for writing a .laz file ("LAZ is not written: ... write .las instead").
+std::string LazNotWrittenMessage();
 
 }  // namespace lidarshop

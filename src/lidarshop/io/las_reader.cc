@@ -8,6 +8,7 @@
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/las_format.h"
+#include "lidarshop/io/laz.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/error.h"
@@ -24,6 +25,10 @@ struct LasHeader {
   int format = 0;
   int record_length = 0;
   int64_t count = 0;
+  // LAZ: the point format byte has LASzip's bits; the points are decoded with the laszip VLR's payload.
+  bool laz = false;
+  int64_t laszip_payload_at = 0;
+  int laszip_payload_size = 0;
   double scale[3] = {1, 1, 1};
   double offset[3] = {0, 0, 0};
 };
@@ -67,11 +72,8 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
          fmt::format("truncated: {} bytes of header, the file has {}", header.header_size, size));
   }
   const uint8_t format_byte = static_cast<uint8_t>(h[las::header::kPointFormat]);
-  if ((format_byte & las::kLazFormatBits) != 0) {
-    Fail(file, las::header::kPointFormat, "Point Data Record Format",
-         fmt::format("{} has LASzip's compression bits: {}", format_byte, LazNotSupportedMessage()));
-  }
-  header.format = format_byte;
+  header.laz = (format_byte & las::kLazFormatBits) != 0;
+  header.format = format_byte & ~las::kLazFormatBits;
   if (las::PointRecordSize(header.format) == 0) {
     Fail(file, las::header::kPointFormat, "Point Data Record Format",
          fmt::format("{} does not exist (LAS 1.4 defines 0 to 10)", header.format));
@@ -104,15 +106,16 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
     }
     const std::string_view user_id(h + position + 2, 16);
     const uint16_t record_id = las::Load<uint16_t>(h + position + 18);
-    if (user_id.substr(0, 14) == "laszip encoded" && record_id == 22204) {
-      ThrowInputError(file, fmt::format("byte {}", position), "VLR laszip encoded", LazNotSupportedMessage());
-    }
-    const int64_t end = position + las::kVlrHeaderSize + las::Load<uint16_t>(h + position + 52);
+    const int64_t end = position + las::kVlrHeaderSize + las::Load<uint16_t>(h + position + 20);
     if (end > header.offset_to_points) {
-      ThrowInputError(file, fmt::format("byte {}", position + 52), "VLR Record Length After Header",
+      ThrowInputError(file, fmt::format("byte {}", position + 20), "VLR Record Length After Header",
                       fmt::format("variable length record {} ends at byte {}, past the start of the point "
                                   "data (byte {})",
                                   i, end, header.offset_to_points));
+    }
+    if (user_id.substr(0, 14) == "laszip encoded" && record_id == laz::kLazVlrRecordId) {
+      header.laszip_payload_at = position + las::kVlrHeaderSize;
+      header.laszip_payload_size = static_cast<int>(end - header.laszip_payload_at);
     }
     position = end;
   }
@@ -133,8 +136,13 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
   const int count_byte = header.minor_version >= 4 && legacy_count == 0 ? las::header::kPointCount
                                                                         : las::header::kLegacyPointCount;
   if (header.count == 0) Fail(file, count_byte, "Number of Point Records", "0: the file holds no points");
+  if (header.laz && header.laszip_payload_size == 0) {
+    Fail(file, las::header::kPointFormat, "Point Data Record Format",
+         fmt::format("{} has LASzip's compression bits but the file has no laszip encoded VLR", format_byte));
+  }
   const int64_t available = size - header.offset_to_points;
-  if (header.count > available / header.record_length) {
+  // LAZ: the decoder bounds the count by the compressed bytes (laz.h).
+  if (!header.laz && header.count > available / header.record_length) {
     Fail(file, count_byte, "Number of Point Records",
          fmt::format("truncated: {} points of {} bytes need {} bytes after byte {}, the file has {}",
                      header.count, header.record_length, SaturatingBytes(header.count, header.record_length),
@@ -165,6 +173,14 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
   io_internal::CheckScanSize(1, header.count, file, "header: Number of Point Records");
   const int64_t count = header.count;
   const char* records = bytes.data() + header.offset_to_points;
+  // LAZ: decoded into the records an uncompressed file would hold (error places are then point indices).
+  std::string decoded;
+  if (header.laz) {
+    decoded = laz::DecodeLazPoints(
+        std::string_view(bytes).substr(header.laszip_payload_at, header.laszip_payload_size), bytes,
+        header.offset_to_points, count, header.format, header.record_length, file);
+    records = decoded.data();
+  }
   const int format = header.format;
   const bool legacy = las::IsLegacyFormat(format);
   const bool rgb = las::HasRgb(format);
@@ -192,10 +208,12 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
     for (int axis = 0; axis < 3; ++axis) {
       const double value = coordinate(p, axis);
       if (!(std::abs(value) <= kMaxCoordinateM)) {
-        ThrowInputError(
-            file, fmt::format("point {} (byte {})", i, header.offset_to_points + i * header.record_length),
-            std::string(1, "XYZ"[axis]),
-            fmt::format("{} is not a coordinate within {} m", value, kMaxCoordinateM));
+        ThrowInputError(file,
+                        header.laz ? fmt::format("point {}", i)
+                                   : fmt::format("point {} (byte {})", i,
+                                                 header.offset_to_points + i * header.record_length),
+                        std::string(1, "XYZ"[axis]),
+                        fmt::format("{} is not a coordinate within {} m", value, kMaxCoordinateM));
       }
       low[axis] = std::min(low[axis], value);
       high[axis] = std::max(high[axis], value);
@@ -259,7 +277,9 @@ ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   const LasHeader header = ParseHeader(bytes, path, file_size);
   io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
   ScanFileHeader file;
-  file.format_version = fmt::format("LAS 1.{} point format {}", header.minor_version, header.format);
+  file.format_version = fmt::format("{} 1.{} point format {}", header.laz ? "LAZ (LAS" : "LAS",
+                                    header.minor_version, header.format) +
+                        (header.laz ? ")" : "");
   ScanHeader scan;
   scan.rows = 1;
   scan.cols = header.count;

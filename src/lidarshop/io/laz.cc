@@ -8,6 +8,7 @@
 #include "lidarshop/io/laz_arithmetic.h"
 #include "lidarshop/io/laz_items.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop::laz {
 namespace {
@@ -369,6 +370,8 @@ std::string DecodeLazPoints(std::string_view laszip_vlr_payload, std::string_vie
     chunks = ReadChunkTable(vlr, file_bytes, offset_to_point_data, point_count, point_record_length, file);
   }
 
+  CheckMemoryBudget(SaturatingBytes(static_cast<int64_t>(point_count), point_record_length),
+                    fmt::format("{}: {} decompressed LAZ points", file, point_count));
   std::string out(point_count * static_cast<uint64_t>(point_record_length), '\0');
   auto* records = reinterpret_cast<uint8_t*>(out.data());
   const auto* data = reinterpret_cast<const uint8_t*>(file_bytes.data());

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::laz {
@@ -271,6 +272,33 @@ TEST(Laz, RefusesBadVlrsAndMismatchedHeaders) {
   EXPECT_THROW(
       DecodeLazPoints(laz.laszip_payload, laz.bytes, laz.offset_to_points, laz.count + 1, 3, 34, "f"),
       InputError);
+}
+
+bool SameMat(const cv::Mat& a, const cv::Mat& b) {
+  return a.empty() == b.empty() &&
+         (a.empty() || (a.size == b.size && a.type() == b.type() &&
+                        std::memcmp(a.data, b.data, a.total() * a.elemSize()) == 0));
+}
+
+// Through the scan reader: a .laz reads as the same scan as its .las twin.
+TEST(Laz, ReadScanFileReadsLazAsItsTwin) {
+  for (const Pair& pair : kPairs) {
+    SCOPED_TRACE(pair.laz);
+    const ScanFile laz = ReadScanFile(kInterop + "laz/" + pair.laz);
+    const ScanFile las = ReadScanFile(kInterop + "las/" + pair.las);
+    EXPECT_EQ(laz.format, "laz");
+    ASSERT_EQ(laz.scans.size(), 1u);
+    const Scan& a = laz.scans[0];
+    const Scan& b = las.scans[0];
+    ASSERT_GT(b.CountValid(), 1000);
+    EXPECT_EQ(a.CountValid(), b.CountValid());
+    EXPECT_TRUE(a.world_from_scanner.isApprox(b.world_from_scanner));
+    EXPECT_TRUE(SameMat(a.point, b.point));
+    EXPECT_TRUE(SameMat(a.valid, b.valid));
+    EXPECT_TRUE(SameMat(a.color, b.color));
+    EXPECT_TRUE(SameMat(a.intensity, b.intensity));
+    EXPECT_TRUE(SameMat(a.label, b.label));
+  }
 }
 
 }  // namespace
