@@ -107,7 +107,7 @@ std::string ChunkPlace(size_t chunk, const Chunk& c) {
 }
 
 // The chunks of a chunked (compressor 2 or 3) file, from the chunk table whose offset is the first 8 bytes of
-// the point data.
+// the point data; none when the file has no table but fixed-size chunks (decoded one after the other).
 std::vector<Chunk> ReadChunkTable(const LazVlr& vlr, std::string_view file_bytes, uint64_t offset,
                                   uint64_t point_count, int record_length, const std::string& file) {
   const uint64_t size = file_bytes.size();
@@ -121,8 +121,12 @@ std::vector<Chunk> ReadChunkTable(const LazVlr& vlr, std::string_view file_bytes
   if (table == -1 && size >= 8)
     table = LoadLe<int64_t>(data + size - 8);  // written last by a streaming writer
   if (table >= 0 && static_cast<uint64_t>(table) + 8 == chunks_start) {
+    // The writer was interrupted before it wrote the table: fixed-size chunks can still be decoded one after
+    // the other (each ends where its decoder stopped), variable ones not.
+    if (vlr.chunk_size != kVariableChunkSize) return {};
     ThrowInputError(file, fmt::format("byte {}", offset), "LAZ chunk table offset",
-                    "the file has no chunk table (its writer was interrupted)");
+                    "the file has no chunk table (its writer was interrupted) and its chunks are of variable "
+                    "size");
   }
   if (table < 0 || static_cast<uint64_t>(table) < chunks_start || static_cast<uint64_t>(table) + 8 > size) {
     ThrowInputError(file, fmt::format("byte {}", offset), "LAZ chunk table offset",
@@ -196,11 +200,14 @@ struct ItemSlot {
   int offset = 0;  // byte in the record
 };
 
-void DecodePointwiseChunk(const std::vector<ItemSlot>& items, const uint8_t* begin, const uint8_t* end,
-                          uint64_t points, int record_length, uint8_t* out, uint64_t& point) {
+// Both chunk decoders return where the chunk's data ended (the next chunk's start when there is no table).
+const uint8_t* DecodePointwiseChunk(const std::vector<ItemSlot>& items, const uint8_t* begin,
+                                    const uint8_t* end, uint64_t points, int record_length, uint8_t* out,
+                                    uint64_t& point) {
+  if (end - begin < record_length) throw LazCorrupt("the chunk ends inside its raw first point");
   std::memcpy(out, begin, record_length);  // the first point is stored raw
   ++point;
-  if (points == 1) return;
+  if (points == 1) return begin + record_length;
   ArithmeticDecoder decoder;
   std::vector<std::unique_ptr<PointwiseItemDecoder>> decoders;
   for (const ItemSlot& slot : items) {
@@ -212,14 +219,16 @@ void DecodePointwiseChunk(const std::vector<ItemSlot>& items, const uint8_t* beg
     uint8_t* record = out + j * record_length;
     for (size_t i = 0; i < items.size(); ++i) decoders[i]->Decode(record + items[i].offset);
   }
+  return decoder.position();  // LASzip's encoder pads each chunk so that its decoder stops at the end
 }
 
-void DecodeLayeredChunk(const std::vector<ItemSlot>& items, const uint8_t* begin, const uint8_t* end,
-                        uint64_t points, uint64_t declared, int record_length, uint8_t* out,
-                        uint64_t& point) {
+const uint8_t* DecodeLayeredChunk(const std::vector<ItemSlot>& items, const uint8_t* begin,
+                                  const uint8_t* end, uint64_t points, uint64_t declared, int record_length,
+                                  uint8_t* out, uint64_t& point) {
+  if (end - begin < record_length) throw LazCorrupt("the chunk ends inside its raw first point");
   std::memcpy(out, begin, record_length);  // the first point is stored raw
   ++point;
-  if (points == 1) return;
+  if (points == 1) return begin + record_length;
   const uint8_t* p = begin + record_length;
   auto read_u32 = [&](const char* what) {
     if (end - p < 4) throw LazCorrupt(fmt::format("the chunk ends inside the {}", what));
@@ -257,6 +266,7 @@ void DecodeLayeredChunk(const std::vector<ItemSlot>& items, const uint8_t* begin
     uint8_t* record = out + j * record_length;
     for (size_t i = 0; i < items.size(); ++i) decoders[i]->Decode(record + items[i].offset, context);
   }
+  return p;
 }
 
 }  // namespace
@@ -376,19 +386,27 @@ std::string DecodeLazPoints(std::string_view laszip_vlr_payload, std::string_vie
   auto* records = reinterpret_cast<uint8_t*>(out.data());
   const auto* data = reinterpret_cast<const uint8_t*>(file_bytes.data());
   uint64_t point = 0;
-  for (size_t i = 0; i < chunks.size(); ++i) {
-    const Chunk& c = chunks[i];
+  // Without a chunk table, each fixed-size chunk starts where the previous one ended.
+  const bool sequential = chunks.empty();
+  uint64_t next_start = offset_to_point_data + 8;
+  for (size_t i = 0; sequential ? point < point_count : i < chunks.size(); ++i) {
+    const Chunk c = sequential ? Chunk{next_start, size - next_start,
+                                       std::min<uint64_t>(vlr.chunk_size, point_count - point),
+                                       std::min<uint64_t>(vlr.chunk_size, point_count - point)}
+                               : chunks[i];
     if (c.points == 0) continue;
     const uint64_t first_point = point;
     try {
       uint8_t* chunk_out = records + point * point_record_length;
+      const uint8_t* end;
       if (vlr.compressor == 3) {
-        DecodeLayeredChunk(items, data + c.start, data + c.start + c.bytes, c.points, c.declared,
-                           point_record_length, chunk_out, point);
+        end = DecodeLayeredChunk(items, data + c.start, data + c.start + c.bytes, c.points, c.declared,
+                                 point_record_length, chunk_out, point);
       } else {
-        DecodePointwiseChunk(items, data + c.start, data + c.start + c.bytes, c.points, point_record_length,
-                             chunk_out, point);
+        end = DecodePointwiseChunk(items, data + c.start, data + c.start + c.bytes, c.points,
+                                   point_record_length, chunk_out, point);
       }
+      next_start = static_cast<uint64_t>(end - data);
     } catch (const LazCorrupt& e) {
       ThrowInputError(
           file, ChunkPlace(i, c), "",

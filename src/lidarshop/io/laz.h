@@ -5,7 +5,7 @@
 // Supported: compressors 1 (pointwise), 2 (pointwise chunked) and 3 (layered chunked), the arithmetic coder
 // (0), items POINT10, GPSTIME11, RGB12, BYTE (versions 1 and 2: point formats 0-3 and extra bytes) and
 // POINT14, RGB14, RGBNIR14, BYTE14 (version 3: point formats 6-8, as COPC uses), fixed and variable chunk
-// sizes. Wave packets (formats 4, 5, 9, 10) are refused.
+// sizes (fixed-size chunks also without a chunk table). Wave packets (formats 4, 5, 9, 10) are refused.
 //
 // Bounds: a point takes at least 2 bits of compressed data (real LAZ takes 1.5-10 bytes a point; LASzip's
 // adaptive models cannot go much below a few hundredths of a bit even for identical points, which no scanner

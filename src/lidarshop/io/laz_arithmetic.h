@@ -67,6 +67,7 @@ class ArithmeticDecoder {
   uint32_t DecodeSymbol(SymbolModel& model);
   uint32_t ReadBits(uint32_t bits);  // 1 to 32 raw bits
   uint32_t ReadInt() { return ReadBits(32); }
+  const uint8_t* position() const { return next_; }  // the next byte to read
   uint64_t ReadInt64() {
     const uint64_t lower = ReadInt();
     return (static_cast<uint64_t>(ReadInt()) << 32) | lower;

@@ -240,6 +240,28 @@ TEST(Laz, RefusesTheChunkTableOffsetPointingElsewhere) {
   }
 }
 
+// A writer interrupted before the chunk table leaves its offset pointing at itself: fixed-size chunks are then
+// decoded one after the other, variable ones (whose point counts only the table holds) are refused.
+TEST(Laz, DecodesFixedSizeChunksWithoutTheChunkTable) {
+  const LasFile laz(kInterop + "laz/autzen_trim.laz");
+  const LasFile las(kInterop + "las/autzen_trim.las");
+  ASSERT_GT(las.count, 2 * 50000u);  // three chunks
+  std::string no_table = laz.bytes;
+  const int64_t itself = laz.offset_to_points;
+  std::memcpy(no_table.data() + laz.offset_to_points, &itself, 8);
+  EXPECT_TRUE(laz.Decode(no_table, laz.laszip_payload) == las.Records());
+  const LasFile copc(kInterop + "laz/1.2-with-color.copc.laz");
+  std::string copc_no_table = copc.bytes;
+  const int64_t copc_itself = copc.offset_to_points;
+  std::memcpy(copc_no_table.data() + copc.offset_to_points, &copc_itself, 8);
+  try {
+    copc.Decode(copc_no_table, copc.laszip_payload);
+    ADD_FAILURE() << "variable chunks without a table were decoded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("variable"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Laz, RefusesBadVlrsAndMismatchedHeaders) {
   const LasFile laz(kInterop + "laz/simple.laz");
   auto with = [&](size_t at, uint16_t value) {
