@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -30,6 +31,21 @@ namespace {
 
 constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
+// `convert --synthesized-mask`: the scan's grid, 255 where a return is synthesized.
+void WriteSynthesizedMask(const std::string& path, const Scan& scan) {
+  // libpng refuses to write images wider than a million pixels (its default user limit).
+  constexpr int kPngMaxWidth = 1000000;
+  if (scan.cols > kPngMaxWidth) {
+    throw OptionsError(
+        fmt::format("--synthesized-mask {}: the scan is {} cells wide, more than PNG's {}; "
+                    "use --drop-synthesized or write LAS, PLY, PCD or E57, which mark them",
+                    path, scan.cols, kPngMaxWidth));
+  }
+  cv::Mat mask(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  if (!scan.synthesized.empty()) mask.setTo(255, (scan.synthesized != 0) & (scan.valid != 0));
+  WriteImage(path, mask);
+}
+
 nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
   nlohmann::ordered_json json;
   json["index"] = index;
@@ -40,6 +56,31 @@ nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
   json["valid"] = scan.CountValid();
   json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
   json["channels"] = ChannelNames(scan);
+  if (!scan.attributes.empty()) {
+    json["attributes"] = nlohmann::ordered_json::array();
+    for (const auto& [name, values] : scan.attributes) json["attributes"].push_back(name);
+  }
+  // Counts as `lasinfo` gives them, for clouds read from LAS: classes and return numbers of the returns.
+  if (scan.source_metadata.count("las.point_format")) {
+    auto counts = [&](const cv::Mat& values) {
+      std::map<int, int64_t> histogram;
+      for (int row = 0; row < scan.rows; ++row) {
+        for (int col = 0; col < scan.cols; ++col) {
+          if (!scan.valid.at<uint8_t>(row, col)) continue;
+          ++histogram[values.empty()            ? 0
+                      : values.type() == CV_32S ? values.at<int32_t>(row, col)
+                                                : values.at<uint8_t>(row, col)];
+        }
+      }
+      nlohmann::ordered_json json_counts = nlohmann::ordered_json::object();
+      for (const auto& [value, n] : histogram) json_counts[std::to_string(value)] = n;
+      return json_counts;
+    };
+    json["classes"] = counts(scan.label);
+    const auto returns = scan.attributes.find(kLasReturnNumber);
+    json["returns"] = counts(returns == scan.attributes.end() ? cv::Mat() : returns->second);
+    if (!scan.source_records.empty()) json["crs"] = LasCrsJson(scan.source_records);
+  }
 
   // Bounds of the returns in the world frame, and range / intensity statistics.
   Eigen::AlignedBox3d world_bounds;
@@ -223,12 +264,19 @@ int RunConvert(int argc, char** argv) {
       "convert"};
   std::string input, output, json_path;
   int scan_index = -1;
-  bool quiet = false;
+  bool quiet = false, drop_synthesized = false;
+  std::string synthesized_mask_path;
   E57WriteOptions e57_options;
   OptionBinder binder(app);
   app.add_option("input", input, "scan file to read")->required();
   app.add_option("output", output, "scan file to write (format from the extension)")->required();
   app.add_option("--scan", scan_index, "write only scan K (from 0); PCD holds one scan");
+  app.add_flag("--drop-synthesized", drop_synthesized,
+               "leave synthesized points out (for targets that cannot mark them: XYZ, PTS, PTX)");
+  app.add_option(
+      "--synthesized-mask", synthesized_mask_path,
+      "PNG of the scan's grid (rows x cols, 1 x N for clouds): 255 = a synthesized point, so that "
+      "targets that cannot mark them lose nothing (one scan: give --scan K for a file of several)");
   AddJsonOption(app, &json_path);
   // --e57-precision-m names the scaled-integer step; --coordinate-scale-m stays (an earlier contract).
   binder.Bind(&e57_options, {.flags = {{"coordinate_scale_m", "--coordinate-scale-m,--e57-precision-m"}},
@@ -246,6 +294,7 @@ int RunConvert(int argc, char** argv) {
         binder.Validate(las);
         CheckOutputPath(output, {input});
         CheckOutputFile("--json", json_path, {}, {input, output});
+        CheckOutputFile("--synthesized-mask", synthesized_mask_path, {"png"}, {input, output, json_path});
         const auto progress = Progress::ForTerminal("convert", 2, quiet);
         ScanFile file;
         std::vector<E57Image> images;         // E57 -> E57 keeps the photos
@@ -263,6 +312,22 @@ int RunConvert(int argc, char** argv) {
         if (scan_index >= 0) {
           scans = {PickScan(file, scan_index, "--scan")};
           if (!second_returns.empty()) second_returns = {second_returns[scan_index]};
+        }
+        if (!synthesized_mask_path.empty()) {
+          if (scans.size() != 1) {
+            throw OptionsError(fmt::format("--synthesized-mask: {} holds {} scans; choose one with --scan K",
+                                           input, scans.size()));
+          }
+          WriteSynthesizedMask(synthesized_mask_path, scans[0]);
+        }
+        int64_t dropped_synthesized = 0;
+        if (drop_synthesized) {
+          for (Scan& scan : scans) {
+            if (scan.synthesized.empty()) continue;
+            dropped_synthesized += cv::countNonZero(scan.synthesized & scan.valid);
+            scan = MaskScan(scan, scan.synthesized == 0);
+            scan.synthesized.release();
+          }
         }
         const bool to_e57 = FileExtension(output) == "e57";
         size_t scans_with_second_returns = 0;
@@ -298,6 +363,7 @@ int RunConvert(int argc, char** argv) {
         json["images"] = images_written;
         json["channels"] = plan.channels;
         json["dropped"] = plan.dropped;
+        if (drop_synthesized) json["synthesized_left_out"] = dropped_synthesized;
         WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
         return 0;
       },

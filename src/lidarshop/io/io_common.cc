@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <limits>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -100,7 +101,7 @@ void FinishScan(Scan* scan, bool fit_grid) {
       if (valid[col]) {
         const float norm = std::sqrt(point[col].dot(point[col]));
         range[col] = norm;
-        direction[col] = point[col] / norm;
+        direction[col] = norm > 0 ? point[col] / norm : cv::Vec3f(0, 0, 0);
       } else {
         point[col] = cv::Vec3f(0, 0, 0);
         range[col] = 0;
@@ -118,6 +119,28 @@ Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& h
     return Eigen::Vector3d::Zero();
   }
   return ((low + high) / 2).array().round().matrix();
+}
+
+double FloatStepAt(double value) {
+  const double magnitude = std::abs(value);
+  if (!(magnitude >= std::numeric_limits<float>::min())) return std::numeric_limits<float>::denorm_min();
+  int exponent = 0;
+  std::frexp(magnitude, &exponent);  // magnitude = m * 2^exponent, m in [0.5, 1)
+  return std::ldexp(1.0, exponent - 24);
+}
+
+bool FloatKeepsStep(const Eigen::Vector3d& low, const Eigen::Vector3d& high, double step_m) {
+  const double largest = std::max(low.cwiseAbs().maxCoeff(), high.cwiseAbs().maxCoeff());
+  return FloatStepAt(largest) / 2 <= step_m / 2 * 0.999;  // rounding to the float grid stays within step / 2
+}
+
+Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high, double step_m) {
+  const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+  if (CloudOrigin(low, high) == zero && FloatKeepsStep(low, high, step_m)) return zero;
+  const Eigen::Vector3d centre = (low + high) / 2;
+  const Eigen::Vector3d metre = centre.array().round().matrix();
+  if (FloatKeepsStep(low - metre, high - metre, step_m)) return metre;
+  return (centre / step_m).array().round().matrix() * step_m;
 }
 
 cv::Mat TextureToRgb8(const cv::Mat& image) {

@@ -33,7 +33,7 @@ void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std
 void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place);
 
 // After a reader has filled `valid` and `point`: sets range = |point| and direction = point / range of valid
-// cells, clears invalid cells (point 0, range 0, intensity 0.5 when present, colour 0) and, when `fit_grid`, fits the
+// cells (a valid point at the origin of an unorganized cloud: range 0, direction 0), clears invalid cells (point 0, range 0, intensity 0.5 when present, colour 0) and, when `fit_grid`, fits the
 // angular grid so that every cell gets a direction (FitGrid). A scan without any return keeps zero
 // directions.
 void FinishScan(Scan* scan, bool fit_grid);
@@ -42,8 +42,17 @@ void FinishScan(Scan* scan, bool fit_grid);
 // becomes world_from_scanner's translation: (0, 0, 0) when every coordinate of the bounds [low, high] is within
 // kCloudFloatSafeM (float steps of 0.06 mm there), else the centre of the bounds rounded to a metre, so that
 // world coordinates keep 0.1 mm over clouds a few kilometres wide.
+// With `step_m` (the file's own resolution, e.g. a LAS scale): (0, 0, 0) only when float also keeps that step
+// over the bounds, and the centre rounded to a metre, or to `step_m` where a metre is too coarse (a cloud in
+// degrees), else — so that a LAS file's integers come back.
 constexpr double kCloudFloatSafeM = 1000.0;
 Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high);
+Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high, double step_m);
+// The spacing of floats at magnitude `value` (2^-23 of its power of two), metres.
+double FloatStepAt(double value);
+// Whether every coordinate in [low, high] (relative to the origin) is a float within half of `step_m` of
+// its double value.
+bool FloatKeepsStep(const Eigen::Vector3d& low, const Eigen::Vector3d& high, double step_m);
 
 // An image as CV_8UC3 RGB (grey and RGBA converted, 16-bit scaled down), for mesh textures.
 cv::Mat TextureToRgb8(const cv::Mat& image);

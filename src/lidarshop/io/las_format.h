@@ -45,6 +45,14 @@ constexpr int kHeaderSize12 = 227;
 constexpr int kHeaderSize13 = 235;
 constexpr int kHeaderSize14 = 375;
 constexpr int kVlrHeaderSize = 54;
+constexpr int kEvlrHeaderSize = 60;
+// Variable length record header (54 bytes; EVLRs: 60, the length a uint64 at byte 20).
+namespace vlr {
+constexpr int kUserId = 2;         // 16 chars
+constexpr int kRecordId = 18;      // uint16
+constexpr int kRecordLength = 20;  // uint16 (EVLR: uint64)
+constexpr int kDescription = 22;   // 32 chars (EVLR: at 28)
+}  // namespace vlr
 
 // Global encoding bit 4: the coordinate reference system is WKT (required with point formats 6-10).
 constexpr uint16_t kGlobalEncodingWkt = 1 << 4;
@@ -59,6 +67,10 @@ inline int PointRecordSize(int format) {
 }
 inline bool IsLegacyFormat(int format) { return format <= 5; }  // 0-5: 5-bit classes, 3-bit returns
 inline bool HasGpsTime(int format) { return format != 0 && format != 2; }
+inline bool HasNir(int format) { return format == 8 || format == 10; }
+constexpr int kNirOffset = 36;  // formats 8 and 10
+// Global encoding bit 0: GPS time is adjusted standard GPS time (else GPS week time).
+constexpr uint16_t kGlobalEncodingGpsStandard = 1 << 0;
 inline bool HasRgb(int format) {
   return format == 2 || format == 3 || format == 5 || format == 7 || format == 8 || format == 10;
 }
@@ -87,6 +99,10 @@ constexpr int kClass14 = 16;  // 6-10: classification (0-255)
 constexpr uint8_t kLegacySyntheticBit = 1 << 5;
 constexpr uint8_t kLegacyClassMask = 0x1F;
 constexpr uint8_t kSyntheticFlag14 = 1 << 0;
+constexpr int kScanAngleRank = 16;        // 0-5: int8, degrees
+constexpr int kUserDataLegacy = 17;       // 0-5
+constexpr int kUserData14 = 17;           // 6-10
+constexpr int kScanAngle14 = 18;          // 6-10: int16, 0.006 degrees
 constexpr int kPointSourceIdLegacy = 18;  // 0-5
 constexpr int kPointSourceId14 = 20;      // 6-10
 constexpr int kGpsTimeLegacy = 20;        // 1, 3, 4, 5

@@ -1,8 +1,10 @@
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_common.h"
@@ -27,14 +29,59 @@ struct LasHeader {
   int64_t count = 0;
   // LAZ: the point format byte has LASzip's bits; the points are decoded with the laszip VLR's payload.
   bool laz = false;
-  int64_t laszip_payload_at = 0;
-  int laszip_payload_size = 0;
+  std::string laszip_payload;
   double scale[3] = {1, 1, 1};
   double offset[3] = {0, 0, 0};
+  uint16_t global_encoding = 0;
+  uint16_t file_source_id = 0;
+  std::vector<SourceRecord> records;  // VLRs and EVLRs, in file order
+  std::vector<std::string> warnings;
 };
+
+std::string FixedText(const char* p, size_t width) {
+  std::string text(p, width);
+  text.resize(std::strlen(text.c_str()));
+  return io_internal::Printable(text);
+}
 
 [[noreturn]] void Fail(const std::string& file, int byte, const char* field, const std::string& message) {
   ThrowInputError(file, fmt::format("header byte {}", byte), field, message);
+}
+
+// Smaller steps are not coordinate steps but corrupt headers (a subnormal scale maps every point onto the
+// offset).
+constexpr double kMinLasScale = 1e-12;
+
+// LAS 1.4's extended variable length records, after the points (coordinate systems as WKT live there).
+// Read only from a whole file; records that do not fit are left out with a warning.
+void ReadExtendedRecords(const std::string& bytes, const std::string& file, int64_t size, LasHeader* header) {
+  if (header->minor_version < 4 || static_cast<int64_t>(bytes.size()) != size) return;
+  const char* h = bytes.data();
+  const uint64_t first = las::Load<uint64_t>(h + las::header::kFirstEvlr);
+  const uint32_t count = las::Load<uint32_t>(h + las::header::kNumberOfEvlrs);
+  if (count == 0) return;
+  uint64_t position = first;
+  for (uint32_t i = 0; i < count; ++i) {
+    const uint64_t length = position <= static_cast<uint64_t>(size) - las::kEvlrHeaderSize
+                                ? las::Load<uint64_t>(h + position + las::vlr::kRecordLength)
+                                : UINT64_MAX;
+    if (position < static_cast<uint64_t>(header->offset_to_points) ||
+        length > static_cast<uint64_t>(size) - position - las::kEvlrHeaderSize) {
+      header->warnings.push_back(fmt::format(
+          "{}: extended variable length record {} at byte {} does not fit in the file ({} bytes); left out "
+          "with the {} after it",
+          file, i, position, size, count - i - 1));
+      return;
+    }
+    SourceRecord record;
+    record.format = "las";
+    record.user_id = FixedText(h + position + las::vlr::kUserId, 16);
+    record.record_id = las::Load<uint16_t>(h + position + las::vlr::kRecordId);
+    record.description = FixedText(h + position + 28, 32);
+    record.payload.assign(h + position + las::kEvlrHeaderSize, static_cast<size_t>(length));
+    header->records.push_back(std::move(record));
+    position += las::kEvlrHeaderSize + length;
+  }
 }
 
 // `bytes` holds the file or (header readers) its start up to the point data; `file_size` is the whole
@@ -95,28 +142,37 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
                      header.offset_to_points, header.header_size, size));
   }
 
+  header.global_encoding = las::Load<uint16_t>(h + las::header::kGlobalEncoding);
+  header.file_source_id = las::Load<uint16_t>(h + las::header::kFileSourceId);
+
   // The variable length records lie between the header and the points; LASzip announces itself in one.
   const uint32_t vlrs = las::Load<uint32_t>(h + las::header::kNumberOfVlrs);
   int64_t position = header.header_size;
+  const int64_t vlr_end = std::min<int64_t>(header.offset_to_points, static_cast<int64_t>(bytes.size()));
   for (uint32_t i = 0; i < vlrs; ++i) {
-    if (position + las::kVlrHeaderSize > header.offset_to_points) {
-      Fail(file, las::header::kNumberOfVlrs, "Number of Variable Length Records",
-           fmt::format("{} records, but record {} at byte {} does not fit before the point data (byte {})",
-                       vlrs, i, position, header.offset_to_points));
+    const int64_t end =
+        position + las::kVlrHeaderSize > vlr_end
+            ? -1
+            : position + las::kVlrHeaderSize + las::Load<uint16_t>(h + position + las::vlr::kRecordLength);
+    if (end < 0 || end > vlr_end) {
+      // Writers that miscount their records are common (PDAL keeps such files readable); the points are
+      // found by the offset to the point data, not by the records.
+      header.warnings.push_back(fmt::format(
+          "{}: the header announces {} variable length records, but record {} at byte {} does not fit "
+          "before the point data (byte {}); read the first {}",
+          file, vlrs, i, position, header.offset_to_points, i));
+      break;
     }
-    const std::string_view user_id(h + position + 2, 16);
-    const uint16_t record_id = las::Load<uint16_t>(h + position + 18);
-    const int64_t end = position + las::kVlrHeaderSize + las::Load<uint16_t>(h + position + 20);
-    if (end > header.offset_to_points) {
-      ThrowInputError(file, fmt::format("byte {}", position + 20), "VLR Record Length After Header",
-                      fmt::format("variable length record {} ends at byte {}, past the start of the point "
-                                  "data (byte {})",
-                                  i, end, header.offset_to_points));
+    SourceRecord record;
+    record.format = "las";
+    record.user_id = FixedText(h + position + las::vlr::kUserId, 16);
+    record.record_id = las::Load<uint16_t>(h + position + las::vlr::kRecordId);
+    record.description = FixedText(h + position + las::vlr::kDescription, 32);
+    record.payload.assign(h + position + las::kVlrHeaderSize, h + end);
+    if (record.user_id == "laszip encoded" && record.record_id == laz::kLazVlrRecordId) {
+      header.laszip_payload.assign(record.payload.begin(), record.payload.end());
     }
-    if (user_id.substr(0, 14) == "laszip encoded" && record_id == laz::kLazVlrRecordId) {
-      header.laszip_payload_at = position + las::kVlrHeaderSize;
-      header.laszip_payload_size = static_cast<int>(end - header.laszip_payload_at);
-    }
+    header.records.push_back(std::move(record));
     position = end;
   }
 
@@ -135,8 +191,7 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
   }
   const int count_byte = header.minor_version >= 4 && legacy_count == 0 ? las::header::kPointCount
                                                                         : las::header::kLegacyPointCount;
-  if (header.count == 0) Fail(file, count_byte, "Number of Point Records", "0: the file holds no points");
-  if (header.laz && header.laszip_payload_size == 0) {
+  if (header.laz && header.laszip_payload.empty()) {
     Fail(file, las::header::kPointFormat, "Point Data Record Format",
          fmt::format("{} has LASzip's compression bits but the file has no laszip encoded VLR", format_byte));
   }
@@ -152,7 +207,7 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
     header.scale[axis] = las::Load<double>(h + las::header::kScale + 8 * axis);
     header.offset[axis] = las::Load<double>(h + las::header::kOffset + 8 * axis);
     const char* names[3] = {"X Scale Factor", "Y Scale Factor", "Z Scale Factor"};
-    if (!std::isfinite(header.scale[axis]) || header.scale[axis] == 0 ||
+    if (!std::isfinite(header.scale[axis]) || std::abs(header.scale[axis]) < kMinLasScale ||
         std::abs(header.scale[axis]) > kMaxCoordinateM) {
       Fail(file, las::header::kScale + 8 * axis, names[axis],
            fmt::format("{} is not a coordinate step", header.scale[axis]));
@@ -162,28 +217,73 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
       Fail(file, las::header::kOffset + 8 * axis, offset_names[axis],
            fmt::format("{} is not a coordinate within {} m", header.offset[axis], kMaxCoordinateM));
     }
+    // The header's bounds must be reachable with 32-bit steps of this scale (a scale of 5e-324 turned every
+    // point into the offset). Bounds that are not numbers, or all 0 (never filled in), are left to the
+    // points' own check.
+    const double bound_high = las::Load<double>(h + las::header::kMaxX + 16 * axis);
+    const double bound_low = las::Load<double>(h + las::header::kMaxX + 16 * axis + 8);
+    if (bound_low == 0 && bound_high == 0) continue;
+    for (const double bound : {bound_low, bound_high}) {
+      const double steps = (bound - header.offset[axis]) / header.scale[axis];
+      if (header.count > 0 && std::isfinite(bound) && !(std::abs(steps) <= 2147483649.0)) {
+        Fail(file, las::header::kScale + 8 * axis, names[axis],
+             fmt::format("{} cannot represent the header's bound {} with 32-bit integers from the offset {}",
+                         header.scale[axis], bound, header.offset[axis]));
+      }
+    }
   }
+  ReadExtendedRecords(bytes, file, size, &header);
   return header;
 }
 
 }  // namespace
 
-Scan ParseLas(const std::string& bytes, const std::string& file) {
-  const LasHeader header = ParseHeader(bytes, file);
-  io_internal::CheckScanSize(1, header.count, file, "header: Number of Point Records");
+namespace {
+
+// The source records the writers carry on: the coordinate reference system and the specification's own
+// descriptions. Others (LASzip, COPC, waveform descriptors, vendors' records) describe a layout or an index
+// of the file they came with, which a written file no longer has.
+bool KeepRecord(const SourceRecord& record) {
+  if (record.user_id == "LASF_Projection") return true;
+  if (record.user_id == "liblas" && record.record_id == 2112) return true;  // an older WKT writer's record
+  return record.user_id == "LASF_Spec" &&
+         (record.record_id == 0 || record.record_id == 3 || record.record_id == 4);
+}
+
+// One attribute channel, created on the first point whose value is not 0.
+template <typename T>
+struct AttributeColumn {
+  const char* name;
+  int type;
+  cv::Mat values;
+  void Set(Scan* scan, int64_t i, T value) {
+    if (value == T{}) return;  // NaN is not 0 and is kept
+    if (values.empty()) values = cv::Mat(1, scan->cols, type, cv::Scalar::all(0));
+    values.at<T>(0, static_cast<int>(i)) = value;
+  }
+  void MoveInto(Scan* scan) {
+    if (!values.empty()) scan->attributes[name] = std::move(values);
+  }
+};
+
+}  // namespace
+
+Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std::string>* warnings) {
+  LasHeader header = ParseHeader(bytes, file);
+  if (header.count > 0) io_internal::CheckScanSize(1, header.count, file, "header: Number of Point Records");
   const int64_t count = header.count;
   const char* records = bytes.data() + header.offset_to_points;
   // LAZ: decoded into the records an uncompressed file would hold (error places are then point indices).
   std::string decoded;
   if (header.laz) {
-    decoded = laz::DecodeLazPoints(
-        std::string_view(bytes).substr(header.laszip_payload_at, header.laszip_payload_size), bytes,
-        header.offset_to_points, count, header.format, header.record_length, file);
+    decoded = laz::DecodeLazPoints(header.laszip_payload, bytes, header.offset_to_points, count,
+                                   header.format, header.record_length, file);
     records = decoded.data();
   }
   const int format = header.format;
   const bool legacy = las::IsLegacyFormat(format);
   const bool rgb = las::HasRgb(format);
+  const int extra_bytes = header.record_length - las::PointRecordSize(format);
   auto record = [&](int64_t i) { return records + i * header.record_length; };
   auto coordinate = [&](const char* p, int axis) {
     return las::Load<int32_t>(p + las::point::kX + 4 * axis) * header.scale[axis] + header.offset[axis];
@@ -203,6 +303,7 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
   Eigen::Vector3d high = -low;
   bool any_intensity = false, any_label = false, any_synthetic = false;
   uint16_t max_rgb = 0;
+  bool rgb_is_8bit_times_257 = true;
   for (int64_t i = 0; i < count; ++i) {
     const char* p = record(i);
     for (int axis = 0; axis < 3; ++axis) {
@@ -222,11 +323,23 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
     any_label |= label_of(p) != 0;
     any_synthetic |= synthetic(p);
     if (rgb) {
-      for (int c = 0; c < 3; ++c)
-        max_rgb = std::max(max_rgb, las::Load<uint16_t>(p + las::RgbOffset(format) + 2 * c));
+      for (int c = 0; c < 3; ++c) {
+        const uint16_t value = las::Load<uint16_t>(p + las::RgbOffset(format) + 2 * c);
+        max_rgb = std::max(max_rgb, value);
+        rgb_is_8bit_times_257 &= value % 257 == 0;
+      }
     }
   }
-  const Eigen::Vector3d origin = io_internal::CloudOrigin(low, high);
+  const double step =
+      std::min({std::abs(header.scale[0]), std::abs(header.scale[1]), std::abs(header.scale[2])});
+  const Eigen::Vector3d origin =
+      count > 0 ? io_internal::CloudOrigin(low, high, step) : Eigen::Vector3d::Zero();
+  if (count > 0 && !io_internal::FloatKeepsStep(low - origin, high - origin, step)) {
+    header.warnings.push_back(fmt::format(
+        "{}: the points span {:.0f} m; relative to their centre a float keeps {:.2g} m, coarser than the "
+        "file's step of {:.2g} m",
+        file, (high - low).maxCoeff(), io_internal::FloatStepAt((high - low).maxCoeff() / 2), step));
+  }
   // 16-bit colour is divided by 257 (65535 -> 255); files with 8-bit values in the 16-bit fields are kept.
   const bool eight_bit_color = max_rgb <= 255;
 
@@ -235,33 +348,116 @@ Scan ParseLas(const std::string& bytes, const std::string& file) {
   scan.world_from_scanner.topRightCorner<3, 1>() = origin;
   if (any_label) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
   if (any_synthetic) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
+  AttributeColumn<double> gps_time{kLasGpsTime, CV_64F};
+  AttributeColumn<uint8_t> return_number{kLasReturnNumber, CV_8U}, returns{kLasNumberOfReturns, CV_8U},
+      class_flags{kLasClassFlags, CV_8U}, channel{kLasScannerChannel, CV_8U},
+      direction{kLasScanDirection, CV_8U}, edge{kLasEdgeOfFlightLine, CV_8U}, user_data{kLasUserData, CV_8U};
+  AttributeColumn<float> scan_angle{kLasScanAngle, CV_32F};
+  AttributeColumn<uint16_t> source_id{kLasPointSourceId, CV_16U}, nir{kLasNir, CV_16U};
+  cv::Mat rgb16 =
+      rgb && !rgb_is_8bit_times_257 ? cv::Mat(1, scan.cols, CV_16UC3, cv::Scalar::all(0)) : cv::Mat();
+  cv::Mat extra;
+  if (extra_bytes > 0 && extra_bytes <= CV_CN_MAX) extra = cv::Mat(1, scan.cols, CV_8UC(extra_bytes));
+  if (extra_bytes > CV_CN_MAX) {
+    header.warnings.push_back(
+        fmt::format("{}: the {} extra bytes of each point are left out (at most {} are kept)", file,
+                    extra_bytes, CV_CN_MAX));
+  }
   uint8_t* valid = scan.valid.ptr<uint8_t>(0);
   cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(0);
   float* intensity = any_intensity ? scan.intensity.ptr<float>(0) : nullptr;
   for (int64_t i = 0; i < count; ++i) {
     const char* p = record(i);
-    const cv::Vec3f relative(static_cast<float>(coordinate(p, 0) - origin.x()),
-                             static_cast<float>(coordinate(p, 1) - origin.y()),
-                             static_cast<float>(coordinate(p, 2) - origin.z()));
-    if (relative == cv::Vec3f(0, 0, 0)) continue;  // no ray from the origin
+    // Every record is a point: in a LAS file (0, 0, 0) is a coordinate like any other.
     valid[i] = kValid;
-    point[i] = relative;
+    point[i] = cv::Vec3f(static_cast<float>(coordinate(p, 0) - origin.x()),
+                         static_cast<float>(coordinate(p, 1) - origin.y()),
+                         static_cast<float>(coordinate(p, 2) - origin.z()));
     if (any_intensity) intensity[i] = las::Load<uint16_t>(p + las::point::kIntensity) / 65535.0f;
     if (rgb) {
       cv::Vec3b& color = scan.color.at<cv::Vec3b>(0, static_cast<int>(i));
       for (int c = 0; c < 3; ++c) {
         const uint16_t value = las::Load<uint16_t>(p + las::RgbOffset(format) + 2 * c);
         color[c] = static_cast<uint8_t>(eight_bit_color ? value : (value + 128) / 257);
+        if (!rgb16.empty()) rgb16.at<cv::Vec3w>(0, static_cast<int>(i))[c] = value;
       }
     }
     if (any_label) scan.label.at<int32_t>(0, static_cast<int>(i)) = label_of(p);
     if (any_synthetic && synthetic(p)) scan.synthesized.at<uint8_t>(0, static_cast<int>(i)) = kValid;
+    const uint8_t return_byte = static_cast<uint8_t>(p[las::point::kReturnByte]);
+    const uint8_t class_byte = static_cast<uint8_t>(p[las::point::kClassByte]);
+    if (legacy) {
+      return_number.Set(&scan, i, return_byte & 7);
+      returns.Set(&scan, i, (return_byte >> 3) & 7);
+      direction.Set(&scan, i, (return_byte >> 6) & 1);
+      edge.Set(&scan, i, (return_byte >> 7) & 1);
+      class_flags.Set(&scan, i, static_cast<uint8_t>((class_byte >> 6) << 1));  // key-point, withheld
+      scan_angle.Set(&scan, i, static_cast<float>(static_cast<int8_t>(p[las::point::kScanAngleRank])));
+      user_data.Set(&scan, i, static_cast<uint8_t>(p[las::point::kUserDataLegacy]));
+      source_id.Set(&scan, i, las::Load<uint16_t>(p + las::point::kPointSourceIdLegacy));
+    } else {
+      return_number.Set(&scan, i, return_byte & 15);
+      returns.Set(&scan, i, return_byte >> 4);
+      class_flags.Set(&scan, i, class_byte & 0x0E);
+      channel.Set(&scan, i, (class_byte >> 4) & 3);
+      direction.Set(&scan, i, (class_byte >> 6) & 1);
+      edge.Set(&scan, i, (class_byte >> 7) & 1);
+      user_data.Set(&scan, i, static_cast<uint8_t>(p[las::point::kUserData14]));
+      scan_angle.Set(&scan, i, static_cast<float>(las::Load<int16_t>(p + las::point::kScanAngle14) * 0.006));
+      source_id.Set(&scan, i, las::Load<uint16_t>(p + las::point::kPointSourceId14));
+    }
+    if (las::HasGpsTime(format)) {
+      gps_time.Set(&scan, i,
+                   las::Load<double>(p + (legacy ? las::point::kGpsTimeLegacy : las::point::kGpsTime14)));
+    }
+    if (las::HasNir(format)) nir.Set(&scan, i, las::Load<uint16_t>(p + las::kNirOffset));
+    if (!extra.empty()) {
+      std::memcpy(extra.ptr<uint8_t>(0) + i * extra_bytes, p + las::PointRecordSize(format), extra_bytes);
+    }
+  }
+  gps_time.MoveInto(&scan);
+  for (auto* column : {&return_number, &returns, &class_flags, &channel, &direction, &edge, &user_data})
+    column->MoveInto(&scan);
+  scan_angle.MoveInto(&scan);
+  source_id.MoveInto(&scan);
+  nir.MoveInto(&scan);
+  if (!rgb16.empty()) scan.attributes[kLasRgb16] = rgb16;
+  if (!extra.empty()) scan.attributes[kLasExtraBytes] = extra;
+
+  std::vector<std::string> left_out;
+  for (SourceRecord& source : header.records) {
+    if (KeepRecord(source)) {
+      scan.source_records.push_back(std::move(source));
+    } else if (!(header.laz && source.user_id == "laszip encoded" &&
+                 source.record_id == laz::kLazVlrRecordId)) {
+      // (LASzip's record describes the compression the reading undid: nothing is lost without it.)
+      left_out.push_back(fmt::format("{} {}", source.user_id, source.record_id));
+    }
+  }
+  if (!left_out.empty()) {
+    header.warnings.push_back(fmt::format(
+        "{}: {} variable length record{} not kept ({}): only the coordinate "
+        "system's and the specification's are carried to written files",
+        file, left_out.size(), left_out.size() == 1 ? " is" : "s are", fmt::join(left_out, ", ")));
+  }
+  scan.source_metadata["las.point_format"] = std::to_string(format);
+  scan.source_metadata["las.minor_version"] = std::to_string(header.minor_version);
+  scan.source_metadata["las.global_encoding"] = std::to_string(header.global_encoding);
+  scan.source_metadata["las.file_source_id"] = std::to_string(header.file_source_id);
+  scan.source_metadata["las.extra_bytes"] = std::to_string(extra.empty() ? 0 : extra_bytes);
+  for (int axis = 0; axis < 3; ++axis) {
+    // Shortest round-trip text: the writer parses back the very same doubles.
+    scan.source_metadata[fmt::format("las.scale_{}", "xyz"[axis])] = fmt::format("{}", header.scale[axis]);
+    scan.source_metadata[fmt::format("las.offset_{}", "xyz"[axis])] = fmt::format("{}", header.offset[axis]);
   }
   io_internal::FinishScan(&scan, /*fit_grid=*/false);
+  if (warnings != nullptr) warnings->insert(warnings->end(), header.warnings.begin(), header.warnings.end());
   return scan;
 }
 
-Scan ReadLas(const std::string& path) { return ParseLas(io_internal::ReadFileToString(path), path); }
+Scan ReadLas(const std::string& path, std::vector<std::string>* warnings) {
+  return ParseLas(io_internal::ReadFileToString(path), path, warnings);
+}
 
 ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   const int64_t file_size = CheckRegularFile(path);
@@ -275,11 +471,11 @@ ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
       bytes = io_internal::ReadFilePrefix(path, needed);
   }
   const LasHeader header = ParseHeader(bytes, path, file_size);
-  io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
+  if (header.count > 0) io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
   ScanFileHeader file;
-  file.format_version = fmt::format("{} 1.{} point format {}", header.laz ? "LAZ (LAS" : "LAS",
-                                    header.minor_version, header.format) +
-                        (header.laz ? ")" : "");
+  file.format_version =
+      header.laz ? fmt::format("LAZ (LAS 1.{} point format {})", header.minor_version, header.format)
+                 : fmt::format("LAS 1.{} point format {}", header.minor_version, header.format);
   ScanHeader scan;
   scan.rows = 1;
   scan.cols = header.count;
@@ -293,10 +489,40 @@ ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   }
   if (low.allFinite() && high.allFinite() && (low.array() <= high.array()).all() &&
       (low.array().abs() <= kMaxCoordinateM).all() && (high.array().abs() <= kMaxCoordinateM).all()) {
-    scan.world_from_scanner.topRightCorner<3, 1>() = io_internal::CloudOrigin(low, high);
+    const double step =
+        std::min({std::abs(header.scale[0]), std::abs(header.scale[1]), std::abs(header.scale[2])});
+    scan.world_from_scanner.topRightCorner<3, 1>() = io_internal::CloudOrigin(low, high, step);
   }
   scan.channels = {"xyz", "range", "intensity", "valid", "direction"};
   if (las::HasRgb(header.format)) scan.channels.push_back("rgb");
+  nlohmann::ordered_json& facts = scan.las;
+  facts["version"] = fmt::format("1.{}", header.minor_version);
+  facts["point_format"] = header.format;
+  facts["record_length"] = header.record_length;
+  facts["extra_bytes"] = header.record_length - las::PointRecordSize(header.format);
+  facts["scale"] = {header.scale[0], header.scale[1], header.scale[2]};
+  facts["offset"] = {header.offset[0], header.offset[1], header.offset[2]};
+  facts["bounds"] = {{"min", {low[0], low[1], low[2]}}, {"max", {high[0], high[1], high[2]}}};
+  nlohmann::ordered_json by_return = nlohmann::ordered_json::array();
+  const bool extended = header.minor_version >= 4 && las::Load<uint64_t>(h + las::header::kPointCount) != 0;
+  for (int r = 0; r < (extended ? 15 : 5); ++r) {
+    by_return.push_back(extended ? las::Load<uint64_t>(h + las::header::kPointsByReturn + 8 * r)
+                                 : las::Load<uint32_t>(h + las::header::kLegacyPointsByReturn + 4 * r));
+  }
+  facts["points_by_return"] = by_return;
+  if (las::HasGpsTime(header.format)) {
+    facts["gps_time"] = header.global_encoding & las::kGlobalEncodingGpsStandard ? "standard" : "week";
+  }
+  facts["file_source_id"] = header.file_source_id;
+  facts["vlrs"] = nlohmann::ordered_json::array();
+  for (const SourceRecord& record : header.records) {
+    facts["vlrs"].push_back({{"user_id", record.user_id},
+                             {"record_id", record.record_id},
+                             {"description", record.description},
+                             {"bytes", record.payload.size()}});
+  }
+  facts["crs"] = LasCrsJson(header.records);
+  file.warnings = header.warnings;
   file.scans.push_back(scan);
   return file;
 }

@@ -120,12 +120,15 @@ const StructInfo& InfoOf<LasWriteOptions>() {
             "LAS 1.x: 4 (LAS 1.4) or 2 (LAS 1.2, formats 0-3)")
         .Range(2, 4);
     b.Field(&LasWriteOptions::point_format, "point_format",
-            "point data record format 0-3 or 6-8; -1 = 7 (1.4) or 2 (1.2) with colour, else 6 or 0")
+            "point data record format 0-3 or 6-8; -1 = the source LAS's when it holds the attributes, else "
+            "8 with NIR, 7 with colour, 6 (1.4); 3/2 with colour, 1/0 (1.2; GPS time decides)")
         .Range(-1, 8);
     b.Field(&LasWriteOptions::coordinate_scale_m, "coordinate_scale_m", "step of the stored coordinates")
         .Unit("m")
         .AboveZero()
         .Max(1);
+    b.Field(&LasWriteOptions::keep_source_scale, "keep_source_scale",
+            "keep the source LAS files' scale and offset when all scans share them (same integers back)");
     b.Check([](const LasWriteOptions& o) {
       CheckOption(
           o.minor_version == 2 || o.minor_version == 4,

@@ -116,6 +116,7 @@ nlohmann::ordered_json ToJson(const ScanHeader& scan, int index) {
   json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
   const nlohmann::ordered_json metadata = MetadataJson(scan.e57);
   if (!metadata.empty()) json["e57"] = metadata;
+  if (!scan.las.is_null()) json["las"] = scan.las;
   return json;
 }
 

@@ -12,7 +12,8 @@
 //   .ply  the header up to end_header: the vertex count, the properties (channels), lidarshop's
 //         "lidarshop_scan" comments (grid and pose of each scan).
 //   .pcd  the header up to DATA: FIELDS (channels), WIDTH x HEIGHT, VIEWPOINT (pose as the reader makes it).
-//   .las  the public header block and the VLRs: point count, point format (colour), bounds.
+//   .las  the public header block and the VLRs: point count, point format (colour), bounds, scale, offset,
+//         points by return, the records and the coordinate reference system.
 //   .xyz .pts  no header: the whole file is read (as ReadScanFile does).
 // Channels are named as ChannelNames (scan/scan.h) names them; a channel is listed only when the header
 // declares it ("intensity" only with a PCD/PLY intensity field, an E57 prototype's intensity, a PTX file (its
@@ -56,6 +57,11 @@ struct ScanHeader {
   std::vector<std::string> channels;  // as ChannelNames names them
   std::string coordinates;            // E57: "cartesian" or "spherical"; else ""
   E57Metadata e57;                    // E57 only
+  // LAS only, as `pdal info` / `lasinfo` show it: {"version", "point_format", "record_length",
+  // "extra_bytes", "scale", "offset", "bounds": {"min", "max"}, "points_by_return", "gps_time":
+  // "standard"|"week", "file_source_id", "vlrs": [{"user_id", "record_id", "description", "bytes"}],
+  // "crs" (LasCrsJson)}; null for other formats.
+  nlohmann::ordered_json las;
 };
 
 // One images2D entry of an E57 file.

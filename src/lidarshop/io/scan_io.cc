@@ -95,6 +95,11 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
   const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
   const PlyProperty* true_range_property = FindScalar(vertex, {"true_range"});
   const PlyProperty* curvature_property = FindScalar(vertex, {"curvature"});
+  // The positions as the file stores them (doubles when the writer needed them): the cloud's floats would
+  // lose half metres 5,000 km out before the pose takes them back to the scanner frame.
+  const PlyProperty* x_property = FindScalar(vertex, {"x"});
+  const PlyProperty* y_property = FindScalar(vertex, {"y"});
+  const PlyProperty* z_property = FindScalar(vertex, {"z"});
 
   if (headers.empty() || row_property == nullptr || col_property == nullptr) {
     // A plain point cloud: one 1 x N scan, every point a return, in the identity pose.
@@ -131,8 +136,11 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     }
     Scan& scan = scans[index];
     const Eigen::Matrix4d& inverse = scanner_from_world[index];
-    const Eigen::Vector3d p =
-        inverse.topLeftCorner<3, 3>() * cloud.points[i].cast<double>() + inverse.topRightCorner<3, 1>();
+    const Eigen::Vector3d world =
+        x_property != nullptr && y_property != nullptr && z_property != nullptr
+            ? Eigen::Vector3d(x_property->values[i], y_property->values[i], z_property->values[i])
+            : cloud.points[i].cast<double>();
+    const Eigen::Vector3d p = inverse.topLeftCorner<3, 3>() * world + inverse.topRightCorner<3, 1>();
     if (p.isZero()) continue;
     if (scan.valid.at<uint8_t>(row, col)) {
       ThrowInputError(path, fmt::format("vertex {}", i), "row/col",
@@ -344,10 +352,14 @@ const std::vector<ScanFormat>& ScanFormats() {
        },
        &WriteE57},
       {"las",
-       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadLas(path)}; },
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadLas(path, warnings)};
+       },
        [](const std::string& path, const std::vector<Scan>& scans) { WriteLas(path, scans); }},
       {"laz",
-       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadLas(path)}; },
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadLas(path, warnings)};
+       },
        nullptr, &LazNotWrittenMessage},
       {"xyz",
        [](const std::string& path, std::vector<std::string>*) {

@@ -95,7 +95,19 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
   };
   for (const Optional& channel : optional) {
     if (!channel.present) continue;
-    if (channel.target == nullptr) {
+    if (channel.target == nullptr && std::string(channel.channel) == "synthesized") {
+      int64_t synthesized = 0;
+      for (const Scan& scan : scans) {
+        if (!scan.synthesized.empty()) synthesized += cv::countNonZero(scan.synthesized & scan.valid);
+      }
+      if (synthesized > 0) {
+        plan.dropped.push_back(
+            fmt::format("{}: {} synthesized point{} written without {} flag ({} cannot mark them; convert "
+                        "--drop-synthesized leaves them out, --synthesized-mask M.png records them)",
+                        path, WithThousandsSeparators(synthesized), synthesized == 1 ? " is" : "s are",
+                        synthesized == 1 ? "its" : "their", holds.name));
+      }
+    } else if (channel.target == nullptr) {
       plan.dropped.push_back(fmt::format("{}: {} are not written ({} has no {} field)", path, channel.plural,
                                          holds.name, channel.channel));
     } else if (channel.target[0] == '\0') {
@@ -108,6 +120,32 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
   if (images > 0 && !holds.images) {
     plan.dropped.push_back(fmt::format("{}: {} image{} (E57 images2D) not written: {} holds no photos", path,
                                        images, images == 1 ? "" : "s", holds.name));
+  }
+  // Carried attributes (Scan::attributes): LAS holds its own; every other writer drops them.
+  std::vector<std::string> attributes;
+  for (const Scan& scan : scans) {
+    for (const auto& [name, values] : scan.attributes) {
+      if (std::find(attributes.begin(), attributes.end(), name) == attributes.end())
+        attributes.push_back(name);
+    }
+  }
+  if (!attributes.empty()) {
+    if (std::string(holds.extension) == "las") {
+      for (const std::string& name : attributes) plan.channels.push_back(name);
+    } else {
+      plan.dropped.push_back(fmt::format("{}: the attributes {} are not written ({} has no fields for them)",
+                                         path, fmt::join(attributes, ", "), holds.name));
+    }
+  }
+  const bool records = std::any_of(scans.begin(), scans.end(), [](const Scan& scan) {
+    return std::any_of(scan.source_records.begin(), scan.source_records.end(),
+                       [](const SourceRecord& record) { return record.user_id == "LASF_Projection"; });
+  });
+  if (records && std::string(holds.extension) != "las") {
+    plan.dropped.push_back(
+        fmt::format("{}: the coordinate reference system (LAS GeoTIFF / WKT records) is not written ({} has "
+                    "no field for it)",
+                    path, holds.name));
   }
   if (scans_with_second_returns > 0) {
     plan.dropped.push_back(

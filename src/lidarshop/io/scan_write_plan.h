@@ -8,9 +8,11 @@
 //   .ply       yes   several  yes   yes        yes     yes             yes     yes         yes           -
 //   .pcd       yes   one      yes   yes        yes     yes             yes     yes         yes           -
 //   .las       -     merged   -     yes        yes     classification  -       -           synthetic     -
-//   .xyz .pts  -     merged   -     yes        yes     -               -       -           refused       -
+//   .xyz .pts  -     merged   -     yes        yes     -               -       -           dropped**     -
 // * PTX has no way to leave the intensity column out: a scan without intensity is written with the PTX
-//   no-information value 0.5, and the plan says so. Second returns (E57 returnIndex 1) are kept only by
+//   no-information value 0.5, and the plan says so. ** XYZ and PTS write synthesized points like measured ones;
+//   the plan says how many. Scan::attributes (LAS GPS time, returns, ...) are held by LAS only, the LAS
+//   coordinate reference system records likewise. Second returns (E57 returnIndex 1) are kept only by
 //   WriteE57 of a whole E57File; a caller that writes them that way passes 0 scans with second returns.
 #pragma once
 

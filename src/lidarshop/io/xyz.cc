@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <iterator>
 #include <limits>
 
@@ -160,23 +161,26 @@ Scan ReadPointList(const std::string& path, PointListKind kind) {
 }
 
 void WritePointList(const std::string& path, const std::vector<Scan>& scans, PointListKind kind) {
-  int64_t count = 0, synthesized = 0;
+  int64_t count = 0;
   bool color = false, intensity = false;
   for (const Scan& scan : scans) {
     CheckScan(scan);
     count += scan.CountValid();
     color |= scan.has_color();
     intensity |= scan.has_intensity();
-    if (!scan.synthesized.empty()) synthesized += cv::countNonZero(scan.synthesized & scan.valid);
-  }
-  const char* name = kind == PointListKind::kPts ? "PTS" : "XYZ";
-  if (synthesized > 0) {
-    ThrowInputError(
-        path, "", "synthesized",
-        fmt::format("{} cannot mark synthesized points ({} of them); write .las, .ply, .pcd or .e57", name,
-                    synthesized));
   }
   if (count == 0) ThrowInputError(path, "", "", "no point with a return to write");
+  // 5 decimals (0.01 mm), more where a LAS source's step is finer (a cloud in degrees of 1e-7).
+  int decimals = 5;
+  for (const Scan& scan : scans) {
+    for (const char* key : {"las.scale_x", "las.scale_y", "las.scale_z"}) {
+      const auto found = scan.source_metadata.find(key);
+      if (found == scan.source_metadata.end()) continue;
+      const double step = std::abs(std::strtod(found->second.c_str(), nullptr));
+      if (step > 0)
+        decimals = std::clamp(static_cast<int>(std::ceil(-std::log10(step) - 1e-9)), decimals, 12);
+    }
+  }
   std::string out;
   out.reserve(static_cast<size_t>(count) * (color ? 56 : 44));
   auto sink = std::back_inserter(out);
@@ -186,7 +190,8 @@ void WritePointList(const std::string& path, const std::vector<Scan>& scans, Poi
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
         const Eigen::Vector3d world = WorldPointOfCell(scan, row, col);
-        fmt::format_to(sink, "{:.5f} {:.5f} {:.5f}", world.x(), world.y(), world.z());
+        fmt::format_to(sink, "{:.{}f} {:.{}f} {:.{}f}", world.x(), decimals, world.y(), decimals, world.z(),
+                       decimals);
         if (intensity) {
           // A scan without intensity among scans with it gets the no-information value 0.5.
           const float value = scan.has_intensity() ? scan.intensity.at<float>(row, col) : 0.5f;

@@ -18,8 +18,9 @@
 // Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm), then, when a scan has
 // intensity, the intensity (XYZ: the shortest decimal that reads back to the same float; PTS:
 // round(i * 4095) - 2048; 0.5 for a scan without among scans with) and, when a scan has
-// colour, r g b (0 0 0 for a scan without). These formats cannot mark synthesized points, so a scan with any
-// synthesized valid point is refused (write LAS, PLY, PCD or E57). Atomic.
+// colour, r g b (0 0 0 for a scan without). These formats cannot mark synthesized points: they are written
+// like measured ones, and PlanScanWrite (io/scan_write_plan.h) says so, so that `convert` warns and can leave
+// them out (--drop-synthesized) or record them (--synthesized-mask). Atomic.
 #pragma once
 
 #include <string>

@@ -7,6 +7,7 @@
 
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
 
@@ -142,19 +143,27 @@ TEST(XyzTest, MalformedLinesNameFileLineAndColumn) {
   EXPECT_THAT(error_for(pts, "1 2 3\n"), AllOf(HasSubstr("line 1"), HasSubstr("after the point count")));
 }
 
-TEST(XyzTest, SynthesizedPointsAreNotWrittenUnmarked) {
+// XYZ and PTS cannot mark synthesized points: they are written, and the write plan says how many went
+// unmarked (what `convert` prints), as for every other thing a target cannot hold.
+TEST(XyzTest, SynthesizedPointsAreWrittenAndThePlanSaysTheyAreUnmarked) {
   TempFolder folder;
   Scan scan = SyntheticScan();
   scan.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
   scan.synthesized(cv::Rect(0, 30, 10, 2)).setTo(kValid);
+  const int64_t synthesized = cv::countNonZero(scan.synthesized & scan.valid);
+  ASSERT_GT(synthesized, 0);
   for (const char* name : {"s.xyz", "s.pts"}) {
-    EXPECT_THAT(InputErrorOf([&] { WriteScanFile(folder.File(name), {scan}); }),
-                AllOf(HasSubstr(name), HasSubstr("cannot mark synthesized points"), HasSubstr(".las")));
-    EXPECT_FALSE(std::filesystem::exists(folder.File(name)));
+    const std::string path = folder.File(name);
+    WriteScanFile(path, {scan});
+    EXPECT_EQ(ReadScanFile(path).scans.at(0).CountValid(), scan.CountValid());
+    const ScanWritePlan plan = PlanScanWrite(path, {scan}, 0, 0);
+    EXPECT_THAT(plan.dropped,
+                testing::Contains(AllOf(HasSubstr(path), HasSubstr(std::to_string(synthesized)),
+                                        HasSubstr("without their flag"), HasSubstr("--drop-synthesized"))));
   }
-  scan.synthesized.setTo(0);  // the channel alone, with nothing synthesized, is fine
-  WriteScanFile(folder.File("s.xyz"), {scan});
-  EXPECT_TRUE(std::filesystem::exists(folder.File("s.xyz")));
+  scan.synthesized.setTo(0);  // the channel alone, with nothing synthesized, says nothing
+  EXPECT_THAT(PlanScanWrite(folder.File("s.xyz"), {scan}, 0, 0).dropped,
+              testing::Not(testing::Contains(HasSubstr("synthesized"))));
 }
 
 }  // namespace

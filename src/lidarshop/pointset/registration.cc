@@ -122,17 +122,31 @@ IcpResult IcpPointToPlane(const PointCloud& fixed, const PointCloud& moving,
 
 ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options,
                                const GlobalAlignOptions* global) {
+  // The clouds are float: registered in a frame centred on the fixed scanner, so that survey coordinates (a
+  // pose 5,000 km out, where a float step is half a metre) register as well as local ones.
+  Eigen::Matrix4d local_from_world = Eigen::Matrix4d::Identity();
+  local_from_world.topRightCorner<3, 1>() = -fixed.world_from_scanner.topRightCorner<3, 1>();
+  auto in_local_frame = [&](const Scan& scan) {
+    Scan local = scan;  // shares the pixels; only the pose differs
+    local.world_from_scanner = local_from_world * scan.world_from_scanner;
+    return local;
+  };
   // Scans without normals get grid normals: oriented toward their scanner, which FPFH needs.
   const NormalOptions grid_normals;
-  const PointCloud fixed_in_world =
-      ToPointCloud(fixed.normal.empty() ? WithGridNormals(fixed, grid_normals) : fixed, true);
-  const PointCloud moving_in_world =
-      ToPointCloud(moving.normal.empty() ? WithGridNormals(moving, grid_normals) : moving, true);
+  const Scan fixed_local =
+      in_local_frame(fixed.normal.empty() ? WithGridNormals(fixed, grid_normals) : fixed);
+  const Scan moving_local =
+      in_local_frame(moving.normal.empty() ? WithGridNormals(moving, grid_normals) : moving);
+  const PointCloud fixed_in_local = ToPointCloud(fixed_local, true);
+  const PointCloud moving_in_local = ToPointCloud(moving_local, true);
   const Eigen::Matrix4d initial =
-      global ? AlignGlobally(fixed_in_world, moving_in_world, *global).fixed_from_moving
+      global ? AlignGlobally(fixed_in_local, moving_in_local, *global).fixed_from_moving
              : Eigen::Matrix4d::Identity();
   ScanRegistration out;
-  out.icp = IcpPointToPlane(fixed_in_world, moving_in_world, initial, options);
+  out.icp = IcpPointToPlane(fixed_in_local, moving_in_local, initial, options);
+  // Back to the world: world_from_local * local correction * local_from_world.
+  const Eigen::Matrix4d world_from_local = local_from_world.inverse();
+  out.icp.fixed_from_moving = world_from_local * out.icp.fixed_from_moving * local_from_world;
   out.registered = moving;
   out.registered.world_from_scanner = out.icp.fixed_from_moving * moving.world_from_scanner;
   return out;

@@ -72,6 +72,7 @@ Scan Clone(const Scan& scan) {
         &copy.normal, &copy.curvature, &copy.true_range, &copy.synthesized}) {
     *channel = channel->clone();
   }
+  for (auto& [name, values] : copy.attributes) values = values.clone();
   return copy;
 }
 
@@ -93,6 +94,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   if (!masked.curvature.empty()) masked.curvature.setTo(NAN, drop);
   if (!masked.true_range.empty()) masked.true_range.setTo(0, drop);
   if (!masked.synthesized.empty()) masked.synthesized.setTo(0, drop);
+  for (auto& [name, values] : masked.attributes) values.setTo(cv::Scalar::all(0), drop);
   return masked;
 }
 
@@ -133,6 +135,11 @@ void CheckScan(const Scan& scan) {
   check(scan.curvature, CV_32F, "curvature", false);
   check(scan.true_range, CV_32F, "true_range", false);
   check(scan.synthesized, CV_8U, "synthesized", false);
+  for (const auto& [name, values] : scan.attributes) {
+    if (values.rows != scan.rows || values.cols != scan.cols) {
+      throw std::logic_error("scan attribute has the wrong size: " + name);
+    }
+  }
 }
 
 std::vector<std::string> ChannelNames(const Scan& scan) {

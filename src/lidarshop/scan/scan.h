@@ -23,12 +23,20 @@
 //                         came from (pointset/normals.h); NaN where invalid or unknown
 //   true_range  CV_32F    noise-free range (synthetic scans), 0 where invalid
 //   synthesized CV_8U     255 = created by lidarshop (e.g. hole filling), 0 = measured
+// Carried, not interpreted (`attributes`): per-cell values of the source file that no algorithm of lidarshop
+// uses but that a user expects back (LAS GPS time, return numbers, scan angle, point source ID, NIR, extra
+// bytes; io/las.h names them). Each is a rows x cols cv::Mat of 1 to 512 channels of any depth, 0 in cells
+// without a return and where the file held 0; a file that holds 0 everywhere has no such attribute. Clone and
+// MaskScan keep them; writers that hold an attribute write it, the others say they drop it
+// (io/scan_write_plan.h). `source_records` keeps file-level records the same way (LAS VLRs of the coordinate
+// reference system), `source_metadata` the source's own settings a writer of the same format reuses.
 //
 // For a valid cell the measured point need not lie exactly on `direction` (orthogonal noise, real scanners);
 // the cell's direction is the nominal grid direction, the point's own direction is point / range.
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -65,6 +73,17 @@ struct ScanGrid {
   bool fitted = false;  // true when estimated from measured points (FitGrid), false when nominal
 };
 
+// A record of the source file kept for writers of the same format: LAS variable length records (`format`
+// "las", user ID, record ID, description, payload bytes).
+struct SourceRecord {
+  std::string format;
+  std::string user_id;
+  int record_id = 0;
+  std::string description;
+  std::string payload;
+  friend bool operator==(const SourceRecord&, const SourceRecord&) = default;
+};
+
 struct Scan {
   int rows = 0;
   int cols = 0;
@@ -86,6 +105,10 @@ struct Scan {
 
   ScanGrid grid;  // empty vectors when the scan has no known grid
 
+  std::map<std::string, cv::Mat> attributes;           // see the top of this file
+  std::vector<SourceRecord> source_records;            // e.g. the CRS VLRs of a LAS file
+  std::map<std::string, std::string> source_metadata;  // e.g. "las.point_format" = "3"
+
   bool has_color() const { return !color.empty(); }
   bool has_intensity() const { return !intensity.empty(); }
   int64_t num_cells() const { return static_cast<int64_t>(rows) * cols; }
@@ -104,7 +127,7 @@ Scan Clone(const Scan& scan);
 
 // The scan with only the cells where `keep_mask` (CV_8U, rows x cols, non-zero = keep) is set: every other
 // cell becomes a cell without a return (valid 0, range 0, point 0, intensity 0.5, colour 0, label kNoLabel,
-// normal 0, curvature NaN, true_range 0, synthesized 0) but keeps its direction; grid, pose and name are kept. Used to write
+// normal 0, curvature NaN, true_range 0, synthesized 0, attributes 0) but keeps its direction; grid, pose and name are kept. Used to write
 // a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error when the mask has the
 // wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);
