@@ -121,6 +121,78 @@ Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& h
   return ((low + high) / 2).array().round().matrix();
 }
 
+void PointBounds(const std::vector<Eigen::Vector3d>& points, const std::vector<uint8_t>& valid,
+                 Eigen::Vector3d* low, Eigen::Vector3d* high) {
+  *low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  *high = -*low;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!valid.empty() && !valid[i]) continue;
+    *low = low->cwiseMin(points[i]);
+    *high = high->cwiseMax(points[i]);
+  }
+}
+
+Eigen::Vector3d OriginClearOfPoints(Eigen::Vector3d origin, const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<uint8_t>& valid) {
+  // A point's float offset is zero only when it lies (all but) exactly on the origin; such a point can sit on
+  // at most one of the candidates origin - k * step, so one of the first points.size() + 1 is free.
+  constexpr double kStepM = 1.0 / 1024;
+  std::vector<int64_t> taken;
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (!valid.empty() && !valid[i]) continue;
+    const Eigen::Vector3d offset = points[i] - origin;
+    if (std::abs(offset.x()) > 1e-30 || std::abs(offset.y()) > 1e-30 || offset.z() > 1e-30) continue;
+    const double steps = std::round(-offset.z() / kStepM);
+    if (std::abs(-offset.z() - steps * kStepM) <= 1e-30 && steps <= static_cast<double>(points.size()))
+      taken.push_back(static_cast<int64_t>(steps));
+  }
+  std::sort(taken.begin(), taken.end());
+  int64_t free_step = 0;
+  for (int64_t step : taken) {
+    if (step == free_step) ++free_step;
+  }
+  origin.z() -= static_cast<double>(free_step) * kStepM;
+  return origin;
+}
+
+Eigen::Vector3d FarScanOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {
+  if (low.cwiseAbs().maxCoeff() <= kScanRangeKeptM && high.cwiseAbs().maxCoeff() <= kScanRangeKeptM) {
+    return Eigen::Vector3d::Zero();
+  }
+  return ((low + high) / 2).array().round().matrix();
+}
+
+Scan UnorganizedScan(const std::vector<Eigen::Vector3d>& points_in_world, const std::vector<uint8_t>& valid,
+                     bool with_color, bool with_intensity, const Eigen::Matrix4d& preferred_pose) {
+  LIDARSHOP_CHECK(valid.empty() || valid.size() == points_in_world.size());
+  const int64_t count = static_cast<int64_t>(points_in_world.size());
+  Scan scan = MakeScan(1, static_cast<int>(count), with_color, with_intensity);
+  Eigen::Vector3d low, high;
+  PointBounds(points_in_world, valid, &low, &high);
+  const Eigen::Matrix3d world_from_scanner_rotation = preferred_pose.topLeftCorner<3, 3>();
+  Eigen::Vector3d origin = preferred_pose.topRightCorner<3, 1>();
+  const bool any = (low.array() <= high.array()).all();
+  if (any && ((low - origin).cwiseAbs().maxCoeff() > kCloudFloatSafeM ||
+              (high - origin).cwiseAbs().maxCoeff() > kCloudFloatSafeM)) {
+    origin = CloudOrigin(low, high);
+  }
+  origin = OriginClearOfPoints(origin, points_in_world, valid);
+  scan.world_from_scanner.topLeftCorner<3, 3>() = world_from_scanner_rotation;
+  scan.world_from_scanner.topRightCorner<3, 1>() = origin;
+  const Eigen::Matrix3d scanner_from_world_rotation = world_from_scanner_rotation.transpose();
+  uint8_t* valid_out = scan.valid.ptr<uint8_t>(0);
+  cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(0);
+  for (int64_t i = 0; i < count; ++i) {
+    if (!valid.empty() && !valid[i]) continue;
+    const Eigen::Vector3f p = (scanner_from_world_rotation * (points_in_world[i] - origin)).cast<float>();
+    LIDARSHOP_CHECK(!p.isZero());
+    valid_out[i] = kValid;
+    point[i] = cv::Vec3f(p.x(), p.y(), p.z());
+  }
+  FinishScan(&scan, /*fit_grid=*/false);
+  return scan;
+}
+
 double FloatStepAt(double value) {
   const double magnitude = std::abs(value);
   if (!(magnitude >= std::numeric_limits<float>::min())) return std::numeric_limits<float>::denorm_min();

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "lidarshop/scan/scan.h"
 
@@ -53,6 +54,41 @@ double FloatStepAt(double value);
 // Whether every coordinate in [low, high] (relative to the origin) is a float within half of `step_m` of
 // its double value.
 bool FloatKeepsStep(const Eigen::Vector3d& low, const Eigen::Vector3d& high, double step_m);
+
+// An unorganized point list (XYZ, PTS, a plain PLY cloud, an unorganized PCD; LAS may use it) as a 1 x N scan
+// in list order, N = points_in_world.size(). `valid` (empty = every entry) marks the entries that are points
+// (a PCD's NaN is not). In an unorganized file the origin is a point like any other: every valid entry becomes
+// a return, (0, 0, 0) included ("no return" is a convention of organized grids only).
+// The pose: `preferred_pose` (a rigid motion; a PCD's VIEWPOINT, identity elsewhere) when every point lies
+// within kCloudFloatSafeM of its position in each axis, else the same rotation with the translation
+// CloudOrigin of the points' bounds. Points are float offsets from that origin, so that world coordinates keep
+// 0.1 mm also 5,000 km from (0, 0, 0). When a point lies exactly on the origin (it would have no ray) the
+// origin moves down (world -z) by a whole number of 2^-10 m steps, the fewest that leave no point on it: every
+// valid cell has range > 0 and a direction. Colour (0) and intensity (0.5) are allocated as asked, for the
+// caller to fill; range and direction are set (FinishScan, no grid).
+Scan UnorganizedScan(const std::vector<Eigen::Vector3d>& points_in_world, const std::vector<uint8_t>& valid,
+                     bool with_color, bool with_intensity,
+                     const Eigen::Matrix4d& preferred_pose = Eigen::Matrix4d::Identity());
+
+// `origin`, moved down (-z of the points' frame) by the fewest whole 2^-10 m steps that leave none of the
+// valid `points` exactly on it (a point there would have no ray); `valid` empty = all.
+Eigen::Vector3d OriginClearOfPoints(Eigen::Vector3d origin, const std::vector<Eigen::Vector3d>& points,
+                                    const std::vector<uint8_t>& valid);
+
+// Organized scans (PTX, organized PCD) keep their scanner origin while every point lies within
+// kScanRangeKeptM of it in each axis (float steps there are at most 1 mm, below any scanner's noise at such
+// ranges; under 2 km they are under 0.12 mm). Points farther away are not rays of that scanner (a file of
+// georeferenced points with an identity pose): the reader then keeps them relative to a local origin
+// (FarScanOrigin) held in the pose and says so in a warning.
+constexpr double kScanRangeKeptM = 10000.0;
+// (0, 0, 0) when the scanner-frame bounds [low, high] lie within kScanRangeKeptM, else the centre of the
+// bounds rounded to a metre (scanner frame).
+Eigen::Vector3d FarScanOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high);
+
+// The world bounds of `points` (entries with valid[i] == 0 skipped; empty `valid` = all); low > high when
+// none is valid.
+void PointBounds(const std::vector<Eigen::Vector3d>& points, const std::vector<uint8_t>& valid,
+                 Eigen::Vector3d* low, Eigen::Vector3d* high);
 
 // An image as CV_8UC3 RGB (grey and RGBA converted, 16-bit scaled down), for mesh textures.
 cv::Mat TextureToRgb8(const cv::Mat& image);

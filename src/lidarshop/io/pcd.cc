@@ -1,6 +1,9 @@
 #include "lidarshop/io/pcd.h"
 
+#include <algorithm>
+#include <array>
 #include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -46,9 +49,15 @@ struct PcdHeader {
   size_t data_offset = 0;
   int64_t data_line = 0;
 
+  // The field called `name` (lower case), compared without case: PDAL writes FIELDS X Y Z Intensity.
   int Find(const std::string& name) const {
     for (size_t i = 0; i < fields.size(); ++i) {
-      if (fields[i].name == name) return static_cast<int>(i);
+      const std::string& field = fields[i].name;
+      if (field.size() == name.size() &&
+          std::equal(field.begin(), field.end(), name.begin(),
+                     [](char a, char b) { return std::tolower(static_cast<unsigned char>(a)) == b; })) {
+        return static_cast<int>(i);
+      }
     }
     return -1;
   }
@@ -128,6 +137,11 @@ PcdHeader ParseHeader(const std::string& bytes, const std::string& file) {
       }
       cursor.NextLine();
       break;
+    } else if (header.fields.empty() && (std::isdigit(static_cast<unsigned char>(keyword[0])) ||
+                                         keyword[0] == '-' || keyword[0] == '+' || keyword[0] == '.')) {
+      cursor.Fail("header", fmt::format("missing: the file starts with data ('{}'), not with the PCD header "
+                                        "(VERSION, FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, POINTS, DATA)",
+                                        io_internal::Printable(keyword)));
     } else {
       cursor.Fail("header",
                   fmt::format("unknown keyword '{}' (not a PCD file?)", io_internal::Printable(keyword)));
@@ -235,9 +249,15 @@ uint32_t PackedColor(const char* p, const PcdField& field) {
   return bits;
 }
 
-// VIEWPOINT as a matrix: the frame the file's coordinates are in.
+// VIEWPOINT as a matrix: the sensor's pose in the frame of the points (world_from_sensor).
 Eigen::Matrix4d Viewpoint(const PcdHeader& header, const std::string& file) {
   const double* v = header.viewpoint;
+  for (int i = 0; i < 7; ++i) {
+    if (!(std::abs(v[i]) <= kMaxCoordinateM)) {
+      ThrowInputError(file, "header", "VIEWPOINT",
+                      fmt::format("{} is not a number within {} m", v[i], kMaxCoordinateM));
+    }
+  }
   Eigen::Matrix4d viewpoint = Eigen::Matrix4d::Identity();
   const Eigen::Quaterniond rotation(v[3], v[4], v[5], v[6]);
   if (rotation.norm() < 1e-9)
@@ -247,8 +267,9 @@ Eigen::Matrix4d Viewpoint(const PcdHeader& header, const std::string& file) {
   return viewpoint;
 }
 
-// The scan's pose: the one lidarshop's comment names (its points are world coordinates), else VIEWPOINT,
-// turned from the optical frame for a foreign organized cloud (a camera image).
+// The scan's pose as the header gives it: the one lidarshop's comment names, else VIEWPOINT, turned from the
+// optical frame for a foreign organized cloud (a camera image; ParsePcd may choose the OpenGL frame instead
+// from where the points lie, and a local origin for points far from the sensor).
 Eigen::Matrix4d WorldFromScanner(const PcdHeader& header, const std::string& file) {
   if (header.has_scanner_pose) return header.world_from_scanner;
   const Eigen::Matrix4d viewpoint = Viewpoint(header, file);
@@ -257,9 +278,9 @@ Eigen::Matrix4d WorldFromScanner(const PcdHeader& header, const std::string& fil
 
 }  // namespace
 
-Scan ParsePcd(const std::string& bytes, const std::string& file) {
+Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std::string>* warnings) {
   if (bytes.empty()) ThrowInputError(file, "byte 0", "", "the file is empty");
-  const PcdHeader header = ParseHeader(bytes, file);
+  PcdHeader header = ParseHeader(bytes, file);
   const int64_t points = header.points;
   const int64_t data_size = points * header.point_size;
   const size_t available = bytes.size() - header.data_offset;
@@ -321,7 +342,8 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
       plane += points * field_bytes;
     }
   } else {
-    // ascii: every value into a binary record of the declared type.
+    // ascii: every value into a binary record of the declared type, except that F values are kept as doubles:
+    // the text holds the file's precision (UTM coordinates in a "SIZE 4" field, as PDAL writes them).
     // Every value takes at least a digit and a separator.
     int64_t values_per_point = 0;
     for (const PcdField& field : header.fields) values_per_point += field.count;
@@ -330,8 +352,16 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
                       fmt::format("truncated: {} points of {} values claimed, only {} bytes follow", points,
                                   values_per_point, available));
     }
-    allocate(data_size);
+    header.point_size = 0;
+    for (PcdField& field : header.fields) {
+      if (field.type == 'F') field.size = 8;
+      field.offset = header.point_size;
+      header.point_size += static_cast<int64_t>(field.size) * field.count;
+    }
+    allocate(points * header.point_size);
     TextCursor cursor(std::string_view(bytes).substr(header.data_offset), file, header.data_line);
+    // Values separated by blanks (spaces or tabs) or by commas (PDAL's utm17_comma.pcd).
+    cursor.set_separator(',');
     for (int64_t i = 0; i < points; ++i) {
       cursor.SkipEmptyLines();
       if (cursor.AtEnd()) cursor.Fail("", fmt::format("truncated: {} points claimed, found {}", points, i));
@@ -339,10 +369,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
         for (int k = 0; k < field.count; ++k) {
           char* out = records.data() + i * header.point_size + field.offset + k * field.size;
           const double value = cursor.Number<double>(field.name, /*allow_nonfinite=*/true);
-          if (field.type == 'F' && field.size == 4) {
-            const float f = static_cast<float>(value);
-            std::memcpy(out, &f, 4);
-          } else if (field.type == 'F') {
+          if (field.type == 'F') {
             std::memcpy(out, &value, 8);
           } else {
             if (!(std::abs(value) < 0x1p63)) cursor.Fail(field.name, "not an integer in range");
@@ -360,51 +387,157 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
 
   const bool organized = header.height > 1;
   const int rows = static_cast<int>(header.height), cols = static_cast<int>(header.width);
+  const auto& f = header.fields;
   const int fx = header.Find("x"), fy = header.Find("y"), fz = header.Find("z");
+  auto record_of = [&](int64_t cell) { return records.data() + cell * header.point_size; };
+  // The point of a cell as the file holds it (world frame); false for a missing point (NaN; (0, 0, 0) in an
+  // organized cloud, the grid's no-return convention).
+  auto file_point = [&](int64_t cell, Eigen::Vector3d* point) {
+    const char* record = record_of(cell);
+    *point = Eigen::Vector3d(LoadValue(record + f[fx].offset, f[fx]), LoadValue(record + f[fy].offset, f[fy]),
+                             LoadValue(record + f[fz].offset, f[fz]));
+    if (!point->allFinite()) return false;
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(std::abs((*point)[axis]) <= kMaxCoordinateM)) {
+        ThrowInputError(file, fmt::format("point {}", cell), f[std::array{fx, fy, fz}[axis]].name,
+                        fmt::format("{} is not a coordinate within {} m", (*point)[axis], kMaxCoordinateM));
+      }
+    }
+    return !(organized && point->isZero());
+  };
+
   int fcolor = header.Find("rgba");
   if (fcolor < 0) fcolor = header.Find("rgb");
+  // PDAL writes colour as three fields Red Green Blue (16-bit); PCL packs it into one rgb/rgba field.
+  const int fred = header.Find("red"), fgreen = header.Find("green"), fblue = header.Find("blue");
+  const bool split_color = fcolor < 0 && fred >= 0 && fgreen >= 0 && fblue >= 0;
+  double split_color_scale = 1.0;
+  if (split_color) {
+    double highest = 0;
+    for (int64_t cell = 0; cell < points; ++cell) {
+      for (int field : {fred, fgreen, fblue})
+        highest = std::max(highest, LoadValue(record_of(cell) + f[field].offset, f[field]));
+    }
+    if (highest > 255) split_color_scale = 1.0 / 257.0;  // 16-bit colour, 65535 -> 255
+  }
   const int fintensity = header.Find("intensity");
+  // Integer intensities (PDAL writes LAS's 16-bit ones) are scaled by their type's range to [0, 1].
+  double intensity_scale = 1.0;
+  if (fintensity >= 0 && f[fintensity].type != 'F') {
+    const int bits = 8 * f[fintensity].size - (f[fintensity].type == 'I' ? 1 : 0);
+    intensity_scale = 1.0 / (std::ldexp(1.0, bits) - 1.0);
+  }
   const int flabel = header.Find("label");
   const int fnx = header.Find("normal_x"), fny = header.Find("normal_y"), fnz = header.Find("normal_z");
   const int fcurvature = header.Find("curvature");
   const int fsynth = header.Find("synthesized");
   const int ftrue = header.Find("true_range");
-  Scan scan = MakeScan(rows, cols, fcolor >= 0, /*with_intensity=*/fintensity >= 0);
-  if (flabel >= 0) scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
+  const bool with_color = fcolor >= 0 || split_color;
   const bool normals = fnx >= 0 && fny >= 0 && fnz >= 0;
+
+  // The file's numbers are the points in the world frame; VIEWPOINT is the sensor's pose in that frame
+  // (PCL's sensor_origin_ / sensor_orientation_, which PCL, Open3D and CloudCompare do not apply to the
+  // points). The scan keeps both: WorldPointOfCell gives the file's numbers, world_from_scanner the pose.
+  Scan scan;
+  if (!organized) {
+    std::vector<Eigen::Vector3d> world(static_cast<size_t>(points));
+    std::vector<uint8_t> valid(static_cast<size_t>(points), 0);
+    for (int64_t cell = 0; cell < points; ++cell) valid[cell] = file_point(cell, &world[cell]) ? 1 : 0;
+    const Eigen::Matrix4d preferred =
+        header.has_scanner_pose ? header.world_from_scanner : Viewpoint(header, file);
+    scan = io_internal::UnorganizedScan(world, valid, with_color, fintensity >= 0, preferred);
+    // Worth a word only when the file gives a sensor pose (an identity VIEWPOINT is PCL's "unknown").
+    if (warnings != nullptr && !header.has_scanner_pose && !preferred.isIdentity() &&
+        !scan.world_from_scanner.topRightCorner<3, 1>().isApprox(preferred.topRightCorner<3, 1>())) {
+      warnings->push_back(
+          fmt::format("{}: the points lie more than {} m from the VIEWPOINT position; the scan's origin is "
+                      "moved near them "
+                      "so that floats keep 0.1 mm (the points are unchanged)",
+                      file, io_internal::kCloudFloatSafeM));
+    }
+  } else {
+    scan = MakeScan(rows, cols, with_color, fintensity >= 0);
+    scan.world_from_scanner = WorldFromScanner(header, file);
+    if (!header.has_scanner_pose) {
+      // An organized cloud is a camera image: the sensor frame is an optical frame, x right, y down, z forward
+      // (PCL), or the OpenGL one, y up and z backward, which a VIEWPOINT turned half a turn about x gives
+      // (PCL's stereo data). The points lie in front of the camera: when most lie behind the optical frame
+      // the sensor frame is the OpenGL one. Either way row 0 is the top of the image, as scans have it.
+      const Eigen::Matrix4d file_from_viewpoint = Viewpoint(header, file).inverse();
+      int64_t front = 0, behind = 0;
+      for (int64_t cell = 0; cell < points; ++cell) {
+        Eigen::Vector3d point;
+        if (!file_point(cell, &point)) continue;
+        const double depth = file_from_viewpoint.row(2).head<3>().dot(point) + file_from_viewpoint(2, 3);
+        (depth < 0 ? behind : front) += 1;
+      }
+      if (behind > 9 * front) {
+        Eigen::Matrix4d flip = Eigen::Matrix4d::Identity();  // OpenGL from optical: half a turn about x
+        flip(1, 1) = flip(2, 2) = -1;
+        scan.world_from_scanner = Viewpoint(header, file) * flip * CameraFromScanner();
+      }
+    }
+    const Eigen::Matrix4d scanner_from_world = scan.world_from_scanner.inverse();
+    const Eigen::Matrix3d rotate = scanner_from_world.topLeftCorner<3, 3>();
+    const Eigen::Vector3d shift = scanner_from_world.topRightCorner<3, 1>();
+    // Points beyond kScanRangeKeptM of the sensor: a local origin held in the pose (io_common.h).
+    std::vector<Eigen::Vector3d> in_scanner(static_cast<size_t>(points));
+    std::vector<uint8_t> valid(static_cast<size_t>(points), 0);
+    Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+    for (int64_t cell = 0; cell < points; ++cell) {
+      Eigen::Vector3d point;
+      if (!file_point(cell, &point)) continue;
+      valid[cell] = 1;
+      in_scanner[cell] = rotate * point + shift;
+      low = low.cwiseMin(in_scanner[cell]);
+      high = high.cwiseMax(in_scanner[cell]);
+    }
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    if ((low.array() <= high.array()).all()) origin = io_internal::FarScanOrigin(low, high);
+    if (!origin.isZero()) {
+      origin = io_internal::OriginClearOfPoints(origin, in_scanner, valid);
+      scan.world_from_scanner.topRightCorner<3, 1>() +=
+          scan.world_from_scanner.topLeftCorner<3, 3>() * origin;
+      if (warnings != nullptr) {
+        warnings->push_back(fmt::format(
+            "{}: the points lie more than {} m from the sensor (VIEWPOINT): they are not read as its rays "
+            "but "
+            "relative to a local origin, so that floats keep 0.1 mm; the directions are from that origin",
+            file, io_internal::kScanRangeKeptM));
+      }
+    }
+    for (int64_t cell = 0; cell < points; ++cell) {
+      if (!valid[cell]) continue;
+      const Eigen::Vector3f p = (in_scanner[cell] - origin).cast<float>();
+      scan.valid.at<uint8_t>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) = kValid;
+      scan.point.at<cv::Vec3f>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) =
+          cv::Vec3f(p.x(), p.y(), p.z());
+    }
+  }
+  if (flabel >= 0) scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
   if (normals) scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
   if (fcurvature >= 0) scan.curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
   if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
-  // The file's coordinates are in the VIEWPOINT frame: world = viewpoint · file. lidarshop's own files say
-  // in a comment which scan pose they hold (the points are world coordinates); a foreign organized cloud is
-  // a camera image in the optical frame, a foreign unorganized one a cloud in the viewpoint's frame.
-  scan.world_from_scanner = WorldFromScanner(header, file);
-  Eigen::Matrix4d scanner_from_file = Eigen::Matrix4d::Identity();
-  if (header.has_scanner_pose)
-    scanner_from_file = header.world_from_scanner.inverse() * Viewpoint(header, file);
-  else if (organized)
-    scanner_from_file = CameraFromScanner().inverse();  // (x, y, z) → (x, z, −y), exactly
-  const Eigen::Matrix3d rotate = scanner_from_file.topLeftCorner<3, 3>();
-  const Eigen::Vector3d shift = scanner_from_file.topRightCorner<3, 1>();
-  const auto& f = header.fields;
+  const Eigen::Matrix3d scanner_from_world_rotation =
+      scan.world_from_scanner.topLeftCorner<3, 3>().transpose();
   for (int row = 0; row < rows; ++row) {
     for (int col = 0; col < cols; ++col) {
-      const char* record = records.data() + (static_cast<int64_t>(row) * cols + col) * header.point_size;
-      const double x = LoadValue(record + f[fx].offset, f[fx]);
-      const double y = LoadValue(record + f[fy].offset, f[fy]);
-      const double z = LoadValue(record + f[fz].offset, f[fz]);
-      if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z) || (x == 0 && y == 0 && z == 0))
-        continue;
-      scan.valid.at<uint8_t>(row, col) = kValid;
-      const Eigen::Vector3f p = (rotate * Eigen::Vector3d(x, y, z) + shift).cast<float>();
-      scan.point.at<cv::Vec3f>(row, col) = cv::Vec3f(p.x(), p.y(), p.z());
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      const char* record = record_of(static_cast<int64_t>(row) * cols + col);
       if (fcolor >= 0) {
         const uint32_t bits = PackedColor(record + f[fcolor].offset, f[fcolor]);
         scan.color.at<cv::Vec3b>(row, col) = cv::Vec3b((bits >> 16) & 0xff, (bits >> 8) & 0xff, bits & 0xff);
+      } else if (split_color) {
+        cv::Vec3b& color = scan.color.at<cv::Vec3b>(row, col);
+        const int channels[3] = {fred, fgreen, fblue};
+        for (int c = 0; c < 3; ++c) {
+          const double value = LoadValue(record + f[channels[c]].offset, f[channels[c]]) * split_color_scale;
+          color[c] = static_cast<uint8_t>(std::clamp(std::round(value), 0.0, 255.0));
+        }
       }
       if (fintensity >= 0) {
-        const double value = LoadValue(record + f[fintensity].offset, f[fintensity]);
+        const double value = LoadValue(record + f[fintensity].offset, f[fintensity]) * intensity_scale;
         if (std::isfinite(value)) scan.intensity.at<float>(row, col) = static_cast<float>(value);
       }
       if (flabel >= 0) {
@@ -412,12 +545,12 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
             io_internal::ToInt32(LoadValue(record + f[flabel].offset, f[flabel]), kNoLabel);
       }
       if (normals) {
-        const double nx = LoadValue(record + f[fnx].offset, f[fnx]);
-        const double ny = LoadValue(record + f[fny].offset, f[fny]);
-        const double nz = LoadValue(record + f[fnz].offset, f[fnz]);
-        if (std::isfinite(nx) && std::isfinite(ny) && std::isfinite(nz)) {
-          const Eigen::Vector3f n = (rotate * Eigen::Vector3d(nx, ny, nz)).cast<float>();
-          scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
+        const Eigen::Vector3d n(LoadValue(record + f[fnx].offset, f[fnx]),
+                                LoadValue(record + f[fny].offset, f[fny]),
+                                LoadValue(record + f[fnz].offset, f[fnz]));
+        if (n.allFinite()) {
+          const Eigen::Vector3f m = (scanner_from_world_rotation * n).cast<float>();
+          scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(m.x(), m.y(), m.z());
         }
       }
       if (fcurvature >= 0) {
@@ -434,7 +567,9 @@ Scan ParsePcd(const std::string& bytes, const std::string& file) {
   return scan;
 }
 
-Scan ReadPcd(const std::string& path) { return ParsePcd(io_internal::ReadFileToString(path), path); }
+Scan ReadPcd(const std::string& path, std::vector<std::string>* warnings) {
+  return ParsePcd(io_internal::ReadFileToString(path), path, warnings);
+}
 
 ScanFileHeader io_internal::ReadPcdHeader(const std::string& path) {
   const int64_t file_bytes = CheckRegularFile(path);
@@ -463,13 +598,34 @@ ScanFileHeader io_internal::ReadPcdHeader(const std::string& path) {
   return file;
 }
 
+bool PcdNeedsDoubleCoordinates(const Scan& scan) {
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      if (WorldPointOfCell(scan, row, col).cwiseAbs().maxCoeff() > io_internal::kCloudFloatSafeM) return true;
+    }
+  }
+  return false;
+}
+
 void WritePcd(const std::string& path, const Scan& scan) {
   CheckScan(scan);
   const Eigen::Matrix4d& world_from_scanner = scan.world_from_scanner;
   const Eigen::Matrix3d rotate = world_from_scanner.topLeftCorner<3, 3>();
   const Eigen::Vector3d shift = world_from_scanner.topRightCorner<3, 1>();
-  // Far from the origin (georeferenced scans) floats would lose millimetres: doubles then, as in PLY.
-  const bool far = shift.norm() > 1e4;
+  // Far from the origin (georeferenced scans) floats would lose precision: doubles then (pcd.h).
+  const bool far = PcdNeedsDoubleCoordinates(scan);
+  // VIEWPOINT: the sensor's pose; an organized scan's sensor frame as PCL's optical frame (pcd.h).
+  const Eigen::Matrix4d viewpoint = scan.rows > 1
+                                        ? Eigen::Matrix4d(world_from_scanner * CameraFromScanner().inverse())
+                                        : world_from_scanner;
+  const Eigen::Quaterniond orientation(Eigen::Matrix3d(viewpoint.topLeftCorner<3, 3>()));
+  std::string viewpoint_text;
+  for (double value : {viewpoint(0, 3), viewpoint(1, 3), viewpoint(2, 3), orientation.w(), orientation.x(),
+                       orientation.y(), orientation.z()}) {
+    if (!viewpoint_text.empty()) viewpoint_text += ' ';
+    io_internal::AppendNumber(&viewpoint_text, value);
+  }
 
   std::string fields = "x y z", sizes = far ? "8 8 8" : "4 4 4", types = "F F F", counts = "1 1 1";
   auto add = [&](const char* name, const char* size, const char* type) {
@@ -496,9 +652,10 @@ void WritePcd(const std::string& path, const Scan& scan) {
   }
   std::string out = fmt::format(
       "# .PCD v0.7 - Point Cloud Data file format (written by lidarshop)\n# frame world\n# {}{}\n"
-      "VERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {}\nHEIGHT {}\nVIEWPOINT 0 0 0 1 0 0 0\n"
+      "VERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {}\nHEIGHT {}\nVIEWPOINT {}\n"
       "POINTS {}\nDATA binary\n",
-      kPoseComment, pose, fields, sizes, types, counts, scan.cols, scan.rows, scan.num_cells());
+      kPoseComment, pose, fields, sizes, types, counts, scan.cols, scan.rows, viewpoint_text,
+      scan.num_cells());
   auto put = [&out](auto value) { out.append(reinterpret_cast<const char*>(&value), sizeof(value)); };
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (int row = 0; row < scan.rows; ++row) {

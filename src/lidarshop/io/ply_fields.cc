@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/util/error.h"
 
@@ -87,10 +88,37 @@ void AddColorProperty(PlyElement* element, const std::vector<Rgb8>& colors) {
   }
 }
 
-PointCloud PointCloudFromPly(const PlyData& ply, const std::string& file) {
+std::vector<Eigen::Vector3d> VertexPositions(const PlyElement& vertex, const std::string& file,
+                                             std::vector<std::string>* warnings) {
+  const PlyProperty* axes[3] = {FindScalar(vertex, {"x"}), FindScalar(vertex, {"y"}),
+                                FindScalar(vertex, {"z"})};
+  if (axes[0] == nullptr || axes[1] == nullptr) {
+    ThrowInputError(file, "header", fmt::format("{} x y", vertex.name),
+                    "missing property: the vertices have no x and y, they are not points");
+  }
+  if (axes[2] == nullptr && warnings != nullptr && vertex.count > 0) {
+    warnings->push_back(fmt::format("{}: the {} element has no z property: every point is read with z = 0",
+                                    file, vertex.name));
+  }
+  std::vector<Eigen::Vector3d> positions(vertex.count, Eigen::Vector3d::Zero());
+  for (int axis = 0; axis < 3; ++axis) {
+    if (axes[axis] == nullptr) continue;
+    for (int64_t i = 0; i < vertex.count; ++i) {
+      const double value = axes[axis]->values[i];
+      if (!(std::abs(value) <= kMaxCoordinateM)) {
+        ThrowInputError(file, fmt::format("{} {}", vertex.name, i), std::string(1, "xyz"[axis]),
+                        fmt::format("{} is not a coordinate within {} m", value, kMaxCoordinateM));
+      }
+      positions[i][axis] = value;
+    }
+  }
+  return positions;
+}
+
+PointCloud PointCloudFromPly(const PlyData& ply, const std::string& file, bool require_positions) {
   const PlyElement& vertex = RequireElement(ply, "vertex", file);
   PointCloud cloud;
-  cloud.points = Vector3Property(vertex, "x", "y", "z", file, true);
+  cloud.points = Vector3Property(vertex, "x", "y", "z", file, require_positions);
   cloud.normals = Vector3Property(vertex, "nx", "ny", "nz", file, false);
   cloud.colors = ColorProperty(vertex);
   if (const PlyProperty* p = FindScalar(vertex, {"intensity", "scalar_intensity", "scalar_Intensity"})) {

@@ -30,7 +30,15 @@ void AddVector3Property(PlyElement* element, const std::vector<Eigen::Vector3f>&
                         const char* b, const char* c, PlyType type = PlyType::kFloat32);
 void AddColorProperty(PlyElement* element, const std::vector<Rgb8>& colors);
 
-PointCloud PointCloudFromPly(const PlyData& ply, const std::string& file);
+// The vertices' channels as a cloud; its points are x y z as floats (InputError without them), or empty when
+// not `require_positions` (the caller reads VertexPositions).
+PointCloud PointCloudFromPly(const PlyData& ply, const std::string& file, bool require_positions = true);
+
+// x y z of every record of `vertex` in the file's precision (double): InputError naming the file without x or
+// y, or for a coordinate not finite or beyond kMaxCoordinateM (naming the vertex); without z (PDAL writes
+// such files) z = 0 and `warnings` (optional) says so.
+std::vector<Eigen::Vector3d> VertexPositions(const PlyElement& vertex, const std::string& file,
+                                             std::vector<std::string>* warnings);
 // The "vertex" element of a cloud: x y z (double when `double_positions`), normals, colours, intensity,
 // label, synthesized.
 PlyElement VertexElementFromCloud(const PointCloud& cloud, bool double_positions);

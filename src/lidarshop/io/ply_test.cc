@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -186,6 +187,85 @@ TEST(PlyTest, PlainCloudBecomesOneRowScan) {
   EXPECT_EQ(file.scans[0].rows, 1);
   EXPECT_EQ(file.scans[0].cols, 3);
   EXPECT_EQ(file.scans[0].CountValid(), 3);
+}
+
+// PDAL's and others' PLY test files: sized type names (int8, uint16, float64), unsized ones, extra
+// properties, meshes, and a file without vertices. Expected values read from the text files.
+TEST(PlyTest, ReadsTheInteropFiles) {
+  const std::string dir = LIDARSHOP_SHARED_DATA_DIR "/interop/ply/";
+  struct Case {
+    const char* file;
+    int points;
+    Eigen::Vector3d first, last;
+    bool z_missing;
+  };
+  const Case cases[] = {
+      {"sized_dims.ply", 1, {1, 12346, 0}, {1, 12346, 0}, true},    // int8 x, uint16 y, no z
+      {"unsized_dims.ply", 1, {1, 12346, 0}, {1, 12346, 0}, true},  // char x, ushort y, no z
+      {"simple_text.ply", 3, {-1, 0, 0}, {1, 0, 0}, false},
+      {"simple_binary.ply", 3, {-1, 0, 0}, {1, 0, 0}, false},
+      {"text_extradim.ply", 1, {-2.64944, -13.0955, 0.00640115}, {-2.64944, -13.0955, 0.00640115}, false},
+      {"mesh.ply", 4, {1, 1, 0}, {2, 2, 2}, false},
+      {"mesh_fixed.ply", 4, {1, 1, 0}, {2, 2, 2}, false},
+  };
+  for (const Case& c : cases) {
+    const ScanFile file = ReadScanFile(dir + c.file);
+    ASSERT_EQ(file.scans.size(), 1u) << c.file;
+    const Scan& scan = file.scans[0];
+    EXPECT_EQ(scan.cols, c.points) << c.file;
+    EXPECT_EQ(scan.CountValid(), c.points) << c.file;
+    EXPECT_LT((WorldPointOfCell(scan, 0, 0) - c.first).cwiseAbs().maxCoeff(), 1e-6) << c.file;
+    EXPECT_LT((WorldPointOfCell(scan, 0, c.points - 1) - c.last).cwiseAbs().maxCoeff(), 1e-6) << c.file;
+    if (c.z_missing) {
+      ASSERT_EQ(file.warnings.size(), 1u) << c.file;
+      EXPECT_THAT(file.warnings[0], ::testing::AllOf(::testing::StartsWith(dir + c.file),
+                                                     ::testing::HasSubstr("no z property")));
+    } else {
+      EXPECT_TRUE(file.warnings.empty()) << c.file;
+    }
+  }
+  // text_extradim: char blue and the extra properties alpha and omg.
+  const Scan extra = ReadScanFile(dir + "text_extradim.ply").scans[0];
+  ASSERT_TRUE(extra.has_color());
+  EXPECT_EQ(extra.color.at<cv::Vec3b>(0, 0), cv::Vec3b(63, 200, 64));
+  ASSERT_FALSE(extra.normal.empty());
+  EXPECT_NEAR(extra.normal.at<cv::Vec3f>(0, 0)[2], 0.999665f, 1e-6f);
+
+  EXPECT_THAT(testing_io::InputErrorOf([&] { ReadScanFile(dir + "no_vertex.ply"); }),
+              ::testing::AllOf(::testing::HasSubstr(dir + "no_vertex.ply"),
+                               ::testing::HasSubstr("element vertex"), ::testing::HasSubstr("missing")));
+  // issue_2421.ply holds z = 1234567890.12345 (1.2 million km): past kMaxCoordinateM, refused by name.
+  EXPECT_THAT(testing_io::InputErrorOf([&] { ReadScanFile(dir + "issue_2421.ply"); }),
+              ::testing::AllOf(::testing::HasSubstr("vertex 0"), ::testing::HasSubstr("field 'z'"),
+                               ::testing::HasSubstr("1234567890.12345")));
+}
+
+// In a plain cloud the origin is a point; coordinates 5,000 km out keep 0.1 mm (doubles in the file, a local
+// origin in the scan), also through a write of the scan.
+TEST(PlyTest, PlainCloudsKeepTheOriginAndFarCoordinates) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float64 x\nproperty float64 y\nproperty float64 z\n"
+      "end_header\n";
+  TempFolder folder;
+  testing_io::WriteText(folder.File("near.ply"), head + "0 0 0\n1 2 3\n-1 0 0\n");
+  const Scan near = ReadScanFile(folder.File("near.ply")).scans[0];
+  EXPECT_EQ(near.CountValid(), 3);
+  EXPECT_EQ(WorldPointOfCell(near, 0, 0), Eigen::Vector3d(0, 0, 0));
+  EXPECT_GT(near.range.at<float>(0, 0), 0.0f);
+
+  const Eigen::Vector3d far[] = {{5000000.1234, -5000000.5678, 1234.0001},
+                                 {5000100.0001, -4999900.4321, 1299.9999},
+                                 {5000050.5, -4999950.5, 1250}};
+  std::string text = head;
+  for (const Eigen::Vector3d& p : far) text += fmt::format("{:.4f} {:.4f} {:.4f}\n", p.x(), p.y(), p.z());
+  testing_io::WriteText(folder.File("far.ply"), text);
+  const Scan scan = ReadScanFile(folder.File("far.ply")).scans[0];
+  WriteScanFile(folder.File("copy.ply"), {scan});
+  const Scan back = ReadScanFile(folder.File("copy.ply")).scans[0];
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT((WorldPointOfCell(scan, 0, i) - far[i]).cwiseAbs().maxCoeff(), 1e-5) << i;
+    EXPECT_LT((WorldPointOfCell(back, 0, i) - far[i]).cwiseAbs().maxCoeff(), 1e-5) << i;
+  }
 }
 
 }  // namespace

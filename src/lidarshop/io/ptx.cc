@@ -4,7 +4,13 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <limits>
+
 #include <fmt/format.h>
+#include <Eigen/SVD>
+
+#include "lidarshop/geometry/transform.h"
 
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_header.h"
@@ -63,7 +69,14 @@ int64_t ReadCount(TextCursor* cursor, const char* what, int scan_index) {
 // A scan's 10 header lines: its size and pose.
 struct PtxScanHead {
   int64_t rows = 0, cols = 0;
+  // The rigid pose: the file's transform, or its rotation and position when the transform carries a scale.
   Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
+  // What takes the file's scanner-frame points into the pose's scanner frame: identity for a rigid transform,
+  // else R^T · A (A the transform's 3 x 3, R its rotation), which applies the scale to the points.
+  bool apply_linear = false;  // scanner_from_file is not the identity
+  bool scaled = false;        // ... and more than the rounding of a printed rotation: a warning
+  Eigen::Matrix3d scanner_from_file = Eigen::Matrix3d::Identity();
+  double scale = 1.0;  // det(A)^(1/3)
 };
 
 PtxScanHead ParseScanHead(TextCursor* cursor, int scan_index) {
@@ -107,15 +120,79 @@ PtxScanHead ParseScanHead(TextCursor* cursor, int scan_index) {
     ThrowInputError(cursor->file(), fmt::format("line {}: {}", cursor->line() - 1, place), "matrix",
                     "not an affine transform: the printed 4th column (Leica layout) must be 0 0 0 1");
   }
+  // A rotation printed to a few decimals is not quite orthonormal (E57 and other writers refuse such a pose):
+  // the pose takes its nearest rotation R (polar decomposition A = R · S, by SVD) and the points S · p, so the
+  // world coordinates stay the transform's. A transform that scales the scanner's axes (PDAL applies the whole
+  // matrix to the points; each scale within [1e-3, 1e3]) is read the same way, with a warning. Anything else
+  // (shear, mirror, a singular or absurd matrix) stays as printed and is refused by CheckScanNumbers.
+  const Eigen::Matrix3d linear = head.world_from_scanner.topLeftCorner<3, 3>();
+  if (IsRigid(head.world_from_scanner, 1e-12)) return head;
+  const bool rigid = PoseProblem(head.world_from_scanner, /*allow_uniform_scale=*/false).empty();
+  if (!rigid) {
+    if (!linear.allFinite() || !(linear.determinant() > 0)) return head;
+    const Eigen::Vector3d scales = linear.colwise().norm().transpose();
+    if (!(scales.minCoeff() >= 1e-3 && scales.maxCoeff() <= 1e3)) return head;
+    const Eigen::Matrix3d normalized = linear * scales.cwiseInverse().asDiagonal();
+    if (!(normalized.transpose() * normalized).isApprox(Eigen::Matrix3d::Identity(), 1e-4)) return head;
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(linear, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
+  head.apply_linear = true;
+  head.scaled = !rigid;
+  head.scale = std::cbrt(linear.determinant());
+  head.scanner_from_file = rotation.transpose() * linear;
+  head.world_from_scanner.topLeftCorner<3, 3>() = rotation;
   return head;
 }
 
-Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& options) {
+// Points beyond kScanRangeKeptM of the scanner (georeferenced points with an identity transform, as PDAL
+// writes them) are kept relative to a local origin near them, held in the pose (io_common.h); `direction`
+// holds each point's remainder (ParseOneScan).
+void MoveToLocalOrigin(Scan* scan, const Eigen::Vector3d& near_origin, const std::string& place,
+                       const std::string& file, std::vector<std::string>* warnings) {
+  std::vector<Eigen::Vector3d> points(static_cast<size_t>(scan->num_cells()));
+  std::vector<uint8_t> valid(points.size(), 0);
+  for (int row = 0; row < scan->rows; ++row) {
+    for (int col = 0; col < scan->cols; ++col) {
+      const size_t cell = static_cast<size_t>(row) * scan->cols + col;
+      if (!scan->valid.ptr<uint8_t>(row)[col]) continue;
+      const cv::Vec3f& p = scan->point.ptr<cv::Vec3f>(row)[col];
+      const cv::Vec3f& rest = scan->direction.ptr<cv::Vec3f>(row)[col];
+      points[cell] = Eigen::Vector3d(double{p[0]} + rest[0], double{p[1]} + rest[1], double{p[2]} + rest[2]);
+      valid[cell] = 1;
+    }
+  }
+  const Eigen::Vector3d origin = io_internal::OriginClearOfPoints(near_origin, points, valid);
+  for (int row = 0; row < scan->rows; ++row) {
+    for (int col = 0; col < scan->cols; ++col) {
+      const size_t cell = static_cast<size_t>(row) * scan->cols + col;
+      if (!valid[cell]) continue;
+      const Eigen::Vector3f p = (points[cell] - origin).cast<float>();
+      scan->point.ptr<cv::Vec3f>(row)[col] = cv::Vec3f(p.x(), p.y(), p.z());
+    }
+  }
+  scan->world_from_scanner.topRightCorner<3, 1>() += scan->world_from_scanner.topLeftCorner<3, 3>() * origin;
+  if (warnings != nullptr) {
+    warnings->push_back(fmt::format(
+        "{}: {}: the points lie more than {} m from the scanner origin: they are not read as its rays but "
+        "relative to a local origin near them, so that floats keep the file's precision; the scanner "
+        "position "
+        "is not kept and the directions are from that origin",
+        file, place, io_internal::kScanRangeKeptM));
+  }
+}
+
+Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& options,
+                  std::vector<std::string>* warnings) {
   const std::string place = fmt::format("scan {}", scan_index + 1);
   const PtxScanHead head = ParseScanHead(cursor, scan_index);
   const int64_t rows = head.rows, cols = head.cols;
   Scan scan = MakeScan(static_cast<int>(rows), static_cast<int>(cols));
   scan.world_from_scanner = head.world_from_scanner;
+  // Points are parsed as doubles and kept as floats; `direction` holds, until FinishScan sets the directions,
+  // what the float left of the double (a float too), so that a scan whose points lie far from its origin can
+  // be moved to a local origin afterwards without losing the file's precision.
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
 
   const int64_t total = rows * cols;
   int64_t done = 0;
@@ -127,11 +204,12 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
                                      place, total, cols, rows, done));
       }
       const int image_row = static_cast<int>(rows - 1 - r);
-      const float x = cursor->Float("x");
-      const float y = cursor->Float("y");
-      const float z = cursor->Float("z");
+      Eigen::Vector3d point;
+      point.x() = cursor->Double("x");
+      point.y() = cursor->Double("y");
+      point.z() = cursor->Double("z");
       const float intensity = cursor->Float("intensity");
-      const bool valid = x != 0 || y != 0 || z != 0;
+      const bool valid = !point.isZero();
       if (!cursor->AtEndOfLine()) {
         const int64_t red = cursor->Int("red");
         const int64_t green = cursor->Int("green");
@@ -150,11 +228,34 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
       }
       cursor->NextLine();
       if (valid) {
+        if (head.apply_linear) point = head.scanner_from_file * point;
+        low = low.cwiseMin(point);
+        high = high.cwiseMax(point);
+        const Eigen::Vector3f rounded = point.cast<float>();
+        if (!rounded.allFinite()) {
+          ThrowInputError(cursor->file(), fmt::format("line {}", cursor->line() - 1), "x y z",
+                          fmt::format("number out of range: {} {} {}", point.x(), point.y(), point.z()));
+        }
+        const Eigen::Vector3f rest = (point - rounded.cast<double>()).cast<float>();
         scan.valid.ptr<uint8_t>(image_row)[col] = kValid;
-        scan.point.ptr<cv::Vec3f>(image_row)[col] = cv::Vec3f(x, y, z);
+        scan.point.ptr<cv::Vec3f>(image_row)[col] = cv::Vec3f(rounded.x(), rounded.y(), rounded.z());
+        scan.direction.ptr<cv::Vec3f>(image_row)[col] = cv::Vec3f(rest.x(), rest.y(), rest.z());
         scan.intensity.ptr<float>(image_row)[col] = intensity;
       }
     }
+  }
+  if (head.scaled && warnings != nullptr) {
+    warnings->push_back(
+        fmt::format("{}: {}: the transform carries a scale (det^(1/3) = {:.6g}): applied to the points, as "
+                    "PDAL does; the "
+                    "scanner pose keeps the transform's rotation and position",
+                    cursor->file(), place, head.scale));
+  }
+  // Coordinates past kMaxCoordinateM are left for CheckScanNumbers to refuse by cell.
+  if ((low.array() <= high.array()).all() && low.cwiseAbs().maxCoeff() <= kMaxCoordinateM &&
+      high.cwiseAbs().maxCoeff() <= kMaxCoordinateM) {
+    const Eigen::Vector3d far_origin = io_internal::FarScanOrigin(low, high);
+    if (!far_origin.isZero()) MoveToLocalOrigin(&scan, far_origin, place, cursor->file(), warnings);
   }
   io_internal::FinishScan(&scan, options.fit_grid);
   return scan;
@@ -162,13 +263,14 @@ Scan ParseOneScan(TextCursor* cursor, int scan_index, const PtxReadOptions& opti
 
 }  // namespace
 
-std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const PtxReadOptions& options) {
+std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const PtxReadOptions& options,
+                           std::vector<std::string>* warnings) {
   TextCursor cursor(text, file);
   std::vector<Scan> scans;
   cursor.SkipEmptyLines();
   if (cursor.AtEnd()) ThrowInputError(file, "line 1", "columns", "the file is empty");
   while (!cursor.AtEnd()) {
-    scans.push_back(ParseOneScan(&cursor, static_cast<int>(scans.size()), options));
+    scans.push_back(ParseOneScan(&cursor, static_cast<int>(scans.size()), options, warnings));
     cursor.SkipEmptyLines();
   }
   return scans;
@@ -235,9 +337,10 @@ std::vector<ScanHeader> io_internal::ReadPtxHeaders(const std::string& path) {
   return scans;
 }
 
-std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options) {
+std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options,
+                          std::vector<std::string>* warnings) {
   const std::string text = io_internal::ReadFileToString(path);
-  return ParsePtx(text, path, options);
+  return ParsePtx(text, path, options, warnings);
 }
 
 std::string FormatPtx(const std::vector<Scan>& scans) {

@@ -13,6 +13,15 @@
 //   points      "x y z intensity" or "x y z intensity r g b", scanner frame, metres, intensity as printed
 //               (usually [0, 1]), colour 0-255; column-major: each column a vertical strip listed bottom to
 //               top, columns left to right. PTX row r (counted from the bottom) is image row rows - 1 - r.
+// The pose is always a rigid motion: a transform A that is not exactly orthonormal (a rotation printed to 6
+// decimals) or that scales the scanner's axes (A = R · diag(sx, sy, sz), each scale in [1e-3, 1e3]; PDAL
+// applies the whole matrix to the points) gives the pose R (polar decomposition A = R · S) and the points
+// S · p, so the world coordinates are the transform's; a scale beyond rounding is said in a warning. A shear,
+// a mirror or a singular matrix is refused (InputError, field 'pose'). Points are parsed as doubles; when
+// they lie more than 10 km (io_common.h kScanRangeKeptM) from the scanner origin (a file of georeferenced
+// points with an identity transform, as PDAL writes them) they are not that scanner's rays: they are kept
+// relative to a local origin near them, held in the pose's position, with a warning, so that world
+// coordinates keep the file's precision.
 // A no-return cell is "0 0 0 0.5" (colour "0 0 0"); reading x = y = z = 0 marks the cell invalid.
 //
 // Readers accept 4- and 7-field lines (a 7-field line in a 4-field scan adds a colour channel), CRLF endings
@@ -37,12 +46,14 @@ struct PtxReadOptions {
 template <>
 const StructInfo& InfoOf<PtxReadOptions>();
 
-// Reads every scan of a PTX file.
-std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options = {});
+// Reads every scan of a PTX file; `warnings` (optional) receives what the reader changed (a scale applied, a
+// local origin chosen), one sentence each starting with the file's path.
+std::vector<Scan> ReadPtx(const std::string& path, const PtxReadOptions& options = {},
+                          std::vector<std::string>* warnings = nullptr);
 
 // Parses PTX text held in memory; `file` names it in error messages.
-std::vector<Scan> ParsePtx(std::string_view text, const std::string& file,
-                           const PtxReadOptions& options = {});
+std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const PtxReadOptions& options = {},
+                           std::vector<std::string>* warnings = nullptr);
 
 // The PTX text of `scans` (floats printed in their shortest round-trip form). Colour lines have 7 fields when
 // the scan has colour.

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
@@ -102,7 +103,8 @@ TEST(PtxTest, FileRoundTripThroughScanIo) {
 
 TEST(PtxTest, ShortestFloatsRoundTripExactly) {
   Scan scan = MakeScan(2, 2);
-  const float values[] = {1.0f / 3.0f, 123456.789f, -1e-5f, 7.0f};
+  // Within kScanRangeKeptM (10 km): farther points would be moved to a local origin.
+  const float values[] = {1.0f / 3.0f, 9876.789f, -1e-5f, 7.0f};
   for (int i = 0; i < 4; ++i) {
     scan.valid.at<uint8_t>(i / 2, i % 2) = kValid;
     scan.point.at<cv::Vec3f>(i / 2, i % 2) = cv::Vec3f(values[i], 1.0f, -values[i]);
@@ -129,6 +131,105 @@ TEST(PtxTest, ErrorsNameLineAndField) {
   text.replace(text.find("0.1 1 0 1"), 9, "0.1 x 0 1");
   EXPECT_THAT([&] { ParsePtx(text, "bad.ptx"); }, testing::ThrowsMessage<InputError>(testing::HasSubstr(
                                                       "bad.ptx: line 15: field 'y': not a number: 'x'")));
+}
+
+// PDAL's PTX test files; expected world coordinates computed from the text (the transform printed in Leica's
+// layout applied by hand).
+TEST(PtxTest, ReadsTheInteropFilesInWorldCoordinates) {
+  const std::string dir = LIDARSHOP_SHARED_DATA_DIR "/interop/ptx/";
+  // A transform with a scale (z doubled: det^(1/3) = 1.26): applied to the points, warned; the pose rigid.
+  const ScanFile scaled = ReadScanFile(dir + "multiple-and-transform.ptx");
+  ASSERT_EQ(scaled.scans.size(), 2u);
+  const Scan& first = scaled.scans[0];
+  EXPECT_EQ(first.CountValid(), 4);
+  EXPECT_TRUE((first.world_from_scanner.topLeftCorner<3, 3>().isIdentity(1e-12)));
+  // The points lie 61 km from the scanner: kept relative to a local origin (a second warning).
+  // Bottom of column 0: "37012.24 49028.31 15.83" -> (600000 + 37012.24, 800000 + 49028.31, 400 + 2 * 15.83).
+  EXPECT_LT(
+      (WorldPointOfCell(first, 1, 0) - Eigen::Vector3d(637012.24, 849028.31, 431.66)).cwiseAbs().maxCoeff(),
+      5e-5);
+  ASSERT_EQ(scaled.warnings.size(), 3u);  // scan 1: the scale and the local origin; scan 2: the local origin
+  EXPECT_THAT(scaled.warnings[0], testing::AllOf(testing::StartsWith(dir + "multiple-and-transform.ptx"),
+                                                 testing::HasSubstr("scan 1"), testing::HasSubstr("scale"),
+                                                 testing::HasSubstr("1.25992")));
+  // Its second scan holds the same points with an identity transform, 1,000 km from the origin: a local
+  // origin keeps the file's centimetres (floats there are 6 cm coarse; relative to the local origin, a few
+  // hundred metres away, 0.03 mm).
+  const Scan& second = scaled.scans[1];
+  EXPECT_EQ(second.CountValid(), 4);
+  EXPECT_LT(
+      (WorldPointOfCell(second, 0, 0) - Eigen::Vector3d(637012.24, 849028.31, 431.66)).cwiseAbs().maxCoeff(),
+      5e-5);
+
+  const ScanFile color = ReadScanFile(dir + "1.2-with-color.ptx");
+  ASSERT_EQ(color.scans.size(), 1u);
+  EXPECT_EQ(color.scans[0].rows, 71);
+  EXPECT_EQ(color.scans[0].cols, 15);
+  EXPECT_EQ(color.scans[0].CountValid(), 15 * 71);
+  // The cloud is 3.4 x 4.6 km wide: its corner points lie 2.2 km from the local origin, where a float keeps
+  // 0.12 mm (the file's resolution is 1 cm).
+  EXPECT_LT((WorldPointOfCell(color.scans[0], 70, 0) - Eigen::Vector3d(637012.24, 849028.31, 431.66))
+                .cwiseAbs()
+                .maxCoeff(),
+            2e-4);
+  EXPECT_EQ(color.scans[0].color.at<cv::Vec3b>(70, 0), cv::Vec3b(68, 77, 88));
+  ASSERT_EQ(color.warnings.size(), 1u);
+  EXPECT_THAT(color.warnings[0], testing::HasSubstr("local origin"));
+
+  const ScanFile plain = ReadScanFile(dir + "no-color.ptx");
+  EXPECT_EQ(plain.scans[0].CountValid(), 15);
+  EXPECT_FALSE(plain.scans[0].has_color());
+  EXPECT_LT((WorldPointOfCell(plain.scans[0], 0, 0) - Eigen::Vector3d(637012.24, 849028.31, 431.66))
+                .cwiseAbs()
+                .maxCoeff(),
+            5e-5);
+
+  // A rotation printed to 6 decimals and a translation: first return of column 0 (bottom to top: 4 empty
+  // cells, then "-0.005630 0.645218 -0.440506"), world = transform applied by hand.
+  const ScanFile complex = ReadScanFile(dir + "complex-transform.ptx");
+  EXPECT_TRUE(complex.warnings.empty());
+  ASSERT_EQ(complex.scans.size(), 1u);
+  // The printed rotation is orthonormal to 1e-5 only: the pose is its nearest rotation (E57 can store it).
+  EXPECT_TRUE(IsRigid(complex.scans[0].world_from_scanner, 1e-12));
+  EXPECT_EQ(complex.scans[0].CountValid(), 4);
+  EXPECT_LT((WorldPointOfCell(complex.scans[0], 1, 0) -
+             Eigen::Vector3d(-3.0344073807900003, -3.173781036324, -1.823750041614))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-6);
+}
+
+// Points 5,000 km from a scanner with an identity transform come back to 0.1 mm; a mirror is refused.
+TEST(PtxTest, FarPointsKeepATenthOfAMillimetreAndMirrorsAreRefused) {
+  const std::string head = "1\n2\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n";
+  std::vector<std::string> warnings;
+  const Scan scan = ParsePtx(head +
+                                 "5000000.1234 -5000000.5678 1234.0001 0.5\n5000001.0001 -4999999.9999 "
+                                 "1234.5 0.5\n",
+                             "far.ptx", {}, &warnings)[0];
+  EXPECT_LT((WorldPointOfCell(scan, 1, 0) - Eigen::Vector3d(5000000.1234, -5000000.5678, 1234.0001))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-5);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 0) - Eigen::Vector3d(5000001.0001, -4999999.9999, 1234.5))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-5);
+  EXPECT_EQ(warnings.size(), 1u);
+  // Written and read back: the same world points.
+  const Scan back = ParsePtx(FormatPtx({scan}), "copy.ptx")[0];
+  for (int row = 0; row < 2; ++row) {
+    EXPECT_LT((WorldPointOfCell(back, row, 0) - WorldPointOfCell(scan, row, 0)).cwiseAbs().maxCoeff(), 1e-6);
+  }
+  const std::string mirror =
+      "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n-1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n1 2 3 0.5\n";
+  EXPECT_THAT(testing_io::InputErrorOf([&] {
+                testing_io::TempFolder folder;
+                testing_io::WriteText(folder.File("mirror.ptx"), mirror);
+                ReadScanFile(folder.File("mirror.ptx"));
+              }),
+              testing::AllOf(testing::HasSubstr("mirror.ptx"), testing::HasSubstr("field 'pose'"),
+                             testing::HasSubstr("mirrored")));
 }
 
 }  // namespace

@@ -33,29 +33,33 @@ constexpr char kScanComment[] = "lidarshop_scan ";
 // ---- PLY: a scan is its valid points in the world frame plus row/col/scan
 // properties and a pose comment ----
 
-// A 1 x N scan of the cloud's points (identity pose; (0, 0, 0) is no return), without a grid.
-Scan ScanFromPointCloud(const PointCloud& cloud) {
-  Scan scan = MakeScan(1, static_cast<int>(cloud.size()), !cloud.colors.empty(), !cloud.intensities.empty());
+// A 1 x N scan of a cloud (world frame) with its channels: every point a return, (0, 0, 0) included, kept
+// relative to a local origin (io_common.h UnorganizedScan); `positions` are the points in double precision
+// (the cloud's own points are floats or absent).
+Scan ScanFromPointCloud(const PointCloud& cloud, const std::vector<Eigen::Vector3d>& positions) {
+  Scan scan = UnorganizedScan(positions, {}, !cloud.colors.empty(), !cloud.intensities.empty());
   if (!cloud.labels.empty()) scan.label = cv::Mat(1, scan.cols, CV_32S, cv::Scalar(kNoLabel));
   if (!cloud.normals.empty()) scan.normal = cv::Mat(1, scan.cols, CV_32FC3, cv::Scalar::all(0));
   if (!cloud.synthesized.empty()) scan.synthesized = cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0));
+  const Eigen::Matrix3d scanner_from_world = scan.world_from_scanner.topLeftCorner<3, 3>().transpose();
   for (int i = 0; i < scan.cols; ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    if (p.isZero()) continue;  // (0, 0, 0) has no ray
-    scan.valid.at<uint8_t>(0, i) = kValid;
-    scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
     if (!cloud.intensities.empty()) scan.intensity.at<float>(0, i) = cloud.intensities[i];
     if (!cloud.colors.empty())
       scan.color.at<cv::Vec3b>(0, i) = cv::Vec3b(cloud.colors[i][0], cloud.colors[i][1], cloud.colors[i][2]);
     if (!cloud.labels.empty()) scan.label.at<int32_t>(0, i) = cloud.labels[i];
     if (!cloud.normals.empty()) {
-      scan.normal.at<cv::Vec3f>(0, i) =
-          cv::Vec3f(cloud.normals[i].x(), cloud.normals[i].y(), cloud.normals[i].z());
+      const Eigen::Vector3f n = (scanner_from_world * cloud.normals[i].cast<double>()).cast<float>();
+      scan.normal.at<cv::Vec3f>(0, i) = cv::Vec3f(n.x(), n.y(), n.z());
     }
     if (!cloud.synthesized.empty()) scan.synthesized.at<uint8_t>(0, i) = cloud.synthesized[i] ? kValid : 0;
   }
-  FinishScan(&scan, /*fit_grid=*/false);
   return scan;
+}
+
+Scan ScanFromPointCloud(const PointCloud& cloud) {
+  std::vector<Eigen::Vector3d> positions(cloud.points.size());
+  for (size_t i = 0; i < positions.size(); ++i) positions[i] = cloud.points[i].cast<double>();
+  return ScanFromPointCloud(cloud, positions);
 }
 
 struct PlyScanHeader {
@@ -85,27 +89,25 @@ std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::stri
   return headers;
 }
 
-std::vector<Scan> ReadPlyScans(const std::string& path) {
+std::vector<Scan> ReadPlyScans(const std::string& path, std::vector<std::string>* warnings) {
   const PlyData ply = ReadPly(path);
   const PlyElement& vertex = RequireElement(ply, "vertex", path);
-  const PointCloud cloud = PointCloudFromPly(ply, path);
+  // The positions as the file stores them (doubles when the writer needed them): the cloud's floats would
+  // lose half metres 5,000 km out before the pose takes them back to the scanner frame.
+  const std::vector<Eigen::Vector3d> positions = VertexPositions(vertex, path, warnings);
+  const PointCloud cloud = PointCloudFromPly(ply, path, /*require_positions=*/false);
   const std::vector<PlyScanHeader> headers = ParseScanComments(ply, path, CheckRegularFile(path));
   const PlyProperty* row_property = FindScalar(vertex, {"row"});
   const PlyProperty* col_property = FindScalar(vertex, {"col"});
   const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
   const PlyProperty* true_range_property = FindScalar(vertex, {"true_range"});
   const PlyProperty* curvature_property = FindScalar(vertex, {"curvature"});
-  // The positions as the file stores them (doubles when the writer needed them): the cloud's floats would
-  // lose half metres 5,000 km out before the pose takes them back to the scanner frame.
-  const PlyProperty* x_property = FindScalar(vertex, {"x"});
-  const PlyProperty* y_property = FindScalar(vertex, {"y"});
-  const PlyProperty* z_property = FindScalar(vertex, {"z"});
 
   if (headers.empty() || row_property == nullptr || col_property == nullptr) {
-    // A plain point cloud: one 1 x N scan, every point a return, in the identity pose.
-    if (cloud.size() == 0) ThrowInputError(path, "header", "element vertex", "no points");
-    CheckScanSize(1, static_cast<int64_t>(cloud.size()), path, "header");
-    return {ScanFromPointCloud(cloud)};
+    // A plain point cloud: one 1 x N scan, every point a return.
+    if (positions.empty()) ThrowInputError(path, "header", "element vertex", "no points");
+    CheckScanSize(1, static_cast<int64_t>(positions.size()), path, "header");
+    return {ScanFromPointCloud(cloud, positions)};
   }
 
   std::vector<Scan> scans;
@@ -124,7 +126,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     scanner_from_world.push_back(header.world_from_scanner.inverse());
     scans.push_back(std::move(scan));
   }
-  for (size_t i = 0; i < cloud.size(); ++i) {
+  for (size_t i = 0; i < positions.size(); ++i) {
     const int64_t index = scan_property != nullptr ? ToInt32(scan_property->values[i]) : 0;
     const int64_t row = ToInt32(row_property->values[i]);
     const int64_t col = ToInt32(col_property->values[i]);
@@ -136,11 +138,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path) {
     }
     Scan& scan = scans[index];
     const Eigen::Matrix4d& inverse = scanner_from_world[index];
-    const Eigen::Vector3d world =
-        x_property != nullptr && y_property != nullptr && z_property != nullptr
-            ? Eigen::Vector3d(x_property->values[i], y_property->values[i], z_property->values[i])
-            : cloud.points[i].cast<double>();
-    const Eigen::Vector3d p = inverse.topLeftCorner<3, 3>() * world + inverse.topRightCorner<3, 1>();
+    const Eigen::Vector3d p = inverse.topLeftCorner<3, 3>() * positions[i] + inverse.topRightCorner<3, 1>();
     if (p.isZero()) continue;
     if (scan.valid.at<uint8_t>(row, col)) {
       ThrowInputError(path, fmt::format("vertex {}", i), "row/col",
@@ -190,7 +188,6 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     curvature |= !scan.curvature.empty();
     synthesized |= !scan.synthesized.empty();
     true_range |= !scan.true_range.empty();
-    far |= scan.world_from_scanner.topRightCorner<3, 1>().norm() > 1e4;  // floats would lose millimetres
   }
   std::vector<double> x, y, z, nx, ny, nz, curv, red, green, blue, intensity, labels, synth, truth, rows,
       cols, index;
@@ -204,6 +201,8 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
         const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
         const Eigen::Vector3d world =
             pose.topLeftCorner<3, 3>() * Eigen::Vector3d(p[0], p[1], p[2]) + pose.topRightCorner<3, 1>();
+        // Past kCloudFloatSafeM floats would lose more than 0.06 mm: doubles then.
+        far |= world.cwiseAbs().maxCoeff() > kCloudFloatSafeM;
         x.push_back(world.x());
         y.push_back(world.y());
         z.push_back(world.z());
@@ -332,11 +331,16 @@ struct ScanFormat {
 
 const std::vector<ScanFormat>& ScanFormats() {
   static const std::vector<ScanFormat> formats = {
-      {"ptx", [](const std::string& path, std::vector<std::string>*) { return ReadPtx(path); }, &WritePtx},
-      {"ply", [](const std::string& path, std::vector<std::string>*) { return ReadPlyScans(path); },
-       &WritePlyScans},
+      {"ptx",
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return ReadPtx(path, {}, warnings);
+       },
+       &WritePtx},
+      {"ply", &ReadPlyScans, &WritePlyScans},
       {"pcd",
-       [](const std::string& path, std::vector<std::string>*) { return std::vector<Scan>{ReadPcd(path)}; },
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadPcd(path, warnings)};
+       },
        [](const std::string& path, const std::vector<Scan>& scans) {
          if (scans.size() != 1) {
            ThrowInputError(path, "", "",
@@ -362,15 +366,15 @@ const std::vector<ScanFormat>& ScanFormats() {
        },
        nullptr, &LazNotWrittenMessage},
       {"xyz",
-       [](const std::string& path, std::vector<std::string>*) {
-         return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz)};
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz, warnings)};
        },
        [](const std::string& path, const std::vector<Scan>& scans) {
          WritePointList(path, scans, PointListKind::kXyz);
        }},
       {"pts",
-       [](const std::string& path, std::vector<std::string>*) {
-         return std::vector<Scan>{ReadPointList(path, PointListKind::kPts)};
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadPointList(path, PointListKind::kPts, warnings)};
        },
        [](const std::string& path, const std::vector<Scan>& scans) {
          WritePointList(path, scans, PointListKind::kPts);

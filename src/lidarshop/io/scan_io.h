@@ -3,8 +3,10 @@
 //   .ptx  Leica ASCII, one or many organized scans            read + write
 //   .e57  ASTM E2807, organized and unstructured scans, images read + write (io/e57.h)
 //   .ply  points with colour/normal/label/synthesized fields   read + write (a scan becomes its valid points;
-//         the grid is kept in element properties `row`/`col` when written by lidarshop)
-//   .pcd  PCL, organized clouds (ascii, binary, binary_compressed) read + write
+//         the grid is kept in element properties `row`/`col` when written by lidarshop; another PLY is one
+//         1 x N cloud, io_common.h UnorganizedScan)
+//   .pcd  PCL, organized clouds (ascii, binary, binary_compressed) read + write (io/pcd.h: the numbers are the
+//         world points, VIEWPOINT the sensor pose)
 //   .las  ASPRS LAS 1.0-1.4, point formats 0-10 read; 1.4/1.2 formats 0-3, 6-8 written (io/las.h): one
 //         unorganized cloud in the world frame (several scans are written as one cloud, point source ID =
 //         scan index)
@@ -13,6 +15,8 @@
 //   .xyz  ASCII "x y z [intensity] [r g b]", world frame, one cloud           read + write (io/xyz.h)
 //   .pts  Leica PTS: a point count line, then as .xyz                        read + write
 //
+// Unorganized formats (PLY clouds, unorganized PCD, LAS, XYZ, PTS) keep every point, (0, 0, 0) included, as float
+// offsets from an origin held in the pose; organized ones (PTX, E57, organized PCD) mark a missing return so.
 // Readers reject malformed input with an InputError naming the file, the line or byte offset and the field;
 // they refuse before allocating when a header claims more cells than memory allows. Writers are atomic.
 #pragma once

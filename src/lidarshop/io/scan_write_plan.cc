@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "lidarshop/io/io_common.h"
+#include "lidarshop/io/pcd.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 
@@ -120,6 +122,13 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
   if (images > 0 && !holds.images) {
     plan.dropped.push_back(fmt::format("{}: {} image{} (E57 images2D) not written: {} holds no photos", path,
                                        images, images == 1 ? "" : "s", holds.name));
+  }
+  if (holds.extension == std::string("pcd") && scans.size() == 1 && PcdNeedsDoubleCoordinates(scans[0])) {
+    plan.dropped.push_back(
+        fmt::format("{}: coordinates beyond {} m from the origin are written as doubles (F 8) to keep 0.1 "
+                    "mm; some readers "
+                    "(Open3D 0.16) read such PCD coordinates as zeros: write .ply, .las or .e57 for them",
+                    path, io_internal::kCloudFloatSafeM));
   }
   // Carried attributes (Scan::attributes): LAS holds its own; every other writer drops them.
   std::vector<std::string> attributes;

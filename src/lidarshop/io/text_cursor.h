@@ -102,9 +102,9 @@ class TextCursor {
     if (*start == '+') ++start;
     T value{};
     const auto [stop, error] = std::from_chars(start, end_, value);
-    if (error != std::errc() || (stop < end_ && !IsSpace(*stop))) {
+    if (error != std::errc() || (stop < end_ && !IsSpace(*stop) && !IsSeparator(*stop))) {
       const char* token_end = p_;
-      while (token_end < end_ && !IsSpace(*token_end)) ++token_end;
+      while (token_end < end_ && !IsSpace(*token_end) && !IsSeparator(*token_end)) ++token_end;
       const std::string token = Printable(std::string_view(p_, token_end - p_));
       if (error == std::errc::result_out_of_range)
         Fail(field, fmt::format("number out of range: '{}'", token));
@@ -116,6 +116,10 @@ class TextCursor {
       }
     }
     p_ = stop;
+    if (separator_ != 0) {
+      SkipBlanks();
+      if (p_ < end_ && *p_ == separator_) ++p_;
+    }
     return value;
   }
   double Double(std::string_view field) { return Number<double>(field); }
@@ -137,12 +141,19 @@ class TextCursor {
 
   static bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
+  // Also accept `separator` (e.g. ',') after a number, before blanks or the next number (PCD ascii data as
+  // PDAL writes it); 0 = numbers are separated by blanks only.
+  void set_separator(char separator) { separator_ = separator; }
+
  private:
   const char* begin_;
   const char* p_;
   const char* end_;
   std::string file_;
   int64_t line_;
+  char separator_ = 0;
+
+  bool IsSeparator(char c) const { return separator_ != 0 && c == separator_; }
 };
 
 }  // namespace lidarshop::io_internal

@@ -20,9 +20,6 @@ namespace {
 
 using io_internal::TextCursor;
 
-// The shortest point line, "0 0 0\n": bounds a PTS count by the bytes that follow it.
-constexpr int64_t kShortestLineBytes = 6;
-
 // Blank-separated tokens on the line starting at `p`.
 int CountTokens(const char* p, const char* end) {
   int tokens = 0;
@@ -41,11 +38,32 @@ struct PointList {
   std::vector<cv::Vec3b> colors;    // empty without colour columns
 };
 
-PointList ParseLines(const std::string& bytes, const std::string& file, PointListKind kind) {
+// True when the line at `p` holds a single whole number: a PTS point count (a point has 3 or more numbers).
+bool IsCountLine(const char* p, const char* end) {
+  if (CountTokens(p, end) != 1) return false;
+  while (p < end && TextCursor::IsSpace(*p) && *p != '\n') ++p;
+  if (p < end && *p == '+') ++p;
+  const char* digits = p;
+  while (p < end && *p >= '0' && *p <= '9') ++p;
+  return p > digits && (p == end || TextCursor::IsSpace(*p));
+}
+
+PointList ParseLines(const std::string& bytes, const std::string& file, PointListKind kind,
+                     std::vector<std::string>* warnings) {
   PointList list;
   TextCursor cursor(bytes, file);
   int columns = 0;
-  int64_t block_left = 0, block_size = 0, block_line = 0;
+  // PTS blocks: the count a count line claims and the points that followed it. A count line that is missing
+  // or wrong does not stop the reading (the points are on their lines), it is a warning.
+  int64_t block_claimed = -1, block_line = 0, block_found = 0;
+  bool warned_missing = false;
+  auto close_block = [&]() {
+    if (block_claimed >= 0 && block_found != block_claimed && warnings != nullptr) {
+      warnings->push_back(
+          fmt::format("{}: line {}: the point count says {} points, {} follow it; all {} were read", file,
+                      block_line, block_claimed, block_found, block_found));
+    }
+  };
   const char* end = bytes.data() + bytes.size();
   for (;;) {
     cursor.SkipEmptyLines();
@@ -56,19 +74,21 @@ PointList ParseLines(const std::string& bytes, const std::string& file, PointLis
       cursor.NextLine();
       continue;
     }
-    if (kind == PointListKind::kPts && block_left == 0) {
+    if (kind == PointListKind::kPts && IsCountLine(cursor.position(), end)) {
+      close_block();
       block_line = cursor.line();
-      block_size = cursor.Int("point count");
-      if (block_size <= 0)
-        cursor.Fail("point count", fmt::format("{} is not a number of points", block_size));
+      block_claimed = cursor.Int("point count");
+      block_found = 0;
       cursor.EndLine("the point count");
-      if (block_size > cursor.remaining() / kShortestLineBytes + 1) {
-        ThrowInputError(file, fmt::format("line {}", block_line), "point count",
-                        fmt::format("truncated: {} points claimed, only {} bytes follow", block_size,
-                                    cursor.remaining()));
-      }
-      block_left = block_size;
       continue;
+    }
+    if (kind == PointListKind::kPts && block_claimed < 0 && !warned_missing) {
+      warned_missing = true;
+      if (warnings != nullptr) {
+        warnings->push_back(fmt::format(
+            "{}: line {}: no point count line before the points (PTS starts with one); read as points", file,
+            cursor.line()));
+      }
     }
     if (columns == 0) {
       columns = CountTokens(cursor.position(), end);
@@ -105,13 +125,9 @@ PointList ParseLines(const std::string& bytes, const std::string& file, PointLis
       cursor.Fail("columns", fmt::format("more than the {} numbers of the first point line", columns));
     }
     cursor.NextLine();
-    if (kind == PointListKind::kPts) --block_left;
+    ++block_found;
   }
-  if (block_left > 0) {
-    ThrowInputError(
-        file, fmt::format("line {}", block_line), "point count",
-        fmt::format("truncated: {} points claimed, found {}", block_size, block_size - block_left));
-  }
+  close_block();
   if (list.points.empty()) ThrowInputError(file, "", "", "no points");
   return list;
 }
@@ -126,38 +142,26 @@ void NormalizeIntensities(std::vector<double>* intensities, PointListKind kind) 
 
 }  // namespace
 
-Scan ParsePointList(const std::string& bytes, const std::string& file, PointListKind kind) {
+Scan ParsePointList(const std::string& bytes, const std::string& file, PointListKind kind,
+                    std::vector<std::string>* warnings) {
   if (bytes.empty()) ThrowInputError(file, "line 1", "", "the file is empty");
   // Every point takes a line: the line count bounds what the lists and the scan may take.
   const int64_t lines = std::count(bytes.begin(), bytes.end(), '\n') + 1;
   io_internal::CheckScanSize(1, std::min<int64_t>(lines, kMaxScanCells + 1), file, "lines");
-  PointList list = ParseLines(bytes, file, kind);
+  PointList list = ParseLines(bytes, file, kind, warnings);
   const int count = static_cast<int>(list.points.size());
   if (!list.intensities.empty()) NormalizeIntensities(&list.intensities, kind);
-
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
-  for (const Eigen::Vector3d& p : list.points) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-  }
-  const Eigen::Vector3d origin = io_internal::CloudOrigin(low, high);
-  Scan scan = MakeScan(1, count, !list.colors.empty(), /*with_intensity=*/!list.intensities.empty());
-  scan.world_from_scanner.topRightCorner<3, 1>() = origin;
+  Scan scan = io_internal::UnorganizedScan(list.points, {}, !list.colors.empty(),
+                                           /*with_intensity=*/!list.intensities.empty());
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3f p = (list.points[i] - origin).cast<float>();
-    if (p.isZero()) continue;  // no ray from the origin
-    scan.valid.at<uint8_t>(0, i) = kValid;
-    scan.point.at<cv::Vec3f>(0, i) = cv::Vec3f(p.x(), p.y(), p.z());
     if (!list.intensities.empty()) scan.intensity.at<float>(0, i) = static_cast<float>(list.intensities[i]);
     if (!list.colors.empty()) scan.color.at<cv::Vec3b>(0, i) = list.colors[i];
   }
-  io_internal::FinishScan(&scan, /*fit_grid=*/false);
   return scan;
 }
 
-Scan ReadPointList(const std::string& path, PointListKind kind) {
-  return ParsePointList(io_internal::ReadFileToString(path), path, kind);
+Scan ReadPointList(const std::string& path, PointListKind kind, std::vector<std::string>* warnings) {
+  return ParsePointList(io_internal::ReadFileToString(path), path, kind, warnings);
 }
 
 void WritePointList(const std::string& path, const std::vector<Scan>& scans, PointListKind kind) {

@@ -1,6 +1,7 @@
 // XYZ and PTS: round trips of a synthetic scan, files written by hand, and the errors of malformed lines.
 #include "lidarshop/io/xyz.h"
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -134,13 +135,123 @@ TEST(XyzTest, MalformedLinesNameFileLineAndColumn) {
   EXPECT_THAT(error_for(xyz, "1 2 3 0.5 1 2 300\n"), AllOf(HasSubstr("field 'blue'"), HasSubstr("0-255")));
   EXPECT_THAT(error_for(xyz, "1 2 nan\n"), AllOf(HasSubstr("field 'z'"), HasSubstr("not a finite")));
   EXPECT_THAT(error_for(xyz, "1 2 3e30\n"), AllOf(HasSubstr("field 'z'"), HasSubstr("within")));
-  EXPECT_THAT(
-      error_for(pts, "1000000000\n1 2 3\n"),
-      AllOf(HasSubstr(pts), HasSubstr("line 1"), HasSubstr("field 'point count'"), HasSubstr("truncated")));
-  EXPECT_THAT(error_for(pts, "3\n1 2 3\n4 5 6\n"),
-              AllOf(HasSubstr("line 1"), HasSubstr("3 points claimed, found 2")));
-  EXPECT_THAT(error_for(pts, "-3\n1 2 3\n"), HasSubstr("not a number of points"));
-  EXPECT_THAT(error_for(pts, "1 2 3\n"), AllOf(HasSubstr("line 1"), HasSubstr("after the point count")));
+  // PTS: a line that is neither a count (one whole number) nor a point of the first point line's columns.
+  EXPECT_THAT(error_for(pts, "-3\n1 2 3\n"), AllOf(HasSubstr(pts), HasSubstr("line 1"),
+                                                   HasSubstr("field 'columns'"), HasSubstr("1 numbers")));
+  EXPECT_THAT(error_for(pts, "2\n1 2 3\n4 5\n"),
+              AllOf(HasSubstr("line 3"), HasSubstr("field 'z'"), HasSubstr("missing")));
+  EXPECT_THAT(error_for(pts, "2\n1 2 3\n4.5\n"),
+              AllOf(HasSubstr("line 3"), HasSubstr("field 'y'"), HasSubstr("missing")));
+  EXPECT_THAT(error_for(pts, "99999999999999999999999\n1 2 3\n"),
+              AllOf(HasSubstr("line 1"), HasSubstr("field 'point count'"), HasSubstr("out of range")));
+}
+
+// A PTS count line that is missing or wrong: every point line is read, a warning names the count.
+TEST(XyzTest, PtsCountMissingOrWrongIsReadWithAWarning) {
+  TempFolder folder;
+  const std::string path = folder.File("count.pts");
+  struct Case {
+    const char* text;
+    int points;
+    const char* warning;  // "" = none
+  };
+  const Case cases[] = {
+      {"2\n1 2 3\n4 5 6\n", 2, ""},
+      {"1 2 3\n4 5 6\n", 2, "line 1: no point count line"},
+      {"5\n1 2 3\n4 5 6\n", 2, "line 1: the point count says 5 points, 2 follow it"},
+      {"1\n1 2 3\n4 5 6\n7 8 9\n", 3, "line 1: the point count says 1 points, 3 follow it"},
+      {"1000000000\n1 2 3\n", 1, "says 1000000000 points, 1 follow"},
+      // Two blocks (one per scan), the second's count wrong.
+      {"1\n1 2 3\n3\n4 5 6\n7 8 9\n", 3, "line 3: the point count says 3 points, 2 follow it"},
+  };
+  for (const Case& c : cases) {
+    WriteText(path, c.text);
+    const ScanFile file = ReadScanFile(path);
+    ASSERT_EQ(file.scans.size(), 1u) << c.text;
+    EXPECT_EQ(file.scans[0].CountValid(), c.points) << c.text;
+    EXPECT_NEAR(WorldPointOfCell(file.scans[0], 0, c.points - 1).z(), 3.0 * c.points, 1e-6) << c.text;
+    if (c.warning[0] == '\0') {
+      EXPECT_TRUE(file.warnings.empty()) << c.text;
+    } else {
+      ASSERT_EQ(file.warnings.size(), 1u) << c.text;
+      EXPECT_THAT(file.warnings[0], AllOf(StartsWith(path), HasSubstr(c.warning))) << c.text;
+    }
+  }
+}
+
+// In a point list the origin is a point like any other (no-return is an organized-grid convention).
+TEST(XyzTest, APointAtTheOriginIsKept) {
+  const Scan scan = ParsePointList("0 0 0\n1 2 3\n0 0 -0.0009765625\n", "origin.xyz", PointListKind::kXyz);
+  ASSERT_EQ(scan.cols, 3);
+  EXPECT_EQ(scan.CountValid(), 3);
+  EXPECT_EQ(WorldPointOfCell(scan, 0, 0), Eigen::Vector3d(0, 0, 0));
+  EXPECT_EQ(WorldPointOfCell(scan, 0, 1), Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(WorldPointOfCell(scan, 0, 2), Eigen::Vector3d(0, 0, -0.0009765625));
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(scan.range.at<float>(0, i), 0.0f) << i;  // every point has a ray from the scan's origin
+    EXPECT_NEAR(cv::norm(scan.direction.at<cv::Vec3f>(0, i)), 1.0, 1e-6) << i;
+  }
+}
+
+// 5,000 km from the origin, the file's 0.1 mm come back.
+TEST(XyzTest, FarCoordinatesKeepATenthOfAMillimetre) {
+  const Eigen::Vector3d points[] = {{5000000.1234, -5000000.5678, 1234.0001},
+                                    {5000123.4567, -4999876.5432, 1301.2345},
+                                    {4999950.0001, -5000050.9999, 1199.9999}};
+  std::string text = "3\n";
+  for (const Eigen::Vector3d& p : points) text += fmt::format("{:.4f} {:.4f} {:.4f}\n", p.x(), p.y(), p.z());
+  for (PointListKind kind : {PointListKind::kXyz, PointListKind::kPts}) {
+    const Scan scan = ParsePointList(kind == PointListKind::kPts ? text : text.substr(2), "far", kind);
+    ASSERT_EQ(scan.CountValid(), 3);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_LT((WorldPointOfCell(scan, 0, i) - points[i]).cwiseAbs().maxCoeff(), 1e-5) << i;
+    }
+  }
+}
+
+// PDAL's PTS and XYZ test files; expected values read from the text files.
+TEST(XyzTest, ReadsTheInteropFiles) {
+  struct Case {
+    const char* file;
+    int points;
+    Eigen::Vector3d first, last;
+    bool color, intensity;
+  };
+  const Case cases[] = {
+      {"pts/autzen.pts",
+       10,
+       {636110.300003, 849345.050003, 512.139999},
+       {636125.879990, 848971.060013, 428.050003},
+       true,
+       true},
+      // Its count line says 8, 9 point lines follow: all are read, with a warning.
+      {"pts/bunny_8.pts", 9, {-0.037829, 0.12794, 0.004474}, {-0.025508, 0.112568, 0.036676}, false, false},
+      {"pts/site_56_8.pts",
+       8,
+       {6691.797611, 17.347517, 1203.033447},
+       {6728.512429, 35.903329, -14.709473},
+       false,
+       true},
+      {"pts/test.pts", 19, {3.980972, -2.006119, -0.010086}, {-19.501053, -24.533554, -1.533951}, true, true},
+      {"xyz/data.xyz", 400, {440750, 3751290, 107}, {441890, 3750150, 107}, false, false},
+  };
+  for (const Case& c : cases) {
+    const ScanFile file = ReadScanFile(std::string(LIDARSHOP_SHARED_DATA_DIR "/interop/") + c.file);
+    ASSERT_EQ(file.scans.size(), 1u) << c.file;
+    const Scan& scan = file.scans[0];
+    if (std::string(c.file) == "pts/bunny_8.pts") {
+      ASSERT_EQ(file.warnings.size(), 1u);
+      EXPECT_THAT(file.warnings[0], HasSubstr("line 1: the point count says 8 points, 9 follow it"));
+    } else {
+      EXPECT_TRUE(file.warnings.empty()) << c.file;
+    }
+    EXPECT_EQ(scan.cols, c.points) << c.file;
+    EXPECT_EQ(scan.CountValid(), c.points) << c.file;
+    EXPECT_EQ(scan.has_color(), c.color) << c.file;
+    EXPECT_EQ(scan.has_intensity(), c.intensity) << c.file;
+    EXPECT_LT((WorldPointOfCell(scan, 0, 0) - c.first).cwiseAbs().maxCoeff(), 1e-5) << c.file;
+    EXPECT_LT((WorldPointOfCell(scan, 0, c.points - 1) - c.last).cwiseAbs().maxCoeff(), 1e-5) << c.file;
+  }
 }
 
 // XYZ and PTS cannot mark synthesized points: they are written, and the write plan says how many went
