@@ -5,8 +5,13 @@
 # Configures build/fuzz (the whole library instrumented, LIDARSHOP_BUILD_FUZZ=ON), replays the regression
 # inputs of data/fuzz_regressions/<reader>_*, seeds each target with the repository's files of its format
 # (tests/hostile/corpus, data/, the shared E57 files) and runs it for the given time. Prints one line per
-# reader (inputs executed, seconds, crashes) and exits non-zero on a crash; crashing inputs are written to
-# build/fuzz/artifacts/ — turn each into data/fuzz_regressions/<reader>_<what>.<ext> after fixing it.
+# reader (inputs executed, seconds, crashes) and exits non-zero on a crash or an out-of-memory report; crashing
+# inputs are written to build/fuzz/artifacts/ — turn each into data/fuzz_regressions/<reader>_<what>.<ext>
+# after fixing it.
+# Memory: every target sets the memory budget to 256 MiB (fuzz/fuzz_util.h, LimitMemory), so a reader may
+# hold about that much; libFuzzer's -rss_limit_mb is that budget + 200 MB + what AddressSanitizer adds (its
+# shadow and a quarantine capped at 64 MB), and -malloc_limit_mb the budget + 200 MB for one allocation: an
+# input that takes more went past the budget, and libFuzzer reports it as out-of-memory — a failure here.
 # scripts/test.sh runs this briefly (15 s a reader); run it longer by hand.
 set -uo pipefail
 cd "$(dirname "$0")/.."
@@ -27,9 +32,14 @@ extension_of() {
   case $1 in scene | strokes) echo json ;; mask) echo png ;; pose) echo txt ;; *) echo "$1" ;; esac
 }
 
-# Large images in a fuzzed PNG must stay within the memory limit inside OpenCV (the targets set it too).
+# OpenCV reads its own pixel limit once, when it loads: set here, it applies (a second line of defence behind
+# the header checks of io/image_io.h, which apply the budget).
 export OPENCV_IO_MAX_IMAGE_PIXELS=$((1 << 22))
-export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+budget_mb=256                                # what LimitMemory sets
+malloc_limit_mb=$((budget_mb + 200))         # one allocation past this went past the budget
+rss_limit_mb=$((budget_mb + 200 + 300))      # + AddressSanitizer's shadow, quarantine and the binary
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1:quarantine_size_mb=64}
+limits=(-rss_limit_mb="$rss_limit_mb" -malloc_limit_mb="$malloc_limit_mb")
 mkdir -p "$build/artifacts"
 status=0 fuzz_passed=0 fuzz_failed=0
 printf '| reader | inputs | seconds | crashes |\n|---|---|---|---|\n'
@@ -74,16 +84,23 @@ open(sys.argv[2], "wb").write(bytes([kinds[ext]]) + d[:65535])' "$f" "$corpus/$(
   regressions=(data/fuzz_regressions/"${reader}"_*)
   crashes=0
   if [[ -f ${regressions[0]} ]]; then
-    if ! "$build/fuzz/${reader}_fuzz" -rss_limit_mb=2048 -timeout=20 "${regressions[@]}" >"$build/$reader.regressions.log" 2>&1; then
+    if ! "$build/fuzz/${reader}_fuzz" "${limits[@]}" -timeout=20 "${regressions[@]}" >"$build/$reader.regressions.log" 2>&1; then
       echo "$reader: a regression input fails again (see $build/$reader.regressions.log)"
       crashes=$((crashes + 1))
     fi
   fi
   before=$(find "$build/artifacts" -name "$reader-*" | wc -l)
-  "$build/fuzz/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=2048 -timeout=20 \
+  "$build/fuzz/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 "${limits[@]}" -timeout=20 \
     -artifact_prefix="$build/artifacts/$reader-" -print_final_stats=1 >"$build/$reader.log" 2>&1
   after=$(find "$build/artifacts" -name "$reader-*" | wc -l)
   crashes=$((crashes + after - before))
+  # An out-of-memory report fails the run even when libFuzzer could not write its input (-rss_limit_mb is
+  # checked by a thread; a malloc past -malloc_limit_mb dies inside the allocator).
+  if grep -qE "ERROR: libFuzzer: out-of-memory|malloc limit|hard rss limit|allocation-size-too-big|out of memory" \
+    "$build/$reader.log" && [[ $after -eq $before ]]; then
+    echo "$reader: out of memory (see $build/$reader.log)"
+    crashes=$((crashes + 1))
+  fi
   inputs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$build/$reader.log" | grep -oE '[0-9]+$')
   took=$(grep -oE 'Done [0-9]+ runs in [0-9]+ second' "$build/$reader.log" | grep -oE '[0-9]+ second' |
     grep -oE '[0-9]+')

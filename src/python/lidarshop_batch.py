@@ -17,8 +17,12 @@ stem, and a relative value holding `{name}` is a per-scan input next to the scan
 --out; a step without one writes to DIR/.work/.
 
 One scan is one task: its steps run one after the other; its record DIR/records/NAME.json (status, per-step
-seconds, error) is written last and atomically. A scan whose record says "ok" and whose outputs exist is
-skipped (resume); a failed scan is recorded and the others go on (it is retried on the next run). At the end
+seconds, error, and the key of what it was made from) is written last and atomically. A scan is skipped
+(resume) only when its record says "ok" and its key still holds: the same steps with the same options and
+flags, the same input files (the scan and its per-scan inputs, by size and modification time in ns), and its
+outputs as the run left them; anything else redoes it. A failed scan is recorded and the others go on (it is
+retried on the next run). A step's options go to DIR/.batch/stepI_options_HASH.json, named by their content,
+so that a file there always describes the options of the runs that used it. At the end
 DIR/summary.json (and one line on stderr): counts, failures, seconds, scans per minute. Exit 0 when every scan
 is done, 1 when any failed, 2 for a bad pipeline or arguments.
 
@@ -28,13 +32,18 @@ blow-up of one scan fails that scan, not the worker; the library stays free of D
 import argparse
 import ctypes
 import glob
+import hashlib
 import json
 import os
+import re
 import signal
 import shutil
 import subprocess
 import sys
 import time
+
+# What lidarshop's --max-memory takes (util/memory_budget.cc ParseMemorySize; it has the last word).
+MEMORY_SIZE = re.compile(r"[0-9]+(\.[0-9]+)?([KMGT](I?B)?|B)?", re.IGNORECASE)
 
 # Commands whose output is their second positional argument instead of -o.
 POSITIONAL_OUTPUT = {"convert"}
@@ -94,16 +103,63 @@ def record_path(out_dir, name):
     return os.path.join(out_dir, "records", name + ".json")
 
 
+def canonical_hash(value):
+    """A short hash of a JSON value that does not depend on key order."""
+    text = json.dumps(value, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def options_path(options_dir, index, step):
+    return os.path.join(options_dir, f"step{index}_options_{canonical_hash(step['options'])}.json")
+
+
+def file_stamp(path):
+    """What identifies a file's content cheaply: its size and modification time (ns); None when missing."""
+    try:
+        status = os.stat(path)
+    except OSError:
+        return None
+    return [status.st_size, status.st_mtime_ns]
+
+
+def per_scan_inputs(pipeline, name, scan_path):
+    """The scan file and every per-scan input the steps name ({name} values, next to the scan file)."""
+    paths = [scan_path]
+    for step in pipeline["steps"]:
+        for key, value in step.items():
+            if key in STEP_KEYS or not isinstance(value, str) or "{name}" not in value:
+                continue
+            text = value.replace("{name}", name)
+            paths.append(text if os.path.isabs(text) else os.path.join(os.path.dirname(scan_path), text))
+    return paths
+
+
+def scan_key(pipeline, scan_path):
+    """What a scan's outputs are made from: the steps (commands, options, flags) and its input files."""
+    name = scan_name(scan_path)
+    return {"steps": canonical_hash(pipeline["steps"]),
+            "inputs": [[path, file_stamp(path)] for path in per_scan_inputs(pipeline, name, scan_path)]}
+
+
+def kept_outputs(pipeline, name, out_dir, scan_path):
+    """The outputs a run keeps (steps with an `output`) and their stamps now."""
+    return [[path, file_stamp(path)] for path, step in zip(step_outputs(pipeline, name, out_dir, scan_path),
+                                                          pipeline["steps"]) if "output" in step]
+
+
 def is_done(pipeline, scan_path, out_dir):
+    """True when the scan's record says "ok" for these steps and these inputs, and its outputs are the ones that
+    run wrote (none missing or replaced since)."""
     name = scan_name(scan_path)
     try:
         with open(record_path(out_dir, name)) as stream:
             record = json.load(stream)
     except (OSError, ValueError):
         return False
-    return record.get("status") == "ok" and all(
-        os.path.exists(path) for path, step in zip(step_outputs(pipeline, name, out_dir, scan_path),
-                                                   pipeline["steps"]) if "output" in step)
+    outputs = kept_outputs(pipeline, name, out_dir, scan_path)
+    return (isinstance(record, dict) and record.get("status") == "ok"
+            and record.get("key") == scan_key(pipeline, scan_path)
+            and all(stamp is not None for _, stamp in outputs) and record.get("outputs") == outputs)
 
 
 def write_json_atomic(path, data):
@@ -116,14 +172,16 @@ def write_json_atomic(path, data):
     os.replace(temporary, path)
 
 
-def step_argv(lidarshop, step, index, input_path, output_path, name, scan_dir, options_dir):
+def step_argv(lidarshop, step, index, input_path, output_path, name, scan_dir, options_dir, max_memory=None):
     argv = [lidarshop, step["command"], input_path]
     if step["command"] in POSITIONAL_OUTPUT:
         argv.append(output_path)
     else:
         argv += ["-o", output_path]
     if "options" in step:
-        argv += ["--options", os.path.join(options_dir, f"step{index}_options.json")]
+        argv += ["--options", options_path(options_dir, index, step)]
+    if max_memory:
+        argv += ["--max-memory", max_memory]
     for key, value in step.items():
         if key in STEP_KEYS:
             continue
@@ -167,8 +225,9 @@ def run_scan(job):
     pipeline, scan_path, out_dir, lidarshop = job["pipeline"], job["scan"], job["out"], job["lidarshop"]
     name = scan_name(scan_path)
     start = time.monotonic()
+    # Taken before the first step: an input changed while the steps run makes the next run redo the scan.
     record = {"scan": scan_path, "name": name, "status": "ok", "steps": [], "host": os.uname().nodename,
-              "pid": os.getpid()}
+              "pid": os.getpid(), "key": scan_key(pipeline, scan_path)}
     outputs = step_outputs(pipeline, name, out_dir, scan_path)
     for output in outputs:
         remove_stale_temporaries(output)
@@ -176,7 +235,7 @@ def run_scan(job):
     for index, (step, output) in enumerate(zip(pipeline["steps"], outputs)):
         os.makedirs(os.path.dirname(output), exist_ok=True)
         argv = step_argv(lidarshop, step, index, input_path, output, name, os.path.dirname(scan_path),
-                         os.path.join(out_dir, ".batch"))
+                         os.path.join(out_dir, ".batch"), job.get("max_memory"))
         step_start = time.monotonic()
         try:
             process = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
@@ -193,6 +252,15 @@ def run_scan(job):
                                 + (lines[-1] if lines else "no message"))
             break
         input_path = output
+    if record["status"] == "ok":
+        record["outputs"] = kept_outputs(pipeline, name, out_dir, scan_path)
+    else:
+        # The outputs of the failed step and those after it are from an earlier run (other options or other
+        # inputs): left there, they would pass for results of this one.
+        for output, step in list(zip(outputs, pipeline["steps"]))[record["failed_step"]:]:
+            if "output" in step and os.path.exists(output):
+                os.remove(output)
+                record.setdefault("removed_stale_outputs", []).append(output)
     record["seconds"] = round(time.monotonic() - start, 3)
     write_json_atomic(record_path(out_dir, name), record)
     return record
@@ -259,6 +327,9 @@ def main(argv=None):
                         help="i/N: only the scans whose index in the sorted list is i modulo N (Slurm arrays)")
     parser.add_argument("--lidarshop", default=None, help="the lidarshop executable (default: the build's)")
     parser.add_argument("--quiet", action="store_true", help="no line per scan on stderr")
+    parser.add_argument("--max-memory", metavar="SIZE", default=None,
+                        help="memory budget of every step (e.g. 4G; lidarshop's --max-memory): larger requests "
+                             "fail up front")
     args = parser.parse_args(argv)
 
     try:
@@ -277,6 +348,10 @@ def main(argv=None):
     if missing:
         print(f"lidarshop batch: {missing[0]}: no such file", file=sys.stderr)
         return 2
+    if args.max_memory is not None and not MEMORY_SIZE.fullmatch(args.max_memory):
+        print(f"lidarshop batch: --max-memory: '{args.max_memory}' is not a memory size (e.g. 512M, 8G)",
+              file=sys.stderr)
+        return 2
     if args.workers is not None and args.workers < 1:
         print("lidarshop batch: --workers: expected a number >= 1", file=sys.stderr)
         return 2
@@ -287,13 +362,14 @@ def main(argv=None):
 
     os.makedirs(os.path.join(out_dir, ".batch"), exist_ok=True)
     for index, step in enumerate(pipeline["steps"]):
-        if "options" in step:
-            write_json_atomic(os.path.join(out_dir, ".batch", f"step{index}_options.json"), step["options"])
+        if "options" in step:  # named by content: rewriting one never changes what an earlier run used
+            write_json_atomic(options_path(os.path.join(out_dir, ".batch"), index, step), step["options"])
 
     start = time.monotonic()
     todo = [path for path in scans if not is_done(pipeline, path, out_dir)]
     skipped = len(scans) - len(todo)
-    jobs = [{"pipeline": pipeline, "scan": path, "out": out_dir, "lidarshop": lidarshop} for path in todo]
+    jobs = [{"pipeline": pipeline, "scan": path, "out": out_dir, "lidarshop": lidarshop,
+             "max_memory": args.max_memory} for path in todo]
 
     def log(record):
         if not args.quiet:

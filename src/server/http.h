@@ -15,6 +15,8 @@
 // After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
 #include <httplib.h>
 
+#include "gated_server.h"
+
 namespace lidarshop::server {
 
 // A model placed in scans: its mesh (for drawing) and its verification side (built once).
@@ -27,7 +29,7 @@ struct ModelEntry {
 
 struct EditorServer::State {
   ServerOptions options;
-  httplib::Server http;
+  GatedServer http;  // httplib's server behind the connection gate (gated_server.h)
   int port = 0;
   int listen_socket = -1;
   std::unique_ptr<JobRunner> runner;
@@ -49,7 +51,11 @@ using State = EditorServer::State;
 // An error answer: {"error": message} with `status`.
 void SendError(httplib::Response& response, int status, const std::string& message);
 void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, int status = 200);
-// The request body as a JSON object; nullopt after answering 400.
+// Limits of JSON request bodies (strokes, options, correspondences; photos are uploaded as images).
+inline constexpr size_t kMaxJsonBodyBytes = size_t{8} << 20;
+inline constexpr int kMaxJsonDepth = 64;
+// The request body as a JSON object; nullopt after answering 400 (not JSON, nested deeper than kMaxJsonDepth)
+// or 413 (above kMaxJsonBodyBytes).
 std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response);
 
 // The PNG of an 8-bit RGB (3 channels) or grey image as the answer.

@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
@@ -225,16 +226,14 @@ void AddRecolorRoutes(State& state) {
                 std::lock_guard lock(document->mutex);
                 if (!PhotoSlot(*document, request, response)) return;  // 400 for an unknown slot
               }
-              const std::vector<uint8_t> bytes(request.body.begin(), request.body.end());
-              cv::Mat decoded;
-              try {
-                decoded = cv::imdecode(bytes, cv::IMREAD_COLOR);
-              } catch (const cv::Exception& error) {
-                return SendError(response, 422, fmt::format("the photo does not decode: {}", error.err));
-              }
-              if (decoded.empty()) return SendError(response, 422, "the photo is not a PNG or JPEG image");
+              // Its size read from its header and checked against the budget before decoding (io/image_io.h).
               cv::Mat rgb;
-              cv::cvtColor(decoded, rgb, cv::COLOR_BGR2RGB);
+              try {
+                rgb = DecodeImage(reinterpret_cast<const uint8_t*>(request.body.data()), request.body.size(),
+                                  "the photo", /*color=*/true);
+              } catch (const InputError& error) {
+                return SendError(response, 422, error.what());
+              }
               std::lock_guard lock(document->mutex);
               cv::Mat* slot = PhotoSlot(*document, request, response);
               if (!slot) return;

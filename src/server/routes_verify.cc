@@ -9,6 +9,7 @@
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/primitives.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/verify/pose_text.h"
@@ -73,7 +74,8 @@ void AddVerifyRoutes(State& state) {
            !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
         if (it.depth() > 1) it.disable_recursion_pending();
         const std::string extension = FileExtension(it->path().string());
-        if (it->is_regular_file() && (extension == "obj" || extension == "ply") && files.size() < 500) {
+        if (it->is_regular_file() && !IsAtomicTemporary(it->path().filename().string()) &&
+            (extension == "obj" || extension == "ply") && files.size() < 500) {
           files.push_back(it->path().string());
         }
       }

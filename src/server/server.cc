@@ -37,10 +37,6 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
   state_->options = std::move(options);
   state_->runner = std::make_unique<JobRunner>(1, 256);
   httplib::Server& http = state_->http;
-  http.new_task_queue = [threads = state_->options.threads] { return new httplib::ThreadPool(threads); };
-  http.set_payload_max_length(static_cast<size_t>(state_->options.max_body_bytes));
-  http.set_keep_alive_timeout(2);
-  http.set_keep_alive_max_count(1000);
   // Debian's httplib listens with a backlog of 5: a burst of new clients overflows it and some connections
   // stall or fail. The socket is remembered here and given a full backlog after binding (a second listen()
   // on a listening socket only changes its backlog).
@@ -105,7 +101,16 @@ void EditorServer::Bind() {
   }
 }
 
-void EditorServer::Run() { state_->http.listen_after_bind(); }
+void EditorServer::Run() {
+  const ServerOptions& options = state_->options;
+  state_->http.StartGate({.threads = options.threads,
+                          .max_connections = options.max_connections,
+                          .header_timeout_s = options.header_timeout_s,
+                          .idle_timeout_s = options.idle_timeout_s,
+                          .max_body_bytes = options.max_body_bytes});
+  state_->http.listen_after_bind();
+  state_->http.StopGate();
+}
 
 void EditorServer::Stop() {
   if (state_->http.is_running()) state_->http.stop();

@@ -4,8 +4,9 @@
 //
 // Safety: it listens on loopback unless told otherwise; every /api/ call needs the token printed at start
 // (401 before any routing); files are opened only under the folders given at start (403 for `..`, symlinks
-// or absolute paths leading outside them); request bodies are size-limited; a malformed request gets a 4xx
-// with a one-line message.
+// or absolute paths leading outside them); request bodies are size-limited (JSON bodies further, in size and
+// nesting depth); a malformed request gets a 4xx with a one-line message; slow, idle or too many clients
+// cannot starve the others (gated_server.h).
 #pragma once
 
 #include <cstdint>
@@ -25,11 +26,15 @@ struct ServerOptions {
   std::vector<std::string> roots;  // folders files may be opened from (canonical paths are compared)
   std::string web_dir;             // the built front end (index.html), served at /; empty = none
   int64_t max_body_bytes = int64_t{64} << 20;  // request bodies above this get 413
-  // Request threads: a keep-alive connection holds one while open, so this bounds the clients served at once
-  // (operations run on their own threads).
+  // Request threads: requests served at once (operations run on their own threads). A connection takes one
+  // only once a request's headers have all arrived (gated_server.h), so idle and slow clients hold none.
   int threads = 64;
-  int max_documents = 16;  // open scans at once; the oldest is closed beyond it
-  int undo_depth = 8;      // edits kept per scan for undo
+  int max_connections = 4096;    // open at once (also kept below the descriptor limit); then the oldest idle
+                                 // one is closed, or the newcomer gets 503
+  double header_timeout_s = 10;  // from a request's first byte to the end of its headers (408 after)
+  double idle_timeout_s = 5;     // a connection with no request under way is closed after this
+  int max_documents = 16;        // open scans at once; the oldest is closed beyond it
+  int undo_depth = 8;            // edits kept per scan for undo
   // Built-in scenes: their names, and a function scanning one (the CLI passes its compiled-in scenes).
   std::vector<std::string> builtin_scenes;
   std::function<Scan(const std::string& name)> scan_builtin;

@@ -2,6 +2,7 @@
 """Writes the hostile-input corpus into tests/hostile/corpus/ and its case list cases.txt.
 
 Usage: make_corpus.py LIDARSHOP_BINARY   (run from anywhere; rewrites tests/hostile/corpus and cases.txt)
+       make_corpus.py --big DIR           (writes the inputs too large for git into DIR: hostile_test.sh's {B})
 
 Each case is one line of cases.txt: `reader|expect|arguments` where expect is `error` (one clean line on stderr
 and a non-zero exit) or `ok`, and the arguments of `lidarshop` use {C} for the corpus folder, {W} for a scratch
@@ -15,6 +16,7 @@ import shutil
 import struct
 import subprocess
 import sys
+import zlib
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 CORPUS = os.path.join(HERE, 'corpus')
@@ -71,6 +73,73 @@ def e57_pages(logical):
     return out
 
 
+def png_chunk(kind, data):
+    return struct.pack('>I', len(data)) + kind + data + struct.pack('>I', zlib.crc32(kind + data))
+
+
+def png_image(width, height, bit_depth=1, colour_type=0, channels=1):
+    """A real (zero-filled) PNG: a 1-bit grey image compresses about 400 pixels into a byte."""
+    row = b'\0' * (1 + (width * channels * bit_depth + 7) // 8)
+    compressor = zlib.compressobj(9)
+    idat = b''.join(compressor.compress(row) for _ in range(height)) + compressor.flush()
+    return (b'\x89PNG\r\n\x1a\n' + png_chunk(b'IHDR', struct.pack('>IIBBBBB', width, height, bit_depth, colour_type, 0, 0, 0))
+            + png_chunk(b'IDAT', idat) + png_chunk(b'IEND', b''))
+
+
+def e57_build(scans, images=(), blobs=()):
+    """An E57 file from scratch: `scans` are (name bytes, recordCount, prototype XML) whose fields must all take
+    no bits (Integer minimum == maximum: no bytestream bytes), `images` are (name, blob index) photos as
+    visualReferenceRepresentation entries of `blobs` (PNG bytes, each stored once)."""
+    logical = bytearray(48)
+    phys = lambda at: at // 1020 * 1024 + at % 1020
+    blob_at = []
+    for blob in blobs:
+        while len(logical) % 8: logical.append(0)
+        blob_at.append(phys(len(logical)))
+        logical += bytes([0]) + bytes(7) + struct.pack('<Q', 16 + len(blob)) + blob
+    while len(logical) % 8: logical.append(0)
+    cv_at = len(logical)
+    logical += bytes([1]) + bytes(7) + struct.pack('<QQQ', 32, phys(cv_at + 32), 0)
+    xml = (b'<?xml version="1.0" encoding="UTF-8"?>\n<e57Root type="Structure" xmlns="http://www.astm.org/COMMIT/E57/2010-e57-v1.0">\n'
+           b'<formatName type="String">ASTM E57 3D Imaging Data File</formatName>\n<guid type="String">hostile</guid>\n'
+           b'<versionMajor type="Integer">1</versionMajor>\n<versionMinor type="Integer">0</versionMinor>\n'
+           b'<data3D type="Vector" allowHeterogeneousChildren="1">\n')
+    for i, (name, count, prototype) in enumerate(scans):
+        xml += (b'<vectorChild type="Structure"><guid type="String">scan%d</guid><name type="String">%s</name>'
+                b'<points type="CompressedVector" fileOffset="%d" recordCount="%d"><prototype type="Structure">%s</prototype>'
+                b'<codecs type="Vector" allowHeterogeneousChildren="1"/></points></vectorChild>\n'
+                % (i, name, phys(cv_at), count, prototype))
+    xml += b'</data3D>\n<images2D type="Vector" allowHeterogeneousChildren="1">\n'
+    for name, blob in images:
+        xml += (b'<vectorChild type="Structure"><name type="String">%s</name><visualReferenceRepresentation type="Structure">'
+                b'<pngImage type="Blob" fileOffset="%d" length="%d"/><imageWidth type="Integer">1</imageWidth>'
+                b'<imageHeight type="Integer">1</imageHeight></visualReferenceRepresentation></vectorChild>\n'
+                % (name, blob_at[blob], len(blobs[blob])))
+    xml += b'</images2D>\n</e57Root>\n'
+    xml_at = len(logical)
+    logical += xml
+    pages = (len(logical) + 1019) // 1020
+    logical[0:48] = b'ASTM-E57' + struct.pack('<IIQQQQ', 1, 0, pages * 1024, phys(xml_at), len(xml), 1024)
+    return e57_pages(bytes(logical))
+
+
+# A point at (1, 5, 0) whose fields take no bits: any recordCount fits in no bytes.
+CONSTANT_POINT = (b'<cartesianX type="Integer" minimum="1" maximum="1"/><cartesianY type="Integer" minimum="5" maximum="5"/>'
+                  b'<cartesianZ type="Integer" minimum="0" maximum="0"/>')
+
+
+def big_files(directory):
+    """Inputs too large to keep in git, written by hostile_test.sh before its cases run ({B})."""
+    os.makedirs(directory, exist_ok=True)
+    # 100,000 scans of one point each in 7 MB (issue 37: 793 MB before the scans were counted).
+    scan = ptx(rows=1, cols=1)
+    with open(os.path.join(directory, 'scans_100k.ptx'), 'w') as f:
+        f.write(scan * 100000)
+    # 20,000 one-box objects in 400 KB: each object costs a mesh and an Embree geometry whatever its size.
+    with open(os.path.join(directory, 'boxes_20k.json'), 'w') as f:
+        f.write('{"objects": [' + ','.join(['{"primitive":"box"}'] * 20000) + ']}')
+
+
 def flips(ext, base, count, rnd):
     """`count` copies of `base` with 1 to 6 random bytes replaced: a clean error or success, nothing else."""
     for i in range(count):
@@ -81,6 +150,9 @@ def flips(ext, base, count, rnd):
 
 
 def main():
+    if sys.argv[1] == '--big':
+        big_files(sys.argv[2])
+        return
     lidarshop = sys.argv[1]
     shutil.rmtree(CORPUS, ignore_errors=True)
     os.makedirs(CORPUS)
@@ -253,7 +325,6 @@ def main():
     scan_case('obj', 'ok', scene('obj_mtl_fifo.json', [{'mesh': 'mtl_fifo.obj', 'translate': [0, 5, 0]}]))
     write('huge_texture.mtl', 'newmtl m\nmap_Kd huge.png\n')
     # a 1 x 1 PNG whose header claims 100000 x 100000 pixels (CRC of IHDR recomputed)
-    import zlib
     ihdr = struct.pack('>IIBBBBB', 100000, 100000, 8, 2, 0, 0, 0)
     png = b'\x89PNG\r\n\x1a\n' + struct.pack('>I', 13) + b'IHDR' + ihdr + struct.pack('>I', zlib.crc32(b'IHDR' + ihdr))
     idat = zlib.compress(b'\0' * 100)
@@ -382,6 +453,53 @@ def main():
     case('xyz', 'error', 'info ' + write('garbage.xyz', bytes(las_random.randrange(256) for _ in range(400))))
     flips('xyz', xyz_points.encode(), 6, las_random)
     case('xyz', 'error', 'info {FIFO}.xyz')
+
+    # ---- issue 37: what the budget must count (each case with a memory limit: its budget + 200 MB)
+    # E57 fields that take no bits: 2^24 records in 3 KB; 8 scans of 2^22 records each.
+    case('budget', 'error', 'convert ' + write('e57_zero_bits.e57', e57_build([(b'zero', 1 << 24, CONSTANT_POINT)])) + ' {W}/o.ply --max-memory 256M -q')
+    case('budget', 'error', 'convert ' + write('e57_zero_bits_8.e57', e57_build([(b'zero', 1 << 22, CONSTANT_POINT)] * 8)) + ' {W}/o.ply --max-memory 1G -q')
+    # PLY: 20 lidarshop_scan comments of 2048 x 2048 cells, each within the limit, together 2.4 GB.
+    many = ply(1, '0 5 0 3 5\n').replace('comment lidarshop_scan 0 4 6 ' + ' '.join(IDENTITY.split()) + '\n',
+                                         ''.join(f'comment lidarshop_scan {i} 2048 2048 ' + ' '.join(IDENTITY.split()) + '\n' for i in range(20)))
+    case('budget', 'error', 'convert ' + write('ply_scans_20x2048sq.ply', many) + ' {W}/o.ply --max-memory 512M -q')
+    # Images: a 20000 x 20000 1-bit PNG of 50 KB decodes to 400 MB grey, 1.2 GB RGB; a 4000 x 4000 one of 2 KB
+    # to 48 MB RGB. The size is in the header: refused (or compared with the scan's) before decoding.
+    huge_png = png_image(20000, 20000)
+    write('png_20000sq.png', huge_png)
+    fill('error', '{C}/png_20000sq.png --max-memory 64M')
+    seg('error', '{C}/png_20000sq.png --max-memory 64M')
+    case('budget', 'error', 'inpaint {C}/good_render.png --mask {C}/png_20000sq.png -o {W}/i.png --max-memory 64M')
+    subprocess.run([lidarshop, 'render', os.path.join(CORPUS, 'good.ptx'), '-o', os.path.join(CORPUS, 'good_render.png')], check=True)
+    write('texture_20000sq.mtl', 'newmtl m\nmap_Kd png_20000sq.png\n')
+    write('texture_20000sq.obj', 'mtllib texture_20000sq.mtl\nv 0 0 0\nv 1 0 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl m\nf 1/1 2/2 3/3\n')
+    scan_case('budget', 'ok', scene('obj_texture_20000sq.json', [{'mesh': 'texture_20000sq.obj', 'translate': [0, 5, 0]}]), '--max-memory 256M')
+    small_scan = [(b'photos', 24, CONSTANT_POINT)]
+    e57_photo = write('e57_photo_20000sq.e57', e57_build(small_scan, [(b'big', 0)], [huge_png]))
+    case('budget', 'any', f'convert {e57_photo} {{W}}/o.e57 --max-memory 512M -q')
+    e57_photos = write('e57_photo_4000sq_x200.e57', e57_build(small_scan, [(b'p%d' % i, 0) for i in range(200)], [png_image(4000, 4000)]))
+    case('budget', 'any', f'convert {e57_photos} {{W}}/o.e57 --max-memory 512M -q')
+    case('budget', 'any@1000M', f'info {e57_photos}')
+    # A Latin-1 scan name: E57 XML is UTF-8.
+    latin1 = write('e57_latin1_name.e57', e57_build([(b'caf\xe9', 24, CONSTANT_POINT)]))
+    case('e57', 'error', f'info {latin1}')
+    case('e57', 'error', f'convert {latin1} {{W}}/o.e57 -q')
+    # The image libraries' own lines: a PNG whose compressed data is broken, a JPEG cut short.
+    subprocess.run([lidarshop, 'render', os.path.join(CORPUS, 'good.ptx'), '--channel', 'valid', '-o', os.path.join(CORPUS, 'good_valid.png')], check=True)
+    broken = bytearray(open(os.path.join(CORPUS, 'good_valid.png'), 'rb').read())
+    at = broken.index(b'IDAT') + 8
+    broken[at:at + 6] = b'\xff' * 6
+    fill('error', write('mask_bad_idat.png', bytes(broken)))
+    subprocess.run([lidarshop, 'render', os.path.join(CORPUS, 'good.ptx'), '--channel', 'valid', '-o', os.path.join(CORPUS, 'good_valid.jpg')], check=True)
+    jpeg = bytearray(open(os.path.join(CORPUS, 'good_valid.jpg'), 'rb').read())
+    os.remove(os.path.join(CORPUS, 'good_valid.jpg'))
+    at = jpeg.index(b'\xff\xda')
+    jpeg[at + 20:at + 24] = b'\xff\xd0\xff\xd5'  # restart markers out of order: libjpeg warns, then decodes
+    fill('any', write('mask_corrupt_data.jpg', bytes(jpeg[:-10]) + b'\xff\xd9'))
+    # Amplification: a PCD claiming 1.2 GB of LZF data in 172 bytes; 100,000 one-point PTX scans in 7 MB.
+    case('budget', 'error@300M', 'info ' + write('lzf_1g.pcd', pcd(100000000, 1, 100000000, data='binary_compressed', body='').encode()
+                                                          + struct.pack('<II', 20, 1200000000) + b'\0' * 20))
+    case('budget', 'error@400M', 'info {B}/scans_100k.ptx')
+    scan_case('budget', 'error', '{B}/boxes_20k.json', '--max-memory 256M')
 
     # ---- options (the options layer: Check() of each command's options)
     L = base_scan

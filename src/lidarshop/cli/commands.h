@@ -91,6 +91,8 @@ const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = 
 // ("512M", "8G"; default half of the RAM), which sets the memory budget (util/memory_budget.h) that
 // header counts, scene complexity, sample and sweep counts are checked against before any allocation.
 void AddQuietFlag(CLI::App& app, bool* quiet);
+// Adds --max-memory SIZE alone; RunCommand adds it to every command that has not.
+void AddMemoryOption(CLI::App& app);
 
 // Adds a --seed option storing into *seed: a whole number in [0, 2^63) (CLI11 alone would
 // wrap "-1" to the largest seed).

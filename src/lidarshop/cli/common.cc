@@ -1,10 +1,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <iostream>
+#include <new>
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -59,6 +62,8 @@ std::string OneLine(const std::exception& error) {
 int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
                const OptionBinder* binder) {
   const std::string name = "lidarshop " + app.get_name();
+  // Every command takes --max-memory (README), also those with no --quiet.
+  if (app.get_option_no_throw("--max-memory") == nullptr) AddMemoryOption(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -84,6 +89,13 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
   } catch (const OptionsError& error) {
     fmt::print(stderr, "{}: {}\n", name, OneLine(error));
     return kExitUsage;
+  } catch (const std::bad_alloc&) {
+    // An allocation no check foresaw: say what ran out and what bounds it, never a bare "std::bad_alloc".
+    fmt::print(stderr,
+               "{}: out of memory: an allocation failed (the memory budget is {} MiB; a smaller --max-memory "
+               "makes large requests fail up front, or free memory and retry)\n",
+               name, MemoryBudgetBytes() >> 20);
+    return kExitBadInput;
   } catch (const std::exception& error) {
     fmt::print(stderr, "{}: {}\n", name, OneLine(error));
     return kExitBadInput;
@@ -134,7 +146,16 @@ void WriteJsonOutput(const std::string& path, const nlohmann::ordered_json& json
   if (path.empty()) return;
   const std::string text = inline_arrays ? DumpWithInlineArrays(json, indent) : json.dump(indent);
   if (path == "-") {
+    errno = 0;
     std::cout << text << "\n" << std::flush;
+    if (!std::cout) {
+      const int saved_errno = errno;
+      std::cout.clear();
+      throw InputError(fmt::format("cannot write the JSON to stdout: {}",
+                                   saved_errno == ENOSPC ? std::string("no space left on device")
+                                   : saved_errno != 0    ? std::string(std::strerror(saved_errno))
+                                                         : std::string("the stream failed")));
+    }
     return;
   }
   WriteFileAtomically(path, [&](std::ostream& out) { out << text << "\n"; });
@@ -191,6 +212,10 @@ const Scan& PickScan(const ScanFile& file, int index, const std::string& flag) {
 
 void AddQuietFlag(CLI::App& app, bool* quiet) {
   app.add_flag("-q,--quiet", *quiet, "no progress output");
+  AddMemoryOption(app);
+}
+
+void AddMemoryOption(CLI::App& app) {
   app.add_option_function<std::string>(
       "--max-memory",
       [](const std::string& text) {

@@ -159,15 +159,10 @@ int RunInpaint(int argc, char** argv) {
         }
         options.stop_for_review = !review_dir.empty();
         const cv::Mat input = ReadImage(image_path);
-        cv::Mat mask = ReadImage(mask_path);
+        cv::Mat mask = ReadImage(mask_path, input.size(), "the image");  // size checked before decoding
         if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
         if (mask.channels() == 4) cv::cvtColor(mask, mask, cv::COLOR_RGBA2GRAY);
         if (mask.depth() != CV_8U) ThrowInputError(mask_path, "", "", "the mask must be an 8-bit image");
-        if (mask.size() != input.size()) {
-          ThrowInputError(mask_path, "", "",
-                          fmt::format("mask is {}x{} but the image is {}x{}", mask.cols, mask.rows,
-                                      input.cols, input.rows));
-        }
         mask = mask > 127;
         std::string extension = std::filesystem::path(output_path).extension().string();
         std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);

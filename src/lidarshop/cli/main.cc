@@ -1,5 +1,7 @@
 // lidarshop — edit terrestrial LiDAR scans. `lidarshop <command> --help` for each command.
 #include <cstring>
+#include <exception>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -8,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace {
 
@@ -72,7 +75,21 @@ int main(int argc, char** argv) {
     return 0;
   }
   for (const Command& command : Commands()) {
-    if (name == command.name) return command.run(argc - 1, argv + 1);
+    if (name != command.name) continue;
+    // RunCommand turns every error into one line; this is the last resort for what escapes it (an allocation
+    // failing while an error is reported, a command that does not use RunCommand).
+    try {
+      return command.run(argc - 1, argv + 1);
+    } catch (const std::bad_alloc&) {
+      fmt::print(stderr,
+                 "lidarshop {}: out of memory: an allocation failed (memory budget {} MiB; --max-memory SIZE "
+                 "makes large requests fail up front)\n",
+                 name, lidarshop::MemoryBudgetBytes() >> 20);
+      return lidarshop::cli::kExitBadInput;
+    } catch (const std::exception& error) {
+      fmt::print(stderr, "lidarshop {}: {}\n", name, error.what());
+      return lidarshop::cli::kExitBadInput;
+    }
   }
   fmt::print(stderr, "lidarshop: unknown command '{}' (lidarshop --help lists the commands)\n", name);
   return 2;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/input_file.h"
 
 namespace lidarshop::cli {
@@ -149,6 +150,8 @@ OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
           [this](const std::string& path) {
             if (root_ == nullptr)
               throw CLI::ValidationError("--options", "this command has no options struct");
+            // No output of this run may replace it (--json FILE naming the options file lost it).
+            ProtectInput(path);
             try {
               const std::string text = ReadRegularFile(path);
               nlohmann::json json;

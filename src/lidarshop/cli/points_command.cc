@@ -36,6 +36,7 @@
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/timer.h"
 #include "lidarshop/verify/pose_text.h"
@@ -400,9 +401,12 @@ int RunPoints(int argc, char** argv) {
           if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
           if (FileExtension(output_path) != "ply")
             throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
+          CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
+          // Before reading the mesh: the samples, and the written cloud's copy of them.
+          CheckMemoryBudget(SaturatingBytes(count, 2 * kSurfaceSampleBytes),
+                            fmt::format("--count {}: sampling {} points", count, count));
           const TriangleMesh mesh = ReadMeshAndWarn(inputs[0]);
           if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
-          CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
           const Timer timer;
           SurfaceSamples samples = SampleSurface(mesh, count, seed);
           PointCloud cloud;

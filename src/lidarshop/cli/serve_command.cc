@@ -1,6 +1,9 @@
 // lidarshop serve: the editor in the browser (src/server, docs/api.md, web/).
 //
 //   lidarshop serve [SCAN...] [--scene NAME] [--port 8080] [--host 127.0.0.1] [--root DIR...] [--web DIR]
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <csignal>
 #include <filesystem>
 
@@ -56,6 +59,13 @@ int RunServe(int argc, char** argv) {
   app.add_option("--web", options.web_dir, "the built front end (default: web/ beside the executable)");
   app.add_option("--token", options.token, "the access token (default: a random one)");
   return RunCommand(app, argc, argv, [&]() {
+    // Every open connection takes a descriptor: the soft limit (often 1024) is raised towards the hard one so
+    // that the server's connection limit (4096) is the one in force.
+    rlimit files{};
+    if (getrlimit(RLIMIT_NOFILE, &files) == 0 && files.rlim_cur < files.rlim_max) {
+      files.rlim_cur = std::min<rlim_t>(files.rlim_max, 8192);
+      setrlimit(RLIMIT_NOFILE, &files);
+    }
     if (options.web_dir.empty()) options.web_dir = DefaultWebDir(argv[0]);
     for (const BuiltinScene& scene : BuiltinScenes()) options.builtin_scenes.push_back(scene.name);
     options.scan_builtin = [](const std::string& name) {

@@ -54,6 +54,11 @@ inline uint64_t PhysicalFromLogical(uint64_t logical) {
 // and its byte offset when a checksum does not match or the size is not whole pages.
 std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical);
 
+// E57's XML is UTF-8 (E2807 8.4): throws InputError naming `path` and the byte of the XML section where the
+// `size` bytes at `xml` are not (a Latin-1 scan name), before pugixml, which does not check, passes them on
+// to JSON output and written files.
+void CheckXmlUtf8(const std::string& path, const char* xml, size_t size);
+
 // Splits logical bytes into pages with their CRCs (the last page is zero-padded).
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical);
 

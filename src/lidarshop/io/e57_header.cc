@@ -183,6 +183,7 @@ ScanFileHeader io_internal::ReadE57Header(const std::string& path) {
                                 header.xml_logical_length, header.xml_physical_offset));
   }
   const std::string xml_text = ReadLogical(path, xml_start, header.xml_logical_length, "XML section");
+  CheckXmlUtf8(path, xml_text.data(), xml_text.size());
   pugi::xml_document doc;
   const pugi::xml_parse_result parsed =
       doc.load_buffer(xml_text.data(), xml_text.size(), pugi::parse_default, pugi::encoding_utf8);

@@ -1,6 +1,8 @@
 // E57 physical pages: CRC-32C and the logical/physical mapping (see e57_format.h).
 #include <array>
 
+#include <fmt/format.h>
+
 #include "lidarshop/io/e57_format.h"
 #include "lidarshop/util/error.h"
 
@@ -110,6 +112,32 @@ Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical)
                     fmt::format("{} (only 1024 is defined)", h.page_size));
   }
   return h;
+}
+
+void CheckXmlUtf8(const std::string& path, const char* xml, size_t size) {
+  const auto* b = reinterpret_cast<const uint8_t*>(xml);
+  for (size_t i = 0; i < size;) {
+    const uint8_t c = b[i];
+    if (c < 0x80) {
+      ++i;
+      continue;
+    }
+    // The length of the sequence and the range of its second byte (no overlong forms, no surrogates, at most
+    // U+10FFFF: RFC 3629's table).
+    const int length = c >= 0xc2 && c <= 0xdf   ? 2
+                       : c >= 0xe0 && c <= 0xef ? 3
+                       : c >= 0xf0 && c <= 0xf4 ? 4
+                                                : 0;
+    const uint8_t low = c == 0xe0 ? 0xa0 : c == 0xf0 ? 0x90 : 0x80;
+    const uint8_t high = c == 0xed ? 0x9f : c == 0xf4 ? 0x8f : 0xbf;
+    bool valid = length > 0 && i + length <= size && b[i + 1] >= low && b[i + 1] <= high;
+    for (int k = 2; valid && k < length; ++k) valid = b[i + k] >= 0x80 && b[i + k] <= 0xbf;
+    if (!valid) {
+      ThrowInputError(path, fmt::format("XML section, byte {}", i), "",
+                      fmt::format("byte 0x{:02x} is not UTF-8 (E57 XML is UTF-8; a Latin-1 name?)", c));
+    }
+    i += length;
+  }
 }
 
 void StoreHeader(const Header& h, uint8_t* out) {

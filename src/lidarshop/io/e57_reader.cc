@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -13,10 +14,12 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace e57 {
@@ -30,6 +33,10 @@ struct Context {
   const std::string& path;
   const std::vector<uint8_t>& logical;
 };
+
+// What the reader holds per record while it places a scan's records (coordinates, state, layer, cell and
+// row index, one decoded field) on top of the scan's own channels.
+constexpr int64_t kReaderBytesPerRecord = 64;
 
 std::string ElementPath(pugi::xml_node node) {
   std::string p;
@@ -797,7 +804,19 @@ std::pair<const uint8_t*, size_t> BlobBytes(const Context& ctx, pugi::xml_node b
   return {L.data() + start + 16, static_cast<size_t>(length)};
 }
 
-void ReadImage(const Context& ctx, pugi::xml_node child, std::vector<E57Image>* images) {
+// The photos read so far: a blob listed by several images2D entries is decoded once (the entries share the
+// decoded pixels), and the stored bytes every entry keeps plus the distinct decoded images stay within the
+// memory budget.
+struct ImageCache {
+  struct Decoded {
+    cv::Mat image;
+    std::string error;
+  };
+  std::map<std::pair<const uint8_t*, size_t>, Decoded> decoded;  // by the blob's bytes
+  int64_t bytes = 0;
+};
+
+void ReadImage(const Context& ctx, pugi::xml_node child, ImageCache* cache, std::vector<E57Image>* images) {
   static const std::pair<const char*, const char*> kRepresentations[] = {
       {"pinholeRepresentation", "pinhole"},
       {"sphericalRepresentation", "spherical"},
@@ -821,23 +840,32 @@ void ReadImage(const Context& ctx, pugi::xml_node child, std::vector<E57Image>* 
     image.width_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageWidth"), 0, 0, 1 << 30));
     image.height_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageHeight"), 0, 0, 1 << 30));
     const auto [bytes, size] = BlobBytes(ctx, blob);
+    cache->bytes += static_cast<int64_t>(size);  // at most the file's size per entry
+    CheckMemoryBudget(cache->bytes, fmt::format("{}: {}: the images2D blobs", ctx.path, ElementPath(blob)));
     image.encoded.assign(bytes, bytes + size);
     image.encoding = std::string(blob.name()) == "jpegImage" ? "jpeg" : "png";
-    cv::Mat decoded;
-    try {
-      decoded = cv::imdecode(
-          cv::Mat(1, static_cast<int>(std::min<size_t>(size, INT32_MAX)), CV_8U, const_cast<uint8_t*>(bytes)),
-          cv::IMREAD_COLOR);
-    } catch (const cv::Exception& e) {
-      decoded.release();
-    }
-    // A blob that does not decode does not make the scans unreadable: keep the entry and say why it is empty.
-    if (decoded.empty()) {
-      image.decode_error =
-          FormatInputError(ctx.path, ElementPath(blob), "",
-                           fmt::format("the {}-byte {} blob does not decode", size, blob.name()));
+    const auto key = std::make_pair(bytes, size);
+    const auto found = cache->decoded.find(key);
+    if (found != cache->decoded.end()) {
+      image.image = found->second.image;
+      image.decode_error = found->second.error;
     } else {
-      cv::cvtColor(decoded, image.image, cv::COLOR_BGR2RGB);
+      // A blob that does not decode (or is too large to) does not make the scans unreadable: keep the entry
+      // and say why it is empty. Its size is read from its header (PNG IHDR, JPEG SOF) before decoding.
+      try {
+        const std::string where = fmt::format("{}-byte {}", size, blob.name());
+        ImageHeader header = ReadImageHeader(bytes, size, where);
+        header.channels = std::max(header.channels, 3);  // decoded as RGB
+        CheckImageHeader(header, where);
+        cache->bytes += std::min(header.DecodedBytes(), int64_t{1} << 60);
+        CheckMemoryBudget(cache->bytes, fmt::format("{}: the images2D photos", ctx.path));
+        image.image = DecodeImage(bytes, size, where, /*color=*/true);
+      } catch (const InputError& error) {
+        image.decode_error =
+            FormatInputError(ctx.path, ElementPath(blob), "",
+                             fmt::format("the blob does not decode or is refused: {}", error.what()));
+      }
+      cache->decoded.emplace(key, ImageCache::Decoded{image.image, image.decode_error});
     }
     images->push_back(std::move(image));
     return;
@@ -864,6 +892,7 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
                     fmt::format("XML section ({} bytes at {}) runs past the end of the file",
                                 header.xml_logical_length, header.xml_physical_offset));
   }
+  CheckXmlUtf8(path, reinterpret_cast<const char*>(logical.data() + xml_start), header.xml_logical_length);
   pugi::xml_document doc;
   const pugi::xml_parse_result parsed = doc.load_buffer(logical.data() + xml_start, header.xml_logical_length,
                                                         pugi::parse_default, pugi::encoding_utf8);
@@ -882,6 +911,19 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
       synthesized_field = std::string(name.substr(6)) + ":" + kSynthesizedLocalName;
     }
   }
+  // A field whose minimum equals its maximum takes no bits, so the bytestreams do not bound recordCount: the
+  // records of all scans (kept at once) are bounded together by the file's bytes, as the structured grids
+  // are, and by the budget, before any is read.
+  int64_t all_records = 0;
+  for (pugi::xml_node child : root.child("data3D").children()) {
+    const pugi::xml_attribute count = child.child("points").attribute("recordCount");
+    if (child.type() != pugi::node_element || !count) continue;
+    all_records +=
+        std::clamp<int64_t>(ParseInt(ctx, child.child("points"), count.value()), 0, kMaxScanCells + 1);
+  }
+  io_internal::CheckCellsFromData(all_records, io_internal::kScanBytesPerCell + kReaderBytesPerRecord,
+                                  static_cast<int64_t>(logical.size()), path, "XML section: data3D",
+                                  "recordCount (records of all scans)");
   E57File file;
   int index = 0;
   for (pugi::xml_node child : root.child("data3D").children()) {
@@ -890,9 +932,10 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
     file.scans.push_back(ReadScan(ctx, child, index++, synthesized_field, &second, &file.warnings));
     file.second_returns.push_back(std::move(second));
   }
+  ImageCache image_cache;
   for (pugi::xml_node child : root.child("images2D").children()) {
     if (child.type() != pugi::node_element) continue;
-    ReadImage(ctx, child, &file.images);
+    ReadImage(ctx, child, &image_cache, &file.images);
   }
   return file;
 }

@@ -6,12 +6,18 @@
 #include <cstring>
 #include <future>
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/e57_format.h"
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -86,6 +92,33 @@ TEST(HostileInputTest, PlyCountsAndCellsMustAgreeWithTheData) {
   EXPECT_THAT(ScanError(path), AllOf(HasSubstr("header: scan 0"), HasSubstr("cells per byte")));
 }
 
+// 20 lidarshop_scan comments of 2048 x 2048 cells are each within the limit of one grid, and 2.4 GB together.
+TEST(HostileInputTest, PlyScanCommentsAreBoundedTogether) {
+  TempFolder folder;
+  const std::string path = folder.File("scans.ply");
+  std::string text = PlyScan(2048, 2048, 1, "0 5 0 3 5\n");
+  std::string comments;
+  for (int i = 1; i < 20; ++i)
+    comments += fmt::format("comment lidarshop_scan {} 2048 2048 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1\n", i);
+  text.insert(text.find("element vertex"), comments);
+  WriteText(path, text);
+  EXPECT_THAT(ScanError(path), AllOf(HasSubstr("header: scans 0 to 1"), HasSubstr("lidarshop_scan grids")));
+}
+
+// Many one-point PTX scans: each costs far more than its 60 bytes (its channels, its grid).
+TEST(HostileInputTest, PtxScansAreBoundedByTheBytes) {
+  TempFolder folder;
+  const std::string path = folder.File("scans.ptx");
+  std::string text;
+  for (int i = 0; i < 100; ++i)
+    text += "1\n1\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n" + std::string(kIdentity) + "0 1 0 0.5\n";
+  WriteText(path, text);
+  EXPECT_THAT(ScanError(path), AllOf(HasSubstr(path), HasSubstr("more than 64 scans")));
+  text.resize(text.size() / 2);
+  WriteText(path, text);
+  EXPECT_EQ(ReadScanFile(path).scans.size(), 50u);
+}
+
 TEST(HostileInputTest, PcdCountsMustAgreeWithTheData) {
   TempFolder folder;
   const std::string path = folder.File("cloud.pcd");
@@ -103,6 +136,116 @@ TEST(HostileInputTest, PcdCountsMustAgreeWithTheData) {
   EXPECT_THAT(ScanError(path), HasSubstr(path));
   WriteText(path, pcd(1 << 20, 1, "0 0 5\n"));
   EXPECT_THAT(ScanError(path), HasSubstr("truncated"));
+}
+
+// 172 bytes claiming 1.2 GB of LZF-compressed points: LZF expands a byte into at most 88.
+TEST(HostileInputTest, PcdCompressedSizeMustFitTheCompressedBytes) {
+  TempFolder folder;
+  const std::string path = folder.File("cloud.pcd");
+  const int64_t budget = MemoryBudgetBytes();
+  SetMemoryBudgetBytes(int64_t{64} << 30);  // the budget would allow the scan: the bytes must not
+  std::string text =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100000000\nHEIGHT 1\n"
+      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100000000\nDATA binary_compressed\n";
+  const uint32_t sizes[2] = {20, 1200000000};
+  text.append(reinterpret_cast<const char*>(sizes), 8);
+  text.append(20, '\0');
+  WriteText(path, text);
+  EXPECT_THAT(ScanError(path), HasSubstr("cannot come from 20 bytes of LZF data"));
+  SetMemoryBudgetBytes(budget);
+}
+
+// An E57 file (pages and CRCs) of scans whose fields all take no bits (Integer minimum == maximum: a point
+// at (1, 5, 0)), so that any recordCount fits in no bytes, and `photos` images2D entries all listing `png`.
+std::vector<uint8_t> ZeroBitE57(const std::vector<std::pair<std::string, int64_t>>& scans,
+                                const std::vector<uchar>& png = {}, int photos = 0) {
+  using namespace e57;  // NOLINT: the format's helpers
+  std::vector<uint8_t> logical(kHeaderSize);
+  const auto align = [&] { logical.resize((logical.size() + 7) / 8 * 8); };
+  const uint64_t blob_at = PhysicalFromLogical(logical.size());
+  logical.resize(logical.size() + 8);  // sectionId 0 (blob), reserved
+  AppendLe<uint64_t>(&logical, 16 + png.size());
+  logical.insert(logical.end(), png.begin(), png.end());
+  align();
+  const uint64_t cv_at = logical.size();
+  logical.push_back(1);  // sectionId 1 (compressed vector), reserved, length, data offset, index offset
+  logical.resize(logical.size() + 7);
+  AppendLe<uint64_t>(&logical, 32);
+  AppendLe<uint64_t>(&logical, PhysicalFromLogical(cv_at + 32));
+  AppendLe<uint64_t>(&logical, 0);
+  std::string xml =
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<e57Root type=\"Structure\" "
+      "xmlns=\"http://www.astm.org/COMMIT/E57/2010-e57-v1.0\"><guid type=\"String\">g</guid>"
+      "<data3D type=\"Vector\">";
+  for (const auto& [name, count] : scans) {
+    xml += fmt::format(
+        "<vectorChild type=\"Structure\"><name type=\"String\">{}</name><points type=\"CompressedVector\" "
+        "fileOffset=\"{}\" recordCount=\"{}\"><prototype type=\"Structure\">"
+        "<cartesianX type=\"Integer\" minimum=\"1\" maximum=\"1\"/><cartesianY type=\"Integer\" "
+        "minimum=\"5\" "
+        "maximum=\"5\"/><cartesianZ type=\"Integer\" minimum=\"0\" maximum=\"0\"/></prototype>"
+        "<codecs type=\"Vector\"/></points></vectorChild>",
+        name, PhysicalFromLogical(cv_at), count);
+  }
+  xml += "</data3D><images2D type=\"Vector\">";
+  for (int i = 0; i < photos; ++i) {
+    xml += fmt::format(
+        "<vectorChild type=\"Structure\"><name type=\"String\">p{}</name><visualReferenceRepresentation "
+        "type=\"Structure\"><pngImage type=\"Blob\" fileOffset=\"{}\" length=\"{}\"/>"
+        "</visualReferenceRepresentation></vectorChild>",
+        i, blob_at, png.size());
+  }
+  xml += "</images2D></e57Root>\n";
+  const uint64_t xml_at = logical.size();
+  logical.insert(logical.end(), xml.begin(), xml.end());
+  Header header;
+  header.file_physical_length = (logical.size() + kPagePayload - 1) / kPagePayload * kPageSize;
+  header.xml_physical_offset = PhysicalFromLogical(xml_at);
+  header.xml_logical_length = xml.size();
+  StoreHeader(header, logical.data());
+  return PagesFromLogical(logical);
+}
+
+std::string E57Error(const std::vector<uint8_t>& bytes) {
+  return testing_io::InputErrorOf([&] { ReadE57Bytes(bytes, "zero_bits.e57"); });
+}
+
+// Fields that take no bits do not bound recordCount by the bytestreams: the records of all scans are bounded
+// by the file's bytes (as grids are) and the budget.
+TEST(HostileInputTest, E57RecordsOfNoBitsAreBoundedByTheBytes) {
+  const E57File small = ReadE57Bytes(ZeroBitE57({{"a", 24}}), "small.e57");
+  ASSERT_EQ(small.scans.size(), 1u);
+  EXPECT_EQ(small.scans[0].CountValid(), 24);
+  EXPECT_THAT(E57Error(ZeroBitE57({{"a", int64_t{1} << 24}})),
+              AllOf(HasSubstr("zero_bits.e57"), HasSubstr("16777216 cells from")));
+  // Eight scans, each within the limit: refused together, before any is read.
+  EXPECT_THAT(E57Error(ZeroBitE57(std::vector<std::pair<std::string, int64_t>>(8, {"a", int64_t{1} << 22}))),
+              AllOf(HasSubstr("33554432 cells from"), HasSubstr("records of all scans")));
+}
+
+// E57's XML is UTF-8: a Latin-1 scan name is refused naming the file and the byte.
+TEST(HostileInputTest, E57NamesMustBeUtf8) {
+  EXPECT_EQ(ReadE57Bytes(ZeroBitE57({{"caf\xc3\xa9", 24}}), "utf8.e57").scans[0].name, "caf\xc3\xa9");
+  EXPECT_THAT(E57Error(ZeroBitE57({{"caf\xe9", 24}})),
+              AllOf(HasSubstr("zero_bits.e57: XML section, byte"), HasSubstr("not UTF-8")));
+}
+
+// A photo blob listed many times is decoded once; one whose header claims more pixels than lidarshop decodes
+// is kept undecoded with the reason, and the scans still read.
+TEST(HostileInputTest, E57PhotosAreCheckedFromTheHeaderAndDecodedOnce) {
+  std::vector<uchar> png;
+  cv::imencode(".png", cv::Mat(200, 300, CV_8UC3, cv::Scalar(1, 2, 3)), png);
+  const E57File file = ReadE57Bytes(ZeroBitE57({{"a", 24}}, png, 50), "photos.e57");
+  ASSERT_EQ(file.images.size(), 50u);
+  EXPECT_EQ(file.images[0].image.size(), cv::Size(300, 200));
+  EXPECT_EQ(file.images[49].image.data, file.images[0].image.data);  // the same pixels, decoded once
+  EXPECT_EQ(file.images[49].encoded, png);
+  for (int i : {16, 20}) png[i] = 0, png[i + 1] = 0, png[i + 2] = 0x4e, png[i + 3] = 0x20;  // 20000 x 20000
+  const E57File huge = ReadE57Bytes(ZeroBitE57({{"a", 24}}, png, 3), "huge.e57");
+  ASSERT_EQ(huge.images.size(), 3u);
+  EXPECT_TRUE(huge.images[2].image.empty());
+  EXPECT_THAT(huge.images[2].decode_error, AllOf(HasSubstr("huge.e57"), HasSubstr("20000 x 20000 pixels")));
+  EXPECT_EQ(huge.scans[0].CountValid(), 24);
 }
 
 TEST(HostileInputTest, LasCountsMustAgreeWithTheData) {

@@ -50,9 +50,7 @@ void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const st
                     fmt::format("{} rows x {} columns is more than the {} cells lidarshop accepts", rows,
                                 cols, kMaxScanCells));
   }
-  // Every channel a reader may fill (point, direction, range, intensity, colour, flags) and the grid fit.
-  constexpr int64_t kBytesPerCell = 64;
-  CheckMemoryBudget(rows * cols * kBytesPerCell,
+  CheckMemoryBudget(rows * cols * kScanBytesPerCell,
                     fmt::format("{}: {}: a scan of {} rows x {} columns", file, place, rows, cols));
 }
 
@@ -68,6 +66,21 @@ void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std
                     "cells per byte; the indices are corrupt",
                     rows, cols, rows * cols, data_bytes, kCellsPerDataByte));
   }
+}
+
+void CheckCellsFromData(int64_t cells, int64_t bytes_per_cell, int64_t data_bytes, const std::string& file,
+                        const std::string& place, const std::string& what) {
+  const int64_t limit = std::min(
+      kMaxScanCells,
+      std::max(int64_t{1} << 22, SaturatingBytes(std::max<int64_t>(data_bytes, 0), kCellsPerDataByte)));
+  if (cells < 0 || cells > limit) {
+    ThrowInputError(file, place, what,
+                    fmt::format("{} cells from {} bytes of data: more than the {} this file can hold ({} "
+                                "cells per byte, {} at most)",
+                                cells, data_bytes, limit, kCellsPerDataByte, kMaxScanCells));
+  }
+  CheckMemoryBudget(SaturatingBytes(cells, bytes_per_cell),
+                    fmt::format("{}: {}: {} {}", file, place, cells, what));
 }
 
 void CheckScanNumbers(const Scan& scan, const std::string& file, const std::string& place) {

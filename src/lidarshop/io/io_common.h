@@ -17,6 +17,10 @@ std::string ReadFilePrefix(const std::string& path, int64_t max_bytes);
 // `size` bytes at `offset` of `path`; throws InputError naming `what` when the file is shorter.
 std::string ReadFileRange(const std::string& path, int64_t offset, int64_t size, const std::string& what);
 
+// What a reader allocates per cell of a scan: every channel it may fill (point, direction, range, intensity,
+// colour, flags) and the grid fit.
+constexpr int64_t kScanBytesPerCell = 64;
+
 // Throws InputError naming `file` and `place` when rows x cols is negative, more than kMaxScanCells, or more
 // than the memory budget (util/memory_budget.h) holds, before anything is allocated.
 void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const std::string& place);
@@ -27,6 +31,12 @@ void CheckScanSize(int64_t rows, int64_t cols, const std::string& file, const st
 constexpr int64_t kCellsPerDataByte = 64;
 void CheckGridFromData(int64_t rows, int64_t cols, int64_t data_bytes, const std::string& file,
                        const std::string& place);
+// The cells (or records) of everything a file declares together — several grids, records of fields that
+// take no bits — against the same bounds as one grid: at most kMaxScanCells, at most
+// max(2^22, kCellsPerDataByte x data_bytes), and `cells x bytes_per_cell` within the memory budget. Throws
+// InputError naming `file`, `place` and `what` ("cells of all lidarshop_scan comments").
+void CheckCellsFromData(int64_t cells, int64_t bytes_per_cell, int64_t data_bytes, const std::string& file,
+                        const std::string& place, const std::string& what);
 
 // Checks what a reader produced before any algorithm sees it: the pose is rigid (geometry
 // PoseProblem) and every valid point is within kMaxCoordinateM. Throws InputError naming `file`,

@@ -320,6 +320,16 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
           file, fmt::format("byte {}", header.data_offset), "compressed size",
           fmt::format("truncated: {} compressed bytes claimed, {} follow", compressed_size, available - 8));
     }
+    // LZF expands at most 264 bytes from a 3-byte back reference: a size past that ratio is refused before
+    // the buffer is zero-filled (a 172-byte file claimed 1.2 GB).
+    constexpr int64_t kLzfMaxBytesPerByte = 88;
+    if (data_size > (int64_t{compressed_size} + 3) * kLzfMaxBytesPerByte) {
+      ThrowInputError(
+          file, fmt::format("byte {}", header.data_offset + 4), "uncompressed size",
+          fmt::format("{} bytes cannot come from {} bytes of LZF data", data_size, compressed_size));
+    }
+    CheckMemoryBudget(SaturatingBytes(data_size, 2), fmt::format("{}: header: POINTS: {} points of {} bytes",
+                                                                 file, points, header.point_size));
     std::vector<char> planar(static_cast<size_t>(data_size));
     const unsigned int decompressed =
         data_size == 0 ? 0

@@ -4,6 +4,7 @@
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -19,6 +20,7 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -269,8 +271,21 @@ std::vector<Scan> ParsePtx(std::string_view text, const std::string& file, const
   std::vector<Scan> scans;
   cursor.SkipEmptyLines();
   if (cursor.AtEnd()) ThrowInputError(file, "line 1", "columns", "the file is empty");
+  // Every scan costs its cells and a fixed part (its channels' headers, its grid) that a 60-byte scan of one
+  // point would make dominant: at most one scan per kBytesPerScan bytes of file (7 MB of 100,000 one-point
+  // scans took 793 MB), and every scan read so far within the budget.
+  constexpr int64_t kBytesPerScan = 4096, kScanFixedBytes = 16384;
+  const int64_t max_scans = std::max<int64_t>(64, static_cast<int64_t>(text.size()) / kBytesPerScan);
+  int64_t bytes_so_far = 0;
   while (!cursor.AtEnd()) {
+    if (static_cast<int64_t>(scans.size()) >= max_scans) {
+      ThrowInputError(file, fmt::format("line {}", cursor.line()), "columns",
+                      fmt::format("more than {} scans in {} bytes (at most one per {} bytes)", max_scans,
+                                  text.size(), kBytesPerScan));
+    }
     scans.push_back(ParseOneScan(&cursor, static_cast<int>(scans.size()), options, warnings));
+    bytes_so_far += kScanFixedBytes + scans.back().num_cells() * io_internal::kScanBytesPerCell;
+    CheckMemoryBudget(bytes_so_far, fmt::format("{}: {} scans", file, scans.size()));
     cursor.SkipEmptyLines();
   }
   return scans;

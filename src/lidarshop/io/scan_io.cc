@@ -71,6 +71,7 @@ struct PlyScanHeader {
 std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::string& path,
                                              int64_t file_bytes) {
   std::vector<PlyScanHeader> headers;
+  int64_t total_cells = 0;  // every scan is allocated at once: bound them together, not one by one
   for (const std::string& comment : ply.comments) {
     if (comment.rfind(kScanComment, 0) != 0) continue;
     std::istringstream stream(comment.substr(sizeof(kScanComment) - 1));
@@ -84,6 +85,10 @@ std::vector<PlyScanHeader> ParseScanComments(const PlyData& ply, const std::stri
     }
     CheckGridFromData(header.rows, header.cols, file_bytes, path,
                       fmt::format("header: scan {}", header.index));
+    total_cells += header.rows * header.cols;
+    CheckCellsFromData(total_cells, kScanBytesPerCell, file_bytes, path,
+                       fmt::format("header: scans 0 to {}", header.index),
+                       "cells of the lidarshop_scan grids");
     headers.push_back(header);
   }
   return headers;

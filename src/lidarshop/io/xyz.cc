@@ -140,6 +140,24 @@ void NormalizeIntensities(std::vector<double>* intensities, PointListKind kind) 
   for (double& value : *intensities) value = (value - low) / (high - low);
 }
 
+// The finest step the file prints: the most digits after a decimal point among the numbers of its first
+// 64 KiB (at most 12), as metres; 0 when none has a fraction. The writers print as many, so that XYZ -> XYZ
+// keeps what the file said.
+double PrintedStep(const std::string& bytes) {
+  int most = 0, digits = -1;
+  for (size_t i = 0; i < std::min<size_t>(bytes.size(), 65536); ++i) {
+    const char c = bytes[i];
+    if (c == '.') {
+      digits = 0;
+    } else if (c >= '0' && c <= '9') {
+      if (digits >= 0) most = std::max(most, ++digits);
+    } else {
+      digits = -1;
+    }
+  }
+  return most == 0 ? 0.0 : std::pow(10.0, -std::min(most, 12));
+}
+
 }  // namespace
 
 Scan ParsePointList(const std::string& bytes, const std::string& file, PointListKind kind,
@@ -157,6 +175,8 @@ Scan ParsePointList(const std::string& bytes, const std::string& file, PointList
     if (!list.intensities.empty()) scan.intensity.at<float>(0, i) = static_cast<float>(list.intensities[i]);
     if (!list.colors.empty()) scan.color.at<cv::Vec3b>(0, i) = list.colors[i];
   }
+  const double step = PrintedStep(bytes);
+  if (step > 0) scan.source_metadata["text.step_m"] = fmt::format("{}", step);
   return scan;
 }
 
@@ -174,10 +194,11 @@ void WritePointList(const std::string& path, const std::vector<Scan>& scans, Poi
     intensity |= scan.has_intensity();
   }
   if (count == 0) ThrowInputError(path, "", "", "no point with a return to write");
-  // 5 decimals (0.01 mm), more where a LAS source's step is finer (a cloud in degrees of 1e-7).
+  // 5 decimals (0.01 mm), more where the source's step is finer: a LAS cloud in degrees of 1e-7, a text file
+  // printed to the micrometre.
   int decimals = 5;
   for (const Scan& scan : scans) {
-    for (const char* key : {"las.scale_x", "las.scale_y", "las.scale_z"}) {
+    for (const char* key : {"las.scale_x", "las.scale_y", "las.scale_z", "text.step_m"}) {
       const auto found = scan.source_metadata.find(key);
       if (found == scan.source_metadata.end()) continue;
       const double step = std::abs(std::strtod(found->second.c_str(), nullptr));

@@ -20,7 +20,9 @@
 // max(1, highest)] to [0, 1] (0-255 files become i / 255). Without an intensity column the scan has no
 // intensity channel. Colour is 0-255 per channel. Errors name the file, the line and the column.
 //
-// Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm), then, when a scan has
+// Reading keeps the finest step the file prints (its first 64 KiB) in Scan::source_metadata["text.step_m"].
+// Writing: the valid points of every scan in the world frame, 5 decimals (0.01 mm) or as many as the
+// source's step needs (text.step_m, a LAS scale; at most 12), then, when a scan has
 // intensity, the intensity (XYZ: the shortest decimal that reads back to the same float; PTS:
 // round(i * 4095) - 2048; 0.5 for a scan without among scans with) and, when a scan has
 // colour, r g b (0 0 0 for a scan without). These formats cannot mark synthesized points: they are written

@@ -5,6 +5,9 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <fmt/format.h>
+
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
@@ -18,6 +21,7 @@ double Uniform01(std::mt19937_64& random) { return static_cast<double>(random() 
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int64_t count, uint64_t seed) {
   SurfaceSamples samples;
   if (mesh.empty() || count <= 0) return samples;
+  CheckMemoryBudget(SaturatingBytes(count, kSurfaceSampleBytes), fmt::format("sampling {} points", count));
   std::vector<double> cumulative_area(mesh.triangles.size());
   double total = 0.0;
   for (size_t f = 0; f < mesh.triangles.size(); ++f) {

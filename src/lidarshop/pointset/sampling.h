@@ -20,8 +20,12 @@ struct SurfaceSamples {
   std::vector<int32_t> triangle_ids;     // #S index of the triangle each point lies on
 };
 
+// Bytes one sample takes in SurfaceSamples (position, normal, triangle id).
+inline constexpr int64_t kSurfaceSampleBytes = 12 + 12 + 4;
+
 // `count` samples; the same mesh, count and seed give the same samples on every machine (mt19937_64, own
 // conversion to [0, 1)). Degenerate triangles (zero area) are never sampled. An empty mesh gives no samples.
+// InputError when `count` samples do not fit the memory budget (util/memory_budget.h).
 SurfaceSamples SampleSurface(const TriangleMesh& mesh, int64_t count, uint64_t seed);
 
 // Surface variation (Pauly et al. 2002) of every point: λ0 / (λ0 + λ1 + λ2) of the covariance of

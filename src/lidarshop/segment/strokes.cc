@@ -107,12 +107,8 @@ cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
     constexpr int64_t kMaxStrokeFileBytes = int64_t{64} << 20;
     strokes = StrokesFromJson(ReadRegularFile(path, kMaxStrokeFileBytes), rows, cols, path);
   } else {
-    cv::Mat painted = ReadImage(path);
-    if (painted.rows != rows || painted.cols != cols) {
-      ThrowInputError(path, "", "",
-                      fmt::format("the stroke image is {} x {} but the scan is {} x {} (cols x rows)",
-                                  painted.cols, painted.rows, cols, rows));
-    }
+    // The size is compared from the image's header, before decoding.
+    cv::Mat painted = ReadImage(path, cv::Size(cols, rows), "the scan");
     if (painted.depth() != CV_8U) ThrowInputError(path, "", "", "a stroke image must be 8-bit");
     strokes = StrokesFromImage(painted, path);
   }

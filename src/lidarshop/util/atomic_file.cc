@@ -1,11 +1,18 @@
 #include "lidarshop/util/atomic_file.h"
 
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 
 #include <fmt/format.h>
 
@@ -14,12 +21,78 @@
 namespace lidarshop {
 namespace {
 
+namespace fs = std::filesystem;
+
+// The temporary's name: ".STEM.tmpPID-N.EXT" (hidden, the target's extension kept for format detection).
+// lidarshop_batch.py and the server's file listing know this form.
+constexpr std::string_view kTemporaryMark = ".tmp";
+
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
-  const std::filesystem::path target(path);
-  const std::string name =
-      fmt::format(".{}.tmp{}-{}{}", target.stem().string(), getpid(), counter++, target.extension().string());
+  const fs::path target(path);
+  const std::string name = fmt::format(".{}{}{}-{}{}", target.stem().string(), kTemporaryMark, getpid(),
+                                       counter++, target.extension().string());
   return (target.parent_path() / name).string();
+}
+
+// The writer's pid when `name` is a temporary of ours for `target` (".STEM.tmpPID-N.EXT"), else 0.
+pid_t TemporaryWriter(const std::string& name, const fs::path& target) {
+  const std::string prefix = "." + target.stem().string() + std::string(kTemporaryMark);
+  const std::string extension = target.extension().string();
+  if (name.size() <= prefix.size() + extension.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+      name.compare(name.size() - extension.size(), extension.size(), extension) != 0) {
+    return 0;
+  }
+  const std::string middle = name.substr(prefix.size(), name.size() - prefix.size() - extension.size());
+  const size_t dash = middle.find('-');
+  if (dash == 0 || dash == std::string::npos || dash + 1 == middle.size()) return 0;
+  for (size_t i = 0; i < middle.size(); ++i) {
+    if (i != dash && (middle[i] < '0' || middle[i] > '9')) return 0;
+  }
+  const long pid = std::strtol(middle.substr(0, dash).c_str(), nullptr, 10);
+  return pid > 0 && pid < (1L << 30) ? static_cast<pid_t>(pid) : 0;
+}
+
+// Removes the temporaries a killed earlier write of `path` left beside it (`kill -9`, a power cut). Only
+// names of our form for this very target are considered, and only when no writer can still own them: the
+// writing process is gone on this machine and the file has not changed for a minute (a folder shared by
+// several machines holds pids that are not ours to test), or the file has not changed for a day whatever its
+// pid says (a pid reused since). A concurrent writer of the same target is alive and writing, so its
+// temporary stays.
+void RemoveStaleTemporaries(const std::string& path) {
+  const fs::path target(path);
+  fs::path folder = target.parent_path();
+  if (folder.empty()) folder = ".";
+  std::error_code error;
+  const auto now = fs::file_time_type::clock::now();
+  for (auto it = fs::directory_iterator(folder, error); !error && it != fs::directory_iterator();
+       it.increment(error)) {
+    const pid_t writer = TemporaryWriter(it->path().filename().string(), target);
+    if (writer == 0 || writer == getpid()) continue;
+    std::error_code status_error;
+    if (!it->is_regular_file(status_error) || it->is_symlink(status_error)) continue;
+    const auto modified = it->last_write_time(status_error);
+    if (status_error) continue;
+    const auto age = now - modified;
+    const bool writer_gone = kill(writer, 0) != 0 && errno == ESRCH;
+    if ((writer_gone && age > std::chrono::minutes(1)) || age > std::chrono::hours(24)) {
+      fs::remove(it->path(), status_error);
+    }
+  }
+}
+
+// Why writing into `folder` failed, for the message: a full disk is said as such (errno from the failed
+// write, or the file system's free blocks when a library swallowed errno).
+std::string WriteFailure(const fs::path& folder, int saved_errno) {
+  struct statvfs space {};
+  const bool full = saved_errno == ENOSPC || saved_errno == EDQUOT ||
+                    (statvfs(folder.c_str(), &space) == 0 && space.f_bavail == 0);
+  if (full) return "no space left on device";
+  std::error_code error;
+  if (!fs::is_directory(folder, error)) return fmt::format("the folder {} does not exist", folder.string());
+  if (access(folder.c_str(), W_OK) != 0) return fmt::format("the folder {} is not writable", folder.string());
+  if (saved_errno != 0) return std::strerror(saved_errno);
+  return "the writer failed";
 }
 
 void Commit(const std::string& temporary, const std::string& path) {
@@ -29,11 +102,34 @@ void Commit(const std::string& temporary, const std::string& path) {
   if (stat(path.c_str(), &target) == 0 && S_ISREG(target.st_mode)) {
     chmod(temporary.c_str(), target.st_mode & 07777);
   }
-  std::filesystem::rename(temporary, path, error);
+  fs::rename(temporary, path, error);
   if (error) {
-    std::filesystem::remove(temporary, error);
+    fs::remove(temporary, error);
     ThrowInputError(path, "", "", "cannot write the file (rename failed)");
   }
+}
+
+std::mutex& ProtectedMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::vector<std::string>& ProtectedInputs() {
+  static std::vector<std::string> inputs;
+  return inputs;
+}
+
+// The protected input `path` would overwrite, or empty.
+std::string ProtectedInputAt(const std::string& path) {
+  std::lock_guard lock(ProtectedMutex());
+  std::error_code error;
+  const fs::path canonical = fs::weakly_canonical(fs::absolute(path, error), error);
+  for (const std::string& input : ProtectedInputs()) {
+    const bool same_file =
+        fs::exists(path, error) && fs::exists(input, error) && fs::equivalent(path, input, error);
+    if (same_file || canonical == fs::weakly_canonical(fs::absolute(input, error), error)) return input;
+  }
+  return "";
 }
 
 }  // namespace
@@ -50,25 +146,56 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
 
 void WritePathAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
   if (path.empty()) ThrowInputError("", "", "", "empty output path");
+  const std::string input = ProtectedInputAt(path);
+  if (!input.empty())
+    ThrowInputError(path, "", "", fmt::format("the output would overwrite the input {}", input));
+  RemoveStaleTemporaries(path);
   const std::string temporary = TemporaryPathFor(path);
+  fs::path folder = fs::path(path).parent_path();
+  if (folder.empty()) folder = ".";
   bool written = false;
+  errno = 0;
   try {
     written = write(temporary);
   } catch (...) {
+    // Asked before the temporary is removed, which frees the space it took.
+    const std::string why = WriteFailure(folder, errno);
     std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
+    fs::remove(temporary, ignored);
+    // A full disk is the one cause worth saying over whatever the writer made of it.
+    if (why == "no space left on device") ThrowInputError(path, "", "", "cannot write the file: " + why);
     throw;
   }
-  if (!written || !std::filesystem::exists(temporary)) {
+  std::error_code exists_error;
+  if (!written || !fs::exists(temporary, exists_error)) {
+    const std::string why = WriteFailure(folder, errno);
     std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
-    ThrowInputError(path, "", "", "cannot write the file (folder missing or not writable?)");
+    fs::remove(temporary, ignored);
+    ThrowInputError(path, "", "", "cannot write the file: " + why);
   }
   Commit(temporary, path);
 }
 
+void ProtectInput(const std::string& path) {
+  std::lock_guard lock(ProtectedMutex());
+  ProtectedInputs().push_back(path);
+}
+
+bool IsAtomicTemporary(const std::string& name) {
+  // ".STEM.tmpPID-N.EXT" or ".STEM.tmpPID-N" (a target without extension).
+  if (name.empty() || name[0] != '.') return false;
+  const size_t mark = name.rfind(kTemporaryMark);
+  if (mark == std::string::npos) return false;
+  size_t i = mark + kTemporaryMark.size();
+  const size_t digits_start = i;
+  while (i < name.size() && name[i] >= '0' && name[i] <= '9') ++i;
+  if (i == digits_start || i >= name.size() || name[i] != '-') return false;
+  const size_t counter_start = ++i;
+  while (i < name.size() && name[i] >= '0' && name[i] <= '9') ++i;
+  return i > counter_start && (i == name.size() || name[i] == '.');
+}
+
 void CheckOutputPath(const std::string& path, const std::vector<std::string>& others) {
-  namespace fs = std::filesystem;
   std::error_code error;
   const fs::path target = fs::absolute(path, error);
   if (fs::is_directory(target, error)) throw OptionsError(fmt::format("{}: is a folder, not a file", path));
@@ -77,7 +204,12 @@ void CheckOutputPath(const std::string& path, const std::vector<std::string>& ot
     throw OptionsError(fmt::format("{}: the folder {} does not exist", path, folder.string()));
   }
   const fs::path canonical = fs::weakly_canonical(target, error);
-  for (const std::string& other : others) {
+  std::vector<std::string> all = others;
+  {
+    std::lock_guard lock(ProtectedMutex());
+    all.insert(all.end(), ProtectedInputs().begin(), ProtectedInputs().end());
+  }
+  for (const std::string& other : all) {
     if (other.empty()) continue;
     const bool same_file =
         fs::exists(target, error) && fs::exists(other, error) && fs::equivalent(target, other, error);

@@ -11,8 +11,9 @@
 namespace lidarshop {
 
 // Calls `write(stream)` on a binary stream to a temporary file in the target's folder, then renames
-// it to `path`. Throws InputError naming `path` when the folder is not writable or the stream
-// fails; the temporary is removed.
+// it to `path`. Throws InputError naming `path` and the cause ("no space left on device", "the folder ... is
+// not writable") when the stream fails, and when `path` is a protected input (ProtectInput); the temporary is
+// removed. Temporaries of an earlier write of the same target whose writer is gone (killed) are removed first.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
 // For writers that need a path (OpenCV's imwrite, a C library): `write(temporary_path)` must create the file
@@ -23,6 +24,15 @@ void WritePathAtomically(const std::string& path, const std::function<bool(const
 // Checks an output path before any long work: its folder must exist, it must not be a folder, and it must not
 // name the same file as any of `others` (the inputs, and the outputs already checked; empty strings are
 // skipped). Throws OptionsError naming the path.
+// The protected inputs (ProtectInput) count among `others`.
 void CheckOutputPath(const std::string& path, const std::vector<std::string>& others);
+
+// Marks `path` as an input of this process that no output may replace (the CLI's --options file): every later
+// CheckOutputPath refuses it, and WriteFileAtomically / WritePathAtomically refuse to write over it.
+void ProtectInput(const std::string& path);
+
+// True when `name` (a file name, no folder) has the form of a temporary of an atomic write
+// (".STEM.tmpPID-N.EXT"): listings of files for people (the server's file dialog) leave these out.
+bool IsAtomicTemporary(const std::string& name);
 
 }  // namespace lidarshop

@@ -1,13 +1,19 @@
-// Atomic outputs keep the permissions of the file they replace and refuse an output equal to an input.
+// Atomic outputs keep the permissions of the file they replace, refuse an output equal to an input (or to a
+// protected input), clean the temporaries of killed writers and say when the disk is full.
 #include "lidarshop/util/atomic_file.h"
 
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <chrono>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "lidarshop/util/error.h"
@@ -63,6 +69,67 @@ TEST(AtomicFileTest, AnOutputEqualToAnInputIsRefused) {
   EXPECT_THROW(CheckOutputPath(folder, {}), OptionsError);
   EXPECT_THROW(CheckOutputPath(folder + "/missing/a.ply", {}), OptionsError);
   EXPECT_NO_THROW(CheckOutputPath(folder + "/b.ply", {input, ""}));
+}
+
+TEST(AtomicFileTest, AProtectedInputIsNeverOverwritten) {
+  const std::string folder = Folder();
+  const std::string options = folder + "/options.json";
+  std::ofstream(options) << "{}";
+  ProtectInput(options);
+  EXPECT_THROW(CheckOutputPath(folder + "/./options.json", {}), OptionsError);
+  EXPECT_THROW(WriteFileAtomically(options, [](std::ostream& out) { out << "report"; }), InputError);
+  std::stringstream text;
+  text << std::ifstream(options).rdbuf();
+  EXPECT_EQ(text.str(), "{}");
+}
+
+TEST(AtomicFileTest, TheTemporariesOfDeadWritersAreRemovedAndOnlyThose) {
+  namespace fs = std::filesystem;
+  const std::string folder = Folder();
+  // A pid that is surely gone: a child that exited and was reaped.
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  ASSERT_GT(child, 0);
+  waitpid(child, nullptr, 0);
+  const auto old = fs::file_time_type::clock::now() - std::chrono::minutes(5);
+  auto make = [&](const std::string& name, bool aged) {
+    const std::string path = folder + "/" + name;
+    std::ofstream(path) << "half";
+    if (aged) fs::last_write_time(path, old);
+    return path;
+  };
+  const std::string dead_old = make(fmt::format(".out.tmp{}-0.ply", child), true);
+  const std::string dead_fresh = make(fmt::format(".out.tmp{}-1.ply", child), false);  // maybe another host's
+  const std::string alive_old = make(fmt::format(".out.tmp{}-2.ply", getppid()), true);  // a live writer
+  const std::string other_target = make(fmt::format(".other.tmp{}-0.ply", child), true);
+  const std::string not_ours = make(fmt::format(".out.tmp{}-x.ply", child), true);
+  WriteFileAtomically(folder + "/out.ply", [](std::ostream& out) { out << "whole"; });
+  EXPECT_FALSE(fs::exists(dead_old));
+  for (const std::string& kept : {dead_fresh, alive_old, other_target, not_ours})
+    EXPECT_TRUE(fs::exists(kept)) << kept;
+  EXPECT_TRUE(IsAtomicTemporary(fs::path(dead_fresh).filename().string()));
+  EXPECT_TRUE(IsAtomicTemporary(".scan.tmp12-3"));
+  EXPECT_FALSE(IsAtomicTemporary(fs::path(not_ours).filename().string()));
+  EXPECT_FALSE(IsAtomicTemporary("scan.tmp12-3.ply"));
+  EXPECT_FALSE(IsAtomicTemporary(".tmp12.ply"));
+  for (const std::string& path : {dead_fresh, alive_old, other_target, not_ours}) fs::remove(path);
+}
+
+TEST(AtomicFileTest, AFullDiskIsSaidAsSuch) {
+  // /dev/full fails every write with ENOSPC; the stream's failure is reported with that cause.
+  const std::string path = Folder() + "/full.ply";
+  try {
+    WritePathAtomically(path, [](const std::string&) {
+      std::ofstream full("/dev/full", std::ios::binary);
+      full << std::string(1 << 16, 'x');
+      full.flush();
+      return static_cast<bool>(full);
+    });
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("no space left on device"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("full.ply"), std::string::npos) << error.what();
+  }
 }
 
 }  // namespace

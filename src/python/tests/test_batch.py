@@ -206,3 +206,75 @@ def test_an_existing_cluster_through_scheduler(scans, tmp_path):
         assert result.returncode == 0, result.stderr
         assert summary(out)["mode"] == f"scheduler {cluster.scheduler_address}"
         check_complete(out, names_of(scans[:4]))
+
+
+def test_resume_redoes_a_scan_whose_inputs_or_steps_changed(scans, tmp_path):
+    """A record holds for the steps and the input files it was made from: changing a step's options (even to
+    invalid ones), replacing an input scan or an output redoes the scans concerned, and only them."""
+    folder = tmp_path / "inputs"
+    folder.mkdir()
+    for path in scans[:2]:
+        for source in (path, path.replace(".ptx", "_mask.png")):
+            with open(source, "rb") as stream, open(folder / os.path.basename(source), "wb") as copy:
+                copy.write(stream.read())
+    inputs = sorted(str(p) for p in folder.glob("*.ptx"))
+    out = str(tmp_path / "out")
+
+    def go(pipeline):
+        result = run([write_pipeline(str(tmp_path), pipeline)] + inputs + ["--out", out, "--serial"])
+        report = summary(out)
+        return result, (report["done"], report["skipped"], report["failed"])
+
+    def stamp(name):
+        return os.stat(os.path.join(out, f"{name}_filled.e57")).st_mtime_ns
+
+    result, counts = go(PIPELINE)
+    assert result.returncode == 0 and counts == (2, 0, 0), result.stderr
+    assert go(PIPELINE)[1] == (0, 2, 0)  # nothing changed: nothing redone
+    before = {name: stamp(name) for name in ("scan00", "scan01")}
+
+    # An input scan replaced by another one (same name): that scan alone is redone.
+    with open(scans[5], "rb") as stream, open(folder / "scan00.ptx", "wb") as copy:
+        copy.write(stream.read())
+    assert go(PIPELINE)[1] == (1, 1, 0)
+    assert stamp("scan00") != before["scan00"] and stamp("scan01") == before["scan01"]
+
+    # Other options for a step: every scan is redone, with an options file that describes them.
+    changed = json.loads(json.dumps(PIPELINE))
+    changed["steps"][0]["options"]["patch_radius"] = 5
+    assert go(changed)[1] == (2, 0, 0)
+    used = {path: json.load(open(path)) for path in glob.glob(os.path.join(out, ".batch", "step0_options_*.json"))}
+    assert len(used) == 2 and all(options in used.values() for options in
+                                  (PIPELINE["steps"][0]["options"], changed["steps"][0]["options"]))
+    assert go(changed)[1] == (0, 2, 0)
+
+    # Options a step refuses: every scan fails, and no output of earlier options is left to pass for a result.
+    invalid = json.loads(json.dumps(PIPELINE))
+    invalid["steps"][0]["options"]["method"] = "nope"
+    result, counts = go(invalid)
+    assert result.returncode == 1 and counts == (0, 0, 2)
+    assert not glob.glob(os.path.join(out, "*_filled.e57")) and not glob.glob(os.path.join(out, "*.ply"))
+    assert all(record["status"] == "failed" for record in records(out).values())
+
+    # Back to the first options: redone (the outputs were removed), then skipped; a replaced output is redone.
+    assert go(PIPELINE)[1] == (2, 0, 0)
+    with open(os.path.join(out, "scan01.ply"), "ab") as stream:
+        stream.write(b"\n")
+    assert go(PIPELINE)[1] == (1, 1, 0)
+    check_complete(out, ["scan00", "scan01"])
+
+
+def test_max_memory_reaches_every_step(scans, tmp_path):
+    # A lidarshop that logs its arguments, then runs the real one.
+    log = tmp_path / "argv.log"
+    wrapper = tmp_path / "lidarshop"
+    wrapper.write_text(f'#!/bin/sh\necho "$@" >> "{log}"\nexec "{CLI}" "$@"\n')
+    wrapper.chmod(0o755)
+    out = str(tmp_path / "out")
+    result = run([write_pipeline(str(tmp_path))] + scans[:1] + ["--out", out, "--serial", "--max-memory", "3G",
+                                                              "--lidarshop", str(wrapper)])
+    assert result.returncode == 0, result.stderr
+    lines = log.read_text().splitlines()
+    assert len(lines) == 2 and all(line.endswith("--max-memory 3G") or "--max-memory 3G " in line for line in lines)
+    result = run([write_pipeline(str(tmp_path))] + scans[:1] + ["--out", out, "--serial", "--max-memory", "lots"])
+    assert result.returncode == 2 and "--max-memory" in result.stderr
