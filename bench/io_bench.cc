@@ -1,4 +1,5 @@
-// File-format speed: PTX parsing (MB/s on one core, target >= 100 MB/s), PLY and PCD reading.
+// File-format speed: PTX parsing (MB/s on one core, target >= 100 MB/s), PLY and PCD reading, LAZ decoding
+// beside LAS reading (the shared autzen_trim pair: 110000 points of format 3, LASzip 3 chunks).
 //
 // The input is generated here: a synthetic 1000 x 1000 PTX scan with colour (7-field lines, ~10 % no-return
 // cells), printed by lidarshop's own writer. Peers in the same run: a naive std::istringstream parser (what a
@@ -12,6 +13,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include "lidarshop/io/io_common.h"
+#include "lidarshop/io/laz.h"
 #include "lidarshop/io/pcd.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/scan_io.h"
@@ -169,6 +172,53 @@ void BM_PcdReadBinaryCompressed(benchmark::State& state) {
       benchmark::Counter(640.0 * 480.0, benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_PcdReadBinaryCompressed)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// LAZ: ReadScanFile of the .laz beside its uncompressed .las twin (the difference is the decoding), and the
+// decoder alone (DecodeLazPoints: compressed bytes to LAS records).
+void BM_LasLazRead(benchmark::State& state, const std::string& name) {
+  ThreadLimit one_core(1);
+  const std::string path = LIDARSHOP_SHARED_DATA_DIR "/interop/" + name;
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError("shared data missing");
+    return;
+  }
+  for (auto _ : state) benchmark::DoNotOptimize(ReadScanFile(path));
+  state.SetBytesProcessed(state.iterations() * static_cast<int64_t>(std::filesystem::file_size(path)));
+  state.counters["points_per_s"] =
+      benchmark::Counter(110000.0, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK_CAPTURE(BM_LasLazRead, las, std::string("las/autzen_trim.las"))
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+BENCHMARK_CAPTURE(BM_LasLazRead, laz, std::string("laz/autzen_trim.laz"))
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+void BM_LazDecode(benchmark::State& state) {
+  ThreadLimit one_core(1);
+  const std::string path = LIDARSHOP_SHARED_DATA_DIR "/interop/laz/autzen_trim.laz";
+  if (!std::filesystem::exists(path)) {
+    state.SkipWithError("shared data missing");
+    return;
+  }
+  const std::string bytes = io_internal::ReadFileToString(path);
+  auto u16 = [&](size_t at) {
+    return static_cast<uint16_t>(static_cast<uint8_t>(bytes[at]) | static_cast<uint8_t>(bytes[at + 1]) << 8);
+  };
+  auto u32 = [&](size_t at) { return static_cast<uint32_t>(u16(at) | u16(at + 2) << 16); };
+  // The LAS 1.2 header's fields and the laszip VLR (the first VLR with record id 22204).
+  std::string_view payload;
+  for (size_t at = u16(94), i = 0; i < u32(100); ++i, at += 54 + u16(at + 20)) {
+    if (u16(at + 18) == laz::kLazVlrRecordId) payload = std::string_view(bytes).substr(at + 54, u16(at + 20));
+  }
+  const uint32_t count = u32(107);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(
+        laz::DecodeLazPoints(payload, bytes, u32(96), count, bytes[104] & 0x3F, u16(105), path));
+  }
+  state.counters["points_per_s"] = benchmark::Counter(count, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_LazDecode)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
 }  // namespace lidarshop

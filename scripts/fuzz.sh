@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes every reader with libFuzzer + AddressSanitizer + UBSan (clang 14 from scripts/setup.sh):
-#   scripts/fuzz.sh [SECONDS_PER_READER=300] [READER...]     readers: ptx ply pcd las xyz pts e57 obj scene strokes
+#   scripts/fuzz.sh [SECONDS_PER_READER=300] [READER...]     readers: ptx ply pcd las laz xyz pts e57 obj scene strokes
 #   mask pose header
 # Configures build/fuzz (the whole library instrumented, LIDARSHOP_BUILD_FUZZ=ON), replays the regression
 # inputs of data/fuzz_regressions/<reader>_*, seeds each target with the repository's files of its format
@@ -18,7 +18,7 @@ cd "$(dirname "$0")/.."
 seconds=${1:-300}
 shift || true
 readers=("$@")
-[[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd las xyz pts e57 obj scene strokes mask pose header)
+[[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd las laz xyz pts e57 obj scene strokes mask pose header)
 shared=${LIDARSHOP_SHARED_DATA_DIR:-$PWD/../shared/data}
 build=build/fuzz
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd .. && pwd)} CCACHE_NOHASHDIR=true
@@ -62,6 +62,11 @@ for reader in "${readers[@]}"; do
       [[ -f $f && $(stat -c %s "$f") -le 4194304 ]] || continue
       python3 -c 'import sys; d=open(sys.argv[1],"rb").read(); open(sys.argv[2],"wb").write(b"".join(d[i:i+1020] for i in range(0,len(d),1024)))' \
         "$f" "$corpus/shared_$(basename "$f").logical"
+    done
+  fi
+  if [[ $reader == laz ]]; then
+    for f in "$shared"/interop/laz/*.laz; do
+      [[ -f $f && $(stat -c %s "$f") -le 65536 ]] && cp "$f" "$corpus/"
     done
   fi
   if [[ $reader == header ]]; then

@@ -262,7 +262,8 @@ void BindFiles(py::module_& m) {
         return std::move(file.scans.front());
       },
       py::arg("path"), py::call_guard<py::gil_scoped_release>(),
-      "Reads the first scan of a .ptx, .e57, .ply, .pcd, .las, .xyz or .pts file. Raises InputError naming "
+      "Reads the first scan of a .ptx, .e57, .ply, .pcd, .las, .laz, .xyz or .pts file. Raises InputError "
+      "naming "
       "the file and "
       "field.");
   m.def(

@@ -24,10 +24,14 @@
 // warning. A count of records that does not fit before the points is read as far as it fits, with a warning.
 // The header's scale, offset, point format, GPS time type and file source ID are kept in
 // Scan::source_metadata ("las.*"), so that LAS -> LAS writes the same integers.
-// LAZ (LASzip-compressed LAS: the point format byte's bit 7, or a .laz file) is refused: "LAZ is not
-// supported: ...". Every header field is checked against the file size before anything is allocated; errors
-// name the file, the byte offset or header, the field and the value. A header that promises more points than
-// the file holds is refused; one that promises 0 gives a scan of 0 points.
+// LAZ (LASzip-compressed LAS: the point format byte's bits 7-6 and a "laszip encoded" VLR) is read the same
+// way: the points are decompressed by io/laz.h (written from the LAZ specification, as no LASzip library is
+// packaged for lidarshop's platform: point formats 0-3 and 6-8 with extra bytes, LASzip 1.0-3.x and COPC
+// files; wave packets are refused) into the records an uncompressed file holds. Every header field is
+// checked against the file size before anything is allocated; errors name the file, the byte offset or
+// header (LAZ: the chunk and point), the field and the value. A header that promises more points than the
+// file holds is refused (LAZ: more than 4 a compressed byte, or than the chunk table holds); one that
+// promises 0 gives a scan of 0 points.
 //
 // Writing: the valid points of every scan in the world frame (world_from_scanner applied), one record each.
 //   coordinates the scale and offset of the source LAS when every scan came from LAS files with the same
@@ -115,7 +119,7 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
 // "linear_units_code", "citation", "keys"}} from GeoTIFF keys (each only when present); {} without either.
 nlohmann::ordered_json LasCrsJson(const std::vector<SourceRecord>& records);
 
-// The message of the InputError for a LAZ file ("LAZ is not supported: ...").
-std::string LazNotSupportedMessage();
+// The message of the InputError for writing a .laz file ("LAZ is not written: ... write .las instead").
+std::string LazNotWrittenMessage();
 
 }  // namespace lidarshop

@@ -10,6 +10,7 @@
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/las_format.h"
+#include "lidarshop/io/laz.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/text_cursor.h"
 #include "lidarshop/util/error.h"
@@ -26,6 +27,9 @@ struct LasHeader {
   int format = 0;
   int record_length = 0;
   int64_t count = 0;
+  // LAZ: the point format byte has LASzip's bits; the points are decoded with the laszip VLR's payload.
+  bool laz = false;
+  std::string laszip_payload;
   double scale[3] = {1, 1, 1};
   double offset[3] = {0, 0, 0};
   uint16_t global_encoding = 0;
@@ -115,11 +119,8 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
          fmt::format("truncated: {} bytes of header, the file has {}", header.header_size, size));
   }
   const uint8_t format_byte = static_cast<uint8_t>(h[las::header::kPointFormat]);
-  if ((format_byte & las::kLazFormatBits) != 0) {
-    Fail(file, las::header::kPointFormat, "Point Data Record Format",
-         fmt::format("{} has LASzip's compression bits: {}", format_byte, LazNotSupportedMessage()));
-  }
-  header.format = format_byte;
+  header.laz = (format_byte & las::kLazFormatBits) != 0;
+  header.format = format_byte & ~las::kLazFormatBits;
   if (las::PointRecordSize(header.format) == 0) {
     Fail(file, las::header::kPointFormat, "Point Data Record Format",
          fmt::format("{} does not exist (LAS 1.4 defines 0 to 10)", header.format));
@@ -167,10 +168,10 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
     record.user_id = FixedText(h + position + las::vlr::kUserId, 16);
     record.record_id = las::Load<uint16_t>(h + position + las::vlr::kRecordId);
     record.description = FixedText(h + position + las::vlr::kDescription, 32);
-    if (record.user_id == "laszip encoded" && record.record_id == 22204) {
-      ThrowInputError(file, fmt::format("byte {}", position), "VLR laszip encoded", LazNotSupportedMessage());
-    }
     record.payload.assign(h + position + las::kVlrHeaderSize, h + end);
+    if (record.user_id == "laszip encoded" && record.record_id == laz::kLazVlrRecordId) {
+      header.laszip_payload.assign(record.payload.begin(), record.payload.end());
+    }
     header.records.push_back(std::move(record));
     position = end;
   }
@@ -190,8 +191,13 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
   }
   const int count_byte = header.minor_version >= 4 && legacy_count == 0 ? las::header::kPointCount
                                                                         : las::header::kLegacyPointCount;
+  if (header.laz && header.laszip_payload.empty()) {
+    Fail(file, las::header::kPointFormat, "Point Data Record Format",
+         fmt::format("{} has LASzip's compression bits but the file has no laszip encoded VLR", format_byte));
+  }
   const int64_t available = size - header.offset_to_points;
-  if (header.count > available / header.record_length) {
+  // LAZ: the decoder bounds the count by the compressed bytes (laz.h).
+  if (!header.laz && header.count > available / header.record_length) {
     Fail(file, count_byte, "Number of Point Records",
          fmt::format("truncated: {} points of {} bytes need {} bytes after byte {}, the file has {}",
                      header.count, header.record_length, SaturatingBytes(header.count, header.record_length),
@@ -267,6 +273,13 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
   if (header.count > 0) io_internal::CheckScanSize(1, header.count, file, "header: Number of Point Records");
   const int64_t count = header.count;
   const char* records = bytes.data() + header.offset_to_points;
+  // LAZ: decoded into the records an uncompressed file would hold (error places are then point indices).
+  std::string decoded;
+  if (header.laz) {
+    decoded = laz::DecodeLazPoints(header.laszip_payload, bytes, header.offset_to_points, count,
+                                   header.format, header.record_length, file);
+    records = decoded.data();
+  }
   const int format = header.format;
   const bool legacy = las::IsLegacyFormat(format);
   const bool rgb = las::HasRgb(format);
@@ -296,10 +309,12 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
     for (int axis = 0; axis < 3; ++axis) {
       const double value = coordinate(p, axis);
       if (!(std::abs(value) <= kMaxCoordinateM)) {
-        ThrowInputError(
-            file, fmt::format("point {} (byte {})", i, header.offset_to_points + i * header.record_length),
-            std::string(1, "XYZ"[axis]),
-            fmt::format("{} is not a coordinate within {} m", value, kMaxCoordinateM));
+        ThrowInputError(file,
+                        header.laz ? fmt::format("point {}", i)
+                                   : fmt::format("point {} (byte {})", i,
+                                                 header.offset_to_points + i * header.record_length),
+                        std::string(1, "XYZ"[axis]),
+                        fmt::format("{} is not a coordinate within {} m", value, kMaxCoordinateM));
       }
       low[axis] = std::min(low[axis], value);
       high[axis] = std::max(high[axis], value);
@@ -413,7 +428,9 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
   for (SourceRecord& source : header.records) {
     if (KeepRecord(source)) {
       scan.source_records.push_back(std::move(source));
-    } else {
+    } else if (!(header.laz && source.user_id == "laszip encoded" &&
+                 source.record_id == laz::kLazVlrRecordId)) {
+      // (LASzip's record describes the compression the reading undid: nothing is lost without it.)
       left_out.push_back(fmt::format("{} {}", source.user_id, source.record_id));
     }
   }
@@ -456,7 +473,9 @@ ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   const LasHeader header = ParseHeader(bytes, path, file_size);
   if (header.count > 0) io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
   ScanFileHeader file;
-  file.format_version = fmt::format("LAS 1.{} point format {}", header.minor_version, header.format);
+  file.format_version =
+      header.laz ? fmt::format("LAZ (LAS 1.{} point format {})", header.minor_version, header.format)
+                 : fmt::format("LAS 1.{} point format {}", header.minor_version, header.format);
   ScanHeader scan;
   scan.rows = 1;
   scan.cols = header.count;

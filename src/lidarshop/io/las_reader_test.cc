@@ -347,29 +347,33 @@ TEST(LasTest, HostileHeadersAreRefusedBeforeAllocating) {
   EXPECT_THAT(ReadScanFile(path).warnings, testing::Contains(HasSubstr("does not fit")));
 }
 
-TEST(LasTest, LazIsRefusedWithTheReason) {
+TEST(LasTest, LazIsReadButNotWritten) {
   TempFolder folder;
   const std::string laz = folder.File("x.laz");
+  // .laz is read as LAS: an uncompressed file of that name too.
   testing_io::WriteText(laz, Build(ThreePoints(4, 6)));
-  EXPECT_THAT(InputErrorOf([&] { ReadScanFile(laz); }),
-              AllOf(HasSubstr(laz), HasSubstr("LAZ is not supported")));
+  EXPECT_EQ(ReadScanFile(laz).scans.at(0).CountValid(),
+            ReadBytes(folder, Build(ThreePoints(4, 6))).CountValid());
   EXPECT_THAT(InputErrorOf([&] { WriteScanFile(laz, {ReadBytes(folder, Build(ThreePoints(4, 6)))}); }),
-              HasSubstr("LAZ is not supported"));
+              AllOf(HasSubstr("LAZ is not written"), HasSubstr("write .las instead")));
   // An output path is checked before any work: a .laz output is refused up front, and not offered.
   EXPECT_THAT(InputErrorOf([&] { CheckScanFileFormat(folder.File("out.laz")); }),
-              HasSubstr("LAZ is not supported"));
+              HasSubstr("LAZ is not written"));
   EXPECT_THAT(SupportedScanWriteExtensions(), testing::Not(testing::Contains("laz")));
-  // LASzip marks compressed point formats with bits 7 and 6, and adds its VLR.
+  EXPECT_THAT(SupportedScanReadExtensions(), testing::Contains("laz"));
+  // LASzip marks compressed point formats with bits 7 and 6, and adds its VLR: bits without the VLR...
   std::string bytes = Build(ThreePoints(4, 6));
   bytes[104] = static_cast<char>(6 | 0x80);
-  EXPECT_THAT(InputErrorOf([&] { ReadBytes(folder, bytes); }), HasSubstr("LAZ is not supported"));
+  EXPECT_THAT(InputErrorOf([&] { ReadBytes(folder, bytes); }), HasSubstr("no laszip encoded VLR"));
+  // ... and a VLR that is not LASzip's (all zero: compressor 0) are refused.
   HandLas with_vlr = ThreePoints(4, 6);
   with_vlr.vlr = std::string(34, '\0');
   bytes = Build(with_vlr);
+  bytes[104] = static_cast<char>(6 | 0x80);
   std::memcpy(bytes.data() + 375 + 2, "laszip encoded\0\0", 16);
   Put<uint16_t>(&bytes, 375 + 18, 22204);
   EXPECT_THAT(InputErrorOf([&] { ReadBytes(folder, bytes); }),
-              AllOf(HasSubstr("byte 375"), HasSubstr("LAZ is not supported")));
+              AllOf(HasSubstr("laszip VLR byte 0"), HasSubstr("compressor")));
 }
 
 }  // namespace

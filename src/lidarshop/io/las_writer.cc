@@ -112,10 +112,9 @@ void PutText(std::string* bytes, int offset, const char* text, size_t width) {
 
 void LasWriteOptions::Check() const { Validate(*this); }
 
-std::string LazNotSupportedMessage() {
-  return "LAZ is not supported: LAZ is LAS compressed by LASzip, whose arithmetic coder no library packaged "
-         "for lidarshop implements; decompress it first (e.g. laszip -i in.laz -o out.las, or PDAL "
-         "translate) or export LAS";
+std::string LazNotWrittenMessage() {
+  return "LAZ is not written: lidarshop reads LAZ but has no LASzip compressor; write .las instead (the same "
+         "points uncompressed; laszip -i out.las -o out.laz compresses it)";
 }
 
 std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,

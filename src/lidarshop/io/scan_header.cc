@@ -73,7 +73,7 @@ ScanHeader ScanHeaderOf(const Scan& scan) {
 }
 
 ScanFileHeader ReadScanHeader(const std::string& path) {
-  CheckScanFileFormat(path);  // unknown extensions and LAZ are refused as ReadScanFile refuses them
+  CheckScanFileReadable(path);  // unknown extensions are refused as ReadScanFile refuses them
   ScanFileHeader file;
   const std::string format = FileExtension(path);
   const int64_t size = CheckRegularFile(path);
@@ -83,7 +83,7 @@ ScanFileHeader ReadScanHeader(const std::string& path) {
     file = io_internal::ReadPlyScanHeader(path);
   } else if (format == "pcd") {
     file = io_internal::ReadPcdHeader(path);
-  } else if (format == "las") {
+  } else if (format == "las" || format == "laz") {
     file = io_internal::ReadLasHeader(path);
   } else if (format == "ptx") {
     file.scans = io_internal::ReadPtxHeaders(path);

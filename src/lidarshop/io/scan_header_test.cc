@@ -271,7 +271,12 @@ TEST(ScanHeader, TruncatedHeadersGiveClearErrors) {
   EXPECT_THAT(cut("e57", 1000), HasSubstr("whole number of 1024-byte E57 pages"));
   EXPECT_THAT(cut("e57", 1024), HasSubstr("filePhysicalLength"));
   EXPECT_THAT(InputErrorOf([&] { ReadScanHeader(folder.File("missing.ptx")); }), HasSubstr("missing.ptx"));
-  EXPECT_THAT(InputErrorOf([&] { ReadScanHeader(folder.File("scan.laz")); }), HasSubstr("LAZ"));
+  EXPECT_THAT(InputErrorOf([&] { ReadScanHeader(folder.File("scan.laz")); }), HasSubstr("scan.laz"));
+  // A LAZ header is a LAS header; the points are compressed.
+  const ScanFileHeader laz = ReadScanHeader(LIDARSHOP_SHARED_DATA_DIR "/interop/laz/autzen_trim.laz");
+  EXPECT_EQ(laz.format_version, "LAZ (LAS 1.2 point format 3)");
+  ASSERT_EQ(laz.scans.size(), 1u);
+  EXPECT_EQ(laz.scans[0].points, 110000);
 }
 
 TEST(ScanHeader, CorruptE57PagesAreNamed) {

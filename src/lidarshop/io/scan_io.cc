@@ -330,8 +330,8 @@ struct ScanFormat {
   // Reads the scans of a file, adding what it left out to `warnings`.
   std::vector<Scan> (*read)(const std::string& path, std::vector<std::string>* warnings);
   void (*write)(const std::string& path, const std::vector<Scan>& scans);
-  // A format known only to be refused (LAZ): neither read nor write is set, this says why.
-  std::string (*refusal)() = nullptr;
+  // A format read but not written (LAZ): write is not set, this says why and what to write instead.
+  std::string (*write_refusal)() = nullptr;
 };
 
 const std::vector<ScanFormat>& ScanFormats() {
@@ -365,7 +365,11 @@ const std::vector<ScanFormat>& ScanFormats() {
          return std::vector<Scan>{ReadLas(path, warnings)};
        },
        [](const std::string& path, const std::vector<Scan>& scans) { WriteLas(path, scans); }},
-      {"laz", nullptr, nullptr, &LazNotSupportedMessage},
+      {"laz",
+       [](const std::string& path, std::vector<std::string>* warnings) {
+         return std::vector<Scan>{ReadLas(path, warnings)};
+       },
+       nullptr, &LazNotWrittenMessage},
       {"xyz",
        [](const std::string& path, std::vector<std::string>* warnings) {
          return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz, warnings)};
@@ -384,11 +388,14 @@ const std::vector<ScanFormat>& ScanFormats() {
   return formats;
 }
 
-const ScanFormat& FormatFor(const std::string& path) {
+enum class Access { kRead, kWrite };
+
+const ScanFormat& FormatFor(const std::string& path, Access access) {
   const std::string extension = FileExtension(path);
   for (const ScanFormat& format : ScanFormats()) {
     if (extension != format.extension) continue;
-    if (format.refusal != nullptr) ThrowInputError(path, "", "", format.refusal());
+    if (access == Access::kWrite && format.write == nullptr)
+      ThrowInputError(path, "", "", format.write_refusal());
     return format;
   }
   std::string known;
@@ -412,7 +419,9 @@ std::string FileExtension(const std::string& path) {
   return extension;
 }
 
-void CheckScanFileFormat(const std::string& path) { FormatFor(path); }
+void CheckScanFileFormat(const std::string& path) { FormatFor(path, Access::kWrite); }
+
+void CheckScanFileReadable(const std::string& path) { FormatFor(path, Access::kRead); }
 
 std::vector<std::string> SupportedScanReadExtensions() {
   std::vector<std::string> extensions;
@@ -429,7 +438,7 @@ std::vector<std::string> SupportedScanWriteExtensions() {
 }
 
 ScanFile ReadScanFile(const std::string& path) {
-  const ScanFormat& format = FormatFor(path);
+  const ScanFormat& format = FormatFor(path, Access::kRead);
   ScanFile file;
   file.path = path;
   file.format = format.extension;
@@ -442,7 +451,7 @@ ScanFile ReadScanFile(const std::string& path) {
 }
 
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
-  const ScanFormat& format = FormatFor(path);
+  const ScanFormat& format = FormatFor(path, Access::kWrite);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
   if (format.extension == "e57" ||
       std::none_of(scans.begin(), scans.end(), [](const Scan& s) { return s.num_cells() == 0; })) {
@@ -459,7 +468,7 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
 }
 
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind) {
-  const std::string extension = FormatFor(path).extension;
+  const std::string extension = FormatFor(path, Access::kWrite).extension;
   CheckScan(front);
   CheckScan(behind);
   if (front.rows != behind.rows || front.cols != behind.cols) {

@@ -9,7 +9,9 @@
 //         world points, VIEWPOINT the sensor pose)
 //   .las  ASPRS LAS 1.0-1.4, point formats 0-10 read; 1.4/1.2 formats 0-3, 6-8 written (io/las.h): one
 //         unorganized cloud in the world frame (several scans are written as one cloud, point source ID =
-//         scan index); .laz is refused ("LAZ is not supported: ...")
+//         scan index)
+//   .laz  LAS compressed by LASzip, read as .las (io/laz.h: point formats 0-3, 6-8); not written ("LAZ is
+//         not written: ... write .las instead")
 //   .xyz  ASCII "x y z [intensity] [r g b]", world frame, one cloud           read + write (io/xyz.h)
 //   .pts  Leica PTS: a point count line, then as .xyz                        read + write
 //
@@ -28,7 +30,7 @@ namespace lidarshop {
 
 struct ScanFile {
   std::string path;
-  std::string format;       // "ptx", "e57", "ply", "pcd", "las", "xyz", "pts"
+  std::string format;       // "ptx", "e57", "ply", "pcd", "las", "laz", "xyz", "pts"
   std::vector<Scan> scans;  // several registered scans where the format allows it
   // What the reader left out or changed while reading a file it could still read, one sentence each,
   // starting with the file's path (e.g. E57 returns beyond the second). The library does not print them;
@@ -62,9 +64,11 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 // Throws InputError naming `path` when the layers differ in size or pose. Atomic.
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind);
 
-// Throws InputError (the same as ReadScanFile / WriteScanFile would) when `path` has no scan format's
-// extension; lets a command refuse an output path before its work.
+// Throws InputError (the same as WriteScanFile would) when `path` has no written scan format's extension
+// (unknown, or .laz); lets a command refuse an output path before its work.
 void CheckScanFileFormat(const std::string& path);
+// The same for an input path (as ReadScanFile would): unknown extensions.
+void CheckScanFileReadable(const std::string& path);
 
 // The extensions (lower case, no dot) of the scan formats ReadScanFile reads and WriteScanFile writes, in the
 // table's order: what a file dialog offers. A format added to the table appears here by itself.
