@@ -15,6 +15,7 @@
 namespace lidarshop {
 namespace {
 
+using ::testing::AllOf;
 using ::testing::HasSubstr;
 
 std::string TempPath(const std::string& name) {
@@ -363,7 +364,8 @@ TEST(E57Reader, RefusesAbsurdSizesBeforeAllocating) {
   const std::string head =
       R"(<?xml version="1.0"?><e57Root type="Structure"><data3D type="Vector"><vectorChild type="Structure">)";
   const std::string tail = R"(</vectorChild></data3D></e57Root>)";
-  // A huge record count with 0-bit fields only would need no bytes at all: refused by the cell limit.
+  // A huge record count with 0-bit fields only would need no bytes at all: refused by the limit on the records
+  // of all scans together (max(2^22, 64 per byte of file)), before any scan is read.
   const std::string huge = head +
                            R"(<points type="CompressedVector" fileOffset="48" recordCount="999999999999">
         <prototype type="Structure"><cartesianX type="Integer" minimum="0" maximum="0"/>
@@ -374,11 +376,11 @@ TEST(E57Reader, RefusesAbsurdSizesBeforeAllocating) {
     ReadE57Bytes(FileWithXml(huge), "huge.e57");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("recordCount 999999999999"));
+    EXPECT_THAT(e.what(), AllOf(HasSubstr("huge.e57"), HasSubstr("recordCount (records of all scans)")));
   }
-  // A record count whose bytestreams cannot fit in the file.
+  // A record count within that limit whose bytestreams cannot fit in the file.
   const std::string big = head +
-                          R"(<points type="CompressedVector" fileOffset="48" recordCount="100000000">
+                          R"(<points type="CompressedVector" fileOffset="48" recordCount="4000000">
         <prototype type="Structure"><cartesianX type="Float"/><cartesianY type="Float"/><cartesianZ type="Float"/>
         </prototype></points>)" +
                           tail;
@@ -386,7 +388,7 @@ TEST(E57Reader, RefusesAbsurdSizesBeforeAllocating) {
     ReadE57Bytes(FileWithXml(big), "big.e57");
     FAIL();
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("needs 2400000000 bytes"));
+    EXPECT_THAT(e.what(), HasSubstr("needs 96000000 bytes"));
   }
   // A grid far larger than the cell limit.
   const std::string grid = head +

@@ -108,7 +108,8 @@ cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
     strokes = StrokesFromJson(ReadRegularFile(path, kMaxStrokeFileBytes), rows, cols, path);
   } else {
     // The size is compared from the image's header, before decoding.
-    cv::Mat painted = ReadImage(path, cv::Size(cols, rows), "the scan");
+    cv::Mat painted =
+        ReadImage(path, cv::Size(cols, rows), "the scan's grid (a stroke image has one pixel per ray)");
     if (painted.depth() != CV_8U) ThrowInputError(path, "", "", "a stroke image must be 8-bit");
     strokes = StrokesFromImage(painted, path);
   }
