@@ -21,7 +21,8 @@ readers=("$@")
 [[ ${#readers[@]} -eq 0 ]] && readers=(ptx ply pcd las laz xyz pts e57 obj scene strokes mask pose header)
 shared=${LIDARSHOP_SHARED_DATA_DIR:-$PWD/../shared/data}
 build=build/fuzz
-export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd .. && pwd)} CCACHE_NOHASHDIR=true
+# Paths relative to the checkout in ccache's hash (as scripts/build.sh): a clone in any folder reuses the objects.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 
 cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
   -DLIDARSHOP_BUILD_FUZZ=ON -DLIDARSHOP_BUILD_TESTS=OFF -DLIDARSHOP_BUILD_BENCH=OFF >/dev/null || exit 1

@@ -5,7 +5,8 @@
 # LIDARSHOP_FUZZ_SECONDS sets the fuzzing time per reader (default 15; 0 skips fuzzing).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$(cd .. && pwd)} CCACHE_NOHASHDIR=true
+# Paths relative to the checkout in ccache's hash (as scripts/build.sh): a clone in any folder reuses the objects.
+export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 if [[ ${1:-} == --sanitize ]]; then
   shift
   bash scripts/setup.sh
