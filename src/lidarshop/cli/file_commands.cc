@@ -334,7 +334,7 @@ int RunConvert(int argc, char** argv) {
         for (const Scan& second : second_returns) scans_with_second_returns += second.CountValid() > 0;
         // E57 -> E57 keeps the second returns; every other target drops them (and says so).
         const ScanWritePlan plan =
-            PlanScanWrite(output, scans, images.size(), to_e57 ? 0 : scans_with_second_returns);
+            PlanScanWrite(output, scans, images.size(), to_e57 ? 0 : scans_with_second_returns, &las);
         if (to_e57) {
           E57File out;
           out.scans = scans;

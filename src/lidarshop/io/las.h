@@ -102,6 +102,11 @@ template <>
 const StructInfo& InfoOf<LasWriteOptions>();
 
 // Reads a LAS file (see above). Throws InputError naming the file, the place and the field.
+// The point data record format EncodeLas writes `scans` in (options.point_format, or the rule above for -1).
+int ChooseLasPointFormat(const std::vector<Scan>& scans, const LasWriteOptions& options);
+// The attributes of Scan::attributes that point format `format` (LAS 1.`minor_version`) cannot hold.
+std::vector<std::string> LasAttributesNotHeld(const std::vector<Scan>& scans, int format);
+
 // What the reader could read but not keep comes in `warnings` (one sentence each, naming the file).
 Scan ReadLas(const std::string& path, std::vector<std::string>* warnings = nullptr);
 Scan ParseLas(const std::string& bytes, const std::string& file,

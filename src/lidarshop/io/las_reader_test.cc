@@ -13,6 +13,7 @@
 
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -219,6 +220,26 @@ TEST(LasTest, LasToLasKeepsEveryPointRecordAndTheCoordinateSystem) {
     EXPECT_EQ(written.substr(header, 54 + las.vlr.size()).substr(54), las.vlr);
     EXPECT_EQ(written.substr(header + 2, 15), "LASF_Projection");
   }
+}
+
+// A point format that cannot hold an attribute: the write plan (what `convert` warns) names it.
+TEST(LasTest, AFormatThatCannotHoldAnAttributeSaysSo) {
+  TempFolder folder;
+  HandLas las = ThreePoints(4, 8);
+  std::string bytes = Build(las);
+  for (size_t i = 0; i < las.points.size(); ++i)
+    Put<uint16_t>(&bytes, 375 + i * 38 + 36, uint16_t{500});  // NIR
+  const Scan scan = ReadBytes(folder, bytes);
+  ASSERT_EQ(scan.attributes.count(kLasNir), 1u);
+  const std::string out = folder.File("out.las");
+  EXPECT_THAT(PlanScanWrite(out, {scan}, 0, 0).dropped, testing::Not(testing::Contains(HasSubstr("nir"))));
+  const LasWriteOptions format1{.minor_version = 2, .point_format = 1};
+  EXPECT_THAT(PlanScanWrite(out, {scan}, 0, 0, &format1).dropped,
+              testing::Contains(AllOf(HasSubstr(out), HasSubstr("point format 1 does not hold nir"),
+                                      testing::Not(HasSubstr("4's formats")))));
+  const LasWriteOptions format3{.minor_version = 2, .point_format = 3};
+  EXPECT_THAT(PlanScanWrite(out, {scan}, 0, 0, &format3).dropped,
+              testing::Contains(AllOf(HasSubstr("nir"), testing::Not(HasSubstr("gps_time")))));
 }
 
 TEST(LasTest, APointAtTheOriginIsAPoint) {

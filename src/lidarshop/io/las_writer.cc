@@ -34,10 +34,9 @@ std::string Common(const std::vector<Scan>& scans, const std::string& key) {
 }
 bool FromLas(const Scan& scan) { return scan.source_metadata.count("las.point_format") > 0; }
 
-// Attributes only LAS 1.4's point formats 6-10 hold.
-bool NeedsFormat14(const std::vector<Scan>& scans) {
+// Values past the legacy formats' fields: return numbers past 7, the overlap flag, classes past 31.
+bool ExceedsLegacyRanges(const std::vector<Scan>& scans) {
   for (const Scan& scan : scans) {
-    if (scan.attributes.count(kLasScannerChannel) || scan.attributes.count(kLasNir)) return true;
     for (const char* name : {kLasReturnNumber, kLasNumberOfReturns}) {
       const auto found = scan.attributes.find(name);
       double high = 0;
@@ -55,24 +54,9 @@ bool NeedsFormat14(const std::vector<Scan>& scans) {
   return false;
 }
 
-int ChooseFormat(const std::vector<Scan>& scans, const LasWriteOptions& options) {
-  if (options.point_format >= 0) return options.point_format;
-  const bool color = SomeScanHasColor(scans);
-  const bool gps = SomeScanHas(scans, kLasGpsTime);
-  const bool nir = SomeScanHas(scans, kLasNir);
-  const bool needs14 = NeedsFormat14(scans);
-  const std::string source = Common(scans, "las.point_format");
-  if (!source.empty()) {
-    // The source's format, waveform packets left out (4, 5, 9, 10 are 1, 3, 6, 8 with them).
-    constexpr int kWithoutWaveform[] = {0, 1, 2, 3, 1, 3, 6, 7, 8, 6, 8};
-    const int format = kWithoutWaveform[std::stoi(source)];
-    const bool fits = (format >= 6 || !needs14) && (format < 6 || options.minor_version >= 4) &&
-                      (las::HasGpsTime(format) || !gps) && (las::HasRgb(format) || !color) &&
-                      (las::HasNir(format) || !nir);
-    if (fits) return format;
-  }
-  if (options.minor_version >= 4) return nir ? 8 : color ? 7 : 6;
-  return color ? (gps ? 3 : 2) : (gps ? 1 : 0);
+// Attributes or values only LAS 1.4's point formats 6-10 hold.
+bool NeedsFormat14(const std::vector<Scan>& scans) {
+  return SomeScanHas(scans, kLasScannerChannel) || SomeScanHas(scans, kLasNir) || ExceedsLegacyRanges(scans);
 }
 
 // The records written after the header: the first scan's LAS source records, the extra bytes' description
@@ -110,6 +94,43 @@ void PutText(std::string* bytes, int offset, const char* text, size_t width) {
 
 }  // namespace
 
+int ChooseLasPointFormat(const std::vector<Scan>& scans, const LasWriteOptions& options) {
+  if (options.point_format >= 0) return options.point_format;
+  const bool color = SomeScanHasColor(scans);
+  const bool gps = SomeScanHas(scans, kLasGpsTime);
+  const bool nir = SomeScanHas(scans, kLasNir);
+  const bool needs14 = NeedsFormat14(scans);
+  const std::string source = Common(scans, "las.point_format");
+  if (!source.empty()) {
+    // The source's format, waveform packets left out (4, 5, 9, 10 are 1, 3, 6, 8 with them).
+    constexpr int kWithoutWaveform[] = {0, 1, 2, 3, 1, 3, 6, 7, 8, 6, 8};
+    const int format = kWithoutWaveform[std::stoi(source)];
+    const bool fits = (format >= 6 || !needs14) && (format < 6 || options.minor_version >= 4) &&
+                      (las::HasGpsTime(format) || !gps) && (las::HasRgb(format) || !color) &&
+                      (las::HasNir(format) || !nir);
+    if (fits) return format;
+  }
+  if (options.minor_version >= 4) return nir ? 8 : color ? 7 : 6;
+  return color ? (gps ? 3 : 2) : (gps ? 1 : 0);
+}
+
+std::vector<std::string> LasAttributesNotHeld(const std::vector<Scan>& scans, int format) {
+  std::vector<std::string> names;
+  auto lost = [&](const char* name, bool held) {
+    if (!held && SomeScanHas(scans, name)) names.push_back(name);
+  };
+  lost(kLasGpsTime, las::HasGpsTime(format));
+  lost(kLasNir, las::HasNir(format));
+  lost(kLasRgb16, las::HasRgb(format));
+  lost(kLasScannerChannel, !las::IsLegacyFormat(format));
+  if (las::IsLegacyFormat(format) && ExceedsLegacyRanges(scans)) {
+    names.push_back(
+        "values only LAS 1.4's formats 6-10 hold (return numbers past 7, the overlap flag, "
+        "classes past 31: clamped)");
+  }
+  return names;
+}
+
 void LasWriteOptions::Check() const { Validate(*this); }
 
 std::string LazNotWrittenMessage() {
@@ -120,7 +141,7 @@ std::string LazNotWrittenMessage() {
 std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,
                       const std::string& file) {
   options.Check();
-  const int format = ChooseFormat(scans, options);
+  const int format = ChooseLasPointFormat(scans, options);
   const int base_record = las::PointRecordSize(format);
   const bool legacy = las::IsLegacyFormat(format);
   const bool rgb = las::HasRgb(format);

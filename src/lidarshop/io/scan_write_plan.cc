@@ -51,7 +51,7 @@ const FormatHolds& HoldsFor(const std::string& path) {
 }  // namespace
 
 ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& scans, size_t images,
-                            size_t scans_with_second_returns) {
+                            size_t scans_with_second_returns, const LasWriteOptions* las) {
   const FormatHolds& holds = HoldsFor(path);
   auto any = [&](auto has) { return std::any_of(scans.begin(), scans.end(), has); };
   ScanWritePlan plan;
@@ -140,7 +140,16 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
   }
   if (!attributes.empty()) {
     if (std::string(holds.extension) == "las") {
-      for (const std::string& name : attributes) plan.channels.push_back(name);
+      const LasWriteOptions options = las != nullptr ? *las : LasWriteOptions{};
+      const int format = ChooseLasPointFormat(scans, options);
+      const std::vector<std::string> lost = LasAttributesNotHeld(scans, format);
+      for (const std::string& name : attributes) {
+        if (std::find(lost.begin(), lost.end(), name) == lost.end()) plan.channels.push_back(name);
+      }
+      if (!lost.empty()) {
+        plan.dropped.push_back(
+            fmt::format("{}: point format {} does not hold {}", path, format, fmt::join(lost, ", ")));
+      }
     } else {
       plan.dropped.push_back(fmt::format("{}: the attributes {} are not written ({} has no fields for them)",
                                          path, fmt::join(attributes, ", "), holds.name));

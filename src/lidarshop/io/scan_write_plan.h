@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "lidarshop/io/las.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop {
@@ -35,8 +36,10 @@ struct ScanWritePlan {
 
 // The plan for writing `scans` to `path` (its extension decides; InputError for an unknown one), with
 // `images` photos (E57 images2D) and `scans_with_second_returns` scans that have second returns in the input.
+// `las` (LAS targets): the options the scans will be written with, so that attributes the chosen point
+// format cannot hold are listed in `dropped` (nullptr: the defaults).
 ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& scans, size_t images,
-                            size_t scans_with_second_returns);
+                            size_t scans_with_second_returns, const LasWriteOptions* las = nullptr);
 
 // One line of what was written: "wrote out.las: 1 scan, 1,234,567 points, channels xyz intensity rgb
 // label→classification" (plus ", 2 images" when `images_written` > 0).
