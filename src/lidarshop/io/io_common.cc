@@ -197,8 +197,9 @@ Scan UnorganizedScan(const std::vector<Eigen::Vector3d>& points_in_world, const 
   cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(0);
   for (int64_t i = 0; i < count; ++i) {
     if (!valid.empty() && !valid[i]) continue;
+    // Not on the origin in double (OriginClearOfPoints); a float that still rounds to 0 is a point at the
+    // origin, which FinishScan keeps with range 0 and no direction.
     const Eigen::Vector3f p = (scanner_from_world_rotation * (points_in_world[i] - origin)).cast<float>();
-    LIDARSHOP_CHECK(!p.isZero());
     valid_out[i] = kValid;
     point[i] = cv::Vec3f(p.x(), p.y(), p.z());
   }

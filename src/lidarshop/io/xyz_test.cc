@@ -254,6 +254,16 @@ TEST(XyzTest, ReadsTheInteropFiles) {
   }
 }
 
+// A point a hundredth of a millimetre from the origin the reader picks (the fuzzer's find: Eigen's fuzzy
+// isZero took it for the origin and a check aborted): read, with its coordinates.
+TEST(XyzTest, APointNextToTheCloudOriginIsRead) {
+  std::vector<std::string> warnings;
+  const Scan scan =
+      ParsePointList("30\n0.00001000 05.0 0100000\n", "near.pts", PointListKind::kPts, &warnings);
+  ASSERT_EQ(scan.CountValid(), 1);
+  EXPECT_LT((WorldPointOfCell(scan, 0, 0) - Eigen::Vector3d(1e-5, 5, 100000)).norm(), 1e-6);
+}
+
 // XYZ and PTS cannot mark synthesized points: they are written, and the write plan says how many went
 // unmarked (what `convert` prints), as for every other thing a target cannot hold.
 TEST(XyzTest, SynthesizedPointsAreWrittenAndThePlanSaysTheyAreUnmarked) {
