@@ -13,12 +13,6 @@ failed=0
 # shellcheck source=check_lib.sh
 source "$(dirname "$0")/check_lib.sh"
 
-expect() {  # expect NAME CONDITION...: the condition (a test command) must hold
-  local name=$1
-  shift
-  if "$@"; then passed=$((passed + 1)); else failed=$((failed + 1)); echo "FAILED: $name"; fi
-}
-
 "$lidarshop" scan mailbox --rows 40 --columns 60 -o "$work/scan.ptx" -q 2>"$work/err" ||
   { echo "cannot make the test scan:"; cat "$work/err"; exit 1; }
 "$lidarshop" render "$work/scan.ptx" --channel valid -o "$work/mask.png" >/dev/null 2>&1
@@ -37,9 +31,9 @@ for command in $commands; do
   esac
   "$lidarshop" "${args[@]}" >"$work/out" 2>"$work/err"
   rc=$?
-  expect "$command --max-memory lots: usage error (exit 2), got $rc: $(head -c 200 "$work/err")" \
+  check "$command --max-memory lots: usage error (exit 2), got $rc: $(head -c 200 "$work/err")" \
     test "$rc" -eq 2 -a "$(wc -l <"$work/err")" -eq 1
-  expect "$command --max-memory lots names the size: $(head -c 200 "$work/err")" \
+  check "$command --max-memory lots names the size: $(head -c 200 "$work/err")" \
     grep -q "'lots' is not a memory size" "$work/err"
 done
 # ... and applies it: the same command fits 1G and not 1M.
@@ -53,7 +47,7 @@ start=$(date +%s)
 fails_clearly "sample-mesh --count 300000000: up front" "--count 300000000: sampling 300000000 points needs" \
   bash -c "ulimit -v 3000000; exec '$lidarshop' points sample-mesh '$work/tri.obj' -o '$work/samples.ply' \
   --count 300000000"
-expect "sample-mesh --count 300000000 took under 5 s" test $(($(date +%s) - start)) -lt 5
+check "sample-mesh --count 300000000 took under 5 s" test $(($(date +%s) - start)) -lt 5
 fails_clearly "sample-mesh --count 300000000 --max-memory 256M" "memory budget of 256 MiB" \
   "$lidarshop" points sample-mesh "$work/tri.obj" -o "$work/samples.ply" --count 300000000 --max-memory 256M
 
@@ -67,8 +61,8 @@ echo '{}' >"$work/convert_options.json"
 cp "$work/convert_options.json" "$work/convert_options.orig"
 fails_clearly "convert --json = --options" "would overwrite .*convert_options.json" "$lidarshop" convert \
   "$work/scan.ptx" "$work/c.e57" --options "$work/convert_options.json" --json "$work/convert_options.json"
-expect "the options files are unchanged" cmp -s "$work/fill_options.json" "$work/fill_options.orig"
-expect "the convert options file is unchanged" cmp -s "$work/convert_options.json" "$work/convert_options.orig"
+check "the options files are unchanged" cmp -s "$work/fill_options.json" "$work/fill_options.orig"
+check "the convert options file is unchanged" cmp -s "$work/convert_options.json" "$work/convert_options.orig"
 
 # A full disk: stdout on /dev/full ...
 fails_clearly "info --json - on /dev/full" "no space left on device" sh -c "'$lidarshop' info '$work/scan.ptx' >/dev/full"
@@ -83,10 +77,10 @@ umount '$work/tiny'
 EOF
 if [ "$(id -u)" -eq 0 ]; then bash "$work/full_disk.sh"; else unshare -rm bash "$work/full_disk.sh"; fi
 if [ -f "$work/full.rc" ]; then
-  expect "convert onto a full tmpfs: exit 1, got $(cat "$work/full.rc")" test "$(cat "$work/full.rc")" -eq 1
-  expect "convert onto a full tmpfs says so: $(cat "$work/full.err")" grep -q "big.ply.*no space left on device" \
+  check "convert onto a full tmpfs: exit 1, got $(cat "$work/full.rc")" test "$(cat "$work/full.rc")" -eq 1
+  check "convert onto a full tmpfs says so: $(cat "$work/full.err")" grep -q "big.ply.*no space left on device" \
     "$work/full.err"
-  expect "convert onto a full tmpfs leaves nothing: $(cat "$work/full.ls")" test ! -s "$work/full.ls"
+  check "convert onto a full tmpfs leaves nothing: $(cat "$work/full.ls")" test ! -s "$work/full.ls"
 else
   echo "NOTE: no tmpfs could be mounted (not root, no user namespaces): the atomic full-disk case did not run"
 fi
@@ -103,10 +97,10 @@ for name in ".c.tmp$dead-0.ply" ".c.tmp$dead-1.ply" ".c.tmp$$-0.ply" ".d.tmp$dea
 done
 touch -d '-2 minutes' "$work/outputs/.c.tmp$dead-0.ply" "$work/outputs/.c.tmp$$-0.ply" "$work/outputs/.d.tmp$dead-0.ply"
 check "convert beside stale temporaries" "$lidarshop" convert "$work/scan.ptx" "$work/outputs/c.ply"
-expect "the dead writer's old temporary is removed" test ! -e "$work/outputs/.c.tmp$dead-0.ply"
-expect "a fresh temporary stays" test -e "$work/outputs/.c.tmp$dead-1.ply"
-expect "a live writer's temporary stays" test -e "$work/outputs/.c.tmp$$-0.ply"
-expect "another target's temporary stays" test -e "$work/outputs/.d.tmp$dead-0.ply"
+check "the dead writer's old temporary is removed" test ! -e "$work/outputs/.c.tmp$dead-0.ply"
+check "a fresh temporary stays" test -e "$work/outputs/.c.tmp$dead-1.ply"
+check "a live writer's temporary stays" test -e "$work/outputs/.c.tmp$$-0.ply"
+check "another target's temporary stays" test -e "$work/outputs/.d.tmp$dead-0.ply"
 # A real kill -9 in the middle of a write leaves its temporary; the next write of the target, a minute on,
 # removes it.
 "$lidarshop" scan mailbox --rows 600 --columns 1200 -o "$work/big.ptx" -q 2>/dev/null
@@ -125,11 +119,11 @@ for _attempt in 1 2 3 4 5; do
   left=$(compgen -G "$work/outputs/.big.tmp$writer-*.ply" | head -1)
   [ -n "$left" ] && break
 done
-expect "kill -9 mid-write leaves a temporary" test -n "$left"
+check "kill -9 mid-write leaves a temporary" test -n "$left"
 if [ -n "$left" ]; then
   touch -d '-2 minutes' "$left"
   check "convert again" "$lidarshop" convert "$work/scan.ptx" "$work/outputs/big.ply"
-  expect "the killed writer's temporary is gone" test ! -e "$left"
+  check "the killed writer's temporary is gone" test ! -e "$left"
 fi
 
 echo "commands_hostile_test: $passed passed, $failed failed"

@@ -11,6 +11,7 @@ broken file is refused with exit 1 and a message naming the file. Prints one lin
 summary line 'N passed, N failed'; --table writes the Markdown table (docs/results/formats/interop.md).
 """
 import argparse
+import json
 import os
 import re
 import struct
@@ -260,7 +261,6 @@ def check_file(lidarshop, rel, path, out_dir):
     if info.returncode != 0:
         row["result"] = "FAIL: info --stats: " + info.stderr.strip().splitlines()[-1][:200]
         return row
-    import json
     stats = json.loads(info.stdout)
     warned = "coarser than the file's step" in info.stderr
     if warned:
@@ -312,7 +312,7 @@ def check_file(lidarshop, rel, path, out_dir):
     return row
 
 
-def hostile_variants(rel, path, out_dir):
+def hostile_variants(lidarshop, rel, path, out_dir):
     """Damaged copies of a valid file (cut in half, 16 bytes flipped with a fixed seed, the first 64 bytes
     zeroed): `info --stats` either reads them or refuses them with exit 1 and one line naming the file —
     never a crash, a hang or a second line from a library."""
@@ -329,7 +329,7 @@ def hostile_variants(rel, path, out_dir):
         with open(variant_path, "wb") as f:
             f.write(variant)
         try:
-            result = run(["prlimit", "--as=4000000000", "--", LIDARSHOP, "info", "--stats", "--max-memory",
+            result = run(["prlimit", "--as=4000000000", "--", lidarshop, "info", "--stats", "--max-memory",
                           "1G", "--json", os.devnull, variant_path])
         except subprocess.TimeoutExpired:
             problems.append(f"{name}: hang")
@@ -342,8 +342,6 @@ def hostile_variants(rel, path, out_dir):
     return problems
 
 
-LIDARSHOP = None
-
 
 def main():
     parser = argparse.ArgumentParser()
@@ -352,8 +350,6 @@ def main():
     parser.add_argument("--table")
     parser.add_argument("--only", help="a substring of the files to run")
     args = parser.parse_args()
-    global LIDARSHOP
-    LIDARSHOP = args.lidarshop
     root = os.path.join(args.data, "interop")
     if not os.path.isdir(root):
         print(f"interop_test: {root} is missing (the shared data must lie beside the checkout)")
@@ -364,7 +360,7 @@ def main():
     with tempfile.TemporaryDirectory() as out_dir:
         for rel in files:
             row = check_file(args.lidarshop, rel, os.path.join(root, rel), out_dir)
-            damaged = hostile_variants(rel, os.path.join(root, rel), out_dir)
+            damaged = hostile_variants(args.lidarshop, rel, os.path.join(root, rel), out_dir)
             if damaged:
                 row["result"] = "FAIL: damaged copies: " + "; ".join(damaged) if row["result"] == "ok" \
                     else row["result"] + "; damaged copies: " + "; ".join(damaged)

@@ -117,6 +117,22 @@ def main():
             limit = 0 if name == "object" else 0.2 * len(reference)
             check(f"{name}: unchanged cells are the input's, to the digit", kept > 100 and changed <= limit,
                   f"{kept} identical, {changed} changed")
+        # Synthesized points into XYZ, which cannot mark them: a warning with their number by default;
+        # --drop-synthesized leaves them out, --synthesized-mask records them on the grid.
+        run(lidarshop, "fill", path("utm.ptx"), "--mask", path("mask.png"), "-o", path("filled.ply"), "--quiet")
+        warned = run(lidarshop, "convert", path("filled.ply"), path("all.xyz")).stderr
+        run(lidarshop, "convert", path("filled.ply"), path("kept.xyz"), "--drop-synthesized",
+            "--synthesized-mask", path("synthesized.png"), "--json", path("convert.json"), "--quiet")
+        left_out = json.load(open(path("convert.json")))["synthesized_left_out"]
+        all_points, kept_points = len(read_xyz(path("all.xyz"))), len(read_xyz(path("kept.xyz")))
+        check("XYZ: the warning says how many synthesized points go unmarked",
+              f"{left_out} synthesized points are written without their flag" in warned, warned.strip()[-200:])
+        check("--drop-synthesized leaves exactly those out", left_out > 0 and kept_points == all_points - left_out,
+              f"{all_points} points, {kept_points} kept, {left_out} left out")
+        png = open(path("synthesized.png"), "rb").read()
+        width, height = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+        check("--synthesized-mask is a picture of the grid", (width, height) == (180, 120),
+              f"{width} x {height}")
         # register: a copy moved by 5 cm comes back; its points are untouched, its pose moves in double.
         run(lidarshop, "points", "transform", path("utm.ptx"), "-o", path("moved.ptx"),
             "--matrix=1,0,0,0.05,0,1,0,0.02,0,0,1,0,0,0,0,1")

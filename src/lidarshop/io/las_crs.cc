@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/io/las.h"
+#include "lidarshop/io/text_cursor.h"
 
 namespace lidarshop {
 namespace {
@@ -19,12 +20,9 @@ constexpr int kProjLinearUnitsGeoKey = 3076;
 constexpr int kGeoAsciiParamsTag = 34737;
 
 // JSON needs UTF-8; the records are ASCII by the specification, so anything else becomes '?'.
-std::string AsciiText(std::string text) {
-  text.resize(std::strlen(text.c_str()));  // NUL-terminated in the file
-  for (char& c : text) {
-    if (c < 32 || c > 126) c = '?';
-  }
-  return text;
+std::string AsciiText(const std::string& text) {
+  const std::string_view terminated(text.c_str());  // NUL-terminated in the file
+  return io_internal::Printable(terminated, terminated.size());
 }
 
 const SourceRecord* Find(const std::vector<SourceRecord>& records, const char* user, int id) {

@@ -242,6 +242,33 @@ TEST(LasTest, AFormatThatCannotHoldAnAttributeSaysSo) {
               testing::Contains(AllOf(HasSubstr("nir"), testing::Not(HasSubstr("gps_time")))));
 }
 
+// LAS 1.4 keeps its coordinate system in extended records after the points: read; one that runs past the
+// file's end is left out with a warning naming the file.
+TEST(LasTest, ExtendedRecordsAfterThePointsAreRead) {
+  TempFolder folder;
+  std::string bytes = Build(ThreePoints(4, 6));
+  const std::string wkt = "PROJCS[\"test\"]";
+  std::string evlr(60, '\0');
+  std::memcpy(evlr.data() + 2, "LASF_Projection", 15);
+  Put<uint16_t>(&evlr, 18, 2112);
+  Put<uint64_t>(&evlr, 20, wkt.size());
+  Put<uint64_t>(&bytes, 235, bytes.size());  // start of the first extended record
+  Put<uint32_t>(&bytes, 243, 1);
+  const std::string path = folder.File("evlr.las");
+  testing_io::WriteText(path, bytes + evlr + wkt);
+  const ScanFile file = ReadScanFile(path);
+  ASSERT_EQ(file.scans.at(0).source_records.size(), 1u);
+  EXPECT_EQ(file.scans[0].source_records[0].payload, wkt);
+  EXPECT_EQ(LasCrsJson(file.scans[0].source_records)["wkt"], wkt);
+  EXPECT_TRUE(file.warnings.empty());
+  testing_io::WriteText(path, bytes + evlr + wkt.substr(0, 5));
+  const ScanFile cut = ReadScanFile(path);
+  EXPECT_TRUE(cut.scans.at(0).source_records.empty());
+  EXPECT_THAT(cut.warnings,
+              testing::Contains(AllOf(HasSubstr(path), HasSubstr("extended variable length record 0"),
+                                      HasSubstr("does not fit"))));
+}
+
 TEST(LasTest, APointAtTheOriginIsAPoint) {
   TempFolder folder;
   HandLas las = ThreePoints(2, 0);

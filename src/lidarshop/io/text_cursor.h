@@ -18,13 +18,14 @@
 
 namespace lidarshop::io_internal {
 
-// At most 40 characters of `text`, with bytes that are not printable ASCII shown as '?' (for error messages).
-inline std::string Printable(std::string_view text) {
-  std::string out(text.substr(0, 40));
+// At most `max_chars` characters of `text` (40: for error messages), with bytes that are not printable ASCII
+// shown as '?'.
+inline std::string Printable(std::string_view text, size_t max_chars = 40) {
+  std::string out(text.substr(0, max_chars));
   for (char& c : out) {
     if (c < 32 || c > 126) c = '?';
   }
-  if (text.size() > 40) out += "...";
+  if (text.size() > max_chars) out += "...";
   return out;
 }
 
