@@ -39,6 +39,20 @@ SymbolModel& Lazy(std::optional<SymbolModel>& model, uint32_t symbols) {
 
 // Version 2: the return counts pick the contexts of the coordinates and the intensity; x and y are predicted
 // by the median of the last five differences of the same return kind.
+// User data (bit 1 of `changed`) and point source ID (bit 0), decoded alike by POINT10 v1 and v2.
+void DecodeUserDataAndSourceId(uint32_t changed, ArithmeticDecoder& d,
+                               std::array<std::optional<SymbolModel>, 256>& user_data,
+                               IntegerDecompressor& point_source_id, uint8_t* last) {
+  if (changed & 2) {
+    last[kUserData] = static_cast<uint8_t>(d.DecodeSymbol(Lazy(user_data[last[kUserData]], 256)));
+  }
+  if (changed & 1) {
+    StoreLe<uint16_t>(
+        last + kPointSourceId,
+        static_cast<uint16_t>(point_source_id.Decompress(LoadLe<uint16_t>(last + kPointSourceId))));
+  }
+}
+
 class Point10V2 final : public PointwiseItemDecoder {
  public:
   Point10V2(ArithmeticDecoder& decoder, const uint8_t* first)
@@ -79,14 +93,7 @@ class Point10V2 final : public PointwiseItemDecoder {
       const uint32_t diff = d_.DecodeSymbol(scan_angle_rank_[scan_direction]);
       last_[kScanAngleRank] = FoldByte(static_cast<int32_t>(diff + last_[kScanAngleRank]));
     }
-    if (changed & 2) {
-      last_[kUserData] = static_cast<uint8_t>(d_.DecodeSymbol(Lazy(user_data_[last_[kUserData]], 256)));
-    }
-    if (changed & 1) {
-      StoreLe<uint16_t>(
-          last_ + kPointSourceId,
-          static_cast<uint16_t>(point_source_id_.Decompress(LoadLe<uint16_t>(last_ + kPointSourceId))));
-    }
+    DecodeUserDataAndSourceId(changed, d_, user_data_, point_source_id_, last_);
 
     const int32_t dx = dx_.Decompress(x_median_[m].Get(), n == 1);
     AddToInt32(last_ + kX, dx);
@@ -157,14 +164,7 @@ class Point10V1 final : public PointwiseItemDecoder {
       last_[kScanAngleRank] =
           static_cast<uint8_t>(scan_angle_rank_.Decompress(last_[kScanAngleRank], k_bits < 3));
     }
-    if (changed & 2) {
-      last_[kUserData] = static_cast<uint8_t>(d_.DecodeSymbol(Lazy(user_data_[last_[kUserData]], 256)));
-    }
-    if (changed & 1) {
-      StoreLe<uint16_t>(
-          last_ + kPointSourceId,
-          static_cast<uint16_t>(point_source_id_.Decompress(LoadLe<uint16_t>(last_ + kPointSourceId))));
-    }
+    DecodeUserDataAndSourceId(changed, d_, user_data_, point_source_id_, last_);
     last_x_diff_[last_incr_] = x_diff;
     last_y_diff_[last_incr_] = y_diff;
     last_incr_ = (last_incr_ + 1) % 3;
