@@ -12,7 +12,9 @@
 # hold about that much; libFuzzer's -rss_limit_mb is that budget + 200 MB + what AddressSanitizer adds (its
 # shadow and a quarantine capped at 64 MB), and -malloc_limit_mb the budget + 200 MB for one allocation: an
 # input that takes more went past the budget, and libFuzzer reports it as out-of-memory — a failure here.
-# scripts/test.sh runs this briefly (15 s a reader); run it longer by hand.
+# scripts/test.sh runs this briefly (15 s a reader) with LIDARSHOP_FUZZ_SEED=1, so CI replays the same
+# mutations on every run (a find there is a find on every machine; a faster one only goes further); by hand the
+# seed is random (0) unless set. Run it longer by hand.
 set -uo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-300}
@@ -92,9 +94,15 @@ open(sys.argv[2], "wb").write(bytes([kinds[ext]]) + d[:65535])' "$f" "$corpus/$(
   fi
   before=$(find "$build/artifacts" -name "$reader-*" | wc -l)
   "$build/fuzz/${reader}_fuzz" "$corpus" -max_total_time="$seconds" -max_len=65536 "${limits[@]}" -timeout=20 \
-    -artifact_prefix="$build/artifacts/$reader-" -print_final_stats=1 >"$build/$reader.log" 2>&1
+    -seed="${LIDARSHOP_FUZZ_SEED:-0}" -artifact_prefix="$build/artifacts/$reader-" -print_final_stats=1 \
+    >"$build/$reader.log" 2>&1
   after=$(find "$build/artifacts" -name "$reader-*" | wc -l)
   crashes=$((crashes + after - before))
+  if [[ $after -gt $before ]]; then  # say what broke where CI's log shows it, not only in build/fuzz
+    grep -m1 -B2 -A12 -E "ERROR: (libFuzzer|AddressSanitizer|LeakSanitizer)|runtime error|terminate called" \
+      "$build/$reader.log" | grep -vE "^ +#([0-9]|1[0-9]) .*(libFuzzer|libc\.so|libstdc|sanitizer)" | head -24
+    grep -E "^artifact_prefix|Test unit written to" "$build/$reader.log" | tail -1
+  fi
   # An out-of-memory report fails the run even when libFuzzer could not write its input (-rss_limit_mb is
   # checked by a thread; a malloc past -malloc_limit_mb dies inside the allocator).
   if grep -qE "ERROR: libFuzzer: out-of-memory|malloc limit|hard rss limit|allocation-size-too-big|out of memory" \

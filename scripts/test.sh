@@ -24,5 +24,5 @@ ctest --test-dir build/release --output-on-failure -j "$(nproc)" "$@"
 bash scripts/web.sh test
 fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-15}
 if [[ $fuzz_seconds -gt 0 ]] && command -v clang++-14 >/dev/null; then
-  bash scripts/fuzz.sh "$fuzz_seconds"
+  LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh "$fuzz_seconds"
 fi

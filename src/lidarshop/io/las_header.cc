@@ -47,11 +47,13 @@ void ReadExtendedRecords(const std::string& bytes, const std::string& file, int6
   if (count == 0) return;
   uint64_t position = first;
   for (uint32_t i = 0; i < count; ++i) {
-    const uint64_t length = position <= static_cast<uint64_t>(size) - las::kEvlrHeaderSize
-                                ? las::Load<uint64_t>(h + position + las::vlr::kRecordLength)
-                                : UINT64_MAX;
-    if (position < static_cast<uint64_t>(header->offset_to_points) ||
-        length > static_cast<uint64_t>(size) - position - las::kEvlrHeaderSize) {
+    // Both sides of each comparison stay within [0, size]: no unsigned wrap-around can let a record pass.
+    const bool header_fits = position >= static_cast<uint64_t>(header->offset_to_points) &&
+                             position <= static_cast<uint64_t>(size) &&
+                             static_cast<uint64_t>(size) - position >= las::kEvlrHeaderSize;
+    const uint64_t length =
+        header_fits ? las::Load<uint64_t>(h + position + las::vlr::kRecordLength) : uint64_t{0};
+    if (!header_fits || length > static_cast<uint64_t>(size) - position - las::kEvlrHeaderSize) {
       header->warnings.push_back(fmt::format(
           "{}: extended variable length record {} at byte {} does not fit in the file ({} bytes); left out "
           "with the {} after it",
