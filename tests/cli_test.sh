@@ -55,10 +55,13 @@ json_check "scan --stats is one JSON object with stage seconds" "$work/stats.jso
   "isinstance(d, dict) and len(json.dumps(d)) > 10"
 check "scan wrote its outputs" test -s "$work/scan.ptx" -a -s "$work/labels.png" -a -s "$work/mesh.ply"
 # car.obj names an MTL file that is not there: the mesh reader's warning is one line on stderr naming the
-# OBJ and the missing file; otherwise the command is quiet when stderr is not a terminal.
+# OBJ and the missing file.
 check "scan prints the mesh reader's warning" \
   grep -qE "^lidarshop: warning: .*scene/meshes/car\.obj: .*VWBugMesh002\.mtl.*without its materials" "$work/scan.err"
-check "scan is quiet when stderr is not a terminal" test "$(grep -vc '^lidarshop: warning: ' "$work/scan.err")" -eq 0
+# Besides warnings, one summary line (#35): what it wrote, how much, how long; no progress bar off a terminal.
+check "scan ends with one summary line when stderr is not a terminal" \
+  test "$(grep -v '^lidarshop: warning: ' "$work/scan.err" | grep -cE '^lidarshop scan: 120 x 180 scan, [0-9]+ returns of 21600 rays -> .*scan\.ptx \([0-9.]+ s\)$')" -eq 1 \
+  -a "$(grep -vc '^lidarshop: warning: ' "$work/scan.err")" -eq 1
 fails_clearly "scan: missing scene" "no_such_scene.json" "$lidarshop" scan "$work/no_such_scene.json" -o "$work/x.ptx"
 # A built-in scene by name, as `demo --scene NAME`; an unknown name lists the built-in ones.
 check "scan a built-in scene by name" sh -c "'$lidarshop' scan parking_lot -o '$work/parking.ply' --rows 30 \
@@ -747,7 +750,7 @@ cp "$work/last.err" "$work/plain_ptx.err"
 check "PTX: the convention intensity is a warning" \
   grep -q "^lidarshop: warning: .*plain.ptx: the input has no intensity, but PTX requires an intensity column: written as 0.5" "$work/plain_ptx.err"
 check "convert prints what it wrote" \
-  grep -qx "wrote .*plain.ptx: 1 scan, 3 points, channels xyz intensity=0.5" "$work/plain_ptx.err"
+  grep -qxE "lidarshop convert: wrote .*plain.ptx: 1 scan, 3 points, channels xyz intensity=0.5 \([0-9.]+ s\)" "$work/plain_ptx.err"
 check "convert labels to PTX" "$lidarshop" convert "$work/scan_labels.ply" "$work/labels.ptx" --json "$work/labels_convert.json"
 cp "$work/last.err" "$work/labels_ptx.err"
 check "PTX drops labels and normals, one line each" sh -c \

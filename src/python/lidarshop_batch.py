@@ -8,8 +8,9 @@ PIPELINE.json:
                 "output": "{name}_removed.e57"},
                {"command": "convert", "output": "{name}.ply"}]}
 
-Each step runs the `lidarshop` command of that name on the previous step's scan (the first step on the scan
-file): `lidarshop COMMAND INPUT -o OUTPUT --options OPTIONS.json --KEY VALUE...` (`convert` takes its output
+Each step runs the `lidarshop` command of that name on the last scan an earlier step wrote (the first step on
+the scan file; an output that is not a scan file, such as a `render` step's PNG, is a side result the next step
+does not take): `lidarshop COMMAND INPUT -o OUTPUT --options OPTIONS.json --KEY VALUE...` (`convert` takes its output
 as the second positional argument). `options` is the command's options as JSON, the same form as the CLI's
 --options files (docs/options.md): checked by the command itself, with its messages. Every other key of a
 step becomes a flag (`"strokes": ...` -> `--strokes ...`, `true` -> a bare flag); `{name}` is the scan's file
@@ -47,6 +48,11 @@ MEMORY_SIZE = re.compile(r"[0-9]+(\.[0-9]+)?([KMGT](I?B)?|B)?", re.IGNORECASE)
 
 # Commands whose output is their second positional argument instead of -o.
 POSITIONAL_OUTPUT = {"convert"}
+# What lidarshop reads as a scan (io/scan_io.h): a step's output with one of these extensions is the next step's
+# input; any other output (a render's PNG, a segment's mask) is a side result and the scan goes on unchanged.
+SCAN_EXTENSIONS = {".ptx", ".e57", ".ply", ".pcd", ".las", ".laz", ".xyz", ".pts"}
+# Commands whose output is a picture, not a scan: a step of theirs without an `output` writes a PNG to .work/.
+PICTURE_OUTPUT = {"render", "segment"}
 STEP_KEYS = {"command", "options", "output"}
 
 
@@ -95,8 +101,13 @@ def step_outputs(pipeline, name, out_dir, scan_path):
         if "output" in step:
             outputs.append(os.path.join(out_dir, step["output"].replace("{name}", name)))
         else:
-            outputs.append(os.path.join(out_dir, ".work", f"{name}.step{index}{extension}"))
+            step_extension = ".png" if step["command"] in PICTURE_OUTPUT else extension
+            outputs.append(os.path.join(out_dir, ".work", f"{name}.step{index}{step_extension}"))
     return outputs
+
+
+def is_scan_file(path):
+    return os.path.splitext(path)[1].lower() in SCAN_EXTENSIONS
 
 
 def record_path(out_dir, name):
@@ -251,7 +262,8 @@ def run_scan(job):
                           error=f"steps[{index}] ({step['command']}) exit {returncode}: "
                                 + (lines[-1] if lines else "no message"))
             break
-        input_path = output
+        if is_scan_file(output):  # the last scan goes on: a picture in the middle is a side result
+            input_path = output
     if record["status"] == "ok":
         record["outputs"] = kept_outputs(pipeline, name, out_dir, scan_path)
     else:
@@ -326,7 +338,8 @@ def main(argv=None):
     parser.add_argument("--shard", type=parse_shard, default=(0, 1),
                         help="i/N: only the scans whose index in the sorted list is i modulo N (Slurm arrays)")
     parser.add_argument("--lidarshop", default=None, help="the lidarshop executable (default: the build's)")
-    parser.add_argument("--quiet", action="store_true", help="no line per scan on stderr")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no line per scan and no summary line on stderr (errors still print)")
     parser.add_argument("--max-memory", metavar="SIZE", default=None,
                         help="memory budget of every step (e.g. 4G; lidarshop's --max-memory): larger requests "
                              "fail up front")
@@ -397,8 +410,9 @@ def main(argv=None):
                                                      else f"local cluster of {workers} workers")}
     summary_name = "summary.json" if shard_count == 1 else f"summary.shard{shard_index}of{shard_count}.json"
     write_json_atomic(os.path.join(out_dir, summary_name), summary)
-    print(f"lidarshop batch: {len(scans)} scans: {done} done, {skipped} skipped, {len(failures)} failed, "
-          f"{seconds:.1f} s ({summary['mode']}); {os.path.join(out_dir, summary_name)}", file=sys.stderr)
+    if not args.quiet:
+        print(f"lidarshop batch: {len(scans)} scans: {done} done, {skipped} skipped, {len(failures)} failed, "
+              f"{seconds:.1f} s ({summary['mode']}); {os.path.join(out_dir, summary_name)}", file=sys.stderr)
     return 1 if failures else 0
 
 

@@ -52,8 +52,20 @@ inline constexpr int kExitUsage = 2;     // usage: unknown option, bad value, mi
 // ("lidarshop scan: <message>"): usage errors (CLI11's, OptionsError, an unknown option with the closest valid
 // one) exit with kExitUsage, everything else (InputError, a library's exception) with kExitBadInput. With a
 // `binder`, option errors name the flag the user typed.
+// Every command takes -q/--quiet and --max-memory (added here when the command did not add them). When the body
+// succeeds and set a summary (Summarize), RunCommand ends with it as one line on stderr, with the wall time:
+// "lidarshop fill: filled 812 of 840 hole cells (3.21 s)"; not with --quiet. On errors the one error line is
+// all that stderr gets.
 int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
                const OptionBinder* binder = nullptr);
+
+// The command's one-line summary for people: what it changed and how much (RunCommand adds the time). The
+// last call wins. A command without one (serve) ends without.
+void Summarize(std::string what);
+// The warnings of a result (SegmentResult::warnings, FillResult::warnings, ...: the result looks wrong), one
+// line each on stderr ("lidarshop segment: warning: <sentence>"), also with --quiet: they say the output may
+// be wrong. The same sentences go into the command's --json "warnings".
+void PrintResultWarnings(const std::vector<std::string>& warnings);
 
 // Adds --json FILE ('-' = stdout): where the command's result goes as JSON. Machine output goes only there;
 // summaries for people go to stderr.
@@ -85,9 +97,17 @@ E57File ReadE57AndWarn(const std::string& path);
 TriangleMesh ReadMeshAndWarn(const std::string& path);
 
 // Scan `index` of `file`; OptionsError naming `flag` (the option the user typed) when out of range.
-const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = "--scan-index");
+const Scan& PickScan(const ScanFile& file, int index, const std::string& flag = "--scan");
 
-// Adds --quiet (no progress bars) to `app`; the flag is stored in *quiet. Also adds --max-memory SIZE
+// Adds --scan K (which scan of a multi-scan file, from 0) and --scan-index, its older name, both into *index:
+// one flag for the scan index in every command that reads one scan (render, convert, segment, fill, remove,
+// recolor). `resection` is the exception: its --scan names a scan FILE, so its index stays --scan-index.
+void AddScanIndexOption(CLI::App& app, int* index,
+                        const std::string& help = "which scan of the file (from 0)");
+// The scan index flag the user typed ("--scan" unless --scan-index), for PickScan's message.
+std::string ScanIndexFlag(const CLI::App& app);
+
+// Adds -q/--quiet (no progress bars, no summary line) to `app`; the flag is stored in *quiet. Also adds --max-memory SIZE
 // ("512M", "8G"; default half of the RAM), which sets the memory budget (util/memory_budget.h) that
 // header counts, scene complexity, sample and sweep counts are checked against before any allocation.
 void AddQuietFlag(CLI::App& app, bool* quiet);

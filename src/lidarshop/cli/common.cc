@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <new>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/core.hpp>
@@ -18,6 +19,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/timer.h"
 
 namespace lidarshop::cli {
 
@@ -57,13 +59,33 @@ std::string OneLine(const std::exception& error) {
   return text;
 }
 
+// The command being run (RunCommand) and the summary its body left (Summarize): one command per process.
+struct CommandReport {
+  std::string name;  // "lidarshop fill"
+  std::optional<std::string> summary;
+};
+CommandReport& Report() {
+  static CommandReport report;
+  return report;
+}
+
 }  // namespace
+
+void Summarize(std::string what) { Report().summary = std::move(what); }
+
+void PrintResultWarnings(const std::vector<std::string>& warnings) {
+  const std::string& name = Report().name.empty() ? std::string("lidarshop") : Report().name;
+  for (const std::string& warning : warnings) fmt::print(stderr, "{}: warning: {}\n", name, warning);
+}
 
 int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
                const OptionBinder* binder) {
   const std::string name = "lidarshop " + app.get_name();
-  // Every command takes --max-memory (README), also those with no --quiet.
+  Report() = {name, std::nullopt};
+  // Every command takes --max-memory and --quiet (README), also those that have no progress to hide.
   if (app.get_option_no_throw("--max-memory") == nullptr) AddMemoryOption(app);
+  if (app.get_option_no_throw("--quiet") == nullptr)
+    app.add_flag("-q,--quiet")->description("no summary line (warnings and errors still print)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -80,7 +102,12 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
     return kExitUsage;
   }
   try {
-    return body();
+    const Timer timer;
+    const int code = body();
+    const CLI::Option* quiet = app.get_option_no_throw("--quiet");
+    if (code == kExitOk && Report().summary && (quiet == nullptr || quiet->count() == 0))
+      fmt::print(stderr, "{}: {} ({:.2f} s)\n", name, *Report().summary, timer.Seconds());
+    return code;
   } catch (const OptionsFieldError& error) {
     const std::string message =
         binder != nullptr ? binder->Reworded(error).what() : std::string(error.what());
@@ -210,8 +237,18 @@ const Scan& PickScan(const ScanFile& file, int index, const std::string& flag) {
   return file.scans[index];
 }
 
+void AddScanIndexOption(CLI::App& app, int* index, const std::string& help) {
+  CLI::Option* scan = app.add_option("--scan", *index, help)->capture_default_str();
+  app.add_option("--scan-index", *index, "= --scan (its older name)")->excludes(scan);
+}
+
+std::string ScanIndexFlag(const CLI::App& app) {
+  return app.count("--scan-index") > 0 ? "--scan-index" : "--scan";
+}
+
 void AddQuietFlag(CLI::App& app, bool* quiet) {
-  app.add_flag("-q,--quiet", *quiet, "no progress output");
+  app.add_flag("-q,--quiet", *quiet,
+               "no progress output and no summary line (warnings and errors still print)");
   AddMemoryOption(app);
 }
 

@@ -545,11 +545,8 @@ int RunDemoSteps(const DemoSettings& settings) {
   WriteText(out_dir / "summary.json", summary.dump(2) + "\n");
   WriteText(out_dir / "index.html", IndexHtml(scene_name, summary));
   WriteJsonOutput(settings.json_path, summary);
-  if (!settings.quiet) {
-    fmt::print(stderr,
-               "lidarshop demo: scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)\n",
-               scene_name, scan.rows, scan.cols, scan.CountValid(), out_dir.string());
-  }
+  Summarize(fmt::format("scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)", scene_name,
+                        scan.rows, scan.cols, scan.CountValid(), out_dir.string()));
   return 0;
 }
 

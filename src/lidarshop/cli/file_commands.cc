@@ -182,6 +182,22 @@ void MergeInto(const nlohmann::ordered_json& from, nlohmann::ordered_json* into,
   }
 }
 
+// `info`'s summary line: the file, its format and how much it holds.
+std::string InfoSummary(const nlohmann::ordered_json& json) {
+  int64_t points = 0;
+  for (const auto& scan : json.value("scans", nlohmann::ordered_json::array())) {
+    if (scan.contains("valid") && scan["valid"].is_number()) {
+      points += scan["valid"].get<int64_t>();
+    } else if (scan.contains("points") && scan["points"].is_number()) {
+      points += scan["points"].get<int64_t>();
+    }
+  }
+  return fmt::format("{}: {} file, {} scan(s), {} points, {} image(s)", json.value("file", std::string()),
+                     json.value("format_version", json.value("format", std::string())),
+                     json.value("scans", nlohmann::ordered_json::array()).size(), points,
+                     json.value("images", nlohmann::ordered_json::array()).size());
+}
+
 }  // namespace
 
 int RunInfo(int argc, char** argv) {
@@ -213,6 +229,7 @@ int RunInfo(int argc, char** argv) {
       nlohmann::ordered_json json = ToJson(header);
       RoundNumbers(&json);
       WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
+      Summarize(InfoSummary(json));
       return 0;
     }
     ScanFile file;
@@ -250,6 +267,7 @@ int RunInfo(int argc, char** argv) {
     }
     RoundNumbers(&json);
     WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
+    Summarize(InfoSummary(json));
     return 0;
   });
 }
@@ -351,7 +369,7 @@ int RunConvert(int argc, char** argv) {
         // After a successful write: what the target could not hold, one line each, then what it holds.
         PrintWarnings(plan.dropped);
         const size_t images_written = to_e57 ? images.size() : 0;
-        if (!quiet) fmt::print(stderr, "{}\n", WrittenSummary(output, scans, images_written, plan));
+        Summarize(WrittenSummary(output, scans, images_written, plan));
         nlohmann::ordered_json json;
         json["input"] = input;
         json["output"] = output;
@@ -503,6 +521,9 @@ int RunRender(int argc, char** argv) {
           json["target_in_world"] = {view.target_in_world.x(), view.target_in_world.y(),
                                      view.target_in_world.z()};
           WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+          Summarize(fmt::format("{} x {} view from ({:.2f}, {:.2f}, {:.2f}) -> {}", picture.cols,
+                                picture.rows, view.eye_in_world.x(), view.eye_in_world.y(),
+                                view.eye_in_world.z(), output));
           return 0;
         }
         options.channel = ParseEnum<RenderChannel>(channel);
@@ -546,7 +567,7 @@ int RunRender(int argc, char** argv) {
           layout = std::move(result.layout);
         }
         json["layout"] = LayoutJson(layout);
-        if (!quiet) fmt::print(stderr, "lidarshop render: {}\n", layout.Describe());
+        Summarize(layout.Describe());
         WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
         return 0;
       },

@@ -100,7 +100,7 @@ int RunFill(int argc, char** argv) {
   app.add_option("--debug", debug_dir,
                  "write gradient magnitude before/after, fill order and source cells here");
   app.add_option("--synthesized-mask", synthesized_mask_path, "write the synthesized cells as a mask PNG");
-  app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
+  AddScanIndexOption(app, &scan_index, "which scan of a multi-scan file (from 0)");
   BindFillOptions(binder, &options);
   AddQuietFlag(app, &quiet);
   return RunCommand(
@@ -112,7 +112,7 @@ int RunFill(int argc, char** argv) {
         CheckOutputFile("--synthesized-mask", synthesized_mask_path, {"png"},
                         {scan_path, mask_path, output_path, json_path});
         const ScanFile file = ReadScanFileAndWarn(scan_path);
-        const Scan& scan = PickScan(file, scan_index);
+        const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         const cv::Mat hole = ReadMask(mask_path, cv::Size(scan.cols, scan.rows), scan_path);
         auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
         const FillResult result = FillScan(scan, hole, options, progress.get());
@@ -121,7 +121,8 @@ int RunFill(int argc, char** argv) {
         if (!synthesized_mask_path.empty()) WriteImage(synthesized_mask_path, result.filled);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         if (!debug_dir.empty()) WriteDebug(debug_dir, result, hole);
-        if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
+        PrintResultWarnings(result.warnings);
+        Summarize(fmt::format("{} -> {}", result.Summary(), output_path));
         return 0;
       },
       &binder);
@@ -146,7 +147,7 @@ int RunRemove(int argc, char** argv) {
   app.add_option("--mask-out", mask_out_path,
                  "write the filled hole (object grown by the margin) as a mask PNG");
   AddJsonOption(app, &json_path, "--json,--report");
-  app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
+  AddScanIndexOption(app, &scan_index, "which scan of a multi-scan file (from 0)");
   // --keep-object: E57 holds the fill as a second return, PLY/PCD as extra points flagged synthesized.
   binder.Bind(&remove, {.keys = {"margin_cells", "keep_object", "fill_enclosed_no_return"},
                         .flags = {{"margin_cells", "--margin"}}});
@@ -165,7 +166,7 @@ int RunRemove(int argc, char** argv) {
         CheckOutputFile("--mask-out", mask_out_path, {"png"}, {scan_path, strokes_path, output_path});
         CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});
         const ScanFile file = ReadScanFileAndWarn(scan_path);
-        const Scan& scan = PickScan(file, scan_index);
+        const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         const cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
         const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
@@ -180,7 +181,9 @@ int RunRemove(int argc, char** argv) {
         }
         if (!mask_out_path.empty()) WriteImage(mask_out_path, hole);
         WriteJsonOutput(json_path, CommandJson(ToJson(remove), ToJson(removed)));
-        if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
+        PrintResultWarnings(removed.warnings);
+        Summarize(
+            fmt::format("removed {} cells: {} -> {}", cv::countNonZero(hole), result.Summary(), output_path));
         return 0;
       },
       &binder);

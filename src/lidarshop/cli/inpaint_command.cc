@@ -224,7 +224,7 @@ int RunInpaint(int argc, char** argv) {
           });
         }
         WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
-        if (!quiet) fmt::print(stderr, "{}\n", result.Summary());
+        Summarize(result.Summary());
         return 0;
       },
       &binder);

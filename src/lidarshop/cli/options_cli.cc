@@ -67,6 +67,8 @@ std::string TypeName(const FieldInfo& field) {
       return "NUMBER";
     case FieldKind::kNumberList:
       return "N,N,...";
+    case FieldKind::kStringList:
+      return "TEXT,TEXT,...";
     default:
       return "TEXT";
   }
@@ -119,6 +121,16 @@ nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
           throw OptionsError(fmt::format("'{}' is not a comma-separated list of numbers", text));
         }
         list.push_back(value);
+        start = end + 1;
+      }
+      return list;
+    }
+    case FieldKind::kStringList: {  // comma-separated, as number lists
+      nlohmann::json list = nlohmann::json::array();
+      size_t start = 0;
+      while (start <= text.size()) {
+        const size_t end = std::min(text.find(',', start), text.size());
+        list.push_back(text.substr(start, end - start));
         start = end + 1;
       }
       return list;

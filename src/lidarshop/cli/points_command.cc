@@ -122,6 +122,19 @@ nlohmann::ordered_json UsedOptions(const PointsOptions& options, const std::stri
   return used;
 }
 
+// The summary line of a points operation, from its --json summary: what it kept or found, of how many points.
+std::string PointsSummary(const nlohmann::ordered_json& summary, const std::string& output_path) {
+  const std::string operation = summary["operation"].get<std::string>();
+  std::string what = fmt::format("{}: {} input points", operation, summary["input_points"].get<int64_t>());
+  if (summary.contains("output_points"))
+    what += fmt::format(", {} output points", summary["output_points"].get<int64_t>());
+  for (const char* key : {"clusters", "regions", "superpixels"}) {
+    if (summary.contains(key)) what += fmt::format(", {} {}", summary[key].get<int64_t>(), key);
+  }
+  if (summary.contains("planes")) what += fmt::format(", {} planes", summary["planes"].size());
+  return what + " -> " + output_path;
+}
+
 // All scans of all inputs as one world-frame cloud, with where each point came from.
 struct Gathered {
   std::vector<Scan> scans;
@@ -419,6 +432,8 @@ int RunPoints(int argc, char** argv) {
                                             {"output_points", cloud.size()},
                                             {"seconds", seconds}};
           WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+          Summarize(fmt::format("sample-mesh: {} points from {} triangles -> {}", cloud.size(),
+                                mesh.num_triangles(), output_path));
           return 0;
         }
         const Timer read_timer;
@@ -484,6 +499,8 @@ int RunPoints(int argc, char** argv) {
           summary["triangles"] = mesh.num_triangles();
           WriteMesh(output_path, mesh);
           WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation, mesh_method), summary));
+          Summarize(fmt::format("mesh ({}): {} vertices, {} triangles from {} points -> {}", mesh_method,
+                                mesh.num_vertices(), mesh.num_triangles(), g.cloud.size(), output_path));
           return 0;
         } else if (operation == "regions" || operation == "superpixels") {
           // Per scan, over its grid: labels into the scan's label channel.
@@ -553,6 +570,7 @@ int RunPoints(int argc, char** argv) {
           WriteScanFile(output_path, scans_out);
         }
         WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+        Summarize(PointsSummary(summary, output_path));
         return 0;
       },
       &binder);
@@ -615,6 +633,10 @@ int RunRegister(int argc, char** argv) {
             {"converged", result.icp.converged}, {"seconds", timer.Seconds()}};
         if (use_global) json["global_options"] = ToJson(global);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        Summarize(fmt::format("{} registered onto {}: RMS {:.4f} m, fitness {:.3f}, {} iterations{} -> {}",
+                              moving_path, fixed_path, result.icp.rms_m, result.icp.fitness,
+                              result.icp.iterations, result.icp.converged ? "" : " (not converged)",
+                              output_path));
         return 0;
       },
       &binder);

@@ -157,7 +157,7 @@ int RunPoisson(int argc, char** argv) {
           result = ReconstructFromGradients(system, boundary_float, gx, gy);
           WriteResult(output_path, result.image, IntegerDepth(boundary));
         }
-        if (!quiet) fmt::print(stderr, "{} unknowns; {}\n", unknowns, result.Summary());
+        Summarize(fmt::format("{} unknowns; {}", unknowns, result.Summary()));
         nlohmann::ordered_json json;
         json["operation"] = *fill ? "fill" : *clone ? "clone" : "reconstruct";
         json["unknowns"] = unknowns;

@@ -1,4 +1,5 @@
 // lidarshop resection | recolor | images | align | photo: photos and scans (recolor/, docs/recolor.md).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -40,7 +41,9 @@ void CheckNotInput(const std::string& output, const std::vector<std::string>& in
   }
 }
 
-Scan ReadOneScan(const std::string& path, int index) { return PickScan(ReadScanFileAndWarn(path), index); }
+Scan ReadOneScan(const std::string& path, int index, const std::string& flag) {
+  return PickScan(ReadScanFileAndWarn(path), index, flag);
+}
 
 // The entry of `images` named `key` or numbered `key`.
 const E57Image& FindImage(const std::vector<E57Image>& images, const std::string& key,
@@ -81,6 +84,7 @@ nlohmann::ordered_json ResectionJson(const ResectionResult& result) {
   for (size_t i = 0; i < result.inlier.size(); ++i)
     per_pair.push_back({{"error_px", result.reprojection_error_px[i]}, {"inlier", result.inlier[i] != 0}});
   json["per_pair"] = per_pair;
+  json["warnings"] = result.warnings;
   return json;
 }
 
@@ -92,9 +96,11 @@ void AddResectionOptions(CLI::App& app, OptionBinder& binder, ResectionOptions* 
                                   {"ransac_iterations", "--iterations"},
                                   {"radial_coefficients", "--radial"}},
                         .group = group});
-  app.add_option("--intrinsics", *intrinsics_path,
-                 "camera JSON whose intrinsics are known: only the pose is estimated (planar targets too)")
-      ->group(group);
+  CLI::Option* intrinsics = app.add_option(
+      "--intrinsics", *intrinsics_path,
+      "camera JSON whose intrinsics are known: only the pose is estimated (planar targets too)");
+  // An empty group name would hide the flag from --help (CLI11's way to hide options).
+  if (!group.empty()) intrinsics->group(group);
 }
 
 }  // namespace
@@ -154,7 +160,7 @@ int RunResection(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {},
                         {pairs_path, scan_path, photo_path, intrinsics_path, output});
         Scan scan;
-        if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index);
+        if (!scan_path.empty()) scan = ReadOneScan(scan_path, scan_index, "--scan-index");
         const Correspondences pairs = ReadCorrespondences(pairs_path, scan_path.empty() ? nullptr : &scan);
         if (pairs.width_px > 0) options.width_px = pairs.width_px, options.height_px = pairs.height_px;
         if (!size.empty()) options.width_px = size[0], options.height_px = size[1];
@@ -168,7 +174,8 @@ int RunResection(int argc, char** argv) {
         const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
         WriteCameraJson(output, result.camera);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), ResectionJson(result)));
-        if (json_path != "-") fmt::print(stderr, "resection: {}\n", result.Summary());
+        PrintResultWarnings(result.warnings);
+        Summarize(fmt::format("{} -> {}", result.Summary(), output));
         return 0;
       },
       &binder);
@@ -193,7 +200,7 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("--correspondences", pairs_path, "pixel <-> point or cell pairs: resection first");
   app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
-  app.add_option("--scan-index", scan_index, "which scan of the file (from 0)");
+  AddScanIndexOption(app, &scan_index);
   AddJsonOption(app, &json_path);
   binder.Bind(&options,
               {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
@@ -209,7 +216,7 @@ int RunRecolor(int argc, char** argv) {
           throw OptionsError("give exactly one of --photo and --image");
         CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
         if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
-        const Scan scan = ReadOneScan(scan_path, scan_index);
+        const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
         cv::Mat photo;
         PinholeCamera camera;
         bool have_camera = false;
@@ -237,6 +244,7 @@ int RunRecolor(int argc, char** argv) {
           const ResectionResult result =
               RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
           fmt::print(stderr, "resection: {}\n", result.Summary());
+          PrintResultWarnings(result.warnings);
           json["resection"] = ResectionJson(result);
           json["resection"]["options"] = ToJson(resection);
           camera = result.camera;
@@ -244,6 +252,11 @@ int RunRecolor(int argc, char** argv) {
           throw OptionsError("give --camera or --correspondences");
         }
         const RecolorResult result = RecolorScan(scan, photo, camera, options);
+        // The resection's warnings (its RMS) and the recolouring's (the colours disagree), in that order.
+        std::vector<std::string> warnings;
+        if (json.contains("resection"))
+          warnings = json["resection"]["warnings"].get<std::vector<std::string>>();
+        warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
         WriteScanFile(output, {result.scan});
         if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
         nlohmann::ordered_json counts;
@@ -251,8 +264,12 @@ int RunRecolor(int argc, char** argv) {
         counts["recolored"] = result.recolored_count;
         counts["outside_image"] = result.outside_image;
         counts["hidden"] = result.hidden;
+        if (std::isfinite(result.disagreement)) counts["disagreement"] = result.disagreement;
+        counts["warnings"] = warnings;
         if (json.is_object()) counts.update(json);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+        PrintResultWarnings(result.warnings);
+        Summarize(fmt::format("{} -> {}", result.Summary(), output));
         return 0;
       },
       &binder);
@@ -300,6 +317,10 @@ int RunImages(int argc, char** argv) {
       }
     }
     WriteJsonOutput(json_path, json);
+    int64_t extracted = 0;
+    for (const auto& image : json["images"]) extracted += image.contains("extracted");
+    Summarize(fmt::format("{}: {} image(s){}", path, file.images.size(),
+                          folder.empty() ? "" : fmt::format(", {} written to {}", extracted, folder)));
     return 0;
   });
 }
@@ -354,6 +375,10 @@ int RunAlign(int argc, char** argv) {
     WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
     json["options"] = {{"scale", with_scale}, {"model", model}, {"threshold_px", threshold_px}};
     WriteJsonOutput(json_path, json);
+    Summarize(json.contains("rms_m")
+                  ? fmt::format("{} transform, RMS {:.4g} m -> {}", json["model"].get<std::string>(),
+                                json["rms_m"].get<double>(), output)
+                  : fmt::format("{}, RMS {:.3g} px -> {}", model, json["rms_px"].get<double>(), output));
     return 0;
   });
 }
@@ -385,6 +410,8 @@ int RunPhoto(int argc, char** argv) {
         json["height_px"] = photo.image.rows;
         json["scene_pixels"] = cv::countNonZero(photo.label != kNoLabel);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        Summarize(fmt::format("{} x {} photo, {} pixels see the scene -> {}", photo.image.cols,
+                              photo.image.rows, json["scene_pixels"].get<int64_t>(), output));
         return 0;
       },
       &binder);

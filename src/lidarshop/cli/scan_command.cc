@@ -157,6 +157,8 @@ int RunScan(int argc, char** argv) {
           if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
           WriteJsonOutput(json_path, CommandJson(ToJson(scene.scanner), json));
         }
+        Summarize(fmt::format("{} x {} scan, {} returns of {} rays -> {}", scan.rows, scan.cols,
+                              scan_stats.returns, scan_stats.rays, output_path));
         return 0;
       },
       &binder);

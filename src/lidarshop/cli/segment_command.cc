@@ -51,7 +51,7 @@ int RunSegment(int argc, char** argv) {
                  "overlay picture path (default: MASK_overlay.png; 'none' = skip)");
   app.add_option("--refine", refine_path, "extra strokes applied as a fast refinement of the first cut");
   AddJsonOption(app, &json_path);
-  app.add_option("--scan-index", scan_index, "which scan of a multi-scan file")->capture_default_str();
+  AddScanIndexOption(app, &scan_index, "which scan of a multi-scan file (from 0)");
   binder.Bind(&options, {.flags = {{"eight_connected", "--eight"},
                                    {"ring_depth_threshold_m", "--ring-threshold"},
                                    {"depth_bin_m", "--depth-bin"},
@@ -72,18 +72,21 @@ int RunSegment(int argc, char** argv) {
           used.push_back(path);
         }
         const ScanFile file = ReadScanFileAndWarn(scan_path);
-        const Scan& scan = PickScan(file, scan_index);
+        const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
         SegmentSession session(scan, options);
         SegmentResult result = session.Run(strokes);
-        if (!quiet) fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());
+        if (!quiet && !refine_path.empty())
+          fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());
         if (!refine_path.empty()) {
           const cv::Mat extra = ReadStrokes(refine_path, scan.rows, scan.cols);
           result = session.Refine(extra);
           strokes.setTo(kStrokeObject, extra == kStrokeObject);
           strokes.setTo(kStrokeBackground, extra == kStrokeBackground);
-          if (!quiet) fmt::print(stderr, "refined: {}\n", result.Summary());
         }
+        PrintResultWarnings(result.warnings);
+        Summarize(fmt::format("{}{}: {} -> {}", ToString(options.method),
+                              refine_path.empty() ? "" : ", refined", result.Summary(), mask_path));
         WriteImage(mask_path, result.mask);
         if (overlay_path != "none") {
           WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,

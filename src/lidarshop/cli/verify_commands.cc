@@ -208,7 +208,7 @@ int RunVerify(int argc, char** argv) {
         const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
         std::vector<std::string> names;
         for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
-        if (!common.quiet) fmt::print(stderr, "{}\n", result.BriefReport());
+        Summarize(result.BriefReport());
         nlohmann::ordered_json json = ResultJson(result, names);
         json["world_from_model"] = MatrixJson(world_from_model);
         json["model_points"] = model.num_points();
@@ -321,13 +321,15 @@ int RunSweep(int argc, char** argv) {
         result["model_options"] = ToJson(common.model_options);
         WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
         if (!common.quiet) {
-          fmt::print(stderr, "{} poses ({} verified), {} refined, {} detection(s):\n", sweep.poses.size(),
-                     sweep.evaluated_poses, sweep.refined.size(), sweep.detections.size());
           for (const Detection& d : sweep.detections) {
-            fmt::print(stderr, "  x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n",
+            fmt::print(stderr,
+                       "  detection at x {:.2f} y {:.2f} yaw {:.1f}: consistency {:.3f}, confidence {:.3f}\n",
                        d.x_m, d.y_m, d.yaw_deg, d.consistency, d.confidence);
           }
         }
+        Summarize(fmt::format("{} poses ({} verified), {} refined, {} detection(s) -> {}", sweep.poses.size(),
+                              sweep.evaluated_poses, sweep.refined.size(), sweep.detections.size(),
+                              (out / "detections.json").string()));
         return 0;
       },
       &binder);

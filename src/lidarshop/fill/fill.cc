@@ -537,6 +537,9 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
   if (result.hole_cells == 0) {
     result.scan = Clone(scan);
     result.filled = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    result.warnings.push_back(
+        "the hole mask is empty (no non-zero cell): nothing was filled, the output is a copy "
+        "of the scan");
     result.timings.total_s = total.Seconds();
     return result;
   }

@@ -144,6 +144,8 @@ struct FillResult {
   cv::Mat fill_order;
   cv::Mat source_cell;  // CV_32SC2: (row, col) each hole cell was copied from, (−1, −1) = known
   FillTimings timings;
+  // What looks wrong with the fill, one sentence each (an empty mask: nothing was filled); empty when nothing.
+  std::vector<std::string> warnings;
   std::string Summary() const;  // one line
 };
 template <>
@@ -153,7 +155,7 @@ const StructInfo& InfoOf<FillResult>();
 
 // Fills `hole` in `scan`. Throws InputError when the mask's size differs from the scan's, when the mask
 // leaves no known cell with a return, or when the scan has no ray directions (an unorganized cloud).
-// An empty mask returns a copy of the scan.
+// An empty mask returns a copy of the scan, with a warning.
 FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
                     Progress* progress = nullptr);
 

@@ -8,6 +8,7 @@
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
@@ -389,6 +390,11 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
   const FillResult empty = FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(0)));
   EXPECT_EQ(empty.synthesized_cells, 0);
   EXPECT_EQ(cv::norm(empty.scan.range, c.scan.range, cv::NORM_INF), 0.0);
+  // ... which says so (#35: `fill` with an empty mask exited 0 silently), where a real hole says nothing.
+  ASSERT_EQ(empty.warnings.size(), 1u);
+  EXPECT_NE(empty.warnings[0].find("mask is empty"), std::string::npos) << empty.warnings[0];
+  EXPECT_TRUE(FillScan(c.scan, c.hole).warnings.empty());
+  EXPECT_EQ(ToJson(empty)["warnings"], nlohmann::ordered_json(empty.warnings));
   // A hole touching the image border, in a scan without colour (intensity guides).
   Scan grey = c.scan;
   grey.color.release();

@@ -247,6 +247,7 @@ const StructInfo& InfoOf<FillResult>() {
         .Unit("m");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
     b.Field(&FillResult::timings, "timings", "wall seconds per step");
+    b.Field(&FillResult::warnings, "warnings", "what looks wrong with the fill, one sentence each");
     return b.Build();
   }();
   return info;
@@ -258,6 +259,7 @@ const StructInfo& InfoOf<RemoveResult>() {
     StructBuilder<RemoveResult> b("RemoveResult", "an object removal: the cut and the fill");
     b.Field(&RemoveResult::cut, "cut", "the object's cut");
     b.Field(&RemoveResult::fill, "fill", "the fill of its hole");
+    b.Field(&RemoveResult::warnings, "warnings", "the cut's and the fill's warnings, one sentence each");
     return b.Build();
   }();
   return info;

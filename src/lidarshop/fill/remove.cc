@@ -24,6 +24,8 @@ RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const Remove
   result.fill = FillScan(scan, result.hole, options.fill, progress);
   if (options.keep_object)
     result.behind = MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask != 0));
+  result.warnings = result.cut.warnings;
+  result.warnings.insert(result.warnings.end(), result.fill.warnings.begin(), result.fill.warnings.end());
   return result;
 }
 

@@ -33,6 +33,9 @@ struct RemoveResult {
   // keep_object: the filled background behind the object's own cells only (the margin ring is background in
   // front already), every other cell without a return, flagged synthesized; empty otherwise.
   Scan behind;
+  // The cut's warnings then the fill's (cut.warnings, fill.warnings), one sentence each; empty when nothing
+  // looks wrong.
+  std::vector<std::string> warnings;
 };
 template <>
 const StructInfo& InfoOf<RemoveResult>();

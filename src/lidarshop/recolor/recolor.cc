@@ -19,8 +19,12 @@ namespace lidarshop {
 void RecolorOptions::Check() const { Validate(*this); }
 
 std::string RecolorResult::Summary() const {
-  return fmt::format("{} of {} points recoloured; {} outside the photo, {} hidden from the camera",
-                     recolored_count, returns, outside_image, hidden);
+  return fmt::format(
+      "{} of {} points recoloured; {} outside the photo, {} hidden from the camera{}", recolored_count,
+      returns, outside_image, hidden,
+      std::isnan(disagreement)
+          ? ""
+          : fmt::format("; {:.0f} % disagree with the scan's own brightness", 100 * disagreement));
 }
 
 cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px) {
@@ -210,7 +214,62 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     result.recolored.at<uint8_t>(r, c) = 255;
     ++result.recolored_count;
   }
+  result.disagreement = RecolorDisagreement(scan, out.color, result.recolored);
+  if (result.disagreement > kRecolorDisagreementLimit) {
+    result.warnings.push_back(fmt::format(
+        "the photo's colours disagree with the scan's own {} on {:.0f} % of the {} recoloured points (more "
+        "than {:.0f} %; unrelated values disagree on {:.0f} %): the camera is probably wrong (check the "
+        "resection's pairs and RMS)",
+        scan.has_color() ? "colours" : "intensity", 100 * result.disagreement, result.recolored_count,
+        100 * kRecolorDisagreementLimit, 100 * (1 - (1 - kRecolorRankGap) * (1 - kRecolorRankGap))));
+  }
   return result;
+}
+
+namespace {
+
+// Quantile ranks in [0, 1] of `values`, ties sharing their mean rank.
+std::vector<double> Ranks(const std::vector<float>& values) {
+  std::vector<int64_t> order(values.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int64_t>(i);
+  std::sort(order.begin(), order.end(), [&](int64_t a, int64_t b) { return values[a] < values[b]; });
+  std::vector<double> ranks(values.size());
+  const double scale = values.size() > 1 ? 1.0 / static_cast<double>(values.size() - 1) : 0.0;
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i;
+    while (j + 1 < order.size() && values[order[j + 1]] == values[order[i]]) ++j;
+    const double rank = 0.5 * static_cast<double>(i + j) * scale;
+    for (size_t k = i; k <= j; ++k) ranks[order[k]] = rank;
+    i = j + 1;
+  }
+  return ranks;
+}
+
+float Luma(const cv::Vec3b& rgb) { return 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2]; }
+
+}  // namespace
+
+double RecolorDisagreement(const Scan& before, const cv::Mat& after_color, const cv::Mat& recolored,
+                           int64_t max_points) {
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  if (!before.has_color() && !before.has_intensity()) return none;
+  const int64_t count = cv::countNonZero(recolored);
+  if (count == 0) return none;
+  const int64_t stride = std::max<int64_t>(1, (count + max_points - 1) / std::max<int64_t>(1, max_points));
+  std::vector<float> own, photo;
+  int64_t seen = 0;
+  for (int r = 0; r < recolored.rows; ++r) {
+    for (int c = 0; c < recolored.cols; ++c) {
+      if (!recolored.at<uint8_t>(r, c) || seen++ % stride != 0) continue;
+      own.push_back(before.has_color() ? Luma(before.color.at<cv::Vec3b>(r, c))
+                                       : before.intensity.at<float>(r, c));
+      photo.push_back(Luma(after_color.at<cv::Vec3b>(r, c)));
+    }
+  }
+  const std::vector<double> own_rank = Ranks(own), photo_rank = Ranks(photo);
+  int64_t disagree = 0;
+  for (size_t i = 0; i < own.size(); ++i) disagree += std::abs(own_rank[i] - photo_rank[i]) > kRecolorRankGap;
+  return static_cast<double>(disagree) / static_cast<double>(own.size());
 }
 
 }  // namespace lidarshop

@@ -33,6 +33,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -77,8 +78,28 @@ struct RecolorResult {
   int64_t recolored_count = 0;  // valid cells that took the photo's colour
   int64_t outside_image = 0;    // behind the camera or projected outside the photo
   int64_t hidden = 0;           // inside the photo but occluded by another surface of the scan
+  // Of the recoloured points, the fraction whose photo colour disagrees with the scan's own colour (or, without
+  // colour, its intensity): their ranks (brightness quantiles among the recoloured points) differ by more than
+  // kRecolorRankGap. Independent values disagree on 1 − (1 − gap)² of the points; NaN when nothing was
+  // recoloured or the scan had neither colour nor intensity.
+  double disagreement = 0;
+  // What looks wrong, one sentence each (most points disagree: the camera is probably wrong); empty if nothing.
+  std::vector<std::string> warnings;
   std::string Summary() const;  // one line
 };
+
+// Two brightness ranks (quantiles in [0, 1]) further apart than this disagree (dimensionless).
+inline constexpr double kRecolorRankGap = 0.25;
+// A recolouring where more than this fraction of the points disagree is reported (dimensionless). Independent
+// values give 1 − (1 − 0.25)² = 0.56; a right camera agrees on most points.
+inline constexpr double kRecolorDisagreementLimit = 0.5;
+
+// The fraction of the points of `recolored` (CV_8U, non-zero = recoloured) whose brightness in `after` (RGB)
+// and in `before` (its colour, else its intensity) differ in rank by more than kRecolorRankGap; NaN when no
+// point is recoloured or `before` has neither colour nor intensity. At most `max_points` points are compared
+// (evenly spread), enough for a fraction.
+double RecolorDisagreement(const Scan& before, const cv::Mat& after_color, const cv::Mat& recolored,
+                           int64_t max_points = 200000);
 
 // `photo` is CV_8UC3 RGB of the camera's size (camera.width_px x camera.height_px), else InputError.
 RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,

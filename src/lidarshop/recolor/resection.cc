@@ -36,6 +36,18 @@ namespace {
 
 using Matrix34d = Eigen::Matrix<double, 3, 4>;
 
+std::vector<std::string> ResectionWarnings(const ResectionResult& result) {
+  std::vector<std::string> warnings;
+  if (result.rms_px > kResectionRmsWarningPx) {
+    warnings.push_back(fmt::format(
+        "the camera's inliers reproject with an RMS of {:.1f} px (more than {:g} px): a pair may be wrong or "
+        "the lens distorts more than the model; a recolouring with it paints objects' edges onto their "
+        "neighbours (check the pairs' error_px)",
+        result.rms_px, kResectionRmsWarningPx));
+  }
+  return warnings;
+}
+
 // Similarity taking `points` (as columns) to zero mean and mean distance sqrt(dimension).
 template <int D>
 Eigen::Matrix<double, D + 1, D + 1> NormalizingTransform(
@@ -558,6 +570,7 @@ ResectionResult Resection(std::span<const PixelPointPair> pairs, const Resection
     result.reprojection_error_px.push_back(ReprojectionError(result.camera, pairs[i]));
   result.num_inliers = static_cast<int>(std::count(result.inlier.begin(), result.inlier.end(), 1));
   result.rms_px = RmsOfInliers(result.camera, pairs, result.inlier);
+  result.warnings = ResectionWarnings(result);
   return result;
 }
 
@@ -612,6 +625,7 @@ ResectionResult ResectWithIntrinsics(std::span<const PixelPointPair> pairs, cons
     result.reprojection_error_px.push_back(ReprojectionError(result.camera, pair));
   result.num_inliers = static_cast<int>(inlier_indices.size());
   result.rms_px = result.dlt_rms_px = RmsOfInliers(result.camera, pairs, result.inlier);
+  result.warnings = ResectionWarnings(result);
   return result;
 }
 

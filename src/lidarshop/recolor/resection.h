@@ -99,8 +99,15 @@ struct ResectionResult {
   double rms_px = 0;      // RMS reprojection error of the inliers with `camera`
   double dlt_rms_px = 0;  // the same with the DLT camera (before refinement)
   int ransac_iterations = 0;
+  // What looks wrong, one sentence each (an RMS above kResectionRmsWarningPx); empty if nothing.
+  std::vector<std::string> warnings;
   std::string Summary() const;  // one line
 };
+
+// A camera whose inliers reproject with an RMS above this is reported, pixels: clicked pairs are good to a
+// pixel or two; beyond a few pixels a pair is wrong or the model (distortion) does not fit, and a recolouring
+// with it paints the edges of objects onto their neighbours.
+inline constexpr double kResectionRmsWarningPx = 3.0;
 
 // Thesis eqs. 3.1–3.6 with normalization: P (3x4, |P| = 1) from at least 6 pairs. No degeneracy check.
 Eigen::Matrix<double, 3, 4> NormalizedDlt(std::span<const PixelPointPair> pairs);

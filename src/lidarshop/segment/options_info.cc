@@ -212,6 +212,7 @@ const StructInfo& InfoOf<SegmentResult>() {
     b.Field(&SegmentResult::length_scale, "length_scale",
             "factor applied to the metric lengths (scale_to_data)");
     b.Field(&SegmentResult::timings, "timings", "wall seconds per stage");
+    b.Field(&SegmentResult::warnings, "warnings", "what looks wrong with the cut, one sentence each");
     return b.Build();
   }();
   return info;

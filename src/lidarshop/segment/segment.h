@@ -39,6 +39,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -201,6 +202,9 @@ struct SegmentResult {
   double length_scale = 1;   // factor applied to the metric lengths (scale_to_data), dimensionless
   double flow = 0;           // value of the last max-flow (the minimum energy, up to constants)
   SegmentTimings timings;
+  // What looks wrong with the cut (segment/cut_checks.h: it grew far past its strokes' part, it touches two
+  // borders), one sentence each; empty when nothing does. The mask is kept as it is.
+  std::vector<std::string> warnings;
   std::string Summary() const;  // one line
 };
 template <>

@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/segment/appearance.h"
+#include "lidarshop/segment/cut_checks.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/segment_graph.h"
 #include "lidarshop/util/error.h"
@@ -34,6 +35,7 @@ struct SegmentSession::Impl {
   Cut last;
   std::vector<uint8_t> last_hard;
   SegmentResult last_result;
+  cv::Mat stroked_part;  // Run(): the part of the step-1 cut the object strokes lie on (cut_checks.h)
   bool ran = false;
 
   const NLinks& Links(const CutWeights& w, std::unique_ptr<NLinks>* cache, SegmentTimings* t) {
@@ -302,6 +304,21 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
   if (o.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
+  // The part of the object the strokes lie on, which the cut is checked against (and Refine's too).
+  s.stroked_part = cv::Mat();
+  if (o.method == SegmentMethod::kTwoStep) {
+    cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+    for (int i = 0; i < s.nodes.num(); ++i)
+      if (hard[i] == kHardObject) object_cells.data[s.nodes.cell_of_node[i]] = 255;
+    cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+    for (int i = 0; i < s.nodes.num(); ++i)
+      if (hard[i] == kHardBackground) barrier.data[s.nodes.cell_of_node[i]] = 255;
+    const cv::Mat stroked = StrokedParts(result.step1_mask, object_cells);
+    WholeObjectOptions unbounded = o.whole_object;  // no growth is a leak here: the image bounds it
+    unbounded.max_growth = static_cast<double>(s.scan.num_cells()) / std::max(1, cv::countNonZero(stroked));
+    s.stroked_part = GrowWholeObject(s.scan, stroked, barrier, unbounded);
+  }
+  result.warnings = CheckCut(result.mask, s.stroked_part, WrapsInAzimuth(s.scan));
   result.timings.total_s = total.Seconds() + result.timings.features_s;
   s.last_result = result;
   s.ran = true;
@@ -353,6 +370,9 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
     result.object_cells = cv::countNonZero(result.mask);
     result.graph_nodes = s.last.num_local(s.nodes.num());
+    // New object strokes ask for more object: the growth is the user's, only the borders are checked.
+    result.warnings =
+        CheckCut(result.mask, object_strokes ? cv::Mat() : s.stroked_part, WrapsInAzimuth(s.scan));
     result.timings.total_s = total.Seconds();
     s.last_result = result;
     return result;
@@ -411,6 +431,8 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
+  result.warnings =
+      CheckCut(result.mask, object_strokes ? cv::Mat() : s.stroked_part, WrapsInAzimuth(s.scan));
   result.timings.total_s = total.Seconds();
   s.last_result = result;
   return result;

@@ -150,6 +150,12 @@ void FieldInfo::CheckValue(const nlohmann::json& value) const {
         CheckRange(element.get<double>(), element.dump());
       }
       return;
+    case FieldKind::kStringList:
+      if (!value.is_array() ||
+          std::any_of(value.begin(), value.end(), [](const auto& element) { return !element.is_string(); })) {
+        throw OptionsError(fmt::format("expected a list of strings, got {}", value.dump()));
+      }
+      return;
     case FieldKind::kUInt64:
       if (!value.is_number_unsigned() && !(value.is_number_integer() && value.get<int64_t>() >= 0)) {
         throw OptionsError(fmt::format("expected a whole number >= 0, got {}", value.dump()));
@@ -316,6 +322,8 @@ nlohmann::json SampleValue(const FieldInfo& field, const nlohmann::ordered_json&
         if (!inside(candidate)) return current;
       }
       return nlohmann::json::array({0.1, 1.5, 2.0 / 3.0});
+    case FieldKind::kStringList:
+      return nlohmann::json::array({"sample one", "sample, two"});
     case FieldKind::kStruct:
       break;
   }

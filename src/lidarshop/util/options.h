@@ -38,7 +38,8 @@
 namespace lidarshop {
 
 // kNumberList: a std::vector of numbers (per-channel weights); the range applies to every element.
-enum class FieldKind { kBool, kInt, kUInt64, kDouble, kString, kEnum, kStruct, kNumberList };
+// kStringList: a std::vector<std::string> (a result's warnings, one sentence each).
+enum class FieldKind { kBool, kInt, kUInt64, kDouble, kString, kEnum, kStruct, kNumberList, kStringList };
 
 template <class T>
 struct IsVector : std::false_type {};
@@ -166,9 +167,14 @@ class StructBuilder {
         return value;
       }
     };
-    if constexpr (IsVector<T>::value) {
+    if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      field.kind = FieldKind::kStringList;
+      field.set = [member](void* object, const nlohmann::json& json) {
+        static_cast<S*>(object)->*member = json.get<T>();
+      };
+    } else if constexpr (IsVector<T>::value) {
       using Element = typename T::value_type;
-      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers");
+      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers or strings");
       field.kind = FieldKind::kNumberList;
       if constexpr (std::is_integral_v<Element>) {
         field.integer_elements = true;
