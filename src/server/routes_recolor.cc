@@ -94,6 +94,9 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
         Snapshot next = document->now;
         next.scan = recolored.scan;
         Commit(*document, std::move(next), undo_depth);
+        // What looks wrong (the resection's RMS, colours that disagree with the scan's own), one sentence each.
+        std::vector<std::string> warnings = camera.warnings;
+        warnings.insert(warnings.end(), recolored.warnings.begin(), recolored.warnings.end());
         return nlohmann::ordered_json{{"inliers", camera.num_inliers},
                                       {"pairs", pairs.size()},
                                       {"rms_px", camera.rms_px},
@@ -103,6 +106,7 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
                                       {"hidden", recolored.hidden},
                                       {"outside_image", recolored.outside_image},
                                       {"summary", camera.Summary() + "; " + recolored.Summary()},
+                                      {"warnings", warnings},
                                       {"version", document->version}};
       },
       response);

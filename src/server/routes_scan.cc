@@ -1,6 +1,7 @@
 // Routes that open, describe, show and save scans (docs/api.md).
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -15,6 +16,7 @@
 
 #include "http.h"
 #include "lidarshop/io/render.h"
+#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -333,6 +335,27 @@ void AddScanRoutes(State& state) {
         if (std::find(readable.begin(), readable.end(), extension) == readable.end()) continue;
         files.push_back({{"path", it->path().string()}, {"bytes", it->file_size()}});
         if (files.size() >= 2000) break;
+      }
+    }
+    // In name order, each with whether its header reads (io/scan_header.h: the header only, cheap), so that the
+    // dialog offers the first file that opens rather than a broken one the folder happened to list first. A
+    // file whose real path leaves the roots (a symlink) is not read: opening it is refused anyway.
+    std::sort(files.begin(), files.end(), [](const auto& a, const auto& b) {
+      return a["path"].template get<std::string>() < b["path"].template get<std::string>();
+    });
+    for (auto& file : files) {
+      const std::string path = file["path"].get<std::string>();
+      if (ResolveUnderRoots(state.options.roots, path).empty()) {
+        file["readable"] = false;
+        file["error"] = "outside the served folders";
+        continue;
+      }
+      try {
+        ReadScanHeader(path);
+        file["readable"] = true;
+      } catch (const std::exception& error) {
+        file["readable"] = false;
+        file["error"] = error.what();
       }
     }
     SendJson(response, {{"roots", state.options.roots}, {"files", files}});

@@ -148,6 +148,17 @@ TEST_F(ServerTest, FilesOnlyUnderTheRoots) {
   std::ofstream(base_ / "root" / "sub" / ".box.tmp99999-0.ptx") << "half";
   const auto files = Json(client_->Get(Api("/api/files")));
   EXPECT_EQ(files["files"].size(), 4u);  // box, moved, broken, link (listed; opening the link fails)
+  // In name order, each saying whether it opens: the dialog starts on the first that does, not on broken.ptx.
+  std::vector<std::string> readable;
+  for (size_t i = 0; i < files["files"].size(); ++i) {
+    const auto& file = files["files"][i];
+    if (i > 0) EXPECT_LT(files["files"][i - 1]["path"].get<std::string>(), file["path"].get<std::string>());
+    if (file["readable"].get<bool>())
+      readable.push_back(fs::path(file["path"].get<std::string>()).filename());
+    else
+      EXPECT_FALSE(file["error"].get<std::string>().empty());
+  }
+  EXPECT_EQ(readable, (std::vector<std::string>{"box.ptx", "moved.ptx"}));
   fs::remove(base_ / "root" / "sub" / ".box.tmp99999-0.ptx");
   const auto opened = client_->Get(Api("/api/open?path=" + (base_ / "root" / "sub" / "box.ptx").string()));
   ASSERT_EQ(opened->status, 200);

@@ -30,6 +30,34 @@ export interface JobInfo {
   result?: Record<string, unknown>;
 }
 
+// One entry of GET /api/files: a scan file under the served folders; `readable` false (with `error`) when its
+// header does not read.
+export interface ScanFileEntry {
+  path: string;
+  bytes?: number;
+  readable?: boolean;
+  error?: string;
+}
+
+// The file the dialog starts on: the first that reads (a server without `readable` marks none broken).
+export function firstReadableFile(files: ScanFileEntry[]): ScanFileEntry | undefined {
+  return files.find((file) => file.readable !== false);
+}
+
+// The dialog's label of a file: its name, and "(does not open)" for a broken one.
+export function fileLabel(file: ScanFileEntry): string {
+  const name = file.path.split('/').pop()!;
+  return file.readable === false ? `${name} (does not open)` : name;
+}
+
+// The warnings of a finished job's result (`warnings`: what looks wrong with a cut, a fill or a recolouring,
+// one sentence each; docs/api.md), with a removal's cut and fill warnings once each. Empty when none.
+export function resultWarnings(job: JobInfo): string[] {
+  const list = job.result?.warnings;
+  if (!Array.isArray(list)) return [];
+  return [...new Set(list.filter((item): item is string => typeof item === 'string'))];
+}
+
 // The points of a scan as typed arrays: positions in the scanner frame (metres), the cell of each point
 // (row * cols + col), RGB and flags (1 = synthesized, 2 = object).
 export interface PointSet {

@@ -1,5 +1,5 @@
 // The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
-import { Api, ApiError, DocumentInfo, JobInfo, MeshData, inverseRigid, multiply, poseMatrix } from './api';
+import { Api, ApiError, DocumentInfo, JobInfo, MeshData, ScanFileEntry, fileLabel, firstReadableFile, inverseRigid, multiply, poseMatrix, resultWarnings } from './api';
 import { PointColouring, PointView } from './pointview';
 import { PairsPanel } from './pairsui';
 import { Brush, RayView, loadImage } from './rayview';
@@ -85,7 +85,9 @@ async function runJob(path: string, body: unknown, what: string, refreshAfter = 
     runningJob = null;
     if (finished.state === 'done') {
       if (refreshAfter) await refresh(true);
-      status(`${what} done. ${element('status').textContent}`);
+      // A result that looks wrong says so first (a cut that leaked, an empty hole, a camera that disagrees).
+      const warnings = resultWarnings(finished).map((warning) => `warning: ${warning}. `).join('');
+      status(`${what} done. ${warnings}${element('status').textContent}`);
     } else {
       status(`${what} ${finished.state}${finished.error ? `: ${finished.error}` : ''}`);
     }
@@ -308,8 +310,17 @@ async function start() {
     const formats = await api.json<{ write: string[] }>('/api/formats');
     element('format').replaceChildren(...formats.write.map((name) => new Option(name, name)));
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
-    const { files } = await api.json<{ files: { path: string }[] }>('/api/files');
-    element('file').replaceChildren(...files.map((file) => new Option(file.path.split('/').pop()!, file.path)));
+    const { files } = await api.json<{ files: ScanFileEntry[] }>('/api/files');
+    const fileSelect = element<HTMLSelectElement>('file');
+    fileSelect.replaceChildren(...files.map((file) => {
+      const option = new Option(fileLabel(file), file.path);
+      option.disabled = file.readable === false; // broken files are listed (with why) but not chosen
+      if (file.error) option.title = file.error;
+      return option;
+    }));
+    // The dialog starts on the first file that opens (the server lists them in name order, broken ones too).
+    const first = firstReadableFile(files);
+    if (first) fileSelect.value = first.path;
     const models = await api.json<{ builtin: string[]; files: string[] }>('/api/models');
     element('model').replaceChildren(...models.builtin.map((name) => new Option(name, name)),
       ...models.files.map((path) => new Option(path.split('/').pop()!, path)));

@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { Api, FLAG_OBJECT, FLAG_SYNTHESIZED, parsePoints } from '../src/api';
+import { Api, FLAG_OBJECT, FLAG_SYNTHESIZED, JobInfo, fileLabel, firstReadableFile, parsePoints, resultWarnings } from '../src/api';
 import { pointColours } from '../src/pointview';
 
 function encode(points: { xyz: number[]; cell: number; rgb: number[]; flag: number }[], rows = 4, cols = 5) {
@@ -74,5 +74,35 @@ describe('poses', () => {
     new Uint32Array(buffer, 52, 3).set([0, 1, 2]);
     expect(Array.from(parseMesh(buffer).indices)).toEqual([0, 1, 2]);
     expect(() => parseMesh(buffer.slice(0, 60))).toThrow(/size/);
+  });
+});
+
+describe('resultWarnings', () => {
+  const job = (result?: Record<string, unknown>): JobInfo => ({ id: 1, kind: 'fill', state: 'done', label: '', done: 1, total: 1, result });
+  it('reads the result warnings, once each', () => {
+    expect(resultWarnings(job({ warnings: ['the hole mask is empty', 'the hole mask is empty'] }))).toEqual(['the hole mask is empty']);
+  });
+  it('gives none for a result without warnings, an empty list or no result', () => {
+    expect(resultWarnings(job({ object_cells: 3 }))).toEqual([]);
+    expect(resultWarnings(job({ warnings: [] }))).toEqual([]);
+    expect(resultWarnings(job())).toEqual([]);
+    expect(resultWarnings(job({ warnings: 'not a list' }))).toEqual([]);
+  });
+});
+
+describe('the file dialog', () => {
+  const files = [
+    { path: '/data/a_broken.e57', readable: false, error: 'a_broken.e57: not an E57 file' },
+    { path: '/data/b_scan.ptx', readable: true },
+    { path: '/data/c_scan.ply', readable: true },
+  ];
+  it('starts on the first file that opens, not on a broken one', () => {
+    expect(firstReadableFile(files)?.path).toBe('/data/b_scan.ptx');
+    expect(firstReadableFile([files[0]])).toBeUndefined();
+    expect(firstReadableFile([{ path: '/x.ptx' }])?.path).toBe('/x.ptx'); // an older server: nothing marked
+  });
+  it('labels a broken file', () => {
+    expect(fileLabel(files[0])).toBe('a_broken.e57 (does not open)');
+    expect(fileLabel(files[1])).toBe('b_scan.ptx');
   });
 });
