@@ -177,5 +177,11 @@ if "$lidarshop" batch --help >/dev/null 2>&1; then
     "'synthesized' in d['scans'][0]['channels'] and d['scans'][0]['rows'] == 120"
 fi
 
+# Start-up: OpenCV's codecs (Debian links them to GDAL and ~120 more libraries) load with the first picture
+# (util/plugin.h), not with every command.
+check "the executable does not link OpenCV's codecs nor GDAL" \
+  sh -c "! ldd '$lidarshop' | grep -qE 'libopencv_imgcodecs|libopencv_ximgproc|libgdal'"
+check "... which load when a picture is written" "$lidarshop" render "$work/scan.ptx" -o "$work/again.png" -q
+
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ]

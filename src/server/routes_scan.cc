@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
@@ -115,7 +116,7 @@ void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
   cv::Mat out = rgb_or_gray;
   if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
   std::vector<uint8_t> png;
-  cv::imencode(".png", out, png);
+  CvImEncode(".png", out, &png);
   response.set_content(std::string(png.begin(), png.end()), "image/png");
 }
 
@@ -413,7 +414,7 @@ void AddScanRoutes(State& state) {
              cv::Mat overlay(mask.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
              overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask);
              std::vector<uint8_t> png;
-             cv::imencode(".png", overlay, png);
+             CvImEncode(".png", overlay, &png);
              response.set_content(std::string(png.begin(), png.end()), "image/png");
            });
   http.Get(R"(/api/docs/(\d+)/points)",

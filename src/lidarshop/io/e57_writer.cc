@@ -13,6 +13,7 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -365,7 +366,7 @@ void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical
     if (image.image.empty()) return;
     cv::Mat bgr;
     cv::cvtColor(image.image, bgr, cv::COLOR_RGB2BGR);
-    cv::imencode(".png", bgr, bytes);
+    CvImEncode(".png", bgr, &bytes);
     encoding = "png";
   }
   while (logical->size() % 8) logical->push_back(0);

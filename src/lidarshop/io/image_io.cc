@@ -21,8 +21,36 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/plugin.h"
 
 namespace lidarshop {
+
+cv::Mat CvImRead(const std::string& path, int flags) {
+  static const auto read = OpenCvPluginFunction<void(const std::string*, int, cv::Mat*)>("lidarshop_imread");
+  cv::Mat image;
+  read(&path, flags, &image);
+  return image;
+}
+
+cv::Mat CvImDecode(const cv::Mat& bytes, int flags) {
+  static const auto decode = OpenCvPluginFunction<void(const cv::Mat*, int, cv::Mat*)>("lidarshop_imdecode");
+  cv::Mat image;
+  decode(&bytes, flags, &image);
+  return image;
+}
+
+bool CvImWrite(const std::string& path, const cv::Mat& image) {
+  static const auto write =
+      OpenCvPluginFunction<bool(const std::string*, const cv::Mat*)>("lidarshop_imwrite");
+  return write(&path, &image);
+}
+
+bool CvImEncode(const std::string& extension, const cv::Mat& image, std::vector<uchar>* bytes) {
+  static const auto encode =
+      OpenCvPluginFunction<bool(const std::string*, const cv::Mat*, std::vector<uchar>*)>(
+          "lidarshop_imencode");
+  return encode(&extension, &image, bytes);
+}
 namespace {
 
 // OpenCV's BGR(A) <-> lidarshop's RGB(A); the conversion is its own inverse.
@@ -251,9 +279,9 @@ cv::Mat Decode(const uint8_t* data, size_t size, const std::string& what, const 
   const std::string printed = QuietDecode([&] {
     try {
       if (header.format == "exr" && !path.empty()) {
-        image = cv::imread(path, flags);
+        image = CvImRead(path, flags);
       } else {
-        image = cv::imdecode(cv::Mat(1, static_cast<int>(size), CV_8U, const_cast<uint8_t*>(data)), flags);
+        image = CvImDecode(cv::Mat(1, static_cast<int>(size), CV_8U, const_cast<uint8_t*>(data)), flags);
       }
     } catch (const cv::Exception& error) {
       image.release();
@@ -349,7 +377,7 @@ void WriteImage(const std::string& path, const cv::Mat& image) {
   const cv::Mat bgr = SwapRedBlue(image);
   WritePathAtomically(path, [&](const std::string& temporary) {
     try {
-      return cv::imwrite(temporary, bgr);
+      return CvImWrite(temporary, bgr);
     } catch (const cv::Exception& error) {
       ThrowInputError(path, "", "", fmt::format("cannot write the image ({})", error.what()));
     }

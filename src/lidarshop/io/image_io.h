@@ -16,6 +16,14 @@
 
 namespace lidarshop {
 
+// OpenCV's codecs through lidarshop's plugin (util/plugin.h, loaded on first use): cv::imread, cv::imdecode,
+// cv::imwrite and cv::imencode with their arguments (BGR order, OpenCV's flags). For the readers and writers
+// below and the server; everything else reads and writes pictures with them.
+cv::Mat CvImRead(const std::string& path, int flags);
+cv::Mat CvImDecode(const cv::Mat& bytes, int flags);
+bool CvImWrite(const std::string& path, const cv::Mat& image);
+bool CvImEncode(const std::string& extension, const cv::Mat& image, std::vector<uchar>* bytes);
+
 // Every image lidarshop reads goes through the functions below: the size is read from the file's header
 // first (ReadImageHeader) and checked against kMaxImagePixels, the size the caller expects and the memory
 // budget (util/memory_budget.h), so that no decoder allocates for a size the bytes merely claim. (OpenCV's own

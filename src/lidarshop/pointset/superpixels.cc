@@ -4,12 +4,11 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/ximgproc/segmentation.hpp>
-#include <opencv2/ximgproc/slic.hpp>
 
 #include "lidarshop/pointset/quickshift.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/plugin.h"
 
 namespace lidarshop {
 
@@ -47,12 +46,13 @@ cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int*
   cv::merge(channels, image);
   cv::Mat labels;
   if (options.method == SuperpixelMethod::kSlic) {
-    const cv::Ptr<cv::ximgproc::SuperpixelSLIC> slic =
-        cv::ximgproc::createSuperpixelSLIC(image, cv::ximgproc::SLICO, options.region_cells, options.ruler);
-    slic->iterate(options.iterations);
-    slic->enforceLabelConnectivity();
-    slic->getLabels(labels);
-    if (num_superpixels) *num_superpixels = slic->getNumberOfSuperpixels();
+    // OpenCV ximgproc through lidarshop's plugin (util/plugin.h: loaded on first use).
+    static const auto slic =
+        OpenCvPluginFunction<void(const cv::Mat*, int, float, int, cv::Mat*, int*)>("lidarshop_slic");
+    int count = 0;
+    slic(&image, options.region_cells, static_cast<float>(options.ruler), options.iterations, &labels,
+         &count);
+    if (num_superpixels) *num_superpixels = count;
   } else if (options.method == SuperpixelMethod::kQuickShift) {
     cv::Mat features;
     image.convertTo(features, CV_32F, options.quickshift_ratio);
@@ -65,10 +65,9 @@ cv::Mat ScanSuperpixels(const Scan& scan, const SuperpixelOptions& options, int*
       std::vector<cv::Mat> first(channels.begin() + 1, channels.end());
       cv::merge(first, image);  // drop red: green, blue, range
     }
-    const cv::Ptr<cv::ximgproc::segmentation::GraphSegmentation> graph =
-        cv::ximgproc::segmentation::createGraphSegmentation(options.graph_sigma, options.graph_k,
-                                                            options.graph_min_cells);
-    graph->processImage(image, labels);
+    static const auto graph = OpenCvPluginFunction<void(const cv::Mat*, double, float, int, cv::Mat*)>(
+        "lidarshop_graph_segmentation");
+    graph(&image, options.graph_sigma, static_cast<float>(options.graph_k), options.graph_min_cells, &labels);
     if (num_superpixels) {
       double high;
       cv::minMaxLoc(labels, nullptr, &high);
