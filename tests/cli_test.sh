@@ -219,7 +219,7 @@ for extension in exr tif; do
   json_check "render range .$extension is float metres" "$work/range_$extension.json" "'metres' in d['values']"
 done
 check "range.exr is OpenEXR" python3 -c "import sys; sys.exit(open('$work/range.exr','rb').read(4) != b'\x76\x2f\x31\x01')"
-fails_clearly "render rgb as .exr" "range, intensity or normals" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --channel rgb
+fails_clearly "render rgb as .exr" "range, elevation, intensity or normals" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --channel rgb
 fails_clearly "render --legend as .exr" "legend" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --legend
 
 # Label legends name the scene's objects; scan --labels writes the colour picture beside the raw one.
