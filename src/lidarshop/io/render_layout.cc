@@ -195,13 +195,14 @@ constexpr int kSpacingPoints = 8;
 // ... and no automatic square is larger than this many times the median one.
 constexpr double kMaxSplatPerMedian = 2.0;
 
-// Draws every projected point (u, v in pixels) as a square, the point nearest to the viewer winning each pixel:
+// Draws every projected point (u, v in pixels; `pixel_m` metres a pixel) as a square, the point nearest to the
+// viewer winning each pixel (among points of one surface, the one whose pixel is nearest):
 // squares of `point_size_px` > 0, or (0: automatic) of kSplatPerSpacing times the local spacing, at most
 // kMaxSplatPerMedian times the median square. Fills `cells` through FillCells (one chosen point per pixel);
 // returns the number of points that show on at least one pixel and sets the median square side in
 // *median_splat_px.
 int64_t SplatCells(const Scan& scan, const std::vector<ProjectedPoint>& projected, int point_size_px,
-                   Scan* cells, double* median_splat_px) {
+                   double pixel_m, Scan* cells, double* median_splat_px) {
   const int rows = cells->rows, cols = cells->cols;
   const int64_t count = static_cast<int64_t>(projected.size());
   std::vector<cv::Point> pixel(projected.size());
@@ -211,14 +212,24 @@ int64_t SplatCells(const Scan& scan, const std::vector<ProjectedPoint>& projecte
   }
   cv::Mat depth(rows, cols, CV_64F, cv::Scalar(std::numeric_limits<double>::infinity()));
   cv::Mat winner(rows, cols, CV_32S, cv::Scalar(-1));
-  // Draws point i as a square of `side` pixels with the depth test.
+  cv::Mat centre_distance(rows, cols, CV_32S, cv::Scalar(std::numeric_limits<int32_t>::max()));
+  // Draws point i as a square of `side` pixels with the depth test. Points within the square's width in
+  // metres of the best depth so far are taken as the same surface: there the point whose pixel is nearest
+  // wins, so that neighbouring squares meet halfway (a sharp picture of the surface) rather than the
+  // slightly nearer one covering the other; a point nearer by more (a crown over the ground) always wins.
   auto draw = [&](int64_t i, int side) {
+    const double same_surface_m = side * pixel_m;
     const int low = -(side - 1) / 2, high = side / 2;  // side 1: the pixel itself; 2: it and the next
     for (int row = std::max(0, pixel[i].y + low); row <= std::min(rows - 1, pixel[i].y + high); ++row) {
       for (int col = std::max(0, pixel[i].x + low); col <= std::min(cols - 1, pixel[i].x + high); ++col) {
         double& best = depth.at<double>(row, col);
-        if (projected[i].depth < best) {
-          best = projected[i].depth;
+        int32_t& best_distance = centre_distance.at<int32_t>(row, col);
+        const int32_t distance =
+            (row - pixel[i].y) * (row - pixel[i].y) + (col - pixel[i].x) * (col - pixel[i].x);
+        const double d = projected[i].depth;
+        if (d < best - same_surface_m || (d <= best + same_surface_m && distance < best_distance)) {
+          best = d;
+          best_distance = distance;
           winner.at<int32_t>(row, col) = static_cast<int32_t>(i);
         }
       }
@@ -347,7 +358,8 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
   layout.view = view;
   layout.cells = EmptyCells(scan, size);
   layout.points = all_points;
-  layout.points_kept = SplatCells(scan, projected, options.point_size_px, &layout.cells, &layout.splat_px);
+  layout.points_kept = SplatCells(scan, projected, options.point_size_px, std::max(step_across, step_down),
+                                  &layout.cells, &layout.splat_px);
   layout.splat_automatic = options.point_size_px == 0;
   layout.picture_size = size;
   layout.pixel_width = step_across;
