@@ -171,15 +171,15 @@ RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
   return result;
 }
 
-// Shades `image` (CV_8UC3, the cells' size) by the gradient of the cells' height towards the viewer of an
-// orthographic view: heights smoothed over about a square's side (the squares of one point are flat, and
-// their steps are not the surface's), normals from central differences in metres, lit from azimuth 315°
-// (north-west) at 45° up; a flat surface keeps its colour, slopes facing the light brighten to 1.3 times.
-void Hillshade(const PictureLayout& layout, cv::Mat* image) {
+// The surface seen in an orthographic view, as unit normals in the view's frame (right, up in the picture,
+// towards the viewer; CV_32FC3, zero where no point is): the cells' heights towards the viewer smoothed over
+// about a square's side (the squares of one point are flat, and their steps are not the surface's), then
+// central differences in metres.
+cv::Mat ViewNormals(const PictureLayout& layout) {
   const Scan& cells = layout.cells;
   const Eigen::Vector3d toward = TowardViewer(layout.view);
-  cv::Mat height(cells.rows, cells.cols, CV_32F, cv::Scalar(0)),
-      weight(cells.rows, cells.cols, CV_32F, cv::Scalar(0));
+  cv::Mat height(cells.rows, cells.cols, CV_32F, cv::Scalar(0));
+  cv::Mat weight(cells.rows, cells.cols, CV_32F, cv::Scalar(0));
   for (int row = 0; row < cells.rows; ++row) {
     for (int col = 0; col < cells.cols; ++col) {
       if (!cells.valid.at<uint8_t>(row, col)) continue;
@@ -195,10 +195,7 @@ void Hillshade(const PictureLayout& layout, cv::Mat* image) {
   cv::GaussianBlur(height, height_sum, cv::Size(), sigma);
   cv::GaussianBlur(weight, weight_sum, cv::Size(), sigma);
   const cv::Mat smooth = height_sum / cv::max(weight_sum, 1e-6);
-  constexpr double kAzimuthRad = 315.0 * M_PI / 180.0, kAltitudeRad = 45.0 * M_PI / 180.0;
-  // Light direction in (right, up in the picture, towards the viewer).
-  const Eigen::Vector3d light(std::cos(kAltitudeRad) * std::sin(kAzimuthRad),
-                              std::cos(kAltitudeRad) * std::cos(kAzimuthRad), std::sin(kAltitudeRad));
+  cv::Mat normals(cells.rows, cells.cols, CV_32FC3, cv::Scalar::all(0));
   for (int row = 0; row < cells.rows; ++row) {
     for (int col = 0; col < cells.cols; ++col) {
       if (!cells.valid.at<uint8_t>(row, col)) continue;
@@ -209,8 +206,46 @@ void Hillshade(const PictureLayout& layout, cv::Mat* image) {
       };
       const double d_right = (at(row, col + 1) - at(row, col - 1)) / (2 * layout.pixel_width);
       const double d_up = (at(row - 1, col) - at(row + 1, col)) / (2 * layout.pixel_height);
-      const Eigen::Vector3d normal = Eigen::Vector3d(-d_right, -d_up, 1.0).normalized();
-      const double shade = std::max(0.0, normal.dot(light)) / light.z();
+      const Eigen::Vector3d n = Eigen::Vector3d(-d_right, -d_up, 1.0).normalized();
+      normals.at<cv::Vec3f>(row, col) =
+          cv::Vec3f(static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()));
+    }
+  }
+  return normals;
+}
+
+// Normals of the surface an orthographic view sees, in the scanner frame (the `normals` channel of a cloud
+// without normals, whose cells have no ray grid to estimate them on).
+cv::Mat OrthographicNormals(const PictureLayout& layout) {
+  const Eigen::Vector3d toward = TowardViewer(layout.view);
+  const Eigen::Vector3d up =
+      layout.view == PictureView::kTop ? Eigen::Vector3d::UnitY() : Eigen::Vector3d::UnitZ();
+  Eigen::Matrix3d world_from_view;
+  world_from_view << up.cross(toward), up, toward;
+  const Eigen::Matrix3d scanner_from_view =
+      layout.cells.world_from_scanner.topLeftCorner<3, 3>().transpose() * world_from_view;
+  cv::Mat normals = ViewNormals(layout);
+  for (auto it = normals.begin<cv::Vec3f>(); it != normals.end<cv::Vec3f>(); ++it) {
+    if (*it == cv::Vec3f(0, 0, 0)) continue;
+    const Eigen::Vector3d n = scanner_from_view * Eigen::Vector3d((*it)[0], (*it)[1], (*it)[2]);
+    *it = cv::Vec3f(static_cast<float>(n.x()), static_cast<float>(n.y()), static_cast<float>(n.z()));
+  }
+  return normals;
+}
+
+// Shades `image` (CV_8UC3, the cells' size) by the surface an orthographic view sees (ViewNormals), lit from
+// azimuth 315° (north-west, up-left in the picture) at 45° up: a flat surface keeps its colour, slopes facing
+// the light brighten to 1.3 times, those facing away darken to a quarter.
+void Hillshade(const PictureLayout& layout, cv::Mat* image) {
+  constexpr double kAzimuthRad = 315.0 * M_PI / 180.0, kAltitudeRad = 45.0 * M_PI / 180.0;
+  const Eigen::Vector3d light(std::cos(kAltitudeRad) * std::sin(kAzimuthRad),
+                              std::cos(kAltitudeRad) * std::cos(kAzimuthRad), std::sin(kAltitudeRad));
+  const cv::Mat normals = ViewNormals(layout);
+  for (int row = 0; row < normals.rows; ++row) {
+    for (int col = 0; col < normals.cols; ++col) {
+      const cv::Vec3f n = normals.at<cv::Vec3f>(row, col);
+      if (n == cv::Vec3f(0, 0, 0)) continue;
+      const double shade = std::max(0.0, n[0] * light.x() + n[1] * light.y() + n[2] * light.z()) / light.z();
       const double factor = std::min(1.3, 0.25 + 0.75 * shade);
       cv::Vec3b& pixel = image->at<cv::Vec3b>(row, col);
       for (int k = 0; k < 3; ++k) pixel[k] = cv::saturate_cast<uint8_t>(pixel[k] * factor);
@@ -267,6 +302,9 @@ PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
     throw OptionsError(
         fmt::format("hillshade shades the orthographic views (top, front, side), not the {} view",
                     ToString(layout.view)));
+  }
+  if (orthographic && options.channel == RenderChannel::kNormals && layout.cells.normal.empty()) {
+    layout.cells.normal = OrthographicNormals(layout);
   }
   RenderResult colored = ColorCells(layout.cells, options);
   // Orthographic cells are the picture's pixels (no resampling), so the shading works on them directly.

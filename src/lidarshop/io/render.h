@@ -11,7 +11,8 @@
 //                  InputError "NAME has no intensity channel; it has: xyz, rgb"
 //   rgb            the scan's colour (InputError when the scan has none)
 //   normals        the normal channel (synthetic scans), or normals estimated from the neighbouring points,
-//                  shown as (n + 1) / 2 in the scanner frame: red = x (right), green = y (forward), blue = z (up)
+//                  shown as (n + 1) / 2 in the scanner frame: red = x (right), green = y (forward), blue = z (up);
+//                  orthographic views of a cloud without normals: the slope of the surface seen (as --hillshade)
 //   labels         distinct colours per object label (InputError when the scan has none); the label channel of
 //                  a scan read from LAS holds its classification and is drawn as `classification`
 //   classification the label channel read as ASPRS classes: their usual colours and names (colormap.h:

@@ -308,6 +308,21 @@ TEST(RenderOrthoTest, HillshadeLightsSlopesFacingNorthWest) {
   EXPECT_GT(grey(lit.image, 5), grey(lit.image, 15) + 40);    // west-facing lit, east-facing in shade
   EXPECT_NEAR(grey(lit.image, 25), grey(flat.image, 25), 2);  // flat ground keeps its colour
   EXPECT_THROW(RenderPicture(cloud, shaded, PictureLayoutOptions{}), OptionsError);  // not orthographic
+
+  // The same slopes give the normals of a cloud without them: up and west (-x) on the west slope, up on the
+  // flat strip, as (n + 1) / 2 in the scanner frame.
+  RenderOptions normals;
+  normals.channel = RenderChannel::kNormals;
+  const PictureResult by_normal = RenderPicture(cloud, normals, View(PictureView::kTop));
+  auto color_at = [&](double x) {
+    return by_normal.image.at<cv::Vec3b>(row, static_cast<int>(x / by_normal.layout.pixel_width));
+  };
+  const double half = 127.5 * (1 - std::sqrt(0.5)), up = 127.5 * (1 + std::sqrt(0.5));  // n = (-1, 0, 1) / √2
+  EXPECT_NEAR(color_at(5)[0], half, 3);
+  EXPECT_NEAR(color_at(5)[1], 127.5, 3);
+  EXPECT_NEAR(color_at(5)[2], up, 3);
+  EXPECT_NEAR(color_at(15)[0], up, 3);
+  EXPECT_NEAR(color_at(25)[2], 255, 2);
 }
 
 }  // namespace
