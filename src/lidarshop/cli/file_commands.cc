@@ -419,9 +419,10 @@ int RunRender(int argc, char** argv) {
   PictureLayoutOptions layout_options;
   OptionBinder binder(app);
   app.add_option("file", input, "scan file")->required();
-  app.add_option("-o,--output", output,
-                 "picture to write: .png, .jpg (colours); .exr, .tif (range in metres, intensity or normals "
-                 "as 32-bit floats, NaN where no return)")
+  app.add_option(
+         "-o,--output", output,
+         "picture to write: .png, .jpg (colours); .exr, .tif (range or elevation in metres, intensity "
+         "or normals as 32-bit floats, NaN where no return)")
       ->required();
   AddJsonOption(app, &json_path);
   // RenderOptions is not described (an optional colour map, NaN bounds): its flags are bound here, with the
@@ -432,7 +433,7 @@ int RunRender(int argc, char** argv) {
                  "what to draw (default: range; elevation in the top, front and side views)")
       ->check(ChoiceOf(channels));
   app.add_flag("--legend", options.legend,
-               "add a colour scale bar, label swatches with names, or the normals key to the right");
+               "add a colour scale bar, label or class swatches with names, or the normals key to the right");
   app.add_option("--scan", scan_index, "which scan of the file (from 0)")->capture_default_str();
   app.add_option("--colormap", color_map,
                  "colour map of metric channels (default: viridis for range and elevation, gray "
