@@ -12,22 +12,20 @@ include(CMakePackageConfigHelpers)
 
 set(LIDARSHOP_CONFIG_INSTALL_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/lidarshop)
 get_target_property(lidarshop_installed_modules lidarshop INTERFACE_LINK_LIBRARIES)
+set(header_modules "")
+set(header_dirs "")
 foreach(module_target ${lidarshop_installed_modules})
   string(REGEX REPLACE "^lidarshop_" "" module ${module_target})
   set_target_properties(${module_target} PROPERTIES EXPORT_NAME ${module})
   get_target_property(module_dir ${module_target} SOURCE_DIR)
-  file(GLOB module_headers CONFIGURE_DEPENDS ${module_dir}/*.h)
-  set(public_headers "")
-  foreach(header ${module_headers})
-    # The opening comment (the first 2000 bytes) says whether a header is internal ("Internal to the io module").
-    file(STRINGS ${header} internal_mark LIMIT_INPUT 2000 REGEX "[Ii]nternals? (to|of) ")
-    if(NOT header MATCHES "_test[A-Za-z0-9_]*\\.h$" AND NOT internal_mark)
-      list(APPEND public_headers ${header})
-    endif()
-  endforeach()
-  install(FILES ${public_headers} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/lidarshop/${module}
-          COMPONENT Development)
+  list(APPEND header_modules ${module})
+  list(APPEND header_dirs ${module_dir})
 endforeach()
+# The public headers are chosen when installing (cmake/LidarshopInstallHeaders.cmake), from the folders as they are.
+install(CODE "set(LIDARSHOP_HEADER_MODULES \"${header_modules}\")
+set(LIDARSHOP_HEADER_DIRS \"${header_dirs}\")
+set(LIDARSHOP_HEADER_DESTINATION \"${CMAKE_INSTALL_INCLUDEDIR}\")" COMPONENT Development)
+install(SCRIPT ${PROJECT_SOURCE_DIR}/cmake/LidarshopInstallHeaders.cmake COMPONENT Development)
 
 install(TARGETS lidarshop ${lidarshop_installed_modules} EXPORT lidarshopTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT Development)

@@ -10,7 +10,8 @@ clang_format=${2:-clang-format}
 cd "$root"
 # A check that cannot run fails: without clang-format nothing is checked, which is not a pass.
 if ! command -v "$clang_format" > /dev/null; then
-  echo "check_format: FAILED: '$clang_format' not found, so no file was checked (scripts/setup.sh installs clang-format)" >&2
+  echo "check_format: FAILED: '$clang_format' not found, so no file was checked" \
+    "(scripts/setup.sh installs clang-format)" >&2
   exit 2
 fi
 folders=()

@@ -24,7 +24,7 @@ ctest --test-dir build/release --output-on-failure -j "$(nproc)" "$@"
 bash scripts/web.sh test
 fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-15}
 if [[ $fuzz_seconds -gt 0 ]]; then
-  # A check that cannot run fails rather than skip: no clang, no fuzzing (LIDARSHOP_FUZZ_SECONDS=0 skips it on purpose).
+  # A check that cannot run fails rather than skip (LIDARSHOP_FUZZ_SECONDS=0 skips fuzzing on purpose).
   command -v clang++-14 >/dev/null ||
     { echo "test.sh: clang++-14 not found, the fuzzers cannot run (scripts/setup.sh installs clang)" >&2; exit 1; }
   LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh "$fuzz_seconds"
