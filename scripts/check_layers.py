@@ -8,7 +8,7 @@ Every C++ file of the repository (outside build folders) belongs to one layer:
 A C++ file in no layer is a problem: the check covers every folder, including ones added later.
 
 For modules it compares
-  - the includes of its library sources (*.h, *.cc, not *_test.cc) with the DEPS of its CMakeLists.txt (exactly:
+  - the includes of its library sources (not tests: *_test.cc, *_test_util.h) with the DEPS of its CMakeLists.txt (exactly:
     an undeclared include and a declared dependency never included are both problems),
   - the DEPS with the "depends on" column of the module table in ARCHITECTURE.md (names of module folders, in
     backticks or plain; other words such as external libraries are ignored),
@@ -41,6 +41,7 @@ ADD_MODULE_RE = re.compile(r"lidarshop_add_module\s*\(([^)]*)\)", re.S)
 KEYWORDS = {"NAME", "DEPS", "LIBS", "TEST_DEPS", "TEST_LIBS"}
 CPP_EXTENSIONS = (".h", ".hh", ".hpp", ".c", ".cc", ".cpp", ".cxx")
 TESTING = "testing"  # the test fixtures module: tests and evaluation programs only
+TEST_FILE_RE = re.compile(r"_test(_[A-Za-z0-9_]+)?\.[a-z]+$")  # foo_test.cc and test helpers (io_test_util.h)
 
 
 class CannotRun(Exception):
@@ -291,7 +292,7 @@ def check(root):
             unplaced.setdefault(os.path.dirname(path), path)
             continue
         kind, name = layer
-        is_test = os.path.basename(path).endswith("_test.cc")
+        is_test = TEST_FILE_RE.search(path) is not None
         text_lines = open(os.path.join(root, path), encoding="utf-8", errors="replace").read().splitlines()
         for number, text in enumerate(text_lines, start=1):
             match = INCLUDE_RE.match(text)
