@@ -27,6 +27,34 @@ set(LIDARSHOP_HEADER_DIRS \"${header_dirs}\")
 set(LIDARSHOP_HEADER_DESTINATION \"${CMAKE_INSTALL_INCLUDEDIR}\")" COMPONENT Development)
 install(SCRIPT ${PROJECT_SOURCE_DIR}/cmake/LidarshopInstallHeaders.cmake COMPONENT Development)
 
+# Eigen's alignment is part of the library's ABI: a struct holding an Eigen::Matrix4d (Scan) has another size and
+# layout when Eigen aligns to 32 bytes (-mavx, -march=native) than to 16, and heap blocks are freed the way they
+# were allocated. The installed targets pin the values the library was compiled with (read from a probe compiled
+# with the library's flags), so a program built with other flags still agrees. The build tree is not changed.
+set(probe_dir ${PROJECT_BINARY_DIR}/CMakeFiles/lidarshop_eigen_abi)
+file(WRITE ${probe_dir}/probe.cc [=[
+#include <Eigen/Core>
+#define LIDARSHOP_TEXT2(x) #x
+#define LIDARSHOP_TEXT(x) LIDARSHOP_TEXT2(x)
+extern const char kLidarshopEigenAbi[] = "lidarshop_eigen_abi=" LIDARSHOP_TEXT(EIGEN_MAX_ALIGN_BYTES) ","
+                                         LIDARSHOP_TEXT(EIGEN_MAX_STATIC_ALIGN_BYTES);
+]=])
+get_directory_property(library_compile_options DIRECTORY ${PROJECT_SOURCE_DIR} COMPILE_OPTIONS)
+set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+try_compile(eigen_probe_compiled ${probe_dir}/build SOURCES ${probe_dir}/probe.cc
+            COMPILE_DEFINITIONS ${library_compile_options} LINK_LIBRARIES Eigen3::Eigen
+            CXX_STANDARD ${CMAKE_CXX_STANDARD} COPY_FILE ${probe_dir}/probe.a OUTPUT_VARIABLE probe_output)
+unset(CMAKE_TRY_COMPILE_TARGET_TYPE)
+set(eigen_abi "")
+if(eigen_probe_compiled)
+  file(STRINGS ${probe_dir}/probe.a eigen_abi REGEX "lidarshop_eigen_abi=[0-9]+,[0-9]+")
+endif()
+if(NOT eigen_abi MATCHES "lidarshop_eigen_abi=([0-9]+),([0-9]+)")
+  message(FATAL_ERROR "lidarshop: could not read Eigen's alignment under the library's flags:\n${probe_output}")
+endif()
+target_compile_definitions(lidarshop_util INTERFACE $<INSTALL_INTERFACE:EIGEN_MAX_ALIGN_BYTES=${CMAKE_MATCH_1}
+                                                                   EIGEN_MAX_STATIC_ALIGN_BYTES=${CMAKE_MATCH_2}>)
+
 install(TARGETS lidarshop ${lidarshop_installed_modules} EXPORT lidarshopTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT Development)
 install(EXPORT lidarshopTargets NAMESPACE lidarshop:: DESTINATION ${LIDARSHOP_CONFIG_INSTALL_DIR}
