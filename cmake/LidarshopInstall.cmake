@@ -41,10 +41,12 @@ extern const char kLidarshopEigenAbi[] = "lidarshop_eigen_abi=" LIDARSHOP_TEXT(E
 ]=])
 get_directory_property(library_compile_options DIRECTORY ${PROJECT_SOURCE_DIR} COMPILE_OPTIONS)
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+set(CMAKE_TRY_COMPILE_CONFIGURATION ${CMAKE_BUILD_TYPE})  # CMAKE_CXX_FLAGS_<build type> too (-march there)
 try_compile(eigen_probe_compiled ${probe_dir}/build SOURCES ${probe_dir}/probe.cc
             COMPILE_DEFINITIONS ${library_compile_options} LINK_LIBRARIES Eigen3::Eigen
             CXX_STANDARD ${CMAKE_CXX_STANDARD} COPY_FILE ${probe_dir}/probe.a OUTPUT_VARIABLE probe_output)
 unset(CMAKE_TRY_COMPILE_TARGET_TYPE)
+unset(CMAKE_TRY_COMPILE_CONFIGURATION)
 set(eigen_abi "")
 if(eigen_probe_compiled)
   file(STRINGS ${probe_dir}/probe.a eigen_abi REGEX "lidarshop_eigen_abi=[0-9]+,[0-9]+")
