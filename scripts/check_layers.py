@@ -89,11 +89,11 @@ def parse_tables(path):
 
 
 def find_table(tables, *columns):
-    """The rows and the column indexes of the first table whose header has all `columns`, or (None, None)."""
+    """The rows and the column indexes of the first table whose header has all `columns`; no rows if none has."""
     for header, rows in tables.items():
         if all(column in header for column in columns):
             return rows, [header.index(column) for column in columns]
-    return None, None
+    return [], [0] * len(columns)
 
 
 def ticked(cell):
@@ -179,7 +179,7 @@ def check(root):
     architecture = os.path.join(root, "ARCHITECTURE.md")
     arch = rel(architecture)
     tables = parse_tables(architecture) if os.path.isfile(architecture) else {}
-    module_rows, (name_col, dep_col) = find_table(tables, "module", "depends on") if tables else (None, (0, 0))
+    module_rows, (name_col, dep_col) = find_table(tables, "module", "depends on")
     if not module_rows:
         problems.append(f"{arch}:1: no module table with a 'depends on' column")
     else:
@@ -225,7 +225,7 @@ def check(root):
     # --- Faces and known exceptions (ARCHITECTURE.md).
     library = {name for name in modules if name != TESTING}
     faces = {}  # name -> (folders, allowed layers, line)
-    face_rows, columns = find_table(tables, "face", "folders", "may include") if tables else (None, None)
+    face_rows, columns = find_table(tables, "face", "folders", "may include")
     if not face_rows:
         problems.append(f"{arch}:1: no face table (| face | folders | may include |)")
     else:
@@ -246,8 +246,8 @@ def check(root):
             problems.append(f"{arch}:{number}: face {name} may include `{layer}`, which is no module or face")
 
     exceptions = []  # [path prefix, allowed layers, line, used]
-    exception_rows, columns = find_table(tables, "known exception", "includes") if tables else (None, None)
-    for cells, number in exception_rows or []:
+    exception_rows, columns = find_table(tables, "known exception", "includes")
+    for cells, number in exception_rows:
         paths = ticked(cells[columns[0]])
         if len(paths) != 1:
             problems.append(f"{arch}:{number}: a known exception names one file or folder in backticks")
