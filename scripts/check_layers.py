@@ -2,14 +2,14 @@
 """Checks that every folder of the source tree keeps the layers ARCHITECTURE.md states.
 
 Every C++ file of the repository (outside build folders) belongs to one layer:
-  - a module: the files directly in src/lidarshop/<m>/, whose CMakeLists.txt has `lidarshop_add_module(NAME m ...)`;
+  - a module: the files directly in src/lidarshop/<m>/, whose CMakeLists.txt calls lidarshop_add_module(NAME m);
   - a program in a subfolder of a module (src/lidarshop/fill/eval/): a consumer of that module;
-  - a face: a folder listed in ARCHITECTURE.md's face table (| face | folders | may include |), with its subfolders.
+  - a face: a folder listed in ARCHITECTURE.md's face table (| face | folders | may include |), and its subfolders.
 A C++ file in no layer is a problem: the check covers every folder, including ones added later.
 
 For modules it compares
-  - the includes of its library sources (not tests: *_test.cc, *_test_util.h) with the DEPS of its CMakeLists.txt (exactly:
-    an undeclared include and a declared dependency never included are both problems),
+  - the includes of its library sources (not tests: *_test.cc, *_test_util.h) with the DEPS of its CMakeLists.txt
+    (exactly: an undeclared include and a declared dependency never included are both problems),
   - the DEPS with the "depends on" column of the module table in ARCHITECTURE.md (names of module folders, in
     backticks or plain; other words such as external libraries are ignored),
   - the order of add_subdirectory() in src/lidarshop/CMakeLists.txt, and finds cycles;
@@ -239,7 +239,7 @@ def check(root):
             for folder in folders:
                 if not os.path.isdir(os.path.join(root, folder)):
                     problems.append(f"{arch}:{number}: face {name} lists {folder}, which is not a folder")
-                elif under(folder, "src/lidarshop") and folder.split("/")[2:3] and folder.split("/")[2] in modules:
+                elif folder.split("/")[:2] == ["src", "lidarshop"] and folder.split("/")[2:] in [[m] for m in modules]:
                     problems.append(f"{arch}:{number}: face {name} lists {folder}, which is a module's folder")
     for name, (_, allowed, number) in faces.items():
         for layer in sorted(allowed - library - set(faces) - {TESTING}):
@@ -364,7 +364,6 @@ def check(root):
             problems.append(f"{arch}:{number}: known exception `{path}` including `{layer}` no longer happens: "
                             f"remove it from the table")
     return problems, len(modules), len(faces), len(files)
-
 
 
 def main():
