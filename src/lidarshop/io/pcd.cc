@@ -575,7 +575,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
   }
   // Pictures show integer intensities in the file's units (io/render.h).
   if (intensity_scale != 1.0)
-    scan.source_metadata["intensity.full_scale"] = fmt::format("{}", 1.0 / intensity_scale);
+    scan.source_metadata["intensity.file_maximum"] = fmt::format("{}", 1.0 / intensity_scale);
   io_internal::FinishScan(&scan, /*fit_grid=*/organized);
   return scan;
 }

@@ -123,8 +123,10 @@ RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
       break;
     case RenderChannel::kIntensity: {
       if (!scan.has_intensity()) ThrowNoIntensity(scan);
-      const double full_scale = IntensityFullScale(scan);
-      metric(full_scale == 1.0 ? scan.intensity : cv::Mat(scan.intensity * full_scale), ColorMap::kGray, "");
+      const auto [low, high] = IntensityFileRange(scan);
+      cv::Mat values = scan.intensity;
+      if (low != 0.0 || high != 1.0) values = scan.intensity * (high - low) + low;
+      metric(values, ColorMap::kGray, "");
       break;
     }
     case RenderChannel::kRgb:
@@ -234,14 +236,19 @@ PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
           std::move(layout)};
 }
 
-double IntensityFullScale(const Scan& scan) {
-  const auto found = scan.source_metadata.find("intensity.full_scale");
-  if (found == scan.source_metadata.end()) return 1.0;
-  double value = 0;
-  const auto [end, error] =
-      std::from_chars(found->second.data(), found->second.data() + found->second.size(), value);
-  // Metadata the scan's own reader wrote; anything else (edited by hand) falls back to the stored scale.
-  return error == std::errc() && std::isfinite(value) && value > 0 ? value : 1.0;
+std::pair<double, double> IntensityFileRange(const Scan& scan) {
+  // Metadata the scan's own reader wrote; anything else (edited by hand, not a number, an empty range) falls
+  // back to the stored scale.
+  auto number = [&](const char* key, double fallback) {
+    const auto found = scan.source_metadata.find(key);
+    if (found == scan.source_metadata.end()) return fallback;
+    double value = 0;
+    const auto [end, error] =
+        std::from_chars(found->second.data(), found->second.data() + found->second.size(), value);
+    return error == std::errc() && std::isfinite(value) && std::abs(value) <= 1e12 ? value : fallback;
+  };
+  const double low = number("intensity.file_minimum", 0.0), high = number("intensity.file_maximum", 1.0);
+  return high > low ? std::pair{low, high} : std::pair{0.0, 1.0};
 }
 
 bool HoldsAsprsClasses(const Scan& scan) { return scan.source_metadata.count("las.point_format") > 0; }

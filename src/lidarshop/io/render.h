@@ -6,8 +6,8 @@
 //   range          metres from the scanner, perceptual colour map (viridis by default) over the 1-99 % quantiles
 //   elevation      world z in metres (the file's own z: a LAS file's elevations), viridis over the 1-99 %
 //                  quantiles; the default of the orthographic views on the command line
-//   intensity      return strength in the file's units (IntensityFullScale: a LAS file's 16-bit values 0-65535,
-//                  a PTX's 0-1), grey (or any map) over the 1-99 % quantiles; a scan without intensity throws
+//   intensity      return strength in the file's units (IntensityFileRange: a LAS file's 16-bit values 0-65535,
+//                  an E57's between its intensity limits, a PTX's 0-1), grey (or any map) over the 1-99 % quantiles; a scan without intensity throws
 //                  InputError "NAME has no intensity channel; it has: xyz, rgb"
 //   rgb            the scan's colour (InputError when the scan has none)
 //   normals        the normal channel (synthetic scans), or normals estimated from the neighbouring points,
@@ -31,6 +31,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -84,10 +85,11 @@ struct PictureResult {
 PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
                             const PictureLayoutOptions& layout_options);
 
-// The value of the full-scale intensity in the file's units: Scan::intensity (0-1) times this is the value the
-// file held. Readers of files with integer intensities say so in source_metadata["intensity.full_scale"] (LAS:
-// 65535); 1 for the others (PTX, E57 scaled by its intensity limits, float fields).
-double IntensityFullScale(const Scan& scan);
+// The values in the file's units that Scan::intensity 0 and 1 stand for: intensity i was the file's
+// first + i * (second - first). Readers that scale intensities to [0, 1] say from what in
+// source_metadata["intensity.file_minimum"] (0 when absent) and ["intensity.file_maximum"]: LAS 0-65535, PCD
+// integer fields 0 to their type's maximum, E57 its intensity limits. {0, 1} for the others (PTX, float fields).
+std::pair<double, double> IntensityFileRange(const Scan& scan);
 
 // True when the scan's label channel holds ASPRS classes: it was read from LAS (source_metadata "las.*").
 bool HoldsAsprsClasses(const Scan& scan);

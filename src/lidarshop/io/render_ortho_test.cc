@@ -231,7 +231,7 @@ TEST(RenderOrthoTest, LasIntensityAndClassesInTheFilesTerms) {
   testing_io::TempFolder folder;
   WriteScanFile(folder.File("field.las"), {CloudOf(points, Eigen::Vector3d(20, 10, 100))});
   const Scan las = ReadScanFile(folder.File("field.las")).scans.at(0);
-  EXPECT_EQ(IntensityFullScale(las), 65535.0);
+  EXPECT_EQ(IntensityFileRange(las), (std::pair{0.0, 65535.0}));
   EXPECT_TRUE(HoldsAsprsClasses(las));
 
   RenderOptions intensity;
@@ -260,7 +260,7 @@ TEST(RenderOrthoTest, LasIntensityAndClassesInTheFilesTerms) {
 
   // A cloud that is not from LAS: intensity as stored, labels as object labels unless asked for classes.
   const Scan plain = CloudOf(points);
-  EXPECT_EQ(IntensityFullScale(plain), 1.0);
+  EXPECT_EQ(IntensityFileRange(plain), (std::pair{0.0, 1.0}));
   const PictureResult stored = RenderPicture(plain, intensity, View(PictureView::kTop));
   EXPECT_LT(stored.scale->max_value, 0.1);
   RenderOptions labels;
@@ -281,6 +281,16 @@ TEST(RenderOrthoTest, RealLasFileGivesAClosedPictureWithItsOwnScales) {
   EXPECT_GT(picture.scale->max_value, 50.0);  // 16-bit units (Autzen's are below 256), not 0.003
   // Most of the picture shows points (sparse 10,653 points over 3.4 km x 4.6 km).
   EXPECT_GT(picture.layout.cells.CountValid(), picture.layout.cells.num_cells() / 2);
+
+  // An E57 with integer intensities and limits -66..66: its values, not the [0, 1] they are kept as.
+  const Scan e57 = ReadScanFile(LIDARSHOP_SHARED_DATA_DIR "/e57/integer_intensity.e57").scans.at(0);
+  EXPECT_EQ(IntensityFileRange(e57), (std::pair{-66.0, 66.0}));
+  const PictureResult e57_picture = RenderPicture(e57, intensity, View(PictureView::kTop));
+  for (const double value : {e57_picture.scale->min_value, e57_picture.scale->max_value}) {
+    EXPECT_GE(value, -66.0);
+    EXPECT_LE(value, 66.0);
+  }
+  EXPECT_TRUE(e57_picture.scale->min_value < 0.0 || e57_picture.scale->max_value > 1.0);
 }
 
 TEST(RenderOrthoTest, HillshadeLightsSlopesFacingNorthWest) {
