@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -194,6 +195,7 @@ constexpr double kSplatPerSpacing = 2.0;
 constexpr int kSpacingPoints = 8;
 // ... and no automatic square is larger than this many times the median one.
 constexpr double kMaxSplatPerMedian = 2.0;
+constexpr int64_t kOrthographicBytesPerPixel = 96;
 
 // Draws every projected point (u, v in pixels; `pixel_m` metres a pixel) as a square, the point nearest to the
 // viewer winning each pixel (among points of one surface, the one whose pixel is nearest):
@@ -354,6 +356,12 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
     p.u = (p.u - u_min) / step_across;
     p.v = (v_min + v_span - p.v) / step_down;
   }
+  // The cells' channels (about 64 bytes a pixel) and the squares' buffers (32): a given size is checked before
+  // anything of that size is allocated.
+  CheckMemoryBudget(
+      SaturatingBytes(static_cast<int64_t>(size.width) * size.height, kOrthographicBytesPerPixel),
+      fmt::format("{}a {} view of {} x {} pixels", scan.name.empty() ? "" : scan.name + ": ", ToString(view),
+                  size.width, size.height));
   PictureLayout layout;
   layout.view = view;
   layout.cells = EmptyCells(scan, size);

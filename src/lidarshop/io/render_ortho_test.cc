@@ -12,6 +12,7 @@
 #include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop {
 namespace {
@@ -145,6 +146,13 @@ TEST(RenderOrthoTest, GivenSizesAndPointSizeAreHonoured) {
   EXPECT_GT(LayOutPicture(CloudOf(points), options).cells.CountValid(), 10 * 25);
   options.point_size_px = -1;
   EXPECT_THROW(LayOutPicture(CloudOf(points), options), OptionsError);
+  // A size past the memory budget is refused before it is allocated.
+  options.point_size_px = 0;
+  options.width_px = options.height_px = 16384;
+  const int64_t budget = MemoryBudgetBytes();
+  SetMemoryBudgetBytes(int64_t{1} << 30);
+  EXPECT_THROW(LayOutPicture(CloudOf(points), options), InputError);
+  SetMemoryBudgetBytes(budget);
 }
 
 TEST(RenderOrthoTest, TheNearestPointToTheViewerWins) {
