@@ -200,6 +200,24 @@ cp "$work/last.err" "$work/bunny_top.err"
 check "render --quiet says nothing" test ! -s "$work/bunny_top.err"
 json_check "render --view top is orthographic in metres" "$work/bunny_top.json" \
   "d['layout']['view'] == 'top' and d['layout']['pixel_unit'] == 'm'"
+# render: pictures of an aerial LAS cloud from above, its own units on the legends.
+autzen="$shared/interop/las/autzen-thin.las"
+check "render LAS --view top" "$lidarshop" render "$autzen" -o "$work/autzen_top.png" --view top --legend \
+  --json "$work/autzen_top.json" --quiet
+json_check "render LAS top: elevation in metres, >= 1000 px, points as squares" "$work/autzen_top.json" \
+  "d['channel'] == 'elevation' and d['scale']['unit'] == 'm' and 400 < d['scale']['min'] < d['scale']['max'] < 600 \
+   and max(d['layout']['source_cols'], d['layout']['source_rows']) >= 1000 and d['layout']['point_size_px'] > 1"
+check "render LAS top intensity" "$lidarshop" render "$autzen" -o "$work/autzen_int.png" --view top \
+  --channel intensity --width 800 --point-size 3 --json "$work/autzen_int.json" --quiet
+json_check "render LAS intensity in 16-bit units, --width and --point-size honoured" "$work/autzen_int.json" \
+  "d['scale']['max'] > 50 and d['width_px'] == 800 and d['layout']['point_size_px'] == 3"
+check "render LAS classes" "$lidarshop" render "$autzen" -o "$work/autzen_cls.png" --view side \
+  --channel classification --legend --json "$work/autzen_cls.json" --quiet
+json_check "render LAS classes are named" "$work/autzen_cls.json" \
+  "d['legend'] == ['1  unclassified', '2  ground'] and d['layout']['view'] == 'side'"
+check "render LAS --hillshade" "$lidarshop" render "$autzen" -o "$work/autzen_hs.png" --view top --hillshade --quiet
+fails_clearly "render --hillshade of a ray grid" "orthographic" "$lidarshop" render "$work/scan.ptx" \
+  -o "$work/x.png" --hillshade
 python3 - "$work/cloud.pcd" <<'PY'
 import math, sys
 # An unorganized cloud as Open3D writes it (HEIGHT 1): a wall 6 m ahead seen over 60 x 20 degrees.
@@ -222,7 +240,7 @@ for extension in exr tif; do
   json_check "render range .$extension is float metres" "$work/range_$extension.json" "'metres' in d['values']"
 done
 check "range.exr is OpenEXR" python3 -c "import sys; sys.exit(open('$work/range.exr','rb').read(4) != b'\x76\x2f\x31\x01')"
-fails_clearly "render rgb as .exr" "range, intensity or normals" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --channel rgb
+fails_clearly "render rgb as .exr" "range, elevation, intensity or normals" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --channel rgb
 fails_clearly "render --legend as .exr" "legend" "$lidarshop" render "$work/scan.ptx" -o "$work/x.exr" --legend
 
 # Label legends name the scene's objects; scan --labels writes the colour picture beside the raw one.

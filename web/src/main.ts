@@ -32,11 +32,12 @@ async function refresh(keepView: boolean) {
   doc = await api.json<DocumentInfo>(`/api/docs/${doc.id}`);
   const channel = element<HTMLSelectElement>('channel').value;
   // A channel the scan does not hold falls back to intensity, then range (a file may hold neither colour nor
-  // intensity).
+  // intensity); labels and classes to range.
   const has = (name: string) => doc!.channels.includes(name);
   let usable = channel;
   if (usable === 'rgb' && !has('color')) usable = 'intensity';
   if (usable === 'intensity' && !has('intensity')) usable = 'range';
+  if ((usable === 'labels' || usable === 'classification') && !has('label')) usable = 'range';
   const aspect = doc.azimuth_step_deg > 0 ? doc.elevation_step_deg / doc.azimuth_step_deg : 1;
   const mask = doc.object_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', v: doc.version }) : null;
   const hole = doc.hole_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', layer: 'hole', v: doc.version }) : null;

@@ -378,8 +378,10 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
   html +=
       "<h2>1. The synthetic scan</h2><p>Every channel of the scan as a picture: azimuth to the right, "
       "elevation "
-      "up (row 0 = highest ray), square angular pixels. Cells where the ray returned nothing are a magenta / "
-      "pink checker, a colour no colour map uses. The raw label image (16-bit, one object label per ray) "
+      "up (row 0 = highest ray), square angular pixels. Cells where the ray returned nothing are a quiet "
+      "grey "
+      "checker, the way image editors show transparency. The raw label image (16-bit, one object label per "
+      "ray) "
       "looks "
       "black in a browser; its colour version has the objects' names.</p>";
   html += figure("rgb.png", "colour") + figure("range.png", "range (m)") +

@@ -416,6 +416,10 @@ nlohmann::ordered_json LayoutJson(const PictureLayout& layout) {
     json["points"] = layout.points;
     json["points_kept"] = layout.points_kept;
   }
+  if (layout.splat_px > 0) {
+    json["point_size_px"] = layout.splat_px;
+    json["point_size"] = layout.splat_automatic ? "twice the local point spacing (median)" : "--point-size";
+  }
   return json;
 }
 
@@ -423,34 +427,44 @@ int RunRender(int argc, char** argv) {
   CLI::App app{
       "Render a channel of a scan as a picture, row 0 = top (highest elevation): square angular pixels by "
       "default (--aspect native: one pixel per ray); an unorganized cloud is projected onto a spherical grid "
-      "around the scanner (--view top|front: orthographic). .exr / .tif write the values as 32-bit floats.",
+      "around the scanner (--view top|front|side: orthographic, at least 1000 pixels on the longer side, "
+      "each point a square sized from the local point spacing, coloured by elevation unless --channel says "
+      "otherwise). .exr / .tif write the values as 32-bit floats.",
       "render"};
-  std::string input, output, channel = "range", color_map, json_path, scene_names;
+  std::string input, output, channel, color_map, json_path, scene_names;
   int scan_index = 0, width_px = 0, height_px = 0;
   RenderOptions options;
   PictureLayoutOptions layout_options;
   OptionBinder binder(app);
   app.add_option("file", input, "scan file")->required();
-  app.add_option("-o,--output", output,
-                 "picture to write: .png, .jpg (colours); .exr, .tif (range in metres, intensity or normals "
-                 "as 32-bit floats, NaN where no return)")
+  app.add_option(
+         "-o,--output", output,
+         "picture to write: .png, .jpg (colours); .exr, .tif (range or elevation in metres, intensity "
+         "or normals as 32-bit floats, NaN where no return)")
       ->required();
   AddJsonOption(app, &json_path);
   // RenderOptions is not described (an optional colour map, NaN bounds): its flags are bound here, with the
   // choices of the described enums.
   const EnumInfo& channels = EnumInfoOf<RenderChannel>();
   const EnumInfo& color_maps = EnumInfoOf<ColorMap>();
-  app.add_option("--channel", channel, "what to draw")->capture_default_str()->check(ChoiceOf(channels));
+  app.add_option("--channel", channel,
+                 "what to draw (default: range; elevation in the top, front and side views)")
+      ->check(ChoiceOf(channels));
   app.add_flag("--legend", options.legend,
-               "add a colour scale bar, label swatches with names, or the normals key to the right");
+               "add a colour scale bar, label or class swatches with names, or the normals key to the right");
   app.add_option("--scan", scan_index, "which scan of the file (from 0)")->capture_default_str();
   app.add_option("--colormap", color_map,
-                 "colour map of metric channels (default: viridis for range, gray "
+                 "colour map of metric channels (default: viridis for range and elevation, gray "
                  "for intensity)")
       ->check(ChoiceOf(color_maps, {"grey"}));
-  app.add_option("--min", options.min_value,
-                 "value of the first colour (metres for range); default: 1 % quantile");
+  app.add_option(
+      "--min", options.min_value,
+      "value of the first colour (metres for range and elevation, the file's units for intensity); "
+      "default: 1 % quantile");
   app.add_option("--max", options.max_value, "value of the last colour; default: 99 % quantile");
+  app.add_flag("--hillshade", options.hillshade,
+               "top, front and side views: shade the colours by the slope of the surface (lit from the "
+               "north-west)");
   app.add_option("--scene", scene_names,
                  "a scene file or built-in scene whose object names label the labels legend");
   // Picture size: the ray picture's and the second viewpoint's.
@@ -476,14 +490,15 @@ int RunRender(int argc, char** argv) {
                  "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
   app.add_option("--around", around_path,
                  "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
-  binder.Bind(&view, {.keys = {"field_of_view_deg", "point_size_px", "synthesized_tint"},
-                      .flags = {{"field_of_view_deg", "--fov"},
-                                {"point_size_px", "--point-size"},
-                                {"synthesized_tint", "--tint-synthesized"}},
+  binder.Bind(&view, {.keys = {"field_of_view_deg", "synthesized_tint"},
+                      .flags = {{"field_of_view_deg", "--fov"}, {"synthesized_tint", "--tint-synthesized"}},
                       .group = "Second viewpoint (--eye / --orbit)"});
   binder.NameFlag("width_px", "--width");
   binder.NameFlag("height_px", "--height");
-  binder.Bind(&layout_options, {.keys = {"view", "aspect"}, .group = "Picture layout"});
+  // --point-size sets the squares of the orthographic views and of the second viewpoint alike.
+  binder.Bind(&layout_options, {.keys = {"view", "aspect", "point_size_px"},
+                                .flags = {{"point_size_px", "--point-size"}},
+                                .group = "Picture layout"});
   bool quiet = false;
   AddQuietFlag(app, &quiet);
   return RunCommand(
@@ -491,6 +506,7 @@ int RunRender(int argc, char** argv) {
       [&] {
         if (width_px > 0) view.width_px = layout_options.width_px = width_px;
         if (height_px > 0) view.height_px = layout_options.height_px = height_px;
+        if (layout_options.point_size_px > 0) view.point_size_px = layout_options.point_size_px;
         binder.Validate(view);
         binder.Validate(layout_options);
         CheckOutputPath(output, {input, around_path});
@@ -526,6 +542,8 @@ int RunRender(int argc, char** argv) {
                                 view.eye_in_world.z(), output));
           return 0;
         }
+        const bool orthographic = TowardViewer(layout_options.view) != Eigen::Vector3d::Zero();
+        if (channel.empty()) channel = orthographic ? "elevation" : "range";
         options.channel = ParseEnum<RenderChannel>(channel);
         if (!color_map.empty())
           options.color_map = (color_map == "grey" ? ColorMap::kGray : ParseEnum<ColorMap>(color_map));
@@ -534,9 +552,14 @@ int RunRender(int argc, char** argv) {
         if (float_picture && options.legend) {
           throw OptionsError(fmt::format("--legend draws on 8-bit pictures; {} holds float values", output));
         }
-        if (float_picture && !HasFloatValues(options.channel)) {
-          throw OptionsError(fmt::format(
-              "{}: float pictures hold range, intensity or normals, not {}; write a .png", output, channel));
+        if (float_picture && (!HasFloatValues(options.channel) || options.hillshade)) {
+          throw OptionsError(
+              fmt::format("{}: float pictures hold range, elevation, intensity or normals, not {}{}; "
+                          "write a .png",
+                          output, channel, options.hillshade ? " with --hillshade" : ""));
+        }
+        if (options.hillshade && !orthographic) {
+          throw OptionsError("--hillshade shades the orthographic views: give --view top, front or side");
         }
         if (!scene_names.empty()) options.label_names = SceneLabelNames(scene_names);
         const ScanFile file = ReadScanFileAndWarn(input);
@@ -551,8 +574,10 @@ int RunRender(int argc, char** argv) {
           WriteImage(output, values.values);
           json["width_px"] = values.values.cols;
           json["height_px"] = values.values.rows;
-          json["values"] = options.channel == RenderChannel::kRange ? "float32 metres, NaN = no return"
-                                                                    : "float32, NaN = no return";
+          json["values"] =
+              options.channel == RenderChannel::kRange || options.channel == RenderChannel::kElevation
+                  ? "float32 metres, NaN = no return"
+                  : "float32, NaN = no return";
           layout = std::move(values.layout);
         } else {
           PictureResult result = RenderPicture(scan, options, layout_options);
@@ -564,6 +589,7 @@ int RunRender(int argc, char** argv) {
                              {"max", result.scale->max_value},
                              {"unit", result.scale->unit}};
           }
+          if (!result.legend_lines.empty()) json["legend"] = result.legend_lines;
           layout = std::move(result.layout);
         }
         json["layout"] = LayoutJson(layout);

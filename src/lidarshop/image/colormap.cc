@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -167,33 +168,101 @@ cv::Mat ColorLabels(const cv::Mat& labels, const cv::Mat& mask) {
   return image;
 }
 
+cv::Mat SwatchLegend(const std::vector<std::pair<cv::Vec3b, std::string>>& entries, int height) {
+  const int row_height = 18;
+  const int needed = static_cast<int>(entries.size()) * row_height + 16;
+  int width = 110;
+  for (const auto& [color, text] : entries) {
+    int baseline = 0;
+    const cv::Size size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
+    width = std::max(width, 28 + size.width + 8);
+  }
+  cv::Mat legend(std::max(height, needed), width, CV_8UC3, cv::Scalar::all(255));
+  for (size_t i = 0; i < entries.size(); ++i) {
+    const int y = 8 + static_cast<int>(i) * row_height;
+    const cv::Vec3b color = entries[i].first;
+    cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar(color[0], color[1], color[2]), cv::FILLED);
+    cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar::all(0));
+    cv::putText(legend, entries[i].second, cv::Point(28, y + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar::all(0), 1, cv::LINE_AA);
+  }
+  return legend;
+}
+
 cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height,
                     const std::map<int32_t, std::string>& names) {
-  const int row_height = 18;
-  const int needed = static_cast<int>(labels.size()) * row_height + 16;
-  std::vector<std::string> texts;
-  int width = 110;
+  std::vector<std::pair<cv::Vec3b, std::string>> entries;
   for (const int32_t label : labels) {
     std::string text = label < 0 ? std::string("none") : fmt::format("label {}", label);
     const auto name = names.find(label);
     if (name != names.end() && !name->second.empty()) {
       text = label < 0 ? name->second : fmt::format("{}  {}", label, name->second);
     }
-    int baseline = 0;
-    const cv::Size size = cv::getTextSize(text, cv::FONT_HERSHEY_SIMPLEX, 0.4, 1, &baseline);
-    width = std::max(width, 28 + size.width + 8);
-    texts.push_back(std::move(text));
+    entries.emplace_back(LabelColor(label), std::move(text));
   }
-  cv::Mat legend(std::max(height, needed), width, CV_8UC3, cv::Scalar::all(255));
-  for (size_t i = 0; i < labels.size(); ++i) {
-    const int y = 8 + static_cast<int>(i) * row_height;
-    const cv::Vec3b color = LabelColor(labels[i]);
-    cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar(color[0], color[1], color[2]), cv::FILLED);
-    cv::rectangle(legend, cv::Rect(8, y, 14, 14), cv::Scalar::all(0));
-    cv::putText(legend, texts[i], cv::Point(28, y + 12), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1,
-                cv::LINE_AA);
+  return SwatchLegend(entries, height);
+}
+
+namespace {
+
+struct AsprsClass {
+  const char* name;
+  cv::Vec3b color;  // RGB
+};
+
+// LAS 1.4 R15 table 17; codes 8 and 12 are "reserved" in 1.4 and had these meanings in LAS 1.1-1.3.
+const AsprsClass kAsprsClasses[] = {
+    {"never classified", {110, 110, 110}},   // 0
+    {"unclassified", {150, 160, 178}},       // 1: slate grey, apart from the checker's neutral greys
+    {"ground", {166, 112, 58}},              // 2
+    {"low vegetation", {160, 215, 110}},     // 3
+    {"medium vegetation", {80, 178, 72}},    // 4
+    {"high vegetation", {22, 118, 48}},      // 5
+    {"building", {228, 82, 52}},             // 6
+    {"low noise", {255, 0, 255}},            // 7
+    {"model key-point", {255, 222, 0}},      // 8
+    {"water", {38, 100, 230}},               // 9
+    {"rail", {140, 80, 160}},                // 10
+    {"road surface", {60, 60, 60}},          // 11
+    {"overlap", {240, 200, 120}},            // 12
+    {"wire guard", {255, 255, 120}},         // 13
+    {"wire conductor", {255, 196, 0}},       // 14
+    {"transmission tower", {200, 120, 0}},   // 15
+    {"wire connector", {255, 140, 200}},     // 16
+    {"bridge deck", {120, 90, 200}},         // 17
+    {"high noise", {200, 0, 200}},           // 18
+    {"overhead structure", {0, 190, 200}},   // 19
+    {"ignored ground", {200, 170, 130}},     // 20
+    {"snow", {232, 244, 255}},               // 21
+    {"temporal exclusion", {120, 120, 60}},  // 22
+};
+constexpr int32_t kAsprsClassCount = static_cast<int32_t>(std::size(kAsprsClasses));
+
+}  // namespace
+
+std::string AsprsClassName(int32_t code) {
+  if (code >= 0 && code < kAsprsClassCount) return kAsprsClasses[code].name;
+  return fmt::format("class {}", code);
+}
+
+cv::Vec3b AsprsClassColor(int32_t code) {
+  if (code >= 0 && code < kAsprsClassCount) return kAsprsClasses[code].color;
+  return LabelColor(code);  // user-defined classes (64-255) and others: distinct colours
+}
+
+cv::Mat ColorAsprsClasses(const cv::Mat& classes, const cv::Mat& mask) {
+  LIDARSHOP_CHECK(classes.type() == CV_32S);
+  LIDARSHOP_CHECK(mask.empty() || (mask.type() == CV_8U && mask.size() == classes.size()));
+  cv::Mat image(classes.size(), CV_8UC3, cv::Scalar::all(0));
+  for (int row = 0; row < classes.rows; ++row) {
+    const int32_t* c = classes.ptr<int32_t>(row);
+    const uint8_t* m = mask.empty() ? nullptr : mask.ptr<uint8_t>(row);
+    cv::Vec3b* out = image.ptr<cv::Vec3b>(row);
+    for (int col = 0; col < classes.cols; ++col) {
+      if (m == nullptr || m[col]) out[col] = AsprsClassColor(c[col]);
+    }
   }
-  return legend;
+  return image;
 }
 
 void PaintNoReturn(cv::Mat* image, const cv::Mat& valid) {
@@ -207,13 +276,13 @@ void PaintNoReturn(cv::Mat* image, const cv::Mat& valid) {
   }
 }
 
-cv::Mat NoReturnKey(int width) {
+cv::Mat NoReturnKey(int width, const std::string& text) {
   cv::Mat key(26, std::max(width, 110), CV_8UC3, cv::Scalar::all(255));
   for (int row = 6; row < 22; ++row) {
     for (int col = 8; col < 24; ++col) key.at<cv::Vec3b>(row, col) = NoReturnColor(row - 6, col - 8);
   }
   cv::rectangle(key, cv::Rect(7, 5, 18, 18), cv::Scalar::all(0));
-  cv::putText(key, "no return", cv::Point(30, 18), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1,
+  cv::putText(key, text, cv::Point(30, 18), cv::FONT_HERSHEY_SIMPLEX, 0.4, cv::Scalar::all(0), 1,
               cv::LINE_AA);
   return key;
 }

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -61,19 +62,33 @@ cv::Mat ColorLabels(const cv::Mat& labels, const cv::Mat& mask);
 cv::Mat LabelLegend(const std::vector<int32_t>& labels, int height,
                     const std::map<int32_t, std::string>& names = {});
 
-// Cells without a return are drawn as a checker of two colours that no colour map, label colour or normal
-// colour takes (magenta and light pink, both at least 50 RGB units from every entry of every map), in squares
-// of kNoReturnCheckerPx pixels: a picture never shows "nothing" as a value.
-inline const cv::Vec3b kNoReturnColorA(255, 0, 255);
-inline const cv::Vec3b kNoReturnColorB(255, 180, 255);
-constexpr int kNoReturnCheckerPx = 4;
+// Cells without a return (or, in projections, pixels no point falls on) are drawn as a quiet grey checker, the
+// way image editors show transparency: light and mid grey squares of kNoReturnCheckerPx pixels. Its greys can
+// be colours of the gray map; the checker pattern (two greys alternating every 8 pixels in both directions),
+// not the colour, tells "nothing here" from a value, and it stays out of the way of the data around it.
+inline const cv::Vec3b kNoReturnColorA(204, 204, 204);
+inline const cv::Vec3b kNoReturnColorB(160, 160, 160);
+constexpr int kNoReturnCheckerPx = 8;
 inline cv::Vec3b NoReturnColor(int row, int col) {
   return ((row / kNoReturnCheckerPx + col / kNoReturnCheckerPx) % 2 == 0) ? kNoReturnColorA : kNoReturnColorB;
 }
 // Paints the no-return checker on `image` (CV_8UC3) where `valid` (CV_8U, same size) is zero.
 void PaintNoReturn(cv::Mat* image, const cv::Mat& valid);
-// A small key for the checker: a swatch and the words "no return" (CV_8UC3, `width` columns, white ground).
-cv::Mat NoReturnKey(int width);
+// A small key for the checker: a swatch and `text` (CV_8UC3, `width` columns, white ground).
+cv::Mat NoReturnKey(int width, const std::string& text = "no return");
+
+// ASPRS standard point classes (LAS 1.4 R15, table 17): the name of a class code ("ground" for 2, "building"
+// for 6, ...; "class 23" for codes without a standard name) and its usual colour, as CloudCompare, QGIS and
+// PDAL's viewers show them (2 ground brown, 3-5 vegetation light to dark green, 6 building orange-red, 9 water
+// blue, 7 and 18 noise magenta, 1 unclassified light grey, ...).
+std::string AsprsClassName(int32_t code);
+cv::Vec3b AsprsClassColor(int32_t code);
+// Colours a CV_32S image of ASPRS class codes; cells where `mask` (CV_8U, empty = everywhere) is zero get black.
+cv::Mat ColorAsprsClasses(const cv::Mat& classes, const cv::Mat& mask);
+
+// A legend of colour swatches, one line of text each (CV_8UC3 RGB, `height` rows at least, white ground); it
+// widens to fit the longest line.
+cv::Mat SwatchLegend(const std::vector<std::pair<cv::Vec3b, std::string>>& entries, int height);
 
 // `top` above `bottom` (CV_8UC3), padded with white to the wider width.
 cv::Mat StackLegends(const cv::Mat& top, const cv::Mat& bottom);

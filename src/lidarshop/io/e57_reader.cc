@@ -706,6 +706,14 @@ void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords&
   Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
                         intensity_field);
   const auto& v = records.Decode(intensity_field);
+  if (l.known && l.maximum > l.minimum) {
+    // Pictures show intensity in the file's units (io/render.h): 0 and 1 stand for the limits.
+    for (Scan* scan : {layers[0], layers[1]}) {
+      if (scan == nullptr) continue;
+      scan->source_metadata["intensity.file_minimum"] = fmt::format("{}", l.minimum);
+      scan->source_metadata["intensity.file_maximum"] = fmt::format("{}", l.maximum);
+    }
+  }
   if (!l.known) {
     // Float intensities without limits: take them as [0, 1] when they are, else stretch the returned range.
     double lo = 0, hi = 1;

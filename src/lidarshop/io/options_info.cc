@@ -18,10 +18,13 @@ const EnumInfo& EnumInfoOf<RenderChannel>() {
   static const EnumInfo info = MakeEnumInfo<RenderChannel>(
       "channel", {{RenderChannel::kRange, "range", "metres from the scanner"},
                   {RenderChannel::kRgb, "rgb", "the scan's colour"},
-                  {RenderChannel::kIntensity, "intensity", "return strength"},
+                  {RenderChannel::kIntensity, "intensity", "return strength in the file's units"},
                   {RenderChannel::kNormals, "normals", "normals as (n + 1) / 2"},
-                  {RenderChannel::kLabels, "labels", "object labels"},
-                  {RenderChannel::kValid, "valid", "white where the ray returned"}});
+                  {RenderChannel::kLabels, "labels", "object labels (a LAS file's: its classes)"},
+                  {RenderChannel::kValid, "valid", "white where the ray returned"},
+                  {RenderChannel::kElevation, "elevation", "world z in metres (the file's z)"},
+                  {RenderChannel::kClassification, "classification",
+                   "labels as ASPRS classes: their names and usual colours"}});
   return info;
 }
 
@@ -32,7 +35,8 @@ const EnumInfo& EnumInfoOf<PictureView>() {
                {PictureView::kGrid, "grid", "the scan's own ray grid"},
                {PictureView::kSphere, "sphere", "points projected onto a spherical grid around the scanner"},
                {PictureView::kTop, "top", "orthographic from above (world x right, y up)"},
-               {PictureView::kFront, "front", "orthographic from the front (world x right, z up)"}});
+               {PictureView::kFront, "front", "orthographic from the front (world x right, z up)"},
+               {PictureView::kSide, "side", "orthographic from the right-hand side (world y right, z up)"}});
   return info;
 }
 
@@ -61,6 +65,16 @@ const StructInfo& InfoOf<PictureLayoutOptions>() {
     b.Field(&PictureLayoutOptions::max_side_px, "max_side_px", "automatic sizes: the longer side at most")
         .Unit("px")
         .Range(16, 16384);
+    b.Field(&PictureLayoutOptions::min_long_side_px, "min_long_side_px",
+            "orthographic views, automatic sizes: the longer side at least (at most max_side_px)")
+        .Unit("px")
+        .Range(16, 16384);
+    b.Field(
+         &PictureLayoutOptions::point_size_px, "point_size_px",
+         "side of the square drawn for each point (orthographic views and the second viewpoint); 0 = twice "
+         "the local point spacing (second viewpoint: 2)")
+        .Unit("px")
+        .Range(0, 32);
     return b.Build();
   }();
   return info;

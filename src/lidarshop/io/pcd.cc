@@ -573,6 +573,9 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
       if (ftrue >= 0) scan.true_range.at<float>(row, col) = LoadValue(record + f[ftrue].offset, f[ftrue]);
     }
   }
+  // Pictures show integer intensities in the file's units (io/render.h).
+  if (intensity_scale != 1.0)
+    scan.source_metadata["intensity.file_maximum"] = fmt::format("{}", 1.0 / intensity_scale);
   io_internal::FinishScan(&scan, /*fit_grid=*/organized);
   return scan;
 }

@@ -1,12 +1,15 @@
 #include "lidarshop/io/render.h"
 
+#include <charconv>
 #include <cmath>
 #include <set>
+#include <system_error>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/io/render_shading.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -59,7 +62,45 @@ cv::Vec3b NormalColor(const cv::Vec3f& n) {
   return out;
 }
 
-// The cells' colours, one pixel per cell, no-return cells left black (painted after resampling).
+// World z of every cell, metres (NaN where the ray did not return).
+cv::Mat ElevationValues(const Scan& scan) {
+  cv::Mat values(scan.rows, scan.cols, CV_32F, cv::Scalar(std::numeric_limits<float>::quiet_NaN()));
+  const Eigen::Vector4d z_row = scan.world_from_scanner.row(2).transpose();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      const cv::Vec3f p = scan.point.at<cv::Vec3f>(row, col);
+      values.at<float>(row, col) = static_cast<float>(z_row.dot(Eigen::Vector4d(p[0], p[1], p[2], 1.0)));
+    }
+  }
+  return values;
+}
+
+void ThrowNoIntensity(const Scan& scan) {
+  // Name what there is instead (leaving out range, valid and direction, which every scan has).
+  std::vector<std::string> present;
+  for (const std::string& name : ChannelNames(scan)) {
+    if (name != "range" && name != "valid" && name != "direction") present.push_back(name);
+  }
+  throw InputError(fmt::format("{} has no intensity channel; it has: {}",
+                               scan.name.empty() ? "the scan" : scan.name, fmt::join(present, ", ")));
+}
+
+// The labels present among the valid cells, at most 40 (a legend, not a catalogue).
+std::vector<int32_t> PresentLabels(const Scan& cells) {
+  std::set<int32_t> present;
+  for (int row = 0; row < cells.rows; ++row) {
+    for (int col = 0; col < cells.cols; ++col) {
+      if (cells.valid.at<uint8_t>(row, col)) present.insert(cells.label.at<int32_t>(row, col));
+    }
+  }
+  std::vector<int32_t> shown(present.begin(), present.end());
+  if (shown.size() > 40) shown.resize(40);
+  return shown;
+}
+
+// The cells' colours, one pixel per cell, no-return cells left black (painted after resampling), and the
+// swatch legend's lines.
 RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
   RenderResult result;
   auto metric = [&](const cv::Mat& values, ColorMap default_map, const std::string& unit) {
@@ -71,22 +112,23 @@ RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
     result.image = ApplyColorMap(values, scan.valid, scale);
     result.scale = scale;
   };
-  switch (options.channel) {
+  RenderChannel channel = options.channel;
+  if (channel == RenderChannel::kLabels && HoldsAsprsClasses(scan)) channel = RenderChannel::kClassification;
+  switch (channel) {
     case RenderChannel::kRange:
       metric(scan.range, ColorMap::kViridis, "m");
       break;
-    case RenderChannel::kIntensity:
-      if (!scan.has_intensity()) {
-        // Name what there is instead (leaving out range, valid and direction, which every scan has).
-        std::vector<std::string> present;
-        for (const std::string& name : ChannelNames(scan)) {
-          if (name != "range" && name != "valid" && name != "direction") present.push_back(name);
-        }
-        throw InputError(fmt::format("{} has no intensity channel; it has: {}",
-                                     scan.name.empty() ? "the scan" : scan.name, fmt::join(present, ", ")));
-      }
-      metric(scan.intensity, ColorMap::kGray, "");
+    case RenderChannel::kElevation:
+      metric(ElevationValues(scan), ColorMap::kViridis, "m");
       break;
+    case RenderChannel::kIntensity: {
+      if (!scan.has_intensity()) ThrowNoIntensity(scan);
+      const auto [low, high] = IntensityFileRange(scan);
+      cv::Mat values = scan.intensity;
+      if (low != 0.0 || high != 1.0) values = scan.intensity * (high - low) + low;
+      metric(values, ColorMap::kGray, "");
+      break;
+    }
     case RenderChannel::kRgb:
       if (!scan.has_color()) ThrowInputError(scan.name, "", "rgb", "the scan has no colour channel");
       result.image = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
@@ -107,6 +149,22 @@ RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
     case RenderChannel::kLabels:
       if (scan.label.empty()) ThrowInputError(scan.name, "", "labels", "the scan has no label channel");
       result.image = ColorLabels(scan.label, scan.valid);
+      for (const int32_t label : PresentLabels(scan)) {
+        const auto name = options.label_names.find(label);
+        const bool named = name != options.label_names.end() && !name->second.empty();
+        result.legend_lines.push_back(label < 0 ? (named ? name->second : "none")
+                                      : named   ? fmt::format("{}  {}", label, name->second)
+                                                : fmt::format("label {}", label));
+      }
+      break;
+    case RenderChannel::kClassification:
+      if (scan.label.empty()) {
+        ThrowInputError(scan.name, "", "classification", "the scan has no classification (label) channel");
+      }
+      result.image = ColorAsprsClasses(scan.label, scan.valid);
+      for (const int32_t code : PresentLabels(scan)) {
+        result.legend_lines.push_back(fmt::format("{}  {}", code, AsprsClassName(code)));
+      }
       break;
     case RenderChannel::kValid:
       result.image = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
@@ -118,7 +176,7 @@ RenderResult ColorCells(const Scan& scan, const RenderOptions& options) {
 
 // The coloured cells resampled to `size`, the no-return checker, and the legend.
 RenderResult FinishPicture(const Scan& cells, RenderResult colored, cv::Size size,
-                           const RenderOptions& options) {
+                           const RenderOptions& options, const std::string& no_data_text = "no return") {
   colored.image = ResampleNearest(colored.image, size);
   const cv::Mat valid = ResampleNearest(cells.valid, size);
   const bool any_no_return = options.channel != RenderChannel::kValid &&
@@ -128,21 +186,20 @@ RenderResult FinishPicture(const Scan& cells, RenderResult colored, cv::Size siz
   cv::Mat legend;
   if (colored.scale) {
     legend = ColorScaleBar(*colored.scale, size.height);
-  } else if (options.channel == RenderChannel::kLabels) {
-    std::set<int32_t> present;
-    for (int row = 0; row < cells.rows; ++row) {
-      for (int col = 0; col < cells.cols; ++col) {
-        if (cells.valid.at<uint8_t>(row, col)) present.insert(cells.label.at<int32_t>(row, col));
-      }
+  } else if (options.channel == RenderChannel::kLabels || options.channel == RenderChannel::kClassification) {
+    const bool classes = options.channel == RenderChannel::kClassification || HoldsAsprsClasses(cells);
+    const std::vector<int32_t> shown = PresentLabels(cells);
+    std::vector<std::pair<cv::Vec3b, std::string>> entries;
+    for (size_t i = 0; i < shown.size(); ++i) {
+      entries.emplace_back(classes ? AsprsClassColor(shown[i]) : LabelColor(shown[i]),
+                           colored.legend_lines[i]);
     }
-    std::vector<int32_t> shown(present.begin(), present.end());
-    if (shown.size() > 40) shown.resize(40);  // a legend, not a catalogue
-    legend = LabelLegend(shown, size.height, options.label_names);
+    legend = SwatchLegend(entries, size.height);
   } else if (options.channel == RenderChannel::kNormals) {
     legend = NormalsKey(std::min(size.height, 160));
   }
   if (legend.empty()) return colored;
-  if (any_no_return) legend = StackLegends(legend, NoReturnKey(legend.cols));
+  if (any_no_return) legend = StackLegends(legend, NoReturnKey(legend.cols, no_data_text));
   colored.image = BesideLegend(colored.image, legend);
   return colored;
 }
@@ -151,6 +208,8 @@ RenderResult FinishPicture(const Scan& cells, RenderResult colored, cv::Size siz
 
 RenderResult RenderScan(const Scan& scan, const RenderOptions& options) {
   options.Check();
+  CheckOption(!options.hillshade,
+              "hillshade shades the orthographic views (top, front, side), not a ray grid");
   CheckScan(scan);
   return FinishPicture(scan, ColorCells(scan, options), cv::Size(scan.cols, scan.rows), options);
 }
@@ -159,14 +218,44 @@ PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
                             const PictureLayoutOptions& layout_options) {
   options.Check();
   PictureLayout layout = LayOutPicture(scan, layout_options);
-  RenderResult colored =
-      FinishPicture(layout.cells, ColorCells(layout.cells, options), layout.picture_size, options);
-  return {std::move(colored.image), std::move(colored.scale), std::move(layout)};
+  const bool orthographic = TowardViewer(layout.view) != Eigen::Vector3d::Zero();
+  if (options.hillshade && !orthographic) {
+    throw OptionsError(
+        fmt::format("hillshade shades the orthographic views (top, front, side), not the {} view",
+                    ToString(layout.view)));
+  }
+  if (orthographic && options.channel == RenderChannel::kNormals && layout.cells.normal.empty()) {
+    layout.cells.normal = OrthographicNormals(layout);
+  }
+  RenderResult colored = ColorCells(layout.cells, options);
+  // Orthographic cells are the picture's pixels (no resampling), so the shading works on them directly.
+  if (options.hillshade) Hillshade(layout, &colored.image);
+  colored = FinishPicture(layout.cells, std::move(colored), layout.picture_size, options,
+                          layout.view == PictureView::kGrid ? "no return" : "no point");
+  return {std::move(colored.image), std::move(colored.scale), std::move(colored.legend_lines),
+          std::move(layout)};
 }
 
+std::pair<double, double> IntensityFileRange(const Scan& scan) {
+  // Metadata the scan's own reader wrote; anything else (edited by hand, not a number, an empty range) falls
+  // back to the stored scale.
+  auto number = [&](const char* key, double fallback) {
+    const auto found = scan.source_metadata.find(key);
+    if (found == scan.source_metadata.end()) return fallback;
+    double value = 0;
+    const auto [end, error] =
+        std::from_chars(found->second.data(), found->second.data() + found->second.size(), value);
+    return error == std::errc() && std::isfinite(value) && std::abs(value) <= 1e12 ? value : fallback;
+  };
+  const double low = number("intensity.file_minimum", 0.0), high = number("intensity.file_maximum", 1.0);
+  return high > low ? std::pair{low, high} : std::pair{0.0, 1.0};
+}
+
+bool HoldsAsprsClasses(const Scan& scan) { return scan.source_metadata.count("las.point_format") > 0; }
+
 bool HasFloatValues(RenderChannel channel) {
-  return channel == RenderChannel::kRange || channel == RenderChannel::kIntensity ||
-         channel == RenderChannel::kNormals;
+  return channel == RenderChannel::kRange || channel == RenderChannel::kElevation ||
+         channel == RenderChannel::kIntensity || channel == RenderChannel::kNormals;
 }
 
 cv::Mat ChannelValues(const Scan& scan, RenderChannel channel) {
@@ -176,6 +265,9 @@ cv::Mat ChannelValues(const Scan& scan, RenderChannel channel) {
   switch (channel) {
     case RenderChannel::kRange:
       values = scan.range.clone();
+      break;
+    case RenderChannel::kElevation:
+      values = ElevationValues(scan);
       break;
     case RenderChannel::kIntensity:
       if (scan.intensity.empty()) {
@@ -188,9 +280,10 @@ cv::Mat ChannelValues(const Scan& scan, RenderChannel channel) {
       break;
     case RenderChannel::kRgb:
     case RenderChannel::kLabels:
+    case RenderChannel::kClassification:
     case RenderChannel::kValid:
       throw OptionsError(fmt::format(
-          "float pictures (.exr, .tif) hold range, intensity or normals, not {}; write {} as .png",
+          "float pictures (.exr, .tif) hold range, elevation, intensity or normals, not {}; write {} as .png",
           ToString(channel), ToString(channel)));
   }
   values.setTo(cv::Scalar::all(nan), scan.valid == 0);

@@ -7,8 +7,10 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -106,6 +108,7 @@ Scan EmptyCells(const Scan& scan, cv::Size size) {
   Scan cells = MakeScan(size.height, size.width, scan.has_color());
   cells.world_from_scanner = scan.world_from_scanner;
   cells.name = scan.name;
+  cells.source_metadata = scan.source_metadata;  // what the channels mean (LAS classes, intensity scale)
   if (scan.intensity.empty()) cells.intensity.release();
   if (!scan.label.empty()) cells.label = cv::Mat(size, CV_32S, cv::Scalar(kNoLabel));
   if (!scan.normal.empty()) cells.normal = cv::Mat(size, CV_32FC3, cv::Scalar::all(0));
@@ -185,6 +188,116 @@ PictureLayout LayOutSphere(const Scan& scan, const PictureLayoutOptions& options
   return layout;
 }
 
+// Orthographic views: the side of an automatic square is this many times the local point spacing (a Poisson
+// spread of points leaves e^-4 = 2 % of the pixels uncovered at 2), and the spacing is read in a window holding
+// at least kSpacingPoints points.
+constexpr double kSplatPerSpacing = 2.0;
+constexpr int kSpacingPoints = 8;
+// ... and no automatic square is larger than this many times the median one.
+constexpr double kMaxSplatPerMedian = 2.0;
+constexpr int64_t kOrthographicBytesPerPixel = 96;
+
+// Draws every projected point (u, v in pixels; `pixel_m` metres a pixel) as a square, the point nearest to the
+// viewer winning each pixel (among points of one surface, the one whose pixel is nearest):
+// squares of `point_size_px` > 0, or (0: automatic) of kSplatPerSpacing times the local spacing, at most
+// kMaxSplatPerMedian times the median square. Fills `cells` through FillCells (one chosen point per pixel);
+// returns the number of points that show on at least one pixel and sets the median square side in
+// *median_splat_px.
+int64_t SplatCells(const Scan& scan, const std::vector<ProjectedPoint>& projected, int point_size_px,
+                   double pixel_m, Scan* cells, double* median_splat_px) {
+  const int rows = cells->rows, cols = cells->cols;
+  const int64_t count = static_cast<int64_t>(projected.size());
+  std::vector<cv::Point> pixel(projected.size());
+  for (int64_t i = 0; i < count; ++i) {
+    pixel[i] = cv::Point(std::clamp(static_cast<int>(std::floor(projected[i].u)), 0, cols - 1),
+                         std::clamp(static_cast<int>(std::floor(projected[i].v)), 0, rows - 1));
+  }
+  cv::Mat depth(rows, cols, CV_64F, cv::Scalar(std::numeric_limits<double>::infinity()));
+  cv::Mat winner(rows, cols, CV_32S, cv::Scalar(-1));
+  cv::Mat centre_distance(rows, cols, CV_32S, cv::Scalar(std::numeric_limits<int32_t>::max()));
+  // Draws point i as a square of `side` pixels with the depth test. Points within the square's width in
+  // metres of the best depth so far are taken as the same surface: there the point whose pixel is nearest
+  // wins, so that neighbouring squares meet halfway (a sharp picture of the surface) rather than the
+  // slightly nearer one covering the other; a point nearer by more (a crown over the ground) always wins.
+  auto draw = [&](int64_t i, int side) {
+    const double same_surface_m = side * pixel_m;
+    const int low = -(side - 1) / 2, high = side / 2;  // side 1: the pixel itself; 2: it and the next
+    for (int row = std::max(0, pixel[i].y + low); row <= std::min(rows - 1, pixel[i].y + high); ++row) {
+      for (int col = std::max(0, pixel[i].x + low); col <= std::min(cols - 1, pixel[i].x + high); ++col) {
+        double& best = depth.at<double>(row, col);
+        int32_t& best_distance = centre_distance.at<int32_t>(row, col);
+        const int32_t distance =
+            (row - pixel[i].y) * (row - pixel[i].y) + (col - pixel[i].x) * (col - pixel[i].x);
+        const double d = projected[i].depth;
+        if (d < best - same_surface_m || (d <= best + same_surface_m && distance < best_distance)) {
+          best = d;
+          best_distance = distance;
+          winner.at<int32_t>(row, col) = static_cast<int32_t>(i);
+        }
+      }
+    }
+  };
+  std::vector<double> sides;
+  if (point_size_px > 0) {
+    for (int64_t i = 0; i < count; ++i) draw(i, point_size_px);
+    *median_splat_px = point_size_px;
+  } else {
+    // Local spacing from the number of pixels with a point in a window around each point (an integral image;
+    // pixels, not points, so that points stacked along the line of sight, a field seen edge-on from the
+    // side, count once): the smallest window of 2w + 1 pixels (w = 1, 2, 4, ...) holding kSpacingPoints,
+    // clipped to the picture.
+    cv::Mat occupied(rows, cols, CV_64F, cv::Scalar(0));  // (cv::integral takes no 32-bit integers)
+    for (const cv::Point& p : pixel) occupied.at<double>(p) = 1.0;
+    cv::Mat sums;
+    cv::integral(occupied, sums, CV_64F);
+    // The largest square: twice the spacing the points would have spread evenly over the picture, and never
+    // less than a 40th of its longer side.
+    const double even_spacing_px = std::sqrt(static_cast<double>(rows) * cols / std::max<int64_t>(count, 1));
+    const int max_side = std::max(
+        {3, std::max(rows, cols) / 40, static_cast<int>(std::ceil(kSplatPerSpacing * even_spacing_px))});
+    auto window_count = [&](const cv::Point& p, int w, int* area) {
+      const int top = std::max(0, p.y - w), bottom = std::min(rows, p.y + w + 1);
+      const int left = std::max(0, p.x - w), right = std::min(cols, p.x + w + 1);
+      *area = (bottom - top) * (right - left);
+      return sums.at<double>(bottom, right) - sums.at<double>(top, right) - sums.at<double>(bottom, left) +
+             sums.at<double>(top, left);
+    };
+    sides.reserve(projected.size());
+    for (int64_t i = 0; i < count; ++i) {
+      int area = 1;
+      double in_window = 1;
+      for (int w = 1;; w *= 2) {
+        in_window = window_count(pixel[i], w, &area);
+        if (in_window >= kSpacingPoints || w >= max_side) break;  // (w >= max_side: the window is 2w + 1)
+      }
+      const double spacing_px = std::sqrt(area / std::max(in_window, 1.0));
+      sides.push_back(
+          std::clamp(std::ceil(kSplatPerSpacing * spacing_px), 1.0, static_cast<double>(max_side)));
+    }
+    // Isolated points (a river's few returns among many around it) stay small squares: a picture shows where
+    // the data is sparse rather than paint it over with blocks.
+    std::vector<double> sorted = sides;
+    const double median = Median(&sorted);
+    const double largest =
+        std::min(static_cast<double>(max_side), std::max(3.0, kMaxSplatPerMedian * median));
+    for (int64_t i = 0; i < count; ++i) draw(i, static_cast<int>(std::min(sides[i], largest)));
+    *median_splat_px = std::min(median, largest);
+  }
+  // One chosen point per pixel, at the pixel's centre, for FillCells to copy.
+  std::vector<ProjectedPoint> chosen;
+  std::vector<uint8_t> shown(projected.size(), 0);
+  for (int row = 0; row < rows; ++row) {
+    for (int col = 0; col < cols; ++col) {
+      const int32_t i = winner.at<int32_t>(row, col);
+      if (i < 0) continue;
+      shown[i] = 1;
+      chosen.push_back({col + 0.5, row + 0.5, 0.0, projected[i].row, projected[i].col});
+    }
+  }
+  FillCells(scan, chosen, cells);
+  return std::count(shown.begin(), shown.end(), 1);
+}
+
 PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const PictureLayoutOptions& options) {
   // u to the right, v up, depth: smaller is nearer to the viewer.
   std::vector<ProjectedPoint> projected;
@@ -194,7 +307,9 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
       if (!scan.valid.at<uint8_t>(row, col)) continue;
       const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
       const ProjectedPoint point = view == PictureView::kTop ? ProjectedPoint{p.x(), p.y(), -p.z(), row, col}
-                                                             : ProjectedPoint{p.x(), p.z(), p.y(), row, col};
+                                   : view == PictureView::kSide
+                                       ? ProjectedPoint{p.y(), p.z(), -p.x(), row, col}
+                                       : ProjectedPoint{p.x(), p.z(), p.y(), row, col};
       u_min = std::min(u_min, point.u);
       u_max = std::max(u_max, point.u);
       v_min = std::min(v_min, point.v);
@@ -229,18 +344,31 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
   });
   const double floor_m = 1e-3;
   const double u_span = std::max(u_max - u_min, floor_m), v_span = std::max(v_max - v_min, floor_m);
-  const double step = std::sqrt(u_span * v_span * kPointsPerCell / static_cast<double>(projected.size()));
+  // Natural size: one point a pixel over the window; the squares close the gaps, so a picture is never
+  // smaller than min_long_side_px on its longer side.
+  double step = std::sqrt(u_span * v_span / static_cast<double>(projected.size()));
+  const double long_side = std::max(u_span, v_span) / step;
+  const double min_long_side = std::min(options.min_long_side_px, options.max_side_px);
+  if (long_side < min_long_side) step *= long_side / min_long_side;
   const cv::Size size = PictureSize(u_span / step, v_span / step, options);
   const double step_across = u_span / size.width, step_down = v_span / size.height;
   for (ProjectedPoint& p : projected) {
     p.u = (p.u - u_min) / step_across;
     p.v = (v_min + v_span - p.v) / step_down;
   }
+  // The cells' channels (about 64 bytes a pixel) and the squares' buffers (32): a given size is checked before
+  // anything of that size is allocated.
+  CheckMemoryBudget(
+      SaturatingBytes(static_cast<int64_t>(size.width) * size.height, kOrthographicBytesPerPixel),
+      fmt::format("{}a {} view of {} x {} pixels", scan.name.empty() ? "" : scan.name + ": ", ToString(view),
+                  size.width, size.height));
   PictureLayout layout;
   layout.view = view;
   layout.cells = EmptyCells(scan, size);
   layout.points = all_points;
-  layout.points_kept = FillCells(scan, projected, &layout.cells);
+  layout.points_kept = SplatCells(scan, projected, options.point_size_px, std::max(step_across, step_down),
+                                  &layout.cells, &layout.splat_px);
+  layout.splat_automatic = options.point_size_px == 0;
   layout.picture_size = size;
   layout.pixel_width = step_across;
   layout.pixel_height = step_down;
@@ -317,6 +445,7 @@ PictureLayout LayOutPicture(const Scan& scan, const PictureLayoutOptions& option
       return LayOutSphere(scan, options);
     case PictureView::kTop:
     case PictureView::kFront:
+    case PictureView::kSide:
       return LayOutOrthographic(scan, view, options);
     case PictureView::kAuto:
     case PictureView::kGrid:
@@ -338,15 +467,33 @@ std::string PictureLayout::Describe() const {
           points, size, pixel, points_kept, points - points_kept);
     case PictureView::kTop:
     case PictureView::kFront:
+    case PictureView::kSide:
       return fmt::format(
-          "{} points projected orthographically ({} view, world frame): {} pixels of {}; {} "
-          "points shown, {} hidden behind nearer ones or outside the window",
-          points, ToString(view), size, pixel, points_kept, points - points_kept);
+          "{} points projected orthographically ({} view, world frame): {} pixels of {}, each point a "
+          "square of {}{:.3g} px{}; {} points shown, {} hidden behind nearer ones or outside the window",
+          points, ToString(view), size, pixel, splat_automatic ? "about " : "", splat_px,
+          splat_automatic ? " (twice the local point spacing)" : "", points_kept, points - points_kept);
     case PictureView::kAuto:
     case PictureView::kGrid:
       break;
   }
   return fmt::format("{} x {} rays shown as {} pixels of {}", cells.cols, cells.rows, size, pixel);
+}
+
+Eigen::Vector3d TowardViewer(PictureView view) {
+  switch (view) {
+    case PictureView::kTop:
+      return Eigen::Vector3d::UnitZ();
+    case PictureView::kFront:
+      return -Eigen::Vector3d::UnitY();
+    case PictureView::kSide:
+      return Eigen::Vector3d::UnitX();
+    case PictureView::kAuto:
+    case PictureView::kGrid:
+    case PictureView::kSphere:
+      break;
+  }
+  return Eigen::Vector3d::Zero();
 }
 
 cv::Mat ResampleNearest(const cv::Mat& image, cv::Size size) {

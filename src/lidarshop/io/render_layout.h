@@ -11,17 +11,27 @@
 //           cell is kept. Azimuths start after the widest empty sector, so a cloud behind the scanner is not
 //           cut in two. Automatic size: about three points a cell over the angular bounding box
 //   top     orthographic from above in the world frame: world x to the right, world y up, the highest point
-//           of each cell kept (automatic size as for sphere). The window holds the 0.5-99.5 % quantiles of
-//           the points on each axis widened by a quarter of their span (at most the points' extent), so that
-//           a scan's few far stray points do not shrink the rest to a corner
+//           of each pixel kept. The window holds the 0.5-99.5 % quantiles of the points on each axis widened
+//           by a quarter of their span (at most the points' extent), so that a scan's few far stray points do
+//           not shrink the rest to a corner. Automatic size: one point a pixel over the window, at least
+//           min_long_side_px (1000) and at most max_side_px on the longer side, square pixels
 //   front   orthographic from the front in the world frame: world x to the right, world z up, looking along
-//           world +y, the point with the smallest y of each cell kept
+//           world +y, the point with the smallest y of each pixel kept
+//   side    orthographic from the right-hand side in the world frame: world y to the right, world z up,
+//           looking along world -x, the point with the largest x of each pixel kept
+//   Orthographic views draw every point as a square with a depth test (the point nearest to the viewer wins
+//   each pixel: a tree's crown hides the ground under it). point_size_px > 0 gives every square that side;
+//   0 (automatic) makes each square twice the local point spacing (the side of a window around the point
+//   holding at least 8 pixels with a point, over the square root of their number; at most twice the median
+//   square, so that isolated points stay small), so that a sparse aerial cloud gives a closed picture.
+//   Pixels no square covers stay empty (the checker of colormap.h)
 //   auto    grid for organized scans, sphere for unorganized clouds (IsUnorganized)
 #pragma once
 
 #include <cstdint>
 #include <string>
 
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
@@ -29,7 +39,7 @@
 
 namespace lidarshop {
 
-enum class PictureView { kAuto, kGrid, kSphere, kTop, kFront };
+enum class PictureView { kAuto, kGrid, kSphere, kTop, kFront, kSide };
 template <>
 const EnumInfo& EnumInfoOf<PictureView>();
 
@@ -45,7 +55,12 @@ struct PictureLayoutOptions {
   int width_px = 0;
   int height_px = 0;
   int max_side_px = 4096;  // pixels: automatic sizes are scaled down to at most this on the longer side
-  void Check() const;      // throws OptionsError
+  // Orthographic views: automatic sizes are scaled up to at least this on the longer side (pixels; at most
+  // max_side_px).
+  int min_long_side_px = 1000;
+  // Orthographic views: side of the square drawn for each point, pixels; 0 = from the local point spacing.
+  int point_size_px = 0;
+  void Check() const;  // throws OptionsError
 };
 template <>
 const StructInfo& InfoOf<PictureLayoutOptions>();
@@ -54,14 +69,19 @@ struct PictureLayout {
   PictureView view = PictureView::kGrid;  // the view used (never kAuto)
   // The organized scan to colour: the input itself (grid) or one cell per picture pixel (projections, whose
   // cells keep the chosen point's channels: point and range in the scanner frame, intensity, colour, label,
-  // normal, synthesized). Same pose and name as the input.
+  // normal, synthesized). Same pose, name and source_metadata as the input.
   Scan cells;
   cv::Size picture_size;  // the picture's size; the cells' images are resampled to it (nearest neighbour)
   // Size of one picture pixel across and down: degrees (grid, sphere) or metres (top, front).
   double pixel_width = 0, pixel_height = 0;
   std::string pixel_unit;  // "deg" or "m"
-  // Projections: points projected, and points kept (the nearest of each cell); grid: both 0.
+  // Projections: points projected, and points kept (the nearest of each cell; orthographic views: the points
+  // that show on at least one pixel); grid: both 0.
   int64_t points = 0, points_kept = 0;
+  // Orthographic views: the median side of the squares the points were drawn as (pixels), and whether it came
+  // from the local point spacing (automatic) or point_size_px.
+  double splat_px = 0;
+  bool splat_automatic = false;
   std::string Describe() const;  // one line saying what was done, for stderr and --json
 };
 
@@ -75,6 +95,11 @@ cv::Vec2d NativeStepsRad(const Scan& scan);
 
 // Throws OptionsError for bad options, InputError (naming the scan) when a projection has no point to show.
 PictureLayout LayOutPicture(const Scan& scan, const PictureLayoutOptions& options);
+
+// Orthographic views: the unit vector of the world frame pointing from the scene towards the viewer (top: +z,
+// front: -y, side: +x); the zero vector for the other views. A point's height towards the viewer is its
+// world position dotted with it (the elevation in the top view).
+Eigen::Vector3d TowardViewer(PictureView view);
 
 // Nearest-neighbour resampling to `size`, pixel centres to pixel centres (values are never mixed).
 cv::Mat ResampleNearest(const cv::Mat& image, cv::Size size);
