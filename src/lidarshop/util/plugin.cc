@@ -32,6 +32,9 @@ void* LoadPlugin() {
 #ifdef LIDARSHOP_OPENCV_PLUGIN_PATH
   tried.push_back(LIDARSHOP_OPENCV_PLUGIN_PATH);
 #endif
+#ifdef LIDARSHOP_OPENCV_PLUGIN_INSTALLED_PATH
+  tried.push_back(LIDARSHOP_OPENCV_PLUGIN_INSTALLED_PATH);
+#endif
   if (const std::string folder = ExecutableFolder(); !folder.empty())
     tried.push_back(folder + "/" + kPluginFile);
   std::string errors;

@@ -1,7 +1,8 @@
 // lidarshop's OpenCV plugin (src/plugins): OpenCV's image codecs and ximgproc, loaded the first time a command
 // reads or writes a picture or computes superpixels. Debian links libopencv_imgcodecs against GDAL and ~120
 // more shared libraries; linked into the executable they cost every command 0.1 s and 45 MB before it starts.
-// The plugin is looked for at $LIDARSHOP_OPENCV_PLUGIN, where the build wrote it, then beside the executable.
+// The plugin is looked for at $LIDARSHOP_OPENCV_PLUGIN, where the build wrote it, where it is installed
+// (LIBDIR/lidarshop), then beside the executable.
 #pragma once
 
 namespace lidarshop {
