@@ -116,6 +116,34 @@ cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
   return strokes;
 }
 
+PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, const std::string& layout_path,
+                                  const std::string& what_scan) {
+  PaintedStrokes strokes;
+  if (FileExtension(path) == "json") {
+    strokes.cells = ReadStrokes(path, scan.rows, scan.cols);
+    return strokes;
+  }
+  const cv::Mat painted = ReadImage(path);
+  if (painted.depth() != CV_8U) ThrowInputError(path, "", "", "a stroke image must be 8-bit");
+  const cv::Mat labels = StrokesFromImage(painted, path);
+  strokes.mapping = FindPictureMapping(scan, path, labels.size(), layout_path, what_scan);
+  if (!strokes.mapping) {
+    strokes.cells = labels;
+    return strokes;
+  }
+  strokes.cells = CellsFromPicture(scan, *strokes.mapping, labels);
+  strokes.picture = labels(cv::Rect(cv::Point(0, 0), strokes.mapping->picture_size)).clone();
+  return strokes;
+}
+
+cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes) {
+  if (strokes.mapping && strokes.mapping->view == PictureView::kGrid) {
+    return SegmentOverlayPicture(scan, mask, strokes.cells, strokes.mapping->picture_size, strokes.picture);
+  }
+  if (IsUnorganized(scan)) return SegmentOverlay(scan, mask, strokes.cells);
+  return SegmentOverlayPicture(scan, mask, strokes.cells, LayOutPicture(scan, {}).picture_size);
+}
+
 cv::Mat StrokesToImage(const cv::Mat& strokes) {
   cv::Mat image(strokes.rows, strokes.cols, CV_8UC3, cv::Scalar(0, 0, 0));
   image.setTo(cv::Scalar(0, 255, 0), strokes == kStrokeObject);
