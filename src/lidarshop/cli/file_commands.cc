@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -21,6 +22,7 @@
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
+#include "lidarshop/pointset/ground.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -516,7 +518,23 @@ int RunRender(int argc, char** argv) {
           } else {
             const cv::Mat region = around_path.empty() ? cv::Mat(scan.valid != 0)
                                                        : ReadMaskForScan(around_path, scan, "", input);
-            const PointViewOptions side = SideView(scan, region, orbit_deg);
+            // Up: the ground's normal when the scan shows a ground (found outside the mask, so that views
+            // before and after an edit inside it keep one camera), else the scan's own up.
+            const std::optional<GroundPlane> ground =
+                FindGround(scan, around_path.empty() ? cv::Mat() : region);
+            const PointViewOptions side =
+                SideView(scan, region, orbit_deg, ground ? ground->normal_in_world : Eigen::Vector3d::Zero());
+            json["up_from"] = ground ? "ground" : "scan";
+            if (ground) {
+              json["ground"] = {{"share", ground->share}, {"tilt_deg", ground->tilt_deg}};
+              if (!quiet) {
+                fmt::print(
+                    stderr,
+                    "lidarshop render: up is the ground's normal ({:.0f} % of the returns on one plane, "
+                    "{:.1f}° from the scanner's z)\n",
+                    100 * ground->share, ground->tilt_deg);
+              }
+            }
             view.eye_in_world = side.eye_in_world;
             view.target_in_world = side.target_in_world;
             view.up_in_world = side.up_in_world;

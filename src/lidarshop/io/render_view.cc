@@ -108,7 +108,8 @@ double MedianRange(const Scan& scan, const cv::Mat& cells) {
 
 }  // namespace
 
-PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg) {
+PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg,
+                          const Eigen::Vector3d& up_in_world) {
   CheckScan(scan);
   LIDARSHOP_CHECK(region.size() == cv::Size(scan.cols, scan.rows) && region.type() == CV_8U);
   // The centre's direction: the mean of the region's ray directions (scanner frame), known for every cell.
@@ -143,7 +144,8 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
   const Eigen::Vector3d scanner = scan.world_from_scanner.topRightCorner<3, 1>();
   const Eigen::Vector3d centre =
       scanner + scan.world_from_scanner.topLeftCorner<3, 3>() * direction_in_scanner * distance_m;
-  const Eigen::Vector3d up = ScanUpInWorld(scan);
+  const Eigen::Vector3d up =
+      up_in_world.isZero(0) ? ScanUpInWorld(scan) : Eigen::Vector3d(up_in_world.normalized());
   const Eigen::Vector3d turned = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, up) * (scanner - centre);
   PointViewOptions view;
   view.eye_in_world = centre + turned;

@@ -8,7 +8,9 @@
 // 640 x 480, points in an optical frame) the camera's -y, because the PCD reader makes its scanner frame from
 // the optical one ((x, y, z)_optical = (x, -z, y)_scanner, io/pcd.cc). ScanUpInWorld gives that axis in the
 // world frame, and second viewpoints keep it up, so a camera-like cloud seen from its own camera (SideView at
-// 0°) looks like its own image, and one seen from 30° off stays upright.
+// 0°) looks like its own image, and one seen from 30° off is not rolled. When the scan shows a ground
+// (pointset/ground.h FindGround: a large plane below the sensor within 60° of its up), `render --orbit` takes
+// the ground's normal as up instead, so a table a camera looks down at stays level as the camera turns.
 //
 // The camera file (`render --camera CAM.json`, `--write-camera CAM.json`), metres and degrees, world frame:
 //   {"eye": [x, y, z], "target": [x, y, z], "up": [x, y, z], "fov_deg": 60, "width": 640, "height": 480}
@@ -51,14 +53,15 @@ Eigen::Vector3d ScanUpInWorld(const Scan& scan);
 cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 
 // A second viewpoint for a region of the scan (CV_8U non-zero cells, e.g. a hole): the camera turns
-// `angle_deg` about the scan's up axis through the region's centre, starting from the scanner's position, and
-// looks at the centre; up is the scan's up. The centre lies along the mean ray direction of the region's cells
+// `angle_deg` about the up axis through the region's centre, starting from the scanner's position, and looks
+// at the centre; up is `up_in_world` (e.g. the ground's normal, pointset/ground.h), zero = the scan's up. The centre lies along the mean ray direction of the region's cells
 // at the median range of the returns in a ring around the region (3, 10, 30 or 100 cells wide, the first that
 // holds returns). Neither depends on what the region's cells hold, so the camera is the same before and after
 // an edit inside the region (a fill, a removal): pictures of both match pixel for pixel where the edited
 // points do not show. A region that covers every cell (the whole scan) has no ring: the median range of its
 // returns is taken.
-PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg);
+PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg,
+                          const Eigen::Vector3d& up_in_world = Eigen::Vector3d::Zero());
 
 // The camera file (see the top): the view's eye, target, up (resolved against `scan` when zero), field of
 // view and size.
