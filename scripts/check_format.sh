@@ -20,10 +20,18 @@ if [ "${#files[@]}" -eq 0 ]; then
   echo "check_format: no C++ files under $root/src" >&2
   exit 2
 fi
-unformatted=()
-for file in "${files[@]}"; do
-  if ! "$clang_format" --dry-run -Werror "$file" > /dev/null 2>&1; then unformatted+=("$file"); fi
-done
+# One clang-format process per batch of files, not per file (seconds instead of half a minute): with
+# --dry-run -Werror it names every file it would change ("FILE:LINE:COL: error: code should be
+# clang-formatted"); any other failure (an unreadable file, a broken .clang-format) stops the check.
+report=$(printf '%s\0' "${files[@]}" |
+  xargs -0 -n 100 -P "$(nproc 2>/dev/null || echo 2)" "$clang_format" --dry-run -Werror 2>&1) && status=0 || status=$?
+mapfile -t unformatted < <(printf '%s\n' "$report" |
+  sed -nE 's/^(.*):[0-9]+:[0-9]+: error: code should be clang-formatted.*/\1/p' | sort -u)
+if [ "$status" -ne 0 ] && [ "${#unformatted[@]}" -eq 0 ]; then
+  echo "check_format: $clang_format failed:" >&2
+  printf '%s\n' "$report" | head -20 >&2
+  exit 2
+fi
 if [ "${#unformatted[@]}" -ne 0 ]; then
   echo "check_format: clang-format would change ${#unformatted[@]} of ${#files[@]} files (run clang-format -i on them):"
   printf '  %s\n' "${unformatted[@]}"

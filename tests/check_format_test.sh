@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Self-test of scripts/check_format.sh on small fake trees that use the repository's .clang-format: an
 # unformatted file is named and fails the check, a formatted one passes, and a hand-laid comment table longer
-# than the column limit is left alone (ReflowComments: false), so formatting never mangles comments.
+# than the column limit is left alone (ReflowComments: false), so formatting never mangles comments; a
+# broken .clang-format fails with exit 2.
 #
 #   tests/check_format_test.sh [CLANG_FORMAT]
 set -euo pipefail
@@ -30,4 +31,9 @@ grep -q "bench/ugly.cc" "$work/out" || fail "the unformatted file is not named: 
 grep -q "src/table.h" "$work/out" && fail "a clean file was named: $(cat "$work/out")"
 "$clang_format" -i "$work/bench/ugly.cc"
 "$here/scripts/check_format.sh" "$work" "$clang_format" > /dev/null || fail "the file still fails after clang-format -i"
+# A check that cannot run is a failure of its own (exit 2), never a pass: a broken .clang-format.
+echo "BasedOnStyle: [not, a, style" > "$work/.clang-format"
+status=0
+"$here/scripts/check_format.sh" "$work" "$clang_format" > "$work/out" 2>&1 || status=$?
+[ "$status" -eq 2 ] || fail "a broken .clang-format gave exit $status: $(cat "$work/out")"
 echo "check_format_test: ok"
