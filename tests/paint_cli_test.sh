@@ -4,9 +4,10 @@
 # cut the same object as the same strokes on the grid; a mask painted on the picture fills the cells under it;
 # a picture of a wrong size gets an error that says which sizes fit; the views before and after `remove` around
 # the hole have the same camera and the same pixels away from the hole. Run by ctest as `paint_cli_test`.
-# Usage: paint_cli_test.sh LIDARSHOP_BINARY
+# Usage: paint_cli_test.sh LIDARSHOP_BINARY SHARED_DATA_DIR
 set -uo pipefail
 lidarshop=$1
+shared=$2
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 passed=0
@@ -240,6 +241,27 @@ fails_clearly "render: one viewpoint at a time" "one of --eye, --orbit and --cam
 echo '{"eye": [0, 0, 0], "target": [0, 1, 0], "up": [0, 0, 1], "fov": 40}' >"$work/bad_camera.json"
 fails_clearly "render: a camera file with an unknown key" "bad_camera.json.*fov.*unknown key" "$lidarshop" render \
   "$work/scan.ptx" --camera "$work/bad_camera.json" -o "$work/x.png"
+
+# Real data: pumpA (345 x 1074 rays, 0.25 x 0.0675 degrees) with the strokes of docs/results/pictures, painted on
+# its default render (1276 x 1074). Written as E57, whose reader fits the grid to the returns: the grid moves
+# with the removal, the camera around the hole must not.
+pump=$shared/e57/pumpA.e57
+pump_strokes=$(dirname "$0")/../docs/results/pictures/pumpA_strokes.png
+check "render pumpA" "$lidarshop" render "$pump" --channel rgb -o "$work/pumpA.png" --quiet
+json_check "pumpA's layout: square pixels" "$work/pumpA.png.layout.json" \
+  "d['picture_width'] == 1276 and d['picture_height'] == 1074 and d['scan_cols'] == 345"
+fails_clearly "pumpA: strokes of the grid's height but another width" \
+  "fits neither .*pumpA.e57's grid \(345 x 1074 cells\).*1276 x 1074 by default" \
+  "$lidarshop" segment "$pump" --strokes "$work/wrong.png" -o "$work/pump_wrong.png" --quiet
+check "remove on pumpA from strokes painted on its render" "$lidarshop" remove "$pump" --strokes "$pump_strokes" \
+  -o "$work/pump_removed.e57" --mask-out "$work/pump_hole.png" --quiet
+check "pumpA before" "$lidarshop" render "$pump" --orbit 30 --around "$work/pump_hole.png" -o "$work/pump_before.png" \
+  --write-camera "$work/pump_camera_before.json" --quiet
+check "pumpA after" "$lidarshop" render "$work/pump_removed.e57" --orbit 30 --around "$work/pump_hole.png" \
+  -o "$work/pump_after.png" --write-camera "$work/pump_camera_after.json" --json "$work/pump_after.json" --quiet
+check "pumpA: the same camera before and after" cmp "$work/pump_camera_before.json" "$work/pump_camera_after.json"
+json_check "pumpA: up is the floor's normal" "$work/pump_after.json" \
+  "d['up_from'] == 'ground' and d['ground']['tilt_deg'] < 5 and d['up_in_world'][2] > 0.99"
 
 echo "paint_cli_test: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -112,33 +112,44 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
                           const Eigen::Vector3d& up_in_world) {
   CheckScan(scan);
   LIDARSHOP_CHECK(region.size() == cv::Size(scan.cols, scan.rows) && region.type() == CV_8U);
-  // The centre's direction: the mean of the region's ray directions (scanner frame), known for every cell.
-  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
-  int64_t count = 0;
-  for (int y = 0; y < scan.rows; ++y) {
-    for (int x = 0; x < scan.cols; ++x) {
-      if (!region.at<uint8_t>(y, x)) continue;
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);
-      direction_sum += Eigen::Vector3d(d[0], d[1], d[2]);
-      ++count;
-    }
-  }
-  // A region all around the scanner (a panorama) has no mean direction: look forward.
-  const Eigen::Vector3d direction_in_scanner = count > 0 && direction_sum.norm() > 0.05 * count
-                                                   ? Eigen::Vector3d(direction_sum.normalized())
-                                                   : Eigen::Vector3d::UnitY();
-  // The distance: the returns around the region, which an edit inside it does not change.
-  double distance_m = std::numeric_limits<double>::quiet_NaN();
+  // The centre: along the mean direction of the returns in a ring around the region, at their median range.
+  // Neither changes when the cells inside the region are edited; the region's own cell directions would (a
+  // grid fitted to the returns, as readers of real scans fit it, moves with them).
   const cv::Mat inside = region != 0;
+  cv::Mat ring;
+  double distance_m = std::numeric_limits<double>::quiet_NaN();
   if (cv::countNonZero(inside) < scan.num_cells()) {
     for (const int width : {3, 10, 30, 100}) {
       cv::Mat grown;
       cv::dilate(inside, grown, cv::Mat(), cv::Point(-1, -1), width);
-      distance_m = MedianRange(scan, grown & ~inside);
+      ring = grown & ~inside;
+      distance_m = MedianRange(scan, ring);
       if (!std::isnan(distance_m)) break;
     }
   }
-  if (std::isnan(distance_m)) distance_m = MedianRange(scan, region);
+  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
+  int64_t count = 0;
+  const bool from_ring = !std::isnan(distance_m);
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (from_ring) {
+        const float range = scan.range.at<float>(y, x);
+        if (!ring.at<uint8_t>(y, x) || !scan.valid.at<uint8_t>(y, x) || !(range > 0)) continue;
+        const cv::Vec3f p = scan.point.at<cv::Vec3f>(y, x);
+        direction_sum += Eigen::Vector3d(p[0], p[1], p[2]) / range;
+      } else {
+        if (!inside.at<uint8_t>(y, x)) continue;
+        const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);  // known for every cell
+        direction_sum += Eigen::Vector3d(d[0], d[1], d[2]);
+      }
+      ++count;
+    }
+  }
+  // Directions all around the scanner (a panorama) have no mean: look forward.
+  const Eigen::Vector3d direction_in_scanner = count > 0 && direction_sum.norm() > 0.05 * count
+                                                   ? Eigen::Vector3d(direction_sum.normalized())
+                                                   : Eigen::Vector3d::UnitY();
+  if (std::isnan(distance_m)) distance_m = MedianRange(scan, inside);
   if (std::isnan(distance_m)) distance_m = MedianRange(scan, scan.valid);
   if (std::isnan(distance_m) || distance_m <= 0) distance_m = 1.0;
   const Eigen::Vector3d scanner = scan.world_from_scanner.topRightCorner<3, 1>();

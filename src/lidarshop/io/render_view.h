@@ -54,12 +54,13 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 
 // A second viewpoint for a region of the scan (CV_8U non-zero cells, e.g. a hole): the camera turns
 // `angle_deg` about the up axis through the region's centre, starting from the scanner's position, and looks
-// at the centre; up is `up_in_world` (e.g. the ground's normal, pointset/ground.h), zero = the scan's up. The centre lies along the mean ray direction of the region's cells
-// at the median range of the returns in a ring around the region (3, 10, 30 or 100 cells wide, the first that
-// holds returns). Neither depends on what the region's cells hold, so the camera is the same before and after
-// an edit inside the region (a fill, a removal): pictures of both match pixel for pixel where the edited
-// points do not show. A region that covers every cell (the whole scan) has no ring: the median range of its
-// returns is taken.
+// at the centre; up is `up_in_world` (e.g. the ground's normal, pointset/ground.h), zero = the scan's up.
+// The centre lies along the mean direction of the returns in a ring around the region (3, 10, 30 or 100 cells
+// wide, the first that holds returns), at their median range. Neither depends on what the region's cells hold
+// (not even their grid directions, which a grid fitted to the returns moves), so the camera is the same before
+// and after an edit inside the region (a fill, a removal): pictures of both match pixel for pixel where the
+// edited points do not show. Without a ring (a region that covers every cell, or one in the sky) the mean of
+// the region's cell directions at the median range of its returns (or of all returns) is taken.
 PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg,
                           const Eigen::Vector3d& up_in_world = Eigen::Vector3d::Zero());
 
