@@ -178,7 +178,9 @@ int RunRemove(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index);
-        const cv::Mat strokes = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path).cells;
+        const PaintedStrokes painted = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path);
+        const cv::Mat& strokes = painted.cells;
+        if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
         const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
         if (progress) progress->Finish();

@@ -46,8 +46,8 @@ int RunSegment(int argc, char** argv) {
       ->required();
   app.add_option(
       "--layout", layout_path,
-      "the layout file of the picture the strokes were painted on (default: STROKES.png.layout.json "
-      "when it exists, else render's default layout at the picture's width)");
+      "the layout file of the picture the strokes (and --refine) were painted on (default: "
+      "STROKES.png.layout.json when it exists, else render's default layout at the picture's width)");
   app.add_option("-o,--output", mask_path, "output mask PNG (255 = object, image orientation)")->required();
   app.add_option("--object", object_path,
                  "write the object as an organized scan here (.ptx, .e57, .ply, .pcd): grid and pose kept, "
@@ -81,6 +81,7 @@ int RunSegment(int argc, char** argv) {
         const Scan& scan = PickScan(file, scan_index);
         PaintedStrokes painted = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path);
         cv::Mat& strokes = painted.cells;
+        if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
         SegmentSession session(scan, options);
         SegmentResult result = session.Run(strokes);
         if (!quiet) fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());

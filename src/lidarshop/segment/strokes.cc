@@ -12,6 +12,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -114,6 +115,15 @@ cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
     strokes = StrokesFromImage(painted, path);
   }
   return strokes;
+}
+
+std::string PaintedStrokes::Describe() const {
+  const std::string cells_text =
+      fmt::format("{} object and {} background cells", cv::countNonZero(cells == kStrokeObject),
+                  cv::countNonZero(cells == kStrokeBackground));
+  if (!mapping) return fmt::format("strokes on the scan's grid: {}", cells_text);
+  return fmt::format("strokes painted on a {} x {} {} picture: {}", mapping->image_size.width,
+                     mapping->image_size.height, ToString(mapping->view), cells_text);
 }
 
 PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, const std::string& layout_path,

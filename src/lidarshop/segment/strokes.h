@@ -49,6 +49,9 @@ struct PaintedStrokes {
   // on a picture `render` wrote; empty for JSON strokes and stroke pictures of the grid's own size.
   cv::Mat picture;
   std::optional<PictureMapping> mapping;  // how that picture maps onto the cells
+  // One line for stderr: where the strokes were painted and the cells they became ("strokes painted on a
+  // 1276 x 1074 grid picture: 52 object and 940 background cells").
+  std::string Describe() const;
 };
 
 // Reads a .json stroke file (grid coordinates) or a stroke picture of the grid's size or of any picture
