@@ -504,6 +504,10 @@ int RunRender(int argc, char** argv) {
         }
         if (!up.empty() && eye.empty())
           throw OptionsError("--up goes with --eye (a camera file holds its up)");
+        // The picture's layout file goes beside it (picture_mapping.h); checked before the long work.
+        if (viewpoints == 0) {
+          CheckOutputFile("-o", LayoutFilePath(output), {}, {input, around_path, camera_path, json_path});
+        }
         if (viewpoints == 1) {
           if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
           const ScanFile file = ReadScanFileAndWarn(input);
@@ -609,7 +613,6 @@ int RunRender(int argc, char** argv) {
         json["layout"] = LayoutJson(layout);
         // The layout beside the picture: what strokes and masks painted on it map onto (picture_mapping.h).
         const std::string layout_path = LayoutFilePath(output);
-        CheckOutputPath(layout_path, {input, around_path, json_path});
         WriteJsonOutput(layout_path, LayoutFileJson(layout, scan, image_size));
         json["layout_file"] = layout_path;
         if (!quiet) fmt::print(stderr, "lidarshop render: {}\n", layout.Describe());
