@@ -4,6 +4,9 @@
 # lidarshop_<name>; every *_test.cc becomes its own test executable and its own ctest, linked against the module,
 # its dependencies and lidarshop_testing (when TEST_DEPS names it). Files are globbed so that adding a source file
 # needs no CMake edit.
+# Headers are found as "lidarshop/<module>/x.h": under src/ in the build, under PREFIX/include once installed
+# (cmake/LidarshopInstall.cmake).
+include(GNUInstallDirs)
 set(LIDARSHOP_ALL_MODULES "" CACHE INTERNAL "")
 
 function(lidarshop_add_module)
@@ -20,12 +23,14 @@ function(lidarshop_add_module)
   endforeach()
   if(sources)
     add_library(${target} STATIC ${sources})
-    target_include_directories(${target} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+    target_include_directories(${target} PUBLIC $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>
+                                                $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     target_link_libraries(${target} PUBLIC ${dep_targets} ${ARG_LIBS})
     target_compile_options(${target} PRIVATE -Wall -Wextra -Wno-unused-parameter -Wno-psabi -fno-math-errno)
   else()
     add_library(${target} INTERFACE)
-    target_include_directories(${target} INTERFACE ${PROJECT_SOURCE_DIR}/src)
+    target_include_directories(${target} INTERFACE $<BUILD_INTERFACE:${PROJECT_SOURCE_DIR}/src>
+                                                   $<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>)
     target_link_libraries(${target} INTERFACE ${dep_targets} ${ARG_LIBS})
   endif()
   set(LIDARSHOP_ALL_MODULES ${LIDARSHOP_ALL_MODULES} ${target} CACHE INTERNAL "")

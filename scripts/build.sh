@@ -9,7 +9,8 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 # Paths relative to the checkout in ccache's hash: a fresh clone elsewhere reuses the objects of an earlier build.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
-cmake -S . -B build/release -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+# The release preset of CMakePresets.json: build/release, Ninja, Release.
+cmake --preset release >/dev/null
 if [[ $# -gt 0 ]]; then
   cmake --build build/release -j "$(nproc)" --target "$@"
   exit

@@ -26,8 +26,8 @@ build=build/fuzz
 # Paths relative to the checkout in ccache's hash (as scripts/build.sh): a clone in any folder reuses the objects.
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++-14 \
-  -DLIDARSHOP_BUILD_FUZZ=ON -DLIDARSHOP_BUILD_TESTS=OFF -DLIDARSHOP_BUILD_BENCH=OFF >/dev/null || exit 1
+# The fuzz preset (CMakePresets.json): build/fuzz, clang++-14, LIDARSHOP_BUILD_FUZZ=ON, no tests or benchmarks.
+cmake --preset fuzz >/dev/null || exit 1
 cmake --build "$build" -j "$(nproc)" --target "${readers[@]/%/_fuzz}" >"$build/build.log" 2>&1 ||
   { tail -30 "$build/build.log"; exit 1; }
 

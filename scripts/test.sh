@@ -10,9 +10,9 @@ export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 if [[ ${1:-} == --sanitize ]]; then
   shift
   bash scripts/setup.sh
-  # Debug info for reports; -O1 keeps the suite's synthetic scenes fast enough under ASan.
-  cmake -S . -B build/asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-    -DLIDARSHOP_SANITIZE=ON -DLIDARSHOP_BUILD_BENCH=OFF >/dev/null
+  # The asan preset (CMakePresets.json): build/asan, debug info for reports, -O1 keeps the suite's synthetic
+  # scenes fast enough under ASan.
+  cmake --preset asan >/dev/null
   cmake --build build/asan -j "$(nproc)"
   # Leak checking stays on; TBB's and Embree's thread pools are torn down at exit.
   ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1} UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1} \
@@ -23,6 +23,9 @@ bash scripts/build.sh
 ctest --test-dir build/release --output-on-failure -j "$(nproc)" "$@"
 bash scripts/web.sh test
 fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-15}
-if [[ $fuzz_seconds -gt 0 ]] && command -v clang++-14 >/dev/null; then
+if [[ $fuzz_seconds -gt 0 ]]; then
+  # A check that cannot run fails rather than skip (LIDARSHOP_FUZZ_SECONDS=0 skips fuzzing on purpose).
+  command -v clang++-14 >/dev/null ||
+    { echo "test.sh: clang++-14 not found, the fuzzers cannot run (scripts/setup.sh installs clang)" >&2; exit 1; }
   LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh "$fuzz_seconds"
 fi

@@ -2,7 +2,7 @@
 # Self-test of scripts/check_format.sh on small fake trees that use the repository's .clang-format: an
 # unformatted file is named and fails the check, a formatted one passes, and a hand-laid comment table longer
 # than the column limit is left alone (ReflowComments: false), so formatting never mangles comments; a
-# broken .clang-format fails with exit 2.
+# missing clang-format and a broken .clang-format fail with exit 2.
 #
 #   tests/check_format_test.sh [CLANG_FORMAT]
 set -euo pipefail
@@ -31,6 +31,11 @@ grep -q "bench/ugly.cc" "$work/out" || fail "the unformatted file is not named: 
 grep -q "src/table.h" "$work/out" && fail "a clean file was named: $(cat "$work/out")"
 "$clang_format" -i "$work/bench/ugly.cc"
 "$here/scripts/check_format.sh" "$work" "$clang_format" > /dev/null || fail "the file still fails after clang-format -i"
+# A clang-format that is not there: the check cannot run, so it fails (exit 2) and says why.
+status=0
+"$here/scripts/check_format.sh" "$work" "$work/no-such-clang-format" > "$work/out" 2>&1 || status=$?
+[ "$status" -eq 2 ] || fail "a missing clang-format gave exit $status, not 2: $(cat "$work/out")"
+grep -q "not found" "$work/out" || fail "a missing clang-format is not named: $(cat "$work/out")"
 # A check that cannot run is a failure of its own (exit 2), never a pass: a broken .clang-format.
 echo "BasedOnStyle: [not, a, style" > "$work/.clang-format"
 status=0
