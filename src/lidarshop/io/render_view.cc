@@ -127,34 +127,43 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
       if (!std::isnan(distance_m)) break;
     }
   }
-  Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
-  int64_t count = 0;
-  const bool from_ring = !std::isnan(distance_m);
-  for (int y = 0; y < scan.rows; ++y) {
-    for (int x = 0; x < scan.cols; ++x) {
-      if (from_ring) {
+  const Eigen::Vector3d scanner = scan.world_from_scanner.topRightCorner<3, 1>();
+  Eigen::Vector3d centre;
+  if (!std::isnan(distance_m)) {
+    Eigen::Vector3d direction_sum = Eigen::Vector3d::Zero();
+    for (int y = 0; y < scan.rows; ++y) {
+      for (int x = 0; x < scan.cols; ++x) {
         const float range = scan.range.at<float>(y, x);
         if (!ring.at<uint8_t>(y, x) || !scan.valid.at<uint8_t>(y, x) || !(range > 0)) continue;
         const cv::Vec3f p = scan.point.at<cv::Vec3f>(y, x);
         direction_sum += Eigen::Vector3d(p[0], p[1], p[2]) / range;
-      } else {
-        if (!inside.at<uint8_t>(y, x)) continue;
-        const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);  // known for every cell
-        direction_sum += Eigen::Vector3d(d[0], d[1], d[2]);
       }
-      ++count;
+    }
+    // A ring all around the scanner (a region that is a band of the panorama) has no mean: look forward.
+    const Eigen::Vector3d direction_in_scanner =
+        direction_sum.norm() > 1e-9 ? Eigen::Vector3d(direction_sum.normalized()) : Eigen::Vector3d::UnitY();
+    centre = scanner + scan.world_from_scanner.topLeftCorner<3, 3>() * direction_in_scanner * distance_m;
+  } else {
+    // No ring (the whole scan, or a region in the sky): the median of the region's returns on each world axis
+    // (else of all returns), which a far wall or a few distant points do not pull away as they pull a mean.
+    std::vector<double> coordinates[3];
+    for (const cv::Mat& cells : {inside, cv::Mat(scan.valid != 0)}) {
+      for (int y = 0; y < scan.rows; ++y) {
+        for (int x = 0; x < scan.cols; ++x) {
+          if (!cells.at<uint8_t>(y, x) || !scan.valid.at<uint8_t>(y, x)) continue;
+          const Eigen::Vector3d p = WorldPointOfCell(scan, y, x);
+          for (int k = 0; k < 3; ++k) coordinates[k].push_back(p[k]);
+        }
+      }
+      if (!coordinates[0].empty()) break;
+    }
+    centre = scanner + scan.world_from_scanner.topLeftCorner<3, 3>().col(1);  // nothing returned: 1 m ahead
+    for (int k = 0; k < 3 && !coordinates[0].empty(); ++k) {
+      std::vector<double>& values = coordinates[k];
+      std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+      centre[k] = values[values.size() / 2];
     }
   }
-  // Directions all around the scanner (a panorama) have no mean: look forward.
-  const Eigen::Vector3d direction_in_scanner = count > 0 && direction_sum.norm() > 0.05 * count
-                                                   ? Eigen::Vector3d(direction_sum.normalized())
-                                                   : Eigen::Vector3d::UnitY();
-  if (std::isnan(distance_m)) distance_m = MedianRange(scan, inside);
-  if (std::isnan(distance_m)) distance_m = MedianRange(scan, scan.valid);
-  if (std::isnan(distance_m) || distance_m <= 0) distance_m = 1.0;
-  const Eigen::Vector3d scanner = scan.world_from_scanner.topRightCorner<3, 1>();
-  const Eigen::Vector3d centre =
-      scanner + scan.world_from_scanner.topLeftCorner<3, 3>() * direction_in_scanner * distance_m;
   const Eigen::Vector3d up =
       up_in_world.isZero(0) ? ScanUpInWorld(scan) : Eigen::Vector3d(up_in_world.normalized());
   const Eigen::Vector3d turned = Eigen::AngleAxisd(angle_deg * M_PI / 180.0, up) * (scanner - centre);

@@ -59,8 +59,9 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 // wide, the first that holds returns), at their median range. Neither depends on what the region's cells hold
 // (not even their grid directions, which a grid fitted to the returns moves), so the camera is the same before
 // and after an edit inside the region (a fill, a removal): pictures of both match pixel for pixel where the
-// edited points do not show. Without a ring (a region that covers every cell, or one in the sky) the mean of
-// the region's cell directions at the median range of its returns (or of all returns) is taken.
+// edited points do not show. Without a ring (a region that covers every cell, or one in the sky) the centre
+// is the median of the region's returns on each world axis (or of all returns; 1 m ahead of the scanner
+// without any).
 PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg,
                           const Eigen::Vector3d& up_in_world = Eigen::Vector3d::Zero());
 
