@@ -24,15 +24,16 @@ cv::Mat MaskOf(const py::handle& mask, const Scan& scan, const std::string& what
 
 namespace {
 
-// Strokes: a uint8 array of 0 / 1 (object) / 2 (background), a path (.png or .json), or the JSON polylines as a
-// dict ({"strokes": [{"label": "object", "points": [[col, row], ...]}]}).
+// Strokes: a uint8 array of 0 / 1 (object) / 2 (background), a path (.png of the grid or painted on a render
+// picture, or .json), or the JSON polylines as a dict ({"strokes": [{"label": "object", "points": [[col, row],
+// ...]}]}).
 cv::Mat StrokesOf(const py::handle& strokes, const Scan& scan) {
   if (py::isinstance<py::dict>(strokes)) {
     return StrokesFromJson(ToJsonValue(strokes).dump(), scan.rows, scan.cols, "strokes");
   }
   if (py::isinstance<py::str>(strokes) || py::hasattr(strokes, "__fspath__")) {
     const std::string path = py::str(py::module_::import("os").attr("fspath")(strokes));
-    return ReadStrokes(path, scan.rows, scan.cols);
+    return ReadStrokesForScan(path, scan, "", "the scan").cells;  // a grid-sized PNG or a render picture
   }
   return ArrayToMat(strokes, CV_8U, 1, scan.rows, scan.cols, "strokes");
 }

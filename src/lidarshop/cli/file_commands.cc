@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,12 +15,14 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/las.h"
+#include "lidarshop/io/picture_mapping.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
+#include "lidarshop/pointset/ground.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -429,7 +432,10 @@ int RunRender(int argc, char** argv) {
       "default (--aspect native: one pixel per ray); an unorganized cloud is projected onto a spherical grid "
       "around the scanner (--view top|front|side: orthographic, at least 1000 pixels on the longer side, "
       "each point a square sized from the local point spacing, coloured by elevation unless --channel says "
-      "otherwise). .exr / .tif write the values as 32-bit floats.",
+      "otherwise). .exr / .tif write the values as 32-bit floats. "
+      "The picture's layout goes beside it (PICTURE.layout.json): strokes and masks painted on the picture "
+      "map onto the scan's cells (segment, remove, fill). --eye, --orbit or --camera draw the points from "
+      "another viewpoint, the scan's up kept up.",
       "render"};
   std::string input, output, channel, color_map, json_path, scene_names;
   int scan_index = 0, width_px = 0, height_px = 0;
@@ -486,10 +492,21 @@ int RunRender(int argc, char** argv) {
   app.add_option("--target", target, "point x,y,z the camera looks at (with --eye)")
       ->delimiter(',')
       ->expected(3);
+  std::vector<double> up;
+  app.add_option("--up", up, "with --eye: the picture's up x,y,z in the world (default: the scan's up)")
+      ->delimiter(',')
+      ->expected(3);
   app.add_option("--orbit", orbit_deg,
-                 "camera turned this many degrees around the scan's (or --around's) centre from the scanner");
+                 "camera turned this many degrees about the scan's up, around the scan's (or --around's) "
+                 "centre, from the scanner");
   app.add_option("--around", around_path,
-                 "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole)");
+                 "with --orbit: a mask PNG of the cells to look at (e.g. a filled hole; the grid's size or "
+                 "painted on a render picture): the camera depends on the mask and the scan's pose only");
+  std::string camera_path, write_camera_path;
+  app.add_option("--camera", camera_path,
+                 "draw the points with this camera file (JSON: eye, target, up, fov_deg, width, height; "
+                 "metres, degrees), e.g. one --write-camera wrote");
+  app.add_option("--write-camera", write_camera_path, "write the camera of --eye, --orbit or --camera here");
   binder.Bind(&view, {.keys = {"field_of_view_deg", "synthesized_tint"},
                       .flags = {{"field_of_view_deg", "--fov"}, {"synthesized_tint", "--tint-synthesized"}},
                       .group = "Second viewpoint (--eye / --orbit)"});
@@ -509,33 +526,78 @@ int RunRender(int argc, char** argv) {
         if (layout_options.point_size_px > 0) view.point_size_px = layout_options.point_size_px;
         binder.Validate(view);
         binder.Validate(layout_options);
-        CheckOutputPath(output, {input, around_path});
-        CheckOutputFile("--json", json_path, {}, {input, around_path, output});
+        CheckOutputPath(output, {input, around_path, camera_path});
+        CheckOutputFile("--json", json_path, {}, {input, around_path, camera_path, output});
+        CheckOutputFile("--write-camera", write_camera_path, {"json"},
+                        {input, around_path, camera_path, output, json_path});
         nlohmann::ordered_json json;
-        if (!eye.empty() || !std::isnan(orbit_deg)) {
-          if (!eye.empty() && !std::isnan(orbit_deg)) throw OptionsError("give --eye or --orbit, not both");
+        const int viewpoints = !eye.empty() + !std::isnan(orbit_deg) + !camera_path.empty();
+        if (viewpoints > 1) throw OptionsError("give one of --eye, --orbit and --camera");
+        if (viewpoints == 0 && !write_camera_path.empty()) {
+          throw OptionsError("--write-camera writes the camera of --eye, --orbit or --camera");
+        }
+        if (!up.empty() && eye.empty())
+          throw OptionsError("--up goes with --eye (a camera file holds its up)");
+        // The picture's layout file goes beside it (picture_mapping.h); checked before the long work.
+        if (viewpoints == 0) {
+          CheckOutputFile("-o", LayoutFilePath(output), {}, {input, around_path, camera_path, json_path});
+        }
+        if (viewpoints == 1) {
           if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
           const ScanFile file = ReadScanFileAndWarn(input);
           const Scan& scan = PickScan(file, scan_index, "--scan");
           if (!eye.empty()) {
             view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
             view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
+            if (!up.empty()) view.up_in_world = Eigen::Vector3d(up[0], up[1], up[2]);
+          } else if (!camera_path.empty()) {
+            constexpr int64_t kMaxCameraBytes = int64_t{1} << 20;
+            ParseCameraJson(ReadRegularFile(camera_path, kMaxCameraBytes), camera_path, &view);
           } else {
-            const cv::Mat region = around_path.empty()
-                                       ? cv::Mat(scan.valid != 0)
-                                       : ReadMask(around_path, cv::Size(scan.cols, scan.rows), input);
-            const PointViewOptions side = SideView(scan, region, orbit_deg);
+            const cv::Mat region = around_path.empty() ? cv::Mat(scan.valid != 0)
+                                                       : ReadMaskForScan(around_path, scan, "", input);
+            // Up: the ground's normal when the scan shows a ground (found outside the mask, so that views
+            // before and after an edit inside it keep one camera), else the scan's own up.
+            const std::optional<GroundPlane> ground =
+                FindGround(scan, around_path.empty() ? cv::Mat() : region);
+            const PointViewOptions side =
+                SideView(scan, region, orbit_deg, ground ? ground->normal_in_world : Eigen::Vector3d::Zero());
+            json["up_from"] = ground ? "ground" : "scan";
+            if (ground) {
+              json["ground"] = {{"share", ground->share}, {"tilt_deg", ground->tilt_deg}};
+              if (!quiet) {
+                fmt::print(
+                    stderr,
+                    "lidarshop render: up is the ground's normal ({:.0f} % of the returns on one plane, "
+                    "{:.1f}° from the scanner's z)\n",
+                    100 * ground->share, ground->tilt_deg);
+              }
+            }
             view.eye_in_world = side.eye_in_world;
             view.target_in_world = side.target_in_world;
+            view.up_in_world = side.up_in_world;
           }
           const cv::Mat picture = RenderPointView(scan, view);
           WriteImage(output, picture);
+          const nlohmann::ordered_json camera = CameraJson(view, scan);
+          if (!write_camera_path.empty()) WriteJsonOutput(write_camera_path, camera, 2, true);
           json["output"] = output;
           json["width_px"] = picture.cols;
           json["height_px"] = picture.rows;
-          json["eye_in_world"] = {view.eye_in_world.x(), view.eye_in_world.y(), view.eye_in_world.z()};
-          json["target_in_world"] = {view.target_in_world.x(), view.target_in_world.y(),
-                                     view.target_in_world.z()};
+          json["eye_in_world"] = camera["eye"];
+          json["target_in_world"] = camera["target"];
+          json["up_in_world"] = camera["up"];
+          json["camera"] = camera;
+          if (!quiet) {
+            auto xyz = [](const Eigen::Vector3d& v) {
+              return fmt::format("{:.3f}, {:.3f}, {:.3f}", v.x(), v.y(), v.z());
+            };
+            fmt::print(stderr,
+                       "lidarshop render: the points seen from ({}) looking at ({}), up ({}): {} x {}\n",
+                       xyz(view.eye_in_world), xyz(view.target_in_world),
+                       xyz(view.up_in_world.isZero(0) ? ScanUpInWorld(scan) : view.up_in_world), picture.cols,
+                       picture.rows);
+          }
           WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
           Summarize(fmt::format("{} x {} view from ({:.2f}, {:.2f}, {:.2f}) -> {}", picture.cols,
                                 picture.rows, view.eye_in_world.x(), view.eye_in_world.y(),
@@ -569,9 +631,11 @@ int RunRender(int argc, char** argv) {
         json["output"] = output;
         json["channel"] = channel;
         PictureLayout layout;
+        cv::Size image_size;
         if (float_picture) {
           ValuesResult values = RenderValues(scan, options.channel, layout_options);
           WriteImage(output, values.values);
+          image_size = values.values.size();
           json["width_px"] = values.values.cols;
           json["height_px"] = values.values.rows;
           json["values"] =
@@ -582,6 +646,7 @@ int RunRender(int argc, char** argv) {
         } else {
           PictureResult result = RenderPicture(scan, options, layout_options);
           WriteImage(output, result.image);
+          image_size = result.image.size();
           json["width_px"] = result.image.cols;
           json["height_px"] = result.image.rows;
           if (result.scale) {
@@ -593,6 +658,10 @@ int RunRender(int argc, char** argv) {
           layout = std::move(result.layout);
         }
         json["layout"] = LayoutJson(layout);
+        // The layout beside the picture: what strokes and masks painted on it map onto (picture_mapping.h).
+        const std::string layout_path = LayoutFilePath(output);
+        WriteJsonOutput(layout_path, LayoutFileJson(layout, scan, image_size));
+        json["layout_file"] = layout_path;
         Summarize(layout.Describe());
         WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
         return 0;

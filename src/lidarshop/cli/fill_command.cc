@@ -17,6 +17,7 @@
 #include "lidarshop/fill/remove.h"
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/io/picture_mapping.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
@@ -86,14 +87,19 @@ int RunFill(int argc, char** argv) {
       "with Poisson, place the points along the scanner's rays and flag them synthesized. Every cell outside "
       "the mask is copied bit for bit.",
       "fill"};
-  std::string scan_path, mask_path, output_path, json_path, debug_dir, synthesized_mask_path;
+  std::string scan_path, mask_path, output_path, json_path, debug_dir, synthesized_mask_path, layout_path;
   int scan_index = 0;
   bool quiet = false;
   FillOptions options;
   OptionBinder binder(app);
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
-  app.add_option("--mask", mask_path, "hole mask PNG, scan image orientation (cols x rows), white = fill")
+  app.add_option("--mask", mask_path,
+                 "hole mask PNG, white = fill: of the scan's grid size (cols x rows) or painted on a picture "
+                 "`lidarshop render` wrote of the scan (any width)")
       ->required();
+  app.add_option("--layout", layout_path,
+                 "the layout file of the picture the mask was painted on (default: MASK.png.layout.json when "
+                 "it exists, else render's default layout at the picture's width)");
   app.add_option("-o,--output", output_path, "filled scan (.ptx, .e57, .ply, .pcd): same grid and pose")
       ->required();
   AddJsonOption(app, &json_path, "--json,--report");
@@ -113,7 +119,7 @@ int RunFill(int argc, char** argv) {
                         {scan_path, mask_path, output_path, json_path});
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
-        const cv::Mat hole = ReadMask(mask_path, cv::Size(scan.cols, scan.rows), scan_path);
+        const cv::Mat hole = ReadMaskForScan(mask_path, scan, layout_path, scan_path);
         auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
         const FillResult result = FillScan(scan, hole, options, progress.get());
         if (progress) progress->Finish();
@@ -134,14 +140,20 @@ int RunRemove(int argc, char** argv) {
       "`segment`), then fill its cells grown by a margin. With --keep-object the object stays and the filled "
       "background is added behind it as a second layer.",
       "remove"};
-  std::string scan_path, strokes_path, output_path, mask_out_path, json_path;
+  std::string scan_path, strokes_path, output_path, mask_out_path, json_path, layout_path;
   int scan_index = 0;
   bool quiet = false;
   RemoveOptions remove;
   OptionBinder binder(app);
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
-  app.add_option("--strokes", strokes_path, "strokes: .png (green object, red background) or .json polylines")
+  app.add_option("--strokes", strokes_path,
+                 "strokes: .png painted on a `render` picture or on the grid (green object, red background), "
+                 "or .json polylines")
       ->required();
+  app.add_option(
+      "--layout", layout_path,
+      "the layout file of the picture the strokes were painted on (default: STROKES.png.layout.json "
+      "when it exists, else render's default layout at the picture's width)");
   app.add_option("-o,--output", output_path, "the scan without the object (.ptx, .e57, .ply, .pcd)")
       ->required();
   app.add_option("--mask-out", mask_out_path,
@@ -167,7 +179,9 @@ int RunRemove(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
-        const cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
+        const PaintedStrokes painted = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path);
+        const cv::Mat& strokes = painted.cells;
+        if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
         const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
         if (progress) progress->Finish();

@@ -28,20 +28,26 @@ std::string DefaultOverlayPath(const std::string& mask_path) {
 int RunSegment(int argc, char** argv) {
   CLI::App app{
       "Cut an object out of a scan from strokes: two-step RGB + depth graph cut (docs/segment.md).\n"
-      "Strokes: a PNG of the scan image's size (green = object, red = background) or JSON polylines in grid "
-      "coordinates. Writes the mask (PNG, 255 = object) and an overlay picture (mask outline and strokes "
-      "over the "
-      "scan's colours; default MASK_overlay.png next to the mask, --overlay none to skip).",
+      "Strokes: painted on a picture `lidarshop render` wrote of the scan (any width; green = object, red = "
+      "background), on a PNG of the scan's grid size, or JSON polylines in grid coordinates. Writes the mask "
+      "(PNG, 255 = object, the scan's grid) and an overlay picture (mask outline and strokes over the scan's "
+      "colours, in render's layout; default MASK_overlay.png next to the mask, --overlay none to skip).",
       "segment"};
   std::string scan_path, strokes_path, mask_path, object_path, rest_path, overlay_path, refine_path,
-      json_path;
+      json_path, layout_path;
   int scan_index = 0;
   bool quiet = false;
   SegmentOptions options;
   OptionBinder binder(app);
   app.add_option("scan", scan_path, "scan file (.ptx, .e57, .pcd, .ply with grid)")->required();
-  app.add_option("--strokes", strokes_path, "strokes: .png (green object, red background) or .json polylines")
+  app.add_option("--strokes", strokes_path,
+                 "strokes: .png painted on a `render` picture or on the grid (green object, red background), "
+                 "or .json polylines")
       ->required();
+  app.add_option(
+      "--layout", layout_path,
+      "the layout file of the picture the strokes (and --refine) were painted on (default: "
+      "STROKES.png.layout.json when it exists, else render's default layout at the picture's width)");
   app.add_option("-o,--output", mask_path, "output mask PNG (255 = object, image orientation)")->required();
   app.add_option("--object", object_path,
                  "write the object as an organized scan here (.ptx, .e57, .ply, .pcd): grid and pose kept, "
@@ -64,7 +70,7 @@ int RunSegment(int argc, char** argv) {
         for (const std::string& path : {object_path, rest_path}) {
           if (!path.empty()) CheckScanFileFormat(path);
         }
-        std::vector<std::string> used = {scan_path, strokes_path, refine_path};
+        std::vector<std::string> used = {scan_path, strokes_path, refine_path, layout_path};
         for (const std::string& path : {mask_path, object_path, rest_path, overlay_path, json_path}) {
           if (path == "-" || path == "none") continue;
           if (path.empty()) continue;
@@ -73,16 +79,27 @@ int RunSegment(int argc, char** argv) {
         }
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
-        cv::Mat strokes = ReadStrokes(strokes_path, scan.rows, scan.cols);
+        PaintedStrokes painted = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path);
+        cv::Mat& strokes = painted.cells;
+        if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
         SegmentSession session(scan, options);
         SegmentResult result = session.Run(strokes);
         if (!quiet && !refine_path.empty())
           fmt::print(stderr, "{}: {}\n", ToString(options.method), result.Summary());
         if (!refine_path.empty()) {
-          const cv::Mat extra = ReadStrokes(refine_path, scan.rows, scan.cols);
-          result = session.Refine(extra);
-          strokes.setTo(kStrokeObject, extra == kStrokeObject);
-          strokes.setTo(kStrokeBackground, extra == kStrokeBackground);
+          const PaintedStrokes extra = ReadStrokesForScan(refine_path, scan, layout_path, scan_path);
+          result = session.Refine(extra.cells);
+          strokes.setTo(kStrokeObject, extra.cells == kStrokeObject);
+          strokes.setTo(kStrokeBackground, extra.cells == kStrokeBackground);
+          // Both painted on the same picture: the overlay shows both as painted; else the cells.
+          if (!painted.picture.empty() && !extra.picture.empty() &&
+              painted.picture.size() == extra.picture.size()) {
+            painted.picture.setTo(kStrokeObject, extra.picture == kStrokeObject);
+            painted.picture.setTo(kStrokeBackground, extra.picture == kStrokeBackground);
+          } else {
+            painted.picture.release();
+            painted.mapping.reset();
+          }
         }
         PrintResultWarnings(result.warnings);
         Summarize(fmt::format("{}{}: {} -> {}", ToString(options.method),
@@ -90,7 +107,7 @@ int RunSegment(int argc, char** argv) {
         WriteImage(mask_path, result.mask);
         if (overlay_path != "none") {
           WriteImage(overlay_path.empty() ? DefaultOverlayPath(mask_path) : overlay_path,
-                     SegmentOverlay(scan, result.mask, strokes));
+                     OverlayOnPicture(scan, result.mask, painted));
         }
         if (!object_path.empty()) WriteScanFile(object_path, {MaskScan(scan, result.mask)});
         if (!rest_path.empty()) WriteScanFile(rest_path, {MaskScan(scan, result.mask == 0)});

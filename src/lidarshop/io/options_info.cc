@@ -83,8 +83,8 @@ const StructInfo& InfoOf<PictureLayoutOptions>() {
 template <>
 const StructInfo& InfoOf<PointViewOptions>() {
   static const StructInfo info = [] {
-    StructBuilder<PointViewOptions> b("PointViewOptions",
-                                      "points from a second viewpoint (eye, target: C++ only)");
+    StructBuilder<PointViewOptions> b(
+        "PointViewOptions", "points from a second viewpoint (eye, target, up: C++ and the camera file)");
     b.Field(&PointViewOptions::field_of_view_deg, "field_of_view_deg", "horizontal field of view")
         .Unit("deg")
         .AboveZero()

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/io/render_layout.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -54,6 +55,47 @@ cv::Mat GrabCutFromStrokes(const Scan& scan, const cv::Mat& strokes, int iterati
   return out;
 }
 
+namespace {
+
+// Object pixels (`mask`, 255/0) tinted and outlined in a colour that stands out from them and their
+// surroundings.
+void TintObject(cv::Mat* picture, const cv::Mat& mask) {
+  // The colour is chosen against the object and a band around it: the outline lies on both.
+  cv::Mat surroundings;
+  cv::dilate(mask, surroundings, cv::Mat(), cv::Point(-1, -1), 5);
+  const cv::Vec3b overlay_rgb = ContrastingOverlayColor(*picture, surroundings);
+  const cv::Scalar overlay(overlay_rgb[0], overlay_rgb[1], overlay_rgb[2]);
+  cv::Mat tinted;
+  cv::addWeighted(*picture, 0.6, cv::Mat(picture->size(), CV_8UC3, overlay), 0.4, 0, tinted);
+  tinted.copyTo(*picture, mask);
+  cv::Mat eroded;
+  cv::erode(mask, eroded, cv::Mat());
+  picture->setTo(overlay, mask & ~eroded);
+}
+
+}  // namespace
+
+cv::Mat SegmentOverlayPicture(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes,
+                              cv::Size picture_size, const cv::Mat& picture_strokes) {
+  CheckScan(scan);
+  cv::Mat picture = ResampleNearest(SegmentOverlay(scan, cv::Mat(), cv::Mat()), picture_size).clone();
+  if (!mask.empty()) {
+    LIDARSHOP_CHECK(mask.size() == cv::Size(scan.cols, scan.rows) && mask.type() == CV_8U);
+    TintObject(&picture, ResampleNearest(mask != 0, picture_size));
+  }
+  cv::Mat shown = picture_strokes;
+  if (shown.empty() && !strokes.empty()) {
+    LIDARSHOP_CHECK(strokes.size() == cv::Size(scan.cols, scan.rows) && strokes.type() == CV_8U);
+    shown = ResampleNearest(strokes, picture_size);
+  }
+  if (!shown.empty()) {
+    LIDARSHOP_CHECK(shown.size() == picture_size && shown.type() == CV_8U);
+    picture.setTo(cv::Scalar(255, 0, 0), shown == kStrokeBackground);
+    picture.setTo(cv::Scalar(0, 255, 0), shown == kStrokeObject);
+  }
+  return picture;
+}
+
 cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes) {
   CheckScan(scan);
   cv::Mat picture = ColorPicture(scan);
@@ -61,17 +103,7 @@ cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& str
   picture.setTo(cv::Scalar(30, 30, 50), scan.valid == 0);
   if (!mask.empty()) {
     LIDARSHOP_CHECK(mask.size() == picture.size() && mask.type() == CV_8U);
-    // The colour is chosen against the object and a band around it: the outline lies on both.
-    cv::Mat surroundings;
-    cv::dilate(mask, surroundings, cv::Mat(), cv::Point(-1, -1), 5);
-    const cv::Vec3b overlay_rgb = ContrastingOverlayColor(picture, surroundings);
-    const cv::Scalar overlay(overlay_rgb[0], overlay_rgb[1], overlay_rgb[2]);
-    cv::Mat tinted;
-    cv::addWeighted(picture, 0.6, cv::Mat(picture.size(), CV_8UC3, overlay), 0.4, 0, tinted);
-    tinted.copyTo(picture, mask);
-    cv::Mat eroded;
-    cv::erode(mask, eroded, cv::Mat());
-    picture.setTo(overlay, mask & ~eroded);
+    TintObject(&picture, mask != 0);
   }
   if (!strokes.empty()) {
     LIDARSHOP_CHECK(strokes.size() == picture.size() && strokes.type() == CV_8U);

@@ -286,6 +286,12 @@ cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
 // green and background strokes red, both widened to OverlayStrokeRadius and rimmed in black. CV_8UC3 RGB.
 cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes);
 
+// The same overlay on a grid picture of `picture_size` (the scan's grid resampled by nearest neighbour, as
+// `render` draws it): object cells tinted, their outline 1 pixel wide, strokes drawn thin — `picture_strokes`
+// (stroke labels of picture_size, as painted) when given, else the stroke cells resampled — never widened.
+cv::Mat SegmentOverlayPicture(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes,
+                              cv::Size picture_size, const cv::Mat& picture_strokes = cv::Mat());
+
 // The overlay colour for `picture_rgb` (CV_8UC3): of a fixed list of saturated colours and white (yellow
 // first), the first one at least 40 CIELAB units from the colours in `region` (CV_8U; empty = the whole
 // picture), else the farthest; distances are taken at the 10th percentile so a few pixels cannot decide.

@@ -12,6 +12,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -114,6 +115,43 @@ cv::Mat ReadStrokes(const std::string& path, int rows, int cols) {
     strokes = StrokesFromImage(painted, path);
   }
   return strokes;
+}
+
+std::string PaintedStrokes::Describe() const {
+  const std::string cells_text =
+      fmt::format("{} object and {} background cells", cv::countNonZero(cells == kStrokeObject),
+                  cv::countNonZero(cells == kStrokeBackground));
+  if (!mapping) return fmt::format("strokes on the scan's grid: {}", cells_text);
+  return fmt::format("strokes painted on a {} x {} {} picture: {}", mapping->image_size.width,
+                     mapping->image_size.height, ToString(mapping->view), cells_text);
+}
+
+PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, const std::string& layout_path,
+                                  const std::string& what_scan) {
+  PaintedStrokes strokes;
+  if (FileExtension(path) == "json") {
+    strokes.cells = ReadStrokes(path, scan.rows, scan.cols);
+    return strokes;
+  }
+  const cv::Mat painted = ReadImage(path);
+  if (painted.depth() != CV_8U) ThrowInputError(path, "", "", "a stroke image must be 8-bit");
+  const cv::Mat labels = StrokesFromImage(painted, path);
+  strokes.mapping = FindPictureMapping(scan, path, labels.size(), layout_path, what_scan);
+  if (!strokes.mapping) {
+    strokes.cells = labels;
+    return strokes;
+  }
+  strokes.cells = CellsFromPicture(scan, *strokes.mapping, labels);
+  strokes.picture = labels(cv::Rect(cv::Point(0, 0), strokes.mapping->picture_size)).clone();
+  return strokes;
+}
+
+cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes) {
+  if (strokes.mapping && strokes.mapping->view == PictureView::kGrid) {
+    return SegmentOverlayPicture(scan, mask, strokes.cells, strokes.mapping->picture_size, strokes.picture);
+  }
+  if (IsUnorganized(scan)) return SegmentOverlay(scan, mask, strokes.cells);
+  return SegmentOverlayPicture(scan, mask, strokes.cells, LayOutPicture(scan, {}).picture_size);
 }
 
 cv::Mat StrokesToImage(const cv::Mat& strokes) {

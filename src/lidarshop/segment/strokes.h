@@ -7,6 +7,9 @@
 // (R >= 160, G <= 96, B <= 96); everything else — black, transparent (alpha < 128), or the scan's own picture
 // — is no stroke. Paint on a blank layer when the scan's picture itself has saturated greens or reds.
 //
+// A stroke picture may also be painted on any picture `render` wrote of the scan (square angular pixels, any
+// width; io/picture_mapping.h): its strokes are mapped onto the grid's cells (ReadStrokesForScan).
+//
 // JSON polylines in grid coordinates:
 //   {"strokes": [
 //      {"label": "object",     "width": 3, "points": [[col, row], [col, row], ...]},
@@ -18,9 +21,13 @@
 // strokes paint over earlier ones.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
+
+#include "lidarshop/io/picture_mapping.h"
+#include "lidarshop/scan/scan.h"
 
 namespace lidarshop {
 
@@ -34,6 +41,31 @@ cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols,
 
 // Reads a .png (or other image) or .json stroke file; the result must be rows x cols (InputError otherwise).
 cv::Mat ReadStrokes(const std::string& path, int rows, int cols);
+
+// Strokes read for a scan: on its grid, and as painted.
+struct PaintedStrokes {
+  cv::Mat cells;  // stroke labels on the scan's grid, CV_8U rows x cols
+  // The labels as painted in the picture's pixels (CV_8U, mapping->picture_size) when the strokes were painted
+  // on a picture `render` wrote; empty for JSON strokes and stroke pictures of the grid's own size.
+  cv::Mat picture;
+  std::optional<PictureMapping> mapping;  // how that picture maps onto the cells
+  // One line for stderr: where the strokes were painted and the cells they became ("strokes painted on a
+  // 1276 x 1074 grid picture: 52 object and 940 background cells").
+  std::string Describe() const;
+};
+
+// Reads a .json stroke file (grid coordinates) or a stroke picture of the grid's size or of any picture
+// `render` wrote of the scan (FindPictureMapping: `layout_path` or PICTURE.layout.json beside it, else
+// render's default layout at its width), mapped onto the cells (CellsFromPicture). Throws InputError naming
+// the file, the sizes it may have and how to get a picture to paint on; `what_scan` names the scan.
+PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, const std::string& layout_path,
+                                  const std::string& what_scan);
+
+// The overlay of `mask` and the strokes in the layout `render` draws by default (square angular pixels), or
+// the layout of the picture the strokes were painted on when it is a grid picture: the scan's colours, object
+// cells tinted with a 1-pixel outline, strokes drawn as painted (or their cells resampled), never widened.
+// Unorganized clouds (no grid picture): SegmentOverlay's one pixel per cell. CV_8UC3 RGB.
+cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes);
 
 // Paints strokes as a PNG-ready RGB image (object green, background red, rest black) — the inverse of
 // StrokesFromImage.

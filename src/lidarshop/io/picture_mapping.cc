@@ -1,0 +1,338 @@
+#include "lidarshop/io/picture_mapping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr const char* kLayoutFormat = "lidarshop picture layout";
+constexpr int kLayoutVersion = 1;
+// Widening of a sphere cell's pixels, at most this many pixels on each side.
+constexpr int kMaxFootprintRadiusPx = 16;
+
+// The most frequent non-zero value of picture[y0..y1][x0..x1] (inclusive), 0 when all are 0; ties go to the
+// value met first.
+uint8_t MostFrequentNonZero(const cv::Mat& picture, int x0, int x1, int y0, int y1) {
+  if (x0 == x1 && y0 == y1) return picture.at<uint8_t>(y0, x0);
+  std::pair<uint8_t, int> found[4] = {};
+  int distinct = 0;
+  for (int y = y0; y <= y1; ++y) {
+    const uint8_t* row = picture.ptr<uint8_t>(y);
+    for (int x = x0; x <= x1; ++x) {
+      const uint8_t value = row[x];
+      if (value == 0) continue;
+      int k = 0;
+      while (k < distinct && found[k].first != value) ++k;
+      if (k == distinct) {
+        if (distinct == 4) continue;  // strokes and masks hold at most two values
+        found[distinct++] = {value, 0};
+      }
+      ++found[k].second;
+    }
+  }
+  uint8_t best = 0;
+  int best_count = 0;
+  for (int k = 0; k < distinct; ++k) {
+    if (found[k].second > best_count) {
+      best = found[k].first;
+      best_count = found[k].second;
+    }
+  }
+  return best;
+}
+
+// For every cell of an axis of `cells` shown by `pixels` pixels (ResampleNearest: pixel p shows cell
+// floor((p + 0.5) * cells / pixels)): the first and last pixel showing it, or the pixel holding its centre.
+std::vector<std::pair<int, int>> PixelsOfCells(int cells, int pixels) {
+  std::vector<std::pair<int, int>> range(static_cast<size_t>(cells), {-1, -1});
+  for (int p = 0; p < pixels; ++p) {
+    const int cell = std::min(cells - 1, static_cast<int>((p + 0.5) * cells / pixels));
+    auto& r = range[static_cast<size_t>(cell)];
+    if (r.first < 0) r.first = p;
+    r.second = p;
+  }
+  for (int cell = 0; cell < cells; ++cell) {
+    auto& r = range[static_cast<size_t>(cell)];
+    if (r.first >= 0) continue;
+    const int p = std::clamp(static_cast<int>((cell + 0.5) * pixels / cells), 0, pixels - 1);
+    r = {p, p};
+  }
+  return range;
+}
+
+double NumberField(const nlohmann::json& doc, const char* key, const std::string& what) {
+  if (!doc.contains(key) || !doc[key].is_number()) ThrowInputError(what, "", key, "missing or not a number");
+  const double value = doc[key].get<double>();
+  if (!std::isfinite(value)) ThrowInputError(what, "", key, "must be finite");
+  return value;
+}
+
+int SizeField(const nlohmann::json& doc, const char* key, const std::string& what) {
+  if (!doc.contains(key) || !doc[key].is_number_integer()) {
+    ThrowInputError(what, "", key, "missing or not an integer");
+  }
+  const int64_t value = doc[key].get<int64_t>();
+  if (value < 1 || value > (int64_t{1} << 24)) ThrowInputError(what, "", key, "must be in [1, 2^24]");
+  return static_cast<int>(value);
+}
+
+}  // namespace
+
+bool HasCellMapping(PictureView view) { return view == PictureView::kGrid || view == PictureView::kSphere; }
+
+PictureMapping MappingOfLayout(const PictureLayout& layout, const Scan& scan, cv::Size image_size) {
+  if (!HasCellMapping(layout.view)) {
+    throw OptionsError(
+        fmt::format("a {} view's pixels do not map onto the scan's cells; paint on the grid or "
+                    "sphere view (render's default)",
+                    ToString(layout.view)));
+  }
+  PictureMapping mapping;
+  mapping.view = layout.view;
+  mapping.scan_rows = scan.rows;
+  mapping.scan_cols = scan.cols;
+  mapping.picture_size = layout.picture_size;
+  mapping.image_size = image_size.empty() ? layout.picture_size : image_size;
+  mapping.pixel_width = layout.pixel_width;
+  mapping.pixel_height = layout.pixel_height;
+  mapping.pixel_unit = layout.pixel_unit;
+  if (layout.view == PictureView::kSphere) {
+    // The cells' grid holds pixel centres: start + (k + 0.5) * step.
+    const std::vector<double>& azimuths = layout.cells.grid.azimuth_rad;
+    const std::vector<double>& elevations = layout.cells.grid.elevation_rad;
+    LIDARSHOP_CHECK(!azimuths.empty() && !elevations.empty());
+    mapping.azimuth_step_rad = azimuths.size() > 1
+                                   ? (azimuths.back() - azimuths.front()) / (azimuths.size() - 1)
+                                   : layout.pixel_width * M_PI / 180.0;
+    mapping.elevation_step_rad = elevations.size() > 1
+                                     ? (elevations.front() - elevations.back()) / (elevations.size() - 1)
+                                     : layout.pixel_height * M_PI / 180.0;
+    mapping.azimuth_left_rad = azimuths.front() - 0.5 * mapping.azimuth_step_rad;
+    mapping.elevation_top_rad = elevations.front() + 0.5 * mapping.elevation_step_rad;
+  }
+  return mapping;
+}
+
+nlohmann::ordered_json PictureMappingJson(const PictureMapping& mapping) {
+  nlohmann::ordered_json json;
+  json["format"] = kLayoutFormat;
+  json["version"] = kLayoutVersion;
+  json["scan_rows"] = mapping.scan_rows;
+  json["scan_cols"] = mapping.scan_cols;
+  json["view"] = ToString(mapping.view);
+  json["image_width"] = mapping.image_size.width;
+  json["image_height"] = mapping.image_size.height;
+  json["picture_width"] = mapping.picture_size.width;
+  json["picture_height"] = mapping.picture_size.height;
+  json["pixel_width"] = mapping.pixel_width;
+  json["pixel_height"] = mapping.pixel_height;
+  json["pixel_unit"] = mapping.pixel_unit;
+  if (mapping.view == PictureView::kSphere) {
+    json["azimuth_left_rad"] = mapping.azimuth_left_rad;
+    json["elevation_top_rad"] = mapping.elevation_top_rad;
+    json["azimuth_step_rad"] = mapping.azimuth_step_rad;
+    json["elevation_step_rad"] = mapping.elevation_step_rad;
+  }
+  return json;
+}
+
+nlohmann::ordered_json LayoutFileJson(const PictureLayout& layout, const Scan& scan, cv::Size image_size) {
+  if (HasCellMapping(layout.view)) return PictureMappingJson(MappingOfLayout(layout, scan, image_size));
+  // Orthographic views: what the picture is, without a cell mapping.
+  nlohmann::ordered_json json;
+  json["format"] = kLayoutFormat;
+  json["version"] = kLayoutVersion;
+  json["scan_rows"] = scan.rows;
+  json["scan_cols"] = scan.cols;
+  json["view"] = ToString(layout.view);
+  json["image_width"] = image_size.empty() ? layout.picture_size.width : image_size.width;
+  json["image_height"] = image_size.empty() ? layout.picture_size.height : image_size.height;
+  json["picture_width"] = layout.picture_size.width;
+  json["picture_height"] = layout.picture_size.height;
+  json["pixel_width"] = layout.pixel_width;
+  json["pixel_height"] = layout.pixel_height;
+  json["pixel_unit"] = layout.pixel_unit;
+  return json;
+}
+
+PictureMapping ParsePictureMapping(const std::string& text, const std::string& what) {
+  nlohmann::json doc;
+  try {
+    doc = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
+  } catch (const nlohmann::json::exception& e) {
+    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
+  }
+  if (!doc.is_object() || !doc.contains("format") || doc["format"] != kLayoutFormat) {
+    ThrowInputError(what, "", "format",
+                    fmt::format("not a picture layout file (\"format\": \"{}\")", kLayoutFormat));
+  }
+  if (!doc.contains("version") || doc["version"] != kLayoutVersion) {
+    ThrowInputError(what, "", "version", fmt::format("lidarshop reads version {}", kLayoutVersion));
+  }
+  PictureMapping mapping;
+  if (!doc.contains("view") || !doc["view"].is_string()) ThrowInputError(what, "", "view", "missing");
+  const std::string view = doc["view"].get<std::string>();
+  if (view == "grid") {
+    mapping.view = PictureView::kGrid;
+  } else if (view == "sphere") {
+    mapping.view = PictureView::kSphere;
+  } else {
+    ThrowInputError(
+        what, "", "view",
+        fmt::format("a {} picture's pixels do not map onto the scan's cells; paint on the picture "
+                    "`lidarshop render SCAN -o PICTURE.png` writes (grid or sphere view)",
+                    view));
+  }
+  mapping.scan_rows = SizeField(doc, "scan_rows", what);
+  mapping.scan_cols = SizeField(doc, "scan_cols", what);
+  mapping.image_size = cv::Size(SizeField(doc, "image_width", what), SizeField(doc, "image_height", what));
+  mapping.picture_size =
+      cv::Size(SizeField(doc, "picture_width", what), SizeField(doc, "picture_height", what));
+  if (mapping.picture_size.width > mapping.image_size.width ||
+      mapping.picture_size.height > mapping.image_size.height) {
+    ThrowInputError(what, "", "picture_width", "the picture is larger than the image holding it");
+  }
+  mapping.pixel_width = NumberField(doc, "pixel_width", what);
+  mapping.pixel_height = NumberField(doc, "pixel_height", what);
+  if (doc.contains("pixel_unit") && doc["pixel_unit"].is_string()) mapping.pixel_unit = doc["pixel_unit"];
+  if (mapping.view == PictureView::kSphere) {
+    mapping.azimuth_left_rad = NumberField(doc, "azimuth_left_rad", what);
+    mapping.elevation_top_rad = NumberField(doc, "elevation_top_rad", what);
+    mapping.azimuth_step_rad = NumberField(doc, "azimuth_step_rad", what);
+    mapping.elevation_step_rad = NumberField(doc, "elevation_step_rad", what);
+    if (!(mapping.azimuth_step_rad > 0) || !(mapping.elevation_step_rad > 0) ||
+        mapping.azimuth_step_rad * mapping.picture_size.width > 2 * M_PI + 1e-6) {
+      ThrowInputError(what, "", "azimuth_step_rad",
+                      "the steps must be positive and the picture at most one turn wide");
+    }
+  }
+  return mapping;
+}
+
+std::string LayoutFilePath(const std::string& picture_path) { return picture_path + ".layout.json"; }
+
+cv::Mat CellsFromPicture(const Scan& scan, const PictureMapping& mapping, const cv::Mat& picture) {
+  CheckScan(scan);
+  LIDARSHOP_CHECK(scan.rows == mapping.scan_rows && scan.cols == mapping.scan_cols);
+  LIDARSHOP_CHECK(picture.type() == CV_8U && picture.size() == mapping.image_size);
+  const int width = mapping.picture_size.width, height = mapping.picture_size.height;
+  cv::Mat cells(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  if (mapping.view == PictureView::kGrid) {
+    const auto across = PixelsOfCells(scan.cols, width), down = PixelsOfCells(scan.rows, height);
+    for (int row = 0; row < scan.rows; ++row) {
+      const auto [y0, y1] = down[static_cast<size_t>(row)];
+      uint8_t* out = cells.ptr<uint8_t>(row);
+      for (int col = 0; col < scan.cols; ++col) {
+        const auto [x0, x1] = across[static_cast<size_t>(col)];
+        out[col] = MostFrequentNonZero(picture, x0, x1, y0, y1);
+      }
+    }
+    return cells;
+  }
+  LIDARSHOP_CHECK(mapping.view == PictureView::kSphere);
+  // Pixels finer than the rays: a cell speaks for the pixels up to half a ray step around its own.
+  int radius_x = 0, radius_y = 0;
+  if (!IsUnorganized(scan)) {
+    const cv::Vec2d steps = NativeStepsRad(scan);
+    radius_x =
+        std::clamp(static_cast<int>(0.5 * steps[0] / mapping.azimuth_step_rad), 0, kMaxFootprintRadiusPx);
+    radius_y =
+        std::clamp(static_cast<int>(0.5 * steps[1] / mapping.elevation_step_rad), 0, kMaxFootprintRadiusPx);
+  }
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+      if (scan.valid.at<uint8_t>(row, col) && scan.range.at<float>(row, col) > 0) {
+        d = scan.point.at<cv::Vec3f>(row, col);  // the projection of LayOutSphere: the point's own direction
+      }
+      if (d == cv::Vec3f(0, 0, 0)) continue;
+      double azimuth = std::atan2(d[0], d[1]);
+      if (azimuth < mapping.azimuth_left_rad) azimuth += 2 * M_PI;
+      const double elevation = std::atan2(d[2], std::hypot(d[0], d[1]));
+      const double u = (azimuth - mapping.azimuth_left_rad) / mapping.azimuth_step_rad;
+      const double v = (mapping.elevation_top_rad - elevation) / mapping.elevation_step_rad;
+      // The extreme points fall on the far edges (LayOutSphere keeps them in the last pixel); rays farther
+      // out are not in the picture.
+      if (u < -1 || v < -1 || u > width + 1 || v > height + 1) continue;
+      const int x = std::clamp(static_cast<int>(std::floor(u)), 0, width - 1);
+      const int y = std::clamp(static_cast<int>(std::floor(v)), 0, height - 1);
+      cells.at<uint8_t>(row, col) =
+          MostFrequentNonZero(picture, std::max(0, x - radius_x), std::min(width - 1, x + radius_x),
+                              std::max(0, y - radius_y), std::min(height - 1, y + radius_y));
+    }
+  }
+  return cells;
+}
+
+std::optional<PictureMapping> FindPictureMapping(const Scan& scan, const std::string& picture_path,
+                                                 cv::Size picture_size, const std::string& layout_path,
+                                                 const std::string& what_scan) {
+  if (picture_size == cv::Size(scan.cols, scan.rows)) return std::nullopt;
+  // The layout file, given or beside the picture.
+  const std::string beside = LayoutFilePath(picture_path);
+  std::error_code error;
+  const std::string file =
+      !layout_path.empty() ? layout_path : (std::filesystem::is_regular_file(beside, error) ? beside : "");
+  if (!file.empty()) {
+    constexpr int64_t kMaxLayoutBytes = int64_t{1} << 20;
+    const PictureMapping mapping = ParsePictureMapping(ReadRegularFile(file, kMaxLayoutBytes), file);
+    if (mapping.scan_rows != scan.rows || mapping.scan_cols != scan.cols) {
+      ThrowInputError(file, "", "scan_cols",
+                      fmt::format("the layout is of a scan of {} x {} cells, {} has {} x {} (cols x rows)",
+                                  mapping.scan_cols, mapping.scan_rows, what_scan, scan.cols, scan.rows));
+    }
+    if (mapping.image_size != picture_size) {
+      ThrowInputError(
+          picture_path, "", "",
+          fmt::format("{} x {} pixels but its layout file {} describes {} x {}", picture_size.width,
+                      picture_size.height, file, mapping.image_size.width, mapping.image_size.height));
+    }
+    return mapping;
+  }
+  // Render's default layout at the picture's width or height (square pixels).
+  constexpr int kLargestPicture = 16384;  // PictureLayoutOptions' limit
+  PictureLayoutOptions options;
+  options.width_px = std::clamp(picture_size.width, 1, kLargestPicture);
+  const PictureLayout at_width = LayOutPicture(scan, options);
+  if (at_width.picture_size == picture_size) return MappingOfLayout(at_width, scan);
+  options.width_px = 0;
+  options.height_px = std::clamp(picture_size.height, 1, kLargestPicture);
+  const PictureLayout at_height = LayOutPicture(scan, options);
+  if (at_height.picture_size == picture_size) return MappingOfLayout(at_height, scan);
+  const PictureLayout automatic = LayOutPicture(scan, PictureLayoutOptions());
+  ThrowInputError(
+      picture_path, "", "",
+      fmt::format("{} x {} pixels fits neither {}'s grid ({} x {} cells) nor a picture `lidarshop render` "
+                  "writes of it ({} x {} by default, or any width with that aspect: {} x {} at this width); "
+                  "paint strokes or masks on `lidarshop render {} -o PICTURE.png` (any --width, --height), "
+                  "or give the "
+                  "picture's layout file with --layout (render writes it beside the picture as "
+                  "PICTURE.png.layout.json)",
+                  picture_size.width, picture_size.height, what_scan, scan.cols, scan.rows,
+                  automatic.picture_size.width, automatic.picture_size.height, at_width.picture_size.width,
+                  at_width.picture_size.height, what_scan));
+}
+
+cv::Mat ReadMaskForScan(const std::string& path, const Scan& scan, const std::string& layout_path,
+                        const std::string& what_scan) {
+  const cv::Mat mask = ReadMask(path, cv::Size(), what_scan);
+  const std::optional<PictureMapping> mapping =
+      FindPictureMapping(scan, path, mask.size(), layout_path, what_scan);
+  if (!mapping) return mask;
+  return CellsFromPicture(scan, *mapping, mask);
+}
+
+}  // namespace lidarshop
