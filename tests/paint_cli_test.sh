@@ -187,6 +187,45 @@ PY
 check "the filled cells are those under the painted mask" python3 "$work/cells.py" "$work" \
   "$work/picture.png.layout.json" "$work/filled_cells.png" "$work/fill.json"
 
+# A mask painted on the view from the front (orthographic: x right, z up): its layout file says where the
+# picture lies in the world (4000 pixels across the ground's 90 m), so the box's front face (x -0.8..0.8, z
+# 0..1.2 at y 7.7) is painted from its coordinates; fill fills the box's cells (columns 39-50, rows 64-82 of
+# the grid) and nothing else; the same layout file with another scan (its points changed) is refused.
+check "render --view front" "$lidarshop" render "$work/scan.ptx" --view front --width 4000 -o "$work/front.png" \
+  --quiet
+json_check "the front view's layout file" "$work/front.png.layout.json" \
+  "d['view'] == 'front' and d['pixel_unit'] == 'm' and d['point_size_px'] == 0 and \
+   d['left_m'] < -0.8 and d['top_m'] > 1.1 and d['picture_width'] == 4000"
+cat >"$work/front_mask.py" <<'PY'
+import json, sys
+sys.path.insert(0, sys.argv[1])
+import pictures
+layout = json.load(open(sys.argv[2]))
+W, H = layout["picture_width"], layout["picture_height"]
+px = lambda x: int((x - layout["left_m"]) / layout["pixel_width"])
+py = lambda z: int((layout["top_m"] - z) / layout["pixel_height"])
+pixels = {(x, y): (255, 255, 255) for x in range(px(-0.5), px(0.5) + 1) for y in range(py(1.0), py(0.2) + 1)}
+assert len(pixels) > 20, len(pixels)
+pictures.write_rgb(sys.argv[3], W, H, pixels)
+PY
+check "paint a mask on the front view" python3 "$work/front_mask.py" "$work" "$work/front.png.layout.json" \
+  "$work/front_painted.png"
+check "fill a mask painted on the front view" "$lidarshop" fill "$work/scan.ptx" --mask "$work/front_painted.png" \
+  --layout "$work/front.png.layout.json" --method laplace -o "$work/front_filled.ply" \
+  --synthesized-mask "$work/front_cells.png" --report "$work/front_fill.json" --quiet
+check "the front view's mask holds only box cells" python3 -c "
+import json, sys
+sys.path.insert(0, '$work')
+import pictures
+w, h, _, rows = pictures.read_png('$work/front_cells.png')
+filled = {(x, y) for y in range(h) for x in range(w) if rows[y][x]}
+hole = json.load(open('$work/front_fill.json'))['hole_cells']
+assert hole >= 20 and filled and all(39 <= x <= 50 and 64 <= y <= 82 for x, y in filled), (hole, sorted(filled)[:5])
+print(hole, len(filled))"
+fails_clearly "a front view's layout file of other points" "front.png.layout.json.*drawn of other points" \
+  "$lidarshop" fill "$work/filled.ply" --mask "$work/front_painted.png" --layout "$work/front.png.layout.json" \
+  -o "$work/front_other.ply" --quiet
+
 # remove from painted strokes; the views before and after around the hole: one camera, the same pixels away
 # from the hole's points.
 check "remove from strokes painted on the picture" "$lidarshop" remove "$work/scan.ptx" \

@@ -20,6 +20,45 @@ constexpr const char* kLayoutFormat = "lidarshop picture layout";
 constexpr int kLayoutVersion = 1;
 // Widening of a sphere cell's pixels, at most this many pixels on each side.
 constexpr int kMaxFootprintRadiusPx = 16;
+constexpr int kMaxLayoutPointSizePx = 32;  // PictureLayoutOptions::point_size_px's range
+
+bool IsOrthographic(PictureView view) {
+  return view == PictureView::kTop || view == PictureView::kFront || view == PictureView::kSide;
+}
+
+// An orthographic picture: each painted pixel votes for the cell whose point it shows; a cell takes its most
+// frequent non-zero vote.
+cv::Mat CellsFromOrthographic(const Scan& scan, const PictureMapping& mapping, const cv::Mat& picture) {
+  LIDARSHOP_CHECK(mapping.source_cells.type() == CV_32S &&
+                  mapping.source_cells.size() == mapping.picture_size);
+  std::vector<std::pair<int32_t, uint8_t>> votes;  // (cell, value), sorted below
+  for (int y = 0; y < mapping.picture_size.height; ++y) {
+    const uint8_t* painted = picture.ptr<uint8_t>(y);
+    const int32_t* shown = mapping.source_cells.ptr<int32_t>(y);
+    for (int x = 0; x < mapping.picture_size.width; ++x) {
+      if (painted[x] != 0 && shown[x] >= 0) votes.emplace_back(shown[x], painted[x]);
+    }
+  }
+  std::sort(votes.begin(), votes.end());
+  cv::Mat cells(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+  const int64_t cell_count = static_cast<int64_t>(scan.rows) * scan.cols;
+  for (size_t begin = 0; begin < votes.size();) {
+    const int32_t cell = votes[begin].first;
+    size_t end = begin;
+    uint8_t best = 0;
+    size_t best_count = 0;
+    while (end < votes.size() && votes[end].first == cell) {
+      size_t run = end;
+      while (run < votes.size() && votes[run] == votes[end]) ++run;
+      if (run - end > best_count) best_count = run - end, best = votes[end].second;
+      end = run;
+    }
+    LIDARSHOP_CHECK(cell < cell_count);
+    cells.at<uint8_t>(cell / scan.cols, cell % scan.cols) = best;
+    begin = end;
+  }
+  return cells;
+}
 
 // The most frequent non-zero value of picture[y0..y1][x0..x1] (inclusive), 0 when all are 0; ties go to the
 // value met first.
@@ -89,15 +128,10 @@ int SizeField(const nlohmann::json& doc, const char* key, const std::string& wha
 
 }  // namespace
 
-bool HasCellMapping(PictureView view) { return view == PictureView::kGrid || view == PictureView::kSphere; }
+bool HasCellMapping(PictureView view) { return view != PictureView::kAuto; }
 
 PictureMapping MappingOfLayout(const PictureLayout& layout, const Scan& scan, cv::Size image_size) {
-  if (!HasCellMapping(layout.view)) {
-    throw OptionsError(
-        fmt::format("a {} view's pixels do not map onto the scan's cells; paint on the grid or "
-                    "sphere view (render's default)",
-                    ToString(layout.view)));
-  }
+  LIDARSHOP_CHECK(HasCellMapping(layout.view));
   PictureMapping mapping;
   mapping.view = layout.view;
   mapping.scan_rows = scan.rows;
@@ -120,6 +154,12 @@ PictureMapping MappingOfLayout(const PictureLayout& layout, const Scan& scan, cv
                                      : layout.pixel_height * M_PI / 180.0;
     mapping.azimuth_left_rad = azimuths.front() - 0.5 * mapping.azimuth_step_rad;
     mapping.elevation_top_rad = elevations.front() + 0.5 * mapping.elevation_step_rad;
+  }
+  if (IsOrthographic(layout.view)) {
+    mapping.point_size_px = layout.splat_automatic ? 0 : static_cast<int>(layout.splat_px);
+    mapping.source_cells = layout.source_cells;
+    mapping.left_m = layout.left_m;
+    mapping.top_m = layout.top_m;
   }
   return mapping;
 }
@@ -144,26 +184,16 @@ nlohmann::ordered_json PictureMappingJson(const PictureMapping& mapping) {
     json["azimuth_step_rad"] = mapping.azimuth_step_rad;
     json["elevation_step_rad"] = mapping.elevation_step_rad;
   }
+  if (IsOrthographic(mapping.view)) {
+    json["point_size_px"] = mapping.point_size_px;
+    json["left_m"] = mapping.left_m;
+    json["top_m"] = mapping.top_m;
+  }
   return json;
 }
 
 nlohmann::ordered_json LayoutFileJson(const PictureLayout& layout, const Scan& scan, cv::Size image_size) {
-  if (HasCellMapping(layout.view)) return PictureMappingJson(MappingOfLayout(layout, scan, image_size));
-  // Orthographic views: what the picture is, without a cell mapping.
-  nlohmann::ordered_json json;
-  json["format"] = kLayoutFormat;
-  json["version"] = kLayoutVersion;
-  json["scan_rows"] = scan.rows;
-  json["scan_cols"] = scan.cols;
-  json["view"] = ToString(layout.view);
-  json["image_width"] = image_size.empty() ? layout.picture_size.width : image_size.width;
-  json["image_height"] = image_size.empty() ? layout.picture_size.height : image_size.height;
-  json["picture_width"] = layout.picture_size.width;
-  json["picture_height"] = layout.picture_size.height;
-  json["pixel_width"] = layout.pixel_width;
-  json["pixel_height"] = layout.pixel_height;
-  json["pixel_unit"] = layout.pixel_unit;
-  return json;
+  return PictureMappingJson(MappingOfLayout(layout, scan, image_size));
 }
 
 PictureMapping ParsePictureMapping(const std::string& text, const std::string& what) {
@@ -185,17 +215,16 @@ PictureMapping ParsePictureMapping(const std::string& text, const std::string& w
   PictureMapping mapping;
   if (!doc.contains("view") || !doc["view"].is_string()) ThrowInputError(what, "", "view", "missing");
   const std::string view = doc["view"].get<std::string>();
-  if (view == "grid") {
-    mapping.view = PictureView::kGrid;
-  } else if (view == "sphere") {
-    mapping.view = PictureView::kSphere;
-  } else {
-    ThrowInputError(
-        what, "", "view",
-        fmt::format("a {} picture's pixels do not map onto the scan's cells; paint on the picture "
-                    "`lidarshop render SCAN -o PICTURE.png` writes (grid or sphere view)",
-                    view));
+  std::optional<PictureView> parsed;
+  for (const EnumInfo::Choice& choice : EnumInfoOf<PictureView>().choices) {
+    if (choice.name == view && HasCellMapping(static_cast<PictureView>(choice.value))) {
+      parsed = static_cast<PictureView>(choice.value);
+    }
   }
+  if (!parsed) {
+    ThrowInputError(what, "", "view", fmt::format("'{}' is not grid, sphere, top, front or side", view));
+  }
+  mapping.view = *parsed;
   mapping.scan_rows = SizeField(doc, "scan_rows", what);
   mapping.scan_cols = SizeField(doc, "scan_cols", what);
   mapping.image_size = cv::Size(SizeField(doc, "image_width", what), SizeField(doc, "image_height", what));
@@ -219,6 +248,18 @@ PictureMapping ParsePictureMapping(const std::string& text, const std::string& w
                       "the steps must be positive and the picture at most one turn wide");
     }
   }
+  if (IsOrthographic(mapping.view)) {
+    if (doc.contains("point_size_px")) {
+      if (!doc["point_size_px"].is_number_integer() || doc["point_size_px"].get<int64_t>() < 0 ||
+          doc["point_size_px"].get<int64_t>() > kMaxLayoutPointSizePx) {
+        ThrowInputError(what, "", "point_size_px",
+                        fmt::format("must be an integer in [0, {}]", kMaxLayoutPointSizePx));
+      }
+      mapping.point_size_px = doc["point_size_px"].get<int>();
+    }
+    mapping.left_m = NumberField(doc, "left_m", what);
+    mapping.top_m = NumberField(doc, "top_m", what);
+  }
   return mapping;
 }
 
@@ -228,6 +269,7 @@ cv::Mat CellsFromPicture(const Scan& scan, const PictureMapping& mapping, const 
   CheckScan(scan);
   LIDARSHOP_CHECK(scan.rows == mapping.scan_rows && scan.cols == mapping.scan_cols);
   LIDARSHOP_CHECK(picture.type() == CV_8U && picture.size() == mapping.image_size);
+  if (IsOrthographic(mapping.view)) return CellsFromOrthographic(scan, mapping, picture);
   const int width = mapping.picture_size.width, height = mapping.picture_size.height;
   cv::Mat cells(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
   if (mapping.view == PictureView::kGrid) {
@@ -277,6 +319,38 @@ cv::Mat CellsFromPicture(const Scan& scan, const PictureMapping& mapping, const 
   return cells;
 }
 
+namespace {
+
+// A top / front / side mapping read from its file gets the cell each pixel shows by laying the view out again
+// at the file's sizes (the same scan and sizes give the same picture); a scan that gives another picture (its
+// points moved since) is refused rather than mapped onto the wrong cells.
+PictureMapping WithSourceCells(const Scan& scan, PictureMapping mapping, const std::string& file) {
+  PictureLayoutOptions options;
+  options.view = mapping.view;
+  options.width_px = mapping.picture_size.width;
+  options.height_px = mapping.picture_size.height;
+  options.point_size_px = mapping.point_size_px;
+  const PictureLayout layout = LayOutPicture(scan, options);
+  const auto same = [](double a, double b) {
+    return std::abs(a - b) <= 1e-9 * std::max({std::abs(a), std::abs(b), 1.0});
+  };
+  if (layout.picture_size != mapping.picture_size || !same(layout.pixel_width, mapping.pixel_width) ||
+      !same(layout.pixel_height, mapping.pixel_height) || !same(layout.left_m, mapping.left_m) ||
+      !same(layout.top_m, mapping.top_m)) {
+    ThrowInputError(
+        file, "", "left_m",
+        fmt::format("the {} view of this scan has pixels of {:.6g} m x {:.6g} m from ({:.6f}, "
+                    "{:.6f}), the layout file {:.6g} m x {:.6g} m from ({:.6f}, {:.6f}): the "
+                    "picture was drawn of other points; render it again",
+                    ToString(mapping.view), layout.pixel_width, layout.pixel_height, layout.left_m,
+                    layout.top_m, mapping.pixel_width, mapping.pixel_height, mapping.left_m, mapping.top_m));
+  }
+  mapping.source_cells = layout.source_cells;
+  return mapping;
+}
+
+}  // namespace
+
 std::optional<PictureMapping> FindPictureMapping(const Scan& scan, const std::string& picture_path,
                                                  cv::Size picture_size, const std::string& layout_path,
                                                  const std::string& what_scan) {
@@ -300,6 +374,7 @@ std::optional<PictureMapping> FindPictureMapping(const Scan& scan, const std::st
           fmt::format("{} x {} pixels but its layout file {} describes {} x {}", picture_size.width,
                       picture_size.height, file, mapping.image_size.width, mapping.image_size.height));
     }
+    if (IsOrthographic(mapping.view)) return WithSourceCells(scan, mapping, file);
     return mapping;
   }
   // Render's default layout at the picture's width or height (square pixels).

@@ -1,16 +1,21 @@
 // Painting on the picture `render` wrote: which cells of a scan the pixels of a picture show, so that strokes
-// and masks drawn on any picture of the grid or sphere layout (square angular pixels, any width) become cells
-// of the scan's grid (docs/file-formats.md, "Picture layout file").
+// and masks drawn on any picture `render` draws of the scan (grid or sphere layout in square angular pixels at
+// any width; top, front and side views) become cells of the scan's grid (docs/file-formats.md, "Picture
+// layout file").
 //
 // `render` writes the mapping beside its picture as PICTURE.layout.json (LayoutFilePath):
 //   {"format": "lidarshop picture layout", "version": 1,
 //    "scan_rows": 1074, "scan_cols": 345,           the scan the picture shows (its grid, cells)
-//    "view": "grid",                                grid | sphere (top / front: no cell mapping)
+//    "view": "grid",                                grid | sphere | top | front | side
 //    "image_width": 1336, "image_height": 1074,     the whole picture file (a legend may sit to the right)
 //    "picture_width": 1276, "picture_height": 1074, the part showing the scan, from the top-left corner
 //    "pixel_width": 0.0675, "pixel_height": 0.0675, "pixel_unit": "deg",
 //    "azimuth_left_rad": ..., "elevation_top_rad": ...,            sphere only: the picture's left and top
-//    "azimuth_step_rad": ..., "elevation_step_rad": ...}           edges and a pixel's size (scanner frame)
+//    "azimuth_step_rad": ..., "elevation_step_rad": ...,           edges and a pixel's size (scanner frame)
+//    "point_size_px": 0,                            top / front / side only: the --point-size it was drawn with
+//                                                   (0 = automatic),
+//    "left_m": ..., "top_m": ...}                   and the world coordinates of the picture's left and top
+//                                                   edges (top: x, y; front: x, z; side: y, z), metres
 //
 // Pixels to cells. grid: the picture is the grid resampled by nearest neighbour (render_layout.h,
 // ResampleNearest), so a cell's pixels are those whose centre falls in it, or the pixel holding its centre
@@ -18,7 +23,10 @@
 // is where its ray (the point's own direction for a return, else the cell's grid direction) meets the
 // spherical grid, widened to half a ray step on each side when pixels are finer than rays. A cell takes the
 // most frequent non-zero value among its pixels (strokes: object or background; masks: set when any of its
-// pixels is set), else 0.
+// pixels is set), else 0. top / front / side: the file holds no pixel-to-cell table (it would be as large as
+// the picture); the view is laid out again from the scan and the file's sizes (LayOutPicture is
+// deterministic), each pixel showing the cell whose point won it (PictureLayout::source_cells). Only cells
+// that show can be painted: a point hidden under another in that view is not reached.
 #pragma once
 
 #include <optional>
@@ -33,7 +41,7 @@
 namespace lidarshop {
 
 struct PictureMapping {
-  PictureView view = PictureView::kGrid;  // kGrid or kSphere
+  PictureView view = PictureView::kGrid;  // never kAuto
   int scan_rows = 0, scan_cols = 0;       // the scan's grid, cells
   cv::Size image_size;                    // the whole picture file, pixels
   cv::Size picture_size;                  // its part that shows the scan (top-left), pixels
@@ -42,17 +50,22 @@ struct PictureMapping {
   // Sphere: the azimuth of the picture's left edge, the elevation of its top edge and a pixel's size across
   // and down, radians, scanner frame (azimuths left of the edge are taken one turn later).
   double azimuth_left_rad = 0, elevation_top_rad = 0, azimuth_step_rad = 0, elevation_step_rad = 0;
+  // top / front / side: the --point-size the picture was drawn with (0 = automatic), and for each picture pixel
+  // the cell it shows (PictureLayout::source_cells; not in the file: FindPictureMapping lays the view out again).
+  int point_size_px = 0;
+  cv::Mat source_cells;
+  double left_m = 0, top_m = 0;  // top / front / side: PictureLayout::left_m, top_m (metres)
 };
 
-// True for the views whose pixels map onto cells (grid, sphere).
+// True for the views whose pixels map onto cells (every view but kAuto).
 bool HasCellMapping(PictureView view);
 
 // The mapping of a laid-out picture of `scan`, drawn in the top-left of an image of `image_size` (the picture
-// plus a legend; empty = the picture alone). Throws OptionsError for views without one (top, front).
+// plus a legend; empty = the picture alone).
 PictureMapping MappingOfLayout(const PictureLayout& layout, const Scan& scan, cv::Size image_size = {});
 
 // The layout file (see the top) and back; ParsePictureMapping throws InputError naming `what` and the field.
-// Layout files of top / front pictures hold no cell mapping; ParsePictureMapping refuses them.
+// A top / front / side mapping read from a file has no source_cells yet (FindPictureMapping adds them).
 nlohmann::ordered_json PictureMappingJson(const PictureMapping& mapping);
 // `scan`: the scan laid out; `image_size`: the picture file (empty = the laid-out picture alone).
 nlohmann::ordered_json LayoutFileJson(const PictureLayout& layout, const Scan& scan, cv::Size image_size);

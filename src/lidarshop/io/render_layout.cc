@@ -195,7 +195,7 @@ constexpr double kSplatPerSpacing = 2.0;
 constexpr int kSpacingPoints = 8;
 // ... and no automatic square is larger than this many times the median one.
 constexpr double kMaxSplatPerMedian = 2.0;
-constexpr int64_t kOrthographicBytesPerPixel = 96;
+constexpr int64_t kOrthographicBytesPerPixel = 100;
 
 // Draws every projected point (u, v in pixels; `pixel_m` metres a pixel) as a square, the point nearest to the
 // viewer winning each pixel (among points of one surface, the one whose pixel is nearest):
@@ -204,7 +204,7 @@ constexpr int64_t kOrthographicBytesPerPixel = 96;
 // returns the number of points that show on at least one pixel and sets the median square side in
 // *median_splat_px.
 int64_t SplatCells(const Scan& scan, const std::vector<ProjectedPoint>& projected, int point_size_px,
-                   double pixel_m, Scan* cells, double* median_splat_px) {
+                   double pixel_m, Scan* cells, cv::Mat* source_cells, double* median_splat_px) {
   const int rows = cells->rows, cols = cells->cols;
   const int64_t count = static_cast<int64_t>(projected.size());
   std::vector<cv::Point> pixel(projected.size());
@@ -286,11 +286,14 @@ int64_t SplatCells(const Scan& scan, const std::vector<ProjectedPoint>& projecte
   // One chosen point per pixel, at the pixel's centre, for FillCells to copy.
   std::vector<ProjectedPoint> chosen;
   std::vector<uint8_t> shown(projected.size(), 0);
+  source_cells->create(rows, cols, CV_32S);
+  source_cells->setTo(-1);
   for (int row = 0; row < rows; ++row) {
     for (int col = 0; col < cols; ++col) {
       const int32_t i = winner.at<int32_t>(row, col);
       if (i < 0) continue;
       shown[i] = 1;
+      source_cells->at<int32_t>(row, col) = projected[i].row * scan.cols + projected[i].col;
       chosen.push_back({col + 0.5, row + 0.5, 0.0, projected[i].row, projected[i].col});
     }
   }
@@ -356,8 +359,8 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
     p.u = (p.u - u_min) / step_across;
     p.v = (v_min + v_span - p.v) / step_down;
   }
-  // The cells' channels (about 64 bytes a pixel) and the squares' buffers (32): a given size is checked before
-  // anything of that size is allocated.
+  // The cells' channels (about 64 bytes a pixel), the squares' buffers (32) and the source cells (4): a given
+  // size is checked before anything of that size is allocated.
   CheckMemoryBudget(
       SaturatingBytes(static_cast<int64_t>(size.width) * size.height, kOrthographicBytesPerPixel),
       fmt::format("{}a {} view of {} x {} pixels", scan.name.empty() ? "" : scan.name + ": ", ToString(view),
@@ -367,12 +370,14 @@ PictureLayout LayOutOrthographic(const Scan& scan, PictureView view, const Pictu
   layout.cells = EmptyCells(scan, size);
   layout.points = all_points;
   layout.points_kept = SplatCells(scan, projected, options.point_size_px, std::max(step_across, step_down),
-                                  &layout.cells, &layout.splat_px);
+                                  &layout.cells, &layout.source_cells, &layout.splat_px);
   layout.splat_automatic = options.point_size_px == 0;
   layout.picture_size = size;
   layout.pixel_width = step_across;
   layout.pixel_height = step_down;
   layout.pixel_unit = "m";
+  layout.left_m = u_min;
+  layout.top_m = v_min + v_span;
   return layout;
 }
 

@@ -82,6 +82,13 @@ struct PictureLayout {
   // from the local point spacing (automatic) or point_size_px.
   double splat_px = 0;
   bool splat_automatic = false;
+  // Orthographic views: for each picture pixel, the scan cell whose point it shows (row * scan cols + col;
+  // CV_32S, -1 where no point shows), so strokes painted on the picture map back onto the scan
+  // (picture_mapping.h). Empty for the other views.
+  cv::Mat source_cells;
+  // Orthographic views: the world coordinates of the picture's left edge (top, front: x; side: y) and top
+  // edge (top: y; front, side: z), metres; a pixel's size is pixel_width x pixel_height.
+  double left_m = 0, top_m = 0;
   std::string Describe() const;  // one line saying what was done, for stderr and --json
 };
 

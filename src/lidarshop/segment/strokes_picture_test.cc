@@ -1,5 +1,11 @@
 // Strokes and masks painted on the pictures `render` draws (io/picture_mapping.h) cut the same object as
 // strokes on the scan's own grid.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
@@ -194,6 +200,55 @@ TEST(StrokesPicture, OverlayIsInRendersLayoutWithThinStrokes) {
                                      cv::Mat(overlay.reshape(1, overlay.total()).col(0) == 0));
   EXPECT_GE(green, 1);
   EXPECT_LE(green, 4);
+}
+
+// Strokes painted on a view from the front (or above) reach the cells whose points show there: the mapping
+// is the picture's own (each painted pixel -> the cell whose point won it), it comes back the same through the
+// layout file (the view laid out again at the file's sizes), and a scan whose points changed is refused.
+TEST(StrokesPicture, PaintingOnAnOrthographicViewReachesTheCellsThatShow) {
+  const Scan scan = BoxScan();
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / fmt::format("lidarshop_strokes_picture_{}", getpid());
+  std::filesystem::create_directories(folder);
+  for (const PictureView view : {PictureView::kFront, PictureView::kTop}) {
+    for (const int point_size_px : {0, 3}) {
+      PictureLayoutOptions options;
+      options.view = view;
+      options.point_size_px = point_size_px;
+      const PictureLayout layout = LayOutPicture(scan, options);
+      ASSERT_EQ(layout.source_cells.size(), layout.picture_size);
+      // Paint every pixel that shows the box; remember which cells those pixels show.
+      cv::Mat painted(layout.picture_size, CV_8U, cv::Scalar(0));
+      std::set<int> shown_box_cells;
+      for (int y = 0; y < painted.rows; ++y) {
+        for (int x = 0; x < painted.cols; ++x) {
+          const int32_t cell = layout.source_cells.at<int32_t>(y, x);
+          if (cell < 0 || scan.label.at<int32_t>(cell / scan.cols, cell % scan.cols) != 1) continue;
+          painted.at<uint8_t>(y, x) = 255;
+          shown_box_cells.insert(cell);
+        }
+      }
+      const std::string what = fmt::format("{} view, point size {}", ToString(view), point_size_px);
+      ASSERT_GT(shown_box_cells.size(), view == PictureView::kFront ? 50u : 5u) << what;
+      const cv::Mat cells = CellsFromPicture(scan, MappingOfLayout(layout, scan), painted);
+      EXPECT_EQ(cv::countNonZero(cells), static_cast<int>(shown_box_cells.size())) << what;
+      EXPECT_EQ(cv::countNonZero(cells & (scan.label != 1)), 0) << what;  // no ground cell picked up
+      // Through the layout file beside the picture: the same cells.
+      const std::string picture = (folder / fmt::format("{}_{}.png", ToString(view), point_size_px)).string();
+      std::ofstream(LayoutFilePath(picture)) << LayoutFileJson(layout, scan, {}).dump();
+      const auto found = FindPictureMapping(scan, picture, layout.picture_size, "", "scan.ptx");
+      ASSERT_TRUE(found) << what;
+      EXPECT_EQ(found->view, view);
+      EXPECT_EQ(found->point_size_px, point_size_px);
+      EXPECT_EQ(cv::countNonZero(CellsFromPicture(scan, *found, painted) != cells), 0) << what;
+      // The scan's points changed since the picture (a quarter of the columns gone): refused, not mis-mapped.
+      Scan changed = Clone(scan);
+      changed.valid.colRange(0, scan.cols / 4).setTo(0);
+      EXPECT_THROW(FindPictureMapping(changed, picture, layout.picture_size, "", "scan.ptx"), InputError)
+          << what;
+    }
+  }
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace
