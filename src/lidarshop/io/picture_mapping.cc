@@ -11,6 +11,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/json_input.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -197,14 +198,7 @@ nlohmann::ordered_json LayoutFileJson(const PictureLayout& layout, const Scan& s
 }
 
 PictureMapping ParsePictureMapping(const std::string& text, const std::string& what) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
-  } catch (const nlohmann::json::exception& e) {
-    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
-  }
+  const nlohmann::json doc = ParseJsonInput(text, what);
   if (!doc.is_object() || !doc.contains("format") || doc["format"] != kLayoutFormat) {
     ThrowInputError(what, "", "format",
                     fmt::format("not a picture layout file (\"format\": \"{}\")", kLayoutFormat));

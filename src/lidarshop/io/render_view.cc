@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/json_input.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -192,14 +193,7 @@ nlohmann::ordered_json CameraJson(const PointViewOptions& view, const Scan& scan
 }
 
 void ParseCameraJson(const std::string& text, const std::string& what, PointViewOptions* view) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
-  } catch (const nlohmann::json::exception& e) {
-    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
-  }
+  const nlohmann::json doc = ParseJsonInput(text, what);
   if (!doc.is_object()) ThrowInputError(what, "", "", "a camera file holds one JSON object");
   for (const auto& [key, value] : doc.items()) {
     if (key != "eye" && key != "target" && key != "up" && key != "fov_deg" && key != "width" &&

@@ -12,6 +12,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/json_input.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -39,14 +40,7 @@ cv::Mat StrokesFromImage(const cv::Mat& painted, const std::string& what) {
 }
 
 cv::Mat StrokesFromJson(const std::string& json_text, int rows, int cols, const std::string& what) {
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(json_text);
-  } catch (const nlohmann::json::parse_error& e) {
-    ThrowInputError(what, fmt::format("byte {}", e.byte), "", "not valid JSON");
-  } catch (const nlohmann::json::exception& e) {  // e.g. a number past double's range: 1e+316
-    ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", e.what()));
-  }
+  const nlohmann::json doc = ParseJsonInput(json_text, what);
   if (!doc.is_object() || !doc.contains("strokes") || !doc["strokes"].is_array()) {
     ThrowInputError(what, "", "strokes", "expected an object with an array \"strokes\"");
   }
