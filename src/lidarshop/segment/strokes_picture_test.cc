@@ -251,5 +251,36 @@ TEST(StrokesPicture, PaintingOnAnOrthographicViewReachesTheCellsThatShow) {
   std::filesystem::remove_all(folder);
 }
 
+// The layout file's orthographic fields are checked like the rest: an unknown view, a point size out of
+// range and a missing origin are refused naming the file and the field.
+TEST(StrokesPicture, OrthographicLayoutFileFieldsAreChecked) {
+  const Scan scan = BoxScan();
+  PictureLayoutOptions options;
+  options.view = PictureView::kTop;
+  const nlohmann::ordered_json good = LayoutFileJson(LayOutPicture(scan, options), scan, {});
+  EXPECT_EQ(ParsePictureMapping(good.dump(), "top.json").view, PictureView::kTop);
+  auto refused = [&](nlohmann::ordered_json doc, const std::string& field) {
+    try {
+      ParsePictureMapping(doc.dump(), "top.json");
+      ADD_FAILURE() << "accepted without a good " << field;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("top.json"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
+  nlohmann::ordered_json doc = good;
+  doc["view"] = "oblique";
+  refused(doc, "view");
+  doc = good;
+  doc["point_size_px"] = 33;
+  refused(doc, "point_size_px");
+  doc = good;
+  doc["point_size_px"] = 2.5;
+  refused(doc, "point_size_px");
+  doc = good;
+  doc.erase("left_m");
+  refused(doc, "left_m");
+}
+
 }  // namespace
 }  // namespace lidarshop
