@@ -7,38 +7,19 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/resection_test_util.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/testing/scenes.h"
 
 namespace lidarshop {
 namespace {
 
-PinholeCamera TrueCamera() {
-  PinholeCamera camera;
-  camera.width_px = 1024;
-  camera.height_px = 768;
-  camera.fx_px = camera.fy_px = 850;
-  camera.cx_px = 512;
-  camera.cy_px = 384;
-  camera.world_from_camera = ComposeTransform({1.5, 0.3, 1.4}, {-92, 3, 8});
-  return camera;
-}
+using testing_resection::TrueCamera;
 
-// `count` points 3-9 m in front of `camera`, their pixels moved by `noise_px` RMS.
+// `count` points 3-9 m in front of `camera`, their pixels moved by `noise_px` RMS, no outliers.
 std::vector<PixelPointPair> NoisyPairs(const PinholeCamera& camera, int count, double noise_px,
                                        uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> unit(0, 1);
-  std::normal_distribution<double> gauss(0, noise_px / std::sqrt(2.0));
-  std::vector<PixelPointPair> pairs;
-  for (int i = 0; i < count; ++i) {
-    const Eigen::Vector2d pixel(20 + unit(rng) * (camera.width_px - 40),
-                                20 + unit(rng) * (camera.height_px - 40));
-    const Eigen::Vector3d in_camera = (3 + 6 * unit(rng)) * UnprojectPixel(camera, pixel);
-    pairs.push_back({pixel + Eigen::Vector2d(gauss(rng), gauss(rng)),
-                     camera.world_from_camera.topLeftCorner<3, 3>() * in_camera + camera.center_in_world()});
-  }
-  return pairs;
+  return testing_resection::MakePairs(camera, count, noise_px, 0.0, seed);
 }
 
 TEST(RecolorWarnings, AResectionWhosePairsAreOffByPixelsIsReported) {
