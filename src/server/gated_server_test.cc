@@ -285,9 +285,9 @@ TEST(GatedServerTest, AHugeJsonBodyIsRefusedWithoutHoldingMemory) {
   const int64_t peak_before = StatusKiB("VmHWM");
   auto post = [&](size_t bytes) {
     std::string request = fmt::format(
-        "POST /api/models?token=t HTTP/1.1\r\nHost: test\r\nContent-Type: application/json\r\n"
+        "POST /api/models?token=t HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Type: application/json\r\n"
         "Content-Length: {}\r\n\r\n",
-        bytes);
+        editor.port(), bytes);
     request.append(bytes, '[');
     return Exchange(editor.port(), request, 30);
   };
