@@ -54,6 +54,11 @@ let step = 0;
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 800 }, acceptDownloads: true });
   page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
+  // The server's Content-Security-Policy must let the editor's own page do all it does.
+  const blocked = [];
+  page.on('console', (message) => {
+    if (/Content Security Policy/i.test(message.text())) blocked.push(message.text());
+  });
   const shot = async (name) => {
     const file = join(artefacts, `${String(++step).padStart(2, '0')}_${name}.png`);
     await page.screenshot({ path: file });
@@ -74,6 +79,9 @@ try {
   };
 
   await page.goto(url);
+  // The server moved the token into an HttpOnly cookie and reloaded the page without it (docs/api.md "Safety").
+  if (new URL(page.url()).searchParams.has('token')) fail(`the token stayed in the page's URL: ${page.url()}`);
+  if ((await page.evaluate(() => document.cookie)).includes('lidarshop_token')) fail('page scripts can read the token cookie');
   await page.selectOption('#scene', 'parking_lot');
   await page.click('#open-scene');
   await waitForStatus(/^parking_lot: \d+ x \d+ cells/, 'open the parking lot');
@@ -206,6 +214,7 @@ try {
   await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
   await shot('landmarks');
 
+  if (blocked.length > 0) fail(`the Content-Security-Policy blocked: ${blocked.join('; ')}`);
   console.log(`e2e: passed (car ${car.cells} cells, segmented ${segmented.object_cells}, synthesized ${removed.synthesized_cells}, saved ${saved})`);
 } finally {
   await browser.close();
