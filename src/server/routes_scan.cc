@@ -22,6 +22,7 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
@@ -426,6 +427,28 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
   response.set_content(std::move(bytes), "application/octet-stream");
 }
 
+// What saving in `format` keeps and drops (io/scan_write_plan.h, the registry's answer), asked before the
+// save so that the editor can warn: {"format", "channels", "dropped", "refused"}; "refused" is the reason a
+// save in that format would fail ("" when it would not).
+void SavePlan(Document& document, const httplib::Request& request, httplib::Response& response) {
+  const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
+  const ScanFormatInfo* info = FindScanFormat(format);
+  if (info == nullptr || !info->write) {
+    SendError(response, 400,
+              fmt::format("format '{}': expected one of {}", format.substr(0, 32),
+                          fmt::join(SupportedScanWriteExtensions(), ", ")));
+    return;
+  }
+  std::lock_guard lock(document.mutex);
+  const bool layer = !document.now.behind.valid.empty();
+  const ScanWritePlan plan = PlanScanWrite(
+      fmt::format("{}.{}", fs::path(document.name).stem().string(), format), {document.now.scan}, 0, 0);
+  SendJson(response, {{"format", format},
+                      {"channels", plan.channels},
+                      {"dropped", plan.dropped},
+                      {"refused", layer && !info->layer_behind ? LayerBehindRefusal(*info) : ""}});
+}
+
 }  // namespace
 
 void AddScanRoutes(State& state) {
@@ -584,6 +607,11 @@ void AddScanRoutes(State& state) {
   http.Get(R"(/api/docs/(\d+)/save)", [&state](const httplib::Request& request, httplib::Response& response) {
     if (auto document = state.FindDocument(request, response)) Save(*document, request, response);
   });
+  http.Get(R"(/api/docs/(\d+)/save-plan)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             if (auto document = state.FindDocument(request, response))
+               SavePlan(*document, request, response);
+           });
 }
 
 }  // namespace lidarshop::server

@@ -304,6 +304,11 @@ TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
   EXPECT_GT(doc["behind_cells"].get<int>(), 50);
   EXPECT_GT(doc["object_cells"].get<int>(), 50);  // the object is still there
   EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save?format=ptx", id)))->status, 400);
+  // The editor asks first: PTX would be refused (the registry's reason), E57 holds the layer.
+  const auto ptx_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=ptx", id))));
+  EXPECT_EQ(ptx_plan["refused"], "PTX cannot hold two returns per cell; write E57, PLY, PCD or LAS");
+  const auto e57_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=e57", id))));
+  EXPECT_EQ(e57_plan["refused"], "");
   const auto e57 = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
   ASSERT_EQ(e57->status, 200);
   const fs::path saved = base_ / "shadow.e57";
@@ -426,6 +431,16 @@ TEST_F(ServerTest, SaveOffersTheLibrarysWriteFormats) {
     EXPECT_EQ(saved->status, 200) << format;
     EXPECT_GT(saved->body.size(), 1000u) << format;
   }
+  // Before saving, the plan says what a format drops (the box, read from PTX, is a grid: XYZ drops it, PLY
+  // keeps it), from the same registry as convert's warnings.
+  const auto xyz_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=xyz", id))));
+  ASSERT_EQ(xyz_plan["dropped"].size(), 1u) << xyz_plan.dump();
+  EXPECT_NE(xyz_plan["dropped"][0].get<std::string>().find("and the scanner pose are not kept"),
+            std::string::npos);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=ply", id))))["dropped"].size(),
+            0u);
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=laz", id)))->status, 400);
+  EXPECT_EQ(formats["formats"].size(), formats["read"].size());  // the registry, one entry per format
   const auto refused = client_->Get(Api(fmt::format("/api/docs/{}/save?format=asc", id)));
   EXPECT_EQ(refused->status, 400);
   // The message lists the library's formats (whatever they are when a writer is added).

@@ -152,7 +152,13 @@ try {
   await shot('orbited');
 
   await page.selectOption('#format', 'e57');
+  // The scene's labels have no field in E57: the editor says so before saving, and saves when accepted.
+  const dialogs = [];
+  page.once('dialog', async (dialog) => { dialogs.push(dialog.message()); await dialog.accept(); });
   const [download] = await Promise.all([page.waitForEvent('download'), page.click('#save')]);
+  if (dialogs.length !== 1 || !/labels are not written/.test(dialogs[0])) {
+    fail(`saving as E57 did not warn that the labels are dropped: ${JSON.stringify(dialogs)}`);
+  }
   const saved = join(artefacts, 'removed.e57');
   await download.saveAs(saved);
   if (!existsSync(saved)) fail('no E57 downloaded');
