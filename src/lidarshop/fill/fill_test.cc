@@ -176,7 +176,8 @@ TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
   const Case c = MakeCase(kWideWallScene, 2);
   const int64_t hole_cells = cv::countNonZero(c.hole);
   ASSERT_GT(hole_cells, 500);
-  FillOptions options;  // windowed by default
+  FillOptions options;
+  options.window_min_margin_cells = 64;  // the default (512) would take the whole 640-column scan
   const FillResult windowed = FillScan(c.scan, c.hole, options);
   options.window_margin = 0;
   const FillResult whole = FillScan(c.scan, c.hole, options);
@@ -218,6 +219,7 @@ TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
 TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
   const Case c = MakeCase(kWideWallScene, 2);
   FillOptions options;
+  options.window_min_margin_cells = 64;
   options.window_min_known_ratio = 1e5;  // more than the whole scan holds: the window becomes the scan
   const FillResult result = FillScan(c.scan, c.hole, options);
   EXPECT_EQ(result.window_rows, c.scan.rows);
