@@ -1,6 +1,6 @@
 // Occlusion-aware recolouring of a scan from a photo (thesis 3.2.2.1).
 //
-// A scan point takes the photo's colour (bilinear at its projection) only when
+// A scan point takes the photo's colour (bilinear at its projection, over the pixels at its depth) only when
 //   1. it lies in front of the camera and projects inside the photo, and
 //   2. the camera sees it: the segment from the point to the camera centre meets no other surface of the
 //      scan.
