@@ -317,18 +317,21 @@ int main(int argc, char** argv) {
       }
     }
     if (resection_only) continue;
-    // Visibility with the true camera: the default (skirts with walls, 1 px margin) and its parts, the literal
-    // segment test, and the visibility test before the skirts (2 px margin).
+    // Visibility with the true camera: the default (skirts with walls, 1 px margin, edge guard) and its parts without
+    // the guard, the literal segment test, and the visibility test before the skirts (2 px margin).
     struct Variant {
       const char* name;
       VisibilityMethod method;
       bool skirts;
       double depth_m;
       int margin_px;
+      bool edge_guard = false;  // the variants show the visibility test alone; the default has the guard
     };
     const Variant variants[] = {
-        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (default)", VisibilityMethod::kZBuffer,
-         true, 0.25, 1},
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin + edge guard (default)",
+         VisibilityMethod::kZBuffer, true, 0.25, 1, true},
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (the default before the edge guard)",
+         VisibilityMethod::kZBuffer, true, 0.25, 1},
         {"true camera, z-buffer + skirt caps only (no walls) + 1 px margin", VisibilityMethod::kZBuffer, true,
          0.0, 1},
         {"true camera, z-buffer + skirts (0.25 m walls), no margin", VisibilityMethod::kZBuffer, true, 0.25,
@@ -345,6 +348,7 @@ int main(int argc, char** argv) {
       options.silhouette_skirts = variant.skirts;
       options.skirt_depth_m = variant.depth_m;
       options.silhouette_margin_px = variant.margin_px;
+      options.edge_guard = variant.edge_guard;
       const RecolorResult result = RecolorScan(s.input, s.photo.image, s.camera, options);
       const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input, result.scan, s.camera);
       fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, variant.name,
