@@ -56,6 +56,7 @@ class ServerTest : public ::testing::Test {
     options.token = "secret-token";
     options.roots = {(base_ / "root").string()};
     options.max_body_bytes = 1 << 20;
+    options.max_documents = 100;  // the tests open more than the default 16 and close none
     options.builtin_scenes = {"tiny"};
     options.scan_builtin = [](const std::string&) { return *scan_; };
     server_ = new EditorServer(options);
@@ -240,6 +241,36 @@ TEST_F(ServerTest, SegmentRemoveUndoSave) {
   EXPECT_EQ(saved->body.substr(0, 8), "ASTM-E57");
 }
 
+// Undo restores the strokes a removal cleared: its snapshot's stroke buffer was zeroed in place when the
+// removal made its next state, so a second removal after undo found no object stroke.
+TEST_F(ServerTest, RemoveUndoRemoveKeepsTheStrokes) {
+  const int id = OpenBox();
+  const std::string strokes = Api(fmt::format("/api/docs/{}/strokes", id));
+  const auto painted = client_->Post(strokes, StrokesBody(), "application/json");
+  ASSERT_EQ(painted->status, 200);
+  const int object_strokes = Json(painted)["object_stroke_cells"];
+  ASSERT_GT(object_strokes, 10);
+  const std::string remove = Api(fmt::format("/api/docs/{}/remove", id));
+  const std::string options = R"({"options": {"fill": {"method": "laplace"}}})";
+  const auto first = Wait(Json(client_->Post(remove, options, "application/json")));
+  ASSERT_EQ(first["state"], "done") << first.dump();
+  const int synthesized = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"];
+  EXPECT_GT(synthesized, 50);
+  EXPECT_EQ(Json(client_->Post(strokes, "{}", "application/json"))["object_stroke_cells"], 0);  // cleared
+  // Undo both: the empty strokes edit and the removal; the strokes are back as they were painted.
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  }
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"], 0);
+  const auto again = Wait(Json(client_->Post(remove, options, "application/json")));
+  ASSERT_EQ(again["state"], "done") << again.dump();
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"], synthesized);
+  // And once more through redo: the history holds each state as it was.
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  const auto repainted = client_->Post(strokes, "{}", "application/json");
+  EXPECT_EQ(Json(repainted)["object_stroke_cells"], object_strokes);
+}
+
 TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
   const int id = OpenBox();
   const std::string strokes = Api(fmt::format("/api/docs/{}/strokes", id));
@@ -273,6 +304,11 @@ TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {
   EXPECT_GT(doc["behind_cells"].get<int>(), 50);
   EXPECT_GT(doc["object_cells"].get<int>(), 50);  // the object is still there
   EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save?format=ptx", id)))->status, 400);
+  // The editor asks first: PTX would be refused (the registry's reason), E57 holds the layer.
+  const auto ptx_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=ptx", id))));
+  EXPECT_EQ(ptx_plan["refused"], "PTX cannot hold two returns per cell; write E57, PLY, PCD or LAS");
+  const auto e57_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=e57", id))));
+  EXPECT_EQ(e57_plan["refused"], "");
   const auto e57 = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
   ASSERT_EQ(e57->status, 200);
   const fs::path saved = base_ / "shadow.e57";
@@ -395,6 +431,16 @@ TEST_F(ServerTest, SaveOffersTheLibrarysWriteFormats) {
     EXPECT_EQ(saved->status, 200) << format;
     EXPECT_GT(saved->body.size(), 1000u) << format;
   }
+  // Before saving, the plan says what a format drops (the box, read from PTX, is a grid: XYZ drops it, PLY
+  // keeps it), from the same registry as convert's warnings.
+  const auto xyz_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=xyz", id))));
+  ASSERT_EQ(xyz_plan["dropped"].size(), 1u) << xyz_plan.dump();
+  EXPECT_NE(xyz_plan["dropped"][0].get<std::string>().find("and the scanner pose are not kept"),
+            std::string::npos);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=ply", id))))["dropped"].size(),
+            0u);
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=laz", id)))->status, 400);
+  EXPECT_EQ(formats["formats"].size(), formats["read"].size());  // the registry, one entry per format
   const auto refused = client_->Get(Api(fmt::format("/api/docs/{}/save?format=asc", id)));
   EXPECT_EQ(refused->status, 400);
   // The message lists the library's formats (whatever they are when a writer is added).

@@ -178,10 +178,29 @@ for (const action of ['undo', 'redo']) {
 element('cancel').addEventListener('click', () => {
   if (runningJob) api.json(`/api/jobs/${runningJob.id}/cancel`, {}, {}).catch(() => {});
 });
-element('save').addEventListener('click', () => {
+element('save').addEventListener('click', async () => {
   if (!doc) return;
+  const format = element<HTMLSelectElement>('format').value;
+  // Ask first what the format would drop: nothing is lost without a word.
+  try {
+    const plan = await api.json<{ dropped: string[]; refused: string }>(`/api/docs/${doc.id}/save-plan`, { format });
+    if (plan.refused) {
+      status(`save: ${plan.refused}`);
+      return;
+    }
+    if (plan.dropped.length > 0) {
+      const lost = plan.dropped.map((line) => `• ${line.replace(/^[^:]*: /, '')}`).join('\n');
+      if (!window.confirm(`Saving as ${format.toUpperCase()} loses:\n${lost}\n\nSave anyway? (E57 keeps everything.)`)) {
+        status(`save: not saved as ${format}`);
+        return;
+      }
+    }
+  } catch (error) {
+    status(`save: ${(error as Error).message}`);
+    return;
+  }
   const link = document.createElement('a');
-  link.href = api.url(`/api/docs/${doc.id}/save`, { format: element<HTMLSelectElement>('format').value });
+  link.href = api.url(`/api/docs/${doc.id}/save`, { format });
   link.download = '';
   link.click();
 });
@@ -309,7 +328,9 @@ async function start() {
   try {
     const { scenes } = await api.json<{ scenes: string[] }>('/api/scenes');
     const formats = await api.json<{ write: string[] }>('/api/formats');
-    element('format').replaceChildren(...formats.write.map((name) => new Option(name, name)));
+    // E57 first: the format that holds everything the editor makes (synthesized flags, photos, two layers).
+    const writable = [...formats.write].sort((a, b) => Number(b === 'e57') - Number(a === 'e57'));
+    element('format').replaceChildren(...writable.map((name) => new Option(name, name)));
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
     const { files } = await api.json<{ files: ScanFileEntry[] }>('/api/files');
     const fileSelect = element<HTMLSelectElement>('file');
