@@ -536,9 +536,15 @@ check "resection" sh -c "'$lidarshop' resection --correspondences '$work/pairs.j
 json_check "resection recovers the camera" "$work/resection.json" \
   "d['inliers'] == 12 and d['rms_px'] < 0.01 and abs(d['focal_px'][0] - 260) < 0.5"
 check "recolor with a camera" sh -c "'$lidarshop' recolor '$work/scan.ptx' --photo '$work/photo.png' \
-  --camera '$work/cam.json' -o '$work/recolored.ply' --recolored-mask '$work/recolored.png' >'$work/recolor.json'"
+  --camera '$work/cam.json' -o '$work/recolored.ply' --recolored-mask '$work/recolored.png' \
+  --uncertain-mask '$work/uncertain.png' >'$work/recolor.json'"
 json_check "recolor counts" "$work/recolor.json" \
-  "d['recolored'] > 0 and d['hidden'] > 0 and d['recolored'] + d['hidden'] + d['outside_image'] == d['returns']"
+  "d['recolored'] > 0 and d['hidden'] > 0 and d['uncertain'] > 0 and d['edge_margin_px'] > 1 and \
+   d['recolored'] + d['hidden'] + d['uncertain'] + d['outside_image'] == d['returns']"
+check "recolor wrote the uncertain mask" test -s "$work/uncertain.png"
+fails_clearly "recolor: the uncertain mask onto the output" "would overwrite" "$lidarshop" recolor "$work/scan.ptx" \
+  --photo "$work/photo.png" --camera "$work/cam.json" -o "$work/u.png" --recolored-mask "$work/m.png" \
+  --uncertain-mask "$work/u.png"
 check "recolor from correspondences" "$lidarshop" recolor "$work/scan.ptx" --photo "$work/photo.png" \
   --correspondences "$work/pairs.json" -o "$work/recolored2.ptx"
 fails_clearly "recolor: a photo that does not decode" "photo.jpg" sh -c "echo garbage >'$work/photo.jpg' && \

@@ -275,6 +275,11 @@ void BindRecolorScan(py::module_& m) {
       .def_readonly("recolored_count", &RecolorResult::recolored_count)
       .def_readonly("outside_image", &RecolorResult::outside_image)
       .def_readonly("hidden", &RecolorResult::hidden)
+      .def_readonly("uncertain", &RecolorResult::uncertain)
+      .def_readonly("edge_margin_px", &RecolorResult::edge_margin_px)
+      .def_property_readonly(
+          "uncertain_mask", [](const RecolorResult& r) { return MatToArray(r.uncertain_mask); },
+          "uint8 (rows, cols): 255 = kept its colour near an occluding edge")
       .def("summary", &RecolorResult::Summary)
       .def("__repr__",
            [](const RecolorResult& r) { return "<lidarshop.RecolorResult " + r.Summary() + ">"; });

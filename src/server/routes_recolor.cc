@@ -4,6 +4,8 @@
 //                    to the other (an edit of its pose), or a similarity reported only
 //   photo <-> photo  pixel pairs between the photo and a second one: a homography or fundamental matrix
 //                    with per-pair errors (the scan does not change)
+#include <algorithm>
+
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -88,7 +90,11 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
         progress.Restart("resection", 2);
         const ResectionResult camera = Resection(pairs, resection, "pairs");
         progress.Advance();
-        const RecolorResult recolored = RecolorScan(start.scan, photo, camera.camera);
+        // The edge guard's margin follows the resection, as the CLI's (recolor/recolor.h).
+        RecolorOptions recolor_options;
+        recolor_options.camera_uncertainty_px =
+            std::max(recolor_options.camera_uncertainty_px, 2 * camera.rms_px);
+        const RecolorResult recolored = RecolorScan(start.scan, photo, camera.camera, recolor_options);
         progress.Advance();
         std::lock_guard lock(document->mutex);
         Snapshot next = document->now;
@@ -104,6 +110,7 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
                                       {"inlier", camera.inlier},
                                       {"recolored_count", recolored.recolored_count},
                                       {"hidden", recolored.hidden},
+                                      {"uncertain", recolored.uncertain},
                                       {"outside_image", recolored.outside_image},
                                       {"summary", camera.Summary() + "; " + recolored.Summary()},
                                       {"warnings", warnings},

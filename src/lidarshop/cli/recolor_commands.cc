@@ -1,4 +1,5 @@
 // lidarshop resection | recolor | images | align | photo: photos and scans (recolor/, docs/recolor.md).
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -186,7 +187,8 @@ int RunRecolor(int argc, char** argv) {
       "Recolour a scan from a photo: occlusion-aware projection (thesis 3.2.2.1, docs/recolor.md). Points "
       "the camera does not see keep their colour.",
       "recolor"};
-  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path, json_path = "-";
+  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path, uncertain_path,
+      json_path = "-";
   int scan_index = 0;
   RecolorOptions options;
   ResectionOptions resection;
@@ -200,6 +202,8 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("--correspondences", pairs_path, "pixel <-> point or cell pairs: resection first");
   app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
+  app.add_option("--uncertain-mask", uncertain_path,
+                 "PNG of the scan grid: 255 = kept its colour near an occluding edge (uncertain)");
   AddScanIndexOption(app, &scan_index);
   AddJsonOption(app, &json_path);
   binder.Bind(&options,
@@ -211,11 +215,14 @@ int RunRecolor(int argc, char** argv) {
         binder.Validate(options);
         binder.Validate(resection);
         CheckOutputFile("--json", json_path, {},
-                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
+                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path, uncertain_path});
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");
         CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
         if (!mask_path.empty()) CheckNotInput(mask_path, {scan_path, photo_path, camera_path, pairs_path});
+        if (!uncertain_path.empty())
+          CheckOutputPath(uncertain_path,
+                          {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
         const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
         cv::Mat photo;
         PinholeCamera camera;
@@ -248,6 +255,8 @@ int RunRecolor(int argc, char** argv) {
           json["resection"] = ResectionJson(result);
           json["resection"]["options"] = ToJson(resection);
           camera = result.camera;
+          // The edge guard's margin follows the resection: a camera is good to about twice its RMS.
+          options.camera_uncertainty_px = std::max(options.camera_uncertainty_px, 2 * result.rms_px);
         } else if (!have_camera) {
           throw OptionsError("give --camera or --correspondences");
         }
@@ -259,11 +268,14 @@ int RunRecolor(int argc, char** argv) {
         warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
         WriteScanFile(output, {result.scan});
         if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
+        if (!uncertain_path.empty()) WriteImage(uncertain_path, result.uncertain_mask);
         nlohmann::ordered_json counts;
         counts["returns"] = result.returns;
         counts["recolored"] = result.recolored_count;
         counts["outside_image"] = result.outside_image;
         counts["hidden"] = result.hidden;
+        counts["uncertain"] = result.uncertain;
+        counts["edge_margin_px"] = result.edge_margin_px;
         if (std::isfinite(result.disagreement)) counts["disagreement"] = result.disagreement;
         counts["warnings"] = warnings;
         if (json.is_object()) counts.update(json);

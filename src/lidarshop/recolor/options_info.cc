@@ -92,6 +92,17 @@ const StructInfo& InfoOf<RecolorOptions>() {
     b.Field(&RecolorOptions::skirt_depth_m, "skirt_depth_m", "skirt walls behind each occluder edge")
         .Unit("m")
         .Min(0);
+    b.Field(&RecolorOptions::edge_guard, "edge_guard",
+            "keep points near an occluding depth edge in the photo (uncertain) instead of recolouring them");
+    b.Field(&RecolorOptions::camera_uncertainty_px, "camera_uncertainty_px",
+            "how far the camera may put a point from its true pixel (edge guard margin, plus one scan step)")
+        .Unit("px")
+        .Min(0)
+        .Max(100);
+    b.Field(&RecolorOptions::edge_min_jump_m, "edge_min_jump_m",
+            "a nearer surface is an occluding edge when this much (plus the tolerances) in front")
+        .Unit("m")
+        .Min(0);
     b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
     b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
     return b.Build();

@@ -20,8 +20,11 @@ void RecolorOptions::Check() const { Validate(*this); }
 
 std::string RecolorResult::Summary() const {
   return fmt::format(
-      "{} of {} points recoloured; {} outside the photo, {} hidden from the camera{}", recolored_count,
+      "{} of {} points recoloured; {} outside the photo, {} hidden from the camera{}{}", recolored_count,
       returns, outside_image, hidden,
+      uncertain > 0 ? fmt::format(", {} kept near occluding edges (uncertain, {:.1f} px margin)", uncertain,
+                                  edge_margin_px)
+                    : "",
       std::isnan(disagreement)
           ? ""
           : fmt::format("; {:.0f} % disagree with the scan's own brightness", 100 * disagreement));
@@ -99,6 +102,63 @@ float Slope(const cv::Mat& d, int r, int c) {
   return (std::isfinite(sx) ? sx : 0.0f) + (std::isfinite(sy) ? sy : 0.0f);
 }
 
+// The scan's angular step, radians: the larger of the median angles between horizontally and between
+// vertically adjacent returns (every 4th row and column, enough for a median).
+double AngularStepRad(const Scan& scan) {
+  std::vector<double> across, down;
+  const auto direction = [&](int r, int c) {
+    const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+    return Eigen::Vector3d(p[0], p[1], p[2]).normalized();
+  };
+  for (int r = 0; r + 1 < scan.rows; r += 4) {
+    for (int c = 0; c + 1 < scan.cols; c += 4) {
+      if (!scan.valid.at<uint8_t>(r, c)) continue;
+      const Eigen::Vector3d here = direction(r, c);
+      if (scan.valid.at<uint8_t>(r, c + 1))
+        across.push_back(std::acos(std::clamp(here.dot(direction(r, c + 1)), -1.0, 1.0)));
+      if (scan.valid.at<uint8_t>(r + 1, c))
+        down.push_back(std::acos(std::clamp(here.dot(direction(r + 1, c)), -1.0, 1.0)));
+    }
+  }
+  const auto median = [](std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+    return v[v.size() / 2];
+  };
+  return std::max(median(across), median(down));
+}
+
+// The photo's colour at `pixel_px`, bilinear over the pixels whose z-buffer distance is within `allowed` of
+// `distance` (no blend across a depth edge); the nearest pixel's colour when none of the four agrees.
+cv::Vec3b SampleAgreeing(const cv::Mat& photo, const cv::Mat& distance_buffer, double sx, double sy,
+                         const Eigen::Vector2d& pixel_px, double distance, double allowed) {
+  const double x = std::clamp(pixel_px.x() - 0.5, 0.0, photo.cols - 1.0);
+  const double y = std::clamp(pixel_px.y() - 0.5, 0.0, photo.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int xs[2] = {x0, std::min(x0 + 1, photo.cols - 1)}, ys[2] = {y0, std::min(y0 + 1, photo.rows - 1)};
+  const double wx[2] = {1 - (x - x0), x - x0}, wy[2] = {1 - (y - y0), y - y0};
+  double sum[3] = {0, 0, 0}, weight = 0;
+  for (int j = 0; j < 2; ++j) {
+    for (int i = 0; i < 2; ++i) {
+      const int zr = std::min(static_cast<int>((ys[j] + 0.5) * sy), distance_buffer.rows - 1);
+      const int zc = std::min(static_cast<int>((xs[i] + 0.5) * sx), distance_buffer.cols - 1);
+      if (std::abs(distance_buffer.at<float>(zr, zc) - distance) > allowed) continue;
+      const double w = wx[i] * wy[j];
+      const cv::Vec3b v = photo.at<cv::Vec3b>(ys[j], xs[i]);
+      for (int c = 0; c < 3; ++c) sum[c] += w * v[c];
+      weight += w;
+    }
+  }
+  if (weight <= 1e-9) {
+    const int nx = std::clamp(static_cast<int>(pixel_px.x()), 0, photo.cols - 1);
+    const int ny = std::clamp(static_cast<int>(pixel_px.y()), 0, photo.rows - 1);
+    return photo.at<cv::Vec3b>(ny, nx);
+  }
+  cv::Vec3b out;
+  for (int c = 0; c < 3; ++c) out[c] = cv::saturate_cast<uint8_t>(sum[c] / weight);
+  return out;
+}
+
 }  // namespace
 
 RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,
@@ -127,6 +187,7 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     }
   }
   result.recolored = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+  result.uncertain_mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
 
   ScanMeshOptions mesh_options;
   mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
@@ -168,7 +229,9 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     }
   }
 
-  std::vector<uint8_t> hidden(candidates.size(), 0);
+  std::vector<uint8_t> hidden(candidates.size(), 0);  // 1 = hidden, 2 = uncertain (edge guard)
+  std::vector<cv::Vec3b> colour(candidates.size());
+  bool colour_done = false;
   const auto tolerance = [&](double distance) {
     return options.depth_tolerance_m + options.relative_depth_tolerance * distance;
   };
@@ -190,6 +253,15 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
     const double sx = static_cast<double>(distance_buffer.cols) / camera.width_px;
     const double sy = static_cast<double>(distance_buffer.rows) / camera.height_px;
+    // The edge guard's window: the camera's uncertainty and one scan step, in z-buffer pixels.
+    int guard = 0;
+    cv::Mat guard_nearest;
+    if (options.edge_guard) {
+      result.edge_margin_px = options.camera_uncertainty_px + AngularStepRad(scan) * camera.fx_px;
+      guard = std::max(m, static_cast<int>(std::ceil(result.edge_margin_px * std::max(sx, sy))));
+      cv::erode(distance_buffer, guard_nearest, cv::Mat::ones(2 * guard + 1, 2 * guard + 1, CV_8U));
+    }
+    colour_done = true;
     ParallelFor(
         static_cast<int64_t>(candidates.size()),
         [&](int64_t i) {
@@ -199,18 +271,32 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
           const double distance = (candidate.point_in_world - center).norm();
           const double allowed = tolerance(distance) + m * Slope(distance_buffer, zr, zc);
           hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
+          const float slope = Slope(distance_buffer, zr, zc);
+          if (!hidden[i] && guard > 0 &&
+              guard_nearest.at<float>(zr, zc) <
+                  distance - tolerance(distance) - options.edge_min_jump_m - guard * slope) {
+            hidden[i] = 2;
+          }
+          if (!hidden[i])
+            colour[i] = SampleAgreeing(photo, distance_buffer, sx, sy, candidate.pixel, distance,
+                                       tolerance(distance) + slope);
         },
         1024);
   }
 
   for (size_t i = 0; i < candidates.size(); ++i) {
+    const int r = static_cast<int>(candidates[i].cell / scan.cols),
+              c = static_cast<int>(candidates[i].cell % scan.cols);
+    if (hidden[i] == 2) {
+      ++result.uncertain;
+      result.uncertain_mask.at<uint8_t>(r, c) = 255;
+      continue;
+    }
     if (hidden[i]) {
       ++result.hidden;
       continue;
     }
-    const int r = static_cast<int>(candidates[i].cell / scan.cols),
-              c = static_cast<int>(candidates[i].cell % scan.cols);
-    out.color.at<cv::Vec3b>(r, c) = SamplePhoto(photo, candidates[i].pixel);
+    out.color.at<cv::Vec3b>(r, c) = colour_done ? colour[i] : SamplePhoto(photo, candidates[i].pixel);
     result.recolored.at<uint8_t>(r, c) = 255;
     ++result.recolored_count;
   }

@@ -1,6 +1,6 @@
 // Occlusion-aware recolouring of a scan from a photo (thesis 3.2.2.1).
 //
-// A scan point takes the photo's colour (bilinear at its projection) only when
+// A scan point takes the photo's colour (bilinear at its projection, over the pixels at its depth) only when
 //   1. it lies in front of the camera and projects inside the photo, and
 //   2. the camera sees it: the segment from the point to the camera centre meets no other surface of the
 //      scan.
@@ -27,6 +27,17 @@
 // A point is also hidden when the first surface at its pixel turns its back to the camera: the scan mesh
 // faces the scanner, so the camera then sees the side of that surface the scanner never saw (a camera facing
 // the scanner across an object sees the object's other side, whose colour is not the scanned side's).
+// Near an occluding edge the z-buffer cannot be trusted: the camera's pose is known only to a pixel or so
+// (a resection's reprojection error), and an occluder's true silhouette lies anywhere within one scan step of
+// its scan mesh. A point the test above lets through is *uncertain* (`edge_guard`) when a surface at least
+// `edge_min_jump_m` + the tolerance nearer than the point lies within `edge_margin` z-buffer pixels of its
+// projection, with edge_margin = camera_uncertainty_px + the scan's angular step in photo pixels (step × fx):
+// it keeps its colour, is counted in `uncertain` and flagged in `RecolorResult::uncertain_mask`. (Issue #30:
+// with a camera resected from 32 noisy pairs, 1.1 % of the hidden points 1.4–4.4 m behind an object, within
+// 4 px of its silhouette, took the object's colour or a blend; bench/results/recolor.md, "street scenes".)
+// The colour of a recoloured point is bilinear over the photo's pixels whose z-buffer distance agrees with
+// the point's (within the tolerance and the local slope), so no blend is taken across a depth edge; when no
+// neighbour agrees, the nearest pixel's colour.
 // `VisibilityMethod::kSegment` instead casts the exact segment of every point (Embree occlusion rays, no
 // pixel margin; skirts when `silhouette_skirts`): without skirts, the literal thesis test.
 #pragma once
@@ -63,6 +74,15 @@ struct RecolorOptions {
   // let 29 hidden points past the 0.5 m deep pillar's unseen side, 0.25 m walls none (at 0.14 % of the
   // visible points); deeper walls hide more of what the camera sees beside occluders.
   double skirt_depth_m = 0.25;
+  // Keep points near an occluding depth edge (above): they are `uncertain`, not recoloured. z-buffer only.
+  bool edge_guard = true;
+  // How far (photo pixels) the camera may put a point from its true pixel: the pose's uncertainty. For a
+  // resected camera about twice its reprojection RMS on the inliers (`lidarshop recolor --correspondences`
+  // uses the larger of this and 2 × the RMS). Part of the edge guard's margin.
+  double camera_uncertainty_px = 1.0;
+  // A nearer surface counts as an occluding edge when it is this much (plus the depth tolerance and the local
+  // slope) in front of the point, metres: smaller steps (a kerb, a window recess) do not hide a point.
+  double edge_min_jump_m = 0.2;
   double zbuffer_scale = 1.0;         // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
   double max_range_jump_ratio = 0.1;  // scan mesh edges (scanner/scan_mesh.h)
   void Check() const;                 // throws OptionsError
@@ -73,11 +93,14 @@ const StructInfo& InfoOf<RecolorOptions>();
 struct RecolorResult {
   Scan scan;  // a clone of the input with `color` replaced where recolored (created, grey from intensity,
               // or black without intensity, when the input had no colour)
-  cv::Mat recolored;            // CV_8U rows x cols: 255 = the point took the photo's colour
-  int64_t returns = 0;          // valid cells
+  cv::Mat recolored;       // CV_8U rows x cols: 255 = the point took the photo's colour
+  cv::Mat uncertain_mask;  // CV_8U rows x cols: 255 = seen, but kept near an occluding edge (`uncertain`)
+  int64_t returns = 0;     // valid cells
   int64_t recolored_count = 0;  // valid cells that took the photo's colour
   int64_t outside_image = 0;    // behind the camera or projected outside the photo
   int64_t hidden = 0;           // inside the photo but occluded by another surface of the scan
+  int64_t uncertain = 0;        // not hidden, but too near an occluding edge in the photo to trust: kept
+  double edge_margin_px = 0;    // the edge guard's margin, photo pixels (0: no guard)
   // Of the recoloured points, the fraction whose photo colour disagrees with the scan's own colour (or, without
   // colour, its intensity): their ranks (brightness quantiles among the recoloured points) differ by more than
   // kRecolorRankGap. Independent values disagree on 1 − (1 − gap)² of the points; NaN when nothing was

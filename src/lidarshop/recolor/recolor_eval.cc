@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -12,14 +13,16 @@
 namespace lidarshop {
 
 std::string RecolorScore::Summary() const {
-  return fmt::format("visible {} ({} recoloured, {:.2f} % correct), hidden {} ({:.2f} % changed), outside {}",
-                     visible, visible_recolored, visible_correct_percent(), hidden, hidden_changed_percent(),
-                     outside);
+  return fmt::format(
+      "visible {} ({} recoloured, {:.2f} % correct, {:.2f} % a wrong colour), hidden {} ({:.2f} % changed; "
+      "{} behind another object, {} of them changed), outside {}",
+      visible, visible_recolored, visible_correct_percent(), visible_wrong_percent(), hidden,
+      hidden_changed_percent(), hidden_behind, hidden_behind_changed, outside);
 }
 
 RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, const Scan& input,
                           const Scan& output, const PinholeCamera& camera, int max_level_difference,
-                          double visibility_tolerance_m) {
+                          double visibility_tolerance_m, double behind_object_m) {
   RaycastScene raycast;
   for (size_t i = 0; i < scene.objects.size(); ++i)
     raycast.AddMesh(MeshInWorld(scene.objects[i]), static_cast<int32_t>(i));
@@ -43,19 +46,26 @@ RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, cons
       const Eigen::Vector3d segment = point_in_world - center;
       ray.origin = center.cast<float>();
       ray.direction = segment.cast<float>();
-      ray.t_far = static_cast<float>(1.0 - visibility_tolerance_m / segment.norm());
       rays.push_back(ray);
       cells.push_back(static_cast<int64_t>(r) * truth.cols + c);
     }
   }
-  std::vector<uint8_t> occluded(rays.size());
-  raycast.Occluded(rays, occluded);
+  // The first hit along each ray (t in units of the segment to the point): hidden when it lies more than the
+  // tolerance before the point.
+  std::vector<RayHit> hits(rays.size());
+  raycast.Cast(rays, hits);
   for (size_t i = 0; i < cells.size(); ++i) {
     const int r = static_cast<int>(cells[i] / truth.cols), c = static_cast<int>(cells[i] % truth.cols);
     const cv::Vec3b before = input.color.at<cv::Vec3b>(r, c), after = output.color.at<cv::Vec3b>(r, c);
-    if (occluded[i]) {
+    const double length = rays[i].direction.cast<double>().norm();
+    const double gap_m = (1.0 - hits[i].t_hit) * length;  // how far before the point the first hit lies
+    if (std::isfinite(hits[i].t_hit) && gap_m > visibility_tolerance_m) {
       ++score.hidden;
       score.hidden_changed += before != after;
+      if (gap_m > behind_object_m) {
+        ++score.hidden_behind;
+        score.hidden_behind_changed += before != after;
+      }
       continue;
     }
     ++score.visible;
@@ -64,6 +74,7 @@ RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, cons
     bool close = true;
     for (int k = 0; k < 3; ++k) close = close && std::abs(after[k] - true_color[k]) <= max_level_difference;
     score.visible_correct += close;
+    score.visible_wrong += before != after && !close;
   }
   return score;
 }

@@ -19,11 +19,21 @@ struct RecolorScore {
   int64_t visible = 0;            // valid points inside the photo that the camera sees (true scene)
   int64_t visible_recolored = 0;  // ... that took a photo colour
   int64_t visible_correct = 0;    // ... whose colour is now within `max_level_difference` of the truth
+  int64_t visible_wrong = 0;      // ... that took a photo colour further than that from the truth
   int64_t hidden = 0;             // valid points inside the photo hidden from the camera by the true scene
   int64_t hidden_changed = 0;     // ... whose colour changed (must be 0)
-  int64_t outside = 0;            // behind the camera or outside the photo
+  // Of the hidden points, those whose first surface towards the camera lies more than
+  // `behind_object_m` in front of them (behind another object, not a fold of their own surface: the bleed
+  // of issue #30), and of those the ones whose colour changed.
+  int64_t hidden_behind = 0;
+  int64_t hidden_behind_changed = 0;
+  int64_t outside = 0;  // behind the camera or outside the photo
   double visible_correct_percent() const { return visible ? 100.0 * visible_correct / visible : 0.0; }
   double hidden_changed_percent() const { return hidden ? 100.0 * hidden_changed / hidden : 0.0; }
+  double visible_wrong_percent() const { return visible ? 100.0 * visible_wrong / visible : 0.0; }
+  double hidden_behind_changed_percent() const {
+    return hidden_behind ? 100.0 * hidden_behind_changed / hidden_behind : 0.0;
+  }
   std::string Summary() const;
 };
 
@@ -32,7 +42,7 @@ struct RecolorScore {
 // scene more than `visibility_tolerance_m` before the point.
 RecolorScore ScoreRecolor(const SceneDescription& scene, const Scan& truth, const Scan& input,
                           const Scan& output, const PinholeCamera& camera, int max_level_difference = 10,
-                          double visibility_tolerance_m = 0.005);
+                          double visibility_tolerance_m = 0.005, double behind_object_m = 0.5);
 
 // `count` correspondences of scan points the camera sees (a user clicks points seen in both): a valid cell
 // drawn at random whose projection lies inside the photo and whose distance from the camera matches the

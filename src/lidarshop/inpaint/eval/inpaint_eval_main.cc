@@ -2,7 +2,13 @@
 // (thesis ch. 7) on images with truth.
 //
 //   inpaint_eval [--scenes DIR] [--images DIR] [--configs a,b,...] [--lookahead M] [--markdown FILE]
-//                [--pictures DIR] [--skip-trashcan]
+//                [--pictures DIR] [--skip-trashcan] [--all-shared-images] [--colour-scenes]
+//
+// Configurations 0-11 are the library's (exhaustive search) with the acceptance tests one by one, combined
+// and forward-looking; 12-25 are what `lidarshop inpaint` runs (two-step search, gain 1.5) with the flags a
+// user can add (bench/results/inpaint.md, "The command's defaults"). The last table gives, per configuration,
+// the mean, 5th percentile and worst PSNR over the images with truth and the seconds over the photos of
+// --images.
 //
 // Images: lettera (its original is the truth), trashcan (no truth: its original still holds the object; time
 // and rejections only) and, for every data/inpaint_eval/*.json scene, the synthetic scan rendered with and
@@ -160,6 +166,45 @@ std::vector<Config> MakeConfigs(int lookahead, const Tuning& t) {
   configs.push_back({fmt::format("combined + lookahead {} (largest margin)", lookahead), combined});
   combined.lookahead_by_margin = false;
   configs.push_back({fmt::format("combined + lookahead {} (first passing)", lookahead), combined});
+  // 12-: the `lidarshop inpaint` command's settings (two-step search, gain 1.5; cli/inpaint_command.cc) with
+  // the flags a user would add; 12 is the command's default before #30, 14 its default since.
+  InpaintOptions command;
+  command.search = InpaintSearchKind::kTwoStep;
+  command.global_gain = 1.5;
+  configs.push_back({"command: --accept none --lookahead 1 (two-step 1.5)", command});
+  command.acceptance = AcceptanceOptions::Combined();
+  configs.push_back({"command: --accept combined", command});
+  for (int m : {2, 4, 8}) {
+    command.lookahead = m;
+    configs.push_back({fmt::format("command: --accept combined --lookahead {}", m), command});
+  }
+  command.lookahead = 4;
+  command.lookahead_by_margin = false;
+  configs.push_back({"command: --accept combined --lookahead 4 --lookahead-by-margin false", command});
+  command.lookahead_by_margin = true;
+  command.acceptance_candidates = 16;
+  configs.push_back({"command: --accept combined --lookahead 4 --accept-candidates 16", command});
+  command.acceptance_candidates = 8;
+  command.search = InpaintSearchKind::kExhaustive;
+  configs.push_back({"command: --accept combined --lookahead 4 --search exhaustive", command});
+  command.search = InpaintSearchKind::kPatchMatch;
+  configs.push_back({"command: --accept combined --lookahead 4 --search patchmatch", command});
+  // Lookahead 1 with the acceptance's own knobs.
+  command.search = InpaintSearchKind::kTwoStep;
+  command.lookahead = 1;
+  for (int k : {4, 16}) {
+    command.acceptance_candidates = k;
+    configs.push_back({fmt::format("command: --accept combined --accept-candidates {}", k), command});
+  }
+  command.acceptance_candidates = 8;
+  command.local_window_radius = 20;
+  configs.push_back({"command: --accept combined --window 20", command});
+  command.local_window_radius = 40;
+  command.acceptance.band_px = 1;
+  configs.push_back({"command: --accept combined --accept-band 1", command});
+  command.acceptance.band_px = AcceptanceOptions::Combined().band_px;
+  command.global_gain = 1.0;
+  configs.push_back({"command: --accept combined --global-gain 1", command});
   return configs;
 }
 
@@ -179,7 +224,7 @@ int main(int argc, char** argv) {
   std::string scenes_dir = LIDARSHOP_SOURCE_DIR "/data/inpaint_eval",
               images_dir = LIDARSHOP_SHARED_DATA_DIR "/images", markdown_path, pictures_dir, only;
   int lookahead = 8;
-  bool skip_trashcan = false;
+  bool skip_trashcan = false, all_shared = false, colour_scenes = false;
   app.add_option("--scenes", scenes_dir, "folder of scene JSON files (label 1 = the object to remove)");
   app.add_option("--images", images_dir, "folder with lettera/ and trashcan/");
   app.add_option("--lookahead", lookahead, "M of the forward-looking configuration")->capture_default_str();
@@ -188,6 +233,11 @@ int main(int argc, char** argv) {
   app.add_option("--pictures", pictures_dir,
                  "write the input, plain and combined fills (and the truth) here, cropped around the hole");
   app.add_flag("--skip-trashcan", skip_trashcan);
+  app.add_flag(
+      "--all-shared-images", all_shared,
+      "also fill bungee and f16 of --images (no truth: time only), for the summary's shared-image time");
+  app.add_flag("--colour-scenes", colour_scenes,
+               "also fill each scene's colour alone (3 channels, as `lidarshop inpaint` fills a photo)");
   Tuning tuning;
   app.add_option("--band", tuning.band_px, "combined: band_px");
   app.add_option("--candidates", tuning.candidates, "combined: acceptance_candidates");
@@ -211,12 +261,35 @@ int main(int argc, char** argv) {
     if (entry.path().extension() == ".json") scene_paths.push_back(entry.path().string());
   std::sort(scene_paths.begin(), scene_paths.end());
   for (const std::string& path : scene_paths) images.push_back(SceneImage(path));
+  if (colour_scenes) {
+    for (const std::string& path : scene_paths) {
+      EvalImage e = SceneImage(path);
+      e.name += " (colour only)";
+      e.image = ColourOf(e.image);
+      e.image.convertTo(e.image, CV_32F);
+      e.range.release();
+      e.true_range.release();
+      images.push_back(e);
+    }
+  }
   if (!skip_trashcan) {
     EvalImage t;
     t.name = "trashcan";
     ReadRgb(images_dir + "/trashcan/trashcan.png").convertTo(t.image, CV_32F);
     t.hole = ReadImage(images_dir + "/trashcan/trashcan_mask.png") > 127;
     images.push_back(t);
+  }
+  if (all_shared) {
+    for (const auto& [name, stem] : {std::pair{"bungee", "bungee"}, std::pair{"f16", "f16"}}) {
+      EvalImage e;
+      e.name = name;
+      ReadRgb(fmt::format("{}/{}/{}.png", images_dir, name, stem)).convertTo(e.image, CV_32F);
+      cv::Mat mask = ReadImage(fmt::format("{}/{}/{}_mask.png", images_dir, name, stem));
+      if (mask.channels() == 3) cv::cvtColor(mask, mask, cv::COLOR_RGB2GRAY);
+      if (mask.channels() == 4) cv::cvtColor(mask, mask, cv::COLOR_RGBA2GRAY);
+      e.hole = mask > 127;
+      images.push_back(e);
+    }
   }
   std::vector<Config> configs = MakeConfigs(lookahead, tuning);
   std::vector<bool> run(configs.size(), only.empty());
@@ -229,7 +302,12 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     out += s;
   };
+  // Per configuration: PSNR of every image with truth, seconds over the images of --images (lettera,
+  // trashcan, bungee, f16: the shared photos, not the synthetic scans).
+  std::vector<std::vector<double>> psnrs(configs.size());
+  std::vector<double> shared_seconds(configs.size(), 0.0);
   for (const EvalImage& e : images) {
+    const bool shared = e.image.channels() == 3 && e.name.find("(colour only)") == std::string::npos;
     const int hole = cv::countNonZero(e.hole);
     emit(fmt::format("\n### {} ({}x{}, {} channels, hole {} px)\n\n", e.name, e.image.cols, e.image.rows,
                      e.image.channels(), hole));
@@ -245,7 +323,8 @@ int main(int argc, char** argv) {
       const cv::Mat rgb = ColourOf(result.image);
       std::string psnr = "-", ssim = "-", rmse = "-";
       if (!e.truth_rgb.empty()) {
-        psnr = fmt::format("{:.2f}", HolePsnr(rgb, e.truth_rgb, e.hole));
+        psnrs[i].push_back(HolePsnr(rgb, e.truth_rgb, e.hole));
+        psnr = fmt::format("{:.2f}", psnrs[i].back());
         ssim = fmt::format("{:.3f}", HoleSsim(rgb, e.truth_rgb, e.hole));
       }
       if (!e.range.empty()) {
@@ -258,6 +337,7 @@ int main(int argc, char** argv) {
         cv::Mat d = depth.image - e.true_range;
         rmse = fmt::format("{:.4f}", std::sqrt(cv::mean(d.mul(d), e.hole)[0]));
       }
+      if (shared) shared_seconds[i] += result.seconds;
       emit(fmt::format("| {} | {} | {} | {} | {} | {} | {} | {:.0f} | {:.2f} |\n", configs[i].name, psnr,
                        ssim, rmse, result.rejected, result.acceptance_fallbacks, result.iterations,
                        static_cast<double>(result.candidates_evaluated) / std::max(result.iterations, 1),
@@ -279,6 +359,21 @@ int main(int argc, char** argv) {
         }
       }
     }
+  }
+  // The distribution over the images with truth: mean, 5th percentile (nearest rank, the lowest of fewer than
+  // 20 images) and worst.
+  emit(
+      "\n### Summary over the images with truth\n\n| configuration | PSNR mean dB | 5th percentile | worst | "
+      "s on the shared photos |\n|---|---|---|---|---|\n");
+  for (size_t i = 0; i < configs.size(); ++i) {
+    if (!run[i] || psnrs[i].empty()) continue;
+    std::vector<double> v = psnrs[i];
+    std::sort(v.begin(), v.end());
+    double mean = 0;
+    for (double x : v) mean += x / v.size();
+    const size_t p5 = static_cast<size_t>(std::ceil(0.05 * v.size())) - 1;
+    emit(fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n", configs[i].name, mean,
+                     v[std::min(p5, v.size() - 1)], v.front(), shared_seconds[i]));
   }
   if (!markdown_path.empty()) {
     std::ofstream file(markdown_path);

@@ -6,23 +6,206 @@
 //   ours    RANSAC DLT + Levenberg-Marquardt (recolor/resection.h)
 //   pnp     OpenCV solvePnPRansac + solvePnPRefineLM given the TRUE intrinsics
 // and the scan, its colours replaced by magenta, is recoloured with each camera and scored against the truth.
+#include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <opencv2/imgproc.hpp>
 
+#include "lidarshop/raycast/raycast.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/recolor_eval.h"
 #include "lidarshop/recolor/resection.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/testing/scenes.h"
+#include "lidarshop/testing/street_scenes.h"
 
 using namespace lidarshop;
 
 namespace {
+
+// Mean, 5th percentile (nearest rank) and worst of `values`; `worst_is_low`: the worst is the smallest.
+std::string Distribution(std::vector<double> values, bool worst_is_low, int decimals) {
+  std::sort(values.begin(), values.end());
+  if (!worst_is_low) std::reverse(values.begin(), values.end());
+  double mean = 0;
+  for (double v : values) mean += v / values.size();
+  const size_t p5 = static_cast<size_t>(std::max(1.0, std::ceil(0.05 * values.size()))) - 1;
+  return fmt::format("{:.{}f} | {:.{}f} | {:.{}f}", mean, decimals, values[p5], decimals, values.front(),
+                     decimals);
+}
+
+// The street scenes (test_scenes::MakeStreetRecolorCase, seeds 1..N): camera `offset_m` beside the scanner,
+// `pairs` correspondences with noise and outliers, resected (ours), recoloured with the default options; per
+// seed and the distribution (issue #30 class 3).
+int RunStreet(int seeds, double offset_m, int pair_count, double noise_px, double outliers, bool per_seed,
+              const RecolorOptions& recolor) {
+  std::vector<double> correct, wrong, unchanged, behind_unchanged, uncertain, true_correct, true_unchanged,
+      true_behind_unchanged;
+  int64_t changed_total = 0, hidden_total = 0, behind_changed_total = 0, behind_total = 0;
+  fmt::print(
+      "street scenes: camera {} m beside the scanner, {} pairs, {} px RMS noise, {:.0f} % outliers\n\n",
+      offset_m, pair_count, noise_px, 100 * outliers);
+  if (per_seed)
+    fmt::print(
+        "| seed | RMS on true pairs, px | visible correct, % | visible wrong colour, % | hidden changed (of) "
+        "| "
+        "behind an object: changed (of) | uncertain | true camera: visible correct, % | behind an "
+        "object: changed |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (int seed = 1; seed <= seeds; ++seed) {
+    const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
+    const Scan truth = test_scenes::ScanScene(c.scene);
+    Scan input = Clone(truth);
+    input.color.setTo(cv::Scalar(250, 0, 250));
+    PhotoOptions photo_options;
+    photo_options.samples_per_axis = 3;  // anti-aliased silhouettes, as a real photo's
+    const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
+    std::vector<PixelPointPair> exact;
+    const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
+                                                                  noise_px, outliers, 1000 + seed, &exact);
+    ResectionOptions options;
+    options.width_px = c.camera.width_px;
+    options.height_px = c.camera.height_px;
+    options.seed = seed;
+    const ResectionResult resection = Resection(pairs, options);
+    const RecolorResult result = RecolorScan(input, photo.image, resection.camera, recolor);
+    const RecolorScore score = ScoreRecolor(c.scene, truth, input, result.scan, c.camera);
+    const RecolorResult true_result = RecolorScan(input, photo.image, c.camera, recolor);
+    const RecolorScore true_score = ScoreRecolor(c.scene, truth, input, true_result.scan, c.camera);
+    correct.push_back(score.visible_correct_percent());
+    wrong.push_back(score.visible_wrong_percent());
+    unchanged.push_back(100 - score.hidden_changed_percent());
+    behind_unchanged.push_back(100 - score.hidden_behind_changed_percent());
+    true_behind_unchanged.push_back(100 - true_score.hidden_behind_changed_percent());
+    behind_changed_total += score.hidden_behind_changed;
+    behind_total += score.hidden_behind;
+    uncertain.push_back(static_cast<double>(result.uncertain));
+    true_correct.push_back(true_score.visible_correct_percent());
+    true_unchanged.push_back(100 - true_score.hidden_changed_percent());
+    changed_total += score.hidden_changed;
+    hidden_total += score.hidden;
+    if (per_seed)
+      fmt::print("| {} | {:.3f} | {:.2f} | {:.2f} | {} ({}) | {} ({}) | {} | {:.2f} | {} |\n", seed,
+                 RmsReprojectionError(resection.camera, exact), score.visible_correct_percent(),
+                 score.visible_wrong_percent(), score.hidden_changed, score.hidden,
+                 score.hidden_behind_changed, score.hidden_behind, result.uncertain,
+                 true_score.visible_correct_percent(), true_score.hidden_behind_changed);
+  }
+  fmt::print("\n| {} seeds | mean | 5th percentile | worst |\n|---|---|---|---|\n", seeds);
+  fmt::print("| visible points correct, % (resected camera) | {} |\n", Distribution(correct, true, 2));
+  fmt::print("| visible points that took a wrong colour, % (resected camera) | {} |\n",
+             Distribution(wrong, false, 2));
+  fmt::print("| hidden points unchanged, % (resected camera) | {} |\n", Distribution(unchanged, true, 3));
+  fmt::print("| hidden behind another object (> 0.5 m): unchanged, % (resected camera) | {} |\n",
+             Distribution(behind_unchanged, true, 3));
+  fmt::print("| uncertain points kept (resected camera) | {} |\n", Distribution(uncertain, false, 0));
+  fmt::print("| visible points correct, % (true camera) | {} |\n", Distribution(true_correct, true, 2));
+  fmt::print("| hidden points unchanged, % (true camera) | {} |\n", Distribution(true_unchanged, true, 3));
+  fmt::print("| hidden behind another object: unchanged, % (true camera) | {} |\n",
+             Distribution(true_behind_unchanged, true, 3));
+  fmt::print("\nhidden points changed over all seeds (resected camera): {} of {} ({:.3f} %)\n", changed_total,
+             hidden_total, 100.0 * changed_total / std::max<int64_t>(1, hidden_total));
+  fmt::print("hidden behind another object, changed over all seeds (resected camera): {} of {} ({:.3f} %)\n",
+             behind_changed_total, behind_total,
+             100.0 * behind_changed_total / std::max<int64_t>(1, behind_total));
+  return 0;
+}
+
+// Where the errors of one street seed come from (for reading, not a table of the results page).
+int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, double outliers,
+                   bool true_camera, const RecolorOptions& recolor) {
+  const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
+  const Scan truth = test_scenes::ScanScene(c.scene);
+  Scan input = Clone(truth);
+  input.color.setTo(cv::Scalar(250, 0, 250));
+  PhotoOptions photo_options;
+  photo_options.samples_per_axis = 3;
+  const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
+  std::vector<PixelPointPair> exact;
+  const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
+                                                                noise_px, outliers, 1000 + seed, &exact);
+  ResectionOptions options;
+  options.width_px = c.camera.width_px;
+  options.height_px = c.camera.height_px;
+  options.seed = seed;
+  const PinholeCamera camera = true_camera ? c.camera : Resection(pairs, options).camera;
+  const RecolorResult result = RecolorScan(input, photo.image, camera, recolor);
+  std::map<int, int64_t> cells_of_label;
+  for (int r = 0; r < truth.rows; ++r)
+    for (int col = 0; col < truth.cols; ++col)
+      if (truth.valid.at<uint8_t>(r, col)) ++cells_of_label[truth.label.at<int32_t>(r, col)];
+  for (const auto& [label, n] : cells_of_label)
+    fmt::print("label {} ({}): {} cells\n", label, c.scene.objects[label].name, n);
+  // Depth edges of the true photo: pixels whose 3x3 neighbourhood spans more than 20 % of their depth.
+  cv::Mat dmax, dmin;
+  cv::dilate(photo.depth_m, dmax, cv::Mat());
+  cv::erode(photo.depth_m, dmin, cv::Mat());
+  const Eigen::Vector3d center = c.camera.center_in_world();
+  RaycastScene raycast;
+  for (size_t i = 0; i < c.scene.objects.size(); ++i)
+    raycast.AddMesh(MeshInWorld(c.scene.objects[i]), static_cast<int32_t>(i));
+  raycast.Commit();
+  int shown = 0;
+  std::map<std::string, int> kinds;
+  for (int r = 0; r < truth.rows; ++r) {
+    for (int col = 0; col < truth.cols; ++col) {
+      if (!truth.valid.at<uint8_t>(r, col)) continue;
+      const Eigen::Vector3d world = WorldPointOfCell(truth, r, col);
+      Eigen::Vector2d pixel;
+      if (!ProjectWorldPoint(c.camera, world, &pixel) || !InsideImage(c.camera, pixel)) continue;
+      const int pr = static_cast<int>(pixel.y()), pc = static_cast<int>(pixel.x());
+      const double distance = (world - center).norm(), seen = photo.depth_m.at<float>(pr, pc);
+      // Distance in pixels to the nearest pixel whose depth is more than 0.3 m nearer than the point.
+      int edge_px = 99;
+      for (int d = 0; d <= 8 && edge_px == 99; ++d)
+        for (int dr = -d; dr <= d; ++dr)
+          for (int dc = -d; dc <= d; ++dc) {
+            const int rr = pr + dr, cc = pc + dc;
+            if (rr < 0 || cc < 0 || rr >= photo.depth_m.rows || cc >= photo.depth_m.cols) continue;
+            if (photo.depth_m.at<float>(rr, cc) < distance - 0.3) edge_px = std::min(edge_px, d);
+          }
+      Ray ray;
+      ray.origin = center.cast<float>();
+      ray.direction = (world - center).cast<float>();
+      RayHit hit;
+      raycast.CastSerial(std::span<const Ray>(&ray, 1), std::span<RayHit>(&hit, 1));
+      const double gap = (1 - hit.t_hit) * distance;  // how far in front of the point the first hit lies
+      const bool hidden = gap > 0.005;
+      const bool changed = result.scan.color.at<cv::Vec3b>(r, col) != cv::Vec3b(250, 0, 250);
+      const cv::Vec3b got = result.scan.color.at<cv::Vec3b>(r, col), want = truth.color.at<cv::Vec3b>(r, col);
+      bool close = true;
+      for (int k = 0; k < 3; ++k) close = close && std::abs(got[k] - want[k]) <= 10;
+      std::string kind;
+      if (hidden && changed) {
+        const int occluder = photo.label.at<int32_t>(pr, pc);
+        const int first = hit.geometry_id;
+        kind = fmt::format(
+            "hidden changed: first hit {} (own {}) {} in front, seen by the scanner: {}, edge {} px", first,
+            truth.label.at<int32_t>(r, col),
+            gap < 0.1 ? "< 0.1 m"
+            : gap < 1 ? "0.1-1 m"
+                      : "> 1 m",
+            cells_of_label.count(first) ? "yes" : "no", edge_px > 4 ? 5 : edge_px);
+        (void)occluder;
+        if (shown++ < 15 || (occluder == 0 && shown < 1000 && shown % 50 == 0))
+          fmt::print("cell {} {} label {} at {:.2f} m, occluder {} at {:.2f} m, edge {} px, got {} {} {}\n",
+                     r, col, truth.label.at<int32_t>(r, col), distance, occluder, seen, edge_px, got[0],
+                     got[1], got[2]);
+      } else if (!hidden && !close) {
+        kind = fmt::format("visible wrong: {}, edge {} px, label {}", changed ? "recoloured" : "kept",
+                           edge_px > 4 ? 5 : edge_px, truth.label.at<int32_t>(r, col));
+      }
+      if (!kind.empty()) ++kinds[kind];
+    }
+  }
+  for (const auto& [kind, n] : kinds) fmt::print("{:6d}  {}\n", n, kind);
+  return 0;
+}
 
 struct Setup {
   SceneDescription scene;
@@ -46,7 +229,28 @@ int main(int argc, char** argv) {
                "also print every draw of \"ours\" (offset, pairs, seed, inliers, RMS)");
   app.add_option("--noise", noise_px, "RMS pixel noise of the correspondences");
   app.add_option("--outliers", outliers, "fraction of outlier pairs");
+  int street = 0, street_pairs = 32;
+  double street_offset_m = 2.0;
+  app.add_option("--street", street,
+                 "instead: the random street scenes, seeds 1..N (test_scenes::MakeStreetRecolorCase)");
+  app.add_option("--street-offset", street_offset_m, "street scenes: camera distance from the scanner, m");
+  app.add_option("--street-pairs", street_pairs, "street scenes: correspondences per seed");
+  int diagnose = 0;
+  bool diagnose_true = false;
+  app.add_option("--diagnose", diagnose, "street scenes: where the errors of this seed come from");
+  app.add_flag("--diagnose-true-camera", diagnose_true, "--diagnose with the true camera");
+  RecolorOptions street_options;
+  bool no_guard = false;
+  app.add_flag("--no-edge-guard", no_guard, "street scenes: recolour without the edge guard (before #30)");
+  app.add_option("--camera-uncertainty", street_options.camera_uncertainty_px,
+                 "street scenes: RecolorOptions::camera_uncertainty_px");
   CLI11_PARSE(app, argc, argv);
+  street_options.edge_guard = !no_guard;
+  if (diagnose > 0)
+    return DiagnoseStreet(diagnose, street_offset_m, street_pairs, noise_px, outliers, diagnose_true,
+                          street_options);
+  if (street > 0)
+    return RunStreet(street, street_offset_m, street_pairs, noise_px, outliers, per_draw, street_options);
 
   fmt::print(
       "noise {} px RMS (σ = {:.3f} px per axis), {:.0f} % outliers, {} draws per row (mean; worst in "
@@ -113,18 +317,21 @@ int main(int argc, char** argv) {
       }
     }
     if (resection_only) continue;
-    // Visibility with the true camera: the default (skirts with walls, 1 px margin) and its parts, the literal
-    // segment test, and the visibility test before the skirts (2 px margin).
+    // Visibility with the true camera: the default (skirts with walls, 1 px margin, edge guard) and its parts without
+    // the guard, the literal segment test, and the visibility test before the skirts (2 px margin).
     struct Variant {
       const char* name;
       VisibilityMethod method;
       bool skirts;
       double depth_m;
       int margin_px;
+      bool edge_guard = false;  // the variants show the visibility test alone; the default has the guard
     };
     const Variant variants[] = {
-        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (default)", VisibilityMethod::kZBuffer,
-         true, 0.25, 1},
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin + edge guard (default)",
+         VisibilityMethod::kZBuffer, true, 0.25, 1, true},
+        {"true camera, z-buffer + skirts (0.25 m walls) + 1 px margin (the default before the edge guard)",
+         VisibilityMethod::kZBuffer, true, 0.25, 1},
         {"true camera, z-buffer + skirt caps only (no walls) + 1 px margin", VisibilityMethod::kZBuffer, true,
          0.0, 1},
         {"true camera, z-buffer + skirts (0.25 m walls), no margin", VisibilityMethod::kZBuffer, true, 0.25,
@@ -141,6 +348,7 @@ int main(int argc, char** argv) {
       options.silhouette_skirts = variant.skirts;
       options.skirt_depth_m = variant.depth_m;
       options.silhouette_margin_px = variant.margin_px;
+      options.edge_guard = variant.edge_guard;
       const RecolorResult result = RecolorScan(s.input, s.photo.image, s.camera, options);
       const RecolorScore score = ScoreRecolor(s.scene, s.truth, s.input, result.scan, s.camera);
       fmt::print("| {:.0f} m | - | {} | 0 | {:.2f} | {:.3f} ({} of {} points) |\n", offset, variant.name,
