@@ -11,6 +11,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/recolor/align.h"
@@ -123,6 +124,27 @@ nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
                             {"pixel_width_m", image.pixel_width_m},
                             {"pixel_height_m", image.pixel_height_m},
                             {"principal_point_px", {image.principal_x_px, image.principal_y_px}}};
+    } else if (image.projection == "spherical") {
+      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
+                            {"pixel_height_rad", image.pixel_height_rad}};
+    } else if (image.projection == "cylindrical") {
+      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
+                            {"pixel_height_m", image.pixel_height_m},
+                            {"radius_m", image.radius_m},
+                            {"principal_y_px", image.principal_y_px}};
+    }
+    if (!image.description.empty()) json["description"] = image.description;
+    if (image.associated_scan >= 0) json["scan"] = image.associated_scan;
+    json["has_mask"] = !image.mask_encoded.empty();
+    // The camera model (io/e57_image_camera.h): null for a visual reference or an entry missing fields.
+    Camera model;
+    std::string model_why;
+    const std::string model_name = E57ImageModel(image);
+    json["model"] = model_name.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(model_name);
+    if (CameraModelOfE57Image(image, &model, &model_why)) {
+      json["camera"] = nlohmann::ordered_json::parse(CameraModelToJson(model));
+    } else if (!model_name.empty()) {
+      json["camera_error"] = model_why;
     }
     PinholeCamera camera;
     std::string why;
@@ -277,7 +299,8 @@ int RunRecolor(int argc, char** argv) {
 
 int RunImages(int argc, char** argv) {
   CLI::App app{
-      "List the photos (images2D) of an E57 file as JSON; --extract writes each photo's stored bytes as they "
+      "List the photos (images2D) of an E57 file as JSON, each with its representation and camera model; "
+      "--extract writes each photo's stored bytes as they "
       "are (JPEG or PNG, EXIF kept).",
       "images"};
   std::string path, folder, json_path = "-";
@@ -385,13 +408,17 @@ int RunAlign(int argc, char** argv) {
 
 int RunPhoto(int argc, char** argv) {
   CLI::App app{
-      "The synthetic camera: render what a pinhole camera sees in a scene, with the scanner's colours.",
+      "The synthetic camera: render what a camera (pinhole, fisheye, spherical or cylindrical: the camera "
+      "JSON's \"model\") sees in a scene, with the scanner's colours.",
       "photo"};
   std::string scene_path, camera_path, output, json_path;
   PhotoOptions options;
   OptionBinder binder(app);
   app.add_option("scene", scene_path, "scene JSON (docs/scene-format.md)")->required();
-  app.add_option("--camera", camera_path, "camera JSON (geometry/camera.h)")->required();
+  app.add_option("--camera", camera_path,
+                 "camera JSON (geometry/camera_model.h; \"model\": pinhole (default), fisheye, spherical, "
+                 "cylindrical)")
+      ->required();
   app.add_option("-o,--output", output, "photo to write (.png, .jpg)")->required();
   AddJsonOption(app, &json_path);
   binder.Bind(&options, {.flags = {{"samples_per_axis", "--samples"}}});
@@ -403,9 +430,11 @@ int RunPhoto(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {scene_path, camera_path, output});
         const SceneDescription scene = LoadScene(scene_path);
         PrintWarnings(scene.warnings);
-        const Photo photo = RenderPhoto(scene, ReadCameraJson(camera_path), options);
+        const Camera camera = ReadCameraModelJson(camera_path);
+        const Photo photo = RenderPhoto(scene, camera, options);
         WriteImage(output, photo.image);
         nlohmann::ordered_json json;
+        json["model"] = CameraModelName(camera.model);
         json["width_px"] = photo.image.cols;
         json["height_px"] = photo.image.rows;
         json["scene_pixels"] = cv::countNonZero(photo.label != kNoLabel);
