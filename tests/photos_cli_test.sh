@@ -61,7 +61,7 @@ check "convert keeps the photos" "$lidarshop" convert "$work/sphere.e57" "$work/
 check "images sphere2.e57" sh -c "'$lidarshop' images '$work/sphere2.e57' >'$work/sphere2_images.json'"
 json_check "converted: the same panorama" "$work/sphere2_images.json" \
   "d['images'][0]['camera'] == json.load(open('$work/sphere_images.json'))['images'][0]['camera']"
-fails_clearly "--photos into a PTX is refused" "--photos needs an .e57 output" \
+fails_clearly "--photos into a PTX is refused" "--photos needs an output that holds photos \(E57\)" \
   "$lidarshop" "${scan[@]}" -o "$work/s.ptx" --photos sphere
 fails_clearly "--photo-size without --photos is refused" "--photo-size is for --photos" \
   "$lidarshop" "${scan[@]}" -o "$work/s.e57" --photo-size 64

@@ -14,6 +14,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/render.h"
@@ -91,9 +92,13 @@ int RunScan(int argc, char** argv) {
         if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
         CheckOutputFile("--json", json_path, {}, {scene_path, output_path, labels_path, mesh_path});
         binder.Validate(mesh_options);
-        if (!photos_kind.empty() && FileExtension(output_path) != "e57")
-          throw OptionsError(
-              fmt::format("--photos needs an .e57 output: {} cannot hold photos", output_path));
+        if (!photos_kind.empty()) {
+          const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
+          if (format == nullptr || !format->images)
+            throw OptionsError(fmt::format(
+                "--photos needs an output that holds photos ({}): {} cannot hold them",
+                FormatNamesWhere([](const ScanFormatInfo& f) { return f.images && f.write; }), output_path));
+        }
         if (photos_kind.empty() && app.count("--photo-size"))
           throw OptionsError("--photo-size is for --photos");
         const ThreadLimit thread_limit(threads);
