@@ -2,7 +2,7 @@
 # End-to-end test of the camera models and the station's photos (#32 items 1-2): `photo` renders a scene with a
 # pinhole (old camera file, no "model"), fisheye, spherical and cylindrical camera; `scan --photos cube|sphere`
 # writes six pinhole faces or one spherical panorama into the E57 with their poses (camera centre 0.15 m above
-# the scanner of parking_lot, at 1.6 m) and gains; `images` lists them with their models; other outputs refuse --photos; the real files
+# the scanner of parking_lot, at 1.6 m) and gains; `recolor --from-e57-images` colours the scan from them; `images` lists them with their models; other outputs refuse --photos; the real files
 # with images still list. Run by ctest as `photos_cli_test`. Usage: photos_cli_test.sh LIDARSHOP_BINARY SHARED
 set -uo pipefail
 lidarshop=$1
@@ -65,6 +65,21 @@ fails_clearly "--photos into a PTX is refused" "--photos needs an output that ho
   "$lidarshop" "${scan[@]}" -o "$work/s.ptx" --photos sphere
 fails_clearly "--photo-size without --photos is refused" "--photo-size is for --photos" \
   "$lidarshop" "${scan[@]}" -o "$work/s.e57" --photo-size 64
+
+# Colour the cube station from its own images: the fitted gains are the true ones where a face colours the scan.
+check "scan a finer cube station" "$lidarshop" scan parking_lot --rows 150 --columns 300 --seed 3 --quiet \
+  -o "$work/cube_fine.e57" --photos cube --photo-size 256 --json "$work/cube_fine_scan.json"
+check "recolor --from-e57-images (cube)" "$lidarshop" recolor "$work/cube_fine.e57" --from-e57-images \
+  -o "$work/cube_coloured.ply" --photo-index-mask "$work/cube_index.png" --json "$work/cube_recolor.json" --quiet
+json_check "cube recolour: most returns coloured, gains of the faces used within 3 %" "$work/cube_recolor.json" \
+  "d['coloured'] > 0.9 * d['returns'] and len(d['photos']) == 6 and \
+   all(abs(g / s['gain'] - 1) < 0.03 for p, s in zip(d['photos'], json.load(open('$work/cube_fine_scan.json'))['photos']) \
+       for g in p['gain'] if g != 1.0)"
+check "the photo index mask is written" test -s "$work/cube_index.png"
+fails_clearly "pumpA has no image with a camera" "no image of scan 0 holds a photo with a camera" \
+  "$lidarshop" recolor "$shared/e57/pumpA.e57" --from-e57-images -o "$work/pump.ply"
+fails_clearly "--from-e57-images takes no --photo" "--from-e57-images takes the photos" \
+  "$lidarshop" recolor "$work/cube.e57" --from-e57-images --photo "$work/pinhole.png" -o "$work/x.ply"
 
 check "images of the real file with every representation" \
   sh -c "'$lidarshop' images '$shared/e57/tiny_pc_and_images.e57' >'$work/tiny.json'"

@@ -19,6 +19,7 @@
 #include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -222,6 +223,15 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("--correspondences", pairs_path, "pixel <-> point or cell pairs: resection first");
   app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
+  bool from_e57_images = false;
+  std::string photo_index_mask_path;
+  app.add_flag("--from-e57-images", from_e57_images,
+               "colour from every images2D entry of the E57 scan that holds a camera (pinhole, spherical, "
+               "cylindrical) and belongs to the scan: per point the best photo that sees it, exposure "
+               "equalised to photo 0's (recolor/station_recolor.h)");
+  app.add_option("--photo-index-mask", photo_index_mask_path,
+                 "--from-e57-images: 16-bit PNG of the scan grid, 1 + the index of the photo that coloured "
+                 "each cell, 0 where none did");
   AddScanIndexOption(app, &scan_index);
   AddJsonOption(app, &json_path);
   binder.Bind(&options,
@@ -232,8 +242,65 @@ int RunRecolor(int argc, char** argv) {
       [&] {
         binder.Validate(options);
         binder.Validate(resection);
-        CheckOutputFile("--json", json_path, {},
-                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path});
+        CheckOutputFile(
+            "--json", json_path, {},
+            {scan_path, photo_path, camera_path, pairs_path, output, mask_path, photo_index_mask_path});
+        if (from_e57_images) {
+          if (!photo_path.empty() || !image_key.empty() || !camera_path.empty() || !pairs_path.empty() ||
+              !mask_path.empty())
+            throw OptionsError(
+                "--from-e57-images takes the photos and cameras from the file: no --photo, --image, "
+                "--camera, "
+                "--correspondences nor --recolored-mask");
+          if (FileExtension(scan_path) != "e57")
+            throw OptionsError("--from-e57-images needs an E57 scan file");
+          CheckNotInput(output, {scan_path});
+          if (!photo_index_mask_path.empty()) {
+            CheckNotInput(photo_index_mask_path, {scan_path});
+            CheckOutputPath(photo_index_mask_path, {scan_path, output});
+          }
+          const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
+          const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
+          std::vector<CameraPhoto> photos;
+          nlohmann::ordered_json used = nlohmann::ordered_json::array(),
+                                 skipped = nlohmann::ordered_json::array();
+          for (size_t i = 0; i < file.images.size(); ++i) {
+            const E57Image& image = file.images[i];
+            Camera camera;
+            std::string why;
+            if (image.associated_scan >= 0 && image.associated_scan != scan_index) {
+              why = fmt::format("belongs to scan {}", image.associated_scan);
+            } else if (image.image.empty()) {
+              why = image.decode_error;
+            } else if (CameraModelOfE57Image(image, &camera, &why)) {
+              used.push_back({{"index", i}, {"name", image.name}, {"model", CameraModelName(camera.model)}});
+              photos.push_back({image.image, camera});
+              continue;
+            }
+            skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
+          }
+          if (photos.empty())
+            ThrowInputError(scan_path, "images2D", "",
+                            fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "
+                                        "`lidarshop images {}` lists them)",
+                                        scan_index, file.images.size(), scan_path));
+          PhotosRecolorOptions photo_options;
+          photo_options.visibility = options;
+          const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
+          WriteScanFile(output, {result.scan});
+          if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
+          nlohmann::ordered_json counts;
+          counts["returns"] = result.returns;
+          counts["coloured"] = result.coloured;
+          counts["constraints"] = result.constraints;
+          for (size_t i = 0; i < used.size(); ++i)
+            used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
+          counts["photos"] = used;
+          counts["skipped"] = skipped;
+          WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+          Summarize(fmt::format("{} -> {}", result.Summary(), output));
+          return 0;
+        }
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");
         CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
