@@ -12,6 +12,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/recolor/align.h"
@@ -19,6 +20,7 @@
 #include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
@@ -124,6 +126,27 @@ nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
                             {"pixel_width_m", image.pixel_width_m},
                             {"pixel_height_m", image.pixel_height_m},
                             {"principal_point_px", {image.principal_x_px, image.principal_y_px}}};
+    } else if (image.projection == "spherical") {
+      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
+                            {"pixel_height_rad", image.pixel_height_rad}};
+    } else if (image.projection == "cylindrical") {
+      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
+                            {"pixel_height_m", image.pixel_height_m},
+                            {"radius_m", image.radius_m},
+                            {"principal_y_px", image.principal_y_px}};
+    }
+    if (!image.description.empty()) json["description"] = image.description;
+    if (image.associated_scan >= 0) json["scan"] = image.associated_scan;
+    json["has_mask"] = !image.mask_encoded.empty();
+    // The camera model (io/e57_image_camera.h): null for a visual reference or an entry missing fields.
+    Camera model;
+    std::string model_why;
+    const std::string model_name = E57ImageModel(image);
+    json["model"] = model_name.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(model_name);
+    if (CameraModelOfE57Image(image, &model, &model_why)) {
+      json["camera"] = nlohmann::ordered_json::parse(CameraModelToJson(model));
+    } else if (!model_name.empty()) {
+      json["camera_error"] = model_why;
     }
     PinholeCamera camera;
     std::string why;
@@ -204,6 +227,15 @@ int RunRecolor(int argc, char** argv) {
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
   app.add_option("--uncertain-mask", uncertain_path,
                  "PNG of the scan grid: 255 = kept its colour near an occluding edge (uncertain)");
+  bool from_e57_images = false;
+  std::string photo_index_mask_path;
+  app.add_flag("--from-e57-images", from_e57_images,
+               "colour from every images2D entry of the E57 scan that holds a camera (pinhole, spherical, "
+               "cylindrical) and belongs to the scan: per point the best photo that sees it, exposure "
+               "equalised to photo 0's (recolor/station_recolor.h)");
+  app.add_option("--photo-index-mask", photo_index_mask_path,
+                 "--from-e57-images: 16-bit PNG of the scan grid, 1 + the index of the photo that coloured "
+                 "each cell, 0 where none did");
   AddScanIndexOption(app, &scan_index);
   AddJsonOption(app, &json_path);
   binder.Bind(&options,
@@ -215,7 +247,64 @@ int RunRecolor(int argc, char** argv) {
         binder.Validate(options);
         binder.Validate(resection);
         CheckOutputFile("--json", json_path, {},
-                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path, uncertain_path});
+                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path, uncertain_path,
+                         photo_index_mask_path});
+        if (from_e57_images) {
+          if (!photo_path.empty() || !image_key.empty() || !camera_path.empty() || !pairs_path.empty() ||
+              !mask_path.empty() || !uncertain_path.empty())
+            throw OptionsError(
+                "--from-e57-images takes the photos and cameras from the file: no --photo, --image, "
+                "--camera, "
+                "--correspondences, --recolored-mask nor --uncertain-mask");
+          if (FileExtension(scan_path) != "e57")
+            throw OptionsError("--from-e57-images needs an E57 scan file");
+          CheckNotInput(output, {scan_path});
+          if (!photo_index_mask_path.empty()) {
+            CheckNotInput(photo_index_mask_path, {scan_path});
+            CheckOutputPath(photo_index_mask_path, {scan_path, output});
+          }
+          const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
+          const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
+          std::vector<CameraPhoto> photos;
+          nlohmann::ordered_json used = nlohmann::ordered_json::array(),
+                                 skipped = nlohmann::ordered_json::array();
+          for (size_t i = 0; i < file.images.size(); ++i) {
+            const E57Image& image = file.images[i];
+            Camera camera;
+            std::string why;
+            if (image.associated_scan >= 0 && image.associated_scan != scan_index) {
+              why = fmt::format("belongs to scan {}", image.associated_scan);
+            } else if (image.image.empty()) {
+              why = image.decode_error;
+            } else if (CameraModelOfE57Image(image, &camera, &why)) {
+              used.push_back({{"index", i}, {"name", image.name}, {"model", CameraModelName(camera.model)}});
+              photos.push_back({image.image, camera});
+              continue;
+            }
+            skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
+          }
+          if (photos.empty())
+            ThrowInputError(scan_path, "images2D", "",
+                            fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "
+                                        "`lidarshop images {}` lists them)",
+                                        scan_index, file.images.size(), scan_path));
+          PhotosRecolorOptions photo_options;
+          photo_options.visibility = options;
+          const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
+          WriteScanFile(output, {result.scan});
+          if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
+          nlohmann::ordered_json counts;
+          counts["returns"] = result.returns;
+          counts["coloured"] = result.coloured;
+          counts["constraints"] = result.constraints;
+          for (size_t i = 0; i < used.size(); ++i)
+            used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
+          counts["photos"] = used;
+          counts["skipped"] = skipped;
+          WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+          Summarize(fmt::format("{} -> {}", result.Summary(), output));
+          return 0;
+        }
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");
         CheckNotInput(output, {scan_path, photo_path, camera_path, pairs_path});
@@ -289,7 +378,8 @@ int RunRecolor(int argc, char** argv) {
 
 int RunImages(int argc, char** argv) {
   CLI::App app{
-      "List the photos (images2D) of an E57 file as JSON; --extract writes each photo's stored bytes as they "
+      "List the photos (images2D) of an E57 file as JSON, each with its representation and camera model; "
+      "--extract writes each photo's stored bytes as they "
       "are (JPEG or PNG, EXIF kept).",
       "images"};
   std::string path, folder, json_path = "-";
@@ -397,13 +487,17 @@ int RunAlign(int argc, char** argv) {
 
 int RunPhoto(int argc, char** argv) {
   CLI::App app{
-      "The synthetic camera: render what a pinhole camera sees in a scene, with the scanner's colours.",
+      "The synthetic camera: render what a camera (pinhole, fisheye, spherical or cylindrical: the camera "
+      "JSON's \"model\") sees in a scene, with the scanner's colours.",
       "photo"};
   std::string scene_path, camera_path, output, json_path;
   PhotoOptions options;
   OptionBinder binder(app);
   app.add_option("scene", scene_path, "scene JSON (docs/scene-format.md)")->required();
-  app.add_option("--camera", camera_path, "camera JSON (geometry/camera.h)")->required();
+  app.add_option("--camera", camera_path,
+                 "camera JSON (geometry/camera_model.h; \"model\": pinhole (default), fisheye, spherical, "
+                 "cylindrical)")
+      ->required();
   app.add_option("-o,--output", output, "photo to write (.png, .jpg)")->required();
   AddJsonOption(app, &json_path);
   binder.Bind(&options, {.flags = {{"samples_per_axis", "--samples"}}});
@@ -415,9 +509,11 @@ int RunPhoto(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {scene_path, camera_path, output});
         const SceneDescription scene = LoadScene(scene_path);
         PrintWarnings(scene.warnings);
-        const Photo photo = RenderPhoto(scene, ReadCameraJson(camera_path), options);
+        const Camera camera = ReadCameraModelJson(camera_path);
+        const Photo photo = RenderPhoto(scene, camera, options);
         WriteImage(output, photo.image);
         nlohmann::ordered_json json;
+        json["model"] = CameraModelName(camera.model);
         json["width_px"] = photo.image.cols;
         json["height_px"] = photo.image.rows;
         json["scene_pixels"] = cv::countNonZero(photo.label != kNoLabel);

@@ -1,9 +1,10 @@
-// lidarshop scan SCENE.json|BUILTIN -o OUT.ptx|.ply [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
-// [--json FILE|-] [--stats]
+// lidarshop scan SCENE.json|BUILTIN -o OUT.ptx|.ply|.e57 [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
+// [--json FILE|-] [--stats] [--photos sphere|cube [--photo-size PX]]
 //
 // Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) or of a built-in scene
 // (parking_lot, ...: the scenes of `demo --scene`) with the synthetic scanner and writes it; --json writes one JSON object with the counts and the seconds of each stage
-// (--stats = --json -). Scanner flags (--rows, --seed, ...) override the scene's "scanner" entries.
+// (--stats = --json -). Scanner flags (--rows, --seed, ...) override the scene's "scanner" entries. --photos
+// (E57 output only) writes the station's own photos into the file's images2D (scanner/station_photos.h).
 #include <filesystem>
 
 #include <fmt/format.h>
@@ -12,6 +13,8 @@
 #include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/render.h"
@@ -20,6 +23,7 @@
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/station_photos.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
@@ -65,6 +69,16 @@ int RunScan(int argc, char** argv) {
   binder.Bind(&scanner_overrides, {.group = "Scanner (default: the scene's \"scanner\")", .overrides = true});
   binder.Bind(&mesh_options,
               {.keys = {"max_range_jump_ratio"}, .flags = {{"max_range_jump_ratio", "--mesh-jump"}}});
+  std::string photos_kind;
+  int photo_size_px = 512;
+  app.add_option("--photos", photos_kind,
+                 "E57 output: also write the station's photos (images2D) from a camera 0.15 m above the "
+                 "scanner, photo 0 at exposure 1, the others with a gain within ±30 % drawn from the seed: "
+                 "sphere = one spherical panorama, cube = six 90° pinhole faces")
+      ->check(CLI::IsMember({"sphere", "cube"}));
+  app.add_option("--photo-size", photo_size_px,
+                 "--photos: the panorama's height (its width is twice) or a cube face's side, pixels")
+      ->capture_default_str();
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
@@ -78,6 +92,15 @@ int RunScan(int argc, char** argv) {
         if (!mesh_path.empty()) CheckOutputPath(mesh_path, {scene_path, output_path, labels_path});
         CheckOutputFile("--json", json_path, {}, {scene_path, output_path, labels_path, mesh_path});
         binder.Validate(mesh_options);
+        if (!photos_kind.empty()) {
+          const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
+          if (format == nullptr || !format->images)
+            throw OptionsError(fmt::format(
+                "--photos needs an output that holds photos ({}): {} cannot hold them",
+                FormatNamesWhere([](const ScanFormatInfo& f) { return f.images && f.write; }), output_path));
+        }
+        if (photos_kind.empty() && app.count("--photo-size"))
+          throw OptionsError("--photo-size is for --photos");
         const ThreadLimit thread_limit(threads);
         Timer total;
         Timer stage;
@@ -100,8 +123,24 @@ int RunScan(int argc, char** argv) {
         }
         const double scanning_seconds = stage.Seconds();
 
+        std::vector<StationPhoto> photos;
+        double photo_seconds = 0;
+        if (!photos_kind.empty()) {
+          stage.Restart();
+          StationPhotoOptions photo_options;
+          photo_options.kind = photos_kind == "cube" ? StationPhotoKind::kCube : StationPhotoKind::kSphere;
+          photo_options.size_px = photo_size_px;
+          photo_options.seed = scene.scanner.seed;
+          photos = RenderStationPhotos(scene, scene.scanner, photo_options);
+          photo_seconds = stage.Seconds();
+        }
+
         stage.Restart();
-        WriteScanFile(output_path, {scan});
+        if (photos.empty()) {
+          WriteScanFile(output_path, {scan});
+        } else {
+          WriteE57(output_path, {scan}, StationPhotosToE57(photos), E57WriteOptions{});
+        }
         const double writing_scan_seconds = stage.Seconds();
         double writing_labels_seconds = 0, meshing_seconds = 0, writing_mesh_seconds = 0;
         int64_t mesh_triangles = 0;
@@ -140,6 +179,17 @@ int RunScan(int argc, char** argv) {
           json["rays"] = scan_stats.rays;
           json["returns"] = scan_stats.returns;
           json["mesh_triangles"] = mesh_triangles;
+          if (!photos.empty()) {
+            nlohmann::ordered_json list = nlohmann::ordered_json::array();
+            for (const StationPhoto& photo : photos) {
+              list.push_back({{"name", photo.name},
+                              {"model", CameraModelName(photo.camera.model)},
+                              {"width_px", photo.image.cols},
+                              {"height_px", photo.image.rows},
+                              {"gain", photo.gain}});
+            }
+            json["photos"] = list;
+          }
           json["threads"] = threads;
           json["seconds"] = {
               {"loading", loading_seconds},
@@ -148,6 +198,7 @@ int RunScan(int argc, char** argv) {
               {"shading", scan_stats.shade_seconds},
               {"scanning", scanning_seconds},
               {"meshing", meshing_seconds},
+              {"photos", photo_seconds},
               {"writing", writing_scan_seconds + writing_labels_seconds + writing_mesh_seconds},
               {"writing_scan", writing_scan_seconds},
               {"writing_labels", writing_labels_seconds},
@@ -157,8 +208,9 @@ int RunScan(int argc, char** argv) {
           if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
           WriteJsonOutput(json_path, CommandJson(ToJson(scene.scanner), json));
         }
-        Summarize(fmt::format("{} x {} scan, {} returns of {} rays -> {}", scan.rows, scan.cols,
-                              scan_stats.returns, scan_stats.rays, output_path));
+        Summarize(fmt::format(
+            "{} x {} scan, {} returns of {} rays{} -> {}", scan.rows, scan.cols, scan_stats.returns,
+            scan_stats.rays, photos.empty() ? "" : fmt::format(", {} photo(s)", photos.size()), output_path));
         return 0;
       },
       &binder);

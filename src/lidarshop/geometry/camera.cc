@@ -142,6 +142,9 @@ PinholeCamera ParseCameraJson(const std::string& json_text, const std::string& w
     ThrowInputError(what, "", "", fmt::format("not valid JSON: {}", error.what()));
   }
   if (!json.is_object()) ThrowInputError(what, "", "", "expected a JSON object");
+  // A camera of another model (geometry/camera_model.h) read as a pinhole one would project wrongly.
+  if (const auto model = json.find("model"); model != json.end() && *model != "pinhole")
+    ThrowInputError(what, "", "model", fmt::format("{}: only pinhole cameras are taken here", model->dump()));
   PinholeCamera camera;
   const auto integer = [&](const char* key) {
     const double value = NumberField(json, key, what, true);

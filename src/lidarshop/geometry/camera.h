@@ -17,6 +17,8 @@
 //    "world_from_camera": [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]],
 //    "units": {"intrinsics": "pixels", "world_from_camera": "metres",
 //              "camera_frame": "x right, y down, z forward"}}
+// A "model" key other than "pinhole" is refused: fisheye, spherical and cylindrical cameras are read by
+// geometry/camera_model.h.
 #pragma once
 
 #include <string>

@@ -13,20 +13,33 @@
 
 namespace lidarshop {
 
-// A photo stored in an E57 file's images2D section (pinhole or spherical representation).
+// A photo stored in an E57 file's images2D section, in any of E57's four representations. The camera model
+// each describes (geometry/camera_model.h) comes from io/e57_image_camera.h.
 struct E57Image {
   std::string name;
   std::string
       projection;  // "pinhole", "spherical", "cylindrical" or "visual" (visualReferenceRepresentation)
   cv::Mat image;   // decoded, RGB
   Eigen::Matrix4d world_from_camera = Eigen::Matrix4d::Identity();
-  // Pinhole intrinsics (metres, as E57 stores them); 0 when absent.
+  // Pinhole intrinsics (metres, as E57 stores them); 0 when absent. The reader fills pixel_width_m and
+  // pixel_height_m with pixelWidth / pixelHeight as stored whatever the representation (radians for a
+  // spherical entry's both and a cylindrical entry's width); pixel_height_m is the cylindrical
+  // representation's pixelHeight (metres on the cylinder) and principal_y_px its principalPointY.
   double focal_length_m = 0, pixel_width_m = 0, pixel_height_m = 0, principal_x_px = 0, principal_y_px = 0;
+  // Spherical: pixelWidth and pixelHeight (radians); cylindrical: pixelWidth (radians) and radius (metres).
+  // 0 when absent. The writer takes the angles from here (from pixel_width_m / pixel_height_m when 0).
+  double pixel_width_rad = 0, pixel_height_rad = 0, radius_m = 0;
   int width_px = 0, height_px = 0;  // imageWidth / imageHeight as the XML states them
   std::string decode_error;  // why `image` is empty when its blob does not decode (e.g. a zero-filled blob)
   // The blob exactly as stored, so that E57 -> E57 keeps the photo bit-exact (recolouring reads it back).
   std::vector<uint8_t> encoded;
-  std::string encoding;  // "jpeg" or "png" (the blob's element: jpegImage / pngImage)
+  std::string encoding;               // "jpeg" or "png" (the blob's element: jpegImage / pngImage)
+  std::vector<uint8_t> mask_encoded;  // the representation's imageMask (PNG) as stored; empty when absent
+  std::string guid;                   // as stored; the writer makes one when empty
+  std::string description;            // as stored; "" when absent
+  // The data3D entry (index into E57File::scans) named by associatedData3DGuid; -1 when none or unknown.
+  // The writer writes that scan's guid.
+  int associated_scan = -1;
 };
 
 struct E57File {
@@ -95,9 +108,11 @@ void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& b
                        const E57WriteOptions& options = {});
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
                                         const E57WriteOptions& options = {});
-// Scans and photos (images2D): each image is written with its name, pose, representation and, for pinhole
-// ones, intrinsics; its blob is `encoded` as stored (encoding "jpeg" or "png"), or `image` encoded as PNG
-// when it has no stored bytes. Images with neither are skipped.
+// Scans and photos (images2D): each image is written with its guid, name, description, pose, the scan it
+// belongs to (associatedData3DGuid), its representation with that representation's fields (pinhole:
+// focalLength, pixelWidth, pixelHeight, principalPointX/Y; spherical: pixelWidth, pixelHeight; cylindrical:
+// pixelWidth, pixelHeight, radius, principalPointY) and imageMask; its blob is `encoded` as stored (encoding
+// "jpeg" or "png"), or `image` encoded as PNG when it has no stored bytes. Images with neither are skipped.
 std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector<E57Image>& images,
                                const E57WriteOptions& options);
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,

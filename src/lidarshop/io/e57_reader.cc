@@ -879,7 +879,8 @@ struct ImageCache {
   int64_t bytes = 0;
 };
 
-void ReadImage(const Context& ctx, pugi::xml_node child, ImageCache* cache, std::vector<E57Image>* images) {
+void ReadImage(const Context& ctx, pugi::xml_node child, const std::vector<std::string>& scan_guids,
+               ImageCache* cache, std::vector<E57Image>* images) {
   static const std::pair<const char*, const char*> kRepresentations[] = {
       {"pinholeRepresentation", "pinhole"},
       {"sphericalRepresentation", "spherical"},
@@ -895,11 +896,33 @@ void ReadImage(const Context& ctx, pugi::xml_node child, ImageCache* cache, std:
     image.name = StringValue(child.child("name"));
     image.projection = projection;
     image.world_from_camera = PoseOf(ctx, child.child("pose"));
+    image.guid = StringValue(child.child("guid"));
+    image.description = StringValue(child.child("description"));
+    if (const pugi::xml_node associated = child.child("associatedData3DGuid")) {
+      const auto found = std::find(scan_guids.begin(), scan_guids.end(), StringValue(associated));
+      if (found != scan_guids.end()) image.associated_scan = static_cast<int>(found - scan_guids.begin());
+    }
+    // pixelWidth / pixelHeight are metres or radians by representation (E2807): pixel_width_m and
+    // pixel_height_m keep them as stored whatever the representation (as they always did), the typed fields
+    // say which is which.
     image.focal_length_m = NumberValue(ctx, rep.child("focalLength"), 0.0);
     image.pixel_width_m = NumberValue(ctx, rep.child("pixelWidth"), 0.0);
     image.pixel_height_m = NumberValue(ctx, rep.child("pixelHeight"), 0.0);
     image.principal_x_px = NumberValue(ctx, rep.child("principalPointX"), 0.0);
     image.principal_y_px = NumberValue(ctx, rep.child("principalPointY"), 0.0);
+    if (image.projection == "spherical") {
+      image.pixel_width_rad = image.pixel_width_m;
+      image.pixel_height_rad = image.pixel_height_m;
+    } else if (image.projection == "cylindrical") {
+      image.pixel_width_rad = image.pixel_width_m;
+      image.radius_m = NumberValue(ctx, rep.child("radius"), 0.0);
+    }
+    if (const pugi::xml_node mask = rep.child("imageMask")) {
+      const auto [mask_bytes, mask_size] = BlobBytes(ctx, mask);
+      cache->bytes += static_cast<int64_t>(mask_size);
+      CheckMemoryBudget(cache->bytes, fmt::format("{}: {}: the images2D blobs", ctx.path, ElementPath(mask)));
+      image.mask_encoded.assign(mask_bytes, mask_bytes + mask_size);
+    }
     image.width_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageWidth"), 0, 0, 1 << 30));
     image.height_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageHeight"), 0, 0, 1 << 30));
     const auto [bytes, size] = BlobBytes(ctx, blob);
@@ -995,10 +1018,14 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
     file.scans.push_back(ReadScan(ctx, child, index++, extension_prefix, &second, &file.warnings));
     file.second_returns.push_back(std::move(second));
   }
+  std::vector<std::string> scan_guids;
+  for (pugi::xml_node child : root.child("data3D").children()) {
+    if (child.type() == pugi::node_element) scan_guids.push_back(StringValue(child.child("guid")));
+  }
   ImageCache image_cache;
   for (pugi::xml_node child : root.child("images2D").children()) {
     if (child.type() != pugi::node_element) continue;
-    ReadImage(ctx, child, &image_cache, &file.images);
+    ReadImage(ctx, child, scan_guids, &image_cache, &file.images);
   }
   return file;
 }

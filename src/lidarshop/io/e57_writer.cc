@@ -358,8 +358,29 @@ void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform) {
   AddFloat(t, "z", transform(2, 3));
 }
 
-// Appends one images2D entry: a blob section with the photo's bytes and its XML element.
-void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical, pugi::xml_node images2d) {
+// Appends a blob section holding `bytes` and returns its logical offset.
+uint64_t AppendBlob(const std::vector<uint8_t>& bytes, std::vector<uint8_t>* logical) {
+  while (logical->size() % 8) logical->push_back(0);
+  const uint64_t start = logical->size();
+  logical->resize(start + 16, 0);  // sectionId 0 (blob), reserved, sectionLogicalLength
+  const uint64_t section_length = 16 + bytes.size();
+  std::memcpy(logical->data() + start + 8, &section_length, 8);
+  logical->insert(logical->end(), bytes.begin(), bytes.end());
+  return start;
+}
+
+void AddBlob(pugi::xml_node parent, const char* name, const std::vector<uint8_t>& bytes,
+             std::vector<uint8_t>* logical) {
+  const uint64_t start = AppendBlob(bytes, logical);
+  pugi::xml_node blob = AddTyped(parent, name, "Blob");
+  blob.append_attribute("fileOffset") = std::to_string(PhysicalFromLogical(start)).c_str();
+  blob.append_attribute("length") = std::to_string(bytes.size()).c_str();
+}
+
+// Appends one images2D entry: blob sections with the photo's bytes (and its mask's) and its XML element.
+// `scan_guids` are the guids of the data3D entries written (associatedData3DGuid).
+void AppendImage(const E57Image& image, int index, const std::vector<std::string>& scan_guids,
+                 std::vector<uint8_t>* logical, pugi::xml_node images2d) {
   std::vector<uint8_t> bytes = image.encoded;
   std::string encoding = image.encoding;
   if (bytes.empty()) {
@@ -369,13 +390,6 @@ void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical
     CvImEncode(".png", bgr, &bytes);
     encoding = "png";
   }
-  while (logical->size() % 8) logical->push_back(0);
-  const uint64_t start = logical->size();
-  logical->resize(start + 16, 0);  // sectionId 0 (blob), reserved, sectionLogicalLength
-  const uint64_t section_length = 16 + bytes.size();
-  std::memcpy(logical->data() + start + 8, &section_length, 8);
-  logical->insert(logical->end(), bytes.begin(), bytes.end());
-
   static const std::pair<const char*, const char*> kRepresentations[] = {
       {"pinhole", "pinholeRepresentation"},
       {"spherical", "sphericalRepresentation"},
@@ -387,13 +401,17 @@ void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical
   }
   pugi::xml_node child = AddTyped(images2d, "vectorChild", "Structure");
   AddString(child, "guid",
-            fmt::format("{{lidarshop-image-{:04d}-{:08x}}}", index, Crc32c(bytes.data(), bytes.size())));
+            !image.guid.empty() ? image.guid
+                                : fmt::format("{{lidarshop-image-{:04d}-{:08x}}}", index,
+                                              Crc32c(bytes.data(), bytes.size())));
   AddString(child, "name", image.name.empty() ? fmt::format("image{:03d}", index) : image.name);
+  if (!image.description.empty()) AddString(child, "description", image.description);
+  if (image.associated_scan >= 0 && image.associated_scan < static_cast<int>(scan_guids.size()))
+    AddString(child, "associatedData3DGuid", scan_guids[image.associated_scan]);
   AddPose(child, image.world_from_camera);
   pugi::xml_node rep = AddTyped(child, element, "Structure");
-  pugi::xml_node blob = AddTyped(rep, encoding == "jpeg" ? "jpegImage" : "pngImage", "Blob");
-  blob.append_attribute("fileOffset") = std::to_string(PhysicalFromLogical(start)).c_str();
-  blob.append_attribute("length") = std::to_string(bytes.size()).c_str();
+  AddBlob(rep, encoding == "jpeg" ? "jpegImage" : "pngImage", bytes, logical);
+  if (!image.mask_encoded.empty()) AddBlob(rep, "imageMask", image.mask_encoded, logical);
   AddInteger(rep, "imageWidth", image.width_px ? image.width_px : image.image.cols);
   AddInteger(rep, "imageHeight", image.height_px ? image.height_px : image.image.rows);
   if (image.projection == "pinhole") {
@@ -401,6 +419,14 @@ void AppendImage(const E57Image& image, int index, std::vector<uint8_t>* logical
     AddFloat(rep, "pixelWidth", image.pixel_width_m);
     AddFloat(rep, "pixelHeight", image.pixel_height_m);
     AddFloat(rep, "principalPointX", image.principal_x_px);
+    AddFloat(rep, "principalPointY", image.principal_y_px);
+  } else if (image.projection == "spherical") {
+    AddFloat(rep, "pixelWidth", image.pixel_width_rad > 0 ? image.pixel_width_rad : image.pixel_width_m);
+    AddFloat(rep, "pixelHeight", image.pixel_height_rad > 0 ? image.pixel_height_rad : image.pixel_height_m);
+  } else if (image.projection == "cylindrical") {
+    AddFloat(rep, "pixelWidth", image.pixel_width_rad > 0 ? image.pixel_width_rad : image.pixel_width_m);
+    AddFloat(rep, "pixelHeight", image.pixel_height_m);
+    AddFloat(rep, "radius", image.radius_m);
     AddFloat(rep, "principalPointY", image.principal_y_px);
   }
 }
@@ -441,8 +467,11 @@ std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<co
   if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
   pugi::xml_node images = AddTyped(root, "images2D", "Vector");
   images.append_attribute("allowHeterogeneousChildren") = "1";
+  std::vector<std::string> scan_guids;
+  for (pugi::xml_node scan : root.child("data3D").children("vectorChild"))
+    scan_guids.push_back(scan.child("guid").text().get());
   for (size_t i = 0; i < image_list.size(); ++i)
-    AppendImage(image_list[i], static_cast<int>(i), &logical, images);
+    AppendImage(image_list[i], static_cast<int>(i), scan_guids, &logical, images);
   // The file guid: a checksum of the binary sections, so that the same scans give the same bytes.
   pugi::xml_node guid = AddTyped(root, "guid", "String");
   guid.append_child(pugi::node_cdata)

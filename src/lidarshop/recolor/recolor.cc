@@ -9,6 +9,7 @@
 
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/recolor/silhouette_skirt.h"
+#include "lidarshop/recolor/visibility.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -51,12 +52,11 @@ namespace {
 // Distance from the camera centre to the first surface of `scene` through each z-buffer pixel (+inf: none);
 // `back_facing` (CV_8U) marks pixels whose first surface turns its back to the camera (the scan mesh faces
 // the scanner: the camera then sees the side of that surface the scanner did not see).
-cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, double scale,
-                       cv::Mat* back_facing) {
-  const int rows = std::max(1, static_cast<int>(std::lround(camera.height_px * scale)));
-  const int cols = std::max(1, static_cast<int>(std::lround(camera.width_px * scale)));
-  const double sy = static_cast<double>(camera.height_px) / rows,
-               sx = static_cast<double>(camera.width_px) / cols;
+cv::Mat DistanceBuffer(const RaycastScene& scene, const Camera& camera, double scale, cv::Mat* back_facing) {
+  const int rows = std::max(1, static_cast<int>(std::lround(camera.height_px() * scale)));
+  const int cols = std::max(1, static_cast<int>(std::lround(camera.width_px() * scale)));
+  const double sy = static_cast<double>(camera.height_px()) / rows,
+               sx = static_cast<double>(camera.width_px()) / cols;
   cv::Mat distance(rows, cols, CV_32F);
   back_facing->create(rows, cols, CV_8U);
   const Eigen::Matrix3f rotation = camera.world_from_camera.topLeftCorner<3, 3>().cast<float>();
@@ -67,7 +67,14 @@ cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, d
     cv::Mat directions(strip_rows, cols, CV_32FC3);
     ParallelFor(strip_rows, [&](int64_t r) {
       for (int c = 0; c < cols; ++c) {
-        const Eigen::Vector3d ray = UnprojectPixel(camera, {(c + 0.5) * sx, (row0 + r + 0.5) * sy});
+        const Eigen::Vector2d pixel((c + 0.5) * sx, (row0 + r + 0.5) * sy);
+        // Pinhole rays keep z = 1 (as always); other models' are unit, zero where a pixel has no ray.
+        Eigen::Vector3d ray = Eigen::Vector3d::Zero();
+        if (camera.model == CameraModel::kPinhole) {
+          ray = UnprojectPixel(camera.pinhole, pixel);
+        } else if (!UnprojectPixel(camera, pixel, &ray)) {
+          ray.setZero();
+        }
         directions.at<cv::Vec3f>(static_cast<int>(r), c) = cv::Vec3f(ray.x(), ray.y(), ray.z());
       }
     });
@@ -76,7 +83,8 @@ cv::Mat DistanceBuffer(const RaycastScene& scene, const PinholeCamera& camera, d
     for (int r = 0; r < strip_rows; ++r) {
       for (int c = 0; c < cols; ++c) {
         const cv::Vec3f d = directions.at<cv::Vec3f>(r, c);
-        distance.at<float>(row0 + r, c) = hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
+        distance.at<float>(row0 + r, c) = d == cv::Vec3f() ? std::numeric_limits<float>::infinity()
+                                                           : hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
         const cv::Vec3f n = hits.normal.at<cv::Vec3f>(r, c);
         const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
         // Skirts (geometry 1) are no surface of the scan: only the scan mesh's own back faces count.
@@ -161,6 +169,126 @@ cv::Vec3b SampleAgreeing(const cv::Mat& photo, const cv::Mat& distance_buffer, d
 
 }  // namespace
 
+namespace recolor_internal {
+
+void BuildOcclusionScene(const Scan& scan, const RecolorOptions& options, RaycastScene* scene) {
+  ScanMeshOptions mesh_options;
+  mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
+  mesh_options.world_frame = true;
+  scene->AddMesh(ScanToMesh(scan, mesh_options), 0);
+  if (options.silhouette_skirts) {
+    SilhouetteSkirtOptions skirt_options;
+    skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
+    skirt_options.depth_m = options.skirt_depth_m;
+    const TriangleMesh skirts = SilhouetteSkirts(scan, skirt_options);
+    if (!skirts.empty()) scene->AddMesh(skirts, 1);
+  }
+  scene->Commit();
+}
+
+Visibility VisibleCells(const Scan& scan, const RaycastScene& scene, const Camera& camera,
+                        const RecolorOptions& options) {
+  Visibility visibility;
+  const Eigen::Vector3d center = camera.center_in_world();
+  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
+
+  // Candidates: valid cells in front of the camera that project inside the photo.
+  struct Candidate {
+    int64_t cell;
+    Eigen::Vector2d pixel;
+    Eigen::Vector3d point_in_world;
+  };
+  std::vector<Candidate> candidates;
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (!scan.valid.at<uint8_t>(r, c)) continue;
+      ++visibility.returns;
+      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+      const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+      Eigen::Vector2d pixel;
+      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
+        ++visibility.outside_image;
+        continue;
+      }
+      candidates.push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+    }
+  }
+
+  std::vector<uint8_t> hidden(candidates.size(), 0);  // 1 = hidden, 2 = uncertain (the edge guard)
+  // Per candidate: how far the photo pixels sampled for it may lie from its depth (infinite: any pixel).
+  std::vector<double> agree(candidates.size(), std::numeric_limits<double>::infinity());
+  const auto tolerance = [&](double distance) {
+    return options.depth_tolerance_m + options.relative_depth_tolerance * distance;
+  };
+  if (options.visibility == VisibilityMethod::kSegment) {
+    std::vector<Ray> rays(candidates.size());
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const Eigen::Vector3d segment = candidates[i].point_in_world - center;
+      const double distance = segment.norm();
+      rays[i].origin = center.cast<float>();
+      rays[i].direction = segment.cast<float>();
+      rays[i].t_far = static_cast<float>(std::max(0.0, 1.0 - tolerance(distance) / distance));
+    }
+    scene.Occluded(rays, hidden);
+  } else {
+    cv::Mat back_facing;
+    const cv::Mat distance_buffer = DistanceBuffer(scene, camera, options.zbuffer_scale, &back_facing);
+    cv::Mat nearest = distance_buffer;
+    const int m = options.silhouette_margin_px;
+    if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
+    const double sx = static_cast<double>(distance_buffer.cols) / camera.width_px();
+    const double sy = static_cast<double>(distance_buffer.rows) / camera.height_px();
+    visibility.distance_buffer = distance_buffer;
+    visibility.buffer_per_photo_px = Eigen::Vector2d(sx, sy);
+    // The edge guard's window: the camera's uncertainty and one scan step, in z-buffer pixels.
+    int guard = 0;
+    cv::Mat guard_nearest;
+    if (options.edge_guard) {
+      visibility.edge_margin_px =
+          options.camera_uncertainty_px + AngularStepRad(scan) / camera.PixelAngleRad();
+      guard = std::max(m, static_cast<int>(std::ceil(visibility.edge_margin_px * std::max(sx, sy))));
+      cv::erode(distance_buffer, guard_nearest, cv::Mat::ones(2 * guard + 1, 2 * guard + 1, CV_8U));
+    }
+    ParallelFor(
+        static_cast<int64_t>(candidates.size()),
+        [&](int64_t i) {
+          const Candidate& candidate = candidates[i];
+          const int zr = std::min(static_cast<int>(candidate.pixel.y() * sy), distance_buffer.rows - 1);
+          const int zc = std::min(static_cast<int>(candidate.pixel.x() * sx), distance_buffer.cols - 1);
+          const double distance = (candidate.point_in_world - center).norm();
+          const float slope = Slope(distance_buffer, zr, zc);
+          const double allowed = tolerance(distance) + m * slope;
+          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
+          // A surface clearly nearer within the guard's window: the point lies by an occluding edge, where
+          // the camera's error can show the occluder's colour; it keeps its own (2 = uncertain).
+          if (!hidden[i] && guard > 0 &&
+              guard_nearest.at<float>(zr, zc) <
+                  distance - tolerance(distance) - options.edge_min_jump_m - guard * slope) {
+            hidden[i] = 2;
+          }
+          agree[i] = tolerance(distance) + slope;
+        },
+        1024);
+  }
+
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    if (hidden[i] == 2) {
+      visibility.uncertain.push_back(candidates[i].cell);
+      continue;
+    }
+    if (hidden[i]) {
+      ++visibility.hidden;
+      continue;
+    }
+    visibility.seen.push_back(
+        {candidates[i].cell, candidates[i].pixel, (candidates[i].point_in_world - center).norm(), agree[i]});
+  }
+  return visibility;
+}
+
+}  // namespace recolor_internal
+
 RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,
                           const RecolorOptions& options) {
   options.Check();
@@ -189,114 +317,28 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
   result.recolored = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
   result.uncertain_mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
 
-  ScanMeshOptions mesh_options;
-  mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
-  mesh_options.world_frame = true;
+  const Camera model = CameraFromPinhole(camera);
   RaycastScene raycast;
-  raycast.AddMesh(ScanToMesh(scan, mesh_options), 0);
-  if (options.silhouette_skirts) {
-    SilhouetteSkirtOptions skirt_options;
-    skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
-    skirt_options.depth_m = options.skirt_depth_m;
-    const TriangleMesh skirts = SilhouetteSkirts(scan, skirt_options);
-    if (!skirts.empty()) raycast.AddMesh(skirts, 1);
+  recolor_internal::BuildOcclusionScene(scan, options, &raycast);
+  const recolor_internal::Visibility visibility =
+      recolor_internal::VisibleCells(scan, raycast, model, options);
+  result.returns = visibility.returns;
+  result.outside_image = visibility.outside_image;
+  result.hidden = visibility.hidden;
+  result.edge_margin_px = visibility.edge_margin_px;
+  for (const int64_t cell : visibility.uncertain) {
+    ++result.uncertain;
+    result.uncertain_mask.at<uint8_t>(static_cast<int>(cell / scan.cols),
+                                      static_cast<int>(cell % scan.cols)) = 255;
   }
-  raycast.Commit();
-
-  const Eigen::Vector3d center = camera.center_in_world();
-  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
-  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
-
-  // Candidates: valid cells in front of the camera that project inside the photo.
-  struct Candidate {
-    int64_t cell;
-    Eigen::Vector2d pixel;
-    Eigen::Vector3d point_in_world;
-  };
-  std::vector<Candidate> candidates;
-  for (int r = 0; r < scan.rows; ++r) {
-    for (int c = 0; c < scan.cols; ++c) {
-      if (!scan.valid.at<uint8_t>(r, c)) continue;
-      ++result.returns;
-      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-      const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
-      Eigen::Vector2d pixel;
-      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
-        ++result.outside_image;
-        continue;
-      }
-      candidates.push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
-    }
-  }
-
-  std::vector<uint8_t> hidden(candidates.size(), 0);  // 1 = hidden, 2 = uncertain (edge guard)
-  std::vector<cv::Vec3b> colour(candidates.size());
-  bool colour_done = false;
-  const auto tolerance = [&](double distance) {
-    return options.depth_tolerance_m + options.relative_depth_tolerance * distance;
-  };
-  if (options.visibility == VisibilityMethod::kSegment) {
-    std::vector<Ray> rays(candidates.size());
-    for (size_t i = 0; i < candidates.size(); ++i) {
-      const Eigen::Vector3d segment = candidates[i].point_in_world - center;
-      const double distance = segment.norm();
-      rays[i].origin = center.cast<float>();
-      rays[i].direction = segment.cast<float>();
-      rays[i].t_far = static_cast<float>(std::max(0.0, 1.0 - tolerance(distance) / distance));
-    }
-    raycast.Occluded(rays, hidden);
-  } else {
-    cv::Mat back_facing;
-    const cv::Mat distance_buffer = DistanceBuffer(raycast, camera, options.zbuffer_scale, &back_facing);
-    cv::Mat nearest = distance_buffer;
-    const int m = options.silhouette_margin_px;
-    if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
-    const double sx = static_cast<double>(distance_buffer.cols) / camera.width_px;
-    const double sy = static_cast<double>(distance_buffer.rows) / camera.height_px;
-    // The edge guard's window: the camera's uncertainty and one scan step, in z-buffer pixels.
-    int guard = 0;
-    cv::Mat guard_nearest;
-    if (options.edge_guard) {
-      result.edge_margin_px = options.camera_uncertainty_px + AngularStepRad(scan) * camera.fx_px;
-      guard = std::max(m, static_cast<int>(std::ceil(result.edge_margin_px * std::max(sx, sy))));
-      cv::erode(distance_buffer, guard_nearest, cv::Mat::ones(2 * guard + 1, 2 * guard + 1, CV_8U));
-    }
-    colour_done = true;
-    ParallelFor(
-        static_cast<int64_t>(candidates.size()),
-        [&](int64_t i) {
-          const Candidate& candidate = candidates[i];
-          const int zr = std::min(static_cast<int>(candidate.pixel.y() * sy), distance_buffer.rows - 1);
-          const int zc = std::min(static_cast<int>(candidate.pixel.x() * sx), distance_buffer.cols - 1);
-          const double distance = (candidate.point_in_world - center).norm();
-          const double allowed = tolerance(distance) + m * Slope(distance_buffer, zr, zc);
-          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
-          const float slope = Slope(distance_buffer, zr, zc);
-          if (!hidden[i] && guard > 0 &&
-              guard_nearest.at<float>(zr, zc) <
-                  distance - tolerance(distance) - options.edge_min_jump_m - guard * slope) {
-            hidden[i] = 2;
-          }
-          if (!hidden[i])
-            colour[i] = SampleAgreeing(photo, distance_buffer, sx, sy, candidate.pixel, distance,
-                                       tolerance(distance) + slope);
-        },
-        1024);
-  }
-
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    const int r = static_cast<int>(candidates[i].cell / scan.cols),
-              c = static_cast<int>(candidates[i].cell % scan.cols);
-    if (hidden[i] == 2) {
-      ++result.uncertain;
-      result.uncertain_mask.at<uint8_t>(r, c) = 255;
-      continue;
-    }
-    if (hidden[i]) {
-      ++result.hidden;
-      continue;
-    }
-    out.color.at<cv::Vec3b>(r, c) = colour_done ? colour[i] : SamplePhoto(photo, candidates[i].pixel);
+  for (const recolor_internal::SeenCell& seen : visibility.seen) {
+    const int r = static_cast<int>(seen.cell / scan.cols), c = static_cast<int>(seen.cell % scan.cols);
+    // No blend across a depth edge: only the photo pixels at the point's own depth (z-buffer visibility).
+    out.color.at<cv::Vec3b>(r, c) =
+        visibility.distance_buffer.empty()
+            ? SamplePhoto(photo, seen.pixel)
+            : SampleAgreeing(photo, visibility.distance_buffer, visibility.buffer_per_photo_px.x(),
+                             visibility.buffer_per_photo_px.y(), seen.pixel, seen.distance_m, seen.agree_m);
     result.recolored.at<uint8_t>(r, c) = 255;
     ++result.recolored_count;
   }

@@ -19,14 +19,21 @@ void PhotoOptions::Check() const { Validate(*this); }
 
 namespace {
 
-// Ray directions (camera frame, z = 1) of a sub-pixel grid: samples x samples rays per pixel.
-cv::Mat SampleDirections(const PinholeCamera& camera, int samples) {
-  cv::Mat directions(camera.height_px * samples, camera.width_px * samples, CV_32FC3);
+// Ray directions (camera frame) of a sub-pixel grid: samples x samples rays per pixel. Pinhole rays have
+// z = 1 (as photos were always rendered); other models' rays are unit vectors, and a pixel without a ray
+// (beyond a fisheye's reach, past a panorama's pole) gets the zero vector.
+cv::Mat SampleDirections(const Camera& camera, int samples) {
+  cv::Mat directions(camera.height_px() * samples, camera.width_px() * samples, CV_32FC3);
   ParallelFor(directions.rows, [&](int64_t row) {
     cv::Vec3f* out = directions.ptr<cv::Vec3f>(static_cast<int>(row));
     for (int col = 0; col < directions.cols; ++col) {
       const Eigen::Vector2d pixel((col + 0.5) / samples, (row + 0.5) / samples);
-      const Eigen::Vector3d ray = UnprojectPixel(camera, pixel);
+      Eigen::Vector3d ray = Eigen::Vector3d::Zero();
+      if (camera.model == CameraModel::kPinhole) {
+        ray = UnprojectPixel(camera.pinhole, pixel);
+      } else if (!UnprojectPixel(camera, pixel, &ray)) {
+        ray.setZero();
+      }
       out[col] =
           cv::Vec3f(static_cast<float>(ray.x()), static_cast<float>(ray.y()), static_cast<float>(ray.z()));
     }
@@ -37,6 +44,11 @@ cv::Mat SampleDirections(const PinholeCamera& camera, int samples) {
 }  // namespace
 
 Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera, const PhotoOptions& options) {
+  camera.Check("camera");
+  return RenderPhoto(scene, CameraFromPinhole(camera), options);
+}
+
+Photo RenderPhoto(const SceneDescription& scene, const Camera& camera, const PhotoOptions& options) {
   options.Check();
   camera.Check("camera");
   std::vector<scanner_internal::ObjectData> objects(scene.objects.size());
@@ -53,14 +65,14 @@ Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera, co
   const Eigen::Matrix3f rotation = camera.world_from_camera.topLeftCorner<3, 3>().cast<float>();
   const Eigen::Vector3f origin = camera.center_in_world().cast<float>();
   // Angular size of a sample: the texture footprint at distance t is t · pixel_angle / cos(incidence).
-  const float sample_angle = static_cast<float>(1.0 / (std::max(camera.fx_px, camera.fy_px) * samples));
+  const float sample_angle = static_cast<float>(camera.PixelAngleRad() / samples);
 
   cv::Mat fine(directions.size(), CV_32FC3);
   ParallelFor(directions.rows, [&](int64_t row_index) {
     const int row = static_cast<int>(row_index);
     for (int col = 0; col < directions.cols; ++col) {
-      const int32_t id = hits.geometry_id.at<int32_t>(row, col);
       const cv::Vec3f d = directions.at<cv::Vec3f>(row, col);
+      const int32_t id = d == cv::Vec3f() ? kInvalidId : hits.geometry_id.at<int32_t>(row, col);
       const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
       const float t = hits.t_hit.at<float>(row, col);
       Rgb8 rgb = options.background;
@@ -91,19 +103,19 @@ Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera, co
   Photo photo;
   cv::Mat averaged = fine;
   if (samples > 1)
-    cv::resize(fine, averaged, cv::Size(camera.width_px, camera.height_px), 0, 0, cv::INTER_AREA);
+    cv::resize(fine, averaged, cv::Size(camera.width_px(), camera.height_px()), 0, 0, cv::INTER_AREA);
   averaged.convertTo(photo.image, CV_8UC3);  // rounds and saturates
   // Label and depth of the pixel centres: the middle sample for odd counts, else re-cast the centres.
   const RayHitImages centre_hits =
       samples == 1 ? hits
                    : raycast.CastImage(camera.world_from_camera, SampleDirections(camera, 1), 0.0f, 1e30f);
   const cv::Mat centre_directions = samples == 1 ? directions : SampleDirections(camera, 1);
-  photo.label.create(camera.height_px, camera.width_px, CV_32S);
-  photo.depth_m.create(camera.height_px, camera.width_px, CV_32F);
-  for (int row = 0; row < camera.height_px; ++row) {
-    for (int col = 0; col < camera.width_px; ++col) {
-      const int32_t id = centre_hits.geometry_id.at<int32_t>(row, col);
+  photo.label.create(camera.height_px(), camera.width_px(), CV_32S);
+  photo.depth_m.create(camera.height_px(), camera.width_px(), CV_32F);
+  for (int row = 0; row < camera.height_px(); ++row) {
+    for (int col = 0; col < camera.width_px(); ++col) {
       const cv::Vec3f d = centre_directions.at<cv::Vec3f>(row, col);
+      const int32_t id = d == cv::Vec3f() ? kInvalidId : centre_hits.geometry_id.at<int32_t>(row, col);
       const float distance = centre_hits.t_hit.at<float>(row, col) * std::sqrt(d.dot(d));
       const bool seen = id != kInvalidId && distance <= options.max_range_m;
       photo.label.at<int32_t>(row, col) = seen ? scene.objects[id].label : kNoLabel;

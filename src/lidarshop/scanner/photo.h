@@ -1,15 +1,18 @@
-// The synthetic camera: what a pinhole camera (geometry/camera.h) sees in a scene, with the scanner's own
+// The synthetic camera: what a camera (a pinhole, geometry/camera.h, or a fisheye, a spherical or a cylindrical
+// panorama, geometry/camera_model.h) sees in a scene, with the scanner's own
 // colours (material, triangle and vertex colours, image textures, procedural textures band-limited to the
 // pixel's footprint: scanner/shade.h, scanner/texture.h), unlit like the scanner's colour channel. Ground
 // truth for resectioning and recolouring (recolor/): tests know the true camera of the photo.
 //
 // Each pixel (x, y) casts the ray of its centre (x + 0.5, y + 0.5) through the camera's distortion (or
 // `samples_per_axis`² rays on a regular sub-grid, averaged) with Embree (raycast/), from the camera centre.
+// Pixels without a ray (beyond a fisheye's reach, past a panorama's pole) are background.
 #pragma once
 
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera.h"
+#include "lidarshop/geometry/camera_model.h"
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/options_fwd.h"
@@ -26,7 +29,7 @@ template <>
 const StructInfo& InfoOf<PhotoOptions>();
 
 struct Photo {
-  cv::Mat image;    // CV_8UC3 RGB, camera.height_px x camera.width_px
+  cv::Mat image;    // CV_8UC3 RGB, camera height x width
   cv::Mat label;    // CV_32S: the label of the object seen by the pixel centre, kNoLabel for background
   cv::Mat depth_m;  // CV_32F: distance from the camera centre to the surface seen by the pixel centre, +inf
                     // for background
@@ -35,5 +38,7 @@ struct Photo {
 // Renders the scene seen by `camera` (camera.Check() must pass; throws InputError otherwise).
 Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera,
                   const PhotoOptions& options = {});
+// Any camera model (camera.Check() must pass).
+Photo RenderPhoto(const SceneDescription& scene, const Camera& camera, const PhotoOptions& options = {});
 
 }  // namespace lidarshop

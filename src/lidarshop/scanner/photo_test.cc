@@ -89,6 +89,64 @@ TEST(Photo, TexturesMatchTheScanAtTheSamePoints) {
   EXPECT_GT(equal, 0.9 * compared);
 }
 
+// Each model sees the red box (label 1) where it projects the box centre, in the box's colour, and the sky
+// above the horizon; pixels without a ray are background.
+TEST(Photo, EveryCameraModelSeesTheBoxWhereItProjects) {
+  test_scenes::GroundAndBoxOptions scene_options;
+  scene_options.ground_texture = false;
+  const SceneDescription scene = test_scenes::MakeGroundAndBoxScene(scene_options);
+  const Rgb8 box_rgb = scene.objects[1].material.color;
+  const cv::Vec3b box_colour(box_rgb[0], box_rgb[1], box_rgb[2]);
+  // Scanner-like frames (z up, y forward) 1.2 m right of the scanner, turned 20° left.
+  const Eigen::Matrix4d scanner_like = ComposeTransform({1.2, 0, 1.5}, {0, 0, 20});
+  std::vector<Camera> cameras;
+  cameras.push_back(SphericalPanorama(180, scanner_like));
+  Camera cylinder;
+  cylinder.model = CameraModel::kCylindrical;
+  cylinder.pinhole.width_px = 360, cylinder.pinhole.height_px = 200;
+  cylinder.pixel_width_rad = 2 * M_PI / 360;
+  cylinder.radius_m = 1;
+  cylinder.pixel_height_m = 0.01;
+  cylinder.principal_y_px = 90;
+  cylinder.world_from_camera = scanner_like;
+  cameras.push_back(cylinder);
+  Camera fisheye;  // > 180° across, looking along +y (camera x right, y down, z forward)
+  fisheye.model = CameraModel::kFisheye;
+  fisheye.pinhole.width_px = fisheye.pinhole.height_px = 240;
+  fisheye.pinhole.fx_px = fisheye.pinhole.fy_px = 45;
+  fisheye.pinhole.cx_px = fisheye.pinhole.cy_px = 120;
+  fisheye.fisheye_k[0] = 0.01;
+  fisheye.world_from_camera = ComposeTransform({1.2, 0, 1.5}, {-90, 0, 20});
+  cameras.push_back(fisheye);
+  for (const Camera& camera : cameras) {
+    SCOPED_TRACE(CameraModelName(camera.model));
+    const Photo photo = RenderPhoto(scene, camera);
+    ASSERT_EQ(photo.image.size(), cv::Size(camera.width_px(), camera.height_px()));
+    Eigen::Vector2d box_pixel, sky_pixel;
+    ASSERT_TRUE(ProjectWorldPoint(camera, {0, 8, 0.5}, &box_pixel));
+    ASSERT_TRUE(InsideImage(camera, box_pixel));
+    const int row = static_cast<int>(box_pixel.y()), col = static_cast<int>(box_pixel.x());
+    EXPECT_EQ(photo.label.at<int32_t>(row, col), 1);
+    EXPECT_EQ(photo.image.at<cv::Vec3b>(row, col), box_colour);
+    EXPECT_NEAR(photo.depth_m.at<float>(row, col),
+                (Eigen::Vector3d(0, 8, 0.5) - Eigen::Vector3d(1.2, 0, 1.5)).norm(), 0.6);
+    ASSERT_TRUE(ProjectWorldPoint(camera, {-30, 40, 30}, &sky_pixel));
+    ASSERT_TRUE(InsideImage(camera, sky_pixel));
+    EXPECT_EQ(photo.label.at<int32_t>(static_cast<int>(sky_pixel.y()), static_cast<int>(sky_pixel.x())),
+              kNoLabel);
+    // The ground fills the bottom row of the panoramas (the camera stands on it).
+    if (camera.model != CameraModel::kFisheye) {
+      EXPECT_EQ(photo.label.at<int32_t>(camera.height_px() - 1, camera.width_px() / 2), 0);
+    }
+  }
+  // The fisheye's corners lie beyond 180°: no ray, background.
+  const Photo fish = RenderPhoto(scene, cameras.back());
+  Eigen::Vector3d ray;
+  EXPECT_FALSE(UnprojectPixel(cameras.back(), {0.5, 0.5}, &ray));
+  EXPECT_EQ(fish.label.at<int32_t>(0, 0), kNoLabel);
+  EXPECT_EQ(fish.image.at<cv::Vec3b>(0, 0), cv::Vec3b(0, 0, 0));
+}
+
 TEST(Photo, RefusesABrokenCamera) {
   PinholeCamera camera = CameraBesideScanner();
   camera.fx_px = 0;

@@ -1,0 +1,168 @@
+#include "lidarshop/recolor/station_recolor.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <Eigen/Dense>
+
+#include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/visibility.h"
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+
+void PhotosRecolorOptions::Check() const {
+  visibility.Check();
+  if (!(border_px >= 0 && border_px < 1e6))
+    throw OptionsError(fmt::format("PhotosRecolorOptions.border_px must be in [0, 1e6), got {}", border_px));
+}
+
+std::string PhotosRecolorResult::Summary() const {
+  return fmt::format("{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs", coloured,
+                     returns, gains.size(), constraints);
+}
+
+namespace {
+
+constexpr double kDarkest = 8, kBrightest = 247;  // values usable for the gain fit (not dark, not saturated)
+
+struct Sample {
+  int photo;
+  cv::Vec3b rgb;
+};
+
+// Least squares for log gains of one channel: rows (i, j, log v_i − log v_j) mean l_i − l_j = that, l_0 = 0.
+std::vector<double> FitLogGains(int photos, const std::vector<std::pair<std::pair<int, int>, double>>& rows) {
+  std::vector<double> result(photos, 0.0);
+  if (photos < 2 || rows.empty()) return result;
+  // Normal equations over l_1..l_{n−1}, with a small ridge that keeps unreached photos at 0 (gain 1).
+  const int n = photos - 1;
+  Eigen::MatrixXd a = Eigen::MatrixXd::Identity(n, n) * 1e-6;
+  Eigen::VectorXd b = Eigen::VectorXd::Zero(n);
+  for (const auto& [pair, value] : rows) {
+    const int i = pair.first - 1, j = pair.second - 1;  // −1 = photo 0 (fixed)
+    if (i >= 0) a(i, i) += 1, b(i) += value;
+    if (j >= 0) a(j, j) += 1, b(j) -= value;
+    if (i >= 0 && j >= 0) a(i, j) -= 1, a(j, i) -= 1;
+  }
+  const Eigen::VectorXd l = a.ldlt().solve(b);
+  for (int k = 0; k < n; ++k) result[k + 1] = l(k);
+  return result;
+}
+
+}  // namespace
+
+PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,
+                                      const PhotosRecolorOptions& options) {
+  options.Check();
+  CheckScan(scan);
+  if (photos.size() > 65534) throw OptionsError("at most 65534 photos");
+  for (size_t i = 0; i < photos.size(); ++i) {
+    const std::string what = fmt::format("photo {}", i);
+    photos[i].camera.Check(what);
+    const cv::Mat& image = photos[i].image;
+    if (image.type() != CV_8UC3 || image.cols != photos[i].camera.width_px() ||
+        image.rows != photos[i].camera.height_px())
+      ThrowInputError(
+          what, "", "image",
+          fmt::format("expected an 8-bit RGB image of {} x {} pixels, got {} x {}",
+                      photos[i].camera.width_px(), photos[i].camera.height_px(), image.cols, image.rows));
+  }
+  RaycastScene scene;
+  recolor_internal::BuildOcclusionScene(scan, options.visibility, &scene);
+  const int64_t cells = static_cast<int64_t>(scan.rows) * scan.cols;
+  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
+  const bool has_normals = !scan.normal.empty();
+
+  // Per cell: every photo's sample, and the best photo with its score.
+  std::vector<std::vector<Sample>> samples(cells);
+  std::vector<int> best(cells, -1);
+  std::vector<double> best_score(cells, -1);
+  PhotosRecolorResult result;
+  for (size_t i = 0; i < photos.size(); ++i) {
+    const Camera& camera = photos[i].camera;
+    const recolor_internal::Visibility visibility =
+        recolor_internal::VisibleCells(scan, scene, camera, options.visibility);
+    result.returns = visibility.returns;
+    for (const recolor_internal::SeenCell& seen : visibility.seen) {
+      const int r = static_cast<int>(seen.cell / scan.cols), c = static_cast<int>(seen.cell % scan.cols);
+      double cos_angle = 1;
+      if (has_normals) {
+        const cv::Vec3f n = scan.normal.at<cv::Vec3f>(r, c);
+        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3d normal = rotation * Eigen::Vector3d(n[0], n[1], n[2]);
+        const Eigen::Vector3d view =
+            (camera.center_in_world() - (rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation))
+                .normalized();
+        if (normal.norm() > 0.5) cos_angle = std::max(0.05, std::abs(normal.normalized().dot(view)));
+      }
+      const double border = std::min({seen.pixel.x(), seen.pixel.y(), camera.width_px() - seen.pixel.x(),
+                                      camera.height_px() - seen.pixel.y()});
+      const double border_factor =
+          options.border_px > 0 ? std::min(1.0, (border + 0.5) / options.border_px) : 1;
+      const double score = cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
+      samples[seen.cell].push_back({static_cast<int>(i), SamplePhoto(photos[i].image, seen.pixel)});
+      if (score > best_score[seen.cell]) best_score[seen.cell] = score, best[seen.cell] = static_cast<int>(i);
+    }
+  }
+
+  // The gains, channel by channel, from the overlaps and from neighbours coloured by different photos.
+  std::vector<std::pair<std::pair<int, int>, double>> rows[3];
+  const auto add = [&](const Sample& a, const Sample& b) {
+    if (a.photo == b.photo) return;
+    for (int ch = 0; ch < 3; ++ch) {
+      const double u = a.rgb[ch], v = b.rgb[ch];
+      if (u < kDarkest || v < kDarkest || u > kBrightest || v > kBrightest) continue;
+      rows[ch].push_back({{a.photo, b.photo}, std::log(u) - std::log(v)});
+    }
+    ++result.constraints;
+  };
+  const auto chosen = [&](int64_t cell) -> const Sample* {
+    for (const Sample& s : samples[cell]) {
+      if (s.photo == best[cell]) return &s;
+    }
+    return nullptr;
+  };
+  for (int64_t cell = 0; cell < cells; ++cell) {
+    const std::vector<Sample>& here = samples[cell];
+    for (size_t a = 0; a < here.size(); ++a) {
+      for (size_t b = a + 1; b < here.size(); ++b) add(here[a], here[b]);
+    }
+    const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
+    const Sample* mine = chosen(cell);
+    if (mine == nullptr) continue;
+    for (const int64_t other :
+         {c + 1 < scan.cols ? cell + 1 : -1, r + 1 < scan.rows ? cell + scan.cols : -1}) {
+      if (other < 0 || best[other] < 0 || best[other] == best[cell]) continue;
+      add(*mine, *chosen(other));
+    }
+  }
+  result.gains.assign(photos.size(), cv::Vec3d(1, 1, 1));
+  if (options.equalize_exposure) {
+    for (int ch = 0; ch < 3; ++ch) {
+      const std::vector<double> log_gains = FitLogGains(static_cast<int>(photos.size()), rows[ch]);
+      for (size_t i = 0; i < photos.size(); ++i) result.gains[i][ch] = std::exp(log_gains[i]);
+    }
+  }
+
+  result.scan = Clone(scan);
+  Scan& out = result.scan;
+  if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  result.photo_index = cv::Mat::zeros(scan.rows, scan.cols, CV_16U);
+  for (int64_t cell = 0; cell < cells; ++cell) {
+    const Sample* sample = chosen(cell);
+    if (sample == nullptr) continue;
+    const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
+    const cv::Vec3d& gain = result.gains[sample->photo];
+    out.color.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uint8_t>(sample->rgb[0] / gain[0]),
+                                              cv::saturate_cast<uint8_t>(sample->rgb[1] / gain[1]),
+                                              cv::saturate_cast<uint8_t>(sample->rgb[2] / gain[2]));
+    result.photo_index.at<uint16_t>(r, c) = static_cast<uint16_t>(sample->photo + 1);
+    ++result.coloured;
+  }
+  return result;
+}
+
+}  // namespace lidarshop

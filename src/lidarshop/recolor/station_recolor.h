@@ -1,0 +1,57 @@
+// Colouring a scan from every photo of its station (issue 32 item 3, the core): the E57 file's own images
+// (io/e57_image_camera.h) or any photos with cameras of any model (geometry/camera_model.h).
+//
+// Per valid cell, the photos that see it (the occlusion test of recolor/recolor.h, per photo), and of those
+// the best one by score = cos(viewing angle) · min(1, distance to the image border / border_px) / distance,
+// the viewing angle taken against the cell's normal when the scan has normals (else 1): a photo that sees
+// the surface squarely, near, and away from its border wins.
+//
+// Exposure: each photo i > 0 gets a gain per channel, g_i,c, relative to photo 0 (g_0 = 1), fitted in the
+// log domain by least squares on the overlaps: for every cell seen by two photos i, j, and for every pair of
+// 4-neighbour cells coloured by different photos (photos that do not overlap, like a cube map's faces, still
+// meet there), log(v_i / g_i) = log(v_j / g_j) for each channel with both values in [8, 247] (not dark, not
+// saturated). Colours come out at photo 0's exposure: v / g. Photos no constraint reaches keep gain 1.
+//
+// Not done here (issue 32 item 3's rest): blending the seams in the gradient domain, white balance beyond the
+// per-channel gain, the CLI (`recolor --from-e57-images`).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/geometry/camera_model.h"
+#include "lidarshop/recolor/recolor.h"
+#include "lidarshop/scan/scan.h"
+
+namespace lidarshop {
+
+struct CameraPhoto {
+  cv::Mat image;  // CV_8UC3 RGB of the camera's size
+  Camera camera;  // world frame
+};
+
+struct PhotosRecolorOptions {
+  RecolorOptions visibility;      // the occlusion test (recolor/recolor.h)
+  double border_px = 16;          // pixels: closer to the border than this lowers a photo's score
+  bool equalize_exposure = true;  // fit and divide by the gains (false: the naive colours)
+  void Check() const;             // throws OptionsError
+};
+
+struct PhotosRecolorResult {
+  Scan scan;                     // a clone of the input with `color` set where a photo saw the cell
+  cv::Mat photo_index;           // CV_16U rows x cols: 1 + the photo that coloured the cell, 0 for none
+  std::vector<cv::Vec3d> gains;  // per photo, RGB, relative to photo 0
+  int64_t returns = 0;           // valid cells
+  int64_t coloured = 0;          // valid cells some photo saw
+  int64_t constraints = 0;       // overlap pairs used to fit the gains
+  std::string Summary() const;   // one line
+};
+
+// Throws InputError when a photo's image does not match its camera (naming the photo's index).
+PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,
+                                      const PhotosRecolorOptions& options = {});
+
+}  // namespace lidarshop
