@@ -15,6 +15,7 @@
 // range RMSE and floating share per seed, and their distribution (mean, 5th and 95th percentile, worst seed);
 // --pictures writes the worst seeds' pictures.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -23,6 +24,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/fill/fill.h"
@@ -86,12 +88,41 @@ cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
   return out;
 }
 
+// Narrows `view` onto the points of `scan` in `hole` (they fill about 40 % of the picture's width) and draws
+// each point as large as the scan's spacing there looks from the camera.
+void ZoomOnHole(const Scan& scan, const cv::Mat& hole, PointViewOptions* view) {
+  Eigen::AlignedBox3d box;
+  double range_sum = 0;
+  int count = 0;
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (!hole.at<uint8_t>(y, x) || !scan.valid.at<uint8_t>(y, x)) continue;
+      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(y, x);
+      box.extend(Eigen::Vector3d(p[0], p[1], p[2]));
+      range_sum += scan.range.at<float>(y, x);
+      ++count;
+    }
+  }
+  if (count == 0) return;
+  const double distance = (view->eye_in_world - view->target_in_world).norm();
+  const double extent = std::max(0.2, box.sizes().maxCoeff());
+  view->field_of_view_deg = std::clamp(2 * std::atan(extent / 0.4 / 2 / distance) * 180 / M_PI, 2.0, 60.0);
+  // The spacing of neighbouring returns at the hole, seen from the camera at about the same distance.
+  const double step_rad = scan.grid.azimuth_rad.size() > 1
+                              ? std::abs(scan.grid.azimuth_rad[1] - scan.grid.azimuth_rad[0])
+                              : 0.002;
+  const double spacing_m = (range_sum / count) * step_rad;
+  const double pixels = spacing_m / distance / (view->field_of_view_deg * M_PI / 180) * view->width_px;
+  view->point_size_px = std::clamp(static_cast<int>(std::ceil(pixels)) + 1, 2, 16);
+}
+
 // Range before / after / truth on one colour scale (lo..hi metres), a second viewpoint of the truth, laplace,
-// depth-patch and gradient, and the |range error| in the hole of every method: <stem>_range.png, _view.png,
-// _error.png in `dir`.
+// depth-patch and gradient (35° about the hole; `zoom` = true narrows its field of view onto the removed object
+// and sizes the points to the scan's spacing, for small far objects), and the |range error| in the hole of
+// every method: <stem>_range.png, _view.png, _error.png in `dir`.
 void WritePictures(const std::string& dir, const std::string& stem, const Scan& with_object,
                    const Scan& truth, const cv::Mat& hole, const std::map<std::string, FillResult>& results,
-                   double lo, double hi) {
+                   double lo, double hi, bool zoom = false) {
   std::vector<cv::Mat> row1 = {Labelled(RangePicture(with_object, lo, hi), "scan"),
                                Labelled(RangePicture(truth, lo, hi), "truth (no object)")};
   std::vector<cv::Mat> row2;
@@ -99,6 +130,7 @@ void WritePictures(const std::string& dir, const std::string& stem, const Scan& 
     PointViewOptions v = SideView(truth, hole, 35.0);
     v.width_px = 480;
     v.height_px = 360;
+    if (zoom) ZoomOnHole(with_object, hole, &v);
     return v;
   }();
   row2.push_back(Labelled(RenderPointView(truth, view), "truth, second viewpoint"));
@@ -217,8 +249,24 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
       cv::Mat hole;
       double distance = 0;
       run(seed, &results, &with_object, &truth, &hole, &distance);
-      WritePictures(pictures_dir, fmt::format("random_{}", seed), with_object, truth, hole, results, 0.0,
-                    2.0 * distance + 10.0);
+      // The colour scale: from the object's nearest to the truth's farthest range in the hole (2 % and 98 %
+      // quantiles), widened by a tenth each way, so that the hole's surfaces are told apart.
+      std::vector<float> ranges;
+      for (const Scan* scan : {&with_object, &truth}) {
+        for (int y = 0; y < hole.rows; ++y)
+          for (int x = 0; x < hole.cols; ++x)
+            if (hole.at<uint8_t>(y, x) && scan->valid.at<uint8_t>(y, x))
+              ranges.push_back(scan->range.at<float>(y, x));
+      }
+      std::sort(ranges.begin(), ranges.end());
+      double lo = ranges.empty() ? 0.0 : ranges[ranges.size() / 50];
+      double hi = ranges.empty() ? 2.0 * distance + 10.0 : ranges[ranges.size() * 49 / 50];
+      hi = std::max(hi, lo + 0.5);
+      const double widen = 0.1 * (hi - lo);
+      lo = std::max(0.0, lo - widen);
+      hi += widen;
+      WritePictures(pictures_dir, fmt::format("random_{}", seed), with_object, truth, hole, results, lo, hi,
+                    true);
     }
     emit(fmt::format("\nPictures (worst floating share, then worst RMSE ratio): seeds {}.\n",
                      fmt::join(worst, ", ")));
