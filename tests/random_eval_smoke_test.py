@@ -47,7 +47,7 @@ def check_rows(rows, columns, ranges):
     assert [int(r[0]) for r in rows] == seeds, f"rows are not one per seed {seeds}: {rows}"
     for row in rows:
         assert len(row) == columns, row
-        assert re.fullmatch(r"[a-z_]+", row[1]), f"target kind {row[1]!r}"
+        assert re.fullmatch(r"[a-z_]+( \*)?", row[1]), f"target kind {row[1]!r}"
         for index, (lo, hi) in ranges.items():
             value = float(row[index])
             assert lo <= value <= hi, f"seed {row[0]}: column {index} = {value} outside [{lo}, {hi}]"

@@ -23,9 +23,12 @@
 // label is SceneDescription::target_label. Objects that would leave fewer than `min_visible_cells` returns in
 // the window (hidden or outside it) are left out: the generator scans the scene once to check.
 //
-// Deterministic: the same seed and options give the same JSON on any CPU and compiler (a std::mt19937_64,
-// whose sequence the standard fixes, mapped to numbers by hand, not by std::*_distribution, whose mapping is
-// the library's own; numbers in the JSON rounded to 0.1 mm and 0.001°).
+// Deterministic: the same seed and options give the same JSON on any CPU and compiler: a std::mt19937_64,
+// whose sequence the standard fixes, mapped to numbers by hand (not by std::*_distribution, whose mapping is
+// the library's own), every draw in its own statement (argument evaluation order is unspecified), and the
+// numbers of the JSON rounded to 0.1 mm and 0.001°, which hides the last-bit differences sin, cos, exp and
+// atan2 may have between C libraries (all but exact ties). The visibility scan is the scanner's, bit-identical
+// on every CPU.
 #pragma once
 
 #include <cstdint>

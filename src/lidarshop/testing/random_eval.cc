@@ -101,4 +101,37 @@ double TargetDistance(const SceneDescription& scene) {
   return (box.center().head<2>() - scene.scanner.position.head<2>()).norm();
 }
 
+bool TargetColouredLikeBackground(const SceneDescription& scene) {
+  TargetPart(scene);
+  auto background = [](const std::string& name) {
+    for (const char* prefix : {"ground_", "wall_", "facade_", "kerb_", "steps_", "ceiling_"}) {
+      if (name.rfind(prefix, 0) == 0) return true;
+    }
+    return false;
+  };
+  for (const SceneObject& part : scene.objects) {
+    if (part.label != scene.target_label) continue;
+    for (const SceneObject& other : scene.objects) {
+      if (background(other.name) && other.material.color == part.material.color) return true;
+    }
+  }
+  return false;
+}
+
+std::string TargetColumn(const SceneDescription& scene) {
+  return TargetKind(scene) + (TargetColouredLikeBackground(scene) ? " *" : "");
+}
+
+std::string MeanWhere(const std::vector<double>& values, const std::vector<bool>& mask, bool which) {
+  LIDARSHOP_CHECK(values.size() == mask.size());
+  double sum = 0;
+  int count = 0;
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (mask[i] != which) continue;
+    sum += values[i];
+    ++count;
+  }
+  return count == 0 ? "0 scenes" : fmt::format("{} scenes, mean {:.3f}", count, sum / count);
+}
+
 }  // namespace lidarshop::test_scenes

@@ -32,5 +32,12 @@ std::vector<size_t> WorstIndices(const std::vector<double>& values, size_t count
 // bounding box of the objects labelled scene.target_label, metres. Throws std::logic_error without a target.
 std::string TargetKind(const SceneDescription& scene);
 double TargetDistance(const SceneDescription& scene);
+// True when a part of the target has the colour of the ground, a wall, a façade, a kerb, steps or a ceiling
+// (objects named "ground_...", "wall_...", ...: the random scenes' background), as a quarter of them do.
+bool TargetColouredLikeBackground(const SceneDescription& scene);
+// The target column of the evaluations' tables: TargetKind, with " *" when coloured like its background.
+std::string TargetColumn(const SceneDescription& scene);
+// "N scenes, mean M" of `values` over the seeds where `mask` is `which`, for the evaluations' summaries.
+std::string MeanWhere(const std::vector<double>& values, const std::vector<bool>& mask, bool which);
 
 }  // namespace lidarshop::test_scenes

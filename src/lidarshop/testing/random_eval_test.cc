@@ -37,5 +37,24 @@ TEST(Distribute, MeanPercentilesAndWorst) {
   EXPECT_THROW(Distribute({}, {}, true), std::logic_error);
 }
 
+TEST(TargetDescription, KindDistanceAndColourLikeTheBackground) {
+  SceneDescription scene = ParseScene(
+      R"({"target_label": 2, "objects": [
+          {"name": "ground_1", "primitive": "plane", "size": [20, 20], "label": 1, "color": [90, 110, 70]},
+          {"name": "bin_2/body", "primitive": "box", "translate": [3, 4, 0.5], "label": 2, "color": [200, 0, 0]},
+          {"name": "bin_2/lid", "primitive": "box", "translate": [3, 4, 1.5], "label": 2, "color": [1, 2, 3]}]})",
+      "t.json", "");
+  scene.scanner.position = Eigen::Vector3d(0, 0, 1.5);
+  EXPECT_EQ(TargetKind(scene), "bin");
+  EXPECT_NEAR(TargetDistance(scene), 5.0, 1e-6);  // the boxes' centre (3, 4) from the scanner (0, 0)
+  EXPECT_FALSE(TargetColouredLikeBackground(scene));
+  EXPECT_EQ(TargetColumn(scene), "bin");
+  scene.objects[2].material.color = scene.objects[0].material.color;  // the lid like the ground
+  EXPECT_TRUE(TargetColouredLikeBackground(scene));
+  EXPECT_EQ(TargetColumn(scene), "bin *");
+  EXPECT_EQ(MeanWhere({1, 2, 4}, {true, false, true}, true), "2 scenes, mean 2.500");
+  EXPECT_EQ(MeanWhere({1, 2, 4}, {true, true, true}, false), "0 scenes");
+}
+
 }  // namespace
 }  // namespace lidarshop::test_scenes

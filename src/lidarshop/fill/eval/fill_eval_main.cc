@@ -169,12 +169,12 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
   };
   emit(fmt::format(
       "\n### Random scenes: seeds {}..{} ({} x {} cells; hole = the target's cells grown by {} cells; truth "
-      "= the "
-      "scene scanned without the target)\n\n"
+      "= the scene scanned without the target; * = the target coloured like its background)\n\n"
       "| seed | target | distance m | hole cells | gradient RMSE mm | Laplace RMSE mm | ratio | gradient "
       "floating % | Laplace floating % | gradient s |\n|---|---|---|---|---|---|---|---|---|---|\n",
       seeds.front(), seeds.back(), scene_options.columns, scene_options.rows, margin));
   std::vector<double> gradient_rmse, laplace_rmse, ratio, gradient_floating, laplace_floating;
+  std::vector<bool> like_background;
   double seconds = 0;
   FillOptions laplace = base;
   laplace.method = FillMethod::kLaplace;
@@ -190,7 +190,7 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     *distance = test_scenes::TargetDistance(scene);
     results->emplace("gradient", FillScan(*with_object, *hole, base));
     results->emplace("laplace", FillScan(*with_object, *hole, laplace));
-    return test_scenes::TargetKind(scene);
+    return test_scenes::TargetColumn(scene);
   };
   for (uint64_t seed : seeds) {
     std::map<std::string, FillResult> results;
@@ -206,6 +206,7 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     laplace_rmse.push_back(l.range_rmse_mm);
     ratio.push_back(g.range_rmse_mm / std::max(1e-6, l.range_rmse_mm));
     gradient_floating.push_back(100 * g.floating_share);
+    like_background.push_back(kind.ends_with(" *"));
     laplace_floating.push_back(100 * l.floating_share);
     emit(fmt::format("| {} | {} | {:.1f} | {} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n",
                      seed, kind, distance, cv::countNonZero(hole), g.range_rmse_mm, l.range_rmse_mm,
@@ -235,6 +236,10 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
       "{:.2f} % (target < 1 %), 95th percentile {:.2f} % (target < 3 %). Gradient fill total {:.1f} s.\n",
       mean(gradient_rmse) / std::max(1e-9, mean(laplace_rmse)), mean(gradient_floating),
       test_scenes::Distribute(gradient_floating, seeds, false).p95, seconds));
+  emit(fmt::format(
+      "Gradient floating % where the target is coloured like its background (*): {}; the others: {}.\n",
+      test_scenes::MeanWhere(gradient_floating, like_background, true),
+      test_scenes::MeanWhere(gradient_floating, like_background, false)));
   if (!pictures_dir.empty()) {
     // The three worst seeds by floating share and the three by RMSE ratio.
     std::vector<uint64_t> worst;

@@ -71,13 +71,14 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
   };
   emit(fmt::format(
       "\n### Random scenes: seeds {}..{} ({} x {} cells; strokes on the target's upper part and the "
-      "background "
-      "below it)\n\n| seed | target | distance m | target cells | two-step IoU | grabCut IoU | two-step s |\n"
+      "background below it; * = the target coloured like its background)\n\n| seed | target | distance m | "
+      "target cells | two-step IoU | grabCut IoU | two-step s |\n"
       "|---|---|---|---|---|---|---|\n",
       seeds.front(), seeds.back(), scene_options.columns, scene_options.rows));
   EvalStrokeOptions stroke_options;
   stroke_options.upper_and_below = true;
   std::vector<double> two_step, grabcut;
+  std::vector<bool> like_background;
   std::vector<uint64_t> scored;
   std::vector<uint64_t> no_room;
   double seconds = 0;
@@ -91,7 +92,7 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     } catch (const InputError&) {
       no_room.push_back(seed);
       emit(fmt::format("| {} | {} | {:.1f} | {} | no room for strokes | | |\n", seed,
-                       test_scenes::TargetKind(scene), test_scenes::TargetDistance(scene),
+                       test_scenes::TargetColumn(scene), test_scenes::TargetDistance(scene),
                        cv::countNonZero(truth)));
       continue;
     }
@@ -109,8 +110,9 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     two_step.push_back(iou);
     grabcut.push_back(grabcut_iou);
     scored.push_back(seed);
+    like_background.push_back(test_scenes::TargetColouredLikeBackground(scene));
     emit(fmt::format("| {} | {} | {:.1f} | {} | {:.3f} | {:.3f} | {:.2f} |\n", seed,
-                     test_scenes::TargetKind(scene), test_scenes::TargetDistance(scene),
+                     test_scenes::TargetColumn(scene), test_scenes::TargetDistance(scene),
                      cv::countNonZero(truth), iou, grabcut_iou, s));
   }
   if (scored.empty()) {
@@ -133,6 +135,13 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
                   "without room for strokes: {}.\n",
                   seconds, better, scored.size(),
                   no_room.empty() ? "none" : fmt::format("{}", fmt::join(no_room, ", "))));
+  emit(fmt::format(
+      "Targets coloured like their background (*): two-step {}, grabCut {}. The others: two-step {}, grabCut "
+      "{}.\n",
+      test_scenes::MeanWhere(two_step, like_background, true),
+      test_scenes::MeanWhere(grabcut, like_background, true),
+      test_scenes::MeanWhere(two_step, like_background, false),
+      test_scenes::MeanWhere(grabcut, like_background, false)));
   if (!dump_dir.empty()) {
     for (size_t i : test_scenes::WorstIndices(two_step, 3, true)) {
       const SceneDescription scene = RandomScene(scored[i], scene_options);
