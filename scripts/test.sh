@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Builds everything and runs every test (one ctest per test file), then fuzzes every reader briefly.
-#   scripts/test.sh [ctest arguments...]     release build (build/release), ctest, scripts/fuzz.sh 15
+#   scripts/test.sh [ctest arguments...]     release build (build/release), ctest, the editor's tests, fuzzing
 #   scripts/test.sh --sanitize [ctest args]  the whole suite built with AddressSanitizer + UBSan in build/asan
-# LIDARSHOP_FUZZ_SECONDS sets the fuzzing time per reader (default 15; 0 skips fuzzing).
+# Fuzzing runs a fixed number of inputs per reader with a fixed seed (scripts/fuzz.sh: LIDARSHOP_FUZZ_RUNS=ci,
+# LIDARSHOP_FUZZ_SEED=1, at most 120 s a reader), so every machine runs the same inputs.
+# LIDARSHOP_FUZZ_SECONDS=S fuzzes S seconds per reader instead; 0 skips fuzzing.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Paths relative to the checkout in ccache's hash (as scripts/build.sh): a clone in any folder reuses the objects.
@@ -22,10 +24,14 @@ fi
 bash scripts/build.sh
 ctest --test-dir build/release --output-on-failure -j "$(nproc)" "$@"
 bash scripts/web.sh test
-fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-15}
-if [[ $fuzz_seconds -gt 0 ]]; then
+fuzz_seconds=${LIDARSHOP_FUZZ_SECONDS:-}
+if [[ $fuzz_seconds != 0 ]]; then
   # A check that cannot run fails rather than skip (LIDARSHOP_FUZZ_SECONDS=0 skips fuzzing on purpose).
   command -v clang++-14 >/dev/null ||
     { echo "test.sh: clang++-14 not found, the fuzzers cannot run (scripts/setup.sh installs clang)" >&2; exit 1; }
-  LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh "$fuzz_seconds"
+  if [[ -z $fuzz_seconds ]]; then
+    LIDARSHOP_FUZZ_RUNS=${LIDARSHOP_FUZZ_RUNS:-ci} LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh 120
+  else
+    LIDARSHOP_FUZZ_SEED=${LIDARSHOP_FUZZ_SEED:-1} bash scripts/fuzz.sh "$fuzz_seconds"
+  fi
 fi

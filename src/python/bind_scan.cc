@@ -247,7 +247,8 @@ SceneDescription SceneOf(const py::object& scene) {
   const std::string text = py::str(py::module_::import("os").attr("fspath")(scene));
   const std::string builtin = BuiltinSceneJson(text);
   py::gil_scoped_release release;
-  if (!builtin.empty() && !fs::exists(text)) {
+  std::error_code not_a_file;
+  if (!builtin.empty() && !fs::exists(text, not_a_file)) {
     return ParseScene(builtin, fmt::format("built-in scene '{}'", text), "");
   }
   return LoadScene(text);

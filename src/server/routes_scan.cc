@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_header.h"
@@ -291,8 +292,8 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
     std::lock_guard lock(document.mutex);
     if (document.now.behind.valid.empty()) {
       WriteScanFile(file.string(), {document.now.scan});
-    } else if (format == "ptx") {
-      SendError(response, 400, "PTX cannot hold the second layer behind the object; save as e57, ply or pcd");
+    } else if (const ScanFormatInfo& info = *FindScanFormat(format); !info.layer_behind) {
+      SendError(response, 400, LayerBehindRefusal(info));
       return;
     } else {
       WriteScanWithLayer(file.string(), document.now.scan, document.now.behind);
@@ -315,7 +316,9 @@ void AddScanRoutes(State& state) {
   });
   // The scan formats the library reads and writes (the open and save dialogs offer these).
   http.Get("/api/formats", [](const httplib::Request&, httplib::Response& response) {
-    SendJson(response, {{"read", SupportedScanReadExtensions()}, {"write", SupportedScanWriteExtensions()}});
+    SendJson(response, {{"read", SupportedScanReadExtensions()},
+                        {"write", SupportedScanWriteExtensions()},
+                        {"formats", ScanFormatsJson()}});
   });
   http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
     SendJson(response, {{"scenes", state.options.builtin_scenes}});

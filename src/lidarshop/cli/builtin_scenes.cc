@@ -19,7 +19,8 @@ SceneDescription LoadSceneOrBuiltin(const std::string& scene) {
   for (const BuiltinScene& builtin : BuiltinScenes()) {
     if (scene == builtin.name) return ParseScene(builtin.json, fmt::format("built-in scene '{}'", scene), "");
   }
-  if (std::filesystem::exists(scene)) {
+  std::error_code not_a_file;
+  if (std::filesystem::exists(scene, not_a_file)) {
     SceneDescription description = LoadScene(scene);
     PrintWarnings(description.warnings);
     return description;

@@ -18,6 +18,7 @@ namespace lidarshop::cli {
 int RunScan(int argc, char** argv);       // scan_command.cc
 int RunInfo(int argc, char** argv);       // file_commands.cc
 int RunConvert(int argc, char** argv);    // file_commands.cc
+int RunFormats(int argc, char** argv);    // formats_command.cc
 int RunRender(int argc, char** argv);     // file_commands.cc
 int RunDemo(int argc, char** argv);       // demo_command.cc
 int RunVerify(int argc, char** argv);     // verify_commands.cc

@@ -13,6 +13,7 @@
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/picture_mapping.h"
@@ -277,11 +278,14 @@ int RunInfo(int argc, char** argv) {
 
 int RunConvert(int argc, char** argv) {
   CLI::App app{
-      "Convert a scan file between .ptx, .e57, .ply, .pcd, .las, .xyz and .pts, keeping the grid where the "
-      "target can hold it (LAS, XYZ and PTS hold points only, in the world frame). Prints one warning for "
-      "each "
-      "thing the target cannot hold (labels, normals, photos, second returns, ...) and one line of what it "
-      "wrote (not with --quiet).",
+      fmt::format(
+          "Convert a scan file between {}, keeping the grid where the target can hold it ({} hold points "
+          "only, in the world frame). Prints one warning for each thing the target cannot hold (labels, "
+          "normals, photos, second returns, ...) and one line of what it wrote (not with --quiet). "
+          "`lidarshop "
+          "formats` lists what each format holds.",
+          FormatNamesWhere([](const ScanFormatInfo& f) { return f.write; }, "and"),
+          FormatNamesWhere([](const ScanFormatInfo& f) { return f.write && !f.grid; }, "and")),
       "convert"};
   std::string input, output, json_path;
   int scan_index = -1;

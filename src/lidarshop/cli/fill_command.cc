@@ -16,6 +16,7 @@
 #include "lidarshop/fill/fill.h"
 #include "lidarshop/fill/remove.h"
 #include "lidarshop/image/colormap.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/picture_mapping.h"
 #include "lidarshop/io/scan_io.h"
@@ -170,10 +171,9 @@ int RunRemove(int argc, char** argv) {
       [&]() {
         binder.Validate(remove);
         CheckOutputFile("-o", output_path, kScanExtensions, {scan_path, strokes_path});
-        if (remove.keep_object && FileExtension(output_path) == "ptx") {
-          throw OptionsError(
-              "--keep-object: PTX cannot hold two returns per cell; write the two layers as .e57, .ply or "
-              ".pcd");
+        if (const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
+            remove.keep_object && format != nullptr && !format->layer_behind) {
+          throw OptionsError("--keep-object: " + LayerBehindRefusal(*format));
         }
         CheckOutputFile("--mask-out", mask_out_path, {"png"}, {scan_path, strokes_path, output_path});
         CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});

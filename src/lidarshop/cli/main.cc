@@ -26,6 +26,7 @@ const std::vector<Command>& Commands() {
       {"scan", lidarshop::cli::RunScan, "synthesize a scan of a scene description (JSON)"},
       {"info", lidarshop::cli::RunInfo, "describe a scan file as JSON"},
       {"convert", lidarshop::cli::RunConvert, "convert between PTX, E57, PLY, PCD, LAS, XYZ and PTS"},
+      {"formats", lidarshop::cli::RunFormats, "the scan formats and what each holds"},
       {"render", lidarshop::cli::RunRender, "render a channel of a scan as a picture"},
       {"verify", lidarshop::cli::RunVerify, "consistency and confidence of an object pose"},
       {"sweep", lidarshop::cli::RunSweep, "verification heat maps over candidate poses"},

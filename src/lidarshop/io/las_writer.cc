@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/las_format.h"
 #include "lidarshop/util/atomic_file.h"
@@ -133,10 +134,7 @@ std::vector<std::string> LasAttributesNotHeld(const std::vector<Scan>& scans, in
 
 void LasWriteOptions::Check() const { Validate(*this); }
 
-std::string LazNotWrittenMessage() {
-  return "LAZ is not written: lidarshop reads LAZ but has no LASzip compressor; write .las instead (the same "
-         "points uncompressed; laszip -i out.las -o out.laz compresses it)";
-}
+std::string LazNotWrittenMessage() { return std::string(FindScanFormat("laz")->write_refusal); }
 
 std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,
                       const std::string& file) {

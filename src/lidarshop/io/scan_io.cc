@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/pcd.h"
@@ -325,17 +326,17 @@ ScanFileHeader PlyFileHeader(const std::string& path) {
 
 // ---- The table ----
 
-struct ScanFormat {
+// The reader and writer of each format of the registry (io/formats.h), which says what each holds and which
+// are read and written; formats_test checks that the two tables agree.
+struct ScanCodec {
   const char* extension;
   // Reads the scans of a file, adding what it left out to `warnings`.
   std::vector<Scan> (*read)(const std::string& path, std::vector<std::string>* warnings);
   void (*write)(const std::string& path, const std::vector<Scan>& scans);
-  // A format read but not written (LAZ): write is not set, this says why and what to write instead.
-  std::string (*write_refusal)() = nullptr;
 };
 
-const std::vector<ScanFormat>& ScanFormats() {
-  static const std::vector<ScanFormat> formats = {
+const std::vector<ScanCodec>& ScanCodecs() {
+  static const std::vector<ScanCodec> formats = {
       {"ptx",
        [](const std::string& path, std::vector<std::string>* warnings) {
          return ReadPtx(path, {}, warnings);
@@ -369,7 +370,7 @@ const std::vector<ScanFormat>& ScanFormats() {
        [](const std::string& path, std::vector<std::string>* warnings) {
          return std::vector<Scan>{ReadLas(path, warnings)};
        },
-       nullptr, &LazNotWrittenMessage},
+       nullptr},
       {"xyz",
        [](const std::string& path, std::vector<std::string>* warnings) {
          return std::vector<Scan>{ReadPointList(path, PointListKind::kXyz, warnings)};
@@ -390,17 +391,17 @@ const std::vector<ScanFormat>& ScanFormats() {
 
 enum class Access { kRead, kWrite };
 
-const ScanFormat& FormatFor(const std::string& path, Access access) {
+const ScanCodec& FormatFor(const std::string& path, Access access) {
   const std::string extension = FileExtension(path);
-  for (const ScanFormat& format : ScanFormats()) {
-    if (extension != format.extension) continue;
-    if (access == Access::kWrite && format.write == nullptr)
-      ThrowInputError(path, "", "", format.write_refusal());
-    return format;
+  const ScanFormatInfo* format = FindScanFormat(extension);
+  if (format != nullptr && access == Access::kWrite && !format->write)
+    ThrowInputError(path, "", "", std::string(format->write_refusal));
+  for (const ScanCodec& codec : ScanCodecs()) {
+    if (format != nullptr && extension == codec.extension) return codec;
   }
   std::string known;
-  for (const ScanFormat& format : ScanFormats()) {
-    if (format.read != nullptr) known += fmt::format("{}.{}", known.empty() ? "" : " ", format.extension);
+  for (const ScanFormatInfo& readable : ScanFormats()) {
+    if (readable.read) known += fmt::format("{}.{}", known.empty() ? "" : " ", readable.extension);
   }
   ThrowInputError(path, "", "",
                   fmt::format("unknown scan format '{}' (lidarshop reads {})",
@@ -425,20 +426,20 @@ void CheckScanFileReadable(const std::string& path) { FormatFor(path, Access::kR
 
 std::vector<std::string> SupportedScanReadExtensions() {
   std::vector<std::string> extensions;
-  for (const ScanFormat& format : ScanFormats())
-    if (format.read) extensions.push_back(format.extension);
+  for (const ScanFormatInfo& format : ScanFormats())
+    if (format.read) extensions.emplace_back(format.extension);
   return extensions;
 }
 
 std::vector<std::string> SupportedScanWriteExtensions() {
   std::vector<std::string> extensions;
-  for (const ScanFormat& format : ScanFormats())
-    if (format.write) extensions.push_back(format.extension);
+  for (const ScanFormatInfo& format : ScanFormats())
+    if (format.write) extensions.emplace_back(format.extension);
   return extensions;
 }
 
 ScanFile ReadScanFile(const std::string& path) {
-  const ScanFormat& format = FormatFor(path, Access::kRead);
+  const ScanCodec& format = FormatFor(path, Access::kRead);
   ScanFile file;
   file.path = path;
   file.format = format.extension;
@@ -451,7 +452,7 @@ ScanFile ReadScanFile(const std::string& path) {
 }
 
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
-  const ScanFormat& format = FormatFor(path, Access::kWrite);
+  const ScanCodec& format = FormatFor(path, Access::kWrite);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
   if (format.extension == "e57" ||
       std::none_of(scans.begin(), scans.end(), [](const Scan& s) { return s.num_cells() == 0; })) {
@@ -479,14 +480,8 @@ void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& 
   if (!front.world_from_scanner.isApprox(behind.world_from_scanner, 1e-9)) {
     ThrowInputError(path, "", "layers", "the layer behind has another pose than the front scan");
   }
-  if (extension == "ptx") {
-    ThrowInputError(path, "", "", "PTX cannot hold two returns per cell; write E57, PLY or PCD");
-  }
-  if (extension == "xyz" || extension == "pts") {
-    ThrowInputError(
-        path, "", "",
-        "XYZ and PTS cannot mark the synthesized layer behind the object; write E57, PLY, PCD or LAS");
-  }
+  const ScanFormatInfo& format = *FindScanFormat(extension);
+  if (!format.layer_behind) ThrowInputError(path, "", "", LayerBehindRefusal(format));
   if (extension == "e57") {
     WriteE57WithLayer(path, front, behind);
     return;

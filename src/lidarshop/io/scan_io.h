@@ -1,4 +1,5 @@
-// Reading and writing scan files, chosen by file extension (a table, Open3D style).
+// Reading and writing scan files, chosen by file extension (a table, Open3D style; what each format holds is
+// the registry of io/formats.h).
 //
 //   .ptx  Leica ASCII, one or many organized scans            read + write
 //   .e57  ASTM E2807, organized and unstructured scans, images read + write (io/e57.h)
@@ -59,8 +60,8 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans);
 //   .pcd  one unorganized cloud (HEIGHT 1, world frame) of both layers' valid points, `synthesized` 0 for
 //         measured points of `front` (or its own flags) and 1 for `behind`
 //   .las  one cloud of both layers' valid points (world frame), the layer behind with the synthetic flag
-//   .ptx  InputError: "PTX cannot hold two returns per cell; write E57, PLY or PCD"
-//   .xyz .pts  InputError: they cannot mark synthesized points
+//   .ptx .xyz .pts  InputError: LayerBehindRefusal (io/formats.h), "PTX cannot hold two returns per cell; write
+//         E57, PLY, PCD or LAS"
 // Throws InputError naming `path` when the layers differ in size or pose. Atomic.
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind);
 

@@ -279,7 +279,7 @@ TEST(ScanLayers, PtxAndMismatchedLayersAreRefused) {
     WriteScanWithLayer(folder.File("kept.ptx"), layers.front, layers.behind);
     FAIL() << "PTX accepted two layers";
   } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("PTX cannot hold two returns per cell; write E57, PLY or PCD"));
+    EXPECT_THAT(e.what(), HasSubstr("PTX cannot hold two returns per cell; write E57, PLY, PCD or LAS"));
   }
   EXPECT_FALSE(std::filesystem::exists(folder.File("kept.ptx")));
   try {

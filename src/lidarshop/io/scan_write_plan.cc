@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/pcd.h"
 #include "lidarshop/io/scan_io.h"
@@ -13,46 +14,16 @@
 namespace lidarshop {
 namespace {
 
-// The name of a channel in the target format: nullptr = not held, "" = the same name, else the target's name.
-struct FormatHolds {
-  const char* extension;
-  const char* name;
-  bool grid;  // rows x cols and the scanner pose
-  bool intensity_required;
-  const char* intensity;
-  const char* color;
-  const char* label;
-  const char* normal;
-  const char* true_range;
-  const char* synthesized;
-  bool images;
-};
-
-// The table of the header; keep it in step with the writers.
-const FormatHolds kFormats[] = {
-    {"ptx", "PTX", true, true, "", "", nullptr, nullptr, nullptr, nullptr, false},
-    {"e57", "E57", true, false, "", "", nullptr, nullptr, nullptr, "lidarshop:synthesized", true},
-    {"ply", "PLY", true, false, "", "", "", "", "", "", false},
-    {"pcd", "PCD", true, false, "", "", "", "", "", "", false},
-    {"las", "LAS", false, false, "", "", "classification", nullptr, nullptr, "synthetic", false},
-    {"xyz", "XYZ", false, false, "", "", nullptr, nullptr, nullptr, nullptr, false},
-    {"pts", "PTS", false, false, "", "", nullptr, nullptr, nullptr, nullptr, false},
-};
-
-const FormatHolds& HoldsFor(const std::string& path) {
+const ScanFormatInfo& HoldsFor(const std::string& path) {
   CheckScanFileFormat(path);  // the reader's own message for unknown or refused extensions
-  const std::string extension = FileExtension(path);
-  for (const FormatHolds& holds : kFormats) {
-    if (extension == holds.extension) return holds;
-  }
-  ThrowInputError(path, "", "", fmt::format("lidarshop does not write '.{}' scans", extension));
+  return *FindScanFormat(FileExtension(path));
 }
 
 }  // namespace
 
 ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& scans, size_t images,
                             size_t scans_with_second_returns, const LasWriteOptions* las) {
-  const FormatHolds& holds = HoldsFor(path);
+  const ScanFormatInfo& holds = HoldsFor(path);
   auto any = [&](auto has) { return std::any_of(scans.begin(), scans.end(), has); };
   ScanWritePlan plan;
   plan.channels.push_back("xyz");
@@ -84,7 +55,7 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
     bool present;
     const char* channel;  // our name
     const char* plural;   // in the sentence
-    const char* target;   // FormatHolds entry
+    ChannelHeld target;
   };
   const Optional optional[] = {
       {any([](const Scan& s) { return s.has_color(); }), "rgb", "colours", holds.color},
@@ -97,7 +68,7 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
   };
   for (const Optional& channel : optional) {
     if (!channel.present) continue;
-    if (channel.target == nullptr && std::string(channel.channel) == "synthesized") {
+    if (!channel.target.held && std::string(channel.channel) == "synthesized") {
       int64_t synthesized = 0;
       for (const Scan& scan : scans) {
         if (!scan.synthesized.empty()) synthesized += cv::countNonZero(scan.synthesized & scan.valid);
@@ -109,13 +80,13 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
                         path, WithThousandsSeparators(synthesized), synthesized == 1 ? " is" : "s are",
                         synthesized == 1 ? "its" : "their", holds.name));
       }
-    } else if (channel.target == nullptr) {
+    } else if (!channel.target.held) {
       plan.dropped.push_back(fmt::format("{}: {} are not written ({} has no {} field)", path, channel.plural,
                                          holds.name, channel.channel));
-    } else if (channel.target[0] == '\0') {
+    } else if (channel.target.name.empty()) {
       plan.channels.push_back(channel.channel);
     } else {
-      plan.channels.push_back(fmt::format("{}→{}", channel.channel, channel.target));
+      plan.channels.push_back(fmt::format("{}→{}", channel.channel, channel.target.name));
     }
   }
 
@@ -123,7 +94,7 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
     plan.dropped.push_back(fmt::format("{}: {} image{} (E57 images2D) not written: {} holds no photos", path,
                                        images, images == 1 ? "" : "s", holds.name));
   }
-  if (holds.extension == std::string("pcd") && scans.size() == 1 && PcdNeedsDoubleCoordinates(scans[0])) {
+  if (holds.extension == "pcd" && scans.size() == 1 && PcdNeedsDoubleCoordinates(scans[0])) {
     plan.dropped.push_back(
         fmt::format("{}: coordinates beyond {} m from the origin are written as doubles (F 8) to keep 0.1 "
                     "mm; some readers "
@@ -139,7 +110,7 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
     }
   }
   if (!attributes.empty()) {
-    if (std::string(holds.extension) == "las") {
+    if (holds.extension == "las") {
       const LasWriteOptions options = las != nullptr ? *las : LasWriteOptions{};
       const int format = ChooseLasPointFormat(scans, options);
       const std::vector<std::string> lost = LasAttributesNotHeld(scans, format);
@@ -159,7 +130,7 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
     return std::any_of(scan.source_records.begin(), scan.source_records.end(),
                        [](const SourceRecord& record) { return record.user_id == "LASF_Projection"; });
   });
-  if (records && std::string(holds.extension) != "las") {
+  if (records && holds.extension != "las") {
     plan.dropped.push_back(
         fmt::format("{}: the coordinate reference system (LAS GeoTIFF / WKT records) is not written ({} has "
                     "no field for it)",

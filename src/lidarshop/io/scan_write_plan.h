@@ -1,19 +1,12 @@
 // What writing scans to a file keeps and what it drops, by the target format (the extension): what `convert`
 // says before and after it writes, so that nothing is lost silently.
 //
-// What each writer holds (see the format headers):
-//   format     grid  scans    pose  intensity  colour  label           normal  true_range  synthesized   photos
-//   .ptx       yes   several  yes   required*  yes     -               -       -           -             -
-//   .e57       yes   several  yes   yes        yes     -               -       -           extension     yes
-//   .ply       yes   several  yes   yes        yes     yes             yes     yes         yes           -
-//   .pcd       yes   one      yes   yes        yes     yes             yes     yes         yes           -
-//   .las       -     merged   -     yes        yes     classification  -       -           synthetic     -
-//   .xyz .pts  -     merged   -     yes        yes     -               -       -           dropped**     -
-// * PTX has no way to leave the intensity column out: a scan without intensity is written with the PTX
-//   no-information value 0.5, and the plan says so. ** XYZ and PTS write synthesized points like measured ones;
-//   the plan says how many. Scan::attributes (LAS GPS time, returns, ...) are held by LAS only, the LAS
-//   coordinate reference system records likewise. Second returns (E57 returnIndex 1) are kept only by
-//   WriteE57 of a whole E57File; a caller that writes them that way passes 0 scans with second returns.
+// What each format holds comes from the registry (io/formats.h; `lidarshop formats` prints it). Beyond it:
+// PTX has no way to leave the intensity column out, so a scan without intensity is written with the PTX
+// no-information value 0.5, and the plan says so; XYZ and PTS write synthesized points like measured ones, and
+// the plan says how many. Scan::attributes (LAS GPS time, returns, ...) are held by LAS only, the LAS
+// coordinate reference system records likewise. Second returns (E57 returnIndex 1) are kept only by
+// WriteE57 of a whole E57File; a caller that writes them that way passes 0 scans with second returns.
 #pragma once
 
 #include <cstddef>

@@ -7,6 +7,8 @@
 #include <set>
 #include <tuple>
 
+#include <fmt/format.h>
+#include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "lidarshop/geometry/transform.h"
@@ -530,6 +532,18 @@ TEST(SceneFile, ErrorsNameTheFileAndTheField) {
       WriteTemporary("scanner_test_bad_primitive.json", R"({"objects": [{"primitive": "torus"}]})"),
       {"'primitive'", "torus"});
   ExpectInputError("/nonexistent/scene.json", {"/nonexistent/scene.json", "cannot open"});
+}
+
+TEST(SceneFile, AMeshNameTooLongForTheSystemIsNotFound) {
+  // The system refuses names past NAME_MAX with an error, not "no": that is a missing mesh, not a crash.
+  const std::string text = fmt::format(R"({{"objects": [{{"mesh": "{}.obj"}}]}})", std::string(5000, 'x'));
+  try {
+    ParseScene(text, "long.json", ".");
+    ADD_FAILURE() << "a mesh name of 5,004 characters was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), testing::HasSubstr("mesh file not found"));
+    EXPECT_THAT(error.what(), testing::HasSubstr("'mesh'"));
+  }
 }
 
 TEST(SceneFile, TheIssueExampleParses) {

@@ -317,7 +317,8 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
   } else {
     const std::string relative = fields.String("mesh", "");
     const std::filesystem::path path = std::filesystem::path(base_dir) / relative;
-    if (!std::filesystem::is_regular_file(path)) {
+    std::error_code not_a_file;  // a name too long for the system is not a file either, not a crash
+    if (!std::filesystem::is_regular_file(path, not_a_file)) {
       fields.Fail("mesh", fmt::format("mesh file not found: '{}' (paths are relative to the scene file)",
                                       path.string()));
     }
