@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/error.h"
@@ -259,7 +260,7 @@ Thing MakeThing(const std::string& kind, Rng* rng) {
     const double height = rng->Uniform(4.0, 7.0);
     thing = Composite("lamp_post", "lamp_post", {{"height", height}}, Metal(rng));
   } else {
-    LIDARSHOP_CHECK(false && "unknown kind");
+    throw std::logic_error("random scene: unknown kind of object '" + kind + "'");
   }
   thing.min = Vector3d::Constant(1e9);
   thing.max = Vector3d::Constant(-1e9);

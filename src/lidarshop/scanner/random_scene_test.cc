@@ -155,6 +155,9 @@ TEST(RandomScene, OptionsAreChecked) {
   options = {};
   options.columns = 10;
   EXPECT_THROW(RandomSceneJson(1, options), OptionsError);
+  options = {};
+  options.min_target_cells = 400 * 300 / 20 + 1;  // more than a twentieth of the window
+  EXPECT_THROW(RandomSceneJson(1, options), OptionsError);
 }
 
 TEST(SceneTargetLabel, MustNameAnObject) {

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <Eigen/Geometry>
@@ -79,8 +80,8 @@ const SceneObject& TargetPart(const SceneDescription& scene) {
   for (const SceneObject& object : scene.objects) {
     if (object.label == scene.target_label) return object;
   }
-  LIDARSHOP_CHECK(false && "the scene names no target");
-  return scene.objects.front();
+  throw std::logic_error("the scene names no target (target_label " + std::to_string(scene.target_label) +
+                         ")");
 }
 
 }  // namespace
