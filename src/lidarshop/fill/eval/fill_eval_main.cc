@@ -317,7 +317,8 @@ int main(int argc, char** argv) {
       "scanner/random_scene.h), the gradient fill against Laplace, the distribution over the seeds");
   app.add_option("--random-columns", scene_options.columns, "random scenes: columns")->capture_default_str();
   app.add_option("--random-rows", scene_options.rows, "random scenes: rows")->capture_default_str();
-  app.add_option("--pictures", pictures_dir, "write range and second-viewpoint pictures here");
+  app.add_option("--pictures", pictures_dir,
+                 "write range and second-viewpoint pictures here (random scenes: of the worst seeds)");
   app.add_option("--patch-radius", base.patch_radius)->capture_default_str();
   app.add_option("--window", base.search_window_radius)->capture_default_str();
   app.add_option("--color-weight", base.color_weight)->capture_default_str();

@@ -220,7 +220,9 @@ int main(int argc, char** argv) {
                "no separation of touching neighbours");
   bool eight = false;
   std::string dump_dir;
-  app.add_option("--dump", dump_dir, "write overlays (step 1 + inferred background, final, grabCut) here");
+  app.add_option("--dump", dump_dir,
+                 "write overlays (step 1 + inferred background, final, grabCut) here (random scenes: of the "
+                 "three worst seeds)");
   app.add_flag("--eight", eight);
   CLI11_PARSE(app, argc, argv);
   if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
