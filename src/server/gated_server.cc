@@ -272,9 +272,14 @@ void GatedServer::Wake() {
 }
 
 void GatedServer::Refuse(int fd, int status, const std::string& message) {
-  const std::string body = nlohmann::json{{"error", message}}.dump();
+  // Bytes that are not UTF-8 (a header value quoted in the message) are replaced, not thrown on.
+  const std::string body =
+      nlohmann::json{{"error", message}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  // The security headers every answer of the editor's server carries (security.cc), for these too.
   const std::string response = fmt::format(
-      "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{}",
+      "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n"
+      "Content-Security-Policy: default-src 'none'; frame-ancestors 'none'\r\nX-Frame-Options: DENY\r\n"
+      "X-Content-Type-Options: nosniff\r\nReferrer-Policy: no-referrer\r\n\r\n{}",
       status, StatusText(status), body.size(), body);
   // Best effort on a non-blocking socket: a short answer fits its send buffer.
   [[maybe_unused]] const ssize_t sent = send(fd, response.data(), response.size(), MSG_NOSIGNAL);

@@ -238,6 +238,8 @@ TEST(GatedServerTest, FramingHeadersAreCheckedStrictly) {
   const std::string twice = Exchange(port, post + "Content-Length: 3\r\nContent-Length: 5\r\n\r\nabcde");
   EXPECT_EQ(twice.rfind("HTTP/1.1 400", 0), 0u) << twice;
   EXPECT_NE(twice.find("more than one Content-Length"), std::string::npos);
+  EXPECT_NE(twice.find("X-Content-Type-Options: nosniff\r\n"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("X-Frame-Options: DENY\r\n"), std::string::npos) << twice;
   EXPECT_EQ(Exchange(port, post + "Transfer-Encoding: chunked\r\n\r\n3\r\nabc\r\n0\r\n\r\n")
                 .rfind("HTTP/1.1 411", 0),
             0u);
@@ -285,9 +287,9 @@ TEST(GatedServerTest, AHugeJsonBodyIsRefusedWithoutHoldingMemory) {
   const int64_t peak_before = StatusKiB("VmHWM");
   auto post = [&](size_t bytes) {
     std::string request = fmt::format(
-        "POST /api/models?token=t HTTP/1.1\r\nHost: test\r\nContent-Type: application/json\r\n"
+        "POST /api/models?token=t HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nContent-Type: application/json\r\n"
         "Content-Length: {}\r\n\r\n",
-        bytes);
+        editor.port(), bytes);
     request.append(bytes, '[');
     return Exchange(editor.port(), request, 30);
   };

@@ -6,9 +6,11 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/util/error.h"
 #include "lidarshop/verify/verify.h"
 #include "server.h"
 #include "state.h"
@@ -27,10 +29,23 @@ struct ModelEntry {
   VerifierModel model;
 };
 
+// Opening one more document is refused: too many are open (`status` 409) or they would hold more memory than
+// allowed (507). Thrown by AddDocument; an InputError for the CLI's `serve SCAN...`.
+class DocumentLimitError : public InputError {
+ public:
+  DocumentLimitError(int status, const std::string& message) : InputError(message), status(status) {}
+  int status;
+};
+
+// The bytes of the distinct buffers of `document`'s state, undo and redo history and photos (buffers the
+// snapshots share count once). Caller holds document.mutex.
+int64_t DocumentBytes(const Document& document);
+
 struct EditorServer::State {
   ServerOptions options;
   GatedServer http;  // httplib's server behind the connection gate (gated_server.h)
   int port = 0;
+  std::vector<std::string> allowed_hosts;  // AllowedHosts of the bound address, set by Bind()
   int listen_socket = -1;
   std::unique_ptr<JobRunner> runner;
   std::mutex documents_mutex;
@@ -39,7 +54,12 @@ struct EditorServer::State {
   std::map<int, std::shared_ptr<ModelEntry>> models;  // guarded by documents_mutex
   int last_model = 0;
 
+  // Throws DocumentLimitError when max_documents are open (nothing else is checked then: call it before
+  // reading a file), or when `more_bytes` more would take the open documents past max_document_bytes.
+  void CheckRoomForDocument(int64_t more_bytes = 0);
+  // Opens `scan` as a new document after CheckRoomForDocument(its bytes); returns its id.
   int AddDocument(std::string name, Scan scan);
+  std::mutex open_mutex;  // one open at a time: the room checked is the room used
   std::shared_ptr<Document> Get(int id);
   std::shared_ptr<ModelEntry> FindModel(
       int id);  // nullptr when there is none  // an id AddDocument just returned
@@ -48,13 +68,36 @@ struct EditorServer::State {
 };
 using State = EditorServer::State;
 
-// An error answer: {"error": message} with `status`.
+// security.cc: who may talk to the server, and the headers of every answer.
+// `text` cut to at most about `max_bytes` (at a UTF-8 boundary) with how much was left out: no answer echoes
+// unbounded input.
+std::string Excerpt(const std::string& text, size_t max_bytes);
+// The Host values a browser may send to this server: `host:port` for localhost, 127.0.0.1, [::1] and the
+// --host value, and every address of the machine (and its name) when bound to a wildcard; lower case.
+std::vector<std::string> AllowedHosts(const std::string& host, int port);
+// Why the request is refused (403), or empty: its Host is not one of `allowed_hosts` (DNS rebinding: a page
+// of another site reaching this server through a name of its own).
+std::string RefusedHost(const httplib::Request& request, const std::vector<std::string>& allowed_hosts);
+// Why an /api/ call is refused (403), or empty: it comes from another site (Sec-Fetch-Site other than
+// same-origin or none) or from a page of another origin (Origin), i.e. cross-site request forgery.
+std::string RefusedOrigin(const httplib::Request& request, const std::vector<std::string>& allowed_hosts);
+// `host` as written in a URL: an IPv6 address in brackets.
+std::string UrlHost(const std::string& host);
+// Content-Security-Policy, X-Frame-Options: DENY, nosniff, Referrer-Policy: no-referrer.
+void AddSecurityHeaders(httplib::Response& response);
+// The cookie holding the token (per port: cookies are not kept apart by port), and a cookie's value.
+std::string TokenCookieName(int port);
+std::string CookieValue(const httplib::Request& request, const std::string& name);
+
+// An error answer: {"error": message} with `status`; the message is cut to kMaxErrorBytes.
 void SendError(httplib::Response& response, int status, const std::string& message);
 void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, int status = 200);
+inline constexpr size_t kMaxErrorBytes = 1000;
 // Limits of JSON request bodies (strokes, options, correspondences; photos are uploaded as images).
 inline constexpr size_t kMaxJsonBodyBytes = size_t{8} << 20;
 inline constexpr int kMaxJsonDepth = 64;
-// The request body as a JSON object; nullopt after answering 400 (not JSON, nested deeper than kMaxJsonDepth)
+// The request body as a JSON object (an empty body is {}); nullopt after answering 415 (a body not sent as
+// Content-Type: application/json), 400 (not JSON, nested deeper than kMaxJsonDepth: checked before parsing)
 // or 413 (above kMaxJsonBodyBytes).
 std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response);
 

@@ -23,7 +23,8 @@ void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int 
   for (const auto& cell : cells) {
     if (!cell.is_array() || cell.size() != 2 || !cell[0].is_number_integer() ||
         !cell[1].is_number_integer()) {
-      throw OptionsFieldError(key, fmt::format("expected [row, col] whole numbers, got {}", cell.dump()));
+      throw OptionsFieldError(
+          key, fmt::format("expected [row, col] whole numbers, got {}", Excerpt(cell.dump(), 80)));
     }
     const int row = cell[0].get<int>(), col = cell[1].get<int>();
     if (row < 0 || row >= strokes.rows || col < 0 || col >= strokes.cols) {
@@ -124,7 +125,8 @@ void Remove(State& state, const std::shared_ptr<Document>& document, const nlohm
           next.object_mask = cv::Mat();
           next.behind = Scan();
         }
-        next.strokes = cv::Mat::zeros(next.scan.rows, next.scan.cols, CV_8U);
+        next.strokes =
+            NewZeros(cv::Size(next.scan.cols, next.scan.rows), CV_8U);  // a new buffer: see Snapshot
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
         json["version"] = document->version;
@@ -227,37 +229,40 @@ void PostDocument(State& state, const std::string& pattern, DocumentHandler hand
       SendError(response, 400, error.what());
     } catch (const InputError& error) {
       SendError(response, 422, error.what());
+    } catch (const nlohmann::json::exception& error) {  // a field of the wrong type (body.value)
+      SendError(response, 400, fmt::format("a field of the request has the wrong type: {}", error.what()));
     }
   });
 }
 
 void AddEditRoutes(State& state) {
-  PostDocument(
-      state, R"(/api/docs/(\d+)/strokes)",
-      [](State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
-         httplib::Response& response) {
-        const int radius = body.value("radius", 2);
-        if (radius < 0 || radius > 200) throw OptionsFieldError("radius", "out of range [0, 200]");
-        std::lock_guard lock(document->mutex);
-        Snapshot next = document->now;
-        next.strokes =
-            body.value("clear", false) ? cv::Mat::zeros(next.strokes.size(), CV_8U) : next.strokes.clone();
-        PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
-        PaintCells(body, "background", 2, radius, next.strokes);
-        PaintCells(body, "erase", 0, radius, next.strokes);
-        if (body.contains("hole") || body.contains("hole_polygon") || body.contains("erase_hole")) {
-          next.hole = next.hole.empty() ? cv::Mat::zeros(next.strokes.size(), CV_8U) : next.hole.clone();
-          PaintCells(body, "hole", 255, radius, next.hole);
-          PaintCells(body, "erase_hole", 0, radius, next.hole);
-          FillPolygon(body, "hole_polygon", next.hole);
-        }
-        Commit(*document, std::move(next), state.options.undo_depth);
-        SendJson(response,
-                 {{"version", document->version},
-                  {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
-                  {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
-                  {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
-      });
+  PostDocument(state, R"(/api/docs/(\d+)/strokes)",
+               [](State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+                  httplib::Response& response) {
+                 const int radius = body.value("radius", 2);
+                 if (radius < 0 || radius > 200) throw OptionsFieldError("radius", "out of range [0, 200]");
+                 std::lock_guard lock(document->mutex);
+                 Snapshot next = document->now;
+                 // New buffers for what this edit paints (Snapshot: the history shares the current ones).
+                 next.strokes =
+                     body.value("clear", false) ? NewZeros(next.strokes.size(), CV_8U) : next.strokes.clone();
+                 PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
+                 PaintCells(body, "background", 2, radius, next.strokes);
+                 PaintCells(body, "erase", 0, radius, next.strokes);
+                 if (body.contains("hole") || body.contains("hole_polygon") || body.contains("erase_hole")) {
+                   next.hole = next.hole.empty() ? NewZeros(next.strokes.size(), CV_8U) : next.hole.clone();
+                   PaintCells(body, "hole", 255, radius, next.hole);
+                   PaintCells(body, "erase_hole", 0, radius, next.hole);
+                   FillPolygon(body, "hole_polygon", next.hole);
+                 }
+                 Commit(*document, std::move(next), state.options.undo_depth);
+                 SendJson(
+                     response,
+                     {{"version", document->version},
+                      {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
+                      {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
+                      {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
+               });
   PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
   PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);
   PostDocument(state, R"(/api/docs/(\d+)/fill)", Fill);

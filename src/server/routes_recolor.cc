@@ -222,28 +222,39 @@ void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohma
 void AddRecolorRoutes(State& state) {
   httplib::Server& http = state.http;
   // A photo as the request body (PNG or JPEG bytes); kept with the document.
-  http.Post(R"(/api/docs/(\d+)/photo)",
-            [&state](const httplib::Request& request, httplib::Response& response) {
-              auto document = state.FindDocument(request, response);
-              if (!document) return;
-              {
-                std::lock_guard lock(document->mutex);
-                if (!PhotoSlot(*document, request, response)) return;  // 400 for an unknown slot
-              }
-              // Its size read from its header and checked against the budget before decoding (io/image_io.h).
-              cv::Mat rgb;
-              try {
-                rgb = DecodeImage(reinterpret_cast<const uint8_t*>(request.body.data()), request.body.size(),
-                                  "the photo", /*color=*/true);
-              } catch (const InputError& error) {
-                return SendError(response, 422, error.what());
-              }
-              std::lock_guard lock(document->mutex);
-              cv::Mat* slot = PhotoSlot(*document, request, response);
-              if (!slot) return;
-              *slot = rgb;
-              SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
-            });
+  http.Post(
+      R"(/api/docs/(\d+)/photo)", [&state](const httplib::Request& request, httplib::Response& response) {
+        auto document = state.FindDocument(request, response);
+        if (!document) return;
+        {
+          std::lock_guard lock(document->mutex);
+          if (!PhotoSlot(*document, request, response)) return;  // 400 for an unknown slot
+        }
+        // Its size read from its header and checked against the photo limit and the budget before
+        // decoding (io/image_io.h): a small PNG may decode to gigabytes.
+        cv::Mat rgb;
+        try {
+          const ImageHeader header = ReadImageHeader(reinterpret_cast<const uint8_t*>(request.body.data()),
+                                                     request.body.size(), "the photo");
+          const int64_t pixels = int64_t{header.width} * header.height;
+          if (pixels > state.options.max_photo_pixels) {
+            return SendError(
+                response, 413,
+                fmt::format("the photo is {} x {} px ({:.1f} Mpx), more than the {:.1f} Mpx "
+                            "this server accepts",
+                            header.width, header.height, pixels / 1e6, state.options.max_photo_pixels / 1e6));
+          }
+          rgb = DecodeImage(reinterpret_cast<const uint8_t*>(request.body.data()), request.body.size(),
+                            "the photo", /*color=*/true);
+        } catch (const InputError& error) {
+          return SendError(response, 422, error.what());
+        }
+        std::lock_guard lock(document->mutex);
+        cv::Mat* slot = PhotoSlot(*document, request, response);
+        if (!slot) return;
+        *slot = rgb;
+        SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
+      });
   http.Get(R"(/api/docs/(\d+)/photo.png)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);

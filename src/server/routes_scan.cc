@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -22,6 +24,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/memory_budget.h"
 
 namespace lidarshop::server {
 
@@ -29,12 +32,17 @@ namespace fs = std::filesystem;
 
 void SendError(httplib::Response& response, int status, const std::string& message) {
   response.status = status;
-  response.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
+  // Cut (a message may quote the request) and with bytes that are not UTF-8 replaced (a path or header
+  // quoted as sent), so that writing the answer cannot throw.
+  response.set_content(nlohmann::json{{"error", Excerpt(message, kMaxErrorBytes)}}.dump(
+                           -1, ' ', false, nlohmann::json::error_handler_t::replace),
+                       "application/json");
 }
 
 void SendJson(httplib::Response& response, const nlohmann::ordered_json& json, int status) {
   response.status = status;
-  response.set_content(json.dump(), "application/json");
+  response.set_content(json.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
+                       "application/json");
 }
 
 namespace {
@@ -64,7 +72,24 @@ int JsonDepth(const std::string& text, int limit) {
 }  // namespace
 
 std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib::Response& response) {
+  if (request.is_multipart_form_data()) {  // a form's body, which httplib has taken apart (request.files)
+    SendError(response, 415,
+              "the request body must be JSON sent as Content-Type: application/json, not a form");
+    return std::nullopt;
+  }
   if (request.body.empty()) return nlohmann::json::object();
+  // Only a body a page could not send without asking first (a cross-origin fetch with this type needs a CORS
+  // preflight, which this server never grants; a form or a text/plain fetch cannot set it).
+  std::string type = request.get_header_value("Content-Type");
+  type = type.substr(0, type.find(';'));
+  type.erase(type.find_last_not_of(" \t") + 1);
+  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (type != "application/json") {
+    SendError(response, 415,
+              fmt::format("the request body must be JSON sent as Content-Type: application/json (was '{}')",
+                          Excerpt(request.get_header_value("Content-Type"), 100)));
+    return std::nullopt;
+  }
   // A JSON body is parsed into about 10 times its size, and each level of nesting costs an allocation: both
   // are bounded before parsing (a 60 MB body of '[' took 1.9 GB). Photos, the one large upload, are not JSON.
   if (request.body.size() > kMaxJsonBodyBytes) {
@@ -121,15 +146,89 @@ void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
   response.set_content(std::string(png.begin(), png.end()), "image/png");
 }
 
+namespace {
+
+// Adds `mat`'s buffer to `seen`, keyed by its allocation: shallow copies (the snapshots') count once.
+void AddBuffer(const cv::Mat& mat, std::map<const void*, int64_t>& seen) {
+  if (mat.empty()) return;
+  const void* key = mat.u != nullptr ? static_cast<const void*>(mat.u) : mat.datastart;
+  seen[key] = static_cast<int64_t>(mat.total() * mat.elemSize());
+}
+
+void CollectBuffers(const Scan& scan, std::map<const void*, int64_t>& seen) {
+  for (const cv::Mat* mat :
+       {&scan.direction, &scan.valid, &scan.range, &scan.point, &scan.intensity, &scan.color, &scan.label,
+        &scan.normal, &scan.curvature, &scan.true_range, &scan.synthesized}) {
+    AddBuffer(*mat, seen);
+  }
+  for (const auto& [name, mat] : scan.attributes) AddBuffer(mat, seen);
+}
+
+void CollectBuffers(const Snapshot& snapshot, std::map<const void*, int64_t>& seen) {
+  CollectBuffers(snapshot.scan, seen);
+  CollectBuffers(snapshot.behind, seen);
+  for (const cv::Mat* mat : {&snapshot.strokes, &snapshot.object_mask, &snapshot.hole}) AddBuffer(*mat, seen);
+}
+
+int64_t Sum(const std::map<const void*, int64_t>& seen) {
+  int64_t bytes = 0;
+  for (const auto& [buffer, size] : seen) bytes += size;
+  return bytes;
+}
+
+}  // namespace
+
+int64_t DocumentBytes(const Document& document) {
+  std::map<const void*, int64_t> seen;
+  CollectBuffers(document.now, seen);
+  for (const auto* history : {&document.undo, &document.redo}) {
+    for (const Snapshot& snapshot : *history) CollectBuffers(snapshot, seen);
+  }
+  AddBuffer(document.photo, seen);
+  AddBuffer(document.photo_b, seen);
+  return Sum(seen);
+}
+
+void State::CheckRoomForDocument(int64_t more_bytes) {
+  std::vector<std::shared_ptr<Document>> open;
+  {
+    std::lock_guard lock(documents_mutex);
+    for (const auto& [id, document] : documents) open.push_back(document);
+  }
+  if (static_cast<int>(open.size()) >= options.max_documents) {
+    throw DocumentLimitError(409, fmt::format("{} scans are open, the most this server keeps: close one (its "
+                                              "unsaved edits are yours to save first), then open this one",
+                                              open.size()));
+  }
+  if (more_bytes <= 0) return;
+  const int64_t limit = options.max_document_bytes > 0 ? options.max_document_bytes : MemoryBudgetBytes();
+  int64_t used = 0;
+  for (const auto& document : open) {
+    std::lock_guard lock(document->mutex);
+    used += DocumentBytes(*document);
+  }
+  if (used + more_bytes > limit) {
+    throw DocumentLimitError(
+        507, fmt::format("not enough memory for this scan: it needs {} MiB and the {} open scans (with their "
+                         "undo history) hold {} MiB of the {} MiB allowed; close one, then open this one",
+                         more_bytes >> 20, open.size(), used >> 20, limit >> 20));
+  }
+}
+
 int State::AddDocument(std::string name, Scan scan) {
   auto document = std::make_shared<Document>();
   document->name = std::move(name);
-  document->now.strokes = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+  document->now.strokes = NewZeros(cv::Size(scan.cols, scan.rows), CV_8U);
   document->now.scan = std::move(scan);
+  std::lock_guard open_lock(open_mutex);
+  {
+    std::map<const void*, int64_t> seen;
+    CollectBuffers(document->now, seen);
+    CheckRoomForDocument(Sum(seen));
+  }
   std::lock_guard lock(documents_mutex);
   document->id = ++last_document;
   documents[document->id] = document;
-  while (static_cast<int>(documents.size()) > options.max_documents) documents.erase(documents.begin());
   return document->id;
 }
 
@@ -247,8 +346,13 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
       SendError(response, 404, fmt::format("no built-in scene '{}'", name));
       return;
     }
-    const int id = state.AddDocument(name, state.options.scan_builtin(name));
-    SendJson(response, DocumentJson(*state.Get(id)));
+    try {
+      state.CheckRoomForDocument();  // before scanning it
+      const int id = state.AddDocument(name, state.options.scan_builtin(name));
+      SendJson(response, DocumentJson(*state.Get(id)));
+    } catch (const DocumentLimitError& error) {
+      SendError(response, error.status, error.what());
+    }
     return;
   }
   const std::string requested = request.get_param_value("path");
@@ -259,6 +363,7 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
     return;
   }
   try {
+    state.CheckRoomForDocument();  // before reading the file
     ScanFile file = ReadScanFile(path);
     const int index = request.has_param("scan") ? std::atoi(request.get_param_value("scan").c_str()) : 0;
     if (index < 0 || index >= static_cast<int>(file.scans.size())) {
@@ -270,6 +375,8 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
     nlohmann::ordered_json reply = DocumentJson(*state.Get(id));
     reply["warnings"] = file.warnings;  // what the reader left out of the file
     SendJson(response, reply);
+  } catch (const DocumentLimitError& error) {
+    SendError(response, error.status, error.what());
   } catch (const InputError& error) {
     SendError(response, 422, error.what());
   }
@@ -283,11 +390,24 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
               fmt::format("format '{}': expected one of {}", format, fmt::join(formats, ", ")));
     return;
   }
-  const fs::path folder = fs::temp_directory_path() / fmt::format("lidarshop-save-{}", getpid());
-  fs::create_directories(folder);
-  const fs::path file =
-      folder / fmt::format("doc{}-{}.{}", document.id,
-                           std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
+  // The writers take a path: the file goes through a folder of its own that only this user can enter
+  // (mkdtemp: a new, unpredictable name, mode 0700), so no other user can pre-create it, follow a symlink
+  // into it, or read the scan while it is written.
+  std::string pattern = (fs::temp_directory_path() / "lidarshop-save-XXXXXX").string();
+  if (mkdtemp(pattern.data()) == nullptr) {
+    SendError(response, 507,
+              fmt::format("cannot make a temporary folder to save in: {}", std::strerror(errno)));
+    return;
+  }
+  const fs::path folder = pattern;
+  struct RemoveFolder {
+    fs::path path;
+    ~RemoveFolder() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  } remove_folder{folder};
+  const fs::path file = folder / fmt::format("doc{}.{}", document.id, format);
   {
     std::lock_guard lock(document.mutex);
     if (document.now.behind.valid.empty()) {
@@ -301,7 +421,6 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
   }
   std::ifstream in(file, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  fs::remove(file);
   const std::string stem = fs::path(document.name).stem().string();
   response.set_header("Content-Disposition", fmt::format("attachment; filename=\"{}.{}\"", stem, format));
   response.set_content(std::move(bytes), "application/octet-stream");

@@ -129,6 +129,8 @@ void AddVerifyRoutes(State& state) {
       SendError(response, 400, error.what());
     } catch (const InputError& error) {
       SendError(response, 422, error.what());
+    } catch (const nlohmann::json::exception& error) {  // a field of the wrong type (body.value)
+      SendError(response, 400, fmt::format("a field of the request has the wrong type: {}", error.what()));
     }
   });
   http.Get(R"(/api/models/(\d+)/mesh)",
@@ -139,36 +141,38 @@ void AddVerifyRoutes(State& state) {
            });
   // Consistency and confidence of a model at a pose in an open scan: x_m, y_m, z_m, yaw_deg, pitch_deg,
   // roll_deg or world_from_model (world frame; PoseOfBody).
-  http.Post(
-      R"(/api/docs/(\d+)/verify)", [&state](const httplib::Request& request, httplib::Response& response) {
-        auto document = state.FindDocument(request, response);
-        if (!document) return;
-        const auto body = BodyJson(request, response);
-        if (!body) return;
-        try {
-          const auto model = state.FindModel(body->value("model", 0));
-          if (!model) return SendError(response, 404, "no such model: POST /api/models first");
-          const Eigen::Matrix4d world_from_model = PoseOfBody(*body);
-          std::shared_ptr<const PreparedScan> prepared;
-          {
-            std::lock_guard lock(document->mutex);
-            if (!document->prepared || document->prepared_version != document->version) {
-              document->prepared = std::make_shared<PreparedScan>(PrepareScan(document->now.scan));
-              document->prepared_version = document->version;
-            }
-            prepared = document->prepared;
-          }
-          const VerifyResult result =
-              VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
-          nlohmann::ordered_json json = ToJson(result);
-          json["summary"] = result.BriefReport();
-          SendJson(response, json);
-        } catch (const OptionsError& error) {
-          SendError(response, 400, error.what());
-        } catch (const InputError& error) {
-          SendError(response, 422, error.what());
+  http.Post(R"(/api/docs/(\d+)/verify)", [&state](const httplib::Request& request,
+                                                  httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    const auto body = BodyJson(request, response);
+    if (!body) return;
+    try {
+      const auto model = state.FindModel(body->value("model", 0));
+      if (!model) return SendError(response, 404, "no such model: POST /api/models first");
+      const Eigen::Matrix4d world_from_model = PoseOfBody(*body);
+      std::shared_ptr<const PreparedScan> prepared;
+      {
+        std::lock_guard lock(document->mutex);
+        if (!document->prepared || document->prepared_version != document->version) {
+          document->prepared = std::make_shared<PreparedScan>(PrepareScan(document->now.scan));
+          document->prepared_version = document->version;
         }
-      });
+        prepared = document->prepared;
+      }
+      const VerifyResult result =
+          VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
+      nlohmann::ordered_json json = ToJson(result);
+      json["summary"] = result.BriefReport();
+      SendJson(response, json);
+    } catch (const OptionsError& error) {
+      SendError(response, 400, error.what());
+    } catch (const InputError& error) {
+      SendError(response, 422, error.what());
+    } catch (const nlohmann::json::exception& error) {  // a field of the wrong type (body.value)
+      SendError(response, 400, fmt::format("a field of the request has the wrong type: {}", error.what()));
+    }
+  });
 }
 
 }  // namespace lidarshop::server

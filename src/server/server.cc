@@ -45,22 +45,57 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
     setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
     state_->listen_socket = socket;
   });
-  // The token is checked before any route is looked at: an unauthenticated caller learns nothing.
+  // Before any route is looked at: the Host (every request), then for /api/ where the call comes from and
+  // its token; an unauthenticated or foreign caller learns nothing.
   http.set_pre_routing_handler([this](const httplib::Request& request, httplib::Response& response) {
-    if (request.path.rfind("/api/", 0) != 0) return httplib::Server::HandlerResponse::Unhandled;
+    const bool api = request.path.rfind("/api/", 0) == 0;
+    std::string refused = RefusedHost(request, state_->allowed_hosts);
+    if (refused.empty() && api) refused = RefusedOrigin(request, state_->allowed_hosts);
+    if (!refused.empty()) {
+      SendError(response, 403, refused);
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    const std::string& token = state_->options.token;
+    const std::string cookie = TokenCookieName(state_->port);
+    if (!api) {
+      // The first page load (the URL `serve` printed): the token goes into a cookie the browser sends back on
+      // every call from this page, and the page is loaded again without the token in its URL (nor in the
+      // history, nor in a Referer).
+      if ((request.method == "GET" || request.method == "HEAD") && request.has_param("token") &&
+          SameToken(request.get_param_value("token"), token)) {
+        std::string query;
+        for (const auto& [key, value] : request.params) {
+          if (key == "token") continue;
+          query += (query.empty() ? "?" : "&") + httplib::detail::encode_query_param(key) + "=" +
+                   httplib::detail::encode_query_param(value);
+        }
+        response.set_header("Set-Cookie",
+                            fmt::format("{}={}; HttpOnly; SameSite=Strict; Path=/", cookie, token));
+        response.set_header("Cache-Control", "no-store");
+        response.set_redirect(request.path + query, 303);
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      return httplib::Server::HandlerResponse::Unhandled;
+    }
     std::string given = request.get_param_value("token");
     const std::string header = request.get_header_value("Authorization");
     if (given.empty() && header.rfind("Bearer ", 0) == 0) given = header.substr(7);
-    if (!SameToken(given, state_->options.token)) {
+    if (given.empty()) given = CookieValue(request, cookie);
+    if (!SameToken(given, token)) {
       SendError(response, 401, "missing or wrong token (the one `lidarshop serve` printed)");
       return httplib::Server::HandlerResponse::Handled;
     }
     return httplib::Server::HandlerResponse::Unhandled;
   });
+  http.set_post_routing_handler(
+      [](const httplib::Request&, httplib::Response& response) { AddSecurityHeaders(response); });
   http.set_exception_handler(
       [](const httplib::Request&, httplib::Response& response, std::exception_ptr error) {
         try {
           std::rethrow_exception(error);
+        } catch (const nlohmann::json::exception& e) {
+          // A field of the request of the wrong type, found past the routes' own checks: the request's fault.
+          SendError(response, 400, fmt::format("a field of the request has the wrong type: {}", e.what()));
         } catch (const std::exception& e) {
           SendError(response, 500, e.what());
         } catch (...) {
@@ -97,8 +132,11 @@ void EditorServer::Bind() {
   if (state_->port > 0 && state_->listen_socket >= 0) ::listen(state_->listen_socket, SOMAXCONN);
   if (state_->port <= 0) {
     throw InputError(fmt::format("{}:{}: cannot listen there (in use, or not an address of this machine)",
-                                 options.host, options.port));
+                                 UrlHost(options.host), options.port));
   }
+  state_->allowed_hosts = AllowedHosts(options.host, state_->port);
+  const std::string warning = BindWarning(options.host);
+  if (!warning.empty()) fmt::print(stderr, "{}\n", warning);
 }
 
 void EditorServer::Run() {
@@ -121,7 +159,7 @@ int EditorServer::port() const { return state_->port; }
 const std::string& EditorServer::token() const { return state_->options.token; }
 
 std::string EditorServer::Url() const {
-  return fmt::format("http://{}:{}/?token={}", state_->options.host, state_->port, state_->options.token);
+  return EditorUrl(state_->options.host, state_->port, state_->options.token);
 }
 
 int EditorServer::OpenAtStart(const std::string& path, std::vector<std::string>* warnings) {

@@ -2,11 +2,18 @@
 // (docs/api.md). No algorithm lives here; options and results travel in the library's one JSON form
 // (util/options.h).
 //
-// Safety: it listens on loopback unless told otherwise; every /api/ call needs the token printed at start
-// (401 before any routing); files are opened only under the folders given at start (403 for `..`, symlinks
-// or absolute paths leading outside them); request bodies are size-limited (JSON bodies further, in size and
-// nesting depth); a malformed request gets a 4xx with a one-line message; slow, idle or too many clients
-// cannot starve the others (gated_server.h).
+// Safety (docs/api.md "Security"): it listens on loopback unless told otherwise (a warning on stderr when
+// not); every /api/ call needs the token printed at start (401 before any routing), as `?token=`, an
+// `Authorization: Bearer` header or the cookie the first page load sets (HttpOnly, SameSite=Strict; the page
+// is then redirected to drop the token from its URL); every request must name this server in its Host, and
+// /api/ calls from another site or origin are refused (403); JSON bodies must say Content-Type:
+// application/json (415); every answer carries a Content-Security-Policy, X-Frame-Options: DENY, nosniff and
+// no-referrer; saves go through a private folder (mkdtemp, 0700); files are opened only under the folders
+// given at start (403 for `..`, symlinks or absolute paths leading outside them); request bodies are
+// size-limited (JSON bodies further, in size and nesting depth, before parsing; photos by their pixels, read
+// from the header before decoding); a malformed request gets a 4xx with a one-line message that does not
+// echo unbounded input; slow, idle or too many clients cannot starve the others (gated_server.h); one
+// scan more than the limits of count and memory is refused, never an open one closed.
 #pragma once
 
 #include <cstdint>
@@ -33,12 +40,23 @@ struct ServerOptions {
                                  // one is closed, or the newcomer gets 503
   double header_timeout_s = 10;  // from a request's first byte to the end of its headers (408 after)
   double idle_timeout_s = 5;     // a connection with no request under way is closed after this
-  int max_documents = 16;        // open scans at once; the oldest is closed beyond it
-  int undo_depth = 8;            // edits kept per scan for undo
+  // Open scans at once: one more is refused (409) until the user closes one; an open scan is never closed
+  // behind the user's back (its unsaved edits would go with it).
+  int max_documents = 16;
+  // The memory open scans may hold, with their undo history and photos, bytes; opening one more past it is
+  // refused (507). 0 = the memory budget (util/memory_budget.h, --max-memory).
+  int64_t max_document_bytes = 0;
+  int64_t max_photo_pixels = 100'000'000;  // an uploaded photo's width x height, read from its header (413)
+  int undo_depth = 8;                      // edits kept per scan for undo
   // Built-in scenes: their names, and a function scanning one (the CLI passes its compiled-in scenes).
   std::vector<std::string> builtin_scenes;
   std::function<Scan(const std::string& name)> scan_builtin;
 };
+
+// http://HOST:PORT/?token=T, with an IPv6 address in brackets (http://[::1]:8080/...).
+std::string EditorUrl(const std::string& host, int port, const std::string& token);
+// A warning for stderr when `host` is not a loopback address (0.0.0.0, ::, a LAN address), else empty.
+std::string BindWarning(const std::string& host);
 
 class EditorServer {
  public:

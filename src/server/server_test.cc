@@ -56,6 +56,7 @@ class ServerTest : public ::testing::Test {
     options.token = "secret-token";
     options.roots = {(base_ / "root").string()};
     options.max_body_bytes = 1 << 20;
+    options.max_documents = 100;  // the tests open more than the default 16 and close none
     options.builtin_scenes = {"tiny"};
     options.scan_builtin = [](const std::string&) { return *scan_; };
     server_ = new EditorServer(options);
@@ -238,6 +239,36 @@ TEST_F(ServerTest, SegmentRemoveUndoSave) {
   const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
   ASSERT_EQ(saved->status, 200);
   EXPECT_EQ(saved->body.substr(0, 8), "ASTM-E57");
+}
+
+// Undo restores the strokes a removal cleared: its snapshot's stroke buffer was zeroed in place when the
+// removal made its next state, so a second removal after undo found no object stroke.
+TEST_F(ServerTest, RemoveUndoRemoveKeepsTheStrokes) {
+  const int id = OpenBox();
+  const std::string strokes = Api(fmt::format("/api/docs/{}/strokes", id));
+  const auto painted = client_->Post(strokes, StrokesBody(), "application/json");
+  ASSERT_EQ(painted->status, 200);
+  const int object_strokes = Json(painted)["object_stroke_cells"];
+  ASSERT_GT(object_strokes, 10);
+  const std::string remove = Api(fmt::format("/api/docs/{}/remove", id));
+  const std::string options = R"({"options": {"fill": {"method": "laplace"}}})";
+  const auto first = Wait(Json(client_->Post(remove, options, "application/json")));
+  ASSERT_EQ(first["state"], "done") << first.dump();
+  const int synthesized = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"];
+  EXPECT_GT(synthesized, 50);
+  EXPECT_EQ(Json(client_->Post(strokes, "{}", "application/json"))["object_stroke_cells"], 0);  // cleared
+  // Undo both: the empty strokes edit and the removal; the strokes are back as they were painted.
+  for (int i = 0; i < 2; ++i) {
+    ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  }
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"], 0);
+  const auto again = Wait(Json(client_->Post(remove, options, "application/json")));
+  ASSERT_EQ(again["state"], "done") << again.dump();
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", id))))["synthesized_cells"], synthesized);
+  // And once more through redo: the history holds each state as it was.
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  const auto repainted = client_->Post(strokes, "{}", "application/json");
+  EXPECT_EQ(Json(repainted)["object_stroke_cells"], object_strokes);
 }
 
 TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {

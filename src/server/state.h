@@ -28,6 +28,12 @@ struct PreparedScan;  // verify/verify.h
 namespace lidarshop::server {
 
 // What an edit changes; undo restores all of it.
+//
+// Snapshots are immutable once committed (copy on write): copying one shares its buffers (cv::Mat and Scan
+// copies are shallow) with the history, so an edit builds every buffer it changes anew — a clone, a library
+// result, or NewZeros — and only then assigns it to a field of its copy. Never write into a buffer of a copy:
+// not through at<>(), setTo, copyTo, cv::circle, nor by assigning a cv::MatExpr (`m = cv::Mat::zeros(...)`
+// writes the zeros into m's existing buffer when the size matches, which the undo entry shares).
 struct Snapshot {
   Scan scan;
   cv::Mat strokes;      // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
@@ -60,6 +66,10 @@ struct ReviewSession {
   // The job filling now (null = none): while it runs the session is its alone. Guarded by Document::mutex.
   std::shared_ptr<Job> job;
 };
+
+// A new zero-filled buffer of `size` and `type`, for a snapshot field (see Snapshot: not cv::Mat::zeros, a
+// cv::MatExpr whose assignment writes into the field's shared buffer).
+inline cv::Mat NewZeros(cv::Size size, int type) { return cv::Mat(size, type, cv::Scalar::all(0)); }
 
 struct Document {
   int id = 0;

@@ -27,6 +27,17 @@ function fail(message) {
   throw new Error(message);
 }
 
+// page.waitForFunction without eval: Playwright's version evaluates its predicate with eval() in the page, which
+// the server's Content-Security-Policy forbids (as it should); this polls page.evaluate (CDP, not eval) instead.
+async function waitForFunction(page, fn, arg, { timeout = 30000 } = {}) {
+  const deadline = Date.now() + timeout;
+  for (;;) {
+    if (await page.evaluate(fn, arg)) return;
+    if (Date.now() > deadline) throw new Error(`timed out after ${timeout} ms waiting for ${fn}`);
+    await new Promise((resolve) => setTimeout(resolve, 100));
+  }
+}
+
 // Starts the server on a free port and resolves with the URL it prints.
 function startServer() {
   const server = spawn(binary, ['serve', '--port', '0', '--web', join(here, '../dist'), '--root', root], {
@@ -54,6 +65,11 @@ let step = 0;
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 800 }, acceptDownloads: true });
   page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
+  // The server's Content-Security-Policy must let the editor's own page do all it does.
+  const blocked = [];
+  page.on('console', (message) => {
+    if (/Content Security Policy/i.test(message.text())) blocked.push(message.text());
+  });
   const shot = async (name) => {
     const file = join(artefacts, `${String(++step).padStart(2, '0')}_${name}.png`);
     await page.screenshot({ path: file });
@@ -66,7 +82,7 @@ try {
   const statusText = () => page.locator('#status').textContent();
   const waitForStatus = async (pattern, what, timeout = 120000) => {
     try {
-      await page.waitForFunction((source) => new RegExp(source).test(document.getElementById('status').textContent),
+      await waitForFunction(page, (source) => new RegExp(source).test(document.getElementById('status').textContent),
         pattern.source, { timeout });
     } catch {
       fail(`${what}: status never matched ${pattern}: '${await statusText()}'`);
@@ -74,6 +90,9 @@ try {
   };
 
   await page.goto(url);
+  // The server moved the token into an HttpOnly cookie and reloaded the page without it (docs/api.md "Safety").
+  if (new URL(page.url()).searchParams.has('token')) fail(`the token stayed in the page's URL: ${page.url()}`);
+  if ((await page.evaluate(() => document.cookie)).includes('lidarshop_token')) fail('page scripts can read the token cookie');
   await page.selectOption('#scene', 'parking_lot');
   await page.click('#open-scene');
   await waitForStatus(/^parking_lot: \d+ x \d+ cells/, 'open the parking lot');
@@ -147,7 +166,7 @@ try {
   const [fr, fc] = verge.center;
   await page.click('#brush-lasso');
   await drag([[fr - 6, fc - 10], [fr - 6, fc + 10], [fr + 6, fc + 10], [fr + 6, fc - 10], [fr - 6, fc - 10]]);
-  await page.waitForFunction(() => window.lidarshop.current().hole_cells > 100, null, { timeout: 30000 });
+  await waitForFunction(page, () => window.lidarshop.current().hole_cells > 100, null, { timeout: 30000 });
   await page.fill('#review-options', JSON.stringify({ review_candidates: 40, acceptance: { auto_accept_hole_fraction: 0, representative: { enabled: true, max_difference: 1e-6 } } }));
   await page.click('#review-fill');
   await waitForStatus(/^review: no patch passes/, 'review fill', 120000);
@@ -158,14 +177,14 @@ try {
   await shot('review');
   const chosen = Number(await page.locator('.review-tile').nth(Math.min(1, tiles - 1)).getAttribute('data-candidate'));
   await page.locator('.review-tile').nth(Math.min(1, tiles - 1)).click();
-  await page.waitForFunction(() => window.lidarshop.review()?.review.review_point === 1, null, { timeout: 60000 });
+  await waitForFunction(page, () => window.lidarshop.review()?.review.review_point === 1, null, { timeout: 60000 });
   const second = await page.evaluate(() => window.lidarshop.review());
   if (JSON.stringify(second.decisions[0].source) !== JSON.stringify(first.review.candidates[chosen].source))
     fail(`accepted candidate ${chosen} but the decision was ${JSON.stringify(second.decisions[0])}`);
   await page.click('#review-place');
   const source = await screen(fr - 20, fc);
   await page.mouse.click(canvas.x + source.x, canvas.y + source.y);
-  await page.waitForFunction(() => window.lidarshop.review()?.review.review_point === 2, null, { timeout: 60000 });
+  await waitForFunction(page, () => window.lidarshop.review()?.review.review_point === 2, null, { timeout: 60000 });
   const third = await page.evaluate(() => window.lidarshop.review());
   if (JSON.stringify(third.decisions[1].source) !== JSON.stringify([fr - 20, fc]))
     fail(`placed by hand at ${[fr - 20, fc]} but the decision was ${JSON.stringify(third.decisions[1])}`);
@@ -176,12 +195,12 @@ try {
   // Landmarks (scan <-> scan): a second copy of the scan registered to the first; the same cells in both give
   // the identity with no residual.
   await page.click('#open-scene');
-  await page.waitForFunction((id) => window.lidarshop.current()?.id !== id, doc.id, { timeout: 120000 });
+  await waitForFunction(page, (id) => window.lidarshop.current()?.id !== id, doc.id, { timeout: 120000 });
   const copy = await page.evaluate(() => window.lidarshop.current());
   await page.selectOption('#pair-mode', 'scan-scan');
-  await page.waitForFunction(() => document.getElementById('align-target').options.length > 0, null, { timeout: 30000 });
+  await waitForFunction(page, () => document.getElementById('align-target').options.length > 0, null, { timeout: 30000 });
   await page.selectOption('#align-target', String(doc.id));
-  await page.waitForFunction((id) => window.lidarshop.pairs().shownTarget === id, doc.id, { timeout: 30000 });
+  await waitForFunction(page, (id) => window.lidarshop.pairs().shownTarget === id, doc.id, { timeout: 30000 });
   await page.click('#brush-none');
   const pointsBuffer = await (await fetch(new URL(`/api/docs/${doc.id}/points?token=${token}`, url))).arrayBuffer();
   const count = new DataView(pointsBuffer).getUint32(4, true);
@@ -197,7 +216,7 @@ try {
     await page.mouse.click(target.x + there.x, target.y + there.y);
   }
   try {
-    await page.waitForFunction(() => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
+    await waitForFunction(page, () => document.getElementById('pairs').textContent === '5 pairs', null, { timeout: 10000 });
   } catch {
     await shot('landmarks_failed');
     fail(`landmarks: ${await page.locator('#pairs').textContent()} picked; status '${await statusText()}'`);
@@ -206,6 +225,7 @@ try {
   await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
   await shot('landmarks');
 
+  if (blocked.length > 0) fail(`the Content-Security-Policy blocked: ${blocked.join('; ')}`);
   console.log(`e2e: passed (car ${car.cells} cells, segmented ${segmented.object_cells}, synthesized ${removed.synthesized_cells}, saved ${saved})`);
 } finally {
   await browser.close();

@@ -1,4 +1,6 @@
-// The editor's calls to `lidarshop serve` (docs/api.md). Every /api/ call carries the token from the page URL.
+// The editor's calls to `lidarshop serve` (docs/api.md). The server moves the token of the URL it printed into an
+// HttpOnly cookie on the first page load and reloads the page without it, so the calls normally carry only the
+// cookie; a page opened with ?token= still puts it on every URL (the server accepts either).
 
 export interface DocumentInfo {
   id: number;
@@ -153,8 +155,10 @@ export class Api {
   }
 
   url(path: string, params: Record<string, string | number> = {}): string {
-    const query = new URLSearchParams({ ...Object.fromEntries(Object.entries(params).map(([k, v]) => [k, String(v)])), token: this.token });
-    return `${this.base}${path}?${query.toString()}`;
+    const query = new URLSearchParams(Object.fromEntries(Object.entries(params).map(([k, v]) => [k, String(v)])));
+    if (this.token) query.set('token', this.token);
+    const text = query.toString();
+    return text ? `${this.base}${path}?${text}` : `${this.base}${path}`;
   }
 
   async json<T>(path: string, params: Record<string, string | number> = {}, body?: unknown): Promise<T> {

@@ -51,6 +51,11 @@ describe('Api', () => {
     const api = Api.fromLocation({ search: '?token=abc123', origin: 'http://127.0.0.1:9' });
     expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range&token=abc123');
   });
+  it('leaves the token out when the page has none (its cookie carries it)', () => {
+    const api = Api.fromLocation({ search: '', origin: 'http://127.0.0.1:9' });
+    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range');
+    expect(api.url('/api/health')).toBe('http://127.0.0.1:9/api/health');
+  });
 });
 
 import { inverseRigid, multiply, parseMesh, poseMatrix } from '../src/api';

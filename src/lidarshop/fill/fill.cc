@@ -524,6 +524,62 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
 
 }  // namespace
 
+namespace {
+
+// The window of FillOptions::window_margin: the hole's bounding box grown, then doubled until it holds enough
+// known returns (the whole scan at most).
+cv::Rect FillWindow(const Scan& scan, const cv::Mat& hole, const cv::Mat& known_valid, int64_t hole_cells,
+                    const FillOptions& options) {
+  const cv::Rect whole(0, 0, scan.cols, scan.rows);
+  if (options.window_margin <= 0) return whole;
+  const cv::Rect box = cv::boundingRect(hole);
+  int64_t margin = std::max<int64_t>(
+      options.window_min_margin_cells,
+      static_cast<int64_t>(std::ceil(options.window_margin * std::max(box.width, box.height))));
+  while (true) {
+    const int64_t x0 = std::max<int64_t>(0, box.x - margin), y0 = std::max<int64_t>(0, box.y - margin);
+    const int64_t x1 = std::min<int64_t>(scan.cols, box.x + box.width + margin);
+    const int64_t y1 = std::min<int64_t>(scan.rows, box.y + box.height + margin);
+    const cv::Rect window(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0),
+                          static_cast<int>(y1 - y0));
+    if (window == whole) return whole;
+    if (cv::countNonZero(known_valid(window)) >= options.window_min_known_ratio * hole_cells) return window;
+    margin *= 2;
+  }
+}
+
+// `windowed`, the fill of the window `window` of `scan`, as the fill of the whole scan: the cells outside the
+// window copied, the per-cell images padded with their "not in the hole" values.
+FillResult ExpandWindowedFill(FillResult windowed, const Scan& scan, const cv::Rect& window) {
+  FillResult result = std::move(windowed);
+  Scan whole = Clone(scan);
+  PasteScan(result.scan, window, &whole);
+  result.scan = std::move(whole);
+  auto pad = [&](cv::Mat* image, const cv::Scalar& outside) {
+    if (image->empty()) return;
+    cv::Mat full(scan.rows, scan.cols, image->type(), outside);
+    image->copyTo(full(window));
+    *image = full;
+  };
+  pad(&result.filled, cv::Scalar(0));
+  pad(&result.gradient_magnitude_before, cv::Scalar(0));
+  pad(&result.gradient_magnitude_after, cv::Scalar(0));
+  pad(&result.fill_order, cv::Scalar(-1));
+  if (!result.source_cell.empty()) {
+    result.source_cell.forEach<cv::Vec2i>([&](cv::Vec2i& source, const int*) {
+      if (source[0] >= 0) source += cv::Vec2i(window.y, window.x);
+    });
+  }
+  pad(&result.source_cell, cv::Scalar(-1, -1));
+  result.window_row = window.y;
+  result.window_col = window.x;
+  result.window_rows = window.height;
+  result.window_cols = window.width;
+  return result;
+}
+
+}  // namespace
+
 FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options,
                     Progress* progress) {
   options.Check();
@@ -560,6 +616,17 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
       }
     }
   }
+  if (const cv::Rect window = FillWindow(scan, in.hole, in.known_valid, result.hole_cells, options);
+      window.area() < scan.rows * scan.cols) {
+    FillOptions whole_window = options;
+    whole_window.window_margin = 0;
+    FillResult windowed = FillScan(CropScan(scan, window), hole_in(window), whole_window, progress);
+    result = ExpandWindowedFill(std::move(windowed), scan, window);
+    result.timings.total_s = total.Seconds();
+    return result;
+  }
+  result.window_rows = scan.rows;
+  result.window_cols = scan.cols;
   in.range = RangeImage(scan);
   in.range.setTo(0, scan.valid == 0);
   in.guide = Guide(scan);

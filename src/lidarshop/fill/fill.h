@@ -110,7 +110,15 @@ struct FillOptions {
   PoissonOptions poisson;   // range reconstruction (and the laplace baseline)
   FillPlaneOptions planes;  // gradient method: reconstructed ranges onto the planes around the hole
   uint64_t seed = 0;        // random choices of the patch fill (ties are broken by position)
-  void Check() const;       // throws OptionsFieldError naming the field
+  // The window the fill works in, so that its cost follows the hole, not the scan: the hole's bounding box
+  // grown by `window_margin` times its larger side (at least `window_min_margin_cells`) on each side, then
+  // doubled until it holds `window_min_known_ratio` times as many known returns as the hole has cells. The
+  // patch search, the gradient statistics, the planes and the Poisson solve see only the window; the cells
+  // outside it are copied. 0 = the whole scan.
+  double window_margin = 2.0;           // hole sizes
+  int window_min_margin_cells = 64;     // cells
+  double window_min_known_ratio = 8.0;  // known returns per hole cell
+  void Check() const;                   // throws OptionsFieldError naming the field
 };
 template <>
 const StructInfo& InfoOf<FillOptions>();
@@ -136,6 +144,9 @@ struct FillResult {
   std::vector<double> lattice_pitches_m, lattice_storeys_m;
   int patches = 0;            // patches copied (patch methods)
   bool exact_search = false;  // the patch search was the exact one (FillOptions::exact_search_max_cost)
+  // The window the fill worked in (FillOptions::window_margin): first row and column, rows and columns; the
+  // whole scan when not windowed.
+  int window_row = 0, window_col = 0, window_rows = 0, window_cols = 0;
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole

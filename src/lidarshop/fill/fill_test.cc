@@ -160,6 +160,70 @@ TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {
   EXPECT_GT(std::abs(leaked.at<double>(5, 4) - ramp.at<double>(5, 4)), 1.0);
 }
 
+// The wall scene seen over 160 degrees at the same angular step: the box's hole is a small part of the scan.
+constexpr const char* kWideWallScene = R"({
+  "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-80, 80], "elevation_deg": [-20, 10], "columns": 640,
+              "rows": 120, "max_range": 40, "los_noise_sigma": 0.002, "seed": 5},
+  "objects": [
+    {"primitive": "plane", "size": [60, 60], "translate": [0, 15, 0], "label": 0, "texture": "grass"},
+    {"primitive": "wall", "size": [12, 0.3, 2.5], "translate": [0, 7, 0], "label": 2, "texture": "brick",
+     "color": [158, 68, 48]},
+    {"primitive": "box", "size": [0.8, 0.5, 1.2], "translate": [0.2, 4.5, 0.6], "label": 1, "color": [40, 60, 200]}
+  ]
+})";
+
+TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
+  const Case c = MakeCase(kWideWallScene, 2);
+  const int64_t hole_cells = cv::countNonZero(c.hole);
+  ASSERT_GT(hole_cells, 500);
+  FillOptions options;  // windowed by default
+  const FillResult windowed = FillScan(c.scan, c.hole, options);
+  options.window_margin = 0;
+  const FillResult whole = FillScan(c.scan, c.hole, options);
+  EXPECT_EQ(whole.window_rows, c.scan.rows);
+  EXPECT_EQ(whole.window_cols, c.scan.cols);
+  // The window holds the hole and its margin, and less than the scan.
+  const cv::Rect box = cv::boundingRect(c.hole);
+  const cv::Rect window(windowed.window_col, windowed.window_row, windowed.window_cols, windowed.window_rows);
+  EXPECT_EQ(window & box, box);
+  EXPECT_LT(window.area(), c.scan.rows * c.scan.cols);
+  EXPECT_GE(window.x, 0);
+  EXPECT_LE(window.x + window.width, c.scan.cols);
+  // Outside the hole every cell is the input's; the same cells are filled; the quality is that of the whole
+  // scan's fill (the window holds the wall and the ground on both sides of the box).
+  const cv::Mat outside = c.hole == 0;
+  EXPECT_EQ(cv::norm(windowed.scan.range, c.scan.range, cv::NORM_INF, outside), 0.0);
+  EXPECT_EQ(cv::norm(windowed.scan.color, c.scan.color, cv::NORM_INF, outside), 0.0);
+  EXPECT_EQ(windowed.hole_cells, hole_cells);
+  EXPECT_EQ(cv::countNonZero(windowed.filled), windowed.synthesized_cells);
+  EXPECT_EQ(cv::countNonZero(windowed.filled & outside), 0);
+  const FillMetrics w = MeasureFill(windowed.scan, c.truth, c.hole);
+  const FillMetrics f = MeasureFill(whole.scan, c.truth, c.hole);
+  EXPECT_LT(w.range_rmse_mm, 1.25 * f.range_rmse_mm + 5)
+      << "window " << w.range_rmse_mm << " whole " << f.range_rmse_mm;
+  EXPECT_LT(w.floating_share, f.floating_share + 0.01);
+  // Every source cell of the windowed fill is a known cell of the whole scan, inside the window.
+  int sources = 0;
+  for (int y = 0; y < c.scan.rows; ++y) {
+    for (int x = 0; x < c.scan.cols; ++x) {
+      const cv::Vec2i source = windowed.source_cell.at<cv::Vec2i>(y, x);
+      if (source[0] < 0) continue;
+      ++sources;
+      EXPECT_TRUE(window.contains(cv::Point(source[1], source[0]))) << source;
+    }
+  }
+  EXPECT_GT(sources, 0);
+}
+
+TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
+  const Case c = MakeCase(kWideWallScene, 2);
+  FillOptions options;
+  options.window_min_known_ratio = 1e5;  // more than the whole scan holds: the window becomes the scan
+  const FillResult result = FillScan(c.scan, c.hole, options);
+  EXPECT_EQ(result.window_rows, c.scan.rows);
+  EXPECT_EQ(result.window_cols, c.scan.cols);
+}
+
 TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
   const Case c = MakeCase(kWallScene, 2);
   ASSERT_GT(cv::countNonZero(c.hole), 500);

@@ -70,6 +70,17 @@ const StructInfo& InfoOf<FillOptions>() {
             "gradient method: cells copied from a repeating facade taken one or more pitches along it");
     b.Field(&FillOptions::planes, "planes", "gradient method: ranges onto the planes seen around the hole");
     b.Field(&FillOptions::seed, "seed", "seed of the patch fill's random choices");
+    b.Field(&FillOptions::window_margin, "window_margin",
+            "work in the hole's bounding box grown by this times its larger side; 0 = the whole scan")
+        .Unit("hole sizes")
+        .Range(0, 1000);
+    b.Field(&FillOptions::window_min_margin_cells, "window_min_margin_cells",
+            "the window's margin around the hole is at least this")
+        .Unit("cells")
+        .Range(0, 1000000);
+    b.Field(&FillOptions::window_min_known_ratio, "window_min_known_ratio",
+            "the window is doubled until it holds this many known returns per hole cell")
+        .Range(0, 1e6);
     b.Check([](const FillOptions& o) {
       if (o.search_window_radius < o.patch_radius) {
         throw OptionsFieldError("search_window_radius", fmt::format("{} is less than the patch radius {}",
@@ -246,6 +257,10 @@ const StructInfo& InfoOf<FillResult>() {
     b.Field(&FillResult::lattice_storeys_m, "lattice_storeys_m", "storey height of each (0 = none)")
         .Unit("m");
     b.Field(&FillResult::candidates_evaluated, "candidates_evaluated", "source patches compared");
+    b.Field(&FillResult::window_row, "window_row", "first row of the window the fill worked in");
+    b.Field(&FillResult::window_col, "window_col", "first column of the window");
+    b.Field(&FillResult::window_rows, "window_rows", "rows of the window").Unit("cells");
+    b.Field(&FillResult::window_cols, "window_cols", "columns of the window").Unit("cells");
     b.Field(&FillResult::timings, "timings", "wall seconds per step");
     b.Field(&FillResult::warnings, "warnings", "what looks wrong with the fill, one sentence each");
     return b.Build();

@@ -1,6 +1,8 @@
 #include "lidarshop/scan/scan.h"
 
 #include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -96,6 +98,85 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   if (!masked.synthesized.empty()) masked.synthesized.setTo(0, drop);
   for (auto& [name, values] : masked.attributes) values.setTo(cv::Scalar::all(0), drop);
   return masked;
+}
+
+namespace {
+
+// Every per-cell channel of a scan with its no-return value (MaskScan's): CropScan and PasteScan visit them
+// all, so a channel added to Scan is added here once.
+template <typename ScanT, typename Visit>
+void ForEachChannel(ScanT& scan, Visit visit) {
+  visit(scan.direction, cv::Scalar::all(0));
+  visit(scan.valid, cv::Scalar(0));
+  visit(scan.range, cv::Scalar(0));
+  visit(scan.point, cv::Scalar::all(0));
+  visit(scan.intensity, cv::Scalar(0.5));
+  visit(scan.color, cv::Scalar::all(0));
+  visit(scan.label, cv::Scalar(kNoLabel));
+  visit(scan.normal, cv::Scalar::all(0));
+  visit(scan.curvature, cv::Scalar(NAN));
+  visit(scan.true_range, cv::Scalar(0));
+  visit(scan.synthesized, cv::Scalar(0));
+}
+
+void CheckWindow(const Scan& scan, const cv::Rect& window, const char* what) {
+  if (window.x < 0 || window.y < 0 || window.width < 0 || window.height < 0 ||
+      window.x + window.width > scan.cols || window.y + window.height > scan.rows) {
+    throw std::logic_error(std::string(what) + ": the window is not inside the scan");
+  }
+}
+
+}  // namespace
+
+Scan CropScan(const Scan& scan, const cv::Rect& window) {
+  CheckScan(scan);
+  CheckWindow(scan, window, "CropScan");
+  Scan part;
+  part.rows = window.height;
+  part.cols = window.width;
+  part.world_from_scanner = scan.world_from_scanner;
+  part.name = scan.name;
+  part.source_records = scan.source_records;
+  part.source_metadata = scan.source_metadata;
+  // Pairs the channels of `scan` and `part` in the same order.
+  std::vector<cv::Mat*> targets;
+  ForEachChannel(part, [&](cv::Mat& channel, const cv::Scalar&) { targets.push_back(&channel); });
+  size_t i = 0;
+  ForEachChannel(scan, [&](const cv::Mat& channel, const cv::Scalar&) {
+    if (!channel.empty()) *targets[i] = channel(window).clone();
+    ++i;
+  });
+  for (const auto& [name, values] : scan.attributes) part.attributes[name] = values(window).clone();
+  if (static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
+      static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
+    part.grid = scan.grid;
+    part.grid.azimuth_rad.assign(scan.grid.azimuth_rad.begin() + window.x,
+                                 scan.grid.azimuth_rad.begin() + window.x + window.width);
+    part.grid.elevation_rad.assign(scan.grid.elevation_rad.begin() + window.y,
+                                   scan.grid.elevation_rad.begin() + window.y + window.height);
+  }
+  return part;
+}
+
+void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan) {
+  CheckWindow(*scan, window, "PasteScan");
+  if (part.rows != window.height || part.cols != window.width)
+    throw std::logic_error("PasteScan: the part's size differs from the window's");
+  std::vector<std::pair<cv::Mat*, cv::Scalar>> targets;
+  ForEachChannel(*scan,
+                 [&](cv::Mat& channel, const cv::Scalar& none) { targets.emplace_back(&channel, none); });
+  size_t i = 0;
+  ForEachChannel(part, [&](const cv::Mat& channel, const cv::Scalar&) {
+    auto& [target, none] = targets[i++];
+    if (channel.empty()) return;
+    if (target->empty()) *target = cv::Mat(scan->rows, scan->cols, channel.type(), none);
+    channel.copyTo((*target)(window));
+  });
+  for (const auto& [name, values] : part.attributes) {
+    cv::Mat& target = scan->attributes[name];
+    if (target.empty()) target = cv::Mat(scan->rows, scan->cols, values.type(), cv::Scalar::all(0));
+    values.copyTo(target(window));
+  }
 }
 
 Scan MakeScan(int rows, int cols, bool with_color, bool with_intensity) {

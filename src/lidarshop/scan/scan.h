@@ -132,6 +132,17 @@ Scan Clone(const Scan& scan);
 // wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);
 
+// The cells of `window` (inside the scan) as a scan of their own: every channel's cells copied, the grid's
+// azimuths and elevations of those columns and rows, pose, name and metadata kept. An edit works on the window
+// around what it changes (fill: a band around the hole) so that its cost follows the edit, not the scan.
+// Throws std::logic_error when `window` is not inside the scan.
+Scan CropScan(const Scan& scan, const cv::Rect& window);
+
+// Writes the cells of `part` into `scan` at `window` (the inverse of CropScan): every channel `part` has; a
+// channel only `part` has is added to `scan` with the no-return value of MaskScan outside the window. Throws
+// std::logic_error when the sizes differ or `window` is not inside the scan.
+void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan);
+
 // A scan with every required channel allocated (no returns, directions zero), intensity (0.5 everywhere) unless
 // `with_intensity` is false, colour (0) when `with_color`, no other optional channel.
 Scan MakeScan(int rows, int cols, bool with_color = false, bool with_intensity = true);

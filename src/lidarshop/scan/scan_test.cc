@@ -172,5 +172,37 @@ TEST(ScanTest, LabelImage16MarksNoReturnAndMissingLabels) {
   EXPECT_EQ(labels.at<uint16_t>(0, 2), kNoReturnLabel16);
 }
 
+TEST(Scan, CropThenPasteGivesTheScanBack) {
+  Scan scan = MakeScan(6, 8, /*with_color=*/true);
+  scan.grid = UniformGrid(6, 8, -0.4, 0.4, -0.3, 0.3);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  for (int i = 0; i < 48; ++i) {
+    scan.range.at<float>(i / 8, i % 8) = 1.0f + i;
+    scan.valid.at<uint8_t>(i / 8, i % 8) = i % 5 ? kValid : 0;
+  }
+  scan.label = cv::Mat(6, 8, CV_32S, cv::Scalar(3));
+  const cv::Rect window(2, 1, 4, 3);
+  Scan part = CropScan(scan, window);
+  ASSERT_EQ(part.rows, 3);
+  ASSERT_EQ(part.cols, 4);
+  EXPECT_EQ(part.range.at<float>(0, 0), scan.range.at<float>(1, 2));
+  EXPECT_EQ(part.grid.azimuth_rad,
+            std::vector<double>(scan.grid.azimuth_rad.begin() + 2, scan.grid.azimuth_rad.begin() + 6));
+  EXPECT_EQ(part.grid.elevation_rad[0], scan.grid.elevation_rad[1]);
+  EXPECT_TRUE(part.intensity.data != scan.intensity.data);  // a copy, not a view of the input
+  // An edit of the part, pasted back: only the window changes; a channel only the part has is added.
+  part.range.setTo(100.0f);
+  part.synthesized = cv::Mat(3, 4, CV_8U, cv::Scalar(1));
+  Scan whole = Clone(scan);
+  PasteScan(part, window, &whole);
+  EXPECT_EQ(cv::countNonZero(whole.range == 100.0f), 12);
+  EXPECT_EQ(whole.range.at<float>(0, 0), scan.range.at<float>(0, 0));
+  ASSERT_FALSE(whole.synthesized.empty());
+  EXPECT_EQ(cv::countNonZero(whole.synthesized), 12);
+  EXPECT_EQ(cv::norm(whole.label, scan.label, cv::NORM_INF), 0.0);
+  EXPECT_THROW(CropScan(scan, cv::Rect(6, 0, 4, 2)), std::logic_error);
+  EXPECT_THROW(PasteScan(part, cv::Rect(0, 0, 2, 2), &whole), std::logic_error);
+}
+
 }  // namespace
 }  // namespace lidarshop

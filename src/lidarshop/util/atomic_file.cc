@@ -1,6 +1,8 @@
 #include "lidarshop/util/atomic_file.h"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -23,16 +25,53 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The temporary's name: ".STEM.tmpPID-N.EXT" (hidden, the target's extension kept for format detection).
+// The temporary's name: ".STEM.tmpPID-N.EXT" (hidden, the target's extension kept for format detection), N a
+// random 64-bit number: another user cannot guess it to plant a symlink there, and two writers of the same
+// target (threads, or processes sharing a pid namespace's numbers on a network folder) never pick the same.
 // lidarshop_batch.py and the server's file listing know this form.
 constexpr std::string_view kTemporaryMark = ".tmp";
 
-std::string TemporaryPathFor(const std::string& path) {
-  static std::atomic<int> counter{0};
+std::string WriteFailure(const fs::path& folder, int saved_errno);
+
+uint64_t RandomNumber() {
+  uint64_t value = 0;
+  if (getrandom(&value, sizeof(value), 0) == static_cast<ssize_t>(sizeof(value))) return value;
+  // No getrandom (an old kernel): a counter mixed with the clock, still never repeated within the process.
+  static std::atomic<uint64_t> counter{0};
+  return (static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count()) << 16) ^
+         counter++;
+}
+
+// The process's umask, read without changing it (umask(2) can only be read by setting it, which would race
+// with other threads creating files): the mode a new output gets, as if the writer had created it.
+mode_t CurrentUmask() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::strtol(line.c_str() + 6, nullptr, 8));
+  }
+  return 022;
+}
+
+// Creates the temporary for `path` — O_CREAT | O_EXCL (never an existing file nor a symlink planted there),
+// mode 0600 until it is complete — and returns its name. Throws InputError when the folder does not take it.
+std::string CreateTemporaryFor(const std::string& path) {
   const fs::path target(path);
-  const std::string name = fmt::format(".{}{}{}-{}{}", target.stem().string(), kTemporaryMark, getpid(),
-                                       counter++, target.extension().string());
-  return (target.parent_path() / name).string();
+  for (int attempt = 0;; ++attempt) {
+    const std::string name = fmt::format(".{}{}{}-{}{}", target.stem().string(), kTemporaryMark, getpid(),
+                                         RandomNumber(), target.extension().string());
+    const std::string temporary = (target.parent_path() / name).string();
+    const int fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    if (fd >= 0) {
+      close(fd);
+      return temporary;
+    }
+    if (errno != EEXIST || attempt >= 100) {
+      fs::path folder = target.parent_path();
+      if (folder.empty()) folder = ".";
+      ThrowInputError(path, "", "", "cannot write the file: " + WriteFailure(folder, errno));
+    }
+  }
 }
 
 // The writer's pid when `name` is a temporary of ours for `target` (".STEM.tmpPID-N.EXT"), else 0.
@@ -97,10 +136,13 @@ std::string WriteFailure(const fs::path& folder, int saved_errno) {
 
 void Commit(const std::string& temporary, const std::string& path) {
   std::error_code error;
-  // A replaced file keeps its permissions (a private 600 scan must not become 644 by being rewritten).
+  // A replaced file keeps its permissions (a private 600 scan must not become 644 by being rewritten); a new
+  // one gets what the umask gives a created file (the temporary was 0600 while it was written).
   struct stat target {};
   if (stat(path.c_str(), &target) == 0 && S_ISREG(target.st_mode)) {
     chmod(temporary.c_str(), target.st_mode & 07777);
+  } else {
+    chmod(temporary.c_str(), 0666 & ~CurrentUmask());
   }
   fs::rename(temporary, path, error);
   if (error) {
@@ -150,7 +192,7 @@ void WritePathAtomically(const std::string& path, const std::function<bool(const
   if (!input.empty())
     ThrowInputError(path, "", "", fmt::format("the output would overwrite the input {}", input));
   RemoveStaleTemporaries(path);
-  const std::string temporary = TemporaryPathFor(path);
+  const std::string temporary = CreateTemporaryFor(path);
   fs::path folder = fs::path(path).parent_path();
   if (folder.empty()) folder = ".";
   bool written = false;

@@ -1,6 +1,9 @@
 // Atomic output: every file lidarshop writes first goes to a temporary file beside the target, which is
 // renamed over the target only when writing succeeded. A crash or an error never leaves a half-written
-// output, and an input is never opened for writing. A file that is replaced keeps its permission bits.
+// output, and an input is never opened for writing. A file that is replaced keeps its permission bits; a new
+// one gets those the umask gives. The temporary's name holds a random number and it is created with O_EXCL,
+// mode 0600, before the writer opens it: a name planted beforehand (a symlink another user made) is never
+// followed, and concurrent writers of one target never share a temporary.
 #pragma once
 
 #include <functional>

@@ -7,7 +7,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
+#include <thread>
+#include <vector>
 
 #include <filesystem>
 #include <fstream>
@@ -113,6 +116,95 @@ TEST(AtomicFileTest, TheTemporariesOfDeadWritersAreRemovedAndOnlyThose) {
   EXPECT_FALSE(IsAtomicTemporary("scan.tmp12-3.ply"));
   EXPECT_FALSE(IsAtomicTemporary(".tmp12.ply"));
   for (const std::string& path : {dead_fresh, alive_old, other_target, not_ours}) fs::remove(path);
+}
+
+// Another user of a shared folder plants symlinks at the temporary names a writer would pick (the old names
+// were ".STEM.tmpPID-N.EXT" with N counting from 0): the write must neither follow them into the victim's
+// file nor rename one of them over the output.
+TEST(AtomicFileTest, APlantedSymlinkIsNeverFollowed) {
+  namespace fs = std::filesystem;
+  const std::string folder = Folder() + "/planted";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const std::string victim = Folder() + "/victim.txt";
+  std::ofstream(victim) << "the victim's own";
+  std::vector<std::string> planted;
+  for (int n = 0; n < 1000; ++n) {
+    planted.push_back(fmt::format("{}/.out.tmp{}-{}.ply", folder, getpid(), n));
+    fs::create_symlink(victim, planted.back());
+  }
+  const std::string output = folder + "/out.ply";
+  for (int i = 0; i < 3; ++i) WriteFileAtomically(output, [](std::ostream& out) { out << "whole"; });
+  std::stringstream victim_text, output_text;
+  victim_text << std::ifstream(victim).rdbuf();
+  output_text << std::ifstream(output).rdbuf();
+  EXPECT_EQ(victim_text.str(), "the victim's own");
+  EXPECT_FALSE(fs::is_symlink(output));
+  EXPECT_EQ(output_text.str(), "whole");
+  for (const std::string& link : planted) EXPECT_TRUE(fs::is_symlink(link)) << link;
+  fs::remove_all(folder);
+  fs::remove(victim);
+}
+
+// The temporary is the writer's alone from the start: created (O_EXCL) at mode 0600 before the writer
+// opens it, under a name nobody can guess; the finished file gets the umask's mode.
+TEST(AtomicFileTest, TheTemporaryIsPrivateAndUnpredictable) {
+  namespace fs = std::filesystem;
+  const std::string output = Folder() + "/private.ply";
+  fs::remove(output);
+  const mode_t old_umask = umask(022);
+  std::vector<std::string> names;
+  for (int i = 0; i < 2; ++i) {
+    WritePathAtomically(output, [&](const std::string& temporary) {
+      struct stat status {};
+      EXPECT_EQ(lstat(temporary.c_str(), &status), 0);
+      EXPECT_TRUE(S_ISREG(status.st_mode));
+      EXPECT_EQ(status.st_mode & 07777, 0600u);
+      EXPECT_TRUE(IsAtomicTemporary(fs::path(temporary).filename().string())) << temporary;
+      names.push_back(temporary);
+      std::ofstream(temporary) << "data";
+      return true;
+    });
+  }
+  umask(old_umask);
+  EXPECT_EQ(ModeOf(output), 0644u);
+  ASSERT_EQ(names.size(), 2u);
+  // Not a counter: the two names differ in more than their last digit.
+  EXPECT_GT(names[0].size() + names[1].size(), 2 * fmt::format(".private.tmp{}-0.ply", getpid()).size() + 20);
+  fs::remove(output);
+}
+
+// Writers of one target at once (threads here): each write is whole, none fails, no temporary is left.
+TEST(AtomicFileTest, ConcurrentWritersOfOneTargetDoNotCollide) {
+  namespace fs = std::filesystem;
+  const std::string folder = Folder() + "/concurrent";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  const std::string output = folder + "/shared.ply";
+  std::atomic<int> failures{0};
+  std::vector<std::thread> writers;
+  for (int k = 0; k < 4; ++k) {
+    writers.emplace_back([&, k] {
+      for (int i = 0; i < 50; ++i) {
+        try {
+          WriteFileAtomically(
+              output, [k](std::ostream& out) { out << std::string(20000, static_cast<char>('a' + k)); });
+        } catch (const std::exception&) {
+          ++failures;
+        }
+      }
+    });
+  }
+  for (std::thread& writer : writers) writer.join();
+  EXPECT_EQ(failures, 0);
+  std::stringstream text;
+  text << std::ifstream(output).rdbuf();
+  ASSERT_EQ(text.str().size(), 20000u);
+  EXPECT_EQ(text.str(), std::string(20000, text.str()[0]));
+  int files = 0;
+  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(folder)) ++files;
+  EXPECT_EQ(files, 1);  // no temporary left behind
+  fs::remove_all(folder);
 }
 
 TEST(AtomicFileTest, AFullDiskIsSaidAsSuch) {
