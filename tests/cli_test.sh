@@ -70,6 +70,21 @@ json_check "the built-in scene was scanned" "$work/parking.json" \
   "d['rows'] == 30 and d['columns'] == 60 and d['objects'] > 3 and d['returns'] > 0"
 fails_clearly "scan: an unknown scene name lists the built-in ones" "no_such_scene.*parking_lot.*" \
   "$lidarshop" scan no_such_scene -o "$work/x.ptx"
+# A random scene from a seed (scanner/random_scene.h): the same seed writes the same scene and scan, and the
+# written scene scans as a file to the same points; SCENE and --random exclude each other.
+check "scan a random scene" sh -c "'$lidarshop' scan --random 7 -o '$work/random7.ply' \
+  --write-scene '$work/random7.json' --json - --quiet >'$work/random7_stats.json'"
+json_check "the random scene is 400 x 300 and names its target" "$work/random7_stats.json" \
+  "d['rows'] == 300 and d['columns'] == 400 and d['target_label'] >= 1 and d['returns'] > 0"
+check "the same seed writes the same scene and scan" sh -c "'$lidarshop' scan --random 7 -o '$work/random7b.ply' \
+  --write-scene '$work/random7b.json' --quiet && cmp '$work/random7.json' '$work/random7b.json' \
+  && cmp '$work/random7.ply' '$work/random7b.ply'"
+check "the written random scene scans to the same points" sh -c "'$lidarshop' scan '$work/random7.json' \
+  -o '$work/random7c.ply' --quiet && cmp '$work/random7.ply' '$work/random7c.ply'"
+fails_clearly "scan: a scene and --random" "exactly one of SCENE and --random" \
+  "$lidarshop" scan parking_lot --random 3 -o "$work/x.ptx"
+fails_clearly "scan: --write-scene without --random" "write-scene needs --random" \
+  "$lidarshop" scan parking_lot --write-scene "$work/x.json" -o "$work/x.ptx"
 # The scene example of docs/scene-format.md runs as the document says: saved in the repository's top folder
 # (here: beside a link to its data/ folder), its mesh path names a mesh of the repository.
 repo=$(cd "$(dirname "$0")/.." && pwd)

@@ -1,11 +1,14 @@
-// lidarshop scan SCENE.json|BUILTIN -o OUT.ptx|.ply|.e57 [--labels L.png] [--mesh M.ply] [--seed N] [--threads N]
-// [--json FILE|-] [--stats] [--photos sphere|cube [--photo-size PX]]
+// lidarshop scan SCENE.json|BUILTIN|--random SEED -o OUT.ptx|.ply|.e57 [--write-scene S.json] [--labels L.png]
+// [--mesh M.ply] [--seed N] [--threads N] [--json FILE|-] [--stats] [--photos sphere|cube [--photo-size PX]]
 //
-// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md) or of a built-in scene
-// (parking_lot, ...: the scenes of `demo --scene`) with the synthetic scanner and writes it; --json writes one JSON object with the counts and the seconds of each stage
-// (--stats = --json -). Scanner flags (--rows, --seed, ...) override the scene's "scanner" entries. --photos
-// (E57 output only) writes the station's own photos into the file's images2D (scanner/station_photos.h).
+// Synthesizes a scan of a scene description (scanner/scene.h, docs/scene-format.md), of a built-in scene
+// (parking_lot, ...: the scenes of `demo --scene`) or of the random scene of a seed (scanner/random_scene.h;
+// --write-scene saves its JSON) with the synthetic scanner and writes it; --json writes one JSON object with
+// the counts and the seconds of each stage (--stats = --json -). Scanner flags (--rows, --seed, ...) override
+// the scene's "scanner" entries. --photos (E57 output only) writes the station's own photos into the file's
+// images2D (scanner/station_photos.h).
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -20,6 +23,7 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
@@ -44,7 +48,8 @@ std::string ColorLabelsPath(const std::string& labels_path) {
 int RunScan(int argc, char** argv) {
   CLI::App app("Synthesize an organized scan of a scene description (JSON) with the synthetic scanner.",
                "scan");
-  std::string scene_path, output_path, labels_path, mesh_path, json_path;
+  std::string scene_path, output_path, labels_path, mesh_path, json_path, write_scene_path;
+  std::optional<uint64_t> random_seed;
   int threads = 0;
   bool stats = false, quiet = false;
   // The scanner flags override the scene file's "scanner": only the ones given are applied.
@@ -52,9 +57,12 @@ int RunScan(int argc, char** argv) {
   ScanMeshOptions mesh_options;
   OptionBinder binder(app);
   app.add_option(
-         "scene", scene_path,
-         "scene description (.json, see docs/scene-format.md) or a built-in scene:" + BuiltinSceneNames())
-      ->required();
+      "scene", scene_path,
+      "scene description (.json, see docs/scene-format.md) or a built-in scene:" + BuiltinSceneNames());
+  app.add_option("--random", random_seed,
+                 "instead of SCENE: the random street or indoor scene of this seed (scanner/random_scene.h; "
+                 "400 x 300 cells, the target object named by the scene's target_label)");
+  app.add_option("--write-scene", write_scene_path, "with --random: also write the scene's JSON here");
   app.add_option("-o,--output", output_path,
                  "output scan: .ptx, .ply, .e57, .pcd (or the points alone: .las, .xyz, .pts)")
       ->required();
@@ -85,6 +93,12 @@ int RunScan(int argc, char** argv) {
       [&]() {
         if (stats && json_path.empty()) json_path = "-";
         CheckOption(threads >= 0, fmt::format("--threads must be >= 0, got {}", threads));
+        CheckOption(scene_path.empty() != !random_seed.has_value(),
+                    "give exactly one of SCENE and --random SEED");
+        CheckOption(write_scene_path.empty() || random_seed.has_value(), "--write-scene needs --random SEED");
+        if (random_seed) scene_path = fmt::format("random scene {}", *random_seed);
+        if (!write_scene_path.empty())
+          CheckOutputPath(write_scene_path, {output_path, labels_path, mesh_path});
         CheckOutputPath(output_path, {scene_path});
         if (!labels_path.empty()) CheckOutputPath(labels_path, {scene_path, output_path});
         const std::string labels_color_path = labels_path.empty() ? "" : ColorLabelsPath(labels_path);
@@ -104,7 +118,16 @@ int RunScan(int argc, char** argv) {
         const ThreadLimit thread_limit(threads);
         Timer total;
         Timer stage;
-        SceneDescription scene = LoadSceneOrBuiltin(scene_path);
+        SceneDescription scene;
+        if (random_seed) {
+          const std::string text = RandomSceneJson(*random_seed);
+          scene = ParseScene(text, scene_path, "");
+          if (!write_scene_path.empty()) {
+            WriteFileAtomically(write_scene_path, [&](std::ostream& out) { out << text << "\n"; });
+          }
+        } else {
+          scene = LoadSceneOrBuiltin(scene_path);
+        }
         StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &scene.scanner);
         scene.scanner.Check();
         const double loading_seconds = stage.Seconds();
@@ -172,6 +195,8 @@ int RunScan(int argc, char** argv) {
             json["labels"] = labels_path;
             json["labels_color"] = labels_color_path;
           }
+          if (!write_scene_path.empty()) json["scene_file"] = write_scene_path;
+          if (scene.target_label >= 0) json["target_label"] = scene.target_label;
           json["objects"] = scene.objects.size();
           json["triangles"] = scanner.num_triangles();
           json["rows"] = scan.rows;

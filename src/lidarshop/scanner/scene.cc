@@ -1,5 +1,6 @@
 #include "lidarshop/scanner/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -430,8 +431,9 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
     ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", error.what()));
   }
   Fields top(root, what, "");
-  top.CheckKeys({"scanner", "objects", "name", "description"});
+  top.CheckKeys({"scanner", "objects", "name", "description", "target_label"});
   SceneDescription scene;
+  scene.target_label = static_cast<int32_t>(top.Integer("target_label", -1, 0, 65534));
   if (top.Has("scanner")) scene.scanner = ParseScanner(Fields(top.Get("scanner"), what, "scanner"));
   if (!top.Has("objects")) top.Fail("objects", "missing (a list of objects)");
   const json& objects = top.Get("objects");
@@ -448,6 +450,11 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   for (size_t i = 0; i < objects.size(); ++i) {
     scene.objects.push_back(ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir,
                                         &scene_triangles, &scene.warnings));
+  }
+  if (scene.target_label >= 0 &&
+      std::none_of(scene.objects.begin(), scene.objects.end(),
+                   [&](const SceneObject& object) { return object.label == scene.target_label; })) {
+    top.Fail("target_label", fmt::format("no object has label {}", scene.target_label));
   }
   return scene;
 }

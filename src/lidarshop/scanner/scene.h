@@ -85,6 +85,9 @@ struct SceneDescription {
   ScannerOptions scanner;
   std::vector<SceneObject> objects;
   std::string path;  // the file it was read from ("" when built in code)
+  // The object an evaluation strokes or removes (scene key "target_label"): every object with this label;
+  // -1 = none named. Random scenes (scanner/random_scene.h) always name one.
+  int32_t target_label = -1;
   // What the mesh readers left out of the scene's mesh files (io/mesh_io.h MeshFile::warnings), one sentence
   // each naming the file; not printed by the library.
   std::vector<std::string> warnings;

@@ -40,8 +40,25 @@ cv::Mat MakeEvalStrokes(const cv::Mat& truth, const cv::Mat& valid, uint64_t see
   cv::dilate(object, near_object, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(m, m)));
   const cv::Mat background = (valid != 0) & (near_object == 0);
   cv::Mat strokes(truth.size(), CV_8U, cv::Scalar(kStrokeNone));
-  DrawRandomStroke(eroded, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeObject, &strokes);
-  DrawRandomStroke(background, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeBackground,
+  cv::Mat object_room = eroded, background_room = background;
+  if (o.upper_and_below) {
+    const cv::Rect inner = cv::boundingRect(eroded), outer = cv::boundingRect(object);
+    object_room = eroded.clone();
+    object_room.rowRange(inner.y + std::max(1, inner.height / 3), object_room.rows).setTo(0);
+    const int below = outer.y + outer.height;  // the first row under the object
+    cv::Mat under = background.clone();
+    under.rowRange(0, below).setTo(0);
+    cv::Mat under_columns = under.clone();
+    under_columns.colRange(0, outer.x).setTo(0);
+    under_columns.colRange(outer.x + outer.width, under.cols).setTo(0);
+    if (cv::countNonZero(under_columns) > 0) {
+      background_room = under_columns;
+    } else if (cv::countNonZero(under) > 0) {
+      background_room = under;
+    }
+  }
+  DrawRandomStroke(object_room, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeObject, &strokes);
+  DrawRandomStroke(background_room, &rng, o.stroke_length_cells, o.stroke_width_cells, kStrokeBackground,
                    &strokes);
   return strokes;
 }

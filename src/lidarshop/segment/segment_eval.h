@@ -21,10 +21,16 @@ struct EvalStrokeOptions {
       12;                        // the background stroke keeps at least this distance from the object, cells
   int stroke_length_cells = 16;  // length of each (horizontal) stroke, cells
   int stroke_width_cells = 2;    // thickness, cells
+  // false: both strokes anywhere in their allowed cells. true: the object stroke on the upper third of the
+  // eroded object (its rows) and the background stroke below the object (rows under its lowest cell, within
+  // its columns where there is room; else anywhere below it; else anywhere), as a user strokes the object
+  // and the ground in front of it (the random-scene evaluation).
+  bool upper_and_below = false;
 };
 
 // One short horizontal object stroke inside the eroded `truth` (CV_8U, non-zero = object) and one background
-// stroke on valid cells away from it, both placed at random with `seed` (same seed = same strokes). Only
+// stroke on valid cells away from it, both placed at random with `seed` (same seed = same strokes; see
+// EvalStrokeOptions::upper_and_below for where). Only
 // valid cells are marked. Throws InputError when the eroded object or the background margin leaves no room.
 cv::Mat MakeEvalStrokes(const cv::Mat& truth, const cv::Mat& valid, uint64_t seed,
                         const EvalStrokeOptions& options = {});

@@ -11,6 +11,35 @@
 namespace lidarshop {
 namespace {
 
+TEST(SegmentEvalTest, UpperAndBelowStrokesLieOnTheObjectsTopAndUnderIt) {
+  // An object of rows 50..149 and columns 100..199 in a 300 x 400 grid of returns.
+  const cv::Mat valid(300, 400, CV_8U, cv::Scalar(255));
+  cv::Mat truth(300, 400, CV_8U, cv::Scalar(0));
+  truth(cv::Rect(100, 50, 100, 100)).setTo(255);
+  EvalStrokeOptions options;
+  options.upper_and_below = true;
+  for (uint64_t seed = 1; seed <= 20; ++seed) {
+    const cv::Mat strokes = MakeEvalStrokes(truth, valid, seed, options);
+    std::vector<cv::Point> object, background;
+    cv::findNonZero(strokes == kStrokeObject, object);
+    cv::findNonZero(strokes == kStrokeBackground, background);
+    ASSERT_FALSE(object.empty());
+    ASSERT_FALSE(background.empty());
+    // The eroded object spans rows 54..145: its upper third ends at row 54 + 30; a 2-cell stroke adds a row.
+    for (const cv::Point& p : object) EXPECT_LE(p.y, 54 + 30 + 1) << seed;
+    for (const cv::Point& p : background) {
+      EXPECT_GE(p.y, 150) << seed;
+      EXPECT_GE(p.x, 100) << seed;
+      EXPECT_LE(p.x, 199) << seed;
+    }
+  }
+  // With no room under the object (it reaches the bottom row), the background stroke goes elsewhere.
+  cv::Mat low(300, 400, CV_8U, cv::Scalar(0));
+  low(cv::Rect(100, 200, 100, 100)).setTo(255);
+  const cv::Mat strokes = MakeEvalStrokes(low, valid, 3, options);
+  EXPECT_GT(cv::countNonZero(strokes == kStrokeBackground), 0);
+}
+
 TEST(SegmentEvalTest, GroundTheDepthCutTookAtTheFootIsLeftToTheColourCut) {
   // electric_box_wall: step 1 takes a fringe of the ground at the box's foot; as hard object seeds those cells
   // stayed in the final mask (IoU 0.990 over the eval's seeds), left free the colour cut drops them.

@@ -2,13 +2,20 @@
 //
 //   fill_eval [--scenes DIR] [--methods gradient,laplace,...] [--margin CELLS] [--markdown FILE]
 //             [--pictures DIR] [--planar NAME,...]
+//   fill_eval --random-seeds 1..100 [--markdown FILE] [--pictures DIR]
 //
 // Every data/fill_eval/*.json scene is scanned twice with the same seed: as it is, and without its label-1
 // objects (the ones to remove). The hole is the removed object's cells grown by the margin; the truth is the
 // scan without the object. Each method fills the same hole of the same scan, and MeasureFill scores it inside
 // the hole. Prints one table per scene and a summary; --markdown writes them, --pictures writes the range
 // images and a second-viewpoint rendering per scene.
+//
+// --random-seeds: instead, the random scenes of those seeds (scanner/random_scene.h, 400 x 300 cells), the
+// object removed their target_label; the gradient fill (FillOptions' defaults, one fill seed) against Laplace:
+// range RMSE and floating share per seed, and their distribution (mean, 5th and 95th percentile, worst seed);
+// --pictures writes the worst seeds' pictures.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -17,6 +24,7 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/fill/fill.h"
@@ -26,7 +34,9 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scanner/scanner.h"
+#include "lidarshop/testing/random_eval.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/options.h"
 
@@ -78,6 +88,198 @@ cv::Mat Labelled(const cv::Mat& picture, const std::string& text) {
   return out;
 }
 
+// Narrows `view` onto the points of `scan` in `hole` (they fill about 40 % of the picture's width) and draws
+// each point as large as the scan's spacing there looks from the camera.
+void ZoomOnHole(const Scan& scan, const cv::Mat& hole, PointViewOptions* view) {
+  Eigen::AlignedBox3d box;
+  double range_sum = 0;
+  int count = 0;
+  for (int y = 0; y < scan.rows; ++y) {
+    for (int x = 0; x < scan.cols; ++x) {
+      if (!hole.at<uint8_t>(y, x) || !scan.valid.at<uint8_t>(y, x)) continue;
+      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(y, x);
+      box.extend(Eigen::Vector3d(p[0], p[1], p[2]));
+      range_sum += scan.range.at<float>(y, x);
+      ++count;
+    }
+  }
+  if (count == 0) return;
+  const double distance = (view->eye_in_world - view->target_in_world).norm();
+  const double extent = std::max(0.2, box.sizes().maxCoeff());
+  view->field_of_view_deg = std::clamp(2 * std::atan(extent / 0.4 / 2 / distance) * 180 / M_PI, 2.0, 60.0);
+  // The spacing of neighbouring returns at the hole, seen from the camera at about the same distance.
+  const double step_rad = scan.grid.azimuth_rad.size() > 1
+                              ? std::abs(scan.grid.azimuth_rad[1] - scan.grid.azimuth_rad[0])
+                              : 0.002;
+  const double spacing_m = (range_sum / count) * step_rad;
+  const double pixels = spacing_m / distance / (view->field_of_view_deg * M_PI / 180) * view->width_px;
+  view->point_size_px = std::clamp(static_cast<int>(std::ceil(pixels)) + 1, 2, 16);
+}
+
+// Range before / after / truth on one colour scale (lo..hi metres), a second viewpoint of the truth, laplace,
+// depth-patch and gradient (35° about the hole; `zoom` = true narrows its field of view onto the removed object
+// and sizes the points to the scan's spacing, for small far objects), and the |range error| in the hole of
+// every method: <stem>_range.png, _view.png, _error.png in `dir`.
+void WritePictures(const std::string& dir, const std::string& stem, const Scan& with_object,
+                   const Scan& truth, const cv::Mat& hole, const std::map<std::string, FillResult>& results,
+                   double lo, double hi, bool zoom = false) {
+  std::vector<cv::Mat> row1 = {Labelled(RangePicture(with_object, lo, hi), "scan"),
+                               Labelled(RangePicture(truth, lo, hi), "truth (no object)")};
+  std::vector<cv::Mat> row2;
+  const PointViewOptions view = [&] {
+    PointViewOptions v = SideView(truth, hole, 35.0);
+    v.width_px = 480;
+    v.height_px = 360;
+    if (zoom) ZoomOnHole(with_object, hole, &v);
+    return v;
+  }();
+  row2.push_back(Labelled(RenderPointView(truth, view), "truth, second viewpoint"));
+  for (const std::string& name :
+       {std::string("laplace"), std::string("depth-patch"), std::string("gradient")}) {
+    if (!results.count(name)) continue;
+    row1.push_back(Labelled(RangePicture(results.at(name).scan, lo, hi), name));
+    PointViewOptions tinted = view;
+    tinted.synthesized_tint = 0.0;
+    row2.push_back(Labelled(RenderPointView(results.at(name).scan, tinted), name + ", second viewpoint"));
+  }
+  std::vector<cv::Mat> row3 = {Labelled(RangePicture(with_object, lo, hi), "hole: |error| 0..0.5 m")};
+  for (const auto& [name, result] : results)
+    row3.push_back(Labelled(ErrorPicture(result.scan, truth, hole), name));
+  cv::Mat errors;
+  cv::hconcat(row3, errors);
+  WriteImage(dir + "/" + stem + "_error.png", errors);
+  cv::Mat top, bottom;
+  cv::hconcat(row1, top);
+  cv::hconcat(row2, bottom);
+  WriteImage(dir + "/" + stem + "_range.png", top);
+  WriteImage(dir + "/" + stem + "_view.png", bottom);
+}
+
+// The random scenes of `seeds` (scanner/random_scene.h): the target removed and filled by the gradient fill
+// (`base`, one fill seed) and by Laplace; range RMSE and floating share (FillMetrics: distance to the truth
+// scan's points and triangles) per seed and their distribution; pictures of the worst seeds in `pictures_dir`.
+int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
+              const FillOptions& base, int margin, const std::string& pictures_dir,
+              const std::string& markdown_path) {
+  std::string report;
+  auto emit = [&](const std::string& text) {
+    fmt::print("{}", text);
+    std::fflush(stdout);
+    report += text;
+  };
+  emit(fmt::format(
+      "\n### Random scenes: seeds {}..{} ({} x {} cells; hole = the target's cells grown by {} cells; truth "
+      "= the scene scanned without the target; * = the target coloured like its background)\n\n"
+      "| seed | target | distance m | hole cells | gradient RMSE mm | Laplace RMSE mm | ratio | gradient "
+      "floating % | Laplace floating % | gradient s |\n|---|---|---|---|---|---|---|---|---|---|\n",
+      seeds.front(), seeds.back(), scene_options.columns, scene_options.rows, margin));
+  std::vector<double> gradient_rmse, laplace_rmse, ratio, gradient_floating, laplace_floating;
+  std::vector<bool> like_background;
+  double seconds = 0;
+  FillOptions laplace = base;
+  laplace.method = FillMethod::kLaplace;
+  auto run = [&](uint64_t seed, std::map<std::string, FillResult>* results, Scan* with_object, Scan* truth,
+                 cv::Mat* hole, double* distance) {
+    const SceneDescription scene = RandomScene(seed, scene_options);
+    *with_object = SynthesizeScan(scene);
+    SceneDescription without = scene;
+    std::erase_if(without.objects,
+                  [&](const SceneObject& object) { return object.label == scene.target_label; });
+    *truth = SynthesizeScan(without);
+    *hole = GrowHole((with_object->label == scene.target_label) & (with_object->valid != 0), margin);
+    *distance = test_scenes::TargetDistance(scene);
+    results->emplace("gradient", FillScan(*with_object, *hole, base));
+    results->emplace("laplace", FillScan(*with_object, *hole, laplace));
+    return test_scenes::TargetColumn(scene);
+  };
+  for (uint64_t seed : seeds) {
+    std::map<std::string, FillResult> results;
+    Scan with_object, truth;
+    cv::Mat hole;
+    double distance = 0;
+    const std::string kind = run(seed, &results, &with_object, &truth, &hole, &distance);
+    const FillMetrics g = MeasureFill(results.at("gradient").scan, truth, hole);
+    const FillMetrics l = MeasureFill(results.at("laplace").scan, truth, hole);
+    const double s = results.at("gradient").timings.total_s;
+    seconds += s;
+    gradient_rmse.push_back(g.range_rmse_mm);
+    laplace_rmse.push_back(l.range_rmse_mm);
+    ratio.push_back(g.range_rmse_mm / std::max(1e-6, l.range_rmse_mm));
+    gradient_floating.push_back(100 * g.floating_share);
+    like_background.push_back(kind.ends_with(" *"));
+    laplace_floating.push_back(100 * l.floating_share);
+    emit(fmt::format("| {} | {} | {:.1f} | {} | {:.1f} | {:.1f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |\n",
+                     seed, kind, distance, cv::countNonZero(hole), g.range_rmse_mm, l.range_rmse_mm,
+                     ratio.back(), gradient_floating.back(), laplace_floating.back(), s));
+  }
+  auto mean = [](const std::vector<double>& v) {
+    double sum = 0;
+    for (double x : v) sum += x;
+    return sum / static_cast<double>(v.size());
+  };
+  emit(
+      "\n| measure (lower is better) | mean | 5th percentile | 95th percentile | worst (seed) |\n"
+      "|---|---|---|---|---|\n");
+  for (const auto& [name, values] : std::vector<std::pair<std::string, const std::vector<double>*>>{
+           {"gradient range RMSE mm", &gradient_rmse},
+           {"Laplace range RMSE mm", &laplace_rmse},
+           {"gradient / Laplace RMSE, per seed", &ratio},
+           {"gradient floating %", &gradient_floating},
+           {"Laplace floating %", &laplace_floating}}) {
+    const test_scenes::SeedDistribution d = test_scenes::Distribute(*values, seeds, false);
+    emit(fmt::format("| {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} ({}) |\n", name, d.mean, d.p5, d.p95, d.worst,
+                     d.worst_seed));
+  }
+  emit(fmt::format(
+      "\nMean gradient RMSE / mean Laplace RMSE: {:.2f} (issue 30's target <= 0.3). Gradient floating share: "
+      "mean "
+      "{:.2f} % (target < 1 %), 95th percentile {:.2f} % (target < 3 %). Gradient fill total {:.1f} s.\n",
+      mean(gradient_rmse) / std::max(1e-9, mean(laplace_rmse)), mean(gradient_floating),
+      test_scenes::Distribute(gradient_floating, seeds, false).p95, seconds));
+  emit(fmt::format(
+      "Gradient floating % where the target is coloured like its background (*): {}; the others: {}.\n",
+      test_scenes::MeanWhere(gradient_floating, like_background, true),
+      test_scenes::MeanWhere(gradient_floating, like_background, false)));
+  if (!pictures_dir.empty()) {
+    // The three worst seeds by floating share and the three by RMSE ratio.
+    std::vector<uint64_t> worst;
+    for (const std::vector<double>* values : {&gradient_floating, &ratio}) {
+      for (size_t i : test_scenes::WorstIndices(*values, 3, false)) {
+        if (std::find(worst.begin(), worst.end(), seeds[i]) == worst.end()) worst.push_back(seeds[i]);
+      }
+    }
+    for (uint64_t seed : worst) {
+      std::map<std::string, FillResult> results;
+      Scan with_object, truth;
+      cv::Mat hole;
+      double distance = 0;
+      run(seed, &results, &with_object, &truth, &hole, &distance);
+      // The colour scale: from the object's nearest to the truth's farthest range in the hole (2 % and 98 %
+      // quantiles), widened by a tenth each way, so that the hole's surfaces are told apart.
+      std::vector<float> ranges;
+      for (const Scan* scan : {&with_object, &truth}) {
+        for (int y = 0; y < hole.rows; ++y)
+          for (int x = 0; x < hole.cols; ++x)
+            if (hole.at<uint8_t>(y, x) && scan->valid.at<uint8_t>(y, x))
+              ranges.push_back(scan->range.at<float>(y, x));
+      }
+      std::sort(ranges.begin(), ranges.end());
+      double lo = ranges.empty() ? 0.0 : ranges[ranges.size() / 50];
+      double hi = ranges.empty() ? 2.0 * distance + 10.0 : ranges[ranges.size() * 49 / 50];
+      hi = std::max(hi, lo + 0.5);
+      const double widen = 0.1 * (hi - lo);
+      lo = std::max(0.0, lo - widen);
+      hi += widen;
+      WritePictures(pictures_dir, fmt::format("random_{}", seed), with_object, truth, hole, results, lo, hi,
+                    true);
+    }
+    emit(fmt::format("\nPictures (worst floating share, then worst RMSE ratio): seeds {}.\n",
+                     fmt::join(worst, ", ")));
+  }
+  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -107,7 +309,16 @@ int main(int argc, char** argv) {
                  "scenes that are planar behind the object (left out of the target mean)")
       ->capture_default_str();
   app.add_option("--markdown", markdown_path, "also write the tables to this file");
-  app.add_option("--pictures", pictures_dir, "write range and second-viewpoint pictures here");
+  std::string random_seeds;
+  RandomSceneOptions scene_options;
+  app.add_option(
+      "--random-seeds", random_seeds,
+      "instead of --scenes: the random scenes of these seeds (A..B, or N = 1..N; "
+      "scanner/random_scene.h), the gradient fill against Laplace, the distribution over the seeds");
+  app.add_option("--random-columns", scene_options.columns, "random scenes: columns")->capture_default_str();
+  app.add_option("--random-rows", scene_options.rows, "random scenes: rows")->capture_default_str();
+  app.add_option("--pictures", pictures_dir,
+                 "write range and second-viewpoint pictures here (random scenes: of the worst seeds)");
   app.add_option("--patch-radius", base.patch_radius)->capture_default_str();
   app.add_option("--window", base.search_window_radius)->capture_default_str();
   app.add_option("--color-weight", base.color_weight)->capture_default_str();
@@ -139,6 +350,12 @@ int main(int argc, char** argv) {
     if (!priority.empty()) base.priority = ParseEnum<InpaintPriorityKind>(priority);
     if (!search.empty()) base.search = ParseEnum<InpaintSearchKind>(search);
     base.Check();
+    if (!random_seeds.empty()) {
+      const std::vector<uint64_t> seeds = test_scenes::ParseSeedRange(random_seeds);
+      scene_options.Check();
+      if (!pictures_dir.empty()) std::filesystem::create_directories(pictures_dir);
+      return RunRandom(seeds, scene_options, base, margin, pictures_dir, markdown_path);
+    }
   } catch (const std::exception& error) {
     fmt::print(stderr, "fill_eval: {}\n", error.what());
     return 2;
@@ -256,37 +473,8 @@ int main(int argc, char** argv) {
       worse_than_laplace.push_back(stem);
     }
     if (!pictures_dir.empty()) {
-      // Range before / after / truth, same colour scale; a second viewpoint of truth, laplace and gradient.
-      const double lo = 0.0, hi = scene.scanner.max_range_m * 0.5;
-      std::vector<cv::Mat> row1 = {Labelled(RangePicture(with_object, lo, hi), "scan"),
-                                   Labelled(RangePicture(truth, lo, hi), "truth (no object)")};
-      std::vector<cv::Mat> row2;
-      const PointViewOptions view = [&] {
-        PointViewOptions v = SideView(truth, hole, 35.0);
-        v.width_px = 480;
-        v.height_px = 360;
-        return v;
-      }();
-      row2.push_back(Labelled(RenderPointView(truth, view), "truth, second viewpoint"));
-      for (const std::string& name :
-           {std::string("laplace"), std::string("depth-patch"), std::string("gradient")}) {
-        if (!results.count(name)) continue;
-        row1.push_back(Labelled(RangePicture(results.at(name).scan, lo, hi), name));
-        PointViewOptions tinted = view;
-        tinted.synthesized_tint = 0.0;
-        row2.push_back(Labelled(RenderPointView(results.at(name).scan, tinted), name + ", second viewpoint"));
-      }
-      std::vector<cv::Mat> row3 = {Labelled(RangePicture(with_object, lo, hi), "hole: |error| 0..0.5 m")};
-      for (const auto& [name, result] : results)
-        row3.push_back(Labelled(ErrorPicture(result.scan, truth, hole), name));
-      cv::Mat errors;
-      cv::hconcat(row3, errors);
-      WriteImage(pictures_dir + "/" + stem + "_error.png", errors);
-      cv::Mat top, bottom;
-      cv::hconcat(row1, top);
-      cv::hconcat(row2, bottom);
-      WriteImage(pictures_dir + "/" + stem + "_range.png", top);
-      WriteImage(pictures_dir + "/" + stem + "_view.png", bottom);
+      WritePictures(pictures_dir, stem, with_object, truth, hole, results, 0.0,
+                    scene.scanner.max_range_m * 0.5);
     }
   }
   emit(

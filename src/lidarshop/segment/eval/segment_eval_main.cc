@@ -1,11 +1,18 @@
 // segment_eval: quality of the two-step segmentation against its baselines on the synthetic evaluation set.
 //
 //   segment_eval [--scenes DIR] [--seeds N] [--model histogram|gmm|both] [--markdown FILE]
+//   segment_eval --random-seeds 1..100 [--markdown FILE] [--dump DIR]
 //
 // Every data/segment_eval/*.json scene is scanned with the synthetic scanner (scanner/scanner.h); the target
 // object is label 1. For each stroke seed, one short stroke inside the eroded object and one in the
 // background are drawn (MakeEvalStrokes) and every method runs on the same strokes. Prints per-scene IoU and
 // the mean IoU, precision and recall of every method; with --markdown, writes the tables there too.
+//
+// --random-seeds: instead, the random scenes of those seeds (scanner/random_scene.h, 400 x 300 cells), the
+// target their target_label; one stroke on the target's upper part and one on the background below it
+// (EvalStrokeOptions::upper_and_below, stroke seed 7919 · seed + 1); the two-step cut and grabCut on the same
+// strokes. Prints a row per seed and the distribution (mean, 5th percentile, worst seed); --dump writes the
+// pictures of the three worst seeds.
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
@@ -17,10 +24,139 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/segment/segment_eval.h"
+#include "lidarshop/testing/random_eval.h"
+#include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/timer.h"
 
 using namespace lidarshop;
+
+namespace {
+
+// Step 1 with the inferred background and the final cut; the truth and grabCut; the two-step errors (missed
+// object cells red, extra cells blue).
+cv::Mat Panel(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes, const SegmentOptions& options,
+              int grabcut_iterations) {
+  SegmentOptions o = options;
+  o.method = SegmentMethod::kTwoStep;
+  const SegmentResult r = SegmentObject(scan, strokes, o);
+  cv::Mat step1 = SegmentOverlay(scan, r.step1_mask, strokes);
+  step1.setTo(cv::Scalar(255, 0, 255), r.inferred_background);
+  cv::Mat row1, row2;
+  cv::hconcat(step1, SegmentOverlay(scan, r.mask, strokes), row1);
+  cv::hconcat(SegmentOverlay(scan, truth, strokes),
+              SegmentOverlay(scan, GrabCutFromStrokes(scan, strokes, grabcut_iterations), strokes), row2);
+  cv::Mat errors(scan.rows, scan.cols, CV_8UC3, cv::Scalar(60, 60, 60));
+  errors.setTo(cv::Scalar(200, 200, 200), truth & r.mask);
+  errors.setTo(cv::Scalar(255, 0, 0), truth & ~r.mask);
+  errors.setTo(cv::Scalar(0, 80, 255), r.mask & ~truth & (scan.valid != 0));
+  cv::Mat row3;
+  cv::resize(errors, row3, row1.size(), 0, 0, cv::INTER_NEAREST);
+  cv::Mat both;
+  cv::vconcat(std::vector<cv::Mat>{row1, row2, row3}, both);
+  return both;
+}
+
+int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
+              const SegmentOptions& options, int grabcut_iterations, const std::string& dump_dir,
+              const std::string& markdown_path) {
+  std::string report;
+  auto emit = [&](const std::string& text) {
+    fmt::print("{}", text);
+    std::fflush(stdout);
+    report += text;
+  };
+  emit(fmt::format(
+      "\n### Random scenes: seeds {}..{} ({} x {} cells; strokes on the target's upper part and the "
+      "background below it; * = the target coloured like its background)\n\n| seed | target | distance m | "
+      "target cells | two-step IoU | grabCut IoU | two-step s |\n"
+      "|---|---|---|---|---|---|---|\n",
+      seeds.front(), seeds.back(), scene_options.columns, scene_options.rows));
+  EvalStrokeOptions stroke_options;
+  stroke_options.upper_and_below = true;
+  std::vector<double> two_step, grabcut;
+  std::vector<bool> like_background;
+  std::vector<uint64_t> scored;
+  std::vector<uint64_t> no_room;
+  double seconds = 0;
+  for (uint64_t seed : seeds) {
+    const SceneDescription scene = RandomScene(seed, scene_options);
+    const Scan scan = SynthesizeScan(scene);
+    const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
+    cv::Mat strokes;
+    try {
+      strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
+    } catch (const InputError&) {
+      no_room.push_back(seed);
+      emit(fmt::format("| {} | {} | {:.1f} | {} | no room for strokes | | |\n", seed,
+                       test_scenes::TargetColumn(scene), test_scenes::TargetDistance(scene),
+                       cv::countNonZero(truth)));
+      continue;
+    }
+    SegmentOptions o = options;
+    o.method = SegmentMethod::kTwoStep;
+    Timer timer;
+    const SegmentResult result = SegmentObject(scan, strokes, o);
+    const double s = timer.Seconds();
+    seconds += s;
+    const double iou = ScoreMask(result.mask, truth, scan.valid).iou;
+    const double grabcut_iou =
+        grabcut_iterations > 0
+            ? ScoreMask(GrabCutFromStrokes(scan, strokes, grabcut_iterations), truth, scan.valid).iou
+            : 0.0;
+    two_step.push_back(iou);
+    grabcut.push_back(grabcut_iou);
+    scored.push_back(seed);
+    like_background.push_back(test_scenes::TargetColouredLikeBackground(scene));
+    emit(fmt::format("| {} | {} | {:.1f} | {} | {:.3f} | {:.3f} | {:.2f} |\n", seed,
+                     test_scenes::TargetColumn(scene), test_scenes::TargetDistance(scene),
+                     cv::countNonZero(truth), iou, grabcut_iou, s));
+  }
+  if (scored.empty()) {
+    fmt::print(stderr, "segment_eval: no random scene had room for strokes\n");
+    return 1;
+  }
+  emit("\n| method | mean IoU | 5th percentile | worst IoU (seed) | scenes |\n|---|---|---|---|---|\n");
+  for (const auto& [name, values] :
+       {std::pair<std::string, const std::vector<double>*>{"two-step", &two_step}, {"grabcut", &grabcut}}) {
+    if (name == "grabcut" && grabcut_iterations == 0) continue;
+    const test_scenes::SeedDistribution d = test_scenes::Distribute(*values, scored, true);
+    emit(fmt::format("| {} | {:.3f} | {:.3f} | {:.3f} ({}) | {} |\n", name, d.mean, d.p5, d.worst,
+                     d.worst_seed, values->size()));
+  }
+  int better = 0;
+  for (size_t i = 0; i < scored.size(); ++i) better += grabcut[i] > two_step[i] + 0.01;
+  emit(
+      fmt::format("\nTwo-step total {:.1f} s. Scenes where grabCut beats two-step by more than 0.01 IoU: {} "
+                  "of {}. Scenes "
+                  "without room for strokes: {}.\n",
+                  seconds, better, scored.size(),
+                  no_room.empty() ? "none" : fmt::format("{}", fmt::join(no_room, ", "))));
+  emit(fmt::format(
+      "Targets coloured like their background (*): two-step {}, grabCut {}. The others: two-step {}, grabCut "
+      "{}.\n",
+      test_scenes::MeanWhere(two_step, like_background, true),
+      test_scenes::MeanWhere(grabcut, like_background, true),
+      test_scenes::MeanWhere(two_step, like_background, false),
+      test_scenes::MeanWhere(grabcut, like_background, false)));
+  if (!dump_dir.empty()) {
+    for (size_t i : test_scenes::WorstIndices(two_step, 3, true)) {
+      const SceneDescription scene = RandomScene(scored[i], scene_options);
+      const Scan scan = SynthesizeScan(scene);
+      const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
+      const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, scored[i] * 7919 + 1, stroke_options);
+      WriteImage(fmt::format("{}/random_{}.png", dump_dir, scored[i]),
+                 Panel(scan, truth, strokes, options, grabcut_iterations));
+    }
+  }
+  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  return 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"Segmentation quality on the synthetic evaluation set (two-step vs baselines)"};
@@ -33,6 +169,13 @@ int main(int argc, char** argv) {
   app.add_option("--model", model, "histogram | gmm | both")->capture_default_str();
   app.add_option("--grabcut-iterations", grabcut_iterations, "0 = skip grabCut")->capture_default_str();
   app.add_option("--markdown", markdown_path, "also write the tables to this file");
+  std::string random_seeds;
+  RandomSceneOptions scene_options;
+  app.add_option("--random-seeds", random_seeds,
+                 "instead of --scenes: the random scenes of these seeds (A..B, or N = 1..N; "
+                 "scanner/random_scene.h), two-step against grabCut, the distribution over the seeds");
+  app.add_option("--random-columns", scene_options.columns, "random scenes: columns")->capture_default_str();
+  app.add_option("--random-rows", scene_options.rows, "random scenes: rows")->capture_default_str();
   // Tuning knobs (the defaults are SegmentOptions').
   app.add_option("--depth-smoothness", options.depth_step.smoothness);
   app.add_option("--depth-bias", options.depth_step.foreground_bias);
@@ -77,7 +220,9 @@ int main(int argc, char** argv) {
                "no separation of touching neighbours");
   bool eight = false;
   std::string dump_dir;
-  app.add_option("--dump", dump_dir, "write overlays (step 1 + inferred background, final, grabCut) here");
+  app.add_option("--dump", dump_dir,
+                 "write overlays (step 1 + inferred background, final, grabCut) here (random scenes: of the "
+                 "three worst seeds)");
   app.add_flag("--eight", eight);
   CLI11_PARSE(app, argc, argv);
   if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
@@ -86,6 +231,16 @@ int main(int argc, char** argv) {
   options.color_step.median_sigma = options.color_step.median_sigma || color_median;
   options.eight_connected = eight;
   options.Check();
+  if (!random_seeds.empty()) {
+    try {
+      const std::vector<uint64_t> seeds = test_scenes::ParseSeedRange(random_seeds);
+      scene_options.Check();
+      return RunRandom(seeds, scene_options, options, grabcut_iterations, dump_dir, markdown_path);
+    } catch (const std::exception& error) {
+      fmt::print(stderr, "segment_eval: {}\n", error.what());
+      return 2;
+    }
+  }
 
   std::vector<std::string> scene_paths;
   for (const auto& entry : std::filesystem::directory_iterator(scenes_dir)) {
@@ -121,24 +276,7 @@ int main(int argc, char** argv) {
         const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, static_cast<uint64_t>(seed) * 7919 + 1);
         if (!dump_dir.empty()) {
           const std::string stem = std::filesystem::path(path).stem().string();
-          SegmentOptions o = options;
-          o.method = SegmentMethod::kTwoStep;
-          const SegmentResult r = SegmentObject(scan, strokes, o);
-          cv::Mat step1 = SegmentOverlay(scan, r.step1_mask, strokes);
-          step1.setTo(cv::Scalar(255, 0, 255), r.inferred_background);
-          cv::Mat row1, row2;
-          cv::hconcat(step1, SegmentOverlay(scan, r.mask, strokes), row1);
-          cv::hconcat(SegmentOverlay(scan, truth, strokes),
-                      SegmentOverlay(scan, GrabCutFromStrokes(scan, strokes), strokes), row2);
-          // Third row: the two-step errors, missed object cells red and extra cells blue, enlarged 2x.
-          cv::Mat errors(scan.rows, scan.cols, CV_8UC3, cv::Scalar(60, 60, 60));
-          errors.setTo(cv::Scalar(200, 200, 200), truth & r.mask);
-          errors.setTo(cv::Scalar(255, 0, 0), truth & ~r.mask);
-          errors.setTo(cv::Scalar(0, 80, 255), r.mask & ~truth & (scan.valid != 0));
-          cv::Mat row3;
-          cv::resize(errors, row3, row1.size(), 0, 0, cv::INTER_NEAREST);
-          cv::Mat both;
-          cv::vconcat(std::vector<cv::Mat>{row1, row2, row3}, both);
+          const cv::Mat both = Panel(scan, truth, strokes, options, 5);
           WriteImage(dump_dir + "/" + stem + (seed == 1 ? "" : "_seed" + std::to_string(seed)) + ".png",
                      both);
         }
