@@ -1,5 +1,9 @@
 #include "lidarshop/fill/fill.h"
 
+#include <stdexcept>
+#include <string>
+#include <utility>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -161,19 +165,19 @@ TEST(RangeGradient, PoissonWithNoDataCellsReconstructsARampExactly) {
 }
 
 // The wall scene seen over 160 degrees at the same angular step: the box's hole is a small part of the scan.
-constexpr const char* kWideWallScene = R"({
-  "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-80, 80], "elevation_deg": [-20, 10], "columns": 640,
-              "rows": 120, "max_range": 40, "los_noise_sigma": 0.002, "seed": 5},
-  "objects": [
-    {"primitive": "plane", "size": [60, 60], "translate": [0, 15, 0], "label": 0, "texture": "grass"},
-    {"primitive": "wall", "size": [12, 0.3, 2.5], "translate": [0, 7, 0], "label": 2, "texture": "brick",
-     "color": [158, 68, 48]},
-    {"primitive": "box", "size": [0.8, 0.5, 1.2], "translate": [0.2, 4.5, 0.6], "label": 1, "color": [40, 60, 200]}
-  ]
-})";
+std::string WideWallScene() {
+  std::string json = kWallScene;
+  for (auto [from, to] : {std::pair{R"("azimuth_deg": [-20, 20])", R"("azimuth_deg": [-80, 80])"},
+                          std::pair{R"("columns": 160)", R"("columns": 640)"}}) {
+    const size_t at = json.find(from);
+    if (at == std::string::npos) throw std::logic_error(std::string("kWallScene has no ") + from);
+    json.replace(at, std::string(from).size(), to);
+  }
+  return json;
+}
 
 TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
-  const Case c = MakeCase(kWideWallScene, 2);
+  const Case c = MakeCase(WideWallScene().c_str(), 2);
   const int64_t hole_cells = cv::countNonZero(c.hole);
   ASSERT_GT(hole_cells, 500);
   FillOptions options;
@@ -217,7 +221,7 @@ TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
 }
 
 TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
-  const Case c = MakeCase(kWideWallScene, 2);
+  const Case c = MakeCase(WideWallScene().c_str(), 2);
   FillOptions options;
   options.window_min_margin_cells = 64;
   options.window_min_known_ratio = 1e5;  // more than the whole scan holds: the window becomes the scan
