@@ -290,6 +290,8 @@ int RunRecolor(int argc, char** argv) {
                                         scan_index, file.images.size(), scan_path));
           PhotosRecolorOptions photo_options;
           photo_options.visibility = options;
+          // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
+          if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
           const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
           WriteScanFile(output, {result.scan});
           if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
