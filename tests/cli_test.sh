@@ -116,6 +116,18 @@ json_check "info --stats keys" "$work/info.json" \
    d['scans'][0]['rows'] == 120 and d['scans'][0]['cols'] == 180 and 0 < d['scans'][0]['valid'] <= 120 * 180 and \
    len(d['scans'][0]['world_from_scanner']) == 4 and abs(d['scans'][0]['world_from_scanner'][2][3] - 1.5) < 1e-6"
 
+# formats: the registry the convert warnings come from, as JSON and as the docs' table.
+check "formats --json" sh -c "'$lidarshop' formats --json - >'$work/formats.json'"
+json_check "formats lists every format read, LAZ not written" "$work/formats.json" \
+  "[f['extension'] for f in d['formats']] == ['ptx', 'e57', 'ply', 'pcd', 'las', 'laz', 'xyz', 'pts'] and \
+   [f['extension'] for f in d['formats'] if not f['write']] == ['laz'] and \
+   next(f for f in d['formats'] if f['extension'] == 'las')['label'] == 'classification'"
+check "formats --markdown is the docs' table" sh -c "'$lidarshop' formats --markdown >'$work/formats.md'"
+check "the docs hold that table, one row per format" python3 -c \
+  "import sys; t = open(sys.argv[1]).read(); assert t.count('\n') == 10 and t in open(sys.argv[2]).read()" \
+  "$work/formats.md" "$(dirname "$0")/../docs/file-formats.md"
+exits_with 2 "formats: an unknown option" "formats" "$lidarshop" formats --csv
+
 # convert: every format keeps every return.
 valid=$(python3 -c "import json; print(json.load(open('$work/info.json'))['scans'][0]['valid'])")
 for format in e57 ply pcd las xyz pts; do

@@ -383,14 +383,24 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
   }
 }
 
-void Save(Document& document, const httplib::Request& request, httplib::Response& response) {
+// The written format the request asks for (`format`, E57 by default), or nullptr after a 400 naming the
+// formats the library writes.
+const ScanFormatInfo* RequestedWriteFormat(const httplib::Request& request, httplib::Response& response) {
   const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
-  const std::vector<std::string> formats = SupportedScanWriteExtensions();
-  if (std::find(formats.begin(), formats.end(), format) == formats.end()) {
+  const ScanFormatInfo* info = FindScanFormat(format);
+  if (info == nullptr || !info->write) {
     SendError(response, 400,
-              fmt::format("format '{}': expected one of {}", format, fmt::join(formats, ", ")));
-    return;
+              fmt::format("format '{}': expected one of {}", format.substr(0, 32),
+                          fmt::join(SupportedScanWriteExtensions(), ", ")));
+    return nullptr;
   }
+  return info;
+}
+
+void Save(Document& document, const httplib::Request& request, httplib::Response& response) {
+  const ScanFormatInfo* info = RequestedWriteFormat(request, response);
+  if (info == nullptr) return;
+  const std::string format(info->extension);
   // The writers take a path: the file goes through a folder of its own that only this user can enter
   // (mkdtemp: a new, unpredictable name, mode 0700), so no other user can pre-create it, follow a symlink
   // into it, or read the scan while it is written.
@@ -413,8 +423,8 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
     std::lock_guard lock(document.mutex);
     if (document.now.behind.valid.empty()) {
       WriteScanFile(file.string(), {document.now.scan});
-    } else if (const ScanFormatInfo& info = *FindScanFormat(format); !info.layer_behind) {
-      SendError(response, 400, LayerBehindRefusal(info));
+    } else if (!info->layer_behind) {
+      SendError(response, 400, LayerBehindRefusal(*info));
       return;
     } else {
       WriteScanWithLayer(file.string(), document.now.scan, document.now.behind);
@@ -431,14 +441,9 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
 // save so that the editor can warn: {"format", "channels", "dropped", "refused"}; "refused" is the reason a
 // save in that format would fail ("" when it would not).
 void SavePlan(Document& document, const httplib::Request& request, httplib::Response& response) {
-  const std::string format = request.has_param("format") ? request.get_param_value("format") : "e57";
-  const ScanFormatInfo* info = FindScanFormat(format);
-  if (info == nullptr || !info->write) {
-    SendError(response, 400,
-              fmt::format("format '{}': expected one of {}", format.substr(0, 32),
-                          fmt::join(SupportedScanWriteExtensions(), ", ")));
-    return;
-  }
+  const ScanFormatInfo* info = RequestedWriteFormat(request, response);
+  if (info == nullptr) return;
+  const std::string format(info->extension);
   std::lock_guard lock(document.mutex);
   const bool layer = !document.now.behind.valid.empty();
   const ScanWritePlan plan = PlanScanWrite(

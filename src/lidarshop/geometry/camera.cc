@@ -1,14 +1,14 @@
 #include "lidarshop/geometry/camera.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/geometry/camera_json.h"
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 
 namespace lidarshop {
 
@@ -120,7 +120,7 @@ std::string CameraToJson(const PinholeCamera& camera) {
   return json.dump(2) + "\n";
 }
 
-namespace {
+namespace camera_json {
 
 double NumberField(const nlohmann::json& object, const char* key, const std::string& what, bool required) {
   const auto it = object.find(key);
@@ -131,6 +131,30 @@ double NumberField(const nlohmann::json& object, const char* key, const std::str
   if (!it->is_number()) ThrowInputError(what, "", key, "expected a number");
   return it->get<double>();
 }
+
+Eigen::Matrix4d WorldFromCamera(const nlohmann::json& object, const std::string& what) {
+  const auto pose = object.find("world_from_camera");
+  if (pose == object.end()) ThrowInputError(what, "", "world_from_camera", "missing");
+  if (!pose->is_array() || pose->size() != 4)
+    ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
+  Eigen::Matrix4d matrix;
+  for (int r = 0; r < 4; ++r) {
+    const nlohmann::json& row = (*pose)[r];
+    if (!row.is_array() || row.size() != 4)
+      ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
+    for (int c = 0; c < 4; ++c) {
+      if (!row[c].is_number()) ThrowInputError(what, "", "world_from_camera", "expected numbers");
+      matrix(r, c) = row[c].get<double>();
+    }
+  }
+  return matrix;
+}
+
+}  // namespace camera_json
+
+namespace {
+
+using camera_json::NumberField;
 
 }  // namespace
 
@@ -168,30 +192,12 @@ PinholeCamera ParseCameraJson(const std::string& json_text, const std::string& w
     camera.p1 = NumberField(d, "p1", what + ": distortion", false);
     camera.p2 = NumberField(d, "p2", what + ": distortion", false);
   }
-  const auto pose = json.find("world_from_camera");
-  if (pose == json.end()) ThrowInputError(what, "", "world_from_camera", "missing");
-  if (!pose->is_array() || pose->size() != 4)
-    ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
-  for (int r = 0; r < 4; ++r) {
-    const nlohmann::json& row = (*pose)[r];
-    if (!row.is_array() || row.size() != 4)
-      ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
-    for (int c = 0; c < 4; ++c) {
-      if (!row[c].is_number()) ThrowInputError(what, "", "world_from_camera", "expected numbers");
-      camera.world_from_camera(r, c) = row[c].get<double>();
-    }
-  }
+  camera.world_from_camera = camera_json::WorldFromCamera(json, what);
   camera.Check(what);
   return camera;
 }
 
-PinholeCamera ReadCameraJson(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) ThrowInputError(path, "", "", "cannot open the file");
-  std::stringstream text;
-  text << stream.rdbuf();
-  return ParseCameraJson(text.str(), path);
-}
+PinholeCamera ReadCameraJson(const std::string& path) { return ParseCameraJson(ReadRegularFile(path), path); }
 
 void WriteCameraJson(const std::string& path, const PinholeCamera& camera) {
   const std::string text = CameraToJson(camera);

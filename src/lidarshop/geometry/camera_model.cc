@@ -1,15 +1,15 @@
 #include "lidarshop/geometry/camera_model.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/geometry/camera_json.h"
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/input_file.h"
 #include "lidarshop/util/json_input.h"
 
 namespace lidarshop {
@@ -279,39 +279,13 @@ std::string CameraModelToJson(const Camera& camera) {
 
 namespace {
 
-double Number(const nlohmann::json& object, const char* key, const std::string& what, bool required) {
-  const auto it = object.find(key);
-  if (it == object.end()) {
-    if (required) ThrowInputError(what, "", key, "missing");
-    return 0.0;
-  }
-  if (!it->is_number()) ThrowInputError(what, "", key, "expected a number");
-  return it->get<double>();
-}
+using camera_json::NumberField;
 
 int Size(const nlohmann::json& json, const char* key, const std::string& what) {
-  const double value = Number(json, key, what, true);
+  const double value = NumberField(json, key, what, true);
   if (value != std::floor(value) || value < 1 || value > 1e6)
     ThrowInputError(what, "", key, fmt::format("expected a whole number in [1, 1e6], got {}", value));
   return static_cast<int>(value);
-}
-
-Eigen::Matrix4d Pose(const nlohmann::json& json, const std::string& what) {
-  const auto pose = json.find("world_from_camera");
-  if (pose == json.end()) ThrowInputError(what, "", "world_from_camera", "missing");
-  if (!pose->is_array() || pose->size() != 4)
-    ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
-  Eigen::Matrix4d matrix;
-  for (int r = 0; r < 4; ++r) {
-    const nlohmann::json& row = (*pose)[r];
-    if (!row.is_array() || row.size() != 4)
-      ThrowInputError(what, "", "world_from_camera", "expected 4 rows of 4 numbers");
-    for (int c = 0; c < 4; ++c) {
-      if (!row[c].is_number()) ThrowInputError(what, "", "world_from_camera", "expected numbers");
-      matrix(r, c) = row[c].get<double>();
-    }
-  }
-  return matrix;
 }
 
 }  // namespace
@@ -334,16 +308,16 @@ Camera ParseCameraModelJson(const std::string& json_text, const std::string& wha
   if (camera.model == CameraModel::kPinhole) return CameraFromPinhole(ParseCameraJson(json_text, what));
   camera.pinhole.width_px = Size(json, "width_px", what);
   camera.pinhole.height_px = Size(json, "height_px", what);
-  camera.world_from_camera = Pose(json, what);
+  camera.world_from_camera = camera_json::WorldFromCamera(json, what);
   switch (camera.model) {
     case CameraModel::kPinhole:
       break;
     case CameraModel::kFisheye:
-      camera.pinhole.fx_px = Number(json, "fx_px", what, true);
-      camera.pinhole.fy_px = Number(json, "fy_px", what, true);
-      camera.pinhole.cx_px = Number(json, "cx_px", what, true);
-      camera.pinhole.cy_px = Number(json, "cy_px", what, true);
-      camera.pinhole.skew_px = Number(json, "skew_px", what, false);
+      camera.pinhole.fx_px = NumberField(json, "fx_px", what, true);
+      camera.pinhole.fy_px = NumberField(json, "fy_px", what, true);
+      camera.pinhole.cx_px = NumberField(json, "cx_px", what, true);
+      camera.pinhole.cy_px = NumberField(json, "cy_px", what, true);
+      camera.pinhole.skew_px = NumberField(json, "skew_px", what, false);
       if (const auto d = json.find("distortion"); d != json.end()) {
         if (!d->is_object()) ThrowInputError(what, "", "distortion", "expected an object {k1, k2, k3, k4}");
         for (const auto& [key, value] : d->items()) {
@@ -352,18 +326,19 @@ Camera ParseCameraModelJson(const std::string& json_text, const std::string& wha
                             fmt::format("'{}' is not a fisheye coefficient (k1, k2, k3, k4)", key));
         }
         const char* keys[] = {"k1", "k2", "k3", "k4"};
-        for (int i = 0; i < 4; ++i) camera.fisheye_k[i] = Number(*d, keys[i], what + ": distortion", false);
+        for (int i = 0; i < 4; ++i)
+          camera.fisheye_k[i] = NumberField(*d, keys[i], what + ": distortion", false);
       }
       break;
     case CameraModel::kSpherical:
-      camera.pixel_width_rad = Number(json, "pixel_width_rad", what, true);
-      camera.pixel_height_rad = Number(json, "pixel_height_rad", what, true);
+      camera.pixel_width_rad = NumberField(json, "pixel_width_rad", what, true);
+      camera.pixel_height_rad = NumberField(json, "pixel_height_rad", what, true);
       break;
     case CameraModel::kCylindrical:
-      camera.pixel_width_rad = Number(json, "pixel_width_rad", what, true);
-      camera.pixel_height_m = Number(json, "pixel_height_m", what, true);
-      camera.radius_m = Number(json, "radius_m", what, true);
-      camera.principal_y_px = Number(json, "principal_y_px", what, true);
+      camera.pixel_width_rad = NumberField(json, "pixel_width_rad", what, true);
+      camera.pixel_height_m = NumberField(json, "pixel_height_m", what, true);
+      camera.radius_m = NumberField(json, "radius_m", what, true);
+      camera.principal_y_px = NumberField(json, "principal_y_px", what, true);
       break;
   }
   camera.Check(what);
@@ -371,11 +346,7 @@ Camera ParseCameraModelJson(const std::string& json_text, const std::string& wha
 }
 
 Camera ReadCameraModelJson(const std::string& path) {
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) ThrowInputError(path, "", "", "cannot open the file");
-  std::stringstream text;
-  text << stream.rdbuf();
-  return ParseCameraModelJson(text.str(), path);
+  return ParseCameraModelJson(ReadRegularFile(path), path);
 }
 
 void WriteCameraModelJson(const std::string& path, const Camera& camera) {

@@ -213,6 +213,21 @@ TEST(CameraModel, JsonErrorsNameTheField) {
                         "pixel_height_rad": 0.1})")
                 .find("'world_from_camera': missing"),
             std::string::npos);
+  // The shared pose reader (geometry/camera_json.h): a row of the wrong length is named too.
+  EXPECT_NE(message(R"({"model": "spherical", "width_px": 4, "height_px": 3, "pixel_width_rad": 0.1,
+                        "pixel_height_rad": 0.1, "world_from_camera": [[1,0,0,0],[0,1,0],[0,0,1,0],[0,0,0,1]]})")
+                .find("'world_from_camera': expected 4 rows of 4 numbers"),
+            std::string::npos);
+  // Files: a missing one and a folder are refused naming the path (util/input_file.h), never read.
+  for (const std::string path : {std::string("/nonexistent/cam.json"), std::string("/tmp")}) {
+    try {
+      ReadCameraModelJson(path);
+      ADD_FAILURE() << path << " was read";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(path), std::string::npos) << error.what();
+    }
+    EXPECT_THROW(ReadCameraJson(path), InputError) << path;
+  }
   EXPECT_NE(message("{not json").find("cam.json"), std::string::npos);
 }
 

@@ -40,21 +40,36 @@ std::vector<CameraPhoto> Photos(const std::vector<StationPhoto>& station) {
   return photos;
 }
 
+// The recolouring scene (textured or plain) scanned over 160° x 100° — wider than the scene's own scanner, so
+// the front, left, right and down faces all see parts of the scan — and its cube map of 400² faces (seed 11).
+struct CubeStation {
+  SceneDescription scene;
+  Scan scan;
+  std::vector<StationPhoto> cube;
+};
+
+CubeStation WideCubeStation(bool textured) {
+  CubeStation station{test_scenes::MakeRecolorScene(textured, 150, 225), {}, {}};
+  ScannerOptions& scanner = station.scene.scanner;
+  scanner.azimuth_min_deg = -80, scanner.azimuth_max_deg = 80;
+  scanner.elevation_min_deg = -70, scanner.elevation_max_deg = 30;
+  scanner.rows = 200, scanner.columns = 320;
+  station.scan = test_scenes::ScanScene(station.scene, scanner);
+  StationPhotoOptions photos;
+  photos.kind = StationPhotoKind::kCube;
+  photos.size_px = 400;
+  photos.seed = 11;
+  station.cube = RenderStationPhotos(station.scene, scanner, photos);
+  return station;
+}
+
 // The recolouring scene (ground, wall, box, pillar) scanned over 160° x 100°, its cube map at gains within ±30 %: each cell
 // coloured from a face that sees it, the colours at photo 0's exposure within 3 RGB units of the truth on
 // average, and better than without exposure equalisation; the fitted gains match the true ones.
 TEST(RecolorFromPhotos, CubeMapWithExposureDifferences) {
-  SceneDescription scene = test_scenes::MakeRecolorScene(false, 150, 225);
-  // Wider than the scene's own scanner: the front, left, right and down faces all see parts of the scan.
-  scene.scanner.azimuth_min_deg = -80, scene.scanner.azimuth_max_deg = 80;
-  scene.scanner.elevation_min_deg = -70, scene.scanner.elevation_max_deg = 30;
-  scene.scanner.rows = 200, scene.scanner.columns = 320;
-  const Scan scan = test_scenes::ScanScene(scene, scene.scanner);
-  StationPhotoOptions station;
-  station.kind = StationPhotoKind::kCube;
-  station.size_px = 400;
-  station.seed = 11;
-  const std::vector<StationPhoto> cube = RenderStationPhotos(scene, scene.scanner, station);
+  const CubeStation station = WideCubeStation(/*textured=*/false);
+  const Scan& scan = station.scan;
+  const std::vector<StationPhoto>& cube = station.cube;
   const PhotosRecolorResult result = RecolorFromPhotos(scan, Photos(cube));
   PhotosRecolorOptions naive_options;
   naive_options.equalize_exposure = false;
@@ -83,16 +98,9 @@ TEST(RecolorFromPhotos, CubeMapWithExposureDifferences) {
 // Textured (grass ground, brick wall): the gains still come back from the seams between faces, and the
 // equalised colours are nearer the truth than the naive ones (the error left is texture resampling).
 TEST(RecolorFromPhotos, TexturedCubeMap) {
-  SceneDescription scene = test_scenes::MakeRecolorScene(true, 150, 225);
-  scene.scanner.azimuth_min_deg = -80, scene.scanner.azimuth_max_deg = 80;
-  scene.scanner.elevation_min_deg = -70, scene.scanner.elevation_max_deg = 30;
-  scene.scanner.rows = 200, scene.scanner.columns = 320;
-  const Scan scan = test_scenes::ScanScene(scene, scene.scanner);
-  StationPhotoOptions station;
-  station.kind = StationPhotoKind::kCube;
-  station.size_px = 400;
-  station.seed = 11;
-  const std::vector<StationPhoto> cube = RenderStationPhotos(scene, scene.scanner, station);
+  const CubeStation station = WideCubeStation(/*textured=*/true);
+  const Scan& scan = station.scan;
+  const std::vector<StationPhoto>& cube = station.cube;
   const PhotosRecolorResult result = RecolorFromPhotos(scan, Photos(cube));
   PhotosRecolorOptions naive_options;
   naive_options.equalize_exposure = false;

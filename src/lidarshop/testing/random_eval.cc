@@ -3,15 +3,27 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
 #include <stdexcept>
 
 #include <fmt/format.h>
 #include <Eigen/Geometry>
 
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::test_scenes {
+
+void EvalReport::Emit(const std::string& text) {
+  fmt::print("{}", text);
+  std::fflush(stdout);
+  text_ += text;
+}
+
+void EvalReport::Write(const std::string& markdown_path) const {
+  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << text_; });
+}
 
 std::vector<uint64_t> ParseSeedRange(const std::string& text, const std::string& flag) {
   auto number = [&](const std::string& part) -> uint64_t {

@@ -11,6 +11,17 @@
 
 namespace lidarshop::test_scenes {
 
+// The tables an evaluation program prints as it goes (stdout, flushed per piece, so a long run shows its
+// progress) and writes whole to its --markdown file at the end (atomically; nothing when the path is empty).
+class EvalReport {
+ public:
+  void Emit(const std::string& text);
+  void Write(const std::string& markdown_path) const;
+
+ private:
+  std::string text_;
+};
+
 // "A..B" (A <= B, both >= 0) or "N" (= 1..N, N >= 1): the seeds in order. Throws OptionsError naming `flag`.
 std::vector<uint64_t> ParseSeedRange(const std::string& text, const std::string& flag = "--random-seeds");
 

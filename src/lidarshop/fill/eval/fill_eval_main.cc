@@ -161,12 +161,8 @@ void WritePictures(const std::string& dir, const std::string& stem, const Scan& 
 int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
               const FillOptions& base, int margin, const std::string& pictures_dir,
               const std::string& markdown_path) {
-  std::string report;
-  auto emit = [&](const std::string& text) {
-    fmt::print("{}", text);
-    std::fflush(stdout);
-    report += text;
-  };
+  test_scenes::EvalReport report;
+  auto emit = [&](const std::string& text) { report.Emit(text); };
   emit(fmt::format(
       "\n### Random scenes: seeds {}..{} ({} x {} cells; hole = the target's cells grown by {} cells; truth "
       "= the scene scanned without the target; * = the target coloured like its background)\n\n"
@@ -276,7 +272,7 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     emit(fmt::format("\nPictures (worst floating share, then worst RMSE ratio): seeds {}.\n",
                      fmt::join(worst, ", ")));
   }
-  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  report.Write(markdown_path);
   return 0;
 }
 
@@ -372,12 +368,8 @@ int main(int argc, char** argv) {
   if (!pictures_dir.empty()) std::filesystem::create_directories(pictures_dir);
   if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
 
-  std::string report;
-  auto emit = [&](const std::string& text) {
-    fmt::print("{}", text);
-    std::fflush(stdout);
-    report += text;
-  };
+  test_scenes::EvalReport report;
+  auto emit = [&](const std::string& text) { report.Emit(text); };
   emit(fmt::format(
       "Hole = the removed object's cells grown by {} cells; truth = the same scan without the object "
       "(same seed). Patch methods: mean over {} fill seeds. Patch radius {}, window {}, weights colour "
@@ -497,6 +489,6 @@ int main(int argc, char** argv) {
         mean(rmse_nonplanar["gradient"]) / std::max(1e-9, mean(rmse_nonplanar["laplace"])),
         worse_than_laplace.empty() ? "none" : fmt::format("{}", fmt::join(worse_than_laplace, ", "))));
   }
-  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  report.Write(markdown_path);
   return 0;
 }

@@ -63,12 +63,8 @@ cv::Mat Panel(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes, co
 int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
               const SegmentOptions& options, int grabcut_iterations, const std::string& dump_dir,
               const std::string& markdown_path) {
-  std::string report;
-  auto emit = [&](const std::string& text) {
-    fmt::print("{}", text);
-    std::fflush(stdout);
-    report += text;
-  };
+  test_scenes::EvalReport report;
+  auto emit = [&](const std::string& text) { report.Emit(text); };
   emit(fmt::format(
       "\n### Random scenes: seeds {}..{} ({} x {} cells; strokes on the target's upper part and the "
       "background below it; * = the target coloured like its background)\n\n| seed | target | distance m | "
@@ -152,7 +148,7 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
                  Panel(scan, truth, strokes, options, grabcut_iterations));
     }
   }
-  if (!markdown_path.empty()) WriteFileAtomically(markdown_path, [&](std::ostream& out) { out << report; });
+  report.Write(markdown_path);
   return 0;
 }
 
@@ -251,11 +247,8 @@ int main(int argc, char** argv) {
   if (model == "both" || model == "histogram") models.push_back(AppearanceModel::kHistogram);
   if (model == "both" || model == "gmm") models.push_back(AppearanceModel::kGmm);
 
-  std::string report;
-  auto emit = [&](const std::string& text) {
-    fmt::print("{}", text);
-    report += text;
-  };
+  test_scenes::EvalReport report;
+  auto emit = [&](const std::string& text) { report.Emit(text); };
   const std::vector<std::string> order = {"two-step", "step-1", "depth", "color", "rgbd", "grabcut"};
   for (AppearanceModel m : models) {
     options.model = m;
@@ -317,9 +310,6 @@ int main(int argc, char** argv) {
                        precision / v.size(), recall / v.size(), min_precision, v.size(), seconds[name]));
     }
   }
-  if (!markdown_path.empty()) {
-    std::ofstream out(markdown_path);
-    out << report;
-  }
+  report.Write(markdown_path);
   return 0;
 }
