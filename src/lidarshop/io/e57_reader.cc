@@ -1038,17 +1038,7 @@ E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& 
 
 E57File ReadE57(const std::string& path) {
   CheckRegularFile(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) ThrowInputError(path, "", "", "cannot determine the file size");
-  in.seekg(0);
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-    ThrowInputError(path, "", "", "read failed");
-  }
-  E57File file = ReadE57Bytes(bytes, path);
+  E57File file = e57::ReadLogical(path, e57::LogicalFromPageFile(path));
   // The same number checks as ReadScanFile: `info` and `images` read E57 files here directly.
   for (size_t i = 0; i < file.scans.size(); ++i) {
     io_internal::CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));
