@@ -7,6 +7,7 @@
 #include <Eigen/Dense>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/seam_blend.h"
 #include "lidarshop/recolor/visibility.h"
 #include "lidarshop/util/error.h"
 
@@ -16,11 +17,19 @@ void PhotosRecolorOptions::Check() const {
   visibility.Check();
   if (!(border_px >= 0 && border_px < 1e6))
     throw OptionsError(fmt::format("PhotosRecolorOptions.border_px must be in [0, 1e6), got {}", border_px));
+  if (!(seam_band_cells >= 1 && seam_band_cells <= 1000))
+    throw OptionsError(
+        fmt::format("PhotosRecolorOptions.seam_band_cells must be in [1, 1000], got {}", seam_band_cells));
+  if (!(seam_depth_jump_m >= 0 && seam_depth_jump_m < 1e6))
+    throw OptionsError(
+        fmt::format("PhotosRecolorOptions.seam_depth_jump_m must be in [0, 1e6), got {}", seam_depth_jump_m));
 }
 
 std::string PhotosRecolorResult::Summary() const {
-  return fmt::format("{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs", coloured,
-                     returns, gains.size(), constraints);
+  return fmt::format(
+      "{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs; {} seam edges, {} cells "
+      "blended in {:.2f} s",
+      coloured, returns, gains.size(), constraints, seam_edges, blended, blend_seconds);
 }
 
 namespace {
@@ -102,7 +111,9 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                                       camera.height_px() - seen.pixel.y()});
       const double border_factor =
           options.border_px > 0 ? std::min(1.0, (border + 0.5) / options.border_px) : 1;
-      const double score = cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
+      const double score = options.nearest_photo
+                               ? 1 / std::max(seen.distance_m, 1e-3)
+                               : cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
       samples[seen.cell].push_back({static_cast<int>(i), SamplePhoto(photos[i].image, seen.pixel)});
       if (score > best_score[seen.cell]) best_score[seen.cell] = score, best[seen.cell] = static_cast<int>(i);
     }
@@ -147,20 +158,77 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     }
   }
 
-  result.scan = Clone(scan);
-  Scan& out = result.scan;
-  if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  // The chosen colours at photo 0's exposure, then the seams blended.
+  const auto corrected = [&](const Sample& sample) {
+    const cv::Vec3d& gain = result.gains[sample.photo];
+    return cv::Vec3d(sample.rgb[0] / gain[0], sample.rgb[1] / gain[1], sample.rgb[2] / gain[2]);
+  };
+  cv::Mat colour(scan.rows, scan.cols, CV_64FC3, cv::Scalar::all(0));
   result.photo_index = cv::Mat::zeros(scan.rows, scan.cols, CV_16U);
   for (int64_t cell = 0; cell < cells; ++cell) {
     const Sample* sample = chosen(cell);
     if (sample == nullptr) continue;
     const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
-    const cv::Vec3d& gain = result.gains[sample->photo];
-    out.color.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uint8_t>(sample->rgb[0] / gain[0]),
-                                              cv::saturate_cast<uint8_t>(sample->rgb[1] / gain[1]),
-                                              cv::saturate_cast<uint8_t>(sample->rgb[2] / gain[2]));
+    colour.at<cv::Vec3d>(r, c) = corrected(*sample);
     result.photo_index.at<uint16_t>(r, c) = static_cast<uint16_t>(sample->photo + 1);
     ++result.coloured;
+  }
+  if (options.blend_seams) {
+    const auto sample_of = [&](int64_t cell, int photo) -> const Sample* {
+      for (const Sample& s : samples[cell]) {
+        if (s.photo == photo) return &s;
+      }
+      return nullptr;
+    };
+    const cv::Mat range = RangeImage(scan);
+    // The guidance from cell a to its neighbour b: their own difference when one photo colours both, else
+    // what the photos that see both show, else 0 on a continuous surface and the step across a depth jump.
+    const auto guidance = [&](int64_t a, int64_t b, int ra, int ca, int rb, int cb) -> cv::Vec3d {
+      const cv::Vec3d& ua = colour.at<cv::Vec3d>(ra, ca);
+      const cv::Vec3d& ub = colour.at<cv::Vec3d>(rb, cb);
+      if (best[a] == best[b]) return ub - ua;
+      cv::Vec3d sum(0, 0, 0);
+      int count = 0;
+      for (const int photo : {best[a], best[b]}) {
+        const Sample *sa = sample_of(a, photo), *sb = sample_of(b, photo);
+        if (sa == nullptr || sb == nullptr) continue;
+        sum += corrected(*sb) - corrected(*sa);
+        ++count;
+      }
+      if (count > 0) return sum / count;
+      const double da = range.at<float>(ra, ca), db = range.at<float>(rb, cb);
+      if (std::abs(da - db) > options.seam_depth_jump_m + 0.02 * std::min(da, db)) return ub - ua;
+      return cv::Vec3d(0, 0, 0);
+    };
+    cv::Mat gx(scan.rows, scan.cols, CV_64FC3, cv::Scalar::all(0)), gy = gx.clone();
+    for (int r = 0; r < scan.rows; ++r) {
+      for (int c = 0; c < scan.cols; ++c) {
+        const int64_t cell = static_cast<int64_t>(r) * scan.cols + c;
+        if (best[cell] < 0) continue;
+        if (c + 1 < scan.cols && best[cell + 1] >= 0)
+          gx.at<cv::Vec3d>(r, c) = guidance(cell, cell + 1, r, c, r, c + 1);
+        if (r + 1 < scan.rows && best[cell + scan.cols] >= 0)
+          gy.at<cv::Vec3d>(r, c) = guidance(cell, cell + scan.cols, r, c, r + 1, c);
+      }
+    }
+    const SeamBlendResult blended = BlendSeams(colour, result.photo_index, gx, gy, options.seam_band_cells);
+    colour = blended.colour;
+    result.seam_edges = blended.seam_edges;
+    result.blended = blended.unknowns;
+    result.blend_seconds = blended.seconds;
+  }
+
+  result.scan = Clone(scan);
+  Scan& out = result.scan;
+  if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (result.photo_index.at<uint16_t>(r, c) == 0) continue;
+      const cv::Vec3d& v = colour.at<cv::Vec3d>(r, c);
+      out.color.at<cv::Vec3b>(r, c) =
+          cv::Vec3b(cv::saturate_cast<uint8_t>(v[0]), cv::saturate_cast<uint8_t>(v[1]),
+                    cv::saturate_cast<uint8_t>(v[2]));
+    }
   }
   return result;
 }

@@ -12,8 +12,13 @@
 // meet there), log(v_i / g_i) = log(v_j / g_j) for each channel with both values in [8, 247] (not dark, not
 // saturated). Colours come out at photo 0's exposure: v / g. Photos no constraint reaches keep gain 1.
 //
-// Not done here (issue 32 item 3's rest): blending the seams in the gradient domain, white balance beyond the
-// per-channel gain, the CLI (`recolor --from-e57-images`).
+// Seams (recolor/seam_blend.h): where the chosen photo changes between 4-neighbour cells, the cells within
+// `seam_band_cells` of the change are solved again in the gradient domain (Poisson, on the scan's grid): the
+// guidance across an edge is the colour difference a photo that sees both cells shows there (the average of
+// both photos' when both do), else — a cube map's faces do not overlap — 0 on a continuous surface and the
+// colours' own step across a depth jump (more than `seam_depth_jump_m` + 2 % of the range apart).
+//
+// Not done here: white balance beyond the per-channel gain.
 #pragma once
 
 #include <cstdint>
@@ -42,9 +47,15 @@ struct PhotosRecolorOptions {
     options.edge_guard = false;
     return options;
   }();
-  double border_px = 16;          // pixels: closer to the border than this lowers a photo's score
-  bool equalize_exposure = true;  // fit and divide by the gains (false: the naive colours)
-  void Check() const;             // throws OptionsError
+  double border_px = 16;            // pixels: closer to the border than this lowers a photo's score
+  bool equalize_exposure = true;    // fit and divide by the gains (false: the naive colours)
+  bool blend_seams = true;          // gradient-domain blending of the seams between photos
+  int seam_band_cells = 12;         // cells each side of a seam solved again; >= 1
+  double seam_depth_jump_m = 0.05;  // a seam edge whose ranges differ by this + 2 % keeps its step
+  // The naive choice (the baseline of the evaluation): the photo whose camera is nearest the point, ties to
+  // the lowest index; no viewing angle, no border distance.
+  bool nearest_photo = false;
+  void Check() const;  // throws OptionsError
 };
 
 struct PhotosRecolorResult {
@@ -54,6 +65,9 @@ struct PhotosRecolorResult {
   int64_t returns = 0;           // valid cells
   int64_t coloured = 0;          // valid cells some photo saw
   int64_t constraints = 0;       // overlap pairs used to fit the gains
+  int64_t seam_edges = 0;        // 4-neighbour pairs of coloured cells coloured by different photos
+  int64_t blended = 0;           // cells solved again by the seam blending
+  double blend_seconds = 0;      // wall clock of the seam blending
   std::string Summary() const;   // one line
 };
 
