@@ -339,24 +339,20 @@ int RunRecolor(int argc, char** argv) {
           }
           const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
           const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
-          std::vector<CameraPhoto> photos;
+          const E57StationPhotos station = StationPhotosOfE57(file, scan_index);
+          const std::vector<CameraPhoto>& photos = station.photos;
           nlohmann::ordered_json used = nlohmann::ordered_json::array(),
                                  skipped = nlohmann::ordered_json::array();
-          for (size_t i = 0; i < file.images.size(); ++i) {
-            const E57Image& image = file.images[i];
-            Camera camera;
-            std::string why;
-            if (image.associated_scan >= 0 && image.associated_scan != scan_index) {
-              why = fmt::format("belongs to scan {}", image.associated_scan);
-            } else if (image.image.empty()) {
-              why = image.decode_error;
-            } else if (CameraModelOfE57Image(image, &camera, &why)) {
-              used.push_back({{"index", i}, {"name", image.name}, {"model", CameraModelName(camera.model)}});
-              photos.push_back({image.image, camera});
-              continue;
-            }
-            skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
+          for (size_t k = 0; k < photos.size(); ++k) {
+            const int i = station.image_index[k];
+            used.push_back({{"index", i},
+                            {"name", file.images[i].name},
+                            {"model", CameraModelName(photos[k].camera.model)}});
           }
+          for (const E57StationPhotos::Skipped& skip : station.skipped)
+            skipped.push_back({{"index", skip.image_index},
+                               {"name", file.images[skip.image_index].name},
+                               {"why", skip.why}});
           if (photos.empty())
             ThrowInputError(scan_path, "images2D", "",
                             fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "

@@ -28,6 +28,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera_model.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/scan/scan.h"
 
@@ -74,5 +75,19 @@ struct PhotosRecolorResult {
 // Throws InputError when a photo's image does not match its camera (naming the photo's index).
 PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,
                                       const PhotosRecolorOptions& options = {});
+
+// The photos of an E57 file that can colour its scan `scan_index` (`recolor --from-e57-images`): every
+// images2D entry that belongs to that scan (or to none), decodes, and holds a camera model
+// (io/e57_image_camera.h). The others are listed with the reason.
+struct E57StationPhotos {
+  std::vector<CameraPhoto> photos;
+  std::vector<int> image_index;  // per photo, its images2D index
+  struct Skipped {
+    int image_index = 0;
+    std::string why;
+  };
+  std::vector<Skipped> skipped;
+};
+E57StationPhotos StationPhotosOfE57(const E57File& file, int scan_index);
 
 }  // namespace lidarshop
