@@ -21,9 +21,9 @@ SeamBlendResult BlendSeams(const cv::Mat& colour, const cv::Mat& photo, const cv
                                   photo.rows, type, m.cols, m.rows, m.type()));
   };
   if (photo.type() != CV_16U || photo.empty()) ThrowInputError("BlendSeams", "", "photo", "expected CV_16U");
-  check(colour, CV_64FC3, "colour");
-  check(gx, CV_64FC3, "gx");
-  check(gy, CV_64FC3, "gy");
+  check(colour, CV_32FC3, "colour");
+  check(gx, CV_32FC3, "gx");
+  check(gy, CV_32FC3, "gy");
   if (band_cells < 1)
     ThrowInputError("BlendSeams", "", "band_cells", fmt::format("must be >= 1, got {}", band_cells));
   const auto start = std::chrono::steady_clock::now();
@@ -46,7 +46,23 @@ SeamBlendResult BlendSeams(const cv::Mat& colour, const cv::Mat& photo, const cv
       }
     }
   }
-  result.colour = colour.clone();
+  // The guidance must carry no flux out of the coloured cells (the caller's zeros, not copied: 10-megapoint
+  // grids) and the cells without colour must hold 0 (they are the no-data boundary).
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const bool here = photo.at<uint16_t>(r, c) != 0;
+      const bool right = here && c + 1 < cols && photo.at<uint16_t>(r, c + 1) != 0;
+      const bool down = here && r + 1 < rows && photo.at<uint16_t>(r + 1, c) != 0;
+      if ((!right && gx.at<cv::Vec3f>(r, c) != cv::Vec3f()) ||
+          (!down && gy.at<cv::Vec3f>(r, c) != cv::Vec3f()))
+        ThrowInputError("BlendSeams", fmt::format("cell ({}, {})", r, c), "gx/gy",
+                        "guidance on an edge that does not join two coloured cells must be 0");
+      if (!here && colour.at<cv::Vec3f>(r, c) != cv::Vec3f())
+        ThrowInputError("BlendSeams", fmt::format("cell ({}, {})", r, c), "colour",
+                        "a cell without a photo must hold 0");
+    }
+  }
+  result.colour = colour;
   if (result.seam_edges == 0) return result;
 
   // Ω: the coloured cells within the band.
@@ -73,23 +89,12 @@ SeamBlendResult BlendSeams(const cv::Mat& colour, const cv::Mat& photo, const cv
   result.unknowns = cv::countNonZero(band);
   if (result.unknowns == 0) return result;
 
-  // The guidance only between two coloured cells (edges to a cell without colour carry no flux).
-  cv::Mat gx_linked = gx.clone(), gy_linked = gy.clone();
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
-      const bool here = photo.at<uint16_t>(r, c) != 0;
-      if (!here || c + 1 >= cols || photo.at<uint16_t>(r, c + 1) == 0) gx_linked.at<cv::Vec3d>(r, c) = {};
-      if (!here || r + 1 >= rows || photo.at<uint16_t>(r + 1, c) == 0) gy_linked.at<cv::Vec3d>(r, c) = {};
-    }
-  }
   PoissonOptions options;
   options.solver = PoissonSolverKind::kDirect;  // no-data edges at Ω take the direct solver anyway
   PoissonLinks links;
   links.no_data = coloured == 0;
   const PoissonSystem system = PreparePoisson(band, options, links);
-  cv::Mat boundary = colour.clone();
-  boundary.setTo(cv::Scalar::all(0), links.no_data);
-  result.colour = SolvePoisson(system, boundary, BackwardDivergence(gx_linked, gy_linked)).image;
+  result.colour = SolvePoisson(system, colour, BackwardDivergence(gx, gy)).image;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
 }

@@ -24,10 +24,11 @@ struct SeamBlendResult {
   double seconds = 0;      // wall clock of the Poisson solve (preparation included)
 };
 
-// colour      rows x cols CV_64FC3: every coloured cell's colour (any units, e.g. RGB 0–255);
+// colour      rows x cols CV_32FC3: every coloured cell's colour (any units, e.g. RGB 0–255), 0 in the others;
 // photo       rows x cols CV_16U: 1 + the photo that coloured the cell, 0 = no colour;
-// gx, gy      rows x cols CV_64FC3: the guidance from a cell to its right / lower neighbour (as
-//             poisson/operators.h lays out ForwardGradient); read only between two coloured cells;
+// gx, gy      rows x cols CV_32FC3: the guidance from a cell to its right / lower neighbour (as
+//             poisson/operators.h lays out ForwardGradient); 0 on every edge that does not join two coloured
+//             cells (no flux there; checked);
 // band_cells  >= 1. Throws InputError when sizes or types differ.
 SeamBlendResult BlendSeams(const cv::Mat& colour, const cv::Mat& photo, const cv::Mat& gx, const cv::Mat& gy,
                            int band_cells);

@@ -1,6 +1,7 @@
 #include "lidarshop/recolor/station_recolor.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -30,8 +31,9 @@ void PhotosRecolorOptions::Check() const {
 std::string PhotosRecolorResult::Summary() const {
   return fmt::format(
       "{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs; {} seam edges, {} cells "
-      "blended in {:.2f} s",
-      coloured, returns, gains.size(), constraints, seam_edges, blended, blend_seconds);
+      "blended (occlusion scene {:.2f} s, visibility {:.2f} s, blending {:.2f} s)",
+      coloured, returns, gains.size(), constraints, seam_edges, blended, scene_seconds, visibility_seconds,
+      blend_seconds);
 }
 
 namespace {
@@ -81,7 +83,12 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                       photos[i].camera.width_px(), photos[i].camera.height_px(), image.cols, image.rows));
   }
   RaycastScene scene;
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   recolor_internal::BuildOcclusionScene(scan, options.visibility, &scene);
+  const double scene_seconds = since(start);
   const int64_t cells = static_cast<int64_t>(scan.rows) * scan.cols;
   const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
   const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
@@ -95,6 +102,8 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
   };
   std::vector<std::vector<PhotoSample>> seen_by(photos.size());
   PhotosRecolorResult result;
+  result.scene_seconds = scene_seconds;
+  const auto visibility_start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < photos.size(); ++i) {
     const Camera& camera = photos[i].camera;
     const Eigen::Vector3d center = camera.center_in_world();
@@ -128,6 +137,7 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
         },
         4096);
   }
+  result.visibility_seconds = since(visibility_start);
   // Per cell its samples, by photo index (compressed rows: `first[cell]` .. `first[cell + 1]`), and the best
   // photo (the highest score; a tie keeps the lower index).
   std::vector<int64_t> first(cells + 1, 0);
@@ -198,23 +208,24 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     const cv::Vec3d& gain = result.gains[sample.photo];
     return cv::Vec3d(sample.rgb[0] / gain[0], sample.rgb[1] / gain[1], sample.rgb[2] / gain[2]);
   };
-  cv::Mat colour(scan.rows, scan.cols, CV_64FC3, cv::Scalar::all(0));
+  cv::Mat colour(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
   result.photo_index = cv::Mat::zeros(scan.rows, scan.cols, CV_16U);
   for (int64_t cell = 0; cell < cells; ++cell) {
     const Sample* sample = chosen(cell);
     if (sample == nullptr) continue;
     const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
-    colour.at<cv::Vec3d>(r, c) = corrected(*sample);
+    colour.at<cv::Vec3f>(r, c) = corrected(*sample);
     result.photo_index.at<uint16_t>(r, c) = static_cast<uint16_t>(sample->photo + 1);
     ++result.coloured;
   }
   if (options.blend_seams) {
+    const auto blend_start = std::chrono::steady_clock::now();
     const cv::Mat range = RangeImage(scan);
     // The guidance from cell a to its neighbour b: their own difference when one photo colours both, else
     // what the photos that see both show, else 0 on a continuous surface and the step across a depth jump.
     const auto guidance = [&](int64_t a, int64_t b, int ra, int ca, int rb, int cb) -> cv::Vec3d {
-      const cv::Vec3d& ua = colour.at<cv::Vec3d>(ra, ca);
-      const cv::Vec3d& ub = colour.at<cv::Vec3d>(rb, cb);
+      const cv::Vec3d& ua = colour.at<cv::Vec3f>(ra, ca);
+      const cv::Vec3d& ub = colour.at<cv::Vec3f>(rb, cb);
       if (best[a] == best[b]) return ub - ua;
       cv::Vec3d sum(0, 0, 0);
       int count = 0;
@@ -229,22 +240,23 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
       if (std::abs(da - db) > options.seam_depth_jump_m + 0.02 * std::min(da, db)) return ub - ua;
       return cv::Vec3d(0, 0, 0);
     };
-    cv::Mat gx(scan.rows, scan.cols, CV_64FC3, cv::Scalar::all(0)), gy = gx.clone();
-    for (int r = 0; r < scan.rows; ++r) {
+    cv::Mat gx(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0)), gy = gx.clone();
+    ParallelFor(scan.rows, [&](int64_t row) {
+      const int r = static_cast<int>(row);
       for (int c = 0; c < scan.cols; ++c) {
         const int64_t cell = static_cast<int64_t>(r) * scan.cols + c;
         if (best[cell] < 0) continue;
         if (c + 1 < scan.cols && best[cell + 1] >= 0)
-          gx.at<cv::Vec3d>(r, c) = guidance(cell, cell + 1, r, c, r, c + 1);
+          gx.at<cv::Vec3f>(r, c) = guidance(cell, cell + 1, r, c, r, c + 1);
         if (r + 1 < scan.rows && best[cell + scan.cols] >= 0)
-          gy.at<cv::Vec3d>(r, c) = guidance(cell, cell + scan.cols, r, c, r + 1, c);
+          gy.at<cv::Vec3f>(r, c) = guidance(cell, cell + scan.cols, r, c, r + 1, c);
       }
-    }
+    });
     const SeamBlendResult blended = BlendSeams(colour, result.photo_index, gx, gy, options.seam_band_cells);
     colour = blended.colour;
     result.seam_edges = blended.seam_edges;
     result.blended = blended.unknowns;
-    result.blend_seconds = blended.seconds;
+    result.blend_seconds = since(blend_start);
   }
 
   result.scan = Clone(scan);
@@ -253,7 +265,7 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
   for (int r = 0; r < scan.rows; ++r) {
     for (int c = 0; c < scan.cols; ++c) {
       if (result.photo_index.at<uint16_t>(r, c) == 0) continue;
-      const cv::Vec3d& v = colour.at<cv::Vec3d>(r, c);
+      const cv::Vec3d& v = colour.at<cv::Vec3f>(r, c);
       out.color.at<cv::Vec3b>(r, c) =
           cv::Vec3b(cv::saturate_cast<uint8_t>(v[0]), cv::saturate_cast<uint8_t>(v[1]),
                     cv::saturate_cast<uint8_t>(v[2]));

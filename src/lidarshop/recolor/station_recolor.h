@@ -68,8 +68,10 @@ struct PhotosRecolorResult {
   int64_t constraints = 0;       // overlap pairs used to fit the gains
   int64_t seam_edges = 0;        // 4-neighbour pairs of coloured cells coloured by different photos
   int64_t blended = 0;           // cells solved again by the seam blending
-  double blend_seconds = 0;      // wall clock of the seam blending
-  std::string Summary() const;   // one line
+  // Wall clock, seconds: the occlusion scene (scan mesh and skirts), every photo's visibility and samples, the
+  // seam blending (guidance and Poisson).
+  double scene_seconds = 0, visibility_seconds = 0, blend_seconds = 0;
+  std::string Summary() const;  // one line
 };
 
 // Throws InputError when a photo's image does not match its camera (naming the photo's index).
