@@ -238,7 +238,7 @@ int RunRecolor(int argc, char** argv) {
   app.add_flag("--from-e57-images", from_e57_images,
                "colour from every images2D entry of the E57 scan that holds a camera (pinhole, spherical, "
                "cylindrical) and belongs to the scan: per point the best photo that sees it, exposure "
-               "equalised to photo 0's (recolor/station_recolor.h)");
+               "equalised to photo 0's, seams blended in the gradient domain (recolor/station_recolor.h)");
   app.add_option("--photo-index-mask", photo_index_mask_path,
                  "--from-e57-images or several --photo: 16-bit PNG of the scan grid, 1 + the index of the "
                  "photo that coloured "
