@@ -21,7 +21,8 @@ check "scan a site" "$lidarshop" scan parking_lot_stations "${small[@]}" -o "$wo
 json_check "scan json lists 3 stations" "$work/scan.json" \
   "len(d['stations']) == 3 and [s['name'] for s in d['stations']] == ['station0', 'station1', 'station2'] \
    and d['stations'][1]['position'] == [-8, 2, 1.6] and d['rays'] == 3 * 120 * 240 \
-   and d['returns'] == sum(s['returns'] for s in d['stations'])"
+   and d['returns'] == sum(s['returns'] for s in d['stations']) \
+   and d['stations'][2]['labels_color'].endswith('L_2_color.png') and 'labels' not in d"
 json_check "the hatchback left, a sedan came" "$work/scan.json" \
   "[s['objects'] for s in d['stations']] == [7, 7, 7]"
 for i in 0 1 2; do

@@ -61,8 +61,8 @@ std::string StationPath(const std::string& path, int station) {
 // Refuses, before any scanning, outputs that would overwrite each other or an input, and a site of several
 // stations into a format that holds one scan (PCD) without --split.
 void CheckStationOutputs(bool site, bool split, int num_stations, const std::string& output_path,
-                         const std::string& labels_path, const std::string& labels_color_path,
-                         const std::string& mesh_path, const std::string& scene_path) {
+                         const std::string& labels_path, const std::string& mesh_path,
+                         const std::string& scene_path) {
   if (!site) return;
   if (!split && num_stations > 1) {
     const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
@@ -85,7 +85,7 @@ void CheckStationOutputs(bool site, bool split, int num_stations, const std::str
     if (split) add(StationPath(output_path, i));
     if (!labels_path.empty()) {
       add(StationPath(labels_path, i));
-      add(StationPath(labels_color_path, i));
+      add(ColorLabelsPath(StationPath(labels_path, i)));  // L_N_color.png beside L_N.png
     }
     if (!mesh_path.empty()) add(StationPath(mesh_path, i));
   }
@@ -185,8 +185,7 @@ int RunScan(int argc, char** argv) {
         const int num_stations = scene.NumStations();
         // A site: several stations, or --split (one file per station, also of a one-station scene).
         const bool site = !scene.stations.empty() || split;
-        CheckStationOutputs(site, split, num_stations, output_path, labels_path, labels_color_path, mesh_path,
-                            scene_path);
+        CheckStationOutputs(site, split, num_stations, output_path, labels_path, mesh_path, scene_path);
         std::vector<SceneDescription> station_scenes;
         for (int i = 0; i < num_stations; ++i) {
           station_scenes.push_back(site ? SceneAtStation(scene, i) : scene);
@@ -276,7 +275,8 @@ int RunScan(int argc, char** argv) {
             colors.channel = RenderChannel::kLabels;
             colors.legend = true;
             colors.label_names = ObjectNamesByLabel(scene);
-            WriteImage(station_path(labels_color_path, i), RenderScan(scan, colors).image);
+            WriteImage(site ? ColorLabelsPath(StationPath(labels_path, i)) : labels_color_path,
+                       RenderScan(scan, colors).image);
             writing_labels_seconds += stage.Seconds();
           }
           if (!mesh_path.empty()) {
@@ -296,7 +296,7 @@ int RunScan(int argc, char** argv) {
           nlohmann::ordered_json json;
           json["scene"] = scene_path;
           json["output"] = output_path;
-          if (!labels_path.empty()) {
+          if (!labels_path.empty() && !site) {  // a site's are per station, under "stations"
             json["labels"] = labels_path;
             json["labels_color"] = labels_color_path;
           }
@@ -322,7 +322,10 @@ int RunScan(int argc, char** argv) {
                                               {"rays", station_stats[i].rays},
                                               {"returns", station_stats[i].returns}};
               if (split) entry["output"] = station_path(output_path, i);
-              if (!labels_path.empty()) entry["labels"] = station_path(labels_path, i);
+              if (!labels_path.empty()) {
+                entry["labels"] = station_path(labels_path, i);
+                entry["labels_color"] = ColorLabelsPath(station_path(labels_path, i));
+              }
               if (!mesh_path.empty()) entry["mesh"] = station_path(mesh_path, i);
               list.push_back(entry);
             }
