@@ -225,6 +225,13 @@ ScanSelector SplitScanSelector(const std::string& path) {
   return {path.substr(0, hash), index};
 }
 
+std::string StationOutputName(const std::string& input) {
+  const ScanSelector selector = SplitScanSelector(input);
+  const std::filesystem::path path(selector.path);
+  if (selector.index < 0) return path.filename().string();
+  return fmt::format("{}_{}{}", path.stem().string(), selector.index, path.extension().string());
+}
+
 ScanFile ReadScanFileAndWarn(const std::string& path) {
   const ScanSelector selector = SplitScanSelector(path);
   if (selector.index >= 0) ProtectInput(selector.path);  // no output may replace FILE of FILE#N

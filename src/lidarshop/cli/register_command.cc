@@ -34,15 +34,6 @@ std::vector<std::vector<double>> MatrixRows(const Eigen::Matrix4d& matrix) {
   return rows;
 }
 
-// Where a moved station goes in DIR: its file's name, or for FILE#N (scan N of a site's file) FILE's stem +
-// _N + its extension.
-std::string StationOutputName(const std::string& input) {
-  const ScanSelector selector = SplitScanSelector(input);
-  const std::filesystem::path path(selector.path);
-  if (selector.index < 0) return path.filename().string();
-  return fmt::format("{}_{}{}", path.stem().string(), selector.index, path.extension().string());
-}
-
 // The site: FIXED and every MOVING registered together; DIR receives the moved stations.
 int RegisterSiteCommand(const std::string& fixed_path, const std::vector<std::string>& moving_paths,
                         const std::string& output_dir, const std::string& json_path, const IcpOptions& icp,

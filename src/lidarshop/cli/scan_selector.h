@@ -17,4 +17,8 @@ struct ScanSelector {
 };
 ScanSelector SplitScanSelector(const std::string& path);
 
+// Where a station read from `input` goes in an output folder (register of a site, clean): its file's name, or
+// for FILE#N (scan N of a site's file) FILE's stem + _N + its extension.
+std::string StationOutputName(const std::string& input);
+
 }  // namespace lidarshop::cli
