@@ -268,9 +268,11 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const auto free = [&](const cv::Mat& grown, cv::Point b) {
     return !grown.at<uint8_t>(b) && scan.valid.at<uint8_t>(b) && (barrier.empty() || !barrier.at<uint8_t>(b));
   };
-  // A cell growth may enter: free and not support.
+  // A cell growth may enter: inside the region (its normals are known only there: reading one outside read
+  // memory past the normals' matrix, and the cut changed with the thread count and from run to run), free and
+  // not support.
   const auto open = [&](const cv::Mat& grown, cv::Point b) {
-    return free(grown, b) && !support.at<uint8_t>(b);
+    return region.contains(b) && free(grown, b) && !support.at<uint8_t>(b);
   };
   cv::Mat grown = mask.clone();
   std::deque<cv::Point> front;
