@@ -184,6 +184,12 @@ void Commit(Document& document, Snapshot next, int undo_depth) {
   document.redo.clear();
   document.now = std::move(next);
   ++document.version;
+  RememberState(document);
+}
+
+void RememberState(Document& document) {
+  document.recent.emplace_back(document.version, document.now);  // shallow: shares the buffers
+  while (document.recent.size() > kRecentStates) document.recent.pop_front();
 }
 
 nlohmann::ordered_json JobJson(const Job& job) {
@@ -281,6 +287,7 @@ void AddEditRoutes(State& state) {
                    document->now = std::move(from.back());
                    from.pop_back();
                    ++document->version;
+                   RememberState(*document);
                    SendJson(response, {{"version", document->version}});
                  });
   }

@@ -262,6 +262,33 @@ void AddRecolorRoutes(State& state) {
         *slot = rgb;
         SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
       });
+  // A photo the scan's E57 file carries (images2D; GET /api/docs/ID's "e57_images") as the photo to recolour
+  // from or the second one: body {"image": K}, ?slot= as for an upload.
+  PostDocument(
+      state, R"(/api/docs/(\d+)/photo-from-e57)",
+      [](State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+         httplib::Response& response) {
+        if (!body.contains("image") || !body["image"].is_number_integer())
+          throw OptionsFieldError("image", "expected the index of one of the scan's E57 photos");
+        const int64_t index = body["image"].get<int64_t>();
+        std::lock_guard lock(document->mutex);
+        if (index < 0 || index >= static_cast<int64_t>(document->e57_images.size())) {
+          throw OptionsFieldError("image", fmt::format("the scan's E57 file has {} photo(s); {} is none",
+                                                       document->e57_images.size(), index));
+        }
+        const E57Image& image = document->e57_images[index];
+        if (image.image.empty()) {
+          return SendError(response, 422,
+                           fmt::format("the E57 photo '{}' does not decode: {}", Excerpt(image.name, 100),
+                                       image.decode_error));
+        }
+        httplib::Request slot_request;  // the slot comes in the body here
+        slot_request.params.emplace("slot", body.value("slot", std::string("a")));
+        cv::Mat* slot = PhotoSlot(*document, slot_request, response);
+        if (!slot) return;
+        *slot = image.image;  // shared, never written: a photo slot is replaced, not edited
+        SendJson(response, {{"width_px", slot->cols}, {"height_px", slot->rows}, {"name", image.name}});
+      });
   http.Get(R"(/api/docs/(\d+)/photo.png)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);
