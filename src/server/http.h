@@ -108,8 +108,8 @@ void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
 // Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
 // Caller holds document.mutex.
 void Commit(Document& document, Snapshot next, int undo_depth);
-// Keeps the document's current state as the one of its current version (Document::recent, the last
-// kRecentStates), for deltas. Called on every version change. Caller holds document.mutex.
+// Records the document's current point state as the one of its current version (Document::recent, the last
+// kRecentStates distinct ones), for deltas. Called on every version change. Caller holds document.mutex.
 inline constexpr size_t kRecentStates = 8;
 void RememberState(Document& document);
 

@@ -118,10 +118,24 @@ std::string PointsBinary(const Document& document) {
   return Encode(header, cells, records, false);
 }
 
+void RememberState(Document& document) {
+  auto& recent = document.recent;
+  if (!recent.empty() && SameBuffers(recent.back().points, document.now, false) &&
+      SameBuffers(recent.back().points, document.now, true)) {
+    recent.back().last_version = document.version;  // the same points: a stroke, a hole
+    return;
+  }
+  Document::PointState state{document.version, document.version, document.now};
+  state.points.strokes = cv::Mat();  // not drawn as points: not kept alive by this list
+  state.points.hole = cv::Mat();
+  recent.push_back(std::move(state));
+  while (recent.size() > kRecentStates) recent.pop_front();
+}
+
 std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since) {
   const Snapshot* old = nullptr;
-  for (const auto& [version, snapshot] : document.recent) {
-    if (version == since) old = &snapshot;
+  for (const auto& state : document.recent) {
+    if (state.first_version <= since && since <= state.last_version) old = &state.points;
   }
   const Snapshot& now = document.now;
   const int rows = now.scan.rows, cols = now.scan.cols;

@@ -187,11 +187,6 @@ void Commit(Document& document, Snapshot next, int undo_depth) {
   RememberState(document);
 }
 
-void RememberState(Document& document) {
-  document.recent.emplace_back(document.version, document.now);  // shallow: shares the buffers
-  while (document.recent.size() > kRecentStates) document.recent.pop_front();
-}
-
 nlohmann::ordered_json JobJson(const Job& job) {
   nlohmann::ordered_json json = {{"id", job.id},
                                  {"kind", job.kind},

@@ -186,7 +186,7 @@ int64_t DocumentBytes(const Document& document) {
   for (const auto* history : {&document.undo, &document.redo}) {
     for (const Snapshot& snapshot : *history) CollectBuffers(snapshot, seen);
   }
-  for (const auto& [version, snapshot] : document.recent) CollectBuffers(snapshot, seen);
+  for (const auto& state : document.recent) CollectBuffers(state.points, seen);
   AddBuffer(document.photo, seen);
   AddBuffer(document.photo_b, seen);
   for (const E57Image& image : document.e57_images) {

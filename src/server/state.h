@@ -78,9 +78,15 @@ struct Document {
   Snapshot now;
   std::vector<Snapshot> undo, redo;
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
-  // The last few states by the version they were shown at (shallow copies sharing the history's buffers),
-  // so that GET /points?since=V can answer only the cells changed since the client's version V.
-  std::deque<std::pair<int64_t, Snapshot>> recent;
+  // The last few distinct point states (what GET /points draws from) with the versions that showed them, so
+  // that GET /points?since=V answers only the cells changed since the client's version V. Consecutive
+  // versions with the same point buffers (strokes, holes) share one entry: many clients painting at once
+  // do not push a client's version out.
+  struct PointState {
+    int64_t first_version = 0, last_version = 0;
+    Snapshot points;  // shallow: shares the history's buffers; strokes and hole left empty
+  };
+  std::deque<PointState> recent;
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
