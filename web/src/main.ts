@@ -239,6 +239,10 @@ element<HTMLInputElement>('radius').addEventListener('change', (event) => {
   rayView.radius = Number((event.target as HTMLInputElement).value);
 });
 element('channel').addEventListener('change', () => refresh(true));
+for (const layer of ['original', 'synthesized', 'object'] as const) {
+  element<HTMLInputElement>(`layer-${layer}`).addEventListener('change', (event) =>
+    pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked));
+}
 element<HTMLInputElement>('point-size').addEventListener('input', (event) => pointView.setPointSize(Number((event.target as HTMLInputElement).value)));
 element<HTMLSelectElement>('point-colour').addEventListener('change', (event) => pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring));
 element('open-scene').addEventListener('click', () => open({ scene: element<HTMLSelectElement>('scene').value }));
@@ -254,17 +258,18 @@ element('fill-shadow').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, { options: { keep_object: true } }, 'fill shadow');
   strokeKinds.clear();
 });
-for (const action of ['undo', 'redo']) {
-  element(action).addEventListener('click', async () => {
-    if (!doc) return;
-    try {
-      await api.json(`/api/docs/${doc.id}/${action}`, {}, {});
-      await refresh(true);
-    } catch (error) {
-      status(`${action}: ${(error as Error).message}`);
-    }
-  });
+// Undo / redo ask the server (which answers 409 when there is nothing to undo or redo): the keys do not wait
+// for the buttons' state, which follows the last refresh.
+async function undoRedo(action: 'undo' | 'redo') {
+  if (!doc) return;
+  try {
+    await api.json(`/api/docs/${doc.id}/${action}`, {}, {});
+    await refresh(true);
+  } catch (error) {
+    status(`${action}: ${(error as Error).message}`);
+  }
 }
+for (const action of ['undo', 'redo'] as const) element(action).addEventListener('click', () => undoRedo(action));
 element('e57-photo').addEventListener('change', () => {
   const value = element<HTMLSelectElement>('e57-photo').value;
   if (value !== '') pairsPanel.useE57Photo(Number(value));
@@ -302,8 +307,8 @@ document.addEventListener('keydown', (event) => {
     rayView.radius = Number(radius.value);
   };
   const key = event.key.toLowerCase();
-  if ((event.ctrlKey || event.metaKey) && (key === 'y' || (key === 'z' && event.shiftKey))) element('redo').click();
-  else if ((event.ctrlKey || event.metaKey) && key === 'z') element('undo').click();
+  if ((event.ctrlKey || event.metaKey) && (key === 'y' || (key === 'z' && event.shiftKey))) undoRedo('redo');
+  else if ((event.ctrlKey || event.metaKey) && key === 'z') undoRedo('undo');
   else if (event.ctrlKey || event.metaKey || event.altKey) return;
   else if (key === 'b') element('brush-object').click();
   else if (key === 'e') element('brush-erase').click();

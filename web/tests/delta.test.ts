@@ -77,3 +77,21 @@ describe('VersionGate', () => {
     expect(gate.version(1)).toBe(0);
   });
 });
+
+import { centrePoint, layerOf, visiblePoints } from '../src/pointview';
+
+describe('layers and the first view', () => {
+  const set = points([row(0, 1), row(7, 2, 1), row(12, 3, 2), row(behind + 12, 4, FLAG_BEHIND)]);
+  it('sorts points into layers and hides one', () => {
+    expect(Array.from(set.flags, layerOf)).toEqual(['original', 'synthesized', 'object', 'synthesized']);
+    const shown = visiblePoints(set, new Set(['synthesized']));
+    expect(Array.from(shown.cells)).toEqual([0, 12]);
+    expect(Array.from(shown.xyz)).toEqual([1, 2, 3, 3, 4, 5]);
+    expect(visiblePoints(set, new Set())).toBe(set);
+  });
+  it('finds the point where the ray image centre looks (front layer only)', () => {
+    // 4 x 5 cells: the centre cell is row 2, col 2 = 12.
+    expect(centrePoint(set)).toEqual([3, 4, 5]);
+    expect(centrePoint(points([]))).toBeNull();
+  });
+});
