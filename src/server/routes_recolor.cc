@@ -11,11 +11,13 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -114,6 +116,63 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
                                       {"outside_image", recolored.outside_image},
                                       {"summary", camera.Summary() + "; " + recolored.Summary()},
                                       {"warnings", warnings},
+                                      {"version", document->version}};
+      },
+      response);
+}
+
+// The station's own photos: every photo of the scan's E57 file that holds a camera (pinhole, spherical,
+// cylindrical; io/e57_image_camera.h) colours the cells it sees best (recolor/station_recolor.h, as `recolor
+// --from-e57-images`); an undoable edit (a job). 400 when no photo holds a camera, saying why for each.
+void RecolorStation(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+                    httplib::Response& response) {
+  const PhotosRecolorOptions options;  // the library's defaults, as the CLI's (no JSON form of its own yet)
+  std::vector<CameraPhoto> photos;
+  nlohmann::ordered_json used = nlohmann::ordered_json::array(), skipped = nlohmann::ordered_json::array();
+  {
+    std::lock_guard lock(document->mutex);
+    for (size_t i = 0; i < document->e57_images.size(); ++i) {
+      const E57Image& image = document->e57_images[i];
+      Camera camera;
+      std::string why;
+      if (image.image.empty()) {
+        why = "does not decode: " + image.decode_error;
+      } else if (CameraModelOfE57Image(image, &camera, &why)) {
+        photos.push_back({image.image, camera});
+        used.push_back({{"index", i}, {"name", image.name}});
+        continue;
+      }
+      skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
+    }
+  }
+  if (photos.empty()) {
+    throw OptionsFieldError(
+        "photos", fmt::format("none of the scan's {} E57 photo(s) holds a camera to colour "
+                              "from{}",
+                              skipped.size(), skipped.empty() ? "" : ": " + Excerpt(skipped.dump(), 300)));
+  }
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "recolor-station",
+      [document, photos, options, used, skipped, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        progress.Restart("colour from the station's photos", 1);
+        const PhotosRecolorResult result = RecolorFromPhotos(start.scan, photos, options);
+        progress.Advance();
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.scan = result.scan;
+        Commit(*document, std::move(next), undo_depth);
+        return nlohmann::ordered_json{{"returns", result.returns},
+                                      {"coloured", result.coloured},
+                                      {"constraints", result.constraints},
+                                      {"used", used},
+                                      {"skipped", skipped},
+                                      {"summary", result.Summary()},
                                       {"version", document->version}};
       },
       response);
@@ -300,6 +359,7 @@ void AddRecolorRoutes(State& state) {
              SendPng(response, *slot);
            });
   PostDocument(state, R"(/api/docs/(\d+)/recolor)", Recolor);
+  PostDocument(state, R"(/api/docs/(\d+)/recolor-station)", RecolorStation);
   PostDocument(state, R"(/api/docs/(\d+)/align)", Align);
   PostDocument(state, R"(/api/docs/(\d+)/photo-match)", MatchPhotos);
 }

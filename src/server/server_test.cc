@@ -440,6 +440,11 @@ TEST_F(ServerTest, E57PhotoAndGuidSurviveAnEditAndASave) {
           ->Post(Api(fmt::format("/api/docs/{}/photo-from-e57", id)), R"({"image": "x"})", "application/json")
           ->status,
       400);
+  // pumpA's photo is a visual one (no camera): colouring from the station's photos says why it cannot.
+  const auto station =
+      client_->Post(Api(fmt::format("/api/docs/{}/recolor-station", id)), "{}", "application/json");
+  EXPECT_EQ(station->status, 400);
+  EXPECT_NE(station->body.find("pumpVisual"), std::string::npos) << station->body;
   client_->Delete(Api(fmt::format("/api/docs/{}", id)));
 }
 

@@ -135,6 +135,7 @@ async function refresh(keepView: boolean, strokesOnly = false) {
       return option;
     }));
     photoSelect.hidden = photos.length === 0;
+    element('recolor-station').hidden = photos.length === 0;
   }
   element<HTMLButtonElement>('undo').disabled = !info.can_undo;
   element<HTMLButtonElement>('redo').disabled = !info.can_redo;
@@ -270,6 +271,7 @@ async function undoRedo(action: 'undo' | 'redo') {
   }
 }
 for (const action of ['undo', 'redo'] as const) element(action).addEventListener('click', () => undoRedo(action));
+element('recolor-station').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/recolor-station`, {}, 'colour from the station\'s photos'));
 element('e57-photo').addEventListener('change', () => {
   const value = element<HTMLSelectElement>('e57-photo').value;
   if (value !== '') pairsPanel.useE57Photo(Number(value));
