@@ -11,7 +11,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
-#include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/correspondences.h"
@@ -131,19 +130,14 @@ void RecolorStation(State& state, const std::shared_ptr<Document>& document, con
   nlohmann::ordered_json used = nlohmann::ordered_json::array(), skipped = nlohmann::ordered_json::array();
   {
     std::lock_guard lock(document->mutex);
-    for (size_t i = 0; i < document->e57_images.size(); ++i) {
-      const E57Image& image = document->e57_images[i];
-      Camera camera;
-      std::string why;
-      if (image.image.empty()) {
-        why = "does not decode: " + image.decode_error;
-      } else if (CameraModelOfE57Image(image, &camera, &why)) {
-        photos.push_back({image.image, camera});
-        used.push_back({{"index", i}, {"name", image.name}});
-        continue;
-      }
-      skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
-    }
+    E57File file;  // the document's photos, as the file's scan 0 holds them (ImagesOfScan)
+    file.images = document->e57_images;
+    const E57StationPhotos station = StationPhotosOfE57(file, 0);  // as `recolor --from-e57-images`
+    photos = station.photos;
+    for (const int index : station.image_index)
+      used.push_back({{"index", index}, {"name", file.images[index].name}});
+    for (const auto& [index, why] : station.skipped)
+      skipped.push_back({{"index", index}, {"name", file.images[index].name}, {"why", why}});
   }
   if (photos.empty()) {
     throw OptionsFieldError(
