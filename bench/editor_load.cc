@@ -3,7 +3,13 @@
 // errors, latency quantiles, and checks that no edit was lost (the document's version grew by exactly the
 // number of strokes the server acknowledged).
 //
-//   editor_load URL [--clients 50] [--seconds 30]      URL as `lidarshop serve` printed it, a scan open
+// --catch-up none|whole|delta: after each acknowledged stroke the client also brings its points up to date as
+// an editor would: `whole` fetches every point again (what the editor did before deltas), `delta` fetches the
+// cells changed since the version it holds (GET /points?since=V, docs/api.md "Deltas"). `bytes_per_edit` is
+// the bytes of those fetches per acknowledged stroke (with `delta`, each client's first fetch of the whole
+// points apart: `first_points_bytes`).
+//
+//   editor_load URL [--clients 50] [--seconds 30] [--catch-up none]   URL as `lidarshop serve` printed it
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -25,9 +31,15 @@ int main(int argc, char** argv) {
   }
   const std::string url = argv[1];
   int clients = 50, seconds = 30;
+  std::string catch_up = "none";
   for (int i = 2; i + 1 < argc; i += 2) {
     if (std::string(argv[i]) == "--clients") clients = std::stoi(argv[i + 1]);
     if (std::string(argv[i]) == "--seconds") seconds = std::stoi(argv[i + 1]);
+    if (std::string(argv[i]) == "--catch-up") catch_up = argv[i + 1];
+  }
+  if (catch_up != "none" && catch_up != "whole" && catch_up != "delta") {
+    fmt::print(stderr, "editor_load: --catch-up none|whole|delta, got '{}'\n", catch_up);
+    return 2;
   }
   const size_t scheme = url.find("://") + 3;
   const size_t path = url.find('/', scheme);
@@ -49,7 +61,7 @@ int main(int argc, char** argv) {
   const int id = document["id"], rows = document["rows"], cols = document["cols"];
   const int64_t version_before = document["version"];
 
-  std::atomic<int64_t> requests{0}, errors{0}, strokes_ok{0};
+  std::atomic<int64_t> requests{0}, errors{0}, strokes_ok{0}, catch_up_bytes{0}, first_bytes{0};
   std::mutex latency_mutex;
   std::vector<double> latencies_ms;
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(seconds);
@@ -59,6 +71,7 @@ int main(int argc, char** argv) {
       httplib::Client client(host, port);
       client.set_read_timeout(60, 0);
       std::vector<double> mine;
+      int64_t held_version = -1;  // the version of the points this client holds (-1: none yet)
       for (int i = 0; std::chrono::steady_clock::now() < deadline; ++i) {
         const auto start = std::chrono::steady_clock::now();
         const bool stroke = i % 2 == 1 && i % 10 != 9;
@@ -76,6 +89,26 @@ int main(int argc, char** argv) {
           ++errors;
         } else if (stroke) {
           ++strokes_ok;
+          if (catch_up == "none") continue;
+          // The editor's refresh after an edit: the points again, whole or the cells changed.
+          const auto points_start = std::chrono::steady_clock::now();
+          const std::string path = catch_up == "delta" && held_version >= 0
+                                       ? fmt::format("/api/docs/{}/points?since={}", id, held_version)
+                                       : fmt::format("/api/docs/{}/points", id);
+          const httplib::Result points = client.Get(api(path));
+          mine.push_back(
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - points_start)
+                  .count());
+          ++requests;
+          if (!points || points->status != 200) {
+            ++errors;
+            continue;
+          }
+          // A client's first fetch is the whole points in either mode (it holds none): counted apart.
+          (catch_up == "delta" && held_version < 0 ? first_bytes : catch_up_bytes) +=
+              static_cast<int64_t>(points->body.size());
+          const std::string version = points->get_header_value("X-Lidarshop-Version");
+          held_version = version.empty() ? -1 : std::stoll(version);
         }
       }
       std::lock_guard lock(latency_mutex);
@@ -99,6 +132,11 @@ int main(int argc, char** argv) {
       {"strokes_acknowledged", strokes_ok.load()},
       {"version_growth", version_after - version_before},
       {"lost_edits", lost},
+      {"catch_up", catch_up},
+      {"first_points_bytes", first_bytes.load()},
+      {"bytes_per_edit",
+       strokes_ok > 0 ? static_cast<double>(catch_up_bytes.load()) / static_cast<double>(strokes_ok.load())
+                      : 0.0},
       {"latency_ms", {{"p50", quantile(0.5)}, {"p99", quantile(0.99)}, {"max", quantile(1.0)}}}};
   fmt::print("{}\n", summary.dump(2));
   return errors == 0 && !lost ? 0 : 1;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/verify/verify.h"
 #include "server.h"
@@ -58,7 +59,7 @@ struct EditorServer::State {
   // reading a file), or when `more_bytes` more would take the open documents past max_document_bytes.
   void CheckRoomForDocument(int64_t more_bytes = 0);
   // Opens `scan` as a new document after CheckRoomForDocument(its bytes); returns its id.
-  int AddDocument(std::string name, Scan scan);
+  int AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_images = {});
   std::mutex open_mutex;  // one open at a time: the room checked is the room used
   std::shared_ptr<Document> Get(int id);
   std::shared_ptr<ModelEntry> FindModel(
@@ -107,6 +108,18 @@ void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
 // Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
 // Caller holds document.mutex.
 void Commit(Document& document, Snapshot next, int undo_depth);
+// Records the document's current point state as the one of its current version (Document::recent, the last
+// kRecentStates distinct ones), for deltas. Called on every version change. Caller holds document.mutex.
+inline constexpr size_t kRecentStates = 8;
+void RememberState(Document& document);
+
+// points.cc: the points of a document as typed arrays (docs/api.md "Points"), whole (LSP1) or the cells that
+// changed since an earlier version (LSD1). Caller holds document.mutex.
+std::string PointsBinary(const Document& document);
+// The LSD1 delta from the state the document had at version `since` to now; nullopt when that state is no
+// longer kept (or the grid changed): the client then gets the whole points.
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since);
+
 // A job's JSON form (GET /api/jobs/ID).
 nlohmann::ordered_json JobJson(const Job& job);
 // Starts `run` on the document as a job of `kind`; answers 202 with the job's JSON, or 503 (and returns null)
@@ -120,6 +133,17 @@ std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& doc
 using DocumentHandler =
     std::function<void(State&, const std::shared_ptr<Document>&, const nlohmann::json&, httplib::Response&)>;
 void PostDocument(State& state, const std::string& pattern, DocumentHandler handler);
+
+// A scan file read for editing: its scans and the reader's warnings, and for an E57 file its photos
+// (images2D), so that a save as E57 writes them back and the recolour tool can use them.
+struct FileForEditing {
+  ScanFile file;
+  std::vector<E57Image> images;
+};
+FileForEditing ReadFileForEditing(const std::string& path);
+// The photos of `images` that belong to scan `index` of their file or to none, associated with the
+// document's scan (associated_scan 0) or with none (-1).
+std::vector<E57Image> ImagesOfScan(const std::vector<E57Image>& images, int index);
 
 // A path given by a client, resolved against the roots: the canonical path when it lies inside one (after
 // following symlinks), else empty. `..` components are refused before any lookup.

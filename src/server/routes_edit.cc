@@ -184,6 +184,7 @@ void Commit(Document& document, Snapshot next, int undo_depth) {
   document.redo.clear();
   document.now = std::move(next);
   ++document.version;
+  RememberState(document);
 }
 
 nlohmann::ordered_json JobJson(const Job& job) {
@@ -281,6 +282,7 @@ void AddEditRoutes(State& state) {
                    document->now = std::move(from.back());
                    from.pop_back();
                    ++document->version;
+                   RememberState(*document);
                    SendJson(response, {{"version", document->version}});
                  });
   }

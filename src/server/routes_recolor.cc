@@ -16,6 +16,7 @@
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -114,6 +115,58 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
                                       {"outside_image", recolored.outside_image},
                                       {"summary", camera.Summary() + "; " + recolored.Summary()},
                                       {"warnings", warnings},
+                                      {"version", document->version}};
+      },
+      response);
+}
+
+// The station's own photos: every photo of the scan's E57 file that holds a camera (pinhole, spherical,
+// cylindrical; io/e57_image_camera.h) colours the cells it sees best (recolor/station_recolor.h, as `recolor
+// --from-e57-images`); an undoable edit (a job). 400 when no photo holds a camera, saying why for each.
+void RecolorStation(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+                    httplib::Response& response) {
+  const PhotosRecolorOptions options;  // the library's defaults, as the CLI's (no JSON form of its own yet)
+  std::vector<CameraPhoto> photos;
+  nlohmann::ordered_json used = nlohmann::ordered_json::array(), skipped = nlohmann::ordered_json::array();
+  {
+    std::lock_guard lock(document->mutex);
+    E57File file;  // the document's photos, as the file's scan 0 holds them (ImagesOfScan)
+    file.images = document->e57_images;
+    const E57StationPhotos station = StationPhotosOfE57(file, 0);  // as `recolor --from-e57-images`
+    photos = station.photos;
+    for (const int index : station.image_index)
+      used.push_back({{"index", index}, {"name", file.images[index].name}});
+    for (const auto& [index, why] : station.skipped)
+      skipped.push_back({{"index", index}, {"name", file.images[index].name}, {"why", why}});
+  }
+  if (photos.empty()) {
+    throw OptionsFieldError(
+        "photos", fmt::format("none of the scan's {} E57 photo(s) holds a camera to colour "
+                              "from{}",
+                              skipped.size(), skipped.empty() ? "" : ": " + Excerpt(skipped.dump(), 300)));
+  }
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "recolor-station",
+      [document, photos, options, used, skipped, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        progress.Restart("colour from the station's photos", 1);
+        const PhotosRecolorResult result = RecolorFromPhotos(start.scan, photos, options);
+        progress.Advance();
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.scan = result.scan;
+        Commit(*document, std::move(next), undo_depth);
+        return nlohmann::ordered_json{{"returns", result.returns},
+                                      {"coloured", result.coloured},
+                                      {"constraints", result.constraints},
+                                      {"used", used},
+                                      {"skipped", skipped},
+                                      {"summary", result.Summary()},
                                       {"version", document->version}};
       },
       response);
@@ -262,6 +315,33 @@ void AddRecolorRoutes(State& state) {
         *slot = rgb;
         SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
       });
+  // A photo the scan's E57 file carries (images2D; GET /api/docs/ID's "e57_images") as the photo to recolour
+  // from or the second one: body {"image": K}, ?slot= as for an upload.
+  PostDocument(
+      state, R"(/api/docs/(\d+)/photo-from-e57)",
+      [](State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+         httplib::Response& response) {
+        if (!body.contains("image") || !body["image"].is_number_integer())
+          throw OptionsFieldError("image", "expected the index of one of the scan's E57 photos");
+        const int64_t index = body["image"].get<int64_t>();
+        std::lock_guard lock(document->mutex);
+        if (index < 0 || index >= static_cast<int64_t>(document->e57_images.size())) {
+          throw OptionsFieldError("image", fmt::format("the scan's E57 file has {} photo(s); {} is none",
+                                                       document->e57_images.size(), index));
+        }
+        const E57Image& image = document->e57_images[index];
+        if (image.image.empty()) {
+          return SendError(response, 422,
+                           fmt::format("the E57 photo '{}' does not decode: {}", Excerpt(image.name, 100),
+                                       image.decode_error));
+        }
+        httplib::Request slot_request;  // the slot comes in the body here
+        slot_request.params.emplace("slot", body.value("slot", std::string("a")));
+        cv::Mat* slot = PhotoSlot(*document, slot_request, response);
+        if (!slot) return;
+        *slot = image.image;  // shared, never written: a photo slot is replaced, not edited
+        SendJson(response, {{"width_px", slot->cols}, {"height_px", slot->rows}, {"name", image.name}});
+      });
   http.Get(R"(/api/docs/(\d+)/photo.png)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);
@@ -273,6 +353,7 @@ void AddRecolorRoutes(State& state) {
              SendPng(response, *slot);
            });
   PostDocument(state, R"(/api/docs/(\d+)/recolor)", Recolor);
+  PostDocument(state, R"(/api/docs/(\d+)/recolor-station)", RecolorStation);
   PostDocument(state, R"(/api/docs/(\d+)/align)", Align);
   PostDocument(state, R"(/api/docs/(\d+)/photo-match)", MatchPhotos);
 }

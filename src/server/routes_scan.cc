@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "http.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/render.h"
@@ -185,8 +186,13 @@ int64_t DocumentBytes(const Document& document) {
   for (const auto* history : {&document.undo, &document.redo}) {
     for (const Snapshot& snapshot : *history) CollectBuffers(snapshot, seen);
   }
+  for (const auto& state : document.recent) CollectBuffers(state.points, seen);
   AddBuffer(document.photo, seen);
   AddBuffer(document.photo_b, seen);
+  for (const E57Image& image : document.e57_images) {
+    AddBuffer(image.image, seen);
+    seen[image.encoded.data()] = static_cast<int64_t>(image.encoded.size());
+  }
   return Sum(seen);
 }
 
@@ -216,17 +222,37 @@ void State::CheckRoomForDocument(int64_t more_bytes) {
   }
 }
 
-int State::AddDocument(std::string name, Scan scan) {
+FileForEditing ReadFileForEditing(const std::string& path) {
+  if (FileExtension(path) != "e57") return {ReadScanFile(path), {}};
+  E57File e57 = ReadE57(path);  // as ReadScanFile reads it, keeping the photos
+  FileForEditing opened;
+  opened.file.path = path;
+  opened.file.format = "e57";
+  opened.file.scans = std::move(e57.scans);
+  opened.file.warnings = std::move(e57.warnings);
+  opened.images = std::move(e57.images);
+  return opened;
+}
+
+std::vector<E57Image> ImagesOfScan(const std::vector<E57Image>& images, int index) {
+  std::vector<E57Image> kept;
+  for (const E57Image& image : images) {
+    if (image.associated_scan != index && image.associated_scan != -1) continue;
+    kept.push_back(image);
+    kept.back().associated_scan = image.associated_scan == index ? 0 : -1;
+  }
+  return kept;
+}
+
+int State::AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_images) {
   auto document = std::make_shared<Document>();
   document->name = std::move(name);
+  document->e57_images = std::move(e57_images);
   document->now.strokes = NewZeros(cv::Size(scan.cols, scan.rows), CV_8U);
   document->now.scan = std::move(scan);
   std::lock_guard open_lock(open_mutex);
-  {
-    std::map<const void*, int64_t> seen;
-    CollectBuffers(document->now, seen);
-    CheckRoomForDocument(Sum(seen));
-  }
+  CheckRoomForDocument(DocumentBytes(*document));
+  RememberState(*document);
   std::lock_guard lock(documents_mutex);
   document->id = ++last_document;
   documents[document->id] = document;
@@ -257,6 +283,20 @@ std::shared_ptr<Document> State::FindDocument(const httplib::Request& request, h
 
 namespace {
 
+// The photos a document carries from its E57 file: {"index", "name", "width_px", "height_px", "usable"}
+// ("usable": decoded, so the recolour tool can take it).
+nlohmann::ordered_json E57ImagesJson(const std::vector<E57Image>& images) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < images.size(); ++i) {
+    list.push_back({{"index", i},
+                    {"name", images[i].name},
+                    {"width_px", images[i].image.empty() ? images[i].width_px : images[i].image.cols},
+                    {"height_px", images[i].image.empty() ? images[i].height_px : images[i].image.rows},
+                    {"usable", !images[i].image.empty()}});
+  }
+  return list;
+}
+
 nlohmann::ordered_json DocumentJson(Document& document) {
   std::lock_guard lock(document.mutex);
   const Scan& scan = document.now.scan;
@@ -286,57 +326,16 @@ nlohmann::ordered_json DocumentJson(Document& document) {
       {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
       {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
       {"hole_cells", document.now.hole.empty() ? 0 : cv::countNonZero(document.now.hole)},
+      {"object_stroke_cells", cv::countNonZero(document.now.strokes == 1)},
+      {"background_stroke_cells", cv::countNonZero(document.now.strokes == 2)},
       {"behind_cells", document.now.behind.valid.empty() ? 0 : cv::countNonZero(document.now.behind.valid)},
       {"world_from_scanner_column_major", pose},
       {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
       {"elevation_step_deg", step_deg(scan.grid.elevation_rad)},
       {"version", document.version},
       {"can_undo", !document.undo.empty()},
-      {"can_redo", !document.redo.empty()}};
-}
-
-// The points of a scan as typed arrays (docs/api.md "Points"): header, xyz float32 (scanner frame), cell index
-// uint32, rgb uint8, flags uint8 (1 = synthesized, 2 = object).
-std::string PointsBinary(const Document& document) {
-  std::vector<float> xyz;
-  std::vector<uint32_t> cells;
-  std::vector<uint8_t> rgb, flags;
-  for (const Scan* layer : {&document.now.scan, &document.now.behind}) {
-    const Scan& scan = *layer;
-    const bool behind = layer == &document.now.behind;
-    if (scan.valid.empty()) continue;
-    for (int r = 0; r < scan.rows; ++r) {
-      for (int c = 0; c < scan.cols; ++c) {
-        if (scan.valid.at<uint8_t>(r, c) == 0) continue;
-        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-        xyz.insert(xyz.end(), {p[0], p[1], p[2]});
-        cells.push_back(static_cast<uint32_t>(r * scan.cols + c));
-        if (scan.has_color()) {
-          const cv::Vec3b color = scan.color.at<cv::Vec3b>(r, c);
-          rgb.insert(rgb.end(), {color[0], color[1], color[2]});
-        } else {
-          const float intensity = scan.intensity.empty() ? 0.7f : scan.intensity.at<float>(r, c);
-          const auto grey = static_cast<uint8_t>(std::clamp(intensity, 0.0f, 1.0f) * 255.0f);
-          rgb.insert(rgb.end(), {grey, grey, grey});
-        }
-        uint8_t flag = 0;
-        if (!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(r, c) != 0) flag |= 1;
-        if (!behind && !document.now.object_mask.empty() && document.now.object_mask.at<uint8_t>(r, c) != 0)
-          flag |= 2;
-        flags.push_back(flag);
-      }
-    }
-  }
-  const Scan& scan = document.now.scan;
-  const uint32_t header[4] = {0x3150534cu /* "LSP1" */, static_cast<uint32_t>(cells.size()),
-                              static_cast<uint32_t>(scan.rows), static_cast<uint32_t>(scan.cols)};
-  std::string bytes(sizeof(header), '\0');
-  std::memcpy(bytes.data(), header, sizeof(header));
-  bytes.append(reinterpret_cast<const char*>(xyz.data()), xyz.size() * sizeof(float));
-  bytes.append(reinterpret_cast<const char*>(cells.data()), cells.size() * sizeof(uint32_t));
-  bytes.append(reinterpret_cast<const char*>(rgb.data()), rgb.size());
-  bytes.append(reinterpret_cast<const char*>(flags.data()), flags.size());
-  return bytes;
+      {"can_redo", !document.redo.empty()},
+      {"e57_images", E57ImagesJson(document.e57_images)}};
 }
 
 void Open(State& state, const httplib::Request& request, httplib::Response& response) {
@@ -365,14 +364,16 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
   }
   try {
     state.CheckRoomForDocument();  // before reading the file
-    ScanFile file = ReadScanFile(path);
+    FileForEditing opened = ReadFileForEditing(path);
+    ScanFile& file = opened.file;
     const int index = request.has_param("scan") ? std::atoi(request.get_param_value("scan").c_str()) : 0;
     if (index < 0 || index >= static_cast<int>(file.scans.size())) {
       SendError(response, 400,
                 fmt::format("scan {} is out of range: the file holds {}", index, file.scans.size()));
       return;
     }
-    const int id = state.AddDocument(fs::path(path).filename().string(), std::move(file.scans[index]));
+    const int id = state.AddDocument(fs::path(path).filename().string(), std::move(file.scans[index]),
+                                     ImagesOfScan(opened.images, index));
     nlohmann::ordered_json reply = DocumentJson(*state.Get(id));
     reply["warnings"] = file.warnings;  // what the reader left out of the file
     SendJson(response, reply);
@@ -421,7 +422,15 @@ void Save(Document& document, const httplib::Request& request, httplib::Response
   const fs::path file = folder / fmt::format("doc{}.{}", document.id, format);
   {
     std::lock_guard lock(document.mutex);
-    if (document.now.behind.valid.empty()) {
+    if (format == "e57" && !document.e57_images.empty()) {
+      // The photos of the file it was opened from go back with it (with the scan's guid and dates, which
+      // the scan keeps in its source_metadata).
+      E57File e57;
+      e57.scans = {document.now.scan};
+      e57.images = document.e57_images;
+      if (!document.now.behind.valid.empty()) e57.second_returns = {document.now.behind};
+      WriteE57(file.string(), e57, E57WriteOptions{});
+    } else if (document.now.behind.valid.empty()) {
       WriteScanFile(file.string(), {document.now.scan});
     } else if (!info->layer_behind) {
       SendError(response, 400, LayerBehindRefusal(*info));
@@ -448,9 +457,15 @@ void SavePlan(Document& document, const httplib::Request& request, httplib::Resp
   const bool layer = !document.now.behind.valid.empty();
   const ScanWritePlan plan = PlanScanWrite(
       fmt::format("{}.{}", fs::path(document.name).stem().string(), format), {document.now.scan}, 0, 0);
+  std::vector<std::string> dropped = plan.dropped;
+  if (format != "e57" && !document.e57_images.empty()) {
+    dropped.push_back(
+        fmt::format("{}: the {} photo(s) of the E57 file (images2D) are not written; E57 keeps them", format,
+                    document.e57_images.size()));
+  }
   SendJson(response, {{"format", format},
                       {"channels", plan.channels},
-                      {"dropped", plan.dropped},
+                      {"dropped", dropped},
                       {"refused", layer && !info->layer_behind ? LayerBehindRefusal(*info) : ""}});
 }
 
@@ -556,7 +571,21 @@ void AddScanRoutes(State& state) {
              if (!document) return;
              std::lock_guard lock(document->mutex);
              const Scan& scan = document->now.scan;
-             const bool hole = request.get_param_value("layer") == "hole";
+             const std::string layer = request.get_param_value("layer");
+             if (layer == "strokes") {
+               // The strokes as the server holds them (the canvas draws these, not a list of its own): the
+               // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
+               // the values 0 / 1 / 2 as grey (segment.h kStroke*).
+               const cv::Mat& strokes = document->now.strokes;
+               if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
+               cv::Mat overlay(strokes.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+               overlay.setTo(cv::Scalar(60, 220, 60, 210), strokes == 1);
+               overlay.setTo(cv::Scalar(60, 60, 230, 210), strokes == 2);
+               std::vector<uint8_t> png;
+               CvImEncode(".png", overlay, &png);
+               return response.set_content(std::string(png.begin(), png.end()), "image/png");
+             }
+             const bool hole = layer == "hole";
              const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
              cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
              if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
@@ -571,7 +600,23 @@ void AddScanRoutes(State& state) {
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);
              if (!document) return;
+             // ?since=V: only the cells that changed since the client's version V (LSD1), when that state is
+             // still kept; else (or without it) the whole points (LSP1). The client tells them by the magic.
+             int64_t since = -1;
+             if (request.has_param("since")) {
+               const std::string text = request.get_param_value("since");
+               char* end = nullptr;
+               since = std::strtoll(text.c_str(), &end, 10);
+               if (text.empty() || *end != '\0' || since < 0)
+                 return SendError(response, 400, "since: expected a version (a whole number >= 0)");
+             }
              std::lock_guard lock(document->mutex);
+             response.set_header("X-Lidarshop-Version", std::to_string(document->version));
+             if (since >= 0) {
+               if (auto delta = PointsDeltaBinary(*document, since)) {
+                 return response.set_content(std::move(*delta), "application/octet-stream");
+               }
+             }
              response.set_content(PointsBinary(*document), "application/octet-stream");
            });
   // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).

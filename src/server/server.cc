@@ -165,10 +165,12 @@ std::string EditorServer::Url() const {
 int EditorServer::OpenAtStart(const std::string& path, std::vector<std::string>* warnings) {
   const std::string folder = fs::weakly_canonical(fs::absolute(path)).parent_path().string();
   state_->options.roots.push_back(folder);
-  ScanFile file = ReadScanFile(path);
+  FileForEditing opened = ReadFileForEditing(path);
+  ScanFile& file = opened.file;
   if (warnings != nullptr) warnings->insert(warnings->end(), file.warnings.begin(), file.warnings.end());
   if (file.scans.empty()) throw InputError(fmt::format("{}: holds no scan", path));
-  return state_->AddDocument(fs::path(path).filename().string(), std::move(file.scans.front()));
+  return state_->AddDocument(fs::path(path).filename().string(), std::move(file.scans.front()),
+                             ImagesOfScan(opened.images, 0));
 }
 
 int EditorServer::OpenScene(const std::string& name) {

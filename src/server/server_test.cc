@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <thread>
 
 #include <fmt/format.h>
@@ -15,6 +16,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include "lidarshop/geometry/camera.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/testing/scenes.h"
@@ -269,6 +271,181 @@ TEST_F(ServerTest, RemoveUndoRemoveKeepsTheStrokes) {
   ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
   const auto repainted = client_->Post(strokes, "{}", "application/json");
   EXPECT_EQ(Json(repainted)["object_stroke_cells"], object_strokes);
+}
+
+// The points as a map from key (cell, + 2^31 for the layer behind a kept object) to the point's bytes (xyz,
+// rgb, flags): from a whole LSP1 answer, or an LSD1 delta applied to `points`.
+using PointMap = std::map<uint32_t, std::string>;
+void ApplyPoints(const std::string& body, PointMap& points, int64_t* from = nullptr, int64_t* to = nullptr) {
+  ASSERT_GE(body.size(), 16u);
+  uint32_t header[6] = {};
+  std::memcpy(header, body.data(), std::min(body.size(), sizeof(header)));
+  const size_t n = header[1];
+  const auto record = [&](const char* xyz, const char* rgb, const char* flags) {
+    return std::string(xyz, 12) + std::string(rgb, 3) + std::string(flags, 1);
+  };
+  if (body.compare(0, 4, "LSP1") == 0) {
+    ASSERT_EQ(body.size(), 16 + n * 20);
+    points.clear();
+    const char* base = body.data() + 16;
+    for (size_t i = 0; i < n; ++i) {
+      uint32_t cell;
+      std::memcpy(&cell, base + 12 * n + 4 * i, 4);
+      const char* flags = base + 19 * n + i;
+      points[cell | ((*flags & 4) != 0 ? 0x80000000u : 0u)] =
+          record(base + 12 * i, base + 16 * n + 3 * i, flags);
+    }
+    return;
+  }
+  ASSERT_EQ(body.compare(0, 4, "LSD1"), 0);
+  ASSERT_EQ(body.size(), 24 + n * 21);
+  if (from) *from = header[4];
+  if (to) *to = header[5];
+  const char* base = body.data() + 24;
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t key;
+    std::memcpy(&key, base + 4 * i, 4);
+    if (base[20 * n + i] == 0) {
+      points.erase(key);
+    } else {
+      points[key] = record(base + 4 * n + 12 * i, base + 16 * n + 3 * i, base + 19 * n + i);
+    }
+  }
+}
+
+// An edit sends only what it changed: the deltas since the client's version, applied in order, give exactly
+// the whole points of each version; a stroke changes no point; an unknown version gets the whole points.
+TEST_F(ServerTest, PointDeltasPatchToTheWholePoints) {
+  const int id = OpenBox();
+  const auto get = [&](const std::string& path) {
+    return client_->Get(Api(fmt::format(fmt::runtime(path), id)));
+  };
+  const auto version = [&] { return Json(get("/api/docs/{}"))["version"].get<int64_t>(); };
+  PointMap client;
+  ApplyPoints(get("/api/docs/{}/points")->body, client);
+  const size_t whole_bytes = get("/api/docs/{}/points")->body.size();
+  int64_t shown = version();
+  // Brings the client to the current version with a delta; checks it against the whole points.
+  const auto catch_up = [&](const char* what) -> size_t {
+    const auto delta = get(fmt::format("/api/docs/{{}}/points?since={}", shown));
+    EXPECT_EQ(delta->status, 200) << what;
+    EXPECT_EQ(delta->body.substr(0, 4), "LSD1") << what;
+    int64_t from = -1, to = -1;
+    ApplyPoints(delta->body, client, &from, &to);
+    EXPECT_EQ(from, shown) << what;
+    shown = to;
+    EXPECT_EQ(to, version()) << what;
+    PointMap whole;
+    ApplyPoints(get("/api/docs/{}/points")->body, whole);
+    EXPECT_TRUE(client == whole) << what << ": the patched points differ from the whole points";
+    return delta->body.size();
+  };
+  ASSERT_EQ(
+      client_->Post(Api(fmt::format("/api/docs/{}/strokes", id)), StrokesBody(), "application/json")->status,
+      200);
+  EXPECT_EQ(catch_up("stroke"), 24u);  // the header only: a stroke moves no point
+  // The strokes as the server holds them, drawn over the ray image (object green, background red).
+  const auto overlay = get("/api/docs/{}/mask.png?layer=strokes&style=overlay");
+  ASSERT_EQ(overlay->status, 200);
+  const cv::Mat strokes =
+      cv::imdecode(std::vector<uint8_t>(overlay->body.begin(), overlay->body.end()), cv::IMREAD_UNCHANGED);
+  ASSERT_EQ(strokes.type(), CV_8UC4);
+  std::vector<cv::Mat> bgra;
+  cv::split(strokes, bgra);
+  EXPECT_EQ(cv::countNonZero(bgra[1] == 220), Json(get("/api/docs/{}"))["object_stroke_cells"]);
+  const auto segmented =
+      Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/segment", id)), "{}", "application/json")));
+  ASSERT_EQ(segmented["state"], "done");
+  const size_t segment_bytes = catch_up("segment");
+  EXPECT_EQ(segment_bytes,
+            24 + 21 * segmented["result"]["object_cells"].get<size_t>());  // their flags changed
+  const auto removed =
+      Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/remove", id)),
+                              R"({"options": {"fill": {"method": "laplace"}}})", "application/json")));
+  ASSERT_EQ(removed["state"], "done");
+  EXPECT_LT(catch_up("remove"), whole_bytes / 2);
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  catch_up("undo");
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/redo", id)), "", "application/json")->status, 200);
+  catch_up("redo");
+  // Many strokes (other clients painting) do not push the client's version out: they share its point state.
+  for (int i = 0; i < 3 * 8; ++i) {
+    ASSERT_EQ(client_
+                  ->Post(Api(fmt::format("/api/docs/{}/strokes", id)), R"({"background": [[1, 1]]})",
+                         "application/json")
+                  ->status,
+              200);
+  }
+  EXPECT_EQ(catch_up("24 strokes"), 24u);
+  // Two versions at once (a client that missed one) and a version no longer kept.
+  const int64_t two_back = shown - 2;
+  PointMap older;
+  ApplyPoints(get(fmt::format("/api/docs/{{}}/points?since={}", 999999))->body, older);  // whole: LSP1
+  EXPECT_TRUE(older == client);
+  EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?since={}", two_back))->body.substr(0, 4), "LSD1");
+  EXPECT_EQ(get("/api/docs/{}/points?since=abc")->status, 400);
+  EXPECT_EQ(get("/api/docs/{}/points?since=-1")->status, 400);
+}
+
+// A scan opened from E57 and edited keeps its photo, scan guid and the file's other metadata when saved as
+// E57; the save plan of another format says the photo is lost; the recolour tool can take the photo.
+TEST_F(ServerTest, E57PhotoAndGuidSurviveAnEditAndASave) {
+  fs::copy_file(LIDARSHOP_SHARED_DATA_DIR "/e57/pumpA.e57", base_ / "root" / "pump.e57",
+                fs::copy_options::overwrite_existing);
+  const E57File original = ReadE57(LIDARSHOP_SHARED_DATA_DIR "/e57/pumpA.e57");
+  const auto opened = client_->Get(Api("/api/open?path=pump.e57"));
+  ASSERT_EQ(opened->status, 200) << opened->body;
+  const auto doc = Json(opened);
+  const int id = doc["id"];
+  ASSERT_EQ(doc["e57_images"].size(), 1u);
+  EXPECT_EQ(doc["e57_images"][0]["name"], "pumpVisual");
+  EXPECT_TRUE(doc["e57_images"][0]["usable"]);
+  // An edit that changes the scan: a painted hole filled.
+  ASSERT_EQ(
+      client_
+          ->Post(Api(fmt::format("/api/docs/{}/strokes", id)),
+                 R"({"hole_polygon": [[500, 100], [500, 140], [540, 140], [540, 100]]})", "application/json")
+          ->status,
+      200);
+  const auto filled = Wait(
+      Json(client_->Post(Api(fmt::format("/api/docs/{}/fill", id)),
+                         R"({"hole": "painted", "options": {"method": "laplace"}})", "application/json")));
+  ASSERT_EQ(filled["state"], "done") << filled.dump();
+  const auto ptx_plan = Json(client_->Get(Api(fmt::format("/api/docs/{}/save-plan?format=ptx", id))));
+  EXPECT_NE(ptx_plan["dropped"].dump().find("photo(s) of the E57 file"), std::string::npos)
+      << ptx_plan.dump();
+  const auto saved = client_->Get(Api(fmt::format("/api/docs/{}/save?format=e57", id)));
+  ASSERT_EQ(saved->status, 200);
+  const E57File back =
+      ReadE57Bytes(std::vector<uint8_t>(saved->body.begin(), saved->body.end()), "saved.e57");
+  ASSERT_EQ(back.images.size(), 1u);
+  EXPECT_EQ(back.images[0].encoded, original.images[0].encoded);  // the photo bit for bit
+  EXPECT_EQ(back.images[0].guid, original.images[0].guid);
+  EXPECT_EQ(back.scans[0].source_metadata.at("e57.guid"), original.scans[0].source_metadata.at("e57.guid"));
+  ASSERT_FALSE(back.scans[0].synthesized.empty());
+  EXPECT_GT(cv::countNonZero(back.scans[0].synthesized), 0);  // the edit is in it
+  // The recolour tool's photo from the file.
+  const auto photo = client_->Post(Api(fmt::format("/api/docs/{}/photo-from-e57", id)), R"({"image": 0})",
+                                   "application/json");
+  ASSERT_EQ(photo->status, 200) << photo->body;
+  EXPECT_EQ(Json(photo)["width_px"], 3072);
+  EXPECT_EQ(client_->Get(Api(fmt::format("/api/docs/{}/photo.png", id)))->status, 200);
+  EXPECT_EQ(
+      client_
+          ->Post(Api(fmt::format("/api/docs/{}/photo-from-e57", id)), R"({"image": 1})", "application/json")
+          ->status,
+      400);
+  EXPECT_EQ(
+      client_
+          ->Post(Api(fmt::format("/api/docs/{}/photo-from-e57", id)), R"({"image": "x"})", "application/json")
+          ->status,
+      400);
+  // pumpA's photo is a visual one (no camera): colouring from the station's photos says why it cannot.
+  const auto station =
+      client_->Post(Api(fmt::format("/api/docs/{}/recolor-station", id)), "{}", "application/json");
+  EXPECT_EQ(station->status, 400);
+  EXPECT_NE(station->body.find("pumpVisual"), std::string::npos) << station->body;
+  client_->Delete(Api(fmt::format("/api/docs/{}", id)));
 }
 
 TEST_F(ServerTest, HoleBrushLassoAndFillShadow) {

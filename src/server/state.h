@@ -17,6 +17,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/inpaint/inpaint_session.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/progress.h"
@@ -77,11 +78,23 @@ struct Document {
   Snapshot now;
   std::vector<Snapshot> undo, redo;
   int64_t version = 0;  // +1 on every edit: clients see whether their view is current
+  // The last few distinct point states (what GET /points draws from) with the versions that showed them, so
+  // that GET /points?since=V answers only the cells changed since the client's version V. Consecutive
+  // versions with the same point buffers (strokes, holes) share one entry: many clients painting at once
+  // do not push a client's version out.
+  struct PointState {
+    int64_t first_version = 0, last_version = 0;
+    Snapshot points;  // shallow: shares the history's buffers; strokes and hole left empty
+  };
+  std::deque<PointState> recent;
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
-  cv::Mat photo;                    // CV_8UC3 RGB: the photo to recolour from (empty = none)
-  cv::Mat photo_b;                  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
+  // The photos (images2D) of the E57 file it was opened from that belong to its scan or to none
+  // (associated_scan 0 or -1): a save as E57 writes them back, the recolour tool can use them.
+  std::vector<E57Image> e57_images;
+  cv::Mat photo;    // CV_8UC3 RGB: the photo to recolour from (empty = none)
+  cv::Mat photo_b;  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
   std::shared_ptr<ReviewSession> review;  // the inpainting review in progress (null = none)
   int64_t prepared_version = -1;
   std::mutex mutex;  // guards every field above

@@ -12,6 +12,8 @@ export interface DocumentInfo {
   synthesized_cells: number;
   object_cells: number;
   hole_cells: number;
+  object_stroke_cells: number;
+  background_stroke_cells: number;
   behind_cells: number;
   world_from_scanner_column_major: number[];
   azimuth_step_deg: number;
@@ -19,6 +21,8 @@ export interface DocumentInfo {
   version: number;
   can_undo: boolean;
   can_redo: boolean;
+  // The photos of the E57 file the scan was opened from (images2D); absent from older servers.
+  e57_images?: { index: number; name: string; width_px: number; height_px: number; usable: boolean }[];
 }
 
 export interface JobInfo {
@@ -182,6 +186,16 @@ export class Api {
     const response = await fetch(this.url(`/api/models/${id}/mesh`));
     if (!response.ok) throw new ApiError(response.status, `mesh: ${response.status}`);
     return parseMesh(await response.arrayBuffer());
+  }
+
+  // The points of document `id` as an answer to show: the cells changed since `since` (LSD1) when the server
+  // still holds that version, else the whole points (LSP1); `version` is the version they show
+  // (X-Lidarshop-Version), `bytes` what travelled.
+  async pointsSince(id: number, since: number | null): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
+    const response = await fetch(this.url(`/api/docs/${id}/points`, since === null ? {} : { since }));
+    if (!response.ok) throw new ApiError(response.status, `points: ${response.status}`);
+    const buffer = await response.arrayBuffer();
+    return { buffer, version: Number(response.headers.get('X-Lidarshop-Version') ?? -1), bytes: buffer.byteLength };
   }
 
   async points(id: number): Promise<PointSet> {

@@ -1,11 +1,12 @@
 // The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
-import { Api, ApiError, DocumentInfo, JobInfo, MeshData, ScanFileEntry, fileLabel, firstReadableFile, inverseRigid, multiply, poseMatrix, resultWarnings } from './api';
+import { Api, ApiError, DocumentInfo, JobInfo, MeshData, PointSet, ScanFileEntry, fileLabel, firstReadableFile, inverseRigid, multiply, poseMatrix, resultWarnings } from './api';
 import { PointColouring, PointView } from './pointview';
 import { PairsPanel } from './pairsui';
 import { Brush, RayView, loadImage } from './rayview';
 import { PendingReview, ReviewChoice, decisionBody } from './review';
 import { ReviewPanel } from './reviewpanel';
 import { Cell, toCellList } from './strokes';
+import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -17,6 +18,13 @@ let doc: DocumentInfo | null = null;
 let runningJob: JobInfo | null = null;
 let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
+let openDocuments: DocumentInfo[] = []; // the server's open documents, for the list
+const gate = new VersionGate(); // answers are shown in version order
+const heldPoints = new Map<number, { version: number; points: PointSet }>(); // per document
+let pointsShown = { id: -1, version: -1 };
+let pointsChain: Promise<void> = Promise.resolve(); // point updates one at a time, in order
+let pointBytes = 0; // bytes of points received (whole or deltas), for tests
+const lastImage = new Map<string, string>(); // "id:channel" -> the ray image URL shown
 const strokeKinds = new Set<Brush>();  // brushes used on the open scan since its last cut was reset
 
 let pending: PendingReview | null = null; // the patch review shown (null = none)
@@ -25,42 +33,126 @@ let placingByHand = false; // the next pick in the ray image is a review's sourc
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {
   rayView, pointView, current: () => doc, verify: () => verify(), review: () => pending, pairs: () => pairsPanel,
+  pointBytes: () => pointBytes, pointsShown: () => pointsShown, documents: () => openDocuments,
+  settled: () => pointsChain.then(() => true),
 };
 
-async function refresh(keepView: boolean) {
+// Brings the held points of document `id` to the server's current version: the cells changed since the held
+// version (a delta), or the whole points the first time; then shows them if the document is still shown.
+function updatePoints(id: number, keepView: boolean): Promise<void> {
+  pointsChain = pointsChain.then(async () => {
+    try {
+      let held = heldPoints.get(id);
+      const answer = await api.pointsSince(id, held ? held.version : null);
+      pointBytes += answer.bytes;
+      const parsed = parsePointsAnswer(answer.buffer);
+      if ('whole' in parsed) {
+        held = { version: answer.version, points: parsed.whole };
+      } else if (held && parsed.delta.from === held.version) {
+        held = { version: parsed.delta.to, points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points };
+      } else {
+        const whole = await api.pointsSince(id, null);
+        pointBytes += whole.bytes;
+        held = { version: whole.version, points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole };
+      }
+      heldPoints.set(id, held);
+      if (doc?.id !== id) return;
+      if (pointsShown.id !== id || pointsShown.version !== held.version || !keepView) {
+        pointView.show(held.points, keepView && pointsShown.id === id);
+        pointsShown = { id, version: held.version };
+      }
+    } catch (error) {
+      status(`points: ${(error as Error).message}`);
+    }
+  });
+  return pointsChain;
+}
+
+// The list of open documents (the server's), the shown one selected.
+async function listDocuments() {
+  const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
+  openDocuments = documents;
+  const select = element<HTMLSelectElement>('documents');
+  select.replaceChildren(...documents.map((d) => {
+    const option = new Option(`#${d.id} ${d.name}${d.can_undo ? ' (edited)' : ''}`, String(d.id));
+    option.title = `${d.rows} x ${d.cols} cells, version ${d.version}`;
+    return option;
+  }));
+  if (doc) select.value = String(doc.id);
+  element<HTMLButtonElement>('close-doc').disabled = documents.length === 0;
+}
+
+// Shows another open document (its history, points and view are the server's; nothing is lost switching).
+async function showDocument(next: DocumentInfo | null) {
+  doc = next;
+  rayView.clearStrokes();
+  strokeKinds.clear();
+  pending = null;
+  reviewPanel.hide();
+  if (doc) {
+    await refresh(false);
+  } else {
+    status('No scan open: open a built-in scene or a file.');
+  }
+  await listDocuments();
+}
+
+// Shows the server's state of the document: its pictures (ray image, object, hole and strokes overlays) and
+// points. `strokesOnly`: an edit of the strokes or the hole, which changes no point or ray image, so only the
+// overlays are fetched. An answer about an older version than the one shown is dropped (VersionGate).
+async function refresh(keepView: boolean, strokesOnly = false) {
   if (!doc) return;
-  doc = await api.json<DocumentInfo>(`/api/docs/${doc.id}`);
+  const id = doc.id;
+  const info = await api.json<DocumentInfo>(`/api/docs/${id}`);
+  if (doc?.id !== id || !gate.accept(id, info.version)) return; // switched away, or overtaken by a newer answer
+  doc = info;
   const channel = element<HTMLSelectElement>('channel').value;
   // A channel the scan does not hold falls back to intensity, then range (a file may hold neither colour nor
   // intensity); labels and classes to range.
-  const has = (name: string) => doc!.channels.includes(name);
+  const has = (name: string) => info.channels.includes(name);
   let usable = channel;
   if (usable === 'rgb' && !has('color')) usable = 'intensity';
   if (usable === 'intensity' && !has('intensity')) usable = 'range';
   if ((usable === 'labels' || usable === 'classification') && !has('label')) usable = 'range';
-  const aspect = doc.azimuth_step_deg > 0 ? doc.elevation_step_deg / doc.azimuth_step_deg : 1;
-  const mask = doc.object_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', v: doc.version }) : null;
-  const hole = doc.hole_cells > 0 ? api.url(`/api/docs/${doc.id}/mask.png`, { style: 'overlay', layer: 'hole', v: doc.version }) : null;
-  await rayView.show(api.url(`/api/docs/${doc.id}/image.png`, { channel: usable, v: doc.version }), mask, hole, doc.rows, doc.cols, aspect, keepView);
-  pointView.show(await api.points(doc.id), keepView);
-  element<HTMLButtonElement>('undo').disabled = !doc.can_undo;
-  element<HTMLButtonElement>('redo').disabled = !doc.can_redo;
-  const behind = doc.behind_cells > 0 ? `, ${doc.behind_cells} behind the object` : '';
-  status(`${doc.name}: ${doc.rows} x ${doc.cols} cells, ${doc.valid_cells} returns, ${doc.synthesized_cells} synthesized, ${doc.object_cells} in the object, ${doc.hole_cells} in the hole${behind} (version ${doc.version})`);
+  const aspect = info.azimuth_step_deg > 0 ? info.elevation_step_deg / info.azimuth_step_deg : 1;
+  const v = info.version;
+  const mask = info.object_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', v }) : null;
+  const hole = info.hole_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'hole', v }) : null;
+  const strokes = api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'strokes', v });
+  const imageKey = `${id}:${usable}`;
+  const image = strokesOnly && lastImage.has(imageKey) ? lastImage.get(imageKey)! : api.url(`/api/docs/${id}/image.png`, { channel: usable, v });
+  lastImage.set(imageKey, image);
+  const shown = await rayView.show(id, v, image, mask, hole, strokes, info.rows, info.cols, aspect, keepView);
+  if (!strokesOnly) await updatePoints(id, keepView);
+  if (!shown || doc?.id !== id || gate.version(id) !== v) return;
+  const photos = info.e57_images ?? [];
+  const photoSelect = element<HTMLSelectElement>('e57-photo');
+  if (photoSelect.dataset.doc !== String(id)) {
+    photoSelect.dataset.doc = String(id);
+    photoSelect.replaceChildren(new Option(`E57 photos (${photos.length})`, ''), ...photos.map((p) => {
+      const option = new Option(`${p.name} (${p.width_px} x ${p.height_px})`, String(p.index));
+      option.disabled = !p.usable;
+      return option;
+    }));
+    photoSelect.hidden = photos.length === 0;
+    element('recolor-station').hidden = photos.length === 0;
+  }
+  element<HTMLButtonElement>('undo').disabled = !info.can_undo;
+  element<HTMLButtonElement>('redo').disabled = !info.can_redo;
+  const behind = info.behind_cells > 0 ? `, ${info.behind_cells} behind the object` : '';
+  status(`${info.name}: ${info.rows} x ${info.cols} cells, ${info.valid_cells} returns, ${info.synthesized_cells} synthesized, ${info.object_cells} in the object, ${info.hole_cells} in the hole${behind} (version ${v})`);
 }
 
 async function open(params: Record<string, string>) {
   try {
     status('opening…');
-    doc = await api.json<DocumentInfo>('/api/open', params);
-    rayView.clearStrokes();
-    strokeKinds.clear();
-    pending = null;
-    reviewPanel.hide();
-    await refresh(false);
+    const opened = await api.json<DocumentInfo>('/api/open', params);
+    await showDocument(opened);
     if (pairsPanel.pairs.mode === 'scan-scan') await pairsPanel.listTargets();
   } catch (error) {
+    // 409 (16 open) or 507 (no memory left): the server refuses rather than closing one; the message says so.
     status(`open failed: ${(error as Error).message}`);
+    await listDocuments().catch(() => {});
   }
 }
 
@@ -105,16 +197,16 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
   try {
     const key = brush === 'lasso' ? 'hole_polygon' : brush;
     await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
+    await refresh(true, true); // the strokes as the server holds them
     status(`${cells.length} ${brush} stroke cells painted`);
-    if (brush === 'hole' || brush === 'lasso') {
-      rayView.clearStrokes(['hole', 'lasso']);
-      await refresh(true);
-    } else if (element<HTMLInputElement>('live').checked && (strokeKinds.add(brush), strokeKinds.size === 2)) {
+    if ((brush === 'object' || brush === 'background') && element<HTMLInputElement>('live').checked &&
+        (strokeKinds.add(brush), strokeKinds.size === 2)) {
       // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut).
       await runJob(`/api/docs/${doc.id}/segment`, { refine: doc.object_cells > 0 }, 'segment');
     }
   } catch (error) {
     status(`stroke failed: ${(error as Error).message}`);
+    await refresh(true, true).catch(() => {});
   }
 };
 rayView.onPick = (cell) => {
@@ -148,6 +240,10 @@ element<HTMLInputElement>('radius').addEventListener('change', (event) => {
   rayView.radius = Number((event.target as HTMLInputElement).value);
 });
 element('channel').addEventListener('change', () => refresh(true));
+for (const layer of ['original', 'synthesized', 'object'] as const) {
+  element<HTMLInputElement>(`layer-${layer}`).addEventListener('change', (event) =>
+    pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked));
+}
 element<HTMLInputElement>('point-size').addEventListener('input', (event) => pointView.setPointSize(Number((event.target as HTMLInputElement).value)));
 element<HTMLSelectElement>('point-colour').addEventListener('change', (event) => pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring));
 element('open-scene').addEventListener('click', () => open({ scene: element<HTMLSelectElement>('scene').value }));
@@ -155,26 +251,76 @@ element('open-file').addEventListener('click', () => open({ path: element<HTMLSe
 element('segment').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/segment`, {}, 'segment'));
 element('remove').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, {}, 'remove');
-  rayView.clearStrokes();
-  strokeKinds.clear();
+  strokeKinds.clear(); // the removal cleared the server's strokes
 });
 element('fill').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, {}, 'fill'));
 element('fill-hole').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, { hole: 'painted' }, 'fill hole'));
 element('fill-shadow').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, { options: { keep_object: true } }, 'fill shadow');
-  rayView.clearStrokes(['object', 'background']);
+  strokeKinds.clear();
 });
-for (const action of ['undo', 'redo']) {
-  element(action).addEventListener('click', async () => {
-    if (!doc) return;
-    try {
-      await api.json(`/api/docs/${doc.id}/${action}`, {}, {});
-      await refresh(true);
-    } catch (error) {
-      status(`${action}: ${(error as Error).message}`);
-    }
-  });
+// Undo / redo ask the server (which answers 409 when there is nothing to undo or redo): the keys do not wait
+// for the buttons' state, which follows the last refresh.
+async function undoRedo(action: 'undo' | 'redo') {
+  if (!doc) return;
+  try {
+    await api.json(`/api/docs/${doc.id}/${action}`, {}, {});
+    await refresh(true);
+  } catch (error) {
+    status(`${action}: ${(error as Error).message}`);
+  }
 }
+for (const action of ['undo', 'redo'] as const) element(action).addEventListener('click', () => undoRedo(action));
+element('recolor-station').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/recolor-station`, {}, 'colour from the station\'s photos'));
+element('e57-photo').addEventListener('change', () => {
+  const value = element<HTMLSelectElement>('e57-photo').value;
+  if (value !== '') pairsPanel.useE57Photo(Number(value));
+});
+element('documents').addEventListener('change', () => {
+  const id = Number(element<HTMLSelectElement>('documents').value);
+  const next = openDocuments.find((d) => d.id === id);
+  if (next && next.id !== doc?.id) showDocument(next);
+});
+element('close-doc').addEventListener('click', async () => {
+  if (!doc) return;
+  const closing = doc;
+  // Closing is the user's alone (the server never closes one); edits not saved are lost, so it asks.
+  if (closing.can_undo && !window.confirm(`Close ${closing.name}? Its edits are lost unless saved.`)) return;
+  try {
+    await api.delete(`/api/docs/${closing.id}`);
+  } catch (error) {
+    status(`close: ${(error as Error).message}`);
+    return;
+  }
+  heldPoints.delete(closing.id);
+  gate.forget(closing.id);
+  await listDocuments();
+  await showDocument(openDocuments[0] ?? null);
+  status(`closed ${closing.name}. ${element('status').textContent}`);
+});
+
+// Keyboard: B / E brush / eraser, [ ] radius, Ctrl+Z / Ctrl+Y (or Ctrl+Shift+Z) undo / redo, F fit view.
+document.addEventListener('keydown', (event) => {
+  const target = event.target as HTMLElement;
+  if (target.closest('input, select, textarea')) return;
+  const radius = element<HTMLInputElement>('radius');
+  const setRadius = (value: number) => {
+    radius.value = String(Math.max(0, Math.min(20, value)));
+    rayView.radius = Number(radius.value);
+  };
+  const key = event.key.toLowerCase();
+  if ((event.ctrlKey || event.metaKey) && (key === 'y' || (key === 'z' && event.shiftKey))) undoRedo('redo');
+  else if ((event.ctrlKey || event.metaKey) && key === 'z') undoRedo('undo');
+  else if (event.ctrlKey || event.metaKey || event.altKey) return;
+  else if (key === 'b') element('brush-object').click();
+  else if (key === 'e') element('brush-erase').click();
+  else if (key === '[') setRadius(Number(radius.value) - 1);
+  else if (key === ']') setRadius(Number(radius.value) + 1);
+  else if (key === 'f') rayView.fitToView();
+  else return;
+  event.preventDefault();
+});
+
 element('cancel').addEventListener('click', () => {
   if (runningJob) api.json(`/api/jobs/${runningJob.id}/cancel`, {}, {}).catch(() => {});
 });
@@ -234,9 +380,10 @@ element('place').addEventListener('click', async () => {
     placed = { id: model.id, mesh: await api.mesh(model.id) };
     if (picked) {
       // The picked cell's point in the world frame (the scan's pose): the model stands there.
-      const points = await api.points(doc.id);
-      const index = points.cells.indexOf(picked.row * doc.cols + picked.col);
-      if (index >= 0) {
+      await pointsChain;
+      const points = heldPoints.get(doc.id)?.points;
+      const index = !points ? -1 : points.cells.indexOf(picked.row * doc.cols + picked.col);
+      if (points && index >= 0) {
         const w = doc.world_from_scanner_column_major;
         const [px, py, pz] = [points.xyz[3 * index], points.xyz[3 * index + 1], points.xyz[3 * index + 2]];
         poseInputs[0].value = (w[0] * px + w[4] * py + w[8] * pz + w[12]).toFixed(2);
@@ -346,11 +493,8 @@ async function start() {
     const models = await api.json<{ builtin: string[]; files: string[] }>('/api/models');
     element('model').replaceChildren(...models.builtin.map((name) => new Option(name, name)),
       ...models.files.map((path) => new Option(path.split('/').pop()!, path)));
-    const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
-    if (documents.length > 0) {
-      doc = documents[0];
-      await refresh(false);
-    }
+    await listDocuments();
+    if (openDocuments.length > 0) await showDocument(openDocuments[0]);
   } catch (error) {
     status(error instanceof ApiError && error.status === 401 ? 'open the URL `lidarshop serve` printed (it holds the token)' : String(error));
   }

@@ -19,6 +19,7 @@ export class PairsPanel {
   readonly pairs = new PairCollector('photo-scan');
   private photoA: HTMLImageElement | null = null;
   private photoB: HTMLImageElement | null = null;
+  residuals: number[] | null = null; // per pair of the last recolouring: reprojection error, px
   private inliers: number[] | null = null; // per pair of the last photo match: 1 = inlier
   readonly targetView: RayView;
   private targetDoc: DocumentInfo | null = null;
@@ -97,7 +98,7 @@ export class PairsPanel {
     const d = this.targetDoc;
     const channel = d.channels.includes('color') ? 'rgb' : d.channels.includes('intensity') ? 'intensity' : 'range';
     const aspect = d.azimuth_step_deg > 0 ? d.elevation_step_deg / d.azimuth_step_deg : 1;
-    await this.targetView.show(api.url(`/api/docs/${id}/image.png`, { channel, v: d.version }), null, null, d.rows, d.cols, aspect, false);
+    await this.targetView.show(id, d.version, api.url(`/api/docs/${id}/image.png`, { channel, v: d.version }), null, null, null, d.rows, d.cols, aspect, false);
     this.shownTarget = id;
   }
 
@@ -130,8 +131,24 @@ export class PairsPanel {
     const doc = this.context.doc();
     if (!file || !doc) return;
     const api = this.context.api;
+    await this.usePhoto(slot, () => fetch(api.url(`/api/docs/${doc.id}/photo`, { slot }), { method: 'POST', body: file, headers: { 'Content-Type': file.type } }));
+  }
+
+  // Photo K of the scan's own E57 file (images2D) as the photo to recolour from.
+  async useE57Photo(index: number, slot: 'a' | 'b' = 'a') {
+    const doc = this.context.doc();
+    if (!doc) return;
+    const api = this.context.api;
+    await this.usePhoto(slot, () => fetch(api.url(`/api/docs/${doc.id}/photo-from-e57`), {
+      method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ image: index, slot }) }));
+  }
+
+  private async usePhoto(slot: 'a' | 'b', send: () => Promise<Response>) {
+    const doc = this.context.doc();
+    if (!doc) return;
+    const api = this.context.api;
     try {
-      const response = await fetch(api.url(`/api/docs/${doc.id}/photo`, { slot }), { method: 'POST', body: file, headers: { 'Content-Type': file.type } });
+      const response = await send();
       if (!response.ok) throw new Error((await response.json()).error);
       const image = new Image();
       image.onload = () => this.draw();
@@ -154,7 +171,16 @@ export class PairsPanel {
     const api = this.context.api;
     try {
       if (mode === 'photo-scan') {
-        await this.context.runJob(`/api/docs/${doc.id}/recolor`, this.pairs.body(), 'recolour');
+        const finished = await this.context.runJob(`/api/docs/${doc.id}/recolor`, this.pairs.body(), 'recolour');
+        // Each pair's residual after the resection: a pair far off is a wrong click (refuse it, pick again).
+        const result = finished?.result as { reprojection_error_px?: number[]; inlier?: number[]; rms_px?: number } | undefined;
+        if (finished?.state === 'done' && result?.reprojection_error_px) {
+          this.residuals = result.reprojection_error_px;
+          const list = result.reprojection_error_px.map((e, i) => `${i + 1}: ${e.toFixed(1)}${result.inlier?.[i] === 0 ? ' (outlier)' : ''}`).join(', ');
+          element('pairs').textContent = `${this.pairs.pairs.length} pairs`;
+          element('pairs').title = `pair residuals (px): ${list}`;
+          this.context.status(`recolour: pair residuals (px) ${list}; RMS ${result.rms_px?.toFixed(2)} px. ${element('status').textContent}`);
+        }
       } else if (mode === 'scan-scan') {
         const target = Number(element<HTMLSelectElement>('align-target').value);
         const result = await api.json<{ rms_m: number; residual_m: number[] }>(`/api/docs/${doc.id}/align`, {}, this.pairs.body({ target }));

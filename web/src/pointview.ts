@@ -5,6 +5,43 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import { FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet } from './api';
 
 export type PointColouring = 'rgb' | 'layers' | 'height';
+export type Layer = 'original' | 'synthesized' | 'object';
+
+// The layer a point belongs to: the object, synthesized (filled, or on the surface behind a kept object), or
+// the original scan.
+export function layerOf(flag: number): Layer {
+  return flag & FLAG_OBJECT ? 'object' : flag & (FLAG_SYNTHESIZED | 4) ? 'synthesized' : 'original';
+}
+
+// The points of the layers not hidden (the same object when none is).
+export function visiblePoints(points: PointSet, hidden: Set<Layer>): PointSet {
+  if (hidden.size === 0) return points;
+  const keep: number[] = [];
+  for (let i = 0; i < points.count; ++i) if (!hidden.has(layerOf(points.flags[i]))) keep.push(i);
+  const n = keep.length;
+  const out: PointSet = { count: n, rows: points.rows, cols: points.cols, xyz: new Float32Array(3 * n), cells: new Uint32Array(n), rgb: new Uint8Array(3 * n), flags: new Uint8Array(n) };
+  keep.forEach((i, k) => {
+    out.xyz.set(points.xyz.subarray(3 * i, 3 * i + 3), 3 * k);
+    out.rgb.set(points.rgb.subarray(3 * i, 3 * i + 3), 3 * k);
+    out.cells[k] = points.cells[i];
+    out.flags[k] = points.flags[i];
+  });
+  return out;
+}
+
+// Where the ray image's centre looks: the point (scanner frame) of the cell nearest the image's centre cell
+// that has one; null without points.
+export function centrePoint(points: PointSet): [number, number, number] | null {
+  const row = Math.floor(points.rows / 2), col = Math.floor(points.cols / 2);
+  let best = -1, bestDistance = Infinity;
+  for (let i = 0; i < points.count; ++i) {
+    if (points.flags[i] & 4) continue; // the layer behind: not what the scanner saw
+    const r = Math.floor(points.cells[i] / points.cols), c = points.cells[i] % points.cols;
+    const distance = Math.abs(r - row) + Math.abs(c - col);
+    if (distance < bestDistance) [best, bestDistance] = [i, distance];
+  }
+  return best < 0 ? null : [points.xyz[3 * best], points.xyz[3 * best + 1], points.xyz[3 * best + 2]];
+}
 
 // Per-point colours (0..1 RGB) for a colouring mode.
 export function pointColours(points: PointSet, mode: PointColouring): Float32Array {
@@ -38,7 +75,9 @@ export class PointView {
   private controls: OrbitControls;
   private cloud: THREE.Points | null = null;
   private marker = new THREE.Mesh(new THREE.SphereGeometry(0.08), new THREE.MeshBasicMaterial({ color: 0xffff00 }));
-  private points: PointSet | null = null;
+  private points: PointSet | null = null; // the points shown (the visible layers)
+  private all: PointSet | null = null; // every point of the scan
+  private hidden = new Set<Layer>();
   private model: THREE.Mesh | null = null;
   private mode: PointColouring = 'rgb';
   private size = 2;
@@ -59,7 +98,16 @@ export class PointView {
     new ResizeObserver(() => this.resize()).observe(container);
   }
 
-  show(points: PointSet, keepCamera: boolean) {
+  // Shows or hides one layer (original / synthesized / object); the camera stays.
+  setLayerVisible(layer: Layer, visible: boolean) {
+    if (visible) this.hidden.delete(layer);
+    else this.hidden.add(layer);
+    if (this.all) this.show(this.all, true);
+  }
+
+  show(all: PointSet, keepCamera: boolean) {
+    this.all = all;
+    const points = visiblePoints(all, this.hidden);
     this.points = points;
     if (this.cloud) {
       this.scene.remove(this.cloud);
@@ -71,10 +119,18 @@ export class PointView {
     this.cloud = new THREE.Points(geometry, new THREE.PointsMaterial({ size: this.size, sizeAttenuation: false, vertexColors: true }));
     this.scene.add(this.cloud);
     if (!keepCamera) {
-      geometry.computeBoundingSphere();
-      const sphere = geometry.boundingSphere!;
-      this.controls.target.copy(sphere.center);
-      this.camera.position.set(sphere.center.x, sphere.center.y - sphere.radius * 0.9, sphere.center.z + sphere.radius * 0.5);
+      // From the scanner (the frame's origin), looking where the ray image's centre looks; orbiting turns
+      // about that point. A scan without a point there falls back to a view of the whole cloud.
+      const centre = centrePoint(all);
+      if (centre && Math.hypot(...centre) > 0.1) {
+        this.camera.position.set(0, 0, 0);
+        this.controls.target.set(...centre);
+      } else {
+        geometry.computeBoundingSphere();
+        const sphere = geometry.boundingSphere!;
+        this.controls.target.copy(sphere.center);
+        this.camera.position.set(sphere.center.x, sphere.center.y - sphere.radius * 0.9, sphere.center.z + sphere.radius * 0.5);
+      }
       this.controls.update();
     }
     this.render();

@@ -1,8 +1,11 @@
 // The scan's ray image on a canvas: any channel, zoom (wheel) and pan (drag with the pick tool or the middle
-// button), strokes painted with the brushes, the segmented object tinted, the picked cell marked.
+// button), strokes painted with the brushes, the segmented object tinted, the picked cell marked. The strokes
+// drawn are the server's (its overlay image of the document's state): an undone stroke disappears, and a
+// stroke keeps the radius it was painted with. A stroke is drawn locally only until the server's state
+// that holds it is shown.
 import { Cell, ImageView, cellsAlong, cellToScreen, fitView, screenToCell, zoomAt } from './strokes';
 
-export type Brush = 'object' | 'background' | 'hole' | 'lasso' | 'none';
+export type Brush = 'object' | 'background' | 'erase' | 'hole' | 'lasso' | 'none';
 
 export class RayView {
   brush: Brush = 'object';
@@ -13,11 +16,14 @@ export class RayView {
   private image: HTMLImageElement | null = null;
   private mask: HTMLImageElement | null = null;
   private holeMask: HTMLImageElement | null = null;
+  private strokeImage: HTMLImageElement | null = null;
+  private shown = { id: -1, version: -1 }; // the document and version of the pictures shown
   private view: ImageView = { scale: 1, aspect: 1, offsetX: 0, offsetY: 0 };
   private rows = 0;
   private cols = 0;
-  private pending: { brush: Brush; cells: Cell[] } | null = null;
-  private strokes: { brush: Brush; cells: Cell[] }[] = [];
+  private pending: { brush: Brush; cells: Cell[]; radius: number } | null = null;
+  // Strokes sent to the server and not yet in a state shown (each with the radius it was painted with).
+  private sent: { brush: Brush; cells: Cell[]; radius: number }[] = [];
   private picked: Cell | null = null;
   private panFrom: { x: number; y: number } | null = null;
 
@@ -34,11 +40,18 @@ export class RayView {
     new ResizeObserver(() => this.fit()).observe(canvas);
   }
 
-  async show(imageUrl: string, maskUrl: string | null, holeUrl: string | null, rows: number, cols: number, aspect: number,
-             keepView: boolean) {
-    const [image, mask, hole] = await Promise.all([loadImage(imageUrl), maskUrl ? loadImage(maskUrl) : Promise.resolve(null),
-                                                   holeUrl ? loadImage(holeUrl) : Promise.resolve(null)]);
+  // Shows the pictures of version `version` of document `id`; an answer older than the one shown (an
+  // overlapping refresh that finished late) is dropped. False when dropped.
+  async show(id: number, version: number, imageUrl: string, maskUrl: string | null, holeUrl: string | null,
+             strokesUrl: string | null, rows: number, cols: number, aspect: number, keepView: boolean): Promise<boolean> {
+    const optional = (url: string | null) => (url ? loadImage(url) : Promise.resolve(null));
+    const [image, mask, hole, strokes] = await Promise.all([loadImage(imageUrl), optional(maskUrl), optional(holeUrl),
+                                                            optional(strokesUrl)]);
+    if (id === this.shown.id && version < this.shown.version) return false;
+    this.shown = { id, version };
     this.holeMask = hole;
+    this.strokeImage = strokes;
+    this.sent = [];
     const sizeChanged = rows !== this.rows || cols !== this.cols;
     this.image = image;
     this.mask = mask;
@@ -47,11 +60,24 @@ export class RayView {
     this.view.aspect = aspect;
     if (!keepView || sizeChanged) this.fit();
     this.draw();
+    return true;
   }
 
-  clearStrokes(brushes: Brush[] = ['object', 'background', 'hole', 'lasso']) {
-    this.strokes = this.strokes.filter((stroke) => !brushes.includes(stroke.brush));
+  // The document and version shown (tests).
+  shownState() {
+    return { ...this.shown, sent: this.sent.length };
+  }
+
+  // Drops strokes drawn locally but not sent (e.g. when another document is shown).
+  clearStrokes() {
+    this.sent = [];
+    this.pending = null;
     this.draw();
+  }
+
+  // Fits the image into the canvas (F).
+  fitToView() {
+    this.fit();
   }
 
   pick(cell: Cell | null) {
@@ -81,7 +107,7 @@ export class RayView {
       return;
     }
     const cell = screenToCell(this.view, event.offsetX, event.offsetY, this.rows, this.cols);
-    if (cell) this.pending = { brush: this.brush, cells: [cell] };
+    if (cell) this.pending = { brush: this.brush, cells: [cell], radius: this.radius };
   }
 
   private move(event: PointerEvent) {
@@ -104,7 +130,7 @@ export class RayView {
     if (!this.pending) return;
     const stroke = this.pending;
     this.pending = null;
-    this.strokes.push(stroke);
+    this.sent.push(stroke);
     this.onStroke(stroke.brush, stroke.cells);
     this.draw();
   }
@@ -124,10 +150,14 @@ export class RayView {
     if (this.mask) {
       context.drawImage(this.mask, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
     }
-    for (const stroke of [...this.strokes, ...(this.pending ? [this.pending] : [])]) {
+    if (this.strokeImage) {
+      context.drawImage(this.strokeImage, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
+    }
+    for (const stroke of [...this.sent, ...(this.pending ? [this.pending] : [])]) {
       context.fillStyle = stroke.brush === 'object' ? 'rgba(60, 220, 60, 0.8)'
-        : stroke.brush === 'background' ? 'rgba(230, 60, 60, 0.8)' : 'rgba(60, 120, 255, 0.8)';
-      const r = stroke.brush === 'lasso' ? 0.5 : Math.max(this.radius, 0.5);
+        : stroke.brush === 'background' ? 'rgba(230, 60, 60, 0.8)' : stroke.brush === 'erase' ? 'rgba(20, 20, 20, 0.7)'
+        : 'rgba(60, 120, 255, 0.8)';
+      const r = stroke.brush === 'lasso' ? 0.5 : Math.max(stroke.radius, 0.5);
       for (const cell of stroke.cells) {
         context.fillRect(offsetX + (cell.col - r + 0.5) * scale, offsetY + (cell.row - r + 0.5) * scale * aspect, 2 * r * scale, 2 * r * scale * aspect);
       }

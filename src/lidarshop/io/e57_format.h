@@ -17,6 +17,7 @@
 #include <cstring>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace lidarshop::e57 {
@@ -162,5 +163,16 @@ Field IntegerField(const char* name, int64_t minimum, int64_t maximum);
 // packets of at most 64 KiB, no index packets) and returns its physical offset.
 uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
                                 std::vector<uint8_t>* logical);
+
+// A data3D entry's metadata that ReadE57 keeps in Scan::source_metadata and the writers write back, so that
+// E57 -> edit -> E57 keeps the scan's identity and date: {E57 element, source_metadata key}. The times are
+// the DateTime's dateTimeValue (GPS seconds) as text. Without "e57.guid" the writer makes a guid.
+inline constexpr std::pair<const char*, const char*> kE57MetadataStrings[] = {
+    {"guid", "e57.guid"},
+    {"sensorVendor", "e57.sensor_vendor"},
+    {"sensorModel", "e57.sensor_model"},
+    {"sensorSerialNumber", "e57.sensor_serial_number"}};
+inline constexpr std::pair<const char*, const char*> kE57MetadataTimes[] = {
+    {"acquisitionStart", "e57.acquisition_start_gps_s"}, {"acquisitionEnd", "e57.acquisition_end_gps_s"}};
 
 }  // namespace lidarshop::e57

@@ -220,5 +220,35 @@ TEST(E57Images, RealFilesListTheirImages) {
   }
 }
 
+// A scan read from E57 keeps its entry's guid, sensor and acquisition times (Scan::source_metadata) and the
+// writer writes them back: an edited scan saved as E57 is still that scan, of that date.
+TEST(E57Images, ScanGuidSensorAndDatesSurviveASave) {
+  const E57File pump = ReadE57(kDir + "pumpA.e57");
+  ASSERT_EQ(pump.scans[0].source_metadata.count("e57.guid"), 1u);
+  EXPECT_EQ(pump.scans[0].source_metadata.at("e57.guid"), "{116B6772-AC46-41B3-B70C-0C63CC671447}");
+  const E57File back = ReadE57Bytes(EncodeE57(pump, {}), "back.e57");
+  EXPECT_EQ(back.scans[0].source_metadata.at("e57.guid"), "{116B6772-AC46-41B3-B70C-0C63CC671447}");
+  ASSERT_EQ(back.images.size(), 1u);
+  EXPECT_EQ(back.images[0].encoded, pump.images[0].encoded);
+  // Times and sensor: written as E57 DateTime structures and strings, read back to the same text.
+  Scan dated = pump.scans[0];
+  dated.source_metadata["e57.acquisition_start_gps_s"] = "1234567890.125";
+  dated.source_metadata["e57.acquisition_end_gps_s"] = "1234567990.5";
+  dated.source_metadata["e57.sensor_vendor"] = "Acme";
+  dated.source_metadata.erase("e57.guid");
+  const E57File again = ReadE57Bytes(EncodeE57(std::vector<Scan>{dated}, E57WriteOptions{}), "dated.e57");
+  EXPECT_EQ(again.scans[0].source_metadata.at("e57.acquisition_start_gps_s"), "1234567890.125");
+  EXPECT_EQ(again.scans[0].source_metadata.at("e57.acquisition_end_gps_s"), "1234567990.5");
+  EXPECT_EQ(again.scans[0].source_metadata.at("e57.sensor_vendor"), "Acme");
+  EXPECT_EQ(again.scans[0].source_metadata.at("e57.guid").rfind("{lidarshop-scan-", 0),
+            0u);  // made, as before
+  // A time that is not a number (not one lidarshop read) is not written.
+  dated.source_metadata["e57.acquisition_start_gps_s"] = "yesterday";
+  EXPECT_EQ(ReadE57Bytes(EncodeE57(std::vector<Scan>{dated}, E57WriteOptions{}), "bad.e57")
+                .scans[0]
+                .source_metadata.count("e57.acquisition_start_gps_s"),
+            0u);
+}
+
 }  // namespace
 }  // namespace lidarshop

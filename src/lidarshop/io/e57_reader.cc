@@ -828,6 +828,16 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
                        /*with_intensity=*/records.Find("intensity") != nullptr);
   scan.name = StringValue(child.child("name"));
   scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
+  // The entry's identity and provenance, which a save as E57 writes back (e57_writer.cc): guid, sensor,
+  // acquisition times (GPS seconds, shortest round-trip text).
+  for (const auto& [element, key] : kE57MetadataStrings) {
+    const std::string value = StringValue(child.child(element));
+    if (!value.empty()) scan.source_metadata[key] = value;
+  }
+  for (const auto& [element, key] : kE57MetadataTimes) {
+    const pugi::xml_node value = child.child(element).child("dateTimeValue");
+    if (value) scan.source_metadata[key] = fmt::format("{}", NumberValue(ctx, value, 0.0));
+  }
   std::vector<uint8_t> state = ReadInvalidState(records);
   const std::vector<float> xyz = ReadCoordinates(records, &state);
   const std::vector<uint8_t> layer = ReadReturnLayers(records);

@@ -1,6 +1,7 @@
 // E57 writer: one compressed-vector section per scan, then the XML section, then pages with CRC-32C.
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <sstream>
@@ -289,12 +290,33 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   const uint64_t offset = AppendCompressedVector(streams, n, logical);
 
   pugi::xml_node child = AddTyped(data3d, "vectorChild", "Structure");
-  AddString(child, "guid",
-            fmt::format("{{lidarshop-scan-{:04d}-{:08x}}}", index,
+  const auto kept = [&scan](const char* key) {
+    const auto found = scan.source_metadata.find(key);
+    return found == scan.source_metadata.end() ? std::string() : found->second;
+  };
+  // The guid the scan was read with (an edited scan is still that scan), else one made from its bytes.
+  const std::string guid = kept("e57.guid");
+  AddString(
+      child, "guid",
+      !guid.empty()
+          ? guid
+          : fmt::format("{{lidarshop-scan-{:04d}-{:08x}}}", index,
                         Crc32c(logical->data() + logical->size() - std::min<size_t>(logical->size(), 4096),
                                std::min<size_t>(logical->size(), 4096))));
   AddString(child, "name", scan.name.empty() ? fmt::format("scan{:03d}", index) : scan.name);
   AddString(child, "description", "written by lidarshop");
+  for (const auto& [element, key] : kE57MetadataStrings) {
+    if (std::string(element) != "guid" && !kept(key).empty()) AddString(child, element, kept(key));
+  }
+  for (const auto& [element, key] : kE57MetadataTimes) {
+    const std::string text = kept(key);
+    char* end = nullptr;
+    const double gps_s = text.empty() ? 0.0 : std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !std::isfinite(gps_s)) continue;  // not a time lidarshop read
+    pugi::xml_node time = AddTyped(child, element, "Structure");
+    AddFloat(time, "dateTimeValue", gps_s);
+    AddInteger(time, "isAtomicClockReferenced", 0);
+  }
   AddPose(child, scan.world_from_scanner);
   {
     pugi::xml_node b = AddTyped(child, "indexBounds", "Structure");
