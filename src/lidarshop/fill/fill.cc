@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
+#include "lidarshop/fill/foreground.h"
 #include "lidarshop/fill/range_gradient.h"
 #include "lidarshop/fill/return_acceptance.h"
 #include "lidarshop/inpaint/offset_completion.h"
@@ -53,6 +54,9 @@ cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
 
 namespace {
 
+// The front cells' least depth jump beyond 0.1 m, per metre of range (fill/foreground.h).
+constexpr double kFrontJumpRatio = 0.03;
+
 // What a method decides for the cells of the hole; the known cells keep the scan's values.
 struct HoleValues {
   cv::Mat has_return;  // CV_8U 255 = the hole cell gets a return
@@ -69,6 +73,7 @@ struct Inputs {
   cv::Mat known_valid;  // CV_8U 255 = outside the hole with a return
   cv::Mat range;        // CV_32F, 0 where no return
   cv::Mat guide;        // CV_32FC(1 or 3): colour in grey levels, or intensity × 255
+  cv::Mat front;        // CV_8U 255 = a known cell in front of the background (fill/foreground.h), or empty
 };
 
 cv::Mat Guide(const Scan& scan) {
@@ -171,7 +176,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
     InpaintStrategies chosen;
     if (inpaint.acceptance.enabled) {
       chosen.acceptance = std::make_unique<fill_internal::ReturnConsistentAcceptance>(
-          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1);
+          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1, in.front);
     }
     return chosen;
   };
@@ -630,6 +635,24 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
   in.range = RangeImage(scan);
   in.range.setTo(0, scan.valid == 0);
   in.guide = Guide(scan);
+  // The gradient fill continues the background only (fill/foreground.h): objects in front of it that touch the
+  // hole are filled along with it (and not written), and no patch copies an object in front of it.
+  const cv::Mat hole = in.hole.clone();
+  bool extended = false;
+  if (options.method == FillMethod::kGradient && options.background_only) {
+    const cv::Rect box = cv::boundingRect(in.hole);
+    const int reach = std::max(48, 2 * box.width);
+    const cv::Mat front =
+        fill_internal::FrontCells(in.range, in.known_valid, in.hole, kFrontJumpRatio, reach);
+    const cv::Mat touching = fill_internal::FrontTouchingHole(front, in.hole, in.known_valid, 2);
+    if (cv::countNonZero(touching) > 0) {
+      cv::bitwise_or(hole, touching, in.hole);
+      extended = true;
+      in.known_valid = (scan.valid != 0) & (in.hole == 0);
+    }
+    in.front = front & (in.hole == 0);
+    result.front_cells = cv::countNonZero(touching);
+  }
 
   HoleValues values;
   switch (options.method) {
@@ -645,6 +668,17 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
     case FillMethod::kTelea:
       TeleaFill(in, options, &values, &result);
       break;
+  }
+  // Back to the hole asked for: the front cells filled with it keep their own values.
+  if (extended) {
+    const cv::Mat extra = in.hole & (hole == 0);
+    if (!values.source.empty()) values.source.setTo(cv::Scalar(-1, -1), extra);
+    if (!result.fill_order.empty()) result.fill_order.setTo(-1, extra);
+    if (!result.gradient_magnitude_after.empty()) {
+      const cv::Mat known = (scan.valid != 0) & extra;
+      result.gradient_magnitude_before.copyTo(result.gradient_magnitude_after, known);
+    }
+    in.hole = hole;
   }
   if (!values.source.empty()) result.source_cell = values.source;
   Timer timer;
