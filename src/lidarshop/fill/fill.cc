@@ -114,6 +114,54 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
     }
   }
   out->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
+  // No return does not appear out of nothing: a part of the hole left without one that touches no known cell
+  // without a return (sky, a dropout on the rim) is a copied no-return pattern — the stereo cloud's dropouts
+  // copied as F-shaped holes into the table behind the mug — and gets a return, with the colour, intensity and
+  // label of the nearest cell that has one.
+  const cv::Mat without = (in.hole != 0) & (out->has_return == 0);
+  cv::Mat ids;
+  const int count = cv::connectedComponents(without, ids, 8, CV_32S);
+  if (count > 1) {
+    std::vector<uint8_t> open(static_cast<size_t>(count), 0);
+    const cv::Mat known_without = (in.hole == 0) & (scan.valid == 0);
+    for (int y = 0; y < scan.rows; ++y) {
+      for (int x = 0; x < scan.cols; ++x) {
+        const int id = ids.at<int32_t>(y, x);
+        if (id == 0 || open[static_cast<size_t>(id)]) continue;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int yy = y + dy, xx = x + dx;
+            const bool outside = yy < 0 || xx < 0 || yy >= scan.rows || xx >= scan.cols;
+            if (outside || known_without.at<uint8_t>(yy, xx)) open[static_cast<size_t>(id)] = 1;
+          }
+      }
+    }
+    cv::Mat island(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    for (int y = 0; y < scan.rows; ++y)
+      for (int x = 0; x < scan.cols; ++x)
+        if (const int id = ids.at<int32_t>(y, x); id > 0 && !open[static_cast<size_t>(id)])
+          island.at<uint8_t>(y, x) = 255;
+    const cv::Mat nearest = NearestKnownCell(island);
+    for (int y = 0; y < scan.rows; ++y) {
+      for (int x = 0; x < scan.cols; ++x) {
+        if (!island.at<uint8_t>(y, x)) continue;
+        const cv::Vec2i n = nearest.at<cv::Vec2i>(y, x);
+        if (n[0] < 0) continue;
+        const bool filled = in.hole.at<uint8_t>(n[0], n[1]) != 0;
+        if (filled ? !out->has_return.at<uint8_t>(n[0], n[1]) : !scan.valid.at<uint8_t>(n[0], n[1])) continue;
+        out->has_return.at<uint8_t>(y, x) = 255;
+        if (!out->color.empty())
+          out->color.at<cv::Vec3b>(y, x) =
+              filled ? out->color.at<cv::Vec3b>(n[0], n[1]) : scan.color.at<cv::Vec3b>(n[0], n[1]);
+        if (!out->intensity.empty())
+          out->intensity.at<float>(y, x) =
+              filled ? out->intensity.at<float>(n[0], n[1]) : scan.intensity.at<float>(n[0], n[1]);
+        if (!out->label.empty())
+          out->label.at<int32_t>(y, x) =
+              filled ? out->label.at<int32_t>(n[0], n[1]) : scan.label.at<int32_t>(n[0], n[1]);
+      }
+    }
+  }
 }
 
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the

@@ -165,6 +165,16 @@ TEST(FillSurroundings, FrontCellsAlongARow) {
   EXPECT_EQ(front.at<uint8_t>(0, 10), 0);  // nearer cell on its right
   EXPECT_EQ(front.at<uint8_t>(0, 11), 0);  // reaches the border
   EXPECT_EQ(front.at<uint8_t>(0, 0), 0);
+  // A dropout of a few cells is not open space behind a run: the surface beyond it decides.
+  cv::Mat row(1, 30, CV_32F, cv::Scalar(10)), row_known(1, 30, CV_8U, cv::Scalar(255));
+  const cv::Mat no_hole(1, 30, CV_8U, cv::Scalar(0));
+  for (int x = 10; x < 13; ++x) row_known.at<uint8_t>(0, x) = 0, row.at<float>(0, x) = 0;  // a dropout
+  for (int x = 20; x < 29; ++x) row_known.at<uint8_t>(0, x) = 0, row.at<float>(0, x) = 0;  // open space
+  // Cells 13..19 at 10 m: 3 cells without a return and the same surface on their left, 9 on their right.
+  EXPECT_EQ(fill_internal::FrontCells(row, row_known, no_hole, 0.03, 12).at<uint8_t>(0, 15), 0);
+  // With a wall 10 m farther beyond the dropout, they stand in front (open space on the right).
+  for (int x = 0; x < 10; ++x) row.at<float>(0, x) = 20;
+  EXPECT_EQ(fill_internal::FrontCells(row, row_known, no_hole, 0.03, 12).at<uint8_t>(0, 15), 255);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@ namespace lidarshop::fill_internal {
 namespace {
 
 constexpr float kFrontJumpM = 0.1f;  // metres: range noise and mixed cells stay below it
+constexpr int kOpenCells = 8;        // cells without a return in a row that are open space behind a run
 
 // The least range step between neighbouring cells of a row that is a silhouette (in metres, at range r): a
 // wall seen at 84° from its normal steps r · 0.0016 · 10 per column of 0.09°, a person 3 m before a wall 35 m
@@ -20,12 +21,19 @@ enum class Beyond { kFarther, kOther };
 
 Beyond Look(const float* range, const uint8_t* known, const uint8_t* hole, int cols, int x, int step,
             float r_end, float ratio) {
+  int without_return = 0;  // cells without a return passed so far
   for (int k = x + step; k >= 0 && k < cols; k += step) {
     if (hole[k]) continue;  // beyond the hole, the far side's surface tells what continues behind it
-    if (!known[k]) return Beyond::kFarther;  // nothing returned behind: sky, beyond range
+    if (!known[k]) {
+      // Nothing returned behind it over a stretch: sky, beyond range. A few cells without a return are a
+      // dropout (a stereo cloud has them all over its table) and are passed like the hole.
+      if (++without_return >= kOpenCells) return Beyond::kFarther;
+      continue;
+    }
     return range[k] > r_end + JumpM(r_end, ratio) ? Beyond::kFarther : Beyond::kOther;
   }
-  return Beyond::kOther;  // the scan's border: no evidence
+  if (without_return > 0) return Beyond::kOther;  // a dropout reaching the border: no evidence
+  return Beyond::kOther;                          // the scan's border: no evidence
 }
 
 }  // namespace

@@ -9,8 +9,8 @@
 //     changes it smoothly, an object standing on either is a run of cells bounded by depth jumps), a run of
 //     known cells without a depth jump inside (neighbours more than 0.1 m + `jump_ratio` × range apart: a
 //     person 3 m before a wall 35 m away is one, a wall seen at 84° from its normal is not), at most
-//     `reach_cells` long, whose neighbours beyond both ends lie farther by such a jump or have no return (sky
-//     behind a post), is in front;
+//     `reach_cells` long, whose neighbours beyond both ends lie farther by such a jump or have no return over 8
+//     cells or more (sky behind a post; fewer are a dropout, passed like the hole), is in front;
 //   * a run that ends at the hole is judged by the first known cell beyond the hole's cells in that row: a
 //     person touching the removed object has the wall beyond it on both sides, the wall between the legs of a
 //     removed table has the same wall beyond the legs and is not in front;
