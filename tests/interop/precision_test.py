@@ -29,7 +29,7 @@ SCENE = {
         {"primitive": "plane", "size": [200, 200], "translate": [0, 0, 0], "label": 0, "texture": "grass"},
         {"primitive": "sphere", "radius": 1.0, "translate": [2, 10, 1], "label": 1, "color": [200, 40, 40]},
         {"primitive": "box", "size": [1, 0.6, 1.2], "translate": [-2, 8, 0.6], "label": 2}]}
-# The sphere (column 112, image row 65) and the ground below it, as in tests/cli_test.sh.
+# The sphere (column 112, image row 65) and the ground below it, as in tests/cli_fixture.sh.
 STROKES = {"strokes": [{"label": "object", "width": 3, "points": [[110, 65], [114, 65]]},
                        {"label": "background", "width": 2, "points": [[5, 115], [175, 115]]}]}
 

@@ -21,46 +21,17 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
+#include "lidarshop/cli/points_operations.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
-#include "lidarshop/pointset/clustering.h"
-#include "lidarshop/pointset/filters.h"
-#include "lidarshop/pointset/hough_planes.h"
-#include "lidarshop/pointset/normals.h"
-#include "lidarshop/pointset/planes.h"
-#include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/sampling.h"
-#include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/timer.h"
-#include "lidarshop/verify/pose_text.h"
-
-namespace lidarshop::cli {
-
-// The options of every points operation, one member per library struct: `--options FILE` sets them by
-// operation ({"planes": {"max_planes": 3}}), and --json's "options" holds the ones the operation used.
-struct PointsOptions {
-  StatisticalOutlierOptions statistical;
-  RadiusOutlierOptions radius;
-  CropOptions crop;
-  NormalOptions normals;
-  RansacPlaneOptions planes;
-  HoughPlaneOptions hough;
-  EuclideanClusterOptions cluster;
-  KMeansOptions kmeans;
-  ScanMeshOptions mesh;
-  SurfaceOptions surface;
-  RegionGrowingOptions regions;
-  SuperpixelOptions superpixels;
-};
-
-}  // namespace lidarshop::cli
 
 namespace lidarshop {
 
@@ -91,40 +62,34 @@ const StructInfo& InfoOf<cli::PointsOptions>() {
 namespace lidarshop::cli {
 namespace {
 
-// The members of PointsOptions each operation uses.
-const std::map<std::string, std::vector<std::string>>& OptionsOfOperation() {
-  static const std::map<std::string, std::vector<std::string>> used = {
-      {"outliers", {"statistical", "radius"}},
-      {"crop", {"crop"}},
-      {"normals", {"normals"}},
-      {"planes", {"planes", "hough"}},
-      {"cluster", {"cluster"}},
-      {"kmeans", {"kmeans"}},
-      {"mesh", {"mesh", "surface"}},
-      {"regions", {"regions", "normals"}},
-      {"superpixels", {"superpixels"}}};
-  return used;
-}
-
-// `mesh_method`: "grid" uses "mesh", a surface reconstruction "surface".
-nlohmann::ordered_json UsedOptions(const PointsOptions& options, const std::string& operation,
-                                   const std::string& mesh_method = "grid") {
+// The options of the members `operation` uses (mesh: the grid mesh's or the surface's, by its method).
+nlohmann::ordered_json UsedOptions(const PointsOptions& options, const PointsOperation& operation,
+                                   const PointsFlags& flags) {
   const nlohmann::ordered_json all = ToJson(options);
   nlohmann::ordered_json used = nlohmann::ordered_json::object();
-  if (operation == "mesh") {
-    const std::string key = mesh_method == "grid" ? "mesh" : "surface";
+  for (const std::string& key : operation.options) {
+    if (operation.name == "mesh" &&
+        key != ((flags.method.empty() || flags.method == "grid") ? "mesh" : "surface"))
+      continue;
     used[key] = all[key];
-    return used;
   }
-  const auto found = OptionsOfOperation().find(operation);
-  if (found == OptionsOfOperation().end()) return used;
-  for (const std::string& key : found->second) used[key] = all[key];
   return used;
 }
 
 // The summary line of a points operation, from its --json summary: what it kept or found, of how many points.
 std::string PointsSummary(const nlohmann::ordered_json& summary, const std::string& output_path) {
   const std::string operation = summary["operation"].get<std::string>();
+  if (summary.contains("vertices")) {  // mesh
+    return fmt::format("mesh ({}): {} vertices, {} triangles from {} points -> {}",
+                       summary["method"].get<std::string>(), summary["vertices"].get<int64_t>(),
+                       summary["triangles"].get<int64_t>(), summary["input_points"].get<int64_t>(),
+                       output_path);
+  }
+  if (!summary.contains("input_points")) {  // sample-mesh
+    return fmt::format("{}: {} points from {} triangles -> {}", operation,
+                       summary["output_points"].get<int64_t>(), summary["triangles"].get<int64_t>(),
+                       output_path);
+  }
   std::string what = fmt::format("{}: {} input points", operation, summary["input_points"].get<int64_t>());
   if (summary.contains("output_points"))
     what += fmt::format(", {} output points", summary["output_points"].get<int64_t>());
@@ -133,103 +98,6 @@ std::string PointsSummary(const nlohmann::ordered_json& summary, const std::stri
   }
   if (summary.contains("planes")) what += fmt::format(", {} planes", summary["planes"].size());
   return what + " -> " + output_path;
-}
-
-// All scans of all inputs as one world-frame cloud, with where each point came from.
-struct Gathered {
-  std::vector<Scan> scans;
-  PointCloud cloud;
-  std::vector<int32_t> scan_of_point;
-  std::vector<int64_t> cell_of_point;
-};
-
-Gathered Gather(const std::vector<std::string>& paths) {
-  Gathered g;
-  for (const std::string& path : paths) {
-    for (const Scan& scan : ReadScanFileAndWarn(path).scans) {
-      std::vector<int64_t> cells;
-      const PointCloud cloud = ToPointCloud(scan, true, &cells);
-      g.cloud = g.cloud.empty() ? cloud : MergeClouds({g.cloud, cloud});
-      g.scan_of_point.insert(g.scan_of_point.end(), cloud.size(), static_cast<int32_t>(g.scans.size()));
-      g.cell_of_point.insert(g.cell_of_point.end(), cells.begin(), cells.end());
-      g.scans.push_back(scan);
-    }
-  }
-  if (g.cloud.empty()) throw InputError("the inputs hold no points");
-  return g;
-}
-
-std::vector<Scan> KeepCells(const Gathered& g, const std::vector<uint8_t>& keep) {
-  std::vector<Scan> out;
-  for (size_t s = 0; s < g.scans.size(); ++s) {
-    std::vector<int64_t> cells;
-    std::vector<uint8_t> flags;
-    for (size_t i = 0; i < keep.size(); ++i) {
-      if (g.scan_of_point[i] != static_cast<int32_t>(s)) continue;
-      cells.push_back(g.cell_of_point[i]);
-      flags.push_back(keep[i]);
-    }
-    out.push_back(KeepScanCells(g.scans[s], cells, flags));
-  }
-  return out;
-}
-
-std::vector<Scan> WithLabels(const Gathered& g, const std::vector<int32_t>& labels) {
-  std::vector<Scan> out;
-  for (const Scan& scan : g.scans) {
-    Scan labelled = scan;
-    labelled.label = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(kNoLabel));
-    out.push_back(labelled);
-  }
-  for (size_t i = 0; i < labels.size(); ++i) {
-    Scan& scan = out[g.scan_of_point[i]];
-    scan.label.at<int32_t>(static_cast<int>(g.cell_of_point[i] / scan.cols), g.cell_of_point[i] % scan.cols) =
-        labels[i];
-  }
-  return out;
-}
-
-// World-frame normals into each scan's normal channel (scanner frame), facing that scan's scanner, and
-// their curvature into the curvature channel (NaN where a point had too few neighbours).
-std::vector<Scan> WithNormals(const Gathered& g, const NormalResult& result) {
-  const std::vector<Eigen::Vector3f>& normals_in_world = result.normals;
-  std::vector<Scan> out;
-  for (const Scan& scan : g.scans) {
-    Scan with = scan;
-    with.normal = cv::Mat(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
-    with.curvature = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN));
-    out.push_back(with);
-  }
-  for (size_t i = 0; i < normals_in_world.size(); ++i) {
-    Scan& scan = out[g.scan_of_point[i]];
-    const Eigen::Matrix3f scanner_from_world =
-        scan.world_from_scanner.topLeftCorner<3, 3>().transpose().cast<float>();
-    const int row = static_cast<int>(g.cell_of_point[i] / scan.cols), col = g.cell_of_point[i] % scan.cols;
-    Eigen::Vector3f n = scanner_from_world * normals_in_world[i];
-    const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-    if (n.dot(Eigen::Vector3f(p[0], p[1], p[2])) > 0.0f) n = -n;
-    scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(n.x(), n.y(), n.z());
-    if (normals_in_world[i].squaredNorm() > 0.0f) scan.curvature.at<float>(row, col) = result.curvature[i];
-  }
-  return out;
-}
-
-// The gathered cloud with normals for a Poisson reconstruction: its own when every scan has them, else
-// estimated from the `neighbors` nearest points, each turned toward the scanner of the scan it came from
-// (several scans see a surface from several sides; one viewpoint would flip some of them).
-PointCloud WithOrientedNormals(const Gathered& g, int neighbors, bool* estimated) {
-  PointCloud cloud = g.cloud;
-  *estimated = cloud.normals.size() != cloud.size();
-  if (!*estimated) return cloud;
-  NormalOptions options;
-  options.neighbors = neighbors;
-  cloud.normals = EstimateNormals(cloud, options).normals;
-  for (size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f scanner_in_world =
-        g.scans[g.scan_of_point[i]].world_from_scanner.topRightCorner<3, 1>().cast<float>();
-    if (cloud.normals[i].dot(scanner_in_world - cloud.points[i]) < 0.0f) cloud.normals[i] = -cloud.normals[i];
-  }
-  return cloud;
 }
 
 // "1,2.5,-3" as numbers; "" as none.
@@ -264,16 +132,13 @@ void CheckOutputs(const std::string& output, const std::string& json,
 
 int RunPoints(int argc, char** argv) {
   CLI::App app{
-      "Point-set tools over scans and clouds (docs/points.md). OPERATION: outliers | voxel | sample | crop | "
-      "transform | merge | normals | planes | cluster | kmeans | mesh | regions | superpixels | sample-mesh "
-      "(IN = a triangle mesh). Scans keep their grid where the operation allows.",
+      "Point-set tools over scans and clouds (docs/points.md). OPERATION: " + PointsOperationNames(" | ") +
+          " (sample-mesh: IN = a triangle mesh). Scans keep their grid where the operation allows.",
       "points"};
-  std::string operation, output_path, json_path, method;
+  std::string operation, output_path, json_path;
   std::vector<std::string> inputs;
-  std::string box_text, polygon_text, matrix_text;
-  bool grid = false, hough = false;
-  double voxel_m = 0.05, max_angle_deg = 10.0;
-  int64_t count = 100000;
+  std::string box_text, polygon_text;
+  PointsFlags flags;
   PointsOptions points;
   // Flags shared by several operations set the first struct's field and are copied to the others when
   // given; the others start from the same value, so a flag left out changes nothing.
@@ -287,20 +152,21 @@ int RunPoints(int argc, char** argv) {
       ->required();
   app.add_option("-o,--output", output_path, "output file; a scan format keeps the grid")->required();
   AddJsonOption(app, &json_path);
-  app.add_option("--method", method,
+  app.add_option("--method", flags.method,
                  "outliers: statistical (default) | radius; mesh: grid (default: the scans' grid mesh) | "
                  "poisson | scale-space (surface reconstruction)");
-  app.add_option("--voxel", voxel_m, "voxel: cube side, metres")->capture_default_str();
-  app.add_option("--count", count, "sample: points to keep; sample-mesh: points to draw")
+  app.add_option("--voxel", flags.voxel_m, "voxel: cube side, metres")->capture_default_str();
+  app.add_option("--count", flags.count, "sample: points to keep; sample-mesh: points to draw")
       ->capture_default_str();
   app.add_option("--box", box_text, "crop: xmin,ymin,zmin,xmax,ymax,zmax (world, metres)");
   app.add_option("--polygon", polygon_text, "crop: x1,y1,x2,y2,... (world xy, metres)");
-  app.add_option("--matrix", matrix_text,
+  app.add_option("--matrix", flags.matrix_text,
                  "transform: new_world_from_world as 16 comma-separated numbers (row major), "
                  "x,y,z,yaw_deg[,pitch_deg,roll_deg] or a pose file (as verify --pose)");
-  app.add_flag("--grid", grid, "normals: from the scan grid instead of a KD-tree");
-  app.add_flag("--hough", hough, "planes: Hough detection (ball accumulator) instead of RANSAC");
-  app.add_option("--max-angle", max_angle_deg, "regions: largest normal angle between neighbours, degrees")
+  app.add_flag("--grid", flags.grid_normals, "normals: from the scan grid instead of a KD-tree");
+  app.add_flag("--hough", flags.hough, "planes: Hough detection (ball accumulator) instead of RANSAC");
+  app.add_option("--max-angle", flags.max_angle_deg,
+                 "regions: largest normal angle between neighbours, degrees")
       ->capture_default_str();
   binder.Bind(&points, {.keys = {"statistical.neighbors", "statistical.std_ratio", "radius.radius_m",
                                  "radius.min_neighbors", "planes.seed"},
@@ -377,199 +243,58 @@ int RunPoints(int argc, char** argv) {
           points.normals.radius_m = points.cluster.radius_m = points.radius.radius_m;
         if (app.count("--seed") > 0)
           points.hough.seed = points.kmeans.seed = points.surface.seed = points.planes.seed;
-        const std::string mesh_method = method.empty() ? "grid" : method;
-        if (operation == "mesh" && mesh_method != "grid") {
-          if (mesh_method != "poisson" && mesh_method != "scale-space")
+        const PointsOperation& op = FindPointsOperation(operation);
+        if (op.name == "mesh" && !flags.method.empty() && flags.method != "grid") {
+          if (flags.method != "poisson" && flags.method != "scale-space")
             throw OptionsError(
-                fmt::format("--method '{}': mesh takes grid, poisson or scale-space", mesh_method));
-          points.surface.method = ParseEnum<SurfaceMethod>(mesh_method);
+                fmt::format("--method '{}': mesh takes grid, poisson or scale-space", flags.method));
+          points.surface.method = ParseEnum<SurfaceMethod>(flags.method);
         }
         binder.Validate(points);
-        const uint64_t seed = points.planes.seed;
-        StatisticalOutlierOptions& statistical = points.statistical;
-        RadiusOutlierOptions& radius_outliers = points.radius;
-        CropOptions& crop = points.crop;
-        NormalOptions& normals = points.normals;
-        RansacPlaneOptions& planes = points.planes;
-        HoughPlaneOptions& hough_options = points.hough;
-        EuclideanClusterOptions& clusters = points.cluster;
-        KMeansOptions& kmeans = points.kmeans;
-        ScanMeshOptions& mesh_options = points.mesh;
-        RegionGrowingOptions& region_options = points.regions;
-        SuperpixelOptions& superpixel_options = points.superpixels;
         CheckOutputs(output_path, json_path, inputs);
-        if (operation == "mesh" && FileExtension(output_path) != "ply") {
-          throw OptionsError(fmt::format("-o {}: mesh writes a triangle mesh, as .ply", output_path));
-        }
-        if ((operation == "voxel" || operation == "merge") && FileExtension(output_path) != "ply") {
-          throw OptionsError(fmt::format("-o {}: {} writes a plain cloud, as .ply", output_path, operation));
-        }
-        const std::vector<double> box = ParseNumbers(box_text, "--box"),
-                                  polygon = ParseNumbers(polygon_text, "--polygon");
-        if (!box.empty() && box.size() != 6)
-          throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
-        if (operation == "sample-mesh") {
-          // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles'
-          // normals.
-          if (inputs.size() != 1) throw OptionsError("sample-mesh takes one mesh (.ply, .obj)");
-          if (FileExtension(output_path) != "ply")
-            throw OptionsError(fmt::format("-o {}: sample-mesh writes .ply", output_path));
-          CheckOption(count > 0, fmt::format("--count must be > 0, got {}", count));
-          // Before reading the mesh: the samples, and the written cloud's copy of them.
-          CheckMemoryBudget(SaturatingBytes(count, 2 * kSurfaceSampleBytes),
-                            fmt::format("--count {}: sampling {} points", count, count));
-          const TriangleMesh mesh = ReadMeshAndWarn(inputs[0]);
-          if (mesh.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
-          const Timer timer;
-          SurfaceSamples samples = SampleSurface(mesh, count, seed);
-          PointCloud cloud;
-          cloud.points = std::move(samples.points);
-          cloud.normals = std::move(samples.normals);
-          const double seconds = timer.Seconds();
-          WritePointCloud(output_path, cloud);
-          nlohmann::ordered_json summary = {{"operation", operation},
-                                            {"triangles", mesh.num_triangles()},
-                                            {"output_points", cloud.size()},
-                                            {"seconds", seconds}};
-          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
-          Summarize(fmt::format("sample-mesh: {} points from {} triangles -> {}", cloud.size(),
-                                mesh.num_triangles(), output_path));
-          return 0;
-        }
-        const Timer read_timer;
-        const Gathered g = Gather(inputs);
-        nlohmann::ordered_json summary = {{"operation", operation},
-                                          {"input_points", g.cloud.size()},
-                                          {"scans", g.scans.size()},
-                                          {"read_seconds", read_timer.Seconds()}};
-        const Timer timer;  // the operation alone, without reading and writing
-        std::vector<Scan> scans_out;
-        PointCloud cloud_out;
-        bool as_cloud = false;
-        if (operation == "outliers" || operation == "crop" || operation == "sample") {
-          std::vector<uint8_t> keep;
-          if (operation == "outliers" && (method.empty() || method == "statistical")) {
-            keep = StatisticalOutlierInliers(g.cloud, statistical);
-          } else if (operation == "outliers" && method == "radius") {
-            keep = RadiusOutlierInliers(g.cloud, radius_outliers);
-          } else if (operation == "outliers") {
-            throw OptionsError(fmt::format("--method '{}': expected statistical or radius", method));
-          } else if (operation == "sample") {
-            keep = RandomSampleInliers(g.cloud, count, seed);
-          } else {
-            if (!box.empty())
-              crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(box[0], box[1], box[2]),
-                                             Eigen::Vector3f(box[3], box[4], box[5]));
-            if (polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
-            for (size_t i = 0; i + 1 < polygon.size(); i += 2)
-              crop.polygon.emplace_back(polygon[i], polygon[i + 1]);
-            keep = CropInliers(g.cloud, crop);
-          }
-          scans_out = KeepCells(g, keep);
-          summary["output_points"] = std::count(keep.begin(), keep.end(), 1);
-        } else if (operation == "voxel") {
-          cloud_out = VoxelDownsample(g.cloud, voxel_m);
-          as_cloud = true;
-        } else if (operation == "merge") {
-          cloud_out = g.cloud;
-          as_cloud = true;
-        } else if (operation == "mesh") {
-          // grid: the grid mesh of any organized scan, real ones included (scanner/scan_mesh.h); otherwise a
-          // surface reconstructed from all the points in the world frame (pointset/surface.h).
-          TriangleMesh mesh;
-          summary["method"] = mesh_method;
-          if (mesh_method == "grid") {
-            for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, mesh_options), &mesh);
-            if (mesh.empty()) {
-              throw InputError(
-                  fmt::format("{}: the grid mesh has no triangles (no two neighbouring cells are joined; a "
-                              "plain cloud has no grid): use --method poisson or scale-space",
-                              fmt::join(inputs, ", ")));
-            }
-          } else if (points.surface.method == SurfaceMethod::kPoisson) {
-            bool estimated = false;
-            const PointCloud cloud = WithOrientedNormals(g, points.surface.normal_neighbors, &estimated);
-            summary["normals"] = estimated ? "estimated" : "input";
-            mesh = ReconstructSurface(cloud, points.surface);
-          } else {
-            mesh = ReconstructSurface(g.cloud, points.surface);
-          }
-          summary["seconds"] = timer.Seconds();
-          summary["vertices"] = mesh.num_vertices();
-          summary["triangles"] = mesh.num_triangles();
-          WriteMesh(output_path, mesh);
-          WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation, mesh_method), summary));
-          Summarize(fmt::format("mesh ({}): {} vertices, {} triangles from {} points -> {}", mesh_method,
-                                mesh.num_vertices(), mesh.num_triangles(), g.cloud.size(), output_path));
-          return 0;
-        } else if (operation == "regions" || operation == "superpixels") {
-          // Per scan, over its grid: labels into the scan's label channel.
-          int total = 0;
-          for (const Scan& scan : g.scans) {
-            Scan labelled = scan;
-            int count = 0;
-            if (operation == "regions") {
-              const Scan with_normals = scan.normal.empty() ? WithGridNormals(scan, normals) : scan;
-              labelled.label = SegmentByRegionGrowing(
-                  scan, region_options, NormalAngleCondition(with_normals, max_angle_deg), &count);
-            } else {
-              labelled.label = ScanSuperpixels(scan, superpixel_options, &count);
-            }
-            total += count;
-            scans_out.push_back(labelled);
-          }
-          summary[operation] = total;
-        } else if (operation == "transform") {
-          if (matrix_text.empty()) throw OptionsError("transform needs --matrix");
-          const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(matrix_text, "--matrix");
-          for (const Scan& scan : g.scans) scans_out.push_back(TransformScan(scan, new_from_world));
-        } else if (operation == "normals") {
-          if (grid) {
-            for (const Scan& scan : g.scans) scans_out.push_back(WithGridNormals(scan, normals));
-          } else {
-            scans_out = WithNormals(g, EstimateNormals(g.cloud, normals));
-          }
-        } else if (operation == "planes") {
-          hough_options.distance_step_m = 2.0 * planes.distance_threshold_m;  // inliers within half a cell
-          hough_options.max_planes = planes.max_planes;
-          hough_options.min_inliers = std::max<int64_t>(3, planes.min_inliers);
-          const std::vector<PlaneFit> fits =
-              hough ? DetectPlanesHough(g.cloud, hough_options) : DetectPlanesRansac(g.cloud, planes);
-          std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
-          summary["planes"] = nlohmann::ordered_json::array();
-          for (size_t p = 0; p < fits.size(); ++p) {
-            for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
-            summary["planes"].push_back(
-                {{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
-                 {"offset_m", fits[p].offset_m},
-                 {"inliers", fits[p].inliers.size()},
-                 {"rms_m", fits[p].rms_m}});
-          }
-          scans_out = WithLabels(g, labels);
-        } else if (operation == "cluster") {
-          const ClusterResult result = EuclideanClusters(g.cloud, clusters);
-          summary["clusters"] = result.num_clusters();
-          summary["cluster_sizes"] = result.sizes;
-          scans_out = WithLabels(g, result.labels);
-        } else if (operation == "kmeans") {
-          const KMeansResult result = KMeans(g.cloud, kmeans);
-          summary["inertia_m2"] = result.inertia_m2;
-          summary["iterations"] = result.iterations;
-          scans_out = WithLabels(g, result.labels);
-        } else {
+        if (op.writes != PointsOutputKind::kScans && FileExtension(output_path) != "ply") {
           throw OptionsError(
-              fmt::format("unknown operation '{}' (outliers, voxel, sample, crop, transform, merge, "
-                          "normals, planes, cluster, kmeans, mesh, regions, superpixels, sample-mesh)",
-                          operation));
+              fmt::format("-o {}: {} writes a {}, as .ply", output_path, op.name,
+                          op.writes == PointsOutputKind::kMesh ? "triangle mesh" : "plain cloud"));
         }
-        summary["seconds"] = timer.Seconds();
-        if (as_cloud) {
-          WritePointCloud(output_path, cloud_out);
-          summary["output_points"] = cloud_out.size();
+        flags.box = ParseNumbers(box_text, "--box");
+        flags.polygon = ParseNumbers(polygon_text, "--polygon");
+        if (!flags.box.empty() && flags.box.size() != 6)
+          throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+        nlohmann::ordered_json summary = {{"operation", op.name}};
+        Gathered g;
+        TriangleMesh mesh_in;
+        if (op.reads_mesh) {
+          if (inputs.size() != 1) throw OptionsError(fmt::format("{} takes one mesh (.ply, .obj)", op.name));
+          CheckOption(flags.count > 0, fmt::format("--count must be > 0, got {}", flags.count));
+          // Before reading the mesh: the samples, and the written cloud's copy of them.
+          CheckMemoryBudget(SaturatingBytes(flags.count, 2 * kSurfaceSampleBytes),
+                            fmt::format("--count {}: sampling {} points", flags.count, flags.count));
+          mesh_in = ReadMeshAndWarn(inputs[0]);
+          if (mesh_in.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", inputs[0]));
         } else {
-          WriteScanFile(output_path, scans_out);
+          const Timer read_timer;
+          g = GatherScans(inputs);
+          summary["input_points"] = g.cloud.size();
+          summary["scans"] = g.scans.size();
+          summary["read_seconds"] = read_timer.Seconds();
         }
-        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, operation), summary));
+        const Timer timer;  // the operation alone, without reading and writing
+        const PointsOutput out = op.run(g, mesh_in, points, flags, &summary);
+        summary["seconds"] = timer.Seconds();
+        switch (op.writes) {
+          case PointsOutputKind::kScans:
+            WriteScanFile(output_path, out.scans);
+            break;
+          case PointsOutputKind::kCloud:
+            WritePointCloud(output_path, out.cloud);
+            summary["output_points"] = out.cloud.size();
+            break;
+          case PointsOutputKind::kMesh:
+            WriteMesh(output_path, out.mesh);
+            break;
+        }
+        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, op, flags), summary));
         Summarize(PointsSummary(summary, output_path));
         return 0;
       },

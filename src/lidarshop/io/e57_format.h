@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,9 @@ inline uint64_t PhysicalFromLogical(uint64_t logical) {
 // Verifies every page's CRC and returns the logical bytes. Throws InputError naming `path`, the page index
 // and its byte offset when a checksum does not match or the size is not whole pages.
 std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical);
+// The same from a file, read a few pages at a time straight into the logical bytes: the file's physical bytes
+// are never held whole (a 100-million-point station's E57 is gigabytes).
+std::vector<uint8_t> LogicalFromPageFile(const std::string& path);
 
 // E57's XML is UTF-8 (E2807 8.4): throws InputError naming `path` and the byte of the XML section where the
 // `size` bytes at `xml` are not (a Latin-1 scan name), before pugixml, which does not check, passes them on
@@ -65,6 +69,8 @@ void CheckXmlUtf8(const std::string& path, const char* xml, size_t size);
 
 // Splits logical bytes into pages with their CRCs (the last page is zero-padded).
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical);
+// The same written to `out` a few pages at a time, without a second whole copy.
+void WritePages(const std::vector<uint8_t>& logical, std::ostream& out);
 
 // The 48-byte file header.
 struct Header {

@@ -1,5 +1,8 @@
 // E57 physical pages: CRC-32C and the logical/physical mapping (see e57_format.h).
+#include <algorithm>
 #include <array>
+#include <cstring>
+#include <fstream>
 
 #include <fmt/format.h>
 
@@ -57,37 +60,93 @@ uint32_t Crc32c(const uint8_t* data, size_t size) {
   return crc ^ 0xFFFFFFFFu;
 }
 
-std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical) {
-  if (physical.size() < kPageSize || physical.size() % kPageSize != 0) {
+namespace {
+
+// Throws unless `size` bytes are a whole, non-zero number of pages.
+void CheckWholePages(const std::string& path, uint64_t size) {
+  if (size < kPageSize || size % kPageSize != 0) {
     ThrowInputError(
-        path, fmt::format("file size {} bytes", physical.size()), "",
+        path, fmt::format("file size {} bytes", size), "",
         fmt::format("not a whole number of {}-byte E57 pages (truncated or not an E57 file)", kPageSize));
   }
-  const size_t pages = physical.size() / kPageSize;
+}
+
+// Checks the CRCs of `count` pages starting with page `first` and copies their payloads to `logical`.
+void CopyPayloads(const std::string& path, const uint8_t* pages, uint64_t first, uint64_t count,
+                  uint8_t* logical) {
+  for (uint64_t p = 0; p < count; ++p) {
+    const uint8_t* page = pages + p * kPageSize;
+    CheckPageCrc(path, page, first + p);
+    std::memcpy(logical + (first + p) * kPagePayload, page, kPagePayload);
+  }
+}
+
+// Page `p` of the logical bytes with its CRC, into `page` (kPageSize bytes; the last page zero-padded).
+void MakePage(const std::vector<uint8_t>& logical, uint64_t p, uint8_t* page) {
+  const size_t begin = p * kPagePayload;
+  const size_t n = std::min<size_t>(kPagePayload, logical.size() - std::min(begin, logical.size()));
+  std::memset(page, 0, kPageSize);
+  if (n) std::memcpy(page, logical.data() + begin, n);
+  const uint32_t crc = Crc32c(page, kPagePayload);
+  page[1020] = crc >> 24;
+  page[1021] = (crc >> 16) & 0xFF;
+  page[1022] = (crc >> 8) & 0xFF;
+  page[1023] = crc & 0xFF;
+}
+
+uint64_t PageCount(const std::vector<uint8_t>& logical) {
+  return std::max<uint64_t>(1, (logical.size() + kPagePayload - 1) / kPagePayload);
+}
+
+constexpr uint64_t kPagesPerChunk = 1024;  // 1 MiB of file read or written at a time
+
+}  // namespace
+
+std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical) {
+  CheckWholePages(path, physical.size());
+  const uint64_t pages = physical.size() / kPageSize;
   std::vector<uint8_t> logical(pages * kPagePayload);
-  for (size_t p = 0; p < pages; ++p) {
-    const uint8_t* page = physical.data() + p * kPageSize;
-    CheckPageCrc(path, page, p);
-    std::memcpy(logical.data() + p * kPagePayload, page, kPagePayload);
+  CopyPayloads(path, physical.data(), 0, pages, logical.data());
+  return logical;
+}
+
+std::vector<uint8_t> LogicalFromPageFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) ThrowInputError(path, "", "", "cannot determine the file size");
+  in.seekg(0);
+  CheckWholePages(path, static_cast<uint64_t>(size));
+  const uint64_t pages = static_cast<uint64_t>(size) / kPageSize;
+  std::vector<uint8_t> logical(pages * kPagePayload);
+  std::vector<uint8_t> chunk(std::min(pages, kPagesPerChunk) * kPageSize);
+  for (uint64_t first = 0; first < pages; first += kPagesPerChunk) {
+    const uint64_t count = std::min(kPagesPerChunk, pages - first);
+    if (!in.read(reinterpret_cast<char*>(chunk.data()), static_cast<std::streamsize>(count * kPageSize))) {
+      ThrowInputError(path, fmt::format("page {} (byte offset {})", first, first * kPageSize), "",
+                      "read failed (the file changed while it was read?)");
+    }
+    CopyPayloads(path, chunk.data(), first, count, logical.data());
   }
   return logical;
 }
 
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical) {
-  const size_t pages = std::max<size_t>(1, (logical.size() + kPagePayload - 1) / kPagePayload);
-  std::vector<uint8_t> physical(pages * kPageSize, 0);
-  for (size_t p = 0; p < pages; ++p) {
-    uint8_t* page = physical.data() + p * kPageSize;
-    const size_t begin = p * kPagePayload;
-    const size_t n = std::min<size_t>(kPagePayload, logical.size() - std::min(begin, logical.size()));
-    if (n) std::memcpy(page, logical.data() + begin, n);
-    const uint32_t crc = Crc32c(page, kPagePayload);
-    page[1020] = crc >> 24;
-    page[1021] = (crc >> 16) & 0xFF;
-    page[1022] = (crc >> 8) & 0xFF;
-    page[1023] = crc & 0xFF;
-  }
+  const uint64_t pages = PageCount(logical);
+  std::vector<uint8_t> physical(pages * kPageSize);
+  for (uint64_t p = 0; p < pages; ++p) MakePage(logical, p, physical.data() + p * kPageSize);
   return physical;
+}
+
+void WritePages(const std::vector<uint8_t>& logical, std::ostream& out) {
+  const uint64_t pages = PageCount(logical);
+  std::vector<uint8_t> chunk(std::min(pages, kPagesPerChunk) * kPageSize);
+  for (uint64_t first = 0; first < pages; first += kPagesPerChunk) {
+    const uint64_t count = std::min(kPagesPerChunk, pages - first);
+    for (uint64_t p = 0; p < count; ++p) MakePage(logical, first + p, chunk.data() + p * kPageSize);
+    out.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(count * kPageSize));
+  }
 }
 
 Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical) {

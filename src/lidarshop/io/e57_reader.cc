@@ -523,19 +523,25 @@ std::vector<float> ReadCoordinates(const PointRecords& records, std::vector<uint
   const bool cartesian = records.cartesian;
   const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
   if (!cartesian) names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
+  if (cartesian) {
+    // One axis at a time, straight into the floats: three whole double copies are 24 bytes a record.
+    for (int k = 0; k < 3; ++k) {
+      const std::vector<double>& axis = records.Decode(records.Find(names[k]));
+      for (int64_t i = 0; i < record_count; ++i) xyz[3 * i + k] = static_cast<float>(axis[i]);
+    }
+    return xyz;
+  }
   std::vector<double> a[3];
   for (int k = 0; k < 3; ++k) a[k] = records.Decode(records.Find(names[k]));
   for (int64_t i = 0; i < record_count; ++i) {
-    double x = a[0][i], y = a[1][i], z = a[2][i];
-    if (!cartesian) {
-      // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
-      const double r = a[0][i], az = a[1][i], el = a[2][i];
-      if (state[i] == 1 || r == 0.0) {
-        x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
-        if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
-      } else {
-        x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
-      }
+    double x, y, z;
+    // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
+    const double r = a[0][i], az = a[1][i], el = a[2][i];
+    if (state[i] == 1 || r == 0.0) {
+      x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
+      if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
+    } else {
+      x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
     }
     xyz[3 * i] = static_cast<float>(x), xyz[3 * i + 1] = static_cast<float>(y),
             xyz[3 * i + 2] = static_cast<float>(z);
@@ -1038,17 +1044,7 @@ E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& 
 
 E57File ReadE57(const std::string& path) {
   CheckRegularFile(path);
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) ThrowInputError(path, "", "", "cannot determine the file size");
-  in.seekg(0);
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) {
-    ThrowInputError(path, "", "", "read failed");
-  }
-  E57File file = ReadE57Bytes(bytes, path);
+  E57File file = e57::ReadLogical(path, e57::LogicalFromPageFile(path));
   // The same number checks as ReadScanFile: `info` and `images` read E57 files here directly.
   for (size_t i = 0; i < file.scans.size(); ++i) {
     io_internal::CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));

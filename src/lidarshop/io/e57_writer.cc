@@ -439,10 +439,10 @@ void E57WriteOptions::Check() const { Validate(*this); }
 namespace e57 {
 namespace {
 
-// The file of `scans` and `image_list`; `behind` (may be null, else one per scan, 0 x 0 = none) holds the
-// second layer of each scan.
-std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
-                            const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
+// The logical bytes (without the pages' checksums) of the file of `scans` and `image_list`; `behind` (may be
+// null, else one per scan, 0 x 0 = none) holds the second layer of each scan.
+std::vector<uint8_t> EncodeLogical(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
+                                   const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
   options.Check();
   std::vector<uint8_t> logical(kHeaderSize, 0);
   pugi::xml_document doc;
@@ -491,13 +491,60 @@ std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<co
   const uint64_t pages = (logical.size() + kPagePayload - 1) / kPagePayload;
   header.file_physical_length = pages * kPageSize;
   StoreHeader(header, logical.data());
-  return PagesFromLogical(logical);
+  return logical;
 }
 
-void WriteBytes(const std::string& path, const std::vector<uint8_t>& bytes) {
-  WriteFileAtomically(path, [&](std::ostream& out) {
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  });
+std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
+                            const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
+  return PagesFromLogical(EncodeLogical(scans, behind, image_list, options));
+}
+
+// Writes the file's pages as they are made: the logical bytes are the one whole copy held.
+void WriteFile(const std::string& path, const std::vector<Scan>& scans,
+               const std::vector<const Scan*>* behind, const std::vector<E57Image>& image_list,
+               const E57WriteOptions& options) {
+  const std::vector<uint8_t> logical = EncodeLogical(scans, behind, image_list, options);
+  WriteFileAtomically(path, [&](std::ostream& out) { WritePages(logical, out); });
+}
+
+}  // namespace
+}  // namespace e57
+
+namespace e57 {
+namespace {
+
+// The second layers the writer takes (one per scan, null = none), and the scans they are made of.
+struct Layers {
+  std::vector<Scan> scans;
+  std::vector<const Scan*> of_scan;
+};
+
+// `behind` as the layer of `front`: every second return is synthesized here (the contract).
+Layers SynthesizedLayer(const Scan& behind) {
+  Layers layers;
+  layers.scans.push_back(behind);  // shares the buffers
+  layers.scans[0].synthesized = cv::Mat();
+  layers.of_scan = {&layers.scans[0]};
+  return layers;
+}
+
+// The second returns of `file`, each scan's own.
+Layers SecondReturns(const E57File& file) {
+  Layers layers;
+  layers.scans.resize(file.scans.size());  // share the file's buffers
+  layers.of_scan.assign(file.scans.size(), nullptr);
+  for (size_t i = 0; i < file.scans.size() && i < file.second_returns.size(); ++i) {
+    Scan& second = layers.scans[i] = file.second_returns[i];
+    if (second.num_cells() == 0) continue;
+    if (second.rows != file.scans[i].rows || second.cols != file.scans[i].cols) {
+      throw std::logic_error("EncodeE57: a scan's second returns differ from it in size");
+    }
+    // A file without lidarshop's flag measured its second returns.
+    if (second.synthesized.empty())
+      second.synthesized = cv::Mat(second.rows, second.cols, CV_8U, cv::Scalar(0));
+    layers.of_scan[i] = &second;
+  }
+  return layers;
 }
 
 }  // namespace
@@ -514,47 +561,35 @@ std::vector<uint8_t> EncodeE57(const std::vector<Scan>& scans, const std::vector
 
 std::vector<uint8_t> EncodeE57WithLayer(const Scan& front, const Scan& behind,
                                         const E57WriteOptions& options) {
-  Scan synthesized_layer = behind;            // shares the buffers
-  synthesized_layer.synthesized = cv::Mat();  // every second return is synthesized here (the contract)
-  const std::vector<const Scan*> layers = {&synthesized_layer};
-  return e57::Encode({front}, &layers, {}, options);
+  const e57::Layers layers = e57::SynthesizedLayer(behind);
+  return e57::Encode({front}, &layers.of_scan, {}, options);
 }
 
 void WriteE57WithLayer(const std::string& path, const Scan& front, const Scan& behind,
                        const E57WriteOptions& options) {
-  e57::WriteBytes(path, EncodeE57WithLayer(front, behind, options));
+  const e57::Layers layers = e57::SynthesizedLayer(behind);
+  e57::WriteFile(path, {front}, &layers.of_scan, {}, options);
 }
 
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const E57WriteOptions& options) {
-  e57::WriteBytes(path, EncodeE57(scans, options));
+  e57::WriteFile(path, scans, nullptr, {}, options);
 }
 
 void WriteE57(const std::string& path, const std::vector<Scan>& scans) { WriteE57(path, scans, {}); }
 
 void WriteE57(const std::string& path, const std::vector<Scan>& scans, const std::vector<E57Image>& images,
               const E57WriteOptions& options) {
-  e57::WriteBytes(path, EncodeE57(scans, images, options));
+  e57::WriteFile(path, scans, nullptr, images, options);
 }
 
 std::vector<uint8_t> EncodeE57(const E57File& file, const E57WriteOptions& options) {
-  std::vector<Scan> seconds(file.scans.size());  // share the file's buffers
-  std::vector<const Scan*> layers(file.scans.size(), nullptr);
-  for (size_t i = 0; i < file.scans.size() && i < file.second_returns.size(); ++i) {
-    Scan& second = seconds[i] = file.second_returns[i];
-    if (second.num_cells() == 0) continue;
-    if (second.rows != file.scans[i].rows || second.cols != file.scans[i].cols) {
-      throw std::logic_error("EncodeE57: a scan's second returns differ from it in size");
-    }
-    // A file without lidarshop's flag measured its second returns.
-    if (second.synthesized.empty())
-      second.synthesized = cv::Mat(second.rows, second.cols, CV_8U, cv::Scalar(0));
-    layers[i] = &second;
-  }
-  return e57::Encode(file.scans, &layers, file.images, options);
+  const e57::Layers layers = e57::SecondReturns(file);
+  return e57::Encode(file.scans, &layers.of_scan, file.images, options);
 }
 
 void WriteE57(const std::string& path, const E57File& file, const E57WriteOptions& options) {
-  e57::WriteBytes(path, EncodeE57(file, options));
+  const e57::Layers layers = e57::SecondReturns(file);
+  e57::WriteFile(path, file.scans, &layers.of_scan, file.images, options);
 }
 
 }  // namespace lidarshop
