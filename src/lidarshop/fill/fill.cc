@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -692,7 +693,21 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
     const int reach = std::max(48, 2 * box.width);
     const cv::Mat front =
         fill_internal::FrontCells(in.range, in.known_valid, in.hole, kFrontJumpRatio, reach);
-    const cv::Mat touching = fill_internal::FrontTouchingHole(front, in.hole, in.known_valid, 2);
+    // The removed object's own returns (the hole's cells that have one) give its range: a neighbour beside it
+    // stands about as near (within the front jump of its farthest part).
+    std::vector<float> object;
+    for (int y = 0; y < scan.rows; ++y)
+      for (int x = 0; x < scan.cols; ++x)
+        if (in.hole.at<uint8_t>(y, x) && scan.valid.at<uint8_t>(y, x))
+          object.push_back(in.range.at<float>(y, x));
+    double max_range_m = std::numeric_limits<double>::infinity();
+    if (!object.empty()) {
+      const size_t far = object.size() * 9 / 10;
+      std::nth_element(object.begin(), object.begin() + static_cast<std::ptrdiff_t>(far), object.end());
+      max_range_m = object[far] * (1.0 + kFrontJumpRatio) + 0.1;
+    }
+    const cv::Mat touching =
+        fill_internal::FrontTouchingHole(front, in.range, in.hole, in.known_valid, max_range_m, 2);
     if (cv::countNonZero(touching) > 0) {
       cv::bitwise_or(hole, touching, in.hole);
       extended = true;

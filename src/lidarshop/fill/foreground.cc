@@ -72,8 +72,8 @@ cv::Mat FrontCells(const cv::Mat& range, const cv::Mat& known_valid, const cv::M
   return front;
 }
 
-cv::Mat FrontTouchingHole(const cv::Mat& front, const cv::Mat& hole, const cv::Mat& known_valid,
-                          int margin_cells) {
+cv::Mat FrontTouchingHole(const cv::Mat& front, const cv::Mat& range, const cv::Mat& hole,
+                          const cv::Mat& known_valid, double max_range_m, int margin_cells) {
   cv::Mat ids;
   const int count = cv::connectedComponents(front, ids, 8, CV_32S);
   cv::Mat rim;
@@ -82,6 +82,20 @@ cv::Mat FrontTouchingHole(const cv::Mat& front, const cv::Mat& hole, const cv::M
   for (int y = 0; y < ids.rows; ++y)
     for (int x = 0; x < ids.cols; ++x)
       if (rim.at<uint8_t>(y, x) && ids.at<int32_t>(y, x) > 0) touching[ids.at<int32_t>(y, x)] = 1;
+  std::vector<double> sum(static_cast<size_t>(count), 0.0);
+  std::vector<int64_t> cells(static_cast<size_t>(count), 0);
+  for (int y = 0; y < ids.rows; ++y) {
+    for (int x = 0; x < ids.cols; ++x) {
+      const int id = ids.at<int32_t>(y, x);
+      if (id <= 0) continue;
+      sum[static_cast<size_t>(id)] += range.at<float>(y, x);
+      ++cells[static_cast<size_t>(id)];
+    }
+  }
+  for (int id = 1; id < count; ++id)
+    if (cells[static_cast<size_t>(id)] &&
+        sum[static_cast<size_t>(id)] / cells[static_cast<size_t>(id)] > max_range_m)
+      touching[static_cast<size_t>(id)] = 0;
   cv::Mat out(front.size(), CV_8U, cv::Scalar(0));
   for (int y = 0; y < ids.rows; ++y)
     for (int x = 0; x < ids.cols; ++x)

@@ -29,9 +29,11 @@ namespace lidarshop::fill_internal {
 cv::Mat FrontCells(const cv::Mat& range, const cv::Mat& known_valid, const cv::Mat& hole, double jump_ratio,
                    int reach_cells);
 
-// The front cells (CV_8U) whose 8-connected part touches the hole, grown by `margin_cells` over known cells
-// (mixed cells at their silhouettes belong to neither surface). CV_8U 255/0, never a hole cell.
-cv::Mat FrontTouchingHole(const cv::Mat& front, const cv::Mat& hole, const cv::Mat& known_valid,
-                          int margin_cells);
+// The front cells (CV_8U) whose 8-connected part touches the hole and whose mean range (`range`, CV_32F) is at
+// most `max_range_m` — a neighbour standing beside the removed object is about as near as it; a wall behind it
+// that merely stands before a farther wall is not taken — grown by `margin_cells` over known cells (mixed cells
+// at their silhouettes belong to neither surface). CV_8U 255/0, never a hole cell.
+cv::Mat FrontTouchingHole(const cv::Mat& front, const cv::Mat& range, const cv::Mat& hole,
+                          const cv::Mat& known_valid, double max_range_m, int margin_cells);
 
 }  // namespace lidarshop::fill_internal
