@@ -2,7 +2,8 @@
 # End-to-end test of the camera models and the station's photos (#32 items 1-2): `photo` renders a scene with a
 # pinhole (old camera file, no "model"), fisheye, spherical and cylindrical camera; `scan --photos cube|sphere`
 # writes six pinhole faces or one spherical panorama into the E57 with their poses (camera centre 0.15 m above
-# the scanner of parking_lot, at 1.6 m) and gains; `recolor --from-e57-images` colours the scan from them; `images` lists them with their models; other outputs refuse --photos; the real files
+# the scanner of parking_lot, at 1.6 m) and gains; `recolor --from-e57-images` colours the scan from them, and
+# `recolor --photo P --camera C` repeated from the same faces extracted; `images` lists them with their models; other outputs refuse --photos; the real files
 # with images still list. Run by ctest as `photos_cli_test`. Usage: photos_cli_test.sh LIDARSHOP_BINARY SHARED
 set -uo pipefail
 lidarshop=$1
@@ -76,6 +77,27 @@ json_check "cube recolour: most returns coloured, gains of the faces used within
    all(abs(g / s['gain'] - 1) < 0.03 for p, s in zip(d['photos'], json.load(open('$work/cube_fine_scan.json'))['photos']) \
        for g in p['gain'] if g != 1.0)"
 check "the photo index mask is written" test -s "$work/cube_index.png"
+# The same faces given as separate photos with their cameras (--photo repeated): the same colouring.
+check "images --extract cube_fine.e57" sh -c "'$lidarshop' images '$work/cube_fine.e57' --extract '$work/faces' >'$work/faces.json'"
+python3 - "$work" <<'PY'
+import json, sys
+work = sys.argv[1]
+args = []
+for i, image in enumerate(json.load(open(work + "/faces.json"))["images"]):
+    json.dump(image["camera"], open(f"{work}/face{i}.json", "w"))
+    args += ["--photo", image["extracted"], "--camera", f"{work}/face{i}.json"]
+open(work + "/face_args", "w").write("\n".join(args))
+PY
+mapfile -t face_args <"$work/face_args"
+check "recolor --photo x6 --camera x6" "$lidarshop" recolor "$work/cube_fine.e57" "${face_args[@]}" \
+  -o "$work/faces_coloured.ply" --photo-index-mask "$work/faces_index.png" --json "$work/faces_recolor.json" --quiet
+json_check "repeated --photo: the gains and counts of --from-e57-images" "$work/faces_recolor.json" \
+  "(lambda e: d['coloured'] == e['coloured'] and d['seam_edges'] == e['seam_edges'] and d['seam_edges'] > 0 and \
+   [p['gain'] for p in d['photos']] == [p['gain'] for p in e['photos']])(json.load(open('$work/cube_recolor.json')))"
+check "repeated --photo: the same photo index mask" cmp "$work/faces_index.png" "$work/cube_index.png"
+fails_clearly "repeated --photo needs a --camera each" "2 --photo need as many --camera" \
+  "$lidarshop" recolor "$work/cube_fine.e57" --photo "$work/pinhole.png" --photo "$work/pinhole.png" \
+  --camera "$work/pinhole.json" -o "$work/x.ply"
 fails_clearly "pumpA has no image with a camera" "no image of scan 0 holds a photo with a camera" \
   "$lidarshop" recolor "$shared/e57/pumpA.e57" --from-e57-images -o "$work/pump.ply"
 fails_clearly "--from-e57-images takes no --photo" "--from-e57-images takes the photos" \

@@ -12,6 +12,7 @@
 #include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/enum_names.h"
@@ -344,6 +345,112 @@ void BindRecolorScan(py::module_& m) {
       "None) and why_no_camera.");
 }
 
+// A camera of any model (geometry/camera_model.h) from a PinholeCamera or a dict of the camera JSON.
+Camera CameraModelOf(const py::handle& camera, const std::string& what) {
+  if (py::isinstance<PinholeCamera>(camera)) return CameraFromPinhole(camera.cast<PinholeCamera>());
+  if (!py::isinstance<py::dict>(camera))
+    throw py::type_error(what + ": expected a PinholeCamera or a dict of the camera JSON (docs/recolor.md)");
+  const std::string text = py::module_::import("json").attr("dumps")(camera).cast<std::string>();
+  return ParseCameraModelJson(text, what);
+}
+
+// The options of a station colouring: RecolorOptions (`options` and keywords) for the occlusion test, without
+// the edge guard unless asked for (PhotosRecolorOptions::visibility), and the station's own fields.
+PhotosRecolorOptions PhotosOptionsOf(const py::object& options, const py::kwargs& kwargs,
+                                     bool equalize_exposure, bool blend_seams, int seam_band_cells,
+                                     bool nearest_photo) {
+  PhotosRecolorOptions result;
+  const bool guard_given = kwargs.contains("edge_guard") || !options.is_none();
+  result.visibility = OptionsOf<RecolorOptions>(options, kwargs);
+  if (!guard_given) result.visibility.edge_guard = false;
+  result.equalize_exposure = equalize_exposure;
+  result.blend_seams = blend_seams;
+  result.seam_band_cells = seam_band_cells;
+  result.nearest_photo = nearest_photo;
+  result.Check();
+  return result;
+}
+
+void BindStationRecolor(py::module_& m) {
+  py::class_<PhotosRecolorResult>(m, "PhotosRecolorResult",
+                                  "The outcome of recolor_from_photos() / recolor_from_e57_images().")
+      .def_readonly("scan", &PhotosRecolorResult::scan, "the scan with its colour set where a photo saw it")
+      .def_property_readonly(
+          "photo_index", [](const PhotosRecolorResult& r) { return MatToArray(r.photo_index); },
+          "uint16 (rows, cols): 1 + the photo that coloured the cell, 0 = none")
+      .def_property_readonly(
+          "gains",
+          [](const PhotosRecolorResult& r) {
+            py::array_t<double> gains({static_cast<py::ssize_t>(r.gains.size()), py::ssize_t{3}});
+            auto view = gains.mutable_unchecked<2>();
+            for (size_t i = 0; i < r.gains.size(); ++i) {
+              for (int ch = 0; ch < 3; ++ch) view(static_cast<py::ssize_t>(i), ch) = r.gains[i][ch];
+            }
+            return gains;
+          },
+          "float64 (photos, 3): each photo's RGB gain relative to photo 0")
+      .def_readonly("returns", &PhotosRecolorResult::returns)
+      .def_readonly("coloured", &PhotosRecolorResult::coloured)
+      .def_readonly("constraints", &PhotosRecolorResult::constraints)
+      .def_readonly("seam_edges", &PhotosRecolorResult::seam_edges)
+      .def_readonly("blended", &PhotosRecolorResult::blended)
+      .def("summary", &PhotosRecolorResult::Summary)
+      .def("__repr__", [](const PhotosRecolorResult& r) {
+        return "<lidarshop.PhotosRecolorResult " + r.Summary() + ">";
+      });
+  m.def(
+      "recolor_from_photos",
+      [](const Scan& scan, const py::list& photos, const py::list& cameras, bool equalize_exposure,
+         bool blend_seams, int seam_band_cells, bool nearest_photo, const py::object& options,
+         const py::kwargs& kwargs) {
+        if (photos.size() != cameras.size())
+          throw py::value_error(
+              fmt::format("photos and cameras: {} photos but {} cameras", photos.size(), cameras.size()));
+        std::vector<CameraPhoto> given;
+        for (size_t i = 0; i < photos.size(); ++i) {
+          const std::string what = fmt::format("cameras[{}]", i);
+          const Camera camera = CameraModelOf(cameras[i], what);
+          given.push_back({ArrayToMat(photos[i], CV_8U, 3, camera.height_px(), camera.width_px(),
+                                      fmt::format("photos[{}]", i)),
+                           camera});
+        }
+        const PhotosRecolorOptions photo_options =
+            PhotosOptionsOf(options, kwargs, equalize_exposure, blend_seams, seam_band_cells, nearest_photo);
+        py::gil_scoped_release release;
+        return RecolorFromPhotos(scan, given, photo_options);
+      },
+      py::arg("scan"), py::arg("photos"), py::arg("cameras"), py::arg("equalize_exposure") = true,
+      py::arg("blend_seams") = true, py::arg("seam_band_cells") = 12, py::arg("nearest_photo") = false,
+      py::arg("options") = py::none(),
+      "Colours the scan from several photos at once (uint8 RGB arrays) with their cameras (PinholeCamera or "
+      "a dict of the camera JSON, any model: docs/recolor.md): per point the best photo that sees it, "
+      "exposure equalised to photo 0's, seams blended (`recolor --photo P --camera C ...`). RecolorOptions "
+      "(`options`, keywords) set the occlusion test. A PhotosRecolorResult.");
+  m.def(
+      "recolor_from_e57_images",
+      [](const std::string& path, int scan_index, bool equalize_exposure, bool blend_seams,
+         int seam_band_cells, bool nearest_photo, const py::object& options, const py::kwargs& kwargs) {
+        const PhotosRecolorOptions photo_options =
+            PhotosOptionsOf(options, kwargs, equalize_exposure, blend_seams, seam_band_cells, nearest_photo);
+        py::gil_scoped_release release;
+        const E57File file = ReadE57(path);
+        if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size()))
+          throw OptionsError(fmt::format("scan_index {} is out of range: {} holds {} scan(s)", scan_index,
+                                         path, file.scans.size()));
+        const E57StationPhotos station = StationPhotosOfE57(file, scan_index);
+        if (station.photos.empty())
+          ThrowInputError(path, "images2D", "",
+                          fmt::format("no image of scan {} holds a photo with a camera ({} image(s))",
+                                      scan_index, file.images.size()));
+        return RecolorFromPhotos(file.scans[scan_index], station.photos, photo_options);
+      },
+      py::arg("path"), py::arg("scan_index") = 0, py::arg("equalize_exposure") = true,
+      py::arg("blend_seams") = true, py::arg("seam_band_cells") = 12, py::arg("nearest_photo") = false,
+      py::arg("options") = py::none(),
+      "Colours scan `scan_index` of an E57 file from its own images (every images2D entry of that scan with "
+      "a camera: `recolor --from-e57-images`). A PhotosRecolorResult.");
+}
+
 }  // namespace
 
 void BindRecolor(py::module_& m) {
@@ -352,6 +459,7 @@ void BindRecolor(py::module_& m) {
   BindResection(m);
   BindAlign(m);
   BindRecolorScan(m);
+  BindStationRecolor(m);
 }
 
 }  // namespace lidarshop::python

@@ -43,6 +43,7 @@ const std::vector<Command>& Commands() {
       {"points", lidarshop::cli::RunPoints,
        "point-set tools: outliers, voxel, crop, normals, planes, clusters"},
       {"register", lidarshop::cli::RunRegister, "register one scan onto another (point-to-plane ICP)"},
+      {"clean", lidarshop::cli::RunClean, "remove what moved between the stations of a site"},
       {"serve", lidarshop::cli::RunServe, "the editor in the browser: look, paint, segment, remove, save"},
       {"batch", lidarshop::cli::RunBatch, "a pipeline of commands over many scans (local or Dask cluster)"},
   };

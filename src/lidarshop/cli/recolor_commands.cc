@@ -210,18 +210,24 @@ int RunRecolor(int argc, char** argv) {
       "Recolour a scan from a photo: occlusion-aware projection (thesis 3.2.2.1, docs/recolor.md). Points "
       "the camera does not see keep their colour.",
       "recolor"};
-  std::string scan_path, photo_path, image_key, camera_path, pairs_path, output, mask_path, uncertain_path,
-      json_path = "-";
+  std::string scan_path, image_key, pairs_path, output, mask_path, uncertain_path, json_path = "-";
+  std::vector<std::string> photo_paths, camera_paths;
   int scan_index = 0;
   RecolorOptions options;
   ResectionOptions resection;
   std::string intrinsics_path;
   OptionBinder binder(app);
   app.add_option("scan", scan_path, "scan file to recolour")->required();
-  app.add_option("--photo", photo_path, "the photo (.jpg, .png)");
+  app.add_option(
+         "--photo", photo_paths,
+         "the photo (.jpg, .png); repeated, each with its --camera (any model), the photos colour the "
+         "scan together as a station's (as --from-e57-images)")
+      ->allow_extra_args(false);
   app.add_option("--image", image_key,
                  "an images2D entry of the E57 scan (name or index) instead of --photo");
-  app.add_option("--camera", camera_path, "camera JSON (lidarshop resection)");
+  app.add_option("--camera", camera_paths,
+                 "camera JSON (lidarshop resection); with several --photo, one per photo in their order")
+      ->allow_extra_args(false);
   app.add_option("--correspondences", pairs_path, "pixel <-> point or cell pairs: resection first");
   app.add_option("-o,--output", output, "recoloured scan to write (format from the extension)")->required();
   app.add_option("--recolored-mask", mask_path, "PNG of the scan grid: 255 = took the photo's colour");
@@ -232,23 +238,91 @@ int RunRecolor(int argc, char** argv) {
   app.add_flag("--from-e57-images", from_e57_images,
                "colour from every images2D entry of the E57 scan that holds a camera (pinhole, spherical, "
                "cylindrical) and belongs to the scan: per point the best photo that sees it, exposure "
-               "equalised to photo 0's (recolor/station_recolor.h)");
+               "equalised to photo 0's, seams blended in the gradient domain (recolor/station_recolor.h)");
   app.add_option("--photo-index-mask", photo_index_mask_path,
-                 "--from-e57-images: 16-bit PNG of the scan grid, 1 + the index of the photo that coloured "
+                 "--from-e57-images or several --photo: 16-bit PNG of the scan grid, 1 + the index of the "
+                 "photo that coloured "
                  "each cell, 0 where none did");
   AddScanIndexOption(app, &scan_index);
   AddJsonOption(app, &json_path);
   binder.Bind(&options,
               {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
   AddResectionOptions(app, binder, &resection, &intrinsics_path, "Resection (with --correspondences)");
+  // Colouring from several photos at once, and what it writes (--from-e57-images, repeated --photo).
+  const auto colour_station = [&](const Scan& scan, const std::vector<CameraPhoto>& photos,
+                                  nlohmann::ordered_json used, const nlohmann::ordered_json& skipped) {
+    PhotosRecolorOptions photo_options;
+    photo_options.visibility = options;
+    // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
+    if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
+    const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
+    WriteScanFile(output, {result.scan});
+    if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
+    nlohmann::ordered_json counts;
+    counts["returns"] = result.returns;
+    counts["coloured"] = result.coloured;
+    counts["constraints"] = result.constraints;
+    counts["seam_edges"] = result.seam_edges;
+    counts["blended"] = result.blended;
+    for (size_t i = 0; i < used.size(); ++i)
+      used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
+    counts["photos"] = used;
+    counts["skipped"] = skipped;
+    WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+    Summarize(fmt::format("{} -> {}", result.Summary(), output));
+    return 0;
+  };
   return RunCommand(
       app, argc, argv,
       [&] {
         binder.Validate(options);
         binder.Validate(resection);
-        CheckOutputFile("--json", json_path, {},
-                        {scan_path, photo_path, camera_path, pairs_path, output, mask_path, uncertain_path,
-                         photo_index_mask_path});
+        const std::string photo_path = photo_paths.size() == 1 ? photo_paths[0] : "";
+        const std::string camera_path = camera_paths.size() == 1 ? camera_paths[0] : "";
+        std::vector<std::string> inputs = {scan_path, pairs_path};
+        inputs.insert(inputs.end(), photo_paths.begin(), photo_paths.end());
+        inputs.insert(inputs.end(), camera_paths.begin(), camera_paths.end());
+        {
+          std::vector<std::string> others = inputs;
+          others.insert(others.end(), {output, mask_path, uncertain_path, photo_index_mask_path});
+          CheckOutputFile("--json", json_path, {}, others);
+        }
+        if (photo_paths.size() >= 2) {
+          if (camera_paths.size() != photo_paths.size())
+            throw OptionsError(
+                fmt::format("{} --photo need as many --camera, one per photo in their order; got {}",
+                            photo_paths.size(), camera_paths.size()));
+          if (from_e57_images || !image_key.empty() || !pairs_path.empty() || !mask_path.empty() ||
+              !uncertain_path.empty())
+            throw OptionsError(
+                "several --photo colour the scan as a station: no --from-e57-images, --image, "
+                "--correspondences, --recolored-mask nor --uncertain-mask");
+          CheckNotInput(output, inputs);
+          if (!photo_index_mask_path.empty()) {
+            CheckNotInput(photo_index_mask_path, inputs);
+            CheckOutputPath(photo_index_mask_path, {scan_path, output});
+          }
+          const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
+          std::vector<CameraPhoto> photos;
+          nlohmann::ordered_json used = nlohmann::ordered_json::array();
+          for (size_t i = 0; i < photo_paths.size(); ++i) {
+            CameraPhoto photo{ReadImage(photo_paths[i]), ReadCameraModelJson(camera_paths[i])};
+            if (photo.image.type() != CV_8UC3)
+              ThrowInputError(photo_paths[i], "", "", "expected an 8-bit RGB photo");
+            if (photo.image.cols != photo.camera.width_px() || photo.image.rows != photo.camera.height_px())
+              ThrowInputError(camera_paths[i], "", "width_px",
+                              fmt::format("the camera is {} x {} pixels, its photo {} is {} x {}",
+                                          photo.camera.width_px(), photo.camera.height_px(), photo_paths[i],
+                                          photo.image.cols, photo.image.rows));
+            used.push_back(
+                {{"index", i}, {"name", photo_paths[i]}, {"model", CameraModelName(photo.camera.model)}});
+            photos.push_back(std::move(photo));
+          }
+          return colour_station(scan, photos, used, nlohmann::ordered_json::array());
+        }
+        if (camera_paths.size() > 1) throw OptionsError("several --camera need as many --photo");
+        if (!photo_index_mask_path.empty() && !from_e57_images)
+          throw OptionsError("--photo-index-mask goes with --from-e57-images or several --photo");
         if (from_e57_images) {
           if (!photo_path.empty() || !image_key.empty() || !camera_path.empty() || !pairs_path.empty() ||
               !mask_path.empty() || !uncertain_path.empty())
@@ -265,47 +339,26 @@ int RunRecolor(int argc, char** argv) {
           }
           const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
           const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
-          std::vector<CameraPhoto> photos;
+          const E57StationPhotos station = StationPhotosOfE57(file, scan_index);
+          const std::vector<CameraPhoto>& photos = station.photos;
           nlohmann::ordered_json used = nlohmann::ordered_json::array(),
                                  skipped = nlohmann::ordered_json::array();
-          for (size_t i = 0; i < file.images.size(); ++i) {
-            const E57Image& image = file.images[i];
-            Camera camera;
-            std::string why;
-            if (image.associated_scan >= 0 && image.associated_scan != scan_index) {
-              why = fmt::format("belongs to scan {}", image.associated_scan);
-            } else if (image.image.empty()) {
-              why = image.decode_error;
-            } else if (CameraModelOfE57Image(image, &camera, &why)) {
-              used.push_back({{"index", i}, {"name", image.name}, {"model", CameraModelName(camera.model)}});
-              photos.push_back({image.image, camera});
-              continue;
-            }
-            skipped.push_back({{"index", i}, {"name", image.name}, {"why", why}});
+          for (size_t k = 0; k < photos.size(); ++k) {
+            const int i = station.image_index[k];
+            used.push_back({{"index", i},
+                            {"name", file.images[i].name},
+                            {"model", CameraModelName(photos[k].camera.model)}});
           }
+          for (const E57StationPhotos::Skipped& skip : station.skipped)
+            skipped.push_back({{"index", skip.image_index},
+                               {"name", file.images[skip.image_index].name},
+                               {"why", skip.why}});
           if (photos.empty())
             ThrowInputError(scan_path, "images2D", "",
                             fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "
                                         "`lidarshop images {}` lists them)",
                                         scan_index, file.images.size(), scan_path));
-          PhotosRecolorOptions photo_options;
-          photo_options.visibility = options;
-          // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
-          if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
-          const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
-          WriteScanFile(output, {result.scan});
-          if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
-          nlohmann::ordered_json counts;
-          counts["returns"] = result.returns;
-          counts["coloured"] = result.coloured;
-          counts["constraints"] = result.constraints;
-          for (size_t i = 0; i < used.size(); ++i)
-            used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
-          counts["photos"] = used;
-          counts["skipped"] = skipped;
-          WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
-          Summarize(fmt::format("{} -> {}", result.Summary(), output));
-          return 0;
+          return colour_station(scan, photos, used, skipped);
         }
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");

@@ -199,19 +199,34 @@ Visibility VisibleCells(const Scan& scan, const RaycastScene& scene, const Camer
     Eigen::Vector2d pixel;
     Eigen::Vector3d point_in_world;
   };
-  std::vector<Candidate> candidates;
-  for (int r = 0; r < scan.rows; ++r) {
+  // Rows in parallel, each into its own list, joined in row order (the same on any thread count).
+  std::vector<std::vector<Candidate>> row_candidates(scan.rows);
+  std::vector<int64_t> row_returns(scan.rows, 0), row_outside(scan.rows, 0);
+  ParallelFor(scan.rows, [&](int64_t row) {
+    const int r = static_cast<int>(row);
     for (int c = 0; c < scan.cols; ++c) {
       if (!scan.valid.at<uint8_t>(r, c)) continue;
-      ++visibility.returns;
+      ++row_returns[r];
       const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
       const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
       Eigen::Vector2d pixel;
       if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
-        ++visibility.outside_image;
+        ++row_outside[r];
         continue;
       }
-      candidates.push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+      row_candidates[r].push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+    }
+  });
+  std::vector<Candidate> candidates;
+  {
+    size_t total = 0;
+    for (const auto& row : row_candidates) total += row.size();
+    candidates.reserve(total);
+    for (int r = 0; r < scan.rows; ++r) {
+      visibility.returns += row_returns[r];
+      visibility.outside_image += row_outside[r];
+      candidates.insert(candidates.end(), row_candidates[r].begin(), row_candidates[r].end());
+      std::vector<Candidate>().swap(row_candidates[r]);
     }
   }
 

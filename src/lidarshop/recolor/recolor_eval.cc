@@ -1,5 +1,6 @@
 #include "lidarshop/recolor/recolor_eval.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -9,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/station_recolor.h"
 
 namespace lidarshop {
 
@@ -120,6 +122,54 @@ double RmsReprojectionError(const PinholeCamera& camera, const std::vector<Pixel
     sum += std::isfinite(e) ? e * e : 1e12;
   }
   return pairs.empty() ? 0.0 : std::sqrt(sum / pairs.size());
+}
+
+StationColourScore ScoreStationColours(const Scan& truth, const PhotosRecolorResult& result) {
+  StationColourScore score;
+  const cv::Mat& photo = result.photo_index;
+  const cv::Mat& colour = result.scan.color;
+  std::vector<double> errors;
+  double seam_sum = 0, ordinary_sum = 0;
+  int64_t ordinary_edges = 0;
+  const auto step = [&](int r0, int c0, int r1, int c1) {
+    const cv::Vec3i a = colour.at<cv::Vec3b>(r0, c0), b = colour.at<cv::Vec3b>(r1, c1);
+    return (std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2])) / 3.0;
+  };
+  for (int r = 0; r < truth.rows; ++r) {
+    for (int c = 0; c < truth.cols; ++c) {
+      if (!truth.valid.at<uint8_t>(r, c)) continue;
+      ++score.returns;
+      const uint16_t here = photo.at<uint16_t>(r, c);
+      if (here == 0) continue;
+      ++score.coloured;
+      const cv::Vec3i a = truth.color.at<cv::Vec3b>(r, c), b = colour.at<cv::Vec3b>(r, c);
+      errors.push_back((std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2])) / 3.0);
+      for (const auto [rn, cn] : {std::pair{r, c + 1}, std::pair{r + 1, c}}) {
+        if (rn >= truth.rows || cn >= truth.cols) continue;
+        const uint16_t there = photo.at<uint16_t>(rn, cn);
+        if (there == 0) continue;
+        if (there != here) {
+          seam_sum += step(r, c, rn, cn);
+          ++score.seam_edges;
+        } else {
+          ordinary_sum += step(r, c, rn, cn);
+          ++ordinary_edges;
+        }
+      }
+    }
+  }
+  if (!errors.empty()) {
+    double sum = 0;
+    for (const double e : errors) sum += e;
+    score.mean_error = sum / static_cast<double>(errors.size());
+    const size_t k =
+        std::min(errors.size() - 1, static_cast<size_t>(0.95 * static_cast<double>(errors.size())));
+    std::nth_element(errors.begin(), errors.begin() + static_cast<std::ptrdiff_t>(k), errors.end());
+    score.p95_error = errors[k];
+  }
+  score.seam_step = score.seam_edges ? seam_sum / static_cast<double>(score.seam_edges) : 0;
+  score.ordinary_step = ordinary_edges ? ordinary_sum / static_cast<double>(ordinary_edges) : 0;
+  return score;
 }
 
 }  // namespace lidarshop

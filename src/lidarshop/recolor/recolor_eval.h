@@ -61,4 +61,22 @@ PinholeCamera EvaluationCamera(double offset_m);
 // RMS reprojection error of `pairs` with `camera`, pixels (a point behind the camera counts 10^6 px).
 double RmsReprojectionError(const PinholeCamera& camera, const std::vector<PixelPointPair>& pairs);
 
+struct PhotosRecolorResult;
+
+// Scoring a station coloured from its own photos (recolor/station_recolor.h) against the truth colours of a
+// synthetic scan (the photos render the scanner's colours at photo 0's exposure; issue 32 item 5).
+struct StationColourScore {
+  int64_t returns = 0;    // valid cells
+  int64_t coloured = 0;   // ... that some photo coloured
+  double mean_error = 0;  // RGB units (mean absolute difference over R, G, B), over the coloured cells
+  double p95_error = 0;   // its 95th percentile
+  // Colour steps (mean absolute RGB difference) between 4-neighbour coloured cells: across a seam (the two
+  // cells coloured by different photos) and across the other neighbours; visibility = seam / ordinary.
+  int64_t seam_edges = 0;
+  double seam_step = 0, ordinary_step = 0;
+  double seam_visibility() const { return ordinary_step > 0 ? seam_step / ordinary_step : 0; }
+  double uncoloured_share() const { return returns ? 1.0 - static_cast<double>(coloured) / returns : 0; }
+};
+StationColourScore ScoreStationColours(const Scan& truth, const PhotosRecolorResult& result);
+
 }  // namespace lidarshop

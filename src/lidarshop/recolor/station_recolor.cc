@@ -1,14 +1,18 @@
 #include "lidarshop/recolor/station_recolor.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include <fmt/format.h>
 #include <Eigen/Dense>
 
+#include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/seam_blend.h"
 #include "lidarshop/recolor/visibility.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 
@@ -16,11 +20,20 @@ void PhotosRecolorOptions::Check() const {
   visibility.Check();
   if (!(border_px >= 0 && border_px < 1e6))
     throw OptionsError(fmt::format("PhotosRecolorOptions.border_px must be in [0, 1e6), got {}", border_px));
+  if (!(seam_band_cells >= 1 && seam_band_cells <= 1000))
+    throw OptionsError(
+        fmt::format("PhotosRecolorOptions.seam_band_cells must be in [1, 1000], got {}", seam_band_cells));
+  if (!(seam_depth_jump_m >= 0 && seam_depth_jump_m < 1e6))
+    throw OptionsError(
+        fmt::format("PhotosRecolorOptions.seam_depth_jump_m must be in [0, 1e6), got {}", seam_depth_jump_m));
 }
 
 std::string PhotosRecolorResult::Summary() const {
-  return fmt::format("{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs", coloured,
-                     returns, gains.size(), constraints);
+  return fmt::format(
+      "{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs; {} seam edges, {} cells "
+      "blended (occlusion scene {:.2f} s, visibility {:.2f} s, blending {:.2f} s)",
+      coloured, returns, gains.size(), constraints, seam_edges, blended, scene_seconds, visibility_seconds,
+      blend_seconds);
 }
 
 namespace {
@@ -70,43 +83,85 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                       photos[i].camera.width_px(), photos[i].camera.height_px(), image.cols, image.rows));
   }
   RaycastScene scene;
+  const auto start = std::chrono::steady_clock::now();
+  const auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   recolor_internal::BuildOcclusionScene(scan, options.visibility, &scene);
+  const double scene_seconds = since(start);
   const int64_t cells = static_cast<int64_t>(scan.rows) * scan.cols;
   const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
   const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
   const bool has_normals = !scan.normal.empty();
 
-  // Per cell: every photo's sample, and the best photo with its score.
-  std::vector<std::vector<Sample>> samples(cells);
-  std::vector<int> best(cells, -1);
-  std::vector<double> best_score(cells, -1);
+  // Per photo, what it sees: each cell's sample and score, in row-major cell order (computed in parallel).
+  struct PhotoSample {
+    int64_t cell;
+    cv::Vec3b rgb;
+    float score;
+  };
+  std::vector<std::vector<PhotoSample>> seen_by(photos.size());
   PhotosRecolorResult result;
+  result.scene_seconds = scene_seconds;
+  const auto visibility_start = std::chrono::steady_clock::now();
   for (size_t i = 0; i < photos.size(); ++i) {
     const Camera& camera = photos[i].camera;
+    const Eigen::Vector3d center = camera.center_in_world();
     const recolor_internal::Visibility visibility =
         recolor_internal::VisibleCells(scan, scene, camera, options.visibility);
     result.returns = visibility.returns;
-    for (const recolor_internal::SeenCell& seen : visibility.seen) {
-      const int r = static_cast<int>(seen.cell / scan.cols), c = static_cast<int>(seen.cell % scan.cols);
-      double cos_angle = 1;
-      if (has_normals) {
-        const cv::Vec3f n = scan.normal.at<cv::Vec3f>(r, c);
-        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-        const Eigen::Vector3d normal = rotation * Eigen::Vector3d(n[0], n[1], n[2]);
-        const Eigen::Vector3d view =
-            (camera.center_in_world() - (rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation))
-                .normalized();
-        if (normal.norm() > 0.5) cos_angle = std::max(0.05, std::abs(normal.normalized().dot(view)));
+    std::vector<PhotoSample>& list = seen_by[i];
+    list.resize(visibility.seen.size());
+    ParallelFor(
+        static_cast<int64_t>(list.size()),
+        [&](int64_t k) {
+          const recolor_internal::SeenCell& seen = visibility.seen[k];
+          const int r = static_cast<int>(seen.cell / scan.cols), c = static_cast<int>(seen.cell % scan.cols);
+          double cos_angle = 1;
+          if (has_normals) {
+            const cv::Vec3f n = scan.normal.at<cv::Vec3f>(r, c);
+            const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+            const Eigen::Vector3d normal = rotation * Eigen::Vector3d(n[0], n[1], n[2]);
+            const Eigen::Vector3d view =
+                (center - (rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation)).normalized();
+            if (normal.norm() > 0.5) cos_angle = std::max(0.05, std::abs(normal.normalized().dot(view)));
+          }
+          const double border = std::min({seen.pixel.x(), seen.pixel.y(), camera.width_px() - seen.pixel.x(),
+                                          camera.height_px() - seen.pixel.y()});
+          const double border_factor =
+              options.border_px > 0 ? std::min(1.0, (border + 0.5) / options.border_px) : 1;
+          const double score = options.nearest_photo
+                                   ? 1 / std::max(seen.distance_m, 1e-3)
+                                   : cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
+          list[k] = {seen.cell, SamplePhoto(photos[i].image, seen.pixel), static_cast<float>(score)};
+        },
+        4096);
+  }
+  result.visibility_seconds = since(visibility_start);
+  // Per cell its samples, by photo index (compressed rows: `first[cell]` .. `first[cell + 1]`), and the best
+  // photo (the highest score; a tie keeps the lower index).
+  std::vector<int64_t> first(cells + 1, 0);
+  for (const auto& list : seen_by) {
+    for (const PhotoSample& s : list) ++first[s.cell + 1];
+  }
+  for (int64_t cell = 0; cell < cells; ++cell) first[cell + 1] += first[cell];
+  std::vector<Sample> samples(static_cast<size_t>(first[cells]));
+  std::vector<int> best(cells, -1);
+  {
+    std::vector<int64_t> next(first.begin(), first.end() - 1);
+    std::vector<float> best_score(cells, -1);
+    for (size_t i = 0; i < seen_by.size(); ++i) {
+      for (const PhotoSample& s : seen_by[i]) {
+        samples[next[s.cell]++] = {static_cast<int>(i), s.rgb};
+        if (s.score > best_score[s.cell]) best_score[s.cell] = s.score, best[s.cell] = static_cast<int>(i);
       }
-      const double border = std::min({seen.pixel.x(), seen.pixel.y(), camera.width_px() - seen.pixel.x(),
-                                      camera.height_px() - seen.pixel.y()});
-      const double border_factor =
-          options.border_px > 0 ? std::min(1.0, (border + 0.5) / options.border_px) : 1;
-      const double score = cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
-      samples[seen.cell].push_back({static_cast<int>(i), SamplePhoto(photos[i].image, seen.pixel)});
-      if (score > best_score[seen.cell]) best_score[seen.cell] = score, best[seen.cell] = static_cast<int>(i);
+      std::vector<PhotoSample>().swap(seen_by[i]);
     }
   }
+  const auto samples_of = [&](int64_t cell) {
+    return std::pair<const Sample*, const Sample*>(samples.data() + first[cell],
+                                                   samples.data() + first[cell + 1]);
+  };
 
   // The gains, channel by channel, from the overlaps and from neighbours coloured by different photos.
   std::vector<std::pair<std::pair<int, int>, double>> rows[3];
@@ -119,16 +174,17 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     }
     ++result.constraints;
   };
-  const auto chosen = [&](int64_t cell) -> const Sample* {
-    for (const Sample& s : samples[cell]) {
-      if (s.photo == best[cell]) return &s;
+  const auto sample_of = [&](int64_t cell, int photo) -> const Sample* {
+    for (auto [s, end] = samples_of(cell); s != end; ++s) {
+      if (s->photo == photo) return s;
     }
     return nullptr;
   };
+  const auto chosen = [&](int64_t cell) { return best[cell] < 0 ? nullptr : sample_of(cell, best[cell]); };
   for (int64_t cell = 0; cell < cells; ++cell) {
-    const std::vector<Sample>& here = samples[cell];
-    for (size_t a = 0; a < here.size(); ++a) {
-      for (size_t b = a + 1; b < here.size(); ++b) add(here[a], here[b]);
+    const auto [begin, end] = samples_of(cell);
+    for (const Sample* a = begin; a != end; ++a) {
+      for (const Sample* b = a + 1; b != end; ++b) add(*a, *b);
     }
     const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
     const Sample* mine = chosen(cell);
@@ -147,20 +203,93 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     }
   }
 
-  result.scan = Clone(scan);
-  Scan& out = result.scan;
-  if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  // The chosen colours at photo 0's exposure, then the seams blended.
+  const auto corrected = [&](const Sample& sample) {
+    const cv::Vec3d& gain = result.gains[sample.photo];
+    return cv::Vec3d(sample.rgb[0] / gain[0], sample.rgb[1] / gain[1], sample.rgb[2] / gain[2]);
+  };
+  cv::Mat colour(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
   result.photo_index = cv::Mat::zeros(scan.rows, scan.cols, CV_16U);
   for (int64_t cell = 0; cell < cells; ++cell) {
     const Sample* sample = chosen(cell);
     if (sample == nullptr) continue;
     const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
-    const cv::Vec3d& gain = result.gains[sample->photo];
-    out.color.at<cv::Vec3b>(r, c) = cv::Vec3b(cv::saturate_cast<uint8_t>(sample->rgb[0] / gain[0]),
-                                              cv::saturate_cast<uint8_t>(sample->rgb[1] / gain[1]),
-                                              cv::saturate_cast<uint8_t>(sample->rgb[2] / gain[2]));
+    colour.at<cv::Vec3f>(r, c) = corrected(*sample);
     result.photo_index.at<uint16_t>(r, c) = static_cast<uint16_t>(sample->photo + 1);
     ++result.coloured;
+  }
+  if (options.blend_seams) {
+    const auto blend_start = std::chrono::steady_clock::now();
+    const cv::Mat range = RangeImage(scan);
+    // The guidance from cell a to its neighbour b: their own difference when one photo colours both, else
+    // what the photos that see both show, else 0 on a continuous surface and the step across a depth jump.
+    const auto guidance = [&](int64_t a, int64_t b, int ra, int ca, int rb, int cb) -> cv::Vec3d {
+      const cv::Vec3d& ua = colour.at<cv::Vec3f>(ra, ca);
+      const cv::Vec3d& ub = colour.at<cv::Vec3f>(rb, cb);
+      if (best[a] == best[b]) return ub - ua;
+      cv::Vec3d sum(0, 0, 0);
+      int count = 0;
+      for (const int photo : {best[a], best[b]}) {
+        const Sample *sa = sample_of(a, photo), *sb = sample_of(b, photo);
+        if (sa == nullptr || sb == nullptr) continue;
+        sum += corrected(*sb) - corrected(*sa);
+        ++count;
+      }
+      if (count > 0) return sum / count;
+      const double da = range.at<float>(ra, ca), db = range.at<float>(rb, cb);
+      if (std::abs(da - db) > options.seam_depth_jump_m + 0.02 * std::min(da, db)) return ub - ua;
+      return cv::Vec3d(0, 0, 0);
+    };
+    cv::Mat gx(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0)), gy = gx.clone();
+    ParallelFor(scan.rows, [&](int64_t row) {
+      const int r = static_cast<int>(row);
+      for (int c = 0; c < scan.cols; ++c) {
+        const int64_t cell = static_cast<int64_t>(r) * scan.cols + c;
+        if (best[cell] < 0) continue;
+        if (c + 1 < scan.cols && best[cell + 1] >= 0)
+          gx.at<cv::Vec3f>(r, c) = guidance(cell, cell + 1, r, c, r, c + 1);
+        if (r + 1 < scan.rows && best[cell + scan.cols] >= 0)
+          gy.at<cv::Vec3f>(r, c) = guidance(cell, cell + scan.cols, r, c, r + 1, c);
+      }
+    });
+    const SeamBlendResult blended = BlendSeams(colour, result.photo_index, gx, gy, options.seam_band_cells);
+    colour = blended.colour;
+    result.seam_edges = blended.seam_edges;
+    result.blended = blended.unknowns;
+    result.blend_seconds = since(blend_start);
+  }
+
+  result.scan = Clone(scan);
+  Scan& out = result.scan;
+  if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (result.photo_index.at<uint16_t>(r, c) == 0) continue;
+      const cv::Vec3d& v = colour.at<cv::Vec3f>(r, c);
+      out.color.at<cv::Vec3b>(r, c) =
+          cv::Vec3b(cv::saturate_cast<uint8_t>(v[0]), cv::saturate_cast<uint8_t>(v[1]),
+                    cv::saturate_cast<uint8_t>(v[2]));
+    }
+  }
+  return result;
+}
+
+E57StationPhotos StationPhotosOfE57(const E57File& file, int scan_index) {
+  E57StationPhotos result;
+  for (size_t i = 0; i < file.images.size(); ++i) {
+    const E57Image& image = file.images[i];
+    Camera camera;
+    std::string why;
+    if (image.associated_scan >= 0 && image.associated_scan != scan_index) {
+      why = fmt::format("belongs to scan {}", image.associated_scan);
+    } else if (image.image.empty()) {
+      why = image.decode_error;
+    } else if (CameraModelOfE57Image(image, &camera, &why)) {
+      result.photos.push_back({image.image, camera});
+      result.image_index.push_back(static_cast<int>(i));
+      continue;
+    }
+    result.skipped.push_back({static_cast<int>(i), why});
   }
   return result;
 }

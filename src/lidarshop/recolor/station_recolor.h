@@ -12,8 +12,13 @@
 // meet there), log(v_i / g_i) = log(v_j / g_j) for each channel with both values in [8, 247] (not dark, not
 // saturated). Colours come out at photo 0's exposure: v / g. Photos no constraint reaches keep gain 1.
 //
-// Not done here (issue 32 item 3's rest): blending the seams in the gradient domain, white balance beyond the
-// per-channel gain, the CLI (`recolor --from-e57-images`).
+// Seams (recolor/seam_blend.h): where the chosen photo changes between 4-neighbour cells, the cells within
+// `seam_band_cells` of the change are solved again in the gradient domain (Poisson, on the scan's grid): the
+// guidance across an edge is the colour difference a photo that sees both cells shows there (the average of
+// both photos' when both do), else — a cube map's faces do not overlap — 0 on a continuous surface and the
+// colours' own step across a depth jump (more than `seam_depth_jump_m` + 2 % of the range apart).
+//
+// Not done here: white balance beyond the per-channel gain.
 #pragma once
 
 #include <cstdint>
@@ -23,6 +28,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera_model.h"
+#include "lidarshop/io/e57.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/scan/scan.h"
 
@@ -42,9 +48,15 @@ struct PhotosRecolorOptions {
     options.edge_guard = false;
     return options;
   }();
-  double border_px = 16;          // pixels: closer to the border than this lowers a photo's score
-  bool equalize_exposure = true;  // fit and divide by the gains (false: the naive colours)
-  void Check() const;             // throws OptionsError
+  double border_px = 16;            // pixels: closer to the border than this lowers a photo's score
+  bool equalize_exposure = true;    // fit and divide by the gains (false: the naive colours)
+  bool blend_seams = true;          // gradient-domain blending of the seams between photos
+  int seam_band_cells = 12;         // cells each side of a seam solved again; >= 1
+  double seam_depth_jump_m = 0.05;  // a seam edge whose ranges differ by this + 2 % keeps its step
+  // The naive choice (the baseline of the evaluation): the photo whose camera is nearest the point, ties to
+  // the lowest index; no viewing angle, no border distance.
+  bool nearest_photo = false;
+  void Check() const;  // throws OptionsError
 };
 
 struct PhotosRecolorResult {
@@ -54,11 +66,30 @@ struct PhotosRecolorResult {
   int64_t returns = 0;           // valid cells
   int64_t coloured = 0;          // valid cells some photo saw
   int64_t constraints = 0;       // overlap pairs used to fit the gains
-  std::string Summary() const;   // one line
+  int64_t seam_edges = 0;        // 4-neighbour pairs of coloured cells coloured by different photos
+  int64_t blended = 0;           // cells solved again by the seam blending
+  // Wall clock, seconds: the occlusion scene (scan mesh and skirts), every photo's visibility and samples, the
+  // seam blending (guidance and Poisson).
+  double scene_seconds = 0, visibility_seconds = 0, blend_seconds = 0;
+  std::string Summary() const;  // one line
 };
 
 // Throws InputError when a photo's image does not match its camera (naming the photo's index).
 PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,
                                       const PhotosRecolorOptions& options = {});
+
+// The photos of an E57 file that can colour its scan `scan_index` (`recolor --from-e57-images`): every
+// images2D entry that belongs to that scan (or to none), decodes, and holds a camera model
+// (io/e57_image_camera.h). The others are listed with the reason.
+struct E57StationPhotos {
+  std::vector<CameraPhoto> photos;
+  std::vector<int> image_index;  // per photo, its images2D index
+  struct Skipped {
+    int image_index = 0;
+    std::string why;
+  };
+  std::vector<Skipped> skipped;
+};
+E57StationPhotos StationPhotosOfE57(const E57File& file, int scan_index);
 
 }  // namespace lidarshop

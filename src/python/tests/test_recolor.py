@@ -1,5 +1,6 @@
 """Recolouring from a photo on a synthetic scene: the photo, the camera and the hidden points are known."""
 import os
+import subprocess
 
 import numpy as np
 import pytest
@@ -112,3 +113,35 @@ def test_photos_stored_in_e57():
     photos = lidarshop.read_e57_photos(path)
     assert len(photos) >= 1
     assert photos[0]["image"].shape == (2304, 3072, 3)
+
+
+def test_station_colouring_from_e57_images_and_photos(tmp_path):
+    """A cube station written by `lidarshop scan --photos cube` (six faces at gains within ±30 %) coloured from its
+    own images, then from the same photos and cameras given one by one: the same colours and gains."""
+    cli = os.environ.get("LIDARSHOP_CLI")
+    assert cli, "LIDARSHOP_CLI (set by ctest) must name the lidarshop executable"
+    station = str(tmp_path / "cube.e57")
+    subprocess.run([cli, "scan", "parking_lot", "--rows", "100", "--columns", "200", "--seed", "3", "--quiet",
+                    "-o", station, "--photos", "cube", "--photo-size", "192"], check=True)
+    result = lidarshop.recolor_from_e57_images(station)
+    assert result.coloured > 0.8 * result.returns  # the cells no face sees (from 0.15 m above) stay as they were
+    assert result.photo_index.shape == result.scan.color.shape[:2] and result.photo_index.dtype == np.uint16
+    assert result.gains.shape == (6, 3) and np.all(result.gains[0] == 1)
+    assert result.seam_edges > 0 and result.blended > 0
+    used = np.unique(result.photo_index[result.photo_index > 0])
+    assert len(used) >= 3
+    photos = lidarshop.read_e57_photos(station)
+    again = lidarshop.recolor_from_photos(lidarshop.read_scan(station), [p["image"] for p in photos],
+                                          [p["camera"] for p in photos])
+    np.testing.assert_array_equal(again.photo_index, result.photo_index)
+    np.testing.assert_array_equal(again.scan.color, result.scan.color)
+    np.testing.assert_allclose(again.gains, result.gains)
+    # The naive colouring (no gains, no blending) leaves the gains at 1 and the seams unblended.
+    naive = lidarshop.recolor_from_photos(lidarshop.read_scan(station), [p["image"] for p in photos],
+                                          [p["camera"] for p in photos], equalize_exposure=False,
+                                          blend_seams=False, nearest_photo=True)
+    assert np.all(naive.gains == 1) and naive.blended == 0
+    with pytest.raises(ValueError, match="6 photos but 5 cameras"):
+        lidarshop.recolor_from_photos(result.scan, [p["image"] for p in photos], [p["camera"] for p in photos][:5])
+    with pytest.raises(lidarshop.InputError, match="no image of scan 0 holds a photo with a camera"):
+        lidarshop.recolor_from_e57_images(os.path.join(SOURCE_DIR, "..", "shared", "data", "e57", "pumpA.e57"))

@@ -1,0 +1,125 @@
+// lidarshop clean: remove what moved between the stations of a site (site/transients.h, docs/stations.md).
+//
+//   lidarshop clean SCAN... --out DIR [--removed-masks] [--json FILE|-]
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/options_cli.h"
+#include "lidarshop/io/image_io.h"
+#include "lidarshop/site/transients.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+#include "lidarshop/util/progress.h"
+
+namespace lidarshop::cli {
+namespace {
+// The formats that keep a station's grid and pose, which the comparison of stations needs back.
+const std::vector<std::string> kStationExtensions = {"ptx", "e57", "ply", "pcd"};
+}  // namespace
+
+int RunClean(int argc, char** argv) {
+  CLI::App app{
+      "Remove what moved between stations (docs/stations.md): a point of one station that the rays of "
+      "another "
+      "passed through, hitting something farther, is transient (a passer-by, a car that left); it is removed "
+      "and its hole filled (synthesized, marked). The stations must be registered (their poses in one world "
+      "frame). Every scan of every input is a station; each input is written to DIR under its own name.",
+      "clean"};
+  std::vector<std::string> inputs;
+  std::string out_dir, json_path;
+  bool removed_masks = false, quiet = false;
+  CleanOptions options;
+  OptionBinder binder(app);
+  app.add_option("scans", inputs, "the stations' scan files (.e57 with several scans, .ptx, .ply, .pcd)")
+      ->required();
+  app.add_option("--out", out_dir, "folder for the cleaned stations (created if missing)")->required();
+  app.add_flag(
+      "--removed-masks", removed_masks,
+      "also write DIR/<stem>_removed.png per station (<stem>_<N>_removed.png for scan N of a file "
+      "with several): 1 + the index of the station that saw through each removed point, 0 elsewhere");
+  AddJsonOption(app, &json_path);
+  binder.Bind(&options, {.keys = {"transients.range_noise_sigma_m", "transients.min_margin_m",
+                                  "transients.neighbourhood_cells", "transients.min_region_cells",
+                                  "transients.grow_cells", "margin_cells", "fill_holes"},
+                         .flags = {{"transients.range_noise_sigma_m", "--range-noise"},
+                                   {"transients.min_margin_m", "--min-margin"},
+                                   {"transients.neighbourhood_cells", "--neighbourhood"},
+                                   {"transients.min_region_cells", "--min-region"},
+                                   {"transients.grow_cells", "--grow"},
+                                   {"margin_cells", "--margin"},
+                                   {"fill_holes", "--fill"}}});
+  AddQuietFlag(app, &quiet);
+  return RunCommand(
+      app, argc, argv,
+      [&]() {
+        binder.Validate(options);
+        namespace fs = std::filesystem;
+        std::vector<ScanFile> files;
+        std::vector<Scan> stations;
+        for (const std::string& path : inputs) {
+          files.push_back(ReadScanFileAndWarn(path));
+          for (const Scan& scan : files.back().scans) stations.push_back(scan);
+        }
+        std::error_code error;
+        fs::create_directories(out_dir, error);
+        if (error || !fs::is_directory(out_dir))
+          throw InputError(fmt::format("--out {}: cannot create the folder", out_dir));
+        std::vector<std::string> outputs;
+        for (const std::string& path : inputs) {
+          const std::string output = (fs::path(out_dir) / fs::path(path).filename()).string();
+          CheckOutputFile("--out", output, kStationExtensions, inputs);
+          outputs.push_back(output);
+        }
+        const int64_t pairs =
+            static_cast<int64_t>(stations.size()) * (static_cast<int64_t>(stations.size()) - 1);
+        auto progress = Progress::ForTerminal("clean", pairs, quiet);
+        const CleanResult result = CleanStations(stations, options, progress.get());
+        if (progress) progress->Finish();
+        nlohmann::ordered_json per_station = nlohmann::ordered_json::array();
+        size_t next = 0;
+        int64_t removed = 0;
+        for (size_t f = 0; f < files.size(); ++f) {
+          std::vector<Scan> cleaned;
+          for (size_t s = 0; s < files[f].scans.size(); ++s, ++next) {
+            cleaned.push_back(result.stations[next]);
+            const StationTransients& found = result.transients.stations[next];
+            removed += found.transient_cells;
+            const std::string stem = fs::path(inputs[f]).stem().string();
+            std::string mask_path;
+            if (removed_masks) {
+              mask_path =
+                  (fs::path(out_dir) / (files[f].scans.size() > 1 ? fmt::format("{}_{}_removed.png", stem, s)
+                                                                  : stem + "_removed.png"))
+                      .string();
+              CheckOutputFile("--removed-masks", mask_path, {"png"}, inputs);
+              WriteImage(mask_path, found.seen_through_by);
+            }
+            per_station.push_back({{"file", inputs[f]},
+                                   {"scan", s},
+                                   {"output", outputs[f]},
+                                   {"returns", stations[next].CountValid()},
+                                   {"removed", found.transient_cells},
+                                   {"seen_through", found.seen_through_cells},
+                                   {"confirmed", found.confirmed_cells},
+                                   {"filled", result.filled_cells[next]},
+                                   {"removed_mask", mask_path}});
+          }
+          WriteScanFile(outputs[f], cleaned);
+        }
+        PrintResultWarnings(result.warnings);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), {{"stations", per_station},
+                                                                 {"removed", removed},
+                                                                 {"warnings", result.warnings}}));
+        Summarize(
+            fmt::format("{} stations: {} transient points removed -> {}", stations.size(), removed, out_dir));
+        return 0;
+      },
+      &binder);
+}
+
+}  // namespace lidarshop::cli

@@ -1,0 +1,282 @@
+#include "lidarshop/site/transients.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include <fmt/format.h>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
+
+namespace lidarshop {
+
+void TransientOptions::Check() const { Validate(*this); }
+void CleanOptions::Check() const { Validate(*this); }
+
+template <>
+const StructInfo& InfoOf<TransientOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<TransientOptions> b("TransientOptions", "points another station saw through");
+    b.Field(&TransientOptions::range_noise_sigma_m, "range_noise_sigma_m", "σ of the stations' range noise")
+        .Unit("m")
+        .Min(0);
+    b.Field(&TransientOptions::sigma_multiple, "sigma_multiple", "the margin holds this many σ").Min(0);
+    b.Field(&TransientOptions::min_margin_m, "min_margin_m", "seen through only this far behind, at least")
+        .Unit("m")
+        .Min(0);
+    b.Field(&TransientOptions::footprint_multiple, "footprint_multiple",
+            "the ray footprint (range x angular step) times this is added to the margin")
+        .Min(0);
+    b.Field(&TransientOptions::neighbourhood_cells, "neighbourhood_cells",
+            "cells on each side of the ray's cell that must all see farther")
+        .Unit("cells")
+        .Range(0, 8);
+    b.Field(&TransientOptions::min_region_cells, "min_region_cells", "smaller transient regions are kept")
+        .Unit("cells")
+        .Min(1);
+    b.Field(&TransientOptions::grow_cells, "grow_cells",
+            "transient regions grow this far over depth-continuous unconfirmed neighbours")
+        .Unit("cells")
+        .Range(0, 32);
+    b.Field(&TransientOptions::grow_max_range_jump, "grow_max_range_jump",
+            "largest relative range step between grown neighbours")
+        .AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<CleanOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<CleanOptions> b("CleanOptions", "remove what moved between stations, fill the holes");
+    b.Field(&CleanOptions::transients, "transients", "what counts as transient");
+    b.Field(&CleanOptions::fill, "fill", "the fill of the removed points' holes");
+    b.Field(&CleanOptions::margin_cells, "margin_cells", "the removed cells are grown by this before filling")
+        .Unit("cells")
+        .Range(0, 32);
+    b.Field(&CleanOptions::fill_holes, "fill_holes", "fill the holes (else: cells without a return)");
+    return b.Build();
+  }();
+  return info;
+}
+
+namespace {
+
+constexpr uint8_t kNoEvidence = 0, kSeenThrough = 1, kConfirmed = 2;
+
+// Where a direction of a station's scanner frame falls on its grid.
+class GridLookup {
+ public:
+  explicit GridLookup(const Scan& scan) : grid_(GridOf(scan)), rows_(scan.rows), cols_(scan.cols) {
+    const std::vector<double>& az = grid_.azimuth_rad;
+    const std::vector<double>& el = grid_.elevation_rad;
+    azimuth_step_ = cols_ > 1 ? std::abs(az.back() - az.front()) / (cols_ - 1) : 1e-3;
+    elevation_step_ = rows_ > 1 ? std::abs(el.front() - el.back()) / (rows_ - 1) : 1e-3;
+  }
+
+  // The nearest cell of the direction of `p` (scanner frame), or false when it lies outside the grid by
+  // more than half a step.
+  bool Cell(const Eigen::Vector3d& p, int* row, int* col) const {
+    const double range = p.norm();
+    if (range <= 0.0) return false;
+    const std::vector<double>& az = grid_.azimuth_rad;
+    const std::vector<double>& el = grid_.elevation_rad;
+    // Azimuth relative to the first column, in [0, 2π): the grid may span past ±π.
+    const double relative =
+        std::fmod(WrapAngle(std::atan2(p.x(), p.y()) - az.front()) + 2.0 * M_PI, 2.0 * M_PI);
+    const double azimuth = az.front() + relative;
+    const auto c_it = std::lower_bound(az.begin(), az.end(), azimuth);
+    int c = static_cast<int>(c_it - az.begin());
+    if (c == cols_) {
+      if (azimuth - az.back() > 0.5 * azimuth_step_) return false;
+      c = cols_ - 1;
+    } else if (c > 0 && azimuth - az[c - 1] < az[c] - azimuth) {
+      --c;
+    }
+    const double elevation = std::asin(std::clamp(p.z() / range, -1.0, 1.0));
+    if (elevation > el.front() + 0.5 * elevation_step_ || elevation < el.back() - 0.5 * elevation_step_)
+      return false;
+    // Elevations decrease down the rows.
+    const auto r_it = std::lower_bound(el.begin(), el.end(), elevation, std::greater<double>());
+    int r = static_cast<int>(r_it - el.begin());
+    if (r == rows_) {
+      r = rows_ - 1;
+    } else if (r > 0 && el[r - 1] - elevation < elevation - el[r]) {
+      --r;
+    }
+    *row = r;
+    *col = c;
+    return true;
+  }
+
+  double step_rad() const { return std::max(azimuth_step_, elevation_step_); }
+
+ private:
+  ScanGrid grid_;
+  int rows_, cols_;
+  double azimuth_step_ = 0, elevation_step_ = 0;
+};
+
+// What station `b` says of each point of station `a`: kSeenThrough, kConfirmed or kNoEvidence, per cell.
+cv::Mat EvidenceFrom(const Scan& a, const Scan& b, const GridLookup& b_grid, const TransientOptions& o) {
+  cv::Mat evidence(a.rows, a.cols, CV_8U, cv::Scalar(kNoEvidence));
+  const Eigen::Matrix4d b_from_a = b.world_from_scanner.inverse() * a.world_from_scanner;
+  const int n = o.neighbourhood_cells;
+  const double step = b_grid.step_rad();
+  ParallelFor(a.rows, [&](int64_t row) {
+    const uint8_t* valid = a.valid.ptr<uint8_t>(static_cast<int>(row));
+    const cv::Vec3f* point = a.point.ptr<cv::Vec3f>(static_cast<int>(row));
+    uint8_t* out = evidence.ptr<uint8_t>(static_cast<int>(row));
+    for (int col = 0; col < a.cols; ++col) {
+      if (valid[col] == 0) continue;
+      const Eigen::Vector3d p_b =
+          b_from_a.topLeftCorner<3, 3>() * Eigen::Vector3d(point[col][0], point[col][1], point[col][2]) +
+          b_from_a.topRightCorner<3, 1>();
+      int r = 0, c = 0;
+      if (!b_grid.Cell(p_b, &r, &c)) continue;
+      const double d = p_b.norm();
+      const double margin =
+          o.min_margin_m + o.sigma_multiple * o.range_noise_sigma_m + o.footprint_multiple * d * step;
+      if (b.valid.at<uint8_t>(r, c) != 0 && std::abs(b.range.at<float>(r, c) - d) <= margin) {
+        out[col] = kConfirmed;
+        continue;
+      }
+      if (r < n || c < n || r + n >= b.rows || c + n >= b.cols) continue;
+      bool through = true;
+      for (int dr = -n; dr <= n && through; ++dr) {
+        for (int dc = -n; dc <= n; ++dc) {
+          // A cell without a return tells nothing: the ray may have met a dark or mirroring surface.
+          if (b.valid.at<uint8_t>(r + dr, c + dc) == 0 || b.range.at<float>(r + dr, c + dc) <= d + margin) {
+            through = false;
+            break;
+          }
+        }
+      }
+      if (through) out[col] = kSeenThrough;
+    }
+  });
+  return evidence;
+}
+
+// Drops regions of `mask` smaller than `min_cells` (8-connected).
+cv::Mat WithoutSmallRegions(const cv::Mat& mask, int min_cells) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<uint8_t> keep(count, 0);
+  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_cells ? 255 : 0;
+  cv::Mat out(mask.size(), CV_8U);
+  for (int r = 0; r < mask.rows; ++r) {
+    const int32_t* l = labels.ptr<int32_t>(r);
+    uint8_t* o = out.ptr<uint8_t>(r);
+    for (int c = 0; c < mask.cols; ++c) o[c] = keep[l[c]];
+  }
+  return out;
+}
+
+// Grows the non-zero cells of `reason` by one cell at a time, `steps` times, into valid cells that no station
+// confirmed and whose range is within `max_jump` (relative) of a neighbour already in; a grown cell takes that
+// neighbour's reason (the first in row order). Sequential, so the result does not depend on threads.
+void GrowOverContinuousDepth(const Scan& scan, const cv::Mat& confirmed, int steps, double max_jump,
+                             cv::Mat* reason) {
+  for (int step = 0; step < steps; ++step) {
+    cv::Mat next = reason->clone();
+    for (int r = 0; r < scan.rows; ++r) {
+      for (int c = 0; c < scan.cols; ++c) {
+        if (reason->at<uint8_t>(r, c) != 0 || scan.valid.at<uint8_t>(r, c) == 0 ||
+            confirmed.at<uint8_t>(r, c) != 0)
+          continue;
+        const float range = scan.range.at<float>(r, c);
+        for (int dr = -1; dr <= 1 && next.at<uint8_t>(r, c) == 0; ++dr) {
+          for (int dc = -1; dc <= 1; ++dc) {
+            const int rr = r + dr, cc = c + dc;
+            if (rr < 0 || cc < 0 || rr >= scan.rows || cc >= scan.cols || reason->at<uint8_t>(rr, cc) == 0)
+              continue;
+            if (std::abs(scan.range.at<float>(rr, cc) - range) <= max_jump * range) {
+              next.at<uint8_t>(r, c) = reason->at<uint8_t>(rr, cc);
+              break;
+            }
+          }
+        }
+      }
+    }
+    *reason = next;
+  }
+}
+
+}  // namespace
+
+TransientResult FindTransients(const std::vector<Scan>& stations, const TransientOptions& options,
+                               Progress* progress) {
+  options.Check();
+  if (stations.size() < 2)
+    throw InputError(fmt::format("finding what moved needs two stations or more, got {}", stations.size()));
+  std::vector<GridLookup> grids;
+  for (size_t i = 0; i < stations.size(); ++i) {
+    CheckScan(stations[i]);
+    if (stations[i].direction.empty() || stations[i].rows < 2 || stations[i].cols < 2)
+      throw InputError(fmt::format("station {} ('{}') has no grid: an unorganized cloud cannot be compared",
+                                   i, stations[i].name));
+    grids.emplace_back(stations[i]);
+  }
+  TransientResult result;
+  for (size_t a = 0; a < stations.size(); ++a) {
+    const Scan& scan = stations[a];
+    StationTransients out;
+    out.seen_through_by = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+    out.confirmed = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+    for (size_t b = 0; b < stations.size(); ++b) {
+      if (b == a) continue;
+      const cv::Mat evidence = EvidenceFrom(scan, stations[b], grids[b], options);
+      out.confirmed.setTo(255, evidence == kConfirmed);
+      out.seen_through_by.setTo(static_cast<int>(std::min<size_t>(b + 1, 255)),
+                                (evidence == kSeenThrough) & (out.seen_through_by == 0));
+      if (progress != nullptr) progress->Advance();
+    }
+    // A point one station saw and another saw through is kept: the seeing station is the better witness at
+    // a grazing ray (and a point seen twice is the wall, not the passer-by).
+    out.seen_through_by.setTo(0, out.confirmed);
+    out.seen_through_cells = cv::countNonZero(out.seen_through_by);
+    out.seen_through_by.setTo(0,
+                              WithoutSmallRegions(out.seen_through_by != 0, options.min_region_cells) == 0);
+    GrowOverContinuousDepth(scan, out.confirmed, options.grow_cells, options.grow_max_range_jump,
+                            &out.seen_through_by);
+    out.transient = out.seen_through_by != 0;
+    out.transient_cells = cv::countNonZero(out.transient);
+    out.confirmed_cells = cv::countNonZero(out.confirmed);
+    result.stations.push_back(std::move(out));
+  }
+  return result;
+}
+
+CleanResult CleanStations(const std::vector<Scan>& stations, const CleanOptions& options,
+                          Progress* progress) {
+  options.Check();
+  CleanResult result;
+  result.transients = FindTransients(stations, options.transients, progress);
+  for (size_t i = 0; i < stations.size(); ++i) {
+    const StationTransients& found = result.transients.stations[i];
+    if (found.transient_cells == 0) {
+      result.stations.push_back(stations[i]);
+      result.filled_cells.push_back(0);
+      continue;
+    }
+    const cv::Mat hole = GrowHole(found.transient, options.margin_cells);
+    if (!options.fill_holes) {
+      result.stations.push_back(MaskScan(stations[i], hole == 0));
+      result.filled_cells.push_back(0);
+      continue;
+    }
+    FillResult filled = FillScan(MaskScan(stations[i], hole == 0), hole, options.fill);
+    for (const std::string& warning : filled.warnings)
+      result.warnings.push_back(fmt::format("station {}: {}", i, warning));
+    result.filled_cells.push_back(filled.synthesized_cells);
+    result.stations.push_back(std::move(filled.scan));
+  }
+  return result;
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,89 @@
+// What moved between the stations of a site: a point one station measured is transient when the rays of
+// another station, which should have seen it, passed through where it was and hit something farther away
+// (free-space evidence; Cyclone's moving-object filter and the "peopleRemover" literature do the same). The
+// stations must be registered: their world_from_scanner put them in one world frame.
+//
+//   FindTransients(stations): per station, the cells whose point another station saw through, and why;
+//   CleanStations(stations):  each station with those points removed and their holes filled.
+//
+// The test, for a point p of station A (world) and another station B: p in B's frame is at range d along a
+// direction that falls on a cell of B's grid. B saw through p when every cell of that cell's neighbourhood
+// (neighbourhood_cells on each side) returned, and returned farther than d + margin, where the margin covers
+// the range noise and the footprint of B's rays at d (a ray beside an edge, or at grazing incidence on the
+// ground, hits nearer and farther than its neighbours; asking all of them to be farther keeps those static).
+// B saw p itself when its cell returned within the margin of d: that point is confirmed static. Transient
+// regions smaller than min_region_cells are dropped (single cells of noise); the rest grow by grow_cells over
+// depth-continuous neighbours that no station confirmed, so that the rims of a person are removed with it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "lidarshop/fill/fill.h"
+#include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
+#include "lidarshop/util/progress.h"
+
+namespace lidarshop {
+
+struct TransientOptions {
+  double range_noise_sigma_m = 0.005;  // σ of the stations' range noise, metres
+  double sigma_multiple = 4.0;         // the margin holds this many σ, plus min_margin_m
+  double min_margin_m = 0.1;           // seen through only this far behind the point at least, metres
+  // The footprint of a ray at range d (d × the grid's angular step) times this is added to the margin.
+  double footprint_multiple = 2.0;
+  int neighbourhood_cells = 1;        // cells on each side of the ray's cell that must all see farther
+  int min_region_cells = 12;          // transient regions (8-connected, in A's grid) smaller are kept
+  int grow_cells = 4;                 // then grown this far over depth-continuous, unconfirmed neighbours
+  double grow_max_range_jump = 0.03;  // largest relative range step between grown neighbours
+
+  void Check() const;  // throws OptionsError
+};
+template <>
+const StructInfo& InfoOf<TransientOptions>();
+
+struct StationTransients {
+  cv::Mat transient;  // CV_8U rows x cols: 255 = a transient point
+  // CV_8U: why: 1 + the index of the first station whose rays passed through the point; 0 = not transient.
+  cv::Mat seen_through_by;
+  cv::Mat confirmed;               // CV_8U: 255 = another station measured the same point (static)
+  int64_t transient_cells = 0;     // non-zero cells of `transient`
+  int64_t confirmed_cells = 0;     // non-zero cells of `confirmed`
+  int64_t seen_through_cells = 0;  // cells with free-space evidence before the region filter and growth
+};
+
+struct TransientResult {
+  std::vector<StationTransients> stations;  // one per input station, in order
+};
+
+// Throws InputError when fewer than two stations are given or a station has no grid (an unorganized cloud).
+TransientResult FindTransients(const std::vector<Scan>& stations, const TransientOptions& options = {},
+                               Progress* progress = nullptr);
+
+struct CleanOptions {
+  TransientOptions transients;
+  FillOptions fill;        // the fill of the removed points' holes
+  int margin_cells = 1;    // the removed cells are grown by this before filling (mixed pixels at rims)
+  bool fill_holes = true;  // false: removed points become cells without a return
+
+  void Check() const;  // throws OptionsError
+};
+template <>
+const StructInfo& InfoOf<CleanOptions>();
+
+struct CleanResult {
+  std::vector<Scan> stations;         // the cleaned stations, in order
+  TransientResult transients;         // what was found
+  std::vector<int64_t> filled_cells;  // per station: cells the fill gave a synthesized return
+  std::vector<std::string> warnings;  // the fills' warnings, naming the station
+};
+
+// Removes every station's transient points and fills their holes (FillScan: synthesized, marked). Filling
+// from what the other stations measured (their real points behind the removed object) is not done yet.
+CleanResult CleanStations(const std::vector<Scan>& stations, const CleanOptions& options = {},
+                          Progress* progress = nullptr);
+
+}  // namespace lidarshop
