@@ -10,6 +10,7 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
+#include "lidarshop/cli/scan_selector.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/site/transients.h"
 #include "lidarshop/util/error.h"
@@ -28,7 +29,8 @@ int RunClean(int argc, char** argv) {
       "another "
       "passed through, hitting something farther, is transient (a passer-by, a car that left); it is removed "
       "and its hole filled (synthesized, marked). The stations must be registered (their poses in one world "
-      "frame). Every scan of every input is a station; each input is written to DIR under its own name.",
+      "frame). Every scan of every input is a station (a site's E57 holds several; FILE#N one of them); each "
+      "input is written to DIR under its own name (FILE#N as FILE's stem_N).",
       "clean"};
   std::vector<std::string> inputs;
   std::string out_dir, json_path;
@@ -71,7 +73,7 @@ int RunClean(int argc, char** argv) {
           throw InputError(fmt::format("--out {}: cannot create the folder", out_dir));
         std::vector<std::string> outputs;
         for (const std::string& path : inputs) {
-          const std::string output = (fs::path(out_dir) / fs::path(path).filename()).string();
+          const std::string output = (fs::path(out_dir) / StationOutputName(path)).string();
           CheckOutputFile("--out", output, kStationExtensions, inputs);
           outputs.push_back(output);
         }
@@ -89,7 +91,7 @@ int RunClean(int argc, char** argv) {
             cleaned.push_back(result.stations[next]);
             const StationTransients& found = result.transients.stations[next];
             removed += found.transient_cells;
-            const std::string stem = fs::path(inputs[f]).stem().string();
+            const std::string stem = fs::path(StationOutputName(inputs[f])).stem().string();
             std::string mask_path;
             if (removed_masks) {
               mask_path =

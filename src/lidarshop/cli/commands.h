@@ -34,7 +34,7 @@ int RunImages(int argc, char** argv);     // recolor_commands.cc
 int RunAlign(int argc, char** argv);      // recolor_commands.cc
 int RunPhoto(int argc, char** argv);      // recolor_commands.cc
 int RunPoints(int argc, char** argv);     // points_command.cc
-int RunRegister(int argc, char** argv);   // points_command.cc
+int RunRegister(int argc, char** argv);   // register_command.cc
 int RunClean(int argc, char** argv);      // clean_command.cc
 int RunBatch(int argc, char** argv);      // batch_command.cc
 int RunServe(int argc, char** argv);      // serve_command.cc

@@ -15,6 +15,7 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
+#include "lidarshop/cli/scan_selector.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
@@ -211,9 +212,40 @@ void PrintWarnings(const std::vector<std::string>& warnings) {
   for (const std::string& warning : warnings) fmt::print(stderr, "lidarshop: warning: {}\n", warning);
 }
 
+ScanSelector SplitScanSelector(const std::string& path) {
+  std::error_code not_a_file;
+  const size_t hash = path.rfind('#');
+  if (hash == std::string::npos || hash == 0 || std::filesystem::exists(path, not_a_file)) return {path, -1};
+  const std::string digits = path.substr(hash + 1);
+  int index = -1;
+  const auto [end, error] = std::from_chars(digits.data(), digits.data() + digits.size(), index);
+  if (digits.empty() || error != std::errc() || end != digits.data() + digits.size() || index < 0) {
+    return {path, -1};
+  }
+  return {path.substr(0, hash), index};
+}
+
+std::string StationOutputName(const std::string& input) {
+  const ScanSelector selector = SplitScanSelector(input);
+  const std::filesystem::path path(selector.path);
+  if (selector.index < 0) return path.filename().string();
+  return fmt::format("{}_{}{}", path.stem().string(), selector.index, path.extension().string());
+}
+
 ScanFile ReadScanFileAndWarn(const std::string& path) {
-  ScanFile file = ReadScanFile(path);
+  const ScanSelector selector = SplitScanSelector(path);
+  if (selector.index >= 0) ProtectInput(selector.path);  // no output may replace FILE of FILE#N
+  ScanFile file = ReadScanFile(selector.path);
   PrintWarnings(file.warnings);
+  if (selector.index >= 0) {
+    if (selector.index >= static_cast<int>(file.scans.size())) {
+      throw OptionsError(fmt::format("{}: scan {} is out of range: {} holds {} scan(s), numbered from 0",
+                                     path, selector.index, selector.path, file.scans.size()));
+    }
+    std::vector<Scan> one = {std::move(file.scans[selector.index])};
+    file.scans = std::move(one);
+    file.path = path;
+  }
   return file;
 }
 

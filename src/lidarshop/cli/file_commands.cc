@@ -11,6 +11,7 @@
 #include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
+#include "lidarshop/cli/scan_selector.h"
 #include "lidarshop/image/colormap.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/formats.h"
@@ -196,10 +197,55 @@ std::string InfoSummary(const nlohmann::ordered_json& json) {
       points += scan["points"].get<int64_t>();
     }
   }
-  return fmt::format("{}: {} file, {} scan(s), {} points, {} image(s)", json.value("file", std::string()),
+  const size_t stations = json.value("stations", nlohmann::ordered_json::array()).size();
+  return fmt::format("{}: {} file, {} scan(s){}, {} points, {} image(s)", json.value("file", std::string()),
                      json.value("format_version", json.value("format", std::string())),
-                     json.value("scans", nlohmann::ordered_json::array()).size(), points,
+                     json.value("scans", nlohmann::ordered_json::array()).size(),
+                     stations > 0 ? fmt::format(" at {} stations", stations) : std::string(), points,
                      json.value("images", nlohmann::ordered_json::array()).size());
+}
+
+// A site's stations (several scans, each with its pose): index, name, position (world, metres) and heading
+// (degrees, the scanner's +y turned about the world z, positive to the left as rotate_deg's yaw); empty for a
+// file of one scan. From the scans' world_from_scanner (4 rows of 4) as `info` lists them.
+nlohmann::ordered_json StationsJson(const nlohmann::ordered_json& scans) {
+  nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+  if (!scans.is_array() || scans.size() < 2) return stations;
+  for (size_t i = 0; i < scans.size(); ++i) {
+    const nlohmann::ordered_json& scan = scans[i];
+    nlohmann::ordered_json station = {{"index", i}, {"name", scan.value("name", std::string())}};
+    const auto it = scan.find("world_from_scanner");
+    if (it != scan.end() && it->is_array() && it->size() == 4 && (*it)[0].is_array() &&
+        (*it)[0].size() == 4) {
+      const auto& m = *it;
+      auto at = [&](int r, int c) { return m[r][c].is_number() ? m[r][c].get<double>() : 0.0; };
+      station["position"] = {at(0, 3), at(1, 3), at(2, 3)};
+      // The scanner's forward axis (+y) in the world is the second column; yaw = atan2(-x, y).
+      station["heading_deg"] = std::atan2(-at(0, 1), at(1, 1)) * 180.0 / M_PI;
+    }
+    stations.push_back(station);
+  }
+  return stations;
+}
+
+// FILE#N given to `info`: only scan N of the listing (and its images); OptionsError when out of range.
+void KeepOnlyScan(const ScanSelector& selector, nlohmann::ordered_json* json) {
+  if (selector.index < 0) return;
+  nlohmann::ordered_json& scans = (*json)["scans"];
+  if (!scans.is_array() || selector.index >= static_cast<int>(scans.size())) {
+    throw OptionsError(fmt::format("{}#{}: scan {} is out of range: {} holds {} scan(s), numbered from 0",
+                                   selector.path, selector.index, selector.index, selector.path,
+                                   scans.is_array() ? scans.size() : 0));
+  }
+  scans = nlohmann::ordered_json::array({scans[selector.index]});
+}
+
+// `info`'s "stations" (several scans: StationsJson), then FILE#N's one scan (KeepOnlyScan).
+void AddStations(const ScanSelector& selector, nlohmann::ordered_json* json) {
+  nlohmann::ordered_json stations = StationsJson(json->value("scans", nlohmann::ordered_json::array()));
+  if (!stations.empty()) (*json)["stations"] = std::move(stations);
+  KeepOnlyScan(selector, json);
+  if (selector.index >= 0) json->erase("stations");
 }
 
 }  // namespace
@@ -214,7 +260,7 @@ int RunInfo(int argc, char** argv) {
       "info"};
   std::string path, json_path = "-";
   bool compact = false, stats = false;
-  app.add_option("file", path, "scan file")->required();
+  app.add_option("file", path, "scan file (FILE#N: scan N alone)")->required();
   AddJsonOption(app, &json_path);
   app.add_flag("--compact", compact, "write the JSON on one line");
   app.add_flag("--stats", stats,
@@ -222,15 +268,18 @@ int RunInfo(int argc, char** argv) {
                "statistics and the angular grid; whether each E57 image decodes");
   return RunCommand(app, argc, argv, [&] {
     CheckOutputFile("--json", json_path, {}, {path});
-    const std::string format = FileExtension(path);
+    const ScanSelector selector = SplitScanSelector(path);
+    const std::string& file_path = selector.path;
+    const std::string format = FileExtension(file_path);
     const bool headerless = format == "xyz" || format == "pts";
     ScanFileHeader header;
     if (!stats || !headerless) {
-      header = ReadScanHeader(path);
+      header = ReadScanHeader(file_path);
       if (!stats) PrintWarnings(header.warnings);
     }
     if (!stats) {
       nlohmann::ordered_json json = ToJson(header);
+      AddStations(selector, &json);
       RoundNumbers(&json);
       WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
       Summarize(InfoSummary(json));
@@ -239,17 +288,17 @@ int RunInfo(int argc, char** argv) {
     ScanFile file;
     std::vector<E57Image> images;
     if (format == "e57") {  // read once, keeping the photos
-      E57File e57 = ReadE57AndWarn(path);
-      file = {path, "e57", std::move(e57.scans), std::move(e57.warnings)};
+      E57File e57 = ReadE57AndWarn(file_path);
+      file = {file_path, "e57", std::move(e57.scans), std::move(e57.warnings)};
       images = std::move(e57.images);
     } else {
-      file = ReadScanFileAndWarn(path);
+      file = ReadScanFileAndWarn(file_path);
     }
     if (headerless) {
-      header.path = path;
+      header.path = file_path;
       header.format = format;
       header.format_version = format == "pts" ? "PTS" : "XYZ";
-      header.file_size_bytes = CheckRegularFile(path);
+      header.file_size_bytes = CheckRegularFile(file_path);
       for (const Scan& scan : file.scans) header.scans.push_back(ScanHeaderOf(scan));
     }
     nlohmann::ordered_json json = ToJson(header);
@@ -269,6 +318,7 @@ int RunInfo(int argc, char** argv) {
         MergeInto(decoded[i], &list[i], {"index", "name", "world_from_camera"});
       }
     }
+    AddStations(selector, &json);
     RoundNumbers(&json);
     WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
     Summarize(InfoSummary(json));

@@ -1,7 +1,8 @@
-// lidarshop points / register: the point-set toolbox over scans and clouds (pointset/*.h, docs/points.md).
+// lidarshop points: the point-set toolbox over scans and clouds (pointset/*.h, docs/points.md).
 //
 //   lidarshop points OPERATION IN... -o OUT [options] [--json FILE|-]
-//   lidarshop register FIXED MOVING -o OUT [--max-distance M] [--json FILE|-]
+//
+// (`register` is in register_command.cc.)
 //
 // Every input scan is taken in the world frame and the operation sees all of them as one cloud. Operations
 // that drop points (outliers, crop, sample) or label them (planes, cluster, kmeans) or give normals keep
@@ -24,7 +25,6 @@
 #include "lidarshop/cli/points_operations.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
-#include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/util/atomic_file.h"
@@ -296,72 +296,6 @@ int RunPoints(int argc, char** argv) {
         }
         WriteJsonOutput(json_path, CommandJson(UsedOptions(points, op, flags), summary));
         Summarize(PointsSummary(summary, output_path));
-        return 0;
-      },
-      &binder);
-}
-
-int RunRegister(int argc, char** argv) {
-  CLI::App app{
-      "Register MOVING onto FIXED by point-to-plane ICP from MOVING's pose (docs/points.md); writes MOVING "
-      "with its world_from_scanner corrected.",
-      "register"};
-  std::string fixed_path, moving_path, output_path, json_path;
-  IcpOptions options;
-  GlobalAlignOptions global;
-  bool use_global = false;
-  OptionBinder binder(app);
-  app.add_option("fixed", fixed_path, "the scan that stays (its first scan)")->required();
-  app.add_option("moving", moving_path, "the scan to move (its first scan)")->required();
-  app.add_option("-o,--output", output_path, "the moving scan with its new pose")->required();
-  AddJsonOption(app, &json_path);
-  binder.Bind(&options, {.flags = {{"max_correspondence_m", "--max-distance"},
-                                   {"min_correspondence_m", "--min-distance"},
-                                   {"max_iterations", "--iterations"}}});
-  app.add_flag("--global", use_global, "no usable pose: align FPFH features by RANSAC first")
-      ->group("Global alignment (--global)");
-  binder.Bind(&global, {.flags = {{"voxel_m", "--voxel"},
-                                  {"feature_radius_m", "--feature-radius"},
-                                  {"normal_radius_m", "--global-normal-radius"},
-                                  {"inlier_distance_m", "--global-inlier-distance"},
-                                  {"max_iterations", "--global-iterations"},
-                                  {"edge_ratio", "--global-edge-ratio"}},
-                        .group = "Global alignment (--global)",
-                        .prefix = "global"});
-  return RunCommand(
-      app, argc, argv,
-      [&]() {
-        binder.Validate(options);
-        if (use_global) {
-          try {
-            Validate(global);
-          } catch (const OptionsFieldError& error) {
-            throw OptionsFieldError("global." + error.key_path(), error.reason());
-          }
-        }
-        CheckOutputs(output_path, json_path, {fixed_path, moving_path});
-        const Timer timer;
-        const ScanFile fixed = ReadScanFileAndWarn(fixed_path), moving = ReadScanFileAndWarn(moving_path);
-        if (fixed.scans.empty() || moving.scans.empty()) throw InputError("register: an input holds no scan");
-        const ScanRegistration result =
-            RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
-        WriteScanFile(output_path, {result.registered});
-        std::vector<std::vector<double>> rows;
-        for (int r = 0; r < 4; ++r) {
-          rows.push_back(
-              {result.registered.world_from_scanner(r, 0), result.registered.world_from_scanner(r, 1),
-               result.registered.world_from_scanner(r, 2), result.registered.world_from_scanner(r, 3)});
-        }
-        nlohmann::ordered_json json = {
-            {"world_from_scanner", rows},        {"rms_m", result.icp.rms_m},
-            {"fitness", result.icp.fitness},     {"iterations", result.icp.iterations},
-            {"converged", result.icp.converged}, {"seconds", timer.Seconds()}};
-        if (use_global) json["global_options"] = ToJson(global);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-        Summarize(fmt::format("{} registered onto {}: RMS {:.4f} m, fitness {:.3f}, {} iterations{} -> {}",
-                              moving_path, fixed_path, result.icp.rms_m, result.icp.fitness,
-                              result.icp.iterations, result.icp.converged ? "" : " (not converged)",
-                              output_path));
         return 0;
       },
       &binder);

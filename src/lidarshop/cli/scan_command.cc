@@ -7,6 +7,11 @@
 // the counts and the seconds of each stage (--stats = --json -). Scanner flags (--rows, --seed, ...) override
 // the scene's "scanner" entries. --photos (E57 output only) writes the station's own photos into the file's
 // images2D (scanner/station_photos.h).
+//
+// A site (scene "stations", docs/stations.md): every station is scanned with the objects there (at_stations)
+// and written into OUT in order (E57: one data3D per station named station0, station1, ... with its pose;
+// PTX: the scans in order), or with --split into OUT's stem + _N; --labels L.png and --mesh M.ply write L_N.png
+// and M_N.ply per station.
 #include <filesystem>
 #include <optional>
 
@@ -43,6 +48,49 @@ std::string ColorLabelsPath(const std::string& labels_path) {
   return (path.parent_path() / (path.stem().string() + "_color.png")).string();
 }
 
+// The name of station i's data3D entry / PTX scan in a site's file.
+std::string StationName(int station) { return fmt::format("station{}", station); }
+
+// OUT.ext -> OUT_N.ext: station N's file of a split site, labels or mesh.
+std::string StationPath(const std::string& path, int station) {
+  const std::filesystem::path p(path);
+  return (p.parent_path() / fmt::format("{}_{}{}", p.stem().string(), station, p.extension().string()))
+      .string();
+}
+
+// Refuses, before any scanning, outputs that would overwrite each other or an input, and a site of several
+// stations into a format that holds one scan (PCD) without --split.
+void CheckStationOutputs(bool site, bool split, int num_stations, const std::string& output_path,
+                         const std::string& labels_path, const std::string& mesh_path,
+                         const std::string& scene_path) {
+  if (!site) return;
+  if (!split && num_stations > 1) {
+    const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
+    if (format != nullptr && format->scans == ScansPerFile::kOne) {
+      throw OptionsError(
+          fmt::format("{} holds one scan and the scene has {} stations: give --split (one file "
+                      "per station) or write {}",
+                      output_path, num_stations, FormatNamesWhere([](const ScanFormatInfo& f) {
+                        return f.write && f.scans == ScansPerFile::kSeveral;
+                      })));
+    }
+  }
+  std::vector<std::string> written = {scene_path};
+  auto add = [&](const std::string& path) {
+    CheckOutputPath(path, written);
+    written.push_back(path);
+  };
+  if (!split) add(output_path);
+  for (int i = 0; i < num_stations; ++i) {
+    if (split) add(StationPath(output_path, i));
+    if (!labels_path.empty()) {
+      add(StationPath(labels_path, i));
+      add(ColorLabelsPath(StationPath(labels_path, i)));  // L_N_color.png beside L_N.png
+    }
+    if (!mesh_path.empty()) add(StationPath(mesh_path, i));
+  }
+}
+
 }  // namespace
 
 int RunScan(int argc, char** argv) {
@@ -51,7 +99,7 @@ int RunScan(int argc, char** argv) {
   std::string scene_path, output_path, labels_path, mesh_path, json_path, write_scene_path;
   std::optional<uint64_t> random_seed;
   int threads = 0;
-  bool stats = false, quiet = false;
+  bool stats = false, quiet = false, split = false;
   // The scanner flags override the scene file's "scanner": only the ones given are applied.
   ScannerOptions scanner_overrides;
   ScanMeshOptions mesh_options;
@@ -70,6 +118,10 @@ int RunScan(int argc, char** argv) {
       "--labels", labels_path,
       "per-ray object labels as a 16-bit single-channel PNG (65535 where the ray returned nothing); their "
       "colour picture with the objects' names goes beside it (L.png -> L_color.png)");
+  app.add_flag(
+      "--split", split,
+      "a site (scene \"stations\"): one file per station, OUT's stem + _N (site_0.ptx, site_1.ptx, ...) "
+      "instead of every station in OUT (E57: one data3D per station, PTX: the scans in order)");
   app.add_option("--mesh", mesh_path, "triangle mesh of the scan (.ply): adjacent returns joined");
   AddJsonOption(app, &json_path);
   app.add_flag("--stats", stats, "= --json -: counts and seconds per stage as one JSON object on stdout");
@@ -128,90 +180,169 @@ int RunScan(int argc, char** argv) {
         } else {
           scene = LoadSceneOrBuiltin(scene_path);
         }
-        StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &scene.scanner);
-        scene.scanner.Check();
+        // One scene per station (a one-station scene is its own station 0): the flags override every
+        // station's scanner.
+        const int num_stations = scene.NumStations();
+        // A site: several stations, or --split (one file per station, also of a one-station scene).
+        const bool site = !scene.stations.empty() || split;
+        CheckStationOutputs(site, split, num_stations, output_path, labels_path, mesh_path, scene_path);
+        std::vector<SceneDescription> station_scenes;
+        for (int i = 0; i < num_stations; ++i) {
+          station_scenes.push_back(site ? SceneAtStation(scene, i) : scene);
+          StructFromJson(InfoOf<ScannerOptions>(), binder.Given(), &station_scenes.back().scanner);
+          station_scenes.back().scanner.Check();
+        }
         const double loading_seconds = stage.Seconds();
 
-        stage.Restart();
-        const SyntheticScanner scanner(scene);
-        const double building_seconds = stage.Seconds();
-
-        stage.Restart();
+        double building_seconds = 0, scanning_seconds = 0, photo_seconds = 0;
         ScanStats scan_stats;
-        Scan scan;
-        {
-          auto progress = Progress::ForTerminal("scanning", scene.scanner.rows, quiet);
-          scan = scanner.Acquire(scene.scanner, progress.get(), &scan_stats);
-          progress->Finish();
-        }
-        const double scanning_seconds = stage.Seconds();
-
-        std::vector<StationPhoto> photos;
-        double photo_seconds = 0;
-        if (!photos_kind.empty()) {
+        int64_t triangles = 0;
+        std::vector<Scan> scans(num_stations);
+        std::vector<std::vector<StationPhoto>> photos(num_stations);
+        std::vector<ScanStats> station_stats(num_stations);
+        std::optional<SyntheticScanner> scanner;
+        for (int i = 0; i < num_stations; ++i) {
+          const SceneDescription& station = station_scenes[i];
+          // Stations that see the same objects share one ray-casting scene.
+          const bool same_objects = i > 0 && station.objects.size() == station_scenes[i - 1].objects.size();
+          if (!same_objects) {
+            stage.Restart();
+            scanner.emplace(station);
+            building_seconds += stage.Seconds();
+            triangles = std::max(triangles, scanner->num_triangles());
+          }
           stage.Restart();
-          StationPhotoOptions photo_options;
-          photo_options.kind = photos_kind == "cube" ? StationPhotoKind::kCube : StationPhotoKind::kSphere;
-          photo_options.size_px = photo_size_px;
-          photo_options.seed = scene.scanner.seed;
-          photos = RenderStationPhotos(scene, scene.scanner, photo_options);
-          photo_seconds = stage.Seconds();
+          {
+            auto progress =
+                Progress::ForTerminal(site ? fmt::format("scanning station {}", i) : std::string("scanning"),
+                                      station.scanner.rows, quiet);
+            scans[i] = scanner->Acquire(station.scanner, progress.get(), &station_stats[i]);
+            progress->Finish();
+          }
+          if (site) scans[i].name = StationName(i);
+          scanning_seconds += stage.Seconds();
+          scan_stats.rays += station_stats[i].rays;
+          scan_stats.returns += station_stats[i].returns;
+          scan_stats.cast_seconds += station_stats[i].cast_seconds;
+          scan_stats.shade_seconds += station_stats[i].shade_seconds;
+          if (!photos_kind.empty()) {
+            stage.Restart();
+            StationPhotoOptions photo_options;
+            photo_options.kind = photos_kind == "cube" ? StationPhotoKind::kCube : StationPhotoKind::kSphere;
+            photo_options.size_px = photo_size_px;
+            photo_options.seed = station.scanner.seed;
+            photos[i] = RenderStationPhotos(station, station.scanner, photo_options);
+            photo_seconds += stage.Seconds();
+          }
         }
 
+        // Where each station goes: all into OUT, or (--split) OUT's stem + _N; the same for labels and mesh.
+        auto station_path = [&](const std::string& path, int i) {
+          return site ? StationPath(path, i) : path;
+        };
         stage.Restart();
-        if (photos.empty()) {
-          WriteScanFile(output_path, {scan});
+        if (!site || !split) {
+          std::vector<E57Image> images;
+          for (int i = 0; i < num_stations; ++i) {
+            const std::vector<E57Image> station_images = StationPhotosToE57(photos[i], i);
+            images.insert(images.end(), station_images.begin(), station_images.end());
+          }
+          if (photos_kind.empty()) {
+            WriteScanFile(output_path, scans);
+          } else {
+            WriteE57(output_path, scans, images, E57WriteOptions{});
+          }
         } else {
-          WriteE57(output_path, {scan}, StationPhotosToE57(photos), E57WriteOptions{});
+          for (int i = 0; i < num_stations; ++i) {
+            if (photos_kind.empty()) {
+              WriteScanFile(station_path(output_path, i), {scans[i]});
+            } else {
+              WriteE57(station_path(output_path, i), {scans[i]}, StationPhotosToE57(photos[i], 0),
+                       E57WriteOptions{});
+            }
+          }
         }
         const double writing_scan_seconds = stage.Seconds();
         double writing_labels_seconds = 0, meshing_seconds = 0, writing_mesh_seconds = 0;
         int64_t mesh_triangles = 0;
-        if (!labels_path.empty()) {
-          stage.Restart();
-          WriteImage(labels_path, LabelImage16(scan));
-          // One pixel per ray like the raw image, so the two overlay; the legend names the objects.
-          RenderOptions colors;
-          colors.channel = RenderChannel::kLabels;
-          colors.legend = true;
-          colors.label_names = ObjectNamesByLabel(scene);
-          WriteImage(labels_color_path, RenderScan(scan, colors).image);
-          writing_labels_seconds = stage.Seconds();
+        for (int i = 0; i < num_stations; ++i) {
+          const Scan& scan = scans[i];
+          if (!labels_path.empty()) {
+            stage.Restart();
+            WriteImage(station_path(labels_path, i), LabelImage16(scan));
+            // One pixel per ray like the raw image, so the two overlay; the legend names the objects.
+            RenderOptions colors;
+            colors.channel = RenderChannel::kLabels;
+            colors.legend = true;
+            colors.label_names = ObjectNamesByLabel(scene);
+            WriteImage(site ? ColorLabelsPath(StationPath(labels_path, i)) : labels_color_path,
+                       RenderScan(scan, colors).image);
+            writing_labels_seconds += stage.Seconds();
+          }
+          if (!mesh_path.empty()) {
+            stage.Restart();
+            const TriangleMesh mesh = ScanToMesh(scan, mesh_options);
+            mesh_triangles += static_cast<int64_t>(mesh.triangles.size());
+            meshing_seconds += stage.Seconds();
+            stage.Restart();
+            WriteMesh(station_path(mesh_path, i), mesh);
+            writing_mesh_seconds += stage.Seconds();
+          }
         }
-        if (!mesh_path.empty()) {
-          stage.Restart();
-          const TriangleMesh mesh = ScanToMesh(scan, mesh_options);
-          mesh_triangles = static_cast<int64_t>(mesh.triangles.size());
-          meshing_seconds = stage.Seconds();
-          stage.Restart();
-          WriteMesh(mesh_path, mesh);
-          writing_mesh_seconds = stage.Seconds();
-        }
+        const Scan& scan = scans[0];
+        size_t num_photos = 0;
+        for (const auto& station_photos : photos) num_photos += station_photos.size();
         if (!json_path.empty()) {
           nlohmann::ordered_json json;
           json["scene"] = scene_path;
           json["output"] = output_path;
-          if (!labels_path.empty()) {
+          if (!labels_path.empty() && !site) {  // a site's are per station, under "stations"
             json["labels"] = labels_path;
             json["labels_color"] = labels_color_path;
           }
           if (!write_scene_path.empty()) json["scene_file"] = write_scene_path;
           if (scene.target_label >= 0) json["target_label"] = scene.target_label;
           json["objects"] = scene.objects.size();
-          json["triangles"] = scanner.num_triangles();
+          json["triangles"] = triangles;
           json["rows"] = scan.rows;
           json["columns"] = scan.cols;
           json["rays"] = scan_stats.rays;
           json["returns"] = scan_stats.returns;
           json["mesh_triangles"] = mesh_triangles;
-          if (!photos.empty()) {
+          if (site) {
             nlohmann::ordered_json list = nlohmann::ordered_json::array();
-            for (const StationPhoto& photo : photos) {
-              list.push_back({{"name", photo.name},
-                              {"model", CameraModelName(photo.camera.model)},
-                              {"width_px", photo.image.cols},
-                              {"height_px", photo.image.rows},
-                              {"gain", photo.gain}});
+            for (int i = 0; i < num_stations; ++i) {
+              const Eigen::Vector3d& position = station_scenes[i].scanner.position;
+              nlohmann::ordered_json entry = {{"index", i},
+                                              {"name", scans[i].name},
+                                              {"position", {position.x(), position.y(), position.z()}},
+                                              {"objects", station_scenes[i].objects.size()},
+                                              {"rows", scans[i].rows},
+                                              {"columns", scans[i].cols},
+                                              {"rays", station_stats[i].rays},
+                                              {"returns", station_stats[i].returns}};
+              if (split) entry["output"] = station_path(output_path, i);
+              if (!labels_path.empty()) {
+                entry["labels"] = station_path(labels_path, i);
+                entry["labels_color"] = ColorLabelsPath(station_path(labels_path, i));
+              }
+              if (!mesh_path.empty()) entry["mesh"] = station_path(mesh_path, i);
+              list.push_back(entry);
+            }
+            json["stations"] = list;
+          }
+          if (num_photos > 0) {
+            nlohmann::ordered_json list = nlohmann::ordered_json::array();
+            for (int i = 0; i < num_stations; ++i) {
+              for (const StationPhoto& photo : photos[i]) {
+                nlohmann::ordered_json entry = {{"name", photo.name},
+                                                {"model", CameraModelName(photo.camera.model)},
+                                                {"width_px", photo.image.cols},
+                                                {"height_px", photo.image.rows},
+                                                {"gain", photo.gain}};
+                if (site) entry["station"] = i;
+                list.push_back(entry);
+              }
             }
             json["photos"] = list;
           }
@@ -231,11 +362,13 @@ int RunScan(int argc, char** argv) {
               {"total", total.Seconds()}};
           json["rays_per_second"] = scan_stats.rays / std::max(1e-9, scanning_seconds);
           if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
-          WriteJsonOutput(json_path, CommandJson(ToJson(scene.scanner), json));
+          WriteJsonOutput(json_path, CommandJson(ToJson(station_scenes[0].scanner), json));
         }
-        Summarize(fmt::format(
-            "{} x {} scan, {} returns of {} rays{} -> {}", scan.rows, scan.cols, scan_stats.returns,
-            scan_stats.rays, photos.empty() ? "" : fmt::format(", {} photo(s)", photos.size()), output_path));
+        Summarize(fmt::format("{}{} x {} scan{}, {} returns of {} rays{} -> {}",
+                              site ? fmt::format("{} stations: ", num_stations) : std::string(), scan.rows,
+                              scan.cols, site ? "s" : "", scan_stats.returns, scan_stats.rays,
+                              num_photos == 0 ? "" : fmt::format(", {} photo(s)", num_photos),
+                              site && split ? station_path(output_path, 0) + " ..." : output_path));
         return 0;
       },
       &binder);

@@ -8,6 +8,7 @@
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/site_registration.h"
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/util/options.h"
@@ -60,6 +61,43 @@ const StructInfo& InfoOf<IcpOptions>() {
         throw OptionsFieldError("min_correspondence_m", "is above max_correspondence_m");
       }
     });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SiteRegistrationOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<SiteRegistrationOptions> b("SiteRegistrationOptions",
+                                             "registration of a whole site (pose graph over station pairs)");
+    b.Field(&SiteRegistrationOptions::max_moving_points, "max_moving_points",
+            "points of a station moved onto another, at most")
+        .Min(1);
+    b.Field(&SiteRegistrationOptions::max_fixed_points, "max_fixed_points",
+            "points of a station others are moved onto, at most")
+        .Min(1);
+    b.Field(&SiteRegistrationOptions::overlap_distance_m, "overlap_distance_m",
+            "two stations overlap where their points lie this close at the poses given")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&SiteRegistrationOptions::min_overlap, "min_overlap",
+            "share of a station's points near another's for the two to be a pair")
+        .Range(0, 1);
+    b.Field(&SiteRegistrationOptions::coarse_correspondence_m, "coarse_correspondence_m",
+            "ICP pairing distance of the coarse pass (the poses' error)")
+        .Unit("m")
+        .AboveZero();
+    b.Field(&SiteRegistrationOptions::min_fitness, "min_fitness",
+            "a pair whose ICP matches less of its points is left out of the graph")
+        .Range(0, 1);
+    b.Field(&SiteRegistrationOptions::graph_iterations, "graph_iterations",
+            "Gauss-Newton steps of the pose graph at most")
+        .Min(1);
+    b.Field(&SiteRegistrationOptions::rotation_scale_m, "rotation_scale_m",
+            "metres per radian of rotation error in the graph")
+        .Unit("m")
+        .AboveZero();
     return b.Build();
   }();
   return info;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -167,9 +168,10 @@ ScannerOptions ParseScanner(const Fields& fields) {
 }
 
 const std::set<std::string> kObjectKeys = {
-    "primitive", "mesh",          "name",  "size",         "radius",         "height", "segments",
-    "translate", "rotate_deg",    "scale", "matrix",       "label",          "color",  "reflectivity",
-    "texture",   "texture_scale", "style", "subdivisions", "wheel_segments", "floors", "windows_per_floor"};
+    "primitive",  "mesh",          "name",  "size",         "radius",         "height", "segments",
+    "translate",  "rotate_deg",    "scale", "matrix",       "label",          "color",  "reflectivity",
+    "texture",    "texture_scale", "style", "subdivisions", "wheel_segments", "floors", "windows_per_floor",
+    "at_stations"};
 
 // Primitive meshes from the object's fields; `color_used` is set when the primitive bakes "color" into its
 // own triangle colours (composite objects).
@@ -304,10 +306,36 @@ TriangleMesh MakePrimitiveMesh(const std::string& primitive, const Fields& field
                           primitive));
 }
 
+// "at_stations": distinct station indices in [0, num_stations), at least one.
+std::vector<int> ParseAtStations(const Fields& fields, int num_stations) {
+  if (!fields.Has("at_stations")) return {};
+  const json& value = fields.Get("at_stations");
+  if (!value.is_array() || value.empty()) {
+    fields.Fail("at_stations",
+                fmt::format("expected a non-empty array of station indices, got {}", value.dump()));
+  }
+  std::vector<int> stations;
+  for (const json& item : value) {
+    if (!item.is_number_integer() || item.get<int64_t>() < 0 || item.get<int64_t>() >= num_stations) {
+      fields.Fail("at_stations",
+                  fmt::format("expected station indices in [0, {}] (the scene has {} station(s)), "
+                              "got {}",
+                              num_stations - 1, num_stations, item.dump()));
+    }
+    const int station = item.get<int>();
+    if (std::find(stations.begin(), stations.end(), station) != stations.end())
+      fields.Fail("at_stations", fmt::format("station {} is listed twice", station));
+    stations.push_back(station);
+  }
+  std::sort(stations.begin(), stations.end());
+  return stations;
+}
+
 SceneObject ParseObject(const Fields& fields, size_t index, const std::string& base_dir,
-                        int64_t* scene_triangles, std::vector<std::string>* warnings) {
+                        int64_t* scene_triangles, std::vector<std::string>* warnings, int num_stations) {
   fields.CheckKeys(kObjectKeys);
   SceneObject object;
+  object.at_stations = ParseAtStations(fields, num_stations);
   object.name = fields.String("name", fmt::format("objects[{}]", index));
   const bool has_primitive = fields.Has("primitive"), has_mesh = fields.Has("mesh");
   if (has_primitive == has_mesh) fields.Fail("primitive", "give exactly one of 'primitive' and 'mesh'");
@@ -409,6 +437,29 @@ ScanGrid ScannerOptions::Grid() const {
                      elevation_max_deg * kRad);
 }
 
+bool SceneObject::AtStation(int station) const {
+  return at_stations.empty() ||
+         std::find(at_stations.begin(), at_stations.end(), station) != at_stations.end();
+}
+
+int SceneDescription::NumStations() const { return stations.empty() ? 1 : static_cast<int>(stations.size()); }
+
+SceneDescription SceneAtStation(const SceneDescription& scene, int station) {
+  if (station < 0 || station >= scene.NumStations()) {
+    throw std::out_of_range(
+        fmt::format("SceneAtStation: station {} of a scene of {} station(s)", station, scene.NumStations()));
+  }
+  SceneDescription out;
+  out.scanner = scene.stations.empty() ? scene.scanner : scene.stations[station];
+  out.path = scene.path;
+  out.target_label = scene.target_label;
+  out.warnings = scene.warnings;
+  for (const SceneObject& object : scene.objects) {
+    if (object.AtStation(station)) out.objects.push_back(object);
+  }
+  return out;
+}
+
 int64_t SceneDescription::NumTriangles() const {
   int64_t total = 0;
   for (const auto& object : objects) total += static_cast<int64_t>(object.mesh.triangles.size());
@@ -431,10 +482,26 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
     ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", error.what()));
   }
   Fields top(root, what, "");
-  top.CheckKeys({"scanner", "objects", "name", "description", "target_label"});
+  top.CheckKeys({"scanner", "stations", "objects", "name", "description", "target_label"});
   SceneDescription scene;
   scene.target_label = static_cast<int32_t>(top.Integer("target_label", -1, 0, 65534));
+  if (top.Has("scanner") && top.Has("stations"))
+    top.Fail("stations", "give either 'scanner' (one station) or 'stations' (a site), not both");
   if (top.Has("scanner")) scene.scanner = ParseScanner(Fields(top.Get("scanner"), what, "scanner"));
+  if (top.Has("stations")) {
+    const json& stations = top.Get("stations");
+    // A site of a few to hundreds of set-ups; each station is a full scan, so this bounds no real survey.
+    constexpr size_t kMaxStations = 1024;
+    if (!stations.is_array() || stations.empty() || stations.size() > kMaxStations) {
+      top.Fail("stations", fmt::format("expected an array of 1 to {} scanners, got {}", kMaxStations,
+                                       stations.is_array() ? fmt::format("{} entries", stations.size())
+                                                           : TypeName(stations)));
+    }
+    for (size_t i = 0; i < stations.size(); ++i) {
+      scene.stations.push_back(ParseScanner(Fields(stations[i], what, fmt::format("stations[{}]", i))));
+    }
+    scene.scanner = scene.stations[0];
+  }
   if (!top.Has("objects")) top.Fail("objects", "missing (a list of objects)");
   const json& objects = top.Get("objects");
   if (!objects.is_array()) top.Fail("objects", fmt::format("expected an array, got {}", TypeName(objects)));
@@ -449,7 +516,7 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
   int64_t scene_triangles = 0;
   for (size_t i = 0; i < objects.size(); ++i) {
     scene.objects.push_back(ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir,
-                                        &scene_triangles, &scene.warnings));
+                                        &scene_triangles, &scene.warnings, scene.NumStations()));
   }
   if (scene.target_label >= 0 &&
       std::none_of(scene.objects.begin(), scene.objects.end(),

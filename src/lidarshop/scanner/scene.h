@@ -11,6 +11,11 @@
 // Transforms: an object is scaled, then rotated (R = Rz * Ry * Rx of `rotate_deg` = [x, y, z] degrees about
 // fixed axes), then translated; or given as a 4x4 `matrix` (row-major rows). The scanner's `rotate_deg`
 // orients its frame (z up, y forward, x right) in the world the same way; `position` is its world origin.
+//
+// A site of several stations (docs/stations.md) gives `"stations": [SCANNER, SCANNER, ...]` (each with the
+// fields of "scanner") in place of "scanner"; an object may carry `"at_stations": [0, 2]` (default: every
+// station), e.g. a car that left between two set-ups. SceneAtStation() gives the one-station scene a station
+// sees.
 #pragma once
 
 #include <cstdint>
@@ -79,10 +84,19 @@ struct SceneObject {
   Eigen::Matrix4d world_from_object = Eigen::Matrix4d::Identity();
   int32_t label = 0;  // in [0, 65534] (65535 marks no return in label PNGs)
   Material material;
+  // "at_stations": the stations (indices into SceneDescription::stations) where the object is there; empty =
+  // every station.
+  std::vector<int> at_stations;
+
+  bool AtStation(int station) const;
 };
 
 struct SceneDescription {
+  // The scanner of a one-station scene; with "stations", a copy of stations[0] (so that code that scans one
+  // station sees the first).
   ScannerOptions scanner;
+  // "stations": every station of a site, in order; empty for a scene with one "scanner" (NumStations() = 1).
+  std::vector<ScannerOptions> stations;
   std::vector<SceneObject> objects;
   std::string path;  // the file it was read from ("" when built in code)
   // The object an evaluation strokes or removes (scene key "target_label"): every object with this label;
@@ -93,7 +107,13 @@ struct SceneDescription {
   std::vector<std::string> warnings;
 
   int64_t NumTriangles() const;
+  // The number of stations: stations.size(), or 1 for a scene with one "scanner".
+  int NumStations() const;
 };
+
+// The one-station scene that station `station` (in [0, NumStations())) sees: its scanner, the objects there
+// (at_stations), no `stations`. Throws std::out_of_range for a station the scene does not have.
+SceneDescription SceneAtStation(const SceneDescription& scene, int station);
 
 // Reads a scene file. Throws InputError naming the file and the field ("parking_lot.json: objects[2]: field
 // 'radius': expected a number > 0, got -1"; unknown keys, missing mesh files and bad types included).

@@ -93,11 +93,20 @@ TEST(CutChecksTest, ACutThatLeaksIntoGroundOfTheObjectsColourIsReported) {
   const cv::Point centre(box.x + box.width / 2, box.y + box.height / 2);
   cv::line(strokes, centre - cv::Point(3, 0), centre + cv::Point(3, 0), cv::Scalar(kStrokeObject), 2);
   cv::line(strokes, cv::Point(10, 30), cv::Point(40, 30), cv::Scalar(kStrokeBackground), 2);  // the wall
-  const SegmentResult result = SegmentObject(scan, strokes, SegmentOptions());
+  SegmentOptions kept;
+  kept.contain_leaks = false;  // the cut as the colour cut left it
+  const SegmentResult result = SegmentObject(scan, strokes, kept);
   ASSERT_GT(result.object_cells, 3 * cv::countNonZero(truth)) << "the constructed cut did not leak";
   ASSERT_EQ(result.warnings.size(), 2u);
   EXPECT_NE(result.warnings[0].find("times that part"), std::string::npos) << result.warnings[0];
   EXPECT_NE(result.warnings[1].find("borders"), std::string::npos) << result.warnings[1];
+  // By default (SegmentOptions::contain_leaks) the leak is contained: the part the strokes lie on is the cut,
+  // and the one warning says so.
+  const SegmentResult contained = SegmentObject(scan, strokes, SegmentOptions());
+  const MaskScores scores = ScoreMask(contained.mask, truth, scan.valid);
+  EXPECT_GT(scores.iou, 0.9) << "precision " << scores.precision << " recall " << scores.recall;
+  ASSERT_EQ(contained.warnings.size(), 1u);
+  EXPECT_NE(contained.warnings[0].find("leaked"), std::string::npos) << contained.warnings[0];
 }
 
 // The evaluation scenes' cuts are right (IoU 0.997 over three stroke seeds): none of them is reported. The

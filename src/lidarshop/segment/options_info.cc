@@ -95,6 +95,12 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "an overhang meets the object along at most this fraction of its outline")
         .Min(0)
         .Max(1);
+    b.Field(&WholeObjectOptions::join_steps, "join_steps",
+            "a closed part across a depth step, touching the object in space, joins it (a post under a box)");
+    b.Field(&WholeObjectOptions::join_max_gap_m, "join_max_gap_m",
+            "... when its cell next to the object lies this close to the object's in space")
+        .Unit("m")
+        .Min(0);
     b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
             "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
     b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",
@@ -173,6 +179,8 @@ const StructInfo& InfoOf<SegmentOptions>() {
         .AboveZero();
     b.Field(&SegmentOptions::grow_whole_object, "grow_whole_object",
             "two-step: parts continuous in depth and orientation with the cut join it");
+    b.Field(&SegmentOptions::contain_leaks, "contain_leaks",
+            "two-step: a cut far past the part its object strokes lie on leaked; that part is taken instead");
     b.Field(&SegmentOptions::whole_object, "whole_object", "the whole-object growth");
     b.Field(&SegmentOptions::include_enclosed_no_return, "include_enclosed_no_return",
             "cells without a return enclosed by the object join the mask");

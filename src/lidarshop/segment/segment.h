@@ -105,6 +105,13 @@ struct WholeObjectOptions {
   // its post, with the stroke on the post).
   bool join_overhangs = true;
   double overhang_max_contact = 0.5;  // ... and meeting the object along at most this fraction of its outline
+  // Parts across a depth step: a part next to the object in the grid behind it across a depth step, its cell
+  // there within join_max_gap_m of the object's in space, that is closed (continued in depth and orientation
+  // by nothing but the support planes it stands on and creases, within the growth's budget) joins it: the post
+  // under a box that overhangs it, table legs under the top. (Not parts in front: a crate before a post's foot
+  // occludes it, a lower crate before the box it carries holds it, and one view does not tell them apart.)
+  bool join_steps = true;
+  double join_max_gap_m = 0.35;  // metres
   // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
   // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
   // and the growth does not enter them.
@@ -181,6 +188,11 @@ struct SegmentOptions {
   bool include_enclosed_no_return = true;
   // Two-step: parts continuous in depth and orientation with the cut join it (GrowWholeObject).
   bool grow_whole_object = true;
+  // Two-step: a cut that adds more than kCutGrowthLimit (cut_checks.h) times the part its object strokes lie
+  // on beyond it leaked (the colour cut took the façade or the road of the object's colour); that part (step
+  // 1's stroked parts grown over depth and orientation, the object as its geometry outlines it) is taken
+  // instead, and a warning says so.
+  bool contain_leaks = true;
   WholeObjectOptions whole_object;
 
   void Check() const;  // throws OptionsFieldError naming the field

@@ -301,9 +301,6 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       break;
     }
   }
-  if (o.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
-  result.object_cells = cv::countNonZero(result.mask);
-  result.graph_nodes = s.last.num_local(s.nodes.num());
   // The part of the object the strokes lie on, which the cut is checked against (and Refine's too).
   s.stroked_part = cv::Mat();
   if (o.method == SegmentMethod::kTwoStep) {
@@ -317,8 +314,29 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
     WholeObjectOptions unbounded = o.whole_object;  // no growth is a leak here: the image bounds it
     unbounded.max_growth = static_cast<double>(s.scan.num_cells()) / std::max(1, cv::countNonZero(stroked));
     s.stroked_part = GrowWholeObject(s.scan, stroked, barrier, unbounded);
+    // A cut far larger than that part leaked (the colour cut took a façade or the ground of the object's
+    // colour): the part, the object as its geometry outlines it, is the answer.
+    const int64_t part_cells = cv::countNonZero(s.stroked_part);
+    // (Both checks: a cut far past a small stroked part that stays inside the picture is usually right, the
+    // depth cut having found only a piece of the object: a bin at 2 m.)
+    if (o.contain_leaks && part_cells > 0 &&
+        static_cast<double>(cv::countNonZero(result.mask & ~s.stroked_part)) >
+            kCutGrowthLimit * static_cast<double>(part_cells) &&
+        CheckCut(result.mask, cv::Mat(), WrapsInAzimuth(s.scan)).size() == 1) {
+      result.warnings.push_back(fmt::format(
+          "the colour cut took {} cells, far past the {} cells of the part the object strokes lie on: it "
+          "leaked, and that part is the cut",
+          cv::countNonZero(result.mask), part_cells));
+      result.mask = s.stroked_part.clone();
+    }
   }
-  result.warnings = CheckCut(result.mask, s.stroked_part, WrapsInAzimuth(s.scan));
+  if (o.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
+  result.object_cells = cv::countNonZero(result.mask);
+  result.graph_nodes = s.last.num_local(s.nodes.num());
+  {
+    std::vector<std::string> checks = CheckCut(result.mask, s.stroked_part, WrapsInAzimuth(s.scan));
+    result.warnings.insert(result.warnings.end(), checks.begin(), checks.end());
+  }
   result.timings.total_s = total.Seconds() + result.timings.features_s;
   s.last_result = result;
   s.ran = true;

@@ -56,8 +56,10 @@ int CountOnPlane(const Scan& scan, const cv::Mat& cells_mask, const cv::Rect& bo
 // in a band around the object, kept when a quarter of their band cells lie outside the object's bounding box
 // (a face of a missed part lies within it; the ground, a table or a wall runs beyond it).
 // `classify` (CV_8U, may be empty = every cell of the region outside the mask): the cells to classify.
+// `max_points` (0 = all): the planes are fitted to at most about this many band cells (a fixed stride).
 cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& region, const cv::Mat& normal,
-                     const WholeObjectOptions& options, const cv::Mat& classify = cv::Mat()) {
+                     const WholeObjectOptions& options, const cv::Mat& classify = cv::Mat(),
+                     size_t max_points = 0) {
   cv::Mat band;
   cv::dilate(mask, band, cv::Mat(), cv::Point(-1, -1), options.support_band_cells);
   band &= ~mask;
@@ -67,6 +69,12 @@ cv::Mat SupportCells(const Scan& scan, const cv::Mat& mask, const cv::Rect& regi
   cv::findNonZero(band(region), cells);
   cv::Mat support = cv::Mat::zeros(mask.size(), CV_8U);
   if (cells.size() < 50) return support;
+  if (max_points > 0 && cells.size() > max_points) {
+    const size_t stride = (cells.size() + max_points - 1) / max_points;
+    std::vector<cv::Point> sample;
+    for (size_t i = 0; i < cells.size(); i += stride) sample.push_back(cells[i]);
+    cells = std::move(sample);
+  }
   for (cv::Point& cell : cells) {
     cell += region.tl();
     const cv::Vec3f& p = scan.point.at<cv::Vec3f>(cell);
@@ -175,6 +183,77 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
   return {};
 }
 
+// A part across a depth step (segment.h WholeObjectOptions::join_steps): from a cell next to the object in the
+// grid, behind it across a depth step, but whose point lies within max_gap_m of the object's cell in space (a
+// post under the box it holds, seen past the box's overhanging front; table legs under the top's edge), the cells `continues(p, q)` joins to it. The part is one of the object's when it is closed: it
+// meets nothing that continues it in depth and orientation but that it may not take (a barrier, a part
+// already turned down, the region's edge), and has at most max_cells cells. `enter(grown, q)`: a
+// cell the part may take; `support(q)`: a cell of the support planes. Returns the cells of the first such part
+// found (empty: none).
+template <typename JumpAt, typename Enter, typename Continues, typename Support>
+std::vector<cv::Point> PartAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& region,
+                                      size_t max_cells, double max_gap_m, const JumpAt& jump_at,
+                                      const Enter& enter, const Continues& continues,
+                                      const Support& support) {
+  constexpr int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
+  constexpr uint8_t kInPart = 1, kRejected = 2;
+  const float max_gap_sq = static_cast<float>(max_gap_m * max_gap_m);
+  const cv::Rect object_box = cv::boundingRect(grown);
+  cv::Mat visited = cv::Mat::zeros(grown.size(), CV_8U);
+  for (int r = region.y; r < region.y + region.height; ++r) {
+    for (int c = region.x; c < region.x + region.width; ++c) {
+      const cv::Point a(c, r);
+      if (!grown.at<uint8_t>(a) || !scan.valid.at<uint8_t>(a)) continue;
+      const cv::Vec3f& point_a = scan.point.at<cv::Vec3f>(a);
+      for (int k = 0; k < 4; ++k) {
+        const cv::Point seed(c + kDc[k], r + kDr[k]);
+        if (!region.contains(seed) || visited.at<uint8_t>(seed) || !enter(grown, seed)) continue;
+        // Behind the object: a part in front of it that stands on the ground may as well be an occluder (a crate
+        // before a post's foot) as what the object rests on.
+        if (scan.range.at<float>(seed) <= scan.range.at<float>(a) + jump_at(a)) continue;
+        const cv::Vec3f gap = scan.point.at<cv::Vec3f>(seed) - point_a;
+        if (gap.dot(gap) > max_gap_sq) continue;
+        std::vector<cv::Point> part = {seed};
+        visited.at<uint8_t>(seed) = kInPart;
+        bool open = false;  // continued by something else
+        for (size_t i = 0; i < part.size() && !open; ++i) {
+          const cv::Point p = part[i];
+          for (int j = 0; j < 4 && !open; ++j) {
+            const cv::Point q(p.x + kDc[j], p.y + kDr[j]);
+            if (!region.contains(q)) {
+              open = true;  // it runs on beyond the region
+              continue;
+            }
+            if (visited.at<uint8_t>(q) == kInPart || !scan.valid.at<uint8_t>(q) || grown.at<uint8_t>(q))
+              continue;
+            if (std::abs(scan.range.at<float>(q) - scan.range.at<float>(p)) > jump_at(p)) continue;  // a step
+            // What it stands on, or another surface meeting it at a crease (the ground at a post's foot,
+            // where the box holding the post keeps the ground out of the support planes' band).
+            if (support(q) || !continues(p, q)) continue;
+            if (visited.at<uint8_t>(q) == kRejected || !enter(grown, q)) {
+              open = true;  // joined in depth to something it may not take: part of something larger
+              continue;
+            }
+            visited.at<uint8_t>(q) = kInPart;
+            part.push_back(q);
+            open = part.size() > max_cells;
+          }
+        }
+        // What an object holds up lies under it, within its width (a post, legs); a closed surface beside it
+        // (a door recess behind a person, a strip of kerb behind a post's foot) is not held by it.
+        if (!open) {
+          const cv::Rect part_box = cv::boundingRect(part);
+          if (part_box.x >= object_box.x - 2 && part_box.br().x <= object_box.br().x + 2 &&
+              part_box.y > object_box.y)
+            return part;
+        }
+        for (const cv::Point& p : part) visited.at<uint8_t>(p) = kRejected;
+      }
+    }
+  }
+  return {};
+}
+
 // How deep into a cut a fringe of its support can reach, cells.
 constexpr int kFringeCells = 4;
 
@@ -185,14 +264,14 @@ struct ObjectFrame {
   cv::Mat normal;  // CV_32FC3 of the region's size
 };
 
-// `margin` cells around the mask's box make the region (-1 = the box's own size again on every side: growth
-// beyond that is a leak anyway). False when the mask holds no cell with a return.
+// `margin` cells around the mask's box make the region (-1 = three times the box's larger side on every side:
+// a box on a post, stroked on the box, has a post up to three times the box's height below it). False when the mask holds no cell with a return.
 // `normals_at` (CV_8U over the scan, may be empty): where the normals are needed; elsewhere they are left 0.
 bool FrameOf(const Scan& scan, const cv::Mat& mask, const WholeObjectOptions& options, int margin,
              const cv::Mat& normals_at, ObjectFrame* frame) {
   frame->box = cv::boundingRect(mask);
   const cv::Rect& box = frame->box;
-  if (margin < 0) margin = std::max(box.width, box.height);
+  if (margin < 0) margin = 3 * std::max(box.width, box.height);
   frame->region = cv::Rect(box.x - margin, box.y - margin, box.width + 2 * margin, box.height + 2 * margin) &
                   cv::Rect(0, 0, scan.cols, scan.rows);
   frame->cell_angle = MeanCellAngle(scan);
@@ -268,9 +347,20 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const auto free = [&](const cv::Mat& grown, cv::Point b) {
     return !grown.at<uint8_t>(b) && scan.valid.at<uint8_t>(b) && (barrier.empty() || !barrier.at<uint8_t>(b));
   };
-  // A cell growth may enter: free and not support.
+  // A cell growth may enter: inside the region (its normals are known only there: reading one outside read
+  // memory past the normals' matrix, and the cut changed with the thread count and from run to run), free and
+  // not support.
   const auto open = [&](const cv::Mat& grown, cv::Point b) {
-    return free(grown, b) && !support.at<uint8_t>(b);
+    return region.contains(b) && free(grown, b) && !support.at<uint8_t>(b);
+  };
+  // The continuous growth stays within the box's own size around it (beyond that it is a leak anyway); the
+  // parts across a step may reach the whole region (a post three times the box's height).
+  const int inner_margin = std::max(box.width, box.height);
+  const cv::Rect inner = cv::Rect(box.x - inner_margin, box.y - inner_margin, box.width + 2 * inner_margin,
+                                  box.height + 2 * inner_margin) &
+                         region;
+  const auto open_inner = [&](const cv::Mat& grown, cv::Point b) {
+    return inner.contains(b) && open(grown, b);
   };
   cv::Mat grown = mask.clone();
   std::deque<cv::Point> front;
@@ -289,7 +379,7 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
     const double jump_m = jump_at(a);
     for (int k = 0; k < 4; ++k) {
       const cv::Point b(a.x + kDc[k], a.y + kDr[k]);
-      if (!open(grown, b)) continue;
+      if (!open_inner(grown, b)) continue;
       if (std::abs(scan.range.at<float>(b) - range_a) > jump_m) continue;
       const cv::Vec3f normal_b = normal.at<cv::Vec3f>(b - region.tl());
       if (normal_b == cv::Vec3f() || normal_a.dot(normal_b) < cos_max) continue;
@@ -313,6 +403,33 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
     if (overhang.empty()) break;
     added += static_cast<int>(overhang.size());
     for (const cv::Point& cell : overhang) grown.at<uint8_t>(cell) = 255;
+  }
+  // Closed parts across a depth step that touch the object in space join it (the post under a box), each
+  // within what is left of the budget.
+  const auto continues = [&](cv::Point p, cv::Point q) {
+    const cv::Vec3f normal_p = normal.at<cv::Vec3f>(p - region.tl()),
+                    normal_q = normal.at<cv::Vec3f>(q - region.tl());
+    return normal_p != cv::Vec3f() && normal_q != cv::Vec3f() && normal_p.dot(normal_q) >= cos_max;
+  };
+  // The support planes of the whole region: a part's foot may stand on ground far from the cut (a post under
+  // a box), beyond the band the cut's own support planes are fitted to.
+  cv::Mat wide_support;
+  if (options.join_steps && added < max_added) {
+    WholeObjectOptions wide = options;
+    wide.support_band_cells = std::max(region.width, region.height);
+    wide_support = SupportCells(scan, grown, region, normal, wide, cv::Mat(), /*max_points=*/20000);
+  }
+  const auto on_support = [&](cv::Point q) { return support.at<uint8_t>(q) || wide_support.at<uint8_t>(q); };
+  const auto enter = [&](const cv::Mat& grown, cv::Point b) {
+    return open(grown, b) && !wide_support.at<uint8_t>(b);
+  };
+  while (options.join_steps && added < max_added) {
+    const std::vector<cv::Point> part =
+        PartAcrossStep(scan, grown, region, static_cast<size_t>(max_added - added), options.join_max_gap_m,
+                       jump_at, enter, continues, on_support);
+    if (part.empty()) break;
+    added += static_cast<int>(part.size());
+    for (const cv::Point& cell : part) grown.at<uint8_t>(cell) = 255;
   }
   return grown;
 }
