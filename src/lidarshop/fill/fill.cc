@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
+#include "lidarshop/fill/foreground.h"
 #include "lidarshop/fill/range_gradient.h"
 #include "lidarshop/fill/return_acceptance.h"
 #include "lidarshop/inpaint/offset_completion.h"
@@ -53,6 +55,9 @@ cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
 
 namespace {
 
+// The front cells' least depth jump beyond 0.1 m, per metre of range (fill/foreground.h).
+constexpr double kFrontJumpRatio = 0.03;
+
 // What a method decides for the cells of the hole; the known cells keep the scan's values.
 struct HoleValues {
   cv::Mat has_return;  // CV_8U 255 = the hole cell gets a return
@@ -69,6 +74,7 @@ struct Inputs {
   cv::Mat known_valid;  // CV_8U 255 = outside the hole with a return
   cv::Mat range;        // CV_32F, 0 where no return
   cv::Mat guide;        // CV_32FC(1 or 3): colour in grey levels, or intensity × 255
+  cv::Mat front;        // CV_8U 255 = a known cell in front of the background (fill/foreground.h), or empty
 };
 
 cv::Mat Guide(const Scan& scan) {
@@ -109,6 +115,54 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
     }
   }
   out->has_return.setTo(0, fill_internal::NoReturnOnBothSides(in.hole, in.known_valid));
+  // No return does not appear out of nothing: a part of the hole left without one that touches no known cell
+  // without a return (sky, a dropout on the rim) is a copied no-return pattern — the stereo cloud's dropouts
+  // copied as F-shaped holes into the table behind the mug — and gets a return, with the colour, intensity and
+  // label of the nearest cell that has one.
+  const cv::Mat without = (in.hole != 0) & (out->has_return == 0);
+  cv::Mat ids;
+  const int count = cv::connectedComponents(without, ids, 8, CV_32S);
+  if (count > 1) {
+    std::vector<uint8_t> open(static_cast<size_t>(count), 0);
+    const cv::Mat known_without = (in.hole == 0) & (scan.valid == 0);
+    for (int y = 0; y < scan.rows; ++y) {
+      for (int x = 0; x < scan.cols; ++x) {
+        const int id = ids.at<int32_t>(y, x);
+        if (id == 0 || open[static_cast<size_t>(id)]) continue;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int yy = y + dy, xx = x + dx;
+            const bool outside = yy < 0 || xx < 0 || yy >= scan.rows || xx >= scan.cols;
+            if (outside || known_without.at<uint8_t>(yy, xx)) open[static_cast<size_t>(id)] = 1;
+          }
+      }
+    }
+    cv::Mat island(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    for (int y = 0; y < scan.rows; ++y)
+      for (int x = 0; x < scan.cols; ++x)
+        if (const int id = ids.at<int32_t>(y, x); id > 0 && !open[static_cast<size_t>(id)])
+          island.at<uint8_t>(y, x) = 255;
+    const cv::Mat nearest = NearestKnownCell(island);
+    for (int y = 0; y < scan.rows; ++y) {
+      for (int x = 0; x < scan.cols; ++x) {
+        if (!island.at<uint8_t>(y, x)) continue;
+        const cv::Vec2i n = nearest.at<cv::Vec2i>(y, x);
+        if (n[0] < 0) continue;
+        const bool filled = in.hole.at<uint8_t>(n[0], n[1]) != 0;
+        if (filled ? !out->has_return.at<uint8_t>(n[0], n[1]) : !scan.valid.at<uint8_t>(n[0], n[1])) continue;
+        out->has_return.at<uint8_t>(y, x) = 255;
+        if (!out->color.empty())
+          out->color.at<cv::Vec3b>(y, x) =
+              filled ? out->color.at<cv::Vec3b>(n[0], n[1]) : scan.color.at<cv::Vec3b>(n[0], n[1]);
+        if (!out->intensity.empty())
+          out->intensity.at<float>(y, x) =
+              filled ? out->intensity.at<float>(n[0], n[1]) : scan.intensity.at<float>(n[0], n[1]);
+        if (!out->label.empty())
+          out->label.at<int32_t>(y, x) =
+              filled ? out->label.at<int32_t>(n[0], n[1]) : scan.label.at<int32_t>(n[0], n[1]);
+      }
+    }
+  }
 }
 
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
@@ -171,7 +225,7 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
     InpaintStrategies chosen;
     if (inpaint.acceptance.enabled) {
       chosen.acceptance = std::make_unique<fill_internal::ReturnConsistentAcceptance>(
-          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1);
+          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1, in.front);
     }
     return chosen;
   };
@@ -630,6 +684,38 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
   in.range = RangeImage(scan);
   in.range.setTo(0, scan.valid == 0);
   in.guide = Guide(scan);
+  // The gradient fill continues the background only (fill/foreground.h): objects in front of it that touch the
+  // hole are filled along with it (and not written), and no patch copies an object in front of it.
+  const cv::Mat hole = in.hole.clone();
+  bool extended = false;
+  if (options.method == FillMethod::kGradient && options.background_only) {
+    const cv::Rect box = cv::boundingRect(in.hole);
+    const int reach = std::max(48, 2 * box.width);
+    const cv::Mat front =
+        fill_internal::FrontCells(in.range, in.known_valid, in.hole, kFrontJumpRatio, reach);
+    // The removed object's own returns (the hole's cells that have one) give its range: a neighbour beside it
+    // stands about as near (within the front jump of its farthest part).
+    std::vector<float> object;
+    for (int y = 0; y < scan.rows; ++y)
+      for (int x = 0; x < scan.cols; ++x)
+        if (in.hole.at<uint8_t>(y, x) && scan.valid.at<uint8_t>(y, x))
+          object.push_back(in.range.at<float>(y, x));
+    double max_range_m = std::numeric_limits<double>::infinity();
+    if (!object.empty()) {
+      const size_t far = object.size() * 9 / 10;
+      std::nth_element(object.begin(), object.begin() + static_cast<std::ptrdiff_t>(far), object.end());
+      max_range_m = object[far] * (1.0 + kFrontJumpRatio) + 0.1;
+    }
+    const cv::Mat touching =
+        fill_internal::FrontTouchingHole(front, in.range, in.hole, in.known_valid, max_range_m, 2);
+    if (cv::countNonZero(touching) > 0) {
+      cv::bitwise_or(hole, touching, in.hole);
+      extended = true;
+      in.known_valid = (scan.valid != 0) & (in.hole == 0);
+    }
+    in.front = front & (in.hole == 0);
+    result.front_cells = cv::countNonZero(touching);
+  }
 
   HoleValues values;
   switch (options.method) {
@@ -645,6 +731,17 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
     case FillMethod::kTelea:
       TeleaFill(in, options, &values, &result);
       break;
+  }
+  // Back to the hole asked for: the front cells filled with it keep their own values.
+  if (extended) {
+    const cv::Mat extra = in.hole & (hole == 0);
+    if (!values.source.empty()) values.source.setTo(cv::Scalar(-1, -1), extra);
+    if (!result.fill_order.empty()) result.fill_order.setTo(-1, extra);
+    if (!result.gradient_magnitude_after.empty()) {
+      const cv::Mat known = (scan.valid != 0) & extra;
+      result.gradient_magnitude_before.copyTo(result.gradient_magnitude_after, known);
+    }
+    in.hole = hole;
   }
   if (!values.source.empty()) result.source_cell = values.source;
   Timer timer;

@@ -91,6 +91,11 @@ struct FillOptions {
   // so that a wall end and the facade far behind it stay apart instead of being joined by a membrane; a part
   // of the hole cut off from every known range by them is left without a return. 0 = never cut.
   double depth_jump_ratio = 0.2;
+  // Gradient method: continue the background only (fill/foreground.h). Objects standing in front of the
+  // surface behind them (a person beside the removed one, a bench) that touch the hole are filled with it —
+  // their own cells are not written — and no patch copying an object in front of the background is taken:
+  // the random scenes' worst fills were a touching person's silhouette copied into the hole.
+  bool background_only = true;
   // Telea baseline.
   double telea_radius_cells = 3.0;  // neighbourhood of the fast-marching inpainting, cells (> 0)
   // Patch methods: complete the hole by shifted copies of the scan at its dominant patch offsets
@@ -143,6 +148,9 @@ struct FillResult {
   int64_t plane_cells = 0;        // synthesized cells placed on a plane seen around the hole
   int64_t offset_cells = 0;       // hole cells copied by offset completion (FillOptions::offset_completion)
   int64_t lattice_cells = 0;      // hole cells copied along a facade's pitch (FillOptions::lattice)
+  // Known cells in front of the background that touch the hole, filled along with it and not written
+  // (FillOptions::background_only).
+  int64_t front_cells = 0;
   // The repeating facades found, one entry per facade and part of the hole: the pitch along it and the storey
   // height up it, metres (0 = does not repeat that way).
   std::vector<double> lattice_pitches_m, lattice_storeys_m;

@@ -61,6 +61,9 @@ const StructInfo& InfoOf<FillOptions>() {
          &FillOptions::depth_jump_ratio, "depth_jump_ratio",
          "an edge whose ranges differ by more than this times the nearer one is a silhouette; 0 = never cut")
         .Min(0);
+    b.Field(&FillOptions::background_only, "background_only",
+            "gradient method: continue the background only (objects in front of it touching the hole are "
+            "filled with it, not written; no patch copies one)");
     b.Field(&FillOptions::telea_radius_cells, "telea_radius_cells",
             "telea: neighbourhood of the fast marching")
         .Unit("cells")
@@ -252,6 +255,9 @@ const StructInfo& InfoOf<FillResult>() {
     b.Field(&FillResult::patches, "patches", "patches copied");
     b.Field(&FillResult::exact_search, "exact_search", "the patch search was the exact one");
     b.Field(&FillResult::lattice_cells, "lattice_cells", "hole cells copied along a facade's pitch");
+    b.Field(&FillResult::front_cells, "front_cells",
+            "known cells in front of the background touching the hole, filled with it and not written")
+        .Unit("cells");
     b.Field(&FillResult::lattice_pitches_m, "lattice_pitches_m", "pitch of each repeating facade (0 = none)")
         .Unit("m");
     b.Field(&FillResult::lattice_storeys_m, "lattice_storeys_m", "storey height of each (0 = none)")

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -30,6 +32,40 @@ constexpr double kParallelCos = 0.99;
 
 // cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
 constexpr float kAgreeingNormal = 0.985f;
+
+// A plane holding this share of the band's cells (and 30) is kept when it is seen on both sides of the hole.
+constexpr double kSmallPlaneShare = 0.01;
+
+// A box of grid cells, [x0, x1) x [y0, y1).
+struct Rect2 {
+  int x0, y0, x1, y1;
+  void Add(int x, int y) {
+    x0 = std::min(x0, x);
+    y0 = std::min(y0, y);
+    x1 = std::max(x1, x + 1);
+    y1 = std::max(y1, y + 1);
+  }
+  // Reaches past `part` on two opposite sides: left and right of it, or above and below.
+  bool Spans(const Rect2& part) const {
+    return (x0 < part.x0 && x1 > part.x1) || (y0 < part.y0 && y1 > part.y1);
+  }
+};
+
+// The largest 8-connected part (on the grid of `size`) of the cells `subset` (indices into `cells`).
+std::vector<uint32_t> LargestConnectedPart(const std::vector<uint32_t>& subset,
+                                           const std::vector<cv::Point>& cells, cv::Size size) {
+  cv::Mat mask(size, CV_8U, cv::Scalar(0));
+  for (uint32_t i : subset) mask.at<uint8_t>(cells[i]) = 255;
+  cv::Mat ids, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, ids, stats, centroids, 8, CV_32S);
+  int best = 0;
+  for (int id = 1; id < count; ++id)
+    if (best == 0 || stats.at<int>(id, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = id;
+  std::vector<uint32_t> part;
+  for (uint32_t i : subset)
+    if (ids.at<int32_t>(cells[i]) == best) part.push_back(i);
+  return part;
+}
 
 enum class Meeting { kNone, kConcave, kConvex };
 
@@ -246,11 +282,56 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
 
   RansacPlaneOptions ransac;
   ransac.distance_threshold_m = *threshold_m;
-  ransac.max_planes = options.max_planes;
-  ransac.min_inliers = std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size())));
-  ransac.seed = seed;
+  ransac.max_planes = 1;
+  ransac.min_inliers = 3;
+  // A plane holding min_share of the band is kept; a smaller one (a kerb's face, a stair riser: 10–20 rows)
+  // only when it continues past the hole, seen on both of its sides.
+  const size_t large = static_cast<size_t>(
+      std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size()))));
+  const size_t small = static_cast<size_t>(
+      std::max(30, static_cast<int>(kSmallPlaneShare * static_cast<double>(cells.size()))));
+  const Rect2 part_box{box.x - roi.x, box.y - roi.y, box.x - roi.x + box.width, box.y - roi.y + box.height};
+  std::vector<uint32_t> remaining(cells.size());
+  for (size_t i = 0; i < cells.size(); ++i) remaining[i] = static_cast<uint32_t>(i);
   std::vector<SeenPlane> planes;
-  for (const PlaneFit& fit : DetectPlanesRansac(cloud, ransac)) {
+  const int attempts = 2 * options.max_planes;
+  for (int attempt = 0; attempt < attempts && static_cast<int>(planes.size()) < options.max_planes;
+       ++attempt) {
+    if (remaining.size() < small) break;
+    PointCloud rest;
+    rest.points.reserve(remaining.size());
+    for (uint32_t i : remaining) rest.points.push_back(cloud.points[i]);
+    ransac.seed = seed + static_cast<uint64_t>(attempt);
+    const PlaneFit hypothesis = FitPlaneRansac(rest, ransac);
+    if (hypothesis.inliers.size() < small) break;
+    // RANSAC's plane may run through two parallel surfaces at once (the road and the pavement behind a kerb,
+    // 2° apart, both within the inlier distance somewhere): refit it to the largest grid-connected part of its
+    // inliers, then take every remaining cell within the distance of the refitted plane.
+    std::vector<uint32_t> inliers;
+    for (uint32_t i : hypothesis.inliers) inliers.push_back(remaining[i]);
+    PlaneFit fit = hypothesis;
+    fit.inliers = LargestConnectedPart(inliers, cells, roi.size());
+    if (fit.inliers.size() >= 3) RefitPlane(cloud.points, &fit);
+    std::vector<uint32_t> kept;
+    // Twice: the part's plane gathers the surface's cells beyond the part (the face on the hole's other
+    // side), and the plane refitted to all of them is the least-squares plane of the whole surface.
+    for (int pass = 0; pass < 2; ++pass) {
+      kept.clear();
+      inliers.clear();
+      for (uint32_t i : remaining)
+        (std::abs(fit.Distance(cloud.points[i])) <= *threshold_m ? inliers : kept).push_back(i);
+      if (pass == 0 && inliers.size() >= 3) {
+        fit.inliers = inliers;
+        RefitPlane(cloud.points, &fit);
+      }
+    }
+    if (inliers.size() < small) {
+      // The refit lost its support: drop what RANSAC found and go on.
+      for (uint32_t i : hypothesis.inliers) remaining[i] = UINT32_MAX;
+      std::erase(remaining, UINT32_MAX);
+      continue;
+    }
+    remaining = std::move(kept);
     SeenPlane plane;
     plane.normal = fit.normal;
     plane.offset_m = fit.offset_m;
@@ -259,17 +340,20 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
       plane.normal = -plane.normal;
       plane.offset_m = -plane.offset_m;
     }
-    plane.seen.reserve(fit.inliers.size());
+    plane.seen.reserve(inliers.size());
     const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
                                  static_cast<float>(plane.normal.z()));
     size_t outer = 0;
-    for (uint32_t i : fit.inliers) {
+    Rect2 seen_box{INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN};
+    for (uint32_t i : inliers) {
       if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
       plane.seen.push_back(cloud.points[i]);
       outer += from_part.at<float>(cells[i]) > 0.5f * band;
+      seen_box.Add(cells[i].x, cells[i].y);
     }
-    if (2 * plane.seen.size() < fit.inliers.size()) continue;  // most cells face elsewhere: not a surface
-    if (4 * outer < plane.seen.size()) continue;               // only on the rim
+    if (2 * plane.seen.size() < inliers.size()) continue;  // most cells face elsewhere: not a surface
+    if (4 * outer < plane.seen.size()) continue;           // only on the rim
+    if (plane.seen.size() < large && !seen_box.Spans(part_box)) continue;  // small, and not past the hole
     // A facade's window panes are a plane of their own a little behind it; they are the facade's relief (a
     // copied pane lands at its offset from the facade), not a surface a cell copied from no plane may snap to.
     const bool relief_of_earlier = std::any_of(planes.begin(), planes.end(), [&](const SeenPlane& earlier) {
