@@ -31,4 +31,37 @@ exits_with 2 "clean: a bad value names the flag" "--min-region: 0 is out of rang
   "$work/st0.e57" "$work/st1.e57" --out "$work/bad" --min-region 0
 fails_clearly "clean: never onto an input" "st0.e57" "$lidarshop" clean "$work/st0.e57" "$work/st1.e57" --out "$work"
 
+# The built-in site: the hatchback stands at stations 0 and 1 (each confirms the other: kept), the sedan (label 7)
+# at station 2 only (stations 0 and 1 see through it: removed from station 2).
+check "scan the built-in site" "$lidarshop" scan parking_lot_stations --rows 160 --columns 320 -o "$work/site.e57" \
+  --labels "$work/site_labels.png" --quiet
+check "clean the site" "$lidarshop" clean "$work/site.e57" --out "$work/site_clean" --removed-masks \
+  --json "$work/site_clean.json" --quiet
+json_check "the sedan goes from station 2, nothing much from 0 and 1" "$work/site_clean.json" \
+  "len(d['stations']) == 3 and d['stations'][2]['removed'] > 100 and \
+   d['stations'][0]['removed'] < 20 and d['stations'][1]['removed'] < 20"
+check "what was removed from station 2 is the sedan" python3 -c "
+import struct, sys, zlib
+def png(path):  # 8- or 16-bit grey PNG, no interlace, as lidarshop writes them
+    data = open(path, 'rb').read(); pos = 8; chunks = b''; width = height = depth = 0
+    while pos < len(data):
+        n = struct.unpack('>I', data[pos:pos + 4])[0]; kind = data[pos + 4:pos + 8]; body = data[pos + 8:pos + 8 + n]
+        if kind == b'IHDR': width, height, depth = struct.unpack('>IIB', body[:9])
+        if kind == b'IDAT': chunks += body
+        pos += 12 + n
+    raw = zlib.decompress(chunks); bpp = depth // 8; stride = width * bpp; rows = []; prev = bytearray(stride)
+    for r in range(height):
+        f = raw[r * (stride + 1)]; line = bytearray(raw[r * (stride + 1) + 1:(r + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0; b = prev[i]; c = prev[i - bpp] if i >= bpp else 0
+            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+            line[i] = (line[i] + [0, a, b, (a + b) // 2, a if pa <= pb and pa <= pc else (b if pb <= pc else c)][f]) & 255
+        rows.append([int.from_bytes(line[i * bpp:(i + 1) * bpp], 'big') for i in range(width)]); prev = line
+    return rows
+removed, labels = png(sys.argv[1]), png(sys.argv[2])
+cells = [labels[r][c] for r in range(len(removed)) for c in range(len(removed[0])) if removed[r][c]]
+sedan = sum(1 for l in cells if l == 7)
+assert cells and sedan >= 0.9 * len(cells), (len(cells), sedan)
+" "$work/site_clean/site_2_removed.png" "$work/site_labels_2.png"
+
 finish

@@ -2,16 +2,9 @@
 # End-to-end test of sites of several stations (issue 31, docs/stations.md): `scan` of a scene with
 # "stations" into one E57 / PTX or one file per station (--split), labels per station, `info` listing the
 # stations, FILE#N and --scan N reading one station, and `register` of a whole site against the scene's true
-# poses. Single-station scenes keep their outputs. Run by ctest as `stations_cli_test`.
-# Usage: stations_cli_test.sh LIDARSHOP_BINARY
-set -uo pipefail
-lidarshop=$1
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-passed=0
-failed=0
-# shellcheck source=check_lib.sh
-source "$(dirname "$0")/check_lib.sh"
+# poses. Single-station scenes keep their outputs. Run by ctest as `stations_cli_test` (tests/cli_fixture.sh says
+# how to run it by hand).
+source "$(dirname "$0")/cli_fixture.sh"
 
 small=(--rows 120 --columns 240)
 
@@ -104,5 +97,4 @@ done
 fails_clearly "site output must be a folder" "folder" \
   "$lidarshop" register "$work/site.e57#0" "$work/station1.e57" "$work/station2.e57" -o "$work/x.e57"
 
-echo "stations_cli_test: $passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

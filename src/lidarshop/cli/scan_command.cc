@@ -203,8 +203,14 @@ int RunScan(int argc, char** argv) {
         std::optional<SyntheticScanner> scanner;
         for (int i = 0; i < num_stations; ++i) {
           const SceneDescription& station = station_scenes[i];
-          // Stations that see the same objects share one ray-casting scene.
-          const bool same_objects = i > 0 && station.objects.size() == station_scenes[i - 1].objects.size();
+          // Stations that see the same objects share one ray-casting scene (the same objects, not as many:
+          // a car that left and another that came are two different scenes).
+          auto objects_at = [&](int k) {
+            std::vector<bool> at;
+            for (const SceneObject& object : scene.objects) at.push_back(!site || object.AtStation(k));
+            return at;
+          };
+          const bool same_objects = i > 0 && objects_at(i) == objects_at(i - 1);
           if (!same_objects) {
             stage.Restart();
             scanner.emplace(station);
