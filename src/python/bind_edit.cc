@@ -13,6 +13,7 @@
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
+#include "lidarshop/site/transients.h"
 
 namespace lidarshop::python {
 
@@ -209,6 +210,33 @@ Returns a FillResult: .scan (the filled Scan, synthesized cells flagged), .fille
       py::arg("boundary"), py::arg("gx"), py::arg("gy"), py::arg("mask"), py::arg("options") = py::none(),
       "Poisson reconstruction ∇²I = div G where mask is non-zero (G = forward differences gx, gy), I = "
       "boundary elsewhere. Returns a PoissonResult.");
+  m.def(
+      "clean",
+      [](const std::vector<Scan>& stations, const py::object& options, const py::kwargs& kwargs) {
+        const CleanOptions clean_options = OptionsOf<CleanOptions>(options, kwargs);
+        CleanResult result;
+        {
+          py::gil_scoped_release release;
+          result = CleanStations(stations, clean_options);
+        }
+        py::list removed, counts;
+        for (size_t i = 0; i < stations.size(); ++i) {
+          const StationTransients& found = result.transients.stations[i];
+          removed.append(MatToArray(found.seen_through_by));
+          py::dict count;
+          count["removed"] = found.transient_cells;
+          count["seen_through"] = found.seen_through_cells;
+          count["confirmed"] = found.confirmed_cells;
+          count["filled"] = result.filled_cells[i];
+          counts.append(count);
+        }
+        return py::make_tuple(result.stations, removed, counts);
+      },
+      py::arg("stations"), py::arg("options") = py::none(),
+      "Removes what moved between registered stations (a point another station's rays passed through, "
+      "hitting farther) and fills the holes (docs/clean.md). Returns (cleaned Scans, removed masks: uint8 "
+      "(rows, cols) per station, 1 + the index of the station that saw through, 0 elsewhere, counts: a dict "
+      "per station). options: a CleanOptions, a dict or keywords.");
 }
 
 }  // namespace lidarshop::python

@@ -28,6 +28,7 @@
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/segment/segment.h"
+#include "lidarshop/site/transients.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
 
@@ -48,6 +49,8 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<FillOptions>(m);
   BindStruct<RemoveOptions>(m);
   BindStruct<FillMetricsOptions>(m);
+  BindStruct<TransientOptions>(m);
+  BindStruct<CleanOptions>(m);
   // The scanner and files
   BindStruct<ScannerOptions>(m);
   BindStruct<PhotoOptions>(m);

@@ -181,3 +181,37 @@ def test_surface_reconstruction():
     assert np.abs(np.linalg.norm(interpolating.vertices - [0, 0, 1], axis=1) - 0.5).max() < 1e-5
     with pytest.raises(lidarshop.InputError, match="one plane"):
         lidarshop.reconstruct_surface(np.column_stack([points[:, :2], np.zeros(3000)]))
+
+
+def street_station(x, y, yaw_deg, seed, passer_by):
+    """A street with a facade from a scanner at (x, y), turned yaw_deg; a passer-by (label 10) when asked."""
+    objects = [{"primitive": "plane", "size": [80, 80], "translate": [0, 20, 0], "label": 0, "texture": "gravel"},
+               {"primitive": "box", "size": [30, 0.5, 8], "translate": [0, 18, 4], "label": 1}]
+    if passer_by:
+        objects.append({"primitive": "cylinder", "radius": 0.25, "height": 1.75, "translate": [1, 8, 0.875],
+                        "label": 10})
+    return lidarshop.scan_scene({
+        "scanner": {"position": [x, y, 1.6], "rotate_deg": [0, 0, yaw_deg], "azimuth_deg": [-60, 60],
+                    "elevation_deg": [-30, 25], "columns": 300, "rows": 140, "max_range": 80,
+                    "los_noise_sigma": 0.004, "orthogonal_noise_sigma": 0.002, "seed": seed},
+        "objects": objects})
+
+
+def test_clean_removes_the_passer_by_another_station_saw_through():
+    first, second = street_station(0, 0, 0, 3, True), street_station(4, 1, -15, 4, False)
+    cleaned, removed, counts = lidarshop.clean([first, second])
+    assert len(cleaned) == 2 and len(removed) == 2
+    labels = np.asarray(first.label)
+    passer_by = labels == 10
+    found = removed[0] > 0
+    assert found.sum() > 100 and counts[0]["removed"] == found.sum()
+    assert (found & passer_by).sum() >= 0.95 * found.sum()  # what went is the passer-by
+    assert (found & passer_by).sum() >= 0.9 * passer_by.sum()  # and most of it went
+    assert (removed[1] > 0).sum() == 0 and counts[1]["removed"] == 0
+    # Station 1 saw through it: every reason is 1 + 1.
+    assert set(np.unique(removed[0][found]).tolist()) == {2}
+    assert counts[0]["filled"] > 0 and np.asarray(cleaned[0].synthesized).sum() > 0
+    with pytest.raises(lidarshop.InputError):
+        lidarshop.clean([first])
+    with pytest.raises(lidarshop.OptionsError):
+        lidarshop.clean([first, second], transients={"min_region_cells": 0})
