@@ -16,6 +16,7 @@
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/site_registration.h"
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/util/error.h"
@@ -434,6 +435,53 @@ void BindRegistration(py::module_& m) {
       py::arg("global_align") = py::none(),
       "(registered Scan, IcpResult): `moving` with a corrected world_from_scanner. global_align: True or "
       "GlobalAlignOptions for a coarse alignment first (scans whose poses are far off).");
+  m.def(
+      "register_site",
+      [](const std::vector<Scan>& stations, int fixed, const py::object& icp, const py::object& options,
+         const py::kwargs& kwargs) {
+        const IcpOptions icp_options = OptionsOf<IcpOptions>(icp);
+        const SiteRegistrationOptions site_options = OptionsOf<SiteRegistrationOptions>(options, kwargs);
+        SiteRegistration result;
+        {
+          py::gil_scoped_release release;
+          result = RegisterSite(stations, fixed, icp_options, site_options);
+        }
+        py::list registered, per_station, per_pair;
+        for (size_t i = 0; i < stations.size(); ++i) {
+          Scan moved = stations[i];  // shares the buffers; only the pose changes
+          moved.world_from_scanner = result.stations[i].world_from_scanner;
+          registered.append(moved);
+          const SiteStation& station = result.stations[i];
+          py::dict d;
+          d["moved_m"] = station.moved_m;
+          d["turned_deg"] = station.turned_deg;
+          d["rms_m"] = station.rms_m;
+          d["graph_translation_m"] = station.graph_translation_m;
+          d["graph_rotation_deg"] = station.graph_rotation_deg;
+          d["pairs"] = station.pairs;
+          per_station.append(d);
+        }
+        for (const SitePair& pair : result.pairs) {
+          py::dict d;
+          d["a"] = pair.a;
+          d["b"] = pair.b;
+          d["overlap"] = pair.overlap;
+          d["rms_m"] = pair.icp.rms_m;
+          d["fitness"] = pair.icp.fitness;
+          d["in_graph"] = pair.in_graph;
+          d["graph_translation_m"] = pair.graph_translation_m;
+          d["graph_rotation_deg"] = pair.graph_rotation_deg;
+          per_pair.append(d);
+        }
+        return py::make_tuple(registered, per_station, per_pair);
+      },
+      py::arg("stations"), py::arg("fixed") = 0, py::arg("icp") = py::none(), py::arg("options") = py::none(),
+      "Registers a site (docs/stations.md): pairwise point-to-plane ICP between overlapping stations and a "
+      "pose "
+      "graph over all pairs, stations[fixed] held. Returns (the stations with their registered "
+      "world_from_scanner, a dict per station: moved_m, turned_deg, rms_m, graph residuals, pairs; a dict "
+      "per "
+      "pair). icp: IcpOptions or a dict; options: SiteRegistrationOptions, a dict or keywords.");
 }
 
 }  // namespace

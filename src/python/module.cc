@@ -20,6 +20,7 @@
 #include "lidarshop/pointset/planes.h"
 #include "lidarshop/pointset/region_growing.h"
 #include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/site_registration.h"
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/poisson/poisson.h"
@@ -50,6 +51,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<RemoveOptions>(m);
   BindStruct<FillMetricsOptions>(m);
   BindStruct<TransientOptions>(m);
+  BindStruct<SiteRegistrationOptions>(m);
   BindStruct<CleanOptions>(m);
   // The scanner and files
   BindStruct<ScannerOptions>(m);

@@ -215,3 +215,38 @@ def test_clean_removes_the_passer_by_another_station_saw_through():
         lidarshop.clean([first])
     with pytest.raises(lidarshop.OptionsError):
         lidarshop.clean([first, second], transients={"min_region_cells": 0})
+
+
+def test_register_site_brings_spoiled_stations_back():
+    # A walled courtyard with boxes at several angles, seen from three stations all around.
+    objects = [{"primitive": "plane", "size": [40, 40], "label": 0},
+               {"primitive": "box", "size": [30, 0.4, 4], "translate": [0, 12, 2]},
+               {"primitive": "box", "size": [30, 0.4, 4], "translate": [0, -12, 2]},
+               {"primitive": "box", "size": [0.4, 24, 4], "translate": [15, 0, 2]},
+               {"primitive": "box", "size": [0.4, 24, 4], "translate": [-15, 0, 2]},
+               {"primitive": "box", "size": [2, 1, 1.5], "rotate_deg": [0, 0, 25], "translate": [-3, 2, 0.75]},
+               {"primitive": "box", "size": [1.5, 1.5, 2.5], "rotate_deg": [0, 0, -40], "translate": [4, -1, 1.25]},
+               {"primitive": "box", "size": [1, 1, 1], "rotate_deg": [20, 30, 10], "translate": [-9, -4, 1.2]}]
+    stations, truth = [], []
+    for k, (x, y, yaw) in enumerate([(-8, -6, 10), (0, -7, -20), (7, 5, 160)]):
+        scan = lidarshop.scan_scene({
+            "scanner": {"position": [x, y, 1.5], "rotate_deg": [0, 0, yaw], "azimuth_deg": [-180, 179.5],
+                        "elevation_deg": [-45, 40], "columns": 480, "rows": 120, "max_range": 60,
+                        "los_noise_sigma": 0.002, "seed": k + 1},
+            "objects": objects})
+        truth.append(np.array(scan.world_from_scanner))
+        stations.append(scan)
+    # Stations 1 and 2 spoiled by 1 degree and 0.2 m.
+    for k in (1, 2):
+        motion = np.eye(4)
+        motion[:3, :3] = rotation_z(1.0 if k == 1 else -1.0)
+        motion[:3, 3] = [0.2, -0.1, 0.05] if k == 1 else [-0.15, 0.1, -0.05]
+        stations[k] = lidarshop.transform_scan(stations[k], motion)
+    registered, per_station, per_pair = lidarshop.register_site(stations, fixed=0)
+    assert len(registered) == 3 and len(per_station) == 3 and len(per_pair) >= 2
+    for k in range(3):
+        error = np.array(registered[k].world_from_scanner)[:3, 3] - truth[k][:3, 3]
+        assert np.linalg.norm(error) < 0.005, (k, error)
+    assert per_station[1]["moved_m"] > 0.1 and per_station[0]["moved_m"] == 0
+    with pytest.raises(lidarshop.OptionsError):  # a site needs two stations
+        lidarshop.register_site([stations[0]])
