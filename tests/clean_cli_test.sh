@@ -29,6 +29,8 @@ check "the cleaned station holds synthesized points" sh -c \
 fails_clearly "clean: one station is not enough" "two stations" "$lidarshop" clean "$work/st0.e57" --out "$work/one"
 exits_with 2 "clean: a bad value names the flag" "--min-region: 0 is out of range" "$lidarshop" clean \
   "$work/st0.e57" "$work/st1.e57" --out "$work/bad" --min-region 0
+fails_clearly "clean: an --out that cannot be a folder" "cannot create the folder" "$lidarshop" clean \
+  "$work/st0.e57" "$work/st1.e57" --out "$work/st0.e57/inside"
 fails_clearly "clean: never onto an input" "st0.e57" "$lidarshop" clean "$work/st0.e57" "$work/st1.e57" --out "$work"
 
 # The built-in site: the hatchback stands at stations 0 and 1 (each confirms the other: kept), the sedan (label 7)

@@ -451,28 +451,9 @@ void BindRegistration(py::module_& m) {
           Scan moved = stations[i];  // shares the buffers; only the pose changes
           moved.world_from_scanner = result.stations[i].world_from_scanner;
           registered.append(moved);
-          const SiteStation& station = result.stations[i];
-          py::dict d;
-          d["moved_m"] = station.moved_m;
-          d["turned_deg"] = station.turned_deg;
-          d["rms_m"] = station.rms_m;
-          d["graph_translation_m"] = station.graph_translation_m;
-          d["graph_rotation_deg"] = station.graph_rotation_deg;
-          d["pairs"] = station.pairs;
-          per_station.append(d);
+          per_station.append(FromJsonValue(SiteStationJson(result.stations[i])));
         }
-        for (const SitePair& pair : result.pairs) {
-          py::dict d;
-          d["a"] = pair.a;
-          d["b"] = pair.b;
-          d["overlap"] = pair.overlap;
-          d["rms_m"] = pair.icp.rms_m;
-          d["fitness"] = pair.icp.fitness;
-          d["in_graph"] = pair.in_graph;
-          d["graph_translation_m"] = pair.graph_translation_m;
-          d["graph_rotation_deg"] = pair.graph_rotation_deg;
-          per_pair.append(d);
-        }
+        for (const SitePair& pair : result.pairs) per_pair.append(FromJsonValue(SitePairJson(pair)));
         return py::make_tuple(registered, per_station, per_pair);
       },
       py::arg("stations"), py::arg("fixed") = 0, py::arg("icp") = py::none(), py::arg("options") = py::none(),

@@ -21,6 +21,13 @@ namespace lidarshop::cli {
 namespace {
 // The formats that keep a station's grid and pose, which the comparison of stations needs back.
 const std::vector<std::string> kStationExtensions = {"ptx", "e57", "ply", "pcd"};
+
+// DIR/<stem>_removed.png, or DIR/<stem>_<N>_removed.png for scan N of a file of several.
+std::string MaskPath(const std::string& out_dir, const std::string& stem, size_t scan, size_t scans_in_file) {
+  const std::string name =
+      scans_in_file > 1 ? fmt::format("{}_{}_removed.png", stem, scan) : stem + "_removed.png";
+  return (std::filesystem::path(out_dir) / name).string();
+}
 }  // namespace
 
 int RunClean(int argc, char** argv) {
@@ -77,6 +84,13 @@ int RunClean(int argc, char** argv) {
           CheckOutputFile("--out", output, kStationExtensions, inputs);
           outputs.push_back(output);
         }
+        // Every output is checked before the long work.
+        for (size_t f = 0; f < files.size() && removed_masks; ++f) {
+          const std::string stem = fs::path(StationOutputName(inputs[f])).stem().string();
+          for (size_t s = 0; s < files[f].scans.size(); ++s)
+            CheckOutputFile("--removed-masks", MaskPath(out_dir, stem, s, files[f].scans.size()), {"png"},
+                            inputs);
+        }
         const int64_t pairs =
             static_cast<int64_t>(stations.size()) * (static_cast<int64_t>(stations.size()) - 1);
         auto progress = Progress::ForTerminal("clean", pairs, quiet);
@@ -92,15 +106,9 @@ int RunClean(int argc, char** argv) {
             const StationTransients& found = result.transients.stations[next];
             removed += found.transient_cells;
             const std::string stem = fs::path(StationOutputName(inputs[f])).stem().string();
-            std::string mask_path;
-            if (removed_masks) {
-              mask_path =
-                  (fs::path(out_dir) / (files[f].scans.size() > 1 ? fmt::format("{}_{}_removed.png", stem, s)
-                                                                  : stem + "_removed.png"))
-                      .string();
-              CheckOutputFile("--removed-masks", mask_path, {"png"}, inputs);
-              WriteImage(mask_path, found.seen_through_by);
-            }
+            const std::string mask_path =
+                removed_masks ? MaskPath(out_dir, stem, s, files[f].scans.size()) : "";
+            if (removed_masks) WriteImage(mask_path, found.seen_through_by);
             per_station.push_back({{"file", inputs[f]},
                                    {"scan", s},
                                    {"output", outputs[f]},

@@ -93,36 +93,19 @@ int RegisterSiteCommand(const std::string& fixed_path, const std::vector<std::st
   for (size_t k = 0; k < stations.size(); ++k) {
     const SiteStation& station = result.stations[k];
     worst_rms = std::max(worst_rms, station.rms_m);
-    station_list.push_back(
-        {{"index", k},
-         {"input", inputs[k]},
-         {"output", k == 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(outputs[k - 1])},
-         {"fixed", k == 0},
-         {"world_from_scanner", MatrixRows(station.world_from_scanner)},
-         {"moved_m", station.moved_m},
-         {"turned_deg", station.turned_deg},
-         {"pairs", station.pairs},
-         {"rms_m", station.rms_m},
-         {"graph_translation_m", station.graph_translation_m},
-         {"graph_rotation_deg", station.graph_rotation_deg}});
+    nlohmann::ordered_json entry = {
+        {"index", k},
+        {"input", inputs[k]},
+        {"output", k == 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(outputs[k - 1])},
+        {"fixed", k == 0}};
+    entry.update(SiteStationJson(station));
+    station_list.push_back(std::move(entry));
   }
   nlohmann::ordered_json pair_list = nlohmann::ordered_json::array();
   int in_graph = 0;
   for (const SitePair& pair : result.pairs) {
     in_graph += pair.in_graph;
-    pair_list.push_back({{"a", pair.a},
-                         {"b", pair.b},
-                         {"overlap", pair.overlap},
-                         {"in_graph", pair.in_graph},
-                         {"rms_m", pair.icp.rms_m},
-                         {"fitness", pair.icp.fitness},
-                         {"correspondences", pair.icp.correspondences},
-                         {"iterations", pair.icp.iterations},
-                         {"converged", pair.icp.converged},
-                         {"graph_translation_m", pair.graph_translation_m},
-                         {"graph_rotation_deg", pair.graph_rotation_deg},
-                         {"a_from_b", MatrixRows(pair.a_from_b_measured)},
-                         {"seconds", pair.seconds}});
+    pair_list.push_back(SitePairJson(pair));
   }
   nlohmann::ordered_json json = {{"stations", station_list},
                                  {"pairs", pair_list},

@@ -305,4 +305,38 @@ SiteRegistration RegisterSite(const std::vector<Scan>& stations, int fixed, cons
   return out;
 }
 
+namespace {
+std::vector<std::vector<double>> Rows(const Eigen::Matrix4d& matrix) {
+  std::vector<std::vector<double>> rows;
+  for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
+  return rows;
+}
+}  // namespace
+
+nlohmann::ordered_json SiteStationJson(const SiteStation& station) {
+  return {{"world_from_scanner", Rows(station.world_from_scanner)},
+          {"moved_m", station.moved_m},
+          {"turned_deg", station.turned_deg},
+          {"pairs", station.pairs},
+          {"rms_m", station.rms_m},
+          {"graph_translation_m", station.graph_translation_m},
+          {"graph_rotation_deg", station.graph_rotation_deg}};
+}
+
+nlohmann::ordered_json SitePairJson(const SitePair& pair) {
+  return {{"a", pair.a},
+          {"b", pair.b},
+          {"overlap", pair.overlap},
+          {"in_graph", pair.in_graph},
+          {"rms_m", pair.icp.rms_m},
+          {"fitness", pair.icp.fitness},
+          {"correspondences", pair.icp.correspondences},
+          {"iterations", pair.icp.iterations},
+          {"converged", pair.icp.converged},
+          {"graph_translation_m", pair.graph_translation_m},
+          {"graph_rotation_deg", pair.graph_rotation_deg},
+          {"a_from_b", Rows(pair.a_from_b_measured)},
+          {"seconds", pair.seconds}};
+}
+
 }  // namespace lidarshop

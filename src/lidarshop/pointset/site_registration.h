@@ -21,6 +21,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/scan/scan.h"
@@ -76,6 +77,13 @@ struct SiteRegistration {
   int graph_iterations = 0;
   double seconds_overlap = 0, seconds_coarse = 0, seconds_fine = 0, seconds_graph = 0;
 };
+
+// The JSON form of a station's and a pair's result, which `lidarshop register --json` and Python's register_site
+// give: a station's world_from_scanner (rows), moved_m, turned_deg, pairs, rms_m and graph residuals; a pair's a,
+// b, overlap, in_graph, its ICP (rms_m, fitness, correspondences, iterations, converged), graph residuals,
+// a_from_b (rows) and seconds.
+nlohmann::ordered_json SiteStationJson(const SiteStation& station);
+nlohmann::ordered_json SitePairJson(const SitePair& pair);
 
 // Registers `stations` (their world_from_scanner as the initial guess) with `stations[fixed]` held. Throws
 // InputError when a station overlaps no other (naming it), when the stations do not form one connected

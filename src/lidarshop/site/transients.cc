@@ -182,6 +182,7 @@ cv::Mat WithoutSmallRegions(const cv::Mat& mask, int min_cells) {
 // neighbour's reason (the first in row order). Sequential, so the result does not depend on threads.
 void GrowOverContinuousDepth(const Scan& scan, const cv::Mat& confirmed, int steps, double max_jump,
                              cv::Mat* reason) {
+  if (cv::countNonZero(*reason) == 0) return;  // nothing moved: no pass over the grid
   for (int step = 0; step < steps; ++step) {
     cv::Mat next = reason->clone();
     for (int r = 0; r < scan.rows; ++r) {

@@ -176,6 +176,8 @@ TEST(FindTransients, TheSameOnOneThreadAndOnTwo) {
 TEST(CleanStations, RemovesTheMovingPointsAndFillsTheirHoles) {
   std::vector<Scan> stations;
   for (size_t i = 0; i < kStations.size(); ++i) stations.push_back(ScanStation(kStations[i], MovingAt(i)));
+  std::vector<Scan> before;
+  for (const Scan& scan : stations) before.push_back(Clone(scan));
   const CleanResult result = CleanStations(stations);
   ASSERT_EQ(result.stations.size(), 3u);
   for (size_t i = 0; i < stations.size(); ++i) {
@@ -194,7 +196,8 @@ TEST(CleanStations, RemovesTheMovingPointsAndFillsTheirHoles) {
     EXPECT_LE(moving_left, moving_before / 20) << "station " << i;
     EXPECT_GT(result.filled_cells[i], moving_before / 2) << "station " << i;
     // The input is untouched.
-    EXPECT_EQ(stations[i].CountValid(), stations[i].valid.total() - cv::countNonZero(stations[i].valid == 0));
+    EXPECT_EQ(cv::countNonZero(stations[i].valid != before[i].valid), 0) << "station " << i;
+    EXPECT_EQ(cv::norm(stations[i].range, before[i].range, cv::NORM_INF), 0.0) << "station " << i;
   }
 }
 
@@ -204,6 +207,9 @@ TEST(FindTransients, NeedsTwoStationsWithGrids) {
   TransientOptions bad;
   bad.min_region_cells = 0;
   EXPECT_THROW(FindTransients({one, one}, bad), OptionsError);
+  // A station that is one row of points (an unorganized cloud as read from a file) has no grid to look into.
+  const Scan cloud = MakeScan(1, 50);
+  EXPECT_THROW(FindTransients({one, cloud}), InputError);
 }
 
 }  // namespace
