@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/site/site_stations.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/verify/verify.h"
 #include "server.h"
@@ -42,6 +43,17 @@ class DocumentLimitError : public InputError {
 // snapshots share count once). Caller holds document.mutex.
 int64_t DocumentBytes(const Document& document);
 
+// A site: open documents that are the stations of one site — the scans of one file of several (an E57 with
+// several data3D), a built-in site, or documents the user grouped (docs/stations.md "In the editor").
+// routes_stations.cc.
+struct Site {
+  int id = 0;
+  std::string name;
+  std::vector<int> documents;  // station i is document documents[i] (a closed one stays listed as closed)
+  // Where each station stands, as opened (poses do not change with edits); the returns are re-counted live.
+  std::vector<StationSummary> stations;
+};
+
 struct EditorServer::State {
   ServerOptions options;
   GatedServer http;  // httplib's server behind the connection gate (gated_server.h)
@@ -54,6 +66,8 @@ struct EditorServer::State {
   int last_document = 0;
   std::map<int, std::shared_ptr<ModelEntry>> models;  // guarded by documents_mutex
   int last_model = 0;
+  std::map<int, std::shared_ptr<Site>> sites;  // guarded by documents_mutex
+  int last_site = 0;
 
   // Throws DocumentLimitError when max_documents are open (nothing else is checked then: call it before
   // reading a file), or when `more_bytes` more would take the open documents past max_document_bytes.
@@ -155,5 +169,6 @@ void AddEditRoutes(State& state);     // routes_edit.cc: strokes, segment, remov
 void AddVerifyRoutes(State& state);   // routes_verify.cc: models, pose verification
 void AddRecolorRoutes(State& state);  // routes_recolor.cc: photos, the three kinds of correspondences
 void AddReviewRoutes(State& state);   // routes_review.cc: inpainting with the patch review
+void AddStationRoutes(State& state);  // routes_stations.cc: sites, their stations, clean
 
 }  // namespace lidarshop::server

@@ -169,7 +169,8 @@ void CollectBuffers(const Scan& scan, std::map<const void*, int64_t>& seen) {
 void CollectBuffers(const Snapshot& snapshot, std::map<const void*, int64_t>& seen) {
   CollectBuffers(snapshot.scan, seen);
   CollectBuffers(snapshot.behind, seen);
-  for (const cv::Mat* mat : {&snapshot.strokes, &snapshot.object_mask, &snapshot.hole}) AddBuffer(*mat, seen);
+  for (const cv::Mat* mat : {&snapshot.strokes, &snapshot.object_mask, &snapshot.hole, &snapshot.removed})
+    AddBuffer(*mat, seen);
 }
 
 int64_t Sum(const std::map<const void*, int64_t>& seen) {

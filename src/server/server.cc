@@ -112,6 +112,7 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
   AddVerifyRoutes(*state_);
   AddRecolorRoutes(*state_);
   AddReviewRoutes(*state_);
+  AddStationRoutes(*state_);
   if (!state_->options.web_dir.empty()) {
     if (!http.set_mount_point("/", state_->options.web_dir)) {
       throw InputError(

@@ -51,6 +51,9 @@ struct ServerOptions {
   // Built-in scenes: their names, and a function scanning one (the CLI passes its compiled-in scenes).
   std::vector<std::string> builtin_scenes;
   std::function<Scan(const std::string& name)> scan_builtin;
+  // Every station of a built-in scene (a site: parking_lot_stations), in order; one scan for a scene with one
+  // scanner. Empty = the site is opened as scan_builtin's one scan (routes_stations.cc).
+  std::function<std::vector<Scan>(const std::string& name)> scan_builtin_stations;
 };
 
 // http://HOST:PORT/?token=T, with an IPv6 address in brackets (http://[::1]:8080/...).

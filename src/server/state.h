@@ -43,6 +43,9 @@ struct Snapshot {
   // The surface completed behind a kept object (fill shadow): a second layer, every cell synthesized or
   // without a return; empty = none. Saved as a second return (E57) or extra points (PLY, PCD).
   Scan behind;
+  // CV_8U 255 = the cells whose point the site's Clean removed as transient (another station saw through
+  // it), shown highlighted until the edit is undone; empty = none (routes_stations.cc).
+  cv::Mat removed;
 };
 
 // The last cut of a document, kept for live refinement (segment/SegmentSession). Used by one job at a time.

@@ -13,6 +13,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
 #include "lidarshop/util/error.h"
 #include "server.h"
 
@@ -74,6 +75,14 @@ int RunServe(int argc, char** argv) {
         const SceneDescription description =
             ParseScene(scene.json, fmt::format("built-in scene '{}'", name), "");
         return SyntheticScanner(description).Acquire(description.scanner);
+      }
+      throw InputError(fmt::format("no built-in scene '{}'", name));
+    };
+    // A site (parking_lot_stations) opened as a site: every station with the objects there.
+    options.scan_builtin_stations = [](const std::string& name) {
+      for (const BuiltinScene& scene : BuiltinScenes()) {
+        if (name == scene.name)
+          return ScanStations(ParseScene(scene.json, fmt::format("built-in scene '{}'", name), ""));
       }
       throw InputError(fmt::format("no built-in scene '{}'", name));
     };

@@ -7,6 +7,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -99,6 +100,27 @@ TEST(Stations, EachStationSeesItsObjectsAndTheSiteRoundTripsThroughE57) {
     EXPECT_LT((file.scans[i].world_from_scanner - scene.stations[i].WorldFromScanner()).norm(), 1e-9);
     EXPECT_EQ(file.scans[i].CountValid(), scans[i].CountValid());
   }
+}
+
+TEST(Stations, ScanStationsScansEveryStationWithTheObjectsThere) {
+  const SceneDescription scene = ParseScene(kSite, "site.json", "");
+  const std::vector<Scan> scans = ScanStations(scene);
+  ASSERT_EQ(scans.size(), 2u);
+  EXPECT_EQ(scans[0].name, "station0");
+  EXPECT_EQ(scans[1].name, "station1");
+  // Each at its own pose, the box only where it stands (station 0).
+  EXPECT_NEAR(scans[0].world_from_scanner(0, 3), -3.0, 1e-9);
+  EXPECT_NEAR(scans[1].world_from_scanner(0, 3), 3.0, 1e-9);
+  EXPECT_GT(CountLabel(scans[0], 2), 20);
+  EXPECT_EQ(CountLabel(scans[1], 2), 0);
+  EXPECT_GT(CountLabel(scans[1], 1), 100);
+  // A scene with one scanner: the one scan SynthesizeScan gives.
+  const SceneDescription one = SceneAtStation(scene, 1);
+  const std::vector<Scan> single = ScanStations(one);
+  ASSERT_EQ(single.size(), 1u);
+  EXPECT_NE(single[0].name, "station0");
+  EXPECT_EQ(single[0].CountValid(), scans[1].CountValid());
+  EXPECT_EQ(cv::norm(single[0].range, scans[1].range, cv::NORM_INF), 0.0);
 }
 
 }  // namespace

@@ -1,0 +1,337 @@
+// Routes of a site's stations (docs/api.md "Stations", docs/stations.md "In the editor"): a file of several
+// scans (or a built-in site) opened as one document per station grouped in a site, open documents grouped
+// into one, a document's stations listed with where they stand, and Clean (site/transients.h CleanStations)
+// over the site as one undoable edit per station. The library does the work (site/site_stations.h,
+// site/transients.h); this file parses, checks and answers.
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+#include <opencv2/core.hpp>
+
+#include "http.h"
+#include "lidarshop/site/site_stations.h"
+#include "lidarshop/site/transients.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop::server {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr size_t kMaxGroupedDocuments = 1024;
+
+// The site document `id` is a station of (the latest that lists it) and its station index; {null, -1} when
+// it is in none.
+std::pair<std::shared_ptr<Site>, int> SiteOf(State& state, int id) {
+  std::lock_guard lock(state.documents_mutex);
+  for (auto it = state.sites.rbegin(); it != state.sites.rend(); ++it) {
+    const std::vector<int>& documents = it->second->documents;
+    const auto found = std::find(documents.begin(), documents.end(), id);
+    if (found != documents.end()) return {it->second, static_cast<int>(found - documents.begin())};
+  }
+  return {nullptr, -1};
+}
+
+// The open document `id`, or null when it was closed.
+std::shared_ptr<Document> OpenDocumentOf(State& state, int id) {
+  std::lock_guard lock(state.documents_mutex);
+  const auto found = state.documents.find(id);
+  return found == state.documents.end() ? nullptr : found->second;
+}
+
+std::shared_ptr<Site> AddSite(State& state, std::string name, std::vector<int> documents,
+                              std::vector<StationSummary> stations) {
+  auto site = std::make_shared<Site>();
+  site->name = std::move(name);
+  site->documents = std::move(documents);
+  site->stations = std::move(stations);
+  std::lock_guard lock(state.documents_mutex);
+  site->id = ++state.last_site;
+  state.sites[site->id] = site;
+  return site;
+}
+
+// {"site", "name", "station": the index of `current_document` (-1 = none), "stations": [the summary of
+// each (site_stations.h) with "document", "open", "current", and while open "version" and "removed_cells"]}.
+nlohmann::ordered_json SiteJson(State& state, const Site& site, int current_document) {
+  nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+  int current = -1;
+  for (size_t i = 0; i < site.documents.size(); ++i) {
+    StationSummary summary = site.stations[i];
+    const auto document = OpenDocumentOf(state, site.documents[i]);
+    int64_t version = -1, removed = 0;
+    if (document) {
+      std::lock_guard lock(document->mutex);
+      summary.returns = document->now.scan.CountValid();
+      version = document->version;
+      removed = document->now.removed.empty() ? 0 : cv::countNonZero(document->now.removed);
+    }
+    nlohmann::ordered_json json = StationSummaryJson(summary);
+    json["document"] = site.documents[i];
+    json["open"] = document != nullptr;
+    json["current"] = site.documents[i] == current_document;
+    if (document) {
+      json["version"] = version;
+      json["removed_cells"] = removed;
+    }
+    if (site.documents[i] == current_document) current = static_cast<int>(i);
+    stations.push_back(std::move(json));
+  }
+  return {{"site", site.id}, {"name", site.name}, {"station", current}, {"stations", stations}};
+}
+
+// Opens `scans` as one document each, named `name#i` (or `name` for one); on any failure (too many open, no
+// memory) the ones already opened are closed again and the error is rethrown. Returns their ids.
+std::vector<int> OpenStations(State& state, const std::string& name, std::vector<Scan> scans,
+                              const std::vector<E57Image>& images) {
+  std::vector<int> ids;
+  try {
+    for (size_t i = 0; i < scans.size(); ++i) {
+      const std::string document_name = scans.size() == 1 ? name : fmt::format("{}#{}", name, i);
+      ids.push_back(state.AddDocument(document_name, std::move(scans[i]), ImagesOfScan(images, int(i))));
+    }
+  } catch (...) {
+    std::lock_guard lock(state.documents_mutex);
+    for (const int id : ids) state.documents.erase(id);
+    throw;
+  }
+  return ids;
+}
+
+// The whole numbers of `body[key]` (a list), or `fallback` without the key; OptionsFieldError otherwise.
+std::vector<int> IntList(const nlohmann::json& body, const char* key, std::vector<int> fallback) {
+  if (!body.contains(key)) return fallback;
+  const nlohmann::json& list = body.at(key);
+  if (!list.is_array()) throw OptionsFieldError(key, "expected a list of whole numbers");
+  if (list.size() > kMaxGroupedDocuments)
+    throw OptionsFieldError(key, fmt::format("more than {} entries", kMaxGroupedDocuments));
+  std::vector<int> values;
+  for (const auto& value : list) {
+    if (!value.is_number_integer() || value.get<int64_t>() < INT32_MIN || value.get<int64_t>() > INT32_MAX)
+      throw OptionsFieldError(key, fmt::format("expected whole numbers, got {}", Excerpt(value.dump(), 40)));
+    values.push_back(value.get<int>());
+  }
+  return values;
+}
+
+// POST /api/sites: {"path": FILE} (every scan of a file of several), {"scene": NAME} (every station of a
+// built-in scene) or {"documents": [ids], "name": N} (open scans grouped); "station" (0) is the one shown.
+void OpenSite(State& state, const nlohmann::json& body, httplib::Response& response) {
+  const int station = body.value("station", 0);
+  const auto check_station = [station](size_t count) {
+    CheckStationIndices({station}, static_cast<int>(count), "station");
+  };
+  std::vector<int> ids;
+  std::vector<StationSummary> summaries;
+  std::string name;
+  std::vector<std::string> warnings;
+  if (body.contains("documents")) {
+    ids = IntList(body, "documents", {});
+    if (ids.size() < 2) throw OptionsFieldError("documents", "a site groups two open scans or more");
+    for (size_t i = 0; i < ids.size(); ++i) {
+      if (std::count(ids.begin(), ids.end(), ids[i]) > 1)
+        throw OptionsFieldError("documents", fmt::format("scan {} is given twice", ids[i]));
+      const auto document = OpenDocumentOf(state, ids[i]);
+      if (!document) return SendError(response, 404, fmt::format("no open scan {}", ids[i]));
+      std::lock_guard lock(document->mutex);
+      summaries.push_back(SummarizeStation(document->now.scan, static_cast<int>(i)));
+      summaries.back().name = document->name;
+    }
+    check_station(ids.size());
+    name = body.value("name", fmt::format("site of {} scans", ids.size()));
+  } else if (body.contains("scene")) {
+    name = body.at("scene").get<std::string>();
+    const auto& names = state.options.builtin_scenes;
+    if (std::find(names.begin(), names.end(), name) == names.end() || !state.options.scan_builtin)
+      return SendError(response, 404, fmt::format("no built-in scene '{}'", Excerpt(name, 100)));
+    state.CheckRoomForDocument();  // before scanning it
+    std::vector<Scan> scans = state.options.scan_builtin_stations
+                                  ? state.options.scan_builtin_stations(name)
+                                  : std::vector<Scan>{state.options.scan_builtin(name)};
+    check_station(scans.size());
+    summaries = SummarizeStations(scans);
+    ids = OpenStations(state, name, std::move(scans), {});
+  } else if (body.contains("path")) {
+    const std::string requested = body.at("path").get<std::string>();
+    const std::string path = ResolveUnderRoots(state.options.roots, requested);
+    if (path.empty()) {
+      return SendError(response, 403,
+                       fmt::format("'{}' is not a file under the folders this server was started with",
+                                   Excerpt(requested, 200)));
+    }
+    state.CheckRoomForDocument();  // before reading the file
+    FileForEditing opened = ReadFileForEditing(path);
+    if (opened.file.scans.empty()) throw InputError(fmt::format("{}: holds no scan", requested));
+    check_station(opened.file.scans.size());
+    warnings = opened.file.warnings;
+    summaries = SummarizeStations(opened.file.scans);
+    name = fs::path(path).filename().string();
+    ids = OpenStations(state, name, std::move(opened.file.scans), opened.images);
+  } else {
+    throw OptionsError("expected \"path\", \"scene\" or \"documents\": what the site is made of");
+  }
+  const auto site = AddSite(state, name, ids, std::move(summaries));
+  nlohmann::ordered_json json = SiteJson(state, *site, ids[station]);
+  json["document"] = ids[station];
+  json["warnings"] = warnings;
+  SendJson(response, json);
+}
+
+// POST /api/docs/ID/clean: {"options": CleanOptions, "stations": [indices] (default: all)}. One job; every
+// station's document whose points changed gets one edit (its own undo), a station edited meanwhile is left
+// as it is and says so.
+void Clean(State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+           httplib::Response& response) {
+  const CleanOptions options =
+      body.contains("options") ? FromJson<CleanOptions>(body.at("options")) : CleanOptions{};
+  options.Check();
+  const auto [site, current] = SiteOf(state, document->id);
+  if (!site) {
+    throw InputError(
+        fmt::format("scan {} is not a station of a site: open a file of several scans as a site, or group "
+                    "open scans into "
+                    "one, then clean",
+                    document->id));
+  }
+  const int num_stations = static_cast<int>(site->documents.size());
+  std::vector<int> all(num_stations);
+  for (int i = 0; i < num_stations; ++i) all[i] = i;
+  const std::vector<int> chosen = IntList(body, "stations", all);
+  CheckStationIndices(chosen, num_stations, "stations");
+  if (chosen.size() < 2)
+    throw OptionsFieldError("stations",
+                            fmt::format("clean compares two stations or more, got {}", chosen.size()));
+  std::vector<std::shared_ptr<Document>> documents;
+  for (const int i : chosen) {
+    documents.push_back(OpenDocumentOf(state, site->documents[i]));
+    if (!documents.back()) {
+      return SendError(response, 409,
+                       fmt::format("station {} (scan {}) was closed: open the site again, or leave it out "
+                                   "(\"stations\")",
+                                   i, site->documents[i]));
+    }
+  }
+  const int undo_depth = state.options.undo_depth;
+  const int current_document = document->id;
+  StartJob(
+      state, document, "clean",
+      [documents, chosen, options, undo_depth, current, current_document](Progress& progress) {
+        std::vector<Scan> scans;
+        std::vector<int64_t> versions;
+        for (const auto& station : documents) {
+          std::lock_guard lock(station->mutex);
+          scans.push_back(station->now.scan);
+          versions.push_back(station->version);
+        }
+        const CleanResult result = CleanStations(scans, options, &progress);
+        nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+        int64_t removed_here = 0, version_here = -1;
+        for (size_t i = 0; i < documents.size(); ++i) {
+          Document& station = *documents[i];
+          const StationTransients& found = result.transients.stations[i];
+          std::lock_guard lock(station.mutex);
+          nlohmann::ordered_json json = {{"station", chosen[i]},
+                                         {"document", station.id},
+                                         {"removed", found.transient_cells},
+                                         {"seen_through", found.seen_through_cells},
+                                         {"confirmed", found.confirmed_cells},
+                                         {"filled", result.filled_cells[i]}};
+          if (station.version != versions[i]) {
+            json["changed"] = false;
+            json["why"] = "edited while the clean ran: left as it is (clean again)";
+          } else if (found.transient_cells == 0) {
+            json["changed"] = false;
+            json["why"] = "nothing moved here";
+          } else {
+            Snapshot next = station.now;
+            next.scan = result.stations[i];
+            next.removed = found.transient.clone();  // a new buffer: see Snapshot
+            Commit(station, std::move(next), undo_depth);
+            json["changed"] = true;
+          }
+          json["version"] = station.version;
+          if (station.id == current_document) {
+            removed_here = found.transient_cells;
+            version_here = station.version;
+          }
+          stations.push_back(std::move(json));
+        }
+        return nlohmann::ordered_json{{"station", current},
+                                      {"removed_cells", removed_here},
+                                      {"version", version_here},
+                                      {"stations", stations},
+                                      {"warnings", result.warnings}};
+      },
+      response);
+}
+
+}  // namespace
+
+void AddStationRoutes(State& state) {
+  httplib::Server& http = state.http;
+  http.Post("/api/sites", [&state](const httplib::Request& request, httplib::Response& response) {
+    const auto body = BodyJson(request, response);
+    if (!body) return;
+    try {
+      OpenSite(state, *body, response);
+    } catch (const DocumentLimitError& error) {
+      SendError(response, error.status, error.what());
+    } catch (const OptionsError& error) {
+      SendError(response, 400, error.what());
+    } catch (const InputError& error) {
+      SendError(response, 422, error.what());
+    } catch (const nlohmann::json::exception& error) {  // a field of the wrong type
+      SendError(response, 400, fmt::format("a field of the request has the wrong type: {}", error.what()));
+    }
+  });
+  http.Get("/api/sites", [&state](const httplib::Request&, httplib::Response& response) {
+    std::vector<std::shared_ptr<Site>> sites;
+    {
+      std::lock_guard lock(state.documents_mutex);
+      for (const auto& [id, site] : state.sites) sites.push_back(site);
+    }
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const auto& site : sites) list.push_back(SiteJson(state, *site, -1));
+    SendJson(response, {{"sites", list}});
+  });
+  // The stations of the site a document belongs to ({"site": null, "station": -1, "stations": []} when none).
+  http.Get(R"(/api/docs/(\d+)/stations)", [&state](const httplib::Request& request,
+                                                   httplib::Response& response) {
+    const auto document = state.FindDocument(request, response);
+    if (!document) return;
+    const auto [site, station] = SiteOf(state, document->id);
+    if (!site) {
+      return SendJson(
+          response,
+          {{"site", nullptr}, {"name", ""}, {"station", -1}, {"stations", nlohmann::ordered_json::array()}});
+    }
+    SendJson(response, SiteJson(state, *site, document->id));
+  });
+  // The cells the last Clean removed from this station, as it stands now: {"version", "cells": [row * cols +
+  // col, ...]} (empty once the clean is undone).
+  http.Get(R"(/api/docs/(\d+)/removed)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             const auto document = state.FindDocument(request, response);
+             if (!document) return;
+             std::vector<int64_t> cells;
+             int64_t version = 0;
+             {
+               std::lock_guard lock(document->mutex);
+               version = document->version;
+               const cv::Mat& removed = document->now.removed;
+               for (int r = 0; r < removed.rows; ++r) {
+                 const uint8_t* row = removed.ptr<uint8_t>(r);
+                 for (int c = 0; c < removed.cols; ++c) {
+                   if (row[c] != 0) cells.push_back(int64_t{r} * removed.cols + c);
+                 }
+               }
+             }
+             SendJson(response, {{"version", version}, {"cells", cells}});
+           });
+  PostDocument(state, R"(/api/docs/(\d+)/clean)", Clean);
+}
+
+}  // namespace lidarshop::server
