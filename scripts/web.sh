@@ -3,7 +3,8 @@
 #   scripts/web.sh build   npm ci (when the lock file changed), type-check, build web/dist, copy it beside the
 #                          lidarshop executable (build/release/web) so `lidarshop serve` finds it
 #   scripts/web.sh test    unit tests (Vitest), then end to end in Debian's chromium (playwright-core) against
-#                          build/release/lidarshop; screenshots in build/e2e/
+#                          build/release/lidarshop (e2e/editor.mjs, then a site's stations: e2e/stations.mjs);
+#                          screenshots in build/e2e/
 set -euo pipefail
 cd "$(dirname "$0")/.."
 command -v npm >/dev/null || { echo "web: npm is not installed (Node.js 20 from the machine's packages)"; exit 1; }
@@ -23,6 +24,7 @@ case ${1:-build} in
   test)
     (cd web && npx vitest run)
     (cd web && node e2e/editor.mjs ../build/release/lidarshop ../build/e2e "${@:2}")
+    (cd web && node e2e/stations.mjs ../build/release/lidarshop ../build/e2e "${@:2}")
     ;;
   *)
     echo "usage: scripts/web.sh build|test [--docs]"

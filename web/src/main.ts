@@ -7,6 +7,7 @@ import { PendingReview, ReviewChoice, decisionBody } from './review';
 import { ReviewPanel } from './reviewpanel';
 import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
+import { StationsPanel } from './stations';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -30,11 +31,20 @@ const strokeKinds = new Set<Brush>();  // brushes used on the open scan since it
 let pending: PendingReview | null = null; // the patch review shown (null = none)
 let placingByHand = false; // the next pick in the ray image is a review's source patch
 
+// The stations of the shown scan's site (stations.ts): the list, their markers in 3-D, Clean.
+async function showById(id: number) {
+  await listDocuments();
+  const next = openDocuments.find((d) => d.id === id);
+  if (next) await showDocument(next);
+}
+const stationsPanel = new StationsPanel({ api, doc: () => doc, show: showById, status, runJob, ...pointView.overlay() },
+                                        element('stations-list'), element<HTMLButtonElement>('clean'), element('clean-result'));
+
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {
   rayView, pointView, current: () => doc, verify: () => verify(), review: () => pending, pairs: () => pairsPanel,
   pointBytes: () => pointBytes, pointsShown: () => pointsShown, documents: () => openDocuments,
-  settled: () => pointsChain.then(() => true),
+  settled: () => pointsChain.then(() => true), stations: () => stationsPanel,
 };
 
 // Brings the held points of document `id` to the server's current version: the cells changed since the held
@@ -124,6 +134,9 @@ async function refresh(keepView: boolean, strokesOnly = false) {
   lastImage.set(imageKey, image);
   const shown = await rayView.show(id, v, image, mask, hole, strokes, info.rows, info.cols, aspect, keepView);
   if (!strokesOnly) await updatePoints(id, keepView);
+  if (!strokesOnly && doc?.id === id) {
+    await stationsPanel.refresh(info, heldPoints.get(id)?.points).catch((error) => status(`stations: ${(error as Error).message}`));
+  }
   if (!shown || doc?.id !== id || gate.version(id) !== v) return;
   const photos = info.e57_images ?? [];
   const photoSelect = element<HTMLSelectElement>('e57-photo');
@@ -244,6 +257,16 @@ for (const layer of ['original', 'synthesized', 'object'] as const) {
   element<HTMLInputElement>(`layer-${layer}`).addEventListener('change', (event) =>
     pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked));
 }
+element<HTMLInputElement>('layer-stations').addEventListener('change', (event) =>
+  stationsPanel.setOthersVisible((event.target as HTMLInputElement).checked));
+const openSite = (body: { scene?: string; path?: string; documents?: number[] }) =>
+  stationsPanel.open(body).catch(async (error) => {
+    status(`open site failed: ${(error as Error).message}`);
+    await listDocuments().catch(() => {});
+  });
+element('open-site-scene').addEventListener('click', () => openSite({ scene: element<HTMLSelectElement>('scene').value }));
+element('open-site-file').addEventListener('click', () => openSite({ path: element<HTMLSelectElement>('file').value }));
+element('group-docs').addEventListener('click', () => openSite({ documents: openDocuments.map((d) => d.id) }));
 element<HTMLInputElement>('point-size').addEventListener('input', (event) => pointView.setPointSize(Number((event.target as HTMLInputElement).value)));
 element<HTMLSelectElement>('point-colour').addEventListener('change', (event) => pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring));
 element('open-scene').addEventListener('click', () => open({ scene: element<HTMLSelectElement>('scene').value }));

@@ -172,6 +172,11 @@ export class PointView {
     this.render();
   }
 
+  // The scene and a redraw, for what other modules draw in the view (stations.ts: the stations' markers).
+  overlay(): { scene: THREE.Scene; render: () => void } {
+    return { scene: this.scene, render: () => this.render() };
+  }
+
   // Orbits the camera about the target by `degrees` (tests and the "orbit" of the closing screenshots).
   orbit(degrees: number) {
     const offset = this.camera.position.clone().sub(this.controls.target);
