@@ -14,6 +14,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::python {
@@ -285,7 +286,10 @@ void BindFiles(py::module_& m) {
       "metadata) and E57 images.");
   m.def(
       "read_scans", [](const std::string& path) { return ReadScanFile(path).scans; }, py::arg("path"),
-      py::call_guard<py::gil_scoped_release>(), "Reads every scan of a file (E57 and PTX hold several).");
+      py::call_guard<py::gil_scoped_release>(),
+      "Reads every scan of a file (E57 and PTX hold several: a site's stations, docs/stations.md) as a list "
+      "of "
+      "organized Scans, in the file's order, each with its pose (world_from_scanner) and name.");
   m.def(
       "write_scan",
       [](const py::object& scans, const std::string& path) {
@@ -369,6 +373,21 @@ void BindFiles(py::module_& m) {
       "fields "
       "changed in it ({'rows': 300, 'los_noise_sigma_m': 0.005}). Returns a Scan with colour, intensity, "
       "labels, normals and true ranges.");
+  m.def(
+      "scan_stations",
+      [](const py::object& scene) {
+        const SceneDescription description = SceneOf(scene);
+        py::gil_scoped_release release;
+        return ScanStations(description);
+      },
+      py::arg("scene"),
+      "Scans every station of a site (a scene with \"stations\", docs/stations.md; as scan_scene: a path, "
+      "dict "
+      "or built-in name such as 'parking_lot_stations'): a list of Scans, in order, each with the objects "
+      "there, "
+      "its pose (world_from_scanner) and the name station0, station1, ... A scene with one scanner gives one "
+      "Scan. write_scan(list, 'site.e57') writes them as one E57 of several data3D; read_scans reads them "
+      "back.");
 }
 
 }  // namespace lidarshop::python

@@ -6,6 +6,8 @@
 
 #include <chrono>
 #include <filesystem>
+#include <map>
+#include <random>
 #include <thread>
 
 #include <fmt/format.h>
@@ -256,6 +258,61 @@ TEST_F(StationsServerTest, StateChangingStationRoutesGoThroughTheSecurityChecks)
   // Reading needs the token too.
   EXPECT_EQ(client_->Get("/api/sites")->status, 401);
   EXPECT_EQ(client_->Get(fmt::format("/api/docs/{}/stations", site["document"].get<int>()))->status, 401);
+}
+
+// Malformed bodies of every shape on the station routes: a 4xx naming the problem, never a 500.
+TEST_F(StationsServerTest, RandomBodiesOnTheStationRoutesGetNo500) {
+  const nlohmann::json site = OpenSite({{"path", "site.e57"}});
+  const int document = site["document"];
+  std::mt19937 random(31);
+  const std::vector<std::string> keys = {"path", "scene", "documents", "station", "stations", "name", "x"};
+  const auto value = [&random]() {
+    nlohmann::json values[] = {nullptr,
+                               true,
+                               -1,
+                               0,
+                               1,
+                               2,
+                               3,
+                               1 << 30,
+                               -2.5,
+                               1e300,
+                               "",
+                               "site.e57",
+                               "../site.e57",
+                               "/etc/passwd",
+                               "parking_lot_stations",
+                               nlohmann::json::array(),
+                               nlohmann::json::object(),
+                               nlohmann::json{0, 1},
+                               nlohmann::json{0, 0},
+                               nlohmann::json{-1, 5},
+                               nlohmann::json{"a", nullptr},
+                               nlohmann::json{{"margin_cells", "x"}},
+                               nlohmann::json{{"nope", 1}}};
+    return values[std::uniform_int_distribution<size_t>(0, std::size(values) - 1)(random)];
+  };
+  std::map<int, int> statuses;
+  for (int i = 0; i < 300; ++i) {
+    nlohmann::json body = nlohmann::json::object();
+    const int count = std::uniform_int_distribution<int>(1, 3)(random);
+    for (int k = 0; k < count; ++k)
+      body[keys[std::uniform_int_distribution<size_t>(0, keys.size() - 1)(random)]] = value();
+    const bool clean = i % 2 == 1;
+    // A clean with options that are not CleanOptions is refused before any job starts.
+    if (clean) body["options"] = i % 4 == 1 ? value() : nlohmann::json{{"margin_cells", -1}};
+    if (clean && body["options"].is_object() && body["options"].empty())
+      body["options"] = nlohmann::json{{"nope", 1}};
+    if (!clean && body.contains("scene") && body["scene"] == "parking_lot_stations") body["station"] = 7;
+    const std::string path = clean ? fmt::format("/api/docs/{}/clean", document) : "/api/sites";
+    const auto answer = Post(path, body);
+    ASSERT_TRUE(answer) << path << " " << body.dump();
+    ++statuses[answer->status];
+    EXPECT_LT(answer->status, 500) << path << " " << body.dump() << " -> " << answer->body;
+    EXPECT_NE(answer->status, 202) << path << " " << body.dump();
+    EXPECT_TRUE(nlohmann::json::accept(answer->body)) << answer->body;
+  }
+  EXPECT_GT(statuses[400], 100);
 }
 
 }  // namespace

@@ -172,9 +172,18 @@ export class PointView {
     this.render();
   }
 
-  // The scene and a redraw, for what other modules draw in the view (stations.ts: the stations' markers).
-  overlay(): { scene: THREE.Scene; render: () => void } {
-    return { scene: this.scene, render: () => this.render() };
+  // The scene and a redraw, for what other modules draw in the view (stations.ts: the stations' markers), and
+  // a turn of the view towards a point (the camera stays where it is).
+  overlay(): { scene: THREE.Scene; render: () => void; focus: (x: number, y: number, z: number) => void } {
+    return {
+      scene: this.scene,
+      render: () => this.render(),
+      focus: (x, y, z) => {
+        this.controls.target.set(x, y, z);
+        this.controls.update();
+        this.render();
+      },
+    };
   }
 
   // Orbits the camera about the target by `degrees` (tests and the "orbit" of the closing screenshots).

@@ -56,6 +56,15 @@ export function stationPositionsInView(site: SiteInfo, worldFromCurrent: number[
   });
 }
 
+// The mean of `xyz` (3 per point), or null when empty.
+export function centroid(xyz: Float32Array): [number, number, number] | null {
+  const n = xyz.length / 3;
+  if (n === 0) return null;
+  const sum = [0, 0, 0];
+  for (let i = 0; i < n; ++i) for (let k = 0; k < 3; ++k) sum[k] += xyz[3 * i + k];
+  return [sum[0] / n, sum[1] / n, sum[2] / n];
+}
+
 // The positions (xyz, 3 per point) of the points of `points` whose cell is in `cells`: the removed cells
 // highlighted (after a clean they hold the filled, synthesized points).
 export function pointsOfCells(points: PointSet, cells: Iterable<number>): Float32Array {
@@ -100,6 +109,7 @@ export interface StationsHost {
   runJob: (path: string, body: unknown, what: string) => Promise<JobInfo | null>;
   scene: THREE.Scene; // the 3-D view's scene (PointView.overlayScene)
   render: () => void; // redraws the 3-D view
+  focus: (x: number, y: number, z: number) => void; // turns the 3-D view towards a point (shown scan's frame)
 }
 
 export class StationsPanel {
@@ -242,6 +252,10 @@ export class StationsPanel {
       const summary = cleanSummary(finished.result);
       this.result.textContent = summary;
       this.host.status(summary);
+      // The view turns towards what was removed here (highlighted).
+      const position = this.removed?.geometry.getAttribute('position');
+      const centre = position ? centroid(position.array as Float32Array) : null;
+      if (centre) this.host.focus(...centre);
     }
   }
 }

@@ -1,6 +1,6 @@
 import { describe, expect, it } from 'vitest';
 import { poseMatrix, PointSet } from '../src/api';
-import { SiteInfo, StationInfo, cleanSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
+import { SiteInfo, StationInfo, centroid, cleanSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
 
 function station(index: number, x: number, y: number, yawDeg: number, extra: Partial<StationInfo> = {}): StationInfo {
   return {
@@ -58,6 +58,13 @@ describe('pointsOfCells', () => {
     expect(Array.from(pointsOfCells(points, [4, 2]))).toEqual([3, 4, 5, 6, 7, 8]);
     expect(pointsOfCells(points, []).length).toBe(0);
     expect(pointsOfCells(points, [5]).length).toBe(0);
+  });
+});
+
+describe('centroid', () => {
+  it('is the mean point, null for none', () => {
+    expect(centroid(new Float32Array([0, 0, 0, 2, 4, -6]))).toEqual([1, 2, -3]);
+    expect(centroid(new Float32Array([]))).toBeNull();
   });
 });
 

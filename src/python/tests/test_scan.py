@@ -166,3 +166,33 @@ def test_builtin_scenes_and_dict_scenes():
     scene["objects"][0]["size"] = [-1, 60]
     with pytest.raises(lidarshop.InputError, match="size"):
         lidarshop.scan_scene(scene)
+
+
+def test_read_scans_gives_a_sites_stations_with_their_poses(tmp_path):
+    # The built-in site on a coarse grid: three stations, the late sedan (label 7) at station 2 only.
+    site = lidarshop.builtin_scene("parking_lot_stations")
+    for station in site["stations"]:
+        station["columns"], station["rows"] = 120, 70
+    stations = lidarshop.scan_stations(site)
+    assert [s.name for s in stations] == ["station0", "station1", "station2"]
+    assert [bool((s.label[s.valid > 0] == 7).any()) for s in stations] == [False, False, True]
+    for extension in ["e57", "ptx"]:
+        path = str(tmp_path / f"site.{extension}")
+        lidarshop.write_scan(stations, path)
+        back = lidarshop.read_scans(path)
+        assert len(back) == 3, extension
+        for i, (read, written) in enumerate(zip(back, stations)):
+            assert (read.rows, read.cols) == (written.rows, written.cols)
+            np.testing.assert_allclose(read.world_from_scanner, written.world_from_scanner, atol=1e-9)
+            np.testing.assert_array_equal(read.valid > 0, written.valid > 0)
+            if extension == "e57":
+                assert read.name == f"station{i}"
+        # Where each stands (x = 0, -8, +8 m) and looks (yaw 0, -30, +30 degrees).
+        for read, x, yaw in zip(back, [0, -8, 8], [0, -30, 30]):
+            pose = read.world_from_scanner
+            assert pose[0, 3] == pytest.approx(x)
+            assert np.degrees(np.arctan2(-pose[0, 1], pose[1, 1])) == pytest.approx(yaw)
+    # One scanner: one scan.
+    mailbox = lidarshop.builtin_scene("mailbox")
+    mailbox["scanner"]["columns"], mailbox["scanner"]["rows"] = 60, 40
+    assert len(lidarshop.scan_stations(mailbox)) == 1
