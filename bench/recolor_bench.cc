@@ -17,8 +17,8 @@
 #include "lidarshop/recolor/distance_raster.h"
 #include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/recolor/visibility.h"
+#include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/station_photos.h"
-#include "lidarshop/testing/scenes.h"
 
 namespace lidarshop {
 namespace {
@@ -33,9 +33,11 @@ const Station& CachedStation(int rows, int columns, int face_px) {
   auto& slot = cache[{rows, columns, face_px}];
   if (!slot) {
     slot = std::make_unique<Station>();
-    const SceneDescription scene = test_scenes::LoadBuiltinScene("parking_lot");
-    const ScannerOptions scanner = test_scenes::SmallScanner(scene.scanner, rows, columns);
-    slot->scan = test_scenes::ScanScene(scene, scanner);
+    const SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/scenes/parking_lot.json");
+    ScannerOptions scanner = scene.scanner;
+    scanner.rows = rows;
+    scanner.columns = columns;
+    slot->scan = SyntheticScanner(scene).Acquire(scanner);
     StationPhotoOptions options;
     options.kind = StationPhotoKind::kCube;
     options.size_px = face_px;
