@@ -249,8 +249,14 @@ void Clean(State& state, const std::shared_ptr<Document>& document, const nlohma
             Snapshot next = station.now;
             next.scan = result.stations[i];
             next.removed = found.transient.clone();  // a new buffer: see Snapshot
-            Commit(station, std::move(next), undo_depth);
-            json["changed"] = true;
+            try {
+              Commit(station, std::move(next), undo_depth);
+              json["changed"] = true;
+            } catch (
+                const DocumentLimitError& error) {  // past the memory limit: this station stays as it was
+              json["changed"] = false;
+              json["why"] = error.what();
+            }
           }
           json["version"] = station.version;
           if (station.id == current_document) {
