@@ -78,6 +78,8 @@ export interface PointSet {
 
 export const FLAG_SYNTHESIZED = 1;
 export const FLAG_OBJECT = 2;
+// The point was filled from what another station of the site measured (real, not synthesized; issue 31 part 3).
+export const FLAG_FROM_STATION = 8;
 
 const MAGIC = 0x3150534c; // "LSP1"
 

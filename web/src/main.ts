@@ -253,7 +253,7 @@ element<HTMLInputElement>('radius').addEventListener('change', (event) => {
   rayView.radius = Number((event.target as HTMLInputElement).value);
 });
 element('channel').addEventListener('change', () => refresh(true));
-for (const layer of ['original', 'synthesized', 'object'] as const) {
+for (const layer of ['original', 'synthesized', 'object', 'from-stations'] as const) {
   element<HTMLInputElement>(`layer-${layer}`).addEventListener('change', (event) =>
     pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked));
 }

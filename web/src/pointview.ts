@@ -1,16 +1,19 @@
 // The scan's points in 3-D (three.js): orbit with the mouse, point size, colour by scan colour, by layer
-// (original grey, synthesized cyan, object orange) or by height; the picked cell's point is marked.
+// (original grey, synthesized cyan, object orange, filled from another station green) or by height; the picked
+// cell's point is marked.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet } from './api';
+import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet } from './api';
 
 export type PointColouring = 'rgb' | 'layers' | 'height';
-export type Layer = 'original' | 'synthesized' | 'object';
+export type Layer = 'original' | 'synthesized' | 'object' | 'from-stations';
 
-// The layer a point belongs to: the object, synthesized (filled, or on the surface behind a kept object), or
-// the original scan.
+// The layer a point belongs to: the object, filled from another station of the site (a real measurement),
+// synthesized (filled, or on the surface behind a kept object), or the original scan.
 export function layerOf(flag: number): Layer {
-  return flag & FLAG_OBJECT ? 'object' : flag & (FLAG_SYNTHESIZED | 4) ? 'synthesized' : 'original';
+  if (flag & FLAG_OBJECT) return 'object';
+  if (flag & FLAG_FROM_STATION) return 'from-stations';
+  return flag & (FLAG_SYNTHESIZED | 4) ? 'synthesized' : 'original';
 }
 
 // The points of the layers not hidden (the same object when none is).
@@ -57,7 +60,7 @@ export function pointColours(points: PointSet, mode: PointColouring): Float32Arr
     let r = points.rgb[3 * i] / 255, g = points.rgb[3 * i + 1] / 255, b = points.rgb[3 * i + 2] / 255;
     if (mode === 'layers') {
       const flag = points.flags[i];
-      [r, g, b] = flag & FLAG_OBJECT ? [1, 0.55, 0.1] : flag & FLAG_SYNTHESIZED ? [0.1, 0.9, 1] : [0.6, 0.6, 0.6];
+      [r, g, b] = flag & FLAG_OBJECT ? [1, 0.55, 0.1] : flag & FLAG_FROM_STATION ? [0.35, 0.9, 0.3] : flag & FLAG_SYNTHESIZED ? [0.1, 0.9, 1] : [0.6, 0.6, 0.6];
     } else if (mode === 'height') {
       const t = zMax > zMin ? (points.xyz[3 * i + 2] - zMin) / (zMax - zMin) : 0.5;
       [r, g, b] = [t, 0.3 + 0.4 * (1 - Math.abs(2 * t - 1)), 1 - t];

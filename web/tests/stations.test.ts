@@ -1,5 +1,6 @@
 import { describe, expect, it } from 'vitest';
-import { poseMatrix, PointSet } from '../src/api';
+import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, poseMatrix, PointSet } from '../src/api';
+import { layerOf, pointColours, visiblePoints } from '../src/pointview';
 import { SiteInfo, StationInfo, centroid, cleanSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
 
 function station(index: number, x: number, y: number, yawDeg: number, extra: Partial<StationInfo> = {}): StationInfo {
@@ -86,5 +87,26 @@ describe('cleanSummary', () => {
   });
   it('copes with no result', () => {
     expect(cleanSummary(undefined)).toBe('clean: no result');
+  });
+});
+
+describe('the layer of points filled from other stations', () => {
+  const points: PointSet = {
+    count: 4, rows: 1, cols: 4,
+    xyz: new Float32Array(12), cells: new Uint32Array([0, 1, 2, 3]), rgb: new Uint8Array(12),
+    flags: new Uint8Array([0, FLAG_SYNTHESIZED, FLAG_FROM_STATION, FLAG_FROM_STATION | FLAG_OBJECT]),
+  };
+  it('is its own layer, distinct from synthesized, the object first', () => {
+    expect(Array.from(points.flags, layerOf)).toEqual(['original', 'synthesized', 'from-stations', 'object']);
+  });
+  it('can be hidden alone', () => {
+    const shown = visiblePoints(points, new Set(['from-stations']));
+    expect(Array.from(shown.cells)).toEqual([0, 1, 3]);
+  });
+  it('has its own colour', () => {
+    const colours = pointColours(points, 'layers');
+    const rgb = (i: number) => Array.from(colours.slice(3 * i, 3 * i + 3));
+    expect(rgb(2)).not.toEqual(rgb(1));
+    expect(rgb(2)).not.toEqual(rgb(0));
   });
 });
