@@ -160,7 +160,7 @@ void AddBuffer(const cv::Mat& mat, std::map<const void*, int64_t>& seen) {
 void CollectBuffers(const Scan& scan, std::map<const void*, int64_t>& seen) {
   for (const cv::Mat* mat :
        {&scan.direction, &scan.valid, &scan.range, &scan.point, &scan.intensity, &scan.color, &scan.label,
-        &scan.normal, &scan.curvature, &scan.true_range, &scan.synthesized}) {
+        &scan.normal, &scan.curvature, &scan.true_range, &scan.synthesized, &scan.from_station}) {
     AddBuffer(*mat, seen);
   }
   for (const auto& [name, mat] : scan.attributes) AddBuffer(mat, seen);

@@ -562,6 +562,7 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
             keep && !values.label.empty() ? values.label.at<int32_t>(y, x) : kNoLabel;
       }
       if (!out.true_range.empty()) out.true_range.at<float>(y, x) = 0.0f;  // no truth for a synthesized point
+      if (!out.from_station.empty()) out.from_station.at<uint8_t>(y, x) = 0;  // invented here, not measured
       if (!out.normal.empty()) out.normal.at<cv::Vec3f>(y, x) = cv::Vec3f(0, 0, 0);
       if (!out.curvature.empty()) out.curvature.at<float>(y, x) = NAN;  // the filled surface's is unknown
       if (keep) {

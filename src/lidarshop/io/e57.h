@@ -58,6 +58,8 @@ struct E57File {
 // xmlns:lidarshop="http://lidarshop.dev/e57/1.0" when a file uses it; its fields are
 // - the points prototype's `lidarshop:synthesized` (Integer 0..1, 1 = created by lidarshop), read back into
 //   Scan::synthesized (255 / 0);
+// - the points prototype's `lidarshop:fromStation` (Integer 0..255: 1 + the index of the other station a
+//   cell's return was taken from, site/from_stations.h; 0 = not), read back into Scan::from_station;
 // - `lidarshop:noReturnDirections` under a data3D entry: a Structure whose `points` CompressedVector holds
 //   one record per cell without a return (rowIndex, columnIndex, the unit ray as single-float
 //   cartesianX/Y/Z), read back into those cells' Scan::direction bit for bit.
@@ -68,7 +70,8 @@ constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 E57File ReadE57(const std::string& path);
 
 // Writes organized scans with pose, intensity and colour (each when the scan has it), row/column index and
-// invalid state, and the synthesized channel (when present) as the extension field lidarshop:synthesized;
+// invalid state, and the synthesized channel (when present) as the extension field lidarshop:synthesized
+// (from_station as lidarshop:fromStation);
 // atomic. Cells without a return get no record in `points` (as scanners' own files): every reader counts and
 // shows the scan's returns only. Their rays go to lidarshop:noReturnDirections (see E57WriteOptions).
 void WriteE57(const std::string& path, const std::vector<Scan>& scans);

@@ -33,6 +33,9 @@ constexpr int kMaxPrototypeFields = 4096;   // more bytestreams than this is a c
 constexpr char kExtensionXmlns[] = "xmlns:lidarshop";
 constexpr char kSynthesizedField[] = "lidarshop:synthesized";
 constexpr char kSynthesizedLocalName[] = "synthesized";
+// Scan::from_station (Integer 0..255: 1 + the index of the station a cell's return was taken from, 0 = not).
+constexpr char kFromStationField[] = "lidarshop:fromStation";
+constexpr char kFromStationLocalName[] = "fromStation";
 // The rays of a scan's cells without a return (e57.h): a Structure under the data3D entry holding a `points`
 // CompressedVector of rowIndex, columnIndex and the unit ray as cartesianX/Y/Z.
 constexpr char kNoReturnDirectionsField[] = "lidarshop:noReturnDirections";

@@ -153,6 +153,11 @@ std::vector<std::string> PrototypeChannels(pugi::xml_node prototype, const std::
   if (has("colorRed") && has("colorGreen") && has("colorBlue")) channels.push_back("rgb");
   if (!synthesized_field.empty() && prototype.child(synthesized_field.c_str()))
     channels.push_back("synthesized");
+  if (!synthesized_field.empty()) {
+    const std::string from_station_field =
+        synthesized_field.substr(0, synthesized_field.find(':') + 1) + kFromStationLocalName;
+    if (prototype.child(from_station_field.c_str())) channels.push_back("from_station");
+  }
   return channels;
 }
 

@@ -779,6 +779,24 @@ void ReadSynthesized(const PointRecords& records, const std::string& synthesized
   }
 }
 
+// lidarshop's `fromStation` extension field ("" when the file does not declare the namespace) into the layers'
+// from_station channels (site/from_stations.h).
+void ReadFromStation(const PointRecords& records, const std::string& field_name, const RecordGrid& grid,
+                     const std::vector<uint8_t>& layer, Scan* const layers[2]) {
+  const Field* field = field_name.empty() ? nullptr : records.Find(field_name.c_str());
+  if (!field) return;
+  const auto& v = records.Decode(field);
+  for (int l = 0; l < 2; ++l) {
+    Scan* s = layers[l];
+    if (s != nullptr && s->num_cells() > 0) s->from_station = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
+  }
+  for (int64_t i = 0; i < records.count; ++i) {
+    if (grid.cell[i] >= 0 && std::isfinite(v[i]) && v[i] > 0.0)
+      layers[layer[i]]->from_station.ptr<uint8_t>()[grid.cell[i]] =
+          static_cast<uint8_t>(std::min(v[i], 255.0));
+  }
+}
+
 // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turns the
 // grid of a structured scan (and its second layer) into image orientation (row 0 = highest elevation, our
 // azimuth increasing to the right) by the data, then gives no-return cells directions from the fitted
@@ -790,8 +808,8 @@ void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* 
     const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
     for (Scan* s : layers) {
       if (s == nullptr || s->num_cells() == 0) continue;
-      for (cv::Mat* m :
-           {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized}) {
+      for (cv::Mat* m : {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color,
+                         &s->synthesized, &s->from_station}) {
         if (!m->empty()) cv::flip(*m, *m, code);
       }
     }
@@ -860,6 +878,8 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   ReadIntensity(ctx, child, records, grid, layer, layers);
   ReadColor(ctx, child, records, grid, layer, layers);
   ReadSynthesized(records, synthesized_field, grid, layer, layers);
+  ReadFromStation(records, extension_prefix.empty() ? "" : extension_prefix + ":" + kFromStationLocalName,
+                  grid, layer, layers);
   if (records.structured && scan.num_cells() > 0)
     OrientStructuredScan(std::move(placed.has_direction), &scan, second);
   return scan;

@@ -283,6 +283,20 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
   }
+  // The cells taken from another station's measurement (site/from_stations.h), per layer when it has them.
+  const bool write_from_station =
+      !scan.from_station.empty() || (behind != nullptr && !behind->from_station.empty());
+  if (write_from_station) {
+    Stream s;
+    s.field = IntegerField(kFromStationField, 0, 255);
+    BitWriter w(s.field.bits);
+    for (int64_t i = 0; i < n; ++i) {
+      const Scan& from = layer_of(i);
+      w.PutInteger(from.from_station.empty() ? 0 : from.from_station.ptr<uint8_t>()[records[i].cell], 0);
+    }
+    s.bytes = w.Finish();
+    streams.push_back(std::move(s));
+  }
 
   for (int axis = 0; axis < 3; ++axis) {
     if (lo[axis] > hi[axis]) lo[axis] = hi[axis] = 0.0;
@@ -361,7 +375,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     AppendNoReturnDirections(scan, direction_cells, logical, child);
     return true;
   }
-  return write_synthesized;
+  return write_synthesized || write_from_station;
 }
 
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform) {

@@ -39,6 +39,8 @@ struct ScanFormatInfo {
   // The file needs an intensity column: a scan without one is written with the format's no-information value.
   bool intensity_required = false;
   ChannelHeld intensity, color, label, normal, true_range, synthesized;
+  // Scan::from_station: the cells filled from another station's measurement (site/from_stations.h).
+  ChannelHeld from_station;
   bool images = false;  // photos with their poses (E57 images2D)
   // A second layer of cells behind the first (remove --keep-object): WriteScanWithLayer.
   bool layer_behind = false;

@@ -15,6 +15,9 @@
 //               fields (every value <= 255, a common writer mistake) are taken as 8-bit
 //   label       the classification value (0-31 in formats 0-5, 0-255 in 6-10) when some point's is non-zero
 //   synthesized the "synthetic" bit (255) when some point has it
+//   from_station the user data byte, when the file holds lidarshop's record (user ID "lidarshop", record 1:
+//               a file lidarshop wrote of scans with cells filled from other stations); otherwise user data
+//               is the kLasUserData attribute
 //   attributes  (Scan::attributes, each only when some point's value is not 0) every other standard field:
 //               kLasGpsTime .. kLasExtraBytes below. The original 16-bit colour is kept in kLasRgb16 when
 //               it is not 8-bit colour times 257, so LAS -> LAS keeps it exactly.
@@ -48,6 +51,9 @@
 //               formats 0-3, classification flags bit 0 in 6-8): synthesized data is always marked
 //   attributes  every kLas* attribute the point format holds; return 1 of 1 and point source ID = the scan's
 //               index where a scan has none
+//   from_station when some scan has the channel (site/from_stations.h): its value (1 + the index of the
+//               station the point was taken from, 0 = not) in the user data byte, which then does not hold the
+//               kLasUserData attribute, and lidarshop's record (user ID "lidarshop", record 1) says so
 // Point format -1 (the default) = the source's format when every scan came from LAS files of one format
 // that holds their attributes, else (1.4) 8 with NIR, 7 with colour, 6 without; (1.2) 3/2 with colour, 1/0.
 // VLRs: the scans' source records (the first scan's, when several scans carry different ones), with the
@@ -82,6 +88,9 @@ inline constexpr const char* kLasNir = "nir";                               // C
 inline constexpr const char* kLasRgb16 = "rgb16";                           // CV_16UC3, R G B
 // CV_8UC(n): the n extra bytes after each record, as the LASF_Spec 4 record in source_records describes them.
 inline constexpr const char* kLasExtraBytes = "las_extra_bytes";
+// lidarshop's variable length record: the user data byte holds Scan::from_station.
+inline constexpr const char* kLasLidarshopUserId = "lidarshop";
+inline constexpr int kLasFromStationRecordId = 1;
 
 struct LasWriteOptions {
   // LAS 1.x: 4 (LAS 1.4, 375-byte header, formats 0-3 and 6-8) or 2 (LAS 1.2, formats 0-3: for older

@@ -207,8 +207,11 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
   if (!extra.empty()) scan.attributes[kLasExtraBytes] = extra;
 
   std::vector<std::string> left_out;
+  bool from_station = false;
   for (SourceRecord& source : header.records) {
-    if (KeepRecord(source)) {
+    if (source.user_id == kLasLidarshopUserId && source.record_id == kLasFromStationRecordId) {
+      from_station = true;  // the user data byte is lidarshop's from_station channel
+    } else if (KeepRecord(source)) {
       scan.source_records.push_back(std::move(source));
     } else if (!(header.laz && source.user_id == "laszip encoded" &&
                  source.record_id == laz::kLazVlrRecordId)) {
@@ -221,6 +224,12 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
         "{}: {} variable length record{} not kept ({}): only the coordinate "
         "system's and the specification's are carried to written files",
         file, left_out.size(), left_out.size() == 1 ? " is" : "s are", fmt::join(left_out, ", ")));
+  }
+  if (from_station) {
+    const auto found = scan.attributes.find(kLasUserData);
+    scan.from_station =
+        found == scan.attributes.end() ? cv::Mat(1, scan.cols, CV_8U, cv::Scalar(0)) : found->second;
+    if (found != scan.attributes.end()) scan.attributes.erase(found);
   }
   scan.source_metadata["las.point_format"] = std::to_string(format);
   scan.source_metadata["las.minor_version"] = std::to_string(header.minor_version);

@@ -68,8 +68,16 @@ std::vector<SourceRecord> RecordsToWrite(const std::vector<Scan>& scans, bool ex
   for (const SourceRecord& record : scans.front().source_records) {
     if (record.format != "las") continue;
     if (record.user_id == "LASF_Spec" && record.record_id == 4 && !extra_bytes) continue;
-    if (record.payload.size() > 65535) continue;  // an extended record's size: not a VLR
+    if (record.payload.size() > 65535) continue;          // an extended record's size: not a VLR
+    if (record.user_id == kLasLidarshopUserId) continue;  // written below when it still holds
     records.push_back(record);
+  }
+  if (std::any_of(scans.begin(), scans.end(), [](const Scan& scan) { return !scan.from_station.empty(); })) {
+    records.push_back(
+        {"las", kLasLidarshopUserId, kLasFromStationRecordId, "user data = from station",
+         "The user data byte of each point is 1 + the index of the other station of the site whose "
+         "measurement was resampled onto this point's ray (lidarshop fill/remove --stations), 0 = "
+         "not."});
   }
   return records;
 }
@@ -319,7 +327,9 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
         const uint8_t direction = AttributeAt<uint8_t>(scan, kLasScanDirection, row, col, 0) & 1;
         const uint8_t edge = AttributeAt<uint8_t>(scan, kLasEdgeOfFlightLine, row, col, 0) & 1;
         const float angle_deg = AttributeAt<float>(scan, kLasScanAngle, row, col, 0.0f);
-        const uint8_t user_data = AttributeAt<uint8_t>(scan, kLasUserData, row, col, 0);
+        const uint8_t user_data = !scan.from_station.empty()
+                                      ? scan.from_station.at<uint8_t>(row, col)
+                                      : AttributeAt<uint8_t>(scan, kLasUserData, row, col, 0);
         const uint16_t source = AttributeAt<uint16_t>(scan, kLasPointSourceId, row, col, default_source);
         if (legacy) {
           out[las::point::kReturnByte] =

@@ -442,6 +442,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
   const int fcurvature = header.Find("curvature");
   const int fsynth = header.Find("synthesized");
   const int ftrue = header.Find("true_range");
+  const int ffrom = header.Find("from_station");
   const bool with_color = fcolor >= 0 || split_color;
   const bool normals = fnx >= 0 && fny >= 0 && fnz >= 0;
 
@@ -529,6 +530,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
   if (fcurvature >= 0) scan.curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
   if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  if (ffrom >= 0) scan.from_station = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   const Eigen::Matrix3d scanner_from_world_rotation =
       scan.world_from_scanner.topLeftCorner<3, 3>().transpose();
   for (int row = 0; row < rows; ++row) {
@@ -571,6 +573,11 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
         scan.synthesized.at<uint8_t>(row, col) = kValid;
       }
       if (ftrue >= 0) scan.true_range.at<float>(row, col) = LoadValue(record + f[ftrue].offset, f[ftrue]);
+      if (ffrom >= 0) {
+        const double from = LoadValue(record + f[ffrom].offset, f[ffrom]);
+        scan.from_station.at<uint8_t>(row, col) =
+            std::isfinite(from) ? static_cast<uint8_t>(std::clamp(from, 0.0, 255.0)) : 0;
+      }
     }
   }
   // Pictures show integer intensities in the file's units (io/render.h).
@@ -607,6 +614,7 @@ ScanFileHeader io_internal::ReadPcdHeader(const std::string& path) {
   if (header.Find("curvature") >= 0) scan.channels.push_back("curvature");
   if (header.Find("true_range") >= 0) scan.channels.push_back("true_range");
   if (header.Find("synthesized") >= 0) scan.channels.push_back("synthesized");
+  if (header.Find("from_station") >= 0) scan.channels.push_back("from_station");
   file.scans.push_back(scan);
   return file;
 }
@@ -658,6 +666,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
   if (!scan.curvature.empty()) add("curvature", "4", "F");  // PCL's PointNormal field
   if (!scan.synthesized.empty()) add("synthesized", "1", "U");
   if (!scan.true_range.empty()) add("true_range", "4", "F");
+  if (!scan.from_station.empty()) add("from_station", "1", "U");
   std::string pose;
   for (int i = 0; i < 16; ++i) {
     pose += ' ';
@@ -699,6 +708,7 @@ void WritePcd(const std::string& path, const Scan& scan) {
       if (!scan.synthesized.empty())
         put(static_cast<uint8_t>(scan.synthesized.at<uint8_t>(row, col) ? 1 : 0));
       if (!scan.true_range.empty()) put(scan.true_range.at<float>(row, col));
+      if (!scan.from_station.empty()) put(static_cast<uint8_t>(scan.from_station.at<uint8_t>(row, col)));
     }
   }
   WriteFileAtomically(path, [&](std::ostream& stream) { stream.write(out.data(), out.size()); });

@@ -108,6 +108,7 @@ std::vector<Scan> ReadPlyScans(const std::string& path, std::vector<std::string>
   const PlyProperty* scan_property = FindScalar(vertex, {"scan"});
   const PlyProperty* true_range_property = FindScalar(vertex, {"true_range"});
   const PlyProperty* curvature_property = FindScalar(vertex, {"curvature"});
+  const PlyProperty* from_station_property = FindScalar(vertex, {"from_station"});
 
   if (headers.empty() || row_property == nullptr || col_property == nullptr) {
     // A plain point cloud: one 1 x N scan, every point a return.
@@ -129,6 +130,8 @@ std::vector<Scan> ReadPlyScans(const std::string& path, std::vector<std::string>
       scan.true_range = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(0));
     if (curvature_property != nullptr)
       scan.curvature = cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN));
+    if (from_station_property != nullptr)
+      scan.from_station = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
     scanner_from_world.push_back(header.world_from_scanner.inverse());
     scans.push_back(std::move(scan));
   }
@@ -168,6 +171,11 @@ std::vector<Scan> ReadPlyScans(const std::string& path, std::vector<std::string>
     if (true_range_property != nullptr) scan.true_range.at<float>(row, col) = true_range_property->values[i];
     if (curvature_property != nullptr && curvature_property->values[i] >= 0.0)  // < 0: unknown (kNoCurvature)
       scan.curvature.at<float>(row, col) = curvature_property->values[i];
+    if (from_station_property != nullptr) {
+      const double from = from_station_property->values[i];
+      scan.from_station.at<uint8_t>(row, col) =
+          std::isfinite(from) ? static_cast<uint8_t>(std::clamp(from, 0.0, 255.0)) : 0;
+    }
   }
   for (Scan& scan : scans) FinishScan(&scan, /*fit_grid=*/true);
   return scans;
@@ -179,7 +187,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   ply.comments.push_back("frame world");
   int64_t total = 0;
   bool color = false, label = false, normal = false, curvature = false, synthesized = false,
-       true_range = false, far = false, any_intensity = false;
+       true_range = false, far = false, any_intensity = false, from_station = false;
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
     CheckScan(scan);
@@ -194,9 +202,10 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
     curvature |= !scan.curvature.empty();
     synthesized |= !scan.synthesized.empty();
     true_range |= !scan.true_range.empty();
+    from_station |= !scan.from_station.empty();
   }
   std::vector<double> x, y, z, nx, ny, nz, curv, red, green, blue, intensity, labels, synth, truth, rows,
-      cols, index;
+      cols, index, from;
   for (std::vector<double>* column : {&x, &y, &z, &intensity, &rows, &cols, &index}) column->reserve(total);
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
@@ -242,6 +251,8 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
         if (synthesized)
           synth.push_back(!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(row, col) ? 1 : 0);
         if (true_range) truth.push_back(scan.true_range.empty() ? 0.0 : scan.true_range.at<float>(row, col));
+        if (from_station)
+          from.push_back(scan.from_station.empty() ? 0 : scan.from_station.at<uint8_t>(row, col));
       }
     }
   }
@@ -265,6 +276,7 @@ void WritePlyScans(const std::string& path, const std::vector<Scan>& scans) {
   if (label) AddScalarProperty(&vertex, "label", PlyType::kInt32, std::move(labels));
   if (synthesized) AddScalarProperty(&vertex, "synthesized", PlyType::kUInt8, std::move(synth));
   if (true_range) AddScalarProperty(&vertex, "true_range", PlyType::kFloat32, std::move(truth));
+  if (from_station) AddScalarProperty(&vertex, "from_station", PlyType::kUInt8, std::move(from));
   AddScalarProperty(&vertex, "row", PlyType::kInt32, std::move(rows));
   AddScalarProperty(&vertex, "col", PlyType::kInt32, std::move(cols));
   AddScalarProperty(&vertex, "scan", PlyType::kInt32, std::move(index));
@@ -299,6 +311,7 @@ ScanFileHeader PlyFileHeader(const std::string& path) {
   if (FindScalar(vertex, {"curvature"})) channels.push_back("curvature");
   if (organized && FindScalar(vertex, {"true_range"})) channels.push_back("true_range");
   if (FindScalar(vertex, {"synthesized"})) channels.push_back("synthesized");
+  if (organized && FindScalar(vertex, {"from_station"})) channels.push_back("from_station");
   if (!organized) {
     if (vertex.count == 0) ThrowInputError(path, "header", "element vertex", "no points");
     CheckScanSize(1, vertex.count, path, "header");

@@ -65,6 +65,8 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
        holds.true_range},
       {any([](const Scan& s) { return !s.synthesized.empty(); }), "synthesized", "synthesized flags",
        holds.synthesized},
+      {any([](const Scan& s) { return !s.from_station.empty(); }), "from_station", "from-station marks",
+       holds.from_station},
   };
   for (const Optional& channel : optional) {
     if (!channel.present) continue;
@@ -79,6 +81,19 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
                         "--drop-synthesized leaves them out, --synthesized-mask M.png records them)",
                         path, WithThousandsSeparators(synthesized), synthesized == 1 ? " is" : "s are",
                         synthesized == 1 ? "its" : "their", holds.name));
+      }
+    } else if (!channel.target.held && std::string(channel.channel) == "from_station") {
+      int64_t taken = 0;
+      for (const Scan& scan : scans) {
+        if (!scan.from_station.empty()) taken += cv::countNonZero(scan.from_station & scan.valid);
+      }
+      if (taken > 0) {
+        plan.dropped.push_back(
+            fmt::format("{}: {} point{} filled from other stations {} written without the from_station "
+                        "channel ({} cannot "
+                        "hold it: write .e57 or .las to keep it; --from-stations-mask M.png records them)",
+                        path, WithThousandsSeparators(taken), taken == 1 ? "" : "s",
+                        taken == 1 ? "is" : "are", holds.name));
       }
     } else if (!channel.target.held) {
       plan.dropped.push_back(fmt::format("{}: {} are not written ({} has no {} field)", path, channel.plural,

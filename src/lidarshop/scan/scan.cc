@@ -71,7 +71,7 @@ Scan Clone(const Scan& scan) {
   Scan copy = scan;
   for (cv::Mat* channel :
        {&copy.direction, &copy.valid, &copy.range, &copy.point, &copy.intensity, &copy.color, &copy.label,
-        &copy.normal, &copy.curvature, &copy.true_range, &copy.synthesized}) {
+        &copy.normal, &copy.curvature, &copy.true_range, &copy.synthesized, &copy.from_station}) {
     *channel = channel->clone();
   }
   for (auto& [name, values] : copy.attributes) values = values.clone();
@@ -96,6 +96,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
   if (!masked.curvature.empty()) masked.curvature.setTo(NAN, drop);
   if (!masked.true_range.empty()) masked.true_range.setTo(0, drop);
   if (!masked.synthesized.empty()) masked.synthesized.setTo(0, drop);
+  if (!masked.from_station.empty()) masked.from_station.setTo(0, drop);
   for (auto& [name, values] : masked.attributes) values.setTo(cv::Scalar::all(0), drop);
   return masked;
 }
@@ -117,6 +118,7 @@ void ForEachChannel(ScanT& scan, Visit visit) {
   visit(scan.curvature, cv::Scalar(NAN));
   visit(scan.true_range, cv::Scalar(0));
   visit(scan.synthesized, cv::Scalar(0));
+  visit(scan.from_station, cv::Scalar(0));
 }
 
 void CheckWindow(const Scan& scan, const cv::Rect& window, const char* what) {
@@ -216,6 +218,7 @@ void CheckScan(const Scan& scan) {
   check(scan.curvature, CV_32F, "curvature", false);
   check(scan.true_range, CV_32F, "true_range", false);
   check(scan.synthesized, CV_8U, "synthesized", false);
+  check(scan.from_station, CV_8U, "from_station", false);
   for (const auto& [name, values] : scan.attributes) {
     if (values.rows != scan.rows || values.cols != scan.cols) {
       throw std::logic_error("scan attribute has the wrong size: " + name);
@@ -234,6 +237,7 @@ std::vector<std::string> ChannelNames(const Scan& scan) {
   if (!scan.curvature.empty()) names.push_back("curvature");
   if (!scan.true_range.empty()) names.push_back("true_range");
   if (!scan.synthesized.empty()) names.push_back("synthesized");
+  if (!scan.from_station.empty()) names.push_back("from_station");
   return names;
 }
 

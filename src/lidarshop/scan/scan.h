@@ -23,6 +23,9 @@
 //                         came from (pointset/normals.h); NaN where invalid or unknown
 //   true_range  CV_32F    noise-free range (synthetic scans), 0 where invalid
 //   synthesized CV_8U     255 = created by lidarshop (e.g. hole filling), 0 = measured
+//   from_station CV_8U    1 + k = a hole cell filled with what another station (k of the list it was given)
+//                         measured, resampled onto this scan's ray (site/from_stations.h); 0 = this scan's own
+//                         measurement or synthesized. Such a cell is measured, not synthesized.
 // Carried, not interpreted (`attributes`): per-cell values of the source file that no algorithm of lidarshop
 // uses but that a user expects back (LAS GPS time, return numbers, scan angle, point source ID, NIR, extra
 // bytes; io/las.h names them). Each is a rows x cols cv::Mat of 1 to 512 channels of any depth, 0 in cells
@@ -102,6 +105,7 @@ struct Scan {
   cv::Mat curvature;
   cv::Mat true_range;
   cv::Mat synthesized;
+  cv::Mat from_station;
 
   ScanGrid grid;  // empty vectors when the scan has no known grid
 
@@ -127,7 +131,7 @@ Scan Clone(const Scan& scan);
 
 // The scan with only the cells where `keep_mask` (CV_8U, rows x cols, non-zero = keep) is set: every other
 // cell becomes a cell without a return (valid 0, range 0, point 0, intensity 0.5, colour 0, label kNoLabel,
-// normal 0, curvature NaN, true_range 0, synthesized 0, attributes 0) but keeps its direction; grid, pose and name are kept. Used to write
+// normal 0, curvature NaN, true_range 0, synthesized 0, from_station 0, attributes 0) but keeps its direction; grid, pose and name are kept. Used to write
 // a cut-out object or the rest of a scan as an organized scan. Throws std::logic_error when the mask has the
 // wrong size or type.
 Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask);

@@ -214,6 +214,7 @@ void SyntheticScanner::AcquireInto(const ScannerOptions& options, Scan* scan_out
   // Every channel is written for every cell by the loops below, so nothing is pre-filled.
   Scan& scan = *scan_out;
   scan.synthesized.release();
+  scan.from_station.release();
   scan.rows = rows;
   scan.cols = cols;
   scan.name = "synthetic";

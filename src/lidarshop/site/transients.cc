@@ -7,6 +7,8 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/site/from_stations.h"
+#include "lidarshop/site/grid_lookup.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
@@ -59,6 +61,8 @@ const StructInfo& InfoOf<CleanOptions>() {
         .Unit("cells")
         .Range(0, 32);
     b.Field(&CleanOptions::fill_holes, "fill_holes", "fill the holes (else: cells without a return)");
+    b.Field(&CleanOptions::from_stations, "from_stations",
+            "fill from what the other stations measured first, synthesize only the rest");
     return b.Build();
   }();
   return info;
@@ -67,59 +71,6 @@ const StructInfo& InfoOf<CleanOptions>() {
 namespace {
 
 constexpr uint8_t kNoEvidence = 0, kSeenThrough = 1, kConfirmed = 2;
-
-// Where a direction of a station's scanner frame falls on its grid.
-class GridLookup {
- public:
-  explicit GridLookup(const Scan& scan) : grid_(GridOf(scan)), rows_(scan.rows), cols_(scan.cols) {
-    const std::vector<double>& az = grid_.azimuth_rad;
-    const std::vector<double>& el = grid_.elevation_rad;
-    azimuth_step_ = cols_ > 1 ? std::abs(az.back() - az.front()) / (cols_ - 1) : 1e-3;
-    elevation_step_ = rows_ > 1 ? std::abs(el.front() - el.back()) / (rows_ - 1) : 1e-3;
-  }
-
-  // The nearest cell of the direction of `p` (scanner frame), or false when it lies outside the grid by
-  // more than half a step.
-  bool Cell(const Eigen::Vector3d& p, int* row, int* col) const {
-    const double range = p.norm();
-    if (range <= 0.0) return false;
-    const std::vector<double>& az = grid_.azimuth_rad;
-    const std::vector<double>& el = grid_.elevation_rad;
-    // Azimuth relative to the first column, in [0, 2π): the grid may span past ±π.
-    const double relative =
-        std::fmod(WrapAngle(std::atan2(p.x(), p.y()) - az.front()) + 2.0 * M_PI, 2.0 * M_PI);
-    const double azimuth = az.front() + relative;
-    const auto c_it = std::lower_bound(az.begin(), az.end(), azimuth);
-    int c = static_cast<int>(c_it - az.begin());
-    if (c == cols_) {
-      if (azimuth - az.back() > 0.5 * azimuth_step_) return false;
-      c = cols_ - 1;
-    } else if (c > 0 && azimuth - az[c - 1] < az[c] - azimuth) {
-      --c;
-    }
-    const double elevation = std::asin(std::clamp(p.z() / range, -1.0, 1.0));
-    if (elevation > el.front() + 0.5 * elevation_step_ || elevation < el.back() - 0.5 * elevation_step_)
-      return false;
-    // Elevations decrease down the rows.
-    const auto r_it = std::lower_bound(el.begin(), el.end(), elevation, std::greater<double>());
-    int r = static_cast<int>(r_it - el.begin());
-    if (r == rows_) {
-      r = rows_ - 1;
-    } else if (r > 0 && el[r - 1] - elevation < elevation - el[r]) {
-      --r;
-    }
-    *row = r;
-    *col = c;
-    return true;
-  }
-
-  double step_rad() const { return std::max(azimuth_step_, elevation_step_); }
-
- private:
-  ScanGrid grid_;
-  int rows_, cols_;
-  double azimuth_step_ = 0, elevation_step_ = 0;
-};
 
 // What station `b` says of each point of station `a`: kSeenThrough, kConfirmed or kNoEvidence, per cell.
 cv::Mat EvidenceFrom(const Scan& a, const Scan& b, const GridLookup& b_grid, const TransientOptions& o) {
@@ -263,18 +214,50 @@ CleanResult CleanStations(const std::vector<Scan>& stations, const CleanOptions&
     if (found.transient_cells == 0) {
       result.stations.push_back(stations[i]);
       result.filled_cells.push_back(0);
+      result.from_station_cells.push_back(0);
       continue;
     }
     const cv::Mat hole = GrowHole(found.transient, options.margin_cells);
     if (!options.fill_holes) {
       result.stations.push_back(MaskScan(stations[i], hole == 0));
       result.filled_cells.push_back(0);
+      result.from_station_cells.push_back(0);
       continue;
     }
-    FillResult filled = FillScan(MaskScan(stations[i], hole == 0), hole, options.fill);
+    if (!options.from_stations) {
+      FillResult filled = FillScan(MaskScan(stations[i], hole == 0), hole, options.fill);
+      for (const std::string& warning : filled.warnings)
+        result.warnings.push_back(fmt::format("station {}: {}", i, warning));
+      result.filled_cells.push_back(filled.synthesized_cells);
+      result.from_station_cells.push_back(0);
+      result.stations.push_back(std::move(filled.scan));
+      continue;
+    }
+    // The other stations, and their indices in the site.
+    std::vector<Scan> others;
+    std::vector<int> index_of_other;
+    for (size_t j = 0; j < stations.size(); ++j) {
+      if (j == i) continue;
+      others.push_back(stations[j]);
+      index_of_other.push_back(static_cast<int>(j));
+    }
+    FromStationsOptions from;
+    from.range_noise_sigma_m = options.transients.range_noise_sigma_m;
+    from.object_margin_cells = options.margin_cells;
+    from.fill = options.fill;
+    FromStationsResult filled = FillFromStations(stations[i], hole, others, from);
     for (const std::string& warning : filled.warnings)
       result.warnings.push_back(fmt::format("station {}: {}", i, warning));
+    // from_station names the station in the site's list, not in `others`.
+    cv::Mat& tag = filled.scan.from_station;
+    for (int r = 0; r < tag.rows; ++r) {
+      uint8_t* t = tag.ptr<uint8_t>(r);
+      const uint8_t* mine = filled.from_station.ptr<uint8_t>(r);
+      for (int c = 0; c < tag.cols; ++c)
+        if (mine[c] != 0) t[c] = static_cast<uint8_t>(std::min(index_of_other[mine[c] - 1] + 1, 255));
+    }
     result.filled_cells.push_back(filled.synthesized_cells);
+    result.from_station_cells.push_back(filled.from_station_cells);
     result.stations.push_back(std::move(filled.scan));
   }
   return result;

@@ -68,6 +68,10 @@ struct CleanOptions {
   FillOptions fill;        // the fill of the removed points' holes
   int margin_cells = 1;    // the removed cells are grown by this before filling (mixed pixels at rims)
   bool fill_holes = true;  // false: removed points become cells without a return
+  // The holes are filled first from what the other stations measured behind the removed points
+  // (site/from_stations.h: its defaults, with transients.range_noise_sigma_m and margin_cells), and only the
+  // rest is synthesized by `fill`; false: every hole cell is synthesized.
+  bool from_stations = true;
 
   void Check() const;  // throws OptionsError
 };
@@ -78,11 +82,15 @@ struct CleanResult {
   std::vector<Scan> stations;         // the cleaned stations, in order
   TransientResult transients;         // what was found
   std::vector<int64_t> filled_cells;  // per station: cells the fill gave a synthesized return
+  // Per station: hole cells given another station's measurement (their Scan::from_station holds 1 + the
+  // index, in the list given to CleanStations, of the station that measured them).
+  std::vector<int64_t> from_station_cells;
   std::vector<std::string> warnings;  // the fills' warnings, naming the station
 };
 
-// Removes every station's transient points and fills their holes (FillScan: synthesized, marked). Filling
-// from what the other stations measured (their real points behind the removed object) is not done yet.
+// Removes every station's transient points and fills their holes: first with what the other stations measured
+// behind them (FillFromStations, marked from_station, not synthesized), then the rest by FillScan
+// (synthesized, marked).
 CleanResult CleanStations(const std::vector<Scan>& stations, const CleanOptions& options = {},
                           Progress* progress = nullptr);
 

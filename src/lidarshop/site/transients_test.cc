@@ -188,13 +188,22 @@ TEST(CleanStations, RemovesTheMovingPointsAndFillsTheirHoles) {
         const bool moving =
             stations[i].valid.at<uint8_t>(r, c) != 0 && stations[i].label.at<int32_t>(r, c) >= 10;
         moving_before += moving;
-        // A moving point left as it was: a measured return at the same range.
-        moving_left +=
-            moving && cleaned.valid.at<uint8_t>(r, c) != 0 && cleaned.synthesized.at<uint8_t>(r, c) == 0;
+        // A moving point left as it was: a measured return of this station, neither synthesized nor taken
+        // from another station.
+        moving_left += moving && cleaned.valid.at<uint8_t>(r, c) != 0 &&
+                       cleaned.synthesized.at<uint8_t>(r, c) == 0 &&
+                       cleaned.from_station.at<uint8_t>(r, c) == 0;
+        // A cell another station filled names that station, never this one, and is not synthesized.
+        const uint8_t from = cleaned.from_station.at<uint8_t>(r, c);
+        EXPECT_TRUE(from == 0 ||
+                    (from != i + 1 && from <= stations.size() && cleaned.synthesized.at<uint8_t>(r, c) == 0))
+            << "station " << i << " cell " << r << ", " << c;
       }
     }
     EXPECT_LE(moving_left, moving_before / 20) << "station " << i;
-    EXPECT_GT(result.filled_cells[i], moving_before / 2) << "station " << i;
+    EXPECT_GT(result.filled_cells[i] + result.from_station_cells[i], moving_before / 2) << "station " << i;
+    // Another station had seen behind what moved: real points first.
+    EXPECT_GT(result.from_station_cells[i], result.filled_cells[i] / 3) << "station " << i;
     // The input is untouched.
     EXPECT_EQ(cv::countNonZero(stations[i].valid != before[i].valid), 0) << "station " << i;
     EXPECT_EQ(cv::norm(stations[i].range, before[i].range, cv::NORM_INF), 0.0) << "station " << i;
