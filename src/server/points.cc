@@ -13,6 +13,7 @@ namespace {
 constexpr uint32_t kPointsMagic = 0x3150534cu;  // "LSP1"
 constexpr uint32_t kDeltaMagic = 0x3144534cu;   // "LSD1"
 constexpr uint8_t kFlagSynthesized = 1, kFlagObject = 2, kFlagBehind = 4;
+constexpr uint8_t kFlagFromStation = 8;       // filled from what another station of the site measured
 constexpr uint32_t kBehindKey = 0x80000000u;  // a delta key's layer bit: the surface behind a kept object
 
 // One cell's point as the client draws it.
@@ -45,6 +46,8 @@ PointRecord RecordAt(const Snapshot& snapshot, bool behind, int r, int c) {
     std::fill(record.rgb, record.rgb + 3, grey);
   }
   if (!scan.synthesized.empty() && scan.synthesized.at<uint8_t>(r, c) != 0) record.flags |= kFlagSynthesized;
+  if (!scan.from_station.empty() && scan.from_station.at<uint8_t>(r, c) != 0)
+    record.flags |= kFlagFromStation;
   if (behind) {
     record.flags |= kFlagBehind;
   } else if (!snapshot.object_mask.empty() && snapshot.object_mask.at<uint8_t>(r, c) != 0) {
@@ -61,7 +64,7 @@ bool SameBuffers(const Snapshot& a, const Snapshot& b, bool behind) {
   const auto same = [](const cv::Mat& m, const cv::Mat& n) { return m.data == n.data && m.size == n.size; };
   return same(x.valid, y.valid) && same(x.point, y.point) && same(x.color, y.color) &&
          same(x.intensity, y.intensity) && same(x.synthesized, y.synthesized) &&
-         (behind || same(a.object_mask, b.object_mask));
+         same(x.from_station, y.from_station) && (behind || same(a.object_mask, b.object_mask));
 }
 
 // Appends the typed arrays of `records` (with their keys) after `header` as the answer's bytes.

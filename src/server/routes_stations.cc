@@ -10,6 +10,8 @@
 #include <opencv2/core.hpp>
 
 #include "http.h"
+#include "lidarshop/fill/remove.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/site/site_stations.h"
 #include "lidarshop/site/transients.h"
 #include "lidarshop/util/error.h"
@@ -274,6 +276,114 @@ void Clean(State& state, const std::shared_ptr<Document>& document, const nlohma
       response);
 }
 
+// POST /api/docs/ID/fill-from-stations: {"hole": "strokes" (the object cut from the strokes, then removed: as
+// `remove`) | "object" (the last cut's cells grown by margin_cells) | "painted", "margin_cells": 2, "stations":
+// [K, ...] (default: every other open station of the site), "options": FromStationsOptions, "remove":
+// RemoveOptions}. One job, one undoable edit of this scan; the cells filled from another station are marked
+// (Scan::from_station) and drawn as their own layer, the rest synthesized.
+void FillFromOtherStations(State& state, const std::shared_ptr<Document>& document,
+                           const nlohmann::json& body, httplib::Response& response) {
+  const FromStationsOptions options =
+      body.contains("options") ? FromJson<FromStationsOptions>(body.at("options")) : FromStationsOptions{};
+  options.Check();
+  const RemoveOptions remove =
+      body.contains("remove") ? FromJson<RemoveOptions>(body.at("remove")) : RemoveOptions{};
+  remove.Check();
+  const std::string which = body.value("hole", std::string("strokes"));
+  if (which != "strokes" && which != "object" && which != "painted")
+    throw OptionsFieldError("hole", "expected \"strokes\", \"object\" or \"painted\"");
+  const int margin = body.value("margin_cells", 2);
+  if (margin < 0 || margin > 100) throw OptionsFieldError("margin_cells", "out of range [0, 100]");
+  const auto [site, current] = SiteOf(state, document->id);
+  if (!site) {
+    throw InputError(
+        fmt::format("scan {} is not a station of a site: open a file of several scans as a site, or group "
+                    "open scans into "
+                    "one, then fill from the other stations",
+                    document->id));
+  }
+  const int num_stations = static_cast<int>(site->documents.size());
+  std::vector<int> others;
+  for (int i = 0; i < num_stations; ++i) {
+    if (i != current && OpenDocumentOf(state, site->documents[i])) others.push_back(i);
+  }
+  const std::vector<int> chosen = IntList(body, "stations", others);
+  CheckStationIndices(chosen, num_stations, "stations");
+  if (std::find(chosen.begin(), chosen.end(), current) != chosen.end())
+    throw OptionsFieldError("stations", fmt::format("station {} is the scan being filled", current));
+  if (chosen.empty()) throw OptionsFieldError("stations", "no other open station to fill from");
+  std::vector<std::shared_ptr<Document>> documents;
+  for (const int i : chosen) {
+    documents.push_back(OpenDocumentOf(state, site->documents[i]));
+    if (!documents.back()) {
+      return SendError(response, 409,
+                       fmt::format("station {} (scan {}) was closed: open the site again, or leave it out "
+                                   "(\"stations\")",
+                                   i, site->documents[i]));
+    }
+  }
+  {
+    std::lock_guard lock(document->mutex);
+    const Snapshot& now = document->now;
+    const cv::Mat& mask = which == "strokes" ? now.strokes : which == "painted" ? now.hole : now.object_mask;
+    if (mask.empty() || cv::countNonZero(which == "strokes" ? mask == 1 : mask) == 0) {
+      throw OptionsFieldError("hole", which == "strokes"   ? "paint the object's strokes first"
+                                      : which == "painted" ? "paint a hole first (hole brush or lasso)"
+                                                           : "segment an object first");
+    }
+  }
+  const int undo_depth = state.options.undo_depth;
+  StartJob(
+      state, document, "fill-from-stations",
+      [document, documents, chosen, options, remove, which, margin, undo_depth](Progress& progress) {
+        Snapshot start;
+        {
+          std::lock_guard lock(document->mutex);
+          start = document->now;
+        }
+        std::vector<Scan> others;
+        for (const auto& station : documents) {
+          std::lock_guard lock(station->mutex);
+          others.push_back(station->now.scan);
+        }
+        FromStationsResult filled;
+        if (which == "strokes") {
+          RemoveFromStationsResult result =
+              RemoveObjectFromStations(start.scan, start.strokes, others, remove, options, &progress);
+          filled = std::move(result.filled);
+        } else {
+          const cv::Mat hole = which == "painted" ? start.hole : GrowHole(start.object_mask, margin);
+          filled = FillFromStations(start.scan, hole, others, options, &progress);
+        }
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        next.scan = filled.scan;
+        if (which == "strokes") {
+          next.strokes =
+              NewZeros(cv::Size(next.scan.cols, next.scan.rows), CV_8U);  // a new buffer: see Snapshot
+          next.object_mask = cv::Mat();
+        } else {
+          (which == "painted" ? next.hole : next.object_mask) = cv::Mat();
+        }
+        Commit(*document, std::move(next), undo_depth);
+        nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+        for (size_t k = 0; k < chosen.size(); ++k) {
+          stations.push_back(
+              {{"station", chosen[k]},
+               {"document", documents[k]->id},
+               {"cells", k < filled.cells_per_station.size() ? filled.cells_per_station[k] : 0}});
+        }
+        return nlohmann::ordered_json{{"hole_cells", filled.hole_cells},
+                                      {"from_station_cells", filled.from_station_cells},
+                                      {"synthesized_cells", filled.synthesized_cells},
+                                      {"no_return_cells", filled.no_return_cells},
+                                      {"stations", stations},
+                                      {"warnings", filled.warnings},
+                                      {"version", document->version}};
+      },
+      response);
+}
+
 }  // namespace
 
 void AddStationRoutes(State& state) {
@@ -338,6 +448,7 @@ void AddStationRoutes(State& state) {
              SendJson(response, {{"version", version}, {"cells", cells}});
            });
   PostDocument(state, R"(/api/docs/(\d+)/clean)", Clean);
+  PostDocument(state, R"(/api/docs/(\d+)/fill-from-stations)", FillFromOtherStations);
 }
 
 }  // namespace lidarshop::server

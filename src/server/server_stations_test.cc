@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -258,6 +259,47 @@ TEST_F(StationsServerTest, StateChangingStationRoutesGoThroughTheSecurityChecks)
   // Reading needs the token too.
   EXPECT_EQ(client_->Get("/api/sites")->status, 401);
   EXPECT_EQ(client_->Get(fmt::format("/api/docs/{}/stations", site["document"].get<int>()))->status, 401);
+}
+
+// Fill from stations: the late sedan's cells of station 2 painted as a hole and filled with what stations 0 and
+// 1 measured behind it (marked from_station, their own layer in the points), one undoable edit.
+TEST_F(StationsServerTest, FillFromStationsTakesTheOtherStationsPoints) {
+  const nlohmann::json site = OpenSite({{"path", "site.e57"}, {"station", 2}});
+  const int document = site["document"];
+  const Scan& station2 = (*site_)[2];
+  nlohmann::json cells = nlohmann::json::array();
+  for (int r = 0; r < station2.rows; ++r)
+    for (int c = 0; c < station2.cols; ++c)
+      if (station2.valid.at<uint8_t>(r, c) && station2.label.at<int32_t>(r, c) == kLateSedanLabel)
+        cells.push_back({r, c});
+  ASSERT_GT(cells.size(), 100u);
+  ASSERT_EQ(Post(fmt::format("/api/docs/{}/strokes", document), {{"hole", cells}, {"radius", 1}})->status,
+            200);
+  const std::string fill = fmt::format("/api/docs/{}/fill-from-stations", document);
+  EXPECT_EQ(Post(fill, {{"hole", "painted"}, {"stations", {2}}})->status, 400);  // itself
+  EXPECT_EQ(Post(fill, {{"hole", "painted"}, {"stations", {0, 5}}})->status, 400);
+  EXPECT_EQ(Post(fill, {{"hole", "nothing"}})->status, 400);
+  EXPECT_EQ(client_->Post(Api(fill), R"({"hole": "painted"})", "text/plain")->status, 415);
+  const auto started = Post(fill, {{"hole", "painted"}});
+  ASSERT_EQ(started->status, 202) << started->body;
+  const nlohmann::json job = Wait(Json(started));
+  ASSERT_EQ(job["state"], "done") << job.dump();
+  const nlohmann::json& result = job["result"];
+  // Stations 0 and 1 saw the bay empty: a real share of the hole comes from them (the rest is synthesized).
+  EXPECT_GT(result["from_station_cells"].get<int64_t>(), 100) << result.dump();
+  ASSERT_EQ(result["stations"].size(), 2u);
+  // The points carry the layer's flag (8) on the cells filled from another station.
+  const auto points = client_->Get(Api(fmt::format("/api/docs/{}/points", document)));
+  ASSERT_EQ(points->status, 200);
+  uint32_t count = 0;
+  std::memcpy(&count, points->body.data() + 4, 4);
+  const uint8_t* flags = reinterpret_cast<const uint8_t*>(points->body.data()) + 16 + size_t{count} * 19;
+  int64_t flagged = 0;
+  for (uint32_t i = 0; i < count; ++i) flagged += (flags[i] & 8) != 0;
+  EXPECT_EQ(flagged, result["from_station_cells"].get<int64_t>());
+  ASSERT_EQ(Post(fmt::format("/api/docs/{}/undo", document), nlohmann::json::object())->status, 200);
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/docs/{}", document))))["valid_cells"].get<int64_t>(),
+            station2.CountValid());
 }
 
 // Malformed bodies of every shape on the station routes: a 4xx naming the problem, never a 500.

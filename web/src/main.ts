@@ -38,7 +38,8 @@ async function showById(id: number) {
   if (next) await showDocument(next);
 }
 const stationsPanel = new StationsPanel({ api, doc: () => doc, show: showById, status, runJob, ...pointView.overlay() },
-                                        element('stations-list'), element<HTMLButtonElement>('clean'), element('clean-result'));
+                                        element('stations-list'), element<HTMLButtonElement>('clean'), element('clean-result'),
+                                        element<HTMLButtonElement>('fill-stations'));
 
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {

@@ -98,6 +98,20 @@ export function cleanSummary(result: Record<string, unknown> | undefined): strin
   return `clean: ${here} points removed here${station >= 0 ? ` (station ${station})` : ''} and filled; ${per}.${others}`;
 }
 
+// The status line after a fill from the other stations: the cells each gave, and what was synthesized.
+export function fillSummary(result: Record<string, unknown> | undefined): string {
+  if (!result || !Array.isArray(result.stations)) return 'fill from stations: no result';
+  const per = (result.stations as { station: number; cells: number }[]).map((s) => `station ${s.station}: ${s.cells}`).join(', ');
+  return `fill from stations: ${Number(result.from_station_cells ?? 0)} of ${Number(result.hole_cells ?? 0)} cells from other stations (${per}), ${Number(result.synthesized_cells ?? 0)} synthesized`;
+}
+
+// What Fill from stations fills: the painted hole, else the object cut from the strokes, else the last cut.
+export function fillHoleKind(doc: { hole_cells: number; object_stroke_cells: number; object_cells: number }): 'painted' | 'strokes' | 'object' {
+  if (doc.hole_cells > 0) return 'painted';
+  if (doc.object_stroke_cells > 0) return 'strokes';
+  return 'object';
+}
+
 // Colours of the other stations' points, by station index.
 const STATION_COLOURS = [0x4aa3ff, 0xffb347, 0x7ddc6a, 0xe07be0, 0xf2e35b, 0x5be0d2];
 
@@ -122,10 +136,11 @@ export class StationsPanel {
   private othersKey = '';
 
   constructor(private host: StationsHost, private list: HTMLElement, private cleanButton: HTMLButtonElement,
-              private result: HTMLElement) {
+              private result: HTMLElement, private fillButton: HTMLButtonElement) {
     host.scene.add(this.markers, this.others);
     this.others.visible = false;
     cleanButton.addEventListener('click', () => this.clean());
+    fillButton.addEventListener('click', () => this.fill());
   }
 
   // Opens a built-in scene or a file as a site (every station a scan of its own) and shows `station`.
@@ -161,6 +176,7 @@ export class StationsPanel {
   private drawList() {
     const site = this.site;
     this.cleanButton.disabled = !site || site.stations.filter((s) => s.open).length < 2;
+    this.fillButton.disabled = this.cleanButton.disabled;
     if (!site) {
       this.list.replaceChildren(Object.assign(document.createElement('div'), {
         className: 'stations-none', textContent: 'not part of a site (open a file of several scans or a site scene as a site)' }));
@@ -241,6 +257,17 @@ export class StationsPanel {
       cloud.matrixAutoUpdate = false;
       cloud.matrix.fromArray(viewFromStation(doc.world_from_scanner_column_major, station.world_from_scanner_column_major));
       this.others.add(cloud);
+    }
+  }
+
+  private async fill() {
+    const doc = this.host.doc();
+    if (!doc || !this.site) return;
+    const finished = await this.host.runJob(`/api/docs/${doc.id}/fill-from-stations`, { hole: fillHoleKind(doc) }, 'fill from stations');
+    if (finished?.state === 'done') {
+      const summary = fillSummary(finished.result);
+      this.result.textContent = summary;
+      this.host.status(summary);
     }
   }
 

@@ -1,7 +1,7 @@
 import { describe, expect, it } from 'vitest';
 import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, poseMatrix, PointSet } from '../src/api';
 import { layerOf, pointColours, visiblePoints } from '../src/pointview';
-import { SiteInfo, StationInfo, centroid, cleanSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
+import { SiteInfo, StationInfo, centroid, cleanSummary, fillHoleKind, fillSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
 
 function station(index: number, x: number, y: number, yawDeg: number, extra: Partial<StationInfo> = {}): StationInfo {
   return {
@@ -108,5 +108,18 @@ describe('the layer of points filled from other stations', () => {
     const rgb = (i: number) => Array.from(colours.slice(3 * i, 3 * i + 3));
     expect(rgb(2)).not.toEqual(rgb(1));
     expect(rgb(2)).not.toEqual(rgb(0));
+  });
+});
+
+describe('fill from stations', () => {
+  it('fills the painted hole first, then the object of the strokes, then the last cut', () => {
+    expect(fillHoleKind({ hole_cells: 5, object_stroke_cells: 3, object_cells: 2 })).toBe('painted');
+    expect(fillHoleKind({ hole_cells: 0, object_stroke_cells: 3, object_cells: 2 })).toBe('strokes');
+    expect(fillHoleKind({ hole_cells: 0, object_stroke_cells: 0, object_cells: 2 })).toBe('object');
+  });
+  it('says what each station gave and what was synthesized', () => {
+    const text = fillSummary({ hole_cells: 100, from_station_cells: 70, synthesized_cells: 30,
+      stations: [{ station: 0, cells: 50 }, { station: 1, cells: 20 }] });
+    expect(text).toBe('fill from stations: 70 of 100 cells from other stations (station 0: 50, station 1: 20), 30 synthesized');
   });
 });
