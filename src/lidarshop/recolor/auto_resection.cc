@@ -316,6 +316,9 @@ std::vector<PixelPointPair> MatchGuided(const Features& photo, const Features& v
   return pairs;
 }
 
+// A found patch's correlation must beat the best one 3 or more pixels away by this much.
+constexpr double kMinPeakMargin = 0.1;
+
 // Dense pairs: patches of the rendering (every `step_px`, one surface, textured) found in the photo within
 // `search_px` by normalized cross-correlation (gain and offset free), the peak refined to sub-pixel by a
 // parabola per axis. The rendering's pixel centre shows a known surface point, so each found patch is a pair.
@@ -343,6 +346,12 @@ std::vector<PixelPointPair> MatchPatches(const cv::Mat& photo_grey, const View& 
       cv::minMaxLoc(score, nullptr, &best, nullptr, &at);
       if (best < min_score || at.x == 0 || at.y == 0 || at.x + 1 == score.cols || at.y + 1 == score.rows)
         continue;
+      // A repeating texture (bricks) correlates as well one period away: the peak must stand out.
+      const cv::Mat peak_free = score.clone();
+      cv::rectangle(peak_free, cv::Rect(at.x - 2, at.y - 2, 5, 5), cv::Scalar(-1), cv::FILLED);
+      double second = -1;
+      cv::minMaxLoc(peak_free, nullptr, &second);
+      if (second > best - kMinPeakMargin) continue;
       const auto peak = [](float left, float centre, float right) {
         const double curvature = left - 2.0 * centre + right;
         return curvature < 0 ? 0.5 * (left - right) / curvature : 0.0;
@@ -692,8 +701,13 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
     PinholeCamera work = Scaled(camera, working.width_px, working.height_px);
     const View view = Render(samples, work);
     const Features view_features = Detect(view.grey, ValidMask(view), options.features);
-    std::vector<PixelPointPair> round_pairs = MatchGuided(
-        working.photo, view_features, view, working.to_photo_x, working.to_photo_y, options.ratio, radius_px);
+    // The first round matches anywhere (the search's camera may be degrees off: its views were rendered from
+    // the scanner centre); later ones near the same place.
+    std::vector<PixelPointPair> round_pairs =
+        round == 0 ? MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                              options.ratio)
+                   : MatchGuided(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                                 options.ratio, radius_px);
     if (options.patch_px > 0) {
       const std::vector<PixelPointPair> dense = MatchPatches(
           working.grey, view, options.patch_px, options.patch_step_px, static_cast<int>(std::ceil(radius_px)),

@@ -21,7 +21,7 @@ struct AutoCase {
 };
 
 // The street scene of `seed` with the ground grass or gravel, the wall brick and each object checker, gravel,
-// brick or plain (drawn from the seed); a scanner of `rows` x `columns` cells over the same field (the
+// brick or plain (drawn from the seed, textures 1-4 x their usual size); a scanner of `rows` x `columns` cells over the same field (the
 // street scenes' 300 x 450 cells are 0.18° apart, twice a photo pixel); the camera `offset_m` =
 // U(0.2, 2.0) m from the scanner, looking 8-12 m ahead (MakeStreetRecolorCase).
 inline AutoCase MakeAutoCase(uint64_t seed, int rows = 600, int columns = 900) {
@@ -37,13 +37,17 @@ inline AutoCase MakeAutoCase(uint64_t seed, int rows = 600, int columns = 900) {
   const TextureKind kinds[] = {TextureKind::kChecker, TextureKind::kGravel, TextureKind::kBrick,
                                TextureKind::kNone};
   for (SceneObject& object : out.scene.objects) {
+    // Texture scales of 2-4: the scanner's cells (0.09°, 2-3 cm at 15 m) resolve the pattern; at scale 1 the
+    // bricks of a wall 20 m away are filtered to a faint mottle in the scan while the photo still shows them.
     if (object.label == 0) {
       object.material.texture = unit(rng) < 0.5 ? TextureKind::kGrass : TextureKind::kGravel;
+      object.material.texture_scale = static_cast<float>(2 + 2 * unit(rng));
     } else if (object.label == 1) {
       object.material.texture = TextureKind::kBrick;
+      object.material.texture_scale = static_cast<float>(2.5 + 1.5 * unit(rng));
     } else {
       object.material.texture = kinds[static_cast<int>(unit(rng) * 4) % 4];
-      object.material.texture_scale = static_cast<float>(0.5 + unit(rng));
+      object.material.texture_scale = static_cast<float>(1 + 1.5 * unit(rng));
     }
   }
   return out;

@@ -16,13 +16,16 @@
 
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/auto_resection_test_util.h"
 #include "lidarshop/recolor/correspondences.h"
+#include "lidarshop/recolor/resection.h"
 #include "lidarshop/util/error.h"
 
 using namespace lidarshop;
@@ -41,7 +44,10 @@ double Percentile(const std::vector<double>& sorted, double p) {
   return sorted[std::min(rank, sorted.size() - 1)];
 }
 
-int RunPumpA(const AutoResectionOptions& options, bool unknown_focal) {
+// `rough_offset_m` > 0: start from the hand-picked pairs' camera moved by this much (and turned by
+// `rough_turn_deg`) instead of searching from the scanner centre.
+int RunPumpA(const AutoResectionOptions& options, bool unknown_focal, double rough_offset_m,
+             double rough_turn_deg) {
   const std::string scan_path = LIDARSHOP_SHARED_DATA_DIR "/e57/pumpA.e57";
   const E57File file = ReadE57(scan_path);
   const ScanFile scans = ReadScanFile(scan_path);
@@ -54,10 +60,29 @@ int RunPumpA(const AutoResectionOptions& options, bool unknown_focal) {
   std::optional<PinholeCamera> intrinsics;
   if (!unknown_focal)
     intrinsics = ReadCameraJson(LIDARSHOP_SOURCE_DIR "/data/recolor/pumpA_intrinsics_exif.json");
+  const PinholeCamera exif = ReadCameraJson(LIDARSHOP_SOURCE_DIR "/data/recolor/pumpA_intrinsics_exif.json");
+  ResectionOptions hand_options;
+  hand_options.width_px = 3072, hand_options.height_px = 2304, hand_options.ransac_threshold_px = 40;
+  const PinholeCamera hand = ResectWithIntrinsics(pairs.pixel_point, exif, hand_options).camera;
+  std::optional<Eigen::Matrix4d> rough;
+  if (rough_offset_m > 0) {
+    Eigen::Matrix4d pose = hand.world_from_camera;
+    pose.topRightCorner<3, 1>() += rough_offset_m * Eigen::Vector3d(1, 1, 1).normalized();
+    pose.topLeftCorner<3, 3>() =
+        pose.topLeftCorner<3, 3>() *
+        Eigen::AngleAxisd(rough_turn_deg * M_PI / 180, Eigen::Vector3d(1, 1, 0).normalized())
+            .toRotationMatrix();
+    rough = pose;
+    fmt::print("pumpA: rough pose = the hand-picked pairs' camera moved {:.2f} m and turned {:.1f}°\n",
+               rough_offset_m, rough_turn_deg);
+  }
   const auto start = std::chrono::steady_clock::now();
   try {
     const AutoResectionResult result =
-        AutoResection(scans.scans.at(0), photo, options, intrinsics, {}, "pumpA");
+        AutoResection(scans.scans.at(0), photo, options, intrinsics, rough, "pumpA");
+    fmt::print("  camera vs the hand-picked pairs' camera: {:.3f} m, {:.3f}°\n",
+               (result.camera.center_in_world() - hand.center_in_world()).norm(),
+               AngleDeg(result.camera.world_from_camera, hand.world_from_camera));
     double sum = 0;
     for (const PixelPointPair& pair : pairs.pixel_point) {
       const double e = ReprojectionError(result.camera, pair);
@@ -79,7 +104,10 @@ int main(int argc, char** argv) {
   CLI::App app{"Automatic resection on textured random street scenes (bench/results/recolor.md)"};
   int first_seed = 1, seeds = 50, threads = 2, rows = 600, columns = 900;
   bool unknown_focal = false, pumpa = false, verbose = false;
-  std::string out_path;
+  std::string out_path, dump_dir;
+  double rough_offset_m = 0, rough_turn_deg = 0;
+  app.add_option("--rough-offset", rough_offset_m, "--pumpa: start this far (m) from the hand pairs' camera");
+  app.add_option("--rough-turn", rough_turn_deg, "--pumpa: and turned this much (degrees)");
   app.add_option("--first-seed", first_seed, "first seed (evaluation: 1; development: 1001)");
   app.add_option("--seeds", seeds, "number of cases");
   app.add_option("--threads", threads, "OpenCV threads");
@@ -95,11 +123,13 @@ int main(int argc, char** argv) {
   app.add_option("--ratio", options.ratio, "AutoResectionOptions::ratio");
   app.add_option("--rounds", options.rounds, "AutoResectionOptions::rounds");
   app.add_option("--threshold", options.ransac_threshold_px, "AutoResectionOptions::ransac_threshold_px");
+  app.add_option("--min-share", options.min_inlier_share, "AutoResectionOptions::min_inlier_share");
   app.add_option("--patch", options.patch_px, "AutoResectionOptions::patch_px");
   app.add_option("--patch-step", options.patch_step_px, "AutoResectionOptions::patch_step_px");
+  app.add_option("--dump", dump_dir, "folder to write each case's photo and scan colours into");
   CLI11_PARSE(app, argc, argv);
   cv::setNumThreads(threads);
-  if (pumpa) return RunPumpA(options, unknown_focal);
+  if (pumpa) return RunPumpA(options, unknown_focal, rough_offset_m, rough_turn_deg);
 
   std::vector<double> centre_cm, angle_deg, rms_px, share, seconds;
   int succeeded = 0, refused = 0;
@@ -110,6 +140,10 @@ int main(int argc, char** argv) {
     const Photo photo = testing_auto_resection::AutoCasePhoto(c);
     std::optional<PinholeCamera> intrinsics;
     if (!unknown_focal) intrinsics = c.camera;
+    if (!dump_dir.empty()) {
+      WriteImage(fmt::format("{}/{}_photo.png", dump_dir, seed), photo.image);
+      WriteImage(fmt::format("{}/{}_scan.png", dump_dir, seed), scan.color);
+    }
     const auto start = std::chrono::steady_clock::now();
     std::string line;
     try {
