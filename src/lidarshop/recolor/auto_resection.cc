@@ -697,6 +697,7 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
   Pose pose = best;
   std::vector<PixelPointPair> pairs;
   double radius_px = options.guided_radius_px;
+  bool dense_rounds = false;
   for (int round = 0; round < options.rounds; ++round) {
     PinholeCamera work = Scaled(camera, working.width_px, working.height_px);
     const View view = Render(samples, work);
@@ -708,7 +709,10 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
                               options.ratio)
                    : MatchGuided(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
                                  options.ratio, radius_px);
-    if (options.patch_px > 0) {
+    // Patches only once SIFT alone has settled (the camera moved less than 1 cm and 0.05° in a round): from a
+    // camera a few pixels off, a patch of a repeating texture (bricks) finds the next brick as well, and the
+    // whole wall shifted by one brick is a consistent, wrong answer.
+    if (dense_rounds) {
       const std::vector<PixelPointPair> dense = MatchPatches(
           working.grey, view, options.patch_px, options.patch_step_px, static_cast<int>(std::ceil(radius_px)),
           options.min_patch_score, working.to_photo_x, working.to_photo_y);
@@ -725,6 +729,10 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
     pairs = std::move(round_pairs);
     // The next search radius follows the estimate's accuracy (never wider than asked).
     radius_px = std::clamp(6 * pose.rms_px / working.to_photo_x, 3.0, options.guided_radius_px);
+    if (!dense_rounds && options.patch_px > 0) {
+      dense_rounds = moved_m < 0.01 && turned_deg < 0.05;
+      continue;
+    }
     if (moved_m < 1e-3 && turned_deg < 5e-3) break;
   }
   if (result.rounds == 0) {

@@ -52,7 +52,7 @@ struct AutoResectionOptions {
   double pixels_per_cell = 1.0;  // working resolution: photo pixels per scan cell (seen from the scanner)
   int features = 4000;           // SIFT features per image at most
   double ratio = 0.8;            // Lowe's ratio test: best / second-best descriptor distance below this
-  int rounds = 6;                // re-render, re-match, re-solve at most this many times
+  int rounds = 8;                // re-render, re-match, re-solve at most this many times
   double guided_radius_px = 12;  // rounds: a photo feature matches view features this near only, working px
   // Rounds also match patches of the rendering in the photo (normalized cross-correlation, sub-pixel peak):
   // dense pairs where SIFT finds few. 0 = off.
