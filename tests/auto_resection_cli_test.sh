@@ -21,6 +21,11 @@ cat >"$work/cam.json" <<'JSON'
 {"width_px": 640, "height_px": 480, "fx_px": 500, "fy_px": 500, "cx_px": 320, "cy_px": 240,
  "world_from_camera": [[1, 0, 0, 0.8], [0, 0, 1, -0.3], [0, -1, 0, 1.6], [0, 0, 0, 1]]}
 JSON
+# A rough guess: 0.4 m to the right and 0.2 m up, turned 3° to the left.
+cat >"$work/rough.json" <<'JSON'
+{"width_px": 640, "height_px": 480, "fx_px": 500, "fy_px": 500, "cx_px": 320, "cy_px": 240,
+ "world_from_camera": [[0.9986295347545738, 0, -0.052335956242943835, 1.2], [0.052335956242943835, 0, 0.9986295347545738, -0.3], [0, -1, 0, 1.8], [0, 0, 0, 1]]}
+JSON
 # The same camera looking straight up at the empty sky: nothing the scan holds.
 cat >"$work/sky.json" <<'JSON'
 {"width_px": 640, "height_px": 480, "fx_px": 500, "fy_px": 500, "cx_px": 320, "cy_px": 240,
@@ -37,10 +42,12 @@ json_check "resection --auto finds the camera" "$work/auto.json" \
    sum((a - b) ** 2 for a, b in zip(d['camera_center'], [0.8, -0.3, 1.6])) ** 0.5 < 0.02"
 json_check "the camera file holds the pose" "$work/auto_cam.json" \
   "abs(d['world_from_camera'][0][3] - 0.8) < 0.02 and abs(d['world_from_camera'][2][1] + 1) < 0.001"
-check "resection --auto with --scan and --photo, focal length searched" sh -c "'$lidarshop' resection --auto \
-  --scan '$work/street.e57' --photo '$work/photo.png' -o '$work/auto_cam2.json' >'$work/auto2.json'"
-json_check "the searched focal length" "$work/auto2.json" \
-  "abs(d['focal_px'][0] - 500) < 25 and d['search_fov_deg'] > 0"
+check "resection --auto with --scan, --photo and a rough pose" sh -c "'$lidarshop' resection --auto \
+  --scan '$work/street.e57' --photo '$work/photo.png' --intrinsics '$work/cam.json' \
+  --rough-camera '$work/rough.json' -o '$work/auto_cam2.json' >'$work/auto2.json'"
+json_check "from the rough pose" "$work/auto2.json" \
+  "d['search_view'] == -1 and \
+   sum((a - b) ** 2 for a, b in zip(d['camera_center'], [0.8, -0.3, 1.6])) ** 0.5 < 0.02"
 check "recolor --auto" sh -c "'$lidarshop' recolor '$work/street.e57' --photo '$work/photo.png' --auto \
   --intrinsics '$work/cam.json' -o '$work/recolored.ply' >'$work/recolor.json'"
 json_check "recolor --auto recolours with the camera it found" "$work/recolor.json" \

@@ -579,6 +579,7 @@ void AutoResectionOptions::Check() const {
   if (!(guided_radius_px > 0)) throw OptionsError("guided_radius_px must be > 0");
   if (!(ransac_threshold_px > 0)) throw OptionsError("ransac_threshold_px must be > 0");
   if (ransac_iterations < 1) throw OptionsError("ransac_iterations must be >= 1");
+  if (search_candidates < 1) throw OptionsError("search_candidates must be >= 1");
   if (min_inliers < 6) throw OptionsError("min_inliers must be at least 6");
   if (!(min_inlier_share >= 0 && min_inlier_share <= 1))
     throw OptionsError("min_inlier_share must be in [0, 1]");
@@ -633,10 +634,14 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
           MakeWorking(photo_grey, IntrinsicsOfFov(photo.cols, photo.rows, fov), samples, options));
   }
 
-  // Search: views from the scanner centre (or the rough pose); the view with the most PnP inliers wins.
-  AutoResectionResult result;
-  Pose best;
-  size_t best_working = 0;
+  // Search: views from the scanner centre (or the rough pose); every view's PnP camera is a candidate, the
+  // one with the most inliers first.
+  struct Candidate {
+    Pose pose;
+    size_t working = 0;
+    int view = -1;
+  };
+  std::vector<Candidate> candidates;
   int most_pairs = 0;
   const Eigen::Matrix3d scanner_rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
   for (size_t w = 0; w < workings.size(); ++w) {
@@ -675,83 +680,98 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
           MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y, options.ratio);
       most_pairs = std::max(most_pairs, static_cast<int>(pairs.size()));
       const Pose pose = SolvePose(pairs, working.intrinsics, threshold_px, options);
-      if (!pose.ok || pose.inliers <= best.inliers) continue;
-      best = pose;
-      best_working = w;
-      result.search_view = rough_world_from_camera ? -1 : static_cast<int>(v);
-      result.search_inliers = pose.inliers;
-      result.search_fov_deg = intrinsics ? 0 : options.fov_candidates_deg[w];
+      if (pose.ok) candidates.push_back({pose, w, rough_world_from_camera ? -1 : static_cast<int>(v)});
     }
   }
-  if (!best.ok)
+  if (candidates.empty())
     ThrowInputError(
         what, "", "features",
         fmt::format("no rendering of the scan matches the photo: at most {} matches in a view, and "
                     "no pose explains 6 of them",
                     most_pairs));
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.pose.inliers > b.pose.inliers; });
 
-  // Rounds: render from the estimate, match near the same place, solve again.
-  const Working& working = workings[best_working];
-  const double threshold_px = options.ransac_threshold_px * working.to_photo_x;
-  PinholeCamera camera = best.camera;
-  Pose pose = best;
-  std::vector<PixelPointPair> pairs;
-  double radius_px = options.guided_radius_px;
-  bool dense_rounds = false;
-  for (int round = 0; round < options.rounds; ++round) {
-    PinholeCamera work = Scaled(camera, working.width_px, working.height_px);
-    const View view = Render(samples, work);
-    const Features view_features = Detect(view.grey, ValidMask(view), options.features);
-    // The first round matches anywhere (the search's camera may be degrees off: its views were rendered from
-    // the scanner centre); later ones near the same place.
-    std::vector<PixelPointPair> round_pairs =
-        round == 0 ? MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
-                              options.ratio)
-                   : MatchGuided(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
-                                 options.ratio, radius_px);
-    // Patches only once SIFT alone has settled (the camera moved less than 1 cm and 0.05° in a round): from a
-    // camera a few pixels off, a patch of a repeating texture (bricks) finds the next brick as well, and the
-    // whole wall shifted by one brick is a consistent, wrong answer.
-    if (dense_rounds) {
-      const std::vector<PixelPointPair> dense = MatchPatches(
-          working.grey, view, options.patch_px, options.patch_step_px, static_cast<int>(std::ceil(radius_px)),
-          options.min_patch_score, working.to_photo_x, working.to_photo_y);
-      round_pairs.insert(round_pairs.end(), dense.begin(), dense.end());
+  // Rounds from one candidate: render from the estimate, match near the same place, solve again.
+  const auto run_rounds = [&](const Candidate& start) {
+    AutoResectionResult out;
+    const Working& working = workings[start.working];
+    const double threshold_px = options.ransac_threshold_px * working.to_photo_x;
+    PinholeCamera camera = start.pose.camera;
+    Pose pose = start.pose;
+    std::vector<PixelPointPair> pairs;
+    double radius_px = options.guided_radius_px;
+    bool dense_rounds = false;
+    for (int round = 0; round < options.rounds; ++round) {
+      PinholeCamera work = Scaled(camera, working.width_px, working.height_px);
+      const View view = Render(samples, work);
+      const Features view_features = Detect(view.grey, ValidMask(view), options.features);
+      // The first round matches anywhere (the search's camera may be degrees off: its views were rendered
+      // from the scanner centre); later ones near the same place.
+      std::vector<PixelPointPair> round_pairs =
+          round == 0 ? MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                                options.ratio)
+                     : MatchGuided(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                                   options.ratio, radius_px);
+      // Patches only once SIFT alone has settled (the camera moved less than 1 cm and 0.05° in a round):
+      // from a camera a few pixels off, a patch of a repeating texture (bricks) finds the next brick as
+      // well, and the whole wall shifted by one brick is a consistent, wrong answer.
+      if (dense_rounds) {
+        const std::vector<PixelPointPair> dense =
+            MatchPatches(working.grey, view, options.patch_px, options.patch_step_px,
+                         static_cast<int>(std::ceil(radius_px)), options.min_patch_score, working.to_photo_x,
+                         working.to_photo_y);
+        round_pairs.insert(round_pairs.end(), dense.begin(), dense.end());
+      }
+      Pose next = SolvePose(round_pairs, camera, threshold_px, options);
+      if (!next.ok) break;
+      if (!intrinsics) RefineFocal(round_pairs, threshold_px, &next);
+      out.rounds = round + 1;
+      const double moved_m = (next.camera.center_in_world() - camera.center_in_world()).norm(),
+                   turned_deg = RotationAngleDeg(next.camera.world_from_camera, camera.world_from_camera);
+      camera = next.camera;
+      pose = next;
+      pairs = std::move(round_pairs);
+      // The next search radius follows the estimate's accuracy (never wider than asked).
+      radius_px = std::clamp(6 * pose.rms_px / working.to_photo_x, 3.0, options.guided_radius_px);
+      if (!dense_rounds && options.patch_px > 0) {
+        dense_rounds = moved_m < 0.01 && turned_deg < 0.05;
+        continue;
+      }
+      if (moved_m < 1e-3 && turned_deg < 5e-3) break;
     }
-    Pose next = SolvePose(round_pairs, camera, threshold_px, options);
-    if (!next.ok) break;
-    if (!intrinsics) RefineFocal(round_pairs, threshold_px, &next);
-    result.rounds = round + 1;
-    const double moved_m = (next.camera.center_in_world() - camera.center_in_world()).norm(),
-                 turned_deg = RotationAngleDeg(next.camera.world_from_camera, camera.world_from_camera);
-    camera = next.camera;
-    pose = next;
-    pairs = std::move(round_pairs);
-    // The next search radius follows the estimate's accuracy (never wider than asked).
-    radius_px = std::clamp(6 * pose.rms_px / working.to_photo_x, 3.0, options.guided_radius_px);
-    if (!dense_rounds && options.patch_px > 0) {
-      dense_rounds = moved_m < 0.01 && turned_deg < 0.05;
-      continue;
-    }
-    if (moved_m < 1e-3 && turned_deg < 5e-3) break;
+    out.camera = camera;
+    out.pairs = std::move(pairs);
+    out.inlier = pose.inlier;
+    out.inliers = out.rounds > 0 ? pose.inliers : 0;
+    out.inlier_share = out.pairs.empty() ? 0 : static_cast<double>(pose.inliers) / out.pairs.size();
+    out.rms_px = pose.rms_px;
+    out.work_scale = 1 / working.to_photo_x;
+    out.rms_work_px = pose.rms_px / working.to_photo_x;
+    out.search_view = start.view;
+    out.search_inliers = start.pose.inliers;
+    out.search_fov_deg = intrinsics ? 0 : options.fov_candidates_deg[start.working];
+    return out;
+  };
+  const auto supported = [&](const AutoResectionResult& r) {
+    return r.rounds > 0 && r.inliers >= options.min_inliers && r.inlier_share >= options.min_inlier_share &&
+           r.rms_work_px <= options.max_rms_px;
+  };
+  // The best candidate first; the next ones only while none gives a supported camera.
+  AutoResectionResult result;
+  for (size_t i = 0; i < candidates.size() && static_cast<int>(i) < options.search_candidates; ++i) {
+    AutoResectionResult r = run_rounds(candidates[i]);
+    const bool better = i == 0 || (supported(r) && !supported(result)) ||
+                        (supported(r) == supported(result) && r.inliers > result.inliers);
+    if (better) result = std::move(r);
+    if (supported(result)) break;
   }
-  if (result.rounds == 0) {
-    pairs.clear();  // the search's pairs are not kept: its pose stands alone
+  if (result.rounds == 0)
     ThrowInputError(what, "", "features",
                     fmt::format("the search found a camera ({} inliers) but no rendering from it matches the "
                                 "photo again: the camera is not supported",
-                                best.inliers));
-  }
-  result.camera = camera;
-  result.pairs = std::move(pairs);
-  result.inlier = pose.inlier;
-  result.inliers = pose.inliers;
-  result.inlier_share = result.pairs.empty() ? 0 : static_cast<double>(pose.inliers) / result.pairs.size();
-  result.rms_px = pose.rms_px;
-  result.work_scale = 1 / working.to_photo_x;
-  result.rms_work_px = pose.rms_px / working.to_photo_x;
-  if (result.inliers < options.min_inliers || result.inlier_share < options.min_inlier_share ||
-      result.rms_work_px > options.max_rms_px)
+                                candidates[0].pose.inliers));
+  if (!supported(result))
     ThrowInputError(
         what, "", "features",
         fmt::format(

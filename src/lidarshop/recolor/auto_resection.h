@@ -11,7 +11,8 @@
 //      (cell angle x range, seen from the camera) into a z-buffer; every pixel keeps the index of the point it
 //      shows (the "point map"). SIFT (OpenCV) on the photo and the view, matched by Lowe's ratio test: a
 //      match is a pair (photo pixel, the view's point). Per view, OpenCV's solvePnPRansac (EPnP minimal sets,
-//      fixed seed); the view and field of view with the most inliers win. With a rough pose
+//      fixed seed); the view and field of view with the most inliers win (the next `search_candidates` - 1
+//      are tried in turn when the rounds from it find no supported camera). With a rough pose
 //      (`AutoResection(..., rough)`) only that view is rendered.
 //   3. Rounds. The scan is rendered again from the estimated camera with the photo's intrinsics and size: the
 //      parallax and the change of viewpoint (a camera metres from the scanner) are gone, so the rendering and
@@ -52,6 +53,8 @@ struct AutoResectionOptions {
   double pixels_per_cell = 1.0;  // working resolution: photo pixels per scan cell (seen from the scanner)
   int features = 4000;           // SIFT features per image at most
   double ratio = 0.8;            // Lowe's ratio test: best / second-best descriptor distance below this
+  // Search cameras tried in turn (most inliers first) while the rounds from them give no supported camera.
+  int search_candidates = 3;
   int rounds = 8;                // re-render, re-match, re-solve at most this many times
   double guided_radius_px = 12;  // rounds: a photo feature matches view features this near only, working px
   // Rounds also match patches of the rendering in the photo (normalized cross-correlation, sub-pixel peak):

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
 
@@ -48,17 +50,23 @@ TEST_P(AutoResectionCases, FindsTheCameraWithin2CmAndATenthOfADegree) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, AutoResectionCases, ::testing::Values(2001, 2002, 2003));
 
-TEST(AutoResection, UnknownFocalLengthIsFound) {
+TEST(AutoResection, StartsFromARoughPose) {
   const AutoCase c = MakeAutoCase(2004);
   const Scan scan = test_scenes::ScanScene(c.scene);
   const Photo photo = AutoCasePhoto(c);
-  const AutoResectionResult result = AutoResection(scan, photo.image, {});
-  EXPECT_NEAR(result.camera.fx_px, c.camera.fx_px, 0.01 * c.camera.fx_px) << result.Summary();
-  EXPECT_LT((result.camera.center_in_world() - c.camera.center_in_world()).norm(), 0.05) << result.Summary();
+  // 0.5 m and 3° off: no search from the scanner centre, one rendering from there.
+  Eigen::Matrix4d rough = c.camera.world_from_camera;
+  rough.topRightCorner<3, 1>() += Eigen::Vector3d(0.3, -0.3, 0.25);
+  rough.topLeftCorner<3, 3>() *=
+      Eigen::AngleAxisd(3 * M_PI / 180, Eigen::Vector3d(0, 1, 0)).toRotationMatrix();
+  const AutoResectionResult result = AutoResection(scan, photo.image, {}, c.camera, rough);
+  EXPECT_EQ(result.search_view, -1);
+  EXPECT_LT((result.camera.center_in_world() - c.camera.center_in_world()).norm(), 0.02) << result.Summary();
+  EXPECT_LT(AngleDeg(result.camera, c.camera), 0.1) << result.Summary();
 }
 
 TEST(AutoResection, SameResultOnOneAndTwoThreads) {
-  const AutoCase c = MakeAutoCase(2005, 300, 450);
+  const AutoCase c = MakeAutoCase(2005);
   const Scan scan = test_scenes::ScanScene(c.scene);
   const Photo photo = AutoCasePhoto(c);
   const int threads = cv::getNumThreads();

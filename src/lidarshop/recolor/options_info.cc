@@ -136,6 +136,9 @@ const StructInfo& InfoOf<AutoResectionOptions>() {
             "Lowe's ratio test: best / second-best distance below this")
         .AboveZero()
         .Max(1);
+    b.Field(&AutoResectionOptions::search_candidates, "search_candidates",
+            "search cameras tried in turn (most inliers first) while none gives a supported camera")
+        .Range(1, 1000);
     b.Field(&AutoResectionOptions::rounds, "rounds", "re-render, re-match, re-solve at most this many times")
         .Min(0);
     b.Field(&AutoResectionOptions::guided_radius_px, "guided_radius_px",
