@@ -20,6 +20,8 @@ namespace lidarshop {
 namespace {
 
 constexpr double kDegPerRad = 180.0 / M_PI;
+// A camera whose last round moved it less than this has settled (a supported camera must have).
+constexpr double kSettledMoveM = 0.01, kSettledTurnDeg = 0.05;
 
 // The scan's valid points in the world frame with their grey value, and the grid that joins them.
 struct ScanSamples {
@@ -729,13 +731,14 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
       out.rounds = round + 1;
       const double moved_m = (next.camera.center_in_world() - camera.center_in_world()).norm(),
                    turned_deg = RotationAngleDeg(next.camera.world_from_camera, camera.world_from_camera);
+      out.last_move_m = moved_m, out.last_turn_deg = turned_deg;
       camera = next.camera;
       pose = next;
       pairs = std::move(round_pairs);
       // The next search radius follows the estimate's accuracy (never wider than asked).
       radius_px = std::clamp(6 * pose.rms_px / working.to_photo_x, 3.0, options.guided_radius_px);
       if (!dense_rounds && options.patch_px > 0) {
-        dense_rounds = moved_m < 0.01 && turned_deg < 0.05;
+        dense_rounds = moved_m < kSettledMoveM && turned_deg < kSettledTurnDeg;
         continue;
       }
       if (moved_m < 1e-3 && turned_deg < 5e-3) break;
@@ -754,8 +757,11 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
     return out;
   };
   const auto supported = [&](const AutoResectionResult& r) {
+    // A camera still moving in its last round has not settled on what the photo shows (a repeating texture
+    // pulls it one period over at a time): not supported either.
     return r.rounds > 0 && r.inliers >= options.min_inliers && r.inlier_share >= options.min_inlier_share &&
-           r.rms_work_px <= options.max_rms_px;
+           r.rms_work_px <= options.max_rms_px && r.last_move_m < kSettledMoveM &&
+           r.last_turn_deg < kSettledTurnDeg;
   };
   // The best candidate first; the next ones only while none gives a supported camera.
   AutoResectionResult result;

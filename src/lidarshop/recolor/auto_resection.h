@@ -23,7 +23,8 @@
 //      over the focal length around it), inliers re-selected. Rounds stop when the camera moves less than
 //      0.5 mm and 0.001°, or after `rounds`.
 //   4. The answer is refused (InputError naming the photo, with the numbers) when fewer than `min_inliers`
-//      pairs or a share below `min_inlier_share` agree, or their RMS exceeds `max_rms_px`: a wrong camera
+//      pairs or a share below `min_inlier_share` agree, their RMS exceeds `max_rms_px`, or the last round still
+//      moved the camera 1 cm or 0.05° (it has not settled: a repeating texture pulls it over): a wrong camera
 //      would recolour the scan with the wrong photo pixels without a sign.
 // Deterministic: keypoints are sorted before their descriptors are computed, the brute-force matcher gives
 // the same answer on any thread count, RANSAC is seeded.
@@ -86,6 +87,8 @@ struct AutoResectionResult {
   int search_view = -1;               // the winning search view (-1 with a rough camera)
   int search_inliers = 0;             // its PnP inliers
   int rounds = 0;                     // rounds run
+  double last_move_m = 0;             // how far the last round moved the camera centre, metres
+  double last_turn_deg = 0;           // and turned it, degrees
   std::vector<std::string> warnings;  // one sentence each
   std::string Summary() const;        // one line
 };
