@@ -5,6 +5,8 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
+#include <random>
 #include <vector>
 
 #include <Eigen/Core>
@@ -65,6 +67,57 @@ std::vector<uint32_t> LargestConnectedPart(const std::vector<uint32_t>& subset,
   for (uint32_t i : subset)
     if (ids.at<int32_t>(cells[i]) == best) part.push_back(i);
   return part;
+}
+
+// The plane of most band cells that lie on it and face its way, among `remaining` (indices into `points`):
+// hypotheses are planes through one cell's point with its grid normal (1-point RANSAC with normals), scored
+// on at most kScoredCells of the cells. RANSAC through three points alone prefers the plane through a
+// flight of steps' nosings, which holds more cells within the distance than any one tread; a tread's cells
+// face up, not along that plane. Its facing inliers, increasing; empty when no cell has a normal.
+constexpr int kFacingHypotheses = 200;
+constexpr size_t kScoredCells = 4000;
+std::vector<uint32_t> FacingPlaneCells(const std::vector<Eigen::Vector3f>& points,
+                                       const std::vector<cv::Vec3f>& normals,
+                                       const std::vector<uint32_t>& remaining, double threshold_m,
+                                       uint64_t seed) {
+  std::mt19937_64 random(seed);
+  std::vector<uint32_t> with_normal;
+  for (uint32_t i : remaining)
+    if (normals[i].dot(normals[i]) > 0.5f) with_normal.push_back(i);
+  if (with_normal.empty()) return {};
+  std::vector<uint32_t> scored = with_normal;
+  if (scored.size() > kScoredCells) {
+    // A fixed sample (partial Fisher–Yates with the generator's raw draws: the same on every platform).
+    for (size_t k = 0; k < kScoredCells; ++k)
+      std::swap(scored[k], scored[k + random() % (scored.size() - k)]);
+    scored.resize(kScoredCells);
+  }
+  auto on_plane = [&](uint32_t i, const cv::Vec3f& n, double offset) {
+    const Eigen::Vector3f& p = points[i];
+    return std::abs(n[0] * p.x() + n[1] * p.y() + n[2] * p.z() + offset) <= threshold_m &&
+           std::abs(n.dot(normals[i])) >= kAgreeingNormal;
+  };
+  size_t best_count = 0;
+  uint32_t best_seed_cell = with_normal[0];
+  for (int h = 0; h < kFacingHypotheses; ++h) {
+    const uint32_t c = with_normal[random() % with_normal.size()];
+    const cv::Vec3f n = normals[c];
+    const Eigen::Vector3f& p = points[c];
+    const double offset = -(n[0] * p.x() + n[1] * p.y() + n[2] * p.z());
+    size_t count = 0;
+    for (uint32_t i : scored) count += on_plane(i, n, offset);
+    if (count > best_count) {
+      best_count = count;
+      best_seed_cell = c;
+    }
+  }
+  const cv::Vec3f n = normals[best_seed_cell];
+  const Eigen::Vector3f& p = points[best_seed_cell];
+  const double offset = -(n[0] * p.x() + n[1] * p.y() + n[2] * p.z());
+  std::vector<uint32_t> cells;
+  for (uint32_t i : with_normal)
+    if (on_plane(i, n, offset)) cells.push_back(i);
+  return cells;
 }
 
 enum class Meeting { kNone, kConcave, kConvex };
@@ -269,6 +322,9 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
   NormalOptions normal_options;
   normal_options.window_cells = 2;
   const cv::Mat normal = EstimateGridNormals(band_view, normal_options).normal;
+  std::vector<cv::Vec3f> cell_normals;
+  cell_normals.reserve(cells.size());
+  for (const cv::Point& c : cells) cell_normals.push_back(normal.at<cv::Vec3f>(c));
   PointCloud cloud;
   std::vector<float> ranges;
   cloud.points.reserve(cells.size());
@@ -280,10 +336,6 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
   std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
   *threshold_m = options.inlier_m + options.inlier_per_m * ranges[ranges.size() / 2];
 
-  RansacPlaneOptions ransac;
-  ransac.distance_threshold_m = *threshold_m;
-  ransac.max_planes = 1;
-  ransac.min_inliers = 3;
   // A plane holding min_share of the band is kept; a smaller one (a kerb's face, a stair riser: 10–20 rows)
   // only when it continues past the hole, seen on both of its sides.
   const size_t large = static_cast<size_t>(
@@ -298,37 +350,49 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
   for (int attempt = 0; attempt < attempts && static_cast<int>(planes.size()) < options.max_planes;
        ++attempt) {
     if (remaining.size() < small) break;
-    PointCloud rest;
-    rest.points.reserve(remaining.size());
-    for (uint32_t i : remaining) rest.points.push_back(cloud.points[i]);
-    ransac.seed = seed + static_cast<uint64_t>(attempt);
-    const PlaneFit hypothesis = FitPlaneRansac(rest, ransac);
-    if (hypothesis.inliers.size() < small) break;
-    // RANSAC's plane may run through two parallel surfaces at once (the road and the pavement behind a kerb,
-    // 2° apart, both within the inlier distance somewhere): refit it to the largest grid-connected part of its
-    // inliers, then take every remaining cell within the distance of the refitted plane.
+    const std::vector<uint32_t> hypothesis = FacingPlaneCells(
+        cloud.points, cell_normals, remaining, *threshold_m, seed + static_cast<uint64_t>(attempt));
+    if (hypothesis.size() < small) break;
+    // The hypothesis's cells may lie on two parallel surfaces at once (the road and the pavement behind a kerb,
+    // 2° apart, both within the inlier distance somewhere): the plane is fitted to the largest grid-connected
+    // part of them, then to every remaining cell within the distance that faces the fitted plane's way. Cells
+    // within the distance that face elsewhere (a riser's cells at a tread's edge) stay for a plane of their own.
+    auto facing = [&](uint32_t i, const PlaneFit& f) {
+      const cv::Vec3f& n = cell_normals[i];
+      return std::abs(n[0] * f.normal.x() + n[1] * f.normal.y() + n[2] * f.normal.z()) >= kAgreeingNormal;
+    };
+    PlaneFit fit;
+    fit.normal = Eigen::Vector3d(cell_normals[hypothesis[0]][0], cell_normals[hypothesis[0]][1],
+                                 cell_normals[hypothesis[0]][2]);
+    fit.inliers = LargestConnectedPart(hypothesis, cells, roi.size());
+    if (fit.inliers.size() < 3) break;
+    RefitPlane(cloud.points, &fit);
     std::vector<uint32_t> inliers;
-    for (uint32_t i : hypothesis.inliers) inliers.push_back(remaining[i]);
-    PlaneFit fit = hypothesis;
-    fit.inliers = LargestConnectedPart(inliers, cells, roi.size());
-    if (fit.inliers.size() >= 3) RefitPlane(cloud.points, &fit);
     std::vector<uint32_t> kept;
+    size_t within = 0;  // remaining cells within the distance, facing any way
     // Twice: the part's plane gathers the surface's cells beyond the part (the face on the hole's other
     // side), and the plane refitted to all of them is the least-squares plane of the whole surface.
     for (int pass = 0; pass < 2; ++pass) {
       kept.clear();
       inliers.clear();
-      for (uint32_t i : remaining)
-        (std::abs(fit.Distance(cloud.points[i])) <= *threshold_m ? inliers : kept).push_back(i);
+      within = 0;
+      for (uint32_t i : remaining) {
+        const bool near = std::abs(fit.Distance(cloud.points[i])) <= *threshold_m;
+        within += near;
+        (near && facing(i, fit) ? inliers : kept).push_back(i);
+      }
       if (pass == 0 && inliers.size() >= 3) {
         fit.inliers = inliers;
         RefitPlane(cloud.points, &fit);
       }
     }
-    if (inliers.size() < small) {
-      // The refit lost its support: drop what RANSAC found and go on.
-      for (uint32_t i : hypothesis.inliers) remaining[i] = UINT32_MAX;
-      std::erase(remaining, UINT32_MAX);
+    if (inliers.size() < small || 2 * inliers.size() < within) {
+      // The refit lost its support, or most cells on the plane face elsewhere (not a surface): drop the
+      // hypothesis's cells and go on.
+      std::vector<uint32_t> rest;
+      std::set_difference(remaining.begin(), remaining.end(), hypothesis.begin(), hypothesis.end(),
+                          std::back_inserter(rest));
+      remaining = std::move(rest);
       continue;
     }
     remaining = std::move(kept);
@@ -341,18 +405,14 @@ std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_i
       plane.offset_m = -plane.offset_m;
     }
     plane.seen.reserve(inliers.size());
-    const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
-                                 static_cast<float>(plane.normal.z()));
     size_t outer = 0;
     Rect2 seen_box{INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN};
-    for (uint32_t i : inliers) {
-      if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
+    for (uint32_t i : inliers) {  // every one faces the plane's way
       plane.seen.push_back(cloud.points[i]);
       outer += from_part.at<float>(cells[i]) > 0.5f * band;
       seen_box.Add(cells[i].x, cells[i].y);
     }
-    if (2 * plane.seen.size() < inliers.size()) continue;  // most cells face elsewhere: not a surface
-    if (4 * outer < plane.seen.size()) continue;           // only on the rim
+    if (4 * outer < plane.seen.size()) continue;                           // only on the rim
     if (plane.seen.size() < large && !seen_box.Spans(part_box)) continue;  // small, and not past the hole
     // A facade's window panes are a plane of their own a little behind it; they are the facade's relief (a
     // copied pane lands at its offset from the facade), not a surface a cell copied from no plane may snap to.
