@@ -35,6 +35,10 @@ constexpr double kParallelCos = 0.99;
 // cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
 constexpr float kAgreeingNormal = 0.985f;
 
+// Two reliefs on one plane differ when they are this far apart (a window recess is 0.1-0.3 m deep; the
+// floating share counts points 0.1 m off the surface).
+constexpr double kReliefStepM = 0.05;
+
 // A plane holding this share of the band's cells (and 30) is kept when it is seen on both sides of the hole.
 constexpr double kSmallPlaneShare = 0.01;
 
@@ -213,12 +217,61 @@ int SourcePlane(const PartPlanes& part, const KnownCells& known, const cv::Vec2i
   return best;
 }
 
+// The offset from plane `k` that the known cells around hole cell (y, x) agree on: the nearest known cells
+// outside the hole (`hole`, CV_8U) left and right of it, and above and below it, each pair counted when both
+// face the plane's way within relief_m of it and agree within `tolerance_m`. A recess's edge hidden by the
+// object and running up through the hole leaves the pair above and below on the cell's side of it (and the
+// pair left and right disagreeing); one running across, the pair left and right. True when one pair agrees,
+// or both agree with each other; `offset_m` receives their mean. A patch is matched on the range's gradients,
+// which are the same on a facade and on a window recess parallel to it: the relief a patch brings is a guess
+// that the cells around the hole can overrule.
+bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
+                    size_t k, double relief_m, double tolerance_m, double* offset_m) {
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
+  std::array<bool, 4> on{};
+  std::array<double, 4> offset{};
+  for (size_t s = 0; s < kSteps.size(); ++s) {
+    int yy = y, xx = x;
+    do {
+      yy += kSteps[s][0];
+      xx += kSteps[s][1];
+    } while (yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols && hole.at<uint8_t>(yy, xx));
+    Eigen::Vector3f normal;
+    if (!known.Usable(yy, xx) || !CellNormal(known, yy, xx, &normal)) continue;
+    if (std::abs(normal.cast<double>().dot(part.planes[k].normal)) < kFacingNormal) continue;
+    offset[s] = part.planes[k].SignedDistance(known.PointAt(yy, xx));
+    on[s] = std::abs(offset[s]) <= relief_m;
+  }
+  const bool row = on[0] && on[1] && std::abs(offset[0] - offset[1]) <= tolerance_m;
+  const bool column = on[2] && on[3] && std::abs(offset[2] - offset[3]) <= tolerance_m;
+  const double row_mean = 0.5 * (offset[0] + offset[1]), column_mean = 0.5 * (offset[2] + offset[3]);
+  if (row && column) {
+    if (std::abs(row_mean - column_mean) > tolerance_m)
+      return false;  // a hidden recess's corner: the patch's
+    *offset_m = 0.5 * (row_mean + column_mean);
+  } else if (row || column) {
+    *offset_m = row ? row_mean : column_mean;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 // The range of a hole cell (ray `dir`, reconstructed range `r`, copied from `from`) on the planes of its
 // part; 0 = keep the reconstruction.
-double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Vec2i& from,
-                     const cv::Vec3f& dir, double r, double agreement_m, const FillPlaneOptions& options) {
+double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole,
+                     const cv::Point& cell, const cv::Vec2i& from, const cv::Vec3f& dir, double r,
+                     double agreement_m, const FillPlaneOptions& options) {
   double source_offset = 0;
   const int source_plane = SourcePlane(part, known, from, options.relief_m, &source_offset);
+  // The source's relief, unless the cells around the hole agree on another (a patch of a window recess
+  // copied onto the plain facade beside it, or of the facade into a recess).
+  double around = 0;
+  if (source_plane >= 0 &&
+      SurroundOffset(part, known, hole, cell.y, cell.x, static_cast<size_t>(source_plane), options.relief_m,
+                     kReliefStepM, &around) &&
+      std::abs(around - source_offset) > kReliefStepM)
+    source_offset = around;
   const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
   const size_t n = part.planes.size();
   // No allocation per cell: FillPlaneOptions::max_planes is at most kMaxPlanes (checked with the options).
@@ -452,7 +505,7 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
         const double travelled_m = to_border.at<float>(y, x) * part.spacing_rad * r;
         const cv::Vec2i from = source.empty() ? cv::Vec2i(-1, -1) : source.at<cv::Vec2i>(y, x);
         const double placed =
-            RangeOnPlanes(part, known, from, direction.at<cv::Vec3f>(y, x), r,
+            RangeOnPlanes(part, known, hole, cv::Point(x, y), from, direction.at<cv::Vec3f>(y, x), r,
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
         if (placed <= 0) continue;
         r = static_cast<float>(placed);
