@@ -257,11 +257,74 @@ bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::M
   return true;
 }
 
+// A hole cell in a narrow gap — at most kNarrowGapCells between the known cells left and right of it, or
+// above and below (a post's column, a leg) — whose two known cells lie on one plane at one relief: the plane
+// `*plane` and that relief `*offset_m`. Such a surface runs on behind a thin object; a patch copied from
+// another surface (a neighbour's side, whose plane the ray meets a little beyond the wall) has no say there.
+constexpr int kNarrowGapCells = 16;
+bool NarrowGapPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
+                    double relief_m, int* plane, double* offset_m) {
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
+  for (size_t pair = 0; pair < 2; ++pair) {
+    std::array<cv::Point, 2> end;
+    int gap = 1;
+    for (size_t side = 0; side < 2; ++side) {
+      const auto& step = kSteps[2 * pair + side];
+      int yy = y, xx = x;
+      do {
+        yy += step[0];
+        xx += step[1];
+        ++gap;
+      } while (gap <= kNarrowGapCells && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
+               hole.at<uint8_t>(yy, xx));
+      end[side] = cv::Point(xx, yy);
+    }
+    if (gap > kNarrowGapCells + 1) continue;
+    std::array<Eigen::Vector3f, 2> normal;
+    if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
+        !CellNormal(known, end[0].y, end[0].x, &normal[0]) ||
+        !CellNormal(known, end[1].y, end[1].x, &normal[1]))
+      continue;
+    int best = -1;
+    double best_offset = 0;
+    for (size_t k = 0; k < part.planes.size(); ++k) {
+      const SeenPlane& p = part.planes[k];
+      const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
+      const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
+      if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
+          std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
+          std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
+        continue;
+      if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
+        best = static_cast<int>(k);
+        best_offset = 0.5 * (a + b);
+      }
+    }
+    if (best >= 0) {
+      *plane = best;
+      *offset_m = best_offset;
+      return true;
+    }
+  }
+  return false;
+}
+
 // The range of a hole cell (ray `dir`, reconstructed range `r`, copied from `from`) on the planes of its
 // part; 0 = keep the reconstruction.
 double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole,
                      const cv::Point& cell, const cv::Vec2i& from, const cv::Vec3f& dir, double r,
                      double agreement_m, const FillPlaneOptions& options) {
+  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  int gap_plane = -1;
+  double gap_offset = 0;
+  if (NarrowGapPlane(part, known, hole, cell.y, cell.x, options.relief_m, &gap_plane, &gap_offset)) {
+    const SeenPlane& p = part.planes[static_cast<size_t>(gap_plane)];
+    const double facing = p.normal.dot(ray);
+    if (std::abs(facing) >= 1e-6) {
+      const double along = (gap_offset - p.offset_m) / facing;
+      if (along > 0 && std::abs(along - r) <= options.tolerance * r) return along;
+    }
+  }
   double source_offset = 0;
   const int source_plane = SourcePlane(part, known, from, options.relief_m, &source_offset);
   // The source's relief, unless the cells around the hole agree on another (a patch of a window recess
@@ -272,7 +335,6 @@ double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::
                      kReliefStepM, &around) &&
       std::abs(around - source_offset) > kReliefStepM)
     source_offset = around;
-  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
   const size_t n = part.planes.size();
   // No allocation per cell: FillPlaneOptions::max_planes is at most kMaxPlanes (checked with the options).
   LIDARSHOP_CHECK(n <= kMaxPlanes);

@@ -12,8 +12,11 @@
 //      reach past the hole on two opposite sides (a kerb's face);
 //   2. a cell's candidates are the planes whose intersection with its ray lies within `tolerance` × the
 //      reconstructed range; with none, the cell keeps the reconstructed range;
-//   3. the cell goes onto the plane its patch source lies on (facing its way, within `relief_m`), at the
-//      source's signed distance from it — relief is copied, not flattened (a window recess stays a recess);
+//   3. a cell in a narrow gap (a post's column) between two known cells on one plane at one relief goes onto
+//      that plane at that relief; otherwise the cell goes onto the plane its patch source lies on (facing its
+//      way, within `relief_m`), at the source's signed distance from it — relief is copied, not flattened (a
+//      window recess stays a recess) — unless the known cells left and right of it, or above and below, agree
+//      on another relief on that plane (patches are matched on range gradients, blind to a recess's depth);
 //      a cell copied from no plane goes onto the nearest candidate only when the reconstruction agrees with it
 //      (`agreement_m`, growing with the distance from the hole's border);
 //   4. then the order the surroundings show: two planes whose seen parts each lie in front of the other meet
