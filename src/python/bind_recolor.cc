@@ -8,6 +8,7 @@
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/recolor/align.h"
+#include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/recolor/recolor.h"
@@ -212,6 +213,55 @@ void BindResection(py::module_& m) {
       },
       py::arg("pixels"), py::arg("points"), py::arg("intrinsics"), py::arg("options") = py::none(),
       "The pose only, with known intrinsics (>= 4 pairs; planar targets allowed). A ResectionResult.");
+  py::class_<AutoResectionResult>(m, "AutoResectionResult",
+                                  "The camera of a photo found from the scan alone, with its pairs.")
+      .def_readonly("camera", &AutoResectionResult::camera)
+      .def_property_readonly(
+          "pixels",
+          [](const AutoResectionResult& r) {
+            std::vector<Eigen::Vector2d> v;
+            for (const PixelPointPair& p : r.pairs) v.push_back(p.pixel_px);
+            return v;
+          },
+          "the last round's photo pixels")
+      .def_property_readonly(
+          "points",
+          [](const AutoResectionResult& r) {
+            std::vector<Eigen::Vector3d> v;
+            for (const PixelPointPair& p : r.pairs) v.push_back(p.point_in_world);
+            return v;
+          },
+          "their world points")
+      .def_property_readonly(
+          "inlier", [](const AutoResectionResult& r) { return BoolArray(r.inlier); }, "bool per pair")
+      .def_readonly("inliers", &AutoResectionResult::inliers)
+      .def_readonly("inlier_share", &AutoResectionResult::inlier_share)
+      .def_readonly("rms_px", &AutoResectionResult::rms_px)
+      .def_readonly("rms_work_px", &AutoResectionResult::rms_work_px)
+      .def_readonly("rounds", &AutoResectionResult::rounds)
+      .def_readonly("search_view", &AutoResectionResult::search_view)
+      .def("summary", &AutoResectionResult::Summary)
+      .def("__repr__", [](const AutoResectionResult& r) {
+        return "<lidarshop.AutoResectionResult " + r.Summary() + ">";
+      });
+  m.def(
+      "auto_resection",
+      [](const Scan& scan, const py::object& photo, const std::optional<PinholeCamera>& intrinsics,
+         const py::object& rough_world_from_camera, const py::object& options, const py::kwargs& kwargs) {
+        const cv::Mat image = ArrayToMat(photo, CV_8U, 3, -1, -1, "photo");
+        std::optional<Eigen::Matrix4d> rough;
+        if (!rough_world_from_camera.is_none())
+          rough = ArrayToMatrix(rough_world_from_camera, "rough_world_from_camera");
+        const AutoResectionOptions auto_options = OptionsOf<AutoResectionOptions>(options, kwargs);
+        py::gil_scoped_release release;
+        return AutoResection(scan, image, auto_options, intrinsics, rough);
+      },
+      py::arg("scan"), py::arg("photo"), py::arg("intrinsics") = py::none(),
+      py::arg("rough_world_from_camera") = py::none(), py::arg("options") = py::none(),
+      "The camera of a photo (uint8 RGB) from the scan alone, no pairs (recolor/auto_resection.h): known "
+      "intrinsics or a field-of-view search, from the scanner centre or a rough pose (4 x 4). Raises "
+      "InputError "
+      "when no camera is supported. An AutoResectionResult.");
 }
 
 void BindAlign(py::module_& m) {

@@ -24,6 +24,7 @@
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/poisson/poisson.h"
+#include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
 #include "lidarshop/scanner/photo.h"
@@ -66,6 +67,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<SweepOptions>(m);
   // Recolouring
   BindStruct<ResectionOptions>(m);
+  BindStruct<AutoResectionOptions>(m);
   BindStruct<RecolorOptions>(m);
   // Point sets
   BindStruct<StatisticalOutlierOptions>(m);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/recolor/align.h"
+#include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/recolor/recolor.h"
@@ -106,6 +108,53 @@ void AddResectionOptions(CLI::App& app, OptionBinder& binder, ResectionOptions* 
   if (!group.empty()) intrinsics->group(group);
 }
 
+// --auto: AutoResectionOptions' flags are --auto-<key> (its seed, threshold and iterations are not the
+// pair resection's).
+void AddAutoResectionOptions(OptionBinder& binder, AutoResectionOptions* options, std::string* rough_path,
+                             CLI::App& app, const std::string& group) {
+  BindSettings settings;
+  for (const FieldInfo& field : InfoOf<AutoResectionOptions>().fields) {
+    std::string flag = "--auto-" + field.key;
+    std::replace(flag.begin(), flag.end(), '_', '-');
+    settings.flags[field.key] = flag;
+  }
+  settings.group = group;
+  binder.Bind(options, settings);
+  app.add_option(
+         "--rough-camera", *rough_path,
+         "with --auto: camera JSON whose pose is a rough guess to start from (instead of a search from "
+         "the scanner centre); its intrinsics are not used")
+      ->group(group);
+}
+
+AutoResectionResult RunAutoResection(const Scan& scan, const cv::Mat& photo,
+                                     const AutoResectionOptions& options, const std::string& intrinsics_path,
+                                     const std::string& rough_path, const std::string& what) {
+  std::optional<PinholeCamera> intrinsics;
+  std::optional<Eigen::Matrix4d> rough;
+  if (!intrinsics_path.empty()) intrinsics = ReadCameraJson(intrinsics_path);
+  if (!rough_path.empty()) rough = ReadCameraModelJson(rough_path).world_from_camera;
+  return AutoResection(scan, photo, options, intrinsics, rough, what);
+}
+
+nlohmann::ordered_json AutoResectionJson(const AutoResectionResult& result) {
+  nlohmann::ordered_json json;
+  json["inliers"] = result.inliers;
+  json["pairs"] = result.pairs.size();
+  json["inlier_share"] = result.inlier_share;
+  json["rms_px"] = result.rms_px;
+  json["rms_work_px"] = result.rms_work_px;
+  json["work_scale"] = result.work_scale;
+  json["rounds"] = result.rounds;
+  json["search_view"] = result.search_view;
+  json["search_inliers"] = result.search_inliers;
+  if (result.search_fov_deg > 0) json["search_fov_deg"] = result.search_fov_deg;
+  json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
+  json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
+                           result.camera.center_in_world().z()};
+  json["warnings"] = result.warnings;
+  return json;
+}
 }  // namespace
 
 nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
@@ -163,12 +212,19 @@ int RunResection(int argc, char** argv) {
       "resection"};
   std::string pairs_path, output, scan_path, photo_path, intrinsics_path, json_path = "-";
   std::vector<int> size;
+  std::vector<std::string> auto_inputs;
+  std::string rough_path;
+  bool auto_mode = false;
   int scan_index = 0;
   ResectionOptions options;
+  AutoResectionOptions auto_options;
   OptionBinder binder(app);
   app.add_option("--correspondences", pairs_path,
-                 "C.json: {\"pairs\": [{\"pixel\": [u, v], \"point\": [x, y, z]}]}")
-      ->required();
+                 "C.json: {\"pairs\": [{\"pixel\": [u, v], \"point\": [x, y, z]}]}");
+  app.add_flag("--auto", auto_mode,
+               "no pairs: register the photo to the scan automatically (rendered views, SIFT, PnP RANSAC; "
+               "recolor/auto_resection.h): resection --auto SCAN PHOTO -o CAM.json");
+  app.add_option("inputs", auto_inputs, "with --auto: SCAN PHOTO (or --scan, --photo)")->expected(0, 2);
   app.add_option("-o,--output", output, "camera JSON to write")->required();
   app.add_option("--scan", scan_path, "the scan whose cells \"cell\": [row, col] refer to");
   app.add_option("--scan-index", scan_index, "which scan of --scan (from 0)");
@@ -176,10 +232,40 @@ int RunResection(int argc, char** argv) {
   app.add_option("--size", size, "the photo's size: WIDTH HEIGHT (instead of --photo)")->expected(2);
   AddJsonOption(app, &json_path);
   AddResectionOptions(app, binder, &options, &intrinsics_path, "");
+  AddAutoResectionOptions(binder, &auto_options, &rough_path, app, "Automatic resection (--auto)");
   return RunCommand(
       app, argc, argv,
       [&] {
         binder.Validate(options);
+        if (auto_mode) {
+          binder.Validate(auto_options);
+          if (!pairs_path.empty()) throw OptionsError("--auto needs no --correspondences");
+          if (!size.empty()) throw OptionsError("--auto takes the photo's size from the photo: no --size");
+          if (auto_inputs.size() >= 1) {
+            if (!scan_path.empty()) throw OptionsError("give the scan once (SCAN or --scan)");
+            scan_path = auto_inputs[0];
+          }
+          if (auto_inputs.size() == 2) {
+            if (!photo_path.empty()) throw OptionsError("give the photo once (PHOTO or --photo)");
+            photo_path = auto_inputs[1];
+          }
+          if (scan_path.empty() || photo_path.empty())
+            throw OptionsError("--auto needs a scan and a photo: resection --auto SCAN PHOTO -o CAM.json");
+          CheckNotInput(output, {scan_path, photo_path, intrinsics_path, rough_path});
+          CheckOutputFile("--json", json_path, {},
+                          {scan_path, photo_path, intrinsics_path, rough_path, output});
+          const Scan scan = ReadOneScan(scan_path, scan_index, "--scan-index");
+          const cv::Mat photo = ReadImage(photo_path);
+          const AutoResectionResult result =
+              RunAutoResection(scan, photo, auto_options, intrinsics_path, rough_path, photo_path);
+          WriteCameraJson(output, result.camera);
+          WriteJsonOutput(json_path, CommandJson(ToJson(auto_options), AutoResectionJson(result)));
+          PrintResultWarnings(result.warnings);
+          Summarize(fmt::format("{} -> {}", result.Summary(), output));
+          return 0;
+        }
+        if (!auto_inputs.empty()) throw OptionsError("SCAN PHOTO go with --auto");
+        if (pairs_path.empty()) throw OptionsError("give --correspondences C.json, or --auto SCAN PHOTO");
         CheckNotInput(output, {pairs_path, scan_path, photo_path, intrinsics_path});
         CheckOutputFile("--json", json_path, {},
                         {pairs_path, scan_path, photo_path, intrinsics_path, output});
@@ -248,6 +334,13 @@ int RunRecolor(int argc, char** argv) {
   binder.Bind(&options,
               {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
   AddResectionOptions(app, binder, &resection, &intrinsics_path, "Resection (with --correspondences)");
+  bool auto_mode = false;
+  std::string rough_path;
+  AutoResectionOptions auto_options;
+  app.add_flag("--auto", auto_mode,
+               "no camera, no pairs: register the photo to the scan automatically first "
+               "(recolor/auto_resection.h; --intrinsics gives known intrinsics)");
+  AddAutoResectionOptions(binder, &auto_options, &rough_path, app, "Automatic resection (--auto)");
   // Colouring from several photos at once, and what it writes (--from-e57-images, repeated --photo).
   // `carried`: the input E57's images of this scan, written on with it when the output is an E57 (a station's
   // photos belong with its scan; a recoloured E57 without them could not be coloured again).
@@ -287,6 +380,13 @@ int RunRecolor(int argc, char** argv) {
       [&] {
         binder.Validate(options);
         binder.Validate(resection);
+        binder.Validate(auto_options);
+        if (auto_mode &&
+            (photo_paths.size() > 1 || from_e57_images || !camera_paths.empty() || !pairs_path.empty()))
+          throw OptionsError(
+              "--auto finds the camera of one photo (--photo or --image): no --camera, --correspondences, "
+              "--from-e57-images nor several --photo");
+        if (!auto_mode && !rough_path.empty()) throw OptionsError("--rough-camera goes with --auto");
         const std::string photo_path = photo_paths.size() == 1 ? photo_paths[0] : "";
         const std::string camera_path = camera_paths.size() == 1 ? camera_paths[0] : "";
         std::vector<std::string> inputs = {scan_path, pairs_path};
@@ -401,15 +501,27 @@ int RunRecolor(int argc, char** argv) {
             ThrowInputError(scan_path, "images2D " + image.name, "", image.decode_error);
           photo = image.image;
           std::string why;
-          have_camera = camera_path.empty() && pairs_path.empty() && CameraFromE57Image(image, &camera, &why);
-          if (!have_camera && camera_path.empty() && pairs_path.empty()) throw OptionsError(why);
+          have_camera = !auto_mode && camera_path.empty() && pairs_path.empty() &&
+                        CameraFromE57Image(image, &camera, &why);
+          if (!have_camera && !auto_mode && camera_path.empty() && pairs_path.empty())
+            throw OptionsError(why);
         } else {
           photo = ReadImage(photo_path);
           if (photo.type() != CV_8UC3) ThrowInputError(photo_path, "", "", "expected an 8-bit RGB photo");
         }
         if (!camera_path.empty() && !pairs_path.empty())
           throw OptionsError("give --camera or --correspondences, not both");
-        if (!camera_path.empty()) {
+        if (auto_mode) {
+          const AutoResectionResult result =
+              RunAutoResection(scan, photo, auto_options, intrinsics_path, rough_path,
+                               photo_path.empty() ? image_key : photo_path);
+          fmt::print(stderr, "{}\n", result.Summary());
+          json["auto_resection"] = AutoResectionJson(result);
+          json["auto_resection"]["options"] = ToJson(auto_options);
+          camera = result.camera;
+          // The edge guard's margin follows the camera's accuracy, as with pairs.
+          options.camera_uncertainty_px = std::max(options.camera_uncertainty_px, 2 * result.rms_px);
+        } else if (!camera_path.empty()) {
           camera = ReadCameraJson(camera_path);
         } else if (!pairs_path.empty()) {
           resection.width_px = photo.cols, resection.height_px = photo.rows;
@@ -423,13 +535,15 @@ int RunRecolor(int argc, char** argv) {
           // The edge guard's margin follows the resection: a camera is good to about twice its RMS.
           options.camera_uncertainty_px = std::max(options.camera_uncertainty_px, 2 * result.rms_px);
         } else if (!have_camera) {
-          throw OptionsError("give --camera or --correspondences");
+          throw OptionsError("give --camera, --correspondences or --auto");
         }
         const RecolorResult result = RecolorScan(scan, photo, camera, options);
         // The resection's warnings (its RMS) and the recolouring's (the colours disagree), in that order.
         std::vector<std::string> warnings;
         if (json.contains("resection"))
           warnings = json["resection"]["warnings"].get<std::vector<std::string>>();
+        if (json.contains("auto_resection"))
+          warnings = json["auto_resection"]["warnings"].get<std::vector<std::string>>();
         warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
         WriteScanFile(output, {result.scan});
         if (!mask_path.empty()) WriteImage(mask_path, result.recolored);

@@ -1,4 +1,5 @@
 // Descriptions of the recolouring options and enums (util/options.h).
+#include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
@@ -105,6 +106,71 @@ const StructInfo& InfoOf<RecolorOptions>() {
         .Min(0);
     b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
     b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<AutoResectionOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<AutoResectionOptions> b(
+        "AutoResectionOptions",
+        "the camera of a photo from the scan alone (rendered views, SIFT, PnP RANSAC)");
+    b.Field(&AutoResectionOptions::fov_candidates_deg, "fov_candidates_deg",
+            "horizontal fields of view tried when the intrinsics are not given")
+        .Unit("deg")
+        .Range(1, 179);
+    b.Field(&AutoResectionOptions::view_azimuths, "view_azimuths", "search views around the scanner's z axis")
+        .Range(1, 72);
+    b.Field(&AutoResectionOptions::view_elevations_deg, "view_elevations_deg",
+            "elevations of the search views")
+        .Unit("deg")
+        .Range(-80, 80);
+    b.Field(&AutoResectionOptions::pixels_per_cell, "pixels_per_cell",
+            "working resolution: photo pixels per scan cell seen from the scanner")
+        .AboveZero()
+        .Max(8);
+    b.Field(&AutoResectionOptions::features, "features", "SIFT features per image at most").Min(50);
+    b.Field(&AutoResectionOptions::ratio, "ratio",
+            "Lowe's ratio test: best / second-best distance below this")
+        .AboveZero()
+        .Max(1);
+    b.Field(&AutoResectionOptions::search_candidates, "search_candidates",
+            "search cameras tried in turn (most inliers first) while none gives a supported camera")
+        .Range(1, 1000);
+    b.Field(&AutoResectionOptions::rounds, "rounds", "re-render, re-match, re-solve at most this many times")
+        .Min(0);
+    b.Field(&AutoResectionOptions::guided_radius_px, "guided_radius_px",
+            "rounds: a photo feature matches rendered features this near only")
+        .Unit("px")
+        .AboveZero();
+    b.Field(&AutoResectionOptions::patch_px, "patch_px",
+            "rounds: side of the rendered patches found in the photo by correlation (0 = off)")
+        .Unit("px")
+        .Range(0, 63);
+    b.Field(&AutoResectionOptions::patch_step_px, "patch_step_px", "patch centres this far apart")
+        .Unit("px")
+        .Range(1, 1000);
+    b.Field(&AutoResectionOptions::min_patch_score, "min_patch_score",
+            "normalized cross-correlation of a found patch at least this")
+        .Range(-1, 1);
+    b.Field(&AutoResectionOptions::ransac_threshold_px, "ransac_threshold_px",
+            "inlier reprojection error (working pixels)")
+        .Unit("px")
+        .AboveZero();
+    b.Field(&AutoResectionOptions::ransac_iterations, "ransac_iterations",
+            "PnP RANSAC's minimal sets at most")
+        .Min(1);
+    b.Field(&AutoResectionOptions::min_inliers, "min_inliers", "fewer agreeing pairs: refused").Min(6);
+    b.Field(&AutoResectionOptions::min_inlier_share, "min_inlier_share",
+            "inliers / pairs below this: refused")
+        .Range(0, 1);
+    b.Field(&AutoResectionOptions::max_rms_px, "max_rms_px",
+            "inliers' RMS above this (working pixels): refused")
+        .Unit("px")
+        .AboveZero();
+    b.Field(&AutoResectionOptions::seed, "seed", "seed of RANSAC's random sets");
     return b.Build();
   }();
   return info;

@@ -145,3 +145,15 @@ def test_station_colouring_from_e57_images_and_photos(tmp_path):
         lidarshop.recolor_from_photos(result.scan, [p["image"] for p in photos], [p["camera"] for p in photos][:5])
     with pytest.raises(lidarshop.InputError, match="no image of scan 0 holds a photo with a camera"):
         lidarshop.recolor_from_e57_images(os.path.join(SOURCE_DIR, "..", "shared", "data", "e57", "pumpA.e57"))
+
+
+def test_auto_resection_refuses_a_photo_of_nothing_the_scan_holds(scene_photo):
+    # The camera without pairs (recolor/auto_resection.h): a photo of the empty sky matches no rendering of the
+    # scan, and the function says so instead of returning a camera. (Its accuracy: auto_resection_test.)
+    scene, camera, _ = scene_photo
+    scan = lidarshop.scan_scene(scene)
+    sky = np.zeros((240, 320, 3), dtype=np.uint8)
+    with pytest.raises(lidarshop.InputError, match="no rendering of the scan matches"):
+        lidarshop.auto_resection(scan, sky, intrinsics=camera)
+    options = lidarshop.AutoResectionOptions(rounds=3)
+    assert options.to_dict()["rounds"] == 3

@@ -1,0 +1,792 @@
+#include "lidarshop/recolor/auto_resection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <span>
+#include <tuple>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Eigen/Geometry>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/util/error.h"
+
+namespace lidarshop {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+// A camera whose last round moved it less than this has settled (a supported camera must have).
+constexpr double kSettledMoveM = 0.01, kSettledTurnDeg = 0.05;
+
+// The scan's valid points in the world frame with their grey value, and the grid that joins them.
+struct ScanSamples {
+  std::vector<Eigen::Vector3d> point_in_world;
+  std::vector<float> grey;
+  std::vector<float> range_m;  // from the scanner centre
+  cv::Mat index;               // CV_32S, the scan's grid: the sample of each cell, -1 without a return
+  double cell_angle_rad = 0;
+  Eigen::Vector3d scanner_in_world = Eigen::Vector3d::Zero();
+};
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// The median angle between neighbouring columns and rows of the scan's grid, radians.
+double CellAngleRad(const Scan& scan) {
+  const ScanGrid grid = GridOf(scan);
+  std::vector<double> steps;
+  for (size_t i = 1; i < grid.azimuth_rad.size(); ++i)
+    steps.push_back(std::abs(grid.azimuth_rad[i] - grid.azimuth_rad[i - 1]));
+  for (size_t i = 1; i < grid.elevation_rad.size(); ++i)
+    steps.push_back(std::abs(grid.elevation_rad[i] - grid.elevation_rad[i - 1]));
+  std::erase_if(steps, [](double s) { return !(s > 1e-7) || s > 0.2; });
+  const double step = Median(steps);
+  return step > 0 ? step : 0.2 / kDegPerRad;
+}
+
+ScanSamples SamplesOf(const Scan& scan, const std::string& what) {
+  cv::Mat grey;
+  if (scan.has_color()) {
+    cv::cvtColor(scan.color, grey, cv::COLOR_RGB2GRAY);
+  } else if (scan.has_intensity()) {
+    scan.intensity.convertTo(grey, CV_8U, 255.0);
+  } else {
+    ThrowInputError(what, "", "color", "automatic resection needs a scan with colour or intensity");
+  }
+  ScanSamples samples;
+  samples.cell_angle_rad = CellAngleRad(scan);
+  samples.scanner_in_world = scan.world_from_scanner.topRightCorner<3, 1>();
+  samples.index = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(-1));
+  for (int r = 0; r < scan.rows; ++r) {
+    for (int c = 0; c < scan.cols; ++c) {
+      if (!scan.valid.at<uint8_t>(r, c)) continue;
+      const Eigen::Vector3d point = WorldPointOfCell(scan, r, c);
+      if (!point.allFinite()) continue;
+      samples.index.at<int32_t>(r, c) = static_cast<int32_t>(samples.point_in_world.size());
+      samples.point_in_world.push_back(point);
+      samples.grey.push_back(grey.at<uint8_t>(r, c));
+      samples.range_m.push_back(static_cast<float>((point - samples.scanner_in_world).norm()));
+    }
+  }
+  return samples;
+}
+
+// A rendering of the scan: grey values and, per pixel, the surface point seen through the pixel's centre.
+struct View {
+  PinholeCamera camera;
+  cv::Mat grey;            // CV_8U
+  cv::Mat point_from_eye;  // CV_32FC3: the point seen minus the camera centre, world axes, metres
+  cv::Mat depth;           // CV_32F: along the optical axis, +inf where nothing is seen
+};
+
+// Neighbouring returns whose ranges differ by more than this ratio lie on different surfaces (a depth edge):
+// no triangle joins them. Ground 40 m from a scanner 1.5 m high changes range by 4 % per 0.09° row.
+constexpr double kMaxRangeRatio = 1.15;
+
+// The scan's grid mesh (two triangles per 2 x 2 cells whose returns lie on one surface; three returns make
+// one) rasterized with a z-buffer; grey and point interpolated perspective-correctly. Vertices are projected
+// with the camera's distortion and the triangles are straight in the image: they are about a pixel wide.
+View Render(const ScanSamples& samples, const PinholeCamera& camera) {
+  View view;
+  view.camera = camera;
+  const int width = camera.width_px, height = camera.height_px;
+  cv::Mat grey(height, width, CV_32F, cv::Scalar(0));
+  view.point_from_eye = cv::Mat(height, width, CV_32FC3, cv::Scalar::all(0));
+  view.depth = cv::Mat(height, width, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  const Eigen::Matrix3d camera_from_world = camera.world_from_camera.topLeftCorner<3, 3>().transpose();
+  const Eigen::Vector3d eye = camera.center_in_world();
+  const size_t n = samples.point_in_world.size();
+  // Per sample: pixel (x, y) and depth z (z <= 0: not projected).
+  std::vector<Eigen::Vector3d> projected(n);
+  std::vector<Eigen::Vector3f> from_eye(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d d = samples.point_in_world[i] - eye;
+    from_eye[i] = d.cast<float>();
+    const Eigen::Vector3d point_in_camera = camera_from_world * d;
+    Eigen::Vector2d pixel;
+    if (point_in_camera.z() < 0.05 || !ProjectCameraPoint(camera, point_in_camera, &pixel)) {
+      projected[i] = Eigen::Vector3d(0, 0, -1);
+      continue;
+    }
+    projected[i] = Eigen::Vector3d(pixel.x(), pixel.y(), point_in_camera.z());
+  }
+  const auto triangle = [&](int a, int b, int c) {
+    const Eigen::Vector3d &pa = projected[a], &pb = projected[b], &pc = projected[c];
+    if (pa.z() <= 0 || pb.z() <= 0 || pc.z() <= 0) return;
+    const float r_min = std::min({samples.range_m[a], samples.range_m[b], samples.range_m[c]}),
+                r_max = std::max({samples.range_m[a], samples.range_m[b], samples.range_m[c]});
+    if (r_max > kMaxRangeRatio * r_min) return;
+    // Triangles seen edge-on or stretched over many pixels are depth edges the range test missed.
+    const double area = (pb.x() - pa.x()) * (pc.y() - pa.y()) - (pc.x() - pa.x()) * (pb.y() - pa.y());
+    if (std::abs(area) < 1e-9) return;
+    const double min_x = std::min({pa.x(), pb.x(), pc.x()}), max_x = std::max({pa.x(), pb.x(), pc.x()});
+    const double min_y = std::min({pa.y(), pb.y(), pc.y()}), max_y = std::max({pa.y(), pb.y(), pc.y()});
+    if (max_x - min_x > 16 || max_y - min_y > 16) return;
+    const int x0 = std::max(0, static_cast<int>(std::ceil(min_x - 0.5))),
+              x1 = std::min(width - 1, static_cast<int>(std::floor(max_x - 0.5)));
+    const int y0 = std::max(0, static_cast<int>(std::ceil(min_y - 0.5))),
+              y1 = std::min(height - 1, static_cast<int>(std::floor(max_y - 0.5)));
+    for (int y = y0; y <= y1; ++y) {
+      const double py = y + 0.5;
+      for (int x = x0; x <= x1; ++x) {
+        const double px = x + 0.5;
+        // Barycentric weights (screen space), then perspective-correct ones (divided by depth).
+        double wa = ((pb.x() - px) * (pc.y() - py) - (pc.x() - px) * (pb.y() - py)) / area;
+        double wb = ((pc.x() - px) * (pa.y() - py) - (pa.x() - px) * (pc.y() - py)) / area;
+        double wc = 1 - wa - wb;
+        if (wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
+        wa /= pa.z(), wb /= pb.z(), wc /= pc.z();
+        const double sum = wa + wb + wc;
+        const float z = static_cast<float>(1 / sum);
+        float& depth = view.depth.at<float>(y, x);
+        if (z >= depth) continue;
+        depth = z;
+        wa /= sum, wb /= sum, wc /= sum;
+        grey.at<float>(y, x) =
+            static_cast<float>(wa * samples.grey[a] + wb * samples.grey[b] + wc * samples.grey[c]);
+        const Eigen::Vector3f p = static_cast<float>(wa) * from_eye[a] +
+                                  static_cast<float>(wb) * from_eye[b] + static_cast<float>(wc) * from_eye[c];
+        view.point_from_eye.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
+      }
+    }
+  };
+  const cv::Mat& index = samples.index;
+  for (int r = 0; r + 1 < index.rows; ++r) {
+    for (int c = 0; c + 1 < index.cols; ++c) {
+      const int a = index.at<int32_t>(r, c), b = index.at<int32_t>(r, c + 1), d = index.at<int32_t>(r + 1, c),
+                e = index.at<int32_t>(r + 1, c + 1);
+      const int count = (a >= 0) + (b >= 0) + (d >= 0) + (e >= 0);
+      if (count == 4) {
+        triangle(a, b, d), triangle(b, e, d);
+      } else if (count == 3) {
+        if (a < 0) triangle(b, e, d);
+        if (b < 0) triangle(a, e, d);
+        if (d < 0) triangle(a, b, e);
+        if (e < 0) triangle(a, b, d);
+      }
+    }
+  }
+  grey.convertTo(view.grey, CV_8U);
+  return view;
+}
+
+struct Features {
+  std::vector<cv::KeyPoint> keys;
+  cv::Mat descriptors;  // CV_32F, one row per key
+};
+
+// SIFT keypoints in a fixed order (position, size, angle), then their descriptors: the same on any thread count.
+Features Detect(const cv::Mat& grey, const cv::Mat& mask, int features) {
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(features);
+  Features out;
+  sift->detect(grey, out.keys, mask);
+  std::sort(out.keys.begin(), out.keys.end(), [](const cv::KeyPoint& a, const cv::KeyPoint& b) {
+    return std::tie(a.pt.y, a.pt.x, a.size, a.angle, a.response, a.octave) <
+           std::tie(b.pt.y, b.pt.x, b.size, b.angle, b.response, b.octave);
+  });
+  if (!out.keys.empty()) sift->compute(grey, out.keys, out.descriptors);
+  return out;
+}
+
+cv::Mat ValidMask(const View& view) {
+  cv::Mat mask = view.depth < std::numeric_limits<float>::infinity();
+  cv::erode(mask, mask, cv::Mat::ones(3, 3, CV_8U));
+  return mask;
+}
+
+// The intrinsics of `camera` for an image `scale_x`, `scale_y` times as wide and high (pose kept).
+PinholeCamera Scaled(const PinholeCamera& camera, int width_px, int height_px) {
+  PinholeCamera out = camera;
+  const double sx = static_cast<double>(width_px) / camera.width_px,
+               sy = static_cast<double>(height_px) / camera.height_px;
+  out.width_px = width_px, out.height_px = height_px;
+  out.fx_px *= sx, out.skew_px *= sx, out.cx_px *= sx;
+  out.fy_px *= sy, out.cy_px *= sy;
+  return out;
+}
+
+// Working-pixel position (continuous) of an OpenCV keypoint.
+Eigen::Vector2d Continuous(const cv::KeyPoint& key) { return {key.pt.x + 0.5, key.pt.y + 0.5}; }
+
+// The world point a view shows at a keypoint: bilinear over the four pixel centres around it when they lie
+// on one surface (depths within 2 %), else the nearest pixel's; false when there is none.
+bool PointAt(const View& view, const cv::KeyPoint& key, Eigen::Vector3d* point_in_world) {
+  const double u = key.pt.x, v = key.pt.y;  // OpenCV: pixel centres at integers
+  const int x0 = static_cast<int>(std::floor(u)), y0 = static_cast<int>(std::floor(v));
+  const double fx = u - x0, fy = v - y0;
+  const Eigen::Vector3d eye = view.camera.center_in_world();
+  const auto inside = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < view.depth.cols && y < view.depth.rows;
+  };
+  if (inside(x0, y0) && inside(x0 + 1, y0 + 1)) {
+    float lo = std::numeric_limits<float>::infinity(), hi = 0;
+    for (int dy = 0; dy < 2; ++dy)
+      for (int dx = 0; dx < 2; ++dx) {
+        const float z = view.depth.at<float>(y0 + dy, x0 + dx);
+        lo = std::min(lo, z), hi = std::max(hi, z);
+      }
+    if (std::isfinite(hi) && hi < 1.02f * lo) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+          const cv::Vec3f p = view.point_from_eye.at<cv::Vec3f>(y0 + dy, x0 + dx);
+          sum += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * Eigen::Vector3d(p[0], p[1], p[2]);
+        }
+      *point_in_world = eye + sum;
+      return true;
+    }
+  }
+  const int x = static_cast<int>(std::lround(u)), y = static_cast<int>(std::lround(v));
+  if (!inside(x, y) || !std::isfinite(view.depth.at<float>(y, x))) return false;
+  const cv::Vec3f p = view.point_from_eye.at<cv::Vec3f>(y, x);
+  *point_in_world = eye + Eigen::Vector3d(p[0], p[1], p[2]);
+  return true;
+}
+
+// Search matches: the ratio test over all of the view's features.
+std::vector<PixelPointPair> MatchAll(const Features& photo, const Features& view_features, const View& view,
+                                     double to_photo_x, double to_photo_y, double ratio) {
+  std::vector<PixelPointPair> pairs;
+  if (photo.keys.size() < 2 || view_features.keys.size() < 2) return pairs;
+  cv::BFMatcher matcher(cv::NORM_L2);
+  std::vector<std::vector<cv::DMatch>> knn;
+  matcher.knnMatch(photo.descriptors, view_features.descriptors, knn, 2);
+  for (const std::vector<cv::DMatch>& m : knn) {
+    if (m.size() < 2 || m[0].distance >= ratio * m[1].distance) continue;
+    Eigen::Vector3d point;
+    if (!PointAt(view, view_features.keys[m[0].trainIdx], &point)) continue;
+    const Eigen::Vector2d q = Continuous(photo.keys[m[0].queryIdx]);
+    pairs.push_back({Eigen::Vector2d(q.x() * to_photo_x, q.y() * to_photo_y), point});
+  }
+  return pairs;
+}
+
+// Round matches: the view is rendered from the camera's estimate, so a photo feature's match lies within
+// `radius_px`; the ratio test runs among those. Pairs are made sub-pixel (header, step 3).
+std::vector<PixelPointPair> MatchGuided(const Features& photo, const Features& view_features,
+                                        const View& view, double to_photo_x, double to_photo_y, double ratio,
+                                        double radius_px) {
+  std::vector<PixelPointPair> pairs;
+  // Buckets of view features by cell of `radius_px` side.
+  const double cell = std::max(radius_px, 1.0);
+  const int grid_cols = static_cast<int>(view.depth.cols / cell) + 1,
+            grid_rows = static_cast<int>(view.depth.rows / cell) + 1;
+  std::vector<std::vector<int>> buckets(static_cast<size_t>(grid_cols) * grid_rows);
+  for (size_t j = 0; j < view_features.keys.size(); ++j) {
+    const cv::Point2f& p = view_features.keys[j].pt;
+    const int gx = std::clamp(static_cast<int>(p.x / cell), 0, grid_cols - 1),
+              gy = std::clamp(static_cast<int>(p.y / cell), 0, grid_rows - 1);
+    buckets[static_cast<size_t>(gy) * grid_cols + gx].push_back(static_cast<int>(j));
+  }
+  const double radius2 = radius_px * radius_px;
+  for (size_t i = 0; i < photo.keys.size(); ++i) {
+    const cv::Point2f& p = photo.keys[i].pt;
+    const int gx = static_cast<int>(p.x / cell), gy = static_cast<int>(p.y / cell);
+    double best = std::numeric_limits<double>::infinity(), second = best;
+    int best_j = -1;
+    for (int by = gy - 1; by <= gy + 1; ++by) {
+      for (int bx = gx - 1; bx <= gx + 1; ++bx) {
+        if (bx < 0 || by < 0 || bx >= grid_cols || by >= grid_rows) continue;
+        for (int j : buckets[static_cast<size_t>(by) * grid_cols + bx]) {
+          const cv::Point2f d = view_features.keys[j].pt - p;
+          if (d.x * d.x + d.y * d.y > radius2) continue;
+          const double distance = cv::norm(photo.descriptors.row(static_cast<int>(i)),
+                                           view_features.descriptors.row(j), cv::NORM_L2);
+          if (distance < best) {
+            second = best, best = distance, best_j = j;
+          } else if (distance < second) {
+            second = distance;
+          }
+        }
+      }
+    }
+    if (best_j < 0 || !(best < ratio * second)) continue;
+    const cv::KeyPoint& key = view_features.keys[best_j];
+    Eigen::Vector3d point;
+    if (!PointAt(view, key, &point)) continue;
+    const Eigen::Vector2d q = Continuous(photo.keys[i]);
+    pairs.push_back({Eigen::Vector2d(q.x() * to_photo_x, q.y() * to_photo_y), point});
+  }
+  return pairs;
+}
+
+// A found patch's correlation must beat the best one 3 or more pixels away by this much.
+constexpr double kMinPeakMargin = 0.1;
+
+// Dense pairs: patches of the rendering (every `step_px`, one surface, textured) found in the photo within
+// `search_px` by normalized cross-correlation (gain and offset free), the peak refined to sub-pixel by a
+// parabola per axis. The rendering's pixel centre shows a known surface point, so each found patch is a pair.
+std::vector<PixelPointPair> MatchPatches(const cv::Mat& photo_grey, const View& view, int patch_px,
+                                         int step_px, int search_px, double min_score, double to_photo_x,
+                                         double to_photo_y) {
+  std::vector<PixelPointPair> pairs;
+  const int half = patch_px / 2, reach = half + search_px;
+  const Eigen::Vector3d eye = view.camera.center_in_world();
+  cv::Mat score;
+  for (int y = reach; y + reach < view.grey.rows && y + reach < photo_grey.rows; y += step_px) {
+    for (int x = reach; x + reach < view.grey.cols && x + reach < photo_grey.cols; x += step_px) {
+      const cv::Rect window(x - half, y - half, 2 * half + 1, 2 * half + 1);
+      double depth_lo = 0, depth_hi = 0;
+      cv::minMaxLoc(view.depth(window), &depth_lo, &depth_hi);
+      if (!std::isfinite(depth_hi) || depth_hi > 1.05 * depth_lo) continue;  // an edge or a hole
+      const cv::Mat templ = view.grey(window);
+      cv::Scalar mean, deviation;
+      cv::meanStdDev(templ, mean, deviation);
+      if (deviation[0] < 4) continue;  // no texture: the correlation has no peak
+      const cv::Rect region(x - reach, y - reach, 2 * reach + 1, 2 * reach + 1);
+      cv::matchTemplate(photo_grey(region), templ, score, cv::TM_CCOEFF_NORMED);
+      double best = 0;
+      cv::Point at;
+      cv::minMaxLoc(score, nullptr, &best, nullptr, &at);
+      if (best < min_score || at.x == 0 || at.y == 0 || at.x + 1 == score.cols || at.y + 1 == score.rows)
+        continue;
+      // A repeating texture (bricks) correlates as well one period away: the peak must stand out.
+      const cv::Mat peak_free = score.clone();
+      cv::rectangle(peak_free, cv::Rect(at.x - 2, at.y - 2, 5, 5), cv::Scalar(-1), cv::FILLED);
+      double second = -1;
+      cv::minMaxLoc(peak_free, nullptr, &second);
+      if (second > best - kMinPeakMargin) continue;
+      const auto peak = [](float left, float centre, float right) {
+        const double curvature = left - 2.0 * centre + right;
+        return curvature < 0 ? 0.5 * (left - right) / curvature : 0.0;
+      };
+      const double dx =
+          at.x - search_px +
+          peak(score.at<float>(at.y, at.x - 1), score.at<float>(at.y, at.x), score.at<float>(at.y, at.x + 1));
+      const double dy =
+          at.y - search_px +
+          peak(score.at<float>(at.y - 1, at.x), score.at<float>(at.y, at.x), score.at<float>(at.y + 1, at.x));
+      const cv::Vec3f p = view.point_from_eye.at<cv::Vec3f>(y, x);
+      pairs.push_back({Eigen::Vector2d((x + 0.5 + dx) * to_photo_x, (y + 0.5 + dy) * to_photo_y),
+                       eye + Eigen::Vector3d(p[0], p[1], p[2])});
+    }
+  }
+  return pairs;
+}
+
+struct Pose {
+  bool ok = false;
+  PinholeCamera camera;
+  std::vector<uint8_t> inlier;
+  int inliers = 0;
+  double rms_px = 0;
+};
+
+// OpenCV's K and distortion of a camera (OpenCV puts the centre of pixel (0, 0) at (0, 0)).
+cv::Matx33d OpenCvK(const PinholeCamera& c) {
+  return cv::Matx33d(c.fx_px, c.skew_px, c.cx_px - 0.5, 0, c.fy_px, c.cy_px - 0.5, 0, 0, 1);
+}
+cv::Mat OpenCvDistortion(const PinholeCamera& c) {
+  return (cv::Mat_<double>(1, 5) << c.k1, c.k2, c.p1, c.p2, c.k3);
+}
+
+void SetPose(const cv::Mat& rvec, const cv::Mat& tvec, PinholeCamera* camera) {
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  Eigen::Matrix3d r;
+  cv::cv2eigen(cv::Mat(rotation), r);
+  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  camera->world_from_camera.setIdentity();
+  camera->world_from_camera.topLeftCorner<3, 3>() = r.transpose();
+  camera->world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
+}
+
+void GetPose(const PinholeCamera& camera, cv::Mat* rvec, cv::Mat* tvec) {
+  const Eigen::Matrix3d r = camera.world_from_camera.topLeftCorner<3, 3>().transpose();
+  const Eigen::Vector3d t = -r * camera.world_from_camera.topRightCorner<3, 1>();
+  cv::Mat rotation;
+  cv::eigen2cv(r, rotation);
+  cv::Rodrigues(rotation, *rvec);
+  *tvec = (cv::Mat_<double>(3, 1) << t.x(), t.y(), t.z());
+}
+
+// Inliers of `camera` within `threshold_px` and their RMS.
+void SelectInliers(std::span<const PixelPointPair> pairs, double threshold_px, Pose* pose) {
+  pose->inlier.assign(pairs.size(), 0);
+  pose->inliers = 0;
+  double sum = 0;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const double error = ReprojectionError(pose->camera, pairs[i]);
+    if (error < threshold_px) pose->inlier[i] = 1, ++pose->inliers, sum += error * error;
+  }
+  pose->rms_px = pose->inliers > 0 ? std::sqrt(sum / pose->inliers) : 0;
+}
+
+// Levenberg–Marquardt on the pose over the current inliers, then inliers re-selected; twice.
+void RefinePose(std::span<const PixelPointPair> pairs, double threshold_px, Pose* pose) {
+  for (int pass = 0; pass < 2 && pose->inliers >= 4; ++pass) {
+    std::vector<cv::Point3d> objects;
+    std::vector<cv::Point2d> images;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!pose->inlier[i]) continue;
+      objects.emplace_back(pairs[i].point_in_world.x(), pairs[i].point_in_world.y(),
+                           pairs[i].point_in_world.z());
+      images.emplace_back(pairs[i].pixel_px.x() - 0.5, pairs[i].pixel_px.y() - 0.5);
+    }
+    cv::Mat rvec, tvec;
+    GetPose(pose->camera, &rvec, &tvec);
+    cv::solvePnPRefineLM(objects, images, OpenCvK(pose->camera), OpenCvDistortion(pose->camera), rvec, tvec,
+                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 50, 1e-10));
+    SetPose(rvec, tvec, &pose->camera);
+    SelectInliers(pairs, threshold_px, pose);
+  }
+}
+
+// PnP RANSAC (EPnP minimal sets; OpenCV seeds its own RANSAC, theRNG is set for good measure) and
+// refinement, pairs in photo pixels with the intrinsics of `intrinsics`.
+Pose SolvePose(std::span<const PixelPointPair> pairs, const PinholeCamera& intrinsics, double threshold_px,
+               const AutoResectionOptions& options) {
+  Pose pose;
+  if (pairs.size() < 6) return pose;
+  std::vector<cv::Point3d> objects;
+  std::vector<cv::Point2d> images;
+  for (const PixelPointPair& pair : pairs) {
+    objects.emplace_back(pair.point_in_world.x(), pair.point_in_world.y(), pair.point_in_world.z());
+    images.emplace_back(pair.pixel_px.x() - 0.5, pair.pixel_px.y() - 0.5);
+  }
+  cv::Mat rvec, tvec;
+  std::vector<int> inliers;
+  cv::theRNG().state = options.seed;
+  bool ok = false;
+  try {
+    ok = cv::solvePnPRansac(objects, images, OpenCvK(intrinsics), OpenCvDistortion(intrinsics), rvec, tvec,
+                            false, options.ransac_iterations, static_cast<float>(threshold_px), 0.9999,
+                            inliers, cv::SOLVEPNP_EPNP);
+  } catch (const cv::Exception&) {
+    ok = false;  // degenerate minimal sets everywhere: no pose
+  }
+  if (!ok || inliers.size() < 6) return pose;
+  pose.camera = intrinsics;
+  SetPose(rvec, tvec, &pose.camera);
+  SelectInliers(pairs, threshold_px, &pose);
+  RefinePose(pairs, threshold_px, &pose);
+  pose.ok = pose.inliers >= 6;
+  return pose;
+}
+
+// Unknown intrinsics: golden-section search of the focal length (square pixels) within ±15 % that gives the
+// inliers the lowest RMS, the pose refined for each; then the pose refined and the inliers re-selected.
+void RefineFocal(std::span<const PixelPointPair> pairs, double threshold_px, Pose* pose) {
+  const std::vector<uint8_t> inlier = pose->inlier;
+  const auto rms_with = [&](double focal_px, PinholeCamera* out) {
+    Pose trial = *pose;
+    trial.camera.fx_px = trial.camera.fy_px = focal_px;
+    std::vector<cv::Point3d> objects;
+    std::vector<cv::Point2d> images;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!inlier[i]) continue;
+      objects.emplace_back(pairs[i].point_in_world.x(), pairs[i].point_in_world.y(),
+                           pairs[i].point_in_world.z());
+      images.emplace_back(pairs[i].pixel_px.x() - 0.5, pairs[i].pixel_px.y() - 0.5);
+    }
+    cv::Mat rvec, tvec;
+    GetPose(trial.camera, &rvec, &tvec);
+    cv::solvePnPRefineLM(objects, images, OpenCvK(trial.camera), OpenCvDistortion(trial.camera), rvec, tvec);
+    SetPose(rvec, tvec, &trial.camera);
+    double sum = 0;
+    int n = 0;
+    for (size_t i = 0; i < pairs.size(); ++i) {
+      if (!inlier[i]) continue;
+      const double e = std::min(ReprojectionError(trial.camera, pairs[i]), 3 * threshold_px);
+      sum += e * e, ++n;
+    }
+    if (out) *out = trial.camera;
+    return n ? sum / n : 0.0;
+  };
+  const double phi = (std::sqrt(5.0) - 1) / 2;
+  double lo = std::log(pose->camera.fx_px / 1.15), hi = std::log(pose->camera.fx_px * 1.15);
+  double a = hi - phi * (hi - lo), b = lo + phi * (hi - lo);
+  double fa = rms_with(std::exp(a), nullptr), fb = rms_with(std::exp(b), nullptr);
+  for (int i = 0; i < 30; ++i) {
+    if (fa < fb) {
+      hi = b, b = a, fb = fa, a = hi - phi * (hi - lo), fa = rms_with(std::exp(a), nullptr);
+    } else {
+      lo = a, a = b, fa = fb, b = lo + phi * (hi - lo), fb = rms_with(std::exp(b), nullptr);
+    }
+  }
+  rms_with(std::exp(0.5 * (lo + hi)), &pose->camera);
+  SelectInliers(pairs, threshold_px, pose);
+  RefinePose(pairs, threshold_px, pose);
+}
+
+// The intrinsics of a horizontal field of view for a photo of this size.
+PinholeCamera IntrinsicsOfFov(int width_px, int height_px, double fov_deg) {
+  PinholeCamera camera;
+  camera.width_px = width_px, camera.height_px = height_px;
+  camera.fx_px = camera.fy_px = 0.5 * width_px / std::tan(0.5 * fov_deg / kDegPerRad);
+  camera.cx_px = 0.5 * width_px, camera.cy_px = 0.5 * height_px;
+  return camera;
+}
+
+double RotationAngleDeg(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+  const Eigen::Matrix3d r = a.topLeftCorner<3, 3>().transpose() * b.topLeftCorner<3, 3>();
+  return std::acos(std::clamp((r.trace() - 1) / 2, -1.0, 1.0)) * kDegPerRad;
+}
+
+// The working images of one set of intrinsics.
+struct Working {
+  PinholeCamera intrinsics;  // photo pixels
+  int width_px = 0, height_px = 0;
+  double to_photo_x = 1, to_photo_y = 1;  // photo pixels per working pixel
+  Features photo;
+  cv::Mat grey;  // CV_8U, the photo at the working size
+};
+
+Working MakeWorking(const cv::Mat& photo_grey, const PinholeCamera& intrinsics, const ScanSamples& samples,
+                    const AutoResectionOptions& options) {
+  Working w;
+  w.intrinsics = intrinsics;
+  const double scale =
+      std::min(1.0, options.pixels_per_cell / (samples.cell_angle_rad * std::max(intrinsics.fx_px, 1.0)));
+  w.width_px = std::max(16, static_cast<int>(std::lround(photo_grey.cols * scale)));
+  w.height_px = std::max(16, static_cast<int>(std::lround(photo_grey.rows * scale)));
+  w.to_photo_x = static_cast<double>(photo_grey.cols) / w.width_px;
+  w.to_photo_y = static_cast<double>(photo_grey.rows) / w.height_px;
+  cv::Mat small;
+  if (w.width_px == photo_grey.cols && w.height_px == photo_grey.rows) {
+    small = photo_grey;
+  } else {
+    cv::resize(photo_grey, small, cv::Size(w.width_px, w.height_px), 0, 0, cv::INTER_AREA);
+  }
+  w.photo = Detect(small, cv::Mat(), options.features);
+  w.grey = small;
+  return w;
+}
+
+}  // namespace
+
+void AutoResectionOptions::Check() const {
+  if (fov_candidates_deg.empty()) throw OptionsError("fov_candidates_deg: give at least one field of view");
+  for (double fov : fov_candidates_deg)
+    if (!(fov > 1 && fov < 179))
+      throw OptionsError(fmt::format("fov_candidates_deg: {} is not in (1, 179)", fov));
+  if (view_elevations_deg.empty()) throw OptionsError("view_elevations_deg: give at least one elevation");
+  for (double e : view_elevations_deg)
+    if (!(std::abs(e) <= 80))
+      throw OptionsError(fmt::format("view_elevations_deg: {} is not in [-80, 80]", e));
+  if (view_azimuths < 1 || view_azimuths > 72) throw OptionsError("view_azimuths must be in [1, 72]");
+  if (!(pixels_per_cell > 0.05 && pixels_per_cell <= 8))
+    throw OptionsError("pixels_per_cell must be in (0.05, 8]");
+  if (features < 50) throw OptionsError("features must be at least 50");
+  if (!(ratio > 0 && ratio <= 1)) throw OptionsError("ratio must be in (0, 1]");
+  if (rounds < 0) throw OptionsError("rounds must be >= 0");
+  if (!(guided_radius_px > 0)) throw OptionsError("guided_radius_px must be > 0");
+  if (!(ransac_threshold_px > 0)) throw OptionsError("ransac_threshold_px must be > 0");
+  if (ransac_iterations < 1) throw OptionsError("ransac_iterations must be >= 1");
+  if (search_candidates < 1) throw OptionsError("search_candidates must be >= 1");
+  if (min_inliers < 6) throw OptionsError("min_inliers must be at least 6");
+  if (!(min_inlier_share >= 0 && min_inlier_share <= 1))
+    throw OptionsError("min_inlier_share must be in [0, 1]");
+  if (!(max_rms_px > 0)) throw OptionsError("max_rms_px must be > 0");
+  if (patch_px < 0 || patch_px > 63 || (patch_px > 0 && patch_px % 2 == 0))
+    throw OptionsError("patch_px must be 0 (off) or odd in [3, 63]");
+  if (patch_step_px < 1) throw OptionsError("patch_step_px must be >= 1");
+  if (!(min_patch_score >= -1 && min_patch_score <= 1))
+    throw OptionsError("min_patch_score must be in [-1, 1]");
+}
+
+std::string AutoResectionResult::Summary() const {
+  return fmt::format(
+      "automatic resection: {} of {} pairs inliers ({:.0f} %), RMS {:.2f} px ({:.2f} working px), {} "
+      "round(s), "
+      "camera at ({:.3f}, {:.3f}, {:.3f}) m, focal {:.1f} px",
+      inliers, pairs.size(), 100 * inlier_share, rms_px, rms_work_px, rounds, camera.center_in_world().x(),
+      camera.center_in_world().y(), camera.center_in_world().z(), camera.fx_px);
+}
+
+AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const AutoResectionOptions& options,
+                                  const std::optional<PinholeCamera>& intrinsics,
+                                  const std::optional<Eigen::Matrix4d>& rough_world_from_camera,
+                                  const std::string& what) {
+  options.Check();
+  if (photo.empty() || (photo.type() != CV_8UC3 && photo.type() != CV_8UC1))
+    ThrowInputError(what, "", "", "automatic resection needs an 8-bit RGB or grey photo");
+  cv::Mat photo_grey;
+  if (photo.channels() == 3) {
+    cv::cvtColor(photo, photo_grey, cv::COLOR_RGB2GRAY);
+  } else {
+    photo_grey = photo;
+  }
+  const ScanSamples samples = SamplesOf(scan, what);
+  if (static_cast<int>(samples.point_in_world.size()) < options.min_inliers)
+    ThrowInputError(what, "", "scan",
+                    fmt::format("the scan has {} returns: too few for an automatic resection",
+                                samples.point_in_world.size()));
+
+  // The intrinsics to try, each with its working images.
+  std::vector<Working> workings;
+  if (intrinsics) {
+    intrinsics->Check(what + " intrinsics");
+    PinholeCamera known = *intrinsics;
+    if (known.width_px != photo.cols || known.height_px != photo.rows)
+      known = Scaled(known, photo.cols, photo.rows);
+    known.world_from_camera.setIdentity();
+    workings.push_back(MakeWorking(photo_grey, known, samples, options));
+  } else {
+    for (double fov : options.fov_candidates_deg)
+      workings.push_back(
+          MakeWorking(photo_grey, IntrinsicsOfFov(photo.cols, photo.rows, fov), samples, options));
+  }
+
+  // Search: views from the scanner centre (or the rough pose); every view's PnP camera is a candidate, the
+  // one with the most inliers first.
+  struct Candidate {
+    Pose pose;
+    size_t working = 0;
+    int view = -1;
+  };
+  std::vector<Candidate> candidates;
+  int most_pairs = 0;
+  const Eigen::Matrix3d scanner_rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+  for (size_t w = 0; w < workings.size(); ++w) {
+    const Working& working = workings[w];
+    const double threshold_px = 3 * options.ransac_threshold_px * working.to_photo_x;
+    std::vector<Eigen::Matrix4d> poses;
+    if (rough_world_from_camera) {
+      poses.push_back(*rough_world_from_camera);
+    } else {
+      for (double elevation_deg : options.view_elevations_deg) {
+        for (int a = 0; a < options.view_azimuths; ++a) {
+          const double azimuth = 2 * M_PI * a / options.view_azimuths, elevation = elevation_deg / kDegPerRad;
+          const Eigen::Vector3d look =
+              scanner_rotation * Eigen::Vector3d(std::cos(elevation) * std::sin(azimuth),
+                                                 std::cos(elevation) * std::cos(azimuth),
+                                                 std::sin(elevation));
+          poses.push_back(
+              CameraLookingAt(samples.scanner_in_world, samples.scanner_in_world + look, 64, 48, 60)
+                  .world_from_camera);
+        }
+      }
+    }
+    for (size_t v = 0; v < poses.size(); ++v) {
+      // The photo's focal length on a canvas 1.5 x as large (the rough pose: the photo's own frame).
+      const double canvas = rough_world_from_camera ? 1.0 : 1.5;
+      PinholeCamera camera = Scaled(working.intrinsics, working.width_px, working.height_px);
+      camera.width_px = static_cast<int>(std::lround(canvas * working.width_px));
+      camera.height_px = static_cast<int>(std::lround(canvas * working.height_px));
+      camera.cx_px += 0.5 * (camera.width_px - working.width_px);
+      camera.cy_px += 0.5 * (camera.height_px - working.height_px);
+      camera.k1 = camera.k2 = camera.k3 = camera.p1 = camera.p2 = 0;
+      camera.world_from_camera = poses[v];
+      const View view = Render(samples, camera);
+      const Features view_features = Detect(view.grey, ValidMask(view), options.features);
+      const std::vector<PixelPointPair> pairs =
+          MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y, options.ratio);
+      most_pairs = std::max(most_pairs, static_cast<int>(pairs.size()));
+      const Pose pose = SolvePose(pairs, working.intrinsics, threshold_px, options);
+      if (pose.ok) candidates.push_back({pose, w, rough_world_from_camera ? -1 : static_cast<int>(v)});
+    }
+  }
+  if (candidates.empty())
+    ThrowInputError(
+        what, "", "features",
+        fmt::format("no rendering of the scan matches the photo: at most {} matches in a view, and "
+                    "no pose explains 6 of them",
+                    most_pairs));
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.pose.inliers > b.pose.inliers; });
+
+  // Rounds from one candidate: render from the estimate, match near the same place, solve again.
+  const auto run_rounds = [&](const Candidate& start) {
+    AutoResectionResult out;
+    const Working& working = workings[start.working];
+    const double threshold_px = options.ransac_threshold_px * working.to_photo_x;
+    PinholeCamera camera = start.pose.camera;
+    Pose pose = start.pose;
+    std::vector<PixelPointPair> pairs;
+    double radius_px = options.guided_radius_px;
+    bool dense_rounds = false;
+    for (int round = 0; round < options.rounds; ++round) {
+      PinholeCamera work = Scaled(camera, working.width_px, working.height_px);
+      const View view = Render(samples, work);
+      const Features view_features = Detect(view.grey, ValidMask(view), options.features);
+      // The first round matches anywhere (the search's camera may be degrees off: its views were rendered
+      // from the scanner centre); later ones near the same place.
+      std::vector<PixelPointPair> round_pairs =
+          round == 0 ? MatchAll(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                                options.ratio)
+                     : MatchGuided(working.photo, view_features, view, working.to_photo_x, working.to_photo_y,
+                                   options.ratio, radius_px);
+      // Patches only once SIFT alone has settled (the camera moved less than 1 cm and 0.05° in a round):
+      // from a camera a few pixels off, a patch of a repeating texture (bricks) finds the next brick as
+      // well, and the whole wall shifted by one brick is a consistent, wrong answer.
+      if (dense_rounds) {
+        const std::vector<PixelPointPair> dense =
+            MatchPatches(working.grey, view, options.patch_px, options.patch_step_px,
+                         static_cast<int>(std::ceil(radius_px)), options.min_patch_score, working.to_photo_x,
+                         working.to_photo_y);
+        round_pairs.insert(round_pairs.end(), dense.begin(), dense.end());
+      }
+      Pose next = SolvePose(round_pairs, camera, threshold_px, options);
+      if (!next.ok) break;
+      if (!intrinsics) RefineFocal(round_pairs, threshold_px, &next);
+      out.rounds = round + 1;
+      const double moved_m = (next.camera.center_in_world() - camera.center_in_world()).norm(),
+                   turned_deg = RotationAngleDeg(next.camera.world_from_camera, camera.world_from_camera);
+      out.last_move_m = moved_m, out.last_turn_deg = turned_deg;
+      camera = next.camera;
+      pose = next;
+      pairs = std::move(round_pairs);
+      // The next search radius follows the estimate's accuracy (never wider than asked).
+      radius_px = std::clamp(6 * pose.rms_px / working.to_photo_x, 3.0, options.guided_radius_px);
+      if (!dense_rounds && options.patch_px > 0) {
+        dense_rounds = moved_m < kSettledMoveM && turned_deg < kSettledTurnDeg;
+        continue;
+      }
+      if (moved_m < 1e-3 && turned_deg < 5e-3) break;
+    }
+    out.camera = camera;
+    out.pairs = std::move(pairs);
+    out.inlier = pose.inlier;
+    out.inliers = out.rounds > 0 ? pose.inliers : 0;
+    out.inlier_share = out.pairs.empty() ? 0 : static_cast<double>(pose.inliers) / out.pairs.size();
+    out.rms_px = pose.rms_px;
+    out.work_scale = 1 / working.to_photo_x;
+    out.rms_work_px = pose.rms_px / working.to_photo_x;
+    out.search_view = start.view;
+    out.search_inliers = start.pose.inliers;
+    out.search_fov_deg = intrinsics ? 0 : options.fov_candidates_deg[start.working];
+    return out;
+  };
+  const auto supported = [&](const AutoResectionResult& r) {
+    // A camera still moving in its last round has not settled on what the photo shows (a repeating texture
+    // pulls it one period over at a time): not supported either.
+    return r.rounds > 0 && r.inliers >= options.min_inliers && r.inlier_share >= options.min_inlier_share &&
+           r.rms_work_px <= options.max_rms_px && r.last_move_m < kSettledMoveM &&
+           r.last_turn_deg < kSettledTurnDeg;
+  };
+  // The best candidate first; the next ones only while none gives a supported camera.
+  AutoResectionResult result;
+  for (size_t i = 0; i < candidates.size() && static_cast<int>(i) < options.search_candidates; ++i) {
+    AutoResectionResult r = run_rounds(candidates[i]);
+    const bool better = i == 0 || (supported(r) && !supported(result)) ||
+                        (supported(r) == supported(result) && r.inliers > result.inliers);
+    if (better) result = std::move(r);
+    if (supported(result)) break;
+  }
+  if (result.rounds == 0)
+    ThrowInputError(what, "", "features",
+                    fmt::format("the search found a camera ({} inliers) but no rendering from it matches the "
+                                "photo again: the camera is not supported",
+                                candidates[0].pose.inliers));
+  if (!supported(result))
+    ThrowInputError(
+        what, "", "features",
+        fmt::format(
+            "no supported camera: {} of {} matches agree ({:.0f} %; at least {} and {:.0f} % needed), "
+            "RMS {:.2f} working px (at most {:.2f}); the photo may not show the scan, or from too far "
+            "(give a rough pose)",
+            result.inliers, result.pairs.size(), 100 * result.inlier_share, options.min_inliers,
+            100 * options.min_inlier_share, result.rms_work_px, options.max_rms_px));
+  return result;
+}
+
+}  // namespace lidarshop
