@@ -1,6 +1,7 @@
 // The editing algorithms: segment, fill, remove an object, inpaint, Poisson; their result classes.
 #include <cstring>
 #include <filesystem>
+#include <optional>
 
 #include <Python.h>
 #include <pybind11/eigen.h>
@@ -13,9 +14,33 @@
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/site/transients.h"
 
 namespace lidarshop::python {
+namespace {
+
+// FillFromStations' result as a dict (the scan, its masks and counts).
+py::dict FromStationsDict(const FromStationsResult& result) {
+  py::dict out;
+  out["scan"] = py::cast(result.scan);
+  out["from_station"] = MatToArray(result.from_station);
+  out["synthesized"] = MatToArray(result.synthesized);
+  out["hole_cells"] = result.hole_cells;
+  out["from_station_cells"] = result.from_station_cells;
+  out["cells_per_station"] = py::cast(result.cells_per_station);
+  out["synthesized_cells"] = result.synthesized_cells;
+  out["no_return_cells"] = result.no_return_cells;
+  out["object_cells"] = py::cast(result.object_cells);
+  out["rim_cells"] = result.rim_cells;
+  out["not_free_cells"] = result.not_free_cells;
+  out["stations_seconds"] = result.stations_seconds;
+  out["fill_seconds"] = result.fill_seconds;
+  out["warnings"] = py::cast(result.warnings);
+  return out;
+}
+
+}  // namespace
 
 // ---- algorithms ----
 
@@ -145,16 +170,62 @@ hole_mask: (rows, cols), non-zero or True = fill this cell. options: a FillOptio
 Returns a FillResult: .scan (the filled Scan, synthesized cells flagged), .filled, counts and .timings.)doc");
   m.def(
       "remove_object",
-      [](const Scan& scan, const py::object& strokes, const py::object& options, const py::kwargs& kwargs) {
+      [](const Scan& scan, const py::object& strokes, const py::object& options,
+         const std::optional<std::vector<Scan>>& stations, const py::kwargs& kwargs) -> py::object {
         const cv::Mat stroke_image = StrokesOf(strokes, scan);
         const RemoveOptions remove_options = OptionsOf<RemoveOptions>(options, kwargs);
-        py::gil_scoped_release release;
-        return RemoveObject(scan, stroke_image, remove_options);
+        if (!stations) {
+          RemoveResult result;
+          {
+            py::gil_scoped_release release;
+            result = RemoveObject(scan, stroke_image, remove_options);
+          }
+          return py::cast(std::move(result));
+        }
+        RemoveFromStationsResult result;
+        {
+          py::gil_scoped_release release;
+          result = RemoveObjectFromStations(scan, stroke_image, *stations, remove_options);
+        }
+        py::dict out;
+        out["cut"] = py::cast(result.cut);
+        out["hole"] = MatToArray(result.hole);
+        out["filled"] = FromStationsDict(result.filled);
+        out["scan"] = py::cast(result.filled.scan);
+        out["behind"] = py::cast(result.behind);
+        out["warnings"] = py::cast(result.warnings);
+        return out;
       },
-      py::arg("scan"), py::arg("strokes"), py::arg("options") = py::none(),
+      py::arg("scan"), py::arg("strokes"), py::arg("options") = py::none(), py::kw_only(),
+      py::arg("stations") = py::none(),
       "Cuts the object marked by strokes out (segment) and fills its cells grown by a margin (fill). Returns "
-      "a "
-      "RemoveResult: .cut (SegmentResult), .hole, .fill (FillResult), .scan, .behind.");
+      "a RemoveResult: .cut (SegmentResult), .hole, .fill (FillResult), .scan, .behind. With stations=[Scan, "
+      "...] (other registered stations of the site) the hole is filled first from what they measured "
+      "(fill_from_stations) and a dict comes back: cut, hole, filled (as fill_from_stations), scan, behind, "
+      "warnings.");
+  m.def(
+      "fill_from_stations",
+      [](const Scan& scan, const py::object& hole, const std::vector<Scan>& stations,
+         const py::object& options, const py::kwargs& kwargs) {
+        const cv::Mat hole_mask = MaskOf(hole, scan, "hole_mask");
+        const FromStationsOptions from_options = OptionsOf<FromStationsOptions>(options, kwargs);
+        FromStationsResult result;
+        {
+          py::gil_scoped_release release;
+          result = FillFromStations(scan, hole_mask, stations, from_options);
+        }
+        return FromStationsDict(result);
+      },
+      py::arg("scan"), py::arg("hole_mask"), py::arg("stations"), py::arg("options") = py::none(),
+      R"doc(Fills a hole from what other registered stations measured behind the removed object, then synthesizes
+only the rest (docs/stations.md "Filling from other stations").
+
+stations: other Scans of the site, their world_from_scanner in one frame with the scan's. options: a
+FromStationsOptions, a dict or keywords. Returns a dict: scan (the filled Scan: from_station = 1 + the station's
+index where a cell was taken from it, synthesized where invented), from_station (uint8 (rows, cols)),
+synthesized (uint8, 255), hole_cells, from_station_cells, cells_per_station, synthesized_cells,
+no_return_cells, object_cells (per station: the removed object marked there), rim_cells, not_free_cells,
+stations_seconds, fill_seconds, warnings.)doc");
   m.def(
       "grow_hole",
       [](const py::object& hole, int margin_cells) {

@@ -89,6 +89,9 @@ const ChannelSpec kChannels[] = {
      "noise-free range (synthetic scans), metres; float32 or None"},
     {"synthesized", &Scan::synthesized, CV_8U, 1, false,
      "255 = created by lidarshop (e.g. a fill); uint8 or None"},
+    {"from_station", &Scan::from_station, CV_8U, 1, false,
+     "1 + the index of the other station a filled cell's return was taken from (fill_from_stations), 0 = "
+     "not; uint8 or None"},
 };
 
 }  // namespace

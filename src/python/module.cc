@@ -30,6 +30,7 @@
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/segment/segment.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/site/transients.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
@@ -53,6 +54,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<FillMetricsOptions>(m);
   BindStruct<TransientOptions>(m);
   BindStruct<SiteRegistrationOptions>(m);
+  BindStruct<FromStationsOptions>(m);
   BindStruct<CleanOptions>(m);
   // The scanner and files
   BindStruct<ScannerOptions>(m);

@@ -35,7 +35,8 @@ int RunClean(int argc, char** argv) {
       "Remove what moved between stations (docs/stations.md): a point of one station that the rays of "
       "another "
       "passed through, hitting something farther, is transient (a passer-by, a car that left); it is removed "
-      "and its hole filled (synthesized, marked). The stations must be registered (their poses in one world "
+      "and its hole filled, first with what the other stations measured there (marked from_station), the "
+      "rest synthesized (marked). The stations must be registered (their poses in one world "
       "frame). Every scan of every input is a station (a site's E57 holds several; FILE#N one of them); each "
       "input is written to DIR under its own name (FILE#N as FILE's stem_N).",
       "clean"};
@@ -54,7 +55,7 @@ int RunClean(int argc, char** argv) {
   AddJsonOption(app, &json_path);
   binder.Bind(&options, {.keys = {"transients.range_noise_sigma_m", "transients.min_margin_m",
                                   "transients.neighbourhood_cells", "transients.min_region_cells",
-                                  "transients.grow_cells", "margin_cells", "fill_holes"},
+                                  "transients.grow_cells", "margin_cells", "fill_holes", "from_stations"},
                          .flags = {{"transients.range_noise_sigma_m", "--range-noise"},
                                    {"transients.min_margin_m", "--min-margin"},
                                    {"transients.neighbourhood_cells", "--neighbourhood"},
@@ -117,6 +118,7 @@ int RunClean(int argc, char** argv) {
                                    {"seen_through", found.seen_through_cells},
                                    {"confirmed", found.confirmed_cells},
                                    {"filled", result.filled_cells[next]},
+                                   {"from_station", result.from_station_cells[next]},
                                    {"removed_mask", mask_path}});
           }
           WriteScanFile(outputs[f], cleaned);

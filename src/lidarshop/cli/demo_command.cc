@@ -7,9 +7,13 @@
 //   3. segment   cut one object out from two automatic strokes, compared with the true labels: segment_*.png
 //   4. remove    fill behind the cut-out object (gradient-domain fill), scored against the scene scanned
 //                again without the object: removed.e57, remove_*.png
+//   4b. stations (parking_lot) the same object removed from station 0 of the built-in site
+//                parking_lot_stations with the real points station 2 measured behind it (the car had left
+//                there), only the rest synthesized (site/from_stations.h): stations_*.png, stations.e57
 //   5. summary   summary.json and index.html, which shows everything on one page
 //
 // The steps only call the library; the scene is compiled into the executable (builtin_scenes.h).
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -34,6 +38,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/segment_eval.h"
 #include "lidarshop/segment/strokes.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
@@ -283,6 +288,81 @@ json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::s
           {"seconds", fill.timings.total_s}};
 }
 
+// The built-in site of a scene ("parking_lot" -> "parking_lot_stations"), whose step 4b fills from a second
+// station; "" when there is none.
+std::string DemoSite(const std::string& scene_name) {
+  for (const BuiltinScene& builtin : BuiltinScenes())
+    if (builtin.name == scene_name + "_stations") return std::string(builtin.name);
+  return "";
+}
+
+// The scan with its colour showing where each filled cell came from: another station's measurement cyan,
+// synthesized magenta, the rest as scanned.
+Scan ColoredBySource(const Scan& scan) {
+  Scan shown = Clone(scan);
+  if (shown.color.empty()) shown.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar(128, 128, 128));
+  if (!scan.from_station.empty()) shown.color.setTo(cv::Scalar(0, 200, 230), scan.from_station != 0);
+  if (!scan.synthesized.empty()) shown.color.setTo(cv::Scalar(230, 0, 200), scan.synthesized != 0);
+  return shown;
+}
+
+// Step 4b: the object removed from station 0 of the scene's site, its hole filled from station 2 first.
+json RunStationsStep(const std::string& site_name, const std::string& object_name, const cv::Mat& object_mask,
+                     const fs::path& out_dir, Progress* progress) {
+  const SceneDescription site = LoadSceneOrBuiltin(site_name);
+  const SceneObject* target = nullptr;
+  for (const SceneObject& object : site.objects)
+    if (object.name == object_name) target = &object;
+  if (target == nullptr || site.NumStations() < 3) return json();
+  progress->Restart("demo: filling from station 2", 4);
+  const Scan station0 = SynthesizeScan(SceneAtStation(site, 0));
+  const Scan station2 = SynthesizeScan(SceneAtStation(site, 2));
+  SceneDescription without = SceneAtStation(site, 0);
+  std::erase_if(without.objects, [&](const SceneObject& object) { return object.name == object_name; });
+  const Scan truth = SynthesizeScan(without);
+  progress->Advance(3);
+  // The segmentation step's cut when station 0 has the scene's grid, else the object's true cells.
+  const cv::Mat object = object_mask.size() == station0.valid.size()
+                             ? object_mask
+                             : (station0.label == target->label) & (station0.valid != 0);
+  const cv::Mat hole = GrowHole(object, 2);
+  const FromStationsResult filled = FillFromStations(station0, hole, {station2});
+  progress->Advance();
+  // The range error of the cells taken from station 2 against the truth, and the whole fill's metrics.
+  double sum = 0;
+  int64_t compared = 0;
+  for (int r = 0; r < truth.rows; ++r) {
+    for (int c = 0; c < truth.cols; ++c) {
+      if (filled.from_station.at<uint8_t>(r, c) == 0 || truth.valid.at<uint8_t>(r, c) == 0) continue;
+      const double error = filled.scan.range.at<float>(r, c) - truth.true_range.at<float>(r, c);
+      sum += error * error;
+      ++compared;
+    }
+  }
+  const FillMetrics m = MeasureFill(filled.scan, truth, hole);
+  WriteScanFile((out_dir / "stations.e57").string(), {filled.scan});
+  PointViewOptions view = SideView(truth, hole, 35.0);
+  view.width_px = 540;
+  view.height_px = 360;
+  WriteImage((out_dir / "stations_view_scan.png").string(), RenderPointView(station0, view));
+  WriteImage((out_dir / "stations_view_filled.png").string(),
+             RenderPointView(ColoredBySource(filled.scan), view));
+  RenderOptions rgb;
+  rgb.channel = RenderChannel::kRgb;
+  WriteImage((out_dir / "stations_rays.png").string(),
+             RenderPicture(ColoredBySource(filled.scan), rgb, {}).image);
+  return {{"object", object_name},
+          {"site", site_name},
+          {"hole_cells", filled.hole_cells},
+          {"from_station_cells", filled.from_station_cells},
+          {"synthesized_cells", filled.synthesized_cells},
+          {"no_return_cells", filled.no_return_cells},
+          {"from_station_rmse_mm", compared > 0 ? 1000 * std::sqrt(sum / compared) : 0.0},
+          {"range_rmse_mm", m.range_rmse_mm},
+          {"floating_points", m.floating_share},
+          {"seconds", filled.stations_seconds + filled.fill_seconds}};
+}
+
 // Step 1's pictures: every channel with its legend (square angular pixels), the range as float metres, and
 // the points from above (a second viewpoint: what the ray picture cannot show, distances on the ground).
 void WriteScanPictures(const SceneDescription& scene, const Scan& scan, const fs::path& out_dir) {
@@ -349,6 +429,15 @@ std::vector<std::pair<std::string, std::string>> DemoFiles(const json& summary) 
     files.insert(files.end(), {{"segment_overlay.png", "segmentation: the cut over the scan's colour"},
                                {"segment_mask.png", "segmentation: the object's cells (white)"},
                                {"segment_strokes.png", "segmentation: the automatic strokes"}});
+  }
+  if (summary.contains("stations")) {
+    files.insert(
+        files.end(),
+        {{"stations.e57", "station 0 of the site with the object removed, filled from station 2 first"},
+         {"stations_view_scan.png", "35° aside: station 0 with the object"},
+         {"stations_view_filled.png",
+          "35° aside: filled from station 2 (cyan: its real points; magenta: synthesized)"},
+         {"stations_rays.png", "the ray picture of the same (cyan: from station 2; magenta: synthesized)"}});
   }
   if (summary.contains("remove")) {
     files.insert(files.end(),
@@ -468,6 +557,22 @@ std::string IndexHtml(const std::string& scene_name, const json& summary) {
         100 * remove["floating_points"].get<double>(), 100 * remove["return_accuracy"].get<double>(),
         remove["color_psnr_db"].get<double>(), remove["seconds"].get<double>());
   }
+  if (summary.contains("stations")) {
+    const json& st = summary["stations"];
+    html += fmt::format(
+        "<h2>4b. Removal with a second station</h2><p>The same object removed from station 0 of the site {}, "
+        "where station 2 stood when the car had left: of its {} hole cells, {} take the real surface station "
+        "2 "
+        "measured behind it (cyan; range RMSE {:.1f} mm against the truth, no noise added: station 2's own "
+        "measurement), {} that no station saw are synthesized (magenta); the whole hole's range RMSE {:.1f} "
+        "mm "
+        "({:.2f} s).</p><img src=\"stations_rays.png\"><br><img src=\"stations_view_scan.png\" "
+        "width=\"49%\"><img src=\"stations_view_filled.png\" width=\"49%\">",
+        st["site"].get<std::string>(), st["hole_cells"].get<int64_t>(),
+        st["from_station_cells"].get<int64_t>(), st["from_station_rmse_mm"].get<double>(),
+        st["synthesized_cells"].get<int64_t>(), st["range_rmse_mm"].get<double>(),
+        st["seconds"].get<double>());
+  }
   html += "<h2>Files</h2><p>Everything in this folder:</p><table>";
   for (const auto& [file, what] : DemoFiles(summary)) {
     html += fmt::format(
@@ -540,6 +645,14 @@ int RunDemoSteps(const DemoSettings& settings) {
     timer.Restart();
     summary["remove"] = RunRemoveStep(scene, scan, segment_object, object_mask, out_dir, progress.get());
     seconds["remove"] = timer.Seconds();
+    if (const std::string site = DemoSite(scene_name); !site.empty()) {
+      timer.Restart();
+      const json stations = RunStationsStep(site, segment_object, object_mask, out_dir, progress.get());
+      if (!stations.is_null()) {
+        summary["stations"] = stations;
+        seconds["stations"] = timer.Seconds();
+      }
+    }
   }
   progress->Finish();
 

@@ -3,6 +3,8 @@
 //   lidarshop fill SCAN --mask HOLE.png -o OUT [--method gradient|laplace|depth-patch|telea]
 //                  [--json R.json] [--debug DIR] [--seed N] [--synthesized-mask M.png]
 //   lidarshop remove SCAN --strokes S -o OUT [--keep-object] [--margin CELLS]
+//   both with --stations OTHER... [--from-stations-mask M.png]: the hole filled first from what the other
+//   stations of the site measured behind the object (site/from_stations.h), the rest synthesized.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,8 +22,10 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/picture_mapping.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/strokes.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -80,6 +84,92 @@ void WriteDebug(const std::string& dir, const FillResult& result, const cv::Mat&
   }
 }
 
+// Formats that cannot hold Scan::from_station (PTX) say so: the cells taken from other stations are written
+// as plain returns.
+void WarnFromStationDropped(const std::string& path, const Scan& scan) {
+  if (scan.from_station.empty()) return;
+  for (const std::string& sentence : PlanScanWrite(path, {scan}, 0, 0).dropped)
+    if (sentence.find("from_station") != std::string::npos) PrintWarnings({sentence});
+}
+
+// --stations and --from-stations-mask, shared by fill and remove.
+struct StationFlags {
+  std::vector<std::string> paths;
+  std::string mask_path;
+  FromStationsOptions options;
+
+  void Add(CLI::App& app, OptionBinder& binder) {
+    app.add_option(
+           "--stations", paths,
+           "other stations of the site, registered with the scan (their poses in one world frame): "
+           "FILE#N for scan N of a file of several, every scan of FILE otherwise (the scan itself is "
+           "left out when listed). The hole is filled first with what they measured behind the object "
+           "(marked from_station, not synthesized); only what no station saw is synthesized")
+        ->group("Fill from other stations");
+    app.add_option("--from-stations-mask", mask_path,
+                   "with --stations: write the cells filled from another station's measurement as a mask PNG "
+                   "of the scan's grid (255 = from a station)")
+        ->group("Fill from other stations");
+    binder.Bind(&options, {.keys = {"range_noise_sigma_m", "min_margin_m", "check_free_space"},
+                           .flags = {{"range_noise_sigma_m", "--station-noise"},
+                                     {"min_margin_m", "--station-margin"},
+                                     {"check_free_space", "--free-space"}},
+                           .group = "Fill from other stations",
+                           .prefix = "from_stations"});
+  }
+
+  // Every scan of the files given, but the scan being filled (same pose and grid size).
+  std::vector<Scan> Read(const Scan& scan, nlohmann::ordered_json* sources) const {
+    std::vector<Scan> stations;
+    for (const std::string& path : paths) {
+      const ScanFile file = ReadScanFileAndWarn(path);
+      for (size_t i = 0; i < file.scans.size(); ++i) {
+        const Scan& other = file.scans[i];
+        if (other.rows == scan.rows && other.cols == scan.cols &&
+            other.world_from_scanner == scan.world_from_scanner)
+          continue;
+        stations.push_back(other);
+        sources->push_back({{"station", stations.size()}, {"file", path}, {"scan", i}, {"name", other.name}});
+      }
+    }
+    if (stations.empty())
+      throw InputError(
+          fmt::format("--stations: {} hold(s) no station other than the scan", fmt::join(paths, ", ")));
+    return stations;
+  }
+};
+
+// The JSON of a fill from stations: the synthesis's result (FillResult's keys), with the counts of the whole
+// hole and of the cells taken from the stations.
+nlohmann::ordered_json FromStationsJson(const FromStationsResult& result,
+                                        const nlohmann::ordered_json& sources) {
+  nlohmann::ordered_json json = result.filled_rest ? ToJson(result.fill) : nlohmann::ordered_json::object();
+  json["hole_cells"] = result.hole_cells;
+  json["from_station_cells"] = result.from_station_cells;
+  json["synthesized_cells"] = result.synthesized_cells;
+  json["no_return_cells"] = result.no_return_cells;
+  nlohmann::ordered_json per_station = nlohmann::ordered_json::array();
+  for (size_t k = 0; k < result.cells_per_station.size(); ++k) {
+    nlohmann::ordered_json station = sources.at(k);
+    station["from_station_cells"] = result.cells_per_station[k];
+    station["object_cells"] = result.object_cells.at(k);
+    per_station.push_back(station);
+  }
+  json["stations"] = per_station;
+  json["rim_cells"] = result.rim_cells;
+  json["not_free_cells"] = result.not_free_cells;
+  json["stations_seconds"] = result.stations_seconds;
+  json["fill_seconds"] = result.fill_seconds;
+  json["warnings"] = result.warnings;
+  return json;
+}
+
+std::string FromStationsSummary(const FromStationsResult& result) {
+  return fmt::format("{} hole cells: {} from other stations, {} synthesized, {} without a return",
+                     result.hole_cells, result.from_station_cells, result.synthesized_cells,
+                     result.no_return_cells);
+}
+
 }  // namespace
 
 int RunFill(int argc, char** argv) {
@@ -109,22 +199,55 @@ int RunFill(int argc, char** argv) {
   app.add_option("--synthesized-mask", synthesized_mask_path, "write the synthesized cells as a mask PNG");
   AddScanIndexOption(app, &scan_index, "which scan of a multi-scan file (from 0)");
   BindFillOptions(binder, &options);
+  StationFlags stations;
+  stations.Add(app, binder);
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
       [&]() {
         binder.Validate(options);
-        CheckOutputFile("-o", output_path, kScanExtensions, {scan_path, mask_path});
-        CheckOutputFile("--json", json_path, {}, {scan_path, mask_path, output_path});
-        CheckOutputFile("--synthesized-mask", synthesized_mask_path, {"png"},
-                        {scan_path, mask_path, output_path, json_path});
+        binder.Validate(stations.options);
+        std::vector<std::string> inputs = {scan_path, mask_path};
+        inputs.insert(inputs.end(), stations.paths.begin(), stations.paths.end());
+        CheckOutputFile("-o", output_path, kScanExtensions, inputs);
+        inputs.push_back(output_path);
+        CheckOutputFile("--json", json_path, {}, inputs);
+        inputs.push_back(json_path);
+        CheckOutputFile("--synthesized-mask", synthesized_mask_path, {"png"}, inputs);
+        inputs.push_back(synthesized_mask_path);
+        if (!stations.mask_path.empty() && stations.paths.empty())
+          throw OptionsError("--from-stations-mask needs --stations");
+        CheckOutputFile("--from-stations-mask", stations.mask_path, {"png"}, inputs);
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         const cv::Mat hole = ReadMaskForScan(mask_path, scan, layout_path, scan_path);
+        if (!stations.paths.empty()) {
+          nlohmann::ordered_json sources = nlohmann::ordered_json::array();
+          const std::vector<Scan> others = stations.Read(scan, &sources);
+          stations.options.fill = options;
+          auto progress = Progress::ForTerminal(
+              "fill from stations", static_cast<int64_t>(others.size()) + cv::countNonZero(hole) / 4096 + 1,
+              quiet);
+          const FromStationsResult result =
+              FillFromStations(scan, hole, others, stations.options, progress.get());
+          if (progress) progress->Finish();
+          WriteScanFile(output_path, {result.scan});
+          WarnFromStationDropped(output_path, result.scan);
+          if (!synthesized_mask_path.empty()) WriteImage(synthesized_mask_path, result.synthesized);
+          if (!stations.mask_path.empty()) WriteImage(stations.mask_path, result.from_station != 0);
+          nlohmann::ordered_json used = ToJson(options);
+          used["from_stations"] = ToJson(stations.options);
+          WriteJsonOutput(json_path, CommandJson(used, FromStationsJson(result, sources)));
+          if (!debug_dir.empty() && result.filled_rest) WriteDebug(debug_dir, result.fill, hole);
+          PrintResultWarnings(result.warnings);
+          Summarize(fmt::format("{} -> {}", FromStationsSummary(result), output_path));
+          return 0;
+        }
         auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
         const FillResult result = FillScan(scan, hole, options, progress.get());
         if (progress) progress->Finish();
         WriteScanFile(output_path, {result.scan});
+        WarnFromStationDropped(output_path, result.scan);
         if (!synthesized_mask_path.empty()) WriteImage(synthesized_mask_path, result.filled);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         if (!debug_dir.empty()) WriteDebug(debug_dir, result, hole);
@@ -165,23 +288,63 @@ int RunRemove(int argc, char** argv) {
   binder.Bind(&remove, {.keys = {"margin_cells", "keep_object", "fill_enclosed_no_return"},
                         .flags = {{"margin_cells", "--margin"}}});
   BindFillOptions(binder, &remove.fill, "fill");
+  StationFlags stations;
+  stations.Add(app, binder);
   AddQuietFlag(app, &quiet);
   return RunCommand(
       app, argc, argv,
       [&]() {
         binder.Validate(remove);
-        CheckOutputFile("-o", output_path, kScanExtensions, {scan_path, strokes_path});
+        binder.Validate(stations.options);
+        std::vector<std::string> inputs = {scan_path, strokes_path};
+        inputs.insert(inputs.end(), stations.paths.begin(), stations.paths.end());
+        CheckOutputFile("-o", output_path, kScanExtensions, inputs);
         if (const ScanFormatInfo* format = FindScanFormat(FileExtension(output_path));
             remove.keep_object && format != nullptr && !format->layer_behind) {
           throw OptionsError("--keep-object: " + LayerBehindRefusal(*format));
         }
-        CheckOutputFile("--mask-out", mask_out_path, {"png"}, {scan_path, strokes_path, output_path});
-        CheckOutputFile("--json", json_path, {}, {scan_path, strokes_path, output_path, mask_out_path});
+        inputs.push_back(output_path);
+        CheckOutputFile("--mask-out", mask_out_path, {"png"}, inputs);
+        inputs.push_back(mask_out_path);
+        CheckOutputFile("--json", json_path, {}, inputs);
+        inputs.push_back(json_path);
+        if (!stations.mask_path.empty() && stations.paths.empty())
+          throw OptionsError("--from-stations-mask needs --stations");
+        CheckOutputFile("--from-stations-mask", stations.mask_path, {"png"}, inputs);
         const ScanFile file = ReadScanFileAndWarn(scan_path);
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         const PaintedStrokes painted = ReadStrokesForScan(strokes_path, scan, layout_path, scan_path);
         const cv::Mat& strokes = painted.cells;
         if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
+        if (!stations.paths.empty()) {
+          nlohmann::ordered_json sources = nlohmann::ordered_json::array();
+          const std::vector<Scan> others = stations.Read(scan, &sources);
+          auto progress =
+              Progress::ForTerminal("remove from stations", static_cast<int64_t>(others.size()) + 1, quiet);
+          const RemoveFromStationsResult removed =
+              RemoveObjectFromStations(scan, strokes, others, remove, stations.options, progress.get());
+          if (progress) progress->Finish();
+          if (!quiet) fmt::print(stderr, "segment: {}\n", removed.cut.Summary());
+          if (remove.keep_object) {
+            WriteScanWithLayer(output_path, scan, removed.behind);
+          } else {
+            WriteScanFile(output_path, {removed.filled.scan});
+            WarnFromStationDropped(output_path, removed.filled.scan);
+          }
+          if (!mask_out_path.empty()) WriteImage(mask_out_path, removed.hole);
+          if (!stations.mask_path.empty()) WriteImage(stations.mask_path, removed.filled.from_station != 0);
+          nlohmann::ordered_json used = ToJson(remove);
+          used["from_stations"] = ToJson(stations.options);
+          nlohmann::ordered_json json = nlohmann::ordered_json::object();
+          json["cut"] = ToJson(removed.cut);
+          json["fill"] = FromStationsJson(removed.filled, sources);
+          json["warnings"] = removed.warnings;
+          WriteJsonOutput(json_path, CommandJson(used, json));
+          PrintResultWarnings(removed.warnings);
+          Summarize(fmt::format("removed {} cells: {} -> {}", cv::countNonZero(removed.hole),
+                                FromStationsSummary(removed.filled), output_path));
+          return 0;
+        }
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
         const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
         if (progress) progress->Finish();
@@ -192,6 +355,7 @@ int RunRemove(int argc, char** argv) {
           WriteScanWithLayer(output_path, scan, removed.behind);
         } else {
           WriteScanFile(output_path, {result.scan});
+          WarnFromStationDropped(output_path, result.scan);
         }
         if (!mask_out_path.empty()) WriteImage(mask_out_path, hole);
         WriteJsonOutput(json_path, CommandJson(ToJson(remove), ToJson(removed)));

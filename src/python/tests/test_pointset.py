@@ -250,3 +250,39 @@ def test_register_site_brings_spoiled_stations_back():
     assert per_station[1]["moved_m"] > 0.1 and per_station[0]["moved_m"] == 0
     with pytest.raises(lidarshop.OptionsError):  # a site needs two stations
         lidarshop.register_site([stations[0]])
+
+
+def test_fill_from_stations_takes_what_the_other_station_measured():
+    first, second = street_station(0, 0, 0, 3, True), street_station(4, 1, -15, 4, False)
+    labels = np.asarray(first.label)
+    hole = lidarshop.grow_hole(((labels == 10) & (np.asarray(first.valid) > 0)).astype(np.uint8) * 255, 2)
+    filled = lidarshop.fill_from_stations(first, hole, [second])
+    hole_cells = int((hole > 0).sum())
+    assert filled["hole_cells"] == hole_cells
+    assert filled["from_station_cells"] > hole_cells / 2
+    assert filled["cells_per_station"] == [filled["from_station_cells"]]
+    from_station = filled["from_station"] > 0
+    assert from_station.sum() == filled["from_station_cells"]
+    assert set(np.unique(filled["from_station"][from_station]).tolist()) == {1}
+    scan = filled["scan"]
+    assert (np.asarray(scan.from_station) > 0).sum() == filled["from_station_cells"]
+    assert (np.asarray(scan.synthesized)[from_station] == 0).all()  # real points, not synthesized
+    assert (labels[from_station] == 10).all()
+    assert (np.asarray(scan.label)[from_station] != 10).all()
+    alone = lidarshop.fill(first, hole)
+    assert filled["synthesized_cells"] < alone.synthesized_cells / 2
+    with pytest.raises(lidarshop.OptionsError):
+        lidarshop.fill_from_stations(first, hole, [second], max_incidence_deg=0)
+    removed = lidarshop.remove_object(first, labels_strokes(labels), stations=[second])
+    assert removed["filled"]["from_station_cells"] > 0 and removed["cut"].object_cells > 50
+
+
+def labels_strokes(labels):
+    """Strokes: object on the passer-by's middle row, background along the bottom rows."""
+    strokes = np.zeros(labels.shape, np.uint8)
+    rows, cols = np.nonzero(labels == 10)
+    middle = int(np.median(rows))
+    on_row = cols[rows == middle]
+    strokes[middle, on_row.min() + 1:on_row.max()] = 1
+    strokes[-3:, :] = 2
+    return strokes
