@@ -41,6 +41,8 @@ class DocumentLimitError : public InputError {
 // The bytes of the distinct buffers of `document`'s state, undo and redo history and photos (buffers the
 // snapshots share count once). Caller holds document.mutex.
 int64_t DocumentBytes(const Document& document);
+// DocumentBytes with `next` committed (the current state kept for undo): what an edit would make it hold.
+int64_t DocumentBytesWith(const Document& document, const Snapshot& next);
 
 struct EditorServer::State {
   ServerOptions options;
@@ -58,6 +60,10 @@ struct EditorServer::State {
   // Throws DocumentLimitError when max_documents are open (nothing else is checked then: call it before
   // reading a file), or when `more_bytes` more would take the open documents past max_document_bytes.
   void CheckRoomForDocument(int64_t more_bytes = 0);
+  // Throws DocumentLimitError (507) when `document` holding `bytes_after` and the other open documents
+  // (their last counted bytes) would pass max_document_bytes: an edit is refused, the document kept as it was.
+  // Caller holds document.mutex (takes documents_mutex, which is never held while waiting for a document).
+  void CheckRoomForEdit(const Document& document, int64_t bytes_after);
   // Opens `scan` as a new document after CheckRoomForDocument(its bytes); returns its id.
   int AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_images = {});
   std::mutex open_mutex;  // one open at a time: the room checked is the room used
@@ -106,6 +112,7 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
 
 // Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
+// Throws DocumentLimitError (507), changing nothing, when the memory limit would be passed (Document::check_room).
 // Caller holds document.mutex.
 void Commit(Document& document, Snapshot next, int undo_depth);
 // Records the document's current point state as the one of its current version (Document::recent, the last

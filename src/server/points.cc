@@ -123,6 +123,7 @@ void RememberState(Document& document) {
   if (!recent.empty() && SameBuffers(recent.back().points, document.now, false) &&
       SameBuffers(recent.back().points, document.now, true)) {
     recent.back().last_version = document.version;  // the same points: a stroke, a hole
+    document.counted_bytes = DocumentBytes(document);
     return;
   }
   Document::PointState state{document.version, document.version, document.now};
@@ -130,6 +131,7 @@ void RememberState(Document& document) {
   state.points.hole = cv::Mat();
   recent.push_back(std::move(state));
   while (recent.size() > kRecentStates) recent.pop_front();
+  document.counted_bytes = DocumentBytes(document);
 }
 
 std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since) {

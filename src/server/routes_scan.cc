@@ -180,8 +180,11 @@ int64_t Sum(const std::map<const void*, int64_t>& seen) {
 
 }  // namespace
 
-int64_t DocumentBytes(const Document& document) {
+int64_t DocumentBytes(const Document& document) { return DocumentBytesWith(document, Snapshot{}); }
+
+int64_t DocumentBytesWith(const Document& document, const Snapshot& next) {
   std::map<const void*, int64_t> seen;
+  CollectBuffers(next, seen);
   CollectBuffers(document.now, seen);
   for (const auto* history : {&document.undo, &document.redo}) {
     for (const Snapshot& snapshot : *history) CollectBuffers(snapshot, seen);
@@ -222,6 +225,25 @@ void State::CheckRoomForDocument(int64_t more_bytes) {
   }
 }
 
+void State::CheckRoomForEdit(const Document& document, int64_t bytes_after) {
+  const int64_t limit = options.max_document_bytes > 0 ? options.max_document_bytes : MemoryBudgetBytes();
+  int64_t others = 0;
+  {
+    std::lock_guard lock(documents_mutex);
+    for (const auto& [id, open] : documents) {
+      if (open.get() != &document) others += open->counted_bytes.load();
+    }
+  }
+  if (others + bytes_after > limit) {
+    throw DocumentLimitError(
+        507,
+        fmt::format("not enough memory for this edit: the scan would hold {} MiB (with its undo history) "
+                    "and the other open scans hold {} MiB of the {} MiB allowed; the scan is kept as it "
+                    "was: save and close another scan, then try again",
+                    bytes_after >> 20, others >> 20, limit >> 20));
+  }
+}
+
 FileForEditing ReadFileForEditing(const std::string& path) {
   if (FileExtension(path) != "e57") return {ReadScanFile(path), {}};
   E57File e57 = ReadE57(path);  // as ReadScanFile reads it, keeping the photos
@@ -252,6 +274,9 @@ int State::AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_im
   document->now.scan = std::move(scan);
   std::lock_guard open_lock(open_mutex);
   CheckRoomForDocument(DocumentBytes(*document));
+  document->check_room = [this](const Document& self, int64_t bytes_after) {
+    CheckRoomForEdit(self, bytes_after);
+  };
   RememberState(*document);
   std::lock_guard lock(documents_mutex);
   document->id = ++last_document;

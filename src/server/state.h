@@ -97,6 +97,12 @@ struct Document {
   cv::Mat photo_b;  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
   std::shared_ptr<ReviewSession> review;  // the inpainting review in progress (null = none)
   int64_t prepared_version = -1;
+  // Memory accounting: the bytes DocumentBytes counted at the last version change (read by other
+  // documents' room checks without this one's mutex), and the check an edit must pass before it is committed
+  // (EditorServer::State::CheckRoomForEdit: throws DocumentLimitError when the document would hold
+  // `bytes_after` and the open documents together would pass the limit). Empty outside a server.
+  std::atomic<int64_t> counted_bytes{0};
+  std::function<void(const Document&, int64_t bytes_after)> check_room;
   std::mutex mutex;  // guards every field above
 };
 
