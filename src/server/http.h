@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/verify/verify.h"
@@ -122,10 +123,21 @@ void RememberState(Document& document);
 
 // points.cc: the points of a document as typed arrays (docs/api.md "Points"), whole (LSP1) or the cells that
 // changed since an earlier version (LSD1). Caller holds document.mutex.
-std::string PointsBinary(const Document& document);
+// `step` > 1: a level of detail, only the cells whose row and column are multiples of it (a large scan's
+// first view; its deltas then name only those cells too).
+std::string PointsBinary(const Document& document, int step = 1);
 // The LSD1 delta from the state the document had at version `since` to now; nullopt when that state is no
 // longer kept (or the grid changed): the client then gets the whole points.
-std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since);
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step = 1);
+
+// pictures.cc: pictures that travel by what changed (docs/api.md "Pictures"). Caller holds document.mutex.
+// The ray image of `options` (`channel` names it): whole, or with `since` >= 0 a kept version's picture, only
+// the box of pixels that changed since (headers X-Lidarshop-Box "col,row,width,height" and X-Lidarshop-Size
+// "cols,rows"; an empty body when nothing changed). Each kept state's picture is rendered once.
+void SendRayPicture(Document& document, const RenderOptions& options, const std::string& channel,
+                    int64_t since, httplib::Response& response);
+// A BGRA overlay as PNG; `crop`: only the box of its drawn (alpha > 0) pixels, with the headers above.
+void SendOverlay(httplib::Response& response, const cv::Mat& bgra, bool crop);
 
 // A job's JSON form (GET /api/jobs/ID).
 nlohmann::ordered_json JobJson(const Job& job);

@@ -97,14 +97,14 @@ std::string Encode(const uint32_t (&header)[N], const std::vector<uint32_t>& key
 
 }  // namespace
 
-std::string PointsBinary(const Document& document) {
+std::string PointsBinary(const Document& document, int step) {
   std::vector<uint32_t> cells;
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
     const Scan& scan = behind ? document.now.behind : document.now.scan;
     if (scan.valid.empty()) continue;
-    for (int r = 0; r < scan.rows; ++r) {
-      for (int c = 0; c < scan.cols; ++c) {
+    for (int r = 0; r < scan.rows; r += step) {
+      for (int c = 0; c < scan.cols; c += step) {
         PointRecord record = RecordAt(document.now, behind, r, c);
         if (!record.present) continue;
         records.push_back(record);
@@ -134,7 +134,7 @@ void RememberState(Document& document) {
   document.counted_bytes = DocumentBytes(document);
 }
 
-std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since) {
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step) {
   const Snapshot* old = nullptr;
   for (const auto& state : document.recent) {
     if (state.first_version <= since && since <= state.last_version) old = &state.points;
@@ -149,8 +149,8 @@ std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t s
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
     if (SameBuffers(*old, now, behind)) continue;
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
+    for (int r = 0; r < rows; r += step) {
+      for (int c = 0; c < cols; c += step) {
         PointRecord record = RecordAt(now, behind, r, c);
         if (record == RecordAt(*old, behind, r, c)) continue;
         keys.push_back(static_cast<uint32_t>(r * cols + c) | (behind ? kBehindKey : 0));

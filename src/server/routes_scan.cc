@@ -141,8 +141,13 @@ std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::
 }
 
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
-  cv::Mat out = rgb_or_gray;
-  if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  // A new buffer for the BGR copy: `rgb_or_gray` may be a kept picture (pictures.cc), not to be swapped in place.
+  cv::Mat out;
+  if (rgb_or_gray.channels() == 3) {
+    cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  } else {
+    out = rgb_or_gray;
+  }
   std::vector<uint8_t> png;
   CvImEncode(".png", out, &png);
   response.set_content(std::string(png.begin(), png.end()), "image/png");
@@ -574,22 +579,31 @@ void AddScanRoutes(State& state) {
       SendJson(response, {{"closed", document->id}});
     }
   });
-  http.Get(R"(/api/docs/(\d+)/image.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             RenderOptions options;
-             try {
-               if (request.has_param("channel"))
-                 options.channel = ParseEnum<RenderChannel>(request.get_param_value("channel"));
-               std::lock_guard lock(document->mutex);
-               SendPng(response, RenderScan(document->now.scan, options).image);
-             } catch (const OptionsError& error) {
-               SendError(response, 400, error.what());
-             } catch (const InputError& error) {
-               SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
-             }
-           });
+  http.Get(R"(/api/docs/(\d+)/image.png)", [&state](const httplib::Request& request,
+                                                    httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    RenderOptions options;
+    try {
+      const std::string channel = request.has_param("channel") ? request.get_param_value("channel") : "range";
+      options.channel = ParseEnum<RenderChannel>(channel);
+      // ?since=V: only the box of pixels that changed since version V (pictures.cc).
+      int64_t since = -1;
+      if (request.has_param("since")) {
+        const std::string text = request.get_param_value("since");
+        char* end = nullptr;
+        since = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || since < 0)
+          return SendError(response, 400, "since: expected a version (a whole number >= 0)");
+      }
+      std::lock_guard lock(document->mutex);
+      SendRayPicture(*document, options, channel, since, response);
+    } catch (const OptionsError& error) {
+      SendError(response, 400, error.what());
+    } catch (const InputError& error) {
+      SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
+    }
+  });
   http.Get(R"(/api/docs/(\d+)/mask.png)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);
@@ -597,6 +611,8 @@ void AddScanRoutes(State& state) {
              std::lock_guard lock(document->mutex);
              const Scan& scan = document->now.scan;
              const std::string layer = request.get_param_value("layer");
+             // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
+             const bool crop = request.get_param_value("crop") == "1";
              if (layer == "strokes") {
                // The strokes as the server holds them (the canvas draws these, not a list of its own): the
                // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
@@ -606,9 +622,7 @@ void AddScanRoutes(State& state) {
                cv::Mat overlay(strokes.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
                overlay.setTo(cv::Scalar(60, 220, 60, 210), strokes == 1);
                overlay.setTo(cv::Scalar(60, 60, 230, 210), strokes == 2);
-               std::vector<uint8_t> png;
-               CvImEncode(".png", overlay, &png);
-               return response.set_content(std::string(png.begin(), png.end()), "image/png");
+               return SendOverlay(response, overlay, crop);
              }
              const bool hole = layer == "hole";
              const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
@@ -617,9 +631,7 @@ void AddScanRoutes(State& state) {
              // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
              cv::Mat overlay(mask.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
              overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask);
-             std::vector<uint8_t> png;
-             CvImEncode(".png", overlay, &png);
-             response.set_content(std::string(png.begin(), png.end()), "image/png");
+             SendOverlay(response, overlay, crop);
            });
   http.Get(R"(/api/docs/(\d+)/points)",
            [&state](const httplib::Request& request, httplib::Response& response) {
@@ -635,14 +647,25 @@ void AddScanRoutes(State& state) {
                if (text.empty() || *end != '\0' || since < 0)
                  return SendError(response, 400, "since: expected a version (a whole number >= 0)");
              }
+             // ?step=K: the level of detail K (every K-th row and column), for a large scan's first view.
+             int step = 1;
+             if (request.has_param("step")) {
+               const std::string text = request.get_param_value("step");
+               char* end = nullptr;
+               const long value = std::strtol(text.c_str(), &end, 10);
+               if (text.empty() || *end != '\0' || value < 1 || value > 64)
+                 return SendError(response, 400, "step: expected a whole number in [1, 64]");
+               step = static_cast<int>(value);
+             }
              std::lock_guard lock(document->mutex);
              response.set_header("X-Lidarshop-Version", std::to_string(document->version));
+             response.set_header("X-Lidarshop-Step", std::to_string(step));
              if (since >= 0) {
-               if (auto delta = PointsDeltaBinary(*document, since)) {
+               if (auto delta = PointsDeltaBinary(*document, since, step)) {
                  return response.set_content(std::move(*delta), "application/octet-stream");
                }
              }
-             response.set_content(PointsBinary(*document), "application/octet-stream");
+             response.set_content(PointsBinary(*document, step), "application/octet-stream");
            });
   // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).
   http.Get(R"(/api/docs/(\d+)/labels)",

@@ -87,6 +87,8 @@ struct Document {
     Snapshot points;  // shallow: shares the history's buffers; strokes and hole left empty
   };
   std::deque<PointState> recent;
+  // Ray images rendered, by (channel, the first version of a state in `recent`): a picture patch compares two.
+  std::map<std::pair<std::string, int64_t>, cv::Mat> pictures;
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)

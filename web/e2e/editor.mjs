@@ -5,7 +5,7 @@
 // docs/results/editor/ with --docs).
 //
 //   node e2e/editor.mjs LIDARSHOP_BINARY ARTEFACTS_DIR [--docs]
-import { spawn, execFileSync } from 'node:child_process';
+import { spawn, spawnSync, execFileSync } from 'node:child_process';
 import { mkdirSync, readFileSync, copyFileSync, existsSync, mkdtempSync } from 'node:fs';
 import { join, dirname } from 'node:path';
 import { tmpdir } from 'node:os';
@@ -93,6 +93,8 @@ try {
   // The server moved the token into an HttpOnly cookie and reloaded the page without it (docs/api.md "Safety").
   if (new URL(page.url()).searchParams.has('token')) fail(`the token stayed in the page's URL: ${page.url()}`);
   if ((await page.evaluate(() => document.cookie)).includes('lidarshop_token')) fail('page scripts can read the token cookie');
+  // E57 first: the save defaults to the format that keeps everything the editor makes.
+  if ((await page.inputValue('#format')) !== 'e57') fail(`the save format defaults to ${await page.inputValue('#format')}, not e57`);
   await page.selectOption('#scene', 'parking_lot');
   await page.click('#open-scene');
   await waitForStatus(/^parking_lot: \d+ x \d+ cells/, 'open the parking lot');
@@ -146,6 +148,7 @@ try {
   // Bytes per edit: the points travel whole once, then each edit sends the cells it changed (docs/api.md
   // "Points"). The whole points of this scan, for comparison: what every edit re-downloaded before.
   const wholeBytes = (await (await fetch(new URL(`/api/docs/${doc.id}/points?token=${token}`, url))).arrayBuffer()).byteLength;
+  const wholePictureBytes = (await (await fetch(new URL(`/api/docs/${doc.id}/image.png?channel=${await page.inputValue('#channel')}&token=${token}`, url))).arrayBuffer()).byteLength;
   const edits = [];
   let apiBytes = 0; // every /api/ answer's body: points, pictures, JSON
   page.on('requestfinished', async (request) => {
@@ -154,13 +157,15 @@ try {
   const bytesOfEdit = async (what, action, done) => {
     await page.evaluate(() => window.lidarshop.settled());
     const before = await page.evaluate(() => window.lidarshop.pointBytes());
+    const picturesBefore = await page.evaluate(() => window.lidarshop.pictureBytes());
     const allBefore = apiBytes;
     await action();
     await done();
     await page.evaluate(() => window.lidarshop.settled());
     await new Promise((resolve) => setTimeout(resolve, 300)); // the last answers' sizes
     const bytes = (await page.evaluate(() => window.lidarshop.pointBytes())) - before;
-    edits.push({ what, bytes, all: apiBytes - allBefore });
+    const pictures = (await page.evaluate(() => window.lidarshop.pictureBytes())) - picturesBefore;
+    edits.push({ what, bytes, pictures, all: apiBytes - allBefore });
     return bytes;
   };
   const current = () => page.evaluate(() => window.lidarshop.current());
@@ -175,12 +180,36 @@ try {
     const d = window.lidarshop.current();
     return d.synthesized_cells === 0 && d.object_stroke_cells > 0 && window.lidarshop.rayView.shownState().version === d.version;
   }, null, { timeout: 60000 }));
+  // The ray image travels as the box of pixels that changed, patched into the picture held: after the undo it
+  // must equal the whole picture of this version, pixel for pixel.
+  const pictureMismatch = () => page.evaluate(async () => {
+    const d = window.lidarshop.current();
+    const channel = document.getElementById('channel').value;
+    const held = window.lidarshop.pictures.heldPicture(d.id, channel);
+    if (!held) return 'no picture held';
+    const answer = await fetch(`/api/docs/${d.id}/image.png?channel=${channel}&v=${held.version}`);
+    const bitmap = await createImageBitmap(await answer.blob());
+    const canvas = document.createElement('canvas');
+    [canvas.width, canvas.height] = [bitmap.width, bitmap.height];
+    const context = canvas.getContext('2d');
+    context.drawImage(bitmap, 0, 0);
+    const whole = context.getImageData(0, 0, bitmap.width, bitmap.height).data;
+    const patched = held.canvas.getContext('2d').getImageData(0, 0, held.canvas.width, held.canvas.height).data;
+    if (whole.length !== patched.length) return `sizes differ: ${whole.length} and ${patched.length}`;
+    let differ = 0;
+    for (let i = 0; i < whole.length; ++i) if (whole[i] !== patched[i]) ++differ;
+    return differ === 0 ? '' : `${differ} of ${whole.length} bytes differ`;
+  });
+  const afterUndo = await pictureMismatch();
+  if (afterUndo) fail(`the patched ray image after undo is not the server's: ${afterUndo}`);
   const undone = await current();
   if (undone.object_stroke_cells === 0 || undone.background_stroke_cells === 0) fail(`undo did not bring the strokes back: ${JSON.stringify(undone)}`);
   await bytesOfEdit('remove again', () => page.click('#remove'), () => waitForStatus(/^remove done/, 'remove after undo', 300000));
   const again = await current();
   if (again.synthesized_cells !== removed.synthesized_cells) fail(`remove after undo: ${again.synthesized_cells} synthesized, first time ${removed.synthesized_cells}`);
   if (!(await versionShown())) fail('the pictures or points shown are not of the current version');
+  const afterRemove = await pictureMismatch();
+  if (afterRemove) fail(`the patched ray image after the second removal is not the server's: ${afterRemove}`);
   await shot('remove_undo_remove');
 
   // Strokes are drawn from the server's state: a stroke appears, undo takes it away, redo brings it back, and a
@@ -305,6 +334,91 @@ try {
   await waitForStatus(/^aligned to scan #\d+: 5 landmarks, RMS 0\.0 mm/, 'align with landmarks', 30000);
   await shot('landmarks');
 
+  // Fill shadow on the second copy, then save: E57 (the default) keeps the surface completed behind the car
+  // (its second returns, synthesized); PTX warns, listing what it drops, and is refused for the layer behind.
+  await page.reload();
+  await waitForFunction(page, () => window.lidarshop.current() !== null, null, { timeout: 60000 });
+  await page.selectOption('#documents', String(copy.id));
+  await waitForFunction(page, (id) => window.lidarshop.current()?.id === id, copy.id, { timeout: 60000 });
+  if ((await page.inputValue('#format')) !== 'e57') fail('after a reload the save format is not e57');
+  await page.selectOption('#pair-mode', 'photo-scan').catch(() => {});
+  const canvasNow = await page.locator('#ray').boundingBox();
+  const dragOn = async (cells) => {
+    const first = await screen(...cells[0]);
+    await page.mouse.move(canvasNow.x + first.x, canvasNow.y + first.y);
+    await page.mouse.down();
+    for (const cell of cells.slice(1)) {
+      const point = await screen(...cell);
+      await page.mouse.move(canvasNow.x + point.x, canvasNow.y + point.y, { steps: 8 });
+    }
+    await page.mouse.up();
+  };
+  await page.click('#brush-object');
+  await dragOn([[cr, Math.round(c0 + 0.25 * (c1 - c0))], [cr, Math.round(c0 + 0.75 * (c1 - c0))]]);
+  await waitForStatus(/object stroke cells painted/, 'object stroke for fill shadow');
+  await page.click('#brush-background');
+  await dragOn([[top, left], [top, right], [bottom, right], [bottom, left], [top, left]]);
+  await waitForStatus(/^segment done/, 'live segmentation for fill shadow');
+  await page.click('#fill-shadow');
+  await waitForStatus(/^fill shadow done/, 'fill shadow', 300000);
+  const shadowed = await current();
+  if (!(shadowed.behind_cells > 100)) fail(`fill shadow made ${shadowed.behind_cells} cells behind the car`);
+  const shadowDialogs = [];
+  page.on('dialog', async (dialog) => { shadowDialogs.push(dialog.message()); await dialog.accept(); });
+  const [shadowDownload] = await Promise.all([page.waitForEvent('download'), page.click('#save')]);
+  const shadowSaved = join(artefacts, 'fill_shadow.e57');
+  await shadowDownload.saveAs(shadowSaved);
+  if (shadowDialogs.some((text) => /synthesized|behind|second return/i.test(text))) fail(`saving as E57 warned of losing the layer: ${shadowDialogs}`);
+  // The saved E57 holds the layer behind as second returns: converting it to PLY says they are dropped there.
+  const converted = spawnSync(binary, ['convert', shadowSaved, join(artefacts, 'fill_shadow.ply')], { encoding: 'utf8' });
+  if (!/second returns of 1 scan are not written/.test(converted.stderr)) fail(`the saved E57 holds no second returns: ${converted.stderr}`);
+  const shadowInfo = JSON.parse(execFileSync(binary, ['info', shadowSaved], { encoding: 'utf8' }));
+  if (!shadowInfo.scans[0].channels.includes('rgb')) fail(`the saved E57 lost its colours: ${shadowInfo.scans[0].channels}`);
+  await page.selectOption('#format', 'ptx');
+  shadowDialogs.length = 0;
+  await page.click('#save');
+  await waitForStatus(/^save: /, 'save as PTX after fill shadow', 30000);
+  const ptxPlan = await (await fetch(new URL(`/api/docs/${copy.id}/save-plan?format=ptx&token=${token}`, url))).json();
+  if (!ptxPlan.refused && ptxPlan.dropped.length === 0) fail(`PTX after fill shadow: nothing dropped or refused: ${JSON.stringify(ptxPlan)}`);
+  if (!(await statusText()).includes(ptxPlan.refused || 'not saved')) fail(`PTX save: the status does not say why: ${await statusText()}`);
+  // Undo the fill shadow (its layer goes): PTX then warns, listing what it drops (the labels), before saving.
+  await page.click('#undo');
+  await waitForFunction(page, () => window.lidarshop.current().behind_cells === 0, null, { timeout: 60000 });
+  shadowDialogs.length = 0;
+  const [ptxDownload] = await Promise.all([page.waitForEvent('download'), page.click('#save')]);
+  if (shadowDialogs.length !== 1 || !/Saving as PTX loses:\n•/.test(shadowDialogs[0])) fail(`a PTX save did not warn with a list: ${JSON.stringify(shadowDialogs)}`);
+  await ptxDownload.saveAs(join(artefacts, 'undone.ptx'));
+  await page.selectOption('#format', 'e57');
+  page.removeAllListeners('dialog');
+  await shot('fill_shadow_saved');
+
+  // The recolour additions on a station with its own photos (E57 images2D): a photo taken from the file
+  // into the photo panel, and colouring from all the station's photos.
+  execFileSync(binary, ['scan', 'parking_lot', '--rows', '120', '--columns', '240', '--photos', 'cube', '--photo-size', '96',
+                        '-o', join(root, 'photos.e57'), '--quiet']);
+  const photosOpened = await (await fetch(new URL(`/api/open?path=photos.e57&token=${token}`, url))).json();
+  if (!(photosOpened.e57_images?.length === 6)) fail(`the station's six photos are not listed: ${JSON.stringify(photosOpened.e57_images)}`);
+  await page.reload();
+  await waitForFunction(page, () => window.lidarshop.current() !== null, null, { timeout: 60000 });
+  await page.selectOption('#documents', String(photosOpened.id));
+  await waitForFunction(page, (id) => window.lidarshop.current()?.id === id, photosOpened.id, { timeout: 60000 });
+  await waitForFunction(page, () => document.getElementById('e57-photo').options.length === 7 && !document.getElementById('e57-photo').hidden, null, { timeout: 30000 });
+  await page.selectOption('#e57-photo', '2');
+  await waitForStatus(/^photo loaded/, 'photo from the E57', 30000);
+  const photoPng = await fetch(new URL(`/api/docs/${photosOpened.id}/photo.png?slot=a&token=${token}`, url));
+  if (photoPng.status !== 200) fail(`the photo taken from the E57 is not the document's photo: ${photoPng.status}`);
+  const colourBefore = await (await fetch(new URL(`/api/docs/${photosOpened.id}/image.png?channel=rgb&token=${token}`, url))).arrayBuffer();
+  const photoVersion = (await current()).version;
+  await page.click('#recolor-station');
+  await waitForStatus(/^colour from the station's photos done/, 'recolour from the station', 300000);
+  if (!((await current()).version > photoVersion)) fail('colouring from the station made no edit');
+  const colourAfter = await (await fetch(new URL(`/api/docs/${photosOpened.id}/image.png?channel=rgb&token=${token}`, url))).arrayBuffer();
+  if (Buffer.from(colourBefore).equals(Buffer.from(colourAfter))) fail('colouring from the station changed no colour');
+  await shot('recolor_station');
+  await fetch(new URL(`/api/docs/${photosOpened.id}?token=${token}`, url), { method: 'DELETE' });
+  await page.reload();
+  await waitForFunction(page, () => window.lidarshop.current() !== null, null, { timeout: 60000 });
+
   // A 17th document is refused, not evicted: the server answers 409 and the editor shows its message; every
   // open document stays (copies of the saved E57 fill the list to 16).
   copyFileSync(saved, join(root, 'removed.e57'));
@@ -334,10 +448,11 @@ try {
   await page.click('#open-file');
   await waitForFunction(page, () => document.getElementById('documents').options.length === 16, null, { timeout: 60000 });
 
-  const full = edits.map((e) => `${e.what} ${e.bytes} B of points, ${e.all} B in all`).join('; ');
-  console.log(`e2e: bytes per edit: ${full}; the whole points are ${wholeBytes} B`);
+  const full = edits.map((e) => `${e.what} ${e.bytes} B of points, ${e.pictures} B of pictures, ${e.all} B in all`).join('; ');
+  console.log(`e2e: bytes per edit: ${full}; the whole points are ${wholeBytes} B, the whole ray image ${wholePictureBytes} B`);
   for (const edit of edits) {
     if (edit.bytes >= wholeBytes / 2) fail(`${edit.what} moved ${edit.bytes} B of points, the whole scan is ${wholeBytes} B`);
+    if (edit.pictures >= wholePictureBytes / 2) fail(`${edit.what} moved ${edit.pictures} B of pictures, the whole ray image is ${wholePictureBytes} B`);
   }
 
   if (blocked.length > 0) fail(`the Content-Security-Policy blocked: ${blocked.join('; ')}`);

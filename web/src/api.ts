@@ -191,8 +191,11 @@ export class Api {
   // The points of document `id` as an answer to show: the cells changed since `since` (LSD1) when the server
   // still holds that version, else the whole points (LSP1); `version` is the version they show
   // (X-Lidarshop-Version), `bytes` what travelled.
-  async pointsSince(id: number, since: number | null): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
-    const response = await fetch(this.url(`/api/docs/${id}/points`, since === null ? {} : { since }));
+  // `step` > 1: the level of detail holding every step-th row and column (a large scan's 3-D view).
+  async pointsSince(id: number, since: number | null, step = 1): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
+    const params: Record<string, number> = since === null ? {} : { since };
+    if (step > 1) params.step = step;
+    const response = await fetch(this.url(`/api/docs/${id}/points`, params));
     if (!response.ok) throw new ApiError(response.status, `points: ${response.status}`);
     const buffer = await response.arrayBuffer();
     return { buffer, version: Number(response.headers.get('X-Lidarshop-Version') ?? -1), bytes: buffer.byteLength };

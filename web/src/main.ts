@@ -7,6 +7,7 @@ import { PendingReview, ReviewChoice, decisionBody } from './review';
 import { ReviewPanel } from './reviewpanel';
 import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
+import { PictureStore, loadOverlay } from './picture';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -20,11 +21,18 @@ let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
 let openDocuments: DocumentInfo[] = []; // the server's open documents, for the list
 const gate = new VersionGate(); // answers are shown in version order
-const heldPoints = new Map<number, { version: number; points: PointSet }>(); // per document
+// Per document: the points held, their version and level of detail (every step-th row and column).
+const heldPoints = new Map<number, { version: number; step: number; points: PointSet }>();
+// Levels of detail of the 3-D view: the first download holds at most about FIRST_POINTS points, then it is
+// refined to at most about MOST_POINTS (a 1400-pixel-wide view shows no more; deltas then name only those cells).
+const FIRST_POINTS = 1_000_000, MOST_POINTS = 4_000_000;
+const stepFor = (returns: number, most: number) => Math.max(1, Math.ceil(Math.sqrt(returns / most)));
 let pointsShown = { id: -1, version: -1 };
 let pointsChain: Promise<void> = Promise.resolve(); // point updates one at a time, in order
 let pointBytes = 0; // bytes of points received (whole or deltas), for tests
-const lastImage = new Map<string, string>(); // "id:channel" -> the ray image URL shown
+const pictures = new PictureStore(); // ray images held per document and channel, patched by what changed
+let overlayBytes = 0; // bytes of overlays received, for tests
+const firstPictures = new Map<number, number>(); // when a large scan's first picture was shown (tests)
 const strokeKinds = new Set<Brush>();  // brushes used on the open scan since its last cut was reset
 
 let pending: PendingReview | null = null; // the patch review shown (null = none)
@@ -33,27 +41,32 @@ let placingByHand = false; // the next pick in the ray image is a review's sourc
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {
   rayView, pointView, current: () => doc, verify: () => verify(), review: () => pending, pairs: () => pairsPanel,
-  pointBytes: () => pointBytes, pointsShown: () => pointsShown, documents: () => openDocuments,
+  pointLevel: () => (doc ? heldPoints.get(doc.id)?.step ?? 0 : 0), firstPictures: () => Object.fromEntries(firstPictures),
+  pictures, pointBytes: () => pointBytes, pictureBytes: () => pictures.bytes + overlayBytes, pointsShown: () => pointsShown, documents: () => openDocuments,
   settled: () => pointsChain.then(() => true),
 };
 
 // Brings the held points of document `id` to the server's current version: the cells changed since the held
 // version (a delta), or the whole points the first time; then shows them if the document is still shown.
-function updatePoints(id: number, keepView: boolean): Promise<void> {
+// `step`: a level of detail to download whole instead (a refinement); by default the one held, or for the first
+// download the coarsest that holds about FIRST_POINTS.
+function updatePoints(id: number, keepView: boolean, step?: number): Promise<void> {
   pointsChain = pointsChain.then(async () => {
     try {
       let held = heldPoints.get(id);
-      const answer = await api.pointsSince(id, held ? held.version : null);
+      if (held && step !== undefined && step !== held.step) held = undefined;
+      const level = held?.step ?? step ?? stepFor(doc?.id === id ? doc.valid_cells : 0, FIRST_POINTS);
+      const answer = await api.pointsSince(id, held ? held.version : null, level);
       pointBytes += answer.bytes;
       const parsed = parsePointsAnswer(answer.buffer);
       if ('whole' in parsed) {
-        held = { version: answer.version, points: parsed.whole };
+        held = { version: answer.version, step: level, points: parsed.whole };
       } else if (held && parsed.delta.from === held.version) {
-        held = { version: parsed.delta.to, points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points };
+        held = { version: parsed.delta.to, step: level, points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points };
       } else {
-        const whole = await api.pointsSince(id, null);
+        const whole = await api.pointsSince(id, null, level);
         pointBytes += whole.bytes;
-        held = { version: whole.version, points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole };
+        held = { version: whole.version, step: level, points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole };
       }
       heldPoints.set(id, held);
       if (doc?.id !== id) return;
@@ -116,14 +129,28 @@ async function refresh(keepView: boolean, strokesOnly = false) {
   if ((usable === 'labels' || usable === 'classification') && !has('label')) usable = 'range';
   const aspect = info.azimuth_step_deg > 0 ? info.elevation_step_deg / info.azimuth_step_deg : 1;
   const v = info.version;
-  const mask = info.object_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', v }) : null;
-  const hole = info.hole_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'hole', v }) : null;
-  const strokes = api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'strokes', v });
-  const imageKey = `${id}:${usable}`;
-  const image = strokesOnly && lastImage.has(imageKey) ? lastImage.get(imageKey)! : api.url(`/api/docs/${id}/image.png`, { channel: usable, v });
-  lastImage.set(imageKey, image);
+  // Overlays cropped to their drawn cells, the ray image patched by the pixels that changed (picture.ts).
+  const overlay = (params: Record<string, string | number>) =>
+    loadOverlay(api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', crop: 1, v, ...params }), info.rows, info.cols,
+                (bytes) => (overlayBytes += bytes));
+  const mask = info.object_cells > 0 ? overlay({}) : null;
+  const hole = info.hole_cells > 0 ? overlay({ layer: 'hole' }) : null;
+  const strokes = overlay({ layer: 'strokes' });
+  const image = pictures.picture((params) => api.url(`/api/docs/${id}/image.png`, params), id, usable, strokesOnly ? -1 : v);
   const shown = await rayView.show(id, v, image, mask, hole, strokes, info.rows, info.cols, aspect, keepView);
-  if (!strokesOnly) await updatePoints(id, keepView);
+  if (!strokesOnly) {
+    // The 3-D view follows the ray image and does not hold it up: a large scan's coarse level first, refined
+    // after the first picture (its deltas then name the refined level's cells).
+    const first = !heldPoints.has(id);
+    const points = updatePoints(id, keepView);
+    const finer = stepFor(info.valid_cells, MOST_POINTS);
+    if (first && finer < stepFor(info.valid_cells, FIRST_POINTS)) {
+      firstPictures.set(id, performance.now());
+      void points.then(() => updatePoints(id, true, finer));
+    } else {
+      await points;
+    }
+  }
   if (!shown || doc?.id !== id || gate.version(id) !== v) return;
   const photos = info.e57_images ?? [];
   const photoSelect = element<HTMLSelectElement>('e57-photo');
@@ -293,6 +320,7 @@ element('close-doc').addEventListener('click', async () => {
     return;
   }
   heldPoints.delete(closing.id);
+  pictures.forget(closing.id);
   gate.forget(closing.id);
   await listDocuments();
   await showDocument(openDocuments[0] ?? null);
