@@ -136,8 +136,9 @@ std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t s
 // "cols,rows"; an empty body when nothing changed). Each kept state's picture is rendered once.
 void SendRayPicture(Document& document, const RenderOptions& options, const std::string& channel,
                     int64_t since, httplib::Response& response);
-// A BGRA overlay as PNG; `crop`: only the box of its drawn (alpha > 0) pixels, with the headers above.
-void SendOverlay(httplib::Response& response, const cv::Mat& bgra, bool crop);
+// A BGRA overlay as PNG; with `box` (of a `size` picture: cropped to its drawn cells, drawn from those
+// cells alone so that a large scan's mostly clear overlay costs its box), with the headers above.
+void SendOverlay(httplib::Response& response, const cv::Mat& bgra, const cv::Rect* box, cv::Size size);
 
 // A job's JSON form (GET /api/jobs/ID).
 nlohmann::ordered_json JobJson(const Job& job);

@@ -90,18 +90,13 @@ void SendRayPicture(Document& document, const RenderOptions& options, const std:
   SendPng(response, after(box));
 }
 
-void SendOverlay(httplib::Response& response, const cv::Mat& bgra, bool crop) {
-  cv::Mat shown = bgra;
-  if (crop) {
-    std::vector<cv::Mat> channels;
-    cv::split(bgra, channels);
-    const cv::Rect box = cv::boundingRect(channels[3]);
-    SetBox(response, box, bgra.size());
-    if (box.empty()) return response.set_content(std::string(), "image/png");
-    shown = bgra(box);
+void SendOverlay(httplib::Response& response, const cv::Mat& bgra, const cv::Rect* box, cv::Size size) {
+  if (box != nullptr) {
+    SetBox(response, *box, size);
+    if (box->empty()) return response.set_content(std::string(), "image/png");
   }
   std::vector<uint8_t> png;
-  CvImEncode(".png", shown, &png);
+  CvImEncode(".png", bgra, &png);
   response.set_content(std::string(png.begin(), png.end()), "image/png");
 }
 

@@ -604,35 +604,39 @@ void AddScanRoutes(State& state) {
       SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
     }
   });
-  http.Get(R"(/api/docs/(\d+)/mask.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             std::lock_guard lock(document->mutex);
-             const Scan& scan = document->now.scan;
-             const std::string layer = request.get_param_value("layer");
-             // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
-             const bool crop = request.get_param_value("crop") == "1";
-             if (layer == "strokes") {
-               // The strokes as the server holds them (the canvas draws these, not a list of its own): the
-               // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
-               // the values 0 / 1 / 2 as grey (segment.h kStroke*).
-               const cv::Mat& strokes = document->now.strokes;
-               if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
-               cv::Mat overlay(strokes.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-               overlay.setTo(cv::Scalar(60, 220, 60, 210), strokes == 1);
-               overlay.setTo(cv::Scalar(60, 60, 230, 210), strokes == 2);
-               return SendOverlay(response, overlay, crop);
-             }
-             const bool hole = layer == "hole";
-             const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
-             cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
-             if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
-             // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
-             cv::Mat overlay(mask.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-             overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask);
-             SendOverlay(response, overlay, crop);
-           });
+  http.Get(
+      R"(/api/docs/(\d+)/mask.png)", [&state](const httplib::Request& request, httplib::Response& response) {
+        auto document = state.FindDocument(request, response);
+        if (!document) return;
+        std::lock_guard lock(document->mutex);
+        const Scan& scan = document->now.scan;
+        const std::string layer = request.get_param_value("layer");
+        // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
+        const bool crop = request.get_param_value("crop") == "1";
+        if (layer == "strokes") {
+          // The strokes as the server holds them (the canvas draws these, not a list of its own): the
+          // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
+          // the values 0 / 1 / 2 as grey (segment.h kStroke*).
+          const cv::Mat& strokes = document->now.strokes;
+          if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
+          // Cropped: only the box of the painted cells is drawn (a large scan's overlay is mostly clear).
+          const cv::Rect box = crop ? cv::boundingRect(strokes) : cv::Rect(0, 0, strokes.cols, strokes.rows);
+          const cv::Mat part = strokes(box);
+          cv::Mat overlay(part.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+          overlay.setTo(cv::Scalar(60, 220, 60, 210), part == 1);
+          overlay.setTo(cv::Scalar(60, 60, 230, 210), part == 2);
+          return SendOverlay(response, overlay, crop ? &box : nullptr, strokes.size());
+        }
+        const bool hole = layer == "hole";
+        const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
+        cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
+        if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
+        // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
+        const cv::Rect box = crop ? cv::boundingRect(mask) : cv::Rect(0, 0, mask.cols, mask.rows);
+        cv::Mat overlay(box.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+        overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
+        SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());
+      });
   http.Get(R"(/api/docs/(\d+)/points)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);

@@ -90,6 +90,7 @@ try {
   result.refined_points_s = (Date.now() - opened) / 1000;
   result.refined_level = await page.evaluate(() => window.lidarshop.pointLevel());
   result.open_bytes = apiBytes;
+  console.log(`e2e station: opened: ${JSON.stringify(result)}`);
   if (result.first_level < 2) fail(`a ${doc.valid_cells}-return station was first downloaded at level ${result.first_level}`);
 
   const canvas = await page.locator('#ray').boundingBox();
@@ -105,10 +106,10 @@ try {
     await page.mouse.up();
   };
   const counters = () => page.evaluate(() => ({ points: window.lidarshop.pointBytes(), pictures: window.lidarshop.pictureBytes() }));
-  const shownCurrent = () => page.evaluate(() => {
+  const shownCurrent = () => {
     const d = window.lidarshop.current();
-    return window.lidarshop.rayView.shownState().version === d.version && window.lidarshop.pointsShown().version === d.version;
-  });
+    return window.lidarshop.rayView.shownState().version === d.version; // points: awaited with settled() below
+  };
   const edits = [];
   const edit = async (what, action, done) => {
     await page.evaluate(() => window.lidarshop.settled());
