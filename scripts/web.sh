@@ -2,7 +2,7 @@
 # The editor's front end (web/): TypeScript built with Vite from npm packages pinned in web/package-lock.json.
 #   scripts/web.sh build   npm ci (when the lock file changed), type-check, build web/dist, copy it beside the
 #                          lidarshop executable (build/release/web) so `lidarshop serve` finds it
-#   scripts/web.sh test    unit tests (Vitest), then end to end in Debian's chromium (playwright-core) against
+#   scripts/web.sh test    lint (ESLint; Prettier's formatting), unit tests (Vitest), then end to end in Debian's chromium (playwright-core) against
 #                          build/release/lidarshop; screenshots in build/e2e/
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +21,7 @@ case ${1:-build} in
     echo "web: built web/dist -> build/release/web"
     ;;
   test)
+    (cd web && npm run --silent lint)
     (cd web && npx vitest run)
     (cd web && node e2e/editor.mjs ../build/release/lidarshop ../build/e2e "${@:2}")
     ;;

@@ -77,6 +77,15 @@ json_check "cube recolour: most returns coloured, gains of the faces used within
    all(abs(g / s['gain'] - 1) < 0.03 for p, s in zip(d['photos'], json.load(open('$work/cube_fine_scan.json'))['photos']) \
        for g in p['gain'] if g != 1.0)"
 check "the photo index mask is written" test -s "$work/cube_index.png"
+# Into an E57 the station's photos go on with the recoloured scan, bit for bit; another format says they go.
+check "recolor --from-e57-images into an E57" "$lidarshop" recolor "$work/cube_fine.e57" --from-e57-images \
+  -o "$work/cube_coloured.e57" --quiet
+check "images cube_coloured.e57" sh -c "'$lidarshop' images '$work/cube_coloured.e57' --extract '$work/carried' >'$work/carried.json'"
+check "images cube_fine.e57 (the input's)" sh -c "'$lidarshop' images '$work/cube_fine.e57' --extract '$work/given' >'$work/given.json'"
+json_check "the recoloured E57 keeps the six faces with their cameras, on scan 0" "$work/carried.json" \
+  "(lambda e: len(d['images']) == 6 and [i['camera'] for i in d['images']] == [i['camera'] for i in e['images']])(json.load(open('$work/given.json')))"
+check "the first face is carried bit for bit" sh -c "cmp \"\$(python3 -c \"import json; print(json.load(open('$work/carried.json'))['images'][0]['extracted'])\")\" \"\$(python3 -c \"import json; print(json.load(open('$work/given.json'))['images'][0]['extracted'])\")\""
+check "a recoloured PLY warns that the photos go" sh -c "'$lidarshop' recolor '$work/cube_fine.e57' --from-e57-images -o '$work/cube_coloured2.ply' 2>&1 | grep -q 'photo(s) are not carried on'"
 # The same faces given as separate photos with their cameras (--photo repeated): the same colouring.
 check "images --extract cube_fine.e57" sh -c "'$lidarshop' images '$work/cube_fine.e57' --extract '$work/faces' >'$work/faces.json'"
 python3 - "$work" <<'PY'

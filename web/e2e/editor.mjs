@@ -119,7 +119,7 @@ try {
     }
     await page.mouse.up();
   };
-  const [cr, cc] = car.center;
+  const [cr] = car.center;
   await page.click('#brush-object');
   await drag([[cr, Math.round(c0 + 0.25 * (c1 - c0))], [cr, Math.round(c0 + 0.75 * (c1 - c0))]]);
   await waitForStatus(/object stroke cells painted/, 'object stroke');

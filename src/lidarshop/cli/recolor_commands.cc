@@ -249,14 +249,24 @@ int RunRecolor(int argc, char** argv) {
               {.flags = {{"silhouette_margin_px", "--margin"}, {"depth_tolerance_m", "--depth-tolerance"}}});
   AddResectionOptions(app, binder, &resection, &intrinsics_path, "Resection (with --correspondences)");
   // Colouring from several photos at once, and what it writes (--from-e57-images, repeated --photo).
+  // `carried`: the input E57's images of this scan, written on with it when the output is an E57 (a station's
+  // photos belong with its scan; a recoloured E57 without them could not be coloured again).
   const auto colour_station = [&](const Scan& scan, const std::vector<CameraPhoto>& photos,
-                                  nlohmann::ordered_json used, const nlohmann::ordered_json& skipped) {
+                                  nlohmann::ordered_json used, const nlohmann::ordered_json& skipped,
+                                  const std::vector<E57Image>& carried) {
     PhotosRecolorOptions photo_options;
     photo_options.visibility = options;
     // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
     if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
     const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
-    WriteScanFile(output, {result.scan});
+    if (FileExtension(output) == "e57" && !carried.empty()) {
+      WriteE57(output, {result.scan}, carried, E57WriteOptions());
+    } else {
+      WriteScanFile(output, {result.scan});
+      if (!carried.empty())
+        PrintWarnings({fmt::format("{}: the station's {} photo(s) are not carried on (only E57 holds photos)",
+                                   output, carried.size())});
+    }
     if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
     nlohmann::ordered_json counts;
     counts["returns"] = result.returns;
@@ -318,7 +328,7 @@ int RunRecolor(int argc, char** argv) {
                 {{"index", i}, {"name", photo_paths[i]}, {"model", CameraModelName(photo.camera.model)}});
             photos.push_back(std::move(photo));
           }
-          return colour_station(scan, photos, used, nlohmann::ordered_json::array());
+          return colour_station(scan, photos, used, nlohmann::ordered_json::array(), {});
         }
         if (camera_paths.size() > 1) throw OptionsError("several --camera need as many --photo");
         if (!photo_index_mask_path.empty() && !from_e57_images)
@@ -337,8 +347,10 @@ int RunRecolor(int argc, char** argv) {
             CheckNotInput(photo_index_mask_path, {scan_path});
             CheckOutputPath(photo_index_mask_path, {scan_path, output});
           }
-          const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
-          const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
+          E57File file = ReadE57AndWarn(scan_path);  // once: a station can be hundreds of MB
+          if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size()))
+            throw OptionsError(fmt::format("{} {} is out of range: {} holds {} scan(s)", ScanIndexFlag(app),
+                                           scan_index, scan_path, file.scans.size()));
           const E57StationPhotos station = StationPhotosOfE57(file, scan_index);
           const std::vector<CameraPhoto>& photos = station.photos;
           nlohmann::ordered_json used = nlohmann::ordered_json::array(),
@@ -358,7 +370,16 @@ int RunRecolor(int argc, char** argv) {
                             fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "
                                         "`lidarshop images {}` lists them)",
                                         scan_index, file.images.size(), scan_path));
-          return colour_station(scan, photos, used, skipped);
+          // This scan's images (and those of no scan), belonging to scan 0 of the output.
+          std::vector<E57Image> carried;
+          for (E57Image& image : file.images) {
+            if (image.associated_scan != scan_index && image.associated_scan != -1) continue;
+            if (image.associated_scan == scan_index) image.associated_scan = 0;
+            carried.push_back(std::move(image));
+          }
+          const Scan scan = std::move(file.scans[scan_index]);
+          file = E57File();
+          return colour_station(scan, photos, used, skipped, carried);
         }
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");

@@ -2,16 +2,14 @@
 
 #include <algorithm>
 #include <array>
-#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>  // cross
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/pointset/normals.h"
-#include "lidarshop/pointset/planes.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -27,45 +25,9 @@ constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
 // cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
 constexpr double kFacingNormal = 0.906;
 
-// cos 8°: planes this parallel, within relief_m of each other, are one surface and its relief.
-constexpr double kParallelCos = 0.99;
-
-// cos 10°: a cell whose grid normal is within 10° of a plane's faces the plane's way.
-constexpr float kAgreeingNormal = 0.985f;
-
-// A plane holding this share of the band's cells (and 30) is kept when it is seen on both sides of the hole.
-constexpr double kSmallPlaneShare = 0.01;
-
-// A box of grid cells, [x0, x1) x [y0, y1).
-struct Rect2 {
-  int x0, y0, x1, y1;
-  void Add(int x, int y) {
-    x0 = std::min(x0, x);
-    y0 = std::min(y0, y);
-    x1 = std::max(x1, x + 1);
-    y1 = std::max(y1, y + 1);
-  }
-  // Reaches past `part` on two opposite sides: left and right of it, or above and below.
-  bool Spans(const Rect2& part) const {
-    return (x0 < part.x0 && x1 > part.x1) || (y0 < part.y0 && y1 > part.y1);
-  }
-};
-
-// The largest 8-connected part (on the grid of `size`) of the cells `subset` (indices into `cells`).
-std::vector<uint32_t> LargestConnectedPart(const std::vector<uint32_t>& subset,
-                                           const std::vector<cv::Point>& cells, cv::Size size) {
-  cv::Mat mask(size, CV_8U, cv::Scalar(0));
-  for (uint32_t i : subset) mask.at<uint8_t>(cells[i]) = 255;
-  cv::Mat ids, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, ids, stats, centroids, 8, CV_32S);
-  int best = 0;
-  for (int id = 1; id < count; ++id)
-    if (best == 0 || stats.at<int>(id, cv::CC_STAT_AREA) > stats.at<int>(best, cv::CC_STAT_AREA)) best = id;
-  std::vector<uint32_t> part;
-  for (uint32_t i : subset)
-    if (ids.at<int32_t>(cells[i]) == best) part.push_back(i);
-  return part;
-}
+// Two reliefs on one plane differ when they are this far apart (a window recess is 0.1-0.3 m deep; the
+// floating share counts points 0.1 m off the surface).
+constexpr double kReliefStepM = 0.05;
 
 enum class Meeting { kNone, kConcave, kConvex };
 
@@ -160,13 +122,124 @@ int SourcePlane(const PartPlanes& part, const KnownCells& known, const cv::Vec2i
   return best;
 }
 
+// The offset from plane `k` that the known cells around hole cell (y, x) agree on: the nearest known cells
+// outside the hole (`hole`, CV_8U) left and right of it, and above and below it, each pair counted when both
+// face the plane's way within relief_m of it and agree within `tolerance_m`. A recess's edge hidden by the
+// object and running up through the hole leaves the pair above and below on the cell's side of it (and the
+// pair left and right disagreeing); one running across, the pair left and right. True when one pair agrees,
+// or both agree with each other; `offset_m` receives their mean. A patch is matched on the range's gradients,
+// which are the same on a facade and on a window recess parallel to it: the relief a patch brings is a guess
+// that the cells around the hole can overrule.
+bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
+                    size_t k, double relief_m, double tolerance_m, double* offset_m) {
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
+  std::array<bool, 4> on{};
+  std::array<double, 4> offset{};
+  for (size_t s = 0; s < kSteps.size(); ++s) {
+    int yy = y, xx = x;
+    do {
+      yy += kSteps[s][0];
+      xx += kSteps[s][1];
+    } while (yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols && hole.at<uint8_t>(yy, xx));
+    Eigen::Vector3f normal;
+    if (!known.Usable(yy, xx) || !CellNormal(known, yy, xx, &normal)) continue;
+    if (std::abs(normal.cast<double>().dot(part.planes[k].normal)) < kFacingNormal) continue;
+    offset[s] = part.planes[k].SignedDistance(known.PointAt(yy, xx));
+    on[s] = std::abs(offset[s]) <= relief_m;
+  }
+  const bool row = on[0] && on[1] && std::abs(offset[0] - offset[1]) <= tolerance_m;
+  const bool column = on[2] && on[3] && std::abs(offset[2] - offset[3]) <= tolerance_m;
+  const double row_mean = 0.5 * (offset[0] + offset[1]), column_mean = 0.5 * (offset[2] + offset[3]);
+  if (row && column) {
+    if (std::abs(row_mean - column_mean) > tolerance_m)
+      return false;  // a hidden recess's corner: the patch's
+    *offset_m = 0.5 * (row_mean + column_mean);
+  } else if (row || column) {
+    *offset_m = row ? row_mean : column_mean;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// A hole cell in a narrow gap — at most kNarrowGapCells between the known cells left and right of it, or
+// above and below (a post's column, a leg) — whose two known cells lie on one plane at one relief: the plane
+// `*plane` and that relief `*offset_m`. Such a surface runs on behind a thin object; a patch copied from
+// another surface (a neighbour's side, whose plane the ray meets a little beyond the wall) has no say there.
+constexpr int kNarrowGapCells = 16;
+bool NarrowGapPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
+                    double relief_m, int* plane, double* offset_m) {
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
+  for (size_t pair = 0; pair < 2; ++pair) {
+    std::array<cv::Point, 2> end;
+    int gap = 1;
+    for (size_t side = 0; side < 2; ++side) {
+      const auto& step = kSteps[2 * pair + side];
+      int yy = y, xx = x;
+      do {
+        yy += step[0];
+        xx += step[1];
+        ++gap;
+      } while (gap <= kNarrowGapCells && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
+               hole.at<uint8_t>(yy, xx));
+      end[side] = cv::Point(xx, yy);
+    }
+    if (gap > kNarrowGapCells + 1) continue;
+    std::array<Eigen::Vector3f, 2> normal;
+    if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
+        !CellNormal(known, end[0].y, end[0].x, &normal[0]) ||
+        !CellNormal(known, end[1].y, end[1].x, &normal[1]))
+      continue;
+    int best = -1;
+    double best_offset = 0;
+    for (size_t k = 0; k < part.planes.size(); ++k) {
+      const SeenPlane& p = part.planes[k];
+      const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
+      const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
+      if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
+          std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
+          std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
+        continue;
+      if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
+        best = static_cast<int>(k);
+        best_offset = 0.5 * (a + b);
+      }
+    }
+    if (best >= 0) {
+      *plane = best;
+      *offset_m = best_offset;
+      return true;
+    }
+  }
+  return false;
+}
+
 // The range of a hole cell (ray `dir`, reconstructed range `r`, copied from `from`) on the planes of its
 // part; 0 = keep the reconstruction.
-double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Vec2i& from,
-                     const cv::Vec3f& dir, double r, double agreement_m, const FillPlaneOptions& options) {
+double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole,
+                     const cv::Point& cell, const cv::Vec2i& from, const cv::Vec3f& dir, double r,
+                     double agreement_m, const FillPlaneOptions& options) {
+  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  int gap_plane = -1;
+  double gap_offset = 0;
+  if (NarrowGapPlane(part, known, hole, cell.y, cell.x, options.relief_m, &gap_plane, &gap_offset)) {
+    const SeenPlane& p = part.planes[static_cast<size_t>(gap_plane)];
+    const double facing = p.normal.dot(ray);
+    if (std::abs(facing) >= 1e-6) {
+      const double along = (gap_offset - p.offset_m) / facing;
+      if (along > 0 && std::abs(along - r) <= options.tolerance * r) return along;
+    }
+  }
   double source_offset = 0;
   const int source_plane = SourcePlane(part, known, from, options.relief_m, &source_offset);
-  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  // The source's relief, unless the cells around the hole agree on another (a patch of a window recess
+  // copied onto the plain facade beside it, or of the facade into a recess).
+  double around = 0;
+  if (source_plane >= 0 &&
+      SurroundOffset(part, known, hole, cell.y, cell.x, static_cast<size_t>(source_plane), options.relief_m,
+                     kReliefStepM, &around) &&
+      std::abs(around - source_offset) > kReliefStepM)
+    source_offset = around;
   const size_t n = part.planes.size();
   // No allocation per cell: FillPlaneOptions::max_planes is at most kMaxPlanes (checked with the options).
   LIDARSHOP_CHECK(n <= kMaxPlanes);
@@ -230,143 +303,6 @@ bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) 
   return true;
 }
 
-std::vector<SeenPlane> BandPlanes(const KnownCells& known, const cv::Mat& part_id, int id,
-                                  const cv::Rect& box, int part_cells, const FillPlaneOptions& options,
-                                  uint64_t seed, double* threshold_m) {
-  int band = options.band_cells;
-  if (band <= 0) {
-    const double diameter = 2.0 * std::sqrt(part_cells / M_PI);
-    band = std::clamp(static_cast<int>(std::lround(diameter / 4.0)), 8, 80);
-  }
-  const cv::Rect roi = cv::Rect(box.x - band, box.y - band, box.width + 2 * band, box.height + 2 * band) &
-                       cv::Rect(0, 0, known.range.cols, known.range.rows);
-  // The part over the band's box only: a hole of many small parts must not cost the whole scan per part.
-  const cv::Mat part = part_id(roi) == id;
-  cv::Mat near_part;
-  cv::dilate(part, near_part, cv::getStructuringElement(cv::MORPH_ELLIPSE, {2 * band + 1, 2 * band + 1}));
-  near_part &= known.valid(roi);
-  std::vector<cv::Point> cells;
-  cv::findNonZero(near_part, cells);
-  // Distance of every band cell from the part: a plane seen only on the hole's rim is what the cut left of
-  // the object itself (its face, missed by a cell or two), not a surface that runs on behind it.
-  cv::Mat from_part;
-  cv::distanceTransform(part == 0, from_part, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  if (cells.size() < 50) return {};
-  // Grid normals of the band (a view of the known cells only), to tell a plane the cells lie on from one that
-  // only runs through them (the plane through the nosings of a flight of steps).
-  Scan band_view;
-  band_view.rows = roi.height;
-  band_view.cols = roi.width;
-  band_view.valid = known.valid(roi);
-  band_view.point = cv::Mat(roi.size(), CV_32FC3, cv::Scalar::all(0));
-  for (int y = 0; y < roi.height; ++y) {
-    for (int x = 0; x < roi.width; ++x) {
-      if (!band_view.valid.at<uint8_t>(y, x)) continue;
-      const Eigen::Vector3f p = known.PointAt(y + roi.y, x + roi.x);
-      band_view.point.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
-    }
-  }
-  NormalOptions normal_options;
-  normal_options.window_cells = 2;
-  const cv::Mat normal = EstimateGridNormals(band_view, normal_options).normal;
-  PointCloud cloud;
-  std::vector<float> ranges;
-  cloud.points.reserve(cells.size());
-  ranges.reserve(cells.size());
-  for (const cv::Point& c : cells) {
-    cloud.points.push_back(known.PointAt(c.y + roi.y, c.x + roi.x));
-    ranges.push_back(known.range.at<float>(c.y + roi.y, c.x + roi.x));
-  }
-  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-  *threshold_m = options.inlier_m + options.inlier_per_m * ranges[ranges.size() / 2];
-
-  RansacPlaneOptions ransac;
-  ransac.distance_threshold_m = *threshold_m;
-  ransac.max_planes = 1;
-  ransac.min_inliers = 3;
-  // A plane holding min_share of the band is kept; a smaller one (a kerb's face, a stair riser: 10–20 rows)
-  // only when it continues past the hole, seen on both of its sides.
-  const size_t large = static_cast<size_t>(
-      std::max(50, static_cast<int>(options.min_share * static_cast<double>(cells.size()))));
-  const size_t small = static_cast<size_t>(
-      std::max(30, static_cast<int>(kSmallPlaneShare * static_cast<double>(cells.size()))));
-  const Rect2 part_box{box.x - roi.x, box.y - roi.y, box.x - roi.x + box.width, box.y - roi.y + box.height};
-  std::vector<uint32_t> remaining(cells.size());
-  for (size_t i = 0; i < cells.size(); ++i) remaining[i] = static_cast<uint32_t>(i);
-  std::vector<SeenPlane> planes;
-  const int attempts = 2 * options.max_planes;
-  for (int attempt = 0; attempt < attempts && static_cast<int>(planes.size()) < options.max_planes;
-       ++attempt) {
-    if (remaining.size() < small) break;
-    PointCloud rest;
-    rest.points.reserve(remaining.size());
-    for (uint32_t i : remaining) rest.points.push_back(cloud.points[i]);
-    ransac.seed = seed + static_cast<uint64_t>(attempt);
-    const PlaneFit hypothesis = FitPlaneRansac(rest, ransac);
-    if (hypothesis.inliers.size() < small) break;
-    // RANSAC's plane may run through two parallel surfaces at once (the road and the pavement behind a kerb,
-    // 2° apart, both within the inlier distance somewhere): refit it to the largest grid-connected part of its
-    // inliers, then take every remaining cell within the distance of the refitted plane.
-    std::vector<uint32_t> inliers;
-    for (uint32_t i : hypothesis.inliers) inliers.push_back(remaining[i]);
-    PlaneFit fit = hypothesis;
-    fit.inliers = LargestConnectedPart(inliers, cells, roi.size());
-    if (fit.inliers.size() >= 3) RefitPlane(cloud.points, &fit);
-    std::vector<uint32_t> kept;
-    // Twice: the part's plane gathers the surface's cells beyond the part (the face on the hole's other
-    // side), and the plane refitted to all of them is the least-squares plane of the whole surface.
-    for (int pass = 0; pass < 2; ++pass) {
-      kept.clear();
-      inliers.clear();
-      for (uint32_t i : remaining)
-        (std::abs(fit.Distance(cloud.points[i])) <= *threshold_m ? inliers : kept).push_back(i);
-      if (pass == 0 && inliers.size() >= 3) {
-        fit.inliers = inliers;
-        RefitPlane(cloud.points, &fit);
-      }
-    }
-    if (inliers.size() < small) {
-      // The refit lost its support: drop what RANSAC found and go on.
-      for (uint32_t i : hypothesis.inliers) remaining[i] = UINT32_MAX;
-      std::erase(remaining, UINT32_MAX);
-      continue;
-    }
-    remaining = std::move(kept);
-    SeenPlane plane;
-    plane.normal = fit.normal;
-    plane.offset_m = fit.offset_m;
-    if (std::abs(plane.offset_m) < 1e-6) continue;  // a plane through the scanner is seen edge-on
-    if (plane.offset_m < 0) {
-      plane.normal = -plane.normal;
-      plane.offset_m = -plane.offset_m;
-    }
-    plane.seen.reserve(inliers.size());
-    const cv::Vec3f plane_normal(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
-                                 static_cast<float>(plane.normal.z()));
-    size_t outer = 0;
-    Rect2 seen_box{INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN};
-    for (uint32_t i : inliers) {
-      if (std::abs(normal.at<cv::Vec3f>(cells[i]).dot(plane_normal)) < kAgreeingNormal) continue;
-      plane.seen.push_back(cloud.points[i]);
-      outer += from_part.at<float>(cells[i]) > 0.5f * band;
-      seen_box.Add(cells[i].x, cells[i].y);
-    }
-    if (2 * plane.seen.size() < inliers.size()) continue;  // most cells face elsewhere: not a surface
-    if (4 * outer < plane.seen.size()) continue;           // only on the rim
-    if (plane.seen.size() < large && !seen_box.Spans(part_box)) continue;  // small, and not past the hole
-    // A facade's window panes are a plane of their own a little behind it; they are the facade's relief (a
-    // copied pane lands at its offset from the facade), not a surface a cell copied from no plane may snap to.
-    const bool relief_of_earlier = std::any_of(planes.begin(), planes.end(), [&](const SeenPlane& earlier) {
-      return std::abs(plane.normal.z()) < kUprightNormalZ &&
-             earlier.normal.dot(plane.normal) > kParallelCos &&
-             std::abs(earlier.offset_m - plane.offset_m) <= options.relief_m;
-    });
-    if (relief_of_earlier) continue;
-    planes.push_back(std::move(plane));
-  }
-  return planes;
-}
-
 int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv::Mat& direction,
                      const cv::Mat& hole, const cv::Mat& has_return, const cv::Mat& source,
                      const FillPlaneOptions& options, uint64_t seed, cv::Mat* hole_range) {
@@ -392,7 +328,7 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
         const double travelled_m = to_border.at<float>(y, x) * part.spacing_rad * r;
         const cv::Vec2i from = source.empty() ? cv::Vec2i(-1, -1) : source.at<cv::Vec2i>(y, x);
         const double placed =
-            RangeOnPlanes(part, known, from, direction.at<cv::Vec3f>(y, x), r,
+            RangeOnPlanes(part, known, hole, cv::Point(x, y), from, direction.at<cv::Vec3f>(y, x), r,
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
         if (placed <= 0) continue;
         r = static_cast<float>(placed);

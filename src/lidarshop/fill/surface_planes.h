@@ -4,14 +4,19 @@
 // the ground come out right near the hole's border, but the hidden wall–ground crease ends up tens of
 // centimetres off, and the points there float. Built surroundings are mostly planes, and the planes seen
 // around the hole continue behind the object. So, after the Poisson step, each filled cell is moved onto one:
-//   1. planes are found by sequential RANSAC among the known cells in a band around each connected part of
-//      the hole (pointset/planes.h), kept when most of their inliers' grid normals agree with them (not the
-//      plane through a staircase's nosings) and a quarter of them lie in the band's outer half (not what the
-//      cut left of the object itself on the hole's rim);
+//   1. planes are found one after another among the known cells in a band around each connected part of
+//      the hole by a RANSAC that counts only cells facing the plane's way (their grid normals; not the plane
+//      through a staircase's nosings), refitted to the largest grid-connected part of those cells and then to
+//      every band cell on it that faces its way, kept when a quarter of them lie in the band's outer half (not
+//      what the cut left of the object itself on the hole's rim) and, below min_share of the band, when they
+//      reach past the hole on two opposite sides (a kerb's face);
 //   2. a cell's candidates are the planes whose intersection with its ray lies within `tolerance` × the
 //      reconstructed range; with none, the cell keeps the reconstructed range;
-//   3. the cell goes onto the plane its patch source lies on (facing its way, within `relief_m`), at the
-//      source's signed distance from it — relief is copied, not flattened (a window recess stays a recess);
+//   3. a cell in a narrow gap (a post's column) between two known cells on one plane at one relief goes onto
+//      that plane at that relief; otherwise the cell goes onto the plane its patch source lies on (facing its
+//      way, within `relief_m`), at the source's signed distance from it — relief is copied, not flattened (a
+//      window recess stays a recess) — unless the known cells left and right of it, or above and below, agree
+//      on another relief on that plane (patches are matched on range gradients, blind to a recess's depth);
 //      a cell copied from no plane goes onto the nearest candidate only when the reconstruction agrees with it
 //      (`agreement_m`, growing with the distance from the hole's border);
 //   4. then the order the surroundings show: two planes whose seen parts each lie in front of the other meet

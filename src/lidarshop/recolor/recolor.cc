@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/distance_raster.h"
 #include "lidarshop/recolor/silhouette_skirt.h"
 #include "lidarshop/recolor/visibility.h"
 #include "lidarshop/scanner/scan_mesh.h"
@@ -52,50 +53,6 @@ namespace {
 // Distance from the camera centre to the first surface of `scene` through each z-buffer pixel (+inf: none);
 // `back_facing` (CV_8U) marks pixels whose first surface turns its back to the camera (the scan mesh faces
 // the scanner: the camera then sees the side of that surface the scanner did not see).
-cv::Mat DistanceBuffer(const RaycastScene& scene, const Camera& camera, double scale, cv::Mat* back_facing) {
-  const int rows = std::max(1, static_cast<int>(std::lround(camera.height_px() * scale)));
-  const int cols = std::max(1, static_cast<int>(std::lround(camera.width_px() * scale)));
-  const double sy = static_cast<double>(camera.height_px()) / rows,
-               sx = static_cast<double>(camera.width_px()) / cols;
-  cv::Mat distance(rows, cols, CV_32F);
-  back_facing->create(rows, cols, CV_8U);
-  const Eigen::Matrix3f rotation = camera.world_from_camera.topLeftCorner<3, 3>().cast<float>();
-  constexpr int kStrip = 128;  // rows per cast: bounded memory for 3072 x 2304 photos
-  RayHitImages hits;
-  for (int row0 = 0; row0 < rows; row0 += kStrip) {
-    const int strip_rows = std::min(kStrip, rows - row0);
-    cv::Mat directions(strip_rows, cols, CV_32FC3);
-    ParallelFor(strip_rows, [&](int64_t r) {
-      for (int c = 0; c < cols; ++c) {
-        const Eigen::Vector2d pixel((c + 0.5) * sx, (row0 + r + 0.5) * sy);
-        // Pinhole rays keep z = 1 (as always); other models' are unit, zero where a pixel has no ray.
-        Eigen::Vector3d ray = Eigen::Vector3d::Zero();
-        if (camera.model == CameraModel::kPinhole) {
-          ray = UnprojectPixel(camera.pinhole, pixel);
-        } else if (!UnprojectPixel(camera, pixel, &ray)) {
-          ray.setZero();
-        }
-        directions.at<cv::Vec3f>(static_cast<int>(r), c) = cv::Vec3f(ray.x(), ray.y(), ray.z());
-      }
-    });
-    scene.CastImage(camera.world_from_camera, directions, 0.0f, std::numeric_limits<float>::infinity(),
-                    CastMethod::kPacket16, &hits);
-    for (int r = 0; r < strip_rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
-        const cv::Vec3f d = directions.at<cv::Vec3f>(r, c);
-        distance.at<float>(row0 + r, c) = d == cv::Vec3f() ? std::numeric_limits<float>::infinity()
-                                                           : hits.t_hit.at<float>(r, c) * std::sqrt(d.dot(d));
-        const cv::Vec3f n = hits.normal.at<cv::Vec3f>(r, c);
-        const Eigen::Vector3f w = rotation * Eigen::Vector3f(d[0], d[1], d[2]);
-        // Skirts (geometry 1) are no surface of the scan: only the scan mesh's own back faces count.
-        back_facing->at<uint8_t>(row0 + r, c) =
-            hits.geometry_id.at<int32_t>(r, c) == 0 && w.dot(Eigen::Vector3f(n[0], n[1], n[2])) > 0 ? 255 : 0;
-      }
-    }
-  }
-  return distance;
-}
-
 // |difference| of two distances, +inf when either is infinite.
 float Step(float a, float b) { return std::isfinite(a) && std::isfinite(b) ? std::abs(a - b) : INFINITY; }
 
@@ -171,22 +128,28 @@ cv::Vec3b SampleAgreeing(const cv::Mat& photo, const cv::Mat& distance_buffer, d
 
 namespace recolor_internal {
 
-void BuildOcclusionScene(const Scan& scan, const RecolorOptions& options, RaycastScene* scene) {
+OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& options) {
+  OcclusionScene scene;
   ScanMeshOptions mesh_options;
   mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
   mesh_options.world_frame = true;
-  scene->AddMesh(ScanToMesh(scan, mesh_options), 0);
+  scene.mesh = ScanToMesh(scan, mesh_options);
   if (options.silhouette_skirts) {
     SilhouetteSkirtOptions skirt_options;
     skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
     skirt_options.depth_m = options.skirt_depth_m;
-    const TriangleMesh skirts = SilhouetteSkirts(scan, skirt_options);
-    if (!skirts.empty()) scene->AddMesh(skirts, 1);
+    scene.skirts = SilhouetteSkirts(scan, skirt_options);
   }
-  scene->Commit();
+  if (options.visibility == VisibilityMethod::kSegment) {
+    scene.segments = std::make_unique<RaycastScene>();
+    if (!scene.mesh.empty()) scene.segments->AddMesh(scene.mesh, 0);
+    if (!scene.skirts.empty()) scene.segments->AddMesh(scene.skirts, 1);
+    scene.segments->Commit();
+  }
+  return scene;
 }
 
-Visibility VisibleCells(const Scan& scan, const RaycastScene& scene, const Camera& camera,
+Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Camera& camera,
                         const RecolorOptions& options) {
   Visibility visibility;
   const Eigen::Vector3d center = camera.center_in_world();
@@ -245,10 +208,12 @@ Visibility VisibleCells(const Scan& scan, const RaycastScene& scene, const Camer
       rays[i].direction = segment.cast<float>();
       rays[i].t_far = static_cast<float>(std::max(0.0, 1.0 - tolerance(distance) / distance));
     }
-    scene.Occluded(rays, hidden);
+    scene.segments->Occluded(rays, hidden);
   } else {
-    cv::Mat back_facing;
-    const cv::Mat distance_buffer = DistanceBuffer(scene, camera, options.zbuffer_scale, &back_facing);
+    const DistanceBuffer buffer =
+        RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale);
+    const cv::Mat& distance_buffer = buffer.distance;
+    const cv::Mat& back_facing = buffer.back_facing;
     cv::Mat nearest = distance_buffer;
     const int m = options.silhouette_margin_px;
     if (m > 0) cv::erode(distance_buffer, nearest, cv::Mat::ones(2 * m + 1, 2 * m + 1, CV_8U));
@@ -333,10 +298,9 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
   result.uncertain_mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
 
   const Camera model = CameraFromPinhole(camera);
-  RaycastScene raycast;
-  recolor_internal::BuildOcclusionScene(scan, options, &raycast);
+  const recolor_internal::OcclusionScene occlusion = recolor_internal::BuildOcclusionScene(scan, options);
   const recolor_internal::Visibility visibility =
-      recolor_internal::VisibleCells(scan, raycast, model, options);
+      recolor_internal::VisibleCells(scan, occlusion, model, options);
   result.returns = visibility.returns;
   result.outside_image = visibility.outside_image;
   result.hidden = visibility.hidden;

@@ -82,12 +82,12 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
           fmt::format("expected an 8-bit RGB image of {} x {} pixels, got {} x {}",
                       photos[i].camera.width_px(), photos[i].camera.height_px(), image.cols, image.rows));
   }
-  RaycastScene scene;
   const auto start = std::chrono::steady_clock::now();
   const auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
-  recolor_internal::BuildOcclusionScene(scan, options.visibility, &scene);
+  const recolor_internal::OcclusionScene scene =
+      recolor_internal::BuildOcclusionScene(scan, options.visibility);
   const double scene_seconds = since(start);
   const int64_t cells = static_cast<int64_t>(scan.rows) * scan.cols;
   const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();

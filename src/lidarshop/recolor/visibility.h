@@ -5,20 +5,29 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera_model.h"
+#include "lidarshop/geometry/mesh.h"
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop::recolor_internal {
 
-// The scan mesh (geometry 0) and its silhouette skirts (geometry 1), world frame, committed.
-void BuildOcclusionScene(const Scan& scan, const RecolorOptions& options, RaycastScene* scene);
+// The scan mesh and its silhouette skirts, world frame. Z-buffer visibility rasterizes them into each
+// camera's buffer (recolor/distance_raster.h); segment visibility casts into `segments`, an Embree scene of
+// both (mesh geometry 0, skirts 1), built only for that method.
+struct OcclusionScene {
+  TriangleMesh mesh;
+  TriangleMesh skirts;
+  std::unique_ptr<RaycastScene> segments;
+};
+OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& options);
 
 struct SeenCell {
   int64_t cell = 0;       // row * cols + col
@@ -42,7 +51,7 @@ struct Visibility {
   Eigen::Vector2d buffer_per_photo_px = Eigen::Vector2d::Ones();
 };
 
-Visibility VisibleCells(const Scan& scan, const RaycastScene& scene, const Camera& camera,
+Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Camera& camera,
                         const RecolorOptions& options);
 
 }  // namespace lidarshop::recolor_internal

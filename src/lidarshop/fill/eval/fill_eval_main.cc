@@ -160,7 +160,7 @@ void WritePictures(const std::string& dir, const std::string& stem, const Scan& 
 // scan's points and triangles) per seed and their distribution; pictures of the worst seeds in `pictures_dir`.
 int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
               const FillOptions& base, int margin, const std::string& pictures_dir,
-              const std::string& markdown_path) {
+              const std::string& markdown_path, const std::string& dump_dir) {
   test_scenes::EvalReport report;
   auto emit = [&](const std::string& text) { report.Emit(text); };
   emit(fmt::format(
@@ -196,6 +196,15 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
     const std::string kind = run(seed, &results, &with_object, &truth, &hole, &distance);
     const FillMetrics g = MeasureFill(results.at("gradient").scan, truth, hole);
     const FillMetrics l = MeasureFill(results.at("laplace").scan, truth, hole);
+    if (!dump_dir.empty()) {
+      const std::string stem = fmt::format("{}/random_{}", dump_dir, seed);
+      std::filesystem::create_directories(dump_dir);
+      WriteScanFile(stem + "_scan.ply", {with_object});
+      WriteScanFile(stem + "_truth.ply", {truth});
+      WriteImage(stem + "_hole.png", hole);
+      WriteScanFile(stem + "_gradient.ply", {results.at("gradient").scan});
+      WriteImage(stem + "_gradient_floating.png", g.floating_cells);
+    }
     const double s = results.at("gradient").timings.total_s;
     seconds += s;
     gradient_rmse.push_back(g.range_rmse_mm);
@@ -326,7 +335,7 @@ int main(int argc, char** argv) {
   std::string dump_dir;
   app.add_option("--dump", dump_dir,
                  "write each scene's scan, truth and hole, and per method the first seed's fill and its "
-                 "floating cells, here (PLY, PNG)");
+                 "floating cells, here (PLY, PNG; random scenes: every seed's gradient fill)");
   std::string options_path;
   app.add_option(
          "--options", options_path,
@@ -350,7 +359,7 @@ int main(int argc, char** argv) {
       const std::vector<uint64_t> seeds = test_scenes::ParseSeedRange(random_seeds);
       scene_options.Check();
       if (!pictures_dir.empty()) std::filesystem::create_directories(pictures_dir);
-      return RunRandom(seeds, scene_options, base, margin, pictures_dir, markdown_path);
+      return RunRandom(seeds, scene_options, base, margin, pictures_dir, markdown_path, dump_dir);
     }
   } catch (const std::exception& error) {
     fmt::print(stderr, "fill_eval: {}\n", error.what());
