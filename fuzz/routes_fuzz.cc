@@ -3,6 +3,7 @@
 // the rest is the JSON body (or, for the GET routes, a query value) — waits for the job it started, closes the
 // document, and checks that the server answered without a 500 and still answers. A crash, a sanitizer report or
 // a 500 (trap) is a finding. One document per input keeps each input's outcome its own.
+#include <cctype>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -79,6 +80,22 @@ constexpr const char* kGetRoutes[] = {"points?since=",
                                       "mask.png?style=overlay&crop=1&layer=",
                                       "save-plan?format="};
 
+// `text` percent-encoded for a query value.
+std::string Percent(const std::string& text) {
+  static const char* hex = "0123456789ABCDEF";
+  std::string out;
+  for (const unsigned char c : text) {
+    if (std::isalnum(c) || c == '-' || c == '_' || c == '.' || c == '~') {
+      out += static_cast<char>(c);
+    } else {
+      out += '%';
+      out += hex[c >> 4];
+      out += hex[c & 15];
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -94,14 +111,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string body(reinterpret_cast<const char*>(data) + 1, size - 1);
   constexpr size_t kPosts = std::size(kPostRoutes), kGets = std::size(kGetRoutes);
   const size_t pick = data[0] % (kPosts + kGets + 1);
-  httplib::Result answer;
-  if (pick < kPosts) {
-    answer = client.Post(Api(doc + kPostRoutes[pick]), body, "application/json");
-  } else if (pick < kPosts + kGets) {
-    answer = client.Get(Api(doc + kGetRoutes[pick - kPosts] + httplib::detail::encode_url(body)));
-  } else {
-    answer = client.Post(Api("/api/models"), body, "application/json");
-  }
+  const auto send = [&]() -> httplib::Result {
+    if (pick < kPosts) return client.Post(Api(doc + kPostRoutes[pick]), body, "application/json");
+    if (pick < kPosts + kGets) return client.Get(Api(doc + kGetRoutes[pick - kPosts] + Percent(body)));
+    return client.Post(Api("/api/models"), body, "application/json");
+  };
+  const httplib::Result answer = send();
   Check(answer);
   if (answer->status == 202) {  // a job: wait for it, so that it ends with its input
     const auto job = nlohmann::json::parse(answer->body, nullptr, false);

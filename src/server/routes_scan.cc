@@ -621,6 +621,7 @@ void AddScanRoutes(State& state) {
           if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
           // Cropped: only the box of the painted cells is drawn (a large scan's overlay is mostly clear).
           const cv::Rect box = crop ? cv::boundingRect(strokes) : cv::Rect(0, 0, strokes.cols, strokes.rows);
+          if (box.empty()) return SendOverlay(response, cv::Mat(), &box, strokes.size());
           const cv::Mat part = strokes(box);
           cv::Mat overlay(part.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
           overlay.setTo(cv::Scalar(60, 220, 60, 210), part == 1);
@@ -633,6 +634,7 @@ void AddScanRoutes(State& state) {
         if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
         // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
         const cv::Rect box = crop ? cv::boundingRect(mask) : cv::Rect(0, 0, mask.cols, mask.rows);
+        if (box.empty()) return SendOverlay(response, cv::Mat(), &box, mask.size());
         cv::Mat overlay(box.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
         overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
         SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());

@@ -19,9 +19,13 @@ const option = (name, fallback) => {
   const i = args.indexOf(name);
   return i >= 0 ? args[i + 1] : fallback;
 };
-const [binary, artefacts = join(tmpdir(), 'lidarshop-e2e-station')] = args.filter((a, i) => !a.startsWith('--') && !args[i - 1]?.startsWith('--'));
-if (!binary) throw new Error('usage: node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C]');
-const rows = Number(option('--rows', 2250)), columns = Number(option('--columns', 3600));
+const [binary, artefacts = join(tmpdir(), 'lidarshop-e2e-station')] = args.filter(
+  (a, i) => !a.startsWith('--') && !args[i - 1]?.startsWith('--'),
+);
+if (!binary)
+  throw new Error('usage: node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C]');
+const rows = Number(option('--rows', 2250)),
+  columns = Number(option('--columns', 3600));
 mkdirSync(artefacts, { recursive: true });
 const root = mkdtempSync(join(tmpdir(), 'lidarshop-e2e-station-'));
 
@@ -43,13 +47,27 @@ async function waitForFunction(page, fn, arg, { timeout = 60000 } = {}) {
 
 const started = Date.now();
 const station = join(root, 'station.e57');
-execFileSync(binary, ['scan', 'parking_lot', '--rows', String(rows), '--columns', String(columns), '-o', station, '--quiet']);
+execFileSync(binary, [
+  'scan',
+  'parking_lot',
+  '--rows',
+  String(rows),
+  '--columns',
+  String(columns),
+  '-o',
+  station,
+  '--quiet',
+]);
 const scanSeconds = (Date.now() - started) / 1000;
 
 // The server opens the station at start (`serve FILE`), as a user opening a scan given on the command line.
-const server = spawn(binary, ['serve', station, '--port', '0', '--web', join(here, '../dist'), '--root', root], {
-  stdio: ['ignore', 'pipe', 'inherit'],
-});
+const server = spawn(
+  binary,
+  ['serve', station, '--port', '0', '--web', join(here, '../dist'), '--root', root],
+  {
+    stdio: ['ignore', 'pipe', 'inherit'],
+  },
+);
 const url = await new Promise((resolve, reject) => {
   let output = '';
   server.stdout.on('data', (chunk) => {
@@ -62,8 +80,17 @@ const url = await new Promise((resolve, reject) => {
 });
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-         '--disable-component-update', '--disable-sync', '--use-gl=swiftshader', '--enable-unsafe-swiftshader'],
+  args: [
+    '--no-sandbox',
+    '--disable-gpu',
+    '--disable-quic',
+    '--no-first-run',
+    '--disable-background-networking',
+    '--disable-component-update',
+    '--disable-sync',
+    '--use-gl=swiftshader',
+    '--enable-unsafe-swiftshader',
+  ],
 });
 const result = { rows, columns, scan_seconds: scanSeconds };
 try {
@@ -84,17 +111,25 @@ try {
   result.returns = doc.valid_cells;
   await page.screenshot({ path: join(artefacts, 'station_opened.png') });
   // The refinement to the finer level (the 3-D view's; it does not hold up the ray image).
-  await waitForFunction(page, () => window.lidarshop.pointLevel() === Math.max(1, Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / 4e6))),
-    null, { timeout: 240000 });
+  await waitForFunction(
+    page,
+    () =>
+      window.lidarshop.pointLevel() ===
+      Math.max(1, Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / 4e6))),
+    null,
+    { timeout: 240000 },
+  );
   await page.evaluate(() => window.lidarshop.settled());
   result.refined_points_s = (Date.now() - opened) / 1000;
   result.refined_level = await page.evaluate(() => window.lidarshop.pointLevel());
   result.open_bytes = apiBytes;
   console.log(`e2e station: opened: ${JSON.stringify(result)}`);
-  if (result.first_level < 2) fail(`a ${doc.valid_cells}-return station was first downloaded at level ${result.first_level}`);
+  if (result.first_level < 2)
+    fail(`a ${doc.valid_cells}-return station was first downloaded at level ${result.first_level}`);
 
   const canvas = await page.locator('#ray').boundingBox();
-  const screen = (row, col) => page.evaluate(([r, c]) => window.lidarshop.rayView.screenOf({ row: r, col: c }), [row, col]);
+  const screen = (row, col) =>
+    page.evaluate(([r, c]) => window.lidarshop.rayView.screenOf({ row: r, col: c }), [row, col]);
   const drag = async (cells) => {
     const first = await screen(...cells[0]);
     await page.mouse.move(canvas.x + first.x, canvas.y + first.y);
@@ -105,7 +140,11 @@ try {
     }
     await page.mouse.up();
   };
-  const counters = () => page.evaluate(() => ({ points: window.lidarshop.pointBytes(), pictures: window.lidarshop.pictureBytes() }));
+  const counters = () =>
+    page.evaluate(() => ({
+      points: window.lidarshop.pointBytes(),
+      pictures: window.lidarshop.pictureBytes(),
+    }));
   const shownCurrent = () => {
     const d = window.lidarshop.current();
     return window.lidarshop.rayView.shownState().version === d.version; // points: awaited with settled() below
@@ -125,42 +164,86 @@ try {
     await page.evaluate(() => window.lidarshop.settled());
     await new Promise((resolve) => setTimeout(resolve, 300)); // the last answers' sizes
     const after = await counters();
-    edits.push({ what, seconds, points: after.points - before.points, pictures: after.pictures - before.pictures, all: apiBytes - allBefore });
+    edits.push({
+      what,
+      seconds,
+      points: after.points - before.points,
+      pictures: after.pictures - before.pictures,
+      all: apiBytes - allBefore,
+    });
   };
-  const newerThan = (version) => waitForFunction(page, (v) => window.lidarshop.current().version > v, version, { timeout: 120000 });
-  const pictureMismatch = () => page.evaluate(async () => {
-    const d = window.lidarshop.current();
-    const channel = document.getElementById('channel').value;
-    const held = window.lidarshop.pictures.heldPicture(d.id, channel);
-    if (!held) return 'no picture held';
-    const bitmap = await createImageBitmap(await (await fetch(`/api/docs/${d.id}/image.png?channel=${channel}&v=${held.version}`)).blob());
-    const canvas = document.createElement('canvas');
-    [canvas.width, canvas.height] = [bitmap.width, bitmap.height];
-    const context = canvas.getContext('2d');
-    context.drawImage(bitmap, 0, 0);
-    const whole = context.getImageData(0, 0, bitmap.width, bitmap.height).data;
-    const patched = held.canvas.getContext('2d').getImageData(0, 0, held.canvas.width, held.canvas.height).data;
-    if (whole.length !== patched.length) return `sizes differ: ${whole.length} and ${patched.length}`;
-    let differ = 0;
-    for (let i = 0; i < whole.length; ++i) if (whole[i] !== patched[i]) ++differ;
-    return differ === 0 ? '' : `${differ} of ${whole.length} bytes differ`;
-  });
+  const newerThan = (version) =>
+    waitForFunction(page, (v) => window.lidarshop.current().version > v, version, { timeout: 120000 });
+  const pictureMismatch = () =>
+    page.evaluate(async () => {
+      const d = window.lidarshop.current();
+      const channel = document.getElementById('channel').value;
+      const held = window.lidarshop.pictures.heldPicture(d.id, channel);
+      if (!held) return 'no picture held';
+      const bitmap = await createImageBitmap(
+        await (await fetch(`/api/docs/${d.id}/image.png?channel=${channel}&v=${held.version}`)).blob(),
+      );
+      const canvas = document.createElement('canvas');
+      [canvas.width, canvas.height] = [bitmap.width, bitmap.height];
+      const context = canvas.getContext('2d');
+      context.drawImage(bitmap, 0, 0);
+      const whole = context.getImageData(0, 0, bitmap.width, bitmap.height).data;
+      const patched = held.canvas
+        .getContext('2d')
+        .getImageData(0, 0, held.canvas.width, held.canvas.height).data;
+      if (whole.length !== patched.length) return `sizes differ: ${whole.length} and ${patched.length}`;
+      let differ = 0;
+      for (let i = 0; i < whole.length; ++i) if (whole[i] !== patched[i]) ++differ;
+      return differ === 0 ? '' : `${differ} of ${whole.length} bytes differ`;
+    });
 
   // A stroke across the ground before the scanner (the lower rows), its undo and redo.
-  const r = Math.round(doc.rows * 0.8), c0 = Math.round(doc.cols * 0.45), c1 = Math.round(doc.cols * 0.55);
+  const r = Math.round(doc.rows * 0.8),
+    c0 = Math.round(doc.cols * 0.45),
+    c1 = Math.round(doc.cols * 0.55);
   await page.click('#brush-object');
-  await edit('stroke', () => drag([[r, c0], [r, c1]]), newerThan);
+  await edit(
+    'stroke',
+    () =>
+      drag([
+        [r, c0],
+        [r, c1],
+      ]),
+    newerThan,
+  );
   await edit('undo stroke', () => page.keyboard.press('Control+z'), newerThan);
   await edit('redo stroke', () => page.keyboard.press('Control+y'), newerThan);
   // A painted hole on the ground, filled (the points there move), then undone.
-  const h = Math.round(doc.rows * 0.03), w = Math.round(doc.cols * 0.02);
+  const h = Math.round(doc.rows * 0.03),
+    w = Math.round(doc.cols * 0.02);
   await page.click('#brush-lasso');
-  await edit('lasso', () => drag([[r - h, c0], [r - h, c0 + w], [r + h, c0 + w], [r + h, c0], [r - h, c0]]), newerThan);
+  await edit(
+    'lasso',
+    () =>
+      drag([
+        [r - h, c0],
+        [r - h, c0 + w],
+        [r + h, c0 + w],
+        [r + h, c0],
+        [r - h, c0],
+      ]),
+    newerThan,
+  );
   const fillStart = (await page.evaluate(() => window.lidarshop.current())).version;
-  await edit('fill hole', () => page.click('#fill-hole'), () => waitForFunction(page, (v) => {
-    const d = window.lidarshop.current();
-    return d.version > v && d.synthesized_cells > 0;
-  }, fillStart, { timeout: 300000 }));
+  await edit(
+    'fill hole',
+    () => page.click('#fill-hole'),
+    () =>
+      waitForFunction(
+        page,
+        (v) => {
+          const d = window.lidarshop.current();
+          return d.version > v && d.synthesized_cells > 0;
+        },
+        fillStart,
+        { timeout: 300000 },
+      ),
+  );
   const filled = await page.evaluate(() => window.lidarshop.current());
   if (filled.synthesized_cells === 0) fail('the fill synthesized nothing');
   const afterFill = await pictureMismatch();
@@ -174,11 +257,14 @@ try {
   result.edits = edits;
   result.whole_points_bytes = wholePoints;
   for (const e of edits) {
-    if (e.points >= wholePoints / 10) fail(`${e.what} moved ${e.points} B of points (the whole points are ${wholePoints} B)`);
+    if (e.points >= wholePoints / 10)
+      fail(`${e.what} moved ${e.points} B of points (the whole points are ${wholePoints} B)`);
     if (e.pictures >= 1_000_000) fail(`${e.what} moved ${e.pictures} B of pictures`);
   }
   console.log(`e2e station: ${JSON.stringify(result)}`);
-  console.log(`e2e station: passed (${doc.valid_cells} returns; first picture ${result.first_picture_s} s; bytes per edit ${edits.map((e) => `${e.what} ${e.all}`).join(', ')})`);
+  console.log(
+    `e2e station: passed (${doc.valid_cells} returns; first picture ${result.first_picture_s} s; bytes per edit ${edits.map((e) => `${e.what} ${e.all}`).join(', ')})`,
+  );
 } finally {
   await browser.close();
   server.kill('SIGTERM');

@@ -4,7 +4,12 @@
 // cells (crop=1). A large scan's edit then moves a few kilobytes of picture, not megabytes.
 
 // A box of cells: column, row, width, height (empty when width or height is 0).
-export interface Box { col: number; row: number; width: number; height: number }
+export interface Box {
+  col: number;
+  row: number;
+  width: number;
+  height: number;
+}
 
 // Parses "col,row,width,height" (X-Lidarshop-Box); null when absent or malformed.
 export function parseBox(header: string | null): Box | null {
@@ -18,9 +23,17 @@ export function parseBox(header: string | null): Box | null {
 // Copies the RGBA pixels of `patch` (box.width x box.height) into `target` (RGBA, width x height) at the box.
 // Throws when the box does not lie inside the target or the patch has the wrong size: a patch for another
 // picture must not be drawn.
-export function patchPixels(target: Uint8ClampedArray, width: number, height: number, patch: Uint8ClampedArray, box: Box): void {
+export function patchPixels(
+  target: Uint8ClampedArray,
+  width: number,
+  height: number,
+  patch: Uint8ClampedArray,
+  box: Box,
+): void {
   if (box.col + box.width > width || box.row + box.height > height) {
-    throw new Error(`picture patch ${box.width} x ${box.height} at (${box.col}, ${box.row}) lies outside the ${width} x ${height} picture`);
+    throw new Error(
+      `picture patch ${box.width} x ${box.height} at (${box.col}, ${box.row}) lies outside the ${width} x ${height} picture`,
+    );
   }
   if (target.length !== 4 * width * height || patch.length !== 4 * box.width * box.height) {
     throw new Error(`picture patch: ${patch.length} bytes for a ${box.width} x ${box.height} box`);
@@ -32,7 +45,10 @@ export function patchPixels(target: Uint8ClampedArray, width: number, height: nu
 }
 
 // An overlay drawn over the ray image: its picture and the box of cells it covers.
-export interface Overlay { image: CanvasImageSource; box: Box }
+export interface Overlay {
+  image: CanvasImageSource;
+  box: Box;
+}
 
 // RGBA pixels of an encoded image (PNG).
 async function decode(blob: Blob): Promise<ImageData> {
@@ -47,12 +63,22 @@ async function decode(blob: Blob): Promise<ImageData> {
 }
 
 // Loads an overlay asked with crop=1 (the whole picture when the server sent no box); null when it draws nothing.
-export async function loadOverlay(url: string, rows: number, cols: number, count: (bytes: number) => void): Promise<Overlay | null> {
+export async function loadOverlay(
+  url: string,
+  rows: number,
+  cols: number,
+  count: (bytes: number) => void,
+): Promise<Overlay | null> {
   const response = await fetch(url);
   if (!response.ok) throw new Error(`could not load ${url.split('?')[0]}: ${response.status}`);
   const blob = await response.blob();
   count(blob.size);
-  const box = parseBox(response.headers.get('X-Lidarshop-Box')) ?? { col: 0, row: 0, width: cols, height: rows };
+  const box = parseBox(response.headers.get('X-Lidarshop-Box')) ?? {
+    col: 0,
+    row: 0,
+    width: cols,
+    height: rows,
+  };
   if (box.width === 0 || box.height === 0) return null;
   return { image: await createImageBitmap(blob), box };
 }
@@ -65,7 +91,12 @@ export class PictureStore {
   private chain: Promise<unknown> = Promise.resolve();
 
   // The ray image of `channel` of document `id` at the server's current version (at least `version`).
-  picture(url: (params: Record<string, string | number>) => string, id: number, channel: string, version: number): Promise<HTMLCanvasElement> {
+  picture(
+    url: (params: Record<string, string | number>) => string,
+    id: number,
+    channel: string,
+    version: number,
+  ): Promise<HTMLCanvasElement> {
     const next = this.chain.then(() => this.fetchPicture(url, id, channel, version));
     this.chain = next.catch(() => {});
     return next;
@@ -82,12 +113,20 @@ export class PictureStore {
     for (const key of [...this.held.keys()]) if (key.startsWith(`${id}:`)) this.held.delete(key);
   }
 
-  private async fetchPicture(url: (params: Record<string, string | number>) => string, id: number, channel: string, version: number) {
+  private async fetchPicture(
+    url: (params: Record<string, string | number>) => string,
+    id: number,
+    channel: string,
+    version: number,
+  ) {
     const key = `${id}:${channel}`;
     const held = this.held.get(key);
     if (held && held.version >= version) return held.canvas;
-    const response = await fetch(url(held ? { channel, v: version, since: held.version } : { channel, v: version }));
-    if (!response.ok) throw new Error(`ray image: ${response.status} ${(await response.text()).slice(0, 200)}`);
+    const response = await fetch(
+      url(held ? { channel, v: version, since: held.version } : { channel, v: version }),
+    );
+    if (!response.ok)
+      throw new Error(`ray image: ${response.status} ${(await response.text()).slice(0, 200)}`);
     const blob = await response.blob();
     this.bytes += blob.size;
     const shows = Number(response.headers.get('X-Lidarshop-Version') ?? version);
@@ -96,7 +135,9 @@ export class PictureStore {
       if (box.width > 0 && box.height > 0) {
         const patch = await decode(blob);
         patchPixels(held.pixels.data, held.pixels.width, held.pixels.height, patch.data, box);
-        held.canvas.getContext('2d')!.putImageData(held.pixels, 0, 0, box.col, box.row, box.width, box.height);
+        held.canvas
+          .getContext('2d')!
+          .putImageData(held.pixels, 0, 0, box.col, box.row, box.width, box.height);
       }
       held.version = shows;
       return held.canvas;

@@ -29,11 +29,15 @@ export class RayView {
   private panFrom: { x: number; y: number } | null = null;
 
   constructor(private canvas: HTMLCanvasElement) {
-    canvas.addEventListener('wheel', (event) => {
-      event.preventDefault();
-      this.view = zoomAt(this.view, event.deltaY < 0 ? 1.25 : 0.8, event.offsetX, event.offsetY);
-      this.draw();
-    }, { passive: false });
+    canvas.addEventListener(
+      'wheel',
+      (event) => {
+        event.preventDefault();
+        this.view = zoomAt(this.view, event.deltaY < 0 ? 1.25 : 0.8, event.offsetX, event.offsetY);
+        this.draw();
+      },
+      { passive: false },
+    );
     canvas.addEventListener('pointerdown', (event) => this.down(event));
     canvas.addEventListener('pointermove', (event) => this.move(event));
     canvas.addEventListener('pointerup', () => this.up());
@@ -45,15 +49,30 @@ export class RayView {
   // overlapping refresh that finished late) is dropped. False when dropped.
   // The picture and overlays are URLs of whole images or what was loaded already (picture.ts: patched ray
   // images, cropped overlays).
-  async show(id: number, version: number, imageSource: string | CanvasImageSource | Promise<CanvasImageSource>,
-             maskSource: OverlaySource, holeSource: OverlaySource, strokesSource: OverlaySource,
-             rows: number, cols: number, aspect: number, keepView: boolean): Promise<boolean> {
-    const whole = (image: CanvasImageSource): Overlay => ({ image, box: { col: 0, row: 0, width: cols, height: rows } });
+  async show(
+    id: number,
+    version: number,
+    imageSource: string | CanvasImageSource | Promise<CanvasImageSource>,
+    maskSource: OverlaySource,
+    holeSource: OverlaySource,
+    strokesSource: OverlaySource,
+    rows: number,
+    cols: number,
+    aspect: number,
+    keepView: boolean,
+  ): Promise<boolean> {
+    const whole = (image: CanvasImageSource): Overlay => ({
+      image,
+      box: { col: 0, row: 0, width: cols, height: rows },
+    });
     const optional = async (source: OverlaySource): Promise<Overlay | null> =>
       typeof source === 'string' ? whole(await loadImage(source)) : source;
     const [image, mask, hole, strokes] = await Promise.all([
       typeof imageSource === 'string' ? loadImage(imageSource) : imageSource,
-      optional(maskSource), optional(holeSource), optional(strokesSource)]);
+      optional(maskSource),
+      optional(holeSource),
+      optional(strokesSource),
+    ]);
     if (id === this.shown.id && version < this.shown.version) return false;
     this.shown = { id, version };
     this.holeMask = hole;
@@ -101,7 +120,8 @@ export class RayView {
     const rect = this.canvas.getBoundingClientRect();
     this.canvas.width = Math.max(1, Math.round(rect.width));
     this.canvas.height = Math.max(1, Math.round(rect.height));
-    if (this.rows > 0) this.view = fitView(this.rows, this.cols, this.view.aspect, this.canvas.width, this.canvas.height);
+    if (this.rows > 0)
+      this.view = fitView(this.rows, this.cols, this.view.aspect, this.canvas.width, this.canvas.height);
     this.draw();
   }
 
@@ -119,7 +139,11 @@ export class RayView {
 
   private move(event: PointerEvent) {
     if (this.panFrom) {
-      this.view = { ...this.view, offsetX: this.view.offsetX + event.offsetX - this.panFrom.x, offsetY: this.view.offsetY + event.offsetY - this.panFrom.y };
+      this.view = {
+        ...this.view,
+        offsetX: this.view.offsetX + event.offsetX - this.panFrom.x,
+        offsetY: this.view.offsetY + event.offsetY - this.panFrom.y,
+      };
       this.panFrom = { x: event.offsetX, y: event.offsetY };
       this.draw();
       return;
@@ -150,20 +174,49 @@ export class RayView {
     if (!this.image) return;
     const { scale, aspect, offsetX, offsetY } = this.view;
     context.imageSmoothingEnabled = false;
-    context.drawImage(this.image, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
+    context.drawImage(
+      this.image,
+      0,
+      0,
+      this.cols,
+      this.rows,
+      offsetX,
+      offsetY,
+      this.cols * scale,
+      this.rows * scale * aspect,
+    );
     for (const overlay of [this.holeMask, this.mask, this.strokeImage]) {
       if (!overlay) continue;
       const { col, row, width, height } = overlay.box;
-      context.drawImage(overlay.image, 0, 0, width, height, offsetX + col * scale, offsetY + row * scale * aspect,
-                        width * scale, height * scale * aspect);
+      context.drawImage(
+        overlay.image,
+        0,
+        0,
+        width,
+        height,
+        offsetX + col * scale,
+        offsetY + row * scale * aspect,
+        width * scale,
+        height * scale * aspect,
+      );
     }
     for (const stroke of [...this.sent, ...(this.pending ? [this.pending] : [])]) {
-      context.fillStyle = stroke.brush === 'object' ? 'rgba(60, 220, 60, 0.8)'
-        : stroke.brush === 'background' ? 'rgba(230, 60, 60, 0.8)' : stroke.brush === 'erase' ? 'rgba(20, 20, 20, 0.7)'
-        : 'rgba(60, 120, 255, 0.8)';
+      context.fillStyle =
+        stroke.brush === 'object'
+          ? 'rgba(60, 220, 60, 0.8)'
+          : stroke.brush === 'background'
+            ? 'rgba(230, 60, 60, 0.8)'
+            : stroke.brush === 'erase'
+              ? 'rgba(20, 20, 20, 0.7)'
+              : 'rgba(60, 120, 255, 0.8)';
       const r = stroke.brush === 'lasso' ? 0.5 : Math.max(stroke.radius, 0.5);
       for (const cell of stroke.cells) {
-        context.fillRect(offsetX + (cell.col - r + 0.5) * scale, offsetY + (cell.row - r + 0.5) * scale * aspect, 2 * r * scale, 2 * r * scale * aspect);
+        context.fillRect(
+          offsetX + (cell.col - r + 0.5) * scale,
+          offsetY + (cell.row - r + 0.5) * scale * aspect,
+          2 * r * scale,
+          2 * r * scale * aspect,
+        );
       }
     }
     if (this.picked) {
