@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/site/site_stations.h"
 #include "lidarshop/util/error.h"
@@ -42,6 +43,8 @@ class DocumentLimitError : public InputError {
 // The bytes of the distinct buffers of `document`'s state, undo and redo history and photos (buffers the
 // snapshots share count once). Caller holds document.mutex.
 int64_t DocumentBytes(const Document& document);
+// DocumentBytes with `next` committed (the current state kept for undo): what an edit would make it hold.
+int64_t DocumentBytesWith(const Document& document, const Snapshot& next);
 
 // A site: open documents that are the stations of one site — the scans of one file of several (an E57 with
 // several data3D), a built-in site, or documents the user grouped (docs/stations.md "In the editor").
@@ -72,6 +75,10 @@ struct EditorServer::State {
   // Throws DocumentLimitError when max_documents are open (nothing else is checked then: call it before
   // reading a file), or when `more_bytes` more would take the open documents past max_document_bytes.
   void CheckRoomForDocument(int64_t more_bytes = 0);
+  // Throws DocumentLimitError (507) when `document` holding `bytes_after` and the other open documents
+  // (their last counted bytes) would pass max_document_bytes: an edit is refused, the document kept as it was.
+  // Caller holds document.mutex (takes documents_mutex, which is never held while waiting for a document).
+  void CheckRoomForEdit(const Document& document, int64_t bytes_after);
   // Opens `scan` as a new document after CheckRoomForDocument(its bytes); returns its id.
   int AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_images = {});
   std::mutex open_mutex;  // one open at a time: the room checked is the room used
@@ -120,6 +127,7 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
 
 // Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
+// Throws DocumentLimitError (507), changing nothing, when the memory limit would be passed (Document::check_room).
 // Caller holds document.mutex.
 void Commit(Document& document, Snapshot next, int undo_depth);
 // Records the document's current point state as the one of its current version (Document::recent, the last
@@ -129,10 +137,22 @@ void RememberState(Document& document);
 
 // points.cc: the points of a document as typed arrays (docs/api.md "Points"), whole (LSP1) or the cells that
 // changed since an earlier version (LSD1). Caller holds document.mutex.
-std::string PointsBinary(const Document& document);
+// `step` > 1: a level of detail, only the cells whose row and column are multiples of it (a large scan's
+// first view; its deltas then name only those cells too).
+std::string PointsBinary(const Document& document, int step = 1);
 // The LSD1 delta from the state the document had at version `since` to now; nullopt when that state is no
 // longer kept (or the grid changed): the client then gets the whole points.
-std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since);
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step = 1);
+
+// pictures.cc: pictures that travel by what changed (docs/api.md "Pictures"). Caller holds document.mutex.
+// The ray image of `options` (`channel` names it): whole, or with `since` >= 0 a kept version's picture, only
+// the box of pixels that changed since (headers X-Lidarshop-Box "col,row,width,height" and X-Lidarshop-Size
+// "cols,rows"; an empty body when nothing changed). Each kept state's picture is rendered once.
+void SendRayPicture(Document& document, const RenderOptions& options, const std::string& channel,
+                    int64_t since, httplib::Response& response);
+// A BGRA overlay as PNG; with `box` (of a `size` picture: cropped to its drawn cells, drawn from those
+// cells alone so that a large scan's mostly clear overlay costs its box), with the headers above.
+void SendOverlay(httplib::Response& response, const cv::Mat& bgra, const cv::Rect* box, cv::Size size);
 
 // A job's JSON form (GET /api/jobs/ID).
 nlohmann::ordered_json JobJson(const Job& job);

@@ -100,14 +100,14 @@ std::string Encode(const uint32_t (&header)[N], const std::vector<uint32_t>& key
 
 }  // namespace
 
-std::string PointsBinary(const Document& document) {
+std::string PointsBinary(const Document& document, int step) {
   std::vector<uint32_t> cells;
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
     const Scan& scan = behind ? document.now.behind : document.now.scan;
     if (scan.valid.empty()) continue;
-    for (int r = 0; r < scan.rows; ++r) {
-      for (int c = 0; c < scan.cols; ++c) {
+    for (int r = 0; r < scan.rows; r += step) {
+      for (int c = 0; c < scan.cols; c += step) {
         PointRecord record = RecordAt(document.now, behind, r, c);
         if (!record.present) continue;
         records.push_back(record);
@@ -126,6 +126,7 @@ void RememberState(Document& document) {
   if (!recent.empty() && SameBuffers(recent.back().points, document.now, false) &&
       SameBuffers(recent.back().points, document.now, true)) {
     recent.back().last_version = document.version;  // the same points: a stroke, a hole
+    document.counted_bytes = DocumentBytes(document);
     return;
   }
   Document::PointState state{document.version, document.version, document.now};
@@ -133,9 +134,10 @@ void RememberState(Document& document) {
   state.points.hole = cv::Mat();
   recent.push_back(std::move(state));
   while (recent.size() > kRecentStates) recent.pop_front();
+  document.counted_bytes = DocumentBytes(document);
 }
 
-std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since) {
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step) {
   const Snapshot* old = nullptr;
   for (const auto& state : document.recent) {
     if (state.first_version <= since && since <= state.last_version) old = &state.points;
@@ -150,8 +152,8 @@ std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t s
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
     if (SameBuffers(*old, now, behind)) continue;
-    for (int r = 0; r < rows; ++r) {
-      for (int c = 0; c < cols; ++c) {
+    for (int r = 0; r < rows; r += step) {
+      for (int c = 0; c < cols; c += step) {
         PointRecord record = RecordAt(now, behind, r, c);
         if (record == RecordAt(*old, behind, r, c)) continue;
         keys.push_back(static_cast<uint32_t>(r * cols + c) | (behind ? kBehindKey : 0));

@@ -179,6 +179,9 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
 }  // namespace
 
 void Commit(Document& document, Snapshot next, int undo_depth) {
+  // Checked before anything changes: a refused edit leaves the document as it was. Counted with the current
+  // state kept for undo and nothing trimmed, so that the check errs on the safe side.
+  if (document.check_room) document.check_room(document, DocumentBytesWith(document, next));
   document.undo.push_back(std::move(document.now));
   if (static_cast<int>(document.undo.size()) > undo_depth) document.undo.erase(document.undo.begin());
   document.redo.clear();
@@ -228,6 +231,8 @@ void PostDocument(State& state, const std::string& pattern, DocumentHandler hand
       handler(state, document, *body, response);
     } catch (const OptionsError& error) {
       SendError(response, 400, error.what());
+    } catch (const DocumentLimitError& error) {  // the edit would pass the memory limit: 507
+      SendError(response, error.status, error.what());
     } catch (const InputError& error) {
       SendError(response, 422, error.what());
     } catch (const nlohmann::json::exception& error) {  // a field of the wrong type (body.value)

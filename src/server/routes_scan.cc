@@ -141,8 +141,13 @@ std::string ResolveUnderRoots(const std::vector<std::string>& roots, const std::
 }
 
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray) {
-  cv::Mat out = rgb_or_gray;
-  if (out.channels() == 3) cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  // A new buffer for the BGR copy: `rgb_or_gray` may be a kept picture (pictures.cc), not to be swapped in place.
+  cv::Mat out;
+  if (rgb_or_gray.channels() == 3) {
+    cv::cvtColor(rgb_or_gray, out, cv::COLOR_RGB2BGR);
+  } else {
+    out = rgb_or_gray;
+  }
   std::vector<uint8_t> png;
   CvImEncode(".png", out, &png);
   response.set_content(std::string(png.begin(), png.end()), "image/png");
@@ -181,8 +186,11 @@ int64_t Sum(const std::map<const void*, int64_t>& seen) {
 
 }  // namespace
 
-int64_t DocumentBytes(const Document& document) {
+int64_t DocumentBytes(const Document& document) { return DocumentBytesWith(document, Snapshot{}); }
+
+int64_t DocumentBytesWith(const Document& document, const Snapshot& next) {
   std::map<const void*, int64_t> seen;
+  CollectBuffers(next, seen);
   CollectBuffers(document.now, seen);
   for (const auto* history : {&document.undo, &document.redo}) {
     for (const Snapshot& snapshot : *history) CollectBuffers(snapshot, seen);
@@ -223,6 +231,25 @@ void State::CheckRoomForDocument(int64_t more_bytes) {
   }
 }
 
+void State::CheckRoomForEdit(const Document& document, int64_t bytes_after) {
+  const int64_t limit = options.max_document_bytes > 0 ? options.max_document_bytes : MemoryBudgetBytes();
+  int64_t others = 0;
+  {
+    std::lock_guard lock(documents_mutex);
+    for (const auto& [id, open] : documents) {
+      if (open.get() != &document) others += open->counted_bytes.load();
+    }
+  }
+  if (others + bytes_after > limit) {
+    throw DocumentLimitError(
+        507,
+        fmt::format("not enough memory for this edit: the scan would hold {} MiB (with its undo history) "
+                    "and the other open scans hold {} MiB of the {} MiB allowed; the scan is kept as it "
+                    "was: save and close another scan, then try again",
+                    bytes_after >> 20, others >> 20, limit >> 20));
+  }
+}
+
 FileForEditing ReadFileForEditing(const std::string& path) {
   if (FileExtension(path) != "e57") return {ReadScanFile(path), {}};
   E57File e57 = ReadE57(path);  // as ReadScanFile reads it, keeping the photos
@@ -253,6 +280,9 @@ int State::AddDocument(std::string name, Scan scan, std::vector<E57Image> e57_im
   document->now.scan = std::move(scan);
   std::lock_guard open_lock(open_mutex);
   CheckRoomForDocument(DocumentBytes(*document));
+  document->check_room = [this](const Document& self, int64_t bytes_after) {
+    CheckRoomForEdit(self, bytes_after);
+  };
   RememberState(*document);
   std::lock_guard lock(documents_mutex);
   document->id = ++last_document;
@@ -550,53 +580,66 @@ void AddScanRoutes(State& state) {
       SendJson(response, {{"closed", document->id}});
     }
   });
-  http.Get(R"(/api/docs/(\d+)/image.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             RenderOptions options;
-             try {
-               if (request.has_param("channel"))
-                 options.channel = ParseEnum<RenderChannel>(request.get_param_value("channel"));
-               std::lock_guard lock(document->mutex);
-               SendPng(response, RenderScan(document->now.scan, options).image);
-             } catch (const OptionsError& error) {
-               SendError(response, 400, error.what());
-             } catch (const InputError& error) {
-               SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
-             }
-           });
-  http.Get(R"(/api/docs/(\d+)/mask.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             std::lock_guard lock(document->mutex);
-             const Scan& scan = document->now.scan;
-             const std::string layer = request.get_param_value("layer");
-             if (layer == "strokes") {
-               // The strokes as the server holds them (the canvas draws these, not a list of its own): the
-               // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
-               // the values 0 / 1 / 2 as grey (segment.h kStroke*).
-               const cv::Mat& strokes = document->now.strokes;
-               if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
-               cv::Mat overlay(strokes.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-               overlay.setTo(cv::Scalar(60, 220, 60, 210), strokes == 1);
-               overlay.setTo(cv::Scalar(60, 60, 230, 210), strokes == 2);
-               std::vector<uint8_t> png;
-               CvImEncode(".png", overlay, &png);
-               return response.set_content(std::string(png.begin(), png.end()), "image/png");
-             }
-             const bool hole = layer == "hole";
-             const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
-             cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
-             if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
-             // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
-             cv::Mat overlay(mask.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-             overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask);
-             std::vector<uint8_t> png;
-             CvImEncode(".png", overlay, &png);
-             response.set_content(std::string(png.begin(), png.end()), "image/png");
-           });
+  http.Get(R"(/api/docs/(\d+)/image.png)", [&state](const httplib::Request& request,
+                                                    httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    RenderOptions options;
+    try {
+      const std::string channel = request.has_param("channel") ? request.get_param_value("channel") : "range";
+      options.channel = ParseEnum<RenderChannel>(channel);
+      // ?since=V: only the box of pixels that changed since version V (pictures.cc).
+      int64_t since = -1;
+      if (request.has_param("since")) {
+        const std::string text = request.get_param_value("since");
+        char* end = nullptr;
+        since = std::strtoll(text.c_str(), &end, 10);
+        if (text.empty() || *end != '\0' || since < 0)
+          return SendError(response, 400, "since: expected a version (a whole number >= 0)");
+      }
+      std::lock_guard lock(document->mutex);
+      SendRayPicture(*document, options, channel, since, response);
+    } catch (const OptionsError& error) {
+      SendError(response, 400, error.what());
+    } catch (const InputError& error) {
+      SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
+    }
+  });
+  http.Get(
+      R"(/api/docs/(\d+)/mask.png)", [&state](const httplib::Request& request, httplib::Response& response) {
+        auto document = state.FindDocument(request, response);
+        if (!document) return;
+        std::lock_guard lock(document->mutex);
+        const Scan& scan = document->now.scan;
+        const std::string layer = request.get_param_value("layer");
+        // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
+        const bool crop = request.get_param_value("crop") == "1";
+        if (layer == "strokes") {
+          // The strokes as the server holds them (the canvas draws these, not a list of its own): the
+          // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
+          // the values 0 / 1 / 2 as grey (segment.h kStroke*).
+          const cv::Mat& strokes = document->now.strokes;
+          if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
+          // Cropped: only the box of the painted cells is drawn (a large scan's overlay is mostly clear).
+          const cv::Rect box = crop ? cv::boundingRect(strokes) : cv::Rect(0, 0, strokes.cols, strokes.rows);
+          if (box.empty()) return SendOverlay(response, cv::Mat(), &box, strokes.size());
+          const cv::Mat part = strokes(box);
+          cv::Mat overlay(part.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+          overlay.setTo(cv::Scalar(60, 220, 60, 210), part == 1);
+          overlay.setTo(cv::Scalar(60, 60, 230, 210), part == 2);
+          return SendOverlay(response, overlay, crop ? &box : nullptr, strokes.size());
+        }
+        const bool hole = layer == "hole";
+        const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
+        cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
+        if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
+        // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
+        const cv::Rect box = crop ? cv::boundingRect(mask) : cv::Rect(0, 0, mask.cols, mask.rows);
+        if (box.empty()) return SendOverlay(response, cv::Mat(), &box, mask.size());
+        cv::Mat overlay(box.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+        overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
+        SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());
+      });
   http.Get(R"(/api/docs/(\d+)/points)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);
@@ -611,14 +654,25 @@ void AddScanRoutes(State& state) {
                if (text.empty() || *end != '\0' || since < 0)
                  return SendError(response, 400, "since: expected a version (a whole number >= 0)");
              }
+             // ?step=K: the level of detail K (every K-th row and column), for a large scan's first view.
+             int step = 1;
+             if (request.has_param("step")) {
+               const std::string text = request.get_param_value("step");
+               char* end = nullptr;
+               const long value = std::strtol(text.c_str(), &end, 10);
+               if (text.empty() || *end != '\0' || value < 1 || value > 64)
+                 return SendError(response, 400, "step: expected a whole number in [1, 64]");
+               step = static_cast<int>(value);
+             }
              std::lock_guard lock(document->mutex);
              response.set_header("X-Lidarshop-Version", std::to_string(document->version));
+             response.set_header("X-Lidarshop-Step", std::to_string(step));
              if (since >= 0) {
-               if (auto delta = PointsDeltaBinary(*document, since)) {
+               if (auto delta = PointsDeltaBinary(*document, since, step)) {
                  return response.set_content(std::move(*delta), "application/octet-stream");
                }
              }
-             response.set_content(PointsBinary(*document), "application/octet-stream");
+             response.set_content(PointsBinary(*document, step), "application/octet-stream");
            });
   // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).
   http.Get(R"(/api/docs/(\d+)/labels)",

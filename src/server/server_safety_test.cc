@@ -14,6 +14,7 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -134,6 +135,73 @@ TEST(ServerSafetyTest, OpeningPastTheMemoryLimitIsRefused) {
   const auto listed = Json(running.client().Get(Running::Api("/api/docs")))["documents"];
   ASSERT_EQ(listed.size(), 1u);
   EXPECT_EQ(listed[0]["id"], first);
+}
+
+TEST(ServerSafetyTest, AnEditPastTheMemoryLimitIsRefusedAndTheDocumentKept) {
+  // Room for the tiny scan and a few strokes buffers (each stroke edit makes a new one, kept for undo), not
+  // for the undo depth of them.
+  const Scan& scan = TinyScan();
+  const int64_t strokes_bytes = static_cast<int64_t>(scan.rows) * scan.cols;
+  int64_t one = strokes_bytes;
+  for (const cv::Mat* mat :
+       {&scan.direction, &scan.valid, &scan.range, &scan.point, &scan.intensity, &scan.color, &scan.label,
+        &scan.normal, &scan.curvature, &scan.true_range, &scan.synthesized}) {
+    one += static_cast<int64_t>(mat->total() * mat->elemSize());
+  }
+  ServerOptions options;
+  options.max_document_bytes = one + 3 * strokes_bytes + strokes_bytes / 2;
+  options.undo_depth = 8;
+  Running running(options);
+  const int id = running.OpenTiny();
+  const std::string strokes = Running::Api(fmt::format("/api/docs/{}/strokes", id));
+  int accepted = 0;
+  std::optional<httplib::Response> refused;
+  for (int i = 0; i < 8; ++i) {
+    auto answer = running.client().Post(
+        strokes,
+        fmt::format(R"({{"object": [[{}, 30]], "background": [[{}, 2]], "radius": 0}})", 28 + i, 34 + i),
+        "application/json");
+    ASSERT_TRUE(answer);
+    if (answer->status != 200) {
+      refused = *answer;
+      break;
+    }
+    ++accepted;
+  }
+  ASSERT_TRUE(refused.has_value()) << "no edit was refused";
+  EXPECT_EQ(accepted, 3);  // the scan + the first strokes buffer + 3 more fit, a 4th does not
+  EXPECT_EQ(refused->status, 507) << refused->body;
+  const std::string message = nlohmann::json::parse(refused->body)["error"].get<std::string>();
+  EXPECT_NE(message.find("not enough memory for this edit"), std::string::npos) << message;
+  EXPECT_NE(message.find("kept as it was"), std::string::npos) << message;
+  // The document is as the last accepted edit left it: its version, its strokes, its undo.
+  auto document = Json(running.client().Get(Running::Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_EQ(document["version"], accepted);
+  EXPECT_EQ(document["object_stroke_cells"], accepted);
+  // A job's edit (a segmentation's new object mask) is refused the same way: the job fails with the message.
+  const auto job =
+      running.client().Post(Running::Api(fmt::format("/api/docs/{}/segment", id)), "{}", "application/json");
+  ASSERT_EQ(job->status, 202) << job->body;
+  const int job_id = Json(job)["id"].get<int>();
+  nlohmann::json state;
+  for (int i = 0; i < 600; ++i) {
+    state = Json(running.client().Get(Running::Api(fmt::format("/api/jobs/{}", job_id))));
+    if (state["state"] != "queued" && state["state"] != "running") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  EXPECT_EQ(state["state"], "failed") << state.dump();
+  EXPECT_NE(state.value("error", "").find("not enough memory for this edit"), std::string::npos)
+      << state.dump();
+  document = Json(running.client().Get(Running::Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_EQ(document["version"], accepted);
+  EXPECT_EQ(document["object_cells"], 0);
+  // Undo frees nothing but needs nothing: it still works, and the server answers.
+  EXPECT_EQ(running.client()
+                .Post(Running::Api(fmt::format("/api/docs/{}/undo", id)), "{}", "application/json")
+                ->status,
+            200);
+  document = Json(running.client().Get(Running::Api(fmt::format("/api/docs/{}", id))));
+  EXPECT_EQ(document["object_stroke_cells"], accepted - 1);
 }
 
 // {"object": [[[...]]]} nested `levels` deep.

@@ -90,6 +90,8 @@ struct Document {
     Snapshot points;  // shallow: shares the history's buffers; strokes and hole left empty
   };
   std::deque<PointState> recent;
+  // Ray images rendered, by (channel, the first version of a state in `recent`): a picture patch compares two.
+  std::map<std::pair<std::string, int64_t>, cv::Mat> pictures;
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
@@ -100,6 +102,12 @@ struct Document {
   cv::Mat photo_b;  // CV_8UC3 RGB: a second photo for photo <-> photo pairs (empty = none)
   std::shared_ptr<ReviewSession> review;  // the inpainting review in progress (null = none)
   int64_t prepared_version = -1;
+  // Memory accounting: the bytes DocumentBytes counted at the last version change (read by other
+  // documents' room checks without this one's mutex), and the check an edit must pass before it is committed
+  // (EditorServer::State::CheckRoomForEdit: throws DocumentLimitError when the document would hold
+  // `bytes_after` and the open documents together would pass the limit). Empty outside a server.
+  std::atomic<int64_t> counted_bytes{0};
+  std::function<void(const Document&, int64_t bytes_after)> check_room;
   std::mutex mutex;  // guards every field above
 };
 

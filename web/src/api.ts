@@ -86,7 +86,8 @@ const MAGIC = 0x3150534c; // "LSP1"
 // Decodes GET /api/docs/ID/points: 16-byte header (magic, count, rows, cols; uint32 little-endian), then
 // xyz float32[3n], cells uint32[n], rgb uint8[3n], flags uint8[n].
 export function parsePoints(buffer: ArrayBuffer): PointSet {
-  if (buffer.byteLength < 16) throw new Error(`points: ${buffer.byteLength} bytes is shorter than the header`);
+  if (buffer.byteLength < 16)
+    throw new Error(`points: ${buffer.byteLength} bytes is shorter than the header`);
   const header = new DataView(buffer, 0, 16);
   if (header.getUint32(0, true) !== MAGIC) throw new Error('points: not LSP1 data');
   const count = header.getUint32(4, true);
@@ -120,40 +121,57 @@ export function parseMesh(buffer: ArrayBuffer): MeshData {
   if (buffer.byteLength < 16) throw new Error('mesh: shorter than the header');
   const header = new DataView(buffer, 0, 16);
   if (header.getUint32(0, true) !== 0x314d534c) throw new Error('mesh: not LSM1 data');
-  const vertices = header.getUint32(4, true), triangles = header.getUint32(8, true);
-  if (buffer.byteLength !== 16 + vertices * 12 + triangles * 12) throw new Error('mesh: size does not match its header');
-  return { vertices, triangles, xyz: new Float32Array(buffer, 16, vertices * 3), indices: new Uint32Array(buffer, 16 + vertices * 12, triangles * 3) };
+  const vertices = header.getUint32(4, true),
+    triangles = header.getUint32(8, true);
+  if (buffer.byteLength !== 16 + vertices * 12 + triangles * 12)
+    throw new Error('mesh: size does not match its header');
+  return {
+    vertices,
+    triangles,
+    xyz: new Float32Array(buffer, 16, vertices * 3),
+    indices: new Uint32Array(buffer, 16 + vertices * 12, triangles * 3),
+  };
 }
 
 // world_from_model of a pose on the ground (verify/PoseFromXyzYaw with no pitch or roll): translate, then yaw
 // about +z, x towards y. Column-major 4x4.
 export function poseMatrix(x: number, y: number, z: number, yawDeg: number): number[] {
-  const c = Math.cos((yawDeg * Math.PI) / 180), s = Math.sin((yawDeg * Math.PI) / 180);
+  const c = Math.cos((yawDeg * Math.PI) / 180),
+    s = Math.sin((yawDeg * Math.PI) / 180);
   return [c, s, 0, 0, -s, c, 0, 0, 0, 0, 1, 0, x, y, z, 1];
 }
 
 // a * b for column-major 4x4 matrices.
 export function multiply(a: number[], b: number[]): number[] {
   const out = new Array(16).fill(0);
-  for (let col = 0; col < 4; ++col) for (let row = 0; row < 4; ++row) for (let k = 0; k < 4; ++k) out[col * 4 + row] += a[k * 4 + row] * b[col * 4 + k];
+  for (let col = 0; col < 4; ++col)
+    for (let row = 0; row < 4; ++row)
+      for (let k = 0; k < 4; ++k) out[col * 4 + row] += a[k * 4 + row] * b[col * 4 + k];
   return out;
 }
 
 // The inverse of a rigid transform (rotation + translation), column-major.
 export function inverseRigid(m: number[]): number[] {
   const out = [m[0], m[4], m[8], 0, m[1], m[5], m[9], 0, m[2], m[6], m[10], 0, 0, 0, 0, 1];
-  for (let row = 0; row < 3; ++row) out[12 + row] = -(out[row] * m[12] + out[4 + row] * m[13] + out[8 + row] * m[14]);
+  for (let row = 0; row < 3; ++row)
+    out[12 + row] = -(out[row] * m[12] + out[4 + row] * m[13] + out[8 + row] * m[14]);
   return out;
 }
 
 export class ApiError extends Error {
-  constructor(public status: number, message: string) {
+  constructor(
+    public status: number,
+    message: string,
+  ) {
     super(message);
   }
 }
 
 export class Api {
-  constructor(private token: string, private base = '') {}
+  constructor(
+    private token: string,
+    private base = '',
+  ) {}
 
   static fromLocation(location: { search: string; origin: string }): Api {
     const token = new URLSearchParams(location.search).get('token') ?? '';
@@ -161,27 +179,39 @@ export class Api {
   }
 
   url(path: string, params: Record<string, string | number> = {}): string {
-    const query = new URLSearchParams(Object.fromEntries(Object.entries(params).map(([k, v]) => [k, String(v)])));
+    const query = new URLSearchParams(
+      Object.fromEntries(Object.entries(params).map(([k, v]) => [k, String(v)])),
+    );
     if (this.token) query.set('token', this.token);
     const text = query.toString();
     return text ? `${this.base}${path}?${text}` : `${this.base}${path}`;
   }
 
   async json<T>(path: string, params: Record<string, string | number> = {}, body?: unknown): Promise<T> {
-    const response = await fetch(this.url(path, params), body === undefined ? {} : {
-      method: 'POST',
-      headers: { 'Content-Type': 'application/json' },
-      body: JSON.stringify(body),
-    });
+    const response = await fetch(
+      this.url(path, params),
+      body === undefined
+        ? {}
+        : {
+            method: 'POST',
+            headers: { 'Content-Type': 'application/json' },
+            body: JSON.stringify(body),
+          },
+    );
     const text = await response.text();
     const json = text ? JSON.parse(text) : {};
-    if (!response.ok) throw new ApiError(response.status, json.error ?? `${response.status} ${response.statusText}`);
+    if (!response.ok)
+      throw new ApiError(response.status, json.error ?? `${response.status} ${response.statusText}`);
     return json as T;
   }
 
   async delete(path: string): Promise<void> {
     const response = await fetch(this.url(path), { method: 'DELETE' });
-    if (!response.ok) throw new ApiError(response.status, (await response.json().catch(() => ({}))).error ?? `${response.status}`);
+    if (!response.ok)
+      throw new ApiError(
+        response.status,
+        (await response.json().catch(() => ({}))).error ?? `${response.status}`,
+      );
   }
 
   async mesh(id: number): Promise<MeshData> {
@@ -193,11 +223,22 @@ export class Api {
   // The points of document `id` as an answer to show: the cells changed since `since` (LSD1) when the server
   // still holds that version, else the whole points (LSP1); `version` is the version they show
   // (X-Lidarshop-Version), `bytes` what travelled.
-  async pointsSince(id: number, since: number | null): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
-    const response = await fetch(this.url(`/api/docs/${id}/points`, since === null ? {} : { since }));
+  // `step` > 1: the level of detail holding every step-th row and column (a large scan's 3-D view).
+  async pointsSince(
+    id: number,
+    since: number | null,
+    step = 1,
+  ): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
+    const params: Record<string, number> = since === null ? {} : { since };
+    if (step > 1) params.step = step;
+    const response = await fetch(this.url(`/api/docs/${id}/points`, params));
     if (!response.ok) throw new ApiError(response.status, `points: ${response.status}`);
     const buffer = await response.arrayBuffer();
-    return { buffer, version: Number(response.headers.get('X-Lidarshop-Version') ?? -1), bytes: buffer.byteLength };
+    return {
+      buffer,
+      version: Number(response.headers.get('X-Lidarshop-Version') ?? -1),
+      bytes: buffer.byteLength,
+    };
   }
 
   async points(id: number): Promise<PointSet> {

@@ -1,5 +1,19 @@
 // The editor: wires the toolbar, the ray image and the 3-D view to the server (docs/api.md).
-import { Api, ApiError, DocumentInfo, JobInfo, MeshData, PointSet, ScanFileEntry, fileLabel, firstReadableFile, inverseRigid, multiply, poseMatrix, resultWarnings } from './api';
+import {
+  Api,
+  ApiError,
+  DocumentInfo,
+  JobInfo,
+  MeshData,
+  PointSet,
+  ScanFileEntry,
+  fileLabel,
+  firstReadableFile,
+  inverseRigid,
+  multiply,
+  poseMatrix,
+  resultWarnings,
+} from './api';
 import { PointColouring, PointView } from './pointview';
 import { PairsPanel } from './pairsui';
 import { Brush, RayView, loadImage } from './rayview';
@@ -8,6 +22,7 @@ import { ReviewPanel } from './reviewpanel';
 import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
 import { StationsPanel } from './stations';
+import { PictureStore, loadOverlay } from './picture';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -21,12 +36,20 @@ let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
 let openDocuments: DocumentInfo[] = []; // the server's open documents, for the list
 const gate = new VersionGate(); // answers are shown in version order
-const heldPoints = new Map<number, { version: number; points: PointSet }>(); // per document
+// Per document: the points held, their version and level of detail (every step-th row and column).
+const heldPoints = new Map<number, { version: number; step: number; points: PointSet }>();
+// Levels of detail of the 3-D view: the first download holds at most about FIRST_POINTS points, then it is
+// refined to at most about MOST_POINTS (a 1400-pixel-wide view shows no more; deltas then name only those cells).
+const FIRST_POINTS = 1_000_000,
+  MOST_POINTS = 4_000_000;
+const stepFor = (returns: number, most: number) => Math.max(1, Math.ceil(Math.sqrt(returns / most)));
 let pointsShown = { id: -1, version: -1 };
 let pointsChain: Promise<void> = Promise.resolve(); // point updates one at a time, in order
 let pointBytes = 0; // bytes of points received (whole or deltas), for tests
-const lastImage = new Map<string, string>(); // "id:channel" -> the ray image URL shown
-const strokeKinds = new Set<Brush>();  // brushes used on the open scan since its last cut was reset
+const pictures = new PictureStore(); // ray images held per document and channel, patched by what changed
+let overlayBytes = 0; // bytes of overlays received, for tests
+const firstPictures = new Map<number, number>(); // when a large scan's first picture was shown (tests)
+const strokeKinds = new Set<Brush>(); // brushes used on the open scan since its last cut was reset
 
 let pending: PendingReview | null = null; // the patch review shown (null = none)
 let placingByHand = false; // the next pick in the ray image is a review's source patch
@@ -43,28 +66,52 @@ const stationsPanel = new StationsPanel({ api, doc: () => doc, show: showById, s
 
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {
-  rayView, pointView, current: () => doc, verify: () => verify(), review: () => pending, pairs: () => pairsPanel,
-  pointBytes: () => pointBytes, pointsShown: () => pointsShown, documents: () => openDocuments,
-  settled: () => pointsChain.then(() => true), stations: () => stationsPanel,
+  rayView,
+  pointView,
+  current: () => doc,
+  verify: () => verify(),
+  review: () => pending,
+  pairs: () => pairsPanel,
+  pointLevel: () => (doc ? (heldPoints.get(doc.id)?.step ?? 0) : 0),
+  firstPictures: () => Object.fromEntries(firstPictures),
+  pictures,
+  pointBytes: () => pointBytes,
+  pictureBytes: () => pictures.bytes + overlayBytes,
+  pointsShown: () => pointsShown,
+  documents: () => openDocuments,
+  settled: () => pointsChain.then(() => true),
+  stations: () => stationsPanel,
 };
 
 // Brings the held points of document `id` to the server's current version: the cells changed since the held
 // version (a delta), or the whole points the first time; then shows them if the document is still shown.
-function updatePoints(id: number, keepView: boolean): Promise<void> {
+// `step`: a level of detail to download whole instead (a refinement); by default the one held, or for the first
+// download the coarsest that holds about FIRST_POINTS.
+function updatePoints(id: number, keepView: boolean, step?: number): Promise<void> {
   pointsChain = pointsChain.then(async () => {
     try {
       let held = heldPoints.get(id);
-      const answer = await api.pointsSince(id, held ? held.version : null);
+      if (held && step !== undefined && step !== held.step) held = undefined;
+      const level = held?.step ?? step ?? stepFor(doc?.id === id ? doc.valid_cells : 0, FIRST_POINTS);
+      const answer = await api.pointsSince(id, held ? held.version : null, level);
       pointBytes += answer.bytes;
       const parsed = parsePointsAnswer(answer.buffer);
       if ('whole' in parsed) {
-        held = { version: answer.version, points: parsed.whole };
+        held = { version: answer.version, step: level, points: parsed.whole };
       } else if (held && parsed.delta.from === held.version) {
-        held = { version: parsed.delta.to, points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points };
+        held = {
+          version: parsed.delta.to,
+          step: level,
+          points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points,
+        };
       } else {
-        const whole = await api.pointsSince(id, null);
+        const whole = await api.pointsSince(id, null, level);
         pointBytes += whole.bytes;
-        held = { version: whole.version, points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole };
+        held = {
+          version: whole.version,
+          step: level,
+          points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole,
+        };
       }
       heldPoints.set(id, held);
       if (doc?.id !== id) return;
@@ -84,11 +131,13 @@ async function listDocuments() {
   const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
   openDocuments = documents;
   const select = element<HTMLSelectElement>('documents');
-  select.replaceChildren(...documents.map((d) => {
-    const option = new Option(`#${d.id} ${d.name}${d.can_undo ? ' (edited)' : ''}`, String(d.id));
-    option.title = `${d.rows} x ${d.cols} cells, version ${d.version}`;
-    return option;
-  }));
+  select.replaceChildren(
+    ...documents.map((d) => {
+      const option = new Option(`#${d.id} ${d.name}${d.can_undo ? ' (edited)' : ''}`, String(d.id));
+      option.title = `${d.rows} x ${d.cols} cells, version ${d.version}`;
+      return option;
+    }),
+  );
   if (doc) select.value = String(doc.id);
   element<HTMLButtonElement>('close-doc').disabled = documents.length === 0;
 }
@@ -127,14 +176,37 @@ async function refresh(keepView: boolean, strokesOnly = false) {
   if ((usable === 'labels' || usable === 'classification') && !has('label')) usable = 'range';
   const aspect = info.azimuth_step_deg > 0 ? info.elevation_step_deg / info.azimuth_step_deg : 1;
   const v = info.version;
-  const mask = info.object_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', v }) : null;
-  const hole = info.hole_cells > 0 ? api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'hole', v }) : null;
-  const strokes = api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', layer: 'strokes', v });
-  const imageKey = `${id}:${usable}`;
-  const image = strokesOnly && lastImage.has(imageKey) ? lastImage.get(imageKey)! : api.url(`/api/docs/${id}/image.png`, { channel: usable, v });
-  lastImage.set(imageKey, image);
+  // Overlays cropped to their drawn cells, the ray image patched by the pixels that changed (picture.ts).
+  const overlay = (params: Record<string, string | number>) =>
+    loadOverlay(
+      api.url(`/api/docs/${id}/mask.png`, { style: 'overlay', crop: 1, v, ...params }),
+      info.rows,
+      info.cols,
+      (bytes) => (overlayBytes += bytes),
+    );
+  const mask = info.object_cells > 0 ? overlay({}) : null;
+  const hole = info.hole_cells > 0 ? overlay({ layer: 'hole' }) : null;
+  const strokes = overlay({ layer: 'strokes' });
+  const image = pictures.picture(
+    (params) => api.url(`/api/docs/${id}/image.png`, params),
+    id,
+    usable,
+    strokesOnly ? -1 : v,
+  );
   const shown = await rayView.show(id, v, image, mask, hole, strokes, info.rows, info.cols, aspect, keepView);
-  if (!strokesOnly) await updatePoints(id, keepView);
+  if (!strokesOnly) {
+    // The 3-D view follows the ray image and does not hold it up: a large scan's coarse level first, refined
+    // after the first picture (its deltas then name the refined level's cells).
+    const first = !heldPoints.has(id);
+    const points = updatePoints(id, keepView);
+    const finer = stepFor(info.valid_cells, MOST_POINTS);
+    if (first && finer < stepFor(info.valid_cells, FIRST_POINTS)) {
+      firstPictures.set(id, performance.now());
+      void points.then(() => updatePoints(id, true, finer));
+    } else {
+      await points;
+    }
+  }
   if (!strokesOnly && doc?.id === id) {
     await stationsPanel.refresh(info, heldPoints.get(id)?.points).catch((error) => status(`stations: ${(error as Error).message}`));
   }
@@ -143,18 +215,23 @@ async function refresh(keepView: boolean, strokesOnly = false) {
   const photoSelect = element<HTMLSelectElement>('e57-photo');
   if (photoSelect.dataset.doc !== String(id)) {
     photoSelect.dataset.doc = String(id);
-    photoSelect.replaceChildren(new Option(`E57 photos (${photos.length})`, ''), ...photos.map((p) => {
-      const option = new Option(`${p.name} (${p.width_px} x ${p.height_px})`, String(p.index));
-      option.disabled = !p.usable;
-      return option;
-    }));
+    photoSelect.replaceChildren(
+      new Option(`E57 photos (${photos.length})`, ''),
+      ...photos.map((p) => {
+        const option = new Option(`${p.name} (${p.width_px} x ${p.height_px})`, String(p.index));
+        option.disabled = !p.usable;
+        return option;
+      }),
+    );
     photoSelect.hidden = photos.length === 0;
     element('recolor-station').hidden = photos.length === 0;
   }
   element<HTMLButtonElement>('undo').disabled = !info.can_undo;
   element<HTMLButtonElement>('redo').disabled = !info.can_redo;
   const behind = info.behind_cells > 0 ? `, ${info.behind_cells} behind the object` : '';
-  status(`${info.name}: ${info.rows} x ${info.cols} cells, ${info.valid_cells} returns, ${info.synthesized_cells} synthesized, ${info.object_cells} in the object, ${info.hole_cells} in the hole${behind} (version ${v})`);
+  status(
+    `${info.name}: ${info.rows} x ${info.cols} cells, ${info.valid_cells} returns, ${info.synthesized_cells} synthesized, ${info.object_cells} in the object, ${info.hole_cells} in the hole${behind} (version ${v})`,
+  );
 }
 
 async function open(params: Record<string, string>) {
@@ -172,7 +249,12 @@ async function open(params: Record<string, string>) {
 
 // Runs an operation as a job; shows the progress bar once it has taken half a second, with cancel. Resolves
 // with the job's last state (null when it could not start); `refreshAfter` reloads the scan when it is done.
-async function runJob(path: string, body: unknown, what: string, refreshAfter = true): Promise<JobInfo | null> {
+async function runJob(
+  path: string,
+  body: unknown,
+  what: string,
+  refreshAfter = true,
+): Promise<JobInfo | null> {
   if (!doc) {
     status('open a scan first');
     return null;
@@ -193,7 +275,9 @@ async function runJob(path: string, body: unknown, what: string, refreshAfter = 
     if (finished.state === 'done') {
       if (refreshAfter) await refresh(true);
       // A result that looks wrong says so first (a cut that leaked, an empty hole, a camera that disagrees).
-      const warnings = resultWarnings(finished).map((warning) => `warning: ${warning}. `).join('');
+      const warnings = resultWarnings(finished)
+        .map((warning) => `warning: ${warning}. `)
+        .join('');
       status(`${what} done. ${warnings}${element('status').textContent}`);
     } else {
       status(`${what} ${finished.state}${finished.error ? `: ${finished.error}` : ''}`);
@@ -213,8 +297,11 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
     await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
     await refresh(true, true); // the strokes as the server holds them
     status(`${cells.length} ${brush} stroke cells painted`);
-    if ((brush === 'object' || brush === 'background') && element<HTMLInputElement>('live').checked &&
-        (strokeKinds.add(brush), strokeKinds.size === 2)) {
+    if (
+      (brush === 'object' || brush === 'background') &&
+      element<HTMLInputElement>('live').checked &&
+      (strokeKinds.add(brush), strokeKinds.size === 2)
+    ) {
       // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut).
       await runJob(`/api/docs/${doc.id}/segment`, { refine: doc.object_cells > 0 }, 'segment');
     }
@@ -256,7 +343,8 @@ element<HTMLInputElement>('radius').addEventListener('change', (event) => {
 element('channel').addEventListener('change', () => refresh(true));
 for (const layer of ['original', 'synthesized', 'object', 'from-stations'] as const) {
   element<HTMLInputElement>(`layer-${layer}`).addEventListener('change', (event) =>
-    pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked));
+    pointView.setLayerVisible(layer, (event.target as HTMLInputElement).checked),
+  );
 }
 element<HTMLInputElement>('layer-stations').addEventListener('change', (event) =>
   stationsPanel.setOthersVisible((event.target as HTMLInputElement).checked));
@@ -268,17 +356,27 @@ const openSite = (body: { scene?: string; path?: string; documents?: number[] })
 element('open-site-scene').addEventListener('click', () => openSite({ scene: element<HTMLSelectElement>('scene').value }));
 element('open-site-file').addEventListener('click', () => openSite({ path: element<HTMLSelectElement>('file').value }));
 element('group-docs').addEventListener('click', () => openSite({ documents: openDocuments.map((d) => d.id) }));
-element<HTMLInputElement>('point-size').addEventListener('input', (event) => pointView.setPointSize(Number((event.target as HTMLInputElement).value)));
-element<HTMLSelectElement>('point-colour').addEventListener('change', (event) => pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring));
-element('open-scene').addEventListener('click', () => open({ scene: element<HTMLSelectElement>('scene').value }));
-element('open-file').addEventListener('click', () => open({ path: element<HTMLSelectElement>('file').value }));
+element<HTMLInputElement>('point-size').addEventListener('input', (event) =>
+  pointView.setPointSize(Number((event.target as HTMLInputElement).value)),
+);
+element<HTMLSelectElement>('point-colour').addEventListener('change', (event) =>
+  pointView.setColouring((event.target as HTMLSelectElement).value as PointColouring),
+);
+element('open-scene').addEventListener('click', () =>
+  open({ scene: element<HTMLSelectElement>('scene').value }),
+);
+element('open-file').addEventListener('click', () =>
+  open({ path: element<HTMLSelectElement>('file').value }),
+);
 element('segment').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/segment`, {}, 'segment'));
 element('remove').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, {}, 'remove');
   strokeKinds.clear(); // the removal cleared the server's strokes
 });
 element('fill').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, {}, 'fill'));
-element('fill-hole').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/fill`, { hole: 'painted' }, 'fill hole'));
+element('fill-hole').addEventListener('click', () =>
+  runJob(`/api/docs/${doc?.id}/fill`, { hole: 'painted' }, 'fill hole'),
+);
 element('fill-shadow').addEventListener('click', async () => {
   await runJob(`/api/docs/${doc?.id}/remove`, { options: { keep_object: true } }, 'fill shadow');
   strokeKinds.clear();
@@ -294,8 +392,11 @@ async function undoRedo(action: 'undo' | 'redo') {
     status(`${action}: ${(error as Error).message}`);
   }
 }
-for (const action of ['undo', 'redo'] as const) element(action).addEventListener('click', () => undoRedo(action));
-element('recolor-station').addEventListener('click', () => runJob(`/api/docs/${doc?.id}/recolor-station`, {}, 'colour from the station\'s photos'));
+for (const action of ['undo', 'redo'] as const)
+  element(action).addEventListener('click', () => undoRedo(action));
+element('recolor-station').addEventListener('click', () =>
+  runJob(`/api/docs/${doc?.id}/recolor-station`, {}, "colour from the station's photos"),
+);
 element('e57-photo').addEventListener('change', () => {
   const value = element<HTMLSelectElement>('e57-photo').value;
   if (value !== '') pairsPanel.useE57Photo(Number(value));
@@ -317,6 +418,7 @@ element('close-doc').addEventListener('click', async () => {
     return;
   }
   heldPoints.delete(closing.id);
+  pictures.forget(closing.id);
   gate.forget(closing.id);
   await listDocuments();
   await showDocument(openDocuments[0] ?? null);
@@ -353,14 +455,20 @@ element('save').addEventListener('click', async () => {
   const format = element<HTMLSelectElement>('format').value;
   // Ask first what the format would drop: nothing is lost without a word.
   try {
-    const plan = await api.json<{ dropped: string[]; refused: string }>(`/api/docs/${doc.id}/save-plan`, { format });
+    const plan = await api.json<{ dropped: string[]; refused: string }>(`/api/docs/${doc.id}/save-plan`, {
+      format,
+    });
     if (plan.refused) {
       status(`save: ${plan.refused}`);
       return;
     }
     if (plan.dropped.length > 0) {
       const lost = plan.dropped.map((line) => `• ${line.replace(/^[^:]*: /, '')}`).join('\n');
-      if (!window.confirm(`Saving as ${format.toUpperCase()} loses:\n${lost}\n\nSave anyway? (E57 keeps everything.)`)) {
+      if (
+        !window.confirm(
+          `Saving as ${format.toUpperCase()} loses:\n${lost}\n\nSave anyway? (E57 keeps everything.)`,
+        )
+      ) {
         status(`save: not saved as ${format}`);
         return;
       }
@@ -383,10 +491,17 @@ async function verify() {
   const [x, y, z, yaw] = poseInputs.map((input) => Number(input.value));
   try {
     const result = await api.json<{ consistency: number | null; confidence: number; summary: string }>(
-      `/api/docs/${doc.id}/verify`, {}, { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } });
+      `/api/docs/${doc.id}/verify`,
+      {},
+      { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } },
+    );
     element('verify-result').textContent = result.summary;
     const scannerFromWorld = inverseRigid(doc.world_from_scanner_column_major);
-    pointView.showModel(placed.mesh, multiply(scannerFromWorld, poseMatrix(x, y, z, yaw)), result.consistency);
+    pointView.showModel(
+      placed.mesh,
+      multiply(scannerFromWorld, poseMatrix(x, y, z, yaw)),
+      result.consistency,
+    );
   } catch (error) {
     element('verify-result').textContent = `verify: ${(error as Error).message}`;
   }
@@ -400,7 +515,11 @@ for (const input of poseInputs) {
 element('place').addEventListener('click', async () => {
   if (!doc) return status('open a scan first');
   try {
-    const model = await api.json<{ id: number }>('/api/models', {}, { model: element<HTMLSelectElement>('model').value });
+    const model = await api.json<{ id: number }>(
+      '/api/models',
+      {},
+      { model: element<HTMLSelectElement>('model').value },
+    );
     placed = { id: model.id, mesh: await api.mesh(model.id) };
     if (picked) {
       // The picked cell's point in the world frame (the scan's pose): the model stands there.
@@ -426,8 +545,12 @@ const pairsPanel = new PairsPanel({ api, doc: () => doc, status, runJob, refresh
 
 // The patch review of the inpainting (thesis 7.1 "User action"): the fill stops where no patch passes the
 // acceptance tests; the panel shows the candidates grouped, a click accepts one, or a pick places one by hand.
-const reviewPanel = new ReviewPanel(element('review-panel'), element<HTMLCanvasElement>('review-target'),
-                                    element('review-tiles'), element('review-caption'));
+const reviewPanel = new ReviewPanel(
+  element('review-panel'),
+  element<HTMLCanvasElement>('review-target'),
+  element('review-tiles'),
+  element('review-caption'),
+);
 let reviewImages = 0; // a counter in the image URLs: each stop's pictures are new
 function setPlacing(on: boolean) {
   placingByHand = on;
@@ -452,12 +575,17 @@ async function showReview() {
   try {
     pending = await api.json<PendingReview>(`/api/docs/${doc.id}/inpaint/review`);
     const v = ++reviewImages;
-    const [canvas, tentative] = await Promise.all(['canvas', 'tentative'].map((layer) =>
-      loadImage(api.url(`/api/docs/${doc!.id}/inpaint/review/image.png`, { layer, v }))));
+    const [canvas, tentative] = await Promise.all(
+      ['canvas', 'tentative'].map((layer) =>
+        loadImage(api.url(`/api/docs/${doc!.id}/inpaint/review/image.png`, { layer, v })),
+      ),
+    );
     reviewPanel.show(pending, canvas, tentative);
     const [row, col] = pending.review.target;
     rayView.pick({ row, col });
-    status(`review: no patch passes at row ${row}, column ${col}; accept a group's patch or place one by hand`);
+    status(
+      `review: no patch passes at row ${row}, column ${col}; accept a group's patch or place one by hand`,
+    );
   } catch (error) {
     status(`review: ${(error as Error).message}`);
   }
@@ -465,7 +593,11 @@ async function showReview() {
 reviewPanel.onAccept = (candidate) => {
   if (!doc) return;
   const choice: ReviewChoice = { candidate };
-  reviewStep(`/api/docs/${doc.id}/inpaint/review/decide`, decisionBody(choice), `accept candidate ${candidate}`);
+  reviewStep(
+    `/api/docs/${doc.id}/inpaint/review/decide`,
+    decisionBody(choice),
+    `accept candidate ${candidate}`,
+  );
 };
 element('review-fill').addEventListener('click', () => {
   if (!doc) return status('open a scan first');
@@ -476,7 +608,11 @@ element('review-fill').addEventListener('click', () => {
   } catch {
     return status('review options: not JSON');
   }
-  reviewStep(`/api/docs/${doc.id}/inpaint/review`, options === undefined ? { hole: 'painted' } : { hole: 'painted', options }, 'review fill');
+  reviewStep(
+    `/api/docs/${doc.id}/inpaint/review`,
+    options === undefined ? { hole: 'painted' } : { hole: 'painted', options },
+    'review fill',
+  );
 });
 element('review-place').addEventListener('click', () => {
   setPlacing(!placingByHand);
@@ -505,22 +641,30 @@ async function start() {
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
     const { files } = await api.json<{ files: ScanFileEntry[] }>('/api/files');
     const fileSelect = element<HTMLSelectElement>('file');
-    fileSelect.replaceChildren(...files.map((file) => {
-      const option = new Option(fileLabel(file), file.path);
-      option.disabled = file.readable === false; // broken files are listed (with why) but not chosen
-      if (file.error) option.title = file.error;
-      return option;
-    }));
+    fileSelect.replaceChildren(
+      ...files.map((file) => {
+        const option = new Option(fileLabel(file), file.path);
+        option.disabled = file.readable === false; // broken files are listed (with why) but not chosen
+        if (file.error) option.title = file.error;
+        return option;
+      }),
+    );
     // The dialog starts on the first file that opens (the server lists them in name order, broken ones too).
     const first = firstReadableFile(files);
     if (first) fileSelect.value = first.path;
     const models = await api.json<{ builtin: string[]; files: string[] }>('/api/models');
-    element('model').replaceChildren(...models.builtin.map((name) => new Option(name, name)),
-      ...models.files.map((path) => new Option(path.split('/').pop()!, path)));
+    element('model').replaceChildren(
+      ...models.builtin.map((name) => new Option(name, name)),
+      ...models.files.map((path) => new Option(path.split('/').pop()!, path)),
+    );
     await listDocuments();
     if (openDocuments.length > 0) await showDocument(openDocuments[0]);
   } catch (error) {
-    status(error instanceof ApiError && error.status === 401 ? 'open the URL `lidarshop serve` printed (it holds the token)' : String(error));
+    status(
+      error instanceof ApiError && error.status === 401
+        ? 'open the URL `lidarshop serve` printed (it holds the token)'
+        : String(error),
+    );
   }
 }
 start();

@@ -3,6 +3,7 @@
 // drawn are the server's (its overlay image of the document's state): an undone stroke disappears, and a
 // stroke keeps the radius it was painted with. A stroke is drawn locally only until the server's state
 // that holds it is shown.
+import { Overlay } from './picture';
 import { Cell, ImageView, cellsAlong, cellToScreen, fitView, screenToCell, zoomAt } from './strokes';
 
 export type Brush = 'object' | 'background' | 'erase' | 'hole' | 'lasso' | 'none';
@@ -13,10 +14,10 @@ export class RayView {
   onStroke: (brush: Brush, cells: Cell[]) => void = () => {};
   onPick: (cell: Cell) => void = () => {};
 
-  private image: HTMLImageElement | null = null;
-  private mask: HTMLImageElement | null = null;
-  private holeMask: HTMLImageElement | null = null;
-  private strokeImage: HTMLImageElement | null = null;
+  private image: CanvasImageSource | null = null;
+  private mask: Overlay | null = null;
+  private holeMask: Overlay | null = null;
+  private strokeImage: Overlay | null = null;
   private shown = { id: -1, version: -1 }; // the document and version of the pictures shown
   private view: ImageView = { scale: 1, aspect: 1, offsetX: 0, offsetY: 0 };
   private rows = 0;
@@ -28,11 +29,15 @@ export class RayView {
   private panFrom: { x: number; y: number } | null = null;
 
   constructor(private canvas: HTMLCanvasElement) {
-    canvas.addEventListener('wheel', (event) => {
-      event.preventDefault();
-      this.view = zoomAt(this.view, event.deltaY < 0 ? 1.25 : 0.8, event.offsetX, event.offsetY);
-      this.draw();
-    }, { passive: false });
+    canvas.addEventListener(
+      'wheel',
+      (event) => {
+        event.preventDefault();
+        this.view = zoomAt(this.view, event.deltaY < 0 ? 1.25 : 0.8, event.offsetX, event.offsetY);
+        this.draw();
+      },
+      { passive: false },
+    );
     canvas.addEventListener('pointerdown', (event) => this.down(event));
     canvas.addEventListener('pointermove', (event) => this.move(event));
     canvas.addEventListener('pointerup', () => this.up());
@@ -42,11 +47,32 @@ export class RayView {
 
   // Shows the pictures of version `version` of document `id`; an answer older than the one shown (an
   // overlapping refresh that finished late) is dropped. False when dropped.
-  async show(id: number, version: number, imageUrl: string, maskUrl: string | null, holeUrl: string | null,
-             strokesUrl: string | null, rows: number, cols: number, aspect: number, keepView: boolean): Promise<boolean> {
-    const optional = (url: string | null) => (url ? loadImage(url) : Promise.resolve(null));
-    const [image, mask, hole, strokes] = await Promise.all([loadImage(imageUrl), optional(maskUrl), optional(holeUrl),
-                                                            optional(strokesUrl)]);
+  // The picture and overlays are URLs of whole images or what was loaded already (picture.ts: patched ray
+  // images, cropped overlays).
+  async show(
+    id: number,
+    version: number,
+    imageSource: string | CanvasImageSource | Promise<CanvasImageSource>,
+    maskSource: OverlaySource,
+    holeSource: OverlaySource,
+    strokesSource: OverlaySource,
+    rows: number,
+    cols: number,
+    aspect: number,
+    keepView: boolean,
+  ): Promise<boolean> {
+    const whole = (image: CanvasImageSource): Overlay => ({
+      image,
+      box: { col: 0, row: 0, width: cols, height: rows },
+    });
+    const optional = async (source: OverlaySource): Promise<Overlay | null> =>
+      typeof source === 'string' ? whole(await loadImage(source)) : source;
+    const [image, mask, hole, strokes] = await Promise.all([
+      typeof imageSource === 'string' ? loadImage(imageSource) : imageSource,
+      optional(maskSource),
+      optional(holeSource),
+      optional(strokesSource),
+    ]);
     if (id === this.shown.id && version < this.shown.version) return false;
     this.shown = { id, version };
     this.holeMask = hole;
@@ -94,7 +120,8 @@ export class RayView {
     const rect = this.canvas.getBoundingClientRect();
     this.canvas.width = Math.max(1, Math.round(rect.width));
     this.canvas.height = Math.max(1, Math.round(rect.height));
-    if (this.rows > 0) this.view = fitView(this.rows, this.cols, this.view.aspect, this.canvas.width, this.canvas.height);
+    if (this.rows > 0)
+      this.view = fitView(this.rows, this.cols, this.view.aspect, this.canvas.width, this.canvas.height);
     this.draw();
   }
 
@@ -112,7 +139,11 @@ export class RayView {
 
   private move(event: PointerEvent) {
     if (this.panFrom) {
-      this.view = { ...this.view, offsetX: this.view.offsetX + event.offsetX - this.panFrom.x, offsetY: this.view.offsetY + event.offsetY - this.panFrom.y };
+      this.view = {
+        ...this.view,
+        offsetX: this.view.offsetX + event.offsetX - this.panFrom.x,
+        offsetY: this.view.offsetY + event.offsetY - this.panFrom.y,
+      };
       this.panFrom = { x: event.offsetX, y: event.offsetY };
       this.draw();
       return;
@@ -143,23 +174,49 @@ export class RayView {
     if (!this.image) return;
     const { scale, aspect, offsetX, offsetY } = this.view;
     context.imageSmoothingEnabled = false;
-    context.drawImage(this.image, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
-    if (this.holeMask) {
-      context.drawImage(this.holeMask, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
-    }
-    if (this.mask) {
-      context.drawImage(this.mask, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
-    }
-    if (this.strokeImage) {
-      context.drawImage(this.strokeImage, 0, 0, this.cols, this.rows, offsetX, offsetY, this.cols * scale, this.rows * scale * aspect);
+    context.drawImage(
+      this.image,
+      0,
+      0,
+      this.cols,
+      this.rows,
+      offsetX,
+      offsetY,
+      this.cols * scale,
+      this.rows * scale * aspect,
+    );
+    for (const overlay of [this.holeMask, this.mask, this.strokeImage]) {
+      if (!overlay) continue;
+      const { col, row, width, height } = overlay.box;
+      context.drawImage(
+        overlay.image,
+        0,
+        0,
+        width,
+        height,
+        offsetX + col * scale,
+        offsetY + row * scale * aspect,
+        width * scale,
+        height * scale * aspect,
+      );
     }
     for (const stroke of [...this.sent, ...(this.pending ? [this.pending] : [])]) {
-      context.fillStyle = stroke.brush === 'object' ? 'rgba(60, 220, 60, 0.8)'
-        : stroke.brush === 'background' ? 'rgba(230, 60, 60, 0.8)' : stroke.brush === 'erase' ? 'rgba(20, 20, 20, 0.7)'
-        : 'rgba(60, 120, 255, 0.8)';
+      context.fillStyle =
+        stroke.brush === 'object'
+          ? 'rgba(60, 220, 60, 0.8)'
+          : stroke.brush === 'background'
+            ? 'rgba(230, 60, 60, 0.8)'
+            : stroke.brush === 'erase'
+              ? 'rgba(20, 20, 20, 0.7)'
+              : 'rgba(60, 120, 255, 0.8)';
       const r = stroke.brush === 'lasso' ? 0.5 : Math.max(stroke.radius, 0.5);
       for (const cell of stroke.cells) {
-        context.fillRect(offsetX + (cell.col - r + 0.5) * scale, offsetY + (cell.row - r + 0.5) * scale * aspect, 2 * r * scale, 2 * r * scale * aspect);
+        context.fillRect(
+          offsetX + (cell.col - r + 0.5) * scale,
+          offsetY + (cell.row - r + 0.5) * scale * aspect,
+          2 * r * scale,
+          2 * r * scale * aspect,
+        );
       }
     }
     if (this.picked) {
@@ -170,6 +227,9 @@ export class RayView {
     }
   }
 }
+
+// An overlay: the URL of a whole overlay image, one loaded already (cropped), or none.
+export type OverlaySource = string | Overlay | null | Promise<Overlay | null>;
 
 export function loadImage(url: string): Promise<HTMLImageElement> {
   return new Promise((resolve, reject) => {

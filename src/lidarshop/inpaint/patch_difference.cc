@@ -108,9 +108,15 @@ __attribute__((target("avx512f"), flatten)) void SsdAvx512(const PreparedRows& p
     const float* tw = p.target_times_sqrt_weight.data() + span.stored_offset;
     const int pairs = (span.blocks8 + 1) / 2;
     for (int m = 0; m < pairs; ++m) {
-      const F16 w = lanes::Load<F16>(sw + 16 * m), t = lanes::Load<F16>(tw + 16 * m);
+      // Loads written out here, not lanes::Load: clang refuses a 64-byte vector returned from a function not
+      // compiled for AVX-512 (an ABI change) even when it is inlined, e.g. in the -mavx2 fuzz build.
+      F16 w, t;
+      __builtin_memcpy(&w, sw + 16 * m, sizeof(F16));
+      __builtin_memcpy(&t, tw + 16 * m, sizeof(F16));
       for (int c = 0; c < N; ++c) {
-        const F16 d = lanes::Load<F16>(s + c * candidate_step + 16 * m) * w - t;
+        F16 d;
+        __builtin_memcpy(&d, s + c * candidate_step + 16 * m, sizeof(F16));
+        d = d * w - t;
         acc[c][m & 1] += d * d;
       }
     }

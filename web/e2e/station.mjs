@@ -1,0 +1,272 @@
+// End to end on a large station (issue 36): the built-in parking lot scanned on a fine grid (by default
+// 2250 x 3600 rays, 5.4 M returns; made here, never committed), served, opened in Debian's chromium. Measures
+// the time from page open to the first ray picture and to the first (coarse) and refined 3-D points, then
+// counts the bytes of each edit — a stroke, its undo and redo, a painted hole filled (points move), its undo —
+// and checks the patched ray image against the server's whole picture after the fill and after its undo.
+// Prints one JSON line with the numbers (bench/results/editor.md).
+//
+//   node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C]
+import { spawn, execFileSync } from 'node:child_process';
+import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { join, dirname } from 'node:path';
+import { tmpdir } from 'node:os';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const args = process.argv.slice(2);
+const option = (name, fallback) => {
+  const i = args.indexOf(name);
+  return i >= 0 ? args[i + 1] : fallback;
+};
+const [binary, artefacts = join(tmpdir(), 'lidarshop-e2e-station')] = args.filter(
+  (a, i) => !a.startsWith('--') && !args[i - 1]?.startsWith('--'),
+);
+if (!binary)
+  throw new Error('usage: node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C]');
+const rows = Number(option('--rows', 2250)),
+  columns = Number(option('--columns', 3600));
+mkdirSync(artefacts, { recursive: true });
+const root = mkdtempSync(join(tmpdir(), 'lidarshop-e2e-station-'));
+
+function fail(message) {
+  console.error(`e2e station: FAILED: ${message}`);
+  process.exitCode = 1;
+  throw new Error(message);
+}
+
+// As editor.mjs: polls page.evaluate (Playwright's waitForFunction uses eval, which the CSP forbids).
+async function waitForFunction(page, fn, arg, { timeout = 60000 } = {}) {
+  const deadline = Date.now() + timeout;
+  for (;;) {
+    if (await page.evaluate(fn, arg)) return;
+    if (Date.now() > deadline) throw new Error(`timed out after ${timeout} ms waiting for ${fn}`);
+    await new Promise((resolve) => setTimeout(resolve, 25));
+  }
+}
+
+const started = Date.now();
+const station = join(root, 'station.e57');
+execFileSync(binary, [
+  'scan',
+  'parking_lot',
+  '--rows',
+  String(rows),
+  '--columns',
+  String(columns),
+  '-o',
+  station,
+  '--quiet',
+]);
+const scanSeconds = (Date.now() - started) / 1000;
+
+// The server opens the station at start (`serve FILE`), as a user opening a scan given on the command line.
+const server = spawn(
+  binary,
+  ['serve', station, '--port', '0', '--web', join(here, '../dist'), '--root', root],
+  {
+    stdio: ['ignore', 'pipe', 'inherit'],
+  },
+);
+const url = await new Promise((resolve, reject) => {
+  let output = '';
+  server.stdout.on('data', (chunk) => {
+    output += chunk;
+    const match = output.match(/http:\/\/\S+/);
+    if (match) resolve(match[0]);
+  });
+  server.on('exit', (code) => reject(new Error(`lidarshop serve exited with ${code}`)));
+  setTimeout(() => reject(new Error('lidarshop serve printed no URL in 120 s')), 120000);
+});
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: [
+    '--no-sandbox',
+    '--disable-gpu',
+    '--disable-quic',
+    '--no-first-run',
+    '--disable-background-networking',
+    '--disable-component-update',
+    '--disable-sync',
+    '--use-gl=swiftshader',
+    '--enable-unsafe-swiftshader',
+  ],
+});
+const result = { rows, columns, scan_seconds: scanSeconds };
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
+  page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
+  let apiBytes = 0;
+  page.on('requestfinished', async (request) => {
+    if (request.url().includes('/api/')) apiBytes += (await request.sizes()).responseBodySize;
+  });
+  const opened = Date.now();
+  await page.goto(url);
+  await waitForFunction(page, () => window.lidarshop?.rayView.shownState().id > 0, null, { timeout: 120000 });
+  result.first_picture_s = (Date.now() - opened) / 1000;
+  await waitForFunction(page, () => window.lidarshop.pointsShown().id > 0, null, { timeout: 120000 });
+  result.first_points_s = (Date.now() - opened) / 1000;
+  result.first_level = await page.evaluate(() => window.lidarshop.pointLevel());
+  const doc = await page.evaluate(() => window.lidarshop.current());
+  result.returns = doc.valid_cells;
+  await page.screenshot({ path: join(artefacts, 'station_opened.png') });
+  // The refinement to the finer level (the 3-D view's; it does not hold up the ray image).
+  await waitForFunction(
+    page,
+    () =>
+      window.lidarshop.pointLevel() ===
+      Math.max(1, Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / 4e6))),
+    null,
+    { timeout: 240000 },
+  );
+  await page.evaluate(() => window.lidarshop.settled());
+  result.refined_points_s = (Date.now() - opened) / 1000;
+  result.refined_level = await page.evaluate(() => window.lidarshop.pointLevel());
+  result.open_bytes = apiBytes;
+  console.log(`e2e station: opened: ${JSON.stringify(result)}`);
+  if (result.first_level < 2)
+    fail(`a ${doc.valid_cells}-return station was first downloaded at level ${result.first_level}`);
+
+  const canvas = await page.locator('#ray').boundingBox();
+  const screen = (row, col) =>
+    page.evaluate(([r, c]) => window.lidarshop.rayView.screenOf({ row: r, col: c }), [row, col]);
+  const drag = async (cells) => {
+    const first = await screen(...cells[0]);
+    await page.mouse.move(canvas.x + first.x, canvas.y + first.y);
+    await page.mouse.down();
+    for (const cell of cells.slice(1)) {
+      const point = await screen(...cell);
+      await page.mouse.move(canvas.x + point.x, canvas.y + point.y, { steps: 4 });
+    }
+    await page.mouse.up();
+  };
+  const counters = () =>
+    page.evaluate(() => ({
+      points: window.lidarshop.pointBytes(),
+      pictures: window.lidarshop.pictureBytes(),
+    }));
+  const shownCurrent = () => {
+    const d = window.lidarshop.current();
+    return window.lidarshop.rayView.shownState().version === d.version; // points: awaited with settled() below
+  };
+  const edits = [];
+  const edit = async (what, action, done) => {
+    await page.evaluate(() => window.lidarshop.settled());
+    await new Promise((resolve) => setTimeout(resolve, 200));
+    const before = await counters();
+    const allBefore = apiBytes;
+    const version = (await page.evaluate(() => window.lidarshop.current())).version;
+    const t0 = Date.now();
+    await action();
+    await done(version);
+    await waitForFunction(page, shownCurrent, null, { timeout: 120000 });
+    const seconds = (Date.now() - t0) / 1000;
+    await page.evaluate(() => window.lidarshop.settled());
+    await new Promise((resolve) => setTimeout(resolve, 300)); // the last answers' sizes
+    const after = await counters();
+    edits.push({
+      what,
+      seconds,
+      points: after.points - before.points,
+      pictures: after.pictures - before.pictures,
+      all: apiBytes - allBefore,
+    });
+  };
+  const newerThan = (version) =>
+    waitForFunction(page, (v) => window.lidarshop.current().version > v, version, { timeout: 120000 });
+  const pictureMismatch = () =>
+    page.evaluate(async () => {
+      const d = window.lidarshop.current();
+      const channel = document.getElementById('channel').value;
+      const held = window.lidarshop.pictures.heldPicture(d.id, channel);
+      if (!held) return 'no picture held';
+      const bitmap = await createImageBitmap(
+        await (await fetch(`/api/docs/${d.id}/image.png?channel=${channel}&v=${held.version}`)).blob(),
+      );
+      const canvas = document.createElement('canvas');
+      [canvas.width, canvas.height] = [bitmap.width, bitmap.height];
+      const context = canvas.getContext('2d');
+      context.drawImage(bitmap, 0, 0);
+      const whole = context.getImageData(0, 0, bitmap.width, bitmap.height).data;
+      const patched = held.canvas
+        .getContext('2d')
+        .getImageData(0, 0, held.canvas.width, held.canvas.height).data;
+      if (whole.length !== patched.length) return `sizes differ: ${whole.length} and ${patched.length}`;
+      let differ = 0;
+      for (let i = 0; i < whole.length; ++i) if (whole[i] !== patched[i]) ++differ;
+      return differ === 0 ? '' : `${differ} of ${whole.length} bytes differ`;
+    });
+
+  // A stroke across the ground before the scanner (the lower rows), its undo and redo.
+  const r = Math.round(doc.rows * 0.8),
+    c0 = Math.round(doc.cols * 0.45),
+    c1 = Math.round(doc.cols * 0.55);
+  await page.click('#brush-object');
+  await edit(
+    'stroke',
+    () =>
+      drag([
+        [r, c0],
+        [r, c1],
+      ]),
+    newerThan,
+  );
+  await edit('undo stroke', () => page.keyboard.press('Control+z'), newerThan);
+  await edit('redo stroke', () => page.keyboard.press('Control+y'), newerThan);
+  // A painted hole on the ground, filled (the points there move), then undone.
+  const h = Math.round(doc.rows * 0.03),
+    w = Math.round(doc.cols * 0.02);
+  await page.click('#brush-lasso');
+  await edit(
+    'lasso',
+    () =>
+      drag([
+        [r - h, c0],
+        [r - h, c0 + w],
+        [r + h, c0 + w],
+        [r + h, c0],
+        [r - h, c0],
+      ]),
+    newerThan,
+  );
+  const fillStart = (await page.evaluate(() => window.lidarshop.current())).version;
+  await edit(
+    'fill hole',
+    () => page.click('#fill-hole'),
+    () =>
+      waitForFunction(
+        page,
+        (v) => {
+          const d = window.lidarshop.current();
+          return d.version > v && d.synthesized_cells > 0;
+        },
+        fillStart,
+        { timeout: 300000 },
+      ),
+  );
+  const filled = await page.evaluate(() => window.lidarshop.current());
+  if (filled.synthesized_cells === 0) fail('the fill synthesized nothing');
+  const afterFill = await pictureMismatch();
+  if (afterFill) fail(`the patched ray image after the fill is not the server's: ${afterFill}`);
+  await edit('undo fill', () => page.click('#undo'), newerThan);
+  const afterUndo = await pictureMismatch();
+  if (afterUndo) fail(`the patched ray image after undoing the fill is not the server's: ${afterUndo}`);
+  await page.screenshot({ path: join(artefacts, 'station_edited.png') });
+
+  const wholePoints = 16 + 20 * doc.valid_cells;
+  result.edits = edits;
+  result.whole_points_bytes = wholePoints;
+  for (const e of edits) {
+    if (e.points >= wholePoints / 10)
+      fail(`${e.what} moved ${e.points} B of points (the whole points are ${wholePoints} B)`);
+    if (e.pictures >= 1_000_000) fail(`${e.what} moved ${e.pictures} B of pictures`);
+  }
+  console.log(`e2e station: ${JSON.stringify(result)}`);
+  console.log(
+    `e2e station: passed (${doc.valid_cells} returns; first picture ${result.first_picture_s} s; bytes per edit ${edits.map((e) => `${e.what} ${e.all}`).join(', ')})`,
+  );
+} finally {
+  await browser.close();
+  server.kill('SIGTERM');
+  rmSync(root, { recursive: true, force: true });
+}
