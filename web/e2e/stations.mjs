@@ -54,8 +54,17 @@ function startServer() {
 const { server, url } = await startServer();
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: ['--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-         '--disable-component-update', '--disable-sync', '--use-gl=swiftshader', '--enable-unsafe-swiftshader'],
+  args: [
+    '--no-sandbox',
+    '--disable-gpu',
+    '--disable-quic',
+    '--no-first-run',
+    '--disable-background-networking',
+    '--disable-component-update',
+    '--disable-sync',
+    '--use-gl=swiftshader',
+    '--enable-unsafe-swiftshader',
+  ],
 });
 let step = 0;
 try {
@@ -70,36 +79,59 @@ try {
     await page.screenshot({ path: file });
     if (toDocs) {
       mkdirSync(join(here, '../../docs/results/editor'), { recursive: true });
-      copyFileSync(file, join(here, '../../docs/results/editor', `stations_${String(step).padStart(2, '0')}_${name}.png`));
+      copyFileSync(
+        file,
+        join(here, '../../docs/results/editor', `stations_${String(step).padStart(2, '0')}_${name}.png`),
+      );
     }
     console.log(`e2e stations: ${name} -> ${file}`);
   };
   const statusText = () => page.locator('#status').textContent();
   const current = () => page.evaluate(() => window.lidarshop.current());
-  const listed = () => page.evaluate(() => Array.from(document.querySelectorAll('#stations-list li.station')).map((li) => ({
-    index: Number(li.dataset.index), current: li.classList.contains('current'), text: li.textContent })));
+  const listed = () =>
+    page.evaluate(() =>
+      Array.from(document.querySelectorAll('#stations-list li.station')).map((li) => ({
+        index: Number(li.dataset.index),
+        current: li.classList.contains('current'),
+        text: li.textContent,
+      })),
+    );
 
   await page.goto(url);
   await page.selectOption('#scene', 'parking_lot_stations');
   await page.click('#open-site-scene');
   try {
-    await waitForFunction(page, () => document.querySelectorAll('#stations-list li.station').length === 3, null, { timeout: 180000 });
+    await waitForFunction(
+      page,
+      () => document.querySelectorAll('#stations-list li.station').length === 3,
+      null,
+      { timeout: 180000 },
+    );
   } catch {
     fail(`the site's stations were never listed: '${await statusText()}'`);
   }
   let stations = await listed();
-  if (!stations[0].current || stations[1].current || stations[2].current) fail(`station 0 is not the one shown: ${JSON.stringify(stations)}`);
-  if (!/^2 · station2 · \(8\.0, 2\.0, 1\.6\) m · 30°/.test(stations[2].text)) fail(`station 2 listed as '${stations[2].text}'`);
+  if (!stations[0].current || stations[1].current || stations[2].current)
+    fail(`station 0 is not the one shown: ${JSON.stringify(stations)}`);
+  if (!/^2 · station2 · \(8\.0, 2\.0, 1\.6\) m · 30°/.test(stations[2].text))
+    fail(`station 2 listed as '${stations[2].text}'`);
   if ((await current()).name !== 'parking_lot_stations#0') fail(`shown: ${(await current()).name}`);
   // Three documents, one per station.
   const documents = await page.evaluate(() => window.lidarshop.documents().map((d) => d.name));
-  for (let i = 0; i < 3; ++i) if (!documents.includes(`parking_lot_stations#${i}`)) fail(`no scan for station ${i}: ${documents}`);
+  for (let i = 0; i < 3; ++i)
+    if (!documents.includes(`parking_lot_stations#${i}`)) fail(`no scan for station ${i}: ${documents}`);
   await shot('listed');
 
   // Station 2 (the late sedan parked there after stations 0 and 1 looked): a click shows it.
   await page.click('#stations-list li.station[data-index="2"]');
-  await waitForFunction(page, () => window.lidarshop.current()?.name === 'parking_lot_stations#2' &&
-    document.querySelector('#stations-list li.station.current')?.dataset.index === '2', null, { timeout: 60000 });
+  await waitForFunction(
+    page,
+    () =>
+      window.lidarshop.current()?.name === 'parking_lot_stations#2' &&
+      document.querySelector('#stations-list li.station.current')?.dataset.index === '2',
+    null,
+    { timeout: 60000 },
+  );
   await page.check('#layer-stations');
   await page.evaluate(() => window.lidarshop.settled());
   await new Promise((resolve) => setTimeout(resolve, 1500));
@@ -110,8 +142,15 @@ try {
   const before = await current();
   await page.click('#clean');
   try {
-    await waitForFunction(page, () => /^clean: \d+ points removed here \(station 2\)/.test(document.getElementById('clean-result').textContent),
-      null, { timeout: 300000 });
+    await waitForFunction(
+      page,
+      () =>
+        /^clean: \d+ points removed here \(station 2\)/.test(
+          document.getElementById('clean-result').textContent,
+        ),
+      null,
+      { timeout: 300000 },
+    );
   } catch {
     fail(`clean: no count shown: '${await statusText()}'`);
   }
@@ -121,7 +160,8 @@ try {
   await waitForFunction(page, () => window.lidarshop.stations().removedShown > 0, null, { timeout: 60000 });
   const highlighted = await page.evaluate(() => window.lidarshop.stations().removedShown);
   const cleaned = await current();
-  if (!cleaned.can_undo || cleaned.synthesized_cells === 0) fail(`clean left no undoable edit: ${JSON.stringify(cleaned)}`);
+  if (!cleaned.can_undo || cleaned.synthesized_cells === 0)
+    fail(`clean left no undoable edit: ${JSON.stringify(cleaned)}`);
   stations = await listed();
   // The filled cells in cyan (layers), the removed ones highlighted in magenta.
   await page.selectOption('#point-colour', 'layers');
@@ -129,16 +169,24 @@ try {
   await page.selectOption('#point-colour', 'rgb');
 
   await page.click('#undo');
-  await waitForFunction(page, () => {
-    const d = window.lidarshop.current();
-    return d && !d.can_undo && d.synthesized_cells === 0 && window.lidarshop.stations().removedShown === 0;
-  }, null, { timeout: 60000 });
+  await waitForFunction(
+    page,
+    () => {
+      const d = window.lidarshop.current();
+      return d && !d.can_undo && d.synthesized_cells === 0 && window.lidarshop.stations().removedShown === 0;
+    },
+    null,
+    { timeout: 60000 },
+  );
   const undone = await current();
-  if (undone.valid_cells !== before.valid_cells) fail(`undo: ${undone.valid_cells} returns, ${before.valid_cells} before the clean`);
+  if (undone.valid_cells !== before.valid_cells)
+    fail(`undo: ${undone.valid_cells} returns, ${before.valid_cells} before the clean`);
   await shot('undone');
 
   if (blocked.length > 0) fail(`the Content-Security-Policy blocked: ${blocked.join('; ')}`);
-  console.log(`e2e stations: passed (3 stations listed; clean removed ${removed} points of station 2, ${highlighted} highlighted; undone)`);
+  console.log(
+    `e2e stations: passed (3 stations listed; clean removed ${removed} points of station 2, ${highlighted} highlighted; undone)`,
+  );
 } finally {
   await browser.close();
   server.kill('SIGTERM');

@@ -29,7 +29,8 @@ export function parseDelta(buffer: ArrayBuffer): PointDelta {
   const header = new DataView(buffer, 0, 24);
   if (header.getUint32(0, true) !== DELTA_MAGIC) throw new Error('delta: not LSD1 data');
   const count = header.getUint32(4, true);
-  if (buffer.byteLength !== 24 + 21 * count) throw new Error(`delta: ${buffer.byteLength} bytes, expected ${24 + 21 * count} for ${count} cells`);
+  if (buffer.byteLength !== 24 + 21 * count)
+    throw new Error(`delta: ${buffer.byteLength} bytes, expected ${24 + 21 * count} for ${count} cells`);
   let offset = 24;
   const keys = new Uint32Array(buffer, offset, count);
   offset += 4 * count;
@@ -40,16 +41,29 @@ export function parseDelta(buffer: ArrayBuffer): PointDelta {
   const flags = new Uint8Array(buffer, offset, count);
   offset += count;
   const present = new Uint8Array(buffer, offset, count);
-  return { from: header.getUint32(16, true), to: header.getUint32(20, true), rows: header.getUint32(8, true), cols: header.getUint32(12, true), count, keys, xyz, rgb, flags, present };
+  return {
+    from: header.getUint32(16, true),
+    to: header.getUint32(20, true),
+    rows: header.getUint32(8, true),
+    cols: header.getUint32(12, true),
+    count,
+    keys,
+    xyz,
+    rgb,
+    flags,
+    present,
+  };
 }
 
 // Whole points (LSP1) or a delta (LSD1), told apart by the magic.
 export function parsePointsAnswer(buffer: ArrayBuffer): { whole: PointSet } | { delta: PointDelta } {
-  if (buffer.byteLength >= 4 && new DataView(buffer).getUint32(0, true) === DELTA_MAGIC) return { delta: parseDelta(buffer) };
+  if (buffer.byteLength >= 4 && new DataView(buffer).getUint32(0, true) === DELTA_MAGIC)
+    return { delta: parseDelta(buffer) };
   return { whole: parsePoints(buffer) };
 }
 
-const keyOf = (points: PointSet, i: number) => points.cells[i] + (points.flags[i] & FLAG_BEHIND ? BEHIND_KEY : 0);
+const keyOf = (points: PointSet, i: number) =>
+  points.cells[i] + (points.flags[i] & FLAG_BEHIND ? BEHIND_KEY : 0);
 
 // The points after `delta`: both are in key order (the server writes the front layer row by row, then the layer
 // behind), so one merge pass gives the new arrays; cells the delta does not name are copied as they were.
@@ -57,10 +71,14 @@ export function applyDelta(points: PointSet, delta: PointDelta): PointSet {
   let added = 0;
   for (let j = 0; j < delta.count; ++j) added += delta.present[j];
   const capacity = points.count + added;
-  const xyz = new Float32Array(3 * capacity), cells = new Uint32Array(capacity);
-  const rgb = new Uint8Array(3 * capacity), flags = new Uint8Array(capacity);
-  let n = 0, i = 0;
-  const copyOld = (from: number, to: number) => { // old points [from, to) in one block each
+  const xyz = new Float32Array(3 * capacity),
+    cells = new Uint32Array(capacity);
+  const rgb = new Uint8Array(3 * capacity),
+    flags = new Uint8Array(capacity);
+  let n = 0,
+    i = 0;
+  const copyOld = (from: number, to: number) => {
+    // old points [from, to) in one block each
     const m = to - from;
     if (m <= 0) return;
     xyz.set(points.xyz.subarray(3 * from, 3 * to), 3 * n);
@@ -72,10 +90,12 @@ export function applyDelta(points: PointSet, delta: PointDelta): PointSet {
   for (let j = 0; j < delta.count; ++j) {
     const key = delta.keys[j];
     // Old points before this key stay: find the first old key >= key (binary search: a delta is usually small).
-    let lo = i, hi = points.count;
+    let lo = i,
+      hi = points.count;
     while (lo < hi) {
       const mid = (lo + hi) >> 1;
-      if (keyOf(points, mid) < key) lo = mid + 1; else hi = mid;
+      if (keyOf(points, mid) < key) lo = mid + 1;
+      else hi = mid;
     }
     copyOld(i, lo);
     i = lo;
@@ -89,7 +109,15 @@ export function applyDelta(points: PointSet, delta: PointDelta): PointSet {
     }
   }
   copyOld(i, points.count);
-  return { count: n, rows: points.rows, cols: points.cols, xyz: xyz.subarray(0, 3 * n), cells: cells.subarray(0, n), rgb: rgb.subarray(0, 3 * n), flags: flags.subarray(0, n) };
+  return {
+    count: n,
+    rows: points.rows,
+    cols: points.cols,
+    xyz: xyz.subarray(0, 3 * n),
+    cells: cells.subarray(0, n),
+    rgb: rgb.subarray(0, 3 * n),
+    flags: flags.subarray(0, n),
+  };
 }
 
 // Applies answers in version order: each answer says the version it shows; one older than what is shown

@@ -60,9 +60,13 @@ async function showById(id: number) {
   const next = openDocuments.find((d) => d.id === id);
   if (next) await showDocument(next);
 }
-const stationsPanel = new StationsPanel({ api, doc: () => doc, show: showById, status, runJob, ...pointView.overlay() },
-                                        element('stations-list'), element<HTMLButtonElement>('clean'), element('clean-result'),
-                                        element<HTMLButtonElement>('fill-stations'));
+const stationsPanel = new StationsPanel(
+  { api, doc: () => doc, show: showById, status, runJob, ...pointView.overlay() },
+  element('stations-list'),
+  element<HTMLButtonElement>('clean'),
+  element('clean-result'),
+  element<HTMLButtonElement>('fill-stations'),
+);
 
 // For end-to-end tests: where a cell is on screen, and what is open.
 (window as unknown as Record<string, unknown>).lidarshop = {
@@ -208,7 +212,9 @@ async function refresh(keepView: boolean, strokesOnly = false) {
     }
   }
   if (!strokesOnly && doc?.id === id) {
-    await stationsPanel.refresh(info, heldPoints.get(id)?.points).catch((error) => status(`stations: ${(error as Error).message}`));
+    await stationsPanel
+      .refresh(info, heldPoints.get(id)?.points)
+      .catch((error) => status(`stations: ${(error as Error).message}`));
   }
   if (!shown || doc?.id !== id || gate.version(id) !== v) return;
   const photos = info.e57_images ?? [];
@@ -347,15 +353,22 @@ for (const layer of ['original', 'synthesized', 'object', 'from-stations'] as co
   );
 }
 element<HTMLInputElement>('layer-stations').addEventListener('change', (event) =>
-  stationsPanel.setOthersVisible((event.target as HTMLInputElement).checked));
+  stationsPanel.setOthersVisible((event.target as HTMLInputElement).checked),
+);
 const openSite = (body: { scene?: string; path?: string; documents?: number[] }) =>
   stationsPanel.open(body).catch(async (error) => {
     status(`open site failed: ${(error as Error).message}`);
     await listDocuments().catch(() => {});
   });
-element('open-site-scene').addEventListener('click', () => openSite({ scene: element<HTMLSelectElement>('scene').value }));
-element('open-site-file').addEventListener('click', () => openSite({ path: element<HTMLSelectElement>('file').value }));
-element('group-docs').addEventListener('click', () => openSite({ documents: openDocuments.map((d) => d.id) }));
+element('open-site-scene').addEventListener('click', () =>
+  openSite({ scene: element<HTMLSelectElement>('scene').value }),
+);
+element('open-site-file').addEventListener('click', () =>
+  openSite({ path: element<HTMLSelectElement>('file').value }),
+);
+element('group-docs').addEventListener('click', () =>
+  openSite({ documents: openDocuments.map((d) => d.id) }),
+);
 element<HTMLInputElement>('point-size').addEventListener('input', (event) =>
   pointView.setPointSize(Number((event.target as HTMLInputElement).value)),
 );

@@ -16,9 +16,27 @@ export interface ModeInfo {
 }
 
 export const MODES: Record<PairMode, ModeInfo> = {
-  'photo-scan': { first: 'a photo pixel', second: 'the same spot in the scan (Pick tool)', route: 'recolor', action: 'Recolour', minimum: 6 },
-  'scan-scan': { first: 'a cell of this scan (Pick tool)', second: 'the same spot in the other scan', route: 'align', action: 'Align', minimum: 3 },
-  'photo-photo': { first: 'a pixel of the photo', second: 'the same spot in the second photo', route: 'photo-match', action: 'Match photos', minimum: 4 },
+  'photo-scan': {
+    first: 'a photo pixel',
+    second: 'the same spot in the scan (Pick tool)',
+    route: 'recolor',
+    action: 'Recolour',
+    minimum: 6,
+  },
+  'scan-scan': {
+    first: 'a cell of this scan (Pick tool)',
+    second: 'the same spot in the other scan',
+    route: 'align',
+    action: 'Align',
+    minimum: 3,
+  },
+  'photo-photo': {
+    first: 'a pixel of the photo',
+    second: 'the same spot in the second photo',
+    route: 'photo-match',
+    action: 'Match photos',
+    minimum: 4,
+  },
 };
 
 export type Pair = { first: Point2; second: Point2 };
@@ -65,9 +83,15 @@ export class PairCollector {
         return { pairs: this.pairs.map((p) => ({ pixel: p.first, cell: p.second })) };
       case 'scan-scan':
         if (extra.target === undefined) throw new Error('landmarks: choose the other scan first');
-        return { target: extra.target, pairs: this.pairs.map((p) => ({ cell: p.first, target_cell: p.second })) };
+        return {
+          target: extra.target,
+          pairs: this.pairs.map((p) => ({ cell: p.first, target_cell: p.second })),
+        };
       case 'photo-photo':
-        return { model: extra.model ?? 'homography', pairs: this.pairs.map((p) => ({ pixel_a: p.first, pixel_b: p.second })) };
+        return {
+          model: extra.model ?? 'homography',
+          pairs: this.pairs.map((p) => ({ pixel_a: p.first, pixel_b: p.second })),
+        };
     }
   }
 }

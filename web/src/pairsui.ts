@@ -33,8 +33,13 @@ export class PairsPanel {
       this.targetView.pick(cell);
       this.second([cell.row, cell.col]);
     };
-    element<HTMLSelectElement>('pair-mode').addEventListener('change', (event) => this.setMode((event.target as HTMLSelectElement).value as PairMode));
-    for (const [id, which] of [['photo', 'a'], ['photo-b', 'b']] as const) {
+    element<HTMLSelectElement>('pair-mode').addEventListener('change', (event) =>
+      this.setMode((event.target as HTMLSelectElement).value as PairMode),
+    );
+    for (const [id, which] of [
+      ['photo', 'a'],
+      ['photo-b', 'b'],
+    ] as const) {
       const canvas = element<HTMLCanvasElement>(id);
       canvas.addEventListener('click', (event) => this.clickPhoto(which, canvas, event));
     }
@@ -54,7 +59,9 @@ export class PairsPanel {
     if (this.pairs.mode === 'photo-scan') this.second([cell.row, cell.col]);
     if (this.pairs.mode === 'scan-scan') {
       this.pairs.first([cell.row, cell.col]);
-      this.context.status(`cell (${cell.row}, ${cell.col}) of this scan: now pick ${MODES['scan-scan'].second}`);
+      this.context.status(
+        `cell (${cell.row}, ${cell.col}) of this scan: now pick ${MODES['scan-scan'].second}`,
+      );
       this.update();
     }
   }
@@ -74,7 +81,9 @@ export class PairsPanel {
     if (mode === 'scan-scan') await this.listTargets();
     element('photo-panel').hidden = mode === 'scan-scan' ? false : !this.photoA;
     this.update();
-    this.context.status(`pairs: pick ${MODES[mode].first}, then ${MODES[mode].second}; ${MODES[mode].minimum} or more pairs`);
+    this.context.status(
+      `pairs: pick ${MODES[mode].first}, then ${MODES[mode].second}; ${MODES[mode].minimum} or more pairs`,
+    );
   }
 
   // The other open scans, for landmarks.
@@ -96,9 +105,24 @@ export class PairsPanel {
     const api = this.context.api;
     this.targetDoc = await api.json<DocumentInfo>(`/api/docs/${id}`);
     const d = this.targetDoc;
-    const channel = d.channels.includes('color') ? 'rgb' : d.channels.includes('intensity') ? 'intensity' : 'range';
+    const channel = d.channels.includes('color')
+      ? 'rgb'
+      : d.channels.includes('intensity')
+        ? 'intensity'
+        : 'range';
     const aspect = d.azimuth_step_deg > 0 ? d.elevation_step_deg / d.azimuth_step_deg : 1;
-    await this.targetView.show(id, d.version, api.url(`/api/docs/${id}/image.png`, { channel, v: d.version }), null, null, null, d.rows, d.cols, aspect, false);
+    await this.targetView.show(
+      id,
+      d.version,
+      api.url(`/api/docs/${id}/image.png`, { channel, v: d.version }),
+      null,
+      null,
+      null,
+      d.rows,
+      d.cols,
+      aspect,
+      false,
+    );
     this.shownTarget = id;
   }
 
@@ -110,7 +134,9 @@ export class PairsPanel {
     }
     this.inliers = null;
     this.update();
-    this.context.status(`${this.pairs.pairs.length} pairs; pick ${MODES[this.pairs.mode].first} for the next`);
+    this.context.status(
+      `${this.pairs.pairs.length} pairs; pick ${MODES[this.pairs.mode].first} for the next`,
+    );
   }
 
   private clickPhoto(which: 'a' | 'b', canvas: HTMLCanvasElement, event: MouseEvent) {
@@ -123,7 +149,9 @@ export class PairsPanel {
     if (this.pairs.mode === 'scan-scan') return;
     this.pairs.first(pixel);
     this.update();
-    this.context.status(`photo pixel (${pixel[0].toFixed(1)}, ${pixel[1].toFixed(1)}): now pick ${MODES[this.pairs.mode].second}`);
+    this.context.status(
+      `photo pixel (${pixel[0].toFixed(1)}, ${pixel[1].toFixed(1)}): now pick ${MODES[this.pairs.mode].second}`,
+    );
   }
 
   private async upload(event: Event, slot: 'a' | 'b') {
@@ -131,7 +159,13 @@ export class PairsPanel {
     const doc = this.context.doc();
     if (!file || !doc) return;
     const api = this.context.api;
-    await this.usePhoto(slot, () => fetch(api.url(`/api/docs/${doc.id}/photo`, { slot }), { method: 'POST', body: file, headers: { 'Content-Type': file.type } }));
+    await this.usePhoto(slot, () =>
+      fetch(api.url(`/api/docs/${doc.id}/photo`, { slot }), {
+        method: 'POST',
+        body: file,
+        headers: { 'Content-Type': file.type },
+      }),
+    );
   }
 
   // Photo K of the scan's own E57 file (images2D) as the photo to recolour from.
@@ -139,8 +173,13 @@ export class PairsPanel {
     const doc = this.context.doc();
     if (!doc) return;
     const api = this.context.api;
-    await this.usePhoto(slot, () => fetch(api.url(`/api/docs/${doc.id}/photo-from-e57`), {
-      method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ image: index, slot }) }));
+    await this.usePhoto(slot, () =>
+      fetch(api.url(`/api/docs/${doc.id}/photo-from-e57`), {
+        method: 'POST',
+        headers: { 'Content-Type': 'application/json' },
+        body: JSON.stringify({ image: index, slot }),
+      }),
+    );
   }
 
   private async usePhoto(slot: 'a' | 'b', send: () => Promise<Response>) {
@@ -158,7 +197,9 @@ export class PairsPanel {
       element('photo-panel').hidden = false;
       this.pairs.clear();
       this.update();
-      this.context.status(`photo loaded: pick ${MODES[this.pairs.mode].first}, then ${MODES[this.pairs.mode].second}`);
+      this.context.status(
+        `photo loaded: pick ${MODES[this.pairs.mode].first}, then ${MODES[this.pairs.mode].second}`,
+      );
     } catch (error) {
       this.context.status(`photo: ${(error as Error).message}`);
     }
@@ -171,28 +212,49 @@ export class PairsPanel {
     const api = this.context.api;
     try {
       if (mode === 'photo-scan') {
-        const finished = await this.context.runJob(`/api/docs/${doc.id}/recolor`, this.pairs.body(), 'recolour');
+        const finished = await this.context.runJob(
+          `/api/docs/${doc.id}/recolor`,
+          this.pairs.body(),
+          'recolour',
+        );
         // Each pair's residual after the resection: a pair far off is a wrong click (refuse it, pick again).
-        const result = finished?.result as { reprojection_error_px?: number[]; inlier?: number[]; rms_px?: number } | undefined;
+        const result = finished?.result as
+          { reprojection_error_px?: number[]; inlier?: number[]; rms_px?: number } | undefined;
         if (finished?.state === 'done' && result?.reprojection_error_px) {
           this.residuals = result.reprojection_error_px;
-          const list = result.reprojection_error_px.map((e, i) => `${i + 1}: ${e.toFixed(1)}${result.inlier?.[i] === 0 ? ' (outlier)' : ''}`).join(', ');
+          const list = result.reprojection_error_px
+            .map((e, i) => `${i + 1}: ${e.toFixed(1)}${result.inlier?.[i] === 0 ? ' (outlier)' : ''}`)
+            .join(', ');
           element('pairs').textContent = `${this.pairs.pairs.length} pairs`;
           element('pairs').title = `pair residuals (px): ${list}`;
-          this.context.status(`recolour: pair residuals (px) ${list}; RMS ${result.rms_px?.toFixed(2)} px. ${element('status').textContent}`);
+          this.context.status(
+            `recolour: pair residuals (px) ${list}; RMS ${result.rms_px?.toFixed(2)} px. ${element('status').textContent}`,
+          );
         }
       } else if (mode === 'scan-scan') {
         const target = Number(element<HTMLSelectElement>('align-target').value);
-        const result = await api.json<{ rms_m: number; residual_m: number[] }>(`/api/docs/${doc.id}/align`, {}, this.pairs.body({ target }));
+        const result = await api.json<{ rms_m: number; residual_m: number[] }>(
+          `/api/docs/${doc.id}/align`,
+          {},
+          this.pairs.body({ target }),
+        );
         await this.context.refresh();
-        this.context.status(`aligned to scan #${target}: ${this.pairs.pairs.length} landmarks, RMS ${(1000 * result.rms_m).toFixed(1)} mm (undo restores the pose)`);
+        this.context.status(
+          `aligned to scan #${target}: ${this.pairs.pairs.length} landmarks, RMS ${(1000 * result.rms_m).toFixed(1)} mm (undo restores the pose)`,
+        );
       } else {
         const model = element<HTMLSelectElement>('photo-model').value as 'homography' | 'fundamental';
-        const result = await api.json<{ rms_px: number; inlier: number[]; matrix_row_major: number[] }>(`/api/docs/${doc.id}/photo-match`, {}, this.pairs.body({ model }));
+        const result = await api.json<{ rms_px: number; inlier: number[]; matrix_row_major: number[] }>(
+          `/api/docs/${doc.id}/photo-match`,
+          {},
+          this.pairs.body({ model }),
+        );
         this.inliers = result.inlier;
         this.draw();
         const outliers = result.inlier.filter((v) => !v).length;
-        this.context.status(`${model}: RMS ${result.rms_px.toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => v.toPrecision(4)).join(' ')}`);
+        this.context.status(
+          `${model}: RMS ${result.rms_px.toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => v.toPrecision(4)).join(' ')}`,
+        );
       }
     } catch (error) {
       this.context.status(`${MODES[mode].action}: ${(error as Error).message}`);
@@ -208,15 +270,27 @@ export class PairsPanel {
     const mode = this.pairs.mode;
     const firsts = mode === 'scan-scan' ? [] : this.pairs.pairs.map((p) => p.first);
     const seconds = mode === 'photo-photo' ? this.pairs.pairs.map((p) => p.second) : [];
-    drawPhoto(element<HTMLCanvasElement>('photo'), this.photoA, firsts, mode === 'scan-scan' ? null : this.pairs.pending, this.inliers);
-    if (mode === 'photo-photo') drawPhoto(element<HTMLCanvasElement>('photo-b'), this.photoB, seconds, null, this.inliers);
+    drawPhoto(
+      element<HTMLCanvasElement>('photo'),
+      this.photoA,
+      firsts,
+      mode === 'scan-scan' ? null : this.pairs.pending,
+      this.inliers,
+    );
+    if (mode === 'photo-photo')
+      drawPhoto(element<HTMLCanvasElement>('photo-b'), this.photoB, seconds, null, this.inliers);
   }
 }
 
 // The photo scaled into its canvas, the pairs' pixels as yellow squares (red: an outlier of the last fit) and
 // the pending pixel outlined.
-function drawPhoto(canvas: HTMLCanvasElement, photo: HTMLImageElement | null, points: Point2[], pending: Point2 | null,
-                   inliers: number[] | null) {
+function drawPhoto(
+  canvas: HTMLCanvasElement,
+  photo: HTMLImageElement | null,
+  points: Point2[],
+  pending: Point2 | null,
+  inliers: number[] | null,
+) {
   const context = canvas.getContext('2d');
   if (!context || !photo || !photo.complete || canvas.hidden) return;
   canvas.width = Math.max(1, canvas.clientWidth);

@@ -22,7 +22,15 @@ export function visiblePoints(points: PointSet, hidden: Set<Layer>): PointSet {
   const keep: number[] = [];
   for (let i = 0; i < points.count; ++i) if (!hidden.has(layerOf(points.flags[i]))) keep.push(i);
   const n = keep.length;
-  const out: PointSet = { count: n, rows: points.rows, cols: points.cols, xyz: new Float32Array(3 * n), cells: new Uint32Array(n), rgb: new Uint8Array(3 * n), flags: new Uint8Array(n) };
+  const out: PointSet = {
+    count: n,
+    rows: points.rows,
+    cols: points.cols,
+    xyz: new Float32Array(3 * n),
+    cells: new Uint32Array(n),
+    rgb: new Uint8Array(3 * n),
+    flags: new Uint8Array(n),
+  };
   keep.forEach((i, k) => {
     out.xyz.set(points.xyz.subarray(3 * i, 3 * i + 3), 3 * k);
     out.rgb.set(points.rgb.subarray(3 * i, 3 * i + 3), 3 * k);
@@ -35,11 +43,14 @@ export function visiblePoints(points: PointSet, hidden: Set<Layer>): PointSet {
 // Where the ray image's centre looks: the point (scanner frame) of the cell nearest the image's centre cell
 // that has one; null without points.
 export function centrePoint(points: PointSet): [number, number, number] | null {
-  const row = Math.floor(points.rows / 2), col = Math.floor(points.cols / 2);
-  let best = -1, bestDistance = Infinity;
+  const row = Math.floor(points.rows / 2),
+    col = Math.floor(points.cols / 2);
+  let best = -1,
+    bestDistance = Infinity;
   for (let i = 0; i < points.count; ++i) {
     if (points.flags[i] & 4) continue; // the layer behind: not what the scanner saw
-    const r = Math.floor(points.cells[i] / points.cols), c = points.cells[i] % points.cols;
+    const r = Math.floor(points.cells[i] / points.cols),
+      c = points.cells[i] % points.cols;
     const distance = Math.abs(r - row) + Math.abs(c - col);
     if (distance < bestDistance) [best, bestDistance] = [i, distance];
   }
@@ -49,7 +60,8 @@ export function centrePoint(points: PointSet): [number, number, number] | null {
 // Per-point colours (0..1 RGB) for a colouring mode.
 export function pointColours(points: PointSet, mode: PointColouring): Float32Array {
   const colours = new Float32Array(points.count * 3);
-  let zMin = Infinity, zMax = -Infinity;
+  let zMin = Infinity,
+    zMax = -Infinity;
   if (mode === 'height') {
     for (let i = 0; i < points.count; ++i) {
       zMin = Math.min(zMin, points.xyz[3 * i + 2]);
@@ -57,10 +69,19 @@ export function pointColours(points: PointSet, mode: PointColouring): Float32Arr
     }
   }
   for (let i = 0; i < points.count; ++i) {
-    let r = points.rgb[3 * i] / 255, g = points.rgb[3 * i + 1] / 255, b = points.rgb[3 * i + 2] / 255;
+    let r = points.rgb[3 * i] / 255,
+      g = points.rgb[3 * i + 1] / 255,
+      b = points.rgb[3 * i + 2] / 255;
     if (mode === 'layers') {
       const flag = points.flags[i];
-      [r, g, b] = flag & FLAG_OBJECT ? [1, 0.55, 0.1] : flag & FLAG_FROM_STATION ? [0.35, 0.9, 0.3] : flag & FLAG_SYNTHESIZED ? [0.1, 0.9, 1] : [0.6, 0.6, 0.6];
+      [r, g, b] =
+        flag & FLAG_OBJECT
+          ? [1, 0.55, 0.1]
+          : flag & FLAG_FROM_STATION
+            ? [0.35, 0.9, 0.3]
+            : flag & FLAG_SYNTHESIZED
+              ? [0.1, 0.9, 1]
+              : [0.6, 0.6, 0.6];
     } else if (mode === 'height') {
       const t = zMax > zMin ? (points.xyz[3 * i + 2] - zMin) / (zMax - zMin) : 0.5;
       [r, g, b] = [t, 0.3 + 0.4 * (1 - Math.abs(2 * t - 1)), 1 - t];
@@ -77,7 +98,10 @@ export class PointView {
   private camera = new THREE.PerspectiveCamera(60, 1, 0.05, 2000);
   private controls: OrbitControls;
   private cloud: THREE.Points | null = null;
-  private marker = new THREE.Mesh(new THREE.SphereGeometry(0.08), new THREE.MeshBasicMaterial({ color: 0xffff00 }));
+  private marker = new THREE.Mesh(
+    new THREE.SphereGeometry(0.08),
+    new THREE.MeshBasicMaterial({ color: 0xffff00 }),
+  );
   private points: PointSet | null = null; // the points shown (the visible layers)
   private all: PointSet | null = null; // every point of the scan
   private hidden = new Set<Layer>();
@@ -119,7 +143,10 @@ export class PointView {
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(points.xyz, 3));
     geometry.setAttribute('color', new THREE.BufferAttribute(pointColours(points, this.mode), 3));
-    this.cloud = new THREE.Points(geometry, new THREE.PointsMaterial({ size: this.size, sizeAttenuation: false, vertexColors: true }));
+    this.cloud = new THREE.Points(
+      geometry,
+      new THREE.PointsMaterial({ size: this.size, sizeAttenuation: false, vertexColors: true }),
+    );
     this.scene.add(this.cloud);
     if (!keepCamera) {
       // From the scanner (the frame's origin), looking where the ray image's centre looks; orbiting turns
@@ -132,7 +159,11 @@ export class PointView {
         geometry.computeBoundingSphere();
         const sphere = geometry.boundingSphere!;
         this.controls.target.copy(sphere.center);
-        this.camera.position.set(sphere.center.x, sphere.center.y - sphere.radius * 0.9, sphere.center.z + sphere.radius * 0.5);
+        this.camera.position.set(
+          sphere.center.x,
+          sphere.center.y - sphere.radius * 0.9,
+          sphere.center.z + sphere.radius * 0.5,
+        );
       }
       this.controls.update();
     }
@@ -142,7 +173,10 @@ export class PointView {
   setColouring(mode: PointColouring) {
     this.mode = mode;
     if (this.points && this.cloud) {
-      this.cloud.geometry.setAttribute('color', new THREE.BufferAttribute(pointColours(this.points, mode), 3));
+      this.cloud.geometry.setAttribute(
+        'color',
+        new THREE.BufferAttribute(pointColours(this.points, mode), 3),
+      );
       this.render();
     }
   }
@@ -157,7 +191,10 @@ export class PointView {
   // consistent its pose is (green consistent, red not, grey unknown).
   showModel(mesh: MeshData, scannerFromModel: number[], consistency: number | null) {
     if (!this.model) {
-      this.model = new THREE.Mesh(new THREE.BufferGeometry(), new THREE.MeshBasicMaterial({ transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
+      this.model = new THREE.Mesh(
+        new THREE.BufferGeometry(),
+        new THREE.MeshBasicMaterial({ transparent: true, opacity: 0.55, side: THREE.DoubleSide }),
+      );
       this.model.matrixAutoUpdate = false;
       this.scene.add(this.model);
     }
@@ -170,7 +207,10 @@ export class PointView {
       this.model.userData.mesh = mesh;
     }
     this.model.matrix.fromArray(scannerFromModel);
-    const colour = consistency === null ? new THREE.Color(0.7, 0.7, 0.7) : new THREE.Color(1 - consistency, consistency, 0.1);
+    const colour =
+      consistency === null
+        ? new THREE.Color(0.7, 0.7, 0.7)
+        : new THREE.Color(1 - consistency, consistency, 0.1);
     (this.model.material as THREE.MeshBasicMaterial).color = colour;
     this.render();
   }
@@ -203,14 +243,22 @@ export class PointView {
     if (!this.points) return;
     const index = this.points.cells.indexOf(cell);
     this.marker.visible = index >= 0;
-    if (index >= 0) this.marker.position.set(this.points.xyz[3 * index], this.points.xyz[3 * index + 1], this.points.xyz[3 * index + 2]);
+    if (index >= 0)
+      this.marker.position.set(
+        this.points.xyz[3 * index],
+        this.points.xyz[3 * index + 1],
+        this.points.xyz[3 * index + 2],
+      );
     this.render();
   }
 
   private pickAt(event: MouseEvent) {
     if (!this.cloud || !this.points) return;
     const rect = this.renderer.domElement.getBoundingClientRect();
-    const mouse = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1, -((event.clientY - rect.top) / rect.height) * 2 + 1);
+    const mouse = new THREE.Vector2(
+      ((event.clientX - rect.left) / rect.width) * 2 - 1,
+      -((event.clientY - rect.top) / rect.height) * 2 + 1,
+    );
     const raycaster = new THREE.Raycaster();
     raycaster.params.Points = { threshold: 0.05 };
     raycaster.setFromCamera(mouse, this.camera);

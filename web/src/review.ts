@@ -51,11 +51,13 @@ export function groupCandidates(pending: PendingReview): ClusterGroup[] {
   return clusters.map((cluster) => {
     const members = cluster.members.map((index) => {
       const candidate = candidates[index];
-      if (!candidate || candidate.cluster !== cluster.index) throw new Error(`review: candidate ${index} is not in cluster ${cluster.index}`);
+      if (!candidate || candidate.cluster !== cluster.index)
+        throw new Error(`review: candidate ${index} is not in cluster ${cluster.index}`);
       return candidate;
     });
     const representative = candidates[cluster.representative];
-    if (!representative || representative.cluster !== cluster.index) throw new Error(`review: cluster ${cluster.index} has no representative`);
+    if (!representative || representative.cluster !== cluster.index)
+      throw new Error(`review: cluster ${cluster.index} has no representative`);
     return { cluster: cluster.index, representative, members, rank: representative.index + 1 };
   });
 }
@@ -81,5 +83,7 @@ export type ReviewChoice = { candidate: number } | { source: [number, number] };
 
 // The body of POST .../inpaint/review/decide.
 export function decisionBody(choice: ReviewChoice): Record<string, unknown> {
-  return 'candidate' in choice ? { candidate: choice.candidate } : { source: [choice.source[0], choice.source[1]] };
+  return 'candidate' in choice
+    ? { candidate: choice.candidate }
+    : { source: [choice.source[0], choice.source[1]] };
 }

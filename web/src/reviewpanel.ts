@@ -7,8 +7,12 @@ import { ClusterGroup, PendingReview, groupCandidates, patchRect, verdictText } 
 export class ReviewPanel {
   onAccept: (candidate: number) => void = () => {};
 
-  constructor(private root: HTMLElement, private target: HTMLCanvasElement, private tiles: HTMLElement,
-              private caption: HTMLElement) {}
+  constructor(
+    private root: HTMLElement,
+    private target: HTMLCanvasElement,
+    private tiles: HTMLElement,
+    private caption: HTMLElement,
+  ) {}
 
   hide() {
     this.root.hidden = true;
@@ -27,7 +31,8 @@ export class ReviewPanel {
     const context = this.target.getContext('2d')!;
     const window = 5 * (2 * radius + 1);
     const zoom = Math.max(1, Math.floor(this.target.width / window));
-    const x0 = review.target[1] - Math.floor(window / 2), y0 = review.target[0] - Math.floor(window / 2);
+    const x0 = review.target[1] - Math.floor(window / 2),
+      y0 = review.target[0] - Math.floor(window / 2);
     context.imageSmoothingEnabled = false;
     context.fillStyle = '#000';
     context.fillRect(0, 0, this.target.width, this.target.height);
@@ -43,7 +48,8 @@ export class ReviewPanel {
     const button = document.createElement('button');
     button.className = 'review-tile';
     button.dataset.candidate = String(group.representative.index);
-    const size = 2 * radius + 1, zoom = 6;
+    const size = 2 * radius + 1,
+      zoom = 6;
     const picture = document.createElement('canvas');
     picture.width = picture.height = size * zoom;
     const context = picture.getContext('2d')!;

@@ -47,12 +47,19 @@ export function viewFromStation(current: number[], station: number[]): number[] 
 }
 
 // Where each station stands in the shown scan's scanner frame (metres).
-export function stationPositionsInView(site: SiteInfo, worldFromCurrent: number[]): [number, number, number][] {
+export function stationPositionsInView(
+  site: SiteInfo,
+  worldFromCurrent: number[],
+): [number, number, number][] {
   const currentFromWorld = inverseRigid(worldFromCurrent);
   return site.stations.map((station) => {
     const [x, y, z] = station.position_m;
     const m = currentFromWorld;
-    return [m[0] * x + m[4] * y + m[8] * z + m[12], m[1] * x + m[5] * y + m[9] * z + m[13], m[2] * x + m[6] * y + m[10] * z + m[14]];
+    return [
+      m[0] * x + m[4] * y + m[8] * z + m[12],
+      m[1] * x + m[5] * y + m[9] * z + m[13],
+      m[2] * x + m[6] * y + m[10] * z + m[14],
+    ];
   });
 }
 
@@ -72,7 +79,8 @@ export function pointsOfCells(points: PointSet, cells: Iterable<number>): Float3
   const out: number[] = [];
   for (let i = 0; i < points.count; ++i) {
     if (points.flags[i] & 4) continue; // the layer behind a kept object
-    if (wanted.has(points.cells[i])) out.push(points.xyz[3 * i], points.xyz[3 * i + 1], points.xyz[3 * i + 2]);
+    if (wanted.has(points.cells[i]))
+      out.push(points.xyz[3 * i], points.xyz[3 * i + 1], points.xyz[3 * i + 2]);
   }
   return new Float32Array(out);
 }
@@ -92,21 +100,30 @@ export function cleanSummary(result: Record<string, unknown> | undefined): strin
   const stations = result.stations as CleanStationResult[];
   const here = Number(result.removed_cells ?? 0);
   const station = Number(result.station ?? -1);
-  const per = stations.map((s) => `station ${s.station}: ${s.removed}${s.changed ? '' : s.why ? ` (${s.why})` : ''}`).join(', ');
+  const per = stations
+    .map((s) => `station ${s.station}: ${s.removed}${s.changed ? '' : s.why ? ` (${s.why})` : ''}`)
+    .join(', ');
   const changed = stations.filter((s) => s.changed && s.station !== station).map((s) => `#${s.document}`);
-  const others = changed.length > 0 ? ` Scans ${changed.join(', ')} were cleaned too: each has its own undo.` : '';
+  const others =
+    changed.length > 0 ? ` Scans ${changed.join(', ')} were cleaned too: each has its own undo.` : '';
   return `clean: ${here} points removed here${station >= 0 ? ` (station ${station})` : ''} and filled; ${per}.${others}`;
 }
 
 // The status line after a fill from the other stations: the cells each gave, and what was synthesized.
 export function fillSummary(result: Record<string, unknown> | undefined): string {
   if (!result || !Array.isArray(result.stations)) return 'fill from stations: no result';
-  const per = (result.stations as { station: number; cells: number }[]).map((s) => `station ${s.station}: ${s.cells}`).join(', ');
+  const per = (result.stations as { station: number; cells: number }[])
+    .map((s) => `station ${s.station}: ${s.cells}`)
+    .join(', ');
   return `fill from stations: ${Number(result.from_station_cells ?? 0)} of ${Number(result.hole_cells ?? 0)} cells from other stations (${per}), ${Number(result.synthesized_cells ?? 0)} synthesized`;
 }
 
 // What Fill from stations fills: the painted hole, else the object cut from the strokes, else the last cut.
-export function fillHoleKind(doc: { hole_cells: number; object_stroke_cells: number; object_cells: number }): 'painted' | 'strokes' | 'object' {
+export function fillHoleKind(doc: {
+  hole_cells: number;
+  object_stroke_cells: number;
+  object_cells: number;
+}): 'painted' | 'strokes' | 'object' {
   if (doc.hole_cells > 0) return 'painted';
   if (doc.object_stroke_cells > 0) return 'strokes';
   return 'object';
@@ -135,8 +152,13 @@ export class StationsPanel {
   private othersVisible = false;
   private othersKey = '';
 
-  constructor(private host: StationsHost, private list: HTMLElement, private cleanButton: HTMLButtonElement,
-              private result: HTMLElement, private fillButton: HTMLButtonElement) {
+  constructor(
+    private host: StationsHost,
+    private list: HTMLElement,
+    private cleanButton: HTMLButtonElement,
+    private result: HTMLElement,
+    private fillButton: HTMLButtonElement,
+  ) {
     host.scene.add(this.markers, this.others);
     this.others.visible = false;
     cleanButton.addEventListener('click', () => this.clean());
@@ -178,8 +200,12 @@ export class StationsPanel {
     this.cleanButton.disabled = !site || site.stations.filter((s) => s.open).length < 2;
     this.fillButton.disabled = this.cleanButton.disabled;
     if (!site) {
-      this.list.replaceChildren(Object.assign(document.createElement('div'), {
-        className: 'stations-none', textContent: 'not part of a site (open a file of several scans or a site scene as a site)' }));
+      this.list.replaceChildren(
+        Object.assign(document.createElement('div'), {
+          className: 'stations-none',
+          textContent: 'not part of a site (open a file of several scans or a site scene as a site)',
+        }),
+      );
       return;
     }
     const items = site.stations.map((station) => {
@@ -188,15 +214,20 @@ export class StationsPanel {
       item.dataset.index = String(station.index);
       item.dataset.document = String(station.document);
       item.textContent = stationLabel(station);
-      item.title = `${station.rows} x ${station.cols} cells, ${station.returns} returns; scan #${station.document}` +
+      item.title =
+        `${station.rows} x ${station.cols} cells, ${station.returns} returns; scan #${station.document}` +
         (station.removed_cells ? `; ${station.removed_cells} removed by the last clean` : '');
-      if (station.open && !station.current) item.addEventListener('click', () => this.host.show(station.document));
+      if (station.open && !station.current)
+        item.addEventListener('click', () => this.host.show(station.document));
       return item;
     });
     const list = document.createElement('ol');
     list.className = 'stations';
     list.replaceChildren(...items);
-    this.list.replaceChildren(Object.assign(document.createElement('div'), { className: 'site-name', textContent: site.name }), list);
+    this.list.replaceChildren(
+      Object.assign(document.createElement('div'), { className: 'site-name', textContent: site.name }),
+      list,
+    );
   }
 
   private drawMarkers(doc: DocumentInfo) {
@@ -209,7 +240,10 @@ export class StationsPanel {
     this.site.stations.forEach((station, i) => {
       const colour = station.current ? 0xffee00 : STATION_COLOURS[station.index % STATION_COLOURS.length];
       // A tripod-like cone standing on the scanner's origin, and the index above it.
-      const cone = new THREE.Mesh(new THREE.ConeGeometry(0.25, 0.6, 12), new THREE.MeshBasicMaterial({ color: colour }));
+      const cone = new THREE.Mesh(
+        new THREE.ConeGeometry(0.25, 0.6, 12),
+        new THREE.MeshBasicMaterial({ color: colour }),
+      );
       cone.rotation.x = Math.PI / 2; // three.js cones point along +y; the view's up is +z
       cone.position.set(positions[i][0], positions[i][1], positions[i][2] - 0.3);
       this.markers.add(cone);
@@ -228,11 +262,16 @@ export class StationsPanel {
     this.removedShown = 0;
     const here = this.site?.stations.find((s) => s.current);
     if (!here || !here.removed_cells || !points) return;
-    const { cells } = await this.host.api.json<{ version: number; cells: number[] }>(`/api/docs/${doc.id}/removed`);
+    const { cells } = await this.host.api.json<{ version: number; cells: number[] }>(
+      `/api/docs/${doc.id}/removed`,
+    );
     const xyz = pointsOfCells(points, cells);
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(xyz, 3));
-    this.removed = new THREE.Points(geometry, new THREE.PointsMaterial({ color: 0xff00ff, size: 4, sizeAttenuation: false }));
+    this.removed = new THREE.Points(
+      geometry,
+      new THREE.PointsMaterial({ color: 0xff00ff, size: 4, sizeAttenuation: false }),
+    );
     this.removedShown = xyz.length / 3;
     this.host.scene.add(this.removed);
   }
@@ -252,10 +291,18 @@ export class StationsPanel {
       const points = await this.host.api.points(station.document);
       const geometry = new THREE.BufferGeometry();
       geometry.setAttribute('position', new THREE.BufferAttribute(points.xyz, 3));
-      const cloud = new THREE.Points(geometry, new THREE.PointsMaterial({
-        color: STATION_COLOURS[station.index % STATION_COLOURS.length], size: 1, sizeAttenuation: false }));
+      const cloud = new THREE.Points(
+        geometry,
+        new THREE.PointsMaterial({
+          color: STATION_COLOURS[station.index % STATION_COLOURS.length],
+          size: 1,
+          sizeAttenuation: false,
+        }),
+      );
       cloud.matrixAutoUpdate = false;
-      cloud.matrix.fromArray(viewFromStation(doc.world_from_scanner_column_major, station.world_from_scanner_column_major));
+      cloud.matrix.fromArray(
+        viewFromStation(doc.world_from_scanner_column_major, station.world_from_scanner_column_major),
+      );
       this.others.add(cloud);
     }
   }
@@ -263,7 +310,11 @@ export class StationsPanel {
   private async fill() {
     const doc = this.host.doc();
     if (!doc || !this.site) return;
-    const finished = await this.host.runJob(`/api/docs/${doc.id}/fill-from-stations`, { hole: fillHoleKind(doc) }, 'fill from stations');
+    const finished = await this.host.runJob(
+      `/api/docs/${doc.id}/fill-from-stations`,
+      { hole: fillHoleKind(doc) },
+      'fill from stations',
+    );
     if (finished?.state === 'done') {
       const summary = fillSummary(finished.result);
       this.result.textContent = summary;
@@ -301,7 +352,9 @@ function textSprite(text: string, colour: number): THREE.Sprite {
   context.textAlign = 'center';
   context.textBaseline = 'middle';
   context.fillText(text, 32, 34);
-  const sprite = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(canvas), depthTest: false }));
+  const sprite = new THREE.Sprite(
+    new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(canvas), depthTest: false }),
+  );
   sprite.scale.set(0.8, 0.8, 1);
   return sprite;
 }

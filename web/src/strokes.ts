@@ -9,15 +9,23 @@ export interface Cell {
 export function cellsAlong(a: Cell, b: Cell): Cell[] {
   const cells: Cell[] = [];
   let { row, col } = a;
-  const dRow = Math.abs(b.row - a.row), dCol = Math.abs(b.col - a.col);
-  const sRow = a.row < b.row ? 1 : -1, sCol = a.col < b.col ? 1 : -1;
+  const dRow = Math.abs(b.row - a.row),
+    dCol = Math.abs(b.col - a.col);
+  const sRow = a.row < b.row ? 1 : -1,
+    sCol = a.col < b.col ? 1 : -1;
   let error = dCol - dRow;
   for (;;) {
     cells.push({ row, col });
     if (row === b.row && col === b.col) break;
     const twice = 2 * error;
-    if (twice > -dRow) { error -= dRow; col += sCol; }
-    if (twice < dCol) { error += dCol; row += sRow; }
+    if (twice > -dRow) {
+      error -= dRow;
+      col += sCol;
+    }
+    if (twice < dCol) {
+      error += dCol;
+      row += sRow;
+    }
   }
   return cells;
 }
@@ -39,20 +47,39 @@ export function screenToCell(view: ImageView, x: number, y: number, rows: number
 }
 
 export function cellToScreen(view: ImageView, cell: Cell): { x: number; y: number } {
-  return { x: view.offsetX + (cell.col + 0.5) * view.scale, y: view.offsetY + (cell.row + 0.5) * view.scale * view.aspect };
+  return {
+    x: view.offsetX + (cell.col + 0.5) * view.scale,
+    y: view.offsetY + (cell.row + 0.5) * view.scale * view.aspect,
+  };
 }
 
 // Zooms by `factor` keeping the screen point (x, y) over the same cell.
 export function zoomAt(view: ImageView, factor: number, x: number, y: number): ImageView {
   const scale = Math.min(64, Math.max(0.05, view.scale * factor));
   const applied = scale / view.scale;
-  return { ...view, scale, offsetX: x - (x - view.offsetX) * applied, offsetY: y - (y - view.offsetY) * applied };
+  return {
+    ...view,
+    scale,
+    offsetX: x - (x - view.offsetX) * applied,
+    offsetY: y - (y - view.offsetY) * applied,
+  };
 }
 
 // The view that fits a rows x cols image into a width x height canvas, centred.
-export function fitView(rows: number, cols: number, aspect: number, width: number, height: number): ImageView {
+export function fitView(
+  rows: number,
+  cols: number,
+  aspect: number,
+  width: number,
+  height: number,
+): ImageView {
   const scale = Math.min(width / cols, height / (rows * aspect));
-  return { scale, aspect, offsetX: (width - cols * scale) / 2, offsetY: (height - rows * aspect * scale) / 2 };
+  return {
+    scale,
+    aspect,
+    offsetX: (width - cols * scale) / 2,
+    offsetY: (height - rows * aspect * scale) / 2,
+  };
 }
 
 // Stroke cells as the API's [[row, col], ...] lists, without repeats.

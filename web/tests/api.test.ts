@@ -1,5 +1,14 @@
 import { describe, expect, it } from 'vitest';
-import { Api, FLAG_OBJECT, FLAG_SYNTHESIZED, JobInfo, fileLabel, firstReadableFile, parsePoints, resultWarnings } from '../src/api';
+import {
+  Api,
+  FLAG_OBJECT,
+  FLAG_SYNTHESIZED,
+  JobInfo,
+  fileLabel,
+  firstReadableFile,
+  parsePoints,
+  resultWarnings,
+} from '../src/api';
 import { pointColours } from '../src/pointview';
 
 function encode(points: { xyz: number[]; cell: number; rgb: number[]; flag: number }[], rows = 4, cols = 5) {
@@ -49,11 +58,15 @@ describe('parsePoints', () => {
 describe('Api', () => {
   it('puts the token on every URL', () => {
     const api = Api.fromLocation({ search: '?token=abc123', origin: 'http://127.0.0.1:9' });
-    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range&token=abc123');
+    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe(
+      'http://127.0.0.1:9/api/docs/3/image.png?channel=range&token=abc123',
+    );
   });
   it('leaves the token out when the page has none (its cookie carries it)', () => {
     const api = Api.fromLocation({ search: '', origin: 'http://127.0.0.1:9' });
-    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe('http://127.0.0.1:9/api/docs/3/image.png?channel=range');
+    expect(api.url('/api/docs/3/image.png', { channel: 'range' })).toBe(
+      'http://127.0.0.1:9/api/docs/3/image.png?channel=range',
+    );
     expect(api.url('/api/health')).toBe('http://127.0.0.1:9/api/health');
   });
 });
@@ -67,7 +80,9 @@ describe('poses', () => {
     expect(x[0]).toBeCloseTo(0);
     expect(x[1]).toBeCloseTo(1); // the model's x axis points along world y
     const identity = multiply(inverseRigid(pose), pose);
-    identity.forEach((value, i) => expect(value).toBeCloseTo([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]));
+    identity.forEach((value, i) =>
+      expect(value).toBeCloseTo([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i]),
+    );
   });
   it('reads a mesh and refuses a wrong size', () => {
     const buffer = new ArrayBuffer(16 + 3 * 12 + 12);
@@ -83,9 +98,19 @@ describe('poses', () => {
 });
 
 describe('resultWarnings', () => {
-  const job = (result?: Record<string, unknown>): JobInfo => ({ id: 1, kind: 'fill', state: 'done', label: '', done: 1, total: 1, result });
+  const job = (result?: Record<string, unknown>): JobInfo => ({
+    id: 1,
+    kind: 'fill',
+    state: 'done',
+    label: '',
+    done: 1,
+    total: 1,
+    result,
+  });
   it('reads the result warnings, once each', () => {
-    expect(resultWarnings(job({ warnings: ['the hole mask is empty', 'the hole mask is empty'] }))).toEqual(['the hole mask is empty']);
+    expect(resultWarnings(job({ warnings: ['the hole mask is empty', 'the hole mask is empty'] }))).toEqual([
+      'the hole mask is empty',
+    ]);
   });
   it('gives none for a result without warnings, an empty list or no result', () => {
     expect(resultWarnings(job({ object_cells: 3 }))).toEqual([]);

@@ -2,12 +2,20 @@ import { describe, expect, it } from 'vitest';
 import { PointSet } from '../src/api';
 import { FLAG_BEHIND, VersionGate, applyDelta, parseDelta, parsePointsAnswer } from '../src/delta';
 
-interface Row { key: number; xyz: number[]; rgb: number[]; flag: number; present?: boolean }
+interface Row {
+  key: number;
+  xyz: number[];
+  rgb: number[];
+  flag: number;
+  present?: boolean;
+}
 
 function points(rows: Row[]): PointSet {
   const n = rows.length;
   return {
-    count: n, rows: 4, cols: 5,
+    count: n,
+    rows: 4,
+    cols: 5,
     xyz: new Float32Array(rows.flatMap((r) => r.xyz)),
     cells: new Uint32Array(rows.map((r) => r.key & 0x7fffffff)),
     rgb: new Uint8Array(rows.flatMap((r) => r.rgb)),
@@ -28,7 +36,13 @@ function encodeDelta(rows: Row[], from = 3, to = 5) {
   return buffer;
 }
 
-const row = (key: number, v: number, flag = 0, present = true): Row => ({ key, xyz: [v, v + 1, v + 2], rgb: [v, v, v], flag, present });
+const row = (key: number, v: number, flag = 0, present = true): Row => ({
+  key,
+  xyz: [v, v + 1, v + 2],
+  rgb: [v, v, v],
+  flag,
+  present,
+});
 const behind = 0x80000000;
 
 describe('deltas', () => {
@@ -41,15 +55,23 @@ describe('deltas', () => {
     expect('delta' in parsePointsAnswer(encodeDelta([]))).toBe(true);
   });
   it('adds, replaces and removes cells in key order, both layers', () => {
-    const before = points([row(1, 10), row(4, 40), row(9, 90), row(behind + 1, 11, FLAG_BEHIND), row(behind + 4, 44, FLAG_BEHIND)]);
-    const delta = parseDelta(encodeDelta([
-      row(0, 1),                                  // added before every point
-      row(4, 0, 0, false),                        // removed
-      row(9, 99, 2),                              // replaced (now in the object)
-      row(12, 120),                               // added between the layers
-      row(behind + 2, 22, FLAG_BEHIND),           // added behind
-      row(behind + 4, 0, FLAG_BEHIND, false),     // removed behind
-    ]));
+    const before = points([
+      row(1, 10),
+      row(4, 40),
+      row(9, 90),
+      row(behind + 1, 11, FLAG_BEHIND),
+      row(behind + 4, 44, FLAG_BEHIND),
+    ]);
+    const delta = parseDelta(
+      encodeDelta([
+        row(0, 1), // added before every point
+        row(4, 0, 0, false), // removed
+        row(9, 99, 2), // replaced (now in the object)
+        row(12, 120), // added between the layers
+        row(behind + 2, 22, FLAG_BEHIND), // added behind
+        row(behind + 4, 0, FLAG_BEHIND, false), // removed behind
+      ]),
+    );
     const after = applyDelta(before, delta);
     expect(Array.from(after.cells)).toEqual([0, 1, 9, 12, 1, 2]);
     expect(Array.from(after.flags)).toEqual([0, 0, 2, 0, FLAG_BEHIND, FLAG_BEHIND]);
@@ -70,8 +92,8 @@ describe('VersionGate', () => {
     const gate = new VersionGate();
     expect(gate.accept(1, 5)).toBe(true);
     expect(gate.accept(1, 4)).toBe(false); // a slow refresh that finished late
-    expect(gate.accept(1, 5)).toBe(true);  // the same version again is fine
-    expect(gate.accept(2, 0)).toBe(true);  // another document has its own order
+    expect(gate.accept(1, 5)).toBe(true); // the same version again is fine
+    expect(gate.accept(2, 0)).toBe(true); // another document has its own order
     gate.forget(1);
     expect(gate.accept(1, 0)).toBe(true);
     expect(gate.version(1)).toBe(0);

@@ -19,12 +19,18 @@ describe('PairCollector', () => {
     const landmarks = new PairCollector('scan-scan');
     landmarks.first([3, 4]);
     landmarks.second([5, 6]);
-    expect(landmarks.body({ target: 2 })).toEqual({ target: 2, pairs: [{ cell: [3, 4], target_cell: [5, 6] }] });
+    expect(landmarks.body({ target: 2 })).toEqual({
+      target: 2,
+      pairs: [{ cell: [3, 4], target_cell: [5, 6] }],
+    });
     expect(() => landmarks.body()).toThrow(/other scan/);
     const photos = new PairCollector('photo-photo');
     photos.first([1, 2]);
     photos.second([3, 4]);
-    expect(photos.body({ model: 'fundamental' })).toEqual({ model: 'fundamental', pairs: [{ pixel_a: [1, 2], pixel_b: [3, 4] }] });
+    expect(photos.body({ model: 'fundamental' })).toEqual({
+      model: 'fundamental',
+      pairs: [{ pixel_a: [1, 2], pixel_b: [3, 4] }],
+    });
     expect(photos.body().model).toBe('homography');
   });
   it('knows when there are enough pairs and undoes the last click', () => {

@@ -1,19 +1,46 @@
 import { describe, expect, it } from 'vitest';
-import { PendingReview, decisionBody, groupCandidates, patchInside, patchRect, verdictText } from '../src/review';
+import {
+  PendingReview,
+  decisionBody,
+  groupCandidates,
+  patchInside,
+  patchRect,
+  verdictText,
+} from '../src/review';
 
 function candidate(index: number, cluster: number, accepted = false) {
-  return { index, source: [10 + index, 20] as [number, number], difference: 100 * (index + 1), cluster, accepted,
-           test: 'histogram', value: 0.31, threshold: 0.15, margin: -1.07 };
+  return {
+    index,
+    source: [10 + index, 20] as [number, number],
+    difference: 100 * (index + 1),
+    cluster,
+    accepted,
+    test: 'histogram',
+    value: 0.31,
+    threshold: 0.15,
+    margin: -1.07,
+  };
 }
 
 function pending(): PendingReview {
   return {
-    state: 'review', channel: 'color', rows: 60, cols: 90, hole_cells: 300, decisions: [],
+    state: 'review',
+    channel: 'color',
+    rows: 60,
+    cols: 90,
+    hole_cells: 300,
+    decisions: [],
     review: {
-      review_point: 0, iteration: 12, target: [44, 15], patch_radius: 4,
+      review_point: 0,
+      iteration: 12,
+      target: [44, 15],
+      patch_radius: 4,
       candidates: [candidate(0, 0), candidate(1, 1), candidate(2, 0), candidate(3, 2), candidate(4, 1)],
-      clusters: [{ index: 0, representative: 0, members: [0, 2] }, { index: 1, representative: 1, members: [1, 4] },
-                 { index: 2, representative: 3, members: [3] }],
+      clusters: [
+        { index: 0, representative: 0, members: [0, 2] },
+        { index: 1, representative: 1, members: [1, 4] },
+        { index: 2, representative: 3, members: [3] },
+      ],
     },
   };
 }

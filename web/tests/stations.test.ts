@@ -1,13 +1,43 @@
 import { describe, expect, it } from 'vitest';
 import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, poseMatrix, PointSet } from '../src/api';
 import { layerOf, pointColours, visiblePoints } from '../src/pointview';
-import { SiteInfo, StationInfo, centroid, cleanSummary, fillHoleKind, fillSummary, pointsOfCells, stationLabel, stationPositionsInView, viewFromStation } from '../src/stations';
+import {
+  SiteInfo,
+  StationInfo,
+  centroid,
+  cleanSummary,
+  fillHoleKind,
+  fillSummary,
+  pointsOfCells,
+  stationLabel,
+  stationPositionsInView,
+  viewFromStation,
+} from '../src/stations';
 
-function station(index: number, x: number, y: number, yawDeg: number, extra: Partial<StationInfo> = {}): StationInfo {
+function station(
+  index: number,
+  x: number,
+  y: number,
+  yawDeg: number,
+  extra: Partial<StationInfo> = {},
+): StationInfo {
   return {
-    index, name: `station${index}`, position_m: [x, y, 1.6], heading_deg: yawDeg,
-    world_from_scanner_column_major: (() => { const m = poseMatrix(x, y, 1.6, yawDeg); return m; })(),
-    rows: 10, cols: 20, returns: 150, organized: true, document: 10 + index, open: true, current: index === 0, ...extra,
+    index,
+    name: `station${index}`,
+    position_m: [x, y, 1.6],
+    heading_deg: yawDeg,
+    world_from_scanner_column_major: (() => {
+      const m = poseMatrix(x, y, 1.6, yawDeg);
+      return m;
+    })(),
+    rows: 10,
+    cols: 20,
+    returns: 150,
+    organized: true,
+    document: 10 + index,
+    open: true,
+    current: index === 0,
+    ...extra,
   };
 }
 
@@ -16,12 +46,19 @@ describe('stationLabel', () => {
     expect(stationLabel(station(2, 8, 2, 30))).toBe('2 · station2 · (8.0, 2.0, 1.6) m · 30°');
   });
   it('names a station without a name by its scan, and says when it is closed', () => {
-    expect(stationLabel(station(1, -8, 2, -30, { name: '', open: false }))).toBe('1 · scan #11 · (-8.0, 2.0, 1.6) m · -30° (closed)');
+    expect(stationLabel(station(1, -8, 2, -30, { name: '', open: false }))).toBe(
+      '1 · scan #11 · (-8.0, 2.0, 1.6) m · -30° (closed)',
+    );
   });
 });
 
-describe('stations in the shown scan\'s frame', () => {
-  const site: SiteInfo = { site: 1, name: 's', station: 1, stations: [station(0, 0, 0, 0), station(1, -8, 2, -30), station(2, 8, 2, 30)] };
+describe("stations in the shown scan's frame", () => {
+  const site: SiteInfo = {
+    site: 1,
+    name: 's',
+    station: 1,
+    stations: [station(0, 0, 0, 0), station(1, -8, 2, -30), station(2, 8, 2, 30)],
+  };
   it('puts the shown station at the origin and the others where they stand from it', () => {
     const positions = stationPositionsInView(site, site.stations[1].world_from_scanner_column_major);
     expect(positions[1].map((v) => Math.abs(v) < 1e-9)).toEqual([true, true, true]);
@@ -29,27 +66,36 @@ describe('stations in the shown scan\'s frame', () => {
     const d = Math.hypot(positions[0][0], positions[0][1]);
     expect(d).toBeCloseTo(Math.hypot(8, 2), 9);
     expect(positions[0][2]).toBeCloseTo(0, 9);
-    const c = Math.cos(-30 * Math.PI / 180), s = Math.sin(-30 * Math.PI / 180);
+    const c = Math.cos((-30 * Math.PI) / 180),
+      s = Math.sin((-30 * Math.PI) / 180);
     // current_from_world rotation is R^T: x' = c*dx + s*dy, y' = -s*dx + c*dy.
     expect(positions[0][0]).toBeCloseTo(c * 8 + s * -2, 9);
     expect(positions[0][1]).toBeCloseTo(-s * 8 + c * -2, 9);
   });
   it('maps a point of another station into the shown frame as the poses say', () => {
-    const m = viewFromStation(site.stations[1].world_from_scanner_column_major, site.stations[2].world_from_scanner_column_major);
+    const m = viewFromStation(
+      site.stations[1].world_from_scanner_column_major,
+      site.stations[2].world_from_scanner_column_major,
+    );
     // The origin of station 2 lands where stationPositionsInView puts it.
     const positions = stationPositionsInView(site, site.stations[1].world_from_scanner_column_major);
     expect(m[12]).toBeCloseTo(positions[2][0], 9);
     expect(m[13]).toBeCloseTo(positions[2][1], 9);
     expect(m[14]).toBeCloseTo(positions[2][2], 9);
     // Identity for the station itself.
-    const self = viewFromStation(site.stations[2].world_from_scanner_column_major, site.stations[2].world_from_scanner_column_major);
+    const self = viewFromStation(
+      site.stations[2].world_from_scanner_column_major,
+      site.stations[2].world_from_scanner_column_major,
+    );
     self.forEach((v, i) => expect(v).toBeCloseTo([1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1][i], 9));
   });
 });
 
 describe('pointsOfCells', () => {
   const points: PointSet = {
-    count: 4, rows: 2, cols: 3,
+    count: 4,
+    rows: 2,
+    cols: 3,
     xyz: new Float32Array([0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]),
     cells: new Uint32Array([0, 2, 4, 4]),
     rgb: new Uint8Array(12),
@@ -72,7 +118,9 @@ describe('centroid', () => {
 describe('cleanSummary', () => {
   it('says how many went here, per station, and which other scans changed', () => {
     const text = cleanSummary({
-      station: 2, removed_cells: 1234, version: 3,
+      station: 2,
+      removed_cells: 1234,
+      version: 3,
       stations: [
         { station: 0, document: 4, removed: 0, filled: 0, changed: false, why: 'nothing moved here' },
         { station: 1, document: 5, removed: 12, filled: 12, changed: true },
@@ -92,8 +140,12 @@ describe('cleanSummary', () => {
 
 describe('the layer of points filled from other stations', () => {
   const points: PointSet = {
-    count: 4, rows: 1, cols: 4,
-    xyz: new Float32Array(12), cells: new Uint32Array([0, 1, 2, 3]), rgb: new Uint8Array(12),
+    count: 4,
+    rows: 1,
+    cols: 4,
+    xyz: new Float32Array(12),
+    cells: new Uint32Array([0, 1, 2, 3]),
+    rgb: new Uint8Array(12),
     flags: new Uint8Array([0, FLAG_SYNTHESIZED, FLAG_FROM_STATION, FLAG_FROM_STATION | FLAG_OBJECT]),
   };
   it('is its own layer, distinct from synthesized, the object first', () => {
@@ -118,8 +170,17 @@ describe('fill from stations', () => {
     expect(fillHoleKind({ hole_cells: 0, object_stroke_cells: 0, object_cells: 2 })).toBe('object');
   });
   it('says what each station gave and what was synthesized', () => {
-    const text = fillSummary({ hole_cells: 100, from_station_cells: 70, synthesized_cells: 30,
-      stations: [{ station: 0, cells: 50 }, { station: 1, cells: 20 }] });
-    expect(text).toBe('fill from stations: 70 of 100 cells from other stations (station 0: 50, station 1: 20), 30 synthesized');
+    const text = fillSummary({
+      hole_cells: 100,
+      from_station_cells: 70,
+      synthesized_cells: 30,
+      stations: [
+        { station: 0, cells: 50 },
+        { station: 1, cells: 20 },
+      ],
+    });
+    expect(text).toBe(
+      'fill from stations: 70 of 100 cells from other stations (station 0: 50, station 1: 20), 30 synthesized',
+    );
   });
 });

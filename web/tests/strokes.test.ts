@@ -22,7 +22,11 @@ describe('views', () => {
   it('maps cells to the screen and back, with square angular pixels', () => {
     const view = fitView(100, 400, 0.5, 800, 600);
     expect(view.scale).toBe(2);
-    for (const cell of [{ row: 0, col: 0 }, { row: 57, col: 311 }, { row: 99, col: 399 }]) {
+    for (const cell of [
+      { row: 0, col: 0 },
+      { row: 57, col: 311 },
+      { row: 99, col: 399 },
+    ]) {
       const { x, y } = cellToScreen(view, cell);
       expect(screenToCell(view, x, y, 100, 400)).toEqual(cell);
     }
@@ -39,6 +43,15 @@ describe('views', () => {
 
 describe('toCellList', () => {
   it('drops repeats', () => {
-    expect(toCellList([{ row: 1, col: 2 }, { row: 1, col: 2 }, { row: 2, col: 1 }])).toEqual([[1, 2], [2, 1]]);
+    expect(
+      toCellList([
+        { row: 1, col: 2 },
+        { row: 1, col: 2 },
+        { row: 2, col: 1 },
+      ]),
+    ).toEqual([
+      [1, 2],
+      [2, 1],
+    ]);
   });
 });
