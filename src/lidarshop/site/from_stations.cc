@@ -113,21 +113,6 @@ struct Station {
   explicit Station(const Scan& s) : scan(&s), grid(s) {}
 };
 
-// Drops 8-connected regions of `mask` smaller than `min_cells`.
-cv::Mat WithoutSmallRegions(const cv::Mat& mask, int min_cells) {
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  std::vector<uint8_t> keep(count, 0);
-  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_cells ? 255 : 0;
-  cv::Mat out(mask.size(), CV_8U);
-  for (int r = 0; r < mask.rows; ++r) {
-    const int32_t* l = labels.ptr<int32_t>(r);
-    uint8_t* o = out.ptr<uint8_t>(r);
-    for (int c = 0; c < mask.cols; ++c) o[c] = keep[l[c]];
-  }
-  return out;
-}
-
 // Step 1 of the header: the removed object as `station` saw it, and the box (scan frame) it stays in.
 void MarkObject(const Scan& scan, const GridLookup& scan_grid, const cv::Mat& object_in_scan,
                 const cv::Mat& hole, const Eigen::AlignedBox3d& object_box, const FromStationsOptions& o,

@@ -1,5 +1,6 @@
 // Internal to the site module: where a direction of a station's scanner frame falls on its grid (the
-// nearest cell), shared by the transient test and the fill from other stations.
+// nearest cell), and the small-region filter of a grid mask; shared by the transient test and the fill from
+// other stations.
 #pragma once
 
 #include <algorithm>
@@ -8,10 +9,26 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/imgproc.hpp>
 
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop {
+
+// `mask` (CV_8U) without its 8-connected regions smaller than `min_cells`: 255 where a kept region is.
+inline cv::Mat WithoutSmallRegions(const cv::Mat& mask, int min_cells) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  std::vector<uint8_t> keep(count, 0);
+  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_cells ? 255 : 0;
+  cv::Mat out(mask.size(), CV_8U);
+  for (int r = 0; r < mask.rows; ++r) {
+    const int32_t* l = labels.ptr<int32_t>(r);
+    uint8_t* o = out.ptr<uint8_t>(r);
+    for (int c = 0; c < mask.cols; ++c) o[c] = keep[l[c]];
+  }
+  return out;
+}
 
 // Where a direction of a station's scanner frame falls on its grid.
 class GridLookup {

@@ -113,21 +113,6 @@ cv::Mat EvidenceFrom(const Scan& a, const Scan& b, const GridLookup& b_grid, con
   return evidence;
 }
 
-// Drops regions of `mask` smaller than `min_cells` (8-connected).
-cv::Mat WithoutSmallRegions(const cv::Mat& mask, int min_cells) {
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  std::vector<uint8_t> keep(count, 0);
-  for (int i = 1; i < count; ++i) keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= min_cells ? 255 : 0;
-  cv::Mat out(mask.size(), CV_8U);
-  for (int r = 0; r < mask.rows; ++r) {
-    const int32_t* l = labels.ptr<int32_t>(r);
-    uint8_t* o = out.ptr<uint8_t>(r);
-    for (int c = 0; c < mask.cols; ++c) o[c] = keep[l[c]];
-  }
-  return out;
-}
-
 // Grows the non-zero cells of `reason` by one cell at a time, `steps` times, into valid cells that no station
 // confirmed and whose range is within `max_jump` (relative) of a neighbour already in; a grown cell takes that
 // neighbour's reason (the first in row order). Sequential, so the result does not depend on threads.
