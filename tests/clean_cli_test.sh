@@ -44,27 +44,11 @@ json_check "the sedan goes from station 2, nothing much from 0 and 1" "$work/sit
   "len(d['stations']) == 3 and d['stations'][2]['removed'] > 100 and \
    d['stations'][0]['removed'] < 20 and d['stations'][1]['removed'] < 20"
 check "what was removed from station 2 is the sedan" python3 -c "
-import struct, sys, zlib
-def png(path):  # 8- or 16-bit grey PNG, no interlace, as lidarshop writes them
-    data = open(path, 'rb').read(); pos = 8; chunks = b''; width = height = depth = 0
-    while pos < len(data):
-        n = struct.unpack('>I', data[pos:pos + 4])[0]; kind = data[pos + 4:pos + 8]; body = data[pos + 8:pos + 8 + n]
-        if kind == b'IHDR': width, height, depth = struct.unpack('>IIB', body[:9])
-        if kind == b'IDAT': chunks += body
-        pos += 12 + n
-    raw = zlib.decompress(chunks); bpp = depth // 8; stride = width * bpp; rows = []; prev = bytearray(stride)
-    for r in range(height):
-        f = raw[r * (stride + 1)]; line = bytearray(raw[r * (stride + 1) + 1:(r + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - bpp] if i >= bpp else 0; b = prev[i]; c = prev[i - bpp] if i >= bpp else 0
-            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            line[i] = (line[i] + [0, a, b, (a + b) // 2, a if pa <= pb and pa <= pc else (b if pb <= pc else c)][f]) & 255
-        rows.append([int.from_bytes(line[i * bpp:(i + 1) * bpp], 'big') for i in range(width)]); prev = line
-    return rows
+import sys; sys.path.insert(0, sys.argv[3]); from png_grey import read as png
 removed, labels = png(sys.argv[1]), png(sys.argv[2])
 cells = [labels[r][c] for r in range(len(removed)) for c in range(len(removed[0])) if removed[r][c]]
 sedan = sum(1 for l in cells if l == 7)
 assert cells and sedan >= 0.9 * len(cells), (len(cells), sedan)
-" "$work/site_clean/site_2_removed.png" "$work/site_labels_2.png"
+" "$work/site_clean/site_2_removed.png" "$work/site_labels_2.png" "$(dirname "$0")"
 
 finish

@@ -9,34 +9,9 @@ source "$(dirname "$0")/cli_fixture.sh"
 check "scan the built-in site" "$lidarshop" scan parking_lot_stations --rows 160 --columns 320 -o "$work/site.e57" \
   --labels "$work/labels.png" --quiet
 
-# Reads and writes 8- and 16-bit grey PNGs (no interlace), as lidarshop writes them.
-cat >"$work/png.py" <<'PY'
-import struct, zlib
-def read(path):
-    data = open(path, 'rb').read(); pos = 8; chunks = b''; width = height = depth = 0
-    while pos < len(data):
-        n = struct.unpack('>I', data[pos:pos + 4])[0]; kind = data[pos + 4:pos + 8]; body = data[pos + 8:pos + 8 + n]
-        if kind == b'IHDR': width, height, depth = struct.unpack('>IIB', body[:9])
-        if kind == b'IDAT': chunks += body
-        pos += 12 + n
-    raw = zlib.decompress(chunks); bpp = depth // 8; stride = width * bpp; rows = []; prev = bytearray(stride)
-    for r in range(height):
-        f = raw[r * (stride + 1)]; line = bytearray(raw[r * (stride + 1) + 1:(r + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - bpp] if i >= bpp else 0; b = prev[i]; c = prev[i - bpp] if i >= bpp else 0
-            p = a + b - c; pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-            line[i] = (line[i] + [0, a, b, (a + b) // 2, a if pa <= pb and pa <= pc else (b if pb <= pc else c)][f]) & 255
-        rows.append([int.from_bytes(line[i * bpp:(i + 1) * bpp], 'big') for i in range(width)]); prev = line
-    return rows
-def write(path, rows):
-    raw = b''.join(b'\0' + bytes(row) for row in rows)
-    chunk = lambda kind, body: struct.pack('>I', len(body)) + kind + body + struct.pack('>I', zlib.crc32(kind + body))
-    open(path, 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', len(rows[0]), len(rows), 8, 0, 0, 0, 0))
-                           + chunk(b'IDAT', zlib.compress(raw)) + chunk(b'IEND', b''))
-PY
 # The hatchback's cells of station 0 grown by 2 cells: the hole; and strokes on it and on the ground.
 check "the hatchback's hole and strokes" python3 -c "
-import json, sys; sys.path.insert(0, sys.argv[1]); import png
+import json, sys; sys.path.insert(0, sys.argv[1]); import png_grey as png
 labels = png.read(sys.argv[2]); h, w = len(labels), len(labels[0])
 car = {(r, c) for r in range(h) for c in range(w) if labels[r][c] == 3}
 assert len(car) > 200, len(car)
@@ -47,7 +22,7 @@ rows = sorted(r for r, c in car); r0 = rows[len(rows) // 2]; cols = sorted(c for
 json.dump({'strokes': [{'label': 'object', 'width': 3, 'points': [[cols[2], r0], [cols[-3], r0]]},
                        {'label': 'background', 'width': 2, 'points': [[5, h - 4], [w - 5, h - 4]]}]},
           open(sys.argv[4], 'w'))
-" "$work" "$work/labels_0.png" "$work/hole.png" "$work/strokes.json"
+" "$(dirname "$0")" "$work/labels_0.png" "$work/hole.png" "$work/strokes.json"
 
 check "fill from station 2" "$lidarshop" fill "$work/site.e57#0" --mask "$work/hole.png" --stations "$work/site.e57#2" \
   -o "$work/filled.e57" --from-stations-mask "$work/from.png" --synthesized-mask "$work/synth.png" \
@@ -63,14 +38,14 @@ import json, sys; a = json.load(open(sys.argv[1])); s = json.load(open(sys.argv[
 assert s['synthesized_cells'] < 0.8 * a['synthesized_cells'], (s['synthesized_cells'], a['synthesized_cells'])
 " "$work/alone.json" "$work/fill.json"
 check "the masks: from-station and synthesized cells apart, inside the hole" python3 -c "
-import json, sys; sys.path.insert(0, sys.argv[1]); import png
+import json, sys; sys.path.insert(0, sys.argv[1]); import png_grey as png
 hole, from_, synth = png.read(sys.argv[2]), png.read(sys.argv[3]), png.read(sys.argv[4]); d = json.load(open(sys.argv[5]))
 cells = [(r, c) for r in range(len(hole)) for c in range(len(hole[0]))]
 assert sum(1 for r, c in cells if from_[r][c]) == d['from_station_cells']
 assert sum(1 for r, c in cells if synth[r][c]) == d['synthesized_cells']
 assert not any(from_[r][c] and synth[r][c] for r, c in cells)
 assert not any((from_[r][c] or synth[r][c]) and not hole[r][c] for r, c in cells)
-" "$work" "$work/hole.png" "$work/from.png" "$work/synth.png" "$work/fill.json"
+" "$(dirname "$0")" "$work/hole.png" "$work/from.png" "$work/synth.png" "$work/fill.json"
 check "E57 keeps the from_station channel" sh -c "'$lidarshop' info '$work/filled.e57' | grep -q from_station"
 check "LAS keeps it as user data" "$lidarshop" convert "$work/filled.e57" "$work/filled.las" --quiet
 check "PLY keeps it" "$lidarshop" convert "$work/filled.e57" "$work/filled.ply" --quiet
