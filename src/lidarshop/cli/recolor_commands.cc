@@ -1,5 +1,6 @@
 // lidarshop resection | recolor | images | align | photo: photos and scans (recolor/, docs/recolor.md).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -344,6 +345,7 @@ int RunRecolor(int argc, char** argv) {
   // Colouring from several photos at once, and what it writes (--from-e57-images, repeated --photo).
   // `carried`: the input E57's images of this scan, written on with it when the output is an E57 (a station's
   // photos belong with its scan; a recoloured E57 without them could not be coloured again).
+  double read_seconds = 0;  // the scan file (and with --from-e57-images its photos) read and decoded
   const auto colour_station = [&](const Scan& scan, const std::vector<CameraPhoto>& photos,
                                   nlohmann::ordered_json used, const nlohmann::ordered_json& skipped,
                                   const std::vector<E57Image>& carried) {
@@ -352,6 +354,7 @@ int RunRecolor(int argc, char** argv) {
     // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
     if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
     const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
+    const auto write_start = std::chrono::steady_clock::now();
     if (FileExtension(output) == "e57" && !carried.empty()) {
       WriteE57(output, {result.scan}, carried, E57WriteOptions());
     } else {
@@ -361,6 +364,8 @@ int RunRecolor(int argc, char** argv) {
                                    output, carried.size())});
     }
     if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
+    const double write_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
     nlohmann::ordered_json counts;
     counts["returns"] = result.returns;
     counts["coloured"] = result.coloured;
@@ -371,6 +376,19 @@ int RunRecolor(int argc, char** argv) {
       used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
     counts["photos"] = used;
     counts["skipped"] = skipped;
+    // Wall clock per phase (issue 32 item 6); "colour" is RecolorFromPhotos as a whole, the others its parts.
+    counts["seconds"] = {{"read", read_seconds},
+                         {"colour", result.total_seconds},
+                         {"write", write_seconds},
+                         {"scene", result.scene_seconds},
+                         {"visibility", result.visibility_seconds},
+                         {"zbuffer", result.zbuffer_seconds},
+                         {"projection", result.projection_seconds},
+                         {"choice", result.choice_seconds},
+                         {"gains", result.gain_seconds},
+                         {"colours", result.colour_seconds},
+                         {"blend", result.blend_seconds},
+                         {"output", result.output_seconds}};
     WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
     Summarize(fmt::format("{} -> {}", result.Summary(), output));
     return 0;
@@ -412,7 +430,9 @@ int RunRecolor(int argc, char** argv) {
             CheckNotInput(photo_index_mask_path, inputs);
             CheckOutputPath(photo_index_mask_path, {scan_path, output});
           }
+          const auto read_start = std::chrono::steady_clock::now();
           const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
+          read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
           std::vector<CameraPhoto> photos;
           nlohmann::ordered_json used = nlohmann::ordered_json::array();
           for (size_t i = 0; i < photo_paths.size(); ++i) {
@@ -447,7 +467,9 @@ int RunRecolor(int argc, char** argv) {
             CheckNotInput(photo_index_mask_path, {scan_path});
             CheckOutputPath(photo_index_mask_path, {scan_path, output});
           }
+          const auto read_start = std::chrono::steady_clock::now();
           E57File file = ReadE57AndWarn(scan_path);  // once: a station can be hundreds of MB
+          read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
           if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size()))
             throw OptionsError(fmt::format("{} {} is out of range: {} holds {} scan(s)", ScanIndexFlag(app),
                                            scan_index, scan_path, file.scans.size()));
