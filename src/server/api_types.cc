@@ -23,9 +23,7 @@ std::vector<TypeScriptStruct> ApiTypes() {
       OptionsType<ModelOptions>(),         // /api/models
       OptionsType<AlignOptions>(),         // /api/docs/ID/photo-match ("model", "threshold_px" in the body)
       // Results (a job's "result", or the answer itself), with the route's own keys beside them.
-      ResultType<SegmentResult>(),
-      ResultType<RemoveResult>(),
-      ResultType<FillResult>(),
+      ResultType<SegmentResult>(), ResultType<RemoveResult>(), ResultType<FillResult>(),
       ResultType<VerifyResult>(),
       ResultType<LandmarkAlignment>(),  // /api/docs/ID/align
       ResultType<PhotoPairModel>(),     // /api/docs/ID/photo-match
