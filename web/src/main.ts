@@ -23,6 +23,7 @@ import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
 import { StationsPanel } from './stations';
 import { PictureStore, loadOverlay } from './picture';
+import { VerifyResult } from './api_types.generated';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -503,7 +504,7 @@ async function verify() {
   if (!doc || !placed) return;
   const [x, y, z, yaw] = poseInputs.map((input) => Number(input.value));
   try {
-    const result = await api.json<{ consistency: number | null; confidence: number; summary: string }>(
+    const result = await api.json<VerifyResult & { summary: string }>(
       `/api/docs/${doc.id}/verify`,
       {},
       { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } },

@@ -645,56 +645,46 @@ int RunAlign(int argc, char** argv) {
       "scaled 4x4 (Umeyama); photo <-> photo pairs (\"pixel_a\"/\"pixel_b\") a 3x3 homography or "
       "fundamental matrix. Writes the matrix as text rows, prints residuals as JSON.",
       "align"};
-  std::string pairs_path, output, model = "homography", json_path = "-";
-  bool with_scale = false;
-  double threshold_px = 3.0;
+  std::string pairs_path, output, json_path = "-";
+  AlignOptions options;
+  OptionBinder binder(app);
   app.add_option("--correspondences", pairs_path, "C.json")->required();
   app.add_option("-o,--output", output, "T.txt to write")->required();
   AddJsonOption(app, &json_path);
-  app.add_flag("--scale", with_scale, "landmarks: allow a uniform scale (similarity)");
-  app.add_option("--model", model, "photo pairs: homography | fundamental")
-      ->check(CLI::IsMember({"homography", "fundamental"}))
-      ->capture_default_str();
-  app.add_option("--threshold", threshold_px, "photo pairs: RANSAC threshold, pixels")->capture_default_str();
-  return RunCommand(app, argc, argv, [&] {
-    CheckNotInput(output, {pairs_path});
-    CheckOutputFile("--json", json_path, {}, {pairs_path, output});
-    const Correspondences pairs = ReadCorrespondences(pairs_path);
-    nlohmann::ordered_json json;
-    std::string text;
-    if (pairs.kind == PairKind::kLandmark) {
-      const LandmarkAlignment result = AlignLandmarks(pairs.landmarks, with_scale, pairs_path);
-      for (int r = 0; r < 4; ++r) {
-        const Eigen::RowVector4d row = result.target_from_source.row(r);
-        text += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}\n", row[0], row[1], row[2], row[3]);
-      }
-      json["model"] = with_scale ? "similarity" : "rigid";
-      json["scale"] = result.scale;
-      json["rms_m"] = result.rms_m;
-      json["residual_m"] = result.residual_m;
-    } else if (pairs.kind == PairKind::kPixelPixel) {
-      const PhotoPairModel result = model == "fundamental"
-                                        ? EstimateFundamental(pairs.pixel_pixel, threshold_px, pairs_path)
-                                        : EstimateHomography(pairs.pixel_pixel, threshold_px, pairs_path);
-      for (int r = 0; r < 3; ++r)
-        text += fmt::format("{:.17g} {:.17g} {:.17g}\n", result.matrix(r, 0), result.matrix(r, 1),
-                            result.matrix(r, 2));
-      json["model"] = model;
-      json["rms_px"] = result.rms_px;
-      json["error_px"] = result.error_px;
-      json["inlier"] = result.inlier;
-    } else {
-      ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
-    }
-    WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
-    json["options"] = {{"scale", with_scale}, {"model", model}, {"threshold_px", threshold_px}};
-    WriteJsonOutput(json_path, json);
-    Summarize(json.contains("rms_m")
-                  ? fmt::format("{} transform, RMS {:.4g} m -> {}", json["model"].get<std::string>(),
-                                json["rms_m"].get<double>(), output)
-                  : fmt::format("{}, RMS {:.3g} px -> {}", model, json["rms_px"].get<double>(), output));
-    return 0;
-  });
+  binder.Bind(&options, {.flags = {{"threshold_px", "--threshold"}}});
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(options);
+        CheckNotInput(output, {pairs_path});
+        CheckOutputFile("--json", json_path, {}, {pairs_path, output});
+        const Correspondences pairs = ReadCorrespondences(pairs_path);
+        nlohmann::ordered_json json;
+        std::string text;
+        if (pairs.kind == PairKind::kLandmark) {
+          const LandmarkAlignment result = AlignLandmarks(pairs.landmarks, options.scale, pairs_path);
+          for (int r = 0; r < 4; ++r) {
+            const Eigen::RowVector4d row = result.target_from_source.row(r);
+            text += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}\n", row[0], row[1], row[2], row[3]);
+          }
+          json = ToJson(result);
+          Summarize(
+              fmt::format("{} transform, RMS {:.4g} m -> {}", ToString(result.model), result.rms_m, output));
+        } else if (pairs.kind == PairKind::kPixelPixel) {
+          const PhotoPairModel result = EstimatePhotoModel(pairs.pixel_pixel, options, pairs_path);
+          for (int r = 0; r < 3; ++r)
+            text += fmt::format("{:.17g} {:.17g} {:.17g}\n", result.matrix(r, 0), result.matrix(r, 1),
+                                result.matrix(r, 2));
+          json = ToJson(result);
+          Summarize(fmt::format("{}, RMS {:.3g} px -> {}", ToString(result.model), result.rms_px, output));
+        } else {
+          ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
+        }
+        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
+      },
+      &binder);
 }
 
 int RunPhoto(int argc, char** argv) {
