@@ -9,11 +9,11 @@
 // the numbers (bench/results/editor.md). --budget S fails the run when the first picture after page open takes
 // longer than S seconds.
 //
-//   node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C] [--budget S] [--keep-scan]
+//   node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C | --station FILE.e57] [--budget S]
 //   (a 4000 x 4000 grid: the 16 M-ray station of issue 34)
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
-import { join, dirname } from 'node:path';
+import { linkSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { join, dirname, resolve } from 'node:path';
 import { tmpdir } from 'node:os';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -51,18 +51,24 @@ async function waitForFunction(page, fn, arg, { timeout = 60000 } = {}) {
 }
 
 const started = Date.now();
+// --station FILE: an E57 station made before (e.g. by a previous run's scan), linked into the served folder.
+const given = option('--station', '');
 const station = join(root, 'station.e57');
-execFileSync(binary, [
-  'scan',
-  'parking_lot',
-  '--rows',
-  String(rows),
-  '--columns',
-  String(columns),
-  '-o',
-  station,
-  '--quiet',
-]);
+if (given) {
+  linkSync(resolve(given), station); // a hard link: a symlink out of the served folder is refused
+} else {
+  execFileSync(binary, [
+    'scan',
+    'parking_lot',
+    '--rows',
+    String(rows),
+    '--columns',
+    String(columns),
+    '-o',
+    station,
+    '--quiet',
+  ]);
+}
 const scanSeconds = (Date.now() - started) / 1000;
 
 // The server opens the station at start (`serve FILE`), as a user opening a scan given on the command line.
@@ -105,12 +111,27 @@ try {
   page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
   let apiBytes = 0;
   page.on('requestfinished', async (request) => {
-    if (request.url().includes('/api/')) apiBytes += (await request.sizes()).responseBodySize;
+    if (request.url().includes('/api/'))
+      apiBytes += (await request.sizes().catch(() => ({ responseBodySize: 0 }))).responseBodySize;
   });
   const opened = Date.now();
   await page.goto(url);
   await waitForFunction(page, () => window.lidarshop?.rayView.shownState().id > 0, null, { timeout: 120000 });
   result.first_picture_s = (Date.now() - opened) / 1000;
+  // Where the time went: the page's requests until the first picture (start and end, ms after page open).
+  result.first_picture_requests = await page.evaluate(() =>
+    performance
+      .getEntriesByType('resource')
+      .filter((e) => e.name.includes('/api/'))
+      .slice(0, 12)
+      .map(
+        (e) =>
+          `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+      ),
+  );
+  result.page_loaded_ms = await page.evaluate(() =>
+    Math.round(performance.getEntriesByType('navigation')[0]?.domContentLoadedEventEnd ?? -1),
+  );
   // The first picture's bytes: what the ray image's requests brought (tiles or the whole picture).
   result.first_picture_bytes = await page.evaluate(() => window.lidarshop.pictureBytes());
   result.tiled = await page.evaluate(() => window.lidarshop.tiled(window.lidarshop.current().id) !== null);
