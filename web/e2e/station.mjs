@@ -159,6 +159,7 @@ try {
   result.first_level = await page.evaluate(() => window.lidarshop.pointLevel());
   const doc = await page.evaluate(() => window.lidarshop.current());
   result.returns = doc.valid_cells;
+  [result.rows, result.columns] = [doc.rows, doc.cols]; // a --station file's own grid
   await page.screenshot({ path: join(artefacts, 'station_opened.png') });
   // The refinement to the finer level (the 3-D view's; it does not hold up the ray image).
   await waitForFunction(
