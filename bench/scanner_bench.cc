@@ -24,7 +24,7 @@
 #include <tbb/parallel_for.h>
 
 #include "lidarshop/scanner/primitives.h"
-#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/texture.h"

@@ -22,7 +22,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/cli/builtin_scenes.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/fill/fill.h"
 #include "lidarshop/fill/fill_metrics.h"
@@ -595,6 +595,7 @@ int RunDemoSteps(const DemoSettings& settings) {
 
   Timer timer;
   const SceneDescription scene = LoadSceneOrBuiltin(settings.scene);
+  PrintWarnings(scene.warnings);
   const SyntheticScanner scanner(scene);
   seconds["load"] = timer.Seconds();
 

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/cli/builtin_scenes.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/cli/scan_selector.h"
