@@ -7,11 +7,11 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
-#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/site_scan.h"

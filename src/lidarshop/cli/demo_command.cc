@@ -22,7 +22,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/fill/fill.h"
 #include "lidarshop/fill/fill_metrics.h"
@@ -33,6 +32,7 @@
 #include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/segment/segment.h"

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/cli/scan_selector.h"
@@ -25,6 +24,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/pointset/ground.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"

@@ -18,7 +18,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
@@ -28,8 +27,9 @@
 #include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scan/scan.h"
-#include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scan/scan_mesh.h"
+#include "lidarshop/scanner/builtin_scenes.h"
+#include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/station_photos.h"
