@@ -23,8 +23,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/scanner/primitives.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/texture.h"

@@ -1,6 +1,6 @@
 // libFuzzer target for stroke JSON (StrokesFromJson) on a 48 x 32 scan grid.
 #include "fuzz/fuzz_util.h"
-#include "lidarshop/segment/strokes.h"
+#include "lidarshop/render/strokes.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   lidarshop::fuzz::LimitMemory();

@@ -11,7 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libmaxflow-dev libsuitesparse-dev liblzf-dev libpugixml-dev libcgal-dev
-  libcpp-httplib-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed
+  libcpp-httplib-dev libkainjow-mustache-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-distributed
   nodejs chromium
 )
 

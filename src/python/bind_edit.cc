@@ -12,8 +12,8 @@
 #include "lidarshop/fill/remove.h"
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/poisson/poisson.h"
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/segment/segment.h"
-#include "lidarshop/segment/strokes.h"
 #include "lidarshop/site/from_stations.h"
 #include "lidarshop/site/transients.h"
 

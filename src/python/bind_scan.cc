@@ -7,11 +7,11 @@
 #include <pybind11/stl.h>
 
 #include "bindings.h"
-#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/site_scan.h"
@@ -227,15 +227,13 @@ void BindMesh(py::module_& m) {
 namespace {
 
 std::string BuiltinSceneJson(const std::string& name) {
-  for (const cli::BuiltinScene& scene : cli::BuiltinScenes()) {
-    if (name == scene.name) return scene.json;
-  }
-  return "";
+  const BuiltinScene* scene = FindBuiltinScene(name);
+  return scene != nullptr ? scene->json : "";
 }
 
 std::string BuiltinNames() {
   std::string names;
-  for (const cli::BuiltinScene& scene : cli::BuiltinScenes())
+  for (const BuiltinScene& scene : BuiltinScenes())
     names += (names.empty() ? "" : ", ") + std::string(scene.name);
   return names;
 }
@@ -342,7 +340,7 @@ void BindFiles(py::module_& m) {
       "builtin_scenes",
       [] {
         std::vector<std::string> names;
-        for (const cli::BuiltinScene& scene : cli::BuiltinScenes()) names.push_back(scene.name);
+        for (const BuiltinScene& scene : BuiltinScenes()) names.push_back(scene.name);
         return names;
       },
       "Names of the scenes compiled into lidarshop (data/scenes/*.json).");

@@ -10,8 +10,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/render.h"
 #include "lidarshop/site/site_stations.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/verify/verify.h"

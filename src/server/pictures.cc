@@ -7,7 +7,7 @@
 
 #include "http.h"
 #include "lidarshop/io/image_io.h"
-#include "lidarshop/io/render.h"
+#include "lidarshop/render/render.h"
 
 namespace lidarshop::server {
 

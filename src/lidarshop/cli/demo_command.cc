@@ -12,35 +12,38 @@
 //                there), only the rest synthesized (site/from_stations.h): stations_*.png, stations.e57
 //   5. summary   summary.json and index.html, which shows everything on one page
 //
-// The steps only call the library; the scene is compiled into the executable (builtin_scenes.h).
+// The steps only call the library; the scene is compiled into the executable (builtin_scenes.h) and says what
+// the steps do with it (its "demo" key: the object to cut out, the sweep, the site); the page is a template
+// (data/demo/index.html.mustache, demo_page.h).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/demo_page.h"
 #include "lidarshop/fill/fill.h"
 #include "lidarshop/fill/fill_metrics.h"
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/image_io.h"
-#include "lidarshop/io/render.h"
-#include "lidarshop/io/render_layout.h"
-#include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/render.h"
+#include "lidarshop/render/render_layout.h"
+#include "lidarshop/render/render_view.h"
+#include "lidarshop/render/strokes.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/segment_eval.h"
-#include "lidarshop/segment/strokes.h"
 #include "lidarshop/site/from_stations.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/util/timer.h"
 #include "lidarshop/verify/sweep.h"
@@ -55,27 +58,16 @@ using nlohmann::json;
 struct DemoSettings {
   std::string scene = "parking_lot";  // a built-in scene name or a scene file
   std::string out_dir = "out";
-  std::string segment_object;  // object name to cut out; "" = the built-in scene's choice
+  std::string segment_object;  // object name to cut out; "" = the scene's choice ("demo"."cut")
   std::string json_path;       // --json: summary.json's content here too ("-" = stdout)
   bool quiet = false;
 };
-
-// The object each built-in scene cuts out in the segmentation step.
-std::string DefaultSegmentObject(const std::string& scene_name) {
-  static const std::map<std::string, std::string> objects = {
-      {"parking_lot", "hatchback"}, {"electric_box", "electric_box"}, {"mailbox", "mailbox"}};
-  const auto found = objects.find(scene_name);
-  return found == objects.end() ? std::string() : found->second;
-}
 
 std::string SceneName(const std::string& scene) { return fs::path(scene).stem().string(); }
 
 void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& stream) { stream << text; });
 }
-
-constexpr const char* kPassColor = "#d8f0d8";
-constexpr const char* kFailColor = "#f6d5d5";
 
 json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
 
@@ -174,16 +166,14 @@ struct DemoSweep {
   SweepOptions options;
 };
 
-std::optional<DemoSweep> DefaultSweep(const std::string& scene_name) {
-  if (scene_name != "parking_lot") return std::nullopt;
+// The scene's sweep ("demo"."sweep"), if it has one.
+std::optional<DemoSweep> SceneSweep(const SceneDescription& scene) {
+  if (scene.demo.sweep_object.empty()) return std::nullopt;
   DemoSweep sweep;
-  sweep.object = "sedan";
-  sweep.options.x_min_m = -9.3;  // the lot in front of the façade, 0.5 m grid, three headings then refinement
-  sweep.options.x_max_m = 9.3;
-  sweep.options.y_min_m = 7.7;
-  sweep.options.y_max_m = 13.3;
-  sweep.options.step_m = 0.5;
-  sweep.options.yaws_deg = {0, 60, 120};
+  sweep.object = scene.demo.sweep_object;
+  if (!scene.demo.sweep_options_json.empty()) {
+    sweep.options = FromJson<SweepOptions>(json::parse(scene.demo.sweep_options_json));
+  }
   return sweep;
 }
 
@@ -286,14 +276,6 @@ json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::s
           {"return_accuracy", m.return_accuracy},
           {"color_psnr_db", m.color_psnr_db},
           {"seconds", fill.timings.total_s}};
-}
-
-// The built-in site of a scene ("parking_lot" -> "parking_lot_stations"), whose step 4b fills from a second
-// station; "" when there is none.
-std::string DemoSite(const std::string& scene_name) {
-  for (const BuiltinScene& builtin : BuiltinScenes())
-    if (builtin.name == scene_name + "_stations") return std::string(builtin.name);
-  return "";
 }
 
 // The scan with its colour showing where each filled cell came from: another station's measurement cyan,
@@ -403,188 +385,6 @@ void WriteScanPictures(const SceneDescription& scene, const Scan& scan, const fs
   WriteImage((out_dir / "top_view.png").string(), RenderPointView(scan, bird));
 }
 
-// Every file the demo writes (index.html aside), with what it holds; the index links them all.
-std::vector<std::pair<std::string, std::string>> DemoFiles(const json& summary) {
-  std::vector<std::pair<std::string, std::string>> files = {
-      {"scan.ptx", "the synthetic scan, Leica PTX (ASCII)"},
-      {"scan.e57", "the synthetic scan, E57"},
-      {"labels.png",
-       "true object label of every ray, raw 16-bit PNG (65535 = no return); labels_view.png is "
-       "its colour picture"},
-      {"rgb.png", "the scan's colour"},
-      {"range.png", "range in metres"},
-      {"range.exr", "range in metres as 32-bit floats, one pixel per ray, NaN = no return"},
-      {"intensity.png", "return intensity"},
-      {"labels_view.png", "object labels in colour, with the objects' names"},
-      {"normals.png", "surface normals, with the key of their colours"},
-      {"top_view.png", "the points from above and behind the scanner (a second viewpoint, perspective)"},
-      {"verify.json", "the verification table as JSON"}};
-  if (summary.contains("sweep")) {
-    files.insert(files.end(),
-                 {{"sweep_consistency.png", "sweep: best consistency over headings, per position"},
-                  {"sweep_confidence.png", "sweep: best confidence over headings, per position"},
-                  {"sweep.csv", "sweep: every pose evaluated"}});
-  }
-  if (summary.contains("segment")) {
-    files.insert(files.end(), {{"segment_overlay.png", "segmentation: the cut over the scan's colour"},
-                               {"segment_mask.png", "segmentation: the object's cells (white)"},
-                               {"segment_strokes.png", "segmentation: the automatic strokes"}});
-  }
-  if (summary.contains("stations")) {
-    files.insert(
-        files.end(),
-        {{"stations.e57", "station 0 of the site with the object removed, filled from station 2 first"},
-         {"stations_view_scan.png", "35° aside: station 0 with the object"},
-         {"stations_view_filled.png",
-          "35° aside: filled from station 2 (cyan: its real points; magenta: synthesized)"},
-         {"stations_rays.png", "the ray picture of the same (cyan: from station 2; magenta: synthesized)"}});
-  }
-  if (summary.contains("remove")) {
-    files.insert(files.end(),
-                 {{"removed.e57", "the scan with the object removed and the hole filled"},
-                  {"remove_range.png", "range after the removal"},
-                  {"remove_view_scan.png", "35° aside: the scan with the object"},
-                  {"remove_view_truth.png", "35° aside: the scene scanned without the object"},
-                  {"remove_view_filled.png", "35° aside: the fill (synthesized points magenta)"}});
-  }
-  files.push_back({"summary.json", "every number of this page"});
-  return files;
-}
-
-std::string IndexHtml(const std::string& scene_name, const json& summary) {
-  std::string html = fmt::format(
-      "<!doctype html><html><head><meta charset=\"utf-8\"><title>lidarshop demo: {0}</title>"
-      "<style>body{{font-family:sans-serif;margin:2em;max-width:1100px}}img{{max-width:100%;"
-      "image-rendering:pixelated;border:1px solid #ccc}}td,th{{padding:2px 8px;text-align:right}}"
-      "pre{{background:#f4f4f4;padding:1em}}</style></head><body><h1>lidarshop demo: {0}</h1>",
-      scene_name);
-  auto figure = [](const std::string& file, const std::string& caption, const std::string& width = "") {
-    return fmt::format(
-        "<figure style=\"display:inline-block;margin:4px;vertical-align:top{}\"><a href=\"{}\">"
-        "<img src=\"{}\"></a><figcaption>{}</figcaption></figure>",
-        width.empty() ? "" : ";width:" + width, file, file, caption);
-  };
-  html +=
-      "<h2>1. The synthetic scan</h2><p>Every channel of the scan as a picture: azimuth to the right, "
-      "elevation "
-      "up (row 0 = highest ray), square angular pixels. Cells where the ray returned nothing are a quiet "
-      "grey "
-      "checker, the way image editors show transparency. The raw label image (16-bit, one object label per "
-      "ray) "
-      "looks "
-      "black in a browser; its colour version has the objects' names.</p>";
-  html += figure("rgb.png", "colour") + figure("range.png", "range (m)") +
-          figure("intensity.png", "intensity") + figure("labels_view.png", "object labels") +
-          figure("normals.png", "surface normals (scanner frame)") +
-          figure("labels.png", "raw 16-bit labels (<a href=\"labels.png\">labels.png</a>)");
-  html +=
-      "<h3>A second viewpoint</h3><p>The points within 2 m of the standing objects seen from straight above "
-      "(orthographic, world x to the right, world y up, the highest point of each cell shown): where the ray "
-      "picture shows directions, this shows distances on the ground and the shadows behind objects.</p>" +
-      figure("top_view.png", "bird's-eye view");
-  const SweepOptions thresholds;
-  html += fmt::format(
-      "<h2>2. Verification</h2><p>Every standing object at its true pose and at two wrong ones, checked "
-      "against the scan. <b>Consistency</b>: of the rays that meet the posed model, the share whose measured "
-      "point is not behind the model (a ray that returned from behind the model went through it): it passes "
-      "above {:.2f}; &mdash; means no ray met the model. <b>Confidence</b>: the share of the model's surface "
-      "the scan has seen: it passes above {:.2f} (one side of a car reaches about 0.3). A pose passes when "
-      "both pass: <span style=\"background:{}\">&nbsp;green row&nbsp;</span> = pass, <span "
-      "style=\"background:{}\">&nbsp;red row&nbsp;</span> = fail, and the failing measure in bold red. "
-      "Expect "
-      "the true poses to pass, the pose 1 m towards the scanner to fail consistency (it stands in front of "
-      "what the scanner saw) and the pose 1 m away to fail confidence (hidden in the object's shadow, "
-      "nothing "
-      "contradicts it but nothing supports it). The <b>ICP cost</b> (mean distance from the scan points near "
-      "the model to the model, metres) is the usual score, shown for comparison: it cannot tell these "
-      "apart.</p><table><tr><th>object</th><th>pose</th><th>consistency</th><th>confidence</th><th>ICP cost "
-      "(m)</th><th>verdict</th></tr>",
-      thresholds.min_consistency, thresholds.min_confidence, kPassColor, kFailColor);
-  for (const json& entry : summary["verify"]) {
-    auto format_number = [](const json& value) {
-      return value.is_null() ? std::string("—") : fmt::format("{:.3f}", value.get<double>());
-    };
-    const bool consistent =
-        !entry["consistency"].is_null() && entry["consistency"].get<double>() > thresholds.min_consistency;
-    const bool confident = entry["confidence"].get<double>() > thresholds.min_confidence;
-    auto cell = [](const std::string& text, bool pass) {
-      return pass ? fmt::format("<td>{}</td>", text)
-                  : fmt::format("<td style=\"color:#b00000;font-weight:bold\">{}</td>", text);
-    };
-    html +=
-        fmt::format("<tr style=\"background:{}\"><td>{}</td><td>{}</td>{}{}<td>{}</td><td>{}</td></tr>",
-                    consistent && confident ? kPassColor : kFailColor, entry["object"].get<std::string>(),
-                    entry["pose"].get<std::string>(), cell(format_number(entry["consistency"]), consistent),
-                    cell(format_number(entry["confidence"]), confident), format_number(entry["icp_cost"]),
-                    consistent && confident ? "pass" : "fail");
-  }
-  html += "</table>";
-  if (summary.contains("sweep")) {
-    const json& sweep = summary["sweep"];
-    html += fmt::format(
-        "<h3>Sweep</h3><p>The {} model at {} candidate poses over the lot (0.5 m grid, three headings, then "
-        "local "
-        "refinement); white rings mark the {} detection(s) that pass consistency &gt; {:.2f} and confidence "
-        "&gt; {:.2f}. The true position is ({:.2f}, {:.2f}).</p><img src=\"sweep_consistency.png\" "
-        "width=\"49%\"><img src=\"sweep_confidence.png\" width=\"49%\">",
-        sweep["model"].get<std::string>(), sweep["poses"].get<size_t>(), sweep["detections"].size(),
-        thresholds.min_consistency, thresholds.min_confidence, sweep["true_position"][0].get<double>(),
-        sweep["true_position"][1].get<double>());
-  }
-  if (summary.contains("segment")) {
-    const json& segment = summary["segment"];
-    html += fmt::format(
-        "<h2>3. Segmentation</h2><p>Object '{}' cut out from two automatic strokes (green object, red "
-        "background): IoU {:.3f}, precision {:.3f}, recall {:.3f} against the true labels.</p>"
-        "<img src=\"segment_overlay.png\"><br><img src=\"segment_strokes.png\" width=\"49%\"> <img "
-        "src=\"segment_mask.png\" width=\"49%\"><br>The strokes (left) and the cut (right, white = object).",
-        segment["object"].get<std::string>(), segment["iou"].get<double>(),
-        segment["precision"].get<double>(), segment["recall"].get<double>());
-  }
-  if (summary.contains("remove")) {
-    const json& remove = summary["remove"];
-    html += fmt::format(
-        "<h2>4. Removal</h2><p>The cut-out object removed: its {} cells (grown by 2) filled in the gradient "
-        "domain, {} new points placed along the scanner's rays (magenta below). Against the scene scanned "
-        "again without the object: range RMSE {:.1f} mm, {:.1f} % of the cells within 20 mm, {:.2f} % of the "
-        "points farther than 10 cm from the true surface, return / no-return right in {:.1f} % of the cells, "
-        "colour PSNR {:.1f} dB ({:.2f} s). From 35° aside: the scan with the object, the truth without it, "
-        "the fill.</p><img src=\"remove_range.png\"><br><img src=\"remove_view_scan.png\" width=\"32%\">"
-        "<img src=\"remove_view_truth.png\" width=\"32%\"><img src=\"remove_view_filled.png\" "
-        "width=\"32%\">",
-        remove["hole_cells"].get<int64_t>(), remove["synthesized_points"].get<int64_t>(),
-        remove["range_rmse_mm"].get<double>(), 100 * remove["within_20mm"].get<double>(),
-        100 * remove["floating_points"].get<double>(), 100 * remove["return_accuracy"].get<double>(),
-        remove["color_psnr_db"].get<double>(), remove["seconds"].get<double>());
-  }
-  if (summary.contains("stations")) {
-    const json& st = summary["stations"];
-    html += fmt::format(
-        "<h2>4b. Removal with a second station</h2><p>The same object removed from station 0 of the site {}, "
-        "where station 2 stood when the car had left: of its {} hole cells, {} take the real surface station "
-        "2 "
-        "measured behind it (cyan; range RMSE {:.1f} mm against the truth, no noise added: station 2's own "
-        "measurement), {} that no station saw are synthesized (magenta); the whole hole's range RMSE {:.1f} "
-        "mm "
-        "({:.2f} s).</p><img src=\"stations_rays.png\"><br><img src=\"stations_view_scan.png\" "
-        "width=\"49%\"><img src=\"stations_view_filled.png\" width=\"49%\">",
-        st["site"].get<std::string>(), st["hole_cells"].get<int64_t>(),
-        st["from_station_cells"].get<int64_t>(), st["from_station_rmse_mm"].get<double>(),
-        st["synthesized_cells"].get<int64_t>(), st["range_rmse_mm"].get<double>(),
-        st["seconds"].get<double>());
-  }
-  html += "<h2>Files</h2><p>Everything in this folder:</p><table>";
-  for (const auto& [file, what] : DemoFiles(summary)) {
-    html += fmt::format(
-        "<tr><td style=\"text-align:left\"><a href=\"{0}\">{0}</a></td><td "
-        "style=\"text-align:left\">{1}</td></tr>",
-        file, what);
-  }
-  html += "</table>";
-  html += fmt::format("<h2>Summary</h2><pre>{}</pre></body></html>\n", summary.dump(2));
-  return html;
-}
-
 int RunDemoSteps(const DemoSettings& settings) {
   const fs::path out_dir(settings.out_dir);
   fs::create_directories(out_dir);
@@ -595,6 +395,7 @@ int RunDemoSteps(const DemoSettings& settings) {
 
   Timer timer;
   const SceneDescription scene = LoadSceneOrBuiltin(settings.scene);
+  PrintWarnings(scene.warnings);
   const SyntheticScanner scanner(scene);
   seconds["load"] = timer.Seconds();
 
@@ -625,7 +426,7 @@ int RunDemoSteps(const DemoSettings& settings) {
   summary["verify"] = RunVerifyStep(scene, scan, out_dir, progress.get());
   seconds["verify"] = timer.Seconds();
 
-  if (const std::optional<DemoSweep> demo_sweep = DefaultSweep(scene_name)) {
+  if (const std::optional<DemoSweep> demo_sweep = SceneSweep(scene)) {
     timer.Restart();
     progress->Restart("demo: sweeping", 1);
     summary["sweep"] = RunSweepStep(scene, scan, *demo_sweep, out_dir, nullptr);
@@ -634,7 +435,7 @@ int RunDemoSteps(const DemoSettings& settings) {
   }
 
   const std::string segment_object =
-      settings.segment_object.empty() ? DefaultSegmentObject(scene_name) : settings.segment_object;
+      settings.segment_object.empty() ? scene.demo.cut_object : settings.segment_object;
   if (!segment_object.empty()) {
     timer.Restart();
     progress->Restart("demo: segmenting", 1);
@@ -645,7 +446,7 @@ int RunDemoSteps(const DemoSettings& settings) {
     timer.Restart();
     summary["remove"] = RunRemoveStep(scene, scan, segment_object, object_mask, out_dir, progress.get());
     seconds["remove"] = timer.Seconds();
-    if (const std::string site = DemoSite(scene_name); !site.empty()) {
+    if (const std::string& site = scene.demo.site; !site.empty()) {
       timer.Restart();
       const json stations = RunStationsStep(site, segment_object, object_mask, out_dir, progress.get());
       if (!stations.is_null()) {
@@ -658,7 +459,7 @@ int RunDemoSteps(const DemoSettings& settings) {
 
   summary["seconds"] = seconds;
   WriteText(out_dir / "summary.json", summary.dump(2) + "\n");
-  WriteText(out_dir / "index.html", IndexHtml(scene_name, summary));
+  WriteText(out_dir / "index.html", DemoPage(scene_name, summary));
   WriteJsonOutput(settings.json_path, summary);
   Summarize(fmt::format("scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)", scene_name,
                         scan.rows, scan.cols, scan.CountValid(), out_dir.string()));

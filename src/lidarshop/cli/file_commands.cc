@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/cli/scan_selector.h"
@@ -17,14 +16,15 @@
 #include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/las.h"
-#include "lidarshop/io/picture_mapping.h"
-#include "lidarshop/io/render.h"
-#include "lidarshop/io/render_layout.h"
-#include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/pointset/ground.h"
+#include "lidarshop/render/picture_mapping.h"
+#include "lidarshop/render/render.h"
+#include "lidarshop/render/render_layout.h"
+#include "lidarshop/render/render_view.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"

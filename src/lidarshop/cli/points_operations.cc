@@ -179,7 +179,7 @@ PointsOutput KMeansOperation(const Gathered& g, const TriangleMesh&, PointsOptio
 
 std::string MeshMethod(const PointsFlags& f) { return f.method.empty() ? "grid" : f.method; }
 
-// grid: the grid mesh of any organized scan, real ones included (scanner/scan_mesh.h); otherwise a surface
+// grid: the grid mesh of any organized scan, real ones included (scan/scan_mesh.h); otherwise a surface
 // reconstructed from all the points in the world frame (pointset/surface.h).
 PointsOutput Mesh(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
   const std::string method = MeshMethod(f);

@@ -21,7 +21,7 @@
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/scan/scan.h"
-#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scan/scan_mesh.h"
 
 namespace lidarshop::cli {
 

@@ -18,18 +18,18 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/formats.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
-#include "lidarshop/io/render.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/render.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/scan/scan_mesh.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/random_scene.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/station_photos.h"
@@ -179,6 +179,7 @@ int RunScan(int argc, char** argv) {
           }
         } else {
           scene = LoadSceneOrBuiltin(scene_path);
+          PrintWarnings(scene.warnings);
         }
         // One scene per station (a one-station scene is its own station 0): the flags override every
         // station's scanner.

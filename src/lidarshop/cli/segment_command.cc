@@ -10,8 +10,8 @@
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/segment/segment.h"
-#include "lidarshop/segment/strokes.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 

@@ -9,8 +9,8 @@
 
 #include <fmt/format.h>
 
-#include "lidarshop/cli/builtin_scenes.h"
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/site_scan.h"

@@ -713,7 +713,7 @@ void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords&
                         intensity_field);
   const auto& v = records.Decode(intensity_field);
   if (l.known && l.maximum > l.minimum) {
-    // Pictures show intensity in the file's units (io/render.h): 0 and 1 stand for the limits.
+    // Pictures show intensity in the file's units (render/render.h): 0 and 1 stand for the limits.
     for (Scan* scan : {layers[0], layers[1]}) {
       if (scan == nullptr) continue;
       scan->source_metadata["intensity.file_minimum"] = fmt::format("{}", l.minimum);

@@ -236,7 +236,7 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
   scan.source_metadata["las.global_encoding"] = std::to_string(header.global_encoding);
   scan.source_metadata["las.file_source_id"] = std::to_string(header.file_source_id);
   scan.source_metadata["las.extra_bytes"] = std::to_string(extra.empty() ? 0 : extra_bytes);
-  // Intensity is kept in [0, 1]; pictures show it in the file's 16-bit units (io/render.h).
+  // Intensity is kept in [0, 1]; pictures show it in the file's 16-bit units (render/render.h).
   if (any_intensity) scan.source_metadata["intensity.file_maximum"] = "65535";
   for (int axis = 0; axis < 3; ++axis) {
     // Shortest round-trip text: the writer parses back the very same doubles.

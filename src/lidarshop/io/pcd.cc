@@ -580,7 +580,7 @@ Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std
       }
     }
   }
-  // Pictures show integer intensities in the file's units (io/render.h).
+  // Pictures show integer intensities in the file's units (render/render.h).
   if (intensity_scale != 1.0)
     scan.source_metadata["intensity.file_maximum"] = fmt::format("{}", 1.0 / intensity_scale);
   io_internal::FinishScan(&scan, /*fit_grid=*/organized);

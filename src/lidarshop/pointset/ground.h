@@ -1,4 +1,4 @@
-// The ground under a scan: the plane a second viewpoint keeps level (io/render_view.h SideView's up). A scan's
+// The ground under a scan: the plane a second viewpoint keeps level (render/render_view.h SideView's up). A scan's
 // own up (the scanner's z, an RGB-D camera's -y) is only the sensor's; a camera that looks down at a table is
 // tilted against it, and orbiting about the camera's up makes the table lean. The ground's normal is the up a
 // person expects when the scan shows a ground.

@@ -7,8 +7,8 @@
 #include <Eigen/Geometry>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/io/render_view.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/render_view.h"
 #include "lidarshop/testing/scenes.h"
 
 namespace lidarshop {

@@ -1,6 +1,6 @@
 // Conditional region growing over an organized scan's grid mesh: the thesis's "mesh front iterator". A front
 // of cells starts at a seed and moves to 4-connected neighbours joined by the grid mesh (both returned, range
-// jump within max_range_jump_ratio, as scanner/scan_mesh.h joins them) and accepted by a pluggable condition.
+// jump within max_range_jump_ratio, as scan/scan_mesh.h joins them) and accepted by a pluggable condition.
 //
 //   RegionGrowingOptions options;
 //   cv::Mat region = GrowRegion(scan, {row, col}, options, NormalAngleCondition(scan, 10.0));

@@ -12,7 +12,7 @@
 #include "lidarshop/recolor/distance_raster.h"
 #include "lidarshop/recolor/silhouette_skirt.h"
 #include "lidarshop/recolor/visibility.h"
-#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"

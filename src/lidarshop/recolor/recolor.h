@@ -7,7 +7,7 @@
 // Otherwise it keeps its own colour. (The thesis's tool let occluded points take the occluder's colour from
 // the photo; here they never change.)
 //
-// Visibility is decided against the scan's own grid mesh (scanner/scan_mesh.h, world frame, edges across
+// Visibility is decided against the scan's own grid mesh (scan/scan_mesh.h, world frame, edges across
 // depth jumps dropped) with Embree: one ray per photo pixel (or per pixel of a reduced "z-buffer",
 // `zbuffer_scale`) from the camera centre gives the distance to the first surface of the scan seen through
 // that pixel. A point at distance d from the camera is hidden when that first surface is nearer than
@@ -84,7 +84,7 @@ struct RecolorOptions {
   // slope) in front of the point, metres: smaller steps (a kerb, a window recess) do not hide a point.
   double edge_min_jump_m = 0.2;
   double zbuffer_scale = 1.0;         // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
-  double max_range_jump_ratio = 0.1;  // scan mesh edges (scanner/scan_mesh.h)
+  double max_range_jump_ratio = 0.1;  // scan mesh edges (scan/scan_mesh.h)
   void Check() const;                 // throws OptionsError
 };
 template <>

@@ -1,7 +1,7 @@
 // Silhouette skirts: the geometry an occluder may have where the scan could not sample it, for visibility
 // tests against the scan's grid mesh (recolor.h).
 //
-// The grid mesh (scanner/scan_mesh.h) drops the edges across depth jumps, so every occluder's mesh stops at
+// The grid mesh (scan/scan_mesh.h) drops the edges across depth jumps, so every occluder's mesh stops at
 // its last cell. Its true silhouette lies somewhere between that cell's ray and the next ray (the one that
 // passed the occluder): up to one angular cell spacing beyond the mesh, i.e. spacing × the occluder's range in
 // metres. Seen from a camera beside the scanner, a point just behind the occluder's edge looks through that
@@ -26,7 +26,7 @@
 namespace lidarshop {
 
 struct SilhouetteSkirtOptions {
-  double max_range_jump_ratio = 0.1;  // the grid mesh's edge rule (scanner/scan_mesh.h), fraction of range
+  double max_range_jump_ratio = 0.1;  // the grid mesh's edge rule (scan/scan_mesh.h), fraction of range
   double depth_m = 0.0;               // walls swept this far back behind each cap, metres; 0 = caps only
   bool world_frame = true;            // vertices in the world frame (world_from_scanner), else scanner frame
 };

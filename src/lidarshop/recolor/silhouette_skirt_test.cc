@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/raycast/raycast.h"
-#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/testing/scenes.h"
 
 namespace lidarshop {

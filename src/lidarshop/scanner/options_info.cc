@@ -3,7 +3,6 @@
 // PhotoOptions' background, CarMeshOptions' paint, FacadeMeshOptions' colours.
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/primitives.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/util/options.h"
@@ -93,20 +92,6 @@ const StructInfo& InfoOf<PhotoOptions>() {
     b.Field(&PhotoOptions::max_range_m, "max_range_m", "farther hits count as background")
         .Unit("m")
         .AboveZero();
-    return b.Build();
-  }();
-  return info;
-}
-
-template <>
-const StructInfo& InfoOf<ScanMeshOptions>() {
-  static const StructInfo info = [] {
-    StructBuilder<ScanMeshOptions> b("ScanMeshOptions", "the triangle mesh of a scan's grid");
-    b.Field(&ScanMeshOptions::max_range_jump_ratio, "max_range_jump_ratio",
-            "largest relative range difference of a kept edge")
-        .AboveZero();
-    b.Field(&ScanMeshOptions::max_edge_m, "max_edge_m", "longest kept edge; 0 = no limit").Unit("m").Min(0);
-    b.Field(&ScanMeshOptions::world_frame, "world_frame", "vertices in the world frame, not the scanner's");
     return b.Build();
   }();
   return info;

@@ -6,8 +6,8 @@
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/scanner/primitives.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
 

@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/primitives.h"
-#include "lidarshop/scanner/scan_mesh.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/util/options_test_util.h"

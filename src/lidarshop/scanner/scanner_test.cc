@@ -579,6 +579,25 @@ TEST(SceneFile, BuiltinScenesLoadAndShowEveryObject) {
   }
 }
 
+TEST(SceneFile, TheDemoKeyNamesObjectsTheSceneHas) {
+  const SceneDescription parking_lot = test_scenes::LoadBuiltinScene("parking_lot");
+  EXPECT_EQ(parking_lot.demo.cut_object, "hatchback");
+  EXPECT_EQ(parking_lot.demo.sweep_object, "sedan");
+  EXPECT_EQ(parking_lot.demo.site, "parking_lot_stations");
+  EXPECT_NE(parking_lot.demo.sweep_options_json.find("\"step_m\":0.5"), std::string::npos);
+  EXPECT_TRUE(test_scenes::LoadBuiltinScene("mailbox").demo.sweep_object.empty());
+  const std::string objects = R"("objects": [{"name": "post", "primitive": "cylinder", "radius": 0.1}])";
+  ExpectInputError(
+      WriteTemporary("scanner_test_demo_cut.json", "{" + objects + R"(, "demo": {"cut": "car"}})"),
+      {"scanner_test_demo_cut.json", "demo", "'cut'", "no object named 'car'"});
+  ExpectInputError(
+      WriteTemporary("scanner_test_demo_key.json", "{" + objects + R"(, "demo": {"cutout": "post"}})"),
+      {"demo", "'cutout'", "unknown key"});
+  ExpectInputError(WriteTemporary("scanner_test_demo_sweep.json",
+                                  "{" + objects + R"(, "demo": {"sweep": {"options": {"step_m": 1}}}})"),
+                   {"demo.sweep", "'object'", "missing"});
+}
+
 TEST(Primitives, CarsHaveRealSizesAndCanBeRefined) {
   for (auto [style, length] :
        {std::pair{CarStyle::kSedan, 4.6}, {CarStyle::kHatchback, 4.0}, {CarStyle::kVan, 4.9}}) {

@@ -47,6 +47,7 @@ class Fields {
     }
   }
   bool Has(const std::string& key) const { return object_.contains(key); }
+  const std::string& What() const { return what_; }
   const json& Get(const std::string& key) const { return object_.at(key); }
 
   double Number(const std::string& key, double fallback) const {
@@ -416,6 +417,42 @@ SceneObject ParseObject(const Fields& fields, size_t index, const std::string& b
   return object;
 }
 
+// The scene's "demo" object: names of objects the scene has, the sweep's options kept as JSON for verify/.
+SceneDemo ParseDemo(const Fields& demo, const SceneDescription& scene) {
+  demo.CheckKeys({"cut", "sweep", "site"});
+  auto object_name = [&](const Fields& fields, const std::string& key) {
+    if (!fields.Has(key)) return std::string();
+    const json& value = fields.Get(key);
+    if (!value.is_string())
+      fields.Fail(key, fmt::format("expected an object's name, got {}", TypeName(value)));
+    const std::string name = value.get<std::string>();
+    if (std::none_of(scene.objects.begin(), scene.objects.end(),
+                     [&](const SceneObject& object) { return object.name == name; })) {
+      fields.Fail(key, fmt::format("the scene has no object named '{}'", name));
+    }
+    return name;
+  };
+  SceneDemo parsed;
+  parsed.cut_object = object_name(demo, "cut");
+  if (demo.Has("site")) {
+    if (!demo.Get("site").is_string())
+      demo.Fail("site", fmt::format("expected a name, got {}", TypeName(demo.Get("site"))));
+    parsed.site = demo.Get("site").get<std::string>();
+  }
+  if (demo.Has("sweep")) {
+    const Fields sweep(demo.Get("sweep"), demo.What(), "demo.sweep");
+    sweep.CheckKeys({"object", "options"});
+    parsed.sweep_object = object_name(sweep, "object");
+    if (parsed.sweep_object.empty()) sweep.Fail("object", "missing (the object whose model is swept)");
+    if (sweep.Has("options")) {
+      if (!sweep.Get("options").is_object())
+        sweep.Fail("options", "expected an object of SweepOptions fields");
+      parsed.sweep_options_json = sweep.Get("options").dump();
+    }
+  }
+  return parsed;
+}
+
 }  // namespace
 
 void ScannerOptions::Check() const {
@@ -482,7 +519,7 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
     ThrowInputError(what, "", "", fmt::format("not usable JSON: {}", error.what()));
   }
   Fields top(root, what, "");
-  top.CheckKeys({"scanner", "stations", "objects", "name", "description", "target_label"});
+  top.CheckKeys({"scanner", "stations", "objects", "name", "description", "target_label", "demo"});
   SceneDescription scene;
   scene.target_label = static_cast<int32_t>(top.Integer("target_label", -1, 0, 65534));
   if (top.Has("scanner") && top.Has("stations"))
@@ -518,6 +555,7 @@ SceneDescription ParseScene(const std::string& json_text, const std::string& wha
     scene.objects.push_back(ParseObject(Fields(objects[i], what, fmt::format("objects[{}]", i)), i, base_dir,
                                         &scene_triangles, &scene.warnings, scene.NumStations()));
   }
+  if (top.Has("demo")) scene.demo = ParseDemo(Fields(top.Get("demo"), what, "demo"), scene);
   if (scene.target_label >= 0 &&
       std::none_of(scene.objects.begin(), scene.objects.end(),
                    [&](const SceneObject& object) { return object.label == scene.target_label; })) {

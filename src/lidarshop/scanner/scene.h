@@ -91,6 +91,15 @@ struct SceneObject {
   bool AtStation(int station) const;
 };
 
+// What `lidarshop demo` does with a scene (scene key "demo", docs/scene-format.md); "" leaves a step out.
+struct SceneDemo {
+  std::string cut_object;    // "cut": the object steps 3 and 4 cut out and remove
+  std::string sweep_object;  // "sweep"."object": the object whose model step 2b sweeps over the scene
+  std::string
+      sweep_options_json;  // "sweep"."options": SweepOptions as JSON text (verify/ reads and checks it)
+  std::string site;        // "site": a built-in site whose station 0 is this scene (step 4b)
+};
+
 struct SceneDescription {
   // The scanner of a one-station scene; with "stations", a copy of stations[0] (so that code that scans one
   // station sees the first).
@@ -105,6 +114,7 @@ struct SceneDescription {
   // What the mesh readers left out of the scene's mesh files (io/mesh_io.h MeshFile::warnings), one sentence
   // each naming the file; not printed by the library.
   std::vector<std::string> warnings;
+  SceneDemo demo;  // scene key "demo"
 
   int64_t NumTriangles() const;
   // The number of stations: stations.size(), or 1 for a scene with one "scanner".

@@ -6,6 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/render/render_layout.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 
@@ -74,6 +75,14 @@ cv::Vec3b ContrastingOverlayColor(const cv::Mat& picture_rgb, const cv::Mat& reg
 int OverlayStrokeRadius(cv::Size picture_size) {
   // One cell on scans up to ~800 cells across, growing so a stroke stays ~0.25 % of the picture wide.
   return std::max(1, std::max(picture_size.width, picture_size.height) / 400);
+}
+
+cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes) {
+  if (strokes.mapping && strokes.mapping->view == PictureView::kGrid) {
+    return SegmentOverlayPicture(scan, mask, strokes.cells, strokes.mapping->picture_size, strokes.picture);
+  }
+  if (IsUnorganized(scan)) return SegmentOverlay(scan, mask, strokes.cells);
+  return SegmentOverlayPicture(scan, mask, strokes.cells, LayOutPicture(scan, {}).picture_size);
 }
 
 }  // namespace lidarshop

@@ -3,7 +3,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 

@@ -43,15 +43,11 @@
 
 #include <opencv2/core.hpp>
 
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
-
-// Stroke label images: CV_8U rows x cols (image orientation), one of these values per cell.
-constexpr uint8_t kStrokeNone = 0;
-constexpr uint8_t kStrokeObject = 1;
-constexpr uint8_t kStrokeBackground = 2;
 
 // Names (util/enum_names.h): "two-step", "depth", "color", "rgbd".
 enum class SegmentMethod { kTwoStep, kDepth, kColor, kRgbd };
@@ -303,6 +299,12 @@ cv::Mat SegmentOverlay(const Scan& scan, const cv::Mat& mask, const cv::Mat& str
 // (stroke labels of picture_size, as painted) when given, else the stroke cells resampled — never widened.
 cv::Mat SegmentOverlayPicture(const Scan& scan, const cv::Mat& mask, const cv::Mat& strokes,
                               cv::Size picture_size, const cv::Mat& picture_strokes = cv::Mat());
+
+// The overlay of `mask` and the strokes in the layout `render` draws by default (square angular pixels), or
+// the layout of the picture the strokes were painted on when it is a grid picture: the scan's colours, object
+// cells tinted with a 1-pixel outline, strokes drawn as painted (or their cells resampled), never widened.
+// Unorganized clouds (no grid picture): SegmentOverlay's one pixel per cell. CV_8UC3 RGB.
+cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes);
 
 // The overlay colour for `picture_rgb` (CV_8UC3): of a fixed list of saturated colours and white (yellow
 // first), the first one at least 40 CIELAB units from the colours in `region` (CV_8U; empty = the whole

@@ -9,8 +9,8 @@
 
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/segment/segment.h"
-#include "lidarshop/segment/strokes.h"
 
 namespace lidarshop {
 namespace {

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/segment/strokes.h"
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {

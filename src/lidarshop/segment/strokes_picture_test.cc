@@ -1,4 +1,4 @@
-// Strokes and masks painted on the pictures `render` draws (io/picture_mapping.h) cut the same object as
+// Strokes and masks painted on the pictures `render` draws (render/picture_mapping.h) cut the same object as
 // strokes on the scan's own grid.
 #include <unistd.h>
 
@@ -10,10 +10,10 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/io/picture_mapping.h"
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/picture_mapping.h"
+#include "lidarshop/render/render_layout.h"
+#include "lidarshop/render/strokes.h"
 #include "lidarshop/segment/segment.h"
-#include "lidarshop/segment/strokes.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
 

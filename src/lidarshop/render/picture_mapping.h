@@ -35,7 +35,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
 
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop {

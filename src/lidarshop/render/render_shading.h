@@ -6,7 +6,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 
 namespace lidarshop {
 

@@ -1,4 +1,4 @@
-#include "lidarshop/segment/strokes.h"
+#include "lidarshop/render/strokes.h"
 
 #include <fstream>
 #include <sstream>
@@ -9,7 +9,6 @@
 
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/scan_io.h"
-#include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/json_input.h"
@@ -138,14 +137,6 @@ PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, con
   strokes.cells = CellsFromPicture(scan, *strokes.mapping, labels);
   strokes.picture = labels(cv::Rect(cv::Point(0, 0), strokes.mapping->picture_size)).clone();
   return strokes;
-}
-
-cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes) {
-  if (strokes.mapping && strokes.mapping->view == PictureView::kGrid) {
-    return SegmentOverlayPicture(scan, mask, strokes.cells, strokes.mapping->picture_size, strokes.picture);
-  }
-  if (IsUnorganized(scan)) return SegmentOverlay(scan, mask, strokes.cells);
-  return SegmentOverlayPicture(scan, mask, strokes.cells, LayOutPicture(scan, {}).picture_size);
 }
 
 cv::Mat StrokesToImage(const cv::Mat& strokes) {

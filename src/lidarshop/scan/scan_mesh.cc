@@ -1,4 +1,4 @@
-#include "lidarshop/scanner/scan_mesh.h"
+#include "lidarshop/scan/scan_mesh.h"
 
 #include <cmath>
 

@@ -1,4 +1,4 @@
-#include "lidarshop/io/render_view.h"
+#include "lidarshop/render/render_view.h"
 
 #include <algorithm>
 #include <cmath>

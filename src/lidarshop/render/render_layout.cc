@@ -1,4 +1,4 @@
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "lidarshop/io/render.h"
+#include "lidarshop/render/render.h"
 
 #include <charconv>
 #include <cmath>
@@ -9,7 +9,7 @@
 #include <fmt/ranges.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/io/render_shading.h"
+#include "lidarshop/render/render_shading.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 

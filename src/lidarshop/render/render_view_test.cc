@@ -1,5 +1,5 @@
 // Second viewpoints keep the scan's up, and their camera depends on the region and the pose only.
-#include "lidarshop/io/render_view.h"
+#include "lidarshop/render/render_view.h"
 
 #include <cmath>
 

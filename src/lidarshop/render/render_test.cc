@@ -1,4 +1,4 @@
-#include "lidarshop/io/render.h"
+#include "lidarshop/render/render.h"
 
 #include <gtest/gtest.h>
 

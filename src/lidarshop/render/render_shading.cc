@@ -1,4 +1,4 @@
-#include "lidarshop/io/render_shading.h"
+#include "lidarshop/render/render_shading.h"
 
 #include <algorithm>
 #include <cmath>

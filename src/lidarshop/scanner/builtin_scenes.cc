@@ -1,13 +1,19 @@
-#include "lidarshop/cli/builtin_scenes.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 
 #include <filesystem>
 
 #include <fmt/format.h>
 
-#include "lidarshop/cli/commands.h"
 #include "lidarshop/util/error.h"
 
-namespace lidarshop::cli {
+namespace lidarshop {
+
+const BuiltinScene* FindBuiltinScene(const std::string& name) {
+  for (const BuiltinScene& builtin : BuiltinScenes()) {
+    if (name == builtin.name) return &builtin;
+  }
+  return nullptr;
+}
 
 std::string BuiltinSceneNames() {
   std::string names;
@@ -16,17 +22,13 @@ std::string BuiltinSceneNames() {
 }
 
 SceneDescription LoadSceneOrBuiltin(const std::string& scene) {
-  for (const BuiltinScene& builtin : BuiltinScenes()) {
-    if (scene == builtin.name) return ParseScene(builtin.json, fmt::format("built-in scene '{}'", scene), "");
+  if (const BuiltinScene* builtin = FindBuiltinScene(scene)) {
+    return ParseScene(builtin->json, fmt::format("built-in scene '{}'", scene), "");
   }
   std::error_code not_a_file;
-  if (std::filesystem::exists(scene, not_a_file)) {
-    SceneDescription description = LoadScene(scene);
-    PrintWarnings(description.warnings);
-    return description;
-  }
+  if (std::filesystem::exists(scene, not_a_file)) return LoadScene(scene);
   throw InputError(fmt::format("'{}' is neither a built-in scene (one of:{}) nor a scene file", scene,
                                BuiltinSceneNames()));
 }
 
-}  // namespace lidarshop::cli
+}  // namespace lidarshop

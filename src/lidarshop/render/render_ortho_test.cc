@@ -8,9 +8,9 @@
 
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/las.h"
-#include "lidarshop/io/render.h"
-#include "lidarshop/io/render_layout.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/render/render.h"
+#include "lidarshop/render/render_layout.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 

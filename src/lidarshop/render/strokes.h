@@ -1,6 +1,6 @@
 // User strokes for segmentation: from a painted PNG or from JSON polylines, into a stroke label image
-// (CV_8U rows x cols, image orientation, values kStrokeNone / kStrokeObject / kStrokeBackground of
-// segment.h).
+// (CV_8U rows x cols, image orientation, values kStrokeNone / kStrokeObject / kStrokeBackground below). Read
+// here, beside the pictures they are painted on; segment/ cuts from the label image.
 //
 // PNG (any size-matched 8-bit RGB or RGBA image, row 0 = top of the scan image): a cell is an OBJECT stroke
 // when it is saturated green (G >= 160, R <= 96, B <= 96) and a BACKGROUND stroke when saturated red
@@ -8,7 +8,7 @@
 // — is no stroke. Paint on a blank layer when the scan's picture itself has saturated greens or reds.
 //
 // A stroke picture may also be painted on any picture `render` wrote of the scan (square angular pixels, any
-// width; io/picture_mapping.h): its strokes are mapped onto the grid's cells (ReadStrokesForScan).
+// width; render/picture_mapping.h): its strokes are mapped onto the grid's cells (ReadStrokesForScan).
 //
 // JSON polylines in grid coordinates:
 //   {"strokes": [
@@ -21,15 +21,21 @@
 // strokes paint over earlier ones.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 
 #include <opencv2/core.hpp>
 
-#include "lidarshop/io/picture_mapping.h"
+#include "lidarshop/render/picture_mapping.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop {
+
+// Stroke label images: CV_8U rows x cols (image orientation), one of these values per cell.
+constexpr uint8_t kStrokeNone = 0;
+constexpr uint8_t kStrokeObject = 1;
+constexpr uint8_t kStrokeBackground = 2;
 
 // Classifies a painted RGB/RGBA CV_8U image (see above). Throws InputError naming `what` on a wrong type.
 cv::Mat StrokesFromImage(const cv::Mat& painted, const std::string& what = "strokes");
@@ -60,12 +66,6 @@ struct PaintedStrokes {
 // the file, the sizes it may have and how to get a picture to paint on; `what_scan` names the scan.
 PaintedStrokes ReadStrokesForScan(const std::string& path, const Scan& scan, const std::string& layout_path,
                                   const std::string& what_scan);
-
-// The overlay of `mask` and the strokes in the layout `render` draws by default (square angular pixels), or
-// the layout of the picture the strokes were painted on when it is a grid picture: the scan's colours, object
-// cells tinted with a 1-pixel outline, strokes drawn as painted (or their cells resampled), never widened.
-// Unorganized clouds (no grid picture): SegmentOverlay's one pixel per cell. CV_8UC3 RGB.
-cv::Mat OverlayOnPicture(const Scan& scan, const cv::Mat& mask, const PaintedStrokes& strokes);
 
 // Paints strokes as a PNG-ready RGB image (object green, background red, rest black) — the inverse of
 // StrokesFromImage.

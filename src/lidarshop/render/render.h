@@ -37,7 +37,7 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/image/colormap.h"
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/options_fwd.h"
 

@@ -1,4 +1,4 @@
-#include "lidarshop/io/picture_mapping.h"
+#include "lidarshop/render/picture_mapping.h"
 
 #include <algorithm>
 #include <cmath>

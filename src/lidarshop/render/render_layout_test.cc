@@ -1,4 +1,4 @@
-#include "lidarshop/io/render_layout.h"
+#include "lidarshop/render/render_layout.h"
 
 #include <cmath>
 
@@ -6,7 +6,7 @@
 
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/io_test_util.h"
-#include "lidarshop/io/render.h"
+#include "lidarshop/render/render.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {

@@ -1,0 +1,99 @@
+// Descriptions of the picture options (util/options.h). RenderOptions is not described: its colour map is
+// optional and its bounds are NaN for "from the data" (the render command binds them by hand).
+#include "lidarshop/render/render.h"
+#include "lidarshop/render/render_layout.h"
+#include "lidarshop/render/render_view.h"
+#include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+template <>
+const EnumInfo& EnumInfoOf<RenderChannel>() {
+  static const EnumInfo info = MakeEnumInfo<RenderChannel>(
+      "channel", {{RenderChannel::kRange, "range", "metres from the scanner"},
+                  {RenderChannel::kRgb, "rgb", "the scan's colour"},
+                  {RenderChannel::kIntensity, "intensity", "return strength in the file's units"},
+                  {RenderChannel::kNormals, "normals", "normals as (n + 1) / 2"},
+                  {RenderChannel::kLabels, "labels", "object labels (a LAS file's: its classes)"},
+                  {RenderChannel::kValid, "valid", "white where the ray returned"},
+                  {RenderChannel::kElevation, "elevation", "world z in metres (the file's z)"},
+                  {RenderChannel::kClassification, "classification",
+                   "labels as ASPRS classes: their names and usual colours"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PictureView>() {
+  static const EnumInfo info = MakeEnumInfo<PictureView>(
+      "view", {{PictureView::kAuto, "auto", "the ray grid of organized scans, a spherical grid for clouds"},
+               {PictureView::kGrid, "grid", "the scan's own ray grid"},
+               {PictureView::kSphere, "sphere", "points projected onto a spherical grid around the scanner"},
+               {PictureView::kTop, "top", "orthographic from above (world x right, y up)"},
+               {PictureView::kFront, "front", "orthographic from the front (world x right, z up)"},
+               {PictureView::kSide, "side", "orthographic from the right-hand side (world y right, z up)"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PixelAspect>() {
+  static const EnumInfo info = MakeEnumInfo<PixelAspect>(
+      "aspect", {{PixelAspect::kSquare, "square", "square angular pixels (the finer native step)"},
+                 {PixelAspect::kNative, "native", "one pixel per ray"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PictureLayoutOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PictureLayoutOptions> b("PictureLayoutOptions",
+                                          "where the pixels of a scan picture come from");
+    b.Field(&PictureLayoutOptions::view, "view", "grid, spherical or orthographic layout");
+    b.Field(&PictureLayoutOptions::aspect, "aspect", "grid view: square angular pixels or one pixel per ray");
+    b.Field(&PictureLayoutOptions::width_px, "width_px",
+            "picture width; 0 = automatic (with only one size given the other keeps the aspect)")
+        .Unit("px")
+        .Range(0, 16384);
+    b.Field(&PictureLayoutOptions::height_px, "height_px", "picture height; 0 = automatic")
+        .Unit("px")
+        .Range(0, 16384);
+    b.Field(&PictureLayoutOptions::max_side_px, "max_side_px", "automatic sizes: the longer side at most")
+        .Unit("px")
+        .Range(16, 16384);
+    b.Field(&PictureLayoutOptions::min_long_side_px, "min_long_side_px",
+            "orthographic views, automatic sizes: the longer side at least (at most max_side_px)")
+        .Unit("px")
+        .Range(16, 16384);
+    b.Field(
+         &PictureLayoutOptions::point_size_px, "point_size_px",
+         "side of the square drawn for each point (orthographic views and the second viewpoint); 0 = twice "
+         "the local point spacing (second viewpoint: 2)")
+        .Unit("px")
+        .Range(0, 32);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PointViewOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<PointViewOptions> b(
+        "PointViewOptions", "points from a second viewpoint (eye, target, up: C++ and the camera file)");
+    b.Field(&PointViewOptions::field_of_view_deg, "field_of_view_deg", "horizontal field of view")
+        .Unit("deg")
+        .AboveZero()
+        .Below(170);
+    b.Field(&PointViewOptions::width_px, "width_px", "picture width").Unit("px").Range(16, 16384);
+    b.Field(&PointViewOptions::height_px, "height_px", "picture height").Unit("px").Range(16, 16384);
+    b.Field(&PointViewOptions::point_size_px, "point_size_px", "side of each drawn point")
+        .Unit("px")
+        .Range(1, 32);
+    b.Field(&PointViewOptions::synthesized_tint, "synthesized_tint", "share of magenta on synthesized points")
+        .Range(0, 1);
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
