@@ -18,7 +18,7 @@
 
 #include "http.h"
 #include "lidarshop/io/image_io.h"
-#include "lidarshop/io/render.h"
+#include "lidarshop/render/render.h"
 #include "lidarshop/util/enum_names.h"
 #include "lidarshop/util/error.h"
 
