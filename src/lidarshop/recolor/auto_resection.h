@@ -79,16 +79,24 @@ struct AutoResectionResult {
   std::vector<PixelPointPair> pairs;  // the last round's pairs (photo pixels, world points)
   std::vector<uint8_t> inlier;        // per pair: 1 = inlier
   int inliers = 0;
-  double inlier_share = 0;            // inliers / pairs
-  double rms_px = 0;                  // RMS reprojection error of the inliers, photo pixels
-  double rms_work_px = 0;             // the same in working pixels (what max_rms_px bounds)
-  double work_scale = 1;              // working pixels per photo pixel (<= 1)
-  double search_fov_deg = 0;          // field of view of the winning search (0 with given intrinsics)
-  int search_view = -1;               // the winning search view (-1 with a rough camera)
-  int search_inliers = 0;             // its PnP inliers
-  int rounds = 0;                     // rounds run
-  double last_move_m = 0;             // how far the last round moved the camera centre, metres
-  double last_turn_deg = 0;           // and turned it, degrees
+  double inlier_share = 0;    // inliers / pairs
+  double rms_px = 0;          // RMS reprojection error of the inliers, photo pixels
+  double rms_work_px = 0;     // the same in working pixels (what max_rms_px bounds)
+  double work_scale = 1;      // working pixels per photo pixel (<= 1)
+  double search_fov_deg = 0;  // field of view of the winning search (0 with given intrinsics)
+  int search_view = -1;       // the winning search view (-1 with a rough camera)
+  int search_inliers = 0;     // its PnP inliers
+  int rounds = 0;             // rounds run
+  double last_move_m = 0;     // how far the last round moved the camera centre, metres
+  double last_turn_deg = 0;   // and turned it, degrees
+  // The independent check (step 5): SIFT pairs ratio-tested over the whole rendering from the final camera,
+  // how many, how many it explains within ransac_threshold_px, and their median error (working pixels).
+  int check_pairs = 0;
+  int check_agree = 0;
+  double check_median_work_px = 0;
+  int check_alt_inliers = 0;
+  double check_alt_move_m = 0;
+  std::string trace;                  // what the search candidate's rounds did (refusals quote it)
   std::vector<std::string> warnings;  // one sentence each
   std::string Summary() const;        // one line
 };
