@@ -26,6 +26,12 @@
 //      pairs or a share below `min_inlier_share` agree, their RMS exceeds `max_rms_px`, or the last round still
 //      moved the camera 1 cm or 0.05° (it has not settled: a repeating texture pulls it over): a wrong camera
 //      would recolour the scan with the wrong photo pixels without a sign.
+//   5. Check. Guided SIFT and patches look only near the estimate, so a repeating texture (bricks) matched one
+//      period over is a consistent answer. The scan is rendered from the final camera and SIFT matched with the
+//      ratio test over the whole rendering (a repeating feature has a second match as good and drops out);
+//      PnP RANSAC on those pairs alone gives a second camera. When it explains at least 12 of them and 1.5 x as
+//      many as the final camera, the camera is ambiguous: the rounds restart from the second camera (twice at
+//      most), else the photo is refused ("ambiguous").
 // Deterministic: keypoints are sorted before their descriptors are computed, the brute-force matcher gives
 // the same answer on any thread count, RANSAC is seeded.
 // Thresholds are in working pixels (about one scan cell); the camera and `rms_px` are in the photo's pixels.
