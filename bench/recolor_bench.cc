@@ -61,6 +61,12 @@ void BM_StationRecolor(benchmark::State& state) {
   state.counters["scene_s"] = result.scene_seconds;
   state.counters["visibility_s"] = result.visibility_seconds;
   state.counters["blend_s"] = result.blend_seconds;
+  state.counters["zbuffer_s"] = result.zbuffer_seconds;
+  state.counters["projection_s"] = result.projection_seconds;
+  state.counters["choice_s"] = result.choice_seconds;
+  state.counters["gain_s"] = result.gain_seconds;
+  state.counters["output_s"] = result.output_seconds;
+  state.counters["total_s"] = result.total_seconds;
 }
 BENCHMARK(BM_StationRecolor)
     ->Args({3000, 5000, 2048})

@@ -24,6 +24,7 @@
 #include "lidarshop/pointset/superpixels.h"
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/poisson/poisson.h"
+#include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
@@ -69,6 +70,7 @@ void BindOptionStructs(py::module_& m) {
   BindStruct<SweepOptions>(m);
   // Recolouring
   BindStruct<ResectionOptions>(m);
+  BindStruct<AlignOptions>(m);
   BindStruct<AutoResectionOptions>(m);
   BindStruct<RecolorOptions>(m);
   // Point sets

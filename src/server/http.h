@@ -150,6 +150,33 @@ std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t s
 // "cols,rows"; an empty body when nothing changed). Each kept state's picture is rendered once.
 void SendRayPicture(Document& document, const RenderOptions& options, const std::string& channel,
                     int64_t since, httplib::Response& response);
+// The picture of `state` in `channel`, rendered once per kept state (Document::pictures).
+cv::Mat Picture(Document& document, const Document::PointState& state, const RenderOptions& options,
+                const std::string& channel);
+// The smallest box holding every pixel where `a` and `b` (same size and type) differ (empty when none).
+cv::Rect ChangedBox(const cv::Mat& a, const cv::Mat& b);
+// Every buffer RenderScan reads is the same: the two scans render the same picture.
+bool SameScanBuffers(const Scan& a, const Scan& b);
+// The point state kept for `version` (Document::recent), or nullptr when it is no longer kept.
+const Document::PointState* StateAt(const Document& document, int64_t version);
+
+// tiles.cc: the ray image as a tile pyramid (docs/api.md "Tiles"). Caller holds document.mutex.
+inline constexpr int kTilePixels = 256;
+// Levels above 0 of a rows x cols picture: the coarsest (the highest) holds the whole picture in one tile.
+int TileLevels(int rows, int cols);
+// {"version", "rows", "cols", "tile_px", "levels": [{"level", "rows", "cols", "tiles_x", "tiles_y"}],
+// "changed"}: with `since` a kept version, "changed" is the box [col, row, width, height] of level-0 pixels that
+// differ between its picture and the current one ([0, 0, 0, 0] when none), else the whole picture.
+nlohmann::ordered_json TilesInfo(Document& document, const RenderOptions& options, const std::string& channel,
+                                 int64_t since);
+// Tile (tx, ty) of `level` as PNG (404 when the level or the tile does not exist); headers X-Lidarshop-Version
+// and X-Lidarshop-Tile-Version (the version whose render made these pixels: a tile untouched by the edits
+// since keeps its older one).
+void SendTile(Document& document, const RenderOptions& options, const std::string& channel, int level, int tx,
+              int ty, httplib::Response& response);
+// The bytes the tile cache of a document may hold; the least recently used tiles are dropped above it.
+inline constexpr int64_t kMaxTileCacheBytes = int64_t{96} << 20;
+
 // A BGRA overlay as PNG; with `box` (of a `size` picture: cropped to its drawn cells, drawn from those
 // cells alone so that a large scan's mostly clear overlay costs its box), with the headers above.
 void SendOverlay(httplib::Response& response, const cv::Mat& bgra, const cv::Rect* box, cv::Size size);
@@ -190,5 +217,6 @@ void AddVerifyRoutes(State& state);   // routes_verify.cc: models, pose verifica
 void AddRecolorRoutes(State& state);  // routes_recolor.cc: photos, the three kinds of correspondences
 void AddReviewRoutes(State& state);   // routes_review.cc: inpainting with the patch review
 void AddStationRoutes(State& state);  // routes_stations.cc: sites, their stations, clean
+void AddTileRoutes(State& state);     // tiles.cc: the ray image's tile pyramid
 
 }  // namespace lidarshop::server

@@ -11,8 +11,6 @@
 
 namespace lidarshop::server {
 
-namespace {
-
 // The point state kept for `version` (Document::recent), or nullptr when it is no longer kept.
 const Document::PointState* StateAt(const Document& document, int64_t version) {
   for (const auto& state : document.recent) {
@@ -21,7 +19,6 @@ const Document::PointState* StateAt(const Document& document, int64_t version) {
   return nullptr;
 }
 
-// Every buffer RenderScan reads: two scans with the same buffers render the same picture.
 bool SameScanBuffers(const Scan& a, const Scan& b) {
   const auto same = [](const cv::Mat& m, const cv::Mat& n) { return m.data == n.data && m.size == n.size; };
   return same(a.valid, b.valid) && same(a.range, b.range) && same(a.point, b.point) &&
@@ -29,8 +26,7 @@ bool SameScanBuffers(const Scan& a, const Scan& b) {
          same(a.synthesized, b.synthesized) && same(a.normal, b.normal);
 }
 
-// The picture of `state` in `channel`, rendered once per kept state (Document::pictures; entries of states
-// no longer kept are dropped).
+// Entries of states no longer kept are dropped.
 cv::Mat Picture(Document& document, const Document::PointState& state, const RenderOptions& options,
                 const std::string& channel) {
   auto& cache = document.pictures;
@@ -46,7 +42,6 @@ cv::Mat Picture(Document& document, const Document::PointState& state, const Ren
   return image;
 }
 
-// The smallest box holding every pixel where `a` and `b` differ (empty when none).
 cv::Rect ChangedBox(const cv::Mat& a, const cv::Mat& b) {
   cv::Mat difference;
   cv::absdiff(a, b, difference);
@@ -60,6 +55,8 @@ cv::Rect ChangedBox(const cv::Mat& a, const cv::Mat& b) {
   any = any.reshape(1, a.rows);
   return cv::boundingRect(any);
 }
+
+namespace {
 
 void SetBox(httplib::Response& response, const cv::Rect& box, const cv::Size& size) {
   response.set_header("X-Lidarshop-Box", fmt::format("{},{},{},{}", box.x, box.y, box.width, box.height));

@@ -24,6 +24,18 @@ namespace lidarshop::server {
 
 namespace {
 
+// A fit's described JSON with its matrix (not a described field) right after "model", where the answers have
+// always had it.
+nlohmann::ordered_json WithMatrix(const nlohmann::ordered_json& fit, const std::string& key,
+                                  const std::vector<double>& matrix) {
+  nlohmann::ordered_json json;
+  for (const auto& [name, value] : fit.items()) {
+    json[name] = value;
+    if (name == "model") json[key] = matrix;
+  }
+  return json;
+}
+
 // ?slot=a (the photo to recolour from, the default) or ?slot=b (the second photo of photo <-> photo pairs).
 cv::Mat* PhotoSlot(Document& document, const httplib::Request& request, httplib::Response& response) {
   const std::string slot = request.has_param("slot") ? request.get_param_value("slot") : std::string("a");
@@ -222,13 +234,9 @@ void Align(State& state, const std::shared_ptr<Document>& document, const nlohma
     }
     const LandmarkAlignment fit = AlignLandmarks(pairs, with_scale, "pairs");
     const Eigen::Matrix4d& t = fit.target_from_source;
-    nlohmann::ordered_json json = {
-        {"model", with_scale ? "similarity" : "rigid"},
-        {"target_from_source_column_major", std::vector<double>(t.data(), t.data() + 16)},
-        {"scale", fit.scale},
-        {"rms_m", fit.rms_m},
-        {"residual_m", fit.residual_m},
-        {"applied", apply}};
+    nlohmann::ordered_json json = WithMatrix(ToJson(fit), "target_from_source_column_major",
+                                             std::vector<double>(t.data(), t.data() + 16));
+    json["applied"] = apply;
     if (apply) {
       Snapshot next = document->now;
       next.scan.world_from_scanner = t * document->now.scan.world_from_scanner;
@@ -246,12 +254,11 @@ void Align(State& state, const std::shared_ptr<Document>& document, const nlohma
 // fundamental matrix (>= 8) by RANSAC, answered at once.
 void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
                  httplib::Response& response) {
-  const std::string model = body.value("model", std::string("homography"));
-  if (model != "homography" && model != "fundamental")
-    throw OptionsFieldError("model", "expected \"homography\" or \"fundamental\"");
-  const double threshold_px = body.value("threshold_px", 3.0);
-  if (!(threshold_px > 0 && threshold_px <= 1000))
-    throw OptionsFieldError("threshold_px", "out of range (0, 1000]");
+  // The body's "model" and "threshold_px" are AlignOptions' keys (the ranges of `lidarshop align`).
+  nlohmann::json given = nlohmann::json::object();
+  for (const char* key : {"model", "threshold_px"})
+    if (body.contains(key)) given[key] = body.at(key);
+  const AlignOptions options = FromJson<AlignOptions>(given);
   std::lock_guard lock(document->mutex);
   if (document->photo.empty() || document->photo_b.empty())
     return SendError(response, 400, "upload both photos first (POST .../photo and .../photo?slot=b)");
@@ -261,17 +268,11 @@ void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohma
       CheckInside(pairs.pixel_pixel[i].pixel_a, document->photo, fmt::format("pairs[{}].pixel_a", i));
       CheckInside(pairs.pixel_pixel[i].pixel_b, document->photo_b, fmt::format("pairs[{}].pixel_b", i));
     }
-    const PhotoPairModel fit = model == "fundamental"
-                                   ? EstimateFundamental(pairs.pixel_pixel, threshold_px, "pairs")
-                                   : EstimateHomography(pairs.pixel_pixel, threshold_px, "pairs");
+    const PhotoPairModel fit = EstimatePhotoModel(pairs.pixel_pixel, options, "pairs");
     std::vector<double> rows;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) rows.push_back(fit.matrix(r, c));
-    SendJson(response, {{"model", model},
-                        {"matrix_row_major", rows},
-                        {"rms_px", fit.rms_px},
-                        {"error_px", fit.error_px},
-                        {"inlier", fit.inlier}});
+    SendJson(response, WithMatrix(ToJson(fit), "matrix_row_major", rows));
   } catch (const InputError& error) {
     throw OptionsError(error.what());  // too few pairs, no model found
   }

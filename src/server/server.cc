@@ -113,6 +113,7 @@ EditorServer::EditorServer(ServerOptions options) : state_(std::make_unique<Stat
   AddRecolorRoutes(*state_);
   AddReviewRoutes(*state_);
   AddStationRoutes(*state_);
+  AddTileRoutes(*state_);
   if (!state_->options.web_dir.empty()) {
     if (!http.set_mount_point("/", state_->options.web_dir)) {
       throw InputError(

@@ -11,6 +11,7 @@
 #include <mutex>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -92,6 +93,18 @@ struct Document {
   std::deque<PointState> recent;
   // Ray images rendered, by (channel, the first version of a state in `recent`): a picture patch compares two.
   std::map<std::pair<std::string, int64_t>, cv::Mat> pictures;
+  // The ray image's tile pyramid (tiles.cc, docs/api.md "Tiles"): encoded tiles by (channel, level, tx, ty),
+  // each with the state it shows (the first version of a state in `recent`). A tile is re-rendered only when
+  // the pixels of its footprint changed between the state it shows and the current one (the changed box of
+  // the two pictures, kept by (channel, from, to) in `changed_boxes`).
+  struct Tile {
+    std::string png;
+    int64_t state = -1;  // Document::PointState::first_version of the state rendered
+    int64_t used = 0;    // a counter: the least recently used tiles go first when the cache is full
+  };
+  std::map<std::tuple<std::string, int, int, int>, Tile> tiles;
+  int64_t tile_bytes = 0, tile_uses = 0;
+  std::map<std::tuple<std::string, int64_t, int64_t>, cv::Rect> changed_boxes;
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)

@@ -197,7 +197,8 @@ try {
   const edits = [];
   let apiBytes = 0; // every /api/ answer's body: points, pictures, JSON
   page.on('requestfinished', async (request) => {
-    if (request.url().includes('/api/')) apiBytes += (await request.sizes()).responseBodySize;
+    if (request.url().includes('/api/'))
+      apiBytes += (await request.sizes().catch(() => ({ responseBodySize: 0 }))).responseBodySize;
   });
   const bytesOfEdit = async (what, action, done) => {
     await page.evaluate(() => window.lidarshop.settled());

@@ -1,14 +1,19 @@
-// End to end on a large station (issue 36): the built-in parking lot scanned on a fine grid (by default
+// End to end on a large station (issues 34 and 36): the built-in parking lot scanned on a fine grid (by default
 // 2250 x 3600 rays, 5.4 M returns; made here, never committed), served, opened in Debian's chromium. Measures
-// the time from page open to the first ray picture and to the first (coarse) and refined 3-D points, then
-// counts the bytes of each edit — a stroke, its undo and redo, a painted hole filled (points move), its undo —
-// and checks the patched ray image against the server's whole picture after the fill and after its undo.
-// Prints one JSON line with the numbers (bench/results/editor.md).
+// how long `serve` reads it, the time from page open to the first ray picture (the coarsest tile, tiles.ts) and
+// to the tiles of the view's level, the bytes until then, and the first (coarse) and refined 3-D points, which
+// must stay within the browser's point budget (1-2 M points); then counts the bytes of each edit — a stroke,
+// its undo and redo, a painted hole filled (points move), its undo — and checks every tile the browser holds
+// against the server's after the fill and after its undo. Last, the station is opened again in the running
+// server (the file dialog): the time to read it and from then to its first picture. Prints one JSON line with
+// the numbers (bench/results/editor.md). --budget S fails the run when the first picture after page open takes
+// longer than S seconds.
 //
-//   node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C]
+//   node e2e/station.mjs LIDARSHOP_BINARY [ARTEFACTS_DIR] [--rows R --columns C | --station FILE.e57] [--budget S]
+//   (a 4000 x 4000 grid: the 16 M-ray station of issue 34)
 import { spawn, execFileSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, rmSync } from 'node:fs';
-import { join, dirname } from 'node:path';
+import { linkSync, mkdirSync, mkdtempSync, rmSync } from 'node:fs';
+import { join, dirname, resolve } from 'node:path';
 import { tmpdir } from 'node:os';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
@@ -46,18 +51,24 @@ async function waitForFunction(page, fn, arg, { timeout = 60000 } = {}) {
 }
 
 const started = Date.now();
+// --station FILE: an E57 station made before (e.g. by a previous run's scan), linked into the served folder.
+const given = option('--station', '');
 const station = join(root, 'station.e57');
-execFileSync(binary, [
-  'scan',
-  'parking_lot',
-  '--rows',
-  String(rows),
-  '--columns',
-  String(columns),
-  '-o',
-  station,
-  '--quiet',
-]);
+if (given) {
+  linkSync(resolve(given), station); // a hard link: a symlink out of the served folder is refused
+} else {
+  execFileSync(binary, [
+    'scan',
+    'parking_lot',
+    '--rows',
+    String(rows),
+    '--columns',
+    String(columns),
+    '-o',
+    station,
+    '--quiet',
+  ]);
+}
 const scanSeconds = (Date.now() - started) / 1000;
 
 // The server opens the station at start (`serve FILE`), as a user opening a scan given on the command line.
@@ -68,6 +79,7 @@ const server = spawn(
     stdio: ['ignore', 'pipe', 'inherit'],
   },
 );
+const serveStarted = Date.now();
 const url = await new Promise((resolve, reject) => {
   let output = '';
   server.stdout.on('data', (chunk) => {
@@ -92,30 +104,72 @@ const browser = await chromium.launch({
     '--enable-unsafe-swiftshader',
   ],
 });
-const result = { rows, columns, scan_seconds: scanSeconds };
+const result = { rows, columns, scan_seconds: scanSeconds, serve_read_s: (Date.now() - serveStarted) / 1000 };
+const budget = Number(option('--budget', 5));
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
   page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
   let apiBytes = 0;
   page.on('requestfinished', async (request) => {
-    if (request.url().includes('/api/')) apiBytes += (await request.sizes()).responseBodySize;
+    if (request.url().includes('/api/'))
+      apiBytes += (await request.sizes().catch(() => ({ responseBodySize: 0 }))).responseBodySize;
   });
   const opened = Date.now();
   await page.goto(url);
   await waitForFunction(page, () => window.lidarshop?.rayView.shownState().id > 0, null, { timeout: 120000 });
   result.first_picture_s = (Date.now() - opened) / 1000;
+  // Where the time went: the page's requests until the first picture (start and end, ms after page open).
+  result.first_picture_requests = await page.evaluate(() =>
+    performance
+      .getEntriesByType('resource')
+      .filter((e) => e.name.includes('/api/'))
+      .slice(0, 12)
+      .map(
+        (e) =>
+          `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+      ),
+  );
+  result.page_loaded_ms = await page.evaluate(() =>
+    Math.round(performance.getEntriesByType('navigation')[0]?.domContentLoadedEventEnd ?? -1),
+  );
+  // The first picture's bytes: what the ray image's requests brought (tiles or the whole picture).
+  result.first_picture_bytes = await page.evaluate(() => window.lidarshop.pictureBytes());
+  result.tiled = await page.evaluate(() => window.lidarshop.tiled(window.lidarshop.current().id) !== null);
+  if (result.tiled) {
+    // The tiles of the level the view needs, all of them held.
+    await waitForFunction(
+      page,
+      () => {
+        const counts = window.lidarshop.tiled(window.lidarshop.current().id).counts();
+        return counts.wanted === 0 && counts.inFlight === 0;
+      },
+      null,
+      { timeout: 120000 },
+    );
+    result.view_tiles_s = (Date.now() - opened) / 1000;
+    result.view_tiles = await page.evaluate(() =>
+      window.lidarshop.tiled(window.lidarshop.current().id).counts(),
+    );
+    result.view_tiles_bytes = await page.evaluate(() => window.lidarshop.pictureBytes());
+  }
+  if (result.first_picture_s > budget)
+    console.error(`e2e station: the first picture took ${result.first_picture_s} s (budget ${budget} s)`);
   await waitForFunction(page, () => window.lidarshop.pointsShown().id > 0, null, { timeout: 120000 });
   result.first_points_s = (Date.now() - opened) / 1000;
   result.first_level = await page.evaluate(() => window.lidarshop.pointLevel());
   const doc = await page.evaluate(() => window.lidarshop.current());
   result.returns = doc.valid_cells;
+  [result.rows, result.columns] = [doc.rows, doc.cols]; // a --station file's own grid
   await page.screenshot({ path: join(artefacts, 'station_opened.png') });
   // The refinement to the finer level (the 3-D view's; it does not hold up the ray image).
   await waitForFunction(
     page,
     () =>
       window.lidarshop.pointLevel() ===
-      Math.max(1, Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / 4e6))),
+      Math.max(
+        1,
+        Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / window.lidarshop.pointBudget)),
+      ),
     null,
     { timeout: 240000 },
   );
@@ -123,6 +177,10 @@ try {
   result.refined_points_s = (Date.now() - opened) / 1000;
   result.refined_level = await page.evaluate(() => window.lidarshop.pointLevel());
   result.open_bytes = apiBytes;
+  result.points_held = await page.evaluate(() => window.lidarshop.pointsHeld());
+  result.point_budget = await page.evaluate(() => window.lidarshop.pointBudget);
+  if (result.points_held > result.point_budget)
+    fail(`the browser holds ${result.points_held} points (budget ${result.point_budget})`);
   console.log(`e2e station: opened: ${JSON.stringify(result)}`);
   if (result.first_level < 2)
     fail(`a ${doc.valid_cells}-return station was first downloaded at level ${result.first_level}`);
@@ -178,6 +236,10 @@ try {
     page.evaluate(async () => {
       const d = window.lidarshop.current();
       const channel = document.getElementById('channel').value;
+      // A tiled picture: every tile held of the version shown must be the server's (tiles.ts).
+      const tiled = window.lidarshop.tiled(d.id);
+      if (tiled)
+        return tiled.version === d.version ? await tiled.mismatch() : `tiles of version ${tiled.version}`;
       const held = window.lidarshop.pictures.heldPicture(d.id, channel);
       if (!held) return 'no picture held';
       const bitmap = await createImageBitmap(
@@ -252,6 +314,31 @@ try {
   const afterUndo = await pictureMismatch();
   if (afterUndo) fail(`the patched ray image after undoing the fill is not the server's: ${afterUndo}`);
   await page.screenshot({ path: join(artefacts, 'station_edited.png') });
+
+  // The station opened again in the running server: the time its read takes, then to its first picture.
+  const points = await page.evaluate(() => window.lidarshop.pointsHeld());
+  if (points > result.point_budget) fail(`the browser holds ${points} points after the edits`);
+  const options = await page.locator('#file option').evaluateAll((all) => all.map((o) => o.value));
+  const file = options.find((value) => value.endsWith('station.e57'));
+  if (!file) fail(`the file dialog does not list station.e57: ${options.join(', ')}`);
+  await page.selectOption('#file', file);
+  const firstId = doc.id;
+  const reopen = Date.now();
+  const answer = page.waitForResponse((response) => response.url().includes('/api/open'), {
+    timeout: 300000,
+  });
+  await page.click('#open-file');
+  await answer;
+  result.reopen_read_s = (Date.now() - reopen) / 1000;
+  const read = Date.now();
+  await waitForFunction(page, (id) => window.lidarshop.rayView.shownState().id > id, firstId, {
+    timeout: 120000,
+  });
+  result.reopen_first_picture_s = (Date.now() - read) / 1000;
+  await page.evaluate(() => window.lidarshop.settled());
+  result.points_held_two_open = await page.evaluate(() => window.lidarshop.pointsHeld());
+  if (result.points_held_two_open > result.point_budget)
+    fail(`with the station open twice the browser holds ${result.points_held_two_open} points`);
 
   const wholePoints = 16 + 20 * doc.valid_cells;
   result.edits = edits;

@@ -23,6 +23,8 @@ import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
 import { StationsPanel } from './stations';
 import { PictureStore, loadOverlay } from './picture';
+import { VerifyResult } from './api_types.generated';
+import { TileStore } from './tiles';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -39,14 +41,19 @@ const gate = new VersionGate(); // answers are shown in version order
 // Per document: the points held, their version and level of detail (every step-th row and column).
 const heldPoints = new Map<number, { version: number; step: number; points: PointSet }>();
 // Levels of detail of the 3-D view: the first download holds at most about FIRST_POINTS points, then it is
-// refined to at most about MOST_POINTS (a 1400-pixel-wide view shows no more; deltas then name only those cells).
+// refined to at most about MOST_POINTS (the browser's budget, issue 34: 1-2 M points; a 1400-pixel-wide view
+// shows no more; deltas then name only those cells).
 const FIRST_POINTS = 1_000_000,
-  MOST_POINTS = 4_000_000;
+  MOST_POINTS = 2_000_000;
+const pointsHeld = () => [...heldPoints.values()].reduce((sum, held) => sum + held.points.count, 0);
 const stepFor = (returns: number, most: number) => Math.max(1, Math.ceil(Math.sqrt(returns / most)));
 let pointsShown = { id: -1, version: -1 };
 let pointsChain: Promise<void> = Promise.resolve(); // point updates one at a time, in order
 let pointBytes = 0; // bytes of points received (whole or deltas), for tests
 const pictures = new PictureStore(); // ray images held per document and channel, patched by what changed
+// A large scan's ray image comes as tiles of the level the zoom needs (tiles.ts), never whole.
+const tiles = new TileStore((path, params) => api.url(path, params));
+const TILED_CELLS = 4_000_000;
 let overlayBytes = 0; // bytes of overlays received, for tests
 const firstPictures = new Map<number, number>(); // when a large scan's first picture was shown (tests)
 const strokeKinds = new Set<Brush>(); // brushes used on the open scan since its last cut was reset
@@ -77,10 +84,15 @@ const stationsPanel = new StationsPanel(
   review: () => pending,
   pairs: () => pairsPanel,
   pointLevel: () => (doc ? (heldPoints.get(doc.id)?.step ?? 0) : 0),
+  // Points the browser holds over every open scan (the budget is MOST_POINTS per scan shown).
+  pointsHeld: () => pointsHeld(),
+  pointBudget: MOST_POINTS,
   firstPictures: () => Object.fromEntries(firstPictures),
   pictures,
   pointBytes: () => pointBytes,
-  pictureBytes: () => pictures.bytes + overlayBytes,
+  pictureBytes: () => pictures.bytes + tiles.totalBytes() + overlayBytes,
+  tiles,
+  tiled: (id: number) => tiles.heldPicture(id, element<HTMLSelectElement>('channel').value),
   pointsShown: () => pointsShown,
   documents: () => openDocuments,
   settled: () => pointsChain.then(() => true),
@@ -118,6 +130,12 @@ function updatePoints(id: number, keepView: boolean, step?: number): Promise<voi
         };
       }
       heldPoints.set(id, held);
+      // The browser's point budget holds over every open scan: other scans' points go first (fetched again
+      // when shown again).
+      for (const other of [...heldPoints.keys()]) {
+        if (pointsHeld() <= MOST_POINTS) break;
+        if (other !== id) heldPoints.delete(other);
+      }
       if (doc?.id !== id) return;
       if (pointsShown.id !== id || pointsShown.version !== held.version || !keepView) {
         pointView.show(held.points, keepView && pointsShown.id === id);
@@ -191,12 +209,15 @@ async function refresh(keepView: boolean, strokesOnly = false) {
   const mask = info.object_cells > 0 ? overlay({}) : null;
   const hole = info.hole_cells > 0 ? overlay({ layer: 'hole' }) : null;
   const strokes = overlay({ layer: 'strokes' });
-  const image = pictures.picture(
-    (params) => api.url(`/api/docs/${id}/image.png`, params),
-    id,
-    usable,
-    strokesOnly ? -1 : v,
-  );
+  const image =
+    info.rows * info.cols > TILED_CELLS
+      ? tiles.picture(id, usable, strokesOnly ? -1 : v)
+      : pictures.picture(
+          (params) => api.url(`/api/docs/${id}/image.png`, params),
+          id,
+          usable,
+          strokesOnly ? -1 : v,
+        );
   const shown = await rayView.show(id, v, image, mask, hole, strokes, info.rows, info.cols, aspect, keepView);
   if (!strokesOnly) {
     // The 3-D view follows the ray image and does not hold it up: a large scan's coarse level first, refined
@@ -432,6 +453,7 @@ element('close-doc').addEventListener('click', async () => {
   }
   heldPoints.delete(closing.id);
   pictures.forget(closing.id);
+  tiles.forget(closing.id);
   gate.forget(closing.id);
   await listDocuments();
   await showDocument(openDocuments[0] ?? null);
@@ -503,7 +525,7 @@ async function verify() {
   if (!doc || !placed) return;
   const [x, y, z, yaw] = poseInputs.map((input) => Number(input.value));
   try {
-    const result = await api.json<{ consistency: number | null; confidence: number; summary: string }>(
+    const result = await api.json<VerifyResult & { summary: string }>(
       `/api/docs/${doc.id}/verify`,
       {},
       { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } },

@@ -2,6 +2,7 @@
 // go to (the photo, the second photo, the other scan's ray image) and the button that sends the pairs to the
 // mode's route (docs/api.md). The clicks in the editor's own ray image and 3-D view arrive through pickCell.
 import { Api, DocumentInfo, JobInfo } from './api';
+import { AlignOptions, LandmarkAlignment, PhotoPairModel } from './api_types.generated';
 import { MODES, PairCollector, PairMode, Point2 } from './pairs';
 import { RayView } from './rayview';
 
@@ -233,18 +234,18 @@ export class PairsPanel {
         }
       } else if (mode === 'scan-scan') {
         const target = Number(element<HTMLSelectElement>('align-target').value);
-        const result = await api.json<{ rms_m: number; residual_m: number[] }>(
+        const result = await api.json<LandmarkAlignment & { target_from_source_column_major: number[] }>(
           `/api/docs/${doc.id}/align`,
           {},
           this.pairs.body({ target }),
         );
         await this.context.refresh();
         this.context.status(
-          `aligned to scan #${target}: ${this.pairs.pairs.length} landmarks, RMS ${(1000 * result.rms_m).toFixed(1)} mm (undo restores the pose)`,
+          `aligned to scan #${target}: ${this.pairs.pairs.length} landmarks, RMS ${(1000 * (result.rms_m ?? NaN)).toFixed(1)} mm (undo restores the pose)`,
         );
       } else {
-        const model = element<HTMLSelectElement>('photo-model').value as 'homography' | 'fundamental';
-        const result = await api.json<{ rms_px: number; inlier: number[]; matrix_row_major: number[] }>(
+        const model = element<HTMLSelectElement>('photo-model').value as AlignOptions['model'];
+        const result = await api.json<PhotoPairModel & { matrix_row_major: number[] }>(
           `/api/docs/${doc.id}/photo-match`,
           {},
           this.pairs.body({ model }),
@@ -253,7 +254,7 @@ export class PairsPanel {
         this.draw();
         const outliers = result.inlier.filter((v) => !v).length;
         this.context.status(
-          `${model}: RMS ${result.rms_px.toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => v.toPrecision(4)).join(' ')}`,
+          `${model}: RMS ${(result.rms_px ?? NaN).toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => v.toPrecision(4)).join(' ')}`,
         );
       }
     } catch (error) {

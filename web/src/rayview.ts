@@ -4,6 +4,7 @@
 // stroke keeps the radius it was painted with. A stroke is drawn locally only until the server's state
 // that holds it is shown.
 import { Overlay } from './picture';
+import { TiledPicture } from './tiles';
 import { Cell, ImageView, cellsAlong, cellToScreen, fitView, screenToCell, zoomAt } from './strokes';
 
 export type Brush = 'object' | 'background' | 'erase' | 'hole' | 'lasso' | 'none';
@@ -14,7 +15,7 @@ export class RayView {
   onStroke: (brush: Brush, cells: Cell[]) => void = () => {};
   onPick: (cell: Cell) => void = () => {};
 
-  private image: CanvasImageSource | null = null;
+  private image: CanvasImageSource | TiledPicture | null = null; // a large scan's picture: tiles (tiles.ts)
   private mask: Overlay | null = null;
   private holeMask: Overlay | null = null;
   private strokeImage: Overlay | null = null;
@@ -52,7 +53,7 @@ export class RayView {
   async show(
     id: number,
     version: number,
-    imageSource: string | CanvasImageSource | Promise<CanvasImageSource>,
+    imageSource: string | CanvasImageSource | Promise<CanvasImageSource | TiledPicture>,
     maskSource: OverlaySource,
     holeSource: OverlaySource,
     strokesSource: OverlaySource,
@@ -80,6 +81,7 @@ export class RayView {
     this.sent = [];
     const sizeChanged = rows !== this.rows || cols !== this.cols;
     this.image = image;
+    if (image instanceof TiledPicture) image.onTile = () => this.draw();
     this.mask = mask;
     this.rows = rows;
     this.cols = cols;
@@ -174,17 +176,21 @@ export class RayView {
     if (!this.image) return;
     const { scale, aspect, offsetX, offsetY } = this.view;
     context.imageSmoothingEnabled = false;
-    context.drawImage(
-      this.image,
-      0,
-      0,
-      this.cols,
-      this.rows,
-      offsetX,
-      offsetY,
-      this.cols * scale,
-      this.rows * scale * aspect,
-    );
+    if (this.image instanceof TiledPicture) {
+      this.image.draw(context, this.view, this.canvas.width, this.canvas.height);
+    } else {
+      context.drawImage(
+        this.image,
+        0,
+        0,
+        this.cols,
+        this.rows,
+        offsetX,
+        offsetY,
+        this.cols * scale,
+        this.rows * scale * aspect,
+      );
+    }
     for (const overlay of [this.holeMask, this.mask, this.strokeImage]) {
       if (!overlay) continue;
       const { col, row, width, height } = overlay.box;

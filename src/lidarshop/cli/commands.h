@@ -38,6 +38,7 @@ int RunRegister(int argc, char** argv);   // register_command.cc
 int RunClean(int argc, char** argv);      // clean_command.cc
 int RunBatch(int argc, char** argv);      // batch_command.cc
 int RunServe(int argc, char** argv);      // serve_command.cc
+int RunSchema(int argc, char** argv);     // schema_command.cc
 
 // The images2D entries of an E57 file as JSON (name, size, representation, pose, intrinsics); `images` and
 // `info` print it. recolor_commands.cc.

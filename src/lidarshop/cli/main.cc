@@ -46,6 +46,7 @@ const std::vector<Command>& Commands() {
       {"clean", lidarshop::cli::RunClean, "remove what moved between the stations of a site"},
       {"serve", lidarshop::cli::RunServe, "the editor in the browser: look, paint, segment, remove, save"},
       {"batch", lidarshop::cli::RunBatch, "a pipeline of commands over many scans (local or Dask cluster)"},
+      {"schema", lidarshop::cli::RunSchema, "the editor's API structs as TypeScript or JSON descriptions"},
   };
   return commands;
 }

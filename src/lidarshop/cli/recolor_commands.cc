@@ -1,5 +1,6 @@
 // lidarshop resection | recolor | images | align | photo: photos and scans (recolor/, docs/recolor.md).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -347,6 +348,7 @@ int RunRecolor(int argc, char** argv) {
   // Colouring from several photos at once, and what it writes (--from-e57-images, repeated --photo).
   // `carried`: the input E57's images of this scan, written on with it when the output is an E57 (a station's
   // photos belong with its scan; a recoloured E57 without them could not be coloured again).
+  double read_seconds = 0;  // the scan file (and with --from-e57-images its photos) read and decoded
   const auto colour_station = [&](const Scan& scan, const std::vector<CameraPhoto>& photos,
                                   nlohmann::ordered_json used, const nlohmann::ordered_json& skipped,
                                   const std::vector<E57Image>& carried) {
@@ -355,6 +357,7 @@ int RunRecolor(int argc, char** argv) {
     // The station's own cameras: the guard only when asked for (PhotosRecolorOptions::visibility).
     if (app.count("--edge-guard") == 0) photo_options.visibility.edge_guard = false;
     const PhotosRecolorResult result = RecolorFromPhotos(scan, photos, photo_options);
+    const auto write_start = std::chrono::steady_clock::now();
     if (FileExtension(output) == "e57" && !carried.empty()) {
       WriteE57(output, {result.scan}, carried, E57WriteOptions());
     } else {
@@ -364,6 +367,8 @@ int RunRecolor(int argc, char** argv) {
                                    output, carried.size())});
     }
     if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
+    const double write_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
     nlohmann::ordered_json counts;
     counts["returns"] = result.returns;
     counts["coloured"] = result.coloured;
@@ -374,6 +379,19 @@ int RunRecolor(int argc, char** argv) {
       used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
     counts["photos"] = used;
     counts["skipped"] = skipped;
+    // Wall clock per phase (issue 32 item 6); "colour" is RecolorFromPhotos as a whole, the others its parts.
+    counts["seconds"] = {{"read", read_seconds},
+                         {"colour", result.total_seconds},
+                         {"write", write_seconds},
+                         {"scene", result.scene_seconds},
+                         {"visibility", result.visibility_seconds},
+                         {"zbuffer", result.zbuffer_seconds},
+                         {"projection", result.projection_seconds},
+                         {"choice", result.choice_seconds},
+                         {"gains", result.gain_seconds},
+                         {"colours", result.colour_seconds},
+                         {"blend", result.blend_seconds},
+                         {"output", result.output_seconds}};
     WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
     Summarize(fmt::format("{} -> {}", result.Summary(), output));
     return 0;
@@ -415,7 +433,9 @@ int RunRecolor(int argc, char** argv) {
             CheckNotInput(photo_index_mask_path, inputs);
             CheckOutputPath(photo_index_mask_path, {scan_path, output});
           }
+          const auto read_start = std::chrono::steady_clock::now();
           const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
+          read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
           std::vector<CameraPhoto> photos;
           nlohmann::ordered_json used = nlohmann::ordered_json::array();
           for (size_t i = 0; i < photo_paths.size(); ++i) {
@@ -450,7 +470,9 @@ int RunRecolor(int argc, char** argv) {
             CheckNotInput(photo_index_mask_path, {scan_path});
             CheckOutputPath(photo_index_mask_path, {scan_path, output});
           }
+          const auto read_start = std::chrono::steady_clock::now();
           E57File file = ReadE57AndWarn(scan_path);  // once: a station can be hundreds of MB
+          read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
           if (scan_index < 0 || scan_index >= static_cast<int>(file.scans.size()))
             throw OptionsError(fmt::format("{} {} is out of range: {} holds {} scan(s)", ScanIndexFlag(app),
                                            scan_index, scan_path, file.scans.size()));
@@ -626,56 +648,46 @@ int RunAlign(int argc, char** argv) {
       "scaled 4x4 (Umeyama); photo <-> photo pairs (\"pixel_a\"/\"pixel_b\") a 3x3 homography or "
       "fundamental matrix. Writes the matrix as text rows, prints residuals as JSON.",
       "align"};
-  std::string pairs_path, output, model = "homography", json_path = "-";
-  bool with_scale = false;
-  double threshold_px = 3.0;
+  std::string pairs_path, output, json_path = "-";
+  AlignOptions options;
+  OptionBinder binder(app);
   app.add_option("--correspondences", pairs_path, "C.json")->required();
   app.add_option("-o,--output", output, "T.txt to write")->required();
   AddJsonOption(app, &json_path);
-  app.add_flag("--scale", with_scale, "landmarks: allow a uniform scale (similarity)");
-  app.add_option("--model", model, "photo pairs: homography | fundamental")
-      ->check(CLI::IsMember({"homography", "fundamental"}))
-      ->capture_default_str();
-  app.add_option("--threshold", threshold_px, "photo pairs: RANSAC threshold, pixels")->capture_default_str();
-  return RunCommand(app, argc, argv, [&] {
-    CheckNotInput(output, {pairs_path});
-    CheckOutputFile("--json", json_path, {}, {pairs_path, output});
-    const Correspondences pairs = ReadCorrespondences(pairs_path);
-    nlohmann::ordered_json json;
-    std::string text;
-    if (pairs.kind == PairKind::kLandmark) {
-      const LandmarkAlignment result = AlignLandmarks(pairs.landmarks, with_scale, pairs_path);
-      for (int r = 0; r < 4; ++r) {
-        const Eigen::RowVector4d row = result.target_from_source.row(r);
-        text += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}\n", row[0], row[1], row[2], row[3]);
-      }
-      json["model"] = with_scale ? "similarity" : "rigid";
-      json["scale"] = result.scale;
-      json["rms_m"] = result.rms_m;
-      json["residual_m"] = result.residual_m;
-    } else if (pairs.kind == PairKind::kPixelPixel) {
-      const PhotoPairModel result = model == "fundamental"
-                                        ? EstimateFundamental(pairs.pixel_pixel, threshold_px, pairs_path)
-                                        : EstimateHomography(pairs.pixel_pixel, threshold_px, pairs_path);
-      for (int r = 0; r < 3; ++r)
-        text += fmt::format("{:.17g} {:.17g} {:.17g}\n", result.matrix(r, 0), result.matrix(r, 1),
-                            result.matrix(r, 2));
-      json["model"] = model;
-      json["rms_px"] = result.rms_px;
-      json["error_px"] = result.error_px;
-      json["inlier"] = result.inlier;
-    } else {
-      ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
-    }
-    WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
-    json["options"] = {{"scale", with_scale}, {"model", model}, {"threshold_px", threshold_px}};
-    WriteJsonOutput(json_path, json);
-    Summarize(json.contains("rms_m")
-                  ? fmt::format("{} transform, RMS {:.4g} m -> {}", json["model"].get<std::string>(),
-                                json["rms_m"].get<double>(), output)
-                  : fmt::format("{}, RMS {:.3g} px -> {}", model, json["rms_px"].get<double>(), output));
-    return 0;
-  });
+  binder.Bind(&options, {.flags = {{"threshold_px", "--threshold"}}});
+  return RunCommand(
+      app, argc, argv,
+      [&] {
+        binder.Validate(options);
+        CheckNotInput(output, {pairs_path});
+        CheckOutputFile("--json", json_path, {}, {pairs_path, output});
+        const Correspondences pairs = ReadCorrespondences(pairs_path);
+        nlohmann::ordered_json json;
+        std::string text;
+        if (pairs.kind == PairKind::kLandmark) {
+          const LandmarkAlignment result = AlignLandmarks(pairs.landmarks, options.scale, pairs_path);
+          for (int r = 0; r < 4; ++r) {
+            const Eigen::RowVector4d row = result.target_from_source.row(r);
+            text += fmt::format("{:.17g} {:.17g} {:.17g} {:.17g}\n", row[0], row[1], row[2], row[3]);
+          }
+          json = ToJson(result);
+          Summarize(
+              fmt::format("{} transform, RMS {:.4g} m -> {}", ToString(result.model), result.rms_m, output));
+        } else if (pairs.kind == PairKind::kPixelPixel) {
+          const PhotoPairModel result = EstimatePhotoModel(pairs.pixel_pixel, options, pairs_path);
+          for (int r = 0; r < 3; ++r)
+            text += fmt::format("{:.17g} {:.17g} {:.17g}\n", result.matrix(r, 0), result.matrix(r, 1),
+                                result.matrix(r, 2));
+          json = ToJson(result);
+          Summarize(fmt::format("{}, RMS {:.3g} px -> {}", ToString(result.model), result.rms_px, output));
+        } else {
+          ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
+        }
+        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        return 0;
+      },
+      &binder);
 }
 
 int RunPhoto(int argc, char** argv) {

@@ -136,6 +136,8 @@ Camera SphericalPanorama(int height_px, const Eigen::Matrix4d& world_from_camera
 }
 
 bool ProjectCameraPoint(const Camera& camera, const Eigen::Vector3d& p, Eigen::Vector2d* pixel_px) {
+  // The pinhole first: it needs no rho, and a 10-megapoint station projects every point into every photo.
+  if (camera.model == CameraModel::kPinhole) return ProjectCameraPoint(camera.pinhole, p, pixel_px);
   const double rho = std::hypot(p.x(), p.y());
   switch (camera.model) {
     case CameraModel::kPinhole:

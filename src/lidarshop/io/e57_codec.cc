@@ -85,6 +85,19 @@ void BitWriter::PutInteger(int64_t value, int64_t minimum) {
 void BitWriter::PutRaw(uint64_t value, int bits) {
   if (bits == 0) return;
   if (bits < 64) value &= (uint64_t{1} << bits) - 1;
+  if (bits <= 56) {
+    // Fast path (every field but doubles): pending_ < 8 after each call, so the value fits the accumulator
+    // whole; flush its whole bytes at once.
+    accumulator_ |= value << pending_;
+    pending_ += bits;
+    const int whole = pending_ >> 3;
+    uint8_t out[8];
+    for (int k = 0; k < whole; ++k) out[k] = static_cast<uint8_t>(accumulator_ >> (8 * k));
+    bytes_.insert(bytes_.end(), out, out + whole);
+    accumulator_ = whole == 8 ? 0 : accumulator_ >> (8 * whole);
+    pending_ -= 8 * whole;
+    return;
+  }
   // accumulator_ holds pending_ (< 8 after each flush) bits; add the low part that fits, flush whole bytes.
   int done = 0;
   while (done < bits) {

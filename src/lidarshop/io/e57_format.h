@@ -45,8 +45,10 @@ constexpr char kNoReturnDirectionsLocalName[] = "noReturnDirections";
 // to keep its memory bounded). Not thread-safe to change while reading.
 extern int64_t g_max_cells;
 
-// CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing-by-8.
+// CRC-32C (Castagnoli, reflected polynomial 0x82F63B78): SSE 4.2's CRC32 instruction where the CPU has it,
+// else Crc32cPortable (slicing-by-8); the same value either way (e57_writer_test).
 uint32_t Crc32c(const uint8_t* data, size_t size);
+uint32_t Crc32cPortable(const uint8_t* data, size_t size);
 
 // Checks one physical page's stored CRC against its payload; throws InputError naming `path`, the page index
 // and its byte offset on a mismatch.
@@ -127,6 +129,8 @@ void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, 
 class BitWriter {
  public:
   explicit BitWriter(int bits) : bits_(bits) {}
+  // Room for `values` values of the writer's width (no reallocation while they are put).
+  void Reserve(int64_t values) { bytes_.reserve(static_cast<size_t>((values * bits_ + 7) / 8)); }
   void PutInteger(int64_t value, int64_t minimum);
   void PutFloat(float value) { PutRaw(BitsOf(value), 32); }
   void PutDouble(double value) { PutRaw(BitsOf(value), 64); }

@@ -45,7 +45,36 @@ void CheckPageCrc(const std::string& path, const uint8_t* page, uint64_t page_in
   }
 }
 
-uint32_t Crc32c(const uint8_t* data, size_t size) {
+namespace {
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+// SSE 4.2's CRC32 instruction computes CRC-32C itself (the same polynomial, reflected): 8 bytes an instruction,
+// several times the tables' speed on the hundreds of MB of a big station's pages.
+__attribute__((target("sse4.2"))) uint32_t Crc32cHardware(const uint8_t* data, size_t size) {
+  uint64_t crc = 0xFFFFFFFFu;
+  while (size >= 8) {
+    uint64_t word;
+    std::memcpy(&word, data, 8);
+    crc = __builtin_ia32_crc32di(crc, word);
+    data += 8;
+    size -= 8;
+  }
+  uint32_t crc32 = static_cast<uint32_t>(crc);
+  while (size--) crc32 = __builtin_ia32_crc32qi(crc32, *data++);
+  return crc32 ^ 0xFFFFFFFFu;
+}
+bool HasCrc32Instruction() {
+  static const bool has = __builtin_cpu_supports("sse4.2");
+  return has;
+}
+#else
+uint32_t Crc32cHardware(const uint8_t*, size_t) { return 0; }
+bool HasCrc32Instruction() { return false; }
+#endif
+
+}  // namespace
+
+uint32_t Crc32cPortable(const uint8_t* data, size_t size) {
   const auto& t = Tables().t;
   uint32_t crc = 0xFFFFFFFFu;
   while (size >= 8) {
@@ -58,6 +87,10 @@ uint32_t Crc32c(const uint8_t* data, size_t size) {
   }
   while (size--) crc = t[0][(crc ^ *data++) & 0xFF] ^ (crc >> 8);
   return crc ^ 0xFFFFFFFFu;
+}
+
+uint32_t Crc32c(const uint8_t* data, size_t size) {
+  return HasCrc32Instruction() ? Crc32cHardware(data, size) : Crc32cPortable(data, size);
 }
 
 namespace {

@@ -86,6 +86,8 @@ void AppendNoReturnDirections(const Scan& scan, const std::vector<int64_t>& cell
   streams[0].field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
   streams[1].field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
   BitWriter wr(streams[0].field.bits), wc(streams[1].field.bits);
+  wr.Reserve(static_cast<int64_t>(cells.size()));
+  wc.Reserve(static_cast<int64_t>(cells.size()));
   for (int64_t c : cells) {
     wr.PutInteger(c / scan.cols, 0);
     wc.PutInteger(c % scan.cols, 0);
@@ -100,6 +102,7 @@ void AppendNoReturnDirections(const Scan& scan, const std::vector<int64_t>& cell
     s.field.type = Field::Type::kFloat;
     s.field.bits = 32;
     BitWriter w(32);
+    w.Reserve(static_cast<int64_t>(cells.size()));
     for (int64_t c : cells) w.PutFloat(direction[c][axis]);
     s.bytes = w.Finish();
   }
@@ -181,12 +184,14 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
       s.field.maximum = raw_max;
       s.field.bits = BitsForRange(raw_min, raw_max);
       BitWriter w(s.field.bits);
+      w.Reserve(n);
       for (int64_t i = 0; i < n; ++i) w.PutInteger(raw[i], raw_min);
       s.bytes = w.Finish();
     } else {
       s.field.type = Field::Type::kFloat;
       s.field.bits = 32;
       BitWriter w(32);
+      w.Reserve(n);
       for (int64_t i = 0; i < n; ++i) w.PutFloat(xyz_of(i, axis));
       s.bytes = w.Finish();
     }
@@ -204,6 +209,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     s.field.type = Field::Type::kFloat;
     s.field.bits = 32;
     BitWriter w(32);
+    w.Reserve(n);
     for (int64_t i = 0; i < n; ++i) {
       const Scan& from = layer_of(i);  // a layer without intensity gets the no-information value
       w.PutFloat(from.has_intensity() ? from.intensity.ptr<float>()[records[i].cell] : 0.5f);
@@ -217,6 +223,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
       Stream s;
       s.field = IntegerField(names[ch], 0, 255);
       BitWriter w(s.field.bits);
+      w.Reserve(n);
       for (int64_t i = 0; i < n; ++i) {
         const Scan& from = layer_of(i);  // a layer without colour is written black
         w.PutInteger(from.has_color() ? from.color.ptr<uint8_t>()[3 * records[i].cell + ch] : 0, 0);
@@ -230,6 +237,8 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     row.field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
     col.field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
     BitWriter wr(row.field.bits), wc(col.field.bits);
+    wr.Reserve(n);
+    wc.Reserve(n);
     for (int64_t i = 0; i < n; ++i) {
       wr.PutInteger(records[i].cell / scan.cols, 0);
       wc.PutInteger(records[i].cell % scan.cols, 0);
@@ -245,6 +254,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     Stream s;
     s.field = IntegerField("cartesianInvalidState", 0, any_invalid ? 2 : 0);
     BitWriter w(s.field.bits);
+    w.Reserve(n);
     for (int64_t i = 0; i < n; ++i) w.PutInteger(records[i].state, 0);
     s.bytes = w.Finish();
     streams.push_back(std::move(s));
@@ -255,6 +265,8 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     index_stream.field = IntegerField("returnIndex", 0, 1);
     count_stream.field = IntegerField("returnCount", 1, 2);
     BitWriter wi(index_stream.field.bits), wn(count_stream.field.bits);
+    wi.Reserve(n);
+    wn.Reserve(n);
     for (int64_t i = 0; i < n; ++i) {
       wi.PutInteger(records[i].layer, 0);
       wn.PutInteger(behind_valid[records[i].cell] ? 2 : 1, 1);
@@ -271,6 +283,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     Stream s;
     s.field = IntegerField(kSynthesizedField, 0, 1);
     BitWriter w(s.field.bits);
+    w.Reserve(n);
     const uint8_t* flags = scan.synthesized.empty() ? nullptr : scan.synthesized.ptr<uint8_t>();
     const uint8_t* behind_flags =
         behind == nullptr || behind->synthesized.empty() ? nullptr : behind->synthesized.ptr<uint8_t>();
@@ -290,6 +303,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     Stream s;
     s.field = IntegerField(kFromStationField, 0, 255);
     BitWriter w(s.field.bits);
+    w.Reserve(n);
     for (int64_t i = 0; i < n; ++i) {
       const Scan& from = layer_of(i);
       w.PutInteger(from.from_station.empty() ? 0 : from.from_station.ptr<uint8_t>()[records[i].cell], 0);

@@ -93,6 +93,20 @@ TEST(E57Codec, Crc32cKnownValue) {
       for (int k = 0; k < 8; ++k) crc = (crc & 1) ? (crc >> 1) ^ 0x82F63B78u : crc >> 1;
     }
     EXPECT_EQ(e57::Crc32c(bytes.data() + 3, n), crc ^ 0xFFFFFFFFu) << n;
+    EXPECT_EQ(e57::Crc32cPortable(bytes.data() + 3, n), crc ^ 0xFFFFFFFFu) << n;
+  }
+}
+
+// The hardware instruction (where the CPU has it) and the tables agree on pages and odd lengths.
+TEST(E57Codec, Crc32cHardwareEqualsPortable) {
+  std::mt19937 rng(3);
+  std::vector<uint8_t> bytes(5000);
+  for (uint8_t& b : bytes) b = static_cast<uint8_t>(rng());
+  for (const size_t offset : {0, 1, 5, 7}) {
+    for (const size_t n : {0, 1, 7, 8, 9, 63, 1020, 1021, 4093}) {
+      EXPECT_EQ(e57::Crc32c(bytes.data() + offset, n), e57::Crc32cPortable(bytes.data() + offset, n))
+          << offset << " " << n;
+    }
   }
 }
 

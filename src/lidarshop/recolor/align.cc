@@ -8,6 +8,7 @@
 #include <opencv2/core/eigen.hpp>
 
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 
@@ -28,6 +29,7 @@ LandmarkAlignment AlignLandmarks(std::span<const PointPair> pairs, bool with_sca
     ThrowInputError(what, "", "pairs",
                     "the landmarks are collinear (or all equal): the rotation is not determined");
   LandmarkAlignment result;
+  result.model = with_scale ? LandmarkModel::kSimilarity : LandmarkModel::kRigid;
   result.target_from_source = Eigen::umeyama(source, target, with_scale);
   result.scale = std::cbrt(result.target_from_source.topLeftCorner<3, 3>().determinant());
   double sum = 0;
@@ -83,9 +85,12 @@ PhotoPairModel EstimateHomography(std::span<const PixelPair> pairs, double thres
   ToOpenCv(pairs, 4, "homography", what, &a, &b);
   std::vector<uchar> mask;
   const cv::Mat h = cv::findHomography(a, b, cv::RANSAC, threshold_px, mask, 2000, 0.999);
-  return Finish(h, mask, pairs, "homography", what, [](const Eigen::Matrix3d& m, const PixelPair& pair) {
-    return ((m * pair.pixel_a.homogeneous()).hnormalized() - pair.pixel_b).norm();
-  });
+  PhotoPairModel result =
+      Finish(h, mask, pairs, "homography", what, [](const Eigen::Matrix3d& m, const PixelPair& pair) {
+        return ((m * pair.pixel_a.homogeneous()).hnormalized() - pair.pixel_b).norm();
+      });
+  result.model = PhotoModel::kHomography;
+  return result;
 }
 
 PhotoPairModel EstimateFundamental(std::span<const PixelPair> pairs, double threshold_px,
@@ -94,11 +99,21 @@ PhotoPairModel EstimateFundamental(std::span<const PixelPair> pairs, double thre
   ToOpenCv(pairs, 8, "fundamental matrix", what, &a, &b);
   std::vector<uchar> mask;
   const cv::Mat f = cv::findFundamentalMat(a, b, cv::FM_RANSAC, threshold_px, 0.999, mask);
-  return Finish(f.rows > 3 ? f.rowRange(0, 3) : f, mask, pairs, "fundamental matrix", what,
-                [](const Eigen::Matrix3d& m, const PixelPair& pair) {
-                  const Eigen::Vector3d line = m * pair.pixel_a.homogeneous();
-                  return std::abs(line.dot(pair.pixel_b.homogeneous())) / line.head<2>().norm();
-                });
+  PhotoPairModel result =
+      Finish(f.rows > 3 ? f.rowRange(0, 3) : f, mask, pairs, "fundamental matrix", what,
+             [](const Eigen::Matrix3d& m, const PixelPair& pair) {
+               const Eigen::Vector3d line = m * pair.pixel_a.homogeneous();
+               return std::abs(line.dot(pair.pixel_b.homogeneous())) / line.head<2>().norm();
+             });
+  result.model = PhotoModel::kFundamental;
+  return result;
+}
+
+PhotoPairModel EstimatePhotoModel(std::span<const PixelPair> pairs, const AlignOptions& options,
+                                  const std::string& what) {
+  Validate(options);
+  return options.model == PhotoModel::kFundamental ? EstimateFundamental(pairs, options.threshold_px, what)
+                                                   : EstimateHomography(pairs, options.threshold_px, what);
 }
 
 }  // namespace lidarshop

@@ -1,4 +1,5 @@
 // Descriptions of the recolouring options and enums (util/options.h).
+#include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
@@ -171,6 +172,67 @@ const StructInfo& InfoOf<AutoResectionOptions>() {
         .Unit("px")
         .AboveZero();
     b.Field(&AutoResectionOptions::seed, "seed", "seed of RANSAC's random sets");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<PhotoModel>() {
+  static const EnumInfo info = MakeEnumInfo<PhotoModel>(
+      "photo pair model", {{PhotoModel::kHomography, "homography", "b = H a (a plane, or a camera turning)"},
+                           {PhotoModel::kFundamental, "fundamental", "b^T F a = 0 (any scene)"}});
+  return info;
+}
+
+template <>
+const EnumInfo& EnumInfoOf<LandmarkModel>() {
+  static const EnumInfo info = MakeEnumInfo<LandmarkModel>(
+      "landmark model",
+      {{LandmarkModel::kRigid, "rigid", "rotation and translation"},
+       {LandmarkModel::kSimilarity, "similarity", "rotation, translation and a uniform scale"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<AlignOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<AlignOptions> b("AlignOptions", "transforms from correspondences");
+    b.Field(&AlignOptions::scale, "scale", "landmarks: allow a uniform scale (similarity)");
+    b.Field(&AlignOptions::model, "model", "photo pairs: the model fitted");
+    b.Field(&AlignOptions::threshold_px, "threshold_px", "photo pairs: RANSAC inlier threshold")
+        .Unit("px")
+        .AboveZero()
+        .Max(1000);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<LandmarkAlignment>() {
+  static const StructInfo info = [] {
+    StructBuilder<LandmarkAlignment> b("LandmarkAlignment", "a transform from scan <-> scan landmarks");
+    b.Field(&LandmarkAlignment::model, "model", "what was fitted");
+    b.Field(&LandmarkAlignment::scale, "scale", "the uniform scale (1 for a rigid transform)");
+    b.Field(&LandmarkAlignment::rms_m, "rms_m", "root mean square of the residuals").Unit("m");
+    b.Field(&LandmarkAlignment::residual_m, "residual_m", "per pair: |T source - target|").Unit("m");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PhotoPairModel>() {
+  static const StructInfo info = [] {
+    StructBuilder<PhotoPairModel> b("PhotoPairModel",
+                                    "a homography or fundamental matrix between two photos");
+    b.Field(&PhotoPairModel::model, "model", "what was fitted");
+    b.Field(&PhotoPairModel::rms_px, "rms_px", "root mean square of the inliers' errors").Unit("px");
+    b.Field(&PhotoPairModel::error_px, "error_px",
+            "per pair: |H a - b|, or the distance of b to the epipolar line F a")
+        .Unit("px");
+    b.Field(&PhotoPairModel::inlier, "inlier", "per pair: 1 = a RANSAC inlier, 0 = an outlier");
     return b.Build();
   }();
   return info;

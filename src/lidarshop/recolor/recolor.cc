@@ -1,6 +1,7 @@
 #include "lidarshop/recolor/recolor.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -210,6 +211,7 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
     }
     scene.segments->Occluded(rays, hidden);
   } else {
+    const auto zbuffer_start = std::chrono::steady_clock::now();
     const DistanceBuffer buffer =
         RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale);
     const cv::Mat& distance_buffer = buffer.distance;
@@ -230,6 +232,8 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
       guard = std::max(m, static_cast<int>(std::ceil(visibility.edge_margin_px * std::max(sx, sy))));
       cv::erode(distance_buffer, guard_nearest, cv::Mat::ones(2 * guard + 1, 2 * guard + 1, CV_8U));
     }
+    visibility.zbuffer_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - zbuffer_start).count();
     ParallelFor(
         static_cast<int64_t>(candidates.size()),
         [&](int64_t i) {

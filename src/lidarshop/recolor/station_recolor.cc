@@ -68,6 +68,7 @@ std::vector<double> FitLogGains(int photos, const std::vector<std::pair<std::pai
 
 PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,
                                       const PhotosRecolorOptions& options) {
+  const auto call_start = std::chrono::steady_clock::now();
   options.Check();
   CheckScan(scan);
   if (photos.size() > 65534) throw OptionsError("at most 65534 photos");
@@ -110,6 +111,7 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     const recolor_internal::Visibility visibility =
         recolor_internal::VisibleCells(scan, scene, camera, options.visibility);
     result.returns = visibility.returns;
+    result.zbuffer_seconds += visibility.zbuffer_seconds;
     std::vector<PhotoSample>& list = seen_by[i];
     list.resize(visibility.seen.size());
     ParallelFor(
@@ -138,6 +140,8 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
         4096);
   }
   result.visibility_seconds = since(visibility_start);
+  result.projection_seconds = result.visibility_seconds - result.zbuffer_seconds;
+  const auto choice_start = std::chrono::steady_clock::now();
   // Per cell its samples, by photo index (compressed rows: `first[cell]` .. `first[cell + 1]`), and the best
   // photo (the highest score; a tie keeps the lower index).
   std::vector<int64_t> first(cells + 1, 0);
@@ -163,6 +167,8 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                                                    samples.data() + first[cell + 1]);
   };
 
+  result.choice_seconds = since(choice_start);
+  const auto gain_start = std::chrono::steady_clock::now();
   // The gains, channel by channel, from the overlaps and from neighbours coloured by different photos.
   std::vector<std::pair<std::pair<int, int>, double>> rows[3];
   const auto add = [&](const Sample& a, const Sample& b) {
@@ -203,6 +209,8 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     }
   }
 
+  result.gain_seconds = since(gain_start);
+  const auto colour_start = std::chrono::steady_clock::now();
   // The chosen colours at photo 0's exposure, then the seams blended.
   const auto corrected = [&](const Sample& sample) {
     const cv::Vec3d& gain = result.gains[sample.photo];
@@ -218,6 +226,7 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     result.photo_index.at<uint16_t>(r, c) = static_cast<uint16_t>(sample->photo + 1);
     ++result.coloured;
   }
+  result.colour_seconds = since(colour_start);
   if (options.blend_seams) {
     const auto blend_start = std::chrono::steady_clock::now();
     const cv::Mat range = RangeImage(scan);
@@ -259,6 +268,7 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     result.blend_seconds = since(blend_start);
   }
 
+  const auto output_start = std::chrono::steady_clock::now();
   result.scan = Clone(scan);
   Scan& out = result.scan;
   if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
@@ -271,6 +281,8 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                     cv::saturate_cast<uint8_t>(v[2]));
     }
   }
+  result.output_seconds = since(output_start);
+  result.total_seconds = since(call_start);
   return result;
 }
 

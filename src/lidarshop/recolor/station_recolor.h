@@ -71,6 +71,12 @@ struct PhotosRecolorResult {
   // Wall clock, seconds: the occlusion scene (scan mesh and skirts), every photo's visibility and samples, the
   // seam blending (guidance and Poisson).
   double scene_seconds = 0, visibility_seconds = 0, blend_seconds = 0;
+  // The phases in finer detail (wall clock, seconds): of visibility_seconds, the z-buffers (rasterization
+  // and erosion) and the projection of the scan's cells into each photo with their occlusion tests; the
+  // choice of each cell's photo (samples gathered per cell); the gain fit; the corrected colours of the chosen
+  // photos; the output scan (clone and colours written); and the whole call (checks included).
+  double zbuffer_seconds = 0, projection_seconds = 0, choice_seconds = 0, gain_seconds = 0,
+         colour_seconds = 0, output_seconds = 0, total_seconds = 0;
   std::string Summary() const;  // one line
 };
 

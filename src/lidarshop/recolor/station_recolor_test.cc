@@ -177,6 +177,16 @@ TEST(RecolorFromPhotos, SphericalPanorama) {
   EXPECT_GT(errors.coloured, 0.95);
   EXPECT_LE(errors.mean, 3.0);
   EXPECT_EQ(result.gains.size(), 1u);
+  // The phase times (issue 32 item 6): each measured, the visibility split into its two parts, and the
+  // phases within the whole call.
+  EXPECT_GT(result.zbuffer_seconds, 0);
+  EXPECT_GE(result.projection_seconds, 0);
+  EXPECT_NEAR(result.zbuffer_seconds + result.projection_seconds, result.visibility_seconds, 1e-9);
+  const double phases = result.scene_seconds + result.visibility_seconds + result.choice_seconds +
+                        result.gain_seconds + result.colour_seconds + result.blend_seconds +
+                        result.output_seconds;
+  EXPECT_GT(result.output_seconds, 0);
+  EXPECT_LE(phases, result.total_seconds + 1e-6);
 }
 
 }  // namespace

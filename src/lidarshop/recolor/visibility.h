@@ -49,6 +49,7 @@ struct Visibility {
   // pixel; empty with segment visibility.
   cv::Mat distance_buffer;
   Eigen::Vector2d buffer_per_photo_px = Eigen::Vector2d::Ones();
+  double zbuffer_seconds = 0;  // wall clock of the z-buffer (rasterization and erosion); 0 for segments
 };
 
 Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Camera& camera,

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {
@@ -136,27 +137,38 @@ void FitGrid(Scan* scan) {
   CheckScan(*scan);
   const int rows = scan->rows, cols = scan->cols;
   std::vector<std::vector<double>> column_azimuths(cols), row_elevations(rows);
-  for (int row = 0; row < rows; ++row) {
-    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
-    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
-    for (int col = 0; col < cols; ++col) {
-      if (!valid[col]) continue;
-      const double x = point[col][0], y = point[col][1], z = point[col][2];
-      const double horizontal = std::hypot(x, y);
-      if (horizontal == 0 && z == 0) continue;
-      row_elevations[row].push_back(std::atan2(z, horizontal));
-      if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
-        column_azimuths[col].push_back(std::atan2(x, y));
+  {
+    // The angles row by row in parallel (a big station has tens of millions of points), then gathered per
+    // column in row order: the samples, and so every value below, are those of a serial pass.
+    std::vector<std::vector<std::pair<int, double>>> row_azimuths(rows);
+    ParallelFor(rows, [&](int64_t r) {
+      const int row = static_cast<int>(r);
+      const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
+      const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+      for (int col = 0; col < cols; ++col) {
+        if (!valid[col]) continue;
+        const double x = point[col][0], y = point[col][1], z = point[col][2];
+        const double horizontal = std::hypot(x, y);
+        if (horizontal == 0 && z == 0) continue;
+        row_elevations[row].push_back(std::atan2(z, horizontal));
+        if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
+          row_azimuths[row].push_back({col, std::atan2(x, y)});
+        }
       }
+    });
+    for (int row = 0; row < rows; ++row) {
+      for (const auto& [col, azimuth] : row_azimuths[row]) column_azimuths[col].push_back(azimuth);
+      std::vector<std::pair<int, double>>().swap(row_azimuths[row]);
     }
   }
 
   std::vector<double> azimuth_medians(cols, kNaN), elevation_medians(rows, kNaN);
   std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
-  for (int col = 0; col < cols; ++col) {
+  ParallelFor(cols, [&](int64_t c) {  // columns are independent
+    const int col = static_cast<int>(c);
     std::vector<double>& samples = column_azimuths[col];
     azimuth_counts[col] = static_cast<int>(samples.size());
-    if (samples.empty()) continue;
+    if (samples.empty()) return;
     double sum_sin = 0, sum_cos = 0;
     for (double angle : samples) {
       sum_sin += std::sin(angle);
@@ -165,7 +177,7 @@ void FitGrid(Scan* scan) {
     const double reference = std::atan2(sum_sin, sum_cos);
     for (double& angle : samples) angle = WrapAngle(angle - reference);
     azimuth_medians[col] = reference + Median(&samples);
-  }
+  });
   // Unwrap across columns so that a scan crossing θ = ±π stays continuous.
   int previous = -1;
   for (int col = 0; col < cols; ++col) {
@@ -176,10 +188,10 @@ void FitGrid(Scan* scan) {
     }
     previous = col;
   }
-  for (int row = 0; row < rows; ++row) {
+  ParallelFor(rows, [&](int64_t row) {
     elevation_counts[row] = static_cast<int>(row_elevations[row].size());
     elevation_medians[row] = Median(&row_elevations[row]);
-  }
+  });
 
   double azimuth_step = MedianStep(azimuth_medians);
   double elevation_step = MedianStep(elevation_medians);
@@ -194,20 +206,28 @@ void FitGrid(Scan* scan) {
   grid.fitted = true;
   scan->direction = DirectionsFromGrid(grid);
 
-  double sum_squares = 0, max_residual = 0;
-  int64_t count = 0;
-  for (int row = 0; row < rows; ++row) {
+  // The residual angles row by row in parallel, summed in cell order (the same sum as a serial pass).
+  std::vector<std::vector<double>> row_residuals(rows);
+  ParallelFor(rows, [&](int64_t r) {
+    const int row = static_cast<int>(r);
     const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
     const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
     const cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
     for (int col = 0; col < cols; ++col) {
       if (!valid[col]) continue;
       const cv::Vec3d p(point[col]), d(direction[col]);
-      const double angle = std::atan2(cv::norm(p.cross(d)), p.dot(d));
+      row_residuals[row].push_back(std::atan2(cv::norm(p.cross(d)), p.dot(d)));
+    }
+  });
+  double sum_squares = 0, max_residual = 0;
+  int64_t count = 0;
+  for (std::vector<double>& residuals : row_residuals) {
+    for (const double angle : residuals) {
       sum_squares += angle * angle;
       max_residual = std::max(max_residual, angle);
       ++count;
     }
+    std::vector<double>().swap(residuals);
   }
   grid.rms_residual_rad = count > 0 ? std::sqrt(sum_squares / count) : 0.0;
   grid.max_residual_rad = max_residual;

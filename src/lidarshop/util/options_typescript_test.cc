@@ -1,0 +1,125 @@
+#include "lidarshop/util/options_typescript.h"
+
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "lidarshop/util/options.h"
+
+namespace lidarshop {
+
+enum class Shade { kLight, kDark };
+struct LeafOptions {
+  int band_px = 2;
+};
+struct TreeOptions {
+  Shade shade = Shade::kDark;
+  double sigma_m = 0.5;
+  std::vector<int> counts;
+  LeafOptions leaf;
+};
+struct TreeResult {
+  double rms_m = 0;
+  std::vector<std::string> warnings;
+};
+
+template <>
+const EnumInfo& EnumInfoOf<Shade>() {
+  static const EnumInfo info =
+      MakeEnumInfo<Shade>("shade", {{Shade::kLight, "light", "pale"}, {Shade::kDark, "dark", "deep"}});
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<LeafOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<LeafOptions> b("LeafOptions", "a leaf");
+    b.Field(&LeafOptions::band_px, "band_px", "band").Unit("px").Range(1, 64);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<TreeOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<TreeOptions> b("TreeOptions", "a tree");
+    b.Field(&TreeOptions::shade, "shade", "its shade");
+    b.Field(&TreeOptions::sigma_m, "sigma_m", "noise").Unit("m").AboveZero();
+    b.Field(&TreeOptions::counts, "counts", "per branch");
+    b.Field(&TreeOptions::leaf, "leaf", "its leaf");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<TreeResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<TreeResult> b("TreeResult", "what came out");
+    b.Field(&TreeResult::rms_m, "rms_m", "fit").Unit("m");
+    b.Field(&TreeResult::warnings, "warnings", "one sentence each");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(OptionsTypeScript, InterfacesFromTheDescriptions) {
+  const std::string text =
+      TypeScriptDeclarations({OptionsType<TreeOptions>(), ResultType<TreeResult>()}, "// header\n");
+  EXPECT_EQ(text,
+            "// header\n"
+            "\n// a tree (C++ TreeOptions)\n"
+            "export interface TreeOptions {\n"
+            "  // its shade: light (pale), dark (deep), default dark\n"
+            "  shade: 'light' | 'dark';\n"
+            "  // noise [m] in > 0, default 0.5\n"
+            "  sigma_m: number;\n"
+            "  // per branch, default []\n"
+            "  counts: number[];\n"
+            "  // its leaf\n"
+            "  leaf: LeafOptions;\n"
+            "}\n"
+            "\n// what came out (C++ TreeResult)\n"
+            "export interface TreeResult {\n"
+            "  // fit [m]\n"
+            "  rms_m: number | null;\n"
+            "  // one sentence each\n"
+            "  warnings: string[];\n"
+            "}\n"
+            "\n// a leaf (C++ LeafOptions)\n"
+            "export interface LeafOptions {\n"
+            "  // band [px] in [1, 64], default 2\n"
+            "  band_px: number;\n"
+            "}\n");
+}
+
+TEST(OptionsTypeScript, LongUnionsBreakAsPrettierDoes) {
+  FieldInfo field;
+  field.key = "method";
+  field.kind = FieldKind::kEnum;
+  EnumInfo many{"many", {}};
+  for (int i = 0; i < 12; ++i) many.choices.push_back({i, "choice-number-" + std::to_string(i), ""});
+  field.choices = &many;
+  StructInfo info{"Wide", "wide", {field}, nullptr};
+  const std::string text = TypeScriptDeclarations({{&info, nullptr, false}}, "");
+  EXPECT_NE(text.find("  method:\n    | 'choice-number-0'\n    | 'choice-number-1'\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("    | 'choice-number-11';\n}"), std::string::npos) << text;
+}
+
+TEST(OptionsTypeScript, TwoStructsOfOneNameThrow) {
+  StructInfo a{"Same", "a", {}, nullptr}, b{"Same", "b", {}, nullptr};
+  EXPECT_THROW(TypeScriptDeclarations({{&a, nullptr, false}, {&b, nullptr, false}}, ""), OptionsError);
+}
+
+TEST(OptionsTypeScript, DescriptionJsonNestsStructs) {
+  const nlohmann::ordered_json json = DescriptionJson(InfoOf<TreeOptions>());
+  EXPECT_EQ(json["name"], "TreeOptions");
+  EXPECT_EQ(json["fields"][0]["choices"], nlohmann::ordered_json::array({"light", "dark"}));
+  EXPECT_EQ(json["fields"][1]["range"], "> 0");
+  EXPECT_EQ(json["fields"][3]["struct"]["fields"][0]["key"], "band_px");
+}
+
+}  // namespace lidarshop

@@ -1,0 +1,20 @@
+// The described structs of the editor's API (docs/api.md): what its routes take under "options" and what
+// its jobs answer. `lidarshop schema --typescript` writes their TypeScript declarations into
+// web/src/api_types.generated.ts (the ctest api_types_test fails when that file is stale), so the front end
+// uses the library's fields, not hand copies of them. A route taking or answering a described struct lists it
+// here.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "lidarshop/util/options_typescript.h"
+
+namespace lidarshop::server {
+
+std::vector<TypeScriptStruct> ApiTypes();
+
+// The generated file's text: ApiTypes() as TypeScript with its header.
+std::string ApiTypesTypeScript();
+
+}  // namespace lidarshop::server
