@@ -158,6 +158,7 @@ int main(int argc, char** argv) {
       line = fmt::format("| {} | {:.2f} | {} | {:.2f} | {:.3f} | {:.2f} | {}/{} | {:.0f} % | {:.1f} | {} |",
                          seed, c.offset_m, ok ? "yes" : "no", dc, da, result.rms_px, result.inliers,
                          result.pairs.size(), 100 * result.inlier_share, s, result.rounds);
+      if (verbose) line += " " + result.trace;
       if (unknown_focal) line += fmt::format(" f {:.1f} (true {:.1f})", result.camera.fx_px, c.camera.fx_px);
     } catch (const InputError& e) {
       ++refused;

@@ -239,6 +239,13 @@ void BindResection(py::module_& m) {
       .def_readonly("rms_px", &AutoResectionResult::rms_px)
       .def_readonly("rms_work_px", &AutoResectionResult::rms_work_px)
       .def_readonly("rounds", &AutoResectionResult::rounds)
+      .def_readonly("check_pairs", &AutoResectionResult::check_pairs,
+                    "SIFT pairs ratio-tested over the whole rendering from the final camera")
+      .def_readonly("check_agree", &AutoResectionResult::check_agree,
+                    "of those, the ones the camera explains")
+      .def_readonly("check_alt_inliers", &AutoResectionResult::check_alt_inliers,
+                    "of those, the most another camera explains (PnP RANSAC on them alone)")
+      .def_readonly("trace", &AutoResectionResult::trace, "what the rounds did")
       .def_readonly("search_view", &AutoResectionResult::search_view)
       .def("summary", &AutoResectionResult::Summary)
       .def("__repr__", [](const AutoResectionResult& r) {

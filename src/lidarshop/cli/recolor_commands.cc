@@ -150,6 +150,9 @@ nlohmann::ordered_json AutoResectionJson(const AutoResectionResult& result) {
   json["search_view"] = result.search_view;
   json["search_inliers"] = result.search_inliers;
   if (result.search_fov_deg > 0) json["search_fov_deg"] = result.search_fov_deg;
+  json["check_pairs"] = result.check_pairs;
+  json["check_agree"] = result.check_agree;
+  json["check_alt_inliers"] = result.check_alt_inliers;
   json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
   json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
                            result.camera.center_in_world().z()};

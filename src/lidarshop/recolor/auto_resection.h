@@ -26,6 +26,12 @@
 //      pairs or a share below `min_inlier_share` agree, their RMS exceeds `max_rms_px`, or the last round still
 //      moved the camera 1 cm or 0.05° (it has not settled: a repeating texture pulls it over): a wrong camera
 //      would recolour the scan with the wrong photo pixels without a sign.
+//   5. Check. Guided SIFT and patches look only near the estimate, so a repeating texture (bricks) matched one
+//      period over is a consistent answer. The scan is rendered from the final camera and SIFT matched with the
+//      ratio test over the whole rendering (a repeating feature has a second match as good and drops out);
+//      PnP RANSAC on those pairs alone gives a second camera. When it explains at least 12 of them and 1.5 x as
+//      many as the final camera, the camera is ambiguous: the rounds restart from the second camera (twice at
+//      most), else the photo is refused ("ambiguous").
 // Deterministic: keypoints are sorted before their descriptors are computed, the brute-force matcher gives
 // the same answer on any thread count, RANSAC is seeded.
 // Thresholds are in working pixels (about one scan cell); the camera and `rms_px` are in the photo's pixels.
@@ -79,16 +85,24 @@ struct AutoResectionResult {
   std::vector<PixelPointPair> pairs;  // the last round's pairs (photo pixels, world points)
   std::vector<uint8_t> inlier;        // per pair: 1 = inlier
   int inliers = 0;
-  double inlier_share = 0;            // inliers / pairs
-  double rms_px = 0;                  // RMS reprojection error of the inliers, photo pixels
-  double rms_work_px = 0;             // the same in working pixels (what max_rms_px bounds)
-  double work_scale = 1;              // working pixels per photo pixel (<= 1)
-  double search_fov_deg = 0;          // field of view of the winning search (0 with given intrinsics)
-  int search_view = -1;               // the winning search view (-1 with a rough camera)
-  int search_inliers = 0;             // its PnP inliers
-  int rounds = 0;                     // rounds run
-  double last_move_m = 0;             // how far the last round moved the camera centre, metres
-  double last_turn_deg = 0;           // and turned it, degrees
+  double inlier_share = 0;    // inliers / pairs
+  double rms_px = 0;          // RMS reprojection error of the inliers, photo pixels
+  double rms_work_px = 0;     // the same in working pixels (what max_rms_px bounds)
+  double work_scale = 1;      // working pixels per photo pixel (<= 1)
+  double search_fov_deg = 0;  // field of view of the winning search (0 with given intrinsics)
+  int search_view = -1;       // the winning search view (-1 with a rough camera)
+  int search_inliers = 0;     // its PnP inliers
+  int rounds = 0;             // rounds run
+  double last_move_m = 0;     // how far the last round moved the camera centre, metres
+  double last_turn_deg = 0;   // and turned it, degrees
+  // The independent check (step 5): SIFT pairs ratio-tested over the whole rendering from the final camera,
+  // how many, how many it explains within ransac_threshold_px, and their median error (working pixels).
+  int check_pairs = 0;
+  int check_agree = 0;
+  double check_median_work_px = 0;
+  int check_alt_inliers = 0;
+  double check_alt_move_m = 0;
+  std::string trace;                  // what the search candidate's rounds did (refusals quote it)
   std::vector<std::string> warnings;  // one sentence each
   std::string Summary() const;        // one line
 };

@@ -50,10 +50,14 @@ TEST_P(AutoResectionCases, FindsTheCameraWithin2CmAndATenthOfADegree) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, AutoResectionCases, ::testing::Values(2001, 2003));
 
-// Seed 2002 (a brick wall filling most of the photo) is refused: what matters is that no wrong camera comes
-// back. Whatever the outcome, a returned camera must be right.
-TEST(AutoResection, ReturnsNoWrongCamera) {
-  const AutoCase c = MakeAutoCase(2002);
+// Brick walls filling most of the photo, whatever the outcome, a returned camera must be right. Seed 2002 is
+// refused. Seed 18 (an evaluation case; before the check of step 5 it came back 8 cm and 0.2° off, the wall
+// matched one brick over by the guided and correlation pairs, 80 % of them agreeing) now restarts from the
+// camera of the unambiguous SIFT pairs.
+class AutoResectionRepeatingTexture : public ::testing::TestWithParam<int> {};
+
+TEST_P(AutoResectionRepeatingTexture, ReturnsNoWrongCamera) {
+  const AutoCase c = MakeAutoCase(GetParam());
   const Scan scan = test_scenes::ScanScene(c.scene);
   const Photo photo = AutoCasePhoto(c);
   try {
@@ -65,6 +69,8 @@ TEST(AutoResection, ReturnsNoWrongCamera) {
     EXPECT_NE(std::string(e.what()).find("no supported camera"), std::string::npos) << e.what();
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Seeds, AutoResectionRepeatingTexture, ::testing::Values(2002, 18));
 
 TEST(AutoResection, StartsFromARoughPose) {
   const AutoCase c = MakeAutoCase(2004);
