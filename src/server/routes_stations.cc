@@ -190,7 +190,10 @@ void Clean(State& state, const std::shared_ptr<Document>& document, const nlohma
   const CleanOptions options =
       body.contains("options") ? FromJson<CleanOptions>(body.at("options")) : CleanOptions{};
   options.Check();
-  const auto [site, current] = SiteOf(state, document->id);
+  // Named variables, not a structured binding: lambdas below capture them (clang 14 refuses bindings).
+  const std::pair<std::shared_ptr<Site>, int> site_of = SiteOf(state, document->id);
+  const std::shared_ptr<Site>& site = site_of.first;
+  const int current = site_of.second;
   if (!site) {
     throw InputError(
         fmt::format("scan {} is not a station of a site: open a file of several scans as a site, or group "
@@ -294,7 +297,10 @@ void FillFromOtherStations(State& state, const std::shared_ptr<Document>& docume
     throw OptionsFieldError("hole", "expected \"strokes\", \"object\" or \"painted\"");
   const int margin = body.value("margin_cells", 2);
   if (margin < 0 || margin > 100) throw OptionsFieldError("margin_cells", "out of range [0, 100]");
-  const auto [site, current] = SiteOf(state, document->id);
+  // Named variables, not a structured binding: lambdas below capture them (clang 14 refuses bindings).
+  const std::pair<std::shared_ptr<Site>, int> site_of = SiteOf(state, document->id);
+  const std::shared_ptr<Site>& site = site_of.first;
+  const int current = site_of.second;
   if (!site) {
     throw InputError(
         fmt::format("scan {} is not a station of a site: open a file of several scans as a site, or group "
@@ -418,7 +424,10 @@ void AddStationRoutes(State& state) {
                                                    httplib::Response& response) {
     const auto document = state.FindDocument(request, response);
     if (!document) return;
-    const auto [site, station] = SiteOf(state, document->id);
+    // Named variables, not a structured binding: lambdas below capture them (clang 14 refuses bindings).
+    const std::pair<std::shared_ptr<Site>, int> site_of = SiteOf(state, document->id);
+    const std::shared_ptr<Site>& site = site_of.first;
+    const int station = site_of.second;
     if (!site) {
       return SendJson(
           response,
