@@ -152,6 +152,46 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
   return 0;
 }
 
+// The windowed two-step cut (SegmentOptions::window_margin_cells) against the whole-scan cut
+// (window_margin_cells = 0), per scene and stroke seed.
+struct WindowComparison {
+  int runs = 0, differing = 0, grown = 0;
+  int64_t differing_cells = 0;
+  double window_fraction = 0;  // sum over runs of window cells / scan cells
+  double seconds_window = 0, seconds_whole = 0;
+  std::vector<std::string> which;  // the runs whose masks differ
+
+  void Add(const std::string& name, const Scan& scan, const cv::Mat& strokes, const SegmentOptions& options) {
+    SegmentOptions windowed = options, whole = options;
+    windowed.method = whole.method = SegmentMethod::kTwoStep;
+    whole.window_margin_cells = 0;
+    Timer timer;
+    const SegmentResult a = SegmentObject(scan, strokes, windowed);
+    seconds_window += timer.Seconds();
+    timer.Restart();
+    const SegmentResult b = SegmentObject(scan, strokes, whole);
+    seconds_whole += timer.Seconds();
+    ++runs;
+    grown += a.window_growths > 0;
+    window_fraction += static_cast<double>(a.window_rows) * a.window_cols / (double(scan.rows) * scan.cols);
+    const int cells = cv::countNonZero(a.mask != b.mask);
+    if (cells > 0) {
+      ++differing;
+      differing_cells += cells;
+      which.push_back(fmt::format("{} ({} cells of {})", name, cells, cv::countNonZero(b.mask)));
+    }
+  }
+  std::string Report(const std::string& what) const {
+    return fmt::format(
+        "{}: the windowed two-step mask differs from the whole-scan one in {} of {} runs ({} cells in "
+        "all){}; "
+        "mean window {:.1f} % of the scan, grown in {} runs; {:.1f} s windowed, {:.1f} s whole scan\n",
+        what, differing, runs, differing_cells,
+        which.empty() ? "" : fmt::format(": {}", fmt::join(which, ", ")),
+        runs > 0 ? 100.0 * window_fraction / runs : 0.0, grown, seconds_window, seconds_whole);
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -220,6 +260,14 @@ int main(int argc, char** argv) {
                  "write overlays (step 1 + inferred background, final, grabCut) here (random scenes: of the "
                  "three worst seeds)");
   app.add_flag("--eight", eight);
+  bool compare_window = false;
+  app.add_flag(
+      "--compare-window", compare_window,
+      "compare the windowed two-step cut (window_margin_cells) with the whole-scan cut on the scenes "
+      "(and the random seeds when given) instead of the tables");
+  app.add_option("--window-margin", options.window_margin_cells,
+                 "the cuts' window margin, cells (0 = whole scan)")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (!dump_dir.empty()) std::filesystem::create_directories(dump_dir);
   options.depth_step.lambda_g = options.depth_step.lambda_b = options.depth_step.lambda_r;
@@ -227,6 +275,48 @@ int main(int argc, char** argv) {
   options.color_step.median_sigma = options.color_step.median_sigma || color_median;
   options.eight_connected = eight;
   options.Check();
+  if (compare_window) {
+    try {
+      WindowComparison set;
+      std::vector<std::string> paths;
+      for (const auto& entry : std::filesystem::directory_iterator(scenes_dir))
+        if (entry.path().extension() == ".json") paths.push_back(entry.path().string());
+      std::sort(paths.begin(), paths.end());
+      for (const std::string& path : paths) {
+        const Scan scan = SynthesizeScan(LoadScene(path));
+        const cv::Mat truth = (scan.label == 1) & (scan.valid != 0);
+        for (int seed = 1; seed <= seeds; ++seed) {
+          const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, static_cast<uint64_t>(seed) * 7919 + 1);
+          set.Add(fmt::format("{}/{}", std::filesystem::path(path).stem().string(), seed), scan, strokes,
+                  options);
+        }
+      }
+      fmt::print(
+          "{}", set.Report(fmt::format("evaluation set ({} scenes x {} stroke seeds)", paths.size(), seeds)));
+      if (!random_seeds.empty()) {
+        WindowComparison random;
+        EvalStrokeOptions stroke_options;
+        stroke_options.upper_and_below = true;
+        for (uint64_t seed : test_scenes::ParseSeedRange(random_seeds)) {
+          const SceneDescription scene = RandomScene(seed, scene_options);
+          const Scan scan = SynthesizeScan(scene);
+          const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
+          cv::Mat strokes;
+          try {
+            strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
+          } catch (const InputError&) {
+            continue;  // no room for strokes (as the random evaluation)
+          }
+          random.Add(fmt::format("seed {}", seed), scan, strokes, options);
+        }
+        fmt::print("{}", random.Report(fmt::format("random scenes {}", random_seeds)));
+      }
+      return 0;
+    } catch (const std::exception& error) {
+      fmt::print(stderr, "segment_eval: {}\n", error.what());
+      return 2;
+    }
+  }
   if (!random_seeds.empty()) {
     try {
       const std::vector<uint64_t> seeds = test_scenes::ParseSeedRange(random_seeds);

@@ -149,6 +149,11 @@ const StructInfo& InfoOf<SegmentOptions>() {
     b.Field(&SegmentOptions::roi_margin_fraction, "roi_margin_fraction",
             "step 3 margin as a fraction of the object box's larger side")
         .Min(0);
+    b.Field(&SegmentOptions::window_margin_cells, "window_margin_cells",
+            "the cuts' graphs cover the strokes' box grown by this, doubled while the cut reaches its edge; "
+            "0 = whole scan")
+        .Unit("cells")
+        .Min(0);
     b.Field(&SegmentOptions::color_bins, "color_bins", "histogram bins per colour channel").Range(2, 64);
     b.Field(&SegmentOptions::depth_bin_m, "depth_bin_m", "range histogram bin width").Unit("m").AboveZero();
     b.Field(&SegmentOptions::depth_smoothing_m, "depth_smoothing_m",
@@ -214,6 +219,11 @@ const StructInfo& InfoOf<SegmentResult>() {
     b.Field(&SegmentResult::object_cells, "object_cells", "cells of the object").Unit("cells");
     b.Field(&SegmentResult::graph_nodes, "graph_nodes", "nodes of the last cut's graph");
     b.Field(&SegmentResult::flow, "flow", "value of the last max-flow");
+    b.Field(&SegmentResult::window_row, "window_row", "first row of the window the cuts' graphs covered");
+    b.Field(&SegmentResult::window_col, "window_col", "first column of the window");
+    b.Field(&SegmentResult::window_rows, "window_rows", "rows of the window").Unit("cells");
+    b.Field(&SegmentResult::window_cols, "window_cols", "columns of the window").Unit("cells");
+    b.Field(&SegmentResult::window_growths, "window_growths", "times the window was grown");
     b.Field(&SegmentResult::ray_spacing_m, "ray_spacing_m",
             "spacing of neighbouring rays at the object strokes")
         .Unit("m");

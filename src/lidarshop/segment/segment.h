@@ -31,6 +31,9 @@
 // Baselines (single cut, the same machinery): kDepth (step 1's weights alone), kColor (step 3's weights from
 // the strokes alone) and kRgbd (standardized λ = 1/3, 1/3, 1/3, 1).
 //
+// Window: the graphs cover the strokes' neighbourhood, grown while the cut reaches its edge
+// (SegmentOptions::window_margin_cells), so the cost follows the object, not the scan.
+//
 // Refinement: SegmentSession keeps the last cut's graph. Refine() with extra strokes turns the stroke cells
 // into hard constraints of that graph and re-runs the max-flow reusing the search trees (BK `reuse_trees`),
 // so the cost is proportional to the change, not to the image. Models, n-links and the step-1 result stay.
@@ -151,6 +154,18 @@ struct SegmentOptions {
   int roi_margin_cells = 50;          // cells (>= 0; 0 disables the ROI)
   double roi_margin_fraction = 0.25;  // of the box's larger side (dimensionless, >= 0)
 
+  // The window the cuts' graphs cover, so that their cost follows the object, not the scan: the bounding box
+  // of the stroke cells (object and background) grown by window_margin_cells on every side, clipped to the
+  // scan. When a cut (step 1 or step 3; the single cut of the baselines; a refinement's) reaches an edge of
+  // the window that is not an edge of the scan, the window is doubled (half its larger side added on every
+  // side) and the cut run again, until it does not or the window is the whole scan; a refinement's strokes
+  // beyond the window widen it likewise. Cells outside the window are background for the cuts; the
+  // whole-object growth, the background inference and the checks read the scan around the cut as they would
+  // without a window. The channels' standardization, the range span of the appearance models and σ² are the
+  // whole scan's (one streaming pass when the session is made), so a cut that stays inside its window is the
+  // cut of the whole scan. 0 = the whole scan.
+  int window_margin_cells = 128;  // cells (>= 0)
+
   // Scale to the data: the range-model lengths below (depth_bin_m, depth_smoothing_m) are given for a ray
   // spacing of reference_spacing_m at the object (terrestrial scans of objects metres away) and multiplied by
   // min(1, measured spacing / reference_spacing_m), the spacing being the object strokes' median range ×
@@ -209,6 +224,10 @@ struct SegmentResult {
   double ray_spacing_m = 0;  // measured spacing of neighbouring rays at the object strokes, metres (0: none)
   double length_scale = 1;   // factor applied to the metric lengths (scale_to_data), dimensionless
   double flow = 0;           // value of the last max-flow (the minimum energy, up to constants)
+  // The window the cuts' graphs covered (SegmentOptions::window_margin_cells): first row and column, rows and
+  // columns (the whole scan when not windowed), and how many times it was grown.
+  int window_row = 0, window_col = 0, window_rows = 0, window_cols = 0;
+  int window_growths = 0;
   SegmentTimings timings;
   // What looks wrong with the cut (segment/cut_checks.h: it grew far past its strokes' part, it touches two
   // borders), one sentence each; empty when nothing does. The mask is kept as it is.

@@ -19,67 +19,164 @@ void ThrowGraphError(const char* message) { throw std::runtime_error(fmt::format
 
 }  // namespace
 
-Nodes MakeNodes(const Scan& scan) {
-  Nodes nodes;
-  nodes.rows = scan.rows;
-  nodes.cols = scan.cols;
-  const cv::Mat rgbd = RgbdImage(scan);
-  nodes.node_of_cell.assign(scan.num_cells(), -1);
-  for (int row = 0; row < scan.rows; ++row) {
-    const uint8_t* valid = scan.valid.ptr<uint8_t>(row);
-    const float* range = scan.range.ptr<float>(row);
+namespace {
+
+// R, G, B in [0, 1] and range in metres of one cell, as RgbdImage (scan/scan.h) gives them.
+inline cv::Vec4f RgbdAt(const Scan& scan, int row, int col) {
+  cv::Vec4f out(0.f, 0.f, 0.f, 0.f);
+  if (!scan.color.empty()) {
+    const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
+    out = cv::Vec4f(c[0] / 255.f, c[1] / 255.f, c[2] / 255.f, 0.f);
+  } else if (!scan.intensity.empty()) {
+    const float gray = scan.intensity.at<float>(row, col);
+    out = cv::Vec4f(gray, gray, gray, 0.f);
+  }
+  out[3] = scan.range.at<float>(row, col);
+  return out;
+}
+
+inline bool IsNode(const Scan& scan, int row, int col) {
+  const float range = scan.range.at<float>(row, col);
+  return scan.valid.at<uint8_t>(row, col) != 0 && std::isfinite(range) && range > 0;
+}
+
+// At most about this many nodes are sampled for the median of the n-link differences.
+constexpr int64_t kMedianSampleNodes = 100000;
+
+}  // namespace
+
+ScanStats ComputeScanStats(const Scan& scan) {
+  ScanStats stats;
+  // Pass 1: the channels' sums, per row so that the result does not depend on threads.
+  struct RowSums {
+    double sum[4] = {0, 0, 0, 0}, sum2[4] = {0, 0, 0, 0};
+    int64_t count = 0;
+    float range_min = std::numeric_limits<float>::max(), range_max = 0;
+  };
+  std::vector<RowSums> rows(scan.rows);
+  ParallelFor(scan.rows, [&](int64_t row) {
+    RowSums& out = rows[row];
     for (int col = 0; col < scan.cols; ++col) {
-      if (valid[col] == 0 || !std::isfinite(range[col]) || range[col] <= 0) continue;
-      const int64_t cell = static_cast<int64_t>(row) * scan.cols + col;
+      if (!IsNode(scan, static_cast<int>(row), col)) continue;
+      const cv::Vec4f v = RgbdAt(scan, static_cast<int>(row), col);
+      for (int c = 0; c < 4; ++c) {
+        out.sum[c] += v[c];
+        out.sum2[c] += double(v[c]) * v[c];
+      }
+      out.range_min = std::min(out.range_min, v[3]);
+      out.range_max = std::max(out.range_max, v[3]);
+      ++out.count;
+    }
+  });
+  double sum[4] = {0, 0, 0, 0}, sum2[4] = {0, 0, 0, 0};
+  std::vector<int64_t> first_node(scan.rows + 1, 0);
+  stats.range_min = std::numeric_limits<float>::max();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int c = 0; c < 4; ++c) sum[c] += rows[row].sum[c], sum2[c] += rows[row].sum2[c];
+    stats.range_min = std::min(stats.range_min, rows[row].range_min);
+    stats.range_max = std::max(stats.range_max, rows[row].range_max);
+    first_node[row + 1] = first_node[row] + rows[row].count;
+  }
+  const int64_t n = stats.num_valid = first_node[scan.rows];
+  if (n == 0) {
+    stats.range_min = stats.range_max = 0;
+    return stats;
+  }
+  for (int c = 0; c < 4; ++c) {
+    stats.mean[c] = static_cast<float>(sum[c] / n);
+    const double var = std::max(0.0, sum2[c] / n - (sum[c] / n) * (sum[c] / n));
+    stats.inv_std[c] = var > 1e-12 ? static_cast<float>(1.0 / std::sqrt(var)) : 1.0f;
+  }
+  // Pass 2: the squared differences of the standardized channels over every link, and the sample.
+  const auto standard = [&](int row, int col) {
+    const cv::Vec4f v = RgbdAt(scan, row, col);
+    cv::Vec4f out;
+    for (int c = 0; c < 4; ++c) out[c] = (v[c] - stats.mean[c]) * stats.inv_std[c];
+    return out;
+  };
+  const int64_t stride = std::max<int64_t>(1, n / kMedianSampleNodes);
+  struct RowLinks {
+    double sum[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+    int64_t count[2] = {0, 0};
+    std::vector<std::pair<uint8_t, cv::Vec4f>> sample;
+  };
+  std::vector<RowLinks> links(scan.rows);
+  ParallelFor(scan.rows, [&](int64_t row64) {
+    const int row = static_cast<int>(row64);
+    RowLinks& out = links[row];
+    int64_t node = first_node[row];
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!IsNode(scan, row, col)) continue;
+      const cv::Vec4f p = standard(row, col);
+      const bool sampled = node % stride == 0;
+      ++node;
+      for (int d = 0; d < 4; ++d) {
+        const int r2 = row + kDirRow[d], c2 = col + kDirCol[d];
+        if (r2 >= scan.rows || c2 < 0 || c2 >= scan.cols || !IsNode(scan, r2, c2)) continue;
+        const cv::Vec4f q = standard(r2, c2);
+        cv::Vec4f diff;
+        for (int c = 0; c < 4; ++c) {
+          diff[c] = p[c] - q[c];
+          out.sum[d < 2 ? 0 : 1][c] += double(diff[c]) * diff[c];
+        }
+        ++out.count[d < 2 ? 0 : 1];
+        if (sampled) out.sample.emplace_back(static_cast<uint8_t>(d), diff);
+      }
+    }
+  });
+  for (const RowLinks& row : links) {
+    for (int k = 0; k < 2; ++k) {
+      for (int c = 0; c < 4; ++c) stats.link_sum[k][c] += row.sum[k][c];
+      stats.link_count[k] += row.count[k];
+    }
+    stats.sample.insert(stats.sample.end(), row.sample.begin(), row.sample.end());
+  }
+  return stats;
+}
+
+Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window) {
+  Nodes nodes;
+  nodes.window = window & cv::Rect(0, 0, scan.cols, scan.rows);
+  nodes.rows = nodes.window.height;
+  nodes.cols = nodes.window.width;
+  nodes.scan_cols = scan.cols;
+  nodes.range_min = stats.range_min;
+  nodes.range_max = stats.range_max;
+  nodes.node_of_cell.assign(static_cast<size_t>(nodes.rows) * nodes.cols, -1);
+  for (int r = 0; r < nodes.rows; ++r) {
+    const int row = nodes.window.y + r;
+    for (int c = 0; c < nodes.cols; ++c) {
+      const int col = nodes.window.x + c;
+      if (!IsNode(scan, row, col)) continue;
+      const int64_t cell = static_cast<int64_t>(r) * nodes.cols + c;
       nodes.node_of_cell[cell] = static_cast<int32_t>(nodes.cell_of_node.size());
       nodes.cell_of_node.push_back(static_cast<int32_t>(cell));
-      nodes.raw.push_back(rgbd.at<cv::Vec4f>(row, col));
+      nodes.raw.push_back(RgbdAt(scan, row, col));
     }
   }
   const int n = nodes.num();
-  if (n == 0) return nodes;
-  double sum[4] = {0, 0, 0, 0}, sum2[4] = {0, 0, 0, 0};
-  nodes.range_min = std::numeric_limits<float>::max();
-  nodes.range_max = 0;
-  for (const cv::Vec4f& v : nodes.raw) {
-    for (int c = 0; c < 4; ++c) {
-      sum[c] += v[c];
-      sum2[c] += double(v[c]) * v[c];
-    }
-    nodes.range_min = std::min(nodes.range_min, v[3]);
-    nodes.range_max = std::max(nodes.range_max, v[3]);
-  }
-  cv::Vec4f mean, inv_std;
-  for (int c = 0; c < 4; ++c) {
-    mean[c] = static_cast<float>(sum[c] / n);
-    const double var = std::max(0.0, sum2[c] / n - (sum[c] / n) * (sum[c] / n));
-    inv_std[c] = var > 1e-12 ? static_cast<float>(1.0 / std::sqrt(var)) : 1.0f;
-  }
   nodes.standard.resize(n);
   ParallelForRange(
       n,
       [&](int64_t begin, int64_t end) {
         for (int64_t i = begin; i < end; ++i) {
-          for (int c = 0; c < 4; ++c) nodes.standard[i][c] = (nodes.raw[i][c] - mean[c]) * inv_std[c];
+          for (int c = 0; c < 4; ++c)
+            nodes.standard[i][c] = (nodes.raw[i][c] - stats.mean[c]) * stats.inv_std[c];
         }
       },
       4096);
   return nodes;
 }
 
-NLinks ComputeNLinks(const Nodes& nodes, const CutWeights& w, bool eight_connected, double sigma_scale) {
+NLinks ComputeNLinks(const Nodes& nodes, const ScanStats& stats, const CutWeights& w, bool eight_connected,
+                     double sigma_scale) {
   NLinks links;
   links.directions = eight_connected ? 4 : 2;
   const int n = nodes.num();
   const float lambda[4] = {float(w.lambda_r), float(w.lambda_g), float(w.lambda_b), float(w.lambda_d)};
   for (int d = 0; d < links.directions; ++d) links.weight[d].assign(n, -1.0f);
-  // Pass 1: weighted squared differences, with per-row partial sums so the σ estimate does not depend on
-  // threads.
-  std::vector<double> row_sum(nodes.rows, 0.0);
-  std::vector<int64_t> row_count(nodes.rows, 0);
+  // Pass 1: weighted squared differences of the window's links.
   ParallelFor(nodes.rows, [&](int64_t row) {
-    double s = 0;
-    int64_t count = 0;
     for (int col = 0; col < nodes.cols; ++col) {
       const int32_t p = nodes.node_of_cell[row * nodes.cols + col];
       if (p < 0) continue;
@@ -94,25 +191,26 @@ NLinks ComputeNLinks(const Nodes& nodes, const CutWeights& w, bool eight_connect
           d2 += lambda[c] * diff * diff;
         }
         links.weight[d][p] = d2;
-        s += d2;
-        ++count;
       }
     }
-    row_sum[row] = s;
-    row_count[row] = count;
   });
-  const double total = std::accumulate(row_sum.begin(), row_sum.end(), 0.0);
-  const int64_t count = std::accumulate(row_count.begin(), row_count.end(), int64_t{0});
+  // σ² from the whole scan's links (ScanStats), so that a window sees the σ² of the whole scan.
+  const int kinds = eight_connected ? 2 : 1;
+  double total = 0;
+  int64_t count = 0;
+  for (int k = 0; k < kinds; ++k) {
+    for (int c = 0; c < 4; ++c) total += lambda[c] * stats.link_sum[k][c];
+    count += stats.link_count[k];
+  }
   const double mean = count > 0 ? total / count : 0.0;
   double typical = mean;
   if (w.median_sigma && count > 0) {
-    // Median over a deterministic stride sample of at most ~200k n-links.
-    const int64_t stride = std::max<int64_t>(1, n / 100000);
     std::vector<float> sample;
-    for (int64_t i = 0; i < n; i += stride) {
-      for (int d = 0; d < links.directions; ++d) {
-        if (links.weight[d][i] >= 0) sample.push_back(links.weight[d][i]);
-      }
+    for (const auto& [d, diff] : stats.sample) {
+      if (d >= links.directions) continue;
+      float d2 = 0;
+      for (int c = 0; c < 4; ++c) d2 += lambda[c] * diff[c] * diff[c];
+      sample.push_back(d2);
     }
     if (!sample.empty()) {
       std::nth_element(sample.begin(), sample.begin() + sample.size() / 2, sample.end());

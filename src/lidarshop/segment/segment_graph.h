@@ -17,18 +17,49 @@ namespace lidarshop::segment_internal {
 
 using Graph = maxflow::Graph<float, float, float>;
 
-// The valid cells as graph nodes, with their standardized channels.
-struct Nodes {
-  int rows = 0, cols = 0;
-  std::vector<int32_t> node_of_cell;  // rows*cols, -1 = no return
-  std::vector<int32_t> cell_of_node;  // #nodes
-  std::vector<cv::Vec4f> raw;         // #nodes: R, G, B in [0, 1], range in metres
-  std::vector<cv::Vec4f> standard;    // #nodes: the same, standardized over the valid cells
-  float range_min = 0, range_max = 0;
-  int num() const { return static_cast<int>(cell_of_node.size()); }
+// What the cut's features are normalized by, over every valid cell of the whole scan (not only the window
+// the graph covers), so that a cut in a window sees the same standardized channels, range span and σ² as one
+// over the whole scan. One streaming pass over the scan's rows; nothing of the scan's size is allocated.
+struct ScanStats {
+  int64_t num_valid = 0;               // cells with a return (valid, finite range > 0)
+  cv::Vec4f mean, inv_std;             // per channel R, G, B, range (range in metres)
+  float range_min = 0, range_max = 0;  // metres
+  // Σ over the links of the squared difference of each standardized channel, and the number of links:
+  // [0] = right and down neighbours, [1] = the two diagonals.
+  double link_sum[2][4] = {{0, 0, 0, 0}, {0, 0, 0, 0}};
+  int64_t link_count[2] = {0, 0};
+  // The links of every stride-th node (stride = max(1, num_valid / 100000)), for CutWeights::median_sigma:
+  // direction (0..3, kDirRow/kDirCol) and the standardized channel differences.
+  std::vector<std::pair<uint8_t, cv::Vec4f>> sample;
 };
 
-Nodes MakeNodes(const Scan& scan);
+ScanStats ComputeScanStats(const Scan& scan);
+
+// The valid cells of `window` (a rectangle of the scan) as graph nodes, with their channels standardized by
+// `stats`. Cells are counted in the window (row-major, window.width columns); ScanCell() gives the scan's.
+struct Nodes {
+  int rows = 0, cols = 0;              // the window's size
+  cv::Rect window;                     // in the scan
+  int scan_cols = 0;                   // columns of the scan
+  std::vector<int32_t> node_of_cell;   // rows*cols, -1 = no return
+  std::vector<int32_t> cell_of_node;   // #nodes, cell of the window
+  std::vector<cv::Vec4f> raw;          // #nodes: R, G, B in [0, 1], range in metres
+  std::vector<cv::Vec4f> standard;     // #nodes: the same, standardized over the scan's valid cells
+  float range_min = 0, range_max = 0;  // over the scan's valid cells, metres
+  int num() const { return static_cast<int>(cell_of_node.size()); }
+  // The scan's cell index (row * scan_cols + col) of node i.
+  int64_t ScanCell(int32_t i) const {
+    const int32_t cell = cell_of_node[i];
+    return static_cast<int64_t>(window.y + cell / cols) * scan_cols + window.x + cell % cols;
+  }
+  // The node of the scan's cell (row, col), -1 when it has no return or lies outside the window.
+  int32_t NodeAt(int row, int col) const {
+    if (!window.contains(cv::Point(col, row))) return -1;
+    return node_of_cell[static_cast<int64_t>(row - window.y) * cols + col - window.x];
+  }
+};
+
+Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window);
 
 // Neighbour offsets in the order right, down, down-right, down-left (each edge is stored once, at its
 // upper/left end).
@@ -42,7 +73,9 @@ struct NLinks {
   double sigma2 = 0;  // the estimated σ² (standardized units)
 };
 
-NLinks ComputeNLinks(const Nodes& nodes, const CutWeights& w, bool eight_connected, double sigma_scale);
+// σ² is estimated from `stats` (the whole scan's links), the weights computed for the window's links.
+NLinks ComputeNLinks(const Nodes& nodes, const ScanStats& stats, const CutWeights& w, bool eight_connected,
+                     double sigma_scale);
 
 // Log densities of colour (per unit volume of [0,1]^3) and range (per metre) under the object and background
 // models (appearance.h), per graph node.
@@ -82,7 +115,7 @@ void BuildAndCut(const Nodes& nodes, const NLinks& links, const LogDensities& lo
                  const std::vector<uint8_t>& hard, SegmentTimings* timings, double* flow, Cut* cut_out);
 
 // Object cells (255) from a cut, keeping only the 4-connected components that contain a kHardObject node of
-// `hard` (per node, not per graph node); cells of other components are dropped.
+// `hard` (per node, not per graph node); cells of other components are dropped. The window's size.
 cv::Mat MaskFromCut(const Nodes& nodes, const Cut& cut, const std::vector<uint8_t>& hard);
 
 }  // namespace lidarshop::segment_internal

@@ -1,5 +1,6 @@
 // SegmentSession: the two-step method (depth-dominant cut, background inference, colour-dominant cut in a
-// region of interest), its single-cut baselines and incremental refinement (segment.h).
+// region of interest), its single-cut baselines and incremental refinement (segment.h), with the cuts' graphs
+// on a window around the strokes that grows while a cut reaches its edge (SegmentOptions::window_margin_cells).
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -25,7 +26,9 @@ struct SegmentSession::Impl {
   Scan scan;
   SegmentOptions given;    // as the caller gave them
   SegmentOptions options;  // in force: `given` with the metric lengths scaled to the data at Run()
-  Nodes nodes;
+  ScanStats stats;         // the whole scan's channel statistics, computed once
+  Nodes nodes;             // the valid cells of the window the cuts' graphs cover
+  int window_growths = 0;  // times the window was grown by the last Run() or Refine()
   // Colour or intensity to tell the object by; without either the colour terms are constant.
   bool has_appearance = false;
   double features_s = 0;
@@ -41,29 +44,124 @@ struct SegmentSession::Impl {
   const NLinks& Links(const CutWeights& w, std::unique_ptr<NLinks>* cache, SegmentTimings* t) {
     if (!*cache) {
       Timer timer;
-      *cache =
-          std::make_unique<NLinks>(ComputeNLinks(nodes, w, options.eight_connected, options.sigma_scale));
+      *cache = std::make_unique<NLinks>(
+          ComputeNLinks(nodes, stats, w, options.eight_connected, options.sigma_scale));
       t->features_s += timer.Seconds();
     }
     return **cache;
   }
 
-  std::vector<uint8_t> HardFromStrokes(const cv::Mat& strokes, const std::string& what) const {
-    if (strokes.rows != nodes.rows || strokes.cols != nodes.cols || strokes.type() != CV_8U) {
-      ThrowInputError(what, "", "",
-                      fmt::format("stroke labels must be CV_8U {} x {} (the scan's size), got {} x {}",
-                                  nodes.rows, nodes.cols, strokes.rows, strokes.cols));
+  // The n-links of `w`, one of the three weights of `options`.
+  const NLinks& LinksFor(const CutWeights* w, SegmentTimings* t) {
+    if (w == &options.depth_step) return Links(*w, &depth_links, t);
+    if (w == &options.color_step) return Links(*w, &color_links, t);
+    return Links(*w, &rgbd_links, t);
+  }
+
+  cv::Rect WholeScan() const { return cv::Rect(0, 0, scan.cols, scan.rows); }
+
+  // The graphs' window: the bounding box of the stroke cells grown by window_margin_cells on every side,
+  // clipped to the scan (window_margin_cells = 0 or no stroke: the whole scan).
+  cv::Rect StrokeWindow(const cv::Mat& strokes) const {
+    if (options.window_margin_cells <= 0) return WholeScan();
+    const cv::Rect box = cv::boundingRect(strokes != kStrokeNone);
+    if (box.empty()) return WholeScan();
+    const int m = options.window_margin_cells;
+    return cv::Rect(box.x - m, box.y - m, box.width + 2 * m, box.height + 2 * m) & WholeScan();
+  }
+
+  // The window doubled: half its larger side (at least the margin) added on every side, clipped to the scan.
+  cv::Rect Grown(const cv::Rect& window) const {
+    const int m = std::max(options.window_margin_cells, (std::max(window.width, window.height) + 1) / 2);
+    return cv::Rect(window.x - m, window.y - m, window.width + 2 * m, window.height + 2 * m) & WholeScan();
+  }
+
+  // Whether `mask` (the scan's size) holds a cell on an edge of the window that is not an edge of the scan:
+  // the object may go on beyond the window, which is grown.
+  bool TouchesWindowEdge(const cv::Mat& mask) const {
+    const cv::Rect& w = nodes.window;
+    if (w == WholeScan()) return false;
+    const auto any = [&](const cv::Rect& line) { return cv::countNonZero(mask(line)) > 0; };
+    return (w.y > 0 && any(cv::Rect(w.x, w.y, w.width, 1))) ||
+           (w.y + w.height < scan.rows && any(cv::Rect(w.x, w.y + w.height - 1, w.width, 1))) ||
+           (w.x > 0 && any(cv::Rect(w.x, w.y, 1, w.height))) ||
+           (w.x + w.width < scan.cols && any(cv::Rect(w.x + w.width - 1, w.y, 1, w.height)));
+  }
+
+  // Makes `window` the graphs' window: new nodes and n-links; the hard labels so far are carried over (cells
+  // outside the old window had none) and the last graph is dropped (its weights are kept for a re-run).
+  void SetWindow(const cv::Rect& window, SegmentTimings* t) {
+    Timer timer;
+    Nodes next = MakeNodes(scan, stats, window);
+    if (!last_hard.empty()) {
+      std::vector<uint8_t> hard(next.num(), kFree);
+      for (int i = 0; i < nodes.num(); ++i) {
+        if (last_hard[i] == kFree) continue;
+        const int64_t cell = nodes.ScanCell(i);
+        const int32_t j = next.NodeAt(static_cast<int>(cell / scan.cols), static_cast<int>(cell % scan.cols));
+        if (j >= 0) hard[j] = last_hard[i];
+      }
+      last_hard.swap(hard);
     }
+    nodes = std::move(next);
+    depth_links.reset();
+    color_links.reset();
+    rgbd_links.reset();
+    const CutWeights* weights = last.weights;
+    last = Cut();
+    last.weights = weights;
+    t->features_s += timer.Seconds();
+  }
+
+  void Report(SegmentResult* result) const {
+    result->window_row = nodes.window.y;
+    result->window_col = nodes.window.x;
+    result->window_rows = nodes.window.height;
+    result->window_cols = nodes.window.width;
+    result->window_growths = window_growths;
+  }
+
+  // Re-runs the last cut on the whole window with every hard cell so far, growing the window while the cut
+  // reaches its edge.
+  cv::Mat RerunLastCut(SegmentResult* result) {
+    result->flow = 0;
+    cv::Mat mask = RunCut(*last.weights, LinksFor(last.weights, &result->timings), last_hard, result);
+    while (TouchesWindowEdge(mask)) {
+      SetWindow(Grown(nodes.window), &result->timings);
+      ++window_growths;
+      mask = RunCut(*last.weights, LinksFor(last.weights, &result->timings), last_hard, result);
+    }
+    return mask;
+  }
+
+  // A mask of the window's size as a mask of the scan's size (0 outside the window).
+  cv::Mat ToScan(const cv::Mat& window_mask) const {
+    if (nodes.window == WholeScan()) return window_mask;
+    cv::Mat mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+    window_mask.copyTo(mask(nodes.window));
+    return mask;
+  }
+
+  std::vector<uint8_t> HardFromStrokes(const cv::Mat& strokes, const std::string& what) const {
+    CheckStrokes(strokes, what);
     std::vector<uint8_t> hard(nodes.num(), kFree);
     const uint8_t* s = strokes.ptr<uint8_t>();
     for (int i = 0; i < nodes.num(); ++i) {
-      const uint8_t v = s[nodes.cell_of_node[i]];
+      const uint8_t v = s[nodes.ScanCell(i)];
       if (v == kStrokeObject)
         hard[i] = kHardObject;
       else if (v == kStrokeBackground)
         hard[i] = kHardBackground;
     }
     return hard;
+  }
+
+  void CheckStrokes(const cv::Mat& strokes, const std::string& what) const {
+    if (strokes.rows != scan.rows || strokes.cols != scan.cols || strokes.type() != CV_8U) {
+      ThrowInputError(what, "", "",
+                      fmt::format("stroke labels must be CV_8U {} x {} (the scan's size), got {} x {}",
+                                  scan.rows, scan.cols, strokes.rows, strokes.cols));
+    }
   }
 
   // The hard labels of the last graph's nodes: `hard` (per node) mapped to the graph.
@@ -74,32 +172,35 @@ struct SegmentSession::Impl {
     return local;
   }
 
-  // Whether `mask` (the last cut's) holds a cell on an edge of the last graph's ROI that is not an image
-  // edge: then the object may go on beyond the ROI, which was too small.
+  // Whether `mask` (the last cut's, the scan's size) holds a cell on an edge of the last graph's ROI that is
+  // not an edge of the window: then the object may go on beyond the ROI, which was too small.
   bool ReachesRoiEdge(const cv::Mat& mask) const {
     const uint8_t* data = mask.ptr<uint8_t>();
     for (size_t k = 0; k < last.on_roi_edge.size(); ++k) {
-      if (last.on_roi_edge[k] && data[nodes.cell_of_node[last.node_of_local[k]]] != 0) return true;
+      if (last.on_roi_edge[k] && data[nodes.ScanCell(last.node_of_local[k])] != 0) return true;
     }
     return false;
   }
 
-  // Sets last's node maps to the valid cells of `roi` (an empty rectangle or the whole image = every node).
-  void SetRoi(const cv::Rect& roi) {
+  // Sets last's node maps to the valid cells of `roi` (in the scan) within the window (an empty rectangle or
+  // one holding the window = every node).
+  void SetRoi(const cv::Rect& roi_in_scan) {
     last.node_of_local.clear();
     last.local_of_node.clear();
     last.on_roi_edge.clear();
-    if (roi.empty() || roi == cv::Rect(0, 0, nodes.cols, nodes.rows)) return;
+    const cv::Rect& w = nodes.window;
+    const cv::Rect roi = roi_in_scan & w;
+    if (roi_in_scan.empty() || roi == w) return;
     last.local_of_node.assign(nodes.num(), -1);
     for (int row = roi.y; row < roi.y + roi.height; ++row) {
       for (int col = roi.x; col < roi.x + roi.width; ++col) {
-        const int32_t i = nodes.node_of_cell[static_cast<int64_t>(row) * nodes.cols + col];
+        const int32_t i = nodes.NodeAt(row, col);
         if (i < 0) continue;
         last.local_of_node[i] = static_cast<int32_t>(last.node_of_local.size());
         last.node_of_local.push_back(i);
-        const bool edge = (row == roi.y && row > 0) ||
-                          (row == roi.y + roi.height - 1 && row < nodes.rows - 1) ||
-                          (col == roi.x && col > 0) || (col == roi.x + roi.width - 1 && col < nodes.cols - 1);
+        const bool edge =
+            (row == roi.y && row > w.y) || (row == roi.y + roi.height - 1 && row < w.y + w.height - 1) ||
+            (col == roi.x && col > w.x) || (col == roi.x + roi.width - 1 && col < w.x + w.width - 1);
         last.on_roi_edge.push_back(edge ? 1 : 0);
       }
     }
@@ -125,7 +226,7 @@ struct SegmentSession::Impl {
     last.links = &links;
     BuildAndCut(nodes, links, logp, w, LocalHard(hard), &result->timings, &result->flow, &last);
     last_hard = hard;
-    return MaskFromCut(nodes, last, hard);
+    return ToScan(MaskFromCut(nodes, last, hard));
   }
 
   // Step 3's region of interest around the step-1 object (SegmentOptions::roi_margin_cells); empty = whole.
@@ -137,36 +238,44 @@ struct SegmentSession::Impl {
         std::max(options.roi_margin_cells,
                  static_cast<int>(std::ceil(options.roi_margin_fraction * std::max(box.width, box.height))));
     const int x0 = std::max(0, box.x - margin), y0 = std::max(0, box.y - margin);
-    const int x1 = std::min(nodes.cols, box.x + box.width + margin);
-    const int y1 = std::min(nodes.rows, box.y + box.height + margin);
+    const int x1 = std::min(scan.cols, box.x + box.width + margin);
+    const int y1 = std::min(scan.rows, box.y + box.height + margin);
     return cv::Rect(x0, y0, x1 - x0, y1 - y0);
   }
 
-  // Step 2: ring cells whose range differs from every step-1 object cell in their window.
+  // Step 2: ring cells whose range differs from every step-1 object cell in their window. Read from the scan
+  // (not the window's nodes): the same cells whatever the window.
   cv::Mat InferBackground(const cv::Mat& step1) const {
     const int r = options.ring_radius_cells;
-    cv::Mat dilated;
-    cv::dilate(step1, dilated, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)));
-    cv::Mat inferred(nodes.rows, nodes.cols, CV_8U, cv::Scalar(0));
-    ParallelFor(nodes.rows, [&](int64_t row) {
+    cv::Mat inferred(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
+    const cv::Rect box = cv::boundingRect(step1);
+    if (box.empty()) return inferred;
+    const cv::Rect ring = cv::Rect(box.x - r, box.y - r, box.width + 2 * r, box.height + 2 * r) & WholeScan();
+    cv::Mat dilated = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+    cv::dilate(step1(ring), dilated(ring),
+               cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * r + 1, 2 * r + 1)),
+               cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    const auto is_node = [&](int row, int col) {
+      const float range = scan.range.at<float>(row, col);
+      return scan.valid.at<uint8_t>(row, col) != 0 && std::isfinite(range) && range > 0;
+    };
+    ParallelFor(ring.height, [&](int64_t k) {
+      const int row = ring.y + static_cast<int>(k);
       const uint8_t* dil = dilated.ptr<uint8_t>(row);
       const uint8_t* obj = step1.ptr<uint8_t>(row);
       uint8_t* out = inferred.ptr<uint8_t>(row);
-      for (int col = 0; col < nodes.cols; ++col) {
-        if (dil[col] == 0 || obj[col] != 0) continue;
-        const int32_t p = nodes.node_of_cell[row * nodes.cols + col];
-        if (p < 0) continue;
-        const float range = nodes.raw[p][3];
+      for (int col = ring.x; col < ring.x + ring.width; ++col) {
+        if (dil[col] == 0 || obj[col] != 0 || !is_node(row, col)) continue;
+        const float range = scan.range.at<float>(row, col);
         float closest = std::numeric_limits<float>::infinity();
         for (int dr = -r; dr <= r; ++dr) {
-          const int rr = static_cast<int>(row) + dr;
-          if (rr < 0 || rr >= nodes.rows) continue;
+          const int rr = row + dr;
+          if (rr < 0 || rr >= scan.rows) continue;
           const uint8_t* obj_row = step1.ptr<uint8_t>(rr);
           for (int dc = -r; dc <= r; ++dc) {
             const int cc = col + dc;
-            if (cc < 0 || cc >= nodes.cols || obj_row[cc] == 0 || dr * dr + dc * dc > r * r) continue;
-            const int32_t q = nodes.node_of_cell[static_cast<int64_t>(rr) * nodes.cols + cc];
-            if (q >= 0) closest = std::min(closest, std::abs(range - nodes.raw[q][3]));
+            if (cc < 0 || cc >= scan.cols || obj_row[cc] == 0 || dr * dr + dc * dc > r * r) continue;
+            if (is_node(rr, cc)) closest = std::min(closest, std::abs(range - scan.range.at<float>(rr, cc)));
           }
         }
         const double threshold = options.ring_depth_threshold_m +
@@ -185,7 +294,8 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
   Timer timer;
   impl_->scan = scan;
   impl_->given = impl_->options = options;
-  impl_->nodes = MakeNodes(scan);
+  // The whole scan's statistics once; the nodes of a window at each Run().
+  impl_->stats = ComputeScanStats(scan);
   impl_->has_appearance = scan.has_color() || scan.has_intensity();
   impl_->features_s = timer.Seconds();
 }
@@ -197,119 +307,142 @@ SegmentSession& SegmentSession::operator=(SegmentSession&&) noexcept = default;
 SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
   Impl& s = *impl_;
   Timer total;
-  SegmentResult result;
-  result.timings.features_s = s.features_s;
+  s.CheckStrokes(strokes, "strokes");
+  const double stats_s = s.features_s;  // the constructor's, before this timer
+  SegmentTimings timings;
+  timings.features_s = s.features_s;
   s.features_s = 0;  // counted once
-  std::vector<uint8_t> hard = s.HardFromStrokes(strokes, "strokes");
-  const bool has_object = std::count(hard.begin(), hard.end(), kHardObject) > 0;
-  const bool has_background = std::count(hard.begin(), hard.end(), kHardBackground) > 0;
-  if (!has_object) ThrowInputError("strokes", "", "", "no object stroke lies on a cell with a return");
-  if (!has_background)
-    ThrowInputError("strokes", "", "", "no background stroke lies on a cell with a return");
+  // The graphs cover a window around the strokes, grown while a cut reaches its edge (a cut inside it is the
+  // cut of the whole scan: cells outside are background).
   s.options = s.given;
-  if (s.given.scale_to_data) {
-    // The object strokes' median range times the ray angle measured around them.
-    cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
-    std::vector<float> ranges;
-    for (int i = 0; i < s.nodes.num(); ++i) {
-      if (hard[i] != kHardObject) continue;
-      object_cells.data[s.nodes.cell_of_node[i]] = 255;
-      ranges.push_back(s.scan.range.at<float>(s.nodes.cell_of_node[i] / s.scan.cols,
-                                              s.nodes.cell_of_node[i] % s.scan.cols));
-    }
-    std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
-    result.ray_spacing_m = ranges[ranges.size() / 2] * RayAngleAt(s.scan, object_cells);
-    if (result.ray_spacing_m > 0) {
-      // Scaled down only: a finer scan (a table top at 1 m) resolves depth steps and range bins the outdoor
-      // lengths would merge, while a coarser one (a facade at 40 m) keeps them — the range noise of a
-      // terrestrial scanner grows far more slowly than the ray spacing (measured: scaling up as well lost the
-      // van before its facade, IoU 0.997 -> 0.811).
-      result.length_scale = std::min(1.0, result.ray_spacing_m / s.given.reference_spacing_m);
-      s.options.depth_bin_m *= result.length_scale;
-      s.options.depth_smoothing_m *= result.length_scale;
-    }
-  }
-  const SegmentOptions& o = s.options;
-  switch (o.method) {
-    case SegmentMethod::kDepth:
-      result.mask =
-          s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
-      break;
-    case SegmentMethod::kColor:
-      if (!s.has_appearance) {
-        throw InputError(
-            "segment: the color method needs colour or intensity, and the scan has neither; use the depth or "
-            "two-step method");
+  cv::Rect window = s.StrokeWindow(strokes);
+  s.window_growths = 0;
+  s.last_hard.clear();
+  SegmentResult result;
+  std::vector<uint8_t> hard;
+  for (;; window = s.Grown(window), ++s.window_growths) {
+    if (s.nodes.window != window || s.nodes.cell_of_node.empty()) s.SetWindow(window, &timings);
+    result = SegmentResult();
+    result.timings = timings;
+    bool touched = false;
+    hard = s.HardFromStrokes(strokes, "strokes");
+    const bool has_object = std::count(hard.begin(), hard.end(), kHardObject) > 0;
+    const bool has_background = std::count(hard.begin(), hard.end(), kHardBackground) > 0;
+    if (!has_object) ThrowInputError("strokes", "", "", "no object stroke lies on a cell with a return");
+    if (!has_background)
+      ThrowInputError("strokes", "", "", "no background stroke lies on a cell with a return");
+    s.options = s.given;
+    if (s.given.scale_to_data) {
+      // The object strokes' median range times the ray angle measured around them.
+      cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+      std::vector<float> ranges;
+      for (int i = 0; i < s.nodes.num(); ++i) {
+        if (hard[i] != kHardObject) continue;
+        object_cells.data[s.nodes.ScanCell(i)] = 255;
+        ranges.push_back(reinterpret_cast<const float*>(s.scan.range.data)[s.nodes.ScanCell(i)]);
       }
-      result.mask =
-          s.RunCut(o.color_step, s.Links(o.color_step, &s.color_links, &result.timings), hard, &result);
-      break;
-    case SegmentMethod::kRgbd:
-      result.mask =
-          s.RunCut(o.rgbd_step, s.Links(o.rgbd_step, &s.rgbd_links, &result.timings), hard, &result);
-      break;
-    case SegmentMethod::kTwoStep: {
-      // Step 1: depth-dominant cut.
-      result.step1_mask =
-          s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
-      // A neighbour touching the object at the same range joins the depth cut; it is background from here on.
-      cv::Mat neighbours;
-      if (o.whole_object.separate_touching) {
-        cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
-        for (int i = 0; i < s.nodes.num(); ++i)
-          if (hard[i] == kHardObject) object_cells.data[s.nodes.cell_of_node[i]] = 255;
-        neighbours = TouchingNeighbours(s.scan, result.step1_mask, object_cells, o.whole_object);
-        result.step1_mask.setTo(0, neighbours);
+      std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+      result.ray_spacing_m = ranges[ranges.size() / 2] * RayAngleAt(s.scan, object_cells);
+      if (result.ray_spacing_m > 0) {
+        // Scaled down only: a finer scan (a table top at 1 m) resolves depth steps and range bins the outdoor
+        // lengths would merge, while a coarser one (a facade at 40 m) keeps them — the range noise of a
+        // terrestrial scanner grows far more slowly than the ray spacing (measured: scaling up as well lost the
+        // van before its facade, IoU 0.997 -> 0.811).
+        result.length_scale = std::min(1.0, result.ray_spacing_m / s.given.reference_spacing_m);
+        s.options.depth_bin_m *= result.length_scale;
+        s.options.depth_smoothing_m *= result.length_scale;
       }
-      // Step 2: background inference on the ring around it.
-      result.inferred_background = s.InferBackground(result.step1_mask);
-      if (!neighbours.empty()) result.inferred_background |= neighbours;
-      if (!s.has_appearance) {
-        // Neither colour nor intensity: step 3 would have nothing to tell the object by and floods the
-        // ring. The depth cut is the answer.
-        result.mask = result.step1_mask.clone();
+    }
+    const SegmentOptions& o = s.options;
+    switch (o.method) {
+      case SegmentMethod::kDepth:
+        result.mask =
+            s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
+        break;
+      case SegmentMethod::kColor:
+        if (!s.has_appearance) {
+          throw InputError(
+              "segment: the color method needs colour or intensity, and the scan has neither; use the depth "
+              "or "
+              "two-step method");
+        }
+        result.mask =
+            s.RunCut(o.color_step, s.Links(o.color_step, &s.color_links, &result.timings), hard, &result);
+        break;
+      case SegmentMethod::kRgbd:
+        result.mask =
+            s.RunCut(o.rgbd_step, s.Links(o.rgbd_step, &s.rgbd_links, &result.timings), hard, &result);
+        break;
+      case SegmentMethod::kTwoStep: {
+        // Step 1: depth-dominant cut.
+        result.step1_mask =
+            s.RunCut(o.depth_step, s.Links(o.depth_step, &s.depth_links, &result.timings), hard, &result);
+        if ((touched = s.TouchesWindowEdge(result.step1_mask))) break;
+        // A neighbour touching the object at the same range joins the depth cut; it is background from here on.
+        cv::Mat neighbours;
+        if (o.whole_object.separate_touching) {
+          cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+          for (int i = 0; i < s.nodes.num(); ++i)
+            if (hard[i] == kHardObject) object_cells.data[s.nodes.ScanCell(i)] = 255;
+          neighbours = TouchingNeighbours(s.scan, result.step1_mask, object_cells, o.whole_object);
+          result.step1_mask.setTo(0, neighbours);
+        }
+        // Step 2: background inference on the ring around it.
+        result.inferred_background = s.InferBackground(result.step1_mask);
+        if (!neighbours.empty()) result.inferred_background |= neighbours;
+        if (!s.has_appearance) {
+          // Neither colour nor intensity: step 3 would have nothing to tell the object by and floods the
+          // ring. The depth cut is the answer.
+          result.mask = result.step1_mask.clone();
+          break;
+        }
+        // Step 3: colour-dominant cut seeded with step 1's object and the inferred + stroked background.
+        std::vector<uint8_t> seeds = hard;
+        // Step 1's cells on a support plane (ground the depth cut took at the object's foot) are left free.
+        cv::Mat step1_seeds = result.step1_mask;
+        if (o.whole_object.free_support_seeds)
+          step1_seeds = result.step1_mask & ~SupportSurfaceCells(s.scan, result.step1_mask, o.whole_object);
+        const uint8_t* step1 = step1_seeds.ptr<uint8_t>();
+        const uint8_t* inferred = result.inferred_background.ptr<uint8_t>();
+        for (int i = 0; i < s.nodes.num(); ++i) {
+          const int64_t cell = s.nodes.ScanCell(i);
+          if (hard[i] == kHardBackground) continue;  // the user's word wins
+          if (step1[cell] != 0)
+            seeds[i] = kHardObject;
+          else if (inferred[cell] != 0)
+            seeds[i] = kHardBackground;
+        }
+        const NLinks& color_links = s.Links(o.color_step, &s.color_links, &result.timings);
+        result.mask = s.RunCut(o.color_step, color_links, seeds, &result, s.Step3Roi(result.step1_mask));
+        // The object reached the ROI's edge: the ROI was too small, cut the whole window (the time of both cuts
+        // is counted).
+        if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
+        if ((touched = s.TouchesWindowEdge(result.mask))) break;
+        // (The growth follows the scan's geometry beyond the window as it would over the whole scan.)
+        if (o.grow_whole_object) {
+          cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+          for (int i = 0; i < s.nodes.num(); ++i)
+            if (hard[i] == kHardBackground) barrier.data[s.nodes.ScanCell(i)] = 255;
+          if (!neighbours.empty()) barrier |= neighbours;
+          result.mask = GrowWholeObject(s.scan, result.mask, barrier, o.whole_object);
+        }
         break;
       }
-      // Step 3: colour-dominant cut seeded with step 1's object and the inferred + stroked background.
-      std::vector<uint8_t> seeds = hard;
-      // Step 1's cells on a support plane (ground the depth cut took at the object's foot) are left free.
-      cv::Mat step1_seeds = result.step1_mask;
-      if (o.whole_object.free_support_seeds)
-        step1_seeds = result.step1_mask & ~SupportSurfaceCells(s.scan, result.step1_mask, o.whole_object);
-      const uint8_t* step1 = step1_seeds.ptr<uint8_t>();
-      const uint8_t* inferred = result.inferred_background.ptr<uint8_t>();
-      for (int i = 0; i < s.nodes.num(); ++i) {
-        const int32_t cell = s.nodes.cell_of_node[i];
-        if (hard[i] == kHardBackground) continue;  // the user's word wins
-        if (step1[cell] != 0)
-          seeds[i] = kHardObject;
-        else if (inferred[cell] != 0)
-          seeds[i] = kHardBackground;
-      }
-      const NLinks& color_links = s.Links(o.color_step, &s.color_links, &result.timings);
-      result.mask = s.RunCut(o.color_step, color_links, seeds, &result, s.Step3Roi(result.step1_mask));
-      // The object reached the ROI's edge: the ROI was too small, cut the whole image (the time of both cuts
-      // is counted).
-      if (s.ReachesRoiEdge(result.mask)) result.mask = s.RunCut(o.color_step, color_links, seeds, &result);
-      if (o.grow_whole_object) {
-        cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
-        for (int i = 0; i < s.nodes.num(); ++i)
-          if (hard[i] == kHardBackground) barrier.data[s.nodes.cell_of_node[i]] = 255;
-        if (!neighbours.empty()) barrier |= neighbours;
-        result.mask = GrowWholeObject(s.scan, result.mask, barrier, o.whole_object);
-      }
-      break;
     }
+    if (o.method != SegmentMethod::kTwoStep) touched = s.TouchesWindowEdge(result.mask);
+    timings = result.timings;
+    if (!touched) break;
   }
+  const SegmentOptions& o = s.options;
   // The part of the object the strokes lie on, which the cut is checked against (and Refine's too).
   s.stroked_part = cv::Mat();
   if (o.method == SegmentMethod::kTwoStep) {
     cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
     for (int i = 0; i < s.nodes.num(); ++i)
-      if (hard[i] == kHardObject) object_cells.data[s.nodes.cell_of_node[i]] = 255;
+      if (hard[i] == kHardObject) object_cells.data[s.nodes.ScanCell(i)] = 255;
     cv::Mat barrier = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
     for (int i = 0; i < s.nodes.num(); ++i)
-      if (hard[i] == kHardBackground) barrier.data[s.nodes.cell_of_node[i]] = 255;
+      if (hard[i] == kHardBackground) barrier.data[s.nodes.ScanCell(i)] = 255;
     const cv::Mat stroked = StrokedParts(result.step1_mask, object_cells);
     WholeObjectOptions unbounded = o.whole_object;  // no growth is a leak here: the image bounds it
     unbounded.max_growth = static_cast<double>(s.scan.num_cells()) / std::max(1, cv::countNonZero(stroked));
@@ -337,7 +470,8 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
     std::vector<std::string> checks = CheckCut(result.mask, s.stroked_part, WrapsInAzimuth(s.scan));
     result.warnings.insert(result.warnings.end(), checks.begin(), checks.end());
   }
-  result.timings.total_s = total.Seconds() + result.timings.features_s;
+  result.timings.total_s = total.Seconds() + stats_s;
+  s.Report(&result);
   s.last_result = result;
   s.ran = true;
   return result;
@@ -347,10 +481,23 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   Impl& s = *impl_;
   if (!s.ran) throw std::logic_error("SegmentSession::Refine called before Run");
   Timer total;
-  const std::vector<uint8_t> extra = s.HardFromStrokes(extra_strokes, "extra strokes");
+  s.CheckStrokes(extra_strokes, "extra strokes");
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
+  s.window_growths = 0;
   bool any = false, outside = false, object_strokes = false, background_strokes = false;
+  {
+    // Strokes beyond the window: the window takes them in (with the margin) and the last cut is re-run on it.
+    const cv::Rect box = cv::boundingRect(extra_strokes != kStrokeNone);
+    if (!box.empty() && (box & s.nodes.window) != box) {
+      const int m = std::max(0, s.options.window_margin_cells);
+      const cv::Rect around(box.x - m, box.y - m, box.width + 2 * m, box.height + 2 * m);
+      s.SetWindow((s.nodes.window | around) & s.WholeScan(), &result.timings);
+      ++s.window_growths;
+      outside = true;
+    }
+  }
+  const std::vector<uint8_t> extra = s.HardFromStrokes(extra_strokes, "extra strokes");
   for (int i = 0; i < s.nodes.num(); ++i) {
     if (extra[i] == kFree || extra[i] == s.last_hard[i]) continue;
     s.last_hard[i] = extra[i];
@@ -373,17 +520,16 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     std::vector<uint8_t> touched(static_cast<size_t>(count), 0);
     for (int i = 0; i < s.nodes.num(); ++i) {
       if (extra[i] != kHardBackground) continue;
-      touched[static_cast<size_t>(reinterpret_cast<const int32_t*>(part.data)[s.nodes.cell_of_node[i]])] = 1;
+      touched[static_cast<size_t>(reinterpret_cast<const int32_t*>(part.data)[s.nodes.ScanCell(i)])] = 1;
     }
     const int32_t* label = reinterpret_cast<const int32_t*>(part.data);
     for (int64_t cell = 0; cell < static_cast<int64_t>(part.total()); ++cell)
       if (label[cell] != 0 && !touched[static_cast<size_t>(label[cell])]) mask->data[cell] = 255;
   };
   if (outside) {
-    // A stroke outside the last cut's region of interest: re-run that cut on the whole image with every hard
-    // cell so far.
-    result.flow = 0;
-    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+    // A stroke outside the last cut's region of interest or window: re-run that cut on the whole window with
+    // every hard cell so far.
+    result.mask = s.RerunLastCut(&result);
     keep_monotone(&result.mask);
     if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
     result.object_cells = cv::countNonZero(result.mask);
@@ -392,6 +538,7 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     result.warnings =
         CheckCut(result.mask, object_strokes ? cv::Mat() : s.stroked_part, WrapsInAzimuth(s.scan));
     result.timings.total_s = total.Seconds();
+    s.Report(&result);
     s.last_result = result;
     return result;
   }
@@ -440,10 +587,10 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   Timer timer;
   if (changed > 0) result.flow = g.maxflow(/*reuse_trees=*/true);
   result.timings.maxflow_s = timer.Seconds();
-  result.mask = MaskFromCut(s.nodes, s.last, s.last_hard);
-  if (s.ReachesRoiEdge(result.mask)) {
-    // The refined object reached the ROI's edge: re-run the cut on the whole image.
-    result.mask = s.RunCut(*s.last.weights, *s.last.links, s.last_hard, &result);
+  result.mask = s.ToScan(MaskFromCut(s.nodes, s.last, s.last_hard));
+  if (s.ReachesRoiEdge(result.mask) || s.TouchesWindowEdge(result.mask)) {
+    // The refined object reached the ROI's or the window's edge: re-run the cut on the whole (grown) window.
+    result.mask = s.RerunLastCut(&result);
   }
   keep_monotone(&result.mask);
   if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
@@ -452,6 +599,7 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   result.warnings =
       CheckCut(result.mask, object_strokes ? cv::Mat() : s.stroked_part, WrapsInAzimuth(s.scan));
   result.timings.total_s = total.Seconds();
+  s.Report(&result);
   s.last_result = result;
   return result;
 }

@@ -188,18 +188,22 @@ std::vector<cv::Point> OverhangingPart(const Scan& scan, const cv::Mat& grown, c
 // post under the box it holds, seen past the box's overhanging front; table legs under the top's edge), the cells `continues(p, q)` joins to it. The part is one of the object's when it is closed: it
 // meets nothing that continues it in depth and orientation but that it may not take (a barrier, a part
 // already turned down, the region's edge), and has at most max_cells cells. `enter(grown, q)`: a
-// cell the part may take; `support(q)`: a cell of the support planes. Returns the cells of the first such part
-// found (empty: none).
-template <typename JumpAt, typename Enter, typename Continues, typename Support>
-std::vector<cv::Point> PartAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& region,
-                                      size_t max_cells, double max_gap_m, const JumpAt& jump_at,
-                                      const Enter& enter, const Continues& continues,
-                                      const Support& support) {
+// cell the part may take; `support(q)`: a cell of the support planes. One raster pass over the region: each
+// part found is handed to `accept(part)` (which adds it to `grown` and returns the cells the budget has left)
+// and the pass goes on, every cell explored at most once. Returns the number of parts accepted. (A pass that
+// returned after the first part and was restarted explored every part turned down before it again, with a new
+// full-scan `visited` and bounding box each time: quadratic in the scan's size at 16 M rays, where a cut has
+// thousands of small parts behind it and large open surfaces before them.)
+template <typename JumpAt, typename Enter, typename Continues, typename Support, typename Accept>
+int PartsAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& region, size_t max_cells,
+                    double max_gap_m, const JumpAt& jump_at, const Enter& enter, const Continues& continues,
+                    const Support& support, const Accept& accept) {
   constexpr int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
   constexpr uint8_t kInPart = 1, kRejected = 2;
   const float max_gap_sq = static_cast<float>(max_gap_m * max_gap_m);
-  const cv::Rect object_box = cv::boundingRect(grown);
+  cv::Rect object_box = cv::boundingRect(grown);
   cv::Mat visited = cv::Mat::zeros(grown.size(), CV_8U);
+  int accepted = 0;
   for (int r = region.y; r < region.y + region.height; ++r) {
     for (int c = region.x; c < region.x + region.width; ++c) {
       const cv::Point a(c, r);
@@ -244,14 +248,20 @@ std::vector<cv::Point> PartAcrossStep(const Scan& scan, const cv::Mat& grown, co
         if (!open) {
           const cv::Rect part_box = cv::boundingRect(part);
           if (part_box.x >= object_box.x - 2 && part_box.br().x <= object_box.br().x + 2 &&
-              part_box.y > object_box.y)
-            return part;
+              part_box.y > object_box.y) {
+            // The part is the object's now (kInPart marks stay: grown holds it from here on).
+            object_box |= part_box;
+            ++accepted;
+            max_cells = accept(part);
+            if (max_cells == 0) return accepted;
+            continue;
+          }
         }
         for (const cv::Point& p : part) visited.at<uint8_t>(p) = kRejected;
       }
     }
   }
-  return {};
+  return accepted;
 }
 
 // How deep into a cut a fringe of its support can reach, cells.
@@ -423,13 +433,15 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const auto enter = [&](const cv::Mat& grown, cv::Point b) {
     return open(grown, b) && !wide_support.at<uint8_t>(b);
   };
-  while (options.join_steps && added < max_added) {
-    const std::vector<cv::Point> part =
-        PartAcrossStep(scan, grown, region, static_cast<size_t>(max_added - added), options.join_max_gap_m,
-                       jump_at, enter, continues, on_support);
-    if (part.empty()) break;
+  const auto accept = [&](const std::vector<cv::Point>& part) {
     added += static_cast<int>(part.size());
     for (const cv::Point& cell : part) grown.at<uint8_t>(cell) = 255;
+    return static_cast<size_t>(std::max(0, max_added - added));
+  };
+  // Passes until one adds nothing: a part joined late in a pass may give seeds to cells the pass had passed.
+  while (options.join_steps && added < max_added &&
+         PartsAcrossStep(scan, grown, region, static_cast<size_t>(max_added - added), options.join_max_gap_m,
+                         jump_at, enter, continues, on_support, accept) > 0) {
   }
   return grown;
 }

@@ -111,6 +111,27 @@ TEST(WholeObjectTest, APostUnderABoxThatOverhangsItJoinsAStrokeOnTheBox) {
   EXPECT_GT(with.iou, 0.95) << "precision " << with.precision << " recall " << with.recall;
 }
 
+TEST(WholeObjectTest, EveryLegUnderATableTopThatOverhangsThemJoins) {
+  // Three closed parts across a depth step under one top: the growth joins them in one pass over the region
+  // (each part explored once), and every one of them, not only the first found.
+  const double xs[3] = {-0.35, 0.0, 0.35};
+  std::vector<Block> blocks = {{{-0.45, 4.75, -1.1}, {0.45, 5.25, -0.9}, cv::Vec3b(40, 60, 170), 1}};
+  for (int i = 0; i < 3; ++i)
+    blocks.push_back({{xs[i] - 0.05, 4.95, -1.5}, {xs[i] + 0.05, 5.05, -1.1}, cv::Vec3b(112, 82, 52), 2 + i});
+  const Scan scan = MakeBlocks(blocks, 5);
+  const cv::Mat top = scan.label == 1;
+  const cv::Mat grown = GrowWholeObject(scan, top, cv::Mat());
+  for (int leg = 2; leg <= 4; ++leg) {
+    const cv::Mat cells = (scan.label == leg) & (scan.valid != 0);
+    const int total = cv::countNonZero(cells);
+    ASSERT_GT(total, 20) << "leg " << leg;
+    EXPECT_GT(cv::countNonZero(grown & cells), 0.8 * total) << "leg " << leg;  // less its foot
+  }
+  // Nothing but the table: the ground and the wall stay out.
+  const cv::Mat table = (scan.label >= 1) & (scan.label <= 4);
+  EXPECT_LT(cv::countNonZero(grown & ~table), 0.02 * cv::countNonZero(table));
+}
+
 TEST(WholeObjectTest, APartInFrontThatStandsOnTheGroundDoesNotJoin) {
   // A crate on the ground in front of the post's foot: in front of the object, but the ground holds it.
   const Block crate = {{-0.25, 4.4, -1.5}, {0.25, 4.7, -1.25}, cv::Vec3b(40, 60, 170), 2};
