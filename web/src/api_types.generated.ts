@@ -29,6 +29,8 @@ export interface SegmentOptions {
   roi_margin_cells: number;
   // step 3 margin as a fraction of the object box's larger side in >= 0, default 0.25
   roi_margin_fraction: number;
+  // the cuts' graphs cover the strokes' box grown by this, doubled while the cut reaches its edge; 0 = whole scan [cells] in >= 0, default 128
+  window_margin_cells: number;
   // histogram bins per colour channel in [2, 64], default 16
   color_bins: number;
   // range histogram bin width [m] in > 0, default 0.05
@@ -267,6 +269,16 @@ export interface SegmentResult {
   graph_nodes: number;
   // value of the last max-flow
   flow: number | null;
+  // first row of the window the cuts' graphs covered
+  window_row: number;
+  // first column of the window
+  window_col: number;
+  // rows of the window [cells]
+  window_rows: number;
+  // columns of the window [cells]
+  window_cols: number;
+  // times the window was grown
+  window_growths: number;
   // spacing of neighbouring rays at the object strokes [m]
   ray_spacing_m: number | null;
   // factor applied to the metric lengths (scale_to_data)
