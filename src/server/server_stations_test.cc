@@ -20,8 +20,7 @@
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/site_scan.h"
 #include "server.h"
-// After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
-#include <httplib.h>
+#include "server_test_util.h"
 
 namespace lidarshop::server {
 namespace {
@@ -53,21 +52,12 @@ class StationsServerTest : public ::testing::Test {
     options.builtin_scenes = {"parking_lot_stations"};
     options.scan_builtin = [](const std::string&) { return (*site_)[0]; };
     options.scan_builtin_stations = [](const std::string&) { return *site_; };
-    server_ = new EditorServer(options);
-    server_->Bind();
-    thread_ = new std::thread([] { server_->Run(); });
-    client_ = new httplib::Client("127.0.0.1", server_->port());
-    client_->set_read_timeout(120, 0);
-    for (int i = 0; i < 100 && !client_->Get("/api/health?token=secret-token"); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    running_ = new RunningServer(options, 120);
+    server_ = &running_->server();
+    client_ = &running_->client();
   }
   static void TearDownTestSuite() {
-    server_->Stop();
-    thread_->join();
-    delete client_;
-    delete thread_;
-    delete server_;
+    delete running_;
     delete site_;
     fs::remove_all(base_);
   }
@@ -103,7 +93,7 @@ class StationsServerTest : public ::testing::Test {
   static inline fs::path base_;
   static inline std::vector<Scan>* site_ = nullptr;
   static inline EditorServer* server_ = nullptr;
-  static inline std::thread* thread_ = nullptr;
+  static inline RunningServer* running_ = nullptr;
   static inline httplib::Client* client_ = nullptr;
 };
 

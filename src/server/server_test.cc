@@ -20,8 +20,9 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/testing/scenes.h"
-// After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
-#include <httplib.h>
+// After every Eigen include: httplib (in server_test_util.h) pulls in <resolv.h>, whose `_res` macro breaks
+// Eigen's headers.
+#include "server_test_util.h"
 
 namespace lidarshop::server {
 namespace {
@@ -61,21 +62,12 @@ class ServerTest : public ::testing::Test {
     options.max_documents = 100;  // the tests open more than the default 16 and close none
     options.builtin_scenes = {"tiny"};
     options.scan_builtin = [](const std::string&) { return *scan_; };
-    server_ = new EditorServer(options);
-    server_->Bind();
-    thread_ = new std::thread([] { server_->Run(); });
-    client_ = new httplib::Client("127.0.0.1", server_->port());
-    client_->set_read_timeout(60, 0);
-    for (int i = 0; i < 100 && !client_->Get("/api/health?token=secret-token"); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    running_ = new RunningServer(options, 60);
+    server_ = &running_->server();
+    client_ = &running_->client();
   }
   static void TearDownTestSuite() {
-    server_->Stop();
-    thread_->join();
-    delete client_;
-    delete thread_;
-    delete server_;
+    delete running_;
     delete scan_;
     fs::remove_all(base_);
   }
@@ -123,7 +115,7 @@ class ServerTest : public ::testing::Test {
   static inline fs::path base_;
   static inline Scan* scan_ = nullptr;
   static inline EditorServer* server_ = nullptr;
-  static inline std::thread* thread_ = nullptr;
+  static inline RunningServer* running_ = nullptr;
   static inline httplib::Client* client_ = nullptr;
 };
 

@@ -14,8 +14,7 @@
 
 #include "lidarshop/testing/scenes.h"
 #include "server.h"
-// After every Eigen include: httplib pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers.
-#include <httplib.h>
+#include "server_test_util.h"
 
 namespace lidarshop::server {
 namespace {
@@ -34,21 +33,12 @@ class TilesTest : public ::testing::Test {
     options.token = "tile-token";
     options.builtin_scenes = {"ground"};
     options.scan_builtin = [](const std::string&) { return *scan_; };
-    server_ = new EditorServer(options);
-    server_->Bind();
-    thread_ = new std::thread([] { server_->Run(); });
-    client_ = new httplib::Client("127.0.0.1", server_->port());
-    client_->set_read_timeout(120, 0);
-    for (int i = 0; i < 100 && !client_->Get("/api/health?token=tile-token"); ++i) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+    running_ = new RunningServer(options, 120);
+    server_ = &running_->server();
+    client_ = &running_->client();
   }
   static void TearDownTestSuite() {
-    server_->Stop();
-    thread_->join();
-    delete client_;
-    delete thread_;
-    delete server_;
+    delete running_;
     delete scan_;
   }
   static std::string Api(const std::string& path) {
@@ -105,12 +95,12 @@ class TilesTest : public ::testing::Test {
 
   static Scan* scan_;
   static EditorServer* server_;
-  static std::thread* thread_;
+  static RunningServer* running_;
   static httplib::Client* client_;
 };
 Scan* TilesTest::scan_ = nullptr;
 EditorServer* TilesTest::server_ = nullptr;
-std::thread* TilesTest::thread_ = nullptr;
+RunningServer* TilesTest::running_ = nullptr;
 httplib::Client* TilesTest::client_ = nullptr;
 
 TEST_F(TilesTest, LevelsHalveAndTilesHoldTheirFootprint) {
