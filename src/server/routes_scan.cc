@@ -27,6 +27,7 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "version_param.h"
 
 namespace lidarshop::server {
 
@@ -590,13 +591,7 @@ void AddScanRoutes(State& state) {
       options.channel = ParseEnum<RenderChannel>(channel);
       // ?since=V: only the box of pixels that changed since version V (pictures.cc).
       int64_t since = -1;
-      if (request.has_param("since")) {
-        const std::string text = request.get_param_value("since");
-        char* end = nullptr;
-        since = std::strtoll(text.c_str(), &end, 10);
-        if (text.empty() || *end != '\0' || since < 0)
-          return SendError(response, 400, "since: expected a version (a whole number >= 0)");
-      }
+      if (!ReadSinceParam(request, response, &since)) return;
       std::lock_guard lock(document->mutex);
       SendRayPicture(*document, options, channel, since, response);
     } catch (const OptionsError& error) {
@@ -647,13 +642,7 @@ void AddScanRoutes(State& state) {
              // ?since=V: only the cells that changed since the client's version V (LSD1), when that state is
              // still kept; else (or without it) the whole points (LSP1). The client tells them by the magic.
              int64_t since = -1;
-             if (request.has_param("since")) {
-               const std::string text = request.get_param_value("since");
-               char* end = nullptr;
-               since = std::strtoll(text.c_str(), &end, 10);
-               if (text.empty() || *end != '\0' || since < 0)
-                 return SendError(response, 400, "since: expected a version (a whole number >= 0)");
-             }
+             if (!ReadSinceParam(request, response, &since)) return;
              // ?step=K: the level of detail K (every K-th row and column), for a large scan's first view.
              int step = 1;
              if (request.has_param("step")) {

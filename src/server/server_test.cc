@@ -377,6 +377,9 @@ TEST_F(ServerTest, PointDeltasPatchToTheWholePoints) {
   EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?since={}", two_back))->body.substr(0, 4), "LSD1");
   EXPECT_EQ(get("/api/docs/{}/points?since=abc")->status, 400);
   EXPECT_EQ(get("/api/docs/{}/points?since=-1")->status, 400);
+  // The picture route reads `since` the same way (version_param.h).
+  EXPECT_EQ(get("/api/docs/{}/image.png?channel=range&since=abc")->status, 400);
+  EXPECT_EQ(get("/api/docs/{}/image.png?channel=range&since=-1")->status, 400);
 }
 
 // A scan opened from E57 and edited keeps its photo, scan guid and the file's other metadata when saved as

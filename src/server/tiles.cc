@@ -21,6 +21,7 @@
 #include "lidarshop/render/render.h"
 #include "lidarshop/util/enum_names.h"
 #include "lidarshop/util/error.h"
+#include "version_param.h"
 
 namespace lidarshop::server {
 
@@ -193,13 +194,7 @@ void AddTileRoutes(State& state) {
                    std::string channel;
                    if (!channel_of(request, options, channel, response)) return;
                    int64_t since = -1;
-                   if (request.has_param("since")) {
-                     const std::string text = request.get_param_value("since");
-                     char* end = nullptr;
-                     since = std::strtoll(text.c_str(), &end, 10);
-                     if (text.empty() || *end != '\0' || since < 0)
-                       return SendError(response, 400, "since: expected a version (a whole number >= 0)");
-                   }
+                   if (!ReadSinceParam(request, response, &since)) return;
                    try {
                      std::lock_guard lock(document->mutex);
                      SendJson(response, TilesInfo(*document, options, channel, since));
