@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/geometry/transform.h"
+#include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/testing/scenes.h"
@@ -576,6 +577,18 @@ TEST(SceneFile, BuiltinScenesLoadAndShowEveryObject) {
     std::set<int32_t> seen(scan.label.begin<int32_t>(), scan.label.end<int32_t>());
     for (const auto& object : scene.objects)
       EXPECT_TRUE(seen.contains(object.label)) << name << " " << object.name;
+  }
+}
+
+TEST(SceneFile, ABuiltinSceneByNameOrElseAFile) {
+  EXPECT_EQ(LoadSceneOrBuiltin("mailbox").demo.cut_object, "mailbox");
+  EXPECT_EQ(FindBuiltinScene("no_such_scene"), nullptr);
+  try {
+    LoadSceneOrBuiltin("no_such_scene");
+    ADD_FAILURE() << "an unknown name was accepted";
+  } catch (const InputError& error) {
+    EXPECT_THAT(error.what(), testing::HasSubstr("'no_such_scene' is neither a built-in scene"));
+    EXPECT_THAT(error.what(), testing::HasSubstr("parking_lot"));
   }
 }
 
