@@ -140,6 +140,7 @@ AutoResectionResult RunAutoResection(const Scan& scan, const cv::Mat& photo,
 
 nlohmann::ordered_json AutoResectionJson(const AutoResectionResult& result) {
   nlohmann::ordered_json json;
+  json["method"] = result.method;
   json["inliers"] = result.inliers;
   json["pairs"] = result.pairs.size();
   json["inlier_share"] = result.inlier_share;
@@ -153,6 +154,10 @@ nlohmann::ordered_json AutoResectionJson(const AutoResectionResult& result) {
   json["check_pairs"] = result.check_pairs;
   json["check_agree"] = result.check_agree;
   json["check_alt_inliers"] = result.check_alt_inliers;
+  if (result.method == "silhouettes") {
+    json["silhouette_edge_share"] = result.silhouette_edge_share;
+    json["silhouette_mutual_information"] = result.silhouette_mutual_information;
+  }
   json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
   json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
                            result.camera.center_in_world().z()};

@@ -14,10 +14,19 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/recolor/auto_resection_render.h"
+#include "lidarshop/recolor/silhouette_alignment.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
 namespace {
+
+using auto_resection_internal::Median;
+using auto_resection_internal::Render;
+using auto_resection_internal::SamplesOf;
+using auto_resection_internal::Scaled;
+using auto_resection_internal::ScanSamples;
+using auto_resection_internal::View;
 
 constexpr double kDegPerRad = 180.0 / M_PI;
 // A camera whose last round moved it less than this has settled (a supported camera must have).
@@ -28,161 +37,6 @@ constexpr double kSettledMoveM = 0.01, kSettledTurnDeg = 0.05;
 constexpr int kMinCheckInliers = 12;
 constexpr double kCheckMargin = 1.5;
 constexpr int kMaxRestarts = 2;
-
-// The scan's valid points in the world frame with their grey value, and the grid that joins them.
-struct ScanSamples {
-  std::vector<Eigen::Vector3d> point_in_world;
-  std::vector<float> grey;
-  std::vector<float> range_m;  // from the scanner centre
-  cv::Mat index;               // CV_32S, the scan's grid: the sample of each cell, -1 without a return
-  double cell_angle_rad = 0;
-  Eigen::Vector3d scanner_in_world = Eigen::Vector3d::Zero();
-};
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
-// The median angle between neighbouring columns and rows of the scan's grid, radians.
-double CellAngleRad(const Scan& scan) {
-  const ScanGrid grid = GridOf(scan);
-  std::vector<double> steps;
-  for (size_t i = 1; i < grid.azimuth_rad.size(); ++i)
-    steps.push_back(std::abs(grid.azimuth_rad[i] - grid.azimuth_rad[i - 1]));
-  for (size_t i = 1; i < grid.elevation_rad.size(); ++i)
-    steps.push_back(std::abs(grid.elevation_rad[i] - grid.elevation_rad[i - 1]));
-  std::erase_if(steps, [](double s) { return !(s > 1e-7) || s > 0.2; });
-  const double step = Median(steps);
-  return step > 0 ? step : 0.2 / kDegPerRad;
-}
-
-ScanSamples SamplesOf(const Scan& scan, const std::string& what) {
-  cv::Mat grey;
-  if (scan.has_color()) {
-    cv::cvtColor(scan.color, grey, cv::COLOR_RGB2GRAY);
-  } else if (scan.has_intensity()) {
-    scan.intensity.convertTo(grey, CV_8U, 255.0);
-  } else {
-    ThrowInputError(what, "", "color", "automatic resection needs a scan with colour or intensity");
-  }
-  ScanSamples samples;
-  samples.cell_angle_rad = CellAngleRad(scan);
-  samples.scanner_in_world = scan.world_from_scanner.topRightCorner<3, 1>();
-  samples.index = cv::Mat(scan.rows, scan.cols, CV_32S, cv::Scalar(-1));
-  for (int r = 0; r < scan.rows; ++r) {
-    for (int c = 0; c < scan.cols; ++c) {
-      if (!scan.valid.at<uint8_t>(r, c)) continue;
-      const Eigen::Vector3d point = WorldPointOfCell(scan, r, c);
-      if (!point.allFinite()) continue;
-      samples.index.at<int32_t>(r, c) = static_cast<int32_t>(samples.point_in_world.size());
-      samples.point_in_world.push_back(point);
-      samples.grey.push_back(grey.at<uint8_t>(r, c));
-      samples.range_m.push_back(static_cast<float>((point - samples.scanner_in_world).norm()));
-    }
-  }
-  return samples;
-}
-
-// A rendering of the scan: grey values and, per pixel, the surface point seen through the pixel's centre.
-struct View {
-  PinholeCamera camera;
-  cv::Mat grey;            // CV_8U
-  cv::Mat point_from_eye;  // CV_32FC3: the point seen minus the camera centre, world axes, metres
-  cv::Mat depth;           // CV_32F: along the optical axis, +inf where nothing is seen
-};
-
-// Neighbouring returns whose ranges differ by more than this ratio lie on different surfaces (a depth edge):
-// no triangle joins them. Ground 40 m from a scanner 1.5 m high changes range by 4 % per 0.09° row.
-constexpr double kMaxRangeRatio = 1.15;
-
-// The scan's grid mesh (two triangles per 2 x 2 cells whose returns lie on one surface; three returns make
-// one) rasterized with a z-buffer; grey and point interpolated perspective-correctly. Vertices are projected
-// with the camera's distortion and the triangles are straight in the image: they are about a pixel wide.
-View Render(const ScanSamples& samples, const PinholeCamera& camera) {
-  View view;
-  view.camera = camera;
-  const int width = camera.width_px, height = camera.height_px;
-  cv::Mat grey(height, width, CV_32F, cv::Scalar(0));
-  view.point_from_eye = cv::Mat(height, width, CV_32FC3, cv::Scalar::all(0));
-  view.depth = cv::Mat(height, width, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
-  const Eigen::Matrix3d camera_from_world = camera.world_from_camera.topLeftCorner<3, 3>().transpose();
-  const Eigen::Vector3d eye = camera.center_in_world();
-  const size_t n = samples.point_in_world.size();
-  // Per sample: pixel (x, y) and depth z (z <= 0: not projected).
-  std::vector<Eigen::Vector3d> projected(n);
-  std::vector<Eigen::Vector3f> from_eye(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d d = samples.point_in_world[i] - eye;
-    from_eye[i] = d.cast<float>();
-    const Eigen::Vector3d point_in_camera = camera_from_world * d;
-    Eigen::Vector2d pixel;
-    if (point_in_camera.z() < 0.05 || !ProjectCameraPoint(camera, point_in_camera, &pixel)) {
-      projected[i] = Eigen::Vector3d(0, 0, -1);
-      continue;
-    }
-    projected[i] = Eigen::Vector3d(pixel.x(), pixel.y(), point_in_camera.z());
-  }
-  const auto triangle = [&](int a, int b, int c) {
-    const Eigen::Vector3d &pa = projected[a], &pb = projected[b], &pc = projected[c];
-    if (pa.z() <= 0 || pb.z() <= 0 || pc.z() <= 0) return;
-    const float r_min = std::min({samples.range_m[a], samples.range_m[b], samples.range_m[c]}),
-                r_max = std::max({samples.range_m[a], samples.range_m[b], samples.range_m[c]});
-    if (r_max > kMaxRangeRatio * r_min) return;
-    // Triangles seen edge-on or stretched over many pixels are depth edges the range test missed.
-    const double area = (pb.x() - pa.x()) * (pc.y() - pa.y()) - (pc.x() - pa.x()) * (pb.y() - pa.y());
-    if (std::abs(area) < 1e-9) return;
-    const double min_x = std::min({pa.x(), pb.x(), pc.x()}), max_x = std::max({pa.x(), pb.x(), pc.x()});
-    const double min_y = std::min({pa.y(), pb.y(), pc.y()}), max_y = std::max({pa.y(), pb.y(), pc.y()});
-    if (max_x - min_x > 16 || max_y - min_y > 16) return;
-    const int x0 = std::max(0, static_cast<int>(std::ceil(min_x - 0.5))),
-              x1 = std::min(width - 1, static_cast<int>(std::floor(max_x - 0.5)));
-    const int y0 = std::max(0, static_cast<int>(std::ceil(min_y - 0.5))),
-              y1 = std::min(height - 1, static_cast<int>(std::floor(max_y - 0.5)));
-    for (int y = y0; y <= y1; ++y) {
-      const double py = y + 0.5;
-      for (int x = x0; x <= x1; ++x) {
-        const double px = x + 0.5;
-        // Barycentric weights (screen space), then perspective-correct ones (divided by depth).
-        double wa = ((pb.x() - px) * (pc.y() - py) - (pc.x() - px) * (pb.y() - py)) / area;
-        double wb = ((pc.x() - px) * (pa.y() - py) - (pa.x() - px) * (pc.y() - py)) / area;
-        double wc = 1 - wa - wb;
-        if (wa < -1e-9 || wb < -1e-9 || wc < -1e-9) continue;
-        wa /= pa.z(), wb /= pb.z(), wc /= pc.z();
-        const double sum = wa + wb + wc;
-        const float z = static_cast<float>(1 / sum);
-        float& depth = view.depth.at<float>(y, x);
-        if (z >= depth) continue;
-        depth = z;
-        wa /= sum, wb /= sum, wc /= sum;
-        grey.at<float>(y, x) =
-            static_cast<float>(wa * samples.grey[a] + wb * samples.grey[b] + wc * samples.grey[c]);
-        const Eigen::Vector3f p = static_cast<float>(wa) * from_eye[a] +
-                                  static_cast<float>(wb) * from_eye[b] + static_cast<float>(wc) * from_eye[c];
-        view.point_from_eye.at<cv::Vec3f>(y, x) = cv::Vec3f(p.x(), p.y(), p.z());
-      }
-    }
-  };
-  const cv::Mat& index = samples.index;
-  for (int r = 0; r + 1 < index.rows; ++r) {
-    for (int c = 0; c + 1 < index.cols; ++c) {
-      const int a = index.at<int32_t>(r, c), b = index.at<int32_t>(r, c + 1), d = index.at<int32_t>(r + 1, c),
-                e = index.at<int32_t>(r + 1, c + 1);
-      const int count = (a >= 0) + (b >= 0) + (d >= 0) + (e >= 0);
-      if (count == 4) {
-        triangle(a, b, d), triangle(b, e, d);
-      } else if (count == 3) {
-        if (a < 0) triangle(b, e, d);
-        if (b < 0) triangle(a, e, d);
-        if (d < 0) triangle(a, b, e);
-        if (e < 0) triangle(a, b, d);
-      }
-    }
-  }
-  grey.convertTo(view.grey, CV_8U);
-  return view;
-}
 
 struct Features {
   std::vector<cv::KeyPoint> keys;
@@ -206,17 +60,6 @@ cv::Mat ValidMask(const View& view) {
   cv::Mat mask = view.depth < std::numeric_limits<float>::infinity();
   cv::erode(mask, mask, cv::Mat::ones(3, 3, CV_8U));
   return mask;
-}
-
-// The intrinsics of `camera` for an image `scale_x`, `scale_y` times as wide and high (pose kept).
-PinholeCamera Scaled(const PinholeCamera& camera, int width_px, int height_px) {
-  PinholeCamera out = camera;
-  const double sx = static_cast<double>(width_px) / camera.width_px,
-               sy = static_cast<double>(height_px) / camera.height_px;
-  out.width_px = width_px, out.height_px = height_px;
-  out.fx_px *= sx, out.skew_px *= sx, out.cx_px *= sx;
-  out.fy_px *= sy, out.cy_px *= sy;
-  return out;
 }
 
 // Working-pixel position (continuous) of an OpenCV keypoint.
@@ -601,18 +444,21 @@ void AutoResectionOptions::Check() const {
 
 std::string AutoResectionResult::Summary() const {
   return fmt::format(
-      "automatic resection: {} of {} pairs inliers ({:.0f} %), RMS {:.2f} px ({:.2f} working px), {} "
+      "automatic resection ({}): {} of {} pairs inliers ({:.0f} %), RMS {:.2f} px ({:.2f} working px), {} "
       "round(s), "
       "camera at ({:.3f}, {:.3f}, {:.3f}) m, focal {:.1f} px",
-      inliers, pairs.size(), 100 * inlier_share, rms_px, rms_work_px, rounds, camera.center_in_world().x(),
-      camera.center_in_world().y(), camera.center_in_world().z(), camera.fx_px);
+      method, inliers, pairs.size(), 100 * inlier_share, rms_px, rms_work_px, rounds,
+      camera.center_in_world().x(), camera.center_in_world().y(), camera.center_in_world().z(), camera.fx_px);
 }
 
-AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const AutoResectionOptions& options,
-                                  const std::optional<PinholeCamera>& intrinsics,
-                                  const std::optional<Eigen::Matrix4d>& rough_world_from_camera,
-                                  const std::string& what) {
-  options.Check();
+namespace {
+
+// Steps 1-5 (features); throws InputError when no camera is supported.
+AutoResectionResult FeatureResection(const Scan& scan, const cv::Mat& photo,
+                                     const AutoResectionOptions& options,
+                                     const std::optional<PinholeCamera>& intrinsics,
+                                     const std::optional<Eigen::Matrix4d>& rough_world_from_camera,
+                                     const std::string& what) {
   if (photo.empty() || (photo.type() != CV_8UC3 && photo.type() != CV_8UC1))
     ThrowInputError(what, "", "", "automatic resection needs an 8-bit RGB or grey photo");
   cv::Mat photo_grey;
@@ -850,6 +696,66 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
             result.inliers, result.pairs.size(), 100 * result.inlier_share, options.min_inliers,
             100 * options.min_inlier_share, result.rms_work_px, options.max_rms_px, traces));
   return result;
+}
+
+}  // namespace
+
+AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const AutoResectionOptions& options,
+                                  const std::optional<PinholeCamera>& intrinsics,
+                                  const std::optional<Eigen::Matrix4d>& rough_world_from_camera,
+                                  const std::string& what) {
+  options.Check();
+  if (photo.empty() || (photo.type() != CV_8UC3 && photo.type() != CV_8UC1))
+    ThrowInputError(what, "", "", "automatic resection needs an 8-bit RGB or grey photo");
+  try {
+    return FeatureResection(scan, photo, options, intrinsics, rough_world_from_camera, what);
+  } catch (const InputError& feature_error) {
+    // Step 6 (header): only from a rough pose with known intrinsics; the synthetic evaluation's searches
+    // from the scanner centre never come here.
+    if (!options.silhouettes || !rough_world_from_camera || !intrinsics) throw;
+    PinholeCamera start = *intrinsics;
+    if (start.width_px != photo.cols || start.height_px != photo.rows)
+      start = Scaled(start, photo.cols, photo.rows);
+    start.world_from_camera = *rough_world_from_camera;
+    cv::Mat photo_grey;
+    if (photo.channels() == 3) {
+      cv::cvtColor(photo, photo_grey, cv::COLOR_RGB2GRAY);
+    } else {
+      photo_grey = photo;
+    }
+    SilhouetteAlignmentOptions silhouette_options;
+    silhouette_options.min_pairs = options.min_inliers;
+    const SilhouetteAlignment aligned = AlignSilhouettes(scan, photo_grey, start, silhouette_options, what);
+    if (!aligned.ok)
+      ThrowInputError(
+          what, "", "features",
+          fmt::format("{} -- and the silhouette alignment from the rough pose is not supported either: {} "
+                      "(at least {:.0f} % of the model edges on a photo edge, mutual information {:.2f} and "
+                      "{} pairs needed)",
+                      feature_error.what(), aligned.trace, 100 * silhouette_options.min_edge_share,
+                      silhouette_options.min_mutual_information, silhouette_options.min_pairs));
+    AutoResectionResult result;
+    result.method = "silhouettes";
+    result.camera = aligned.camera;
+    result.pairs = aligned.pairs;
+    result.inlier.assign(aligned.pairs.size(), 1);
+    result.inliers = aligned.inliers;
+    result.inlier_share = aligned.pairs.empty() ? 0 : 1;
+    result.rms_px = aligned.rms_px;
+    result.work_scale = aligned.work_scale;
+    result.rms_work_px = aligned.rms_px * aligned.work_scale;
+    result.silhouette_edge_share = aligned.edge_share;
+    result.silhouette_mutual_information = aligned.mutual_information;
+    result.trace = aligned.trace;
+    result.warnings.push_back(fmt::format(
+        "{}: no rendering of the scan shares enough features with the photo; the camera comes from the "
+        "silhouette alignment (outlines and intensity, from the rough pose): {:.0f} % of the scan's outlines "
+        "lie "
+        "on the photo's edges. It is coarser than a feature camera (pumpA: about 18 px from its hand-picked "
+        "pairs, whose own RMS is 6.3 px): check the recolouring's edges",
+        what, 100 * aligned.edge_share));
+    return result;
+  }
 }
 
 }  // namespace lidarshop

@@ -32,6 +32,10 @@
 //      PnP RANSAC on those pairs alone gives a second camera. When it explains at least 12 of them and 1.5 x as
 //      many as the final camera, the camera is ambiguous: the rounds restart from the second camera (twice at
 //      most), else the photo is refused ("ambiguous").
+//   6. Silhouettes (silhouette_alignment.h): with a rough pose and known intrinsics, a photo refused by
+//      steps 1-5 is aligned by the scan's outlines and intensity instead — a photo from the far side of the
+//      objects (pumpA's) shows their backs, which share no features with the scanner's side. Refused as well
+//      when the outlines do not land on the photo's edges. The result says method "silhouettes" and warns.
 // Deterministic: keypoints are sorted before their descriptors are computed, the brute-force matcher gives
 // the same answer on any thread count, RANSAC is seeded.
 // Thresholds are in working pixels (about one scan cell); the camera and `rms_px` are in the photo's pixels.
@@ -75,12 +79,16 @@ struct AutoResectionOptions {
   double min_inlier_share = 0.25;    // inliers / pairs of the last round below this: refused
   double max_rms_px = 1.5;           // inliers' RMS above this (working pixels): refused
   uint64_t seed = 1;                 // RANSAC's random sets
-  void Check() const;                // throws OptionsError
+  // Step 6: with a rough pose and known intrinsics, when no feature camera is supported, align the scan's
+  // outlines and intensity to the photo instead (silhouette_alignment.h).
+  bool silhouettes = true;
+  void Check() const;  // throws OptionsError
 };
 template <>
 const StructInfo& InfoOf<AutoResectionOptions>();
 
 struct AutoResectionResult {
+  std::string method = "features";    // or "silhouettes" (step 6)
   PinholeCamera camera;               // in the photo's pixels
   std::vector<PixelPointPair> pairs;  // the last round's pairs (photo pixels, world points)
   std::vector<uint8_t> inlier;        // per pair: 1 = inlier
@@ -102,6 +110,9 @@ struct AutoResectionResult {
   double check_median_work_px = 0;
   int check_alt_inliers = 0;
   double check_alt_move_m = 0;
+  // Step 6 only: the share of the scan's outlines on a photo edge and the mutual information (nats).
+  double silhouette_edge_share = 0;
+  double silhouette_mutual_information = 0;
   std::string trace;                  // what the search candidate's rounds did (refusals quote it)
   std::vector<std::string> warnings;  // one sentence each
   std::string Summary() const;        // one line

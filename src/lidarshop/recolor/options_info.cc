@@ -172,6 +172,9 @@ const StructInfo& InfoOf<AutoResectionOptions>() {
         .Unit("px")
         .AboveZero();
     b.Field(&AutoResectionOptions::seed, "seed", "seed of RANSAC's random sets");
+    b.Field(&AutoResectionOptions::silhouettes, "silhouettes",
+            "with a rough pose and known intrinsics, when no feature camera is supported: align the scan's "
+            "outlines and intensity to the photo instead (recolor/silhouette_alignment.h)");
     return b.Build();
   }();
   return info;
