@@ -88,6 +88,9 @@ int RunPumpA(const AutoResectionOptions& options, bool unknown_focal, double rou
       const double e = ReprojectionError(result.camera, pair);
       sum += e * e;
     }
+    if (result.method == "silhouettes")
+      fmt::print("  silhouettes: {:.0f} % of the model edges on a photo edge, mutual information {:.3f}\n",
+                 100 * result.silhouette_edge_share, result.silhouette_mutual_information);
     fmt::print("pumpA: {}\n  RMS on the {} hand-picked pairs: {:.2f} px ({:.1f} s)\n", result.Summary(),
                pairs.pixel_point.size(), std::sqrt(sum / pairs.pixel_point.size()),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
