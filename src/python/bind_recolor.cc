@@ -247,6 +247,12 @@ void BindResection(py::module_& m) {
                     "of those, the most another camera explains (PnP RANSAC on them alone)")
       .def_readonly("trace", &AutoResectionResult::trace, "what the rounds did")
       .def_readonly("search_view", &AutoResectionResult::search_view)
+      .def_readonly("method", &AutoResectionResult::method,
+                    "'features', or 'silhouettes' (a rough pose's fallback: recolor/silhouette_alignment.h)")
+      .def_readonly("silhouette_edge_share", &AutoResectionResult::silhouette_edge_share,
+                    "silhouettes: share of the scan's outlines on a photo edge")
+      .def_readonly("silhouette_mutual_information", &AutoResectionResult::silhouette_mutual_information,
+                    "silhouettes: mutual information of the scan's intensity and the photo, nats")
       .def("summary", &AutoResectionResult::Summary)
       .def("__repr__", [](const AutoResectionResult& r) {
         return "<lidarshop.AutoResectionResult " + r.Summary() + ">";

@@ -751,7 +751,7 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
         "{}: no rendering of the scan shares enough features with the photo; the camera comes from the "
         "silhouette alignment (outlines and intensity, from the rough pose): {:.0f} % of the scan's outlines "
         "lie "
-        "on the photo's edges. It is coarser than a feature camera (pumpA: about 18 px from its hand-picked "
+        "on the photo's edges. It is coarser than a feature camera (pumpA: about 19 px from its hand-picked "
         "pairs, whose own RMS is 6.3 px): check the recolouring's edges",
         what, 100 * aligned.edge_share));
     return result;
