@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <optional>
 #include <string>
@@ -91,6 +92,7 @@ int RunPumpA(const AutoResectionOptions& options, bool unknown_focal, double rou
     if (result.method == "silhouettes")
       fmt::print("  silhouettes: {:.0f} % of the model edges on a photo edge, mutual information {:.3f}\n",
                  100 * result.silhouette_edge_share, result.silhouette_mutual_information);
+    if (std::getenv("TRACE")) fmt::print("  trace: {}\n", result.trace);
     fmt::print("pumpA: {}\n  RMS on the {} hand-picked pairs: {:.2f} px ({:.1f} s)\n", result.Summary(),
                pairs.pixel_point.size(), std::sqrt(sum / pairs.pixel_point.size()),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

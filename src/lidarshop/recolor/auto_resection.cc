@@ -729,11 +729,13 @@ AutoResectionResult AutoResection(const Scan& scan, const cv::Mat& photo, const 
     if (!aligned.ok)
       ThrowInputError(
           what, "", "features",
-          fmt::format("{} -- and the silhouette alignment from the rough pose is not supported either: {} "
-                      "(at least {:.0f} % of the model edges on a photo edge, mutual information {:.2f} and "
-                      "{} pairs needed)",
-                      feature_error.what(), aligned.trace, 100 * silhouette_options.min_edge_share,
-                      silhouette_options.min_mutual_information, silhouette_options.min_pairs));
+          fmt::format(
+              "{} -- and the silhouette alignment from the rough pose is not supported either: {} "
+              "(at least {:.0f} % of the model edges on a photo edge at 384 px wide and {:.0f} % at 768 px, "
+              "mutual information {:.2f} and {} pairs needed)",
+              feature_error.what(), aligned.trace, 100 * silhouette_options.min_edge_share,
+              100 * silhouette_options.min_fine_edge_share, silhouette_options.min_mutual_information,
+              silhouette_options.min_pairs));
     AutoResectionResult result;
     result.method = "silhouettes";
     result.camera = aligned.camera;

@@ -351,9 +351,12 @@ SilhouetteAlignment AlignSilhouettes(const Scan& scan, const cv::Mat& photo_grey
         if ((camera.center_in_world() - before).norm() < 0.002) break;
       }
     }
-    if (width == 384) {
+    {
       const PinholeCamera work = Scaled(camera, size.width_px, size.height_px);
-      out.edge_share = EdgeShare(ModelEdgesOf(intensity, contours, work), edges, work);
+      const double share = EdgeShare(ModelEdgesOf(intensity, contours, work), edges, work);
+      if (width == 384) out.edge_share = share;
+      if (width == 768) out.fine_edge_share = share;
+      out.trace += fmt::format(" share at {} px {:.3f};", size.width_px, share);
     }
     if (size.width_px == start.width_px) break;
   }
@@ -367,7 +370,7 @@ SilhouetteAlignment AlignSilhouettes(const Scan& scan, const cv::Mat& photo_grey
       " silhouettes: {} pairs, RMS {:.2f} px, {:.0f} % of the model edges on a photo edge, "
       "MI {:.3f}",
       out.inliers, out.rms_px, 100 * out.edge_share, out.mutual_information);
-  out.ok = out.edge_share >= options.min_edge_share &&
+  out.ok = out.edge_share >= options.min_edge_share && out.fine_edge_share >= options.min_fine_edge_share &&
            out.mutual_information >= options.min_mutual_information && out.inliers >= options.min_pairs;
   return out;
 }

@@ -18,9 +18,11 @@
 //      and the pose refined by Levenberg–Marquardt on the pairs; repeated until it moves less than 2 mm, at
 //      384, 768 and 1536 px wide.
 //   4. Accepted only when at least `min_edge_share` of the model edges lie within 1.5 px of a photo edge of
-//      their orientation at 384 px wide (pumpA: 0.37 at the hand-picked pairs' camera and at the result,
-//      0.13–0.23 at cameras 40–430 px off), the mutual information at 192 px wide is at least
-//      `min_mutual_information`, and at least `min_pairs` pairs agree.
+//      their orientation at 384 px wide and `min_fine_edge_share` at 768 px wide, the mutual information at
+//      192 px wide is at least `min_mutual_information`, and at least `min_pairs` pairs agree. Calibrated on
+//      pumpA alone (bench/results/recolor.md): its accepted cameras, 17–20 px from the hand-picked pairs,
+//      have 0.35–0.38 and 0.249–0.262; a camera 104 px off (from a start 1 m and 5° off) 0.33 and 0.220,
+//      refused ones 0.26–0.30 and 0.185. The mutual information does not tell them apart (0.15–0.19 both).
 #pragma once
 
 #include <string>
@@ -37,6 +39,7 @@ namespace lidarshop {
 
 struct SilhouetteAlignmentOptions {
   double min_edge_share = 0.3;           // model edges within 1.5 px of a photo edge, at 384 px wide
+  double min_fine_edge_share = 0.24;     // the same at 768 px wide
   double min_mutual_information = 0.12;  // nats, 32 x 32 bins, at 192 px wide
   int min_pairs = 40;
 };
@@ -48,7 +51,8 @@ struct SilhouetteAlignment {
   int inliers = 0;                    // pairs within 2 px (at 1536 px wide) after the refinement
   double rms_px = 0;                  // their RMS, photo pixels (distance to the edge's line)
   double work_scale = 1;              // working pixels per photo pixel of the last stage
-  double edge_share = 0;              // step 4
+  double edge_share = 0;              // step 4, at 384 px wide
+  double fine_edge_share = 0;         // step 4, at 768 px wide
   double mutual_information = 0;      // step 4
   std::string trace;                  // what each stage did
 };
