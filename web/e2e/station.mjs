@@ -214,17 +214,23 @@ try {
     const before = await counters();
     const allBefore = apiBytes;
     const version = (await page.evaluate(() => window.lidarshop.current())).version;
+    const pageT0 = await page.evaluate(() => Math.round(performance.now()));
     const t0 = Date.now();
     await action();
     await done(version);
     await waitForFunction(page, shownCurrent, null, { timeout: 120000 });
     const seconds = (Date.now() - t0) / 1000;
+    const pageT1 = await page.evaluate(() => Math.round(performance.now()));
+    // The frame that showed the edit's picture (the page may be busy after it, e.g. with the 3-D view).
+    const drawnAt = await page.evaluate(() => window.lidarshop.rayView.shownState().drawnAt);
     await page.evaluate(() => window.lidarshop.settled());
     await new Promise((resolve) => setTimeout(resolve, 300)); // the last answers' sizes
     const after = await counters();
     edits.push({
       what,
       seconds,
+      page_ms: [pageT0, pageT1], // start and end in the page's clock (performance.now)
+      picture_s: drawnAt >= pageT0 ? Math.round(drawnAt - pageT0) / 1000 : null, // start -> picture drawn
       points: after.points - before.points,
       pictures: after.pictures - before.pictures,
       all: apiBytes - allBefore,
@@ -314,6 +320,65 @@ try {
   const afterUndo = await pictureMismatch();
   if (afterUndo) fail(`the patched ray image after undoing the fill is not the server's: ${afterUndo}`);
   await page.screenshot({ path: join(artefacts, 'station_edited.png') });
+
+  // The live cut (issue 36's stroke -> cut -> picture): the lasso and the ground stroke undone, an object stroke
+  // across the hatchback (the parking lot's car left of the scanner's view centre; its place as a fraction of the
+  // grid, so any grid size of that scene), then a background stroke under it: with Live on, that stroke runs the
+  // first cut; one more object stroke refines the cut incrementally. Each is timed from the stroke's start to
+  // the picture of the job's result shown.
+  for (let i = 0; i < 2; ++i) {
+    const v = (await page.evaluate(() => window.lidarshop.current())).version;
+    await page.keyboard.press('Control+z');
+    await newerThan(v);
+  }
+  // The segment jobs' own timings (SegmentResult's, seconds), from their answers.
+  const segmentTimings = [];
+  page.on('response', async (response) => {
+    if (!/\/api\/jobs\/\d+$/.test(response.url())) return;
+    const job = await response.json().catch(() => null);
+    if (job?.kind === 'segment' && job.state === 'done')
+      segmentTimings.push({ refined: job.result.refined, ...job.result.timings });
+  });
+  const at = (fr, fc) => [Math.round(doc.rows * fr), Math.round(doc.cols * fc)];
+  const jobsFinished = () => page.evaluate(() => window.lidarshop.jobsFinished());
+  const afterJob = (before) => () =>
+    waitForFunction(page, (n) => window.lidarshop.jobsFinished() > n, before, { timeout: 300000 });
+  await page.click('#brush-object');
+  await edit('object stroke', () => drag([at(0.583, 0.452), at(0.583, 0.546)]), newerThan);
+  await page.click('#brush-background');
+  await edit(
+    'background stroke -> first cut',
+    () => drag([at(0.647, 0.402), at(0.647, 0.592)]),
+    afterJob(await jobsFinished()),
+  );
+  const cut = await page.evaluate(() => window.lidarshop.current());
+  if (!(cut.object_cells > 0)) fail('the live cut took no cell');
+  await page.click('#brush-object');
+  // (The browser keeps 250 resource timings by default: the buffer is full by now.)
+  const refineStart = await page.evaluate(() => {
+    performance.clearResourceTimings();
+    return performance.now();
+  });
+  await edit(
+    'object stroke -> refined cut',
+    () => drag([at(0.6, 0.47), at(0.6, 0.53)]),
+    afterJob(await jobsFinished()),
+  );
+  result.cut_cells = [cut.object_cells, (await page.evaluate(() => window.lidarshop.current())).object_cells];
+  result.cut_timings = segmentTimings;
+  // Where the refinement's time went: its requests (start-end, ms after page open).
+  result.refine_requests = await page.evaluate(
+    (since) =>
+      performance
+        .getEntriesByType('resource')
+        .filter((e) => e.name.includes('/api/') && e.startTime >= since)
+        .map(
+          (e) =>
+            `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+        ),
+    refineStart,
+  );
+  await page.screenshot({ path: join(artefacts, 'station_cut.png') });
 
   // The station opened again in the running server: the time its read takes, then to its first picture.
   const points = await page.evaluate(() => window.lidarshop.pointsHeld());
