@@ -332,15 +332,21 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
   try {
     const key = brush === 'lasso' ? 'hole_polygon' : brush;
     await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
-    await refresh(true, true); // the strokes as the server holds them
-    status(`${cells.length} ${brush} stroke cells painted`);
+    const hadCut = doc.object_cells > 0;
+    const strokesShown = refresh(true, true); // the strokes as the server holds them
     if (
       (brush === 'object' || brush === 'background') &&
       element<HTMLInputElement>('live').checked &&
       (strokeKinds.add(brush), strokeKinds.size === 2)
     ) {
-      // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut).
-      await runJob(`/api/docs/${doc.id}/segment`, { refine: doc.object_cells > 0 }, 'segment');
+      // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut). The
+      // cut starts without waiting for the strokes' picture: answers are shown in version order (VersionGate),
+      // so the strokes' picture is dropped if the cut's comes first.
+      status(`${cells.length} ${brush} stroke cells painted`);
+      await Promise.all([strokesShown, runJob(`/api/docs/${doc.id}/segment`, { refine: hadCut }, 'segment')]);
+    } else {
+      await strokesShown;
+      status(`${cells.length} ${brush} stroke cells painted`);
     }
   } catch (error) {
     status(`stroke failed: ${(error as Error).message}`);

@@ -90,8 +90,9 @@ class SupportPlanes {
  public:
   // `classify` (CV_8U, may be empty = every cell of the region outside the mask): the cells that may be support.
   // `max_points` (0 = all): the planes are fitted to at most about this many band cells (a fixed stride).
-  SupportPlanes(const Scan& scan, const cv::Mat& mask, const cv::Rect& region, const WholeObjectOptions& options,
-                const cv::Mat& classify = cv::Mat(), size_t max_points = 0);
+  SupportPlanes(const Scan& scan, const cv::Mat& mask, const cv::Rect& region,
+                const WholeObjectOptions& options, const cv::Mat& classify = cv::Mat(),
+                size_t max_points = 0);
   bool At(cv::Point cell, LazyNormals& normals) const {
     if (planes_.empty() || !region_.contains(cell) || !scan_->valid.at<uint8_t>(cell)) return false;
     if (classify_.empty() ? mask_.at<uint8_t>(cell) != 0 : !classify_.at<uint8_t>(cell)) return false;
@@ -169,8 +170,9 @@ SupportPlanes::SupportPlanes(const Scan& scan, const cv::Mat& mask, const cv::Re
     if (4 * outside_box < plane.inliers.size()) continue;
     // A plane through much of the cut itself is a face of the object (its other half in another colour).
     if (5 * CountOnPlane(scan, mask, box, plane, options.support_distance_m) > object_cells) continue;
-    planes_.push_back({plane, cv::Vec3f(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
-                                        static_cast<float>(plane.normal.z()))});
+    planes_.push_back(
+        {plane, cv::Vec3f(static_cast<float>(plane.normal.x()), static_cast<float>(plane.normal.y()),
+                          static_cast<float>(plane.normal.z()))});
   }
 }
 
@@ -292,7 +294,8 @@ int PartsAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& regi
             open = true;  // it runs on beyond the region
             continue;
           }
-          if (visited.at<uint8_t>(q) == kInPart || !scan.valid.at<uint8_t>(q) || grown.at<uint8_t>(q)) continue;
+          if (visited.at<uint8_t>(q) == kInPart || !scan.valid.at<uint8_t>(q) || grown.at<uint8_t>(q))
+            continue;
           if (std::abs(scan.range.at<float>(q) - scan.range.at<float>(p)) > jump_at(p)) continue;  // a step
           // What it stands on, or another surface meeting it at a crease (the ground at a post's foot,
           // where the box holding the post keeps the ground out of the support planes' band).
@@ -496,8 +499,8 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
     for (const cv::Point& cell : part) grown.at<uint8_t>(cell) = 255;
     return static_cast<size_t>(std::max(0, max_added - added));
   };
-  PartsAcrossStep(scan, grown, region, static_cast<size_t>(max_added - added), options.join_max_gap_m, jump_at,
-                  enter, continues, on_support, accept);
+  PartsAcrossStep(scan, grown, region, static_cast<size_t>(max_added - added), options.join_max_gap_m,
+                  jump_at, enter, continues, on_support, accept);
   return grown;
 }
 
