@@ -336,7 +336,7 @@ try {
   // The segment jobs' own timings (SegmentResult's, seconds), from their answers.
   const segmentTimings = [];
   page.on('response', async (response) => {
-    if (!/\/api\/jobs\/\d+$/.test(response.url())) return;
+    if (!/\/api\/jobs\/\d+(\?|$)/.test(response.url())) return;
     const job = await response.json().catch(() => null);
     if (job?.kind === 'segment' && job.state === 'done')
       segmentTimings.push({ refined: job.result.refined, ...job.result.timings });
