@@ -141,6 +141,11 @@ OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& optio
     skirt_options.depth_m = options.skirt_depth_m;
     scene.skirts = SilhouetteSkirts(scan, skirt_options);
   }
+  if (options.visibility == VisibilityMethod::kZBuffer) {
+    scene.mesh_blocks = TriangleBlockBoxes(scene.mesh);
+    scene.skirt_blocks = TriangleBlockBoxes(scene.skirts);
+  }
+  scene.cells = CellBoxesOf(scan);
   if (options.visibility == VisibilityMethod::kSegment) {
     scene.segments = std::make_unique<RaycastScene>();
     if (!scene.mesh.empty()) scene.segments->AddMesh(scene.mesh, 0);
@@ -166,19 +171,38 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
   // Rows in parallel, each into its own list, joined in row order (the same on any thread count).
   std::vector<std::vector<Candidate>> row_candidates(scan.rows);
   std::vector<int64_t> row_returns(scan.rows, 0), row_outside(scan.rows, 0);
+  // Row segments whose box lies outside the image's view planes are outside the image whole (view_cull.h).
+  const ViewPlanes planes = ImageViewPlanes(camera);
+  const CellBoxes& boxes = scene.cells;
+  const bool by_segment =
+      boxes.segments > 0 && boxes.valid.size() == static_cast<size_t>(scan.rows) * boxes.segments;
   ParallelFor(scan.rows, [&](int64_t row) {
     const int r = static_cast<int>(row);
-    for (int c = 0; c < scan.cols; ++c) {
-      if (!scan.valid.at<uint8_t>(r, c)) continue;
-      ++row_returns[r];
-      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-      const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
-      Eigen::Vector2d pixel;
-      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
-        ++row_outside[r];
-        continue;
+    const int segments = by_segment ? boxes.segments : 1;
+    for (int s = 0; s < segments; ++s) {
+      const int c_begin = by_segment ? s * boxes.segment_cols : 0;
+      const int c_end = by_segment ? std::min(scan.cols, c_begin + boxes.segment_cols) : scan.cols;
+      if (by_segment) {
+        const size_t box = static_cast<size_t>(r) * boxes.segments + s;
+        if (boxes.valid[box] == 0) continue;
+        if (planes.count > 0 && planes.Outside(boxes.boxes[box])) {
+          row_returns[r] += boxes.valid[box];
+          row_outside[r] += boxes.valid[box];
+          continue;
+        }
       }
-      row_candidates[r].push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+      for (int c = c_begin; c < c_end; ++c) {
+        if (!scan.valid.at<uint8_t>(r, c)) continue;
+        ++row_returns[r];
+        const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
+        const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+        Eigen::Vector2d pixel;
+        if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
+          ++row_outside[r];
+          continue;
+        }
+        row_candidates[r].push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
+      }
     }
   });
   std::vector<Candidate> candidates;
@@ -213,7 +237,9 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
   } else {
     const auto zbuffer_start = std::chrono::steady_clock::now();
     const DistanceBuffer buffer =
-        RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale);
+        RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale, RasterOptions(),
+                             {scene.mesh_blocks.empty() ? nullptr : &scene.mesh_blocks,
+                              scene.skirt_blocks.empty() ? nullptr : &scene.skirt_blocks});
     const cv::Mat& distance_buffer = buffer.distance;
     const cv::Mat& back_facing = buffer.back_facing;
     cv::Mat nearest = distance_buffer;
