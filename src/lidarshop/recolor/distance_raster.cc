@@ -162,26 +162,23 @@ float RayDistance(const Eigen::Vector3f& ray, float ray_norm, const Eigen::Vecto
   return t > 0 ? t * ray_norm : -1;
 }
 
-// The ray of each buffer pixel (camera frame) and its length: from a table, or — an undistorted pinhole, whose
-// rays cost a few operations — computed where needed (the same arithmetic as PixelRay, so the same floats),
-// which spares each photo a table of 16 bytes per pixel.
+// The ray of each buffer pixel (camera frame) and its length: from a table, or — an undistorted pinhole
+// without skew, whose ray is (a(col), b(row), 1) — from a row and a column of normalized coordinates (the same
+// arithmetic as PixelRay, so the same floats), which spares each photo a table of 16 bytes per pixel.
 struct PixelRays {
   const BufferGeometry* g = nullptr;
-  bool computed = false;
-  double fx = 1, fy = 1, cx = 0, cy = 0, skew = 0;  // computed: the pinhole's intrinsics
-  std::vector<Eigen::Vector3f> table;
+  bool separable = false;
+  std::vector<float> a_of_col, b_of_row;  // separable
+  std::vector<Eigen::Vector3f> table;     // otherwise
   std::vector<float> norms;
 
   Eigen::Vector3f Ray(int row, int col, float* norm) const {
-    if (!computed) {
+    if (!separable) {
       const size_t pixel = static_cast<size_t>(row) * g->cols + col;
       *norm = norms[pixel];
       return table[pixel];
     }
-    const double px = (col + 0.5) * g->sx, py = (row + 0.5) * g->sy;
-    const double b = (py - cy) / fy;
-    const double a = (px - cx - skew * b) / fx;
-    const Eigen::Vector3f ray = Eigen::Vector3d(a, b, 1.0).cast<float>();
+    const Eigen::Vector3f ray(a_of_col[col], b_of_row[row], 1.0f);
     *norm = ray.norm();
     return ray;
   }
@@ -190,10 +187,14 @@ struct PixelRays {
 PixelRays RaysOf(const Camera& camera, const BufferGeometry& g) {
   PixelRays rays;
   rays.g = &g;
-  if (camera.model == CameraModel::kPinhole && !camera.pinhole.has_distortion()) {
-    const PinholeCamera& k = camera.pinhole;
-    rays.computed = true;
-    rays.fx = k.fx_px, rays.fy = k.fy_px, rays.cx = k.cx_px, rays.cy = k.cy_px, rays.skew = k.skew_px;
+  const PinholeCamera& k = camera.pinhole;
+  if (camera.model == CameraModel::kPinhole && !k.has_distortion() && k.skew_px == 0) {
+    rays.separable = true;
+    // UnprojectPixel's b = (y − cy) / fy and a = (x − cx − skew · b) / fx, with skew 0.
+    for (int r = 0; r < g.rows; ++r)
+      rays.b_of_row.push_back(static_cast<float>(((r + 0.5) * g.sy - k.cy_px) / k.fy_px));
+    for (int c = 0; c < g.cols; ++c)
+      rays.a_of_col.push_back(static_cast<float>(((c + 0.5) * g.sx - k.cx_px - k.skew_px * 0.0) / k.fx_px));
     return rays;
   }
   const int64_t pixels = static_cast<int64_t>(g.rows) * g.cols;
