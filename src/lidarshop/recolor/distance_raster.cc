@@ -353,8 +353,11 @@ DistanceBuffer RasterDistanceBuffer(const TriangleMesh& mesh, const TriangleMesh
   std::vector<std::atomic<uint64_t>> keys(pixels);
   for (auto& key : keys) key.store(kNoHit, std::memory_order_relaxed);
 
+  // An undistorted pinhole maps a triangle to the triangle of its corners' pixels: its box needs no padding
+  // for bent edges (the flag was declared but never set before).
   const RasterTarget target{
-      g, rays, keys, camera.model == CameraModel::kSpherical || camera.model == CameraModel::kCylindrical};
+      g, rays, keys, camera.model == CameraModel::kSpherical || camera.model == CameraModel::kCylindrical,
+      camera.model == CameraModel::kPinhole && !camera.pinhole.has_distortion()};
   const ViewPlanes planes = options.cull_outside_view ? ImageViewPlanes(camera) : ViewPlanes();
   std::vector<Eigen::AlignedBox3f> own_mesh_boxes, own_skirt_boxes;
   const std::vector<Eigen::AlignedBox3f>* mesh_boxes = block_boxes.mesh;
