@@ -26,7 +26,11 @@ ViewPlanes ImageViewPlanes(const Camera& camera) {
   const double w = camera.width_px(), h = camera.height_px();
   const auto take = [&](double px, double py) {
     const Eigen::Vector3d ray = UnprojectPixel(camera.pinhole, Eigen::Vector2d(px, py));
-    if (!(ray.z() > 0) || !ray.allFinite()) {
+    // The undistortion is a fixed-point iteration: where it did not converge (a strong distortion at the
+    // corners), the ray does not project back to its pixel and the bound would be wrong: no bound then.
+    Eigen::Vector2d back;
+    if (!(ray.z() > 0) || !ray.allFinite() || !ProjectCameraPoint(camera.pinhole, ray, &back) ||
+        (back - Eigen::Vector2d(px, py)).norm() > 0.25) {
       x_min = y_min = -INFINITY;  // no bound: keep everything
       return;
     }

@@ -6,7 +6,8 @@
 // distortion that bends the border between samples). A point strictly outside one of them projects outside
 // the image, and a triangle with its three corners outside the same plane meets no ray of the image, so
 // skipping them changes no z-buffer pixel and no visibility (distance_raster_test, station_recolor_test
-// compare culled with unculled). Other models (fisheye, spherical, cylindrical) get no planes: nothing is
+// compare culled with unculled). A pinhole whose border rays do not project back to their pixels (an
+// undistortion that did not converge) gets no planes. Other models (fisheye, spherical, cylindrical) get no planes: nothing is
 // culled.
 //
 // Boxes are kept per block of consecutive triangles of a mesh (a scan mesh's triangles run in row-major cell

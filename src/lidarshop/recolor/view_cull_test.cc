@@ -59,5 +59,15 @@ TEST(ViewCull, BoxesOutsideOnePlaneOnly) {
   EXPECT_EQ(ImageViewPlanes(SphericalPanorama(100, Eigen::Matrix4d::Identity())).count, 0);
 }
 
+// A distortion the fixed-point undistortion cannot invert at the corners: no planes, nothing culled.
+TEST(ViewCull, NoPlanesWhereTheBorderRaysDoNotProjectBack) {
+  PinholeCamera wild = CameraLookingAt({0, 0, 0}, {10, 0, 0}, 400, 300, 120);
+  wild.k1 = 2.5, wild.k2 = 3.0;
+  EXPECT_EQ(ImageViewPlanes(CameraFromPinhole(wild)).count, 0);
+  PinholeCamera ordinary = CameraLookingAt({0, 0, 0}, {10, 0, 0}, 400, 300, 70);
+  ordinary.k1 = -0.1;  // an ordinary barrel distortion is bounded
+  EXPECT_EQ(ImageViewPlanes(CameraFromPinhole(ordinary)).count, 4);
+}
+
 }  // namespace
 }  // namespace lidarshop::recolor_internal
