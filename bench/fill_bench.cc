@@ -46,13 +46,13 @@ const Problem& GetProblem(int kind) {
 }
 
 void BM_FillScan(benchmark::State& state, FillMethod method, bool acceptance, bool offsets = false,
-                 InpaintSearchKind search = FillOptions().search) {
+                 InpaintSearchKind search = FillOptions().inpaint.search) {
   const Problem& problem = GetProblem(static_cast<int>(state.range(0)));
   FillOptions options;
   options.method = method;
-  options.acceptance.enabled = acceptance;
+  options.inpaint.acceptance.enabled = acceptance;
   options.offset_completion = offsets;
-  options.search = search;
+  options.inpaint.search = search;
   FillResult result;
   for (auto _ : state) {
     result = FillScan(problem.scan, problem.hole, options);

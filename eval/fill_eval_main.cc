@@ -308,7 +308,7 @@ int main(int argc, char** argv) {
   app.add_option("--seeds", seeds, "fills per patch method (seeds 0..N-1 added to --seed); metrics are means")
       ->capture_default_str()
       ->check(CLI::Range(1, 100));
-  app.add_option("--seed", base.seed, "first seed")->capture_default_str();
+  app.add_option("--seed", base.inpaint.seed, "first seed")->capture_default_str();
   app.add_option("--margin", margin, "hole = object cells grown by this many cells")->capture_default_str();
   app.add_option("--planar", planar_text,
                  "scenes that are planar behind the object (left out of the target mean)")
@@ -324,14 +324,14 @@ int main(int argc, char** argv) {
   app.add_option("--random-rows", scene_options.rows, "random scenes: rows")->capture_default_str();
   app.add_option("--pictures", pictures_dir,
                  "write range and second-viewpoint pictures here (random scenes: of the worst seeds)");
-  app.add_option("--patch-radius", base.patch_radius)->capture_default_str();
-  app.add_option("--window", base.search_window_radius)->capture_default_str();
+  app.add_option("--patch-radius", base.inpaint.patch_radius)->capture_default_str();
+  app.add_option("--window", base.inpaint.local_window_radius)->capture_default_str();
   app.add_option("--color-weight", base.color_weight)->capture_default_str();
   app.add_option("--gradient-weight", base.gradient_weight)->capture_default_str();
   app.add_option("--return-weight", base.return_weight)->capture_default_str();
-  app.add_option("--pm-samples", base.patchmatch_random_samples)->capture_default_str();
-  app.add_option("--accept-local-first", base.acceptance_local_first)->capture_default_str();
-  app.add_option("--pm-iterations", base.patchmatch_iterations)->capture_default_str();
+  app.add_option("--pm-samples", base.inpaint.patchmatch_random_samples)->capture_default_str();
+  app.add_option("--accept-local-first", base.inpaint.acceptance_local_first)->capture_default_str();
+  app.add_option("--pm-iterations", base.inpaint.patchmatch_iterations)->capture_default_str();
   std::string dump_dir;
   app.add_option("--dump", dump_dir,
                  "write each scene's scan, truth and hole, and per method the first seed's fill and its "
@@ -352,8 +352,8 @@ int main(int argc, char** argv) {
       base = FromJson<FillOptions>(nlohmann::json::parse(file), FillOptions{});
       CLI11_PARSE(app, argc, argv);
     }
-    if (!priority.empty()) base.priority = ParseEnum<InpaintPriorityKind>(priority);
-    if (!search.empty()) base.search = ParseEnum<InpaintSearchKind>(search);
+    if (!priority.empty()) base.inpaint.priority = ParseEnum<InpaintPriorityKind>(priority);
+    if (!search.empty()) base.inpaint.search = ParseEnum<InpaintSearchKind>(search);
     base.Check();
     if (!random_seeds.empty()) {
       const std::vector<uint64_t> seeds = test_scenes::ParseSeedRange(random_seeds);
@@ -383,8 +383,8 @@ int main(int argc, char** argv) {
       "Hole = the removed object's cells grown by {} cells; truth = the same scan without the object "
       "(same seed). Patch methods: mean over {} fill seeds. Patch radius {}, window {}, weights colour "
       "{} / gradient {} / return {}.\n",
-      margin, seeds, base.patch_radius, base.search_window_radius, base.color_weight, base.gradient_weight,
-      base.return_weight));
+      margin, seeds, base.inpaint.patch_radius, base.inpaint.local_window_radius, base.color_weight,
+      base.gradient_weight, base.return_weight));
   std::map<std::string, std::vector<double>> rmse_nonplanar, floating_all;
   std::map<std::string, double> seconds_all;
   std::vector<std::string> worse_than_laplace;
@@ -428,7 +428,7 @@ int main(int argc, char** argv) {
       if (name == "gradient-range") options.inverse_range = false;
       // "gradient-plain": without the acceptance tests of inpaint/acceptance.h
       // (the best patch difference wins).
-      if (name == "gradient-plain") options.acceptance.enabled = false;
+      if (name == "gradient-plain") options.inpaint.acceptance.enabled = false;
       // Patch methods draw random samples: their metrics are the mean over `seeds` fills (the pictures show
       // the first); the other methods are deterministic.
       const bool random =
@@ -438,7 +438,7 @@ int main(int argc, char** argv) {
       double seconds = 0;
       const int runs = random ? seeds : 1;
       for (int k = 0; k < runs; ++k) {
-        options.seed = base.seed + static_cast<uint64_t>(k);
+        options.inpaint.seed = base.inpaint.seed + static_cast<uint64_t>(k);
         FillResult run = FillScan(with_object, hole, options);
         const FillMetrics one = MeasureFill(run.scan, truth, hole);
         seconds += run.timings.total_s / runs;

@@ -71,8 +71,9 @@ exits_with 1 "bad input: a file that does not parse" "garbage.ptx" \
 printf '{"patch_radius": 3, "method": "laplace", "acceptance": {"band_px": 3}}\n' >"$work/fill_options.json"
 check "fill --options FILE, flags win" "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/opt.ply" \
   --options "$work/fill_options.json" --method gradient --json "$work/opt.json" --quiet
+# The flat keys of before are aliases of the nested inpainting (FillOptions::inpaint): --json writes it nested.
 json_check "fill --options keys reach the options" "$work/opt.json" \
-  "d['options']['patch_radius'] == 3 and d['options']['method'] == 'gradient' and d['options']['acceptance']['band_px'] == 3"
+  "d['options']['inpaint']['patch_radius'] == 3 and d['options']['method'] == 'gradient' and d['options']['inpaint']['acceptance']['band_px'] == 3 and 'patch_radius' not in d['options']"
 printf '{"patch_radius": 3, "acceptance": {"band": 3}}\n' >"$work/bad_options.json"
 exits_with 2 "--options: an unknown key names the path" "acceptance.band: unknown option \(did you mean 'band_px'\?\)" \
   "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/opt.ply" --options "$work/bad_options.json"

@@ -47,6 +47,10 @@ std::string StructDoc(const StructInfo& info, const void* defaults) {
     line = line.substr(0, line.find('\n'));
     doc += fmt::format("  {}: {}\n", field.key, line);
   }
+  if (!info.aliases.empty()) {
+    doc += "\nAliases (older keys, read and set the nested field):\n";
+    for (const FieldInfo& alias : info.aliases) doc += fmt::format("  {}: {}\n", alias.key, alias.alias_of);
+  }
   return doc;
 }
 

@@ -5,7 +5,8 @@
 //   BindStruct<FillOptions>(m);   // lidarshop.FillOptions(patch_radius=6, method="laplace")
 //
 // gives a class named after StructInfo::name with
-//   - one attribute per field: numbers, bools, strings, number lists as Python values; enums as their names
+//   - one attribute per field and per alias (an older flat key of a nested field: FillOptions.patch_radius
+//     is FillOptions.inpaint.patch_radius); numbers, bools, strings, number lists as Python values; enums as their names
 //     ("laplace"); nested structs as nested objects (changing `o.poisson.tolerance` changes `o`);
 //     assignment checks the value (kind and range) and raises lidarshop.OptionsError (a ValueError) with the
 //     library's message, naming the key;
@@ -85,10 +86,31 @@ py::class_<S> BindStruct(py::module_& m, bool read_only = false) {
           doc.c_str());
     }
   }
+  // An alias (an older flat key of a nested field, util/options.h) reads and sets that field; it is not in
+  // `fields` nor in to_dict().
+  for (const FieldInfo& alias : info.aliases) {
+    const FieldInfo* alias_pointer = &alias;
+    auto getter = [alias_pointer](py::object self) {
+      return GetField(*alias_pointer, self.cast<S*>(), self);
+    };
+    const std::string doc =
+        fmt::format("Alias of {}: {}", alias.alias_of, FieldDoc(alias, alias.get(&defaults)));
+    if (read_only) {
+      cls.def_property_readonly(alias.key.c_str(), getter, doc.c_str());
+    } else {
+      cls.def_property(
+          alias.key.c_str(), getter,
+          [alias_pointer](S& self, const py::object& value) {
+            SetField(InfoOf<S>(), *alias_pointer, &self, value);
+          },
+          doc.c_str());
+    }
+  }
   // A misspelt attribute raises AttributeError with the closest field (pybind11 would say only "no attribute").
   cls.def("__setattr__", [](py::object self, const std::string& name, py::object value) {
     if (name.empty() || name[0] != '_') {
-      const std::vector<std::string> keys = InfoOf<S>().Keys();
+      std::vector<std::string> keys = InfoOf<S>().Keys();
+      for (const std::string& alias : InfoOf<S>().AliasKeys()) keys.push_back(alias);
       if (std::find(keys.begin(), keys.end(), name) == keys.end()) {
         const std::string closest = ClosestMatch(name, keys);
         throw py::attribute_error(

@@ -70,23 +70,24 @@ void JobRunner::Work() {
       queue_.pop_front();
     }
     if (job->progress.cancelled()) {
-      job->state = JobState::kCancelled;
+      job->End(JobState::kCancelled);
       continue;
     }
     job->state = JobState::kRunning;
+    JobState final_state = JobState::kDone;
     try {
       nlohmann::ordered_json result = job->run(job->progress);
       std::lock_guard lock(job->mutex);
       job->result = std::move(result);
-      job->state = JobState::kDone;
     } catch (const CancelledError&) {
-      job->state = JobState::kCancelled;
+      final_state = JobState::kCancelled;
     } catch (const std::exception& error) {
       std::lock_guard lock(job->mutex);
       job->error = error.what();
-      job->state = JobState::kFailed;
+      final_state = JobState::kFailed;
     }
     job->run = nullptr;  // releases what the operation captured
+    job->End(final_state);
   }
 }
 

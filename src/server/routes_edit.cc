@@ -1,5 +1,9 @@
 // Routes that edit scans — strokes, segmentation, removal, fill, undo — and the operations they start
-// (docs/api.md). Long operations run as jobs off the request thread; clients poll /api/jobs/ID.
+// (docs/api.md). Long operations run as jobs off the request thread; clients poll /api/jobs/ID (a long poll
+// with ?wait_ms=).
+#include <chrono>
+#include <cstdlib>
+
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
@@ -190,6 +194,9 @@ void Commit(Document& document, Snapshot next, int undo_depth) {
   RememberState(document);
 }
 
+// The longest a GET of a job waits for its end (a request thread is held meanwhile).
+constexpr long kMaxJobWaitMs = 2000;
+
 nlohmann::ordered_json JobJson(const Job& job) {
   nlohmann::ordered_json json = {{"id", job.id},
                                  {"kind", job.kind},
@@ -291,12 +298,24 @@ void AddEditRoutes(State& state) {
                    SendJson(response, {{"version", document->version}});
                  });
   }
-  state.http.Get(R"(/api/jobs/(\d+))",
-                 [&state](const httplib::Request& request, httplib::Response& response) {
-                   const auto job = state.runner->Find(std::atoi(request.matches[1].str().c_str()));
-                   if (!job) return SendError(response, 404, "no such job");
-                   SendJson(response, JobJson(*job));
-                 });
+  state.http.Get(R"(/api/jobs/(\d+))", [&state](const httplib::Request& request,
+                                                httplib::Response& response) {
+    const auto job = state.runner->Find(std::atoi(request.matches[1].str().c_str()));
+    if (!job) return SendError(response, 404, "no such job");
+    // ?wait_ms=N: answer when the job ends, or after N ms (a long poll: the client hears of
+    // the end when it comes instead of at its next poll).
+    if (request.has_param("wait_ms")) {
+      const std::string text = request.get_param_value("wait_ms");
+      char* end = nullptr;
+      const long value = std::strtol(text.c_str(), &end, 10);
+      if (text.empty() || *end != '\0' || value < 0 || value > kMaxJobWaitMs) {
+        return SendError(response, 400,
+                         fmt::format("wait_ms: expected a whole number of ms from 0 to {}", kMaxJobWaitMs));
+      }
+      job->WaitEnded(std::chrono::milliseconds(value));
+    }
+    SendJson(response, JobJson(*job));
+  });
   state.http.Post(R"(/api/jobs/(\d+)/cancel)",
                   [&state](const httplib::Request& request, httplib::Response& response) {
                     const auto job = state.runner->Find(std::atoi(request.matches[1].str().c_str()));

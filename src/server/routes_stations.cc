@@ -424,10 +424,7 @@ void AddStationRoutes(State& state) {
                                                    httplib::Response& response) {
     const auto document = state.FindDocument(request, response);
     if (!document) return;
-    // Named variables, not a structured binding: lambdas below capture them (clang 14 refuses bindings).
-    const std::pair<std::shared_ptr<Site>, int> site_of = SiteOf(state, document->id);
-    const std::shared_ptr<Site>& site = site_of.first;
-    const int station = site_of.second;
+    const std::shared_ptr<Site> site = SiteOf(state, document->id).first;
     if (!site) {
       return SendJson(
           response,

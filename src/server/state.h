@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -136,6 +137,27 @@ struct Job {
   std::string error;
   nlohmann::ordered_json result;
   std::function<nlohmann::ordered_json(Progress&)> run;
+
+  // Sets a final state (done, failed, cancelled) and wakes the requests waiting for one.
+  void End(JobState final_state) {
+    {
+      std::lock_guard lock(mutex);
+      state = final_state;
+    }
+    ended_.notify_all();
+  }
+  // Waits at most `timeout` for a final state (GET /api/jobs/ID?wait_ms=: the client learns of the end when it
+  // comes, not at its next poll); true when there is one.
+  bool WaitEnded(std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex);
+    return ended_.wait_for(lock, timeout, [&] {
+      const JobState now = state.load();
+      return now != JobState::kQueued && now != JobState::kRunning;
+    });
+  }
+
+ private:
+  std::condition_variable ended_;
 };
 
 // Runs jobs on a fixed number of worker threads, in the order they were queued.

@@ -4,7 +4,9 @@
 // to the tiles of the view's level, the bytes until then, and the first (coarse) and refined 3-D points, which
 // must stay within the browser's point budget (1-2 M points); then counts the bytes of each edit — a stroke,
 // its undo and redo, a painted hole filled (points move), its undo — and checks every tile the browser holds
-// against the server's after the fill and after its undo. Last, the station is opened again in the running
+// against the server's after the fill and after its undo. Then the live cut on the parking lot's hatchback: an
+// object stroke, a background stroke that runs the first cut, and two strokes that refine it (one inside, one
+// taking the car's end away), each timed to the frame that shows its picture. Last, the station is opened again in the running
 // server (the file dialog): the time to read it and from then to its first picture. Prints one JSON line with
 // the numbers (bench/results/editor.md). --budget S fails the run when the first picture after page open takes
 // longer than S seconds.
@@ -214,17 +216,23 @@ try {
     const before = await counters();
     const allBefore = apiBytes;
     const version = (await page.evaluate(() => window.lidarshop.current())).version;
+    const pageT0 = await page.evaluate(() => Math.round(performance.now()));
     const t0 = Date.now();
     await action();
     await done(version);
     await waitForFunction(page, shownCurrent, null, { timeout: 120000 });
     const seconds = (Date.now() - t0) / 1000;
+    const pageT1 = await page.evaluate(() => Math.round(performance.now()));
+    // The frame that showed the edit's picture (the page may be busy after it, e.g. with the 3-D view).
+    const drawnAt = await page.evaluate(() => window.lidarshop.rayView.shownState().drawnAt);
     await page.evaluate(() => window.lidarshop.settled());
     await new Promise((resolve) => setTimeout(resolve, 300)); // the last answers' sizes
     const after = await counters();
     edits.push({
       what,
       seconds,
+      page_ms: [pageT0, pageT1], // start and end in the page's clock (performance.now)
+      picture_s: drawnAt >= pageT0 ? Math.round(drawnAt - pageT0) / 1000 : null, // start -> picture drawn
       points: after.points - before.points,
       pictures: after.pictures - before.pictures,
       all: apiBytes - allBefore,
@@ -315,6 +323,76 @@ try {
   if (afterUndo) fail(`the patched ray image after undoing the fill is not the server's: ${afterUndo}`);
   await page.screenshot({ path: join(artefacts, 'station_edited.png') });
 
+  // The live cut (issue 36's stroke -> cut -> picture): the lasso and the ground stroke undone, an object stroke
+  // across the hatchback (the parking lot's car left of the scanner's view centre; its place as a fraction of the
+  // grid, so any grid size of that scene), then a background stroke under it: with Live on, that stroke runs the
+  // first cut; later strokes refine it incrementally. Each is timed from the stroke's start to the frame that
+  // shows the job's result (picture_s) and to the page settled (seconds).
+  for (let i = 0; i < 2; ++i) {
+    const v = (await page.evaluate(() => window.lidarshop.current())).version;
+    await page.keyboard.press('Control+z');
+    await newerThan(v);
+  }
+  // The segment jobs' own timings (SegmentResult's, seconds), from their answers.
+  const segmentTimings = [];
+  page.on('response', async (response) => {
+    if (!/\/api\/jobs\/\d+(\?|$)/.test(response.url())) return;
+    const job = await response.json().catch(() => null);
+    if (job?.kind === 'segment' && job.state === 'done')
+      segmentTimings.push({ refined: job.result.refined, ...job.result.timings });
+  });
+  const at = (fr, fc) => [Math.round(doc.rows * fr), Math.round(doc.cols * fc)];
+  const jobsFinished = () => page.evaluate(() => window.lidarshop.jobsFinished());
+  const afterJob = (before) => () =>
+    waitForFunction(page, (n) => window.lidarshop.jobsFinished() > n, before, { timeout: 300000 });
+  await page.click('#brush-object');
+  await edit('object stroke', () => drag([at(0.583, 0.452), at(0.583, 0.546)]), newerThan);
+  await page.click('#brush-background');
+  await edit(
+    'background stroke -> first cut',
+    () => drag([at(0.647, 0.402), at(0.647, 0.592)]),
+    afterJob(await jobsFinished()),
+  );
+  const cut = await page.evaluate(() => window.lidarshop.current());
+  if (!(cut.object_cells > 0)) fail('the live cut took no cell');
+  // (The browser keeps 250 resource timings by default: the buffer is full by now.)
+  const refineStart = await page.evaluate(() => {
+    performance.clearResourceTimings();
+    return performance.now();
+  });
+  // Two refinements: an object stroke inside the cut (nothing changes), a background stroke across the car's
+  // left end (the cut gives those cells up).
+  await page.click('#brush-object');
+  await edit(
+    'object stroke -> refined cut',
+    () => drag([at(0.6, 0.47), at(0.6, 0.53)]),
+    afterJob(await jobsFinished()),
+  );
+  await page.click('#brush-background');
+  await edit(
+    'background stroke -> refined cut',
+    () => drag([at(0.6, 0.404), at(0.6, 0.42)]),
+    afterJob(await jobsFinished()),
+  );
+  const refined = await page.evaluate(() => window.lidarshop.current());
+  result.cut_cells = [cut.object_cells, refined.object_cells];
+  if (!(refined.object_cells < cut.object_cells && refined.object_cells > cut.object_cells / 2))
+    fail(`the background stroke took the cut from ${cut.object_cells} to ${refined.object_cells} cells`);
+  result.cut_timings = segmentTimings;
+  // Where the refinement's time went: its requests (start-end, ms after page open).
+  result.refine_requests = await page.evaluate(
+    (since) =>
+      performance
+        .getEntriesByType('resource')
+        .filter((e) => e.name.includes('/api/') && e.startTime >= since)
+        .map(
+          (e) =>
+            `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+        ),
+    refineStart,
+  );
+  await page.screenshot({ path: join(artefacts, 'station_cut.png') });
+
   // The station opened again in the running server: the time its read takes, then to its first picture.
   const points = await page.evaluate(() => window.lidarshop.pointsHeld());
   if (points > result.point_budget) fail(`the browser holds ${points} points after the edits`);
@@ -350,7 +428,10 @@ try {
   }
   console.log(`e2e station: ${JSON.stringify(result)}`);
   console.log(
-    `e2e station: passed (${doc.valid_cells} returns; first picture ${result.first_picture_s} s; bytes per edit ${edits.map((e) => `${e.what} ${e.all}`).join(', ')})`,
+    `e2e station: passed (${doc.valid_cells} returns; first picture ${result.first_picture_s} s; stroke -> cut -> picture ${edits
+      .filter((e) => e.what.includes('cut'))
+      .map((e) => `${e.what.split(' ->')[0]} ${e.picture_s} s`)
+      .join(', ')}; bytes per edit ${edits.map((e) => `${e.what} ${e.all}`).join(', ')})`,
   );
 } finally {
   await browser.close();

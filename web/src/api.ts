@@ -247,13 +247,14 @@ export class Api {
     return parsePoints(await response.arrayBuffer());
   }
 
-  // Polls a job every `interval_ms` until it ends, reporting progress; resolves with its last state.
-  async waitForJob(job: JobInfo, onProgress: (job: JobInfo) => void, interval_ms = 150): Promise<JobInfo> {
+  // Asks for a job's state until it ends, reporting progress; resolves with its last state. Each request
+  // waits on the server up to `wait_ms` for the end (a long poll): the end is seen when it comes, progress at
+  // least every `wait_ms`.
+  async waitForJob(job: JobInfo, onProgress: (job: JobInfo) => void, wait_ms = 250): Promise<JobInfo> {
     let current = job;
     while (current.state === 'queued' || current.state === 'running') {
       onProgress(current);
-      await new Promise((resolve) => setTimeout(resolve, interval_ms));
-      current = await this.json<JobInfo>(`/api/jobs/${current.id}`);
+      current = await this.json<JobInfo>(`/api/jobs/${current.id}`, { wait_ms });
     }
     onProgress(current);
     return current;

@@ -83,24 +83,10 @@ export interface RemoveOptions {
 export interface FillOptions {
   // fill method: gradient (range gradients inpainted by patches, then Poisson), laplace (membrane (Laplace) fill of range and colour), depth-patch (patches of the range itself (the thesis's failure)), telea (OpenCV fast-marching inpainting of range and colour), default gradient
   method: 'gradient' | 'laplace' | 'depth-patch' | 'telea';
-  // patch half-width; patches are 2r+1 wide [cells] in [1, 15], default 4
-  patch_radius: number;
-  // fill order of the patch methods: criminisi (confidence x data term (Criminisi 2004)), onion-peel (outside in, by distance to the boundary), random (random front pixel (seeded)), default criminisi
-  priority: 'criminisi' | 'onion-peel' | 'random';
-  // source search of the patch methods: exhaustive (every source patch (exact)), local (sources within the local window), two-step (local window, then the whole image if global_gain times better), patchmatch (PatchMatch random search + propagation (approximate)), default patchmatch
-  search: 'exhaustive' | 'local' | 'two-step' | 'patchmatch';
+  // patch inpainting of the patch methods (channel_weights empty and stop_for_review false: the fill decides them)
+  inpaint: InpaintOptions;
   // with patchmatch: the exact search when hole cells x scan cells is at most this; 0 = never [cells x cells] in >= 0, default 10000000000.0
   exact_search_max_cost: number;
-  // half-width of the local source search (and PatchMatch's near samples) [cells] in >= 1, default 50
-  search_window_radius: number;
-  // PatchMatch: uniform draws over the scan per query in [1, 100000], default 48
-  patchmatch_random_samples: number;
-  // PatchMatch: propagation + random-search rounds per query in [1, 100], default 4
-  patchmatch_iterations: number;
-  // patch acceptance tests (the combined set by default)
-  acceptance: AcceptanceOptions;
-  // with acceptance: search the local window exhaustively before the whole scan, default true
-  acceptance_local_first: boolean;
   // patch difference weight of each colour channel in >= 0, default 1.0
   color_weight: number;
   // patch difference weight of each range-gradient channel in >= 0, default 1.0
@@ -125,8 +111,6 @@ export interface FillOptions {
   lattice: FacadeLatticeOptions;
   // gradient method: ranges onto the planes seen around the hole
   planes: FillPlaneOptions;
-  // seed of the patch fill's random choices, default 0
-  seed: number;
   // work in the hole's bounding box grown by this times its larger side; 0 = the whole scan [hole sizes] in [0, 1000], default 2.0
   window_margin: number;
   // the window's margin around the hole is at least this [cells] in [0, 1000000], default 512
@@ -447,28 +431,6 @@ export interface WholeObjectOptions {
   neighbour_min_fraction: number;
 }
 
-// patch acceptance tests (thesis 7.1), ANDed (C++ AcceptanceOptions)
-export interface AcceptanceOptions {
-  // run the acceptance tests, default true
-  enabled: boolean;
-  // mean test
-  mean: MeanTestOptions;
-  // representative colour test
-  representative: RepresentativeTestOptions;
-  // histogram test
-  histogram: HistogramTestOptions;
-  // smooth-versus-textured test
-  smooth_texture: SmoothTextureTestOptions;
-  // compare only bands this wide along the hole boundary; 0 = whole regions [px] in >= 0, default 2
-  band_px: number;
-  // also compare the known part with the source's pixels there, default false
-  also_known_to_known: boolean;
-  // accept when hole pixels are below this fraction of the patch in [0, 1], default 0.1
-  auto_accept_hole_fraction: number;
-  // a region with fewer pixels passes (too few to judge) in >= 1, default 4
-  min_region_pixels: number;
-}
-
 // completion by shifted copies at the dominant patch offsets (He & Sun 2012) (C++ OffsetCompletionOptions)
 export interface OffsetCompletionOptions {
   // half-width of the patches described for the offset statistics [px] in [1, 32], default 4
@@ -551,6 +513,28 @@ export interface FillPlaneOptions {
   relief_m: number;
 }
 
+// patch acceptance tests (thesis 7.1), ANDed (C++ AcceptanceOptions)
+export interface AcceptanceOptions {
+  // run the acceptance tests, default false
+  enabled: boolean;
+  // mean test
+  mean: MeanTestOptions;
+  // representative colour test
+  representative: RepresentativeTestOptions;
+  // histogram test
+  histogram: HistogramTestOptions;
+  // smooth-versus-textured test
+  smooth_texture: SmoothTextureTestOptions;
+  // compare only bands this wide along the hole boundary; 0 = whole regions [px] in >= 0, default 0
+  band_px: number;
+  // also compare the known part with the source's pixels there, default false
+  also_known_to_known: boolean;
+  // accept when hole pixels are below this fraction of the patch in [0, 1], default 0.1
+  auto_accept_hole_fraction: number;
+  // a region with fewer pixels passes (too few to judge) in >= 1, default 4
+  min_region_pixels: number;
+}
+
 // points another station saw through (C++ TransientOptions)
 export interface TransientOptions {
   // σ of the stations' range noise [m] in >= 0, default 0.005
@@ -613,7 +597,7 @@ export interface MeanTestOptions {
 
 // representative colour test (per-channel medians) (C++ RepresentativeTestOptions)
 export interface RepresentativeTestOptions {
-  // run the representative colour test, default true
+  // run the representative colour test, default false
   enabled: boolean;
   // |median K - median H| to reject at [value range] in > 0, default 0.15
   max_difference: number;
@@ -621,7 +605,7 @@ export interface RepresentativeTestOptions {
 
 // histogram test (C++ HistogramTestOptions)
 export interface HistogramTestOptions {
-  // run the histogram test, default true
+  // run the histogram test, default false
   enabled: boolean;
   // bins per channel in [2, 256], default 16
   bins: number;
@@ -629,7 +613,7 @@ export interface HistogramTestOptions {
   range: 'full' | 'compressed';
   // histogram distance: intersection (1 - sum of bin minima), emd (earth mover's distance, sum |CDF1 - CDF2| / bins), default emd
   metric: 'intersection' | 'emd';
-  // compare the four half-patches apart, the worst counts, default true
+  // compare the four half-patches apart, the worst counts, default false
   quadrants: boolean;
   // normalised distance to reject at in [0, 1], default 0.15
   max_distance: number;
@@ -637,7 +621,7 @@ export interface HistogramTestOptions {
 
 // smooth-versus-textured test (C++ SmoothTextureTestOptions)
 export interface SmoothTextureTestOptions {
-  // run the smooth-versus-textured test, default true
+  // run the smooth-versus-textured test, default false
   enabled: boolean;
   // a known region below this is smooth [value range] in >= 0, default 0.02
   texture_sigma: number;

@@ -34,6 +34,7 @@ const rayView = new RayView(element<HTMLCanvasElement>('ray'));
 const pointView = new PointView(element('points'));
 let doc: DocumentInfo | null = null;
 let runningJob: JobInfo | null = null;
+let jobsFinished = 0; // jobs that ended (done, failed or cancelled): for end-to-end tests
 let placed: { id: number; mesh: MeshData } | null = null;
 let picked: { row: number; col: number } | null = null;
 let openDocuments: DocumentInfo[] = []; // the server's open documents, for the list
@@ -47,7 +48,11 @@ const FIRST_POINTS = 1_000_000,
   MOST_POINTS = 2_000_000;
 const pointsHeld = () => [...heldPoints.values()].reduce((sum, held) => sum + held.points.count, 0);
 const stepFor = (returns: number, most: number) => Math.max(1, Math.ceil(Math.sqrt(returns / most)));
-let pointsShown = { id: -1, version: -1 };
+let pointsShown: { id: number; version: number; points: PointSet | null } = {
+  id: -1,
+  version: -1,
+  points: null,
+};
 let pointsChain: Promise<void> = Promise.resolve(); // point updates one at a time, in order
 let pointBytes = 0; // bytes of points received (whole or deltas), for tests
 const pictures = new PictureStore(); // ray images held per document and channel, patched by what changed
@@ -97,6 +102,7 @@ const stationsPanel = new StationsPanel(
   documents: () => openDocuments,
   settled: () => pointsChain.then(() => true),
   stations: () => stationsPanel,
+  jobsFinished: () => jobsFinished,
 };
 
 // Brings the held points of document `id` to the server's current version: the cells changed since the held
@@ -137,10 +143,12 @@ function updatePoints(id: number, keepView: boolean, step?: number): Promise<voi
         if (other !== id) heldPoints.delete(other);
       }
       if (doc?.id !== id) return;
-      if (pointsShown.id !== id || pointsShown.version !== held.version || !keepView) {
+      // An edit that moved no point (a stroke, a cut that changed no cell of this level) keeps the points
+      // shown: building the view's buffers again costs seconds at a million points.
+      if (pointsShown.id !== id || pointsShown.points !== held.points || !keepView) {
         pointView.show(held.points, keepView && pointsShown.id === id);
-        pointsShown = { id, version: held.version };
       }
+      pointsShown = { id, version: held.version, points: held.points };
     } catch (error) {
       status(`points: ${(error as Error).message}`);
     }
@@ -309,9 +317,11 @@ async function runJob(
     } else {
       status(`${what} ${finished.state}${finished.error ? `: ${finished.error}` : ''}`);
     }
+    ++jobsFinished; // after the refresh: the document shown is the job's result
     return finished;
   } catch (error) {
     element('progress').hidden = true;
+    ++jobsFinished;
     status(`${what} failed: ${error instanceof ApiError ? error.message : String(error)}`);
     return null;
   }
@@ -322,15 +332,21 @@ rayView.onStroke = async (brush: Brush, cells: Cell[]) => {
   try {
     const key = brush === 'lasso' ? 'hole_polygon' : brush;
     await api.json(`/api/docs/${doc.id}/strokes`, {}, { [key]: toCellList(cells), radius: rayView.radius });
-    await refresh(true, true); // the strokes as the server holds them
-    status(`${cells.length} ${brush} stroke cells painted`);
+    const hadCut = doc.object_cells > 0;
+    const strokesShown = refresh(true, true); // the strokes as the server holds them
     if (
       (brush === 'object' || brush === 'background') &&
       element<HTMLInputElement>('live').checked &&
       (strokeKinds.add(brush), strokeKinds.size === 2)
     ) {
-      // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut).
-      await runJob(`/api/docs/${doc.id}/segment`, { refine: doc.object_cells > 0 }, 'segment');
+      // Live: once both kinds of strokes exist, every stroke re-cuts (incrementally after the first cut). The
+      // cut starts without waiting for the strokes' picture: answers are shown in version order (VersionGate),
+      // so the strokes' picture is dropped if the cut's comes first.
+      status(`${cells.length} ${brush} stroke cells painted`);
+      await Promise.all([strokesShown, runJob(`/api/docs/${doc.id}/segment`, { refine: hadCut }, 'segment')]);
+    } else {
+      await strokesShown;
+      status(`${cells.length} ${brush} stroke cells painted`);
     }
   } catch (error) {
     status(`stroke failed: ${(error as Error).message}`);

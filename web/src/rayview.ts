@@ -19,7 +19,9 @@ export class RayView {
   private mask: Overlay | null = null;
   private holeMask: Overlay | null = null;
   private strokeImage: Overlay | null = null;
-  private shown = { id: -1, version: -1 }; // the document and version of the pictures shown
+  // The document and version of the pictures shown, and when the frame showing them was drawn (performance.now;
+  // -1 until then): what a stroke's round trip is timed to.
+  private shown = { id: -1, version: -1, drawnAt: -1 };
   private view: ImageView = { scale: 1, aspect: 1, offsetX: 0, offsetY: 0 };
   private rows = 0;
   private cols = 0;
@@ -75,7 +77,8 @@ export class RayView {
       optional(strokesSource),
     ]);
     if (id === this.shown.id && version < this.shown.version) return false;
-    this.shown = { id, version };
+    const shown = { id, version, drawnAt: -1 };
+    this.shown = shown;
     this.holeMask = hole;
     this.strokeImage = strokes;
     this.sent = [];
@@ -88,6 +91,7 @@ export class RayView {
     this.view.aspect = aspect;
     if (!keepView || sizeChanged) this.fit();
     this.draw();
+    requestAnimationFrame(() => (shown.drawnAt = performance.now()));
     return true;
   }
 

@@ -178,12 +178,15 @@ export class StationsPanel {
   async refresh(doc: DocumentInfo, points: PointSet | undefined) {
     const site = await this.host.api.json<SiteInfo>(`/api/docs/${doc.id}/stations`);
     if (this.host.doc()?.id !== doc.id) return;
+    // A scan outside a site, before and after, has nothing of this panel in the 3-D view: no frame is drawn
+    // for it (a frame of a million points takes most of a second without a GPU).
+    const drawnBefore = this.site !== null || this.removed !== null;
     this.site = site.site === null ? null : site;
     this.drawList();
     this.drawMarkers(doc);
     await this.drawRemoved(doc, points);
     if (this.othersVisible) await this.drawOthers(doc);
-    this.host.render();
+    if (drawnBefore || this.site !== null || this.removed !== null) this.host.render();
   }
 
   // Shows or hides the other stations' points (the "other stations" layer).

@@ -34,19 +34,6 @@ std::string LongName(const std::string& names) {
   return best;
 }
 
-// The field at `key_path` ("poisson.solver") of `info`, and the address of its struct inside `object`.
-const FieldInfo* FindPath(const StructInfo& info, void* object, const std::string& key_path, void** owner) {
-  const size_t dot = key_path.find('.');
-  const FieldInfo* field = info.Find(key_path.substr(0, dot));
-  if (field == nullptr) return nullptr;
-  if (dot == std::string::npos) {
-    *owner = object;
-    return field;
-  }
-  if (field->kind != FieldKind::kStruct) return nullptr;
-  return FindPath(*field->nested, field->nested_of(object), key_path.substr(dot + 1), owner);
-}
-
 std::string HelpText(const FieldInfo& field) {
   std::string help = field.doc;
   std::vector<std::string> notes;
@@ -187,26 +174,37 @@ OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
 void OptionBinder::BindStruct(const StructInfo& info, void* object, const BindSettings& settings) {
   std::vector<std::string> keys = settings.keys;
   if (keys.empty()) {
-    for (const FieldInfo& field : info.fields) {
+    // Fields and aliases (a nested field's older flat key, util/options.h) in the order they were described,
+    // so that the help lists the flags as it did before the nesting.
+    const auto add = [&](const FieldInfo& field) {
       const bool skipped =
           std::find(settings.skip.begin(), settings.skip.end(), field.key) != settings.skip.end();
       if (field.kind != FieldKind::kStruct && !skipped) keys.push_back(field.key);
+    };
+    for (size_t i = 0; i <= info.fields.size(); ++i) {
+      for (const FieldInfo& alias : info.aliases) {
+        if (alias.position == i) add(alias);
+      }
+      if (i < info.fields.size()) add(info.fields[i]);
     }
   }
   for (const std::string& key_path : keys) {
     void* owner = nullptr;
-    const FieldInfo* field = FindPath(info, object, key_path, &owner);
+    std::string canonical_path;
+    const FieldInfo* field = FindFieldPath(info, key_path, object, &owner, &canonical_path);
     LIDARSHOP_CHECK(field != nullptr && field->kind != FieldKind::kStruct);
-    BindField(*field, owner, key_path, settings, object == root_ || !settings.prefix.empty());
+    BindField(*field, owner, key_path, canonical_path, settings, object == root_ || !settings.prefix.empty());
   }
 }
 
 void OptionBinder::BindField(const FieldInfo& field, void* object, const std::string& key_path,
-                             const BindSettings& settings, bool in_root) {
+                             const std::string& canonical_path, const BindSettings& settings, bool in_root) {
   const auto renamed = settings.flags.find(key_path);
   const std::string names = renamed != settings.flags.end() ? renamed->second : DefaultFlag(key_path);
   const std::string flag = LongName(names);
-  const std::string full_path = settings.prefix.empty() ? key_path : settings.prefix + "." + key_path;
+  // Errors name the field by its path without aliases ("inpaint.local_window_radius").
+  const std::string full_path =
+      settings.prefix.empty() ? canonical_path : settings.prefix + "." + canonical_path;
   flag_of_key_[full_path] = flag;
   const FieldInfo* info = &field;
   const auto set = [this, info, object, flag, full_path, in_root](const std::string& text) {

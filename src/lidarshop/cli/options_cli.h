@@ -16,7 +16,8 @@ namespace lidarshop::cli {
 
 // How a command shows the fields of one options struct.
 struct BindSettings {
-  // Keys to bind: "patch_radius", "poisson.solver" (a nested field). Empty = every non-struct top-level field.
+  // Keys to bind: "patch_radius", "poisson.solver" (a nested field), or an alias (util/options.h). Empty =
+  // every top-level field and alias that is not a struct.
   std::vector<std::string> keys;
   std::vector<std::string> skip;  // keys left out of the default set
   // Flag names for keys whose flag is a contract of the command ("search_window_radius" -> "--window");
@@ -74,7 +75,7 @@ class OptionBinder {
   void BindStruct(const StructInfo& info, void* object, const BindSettings& settings);
   // `in_root`: the field is part of the command's options (the first struct bound), so Given() lists it.
   void BindField(const FieldInfo& field, void* object, const std::string& key_path,
-                 const BindSettings& settings, bool in_root);
+                 const std::string& canonical_path, const BindSettings& settings, bool in_root);
 
   CLI::App& app_;
   std::map<std::string, std::string> flag_of_key_;

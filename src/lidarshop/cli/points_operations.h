@@ -22,6 +22,7 @@
 #include "lidarshop/pointset/surface.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scan/scan_mesh.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop::cli {
 
@@ -41,6 +42,15 @@ struct PointsOptions {
   RegionGrowingOptions regions;
   SuperpixelOptions superpixels;
 };
+
+}  // namespace lidarshop::cli
+
+namespace lidarshop {
+template <>
+const StructInfo& InfoOf<cli::PointsOptions>();  // points_command.cc
+}  // namespace lidarshop
+
+namespace lidarshop::cli {
 
 // The command's own flags that are no library option.
 struct PointsFlags {

@@ -384,7 +384,8 @@ int RunRecolor(int argc, char** argv) {
       used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
     counts["photos"] = used;
     counts["skipped"] = skipped;
-    // Wall clock per phase (issue 32 item 6); "colour" is RecolorFromPhotos as a whole, the others its parts.
+    // Wall clock per phase (issue 32 item 6); "colour" is RecolorFromPhotos as a whole, the others its parts;
+    // "colour_cpu" the process's CPU time during it (every thread).
     counts["seconds"] = {{"read", read_seconds},
                          {"colour", result.total_seconds},
                          {"write", write_seconds},
@@ -396,7 +397,8 @@ int RunRecolor(int argc, char** argv) {
                          {"gains", result.gain_seconds},
                          {"colours", result.colour_seconds},
                          {"blend", result.blend_seconds},
-                         {"output", result.output_seconds}};
+                         {"output", result.output_seconds},
+                         {"colour_cpu", result.cpu_seconds}};
     WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
     Summarize(fmt::format("{} -> {}", result.Summary(), output));
     return 0;

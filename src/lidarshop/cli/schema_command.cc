@@ -1,7 +1,9 @@
-// `lidarshop schema`: the described structs of the editor's API (server/api_types.h) as TypeScript
-// declarations (web/src/api_types.generated.ts; the ctest api_types_test keeps that file current) or as
-// JSON descriptions (each field's key, kind, doc, unit, range, choices and nested struct).
+// `lidarshop schema`: the described structs (util/options.h) as the TypeScript declarations of the editor's
+// API (server/api_types.h; web/src/api_types.generated.ts, kept current by the ctest api_types_test), as the
+// reference part of docs/options.md (every struct a command takes or answers; kept current by options_md_test)
+// or as JSON descriptions (each field's key, kind, doc, unit, range, choices and nested struct).
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include <fmt/format.h>
@@ -9,25 +11,86 @@
 
 #include "api_types.h"
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/points_operations.h"
+#include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/io/e57.h"
+#include "lidarshop/io/las.h"
+#include "lidarshop/io/ptx.h"
+#include "lidarshop/pointset/features.h"
+#include "lidarshop/pointset/registration.h"
+#include "lidarshop/pointset/site_registration.h"
+#include "lidarshop/poisson/poisson.h"
+#include "lidarshop/recolor/auto_resection.h"
+#include "lidarshop/recolor/recolor.h"
+#include "lidarshop/recolor/resection.h"
+#include "lidarshop/render/render_layout.h"
+#include "lidarshop/render/render_view.h"
+#include "lidarshop/scan/scan_mesh.h"
+#include "lidarshop/scanner/photo.h"
+#include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/atomic_file.h"
+#include "lidarshop/util/input_file.h"
+#include "lidarshop/util/options_markdown.h"
+#include "lidarshop/verify/sweep.h"
+#include "lidarshop/verify/verify.h"
 
 namespace lidarshop::cli {
+namespace {
+
+// The structs docs/options.md describes: the editor's API (the same list as the TypeScript types), then what
+// the commands take and answer beyond it, in the order of the page's table of commands. Nested structs follow
+// their holders by themselves.
+std::vector<TypeScriptStruct> DocumentedStructs() {
+  std::vector<TypeScriptStruct> structs = server::ApiTypes();
+  for (const TypeScriptStruct& entry : {
+           OptionsType<ScannerOptions>(),           // scan
+           OptionsType<ScanMeshOptions>(),          // scan --mesh-jump, points mesh
+           OptionsType<PtxReadOptions>(),           // reading PTX
+           OptionsType<E57WriteOptions>(),          // convert, E57 output
+           OptionsType<LasWriteOptions>(),          // LAS output
+           OptionsType<PointViewOptions>(),         // render
+           OptionsType<PictureLayoutOptions>(),     // render
+           OptionsType<VerifyOptions>(),            // verify, sweep
+           OptionsType<SweepOptions>(),             // sweep
+           OptionsType<PoissonOptions>(),           // poisson
+           OptionsType<FillMetricsOptions>(),       // fill_eval
+           OptionsType<ResectionOptions>(),         // resection, recolor
+           OptionsType<AutoResectionOptions>(),     // resection --auto
+           OptionsType<RecolorOptions>(),           // recolor
+           OptionsType<PhotoOptions>(),             // photo
+           OptionsType<PointsOptions>(),            // points
+           OptionsType<IcpOptions>(),               // register
+           OptionsType<GlobalAlignOptions>(),       // register --global
+           OptionsType<SiteRegistrationOptions>(),  // register, several MOVING
+       }) {
+    structs.push_back(entry);
+  }
+  return structs;
+}
+
+}  // namespace
 
 int RunSchema(int argc, char** argv) {
   CLI::App app{
-      "The option and result structs of the editor's API as the library describes them (src/server/"
-      "api_types.cc): TypeScript declarations for the front end (--typescript) or their descriptions as "
-      "JSON (--json).",
+      "The option and result structs as the library describes them: TypeScript declarations of the editor's "
+      "API for the front end (--typescript, src/server/api_types.cc), the reference part of docs/options.md "
+      "(--markdown) or their descriptions as JSON (--json).",
       "schema"};
   std::string json_path, output;
-  bool typescript = false;
+  bool typescript = false, markdown = false;
   AddJsonOption(app, &json_path);
   app.add_flag("--typescript", typescript,
                "write the TypeScript declarations (web/src/api_types.generated.ts)");
-  app.add_option("-o,--output", output, "with --typescript: the file to write (default: stdout)");
+  app.add_flag("--markdown", markdown,
+               "write the reference of every described struct: with -o, into that page below its line "
+               "\"<!-- Generated below ... -->\" (the hand-written part above it stays); else on stdout");
+  app.add_option("-o,--output", output,
+                 "with --typescript or --markdown: the file to write (default: stdout)");
   return RunCommand(app, argc, argv, [&]() {
-    if (typescript && !json_path.empty()) throw OptionsError("--typescript and --json: give one");
-    if (!output.empty() && !typescript) throw OptionsError("--output goes with --typescript");
+    if (int(typescript) + int(markdown) + int(!json_path.empty()) > 1)
+      throw OptionsError("--typescript, --markdown and --json: give one");
+    if (!output.empty() && !typescript && !markdown)
+      throw OptionsError("--output goes with --typescript or --markdown");
     if (typescript) {
       if (!output.empty()) CheckOutputFile("--output", output, {"ts"}, {});
       const std::string text = server::ApiTypesTypeScript();
@@ -36,6 +99,18 @@ int RunSchema(int argc, char** argv) {
       } else {
         WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
         Summarize(fmt::format("{} structs -> {}", server::ApiTypes().size(), output));
+      }
+    } else if (markdown) {
+      const std::string reference = MarkdownReference(DocumentedStructs());
+      if (output.empty()) {
+        fmt::print("{}", reference);
+      } else {
+        // The page is updated in place, like a formatter: its hand-written part is read from it.
+        CheckOutputFile("--output", output, {"md"}, {});
+        const std::string page = ReadRegularFile(output);
+        const std::string text = ReplaceGeneratedPart(page, reference);
+        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        Summarize(fmt::format("{} structs -> {}", DocumentedStructs().size(), output));
       }
     } else if (!json_path.empty()) {
       nlohmann::ordered_json list = nlohmann::ordered_json::array();
@@ -46,7 +121,7 @@ int RunSchema(int argc, char** argv) {
       }
       WriteJsonOutput(json_path, {{"structs", list}});
     } else {
-      throw OptionsError("give --typescript or --json FILE");
+      throw OptionsError("give --typescript, --markdown or --json FILE");
     }
     return kExitOk;
   });

@@ -30,6 +30,15 @@ using fill_internal::UnanchoredCells;
 
 void FillOptions::Check() const { Validate(*this); }
 
+InpaintOptions FillInpaintDefaults() {
+  InpaintOptions inpaint;
+  inpaint.patch_radius = 4;
+  inpaint.search = InpaintSearchKind::kPatchMatch;
+  inpaint.local_window_radius = 50;
+  inpaint.acceptance = AcceptanceOptions::Combined();
+  return inpaint;
+}
+
 std::string FillResult::Summary() const {
   return fmt::format(
       "filled {} hole cells: {} synthesized points, {} left without a return{}, {} patches{}; {:.2f} s "
@@ -196,23 +205,17 @@ cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
 
 InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure, const FillOptions& options,
                         Progress* progress, FillResult* result_counts) {
-  InpaintOptions inpaint;
-  inpaint.patch_radius = options.patch_radius;
+  // The fill's inpainting as described (FillOptions::inpaint), with the search and the channel weights that
+  // the fill decides.
+  InpaintOptions inpaint = options.inpaint;
   // The exact search is the two-step one with the local window as its first bound: the same best patch,
   // found sooner.
   const double cost = static_cast<double>(result_counts->hole_cells) * static_cast<double>(in.hole.total());
   const bool exact =
-      options.search == InpaintSearchKind::kExhaustive ||
-      (options.search == InpaintSearchKind::kPatchMatch && cost <= options.exact_search_max_cost);
-  inpaint.search = exact ? InpaintSearchKind::kTwoStep : options.search;
+      inpaint.search == InpaintSearchKind::kExhaustive ||
+      (inpaint.search == InpaintSearchKind::kPatchMatch && cost <= options.exact_search_max_cost);
+  if (exact) inpaint.search = InpaintSearchKind::kTwoStep;
   result_counts->exact_search = exact;
-  inpaint.priority = options.priority;
-  inpaint.patchmatch_random_samples = options.patchmatch_random_samples;
-  inpaint.patchmatch_iterations = options.patchmatch_iterations;
-  inpaint.acceptance = options.acceptance;
-  inpaint.acceptance_local_first = options.acceptance_local_first;
-  inpaint.local_window_radius = options.search_window_radius;
-  inpaint.seed = options.seed;
   inpaint.channel_weights.assign(static_cast<size_t>(in.guide.channels()),
                                  static_cast<float>(options.color_weight));
   for (size_t k = 0; k < structure.size(); ++k)
@@ -318,7 +321,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
     source = source.clone();
     const fill_internal::FacadeLatticeReport lattice = fill_internal::RefineSourcesByLattice(
         in.range, in.known_valid, in.scan->direction, in.guide, in.hole, GridOf(*in.scan), options.planes,
-        options.lattice, options.seed, &source, &relief_range);
+        options.lattice, options.inpaint.seed, &source, &relief_range);
     result->lattice_cells = lattice.cells;
     result->lattice_pitches_m = lattice.pitches_m;
     result->lattice_storeys_m = lattice.storeys_m;
@@ -390,7 +393,7 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   timer.Restart();
   result->plane_cells =
       fill_internal::SnapToPlanes(in.range, in.known_valid, in.scan->direction, in.hole, values->has_return,
-                                  source, options.planes, options.seed, &values->range);
+                                  source, options.planes, options.inpaint.seed, &values->range);
   // The lattice's cells stand on their facade, refitted over a storey and several pitches of it, at their
   // source's relief: the planes of the band around the hole keep a tilt a narrow band cannot pin down, which a
   // source a pitch away would carry (a degree is 0.07 m at four metres). Only where the reconstruction agrees

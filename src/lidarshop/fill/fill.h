@@ -48,32 +48,40 @@ enum class FillMethod { kGradient, kLaplace, kDepthPatch, kTelea };
 template <>
 const EnumInfo& EnumInfoOf<FillMethod>();
 
+// The fill's patch inpainting (gradient and depth-patch methods) as InpaintOptions with the fill's defaults:
+// 9 x 9 patches (with 6 channels one AVX-512 row per patch row), PatchMatch, a 50-cell local window and the
+// combined acceptance tests. FillOptions::inpaint starts from it.
+InpaintOptions FillInpaintDefaults();
+
+// The largest patch radius the fill takes (InpaintOptions allows more), cells.
+inline constexpr int kFillMaxPatchRadius = 15;
+
 struct FillOptions {
   FillMethod method = FillMethod::kGradient;
-  // Patch fill (gradient and depth-patch).
-  int patch_radius = 4;  // cells; patches are (2r+1)² (9 x 9: with 6 channels one AVX-512 row per patch row)
-  InpaintPriorityKind priority = InpaintPriorityKind::kCriminisi;  // fill order
-  // PatchMatch: random samples over the whole scan plus samples near the target (a surface hidden behind a
-  // large object is found far away, e.g. a facade above a car). kExhaustive runs the two-step search with the
-  // local window as its first bound (the same patches).
-  InpaintSearchKind search = InpaintSearchKind::kPatchMatch;
+  // Patch fill (gradient and depth-patch): the inpainting of the joint image, nested (the CLI's flags and the
+  // flat JSON keys of before stay as aliases: patch_radius, priority, search, search_window_radius =
+  // inpaint.local_window_radius, patchmatch_random_samples, patchmatch_iterations, acceptance,
+  // acceptance_local_first, seed). The fill reads every field but these, which it decides itself:
+  //   search           kExhaustive runs the two-step search with the local window as its first bound (the
+  //                    same patches, found sooner); PatchMatch draws random samples over the whole scan plus
+  //                    samples near the target (a surface hidden behind a large object is found far away,
+  //                    e.g. a facade above a car), and gives way to the exact search by exact_search_max_cost;
+  //   channel_weights  must stay empty: the weights are color_weight, gradient_weight and return_weight;
+  //   stop_for_review  must stay false (the fill cannot stop half way);
+  //   seed             also seeds the facade lattice's and the planes' RANSAC;
+  //   acceptance       the patch acceptance tests (inpaint/acceptance.h, thesis 7.1), the combined set by
+  //                    default: a patch is copied only when what it brings agrees with the target's known part
+  //                    (measured on data/fill_eval: mean range RMSE over the non-planar scenes 24 mm with them,
+  //                    195 mm without; bench/results/fill.md); `enabled = false` trusts the best patch
+  //                    difference alone. acceptance_local_first: search the local window exhaustively first,
+  //                    then the whole scan (true), or offer the configured search's best candidates only.
+  InpaintOptions inpaint = FillInpaintDefaults();
   // With PatchMatch: the exact search instead when its cost, hole cells x scan cells, is at most this. A
   // 20,000-cell hole in a 480 x 320 scan (3e9) takes about 0.5 s exact; a 100,000-cell hole in a 1000 x 1000
   // scan (1e11) 8 to 16 s, where PatchMatch takes 1.5 s. Measured on data/fill_eval (bench/results/fill.md):
   // mean range RMSE over the non-planar scenes 24.5 mm exact, 81.0 mm PatchMatch, whose local-first candidates
   // let the ground climb into a facade behind a van. 0 = always PatchMatch.
   double exact_search_max_cost = 1e10;
-  int search_window_radius = 50;       // cells; local window (local search; PatchMatch's near samples)
-  int patchmatch_random_samples = 48;  // PatchMatch: uniform draws over the scan per query (>= 1)
-  int patchmatch_iterations = 4;       // PatchMatch: propagation + random-search rounds per query (>= 1)
-  // Patch acceptance tests (inpaint/acceptance.h, thesis 7.1), the combined set by default: a patch is copied
-  // only when what it brings agrees with the target's known part (measured on data/fill_eval: mean range RMSE
-  // over the non-planar scenes 24 mm with them, 195 mm without; bench/results/fill.md). `enabled = false`
-  // trusts the best patch difference alone.
-  AcceptanceOptions acceptance = AcceptanceOptions::Combined();
-  // With acceptance: search the local window exhaustively first, then the whole scan (true), or offer the
-  // configured search's best candidates only (false, faster).
-  bool acceptance_local_first = true;
   // Channel weights of the patch difference. Colour is in grey levels (0..255, or intensity × 255; a scan with
   // neither colour nor intensity has a constant colour channel, so only the range gradients guide); a range
   // gradient g becomes 255 · asinh(g / s) / asinh(1) with s its 90th percentile over the known cells (range
@@ -114,7 +122,6 @@ struct FillOptions {
   FacadeLatticeOptions lattice;
   PoissonOptions poisson;   // range reconstruction (and the laplace baseline)
   FillPlaneOptions planes;  // gradient method: reconstructed ranges onto the planes around the hole
-  uint64_t seed = 0;        // random choices of the patch fill (ties are broken by position)
   // The window the fill works in, so that its cost follows the hole, not the scan: the hole's bounding box
   // grown by `window_margin` times its larger side (at least `window_min_margin_cells`) on each side, then
   // doubled until it holds `window_min_known_ratio` times as many known returns as the hole has cells. The

@@ -126,7 +126,7 @@ TEST(FillSurroundings, KerbStepsKeepsItsScore) {
   double rmse_mm = 0, within = 0;
   for (uint64_t seed = 0; seed < 3; ++seed) {  // fill_eval's three fills
     FillOptions options;
-    options.seed = seed;
+    options.inpaint.seed = seed;
     const FillMetrics m = MeasureFill(FillScan(c.scan, c.hole, options).scan, c.truth, c.hole);
     rmse_mm += m.range_rmse_mm / 3;
     within += m.within_share / 3;

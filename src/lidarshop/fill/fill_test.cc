@@ -340,11 +340,11 @@ TEST(FillScan, SmallHolesGetTheExactSearch) {
   FillOptions options;
   const FillResult automatic = FillScan(c.scan, c.hole, options);
   EXPECT_TRUE(automatic.exact_search);
-  options.search = InpaintSearchKind::kExhaustive;
+  options.inpaint.search = InpaintSearchKind::kExhaustive;
   const FillResult exact = FillScan(c.scan, c.hole, options);
   EXPECT_TRUE(exact.exact_search);
   EXPECT_EQ(cv::countNonZero(automatic.scan.range != exact.scan.range), 0);
-  options.search = InpaintSearchKind::kPatchMatch;
+  options.inpaint.search = InpaintSearchKind::kPatchMatch;
   options.exact_search_max_cost = 0;
   const FillResult patchmatch = FillScan(c.scan, c.hole, options);
   EXPECT_FALSE(patchmatch.exact_search);
@@ -436,7 +436,7 @@ TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
 TEST(FillScan, SameSeedSameFillOnAnyThreadCount) {
   const Case c = MakeCase(kWallScene, 1);
   FillOptions options;
-  options.seed = 3;
+  options.inpaint.seed = 3;
   const FillResult a = FillScan(c.scan, c.hole, options);
   FillResult b;
   {
@@ -449,7 +449,7 @@ TEST(FillScan, SameSeedSameFillOnAnyThreadCount) {
   // planes, refitted by least squares after RANSAC, give the same answer for every seed).
   options.exact_search_max_cost = 0;
   const FillResult drawn = FillScan(c.scan, c.hole, options);
-  options.seed = 4;
+  options.inpaint.seed = 4;
   const FillResult other = FillScan(c.scan, c.hole, options);
   EXPECT_GT(cv::norm(drawn.scan.range, other.scan.range, cv::NORM_INF), 0.0);
 }
@@ -521,7 +521,7 @@ TEST(FillScan, BadAndEdgeCaseMasks) {
     EXPECT_EQ(small.synthesized_cells + small.no_return_cells, 9);
   }
   FillOptions bad;
-  bad.patch_radius = 0;
+  bad.inpaint.patch_radius = 0;
   EXPECT_THROW(FillScan(c.scan, border, bad), OptionsError);
   EXPECT_THROW(ParseEnum<FillMethod>("magic"), OptionsError);
 }

@@ -22,28 +22,23 @@ const StructInfo& InfoOf<FillOptions>() {
   static const StructInfo info = [] {
     StructBuilder<FillOptions> b("FillOptions", "hole filling in scans");
     b.Field(&FillOptions::method, "method", "fill method");
-    b.Field(&FillOptions::patch_radius, "patch_radius", "patch half-width; patches are 2r+1 wide")
-        .Unit("cells")
-        .Range(1, 15);
-    b.Field(&FillOptions::priority, "priority", "fill order of the patch methods");
-    b.Field(&FillOptions::search, "search", "source search of the patch methods");
+    b.Field(
+        &FillOptions::inpaint, "inpaint",
+        "patch inpainting of the patch methods (channel_weights empty and stop_for_review false: the fill "
+        "decides them)");
+    // The flat keys and flags of before the nesting.
+    b.Alias("patch_radius", "inpaint.patch_radius").Range(1, kFillMaxPatchRadius);
+    b.Alias("priority", "inpaint.priority");
+    b.Alias("search", "inpaint.search");
     b.Field(&FillOptions::exact_search_max_cost, "exact_search_max_cost",
             "with patchmatch: the exact search when hole cells x scan cells is at most this; 0 = never")
         .Unit("cells x cells")
         .Min(0);
-    b.Field(&FillOptions::search_window_radius, "search_window_radius",
-            "half-width of the local source search (and PatchMatch's near samples)")
-        .Unit("cells")
-        .Min(1);
-    b.Field(&FillOptions::patchmatch_random_samples, "patchmatch_random_samples",
-            "PatchMatch: uniform draws over the scan per query")
-        .Range(1, 100000);
-    b.Field(&FillOptions::patchmatch_iterations, "patchmatch_iterations",
-            "PatchMatch: propagation + random-search rounds per query")
-        .Range(1, 100);
-    b.Field(&FillOptions::acceptance, "acceptance", "patch acceptance tests (the combined set by default)");
-    b.Field(&FillOptions::acceptance_local_first, "acceptance_local_first",
-            "with acceptance: search the local window exhaustively before the whole scan");
+    b.Alias("search_window_radius", "inpaint.local_window_radius");
+    b.Alias("patchmatch_random_samples", "inpaint.patchmatch_random_samples").Range(1, 100000);
+    b.Alias("patchmatch_iterations", "inpaint.patchmatch_iterations").Range(1, 100);
+    b.Alias("acceptance", "inpaint.acceptance");
+    b.Alias("acceptance_local_first", "inpaint.acceptance_local_first");
     b.Field(&FillOptions::color_weight, "color_weight", "patch difference weight of each colour channel")
         .Min(0);
     b.Field(&FillOptions::gradient_weight, "gradient_weight",
@@ -72,7 +67,7 @@ const StructInfo& InfoOf<FillOptions>() {
     b.Field(&FillOptions::lattice, "lattice",
             "gradient method: cells copied from a repeating facade taken one or more pitches along it");
     b.Field(&FillOptions::planes, "planes", "gradient method: ranges onto the planes seen around the hole");
-    b.Field(&FillOptions::seed, "seed", "seed of the patch fill's random choices");
+    b.Alias("seed", "inpaint.seed");
     b.Field(&FillOptions::window_margin, "window_margin",
             "work in the hole's bounding box grown by this times its larger side; 0 = the whole scan")
         .Unit("hole sizes")
@@ -85,9 +80,18 @@ const StructInfo& InfoOf<FillOptions>() {
             "the window is doubled until it holds this many known returns per hole cell")
         .Range(0, 1e6);
     b.Check([](const FillOptions& o) {
-      if (o.search_window_radius < o.patch_radius) {
-        throw OptionsFieldError("search_window_radius", fmt::format("{} is less than the patch radius {}",
-                                                                    o.search_window_radius, o.patch_radius));
+      if (!o.inpaint.channel_weights.empty()) {
+        throw OptionsFieldError(
+            "inpaint.channel_weights",
+            "must be empty: the fill weighs its channels by color_weight, gradient_weight "
+            "and return_weight");
+      }
+      if (o.inpaint.stop_for_review)
+        throw OptionsFieldError("inpaint.stop_for_review", "the fill cannot stop for a review");
+      if (o.inpaint.local_window_radius < o.inpaint.patch_radius) {
+        throw OptionsFieldError("inpaint.local_window_radius",
+                                fmt::format("{} is less than the patch radius {}",
+                                            o.inpaint.local_window_radius, o.inpaint.patch_radius));
       }
       if (o.color_weight + o.gradient_weight + o.return_weight <= 0) {
         throw OptionsFieldError("color_weight", "one of the colour, gradient and return weights must be > 0");

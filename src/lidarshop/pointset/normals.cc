@@ -81,33 +81,38 @@ NormalResult EstimateNormals(const PointCloud& cloud, const NormalOptions& optio
   return result;
 }
 
+bool GridNormalAt(const Scan& scan, const NormalOptions& options, int row, int col, cv::Vec3f* normal,
+                  float* curvature) {
+  if (!scan.valid.at<uint8_t>(row, col)) return false;
+  const int w = options.window_cells;
+  const float radius_sq = static_cast<float>(options.radius_m * options.radius_m);
+  const cv::Vec3f& c = scan.point.at<cv::Vec3f>(row, col);
+  const Eigen::Vector3f centre(c[0], c[1], c[2]);
+  Covariance covariance;
+  for (int r = std::max(0, row - w); r <= std::min(scan.rows - 1, row + w); ++r) {
+    for (int k = std::max(0, col - w); k <= std::min(scan.cols - 1, col + w); ++k) {
+      if (!scan.valid.at<uint8_t>(r, k)) continue;
+      const cv::Vec3f& q = scan.point.at<cv::Vec3f>(r, k);
+      const Eigen::Vector3f relative = Eigen::Vector3f(q[0], q[1], q[2]) - centre;
+      if (radius_sq > 0.0f && relative.squaredNorm() >= radius_sq) continue;
+      covariance.Add(relative);
+    }
+  }
+  Eigen::Vector3f n;
+  if (!covariance.Solve(-centre, &n, curvature)) return false;
+  *normal = cv::Vec3f(n.x(), n.y(), n.z());
+  return true;
+}
+
 GridNormalResult EstimateGridNormals(const Scan& scan, const NormalOptions& options) {
   options.Check();
   if (scan.CountValid() < 3) throw InputError("grid normals: the scan has fewer than 3 returns");
   GridNormalResult result{cv::Mat(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0)),
                           cv::Mat(scan.rows, scan.cols, CV_32F, cv::Scalar(NAN))};
-  const int w = options.window_cells;
-  const float radius_sq = static_cast<float>(options.radius_m * options.radius_m);
   ParallelFor(scan.rows, [&](int64_t row) {
     for (int col = 0; col < scan.cols; ++col) {
-      if (!scan.valid.at<uint8_t>(row, col)) continue;
-      const cv::Vec3f& c = scan.point.at<cv::Vec3f>(row, col);
-      const Eigen::Vector3f centre(c[0], c[1], c[2]);
-      Covariance covariance;
-      for (int r = std::max<int>(0, row - w); r <= std::min<int>(scan.rows - 1, row + w); ++r) {
-        for (int k = std::max(0, col - w); k <= std::min(scan.cols - 1, col + w); ++k) {
-          if (!scan.valid.at<uint8_t>(r, k)) continue;
-          const cv::Vec3f& q = scan.point.at<cv::Vec3f>(r, k);
-          const Eigen::Vector3f relative = Eigen::Vector3f(q[0], q[1], q[2]) - centre;
-          if (radius_sq > 0.0f && relative.squaredNorm() >= radius_sq) continue;
-          covariance.Add(relative);
-        }
-      }
-      Eigen::Vector3f normal;
-      float curvature;
-      if (!covariance.Solve(-centre, &normal, &curvature)) continue;
-      result.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(normal.x(), normal.y(), normal.z());
-      result.curvature.at<float>(row, col) = curvature;
+      GridNormalAt(scan, options, static_cast<int>(row), col, &result.normal.at<cv::Vec3f>(row, col),
+                   &result.curvature.at<float>(row, col));
     }
   });
   return result;

@@ -47,6 +47,11 @@ struct GridNormalResult {
   cv::Mat curvature;
 };
 GridNormalResult EstimateGridNormals(const Scan& scan, const NormalOptions& options);
+// One cell's grid normal and curvature as EstimateGridNormals computes it (the same numbers), for callers that
+// need a few cells of a large scan; false (outputs untouched) where EstimateGridNormals leaves 0 / NaN.
+// `options` is not checked here.
+bool GridNormalAt(const Scan& scan, const NormalOptions& options, int row, int col, cv::Vec3f* normal,
+                  float* curvature);
 
 // The scan with its `normal` and `curvature` channels replaced by the grid normals and their curvature.
 Scan WithGridNormals(const Scan& scan, const NormalOptions& options);

@@ -316,21 +316,40 @@ void SolveChannels(const PoissonSystem::Impl& system, const cv::Mat& boundary, c
 // A NaN or inf among the values the solve reads (boundary pixels next to Ω, or the divergence in Ω) would
 // spread through the whole hole; refuse it, naming the first such pixel. Values elsewhere are not read.
 static void RefuseNonFinite(const cv::Mat& values, const cv::Mat& mask, bool inside, const char* what) {
-  cv::Mat read;
-  if (inside) {
-    read = mask;
-  } else {
-    cv::dilate(mask, read, cv::Mat::ones(3, 3, CV_8U));
-    read.setTo(0, mask);
-  }
-  cv::Mat zeroed = cv::Mat::zeros(values.size(), values.type());
-  values.copyTo(zeroed, read);
-  cv::Point at;
-  if (!cv::checkRange(zeroed, /*quiet=*/true, &at)) {
-    throw InputError(
-        fmt::format("SolvePoisson: {} holds NaN or inf at pixel (x {}, y {}) {} the hole; fix "
-                    "or mask that pixel",
-                    what, at.x, at.y, inside ? "inside" : "next to"));
+  // Row by row over the mask alone (no image of the grid's size: a thin band in a 10-megapixel grid reads a
+  // few hundred thousand values); the first pixel in row-major order is named, as cv::checkRange would.
+  const int rows = mask.rows, cols = mask.cols, channels = values.channels();
+  const bool is_double = values.depth() == CV_64F;
+  const auto finite = [&](int r, int c) {
+    for (int k = 0; k < channels; ++k) {
+      const double v = is_double ? values.ptr<double>(r)[c * channels + k]
+                                 : static_cast<double>(values.ptr<float>(r)[c * channels + k]);
+      if (!std::isfinite(v)) return false;
+    }
+    return true;
+  };
+  for (int r = 0; r < rows; ++r) {
+    const uint8_t* here = mask.ptr<uint8_t>(r);
+    const uint8_t* above = r > 0 ? mask.ptr<uint8_t>(r - 1) : nullptr;
+    const uint8_t* below = r + 1 < rows ? mask.ptr<uint8_t>(r + 1) : nullptr;
+    for (int c = 0; c < cols; ++c) {
+      bool read = here[c] != 0;
+      if (!inside) {
+        // Next to the hole: outside it, with a pixel of it among the 3 x 3 around.
+        if (read) continue;
+        for (int dc = -1; dc <= 1 && !read; ++dc) {
+          const int x = c + dc;
+          if (x < 0 || x >= cols) continue;
+          read = here[x] || (above != nullptr && above[x]) || (below != nullptr && below[x]);
+        }
+      }
+      if (read && !finite(r, c)) {
+        throw InputError(
+            fmt::format("SolvePoisson: {} holds NaN or inf at pixel (x {}, y {}) {} the hole; fix "
+                        "or mask that pixel",
+                        what, c, r, inside ? "inside" : "next to"));
+      }
+    }
   }
 }
 
@@ -355,7 +374,12 @@ PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& bo
           divergence_in.cols, divergence_in.rows, divergence_in.channels(), system.size.width,
           system.size.height, n));
     }
-    divergence_in.convertTo(divergence, depth);
+    // Only read: no copy when it is already of the solve's depth (a 10-megapixel grid's divergence is 120 MB).
+    if (divergence_in.depth() == depth) {
+      divergence = divergence_in;
+    } else {
+      divergence_in.convertTo(divergence, depth);
+    }
   }
   RefuseNonFinite(boundary, system_handle.Mask(), /*inside=*/false, "the boundary image");
   if (!divergence.empty())

@@ -5,11 +5,13 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <mutex>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "lidarshop/recolor/view_cull.h"
 #include "lidarshop/util/parallel.h"
 
 namespace lidarshop::recolor_internal {
@@ -51,29 +53,51 @@ Eigen::Vector3f EmbreeNormal(const Eigen::Vector3f& v0, const Eigen::Vector3f& v
   return (v1 - v0).cross(v2 - v0);
 }
 
+// Trivially constructible: a photo's buffer of them is allocated for every mesh vertex but written only for
+// the vertices of the blocks its view reaches (the pages of the others are never touched).
 struct ProjectedVertex {
   Eigen::Vector3f in_camera;
-  float x = 0, y = 0;  // continuous buffer pixels
-  bool projects = false;
-  bool behind = false;  // pinhole: z <= 0
+  float x, y;       // continuous buffer pixels
+  bool projects;    // false: the camera model gives the vertex no pixel
+  bool behind;      // pinhole: z <= 0
+  uint8_t outcode;  // ViewPlanes::Outcode
 };
 
-std::vector<ProjectedVertex> ProjectVertices(const TriangleMesh& mesh, const Camera& camera,
-                                             const BufferGeometry& g) {
+// The vertices of the blocks `blocks` (indices into the mesh's blocks of kCullBlockTriangles), projected; the
+// other entries are left unwritten.
+std::unique_ptr<ProjectedVertex[]> ProjectVertices(const TriangleMesh& mesh, const Camera& camera,
+                                                   const BufferGeometry& g, const ViewPlanes& planes,
+                                                   const std::vector<int32_t>& blocks) {
   const Eigen::Matrix3d camera_from_world = camera.world_from_camera.topLeftCorner<3, 3>().transpose();
   const Eigen::Vector3d center = camera.center_in_world();
-  std::vector<ProjectedVertex> out(mesh.vertices.size());
+  auto out = std::make_unique_for_overwrite<ProjectedVertex[]>(mesh.vertices.size());
+  const int64_t triangles = static_cast<int64_t>(mesh.triangles.size());
+  // Which vertices: a byte each (zero pages cost nothing until written), set from the blocks in parallel.
+  std::vector<uint8_t> needed(mesh.vertices.size(), 0);
+  ParallelFor(
+      static_cast<int64_t>(blocks.size()),
+      [&](int64_t i) {
+        const int64_t begin = static_cast<int64_t>(blocks[i]) * kCullBlockTriangles;
+        const int64_t end = std::min(triangles, begin + kCullBlockTriangles);
+        for (int64_t f = begin; f < end; ++f) {
+          for (int k = 0; k < 3; ++k)
+            std::atomic_ref<uint8_t>(needed[mesh.triangles[f][k]]).store(1, std::memory_order_relaxed);
+        }
+      },
+      16);
   ParallelForRange(
-      static_cast<int64_t>(out.size()),
+      static_cast<int64_t>(mesh.vertices.size()),
       [&](int64_t begin, int64_t end) {
         for (int64_t v = begin; v < end; ++v) {
+          if (!needed[v]) continue;
           const Eigen::Vector3d p = camera_from_world * (mesh.vertices[v].cast<double>() - center);
           ProjectedVertex& pv = out[v];
           pv.in_camera = p.cast<float>();
-          if (camera.model == CameraModel::kPinhole && p.z() <= 0) {
-            pv.behind = true;
-            continue;
-          }
+          pv.x = pv.y = 0;
+          pv.projects = false;
+          pv.behind = camera.model == CameraModel::kPinhole && p.z() <= 0;
+          pv.outcode = planes.Outcode(pv.in_camera);
+          if (pv.behind) continue;
           Eigen::Vector2d pixel;
           if (!ProjectCameraPoint(camera, p, &pixel)) continue;
           pv.projects = true;
@@ -82,6 +106,26 @@ std::vector<ProjectedVertex> ProjectVertices(const TriangleMesh& mesh, const Cam
         }
       },
       4096);
+  return out;
+}
+
+// The blocks of `mesh` whose box the view can reach (every block without planes), in order.
+std::vector<int32_t> BlocksInView(const TriangleMesh& mesh, const ViewPlanes& planes,
+                                  const std::vector<Eigen::AlignedBox3f>* boxes) {
+  const int64_t blocks =
+      (static_cast<int64_t>(mesh.triangles.size()) + kCullBlockTriangles - 1) / kCullBlockTriangles;
+  std::vector<int32_t> out;
+  if (planes.count == 0 || boxes == nullptr || static_cast<int64_t>(boxes->size()) != blocks) {
+    out.resize(blocks);
+    for (int64_t b = 0; b < blocks; ++b) out[b] = static_cast<int32_t>(b);
+    return out;
+  }
+  std::vector<uint8_t> keep(blocks);
+  ParallelFor(
+      blocks, [&](int64_t b) { keep[b] = !planes.Outside((*boxes)[b]); }, 1024);
+  for (int64_t b = 0; b < blocks; ++b) {
+    if (keep[b]) out.push_back(static_cast<int32_t>(b));
+  }
   return out;
 }
 
@@ -118,60 +162,116 @@ float RayDistance(const Eigen::Vector3f& ray, float ray_norm, const Eigen::Vecto
   return t > 0 ? t * ray_norm : -1;
 }
 
+// The ray of each buffer pixel (camera frame) and its length: from a table, or — an undistorted pinhole
+// without skew, whose ray is (a(col), b(row), 1) — from a row and a column of normalized coordinates (the same
+// arithmetic as PixelRay, so the same floats), which spares each photo a table of 16 bytes per pixel.
+struct PixelRays {
+  const BufferGeometry* g = nullptr;
+  bool separable = false;
+  std::vector<float> a_of_col, b_of_row;  // separable
+  std::vector<Eigen::Vector3f> table;     // otherwise
+  std::vector<float> norms;
+
+  Eigen::Vector3f Ray(int row, int col, float* norm) const {
+    if (!separable) {
+      const size_t pixel = static_cast<size_t>(row) * g->cols + col;
+      *norm = norms[pixel];
+      return table[pixel];
+    }
+    const Eigen::Vector3f ray(a_of_col[col], b_of_row[row], 1.0f);
+    *norm = ray.norm();
+    return ray;
+  }
+};
+
+PixelRays RaysOf(const Camera& camera, const BufferGeometry& g) {
+  PixelRays rays;
+  rays.g = &g;
+  const PinholeCamera& k = camera.pinhole;
+  if (camera.model == CameraModel::kPinhole && !k.has_distortion() && k.skew_px == 0) {
+    rays.separable = true;
+    // UnprojectPixel's b = (y − cy) / fy and a = (x − cx − skew · b) / fx, with skew 0.
+    for (int r = 0; r < g.rows; ++r)
+      rays.b_of_row.push_back(static_cast<float>(((r + 0.5) * g.sy - k.cy_px) / k.fy_px));
+    for (int c = 0; c < g.cols; ++c)
+      rays.a_of_col.push_back(static_cast<float>(((c + 0.5) * g.sx - k.cx_px - k.skew_px * 0.0) / k.fx_px));
+    return rays;
+  }
+  const int64_t pixels = static_cast<int64_t>(g.rows) * g.cols;
+  rays.table.resize(pixels);
+  rays.norms.resize(pixels);
+  ParallelFor(g.rows, [&](int64_t r) {
+    for (int c = 0; c < g.cols; ++c) {
+      const size_t pixel = static_cast<size_t>(r) * g.cols + c;
+      rays.table[pixel] = PixelRay(camera, g, static_cast<int>(r), c);
+      rays.norms[pixel] = rays.table[pixel].norm();
+    }
+  });
+  return rays;
+}
+
 struct RasterTarget {
   const BufferGeometry& g;
-  const std::vector<Eigen::Vector3f>& rays;  // per buffer pixel, camera frame
-  const std::vector<float>& ray_norms;
+  const PixelRays& rays;
   std::vector<std::atomic<uint64_t>>& keys;
   bool panorama = false;        // spherical or cylindrical: a triangle across the seam is cast
   bool straight_edges = false;  // a pinhole without distortion maps a triangle's edges to straight lines
 };
 
 // Rasterizes one mesh; appends the triangles it leaves to the cast to `cast` (indices into the mesh).
-void RasterMesh(const TriangleMesh& mesh, const std::vector<ProjectedVertex>& vertices, uint32_t index_base,
-                const RasterTarget& target, const RasterOptions& options, std::vector<int32_t>* cast) {
+// Only the triangles of `blocks`; a triangle with its corners outside one view plane meets no ray of the image.
+void RasterMesh(const TriangleMesh& mesh, const ProjectedVertex* vertices, const std::vector<int32_t>& blocks,
+                uint32_t index_base, const RasterTarget& target, const RasterOptions& options,
+                std::vector<int32_t>* cast) {
   std::mutex cast_mutex;
   const BufferGeometry& g = target.g;
+  const int64_t triangles = static_cast<int64_t>(mesh.triangles.size());
   ParallelForRange(
-      static_cast<int64_t>(mesh.triangles.size()),
-      [&](int64_t begin, int64_t end) {
+      static_cast<int64_t>(blocks.size()),
+      [&](int64_t block_begin, int64_t block_end) {
         std::vector<int32_t> local_cast;
-        for (int64_t f = begin; f < end; ++f) {
-          const Eigen::Vector3i& t = mesh.triangles[f];
-          const ProjectedVertex& a = vertices[t[0]];
-          const ProjectedVertex& b = vertices[t[1]];
-          const ProjectedVertex& c = vertices[t[2]];
-          if (a.behind && b.behind && c.behind) continue;  // every pinhole ray has z > 0
-          if (!a.projects || !b.projects || !c.projects) {
-            local_cast.push_back(static_cast<int32_t>(f));
-            continue;
-          }
-          const float min_x = std::min({a.x, b.x, c.x}), max_x = std::max({a.x, b.x, c.x});
-          const float min_y = std::min({a.y, b.y, c.y}), max_y = std::max({a.y, b.y, c.y});
-          const float size = std::max(max_x - min_x, max_y - min_y);
-          if (size > options.max_raster_px || (target.panorama && max_x - min_x > 0.5f * g.cols)) {
-            local_cast.push_back(static_cast<int32_t>(f));
-            continue;
-          }
-          // The corners' box holds the projection but for edges a camera model bends, and rounding.
-          const float pad =
-              0.01f + (target.straight_edges ? 0.0f : static_cast<float>(options.bend_margin) * size);
-          // Pixel centres (col + 0.5, row + 0.5) inside the padded box.
-          const int c0 = std::max(0, static_cast<int>(std::ceil(min_x - pad - 0.5f)));
-          const int c1 = std::min(g.cols - 1, static_cast<int>(std::floor(max_x + pad - 0.5f)));
-          const int r0 = std::max(0, static_cast<int>(std::ceil(min_y - pad - 0.5f)));
-          const int r1 = std::min(g.rows - 1, static_cast<int>(std::floor(max_y + pad - 0.5f)));
-          if (c0 > c1 || r0 > r1) continue;
-          const Eigen::Vector3f& v0 = a.in_camera;
-          const Eigen::Vector3f e1 = b.in_camera - v0, e2 = c.in_camera - v0;
-          const uint32_t index = index_base + static_cast<uint32_t>(f);
-          for (int r = r0; r <= r1; ++r) {
-            for (int col = c0; col <= c1; ++col) {
-              const size_t pixel = static_cast<size_t>(r) * g.cols + col;
-              const float norm = target.ray_norms[pixel];
-              if (norm == 0.0f) continue;
-              const float distance = RayDistance(target.rays[pixel], norm, v0, e1, e2);
-              if (distance > 0) AtomicMin(target.keys[pixel], HitKey(distance, index));
+        for (int64_t i = block_begin; i < block_end; ++i) {
+          const int64_t begin = static_cast<int64_t>(blocks[i]) * kCullBlockTriangles;
+          const int64_t end = std::min(triangles, begin + kCullBlockTriangles);
+          for (int64_t f = begin; f < end; ++f) {
+            const Eigen::Vector3i& t = mesh.triangles[f];
+            const ProjectedVertex& a = vertices[t[0]];
+            const ProjectedVertex& b = vertices[t[1]];
+            const ProjectedVertex& c = vertices[t[2]];
+            if (a.behind && b.behind && c.behind) continue;  // every pinhole ray has z > 0
+            if ((a.outcode & b.outcode & c.outcode) != 0) continue;
+            if (!a.projects || !b.projects || !c.projects) {
+              local_cast.push_back(static_cast<int32_t>(f));
+              continue;
+            }
+            const float min_x = std::min({a.x, b.x, c.x}), max_x = std::max({a.x, b.x, c.x});
+            const float min_y = std::min({a.y, b.y, c.y}), max_y = std::max({a.y, b.y, c.y});
+            const float size = std::max(max_x - min_x, max_y - min_y);
+            if (size > options.max_raster_px || (target.panorama && max_x - min_x > 0.5f * g.cols)) {
+              local_cast.push_back(static_cast<int32_t>(f));
+              continue;
+            }
+            // The corners' box holds the projection but for edges a camera model bends, and rounding.
+            const float pad =
+                0.01f + (target.straight_edges ? 0.0f : static_cast<float>(options.bend_margin) * size);
+            // Pixel centres (col + 0.5, row + 0.5) inside the padded box.
+            const int c0 = std::max(0, static_cast<int>(std::ceil(min_x - pad - 0.5f)));
+            const int c1 = std::min(g.cols - 1, static_cast<int>(std::floor(max_x + pad - 0.5f)));
+            const int r0 = std::max(0, static_cast<int>(std::ceil(min_y - pad - 0.5f)));
+            const int r1 = std::min(g.rows - 1, static_cast<int>(std::floor(max_y + pad - 0.5f)));
+            if (c0 > c1 || r0 > r1) continue;
+            const Eigen::Vector3f& v0 = a.in_camera;
+            const Eigen::Vector3f e1 = b.in_camera - v0, e2 = c.in_camera - v0;
+            const uint32_t index = index_base + static_cast<uint32_t>(f);
+            for (int r = r0; r <= r1; ++r) {
+              for (int col = c0; col <= c1; ++col) {
+                const size_t pixel = static_cast<size_t>(r) * g.cols + col;
+                float norm;
+                const Eigen::Vector3f ray = target.rays.Ray(r, col, &norm);
+                if (norm == 0.0f) continue;
+                const float distance = RayDistance(ray, norm, v0, e1, e2);
+                if (distance > 0) AtomicMin(target.keys[pixel], HitKey(distance, index));
+              }
             }
           }
         }
@@ -180,7 +280,7 @@ void RasterMesh(const TriangleMesh& mesh, const std::vector<ProjectedVertex>& ve
           cast->insert(cast->end(), local_cast.begin(), local_cast.end());
         }
       },
-      2048);
+      8);
   std::sort(cast->begin(), cast->end());  // chunks finish in any order
 }
 
@@ -242,33 +342,39 @@ DistanceBuffer CastDistanceBuffer(const RaycastScene& scene, const Camera& camer
 }
 
 DistanceBuffer RasterDistanceBuffer(const TriangleMesh& mesh, const TriangleMesh& skirts,
-                                    const Camera& camera, double scale, const RasterOptions& options) {
+                                    const Camera& camera, double scale, const RasterOptions& options,
+                                    const RasterBlockBoxes& block_boxes) {
   const BufferGeometry g = BufferFor(camera, scale);
   const int64_t pixels = static_cast<int64_t>(g.rows) * g.cols;
   if (mesh.triangles.size() + skirts.triangles.size() >= std::numeric_limits<uint32_t>::max())
     throw std::length_error("RasterDistanceBuffer: more than 2^32 - 1 triangles");
 
-  std::vector<Eigen::Vector3f> rays(pixels);
-  std::vector<float> ray_norms(pixels);
-  ParallelFor(g.rows, [&](int64_t r) {
-    for (int c = 0; c < g.cols; ++c) {
-      const size_t pixel = static_cast<size_t>(r) * g.cols + c;
-      rays[pixel] = PixelRay(camera, g, static_cast<int>(r), c);
-      ray_norms[pixel] = rays[pixel].norm();
-    }
-  });
+  const PixelRays rays = RaysOf(camera, g);
   std::vector<std::atomic<uint64_t>> keys(pixels);
   for (auto& key : keys) key.store(kNoHit, std::memory_order_relaxed);
 
+  // An undistorted pinhole maps a triangle to the triangle of its corners' pixels: its box needs no padding
+  // for bent edges (the flag was declared but never set before).
   const RasterTarget target{
-      g, rays, ray_norms, keys,
-      camera.model == CameraModel::kSpherical || camera.model == CameraModel::kCylindrical};
-  const std::vector<ProjectedVertex> mesh_vertices = ProjectVertices(mesh, camera, g);
+      g, rays, keys, camera.model == CameraModel::kSpherical || camera.model == CameraModel::kCylindrical,
+      camera.model == CameraModel::kPinhole && !camera.pinhole.has_distortion()};
+  const ViewPlanes planes = options.cull_outside_view ? ImageViewPlanes(camera) : ViewPlanes();
+  std::vector<Eigen::AlignedBox3f> own_mesh_boxes, own_skirt_boxes;
+  const std::vector<Eigen::AlignedBox3f>* mesh_boxes = block_boxes.mesh;
+  const std::vector<Eigen::AlignedBox3f>* skirt_boxes = block_boxes.skirts;
+  if (planes.count > 0 && mesh_boxes == nullptr) mesh_boxes = &(own_mesh_boxes = TriangleBlockBoxes(mesh));
+  if (planes.count > 0 && skirt_boxes == nullptr)
+    skirt_boxes = &(own_skirt_boxes = TriangleBlockBoxes(skirts));
+  const std::vector<int32_t> mesh_blocks = BlocksInView(mesh, planes, mesh_boxes);
+  const std::vector<int32_t> skirt_blocks = BlocksInView(skirts, planes, skirt_boxes);
+  const std::unique_ptr<ProjectedVertex[]> mesh_vertices =
+      ProjectVertices(mesh, camera, g, planes, mesh_blocks);
   std::vector<int32_t> cast_mesh, cast_skirts;
-  RasterMesh(mesh, mesh_vertices, 0, target, options, &cast_mesh);
-  std::vector<ProjectedVertex> skirt_vertices = ProjectVertices(skirts, camera, g);
-  RasterMesh(skirts, skirt_vertices, static_cast<uint32_t>(mesh.triangles.size()), target, options,
-             &cast_skirts);
+  RasterMesh(mesh, mesh_vertices.get(), mesh_blocks, 0, target, options, &cast_mesh);
+  const std::unique_ptr<ProjectedVertex[]> skirt_vertices =
+      ProjectVertices(skirts, camera, g, planes, skirt_blocks);
+  RasterMesh(skirts, skirt_vertices.get(), skirt_blocks, static_cast<uint32_t>(mesh.triangles.size()), target,
+             options, &cast_skirts);
 
   DistanceBuffer out;
   out.distance.create(g.rows, g.cols, CV_32F);
@@ -291,7 +397,8 @@ DistanceBuffer RasterDistanceBuffer(const TriangleMesh& mesh, const TriangleMesh
       const Eigen::Vector3i& t = mesh.triangles[triangle];
       const Eigen::Vector3f n = EmbreeNormal(mesh_vertices[t[0]].in_camera, mesh_vertices[t[1]].in_camera,
                                              mesh_vertices[t[2]].in_camera);
-      back = rays[pixel].dot(n) > 0 ? 255 : 0;
+      float norm;
+      back = rays.Ray(static_cast<int>(r), c, &norm).dot(n) > 0 ? 255 : 0;
     }
   });
 

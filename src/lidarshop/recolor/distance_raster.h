@@ -14,6 +14,9 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
 
 #include <opencv2/core.hpp>
 
@@ -40,9 +43,20 @@ struct RasterOptions {
   // bend_margin × its size (a 96-pixel edge of a panorama bends by well under a pixel within 90°).
   int max_raster_px = 96;
   double bend_margin = 0.05;
+  // Skip the triangles outside the image's view (recolor/view_cull.h: a pinhole's pyramid; a block of
+  // triangles whose box lies outside it is skipped whole). The buffer is the same either way.
+  bool cull_outside_view = true;
+};
+
+// The boxes of each mesh's blocks of triangles (recolor/view_cull.h TriangleBlockBoxes), computed once for
+// all the photos of a station; null: computed here when the camera has view planes.
+struct RasterBlockBoxes {
+  const std::vector<Eigen::AlignedBox3f>* mesh = nullptr;
+  const std::vector<Eigen::AlignedBox3f>* skirts = nullptr;
 };
 
 DistanceBuffer RasterDistanceBuffer(const TriangleMesh& mesh, const TriangleMesh& skirts,
-                                    const Camera& camera, double scale, const RasterOptions& options = {});
+                                    const Camera& camera, double scale, const RasterOptions& options = {},
+                                    const RasterBlockBoxes& block_boxes = {});
 
 }  // namespace lidarshop::recolor_internal

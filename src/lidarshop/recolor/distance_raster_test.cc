@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarshop/recolor/view_cull.h"
 #include "lidarshop/recolor/visibility.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/parallel.h"
@@ -116,9 +117,42 @@ TEST_F(DistanceRasterTest, TrianglesLeftToTheCastMergeIntoTheBuffer) {
   RasterOptions tiny;
   tiny.max_raster_px = 1;
   EXPECT_GT(ExpectSameAsCast(camera, "pinhole, wide triangles cast", 1.0, tiny), 1000);
-  // Inside the scene, a metre before the wall, looking along it: many triangles straddle the image plane.
+  // Inside the scene, a metre before the wall, looking along it: many triangles straddle the image plane
+  // (without the view culling, which drops those outside the image's pyramid: then none is left to cast).
   const Camera inside = CameraFromPinhole(CameraLookingAt({0.5, 8.5, 1.0}, {-3, 9.5, 1.0}, 400, 300, 100));
-  EXPECT_GT(ExpectSameAsCast(inside, "pinhole inside the scene"), 0);
+  RasterOptions no_cull;
+  no_cull.cull_outside_view = false;
+  EXPECT_GT(ExpectSameAsCast(inside, "pinhole inside the scene, not culled", 1.0, no_cull), 0);
+  EXPECT_EQ(ExpectSameAsCast(inside, "pinhole inside the scene"), 0);
+}
+
+// The view culling (recolor/view_cull.h) changes no pixel: the same buffer, bit for bit, with and without it,
+// from the blocks' boxes given or computed here.
+TEST_F(DistanceRasterTest, CullingOutsideTheViewChangesNoPixel) {
+  PinholeCamera distorted = CameraLookingAt({-0.8, 0.5, 1.2}, {0, 10, 1.5}, 400, 300, 80);
+  distorted.k1 = -0.12, distorted.k2 = 0.03, distorted.p1 = 0.001, distorted.p2 = -0.0005;
+  const Camera cameras[] = {
+      CameraFromPinhole(CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 400, 300, 75)),
+      CameraFromPinhole(distorted),
+      CameraFromPinhole(CameraLookingAt({0.5, 8.5, 1.0}, {-3, 9.5, 1.0}, 400, 300, 100)),
+      CameraFromPinhole(CameraLookingAt({0, 0, 1.6}, {0, 10, 1.6}, 300, 300, 90)),  // a cube face
+  };
+  RasterOptions no_cull;
+  no_cull.cull_outside_view = false;
+  const std::vector<Eigen::AlignedBox3f> mesh_boxes = TriangleBlockBoxes(occlusion_.mesh);
+  const std::vector<Eigen::AlignedBox3f> skirt_boxes = TriangleBlockBoxes(occlusion_.skirts);
+  for (const Camera& camera : cameras) {
+    const DistanceBuffer all = RasterDistanceBuffer(occlusion_.mesh, occlusion_.skirts, camera, 1.0, no_cull);
+    const DistanceBuffer culled = RasterDistanceBuffer(occlusion_.mesh, occlusion_.skirts, camera, 1.0);
+    const DistanceBuffer given = RasterDistanceBuffer(occlusion_.mesh, occlusion_.skirts, camera, 1.0, {},
+                                                      {&mesh_boxes, &skirt_boxes});
+    EXPECT_GT(cv::countNonZero(all.distance < 1e30), 5000);  // it sees the scene
+    for (const DistanceBuffer* b : {&culled, &given}) {
+      EXPECT_EQ(cv::norm(all.distance != b->distance, cv::NORM_L1), 0.0);  // +inf == +inf
+      EXPECT_EQ(cv::norm(all.back_facing, b->back_facing, cv::NORM_L1), 0.0);
+      EXPECT_LE(b->cast_triangles, all.cast_triangles);
+    }
+  }
 }
 
 TEST_F(DistanceRasterTest, SameBufferOnAnyThreadCount) {

@@ -134,13 +134,22 @@ OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& optio
   ScanMeshOptions mesh_options;
   mesh_options.max_range_jump_ratio = options.max_range_jump_ratio;
   mesh_options.world_frame = true;
-  scene.mesh = ScanToMesh(scan, mesh_options);
-  if (options.silhouette_skirts) {
-    SilhouetteSkirtOptions skirt_options;
-    skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
-    skirt_options.depth_m = options.skirt_depth_m;
-    scene.skirts = SilhouetteSkirts(scan, skirt_options);
+  // The mesh and the skirts are independent (each parallel inside, serial in parts): built side by side.
+  ParallelFor(2, [&](int64_t part) {
+    if (part == 0) {
+      scene.mesh = ScanToMesh(scan, mesh_options);
+    } else if (options.silhouette_skirts) {
+      SilhouetteSkirtOptions skirt_options;
+      skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
+      skirt_options.depth_m = options.skirt_depth_m;
+      scene.skirts = SilhouetteSkirts(scan, skirt_options);
+    }
+  });
+  if (options.visibility == VisibilityMethod::kZBuffer) {
+    scene.mesh_blocks = TriangleBlockBoxes(scene.mesh);
+    scene.skirt_blocks = TriangleBlockBoxes(scene.skirts);
   }
+  scene.cells = CellBoxesOf(scan);
   if (options.visibility == VisibilityMethod::kSegment) {
     scene.segments = std::make_unique<RaycastScene>();
     if (!scene.mesh.empty()) scene.segments->AddMesh(scene.mesh, 0);
@@ -156,51 +165,72 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
   const Eigen::Vector3d center = camera.center_in_world();
   const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
   const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
-
-  // Candidates: valid cells in front of the camera that project inside the photo.
-  struct Candidate {
-    int64_t cell;
-    Eigen::Vector2d pixel;
-    Eigen::Vector3d point_in_world;
-  };
-  // Rows in parallel, each into its own list, joined in row order (the same on any thread count).
-  std::vector<std::vector<Candidate>> row_candidates(scan.rows);
-  std::vector<int64_t> row_returns(scan.rows, 0), row_outside(scan.rows, 0);
-  ParallelFor(scan.rows, [&](int64_t row) {
-    const int r = static_cast<int>(row);
-    for (int c = 0; c < scan.cols; ++c) {
-      if (!scan.valid.at<uint8_t>(r, c)) continue;
-      ++row_returns[r];
-      const cv::Vec3f p = scan.point.at<cv::Vec3f>(r, c);
-      const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
-      Eigen::Vector2d pixel;
-      if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
-        ++row_outside[r];
-        continue;
-      }
-      row_candidates[r].push_back({static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world});
-    }
-  });
-  std::vector<Candidate> candidates;
-  {
-    size_t total = 0;
-    for (const auto& row : row_candidates) total += row.size();
-    candidates.reserve(total);
-    for (int r = 0; r < scan.rows; ++r) {
-      visibility.returns += row_returns[r];
-      visibility.outside_image += row_outside[r];
-      candidates.insert(candidates.end(), row_candidates[r].begin(), row_candidates[r].end());
-      std::vector<Candidate>().swap(row_candidates[r]);
-    }
-  }
-
-  std::vector<uint8_t> hidden(candidates.size(), 0);  // 1 = hidden, 2 = uncertain (the edge guard)
-  // Per candidate: how far the photo pixels sampled for it may lie from its depth (infinite: any pixel).
-  std::vector<double> agree(candidates.size(), std::numeric_limits<double>::infinity());
   const auto tolerance = [&](double distance) {
     return options.depth_tolerance_m + options.relative_depth_tolerance * distance;
   };
+
+  // Calls in_view(cell, pixel, point_in_world) for every valid cell of row r in front of the camera that
+  // projects inside the photo, in column order; counts the row's returns and the cells outside. Row segments
+  // whose box lies outside the image's view planes are outside the image whole (view_cull.h).
+  const ViewPlanes planes = ImageViewPlanes(camera);
+  const CellBoxes& boxes = scene.cells;
+  const bool by_segment =
+      boxes.segments > 0 && boxes.valid.size() == static_cast<size_t>(scan.rows) * boxes.segments;
+  std::vector<int64_t> row_returns(scan.rows, 0), row_outside(scan.rows, 0);
+  const auto for_each_in_view = [&](int r, const auto& in_view) {
+    const int segments = by_segment ? boxes.segments : 1;
+    for (int s = 0; s < segments; ++s) {
+      const int c_begin = by_segment ? s * boxes.segment_cols : 0;
+      const int c_end = by_segment ? std::min(scan.cols, c_begin + boxes.segment_cols) : scan.cols;
+      if (by_segment) {
+        const size_t box = static_cast<size_t>(r) * boxes.segments + s;
+        if (boxes.valid[box] == 0) continue;
+        if (planes.count > 0 && planes.Outside(boxes.boxes[box])) {
+          row_returns[r] += boxes.valid[box];
+          row_outside[r] += boxes.valid[box];
+          continue;
+        }
+      }
+      const uint8_t* valid = scan.valid.ptr<uint8_t>(r);
+      const cv::Vec3f* points = scan.point.ptr<cv::Vec3f>(r);
+      for (int c = c_begin; c < c_end; ++c) {
+        if (!valid[c]) continue;
+        ++row_returns[r];
+        const cv::Vec3f& p = points[c];
+        const Eigen::Vector3d point_in_world = rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation;
+        Eigen::Vector2d pixel;
+        if (!ProjectWorldPoint(camera, point_in_world, &pixel) || !InsideImage(camera, pixel)) {
+          ++row_outside[r];
+          continue;
+        }
+        in_view(static_cast<int64_t>(r) * scan.cols + c, pixel, point_in_world);
+      }
+    }
+  };
+  // Rows in parallel, each into its own lists, joined in row order (the same on any thread count).
+  std::vector<std::vector<SeenCell>> row_seen(scan.rows);
+  std::vector<std::vector<int64_t>> row_uncertain(scan.rows);
+  std::vector<int64_t> row_hidden(scan.rows, 0);
+
   if (options.visibility == VisibilityMethod::kSegment) {
+    struct Candidate {
+      int64_t cell;
+      Eigen::Vector2d pixel;
+      Eigen::Vector3d point_in_world;
+    };
+    std::vector<std::vector<Candidate>> row_candidates(scan.rows);
+    ParallelFor(scan.rows, [&](int64_t row) {
+      for_each_in_view(static_cast<int>(row), [&](int64_t cell, const Eigen::Vector2d& pixel,
+                                                  const Eigen::Vector3d& point_in_world) {
+        row_candidates[row].push_back({cell, pixel, point_in_world});
+      });
+    });
+    std::vector<Candidate> candidates;
+    for (auto& row : row_candidates) {
+      candidates.insert(candidates.end(), row.begin(), row.end());
+      std::vector<Candidate>().swap(row);
+    }
+    std::vector<uint8_t> hidden(candidates.size(), 0);
     std::vector<Ray> rays(candidates.size());
     for (size_t i = 0; i < candidates.size(); ++i) {
       const Eigen::Vector3d segment = candidates[i].point_in_world - center;
@@ -210,10 +240,23 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
       rays[i].t_far = static_cast<float>(std::max(0.0, 1.0 - tolerance(distance) / distance));
     }
     scene.segments->Occluded(rays, hidden);
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const int64_t row = candidates[i].cell / scan.cols;
+      if (hidden[i]) {
+        ++row_hidden[row];
+        continue;
+      }
+      row_seen[row].push_back({candidates[i].cell, candidates[i].pixel,
+                               (candidates[i].point_in_world - center).norm(),
+                               std::numeric_limits<double>::infinity()});
+    }
   } else {
+    // The z-buffer first, then every cell projected and tested in one pass (no list of candidates).
     const auto zbuffer_start = std::chrono::steady_clock::now();
     const DistanceBuffer buffer =
-        RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale);
+        RasterDistanceBuffer(scene.mesh, scene.skirts, camera, options.zbuffer_scale, RasterOptions(),
+                             {scene.mesh_blocks.empty() ? nullptr : &scene.mesh_blocks,
+                              scene.skirt_blocks.empty() ? nullptr : &scene.skirt_blocks});
     const cv::Mat& distance_buffer = buffer.distance;
     const cv::Mat& back_facing = buffer.back_facing;
     cv::Mat nearest = distance_buffer;
@@ -234,39 +277,41 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
     }
     visibility.zbuffer_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - zbuffer_start).count();
-    ParallelFor(
-        static_cast<int64_t>(candidates.size()),
-        [&](int64_t i) {
-          const Candidate& candidate = candidates[i];
-          const int zr = std::min(static_cast<int>(candidate.pixel.y() * sy), distance_buffer.rows - 1);
-          const int zc = std::min(static_cast<int>(candidate.pixel.x() * sx), distance_buffer.cols - 1);
-          const double distance = (candidate.point_in_world - center).norm();
-          const float slope = Slope(distance_buffer, zr, zc);
-          const double allowed = tolerance(distance) + m * slope;
-          hidden[i] = nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0;
-          // A surface clearly nearer within the guard's window: the point lies by an occluding edge, where
-          // the camera's error can show the occluder's colour; it keeps its own (2 = uncertain).
-          if (!hidden[i] && guard > 0 &&
-              guard_nearest.at<float>(zr, zc) <
-                  distance - tolerance(distance) - options.edge_min_jump_m - guard * slope) {
-            hidden[i] = 2;
-          }
-          agree[i] = tolerance(distance) + slope;
-        },
-        1024);
+    ParallelFor(scan.rows, [&](int64_t row) {
+      for_each_in_view(static_cast<int>(row), [&](int64_t cell, const Eigen::Vector2d& pixel,
+                                                  const Eigen::Vector3d& point_in_world) {
+        const int zr = std::min(static_cast<int>(pixel.y() * sy), distance_buffer.rows - 1);
+        const int zc = std::min(static_cast<int>(pixel.x() * sx), distance_buffer.cols - 1);
+        const double distance = (point_in_world - center).norm();
+        const float slope = Slope(distance_buffer, zr, zc);
+        const double allowed = tolerance(distance) + m * slope;
+        if (nearest.at<float>(zr, zc) < distance - allowed || back_facing.at<uint8_t>(zr, zc) != 0) {
+          ++row_hidden[row];
+          return;
+        }
+        // A surface clearly nearer within the guard's window: the point lies by an occluding edge, where
+        // the camera's error can show the occluder's colour; it keeps its own (uncertain).
+        if (guard > 0 && guard_nearest.at<float>(zr, zc) <
+                             distance - tolerance(distance) - options.edge_min_jump_m - guard * slope) {
+          row_uncertain[row].push_back(cell);
+          return;
+        }
+        row_seen[row].push_back({cell, pixel, distance, tolerance(distance) + slope});
+      });
+    });
   }
 
-  for (size_t i = 0; i < candidates.size(); ++i) {
-    if (hidden[i] == 2) {
-      visibility.uncertain.push_back(candidates[i].cell);
-      continue;
-    }
-    if (hidden[i]) {
-      ++visibility.hidden;
-      continue;
-    }
-    visibility.seen.push_back(
-        {candidates[i].cell, candidates[i].pixel, (candidates[i].point_in_world - center).norm(), agree[i]});
+  size_t seen = 0, uncertain = 0;
+  for (int r = 0; r < scan.rows; ++r) seen += row_seen[r].size(), uncertain += row_uncertain[r].size();
+  visibility.seen.reserve(seen);
+  visibility.uncertain.reserve(uncertain);
+  for (int r = 0; r < scan.rows; ++r) {
+    visibility.returns += row_returns[r];
+    visibility.outside_image += row_outside[r];
+    visibility.hidden += row_hidden[r];
+    visibility.seen.insert(visibility.seen.end(), row_seen[r].begin(), row_seen[r].end());
+    visibility.uncertain.insert(visibility.uncertain.end(), row_uncertain[r].begin(), row_uncertain[r].end());
+    std::vector<SeenCell>().swap(row_seen[r]);
   }
   return visibility;
 }

@@ -9,6 +9,7 @@
 #include "lidarshop/poisson/operators.h"
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 
@@ -48,19 +49,30 @@ SeamBlendResult BlendSeams(const cv::Mat& colour, const cv::Mat& photo, const cv
   }
   // The guidance must carry no flux out of the coloured cells (the caller's zeros, not copied: 10-megapoint
   // grids) and the cells without colour must hold 0 (they are the no-data boundary).
-  for (int r = 0; r < rows; ++r) {
+  // Rows in parallel (a 10-megapoint grid), then the first row with a fault checked again to name its cell.
+  const auto check_row = [&](int r, bool report) {
     for (int c = 0; c < cols; ++c) {
       const bool here = photo.at<uint16_t>(r, c) != 0;
       const bool right = here && c + 1 < cols && photo.at<uint16_t>(r, c + 1) != 0;
       const bool down = here && r + 1 < rows && photo.at<uint16_t>(r + 1, c) != 0;
       if ((!right && gx.at<cv::Vec3f>(r, c) != cv::Vec3f()) ||
-          (!down && gy.at<cv::Vec3f>(r, c) != cv::Vec3f()))
+          (!down && gy.at<cv::Vec3f>(r, c) != cv::Vec3f())) {
+        if (!report) return false;
         ThrowInputError("BlendSeams", fmt::format("cell ({}, {})", r, c), "gx/gy",
                         "guidance on an edge that does not join two coloured cells must be 0");
-      if (!here && colour.at<cv::Vec3f>(r, c) != cv::Vec3f())
+      }
+      if (!here && colour.at<cv::Vec3f>(r, c) != cv::Vec3f()) {
+        if (!report) return false;
         ThrowInputError("BlendSeams", fmt::format("cell ({}, {})", r, c), "colour",
                         "a cell without a photo must hold 0");
+      }
     }
+    return true;
+  };
+  std::vector<uint8_t> row_ok(rows, 1);
+  ParallelFor(rows, [&](int64_t r) { row_ok[r] = check_row(static_cast<int>(r), false); });
+  for (int r = 0; r < rows; ++r) {
+    if (!row_ok[r]) check_row(r, true);  // throws, naming the first faulty cell
   }
   result.colour = colour;
   if (result.seam_edges == 0) return result;

@@ -1,6 +1,7 @@
 #include "lidarshop/recolor/seam_blend.h"
 
 #include <cmath>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -46,6 +47,29 @@ TEST(BlendSeams, RemovesAStepAndKeepsTheGradient) {
   leaking.at<cv::Vec3f>(0, 0) = cv::Vec3f::all(1);  // flux out of a cell without colour
   EXPECT_THROW(BlendSeams(colour, photo, leaking, gy, band), InputError);
   EXPECT_THROW(BlendSeams(colour, photo, gx(cv::Rect(0, 0, 10, 10)), gy, band), InputError);
+}
+
+// Guidance out of a coloured cell, or a colour where no photo coloured the cell, is refused naming the first such
+// cell in row-major order (the rows are checked in parallel).
+TEST(BlendSeams, RefusesFluxOutOfTheColouredCellsNamingTheFirstCell) {
+  const int rows = 200, cols = 50;
+  cv::Mat colour(rows, cols, CV_32FC3, cv::Scalar::all(10)), photo(rows, cols, CV_16U, cv::Scalar(1)),
+      gx(rows, cols, CV_32FC3, cv::Scalar::all(0)), gy = gx.clone();
+  photo.at<uint16_t>(150, 7) = 0, colour.at<cv::Vec3f>(150, 7) = cv::Vec3f();
+  photo.at<uint16_t>(90, 3) = 0, colour.at<cv::Vec3f>(90, 3) = cv::Vec3f();
+  gx.at<cv::Vec3f>(150, 6) = cv::Vec3f(1, 0, 0);  // into the uncoloured cell (150, 7)
+  const auto message = [&] {
+    try {
+      BlendSeams(colour, photo, gx, gy, 2);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message().find("cell (150, 6)"), std::string::npos) << message();
+  colour.at<cv::Vec3f>(90, 3) = cv::Vec3f(5, 5, 5);  // an earlier row: that one is named
+  EXPECT_NE(message().find("cell (90, 3)"), std::string::npos) << message();
+  EXPECT_NE(message().find("colour"), std::string::npos) << message();
 }
 
 }  // namespace

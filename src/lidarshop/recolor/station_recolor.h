@@ -77,6 +77,9 @@ struct PhotosRecolorResult {
   // photos; the output scan (clone and colours written); and the whole call (checks included).
   double zbuffer_seconds = 0, projection_seconds = 0, choice_seconds = 0, gain_seconds = 0,
          colour_seconds = 0, output_seconds = 0, total_seconds = 0;
+  // The process's CPU time (every thread, user + system) during the call: on a shared machine, where the wall
+  // clock depends on the load, the measure of the work done.
+  double cpu_seconds = 0;
   std::string Summary() const;  // one line
 };
 

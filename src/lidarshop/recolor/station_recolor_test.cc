@@ -7,6 +7,7 @@
 #include "lidarshop/recolor/recolor_eval.h"
 #include "lidarshop/scanner/station_photos.h"
 #include "lidarshop/testing/scenes.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 namespace {
@@ -187,6 +188,30 @@ TEST(RecolorFromPhotos, SphericalPanorama) {
                         result.output_seconds;
   EXPECT_GT(result.output_seconds, 0);
   EXPECT_LE(phases, result.total_seconds + 1e-6);
+}
+
+}  // namespace
+}  // namespace lidarshop
+
+namespace lidarshop {
+namespace {
+
+// The same colours, photo indices and gains on one thread as on all (the per-photo culling, projection and
+// z-buffers run in parallel; every list is joined in a fixed order).
+TEST(RecolorFromPhotos, SameResultOnAnyThreadCount) {
+  const CubeStation station = WideCubeStation(/*textured=*/true);
+  PhotosRecolorResult one;
+  {
+    const ThreadLimit limit(1);
+    one = RecolorFromPhotos(station.scan, Photos(station.cube));
+  }
+  const PhotosRecolorResult all = RecolorFromPhotos(station.scan, Photos(station.cube));
+  EXPECT_GT(all.coloured, station.scan.rows * station.scan.cols / 2);
+  EXPECT_EQ(one.coloured, all.coloured);
+  EXPECT_EQ(cv::norm(one.photo_index, all.photo_index, cv::NORM_L1), 0.0);
+  EXPECT_EQ(cv::norm(one.scan.color, all.scan.color, cv::NORM_L1), 0.0);
+  for (size_t i = 0; i < all.gains.size(); ++i) EXPECT_EQ(one.gains[i], all.gains[i]) << i;
+  EXPECT_GT(all.cpu_seconds, 0.0);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "lidarshop/geometry/mesh.h"
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/recolor/recolor.h"
+#include "lidarshop/recolor/view_cull.h"
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop::recolor_internal {
@@ -22,10 +23,14 @@ namespace lidarshop::recolor_internal {
 // The scan mesh and its silhouette skirts, world frame. Z-buffer visibility rasterizes them into each
 // camera's buffer (recolor/distance_raster.h); segment visibility casts into `segments`, an Embree scene of
 // both (mesh geometry 0, skirts 1), built only for that method.
+// `mesh_blocks`, `skirt_blocks` and `cells` (recolor/view_cull.h) let each camera skip the triangles and the
+// cells its view cannot reach; built once, used by every photo.
 struct OcclusionScene {
   TriangleMesh mesh;
   TriangleMesh skirts;
   std::unique_ptr<RaycastScene> segments;
+  std::vector<Eigen::AlignedBox3f> mesh_blocks, skirt_blocks;
+  CellBoxes cells;
 };
 OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& options);
 

@@ -1,5 +1,6 @@
 #include "lidarshop/scan/scan_mesh.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -7,6 +8,7 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 
@@ -28,8 +30,11 @@ TriangleMesh ScanToMesh(const Scan& scan, const ScanMeshOptions& options) {
     return d.dot(d) <= max_edge_sq;
   };
   // Triangles over cell indices first, then compact the vertices that are used.
-  std::vector<Eigen::Vector3i> cell_triangles;
-  for (int r = 0; r + 1 < rows; ++r) {
+  // Rows in parallel, each into its own list, joined in row order (the same mesh on any thread count).
+  std::vector<std::vector<Eigen::Vector3i>> row_triangles(std::max(0, rows - 1));
+  ParallelFor(rows - 1 > 0 ? rows - 1 : 0, [&](int64_t row) {
+    const int r = static_cast<int>(row);
+    std::vector<Eigen::Vector3i>& cell_triangles = row_triangles[row];
     for (int c = 0; c + 1 < cols; ++c) {
       const bool va = valid(r, c), vb = valid(r, c + 1), vc = valid(r + 1, c), vd = valid(r + 1, c + 1);
       const int a = r * cols + c, b = a + 1, cc = a + cols, d = cc + 1;
@@ -40,6 +45,16 @@ TriangleMesh ScanToMesh(const Scan& scan, const ScanMeshOptions& options) {
       if (vd && bc && joined(r, c + 1, r + 1, c + 1) && joined(r + 1, c, r + 1, c + 1)) {
         cell_triangles.emplace_back(b, cc, d);
       }
+    }
+  });
+  std::vector<Eigen::Vector3i> cell_triangles;
+  {
+    size_t total = 0;
+    for (const auto& row : row_triangles) total += row.size();
+    cell_triangles.reserve(total);
+    for (auto& row : row_triangles) {
+      cell_triangles.insert(cell_triangles.end(), row.begin(), row.end());
+      std::vector<Eigen::Vector3i>().swap(row);
     }
   }
   std::vector<int> vertex_of_cell(static_cast<size_t>(rows) * cols, -1);

@@ -196,8 +196,17 @@ std::string Join(const std::string& path, const std::string& key) {
   return path.empty() ? key : path + "." + key;
 }
 
-// Cross-field checks throw OptionsError (no key) or OptionsFieldError (a key inside the struct).
+// Cross-field checks throw OptionsError (no key) or OptionsFieldError (a key inside the struct). An alias's
+// narrower range is one: the nested field is checked against it, under its own path.
 void RunCheck(const StructInfo& info, const void* object, const std::string& path) {
+  for (const FieldInfo& alias : info.aliases) {
+    if (alias.kind == FieldKind::kStruct) continue;
+    try {
+      alias.CheckValue(alias.get(object));
+    } catch (const OptionsError& error) {
+      throw OptionsFieldError(Join(path, alias.alias_of), error.what());
+    }
+  }
   if (!info.check) return;
   try {
     info.check(object);
@@ -233,10 +242,80 @@ const FieldInfo* StructInfo::Find(std::string_view key) const {
   return nullptr;
 }
 
+const FieldInfo* StructInfo::FindAlias(std::string_view key) const {
+  for (const FieldInfo& alias : aliases) {
+    if (alias.key == key) return &alias;
+  }
+  return nullptr;
+}
+
 std::vector<std::string> StructInfo::Keys() const {
   std::vector<std::string> keys;
   for (const FieldInfo& field : fields) keys.push_back(field.key);
   return keys;
+}
+
+std::vector<std::string> StructInfo::AliasKeys() const {
+  std::vector<std::string> keys;
+  for (const FieldInfo& alias : aliases) keys.push_back(alias.key);
+  return keys;
+}
+
+FieldInfo MakeAlias(const StructInfo& info, std::string key, const std::string& target_path) {
+  // The target's struct from the alias's: the nested_of of each struct on the way, composed. Copies of the
+  // accessors, not pointers: `info` is still being built and its fields may move.
+  std::function<void*(void*)> owner_of = [](void* object) { return object; };
+  const StructInfo* current = &info;
+  const FieldInfo* field = nullptr;
+  for (size_t start = 0;;) {
+    const size_t dot = target_path.find('.', start);
+    field = current->Find(target_path.substr(start, dot == std::string::npos ? dot : dot - start));
+    LIDARSHOP_CHECK(field != nullptr && "an alias names a described field");
+    if (dot == std::string::npos) break;
+    LIDARSHOP_CHECK(field->kind == FieldKind::kStruct);
+    owner_of = [owner_of, nested_of = field->nested_of](void* object) { return nested_of(owner_of(object)); };
+    current = field->nested;
+    start = dot + 1;
+  }
+  LIDARSHOP_CHECK(info.Find(key) == nullptr && info.FindAlias(key) == nullptr);
+  FieldInfo alias = *field;  // kind, doc, unit, range, choices, nested struct
+  alias.key = std::move(key);
+  alias.alias_of = target_path;
+  alias.position = info.fields.size();
+  alias.get = [get = field->get, owner_of](const void* object) {
+    return get(owner_of(const_cast<void*>(object)));
+  };
+  if (field->set) {
+    alias.set = [set = field->set, owner_of](void* object, const nlohmann::json& value) {
+      set(owner_of(object), value);
+    };
+  }
+  if (field->nested_of) {
+    alias.nested_of = [nested_of = field->nested_of, owner_of](void* object) {
+      return nested_of(owner_of(object));
+    };
+  }
+  return alias;
+}
+
+const FieldInfo* FindFieldPath(const StructInfo& info, const std::string& key_path, void* object,
+                               void** owner, std::string* canonical_path) {
+  const size_t dot = key_path.find('.');
+  const std::string key = key_path.substr(0, dot);
+  const FieldInfo* field = info.Find(key);
+  if (field == nullptr) field = info.FindAlias(key);
+  if (field == nullptr) return nullptr;
+  const std::string canonical = field->alias_of.empty() ? key : field->alias_of;
+  if (dot == std::string::npos) {
+    *owner = object;
+    *canonical_path = canonical;
+    return field;
+  }
+  if (field->kind != FieldKind::kStruct) return nullptr;
+  const FieldInfo* inner = FindFieldPath(*field->nested, key_path.substr(dot + 1), field->nested_of(object),
+                                         owner, canonical_path);
+  if (inner != nullptr) *canonical_path = canonical + "." + *canonical_path;
+  return inner;
 }
 
 nlohmann::ordered_json StructToJson(const StructInfo& info, const void* object) {
@@ -244,6 +323,23 @@ nlohmann::ordered_json StructToJson(const StructInfo& info, const void* object) 
   for (const FieldInfo& field : info.fields) json[field.key] = field.get(object);
   return json;
 }
+
+namespace {
+
+// Whether `json` has a value at the key path "inpaint.patch_radius".
+bool HasPath(const nlohmann::json& json, const std::string& key_path) {
+  const nlohmann::json* place = &json;
+  for (size_t start = 0;;) {
+    const size_t dot = key_path.find('.', start);
+    const std::string key = key_path.substr(start, dot == std::string::npos ? dot : dot - start);
+    if (!place->is_object() || !place->contains(key)) return false;
+    place = &place->at(key);
+    if (dot == std::string::npos) return true;
+    start = dot + 1;
+  }
+}
+
+}  // namespace
 
 void StructFromJson(const StructInfo& info, const nlohmann::json& json, void* object,
                     const std::string& path) {
@@ -256,7 +352,17 @@ void StructFromJson(const StructInfo& info, const nlohmann::json& json, void* ob
     const std::string key_path = Join(path, key);
     const FieldInfo* field = info.Find(key);
     if (field == nullptr) {
-      const std::string closest = ClosestMatch(key, info.Keys());
+      field = info.FindAlias(key);
+      // Both names of one field in one object: which one wins would depend on the keys' order.
+      if (field != nullptr && HasPath(json, field->alias_of)) {
+        throw OptionsFieldError(
+            key_path, fmt::format("also given as {}; give one of the two", Join(path, field->alias_of)));
+      }
+    }
+    if (field == nullptr) {
+      std::vector<std::string> keys = info.Keys();
+      for (const FieldInfo& alias : info.aliases) keys.push_back(alias.key);
+      const std::string closest = ClosestMatch(key, keys);
       throw OptionsFieldError(
           key_path, fmt::format("unknown option{}",
                                 closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest)));
@@ -332,11 +438,15 @@ nlohmann::json SampleValue(const FieldInfo& field, const nlohmann::ordered_json&
 
 }  // namespace
 
-int SetSampleValues(const StructInfo& info, void* object) {
+namespace {
+
+// `validate_root` checks the outermost struct: a nested field's sample may be valid for its own struct and
+// not for the one holding it (FillOptions refuses InpaintOptions::stop_for_review).
+int SetSamples(const StructInfo& info, void* object, const std::function<void()>& validate_root) {
   int changed = 0;
   for (const FieldInfo& field : info.fields) {
     if (field.kind == FieldKind::kStruct) {
-      changed += SetSampleValues(*field.nested, field.nested_of(object));
+      changed += SetSamples(*field.nested, field.nested_of(object), validate_root);
       continue;
     }
     const nlohmann::ordered_json before = field.get(object);
@@ -344,13 +454,19 @@ int SetSampleValues(const StructInfo& info, void* object) {
     if (sample == nlohmann::json(before)) continue;
     field.set(object, sample);
     try {
-      ValidateStruct(info, object);
+      validate_root();
       ++changed;
     } catch (const OptionsError&) {
       field.set(object, before);
     }
   }
   return changed;
+}
+
+}  // namespace
+
+int SetSampleValues(const StructInfo& info, void* object) {
+  return SetSamples(info, object, [&] { ValidateStruct(info, object); });
 }
 
 std::string ValueText(const nlohmann::ordered_json& value) {

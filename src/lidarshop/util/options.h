@@ -17,6 +17,11 @@
 //
 // and declares `template <> const StructInfo& InfoOf<FillOptions>();` next to the struct. Enums are described
 // the same way by `EnumInfoOf<E>()` (util/enum_names.h), and convert to and from strings only through it.
+//
+// A struct that holds another's options nests it (`InpaintOptions inpaint;` in FillOptions, described by
+// `b.Field(&FillOptions::inpaint, ...)`) instead of copying its fields. Where fields used to be flat, the old
+// keys stay as aliases (`b.Alias("patch_radius", "inpaint.patch_radius")`): JSON, the CLI's flags and Python's
+// attributes accept them and set the nested field; ToJson writes only the nested form.
 #pragma once
 
 #include <cmath>
@@ -65,6 +70,11 @@ struct FieldInfo {
   std::function<nlohmann::ordered_json(const void*)> get;
   std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
   std::function<void*(void*)> nested_of;                  // kStruct: the member's address
+  // An alias (StructInfo::aliases): the key path of the field it stands for ("inpaint.patch_radius"), and
+  // how many fields of its struct were described before it (where its flag goes in the CLI's help). Its
+  // get / set / nested_of reach that field from the alias's own struct.
+  std::string alias_of;
+  size_t position = 0;
 
   FieldInfo& Unit(std::string unit_name);
   FieldInfo& Range(double low, double high);
@@ -85,9 +95,27 @@ struct StructInfo {
   std::vector<FieldInfo> fields;
   // Cross-field checks after every field is set (e.g. min < max); throws OptionsError. May be empty.
   std::function<void(const void*)> check;
-  const FieldInfo* Find(std::string_view key) const;
-  std::vector<std::string> Keys() const;
+  // Older keys of nested fields (FieldInfo::alias_of), accepted on input, never written. Not in `fields`:
+  // everything that lists or writes a struct's fields sees each field once.
+  std::vector<FieldInfo> aliases;
+  // The JSON form of a default-constructed struct (ToJson(S{})): its own defaults, which a struct holding it
+  // may change (FillOptions::inpaint starts from FillInpaintDefaults()).
+  std::function<nlohmann::ordered_json()> default_json;
+  const FieldInfo* Find(std::string_view key) const;       // a field (not an alias)
+  const FieldInfo* FindAlias(std::string_view key) const;  // an alias
+  std::vector<std::string> Keys() const;                   // the fields' keys, in order
+  std::vector<std::string> AliasKeys() const;
 };
+
+// The field at `key_path` ("poisson.solver"; any segment may be an alias: "acceptance.enabled"), with the
+// struct inside `object` its get / set apply to in *owner (an alias's own struct: its accessors reach the
+// nested field) and the path without aliases in *canonical_path ("inpaint.acceptance.enabled"). nullptr when
+// nothing has that path.
+const FieldInfo* FindFieldPath(const StructInfo& info, const std::string& key_path, void* object,
+                               void** owner, std::string* canonical_path);
+
+// An alias `key` of the field at `target_path` inside `info` (StructBuilder::Alias).
+FieldInfo MakeAlias(const StructInfo& info, std::string key, const std::string& target_path);
 
 // An option with a bad value, found by key: `key_path` is the JSON path ("acceptance.band_px"), `reason` what
 // is wrong ("0 is out of range [1, 64]"). what() is "key_path: reason"; the CLI words it with the flag instead.
@@ -145,6 +173,10 @@ class StructBuilder {
   StructBuilder(std::string name, std::string doc) {
     info_.name = std::move(name);
     info_.doc = std::move(doc);
+    info_.default_json = [] {
+      const S defaults{};
+      return StructToJson(InfoOf<S>(), &defaults);
+    };
   }
 
   template <class T>
@@ -207,6 +239,15 @@ class StructBuilder {
     }
     info_.fields.push_back(std::move(field));
     return info_.fields.back();
+  }
+
+  // `key` kept as an alias of the nested field at `target_path` ("patch_radius" for "inpaint.patch_radius"),
+  // described after that struct's field. It has the target's kind, doc, unit and range; a narrower Range()
+  // applies to the nested field inside this struct (FillOptions takes patches up to 15 cells, InpaintOptions
+  // up to 64): checked with the cross-field checks, an error names the nested path ("inpaint.patch_radius").
+  FieldInfo& Alias(std::string key, const std::string& target_path) {
+    info_.aliases.push_back(MakeAlias(info_, std::move(key), target_path));
+    return info_.aliases.back();
   }
 
   // Cross-field check of the whole struct, e.g. [](const S& s) { s.Check(); }.

@@ -63,6 +63,90 @@ const StructInfo& InfoOf<OuterOptions>() {
   return info;
 }
 
+// Options that nest OuterOptions and keep older flat keys as aliases (FillOptions keeps patch_radius for
+// inpaint.patch_radius), one with a narrower range, one of a nested struct, one two levels down.
+struct HolderOptions {
+  OuterOptions outer;
+  int count = 1;
+};
+
+template <>
+const StructInfo& InfoOf<HolderOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<HolderOptions> b("HolderOptions", "holder");
+    b.Field(&HolderOptions::outer, "outer", "outer");
+    b.Alias("radius", "outer.patch_radius").Range(1, 8);
+    b.Alias("inner", "outer.inner");
+    b.Field(&HolderOptions::count, "count", "count").Min(0);
+    b.Alias("band_px", "outer.inner.band_px");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(Options, AliasesSetTheNestedField) {
+  const HolderOptions o = FromJson<HolderOptions>({{"radius", 5}, {"band_px", 7}, {"count", 3}});
+  EXPECT_EQ(o.outer.patch_radius, 5);
+  EXPECT_EQ(o.outer.inner.band_px, 7);
+  EXPECT_EQ(o.count, 3);
+  const HolderOptions n = FromJson<HolderOptions>({{"inner", {{"enabled", true}, {"band_px", 9}}}});
+  EXPECT_TRUE(n.outer.inner.enabled);
+  EXPECT_EQ(n.outer.inner.band_px, 9);
+  // Written once, nested: the aliases are no keys of the JSON form, the description lists them apart.
+  const nlohmann::ordered_json json = ToJson(o);
+  EXPECT_EQ(json.size(), 2u);
+  EXPECT_EQ(json["outer"]["patch_radius"], 5);
+  EXPECT_FALSE(json.contains("radius"));
+  const StructInfo& info = InfoOf<HolderOptions>();
+  EXPECT_EQ(info.Keys(), (std::vector<std::string>{"outer", "count"}));
+  EXPECT_EQ(info.AliasKeys(), (std::vector<std::string>{"radius", "inner", "band_px"}));
+  EXPECT_EQ(info.FindAlias("radius")->kind, FieldKind::kInt);
+  EXPECT_EQ(info.FindAlias("radius")->doc, "radius");  // the nested field's doc
+  EXPECT_EQ(info.FindAlias("radius")->position, 1u);   // after "outer"
+  EXPECT_EQ(info.FindAlias("band_px")->position, 2u);  // after "count"
+  ExpectExactRoundTrip<HolderOptions>();
+}
+
+TEST(Options, AliasErrors) {
+  // The alias's narrower range, through the alias and through the nested path.
+  ExpectRejected<HolderOptions>({{"radius", 9}}, "radius", "9 is out of range [1, 8]");
+  ExpectRejected<HolderOptions>({{"outer", {{"patch_radius", 9}}}}, "outer.patch_radius",
+                                "9 is out of range [1, 8]");
+  ExpectRejected<HolderOptions>({{"outer", {{"patch_radius", 16}}}}, "outer.patch_radius",
+                                "16 is out of range [1, 15]");
+  HolderOptions wide;
+  wide.outer.patch_radius = 12;
+  EXPECT_THROW(Validate(wide), OptionsFieldError);
+  ExpectRejected<HolderOptions>({{"band_px", 0}}, "band_px", "out of range [1, 64]");
+  ExpectRejected<HolderOptions>({{"inner", {{"band_pix", 3}}}}, "inner.band_pix", "did you mean 'band_px'");
+  // Both names of one field.
+  ExpectRejected<HolderOptions>({{"radius", 3}, {"outer", {{"patch_radius", 3}}}}, "radius",
+                                "also given as outer.patch_radius");
+  // A misspelt alias is suggested like a field.
+  ExpectRejected<HolderOptions>({{"radus", 3}}, "radus", "did you mean 'radius'");
+}
+
+TEST(Options, FindFieldPathThroughAliases) {
+  HolderOptions o;
+  void* owner = nullptr;
+  std::string canonical;
+  const StructInfo& info = InfoOf<HolderOptions>();
+  const FieldInfo* field = FindFieldPath(info, "inner.enabled", &o, &owner, &canonical);
+  ASSERT_NE(field, nullptr);
+  EXPECT_EQ(canonical, "outer.inner.enabled");
+  EXPECT_EQ(owner, &o.outer.inner);
+  field = FindFieldPath(info, "radius", &o, &owner, &canonical);
+  ASSERT_NE(field, nullptr);
+  EXPECT_EQ(canonical, "outer.patch_radius");
+  field->set(owner, 6);  // through the alias's own struct
+  EXPECT_EQ(o.outer.patch_radius, 6);
+  EXPECT_EQ(field->get(owner), 6);
+  EXPECT_EQ(FindFieldPath(info, "outer.flavour", &o, &owner, &canonical)->kind, FieldKind::kEnum);
+  EXPECT_EQ(canonical, "outer.flavour");
+  EXPECT_EQ(FindFieldPath(info, "radius.x", &o, &owner, &canonical), nullptr);
+  EXPECT_EQ(FindFieldPath(info, "nothing", &o, &owner, &canonical), nullptr);
+}
+
 TEST(Options, RoundTripIsExact) {
   ExpectExactRoundTrip<OuterOptions>();
   OuterOptions o;

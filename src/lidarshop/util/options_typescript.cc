@@ -156,7 +156,15 @@ nlohmann::ordered_json DescriptionJson(const StructInfo& info) {
     if (field.nested != nullptr) json["struct"] = DescriptionJson(*field.nested);
     fields.push_back(std::move(json));
   }
-  return {{"name", info.name}, {"doc", info.doc}, {"fields", fields}};
+  nlohmann::ordered_json description = {{"name", info.name}, {"doc", info.doc}, {"fields", fields}};
+  if (!info.aliases.empty()) {
+    nlohmann::ordered_json aliases = nlohmann::ordered_json::array();
+    for (const FieldInfo& alias : info.aliases) {
+      aliases.push_back({{"key", alias.key}, {"alias_of", alias.alias_of}, {"range", alias.RangeText()}});
+    }
+    description["aliases"] = std::move(aliases);
+  }
+  return description;
 }
 
 }  // namespace lidarshop

@@ -40,7 +40,8 @@ TypeScriptStruct ResultType() {
 std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs, std::string_view header);
 
 // The description of `info` and its nested structs as JSON (for tools and tests): {"name", "doc", "fields":
-// [{"key", "kind", "doc", "unit", "range", "choices", "struct"}]}.
+// [{"key", "kind", "doc", "unit", "range", "choices", "struct"}]}, and "aliases": [{"key", "alias_of", "range"}]
+// when it has some.
 nlohmann::ordered_json DescriptionJson(const StructInfo& info);
 
 }  // namespace lidarshop

@@ -36,7 +36,11 @@ def test_keywords_and_attributes():
     assert options.poisson.tolerance == 1e-4
     assert options.to_dict()["poisson"]["tolerance"] == 1e-4
     options.acceptance.mean.enabled = False
-    assert options.to_dict()["acceptance"]["mean"]["enabled"] is False
+    # acceptance is an alias of inpaint.acceptance (FillOptions nests its inpainting): to_dict() is nested.
+    assert options.to_dict()["inpaint"]["acceptance"]["mean"]["enabled"] is False
+    assert options.inpaint.acceptance.mean.enabled is False and "acceptance" not in options.to_dict()
+    options.patch_radius = 6
+    assert options.inpaint.patch_radius == 6 and "patch_radius" not in lidarshop.FillOptions.fields
     options.poisson = lidarshop.PoissonOptions(max_levels=3)
     assert options.poisson.max_levels == 3
     options.poisson = {"solver": "multigrid"}  # a dict sets the keys it names
@@ -92,11 +96,11 @@ def test_errors_carry_the_library_messages():
 
 def test_docs_and_repr_come_from_the_descriptions():
     doc = lidarshop.FillOptions.patch_radius.__doc__
-    assert "[cells]" in doc and "[1, 15]" in doc and "default 4" in doc
+    assert "Alias of inpaint.patch_radius" in doc and "[px]" in doc and "[1, 15]" in doc and "default 4" in doc
     assert "gradient" in lidarshop.FillOptions.method.__doc__ and "laplace" in lidarshop.FillOptions.method.__doc__
     assert "patch_radius:" in lidarshop.FillOptions.__doc__
     text = repr(lidarshop.FillOptions(method="telea"))
-    assert text.startswith("FillOptions(method='telea', patch_radius=4")
+    assert text.startswith("FillOptions(method='telea', inpaint=InpaintOptions(patch_radius=4")
     assert "poisson=PoissonOptions(" in text
 
 
