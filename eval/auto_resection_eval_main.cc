@@ -48,7 +48,7 @@ double Percentile(const std::vector<double>& sorted, double p) {
 // `rough_offset_m` > 0: start from the hand-picked pairs' camera moved by this much (and turned by
 // `rough_turn_deg`) instead of searching from the scanner centre.
 int RunPumpA(const AutoResectionOptions& options, bool unknown_focal, double rough_offset_m,
-             double rough_turn_deg) {
+             double rough_turn_deg, bool verbose) {
   const std::string scan_path = LIDARSHOP_SHARED_DATA_DIR "/e57/pumpA.e57";
   const E57File file = ReadE57(scan_path);
   const ScanFile scans = ReadScanFile(scan_path);
@@ -92,7 +92,7 @@ int RunPumpA(const AutoResectionOptions& options, bool unknown_focal, double rou
     if (result.method == "silhouettes")
       fmt::print("  silhouettes: {:.0f} % of the model edges on a photo edge, mutual information {:.3f}\n",
                  100 * result.silhouette_edge_share, result.silhouette_mutual_information);
-    if (std::getenv("TRACE")) fmt::print("  trace: {}\n", result.trace);
+    if (verbose) fmt::print("  trace: {}\n", result.trace);
     fmt::print("pumpA: {}\n  RMS on the {} hand-picked pairs: {:.2f} px ({:.1f} s)\n", result.Summary(),
                pairs.pixel_point.size(), std::sqrt(sum / pairs.pixel_point.size()),
                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
   app.add_option("--columns", columns, "scan columns");
   app.add_flag("--unknown-focal", unknown_focal, "search the field of view instead of giving the intrinsics");
   app.add_flag("--pumpa", pumpa, "pumpA's photo against its hand-picked pairs");
-  app.add_flag("-v,--verbose", verbose, "one line per case");
+  app.add_flag("-v,--verbose", verbose, "one line per case (--pumpa: the trace of each step)");
   app.add_option("--out", out_path, "markdown table to write");
   AutoResectionOptions options;
   app.add_option("--pixels-per-cell", options.pixels_per_cell, "AutoResectionOptions::pixels_per_cell");
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
   app.add_option("--dump", dump_dir, "folder to write each case's photo and scan colours into");
   CLI11_PARSE(app, argc, argv);
   cv::setNumThreads(threads);
-  if (pumpa) return RunPumpA(options, unknown_focal, rough_offset_m, rough_turn_deg);
+  if (pumpa) return RunPumpA(options, unknown_focal, rough_offset_m, rough_turn_deg, verbose);
 
   std::vector<double> centre_cm, angle_deg, rms_px, share, seconds;
   int succeeded = 0, refused = 0;
