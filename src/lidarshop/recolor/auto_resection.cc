@@ -26,6 +26,7 @@ using auto_resection_internal::Render;
 using auto_resection_internal::SamplesOf;
 using auto_resection_internal::Scaled;
 using auto_resection_internal::ScanSamples;
+using auto_resection_internal::SetPose;
 using auto_resection_internal::View;
 
 constexpr double kDegPerRad = 180.0 / M_PI;
@@ -235,17 +236,6 @@ cv::Matx33d OpenCvK(const PinholeCamera& c) {
 }
 cv::Mat OpenCvDistortion(const PinholeCamera& c) {
   return (cv::Mat_<double>(1, 5) << c.k1, c.k2, c.p1, c.p2, c.k3);
-}
-
-void SetPose(const cv::Mat& rvec, const cv::Mat& tvec, PinholeCamera* camera) {
-  cv::Matx33d rotation;
-  cv::Rodrigues(rvec, rotation);
-  Eigen::Matrix3d r;
-  cv::cv2eigen(cv::Mat(rotation), r);
-  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  camera->world_from_camera.setIdentity();
-  camera->world_from_camera.topLeftCorner<3, 3>() = r.transpose();
-  camera->world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
 }
 
 void GetPose(const PinholeCamera& camera, cv::Mat* rvec, cv::Mat* tvec) {

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/util/error.h"
@@ -156,6 +158,17 @@ PinholeCamera Scaled(const PinholeCamera& camera, int width_px, int height_px) {
   out.fx_px *= sx, out.skew_px *= sx, out.cx_px *= sx;
   out.fy_px *= sy, out.cy_px *= sy;
   return out;
+}
+
+void SetPose(const cv::Mat& rvec, const cv::Mat& tvec, PinholeCamera* camera) {
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  Eigen::Matrix3d r;
+  cv::cv2eigen(cv::Mat(rotation), r);
+  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
+  camera->world_from_camera.setIdentity();
+  camera->world_from_camera.topLeftCorner<3, 3>() = r.transpose();
+  camera->world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
 }
 
 }  // namespace lidarshop::auto_resection_internal

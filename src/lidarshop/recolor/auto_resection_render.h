@@ -50,4 +50,7 @@ View Render(const ScanSamples& samples, const PinholeCamera& camera);
 // The intrinsics of `camera` for an image `width_px` x `height_px` (pose kept).
 PinholeCamera Scaled(const PinholeCamera& camera, int width_px, int height_px);
 
+// Sets camera's pose from OpenCV's rvec and tvec (the world in the camera's frame, as solvePnP gives it).
+void SetPose(const cv::Mat& rvec, const cv::Mat& tvec, PinholeCamera* camera);
+
 }  // namespace lidarshop::auto_resection_internal

@@ -20,6 +20,7 @@ using auto_resection_internal::Render;
 using auto_resection_internal::SamplesOf;
 using auto_resection_internal::Scaled;
 using auto_resection_internal::ScanSamples;
+using auto_resection_internal::SetPose;
 using auto_resection_internal::Shade;
 using auto_resection_internal::View;
 
@@ -251,17 +252,6 @@ double EdgeShare(const std::vector<ModelEdge>& model, const PhotoEdges& edges, c
     if (x >= 0 && y >= 0 && x < d.cols && y < d.rows && d.at<float>(y, x) <= kNearPx) ++near;
   }
   return model.empty() ? 0 : static_cast<double>(near) / model.size();
-}
-
-void SetPose(const cv::Mat& rvec, const cv::Mat& tvec, PinholeCamera* camera) {
-  cv::Matx33d rotation;
-  cv::Rodrigues(rvec, rotation);
-  Eigen::Matrix3d r;
-  cv::cv2eigen(cv::Mat(rotation), r);
-  const Eigen::Vector3d t(tvec.at<double>(0), tvec.at<double>(1), tvec.at<double>(2));
-  camera->world_from_camera.setIdentity();
-  camera->world_from_camera.topLeftCorner<3, 3>() = r.transpose();
-  camera->world_from_camera.topRightCorner<3, 1>() = -r.transpose() * t;
 }
 
 // One iteration of step 3 at `work`'s size: pairs, then LM on the pose (in photo pixels).
