@@ -97,18 +97,8 @@ std::string ChoicesText(const StructInfo& info) {
 
 std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
   std::string out;
-  std::map<std::string, const StructInfo*> written;
-  std::deque<TypeScriptStruct> queue(structs.begin(), structs.end());
-  while (!queue.empty()) {
-    const TypeScriptStruct entry = queue.front();
-    queue.pop_front();
+  VisitDescribedStructs(structs, [&out](const TypeScriptStruct& entry, const auto& push) {
     const StructInfo& info = *entry.info;
-    if (const auto found = written.find(info.name); found != written.end()) {
-      if (found->second != &info)
-        throw OptionsError(fmt::format("two described structs are named {}", info.name));
-      continue;
-    }
-    written[info.name] = &info;
     const bool options = !entry.answer;
     // An options struct's own defaults; a result has none worth printing.
     const nlohmann::ordered_json defaults =
@@ -122,7 +112,7 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
       if (!options) {
         out += fmt::format("| `{}` | {} | {} | {} |\n", field.key, Cell(TypeText(field)), Cell(field.unit),
                            Cell(field.doc));
-        if (field.kind == FieldKind::kStruct) queue.push_back({field.nested, nullptr, true});
+        if (field.kind == FieldKind::kStruct) push({field.nested, nullptr, true});
         continue;
       }
       std::string default_text;
@@ -132,7 +122,7 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
         if (defaults.contains(field.key) && field.nested->default_json)
           Differences(defaults.at(field.key), field.nested->default_json(), "", &differences);
         default_text = differences.empty() ? "its defaults" : fmt::format("{}", fmt::join(differences, ", "));
-        queue.push_back({field.nested, nullptr, false});
+        push({field.nested, nullptr, false});
       } else {
         default_text = defaults.contains(field.key) ? ValueCell(defaults.at(field.key)) : "";
       }
@@ -153,7 +143,7 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
           "{}.\n",
           fmt::join(aliases, ", "));
     }
-  }
+  });
   return out;
 }
 

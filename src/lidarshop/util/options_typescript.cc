@@ -108,22 +108,33 @@ void AppendMember(const FieldInfo& field, const std::vector<std::string>& altern
 
 }  // namespace
 
-std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs, std::string_view header) {
-  std::string out(header);
-  if (!out.empty() && out.back() != '\n') out += '\n';
-  // Breadth first: the structs given, in order, then the structs nested in them as first met.
+void VisitDescribedStructs(
+    const std::vector<TypeScriptStruct>& structs,
+    const std::function<void(const TypeScriptStruct&, const std::function<void(TypeScriptStruct)>&)>& visit) {
   std::deque<TypeScriptStruct> queue(structs.begin(), structs.end());
-  std::map<std::string, const StructInfo*> written;
+  std::map<std::string, const StructInfo*> visited;
+  const std::function<void(TypeScriptStruct)> push = [&queue](TypeScriptStruct nested) {
+    queue.push_back(std::move(nested));
+  };
   while (!queue.empty()) {
     const TypeScriptStruct entry = queue.front();
     queue.pop_front();
     const StructInfo& info = *entry.info;
-    if (const auto found = written.find(info.name); found != written.end()) {
+    if (const auto found = visited.find(info.name); found != visited.end()) {
       if (found->second != &info)
         throw OptionsError(fmt::format("two described structs are named {}", info.name));
       continue;
     }
-    written[info.name] = &info;
+    visited[info.name] = &info;
+    visit(entry, push);
+  }
+}
+
+std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs, std::string_view header) {
+  std::string out(header);
+  if (!out.empty() && out.back() != '\n') out += '\n';
+  VisitDescribedStructs(structs, [&out](const TypeScriptStruct& entry, const auto& push) {
+    const StructInfo& info = *entry.info;
     const nlohmann::ordered_json* defaults = entry.defaults.is_object() ? &entry.defaults : nullptr;
     out += fmt::format("\n// {} (C++ {})\nexport interface {} {{\n", info.doc, info.name, info.name);
     for (const FieldInfo& field : info.fields) {
@@ -132,11 +143,11 @@ std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs,
       if (field.kind == FieldKind::kStruct) {
         TypeScriptStruct nested{field.nested, nullptr, entry.answer};
         if (defaults != nullptr && defaults->contains(field.key)) nested.defaults = defaults->at(field.key);
-        queue.push_back(std::move(nested));
+        push(std::move(nested));
       }
     }
     out += "}\n";
-  }
+  });
   return out;
 }
 

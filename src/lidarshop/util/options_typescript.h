@@ -5,6 +5,7 @@
 // quotes), so `npm run lint` passes on the generated file as it is.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,13 @@ struct TypeScriptStruct {
   // `number | null`. Options never hold NaN (their ranges reject it).
   bool answer = false;
 };
+
+// Visits `structs` in order, then the structs nested in them as first met (breadth first), each name once:
+// `visit(entry, push)` handles one and calls `push` for each struct it holds. Throws OptionsError when two
+// different structs share a name.
+void VisitDescribedStructs(
+    const std::vector<TypeScriptStruct>& structs,
+    const std::function<void(const TypeScriptStruct&, const std::function<void(TypeScriptStruct)>&)>& visit);
 
 template <class S>
 TypeScriptStruct OptionsType() {
