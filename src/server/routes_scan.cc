@@ -112,7 +112,7 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
       return std::nullopt;
     }
     return json;
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // a syntax error, or a number past double's range
     SendError(response, 400, fmt::format("the request body is not JSON: {}", error.what()));
     return std::nullopt;
   }

@@ -182,6 +182,7 @@ TEST_F(ServerTest, MalformedRequestsGet4xx) {
   const std::string strokes = fmt::format("/api/docs/{}/strokes", id);
   EXPECT_EQ(client_->Post(Api(strokes), "{not json", "application/json")->status, 400);
   EXPECT_EQ(client_->Post(Api(strokes), "[1,2]", "application/json")->status, 400);
+  EXPECT_EQ(client_->Post(Api(strokes), R"({"radius": 1e999})", "application/json")->status, 400);
   EXPECT_EQ(client_->Post(Api(strokes), R"({"object": [[1000, 5]]})", "application/json")->status, 400);
   EXPECT_EQ(client_->Post(Api(strokes), R"({"object": [["a", 5]]})", "application/json")->status, 400);
   const auto bad_option = client_->Post(Api(fmt::format("/api/docs/{}/segment", id)),

@@ -156,7 +156,7 @@ OptionBinder::OptionBinder(CLI::App& app) : app_(app) {
               nlohmann::json json;
               try {
                 json = nlohmann::json::parse(text);
-              } catch (const nlohmann::json::parse_error& error) {
+              } catch (const nlohmann::json::exception& error) {  // syntax, or a number past double's range
                 throw OptionsError(fmt::format("{}: not JSON: {}", path, error.what()));
               }
               StructFromJson(*root_info_, json, root_);

@@ -95,7 +95,7 @@ Eigen::Matrix4d ParsePose(const std::string& text, const std::string& what) {
     nlohmann::json json;
     try {
       json = nlohmann::json::parse(contents);
-    } catch (const nlohmann::json::parse_error& error) {
+    } catch (const nlohmann::json::exception& error) {  // a syntax error, or a number past double's range
       throw InputError(fmt::format("{}: not JSON: {}", text, error.what()));
     }
     try {

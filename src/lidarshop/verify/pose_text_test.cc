@@ -123,6 +123,10 @@ TEST_F(PoseFileTest, BadPosesGiveOneLineNamingTheSource) {
             bad_key + ": yaw: unknown key (x_m, y_m, z_m, yaw_deg, pitch_deg, roll_deg or world_from_model)");
   const std::string not_json = Write("broken.json", "{\"x_m\": ");
   EXPECT_NE(message([&] { ParsePose(not_json); }).find(not_json + ": not JSON"), std::string::npos);
+  // A number past double's range is nlohmann's out_of_range, not a parse_error: it ended the process
+  // (found by pose_fuzz).
+  const std::string overflow = Write("overflow.json", R"({"x_m": 0.0157e886661})");
+  EXPECT_NE(message([&] { ParsePose(overflow); }).find(overflow + ": not JSON"), std::string::npos);
   const std::string mirrored =
       Write("mirror.json", R"({"world_from_model": [[-1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]})");
   EXPECT_EQ(message([&] { ParsePose(mirrored); }),
