@@ -347,12 +347,12 @@ try {
     waitForFunction(page, (n) => window.lidarshop.jobsFinished() > n, before, { timeout: 300000 });
   await page.click('#brush-object');
   await edit('object stroke', () => drag([at(0.583, 0.452), at(0.583, 0.546)]), newerThan);
-  await page.click('#brush-background');
-  await edit(
-    'background stroke -> first cut',
-    () => drag([at(0.647, 0.402), at(0.647, 0.592)]),
-    afterJob(await jobsFinished()),
-  );
+  // A stroke with the brush `brush` from grid fraction `from` to `to` that runs a cut (Live): timed to its end.
+  const cutStroke = async (what, brush, from, to) => {
+    await page.click(`#brush-${brush}`);
+    await edit(what, () => drag([at(...from), at(...to)]), afterJob(await jobsFinished()));
+  };
+  await cutStroke('background stroke -> first cut', 'background', [0.647, 0.402], [0.647, 0.592]);
   const cut = await page.evaluate(() => window.lidarshop.current());
   if (!(cut.object_cells > 0)) fail('the live cut took no cell');
   // (The browser keeps 250 resource timings by default: the buffer is full by now.)
@@ -362,18 +362,8 @@ try {
   });
   // Two refinements: an object stroke inside the cut (nothing changes), a background stroke across the car's
   // left end (the cut gives those cells up).
-  await page.click('#brush-object');
-  await edit(
-    'object stroke -> refined cut',
-    () => drag([at(0.6, 0.47), at(0.6, 0.53)]),
-    afterJob(await jobsFinished()),
-  );
-  await page.click('#brush-background');
-  await edit(
-    'background stroke -> refined cut',
-    () => drag([at(0.6, 0.404), at(0.6, 0.42)]),
-    afterJob(await jobsFinished()),
-  );
+  await cutStroke('object stroke -> refined cut', 'object', [0.6, 0.47], [0.6, 0.53]);
+  await cutStroke('background stroke -> refined cut', 'background', [0.6, 0.404], [0.6, 0.42]);
   const refined = await page.evaluate(() => window.lidarshop.current());
   result.cut_cells = [cut.object_cells, refined.object_cells];
   if (!(refined.object_cells < cut.object_cells && refined.object_cells > cut.object_cells / 2))
