@@ -60,6 +60,27 @@ cv::Mat Panel(const Scan& scan, const cv::Mat& truth, const cv::Mat& strokes, co
   return both;
 }
 
+// A random scene of the evaluation: its scan, the target's cells and the two automatic strokes (seeded from
+// the scene's seed); `strokes` empty when the target leaves no room for them.
+struct RandomCase {
+  SceneDescription scene;
+  Scan scan;
+  cv::Mat truth, strokes;
+};
+RandomCase MakeRandomCase(uint64_t seed, const RandomSceneOptions& scene_options) {
+  RandomCase c;
+  c.scene = RandomScene(seed, scene_options);
+  c.scan = SynthesizeScan(c.scene);
+  c.truth = (c.scan.label == c.scene.target_label) & (c.scan.valid != 0);
+  EvalStrokeOptions stroke_options;
+  stroke_options.upper_and_below = true;
+  try {
+    c.strokes = MakeEvalStrokes(c.truth, c.scan.valid, seed * 7919 + 1, stroke_options);
+  } catch (const InputError&) {
+  }
+  return c;
+}
+
 int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scene_options,
               const SegmentOptions& options, int grabcut_iterations, const std::string& dump_dir,
               const std::string& markdown_path) {
@@ -71,21 +92,18 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
       "target cells | two-step IoU | grabCut IoU | two-step s |\n"
       "|---|---|---|---|---|---|---|\n",
       seeds.front(), seeds.back(), scene_options.columns, scene_options.rows));
-  EvalStrokeOptions stroke_options;
-  stroke_options.upper_and_below = true;
   std::vector<double> two_step, grabcut;
   std::vector<bool> like_background;
   std::vector<uint64_t> scored;
   std::vector<uint64_t> no_room;
   double seconds = 0;
   for (uint64_t seed : seeds) {
-    const SceneDescription scene = RandomScene(seed, scene_options);
-    const Scan scan = SynthesizeScan(scene);
-    const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
-    cv::Mat strokes;
-    try {
-      strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
-    } catch (const InputError&) {
+    const RandomCase random_case = MakeRandomCase(seed, scene_options);
+    const SceneDescription& scene = random_case.scene;
+    const Scan& scan = random_case.scan;
+    const cv::Mat& truth = random_case.truth;
+    const cv::Mat& strokes = random_case.strokes;
+    if (strokes.empty()) {
       no_room.push_back(seed);
       emit(fmt::format("| {} | {} | {:.1f} | {} | no room for strokes | | |\n", seed,
                        test_scenes::TargetColumn(scene), test_scenes::TargetDistance(scene),
@@ -140,12 +158,9 @@ int RunRandom(const std::vector<uint64_t>& seeds, const RandomSceneOptions& scen
       test_scenes::MeanWhere(grabcut, like_background, false)));
   if (!dump_dir.empty()) {
     for (size_t i : test_scenes::WorstIndices(two_step, 3, true)) {
-      const SceneDescription scene = RandomScene(scored[i], scene_options);
-      const Scan scan = SynthesizeScan(scene);
-      const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
-      const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, scored[i] * 7919 + 1, stroke_options);
+      const RandomCase worst = MakeRandomCase(scored[i], scene_options);  // scored: it had room for strokes
       WriteImage(fmt::format("{}/random_{}.png", dump_dir, scored[i]),
-                 Panel(scan, truth, strokes, options, grabcut_iterations));
+                 Panel(worst.scan, worst.truth, worst.strokes, options, grabcut_iterations));
     }
   }
   report.Write(markdown_path);
@@ -295,19 +310,10 @@ int main(int argc, char** argv) {
           "{}", set.Report(fmt::format("evaluation set ({} scenes x {} stroke seeds)", paths.size(), seeds)));
       if (!random_seeds.empty()) {
         WindowComparison random;
-        EvalStrokeOptions stroke_options;
-        stroke_options.upper_and_below = true;
         for (uint64_t seed : test_scenes::ParseSeedRange(random_seeds)) {
-          const SceneDescription scene = RandomScene(seed, scene_options);
-          const Scan scan = SynthesizeScan(scene);
-          const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
-          cv::Mat strokes;
-          try {
-            strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
-          } catch (const InputError&) {
-            continue;  // no room for strokes (as the random evaluation)
-          }
-          random.Add(fmt::format("seed {}", seed), scan, strokes, options);
+          const RandomCase random_case = MakeRandomCase(seed, scene_options);
+          if (random_case.strokes.empty()) continue;  // no room for strokes (as the random evaluation)
+          random.Add(fmt::format("seed {}", seed), random_case.scan, random_case.strokes, options);
         }
         fmt::print("{}", random.Report(fmt::format("random scenes {}", random_seeds)));
       }

@@ -13,6 +13,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "version_param.h"
 
 namespace lidarshop::server {
 
@@ -304,16 +305,12 @@ void AddEditRoutes(State& state) {
     if (!job) return SendError(response, 404, "no such job");
     // ?wait_ms=N: answer when the job ends, or after N ms (a long poll: the client hears of
     // the end when it comes instead of at its next poll).
-    if (request.has_param("wait_ms")) {
-      const std::string text = request.get_param_value("wait_ms");
-      char* end = nullptr;
-      const long value = std::strtol(text.c_str(), &end, 10);
-      if (text.empty() || *end != '\0' || value < 0 || value > kMaxJobWaitMs) {
-        return SendError(response, 400,
-                         fmt::format("wait_ms: expected a whole number of ms from 0 to {}", kMaxJobWaitMs));
-      }
-      job->WaitEnded(std::chrono::milliseconds(value));
+    int64_t wait_ms = 0;
+    const std::string expected = fmt::format("a whole number of ms from 0 to {}", kMaxJobWaitMs);
+    if (!ReadWholeNumberParam(request, response, "wait_ms", 0, kMaxJobWaitMs, expected.c_str(), &wait_ms)) {
+      return;
     }
+    if (wait_ms > 0) job->WaitEnded(std::chrono::milliseconds(wait_ms));
     SendJson(response, JobJson(*job));
   });
   state.http.Post(R"(/api/jobs/(\d+)/cancel)",

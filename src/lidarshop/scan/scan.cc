@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/scan/rgbd_cell.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -321,20 +322,9 @@ cv::Mat DepthImage(const Scan& scan) {
 }
 
 cv::Mat RgbdImage(const Scan& scan) {
-  cv::Mat rgbd(scan.rows, scan.cols, CV_32FC4, cv::Scalar::all(0));
-  for (int row = 0; row < scan.rows; ++row) {
-    for (int col = 0; col < scan.cols; ++col) {
-      cv::Vec4f& out = rgbd.at<cv::Vec4f>(row, col);
-      if (!scan.color.empty()) {
-        const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
-        out = cv::Vec4f(c[0] / 255.f, c[1] / 255.f, c[2] / 255.f, 0.f);
-      } else if (!scan.intensity.empty()) {
-        const float gray = scan.intensity.at<float>(row, col);
-        out = cv::Vec4f(gray, gray, gray, 0.f);
-      }
-      out[3] = scan.range.at<float>(row, col);
-    }
-  }
+  cv::Mat rgbd(scan.rows, scan.cols, CV_32FC4);
+  for (int row = 0; row < scan.rows; ++row)
+    for (int col = 0; col < scan.cols; ++col) rgbd.at<cv::Vec4f>(row, col) = RgbdAt(scan, row, col);
   return rgbd;
 }
 

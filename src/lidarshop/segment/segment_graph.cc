@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/scan/rgbd_cell.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/timer.h"
 
@@ -20,20 +21,6 @@ void ThrowGraphError(const char* message) { throw std::runtime_error(fmt::format
 }  // namespace
 
 namespace {
-
-// R, G, B in [0, 1] and range in metres of one cell, as RgbdImage (scan/scan.h) gives them.
-inline cv::Vec4f RgbdAt(const Scan& scan, int row, int col) {
-  cv::Vec4f out(0.f, 0.f, 0.f, 0.f);
-  if (!scan.color.empty()) {
-    const cv::Vec3b& c = scan.color.at<cv::Vec3b>(row, col);
-    out = cv::Vec4f(c[0] / 255.f, c[1] / 255.f, c[2] / 255.f, 0.f);
-  } else if (!scan.intensity.empty()) {
-    const float gray = scan.intensity.at<float>(row, col);
-    out = cv::Vec4f(gray, gray, gray, 0.f);
-  }
-  out[3] = scan.range.at<float>(row, col);
-  return out;
-}
 
 inline bool IsNode(const Scan& scan, int row, int col) {
   const float range = scan.range.at<float>(row, col);
