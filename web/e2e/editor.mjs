@@ -636,6 +636,9 @@ try {
     { timeout: 30000 },
   );
   await page.selectOption('#file', { label: 'removed.e57' });
+  // The reloaded page finishes showing its document (the status names its version) before the 17th opens: a
+  // show that ended after the refusal would write over its message (seen in CI).
+  await waitForStatus(/\(version \d+\)$/, 'the reloaded page shows its document');
   const refused = await new Promise((resolve) => {
     page.on('response', (response) => {
       if (response.url().includes('/api/open')) resolve(response.status());
