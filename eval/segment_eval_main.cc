@@ -258,6 +258,8 @@ int main(int argc, char** argv) {
   app.add_option("--grow-max", options.whole_object.max_growth,
                  "whole-object growth: at most this times the cut");
   app.add_flag("!--no-grow", options.grow_whole_object, "no whole-object growth");
+  app.add_option("--coarse-max-cells", options.coarse_max_cells,
+                 "coarse to fine above this many cells (0 = always full resolution)");
   app.add_option("--crevice-flank-deg", options.whole_object.crevice_flank_deg,
                  "touching neighbours: steepness of a crevice's flanks, degrees");
   app.add_option("--crevice-baseline", options.whole_object.crevice_baseline_cells,

@@ -31,6 +31,8 @@ export interface SegmentOptions {
   roi_margin_fraction: number;
   // the cuts' graphs cover the strokes' box grown by this, doubled while the cut reaches its edge; 0 = whole scan [cells] in >= 0, default 128
   window_margin_cells: number;
+  // a scan of more cells is cut on a coarser level (every f-th ray) and its outline re-cut at full resolution; 0 = always full resolution [cells] in >= 0, default 1000000
+  coarse_max_cells: number;
   // histogram bins per colour channel in [2, 64], default 16
   color_bins: number;
   // range histogram bin width [m] in > 0, default 0.05
@@ -263,6 +265,8 @@ export interface SegmentResult {
   window_cols: number;
   // times the window was grown
   window_growths: number;
+  // 1 = cut at full resolution; f = on every f-th ray, the outline re-cut at full resolution
+  coarse_factor: number;
   // spacing of neighbouring rays at the object strokes [m]
   ray_spacing_m: number | null;
   // factor applied to the metric lengths (scale_to_data)

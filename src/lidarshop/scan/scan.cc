@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/scan/rgbd_cell.h"
+#include "lidarshop/scan/scan_channels.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -104,23 +105,7 @@ Scan MaskScan(const Scan& scan, const cv::Mat& keep_mask) {
 
 namespace {
 
-// Every per-cell channel of a scan with its no-return value (MaskScan's): CropScan and PasteScan visit them
-// all, so a channel added to Scan is added here once.
-template <typename ScanT, typename Visit>
-void ForEachChannel(ScanT& scan, Visit visit) {
-  visit(scan.direction, cv::Scalar::all(0));
-  visit(scan.valid, cv::Scalar(0));
-  visit(scan.range, cv::Scalar(0));
-  visit(scan.point, cv::Scalar::all(0));
-  visit(scan.intensity, cv::Scalar(0.5));
-  visit(scan.color, cv::Scalar::all(0));
-  visit(scan.label, cv::Scalar(kNoLabel));
-  visit(scan.normal, cv::Scalar::all(0));
-  visit(scan.curvature, cv::Scalar(NAN));
-  visit(scan.true_range, cv::Scalar(0));
-  visit(scan.synthesized, cv::Scalar(0));
-  visit(scan.from_station, cv::Scalar(0));
-}
+using scan_internal::ForEachChannel;
 
 void CheckWindow(const Scan& scan, const cv::Rect& window, const char* what) {
   if (window.x < 0 || window.y < 0 || window.width < 0 || window.height < 0 ||

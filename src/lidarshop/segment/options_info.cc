@@ -154,6 +154,11 @@ const StructInfo& InfoOf<SegmentOptions>() {
             "0 = whole scan")
         .Unit("cells")
         .Min(0);
+    b.Field(&SegmentOptions::coarse_max_cells, "coarse_max_cells",
+            "a scan of more cells is cut on a coarser level (every f-th ray) and its outline re-cut at full "
+            "resolution; 0 = always full resolution")
+        .Unit("cells")
+        .Min(0);
     b.Field(&SegmentOptions::color_bins, "color_bins", "histogram bins per colour channel").Range(2, 64);
     b.Field(&SegmentOptions::depth_bin_m, "depth_bin_m", "range histogram bin width").Unit("m").AboveZero();
     b.Field(&SegmentOptions::depth_smoothing_m, "depth_smoothing_m",
@@ -224,6 +229,8 @@ const StructInfo& InfoOf<SegmentResult>() {
     b.Field(&SegmentResult::window_rows, "window_rows", "rows of the window").Unit("cells");
     b.Field(&SegmentResult::window_cols, "window_cols", "columns of the window").Unit("cells");
     b.Field(&SegmentResult::window_growths, "window_growths", "times the window was grown");
+    b.Field(&SegmentResult::coarse_factor, "coarse_factor",
+            "1 = cut at full resolution; f = on every f-th ray, the outline re-cut at full resolution");
     b.Field(&SegmentResult::ray_spacing_m, "ray_spacing_m",
             "spacing of neighbouring rays at the object strokes")
         .Unit("m");

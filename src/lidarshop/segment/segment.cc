@@ -16,11 +16,14 @@ void SegmentOptions::Check() const { Validate(*this); }
 void WholeObjectOptions::Check() const { Validate(*this); }
 
 std::string SegmentResult::Summary() const {
-  return fmt::format(
+  std::string summary = fmt::format(
       "{} object cells, flow {:.1f}, {:.3f} s (features {:.3f}, models {:.3f}, graph {:.3f}, "
       "max-flow {:.3f})",
       object_cells, flow, timings.total_s, timings.features_s, timings.models_s, timings.graph_s,
       timings.maxflow_s);
+  if (coarse_factor > 1)
+    summary += fmt::format(", cut on every {}th ray, outline re-cut at full resolution", coarse_factor);
+  return summary;
 }
 
 namespace {

@@ -166,6 +166,15 @@ struct SegmentOptions {
   // cut of the whole scan. 0 = the whole scan.
   int window_margin_cells = 128;  // cells (>= 0)
 
+  // Coarse to fine, so that a cut of a large station costs what its object's outline does: a scan of more
+  // cells than this is cut first on a coarser level (DecimateScan, scan/scan_level.h: every f-th ray each way,
+  // f the smallest power of two that brings the level to at most this many cells) by the whole method above,
+  // with the same options (cell counts are the level's: they were chosen for scans of about this size); its
+  // object is taken to full resolution and the cells within two coarse cells of its outline are cut again
+  // there (one colour-dominant cut: models from the level's object and its surroundings, every stroke hard).
+  // Refine() refines the level's cut and re-cuts the outline likewise. 0 = always full resolution.
+  int coarse_max_cells = 1000000;  // cells (>= 0)
+
   // Scale to the data: the range-model lengths below (depth_bin_m, depth_smoothing_m) are given for a ray
   // spacing of reference_spacing_m at the object (terrestrial scans of objects metres away) and multiplied by
   // min(1, measured spacing / reference_spacing_m), the spacing being the object strokes' median range ×
@@ -228,6 +237,9 @@ struct SegmentResult {
   // columns (the whole scan when not windowed), and how many times it was grown.
   int window_row = 0, window_col = 0, window_rows = 0, window_cols = 0;
   int window_growths = 0;
+  // 1 = cut at full resolution; f > 1 = on the level of every f-th ray, its outline re-cut at full resolution
+  // (SegmentOptions::coarse_max_cells; the window is then the level's, in full-resolution cells).
+  int coarse_factor = 1;
   SegmentTimings timings;
   // What looks wrong with the cut (segment/cut_checks.h: it grew far past its strokes' part, it touches two
   // borders), one sentence each; empty when nothing does. The mask is kept as it is.

@@ -32,7 +32,8 @@ constexpr int64_t kMedianSampleNodes = 100000;
 
 }  // namespace
 
-ScanStats ComputeScanStats(const Scan& scan) {
+ScanStats ComputeScanStats(const Scan& scan, int row_step) {
+  row_step = std::max(1, row_step);
   ScanStats stats;
   // Pass 1: the channels' sums, per row so that the result does not depend on threads.
   struct RowSums {
@@ -43,6 +44,7 @@ ScanStats ComputeScanStats(const Scan& scan) {
   std::vector<RowSums> rows(scan.rows);
   ParallelFor(scan.rows, [&](int64_t row) {
     RowSums& out = rows[row];
+    if (row % row_step != 0) return;
     for (int col = 0; col < scan.cols; ++col) {
       if (!IsNode(scan, static_cast<int>(row), col)) continue;
       const cv::Vec4f v = RgbdAt(scan, static_cast<int>(row), col);
@@ -91,6 +93,7 @@ ScanStats ComputeScanStats(const Scan& scan) {
   ParallelFor(scan.rows, [&](int64_t row64) {
     const int row = static_cast<int>(row64);
     RowLinks& out = links[row];
+    if (row % row_step != 0) return;
     int64_t node = first_node[row];
     for (int col = 0; col < scan.cols; ++col) {
       if (!IsNode(scan, row, col)) continue;
@@ -121,7 +124,7 @@ ScanStats ComputeScanStats(const Scan& scan) {
   return stats;
 }
 
-Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window) {
+Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window, const cv::Mat& include) {
   Nodes nodes;
   nodes.window = window & cv::Rect(0, 0, scan.cols, scan.rows);
   nodes.rows = nodes.window.height;
@@ -132,9 +135,10 @@ Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window
   nodes.node_of_cell.assign(static_cast<size_t>(nodes.rows) * nodes.cols, -1);
   for (int r = 0; r < nodes.rows; ++r) {
     const int row = nodes.window.y + r;
+    const uint8_t* included = include.empty() ? nullptr : include.ptr<uint8_t>(r);
     for (int c = 0; c < nodes.cols; ++c) {
       const int col = nodes.window.x + c;
-      if (!IsNode(scan, row, col)) continue;
+      if ((included != nullptr && included[c] == 0) || !IsNode(scan, row, col)) continue;
       const int64_t cell = static_cast<int64_t>(r) * nodes.cols + c;
       nodes.node_of_cell[cell] = static_cast<int32_t>(nodes.cell_of_node.size());
       nodes.cell_of_node.push_back(static_cast<int32_t>(cell));

@@ -33,7 +33,9 @@ struct ScanStats {
   std::vector<std::pair<uint8_t, cv::Vec4f>> sample;
 };
 
-ScanStats ComputeScanStats(const Scan& scan);
+// row_step > 1: only every row_step-th row (with its links to the next row), for a quick estimate at a fine
+// level whose coarse level was cut (coarse_to_fine.h).
+ScanStats ComputeScanStats(const Scan& scan, int row_step = 1);
 
 // The valid cells of `window` (a rectangle of the scan) as graph nodes, with their channels standardized by
 // `stats`. Cells are counted in the window (row-major, window.width columns); ScanCell() gives the scan's.
@@ -59,7 +61,9 @@ struct Nodes {
   }
 };
 
-Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window);
+// `include` (CV_8U of the window's size; empty = every cell): only its non-zero cells become nodes.
+Nodes MakeNodes(const Scan& scan, const ScanStats& stats, const cv::Rect& window,
+                const cv::Mat& include = cv::Mat());
 
 // Neighbour offsets in the order right, down, down-right, down-left (each edge is stored once, at its
 // upper/left end).

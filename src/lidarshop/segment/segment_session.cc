@@ -10,7 +10,9 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/scan/scan_level.h"
 #include "lidarshop/segment/appearance.h"
+#include "lidarshop/segment/coarse_to_fine.h"
 #include "lidarshop/segment/cut_checks.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/segment_graph.h"
@@ -21,6 +23,32 @@
 namespace lidarshop {
 
 using namespace segment_internal;  // NOLINT: the graph and appearance helpers of this module
+
+namespace {
+
+// Refine()'s rule that strokes say only what they say (SegmentOptions::refine_monotone), applied to `mask`
+// after a refinement from `previous`: object strokes alone only add, background strokes alone only remove the
+// 8-connected parts of the dropped cells that hold one of `background_cells` (scan cells of the new
+// background strokes). Mixed strokes keep the new cut.
+void KeepMonotone(const cv::Mat& previous, bool object_strokes, bool background_strokes,
+                  const std::vector<int64_t>& background_cells, cv::Mat* mask) {
+  if (previous.empty() || object_strokes == background_strokes) return;
+  if (object_strokes) {
+    *mask |= previous;
+    return;
+  }
+  // Re-learnt models must not take away object parts elsewhere.
+  *mask &= previous;
+  cv::Mat dropped = previous & ~*mask, part;
+  const int count = cv::connectedComponents(dropped, part, 8, CV_32S);
+  std::vector<uint8_t> touched(static_cast<size_t>(count), 0);
+  const int32_t* label = reinterpret_cast<const int32_t*>(part.data);
+  for (int64_t cell : background_cells) touched[static_cast<size_t>(label[cell])] = 1;
+  for (int64_t cell = 0; cell < static_cast<int64_t>(part.total()); ++cell)
+    if (label[cell] != 0 && !touched[static_cast<size_t>(label[cell])]) mask->data[cell] = 255;
+}
+
+}  // namespace
 
 struct SegmentSession::Impl {
   Scan scan;
@@ -40,6 +68,42 @@ struct SegmentSession::Impl {
   SegmentResult last_result;
   cv::Mat stroked_part;  // Run(): the part of the step-1 cut the object strokes lie on (cut_checks.h)
   bool ran = false;
+  // Coarse to fine (SegmentOptions::coarse_max_cells): the level's factor, session and cells
+  // (DecimatedCells), and every stroke so far at full resolution (the outline's cut takes them all).
+  int factor = 1;
+  std::unique_ptr<SegmentSession> level;
+  cv::Mat level_cells;
+  cv::Mat strokes_so_far;
+
+  // The result at full resolution of the level's cut `at_level`: its outline re-cut (coarse_to_fine.h).
+  SegmentResult FromLevel(const SegmentResult& at_level, const Timer& total, double stats_s) const {
+    SegmentResult result;
+    result.timings = at_level.timings;
+    const cv::Size full(scan.cols, scan.rows);
+    result.mask = CutOutlineAtFullResolution(scan, stats, at_level.mask, level_cells, factor, strokes_so_far,
+                                             given, has_appearance, &result);
+    const cv::Mat valid = scan.valid != 0;
+    if (!at_level.step1_mask.empty())
+      result.step1_mask = FullResolution(at_level.step1_mask, factor, full) & valid;
+    if (!at_level.inferred_background.empty())
+      result.inferred_background = FullResolution(at_level.inferred_background, factor, full) & valid;
+    if (given.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, scan.valid);
+    result.object_cells = cv::countNonZero(result.mask);
+    result.ray_spacing_m = at_level.ray_spacing_m;
+    result.length_scale = at_level.length_scale;
+    const cv::Rect window = cv::Rect(at_level.window_col * factor, at_level.window_row * factor,
+                                     at_level.window_cols * factor, at_level.window_rows * factor) &
+                            WholeScan();
+    result.window_row = window.y;
+    result.window_col = window.x;
+    result.window_rows = window.height;
+    result.window_cols = window.width;
+    result.window_growths = at_level.window_growths;
+    result.coarse_factor = factor;
+    result.warnings = at_level.warnings;
+    result.timings.total_s = total.Seconds() + stats_s;
+    return result;
+  }
 
   const NLinks& Links(const CutWeights& w, std::unique_ptr<NLinks>* cache, SegmentTimings* t) {
     if (!*cache) {
@@ -294,8 +358,19 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
   Timer timer;
   impl_->scan = scan;
   impl_->given = impl_->options = options;
-  // The whole scan's statistics once; the nodes of a window at each Run().
-  impl_->stats = ComputeScanStats(scan);
+  impl_->factor = CoarseFactor(scan.rows, scan.cols, options.coarse_max_cells);
+  if (impl_->factor > 1) {
+    // The level is cut by the whole method; here only its outline is, so rows sampled suffice for the
+    // standardization and σ².
+    SegmentOptions at_level = options;
+    at_level.coarse_max_cells = 0;
+    impl_->level = std::make_unique<SegmentSession>(DecimateScan(scan, impl_->factor), at_level);
+    impl_->level_cells = DecimatedCells(scan, impl_->factor);
+    impl_->stats = ComputeScanStats(scan, impl_->factor);
+  } else {
+    // The whole scan's statistics once; the nodes of a window at each Run().
+    impl_->stats = ComputeScanStats(scan);
+  }
   impl_->has_appearance = scan.has_color() || scan.has_intensity();
   impl_->features_s = timer.Seconds();
 }
@@ -312,6 +387,14 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
   SegmentTimings timings;
   timings.features_s = s.features_s;
   s.features_s = 0;  // counted once
+  if (s.level) {
+    s.strokes_so_far = strokes.clone();
+    const SegmentResult at_level = s.level->Run(CoarseStrokes(s.scan, s.level_cells, strokes, s.factor));
+    s.last_result = s.FromLevel(at_level, total, stats_s);
+    s.last_result.timings.features_s += timings.features_s;
+    s.ran = true;
+    return s.last_result;
+  }
   // The graphs cover a window around the strokes, grown while a cut reaches its edge (a cut inside it is the
   // cut of the whole scan: cells outside are background).
   s.options = s.given;
@@ -482,6 +565,29 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   if (!s.ran) throw std::logic_error("SegmentSession::Refine called before Run");
   Timer total;
   s.CheckStrokes(extra_strokes, "extra strokes");
+  if (s.level) {
+    bool object_strokes = false, background_strokes = false;
+    std::vector<int64_t> background_cells;
+    const uint8_t* extra = extra_strokes.ptr<uint8_t>();
+    for (int64_t cell = 0; cell < static_cast<int64_t>(extra_strokes.total()); ++cell) {
+      if (extra[cell] == kStrokeNone || s.scan.valid.data[cell] == 0) continue;
+      s.strokes_so_far.data[cell] = extra[cell];
+      if (extra[cell] == kStrokeObject) {
+        object_strokes = true;
+      } else {
+        background_strokes = true;
+        background_cells.push_back(cell);
+      }
+    }
+    const SegmentResult at_level =
+        s.level->Refine(CoarseStrokes(s.scan, s.level_cells, extra_strokes, s.factor));
+    SegmentResult result = s.FromLevel(at_level, total, 0);
+    if (s.given.refine_monotone)
+      KeepMonotone(s.last_result.mask, object_strokes, background_strokes, background_cells, &result.mask);
+    result.object_cells = cv::countNonZero(result.mask);
+    s.last_result = result;
+    return result;
+  }
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
   s.window_growths = 0;
@@ -507,24 +613,11 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   }
   const cv::Mat previous_mask = s.last_result.mask;
   const auto keep_monotone = [&](cv::Mat* mask) {
-    if (!s.options.refine_monotone || previous_mask.empty() || object_strokes == background_strokes) return;
-    if (object_strokes) {
-      *mask |= previous_mask;
-      return;
-    }
-    // Background strokes remove what they touch: of the cells the new cut drops, only the 8-connected parts
-    // that hold a new stroke cell leave (re-learnt models must not take away object parts elsewhere).
-    *mask &= previous_mask;
-    cv::Mat dropped = previous_mask & ~*mask, part;
-    const int count = cv::connectedComponents(dropped, part, 8, CV_32S);
-    std::vector<uint8_t> touched(static_cast<size_t>(count), 0);
-    for (int i = 0; i < s.nodes.num(); ++i) {
-      if (extra[i] != kHardBackground) continue;
-      touched[static_cast<size_t>(reinterpret_cast<const int32_t*>(part.data)[s.nodes.ScanCell(i)])] = 1;
-    }
-    const int32_t* label = reinterpret_cast<const int32_t*>(part.data);
-    for (int64_t cell = 0; cell < static_cast<int64_t>(part.total()); ++cell)
-      if (label[cell] != 0 && !touched[static_cast<size_t>(label[cell])]) mask->data[cell] = 255;
+    if (!s.options.refine_monotone) return;
+    std::vector<int64_t> background_cells;
+    for (int i = 0; i < s.nodes.num(); ++i)
+      if (extra[i] == kHardBackground) background_cells.push_back(s.nodes.ScanCell(i));
+    KeepMonotone(previous_mask, object_strokes, background_strokes, background_cells, mask);
   };
   if (outside) {
     // A stroke outside the last cut's region of interest or window: re-run that cut on the whole window with

@@ -1,0 +1,198 @@
+#include "lidarshop/segment/coarse_to_fine.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/render/strokes.h"
+#include "lidarshop/segment/appearance.h"
+#include "lidarshop/segment/segment_graph.h"
+#include "lidarshop/util/timer.h"
+
+namespace lidarshop::segment_internal {
+namespace {
+
+// Model samples are thinned to about this many cells per side: the mixtures fit as well and in bounded time.
+constexpr size_t kMaxModelSamples = 40000;
+
+cv::Mat Morph(const cv::Mat& mask, int op, int radius) {
+  cv::Mat out;
+  cv::morphologyEx(mask, out, op,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)),
+                   cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  return out;
+}
+
+// Every k-th of `cells`, k chosen so that at most kMaxModelSamples remain (deterministic).
+std::vector<int32_t> Thinned(std::vector<int32_t> cells) {
+  if (cells.size() <= kMaxModelSamples) return cells;
+  const size_t step = (cells.size() + kMaxModelSamples - 1) / kMaxModelSamples;
+  std::vector<int32_t> out;
+  for (size_t i = 0; i < cells.size(); i += step) out.push_back(cells[i]);
+  return out;
+}
+
+}  // namespace
+
+int CoarseFactor(int rows, int cols, int64_t max_cells) {
+  if (max_cells <= 0) return 1;
+  int factor = 1;
+  const auto cells = [&](int f) {
+    return static_cast<int64_t>((rows + f - 1) / f) * static_cast<int64_t>((cols + f - 1) / f);
+  };
+  while (cells(factor) > max_cells && factor < (1 << 20)) factor *= 2;
+  return factor;
+}
+
+cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const cv::Mat& strokes, int factor) {
+  cv::Mat coarse(level_cells.rows, level_cells.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const float* range = scan.range.ptr<float>();
+  for (int row = 0; row < strokes.rows; ++row) {
+    const uint8_t* s = strokes.ptr<uint8_t>(row);
+    uint8_t* out = coarse.ptr<uint8_t>(row / factor);
+    const int32_t* representative = level_cells.ptr<int32_t>(row / factor);
+    for (int col = 0; col < strokes.cols; ++col) {
+      if (s[col] == kStrokeNone || scan.valid.at<uint8_t>(row, col) == 0) continue;
+      const int32_t own = representative[col / factor];
+      if (scan.valid.data[own] == 0) continue;
+      const float r = range[static_cast<int64_t>(row) * scan.cols + col];
+      if (std::abs(range[own] - r) > kStrokeSurfaceFraction * r) continue;
+      uint8_t& c = out[col / factor];
+      if (c != kStrokeBackground) c = s[col];
+    }
+  }
+  return coarse;
+}
+
+cv::Mat FullResolution(const cv::Mat& coarse_mask, int factor, cv::Size full) {
+  if (coarse_mask.empty()) return cv::Mat();
+  cv::Mat up;
+  cv::resize(coarse_mask, up, cv::Size(coarse_mask.cols * factor, coarse_mask.rows * factor), 0, 0,
+             cv::INTER_NEAREST);
+  return up(cv::Rect(0, 0, full.width, full.height)).clone();
+}
+
+cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, const cv::Mat& coarse_mask,
+                                   const cv::Mat& coarse_cells, int factor, const cv::Mat& strokes,
+                                   const SegmentOptions& options, bool has_appearance,
+                                   SegmentResult* result) {
+  Timer timer;
+  const cv::Size full(scan.cols, scan.rows);
+  cv::Mat object = (coarse_mask != 0);
+  // On the level: inside (deeper than the band), the band, the graph (the band and one level cell of hard rim
+  // on each side) and the surroundings the background model is learnt from.
+  const cv::Mat inside = Morph(object, cv::MORPH_ERODE, kBandCoarseCells);
+  const cv::Mat outer = Morph(object, cv::MORPH_DILATE, kBandCoarseCells);
+  const cv::Mat band = outer & ~inside;
+  const cv::Mat graph_cells = Morph(band, cv::MORPH_DILATE, 1);
+  const cv::Mat around = Morph(object, cv::MORPH_DILATE, 4 * kBandCoarseCells) & ~outer;
+  // The full-resolution window: the surroundings' box.
+  const cv::Rect coarse_box = cv::boundingRect(around | object);
+  const cv::Rect window = cv::Rect(coarse_box.x * factor, coarse_box.y * factor, coarse_box.width * factor,
+                                   coarse_box.height * factor) &
+                          cv::Rect(0, 0, scan.cols, scan.rows);
+  const cv::Mat inside_full = FullResolution(inside, factor, full);
+  const cv::Mat band_full = FullResolution(band, factor, full);
+  cv::Mat include = FullResolution(graph_cells, factor, full)(window).clone();
+  // Model samples: the level's representatives of the inside and of the surroundings.
+  std::vector<int32_t> object_cells, background_cells;
+  for (int r = 0; r < coarse_mask.rows; ++r) {
+    const int32_t* cell = coarse_cells.ptr<int32_t>(r);
+    for (int c = 0; c < coarse_mask.cols; ++c) {
+      if (scan.valid.data[cell[c]] == 0) continue;
+      if (inside.at<uint8_t>(r, c) != 0)
+        object_cells.push_back(cell[c]);
+      else if (around.at<uint8_t>(r, c) != 0)
+        background_cells.push_back(cell[c]);
+    }
+  }
+  object_cells = Thinned(std::move(object_cells));
+  background_cells = Thinned(std::move(background_cells));
+  // The level's band cells hold object cells too (its outline ran through them): without an inside cell (a
+  // thin object) its object cells are the samples.
+  if (object_cells.empty()) {
+    for (int r = 0; r < coarse_mask.rows; ++r) {
+      const int32_t* cell = coarse_cells.ptr<int32_t>(r);
+      for (int c = 0; c < coarse_mask.cols; ++c)
+        if (object.at<uint8_t>(r, c) != 0 && scan.valid.data[cell[c]] != 0) object_cells.push_back(cell[c]);
+    }
+  }
+  for (const std::vector<int32_t>* cells : {&object_cells, &background_cells}) {
+    for (int32_t cell : *cells) {
+      const int row = cell / scan.cols - window.y, col = cell % scan.cols - window.x;
+      if (row >= 0 && col >= 0 && row < window.height && col < window.width)
+        include.at<uint8_t>(row, col) = 2;
+    }
+  }
+  Nodes nodes = MakeNodes(scan, stats, window, include);
+  // Graph nodes: the band and its rim (include == 1, or a sample cell that lies there too).
+  const cv::Mat graph_full = FullResolution(graph_cells, factor, full);
+  Cut cut;
+  cut.local_of_node.assign(nodes.num(), -1);
+  std::vector<int32_t> object_nodes, background_nodes;
+  std::vector<uint8_t> hard;  // per graph node
+  const uint8_t* stroke = strokes.ptr<uint8_t>();
+  for (int i = 0; i < nodes.num(); ++i) {
+    const int64_t cell = nodes.ScanCell(i);
+    if (graph_full.data[cell] != 0) {
+      cut.local_of_node[i] = static_cast<int32_t>(cut.node_of_local.size());
+      cut.node_of_local.push_back(i);
+      uint8_t h = kFree;
+      if (stroke[cell] == kStrokeObject)
+        h = kHardObject;
+      else if (stroke[cell] == kStrokeBackground)
+        h = kHardBackground;
+      else if (band_full.data[cell] == 0)
+        h = inside_full.data[cell] != 0 ? kHardObject : kHardBackground;
+      hard.push_back(h);
+    }
+  }
+  cut.on_roi_edge.assign(cut.node_of_local.size(), 0);
+  {
+    // The samples' nodes.
+    const auto to_nodes = [&](const std::vector<int32_t>& cells, std::vector<int32_t>* out) {
+      for (int32_t cell : cells) {
+        const int32_t i = nodes.NodeAt(cell / scan.cols, cell % scan.cols);
+        if (i >= 0) out->push_back(i);
+      }
+    };
+    to_nodes(object_cells, &object_nodes);
+    to_nodes(background_cells, &background_nodes);
+  }
+  const CutWeights& weights = has_appearance ? options.color_step : options.depth_step;
+  const NLinks links = ComputeNLinks(nodes, stats, weights, options.eight_connected, options.sigma_scale);
+  result->timings.features_s += timer.Seconds();
+  timer.Restart();
+  const LogDensities logp =
+      ComputeLogDensities(nodes, object_nodes, background_nodes, options, &cut.node_of_local);
+  result->timings.models_s += timer.Seconds();
+  double flow = 0;
+  BuildAndCut(nodes, links, logp, weights, hard, &result->timings, &flow, &cut);
+  result->flow = flow;
+  result->graph_nodes = static_cast<int64_t>(cut.node_of_local.size());
+  timer.Restart();
+  // The object: inside, and the band's cells the cut gave the object.
+  cv::Mat mask = inside_full & (scan.valid != 0);
+  for (size_t k = 0; k < cut.node_of_local.size(); ++k) {
+    if (cut.graph->what_segment(static_cast<int>(k), Graph::SINK) == Graph::SOURCE)
+      mask.data[nodes.ScanCell(cut.node_of_local[k])] = 255;
+  }
+  // Keep the parts that hold an inside cell or an object stroke.
+  cv::Mat labels;
+  const int count = cv::connectedComponents(mask, labels, 4, CV_32S);
+  std::vector<uint8_t> keep(static_cast<size_t>(count), 0);
+  const int32_t* label = labels.ptr<int32_t>();
+  for (int64_t cell = 0; cell < static_cast<int64_t>(mask.total()); ++cell) {
+    if (mask.data[cell] != 0 && (inside_full.data[cell] != 0 || stroke[cell] == kStrokeObject))
+      keep[static_cast<size_t>(label[cell])] = 1;
+  }
+  keep[0] = 0;
+  for (int64_t cell = 0; cell < static_cast<int64_t>(mask.total()); ++cell)
+    if (mask.data[cell] != 0 && !keep[static_cast<size_t>(label[cell])]) mask.data[cell] = 0;
+  result->timings.graph_s += timer.Seconds();
+  return mask;
+}
+
+}  // namespace lidarshop::segment_internal
