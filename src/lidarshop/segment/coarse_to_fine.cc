@@ -79,8 +79,9 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
                                    const SegmentOptions& options, bool has_appearance,
                                    SegmentResult* result) {
   Timer timer;
-  const cv::Size full(scan.cols, scan.rows);
-  cv::Mat object = (coarse_mask != 0);
+  cv::Mat mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+  const cv::Mat object = (coarse_mask != 0);
+  if (cv::countNonZero(object) == 0) return mask;
   // On the level: inside (deeper than the band), the band, the graph (the band and one level cell of hard rim
   // on each side) and the surroundings the background model is learnt from.
   const cv::Mat inside = Morph(object, cv::MORPH_ERODE, kBandCoarseCells);
@@ -88,19 +89,21 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   const cv::Mat band = outer & ~inside;
   const cv::Mat graph_cells = Morph(band, cv::MORPH_DILATE, 1);
   const cv::Mat around = Morph(object, cv::MORPH_DILATE, 4 * kBandCoarseCells) & ~outer;
-  // The full-resolution window: the surroundings' box.
+  // Everything below happens in the full-resolution window of the surroundings' box (the band and the
+  // graph lie inside it); a level mask there is its blocks' cells.
   const cv::Rect coarse_box = cv::boundingRect(around | object);
   const cv::Rect window = cv::Rect(coarse_box.x * factor, coarse_box.y * factor, coarse_box.width * factor,
                                    coarse_box.height * factor) &
                           cv::Rect(0, 0, scan.cols, scan.rows);
-  const cv::Mat inside_full = FullResolution(inside, factor, full);
-  const cv::Mat band_full = FullResolution(band, factor, full);
-  cv::Mat include = FullResolution(graph_cells, factor, full)(window).clone();
+  const auto in_window = [&](const cv::Mat& level_mask) {
+    return FullResolution(level_mask(coarse_box), factor, window.size());
+  };
+  const cv::Mat inside_w = in_window(inside), band_w = in_window(band), graph_w = in_window(graph_cells);
   // Model samples: the level's representatives of the inside and of the surroundings.
   std::vector<int32_t> object_cells, background_cells;
-  for (int r = 0; r < coarse_mask.rows; ++r) {
+  for (int r = coarse_box.y; r < coarse_box.y + coarse_box.height; ++r) {
     const int32_t* cell = coarse_cells.ptr<int32_t>(r);
-    for (int c = 0; c < coarse_mask.cols; ++c) {
+    for (int c = coarse_box.x; c < coarse_box.x + coarse_box.width; ++c) {
       if (scan.valid.data[cell[c]] == 0) continue;
       if (inside.at<uint8_t>(r, c) != 0)
         object_cells.push_back(cell[c]);
@@ -113,54 +116,52 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   // The level's band cells hold object cells too (its outline ran through them): without an inside cell (a
   // thin object) its object cells are the samples.
   if (object_cells.empty()) {
-    for (int r = 0; r < coarse_mask.rows; ++r) {
+    for (int r = coarse_box.y; r < coarse_box.y + coarse_box.height; ++r) {
       const int32_t* cell = coarse_cells.ptr<int32_t>(r);
-      for (int c = 0; c < coarse_mask.cols; ++c)
+      for (int c = coarse_box.x; c < coarse_box.x + coarse_box.width; ++c)
         if (object.at<uint8_t>(r, c) != 0 && scan.valid.data[cell[c]] != 0) object_cells.push_back(cell[c]);
     }
   }
+  cv::Mat include = graph_w.clone();
   for (const std::vector<int32_t>* cells : {&object_cells, &background_cells}) {
     for (int32_t cell : *cells) {
       const int row = cell / scan.cols - window.y, col = cell % scan.cols - window.x;
       if (row >= 0 && col >= 0 && row < window.height && col < window.width)
-        include.at<uint8_t>(row, col) = 2;
+        include.at<uint8_t>(row, col) = 1;
     }
   }
-  Nodes nodes = MakeNodes(scan, stats, window, include);
-  // Graph nodes: the band and its rim (include == 1, or a sample cell that lies there too).
-  const cv::Mat graph_full = FullResolution(graph_cells, factor, full);
+  const Nodes nodes = MakeNodes(scan, stats, window, include);
+  // Graph nodes: the band and its rim; the rim is hard (inside: object, outside: background), and so is
+  // every stroke cell.
   Cut cut;
   cut.local_of_node.assign(nodes.num(), -1);
-  std::vector<int32_t> object_nodes, background_nodes;
   std::vector<uint8_t> hard;  // per graph node
   const uint8_t* stroke = strokes.ptr<uint8_t>();
   for (int i = 0; i < nodes.num(); ++i) {
-    const int64_t cell = nodes.ScanCell(i);
-    if (graph_full.data[cell] != 0) {
-      cut.local_of_node[i] = static_cast<int32_t>(cut.node_of_local.size());
-      cut.node_of_local.push_back(i);
-      uint8_t h = kFree;
-      if (stroke[cell] == kStrokeObject)
-        h = kHardObject;
-      else if (stroke[cell] == kStrokeBackground)
-        h = kHardBackground;
-      else if (band_full.data[cell] == 0)
-        h = inside_full.data[cell] != 0 ? kHardObject : kHardBackground;
-      hard.push_back(h);
-    }
+    const int32_t cell = nodes.cell_of_node[i];  // in the window
+    if (graph_w.data[cell] == 0) continue;
+    cut.local_of_node[i] = static_cast<int32_t>(cut.node_of_local.size());
+    cut.node_of_local.push_back(i);
+    const uint8_t label = stroke[nodes.ScanCell(i)];
+    uint8_t h = kFree;
+    if (label == kStrokeObject)
+      h = kHardObject;
+    else if (label == kStrokeBackground)
+      h = kHardBackground;
+    else if (band_w.data[cell] == 0)
+      h = inside_w.data[cell] != 0 ? kHardObject : kHardBackground;
+    hard.push_back(h);
   }
   cut.on_roi_edge.assign(cut.node_of_local.size(), 0);
-  {
-    // The samples' nodes.
-    const auto to_nodes = [&](const std::vector<int32_t>& cells, std::vector<int32_t>* out) {
-      for (int32_t cell : cells) {
-        const int32_t i = nodes.NodeAt(cell / scan.cols, cell % scan.cols);
-        if (i >= 0) out->push_back(i);
-      }
-    };
-    to_nodes(object_cells, &object_nodes);
-    to_nodes(background_cells, &background_nodes);
-  }
+  std::vector<int32_t> object_nodes, background_nodes;
+  const auto to_nodes = [&](const std::vector<int32_t>& cells, std::vector<int32_t>* out) {
+    for (int32_t cell : cells) {
+      const int32_t i = nodes.NodeAt(cell / scan.cols, cell % scan.cols);
+      if (i >= 0) out->push_back(i);
+    }
+  };
+  to_nodes(object_cells, &object_nodes);
+  to_nodes(background_cells, &background_nodes);
   const CutWeights& weights = has_appearance ? options.color_step : options.depth_step;
   const NLinks links = ComputeNLinks(nodes, stats, weights, options.eight_connected, options.sigma_scale);
   result->timings.features_s += timer.Seconds();
@@ -173,24 +174,33 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   result->flow = flow;
   result->graph_nodes = static_cast<int64_t>(cut.node_of_local.size());
   timer.Restart();
-  // The object: inside, and the band's cells the cut gave the object.
-  cv::Mat mask = inside_full & (scan.valid != 0);
+  // The object: inside (its cells with a return), and the band's cells the cut gave the object.
+  cv::Mat object_w = inside_w & (scan.valid(window) != 0);
   for (size_t k = 0; k < cut.node_of_local.size(); ++k) {
     if (cut.graph->what_segment(static_cast<int>(k), Graph::SINK) == Graph::SOURCE)
-      mask.data[nodes.ScanCell(cut.node_of_local[k])] = 255;
+      object_w.data[nodes.cell_of_node[cut.node_of_local[k]]] = 255;
   }
   // Keep the parts that hold an inside cell or an object stroke.
   cv::Mat labels;
-  const int count = cv::connectedComponents(mask, labels, 4, CV_32S);
+  const int count = cv::connectedComponents(object_w, labels, 4, CV_32S);
   std::vector<uint8_t> keep(static_cast<size_t>(count), 0);
-  const int32_t* label = labels.ptr<int32_t>();
-  for (int64_t cell = 0; cell < static_cast<int64_t>(mask.total()); ++cell) {
-    if (mask.data[cell] != 0 && (inside_full.data[cell] != 0 || stroke[cell] == kStrokeObject))
-      keep[static_cast<size_t>(label[cell])] = 1;
+  const cv::Mat stroke_w = strokes(window);
+  for (int row = 0; row < window.height; ++row) {
+    const uint8_t *o = object_w.ptr<uint8_t>(row), *in = inside_w.ptr<uint8_t>(row),
+                  *st = stroke_w.ptr<uint8_t>(row);
+    const int32_t* label = labels.ptr<int32_t>(row);
+    for (int col = 0; col < window.width; ++col)
+      if (o[col] != 0 && (in[col] != 0 || st[col] == kStrokeObject))
+        keep[static_cast<size_t>(label[col])] = 1;
   }
   keep[0] = 0;
-  for (int64_t cell = 0; cell < static_cast<int64_t>(mask.total()); ++cell)
-    if (mask.data[cell] != 0 && !keep[static_cast<size_t>(label[cell])]) mask.data[cell] = 0;
+  for (int row = 0; row < window.height; ++row) {
+    uint8_t* o = object_w.ptr<uint8_t>(row);
+    const int32_t* label = labels.ptr<int32_t>(row);
+    for (int col = 0; col < window.width; ++col)
+      if (o[col] != 0 && !keep[static_cast<size_t>(label[col])]) o[col] = 0;
+  }
+  object_w.copyTo(mask(window));
   result->timings.graph_s += timer.Seconds();
   return mask;
 }
