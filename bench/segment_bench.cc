@@ -59,13 +59,14 @@ const Fixture& GetFixture() {
 }
 
 void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel model, int roi_margin_cells = -1,
-             double roi_margin_fraction = -1) {
+             double roi_margin_fraction = -1, int coarse_max_cells = -1) {
   const Fixture& f = GetFixture();
   SegmentOptions options;
   options.method = method;
   options.model = model;
   if (roi_margin_cells >= 0) options.roi_margin_cells = roi_margin_cells;
   if (roi_margin_fraction >= 0) options.roi_margin_fraction = roi_margin_fraction;
+  if (coarse_max_cells >= 0) options.coarse_max_cells = coarse_max_cells;
   SegmentResult result;
   for (auto _ : state) {
     SegmentSession session(f.scan, options);
@@ -80,6 +81,7 @@ void Segment(benchmark::State& state, SegmentMethod method, AppearanceModel mode
   state.counters["features_s"] = result.timings.features_s;
   state.counters["cells"] = static_cast<double>(f.scan.CountValid());
   state.counters["last_graph_nodes"] = static_cast<double>(result.graph_nodes);
+  state.counters["coarse_factor"] = result.coarse_factor;
 }
 
 void BM_TwoStepGmm(benchmark::State& state) {
@@ -92,6 +94,12 @@ void BM_TwoStepGmmWholeImage(benchmark::State& state) {
 // Step 3's ROI margin as a fraction of the step-1 box, in percent (the margin is at least 50 cells).
 void BM_TwoStepGmmRoiFraction(benchmark::State& state) {
   Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm, 50, state.range(0) / 100.0);
+}
+// Coarse to fine (SegmentOptions::coarse_max_cells) on the level of every f-th ray, f = the argument: the
+// 1000 x 1000 scan is at the default's limit, so it is cut at full resolution unless asked.
+void BM_TwoStepGmmCoarseToFine(benchmark::State& state) {
+  const int factor = static_cast<int>(state.range(0));
+  Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kGmm, -1, -1, 1000000 / (factor * factor));
 }
 void BM_TwoStepHistogram(benchmark::State& state) {
   Segment(state, SegmentMethod::kTwoStep, AppearanceModel::kHistogram);
@@ -150,6 +158,7 @@ void BM_OpenCvGrabCut(benchmark::State& state) {
 BENCHMARK(BM_TwoStepGmm)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_TwoStepGmmWholeImage)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_TwoStepGmmRoiFraction)->Arg(10)->Arg(25)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(BM_TwoStepGmmCoarseToFine)->Arg(2)->Arg(4)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_TwoStepHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_OneCutDepthHistogram)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(BM_RefineOneStroke)->Unit(benchmark::kMillisecond)->Iterations(5);
