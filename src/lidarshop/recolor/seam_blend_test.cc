@@ -1,10 +1,15 @@
 #include "lidarshop/recolor/seam_blend.h"
 
 #include <cmath>
+#include <random>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
+#include "lidarshop/poisson/operators.h"
+#include "lidarshop/poisson/poisson.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -70,6 +75,94 @@ TEST(BlendSeams, RefusesFluxOutOfTheColouredCellsNamingTheFirstCell) {
   colour.at<cv::Vec3f>(90, 3) = cv::Vec3f(5, 5, 5);  // an earlier row: that one is named
   EXPECT_NE(message().find("cell (90, 3)"), std::string::npos) << message();
   EXPECT_NE(message().find("colour"), std::string::npos) << message();
+}
+
+// The band's equations assembled from the band alone are the Poisson engine's for the band mask (no-data where
+// no photo coloured a cell), so the solution is the engine's to the bit: on random photo regions with holes, an
+// island wholly within the band (anchored) and random colours and guidance.
+TEST(BlendSeams, EqualsThePoissonEngineOnTheBandMaskBitForBit) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> value(0, 255), step(-20, 20);
+  const int rows = 90, cols = 120, band = 3;
+  cv::Mat photo(rows, cols, CV_16U), colour(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      photo.at<uint16_t>(r, c) = static_cast<uint16_t>(1 + (c * 3 + r) / 70 + (r > 2 * c - 40 ? 3 : 0));
+      if (random() % 17 == 0) photo.at<uint16_t>(r, c) = 0;  // holes
+    }
+  }
+  cv::rectangle(photo, cv::Rect(90, 60, 9, 9), cv::Scalar(0), 1);  // a ring of no colour around an island
+  cv::rectangle(photo, cv::Rect(91, 61, 7, 7), cv::Scalar(1), cv::FILLED);
+  cv::rectangle(photo, cv::Rect(94, 61, 4, 7), cv::Scalar(2), cv::FILLED);  // with a seam: all in the band
+  cv::Mat gx(rows, cols, CV_32FC3, cv::Scalar::all(0)), gy = gx.clone();
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      if (photo.at<uint16_t>(r, c) == 0) continue;
+      colour.at<cv::Vec3f>(r, c) = cv::Vec3f(value(random), value(random), value(random));
+      if (c + 1 < cols && photo.at<uint16_t>(r, c + 1) != 0)
+        gx.at<cv::Vec3f>(r, c) = cv::Vec3f(step(random), step(random), step(random));
+      if (r + 1 < rows && photo.at<uint16_t>(r + 1, c) != 0)
+        gy.at<cv::Vec3f>(r, c) = cv::Vec3f(step(random), step(random), step(random));
+    }
+  }
+  const SeamBlendResult result = BlendSeams(colour, photo, gx, gy, band);
+
+  // The reference: the band mask, its coloured parts without a known cell anchored at their first cell.
+  const cv::Mat coloured = photo > 0;
+  cv::Mat seam = cv::Mat::zeros(rows, cols, CV_8U);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const uint16_t p = photo.at<uint16_t>(r, c);
+      if (p == 0) continue;
+      for (const auto& [nr, nc] : {std::pair{r, c + 1}, std::pair{r + 1, c}}) {
+        if (nr >= rows || nc >= cols) continue;
+        const uint16_t q = photo.at<uint16_t>(nr, nc);
+        if (q != 0 && q != p) seam.at<uint8_t>(r, c) = seam.at<uint8_t>(nr, nc) = 255;
+      }
+    }
+  }
+  cv::Mat mask;
+  cv::dilate(seam, mask, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * band + 1, 2 * band + 1)));
+  mask &= coloured;
+  cv::Mat labels;
+  const int parts = cv::connectedComponents(coloured, labels, 4, CV_32S);
+  std::vector<char> has_known(parts, 0);
+  std::vector<cv::Point> first(parts, cv::Point(-1, -1));
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const int label = labels.at<int>(r, c);
+      if (label == 0) continue;
+      if (first[label].x < 0) first[label] = cv::Point(c, r);
+      if (!mask.at<uint8_t>(r, c)) has_known[label] = 1;
+    }
+  }
+  int anchored = 0;
+  for (int label = 1; label < parts; ++label) {
+    if (!has_known[label]) mask.at<uint8_t>(first[label]) = 0, ++anchored;
+  }
+  ASSERT_GE(anchored, 1);  // the island
+  PoissonOptions options;
+  options.solver = PoissonSolverKind::kDirect;
+  PoissonLinks links;
+  links.no_data = coloured == 0;
+  const PoissonSystem system = PreparePoisson(mask, options, links);
+  const cv::Mat expected = SolvePoisson(system, colour, BackwardDivergence(gx, gy)).image;
+  EXPECT_EQ(result.unknowns, cv::countNonZero(mask));
+  EXPECT_GT(result.unknowns, 1000);
+  int differing = 0;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      for (int ch = 0; ch < 3; ++ch) {
+        if (result.colour.at<cv::Vec3f>(r, c)[ch] != expected.at<cv::Vec3f>(r, c)[ch]) {
+          if (++differing <= 5)
+            ADD_FAILURE() << "(" << r << ", " << c << ")[" << ch
+                          << "]: " << result.colour.at<cv::Vec3f>(r, c)[ch] << " vs "
+                          << expected.at<cv::Vec3f>(r, c)[ch];
+        }
+      }
+    }
+  }
+  EXPECT_EQ(differing, 0);
 }
 
 }  // namespace

@@ -213,36 +213,42 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
 
   result.gain_seconds = since(gain_start);
   const auto colour_start = std::chrono::steady_clock::now();
-  // The chosen colours at photo 0's exposure, then the seams blended.
+  // The chosen colours at photo 0's exposure (as float: the blend's values, rounded once on output), then the
+  // seams blended. No grid of colours: a cell's colour is its chosen sample's, read where needed.
   const auto corrected = [&](const Sample& sample) {
     const cv::Vec3d& gain = result.gains[sample.photo];
     return cv::Vec3d(sample.rgb[0] / gain[0], sample.rgb[1] / gain[1], sample.rgb[2] / gain[2]);
   };
-  cv::Mat colour(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0));
-  result.photo_index = cv::Mat::zeros(scan.rows, scan.cols, CV_16U);
+  const auto colour_of = [&](int64_t cell) {
+    const cv::Vec3d v = corrected(*chosen(cell));
+    // Through memory: the colours must be floats (the guidance is the difference of two of them, as when a
+    // grid of float colours held them), and GCC 12 at -O2 was seen to use the unrounded doubles instead.
+    volatile float rounded[3] = {static_cast<float>(v[0]), static_cast<float>(v[1]),
+                                 static_cast<float>(v[2])};
+    return cv::Vec3f(rounded[0], rounded[1], rounded[2]);
+  };
+  result.photo_index = cv::Mat(scan.rows, scan.cols, CV_16U);
   std::vector<int64_t> row_coloured(scan.rows, 0);
   ParallelFor(scan.rows, [&](int64_t row) {
     const int r = static_cast<int>(row);
-    cv::Vec3f* colour_row = colour.ptr<cv::Vec3f>(r);
     uint16_t* index_row = result.photo_index.ptr<uint16_t>(r);
+    const int* best_row = best.data() + row * scan.cols;
     for (int c = 0; c < scan.cols; ++c) {
-      const Sample* sample = chosen(static_cast<int64_t>(r) * scan.cols + c);
-      if (sample == nullptr) continue;
-      colour_row[c] = corrected(*sample);
-      index_row[c] = static_cast<uint16_t>(sample->photo + 1);
-      ++row_coloured[r];
+      index_row[c] = static_cast<uint16_t>(best_row[c] + 1);
+      row_coloured[r] += best_row[c] >= 0;
     }
   });
   for (const int64_t n : row_coloured) result.coloured += n;
   result.colour_seconds = since(colour_start);
+  SeamBandSolution band;
   if (options.blend_seams) {
     const auto blend_start = std::chrono::steady_clock::now();
-    const cv::Mat range = RangeImage(scan);
+    const cv::Mat& range = scan.range;
     // The guidance from cell a to its neighbour b: their own difference when one photo colours both, else
     // what the photos that see both show, else 0 on a continuous surface and the step across a depth jump.
-    const auto guidance = [&](int64_t a, int64_t b, int ra, int ca, int rb, int cb) -> cv::Vec3d {
-      const cv::Vec3d& ua = colour.at<cv::Vec3f>(ra, ca);
-      const cv::Vec3d& ub = colour.at<cv::Vec3f>(rb, cb);
+    const auto guidance = [&](int64_t a, int64_t b) -> cv::Vec3d {
+      const cv::Vec3f fa = colour_of(a), fb = colour_of(b);
+      const cv::Vec3d ua(fa[0], fa[1], fa[2]), ub(fb[0], fb[1], fb[2]);
       if (best[a] == best[b]) return ub - ua;
       cv::Vec3d sum(0, 0, 0);
       int count = 0;
@@ -253,26 +259,17 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
         ++count;
       }
       if (count > 0) return sum / count;
-      const double da = range.at<float>(ra, ca), db = range.at<float>(rb, cb);
+      const double da = range.at<float>(static_cast<int>(a / scan.cols), static_cast<int>(a % scan.cols));
+      const double db = range.at<float>(static_cast<int>(b / scan.cols), static_cast<int>(b % scan.cols));
       if (std::abs(da - db) > options.seam_depth_jump_m + 0.02 * std::min(da, db)) return ub - ua;
       return cv::Vec3d(0, 0, 0);
     };
-    cv::Mat gx(scan.rows, scan.cols, CV_32FC3, cv::Scalar::all(0)), gy = gx.clone();
-    ParallelFor(scan.rows, [&](int64_t row) {
-      const int r = static_cast<int>(row);
-      for (int c = 0; c < scan.cols; ++c) {
-        const int64_t cell = static_cast<int64_t>(r) * scan.cols + c;
-        if (best[cell] < 0) continue;
-        if (c + 1 < scan.cols && best[cell + 1] >= 0)
-          gx.at<cv::Vec3f>(r, c) = guidance(cell, cell + 1, r, c, r, c + 1);
-        if (r + 1 < scan.rows && best[cell + scan.cols] >= 0)
-          gy.at<cv::Vec3f>(r, c) = guidance(cell, cell + scan.cols, r, c, r + 1, c);
-      }
-    });
-    const SeamBlendResult blended = BlendSeams(colour, result.photo_index, gx, gy, options.seam_band_cells);
-    colour = blended.colour;
-    result.seam_edges = blended.seam_edges;
-    result.blended = blended.unknowns;
+    band = SolveSeamBand(result.photo_index, options.seam_band_cells, colour_of,
+                         [&](int64_t cell, bool down) -> cv::Vec3f {
+                           return guidance(cell, down ? cell + scan.cols : cell + 1);
+                         });
+    result.seam_edges = band.seam_edges;
+    result.blended = static_cast<int64_t>(band.cells.size());
     result.blend_seconds = since(blend_start);
   }
 
@@ -280,15 +277,19 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
   result.scan = Clone(scan);
   Scan& out = result.scan;
   if (!out.has_color()) out.color = cv::Mat(scan.rows, scan.cols, CV_8UC3, cv::Scalar::all(0));
+  const auto write = [&](int64_t cell, const cv::Vec3f& v) {
+    out.color.at<cv::Vec3b>(static_cast<int>(cell / scan.cols), static_cast<int>(cell % scan.cols)) =
+        cv::Vec3b(cv::saturate_cast<uint8_t>(static_cast<double>(v[0])),
+                  cv::saturate_cast<uint8_t>(static_cast<double>(v[1])),
+                  cv::saturate_cast<uint8_t>(static_cast<double>(v[2])));
+  };
   ParallelFor(scan.rows, [&](int64_t row) {
-    const int r = static_cast<int>(row);
-    for (int c = 0; c < scan.cols; ++c) {
-      if (result.photo_index.at<uint16_t>(r, c) == 0) continue;
-      const cv::Vec3d& v = colour.at<cv::Vec3f>(r, c);
-      out.color.at<cv::Vec3b>(r, c) =
-          cv::Vec3b(cv::saturate_cast<uint8_t>(v[0]), cv::saturate_cast<uint8_t>(v[1]),
-                    cv::saturate_cast<uint8_t>(v[2]));
+    for (int64_t cell = row * scan.cols; cell < (row + 1) * scan.cols; ++cell) {
+      if (best[cell] >= 0) write(cell, colour_of(cell));
     }
+  });
+  ParallelForRange(static_cast<int64_t>(band.cells.size()), [&](int64_t begin, int64_t end) {
+    for (int64_t k = begin; k < end; ++k) write(band.cells[k], band.colour[k]);
   });
   result.output_seconds = since(output_start);
   result.total_seconds = since(call_start);
