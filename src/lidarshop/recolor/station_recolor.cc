@@ -145,25 +145,43 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
   result.projection_seconds = result.visibility_seconds - result.zbuffer_seconds;
   const auto choice_start = std::chrono::steady_clock::now();
   // Per cell its samples, by photo index (compressed rows: `first[cell]` .. `first[cell + 1]`), and the best
-  // photo (the highest score; a tie keeps the lower index).
-  std::vector<int64_t> first(cells + 1, 0);
-  for (const auto& list : seen_by) {
-    for (const PhotoSample& s : list) ++first[s.cell + 1];
+  // photo (the highest score; a tie keeps the lower index). Built over blocks of rows in parallel: each photo's
+  // list is in cell order, so a block's part of it is found by binary search, and within a cell the photos
+  // are visited in index order as a serial pass would (the same result on any thread count).
+  const int64_t block_cells = 64 * static_cast<int64_t>(scan.cols);
+  const int64_t blocks = (cells + block_cells - 1) / block_cells;
+  std::vector<std::vector<size_t>> bounds(seen_by.size(), std::vector<size_t>(blocks + 1));
+  for (size_t i = 0; i < seen_by.size(); ++i) {
+    for (int64_t b = 0; b <= blocks; ++b) {
+      bounds[i][b] = static_cast<size_t>(
+          std::lower_bound(seen_by[i].begin(), seen_by[i].end(), std::min(cells, b * block_cells),
+                           [](const PhotoSample& s, int64_t cell) { return s.cell < cell; }) -
+          seen_by[i].begin());
+    }
   }
+  std::vector<int64_t> first(cells + 1, 0);
+  ParallelFor(blocks, [&](int64_t b) {  // block b writes first[c + 1] for its own cells c only
+    for (size_t i = 0; i < seen_by.size(); ++i) {
+      for (size_t k = bounds[i][b]; k < bounds[i][b + 1]; ++k) ++first[seen_by[i][k].cell + 1];
+    }
+  });
   for (int64_t cell = 0; cell < cells; ++cell) first[cell + 1] += first[cell];
   std::vector<Sample> samples(static_cast<size_t>(first[cells]));
   std::vector<int> best(cells, -1);
-  {
-    std::vector<int64_t> next(first.begin(), first.end() - 1);
-    std::vector<float> best_score(cells, -1);
+  ParallelFor(blocks, [&](int64_t b) {
+    const int64_t begin = b * block_cells, end = std::min(cells, begin + block_cells);
+    std::vector<int64_t> next(first.begin() + begin, first.begin() + end);
+    std::vector<float> best_score(end - begin, -1);
     for (size_t i = 0; i < seen_by.size(); ++i) {
-      for (const PhotoSample& s : seen_by[i]) {
-        samples[next[s.cell]++] = {static_cast<int>(i), s.rgb};
-        if (s.score > best_score[s.cell]) best_score[s.cell] = s.score, best[s.cell] = static_cast<int>(i);
+      for (size_t k = bounds[i][b]; k < bounds[i][b + 1]; ++k) {
+        const PhotoSample& s = seen_by[i][k];
+        const int64_t at = s.cell - begin;
+        samples[next[at]++] = {static_cast<int>(i), s.rgb};
+        if (s.score > best_score[at]) best_score[at] = s.score, best[s.cell] = static_cast<int>(i);
       }
-      std::vector<PhotoSample>().swap(seen_by[i]);
     }
-  }
+  });
+  std::vector<std::vector<PhotoSample>>().swap(seen_by);
   const auto samples_of = [&](int64_t cell) {
     return std::pair<const Sample*, const Sample*>(samples.data() + first[cell],
                                                    samples.data() + first[cell + 1]);
