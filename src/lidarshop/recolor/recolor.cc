@@ -160,7 +160,7 @@ OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& optio
 }
 
 Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Camera& camera,
-                        const RecolorOptions& options) {
+                        const RecolorOptions& options, bool by_row) {
   Visibility visibility;
   const Eigen::Vector3d center = camera.center_in_world();
   const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
@@ -303,16 +303,18 @@ Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Cam
 
   size_t seen = 0, uncertain = 0;
   for (int r = 0; r < scan.rows; ++r) seen += row_seen[r].size(), uncertain += row_uncertain[r].size();
-  visibility.seen.reserve(seen);
+  if (!by_row) visibility.seen.reserve(seen);
   visibility.uncertain.reserve(uncertain);
   for (int r = 0; r < scan.rows; ++r) {
     visibility.returns += row_returns[r];
     visibility.outside_image += row_outside[r];
     visibility.hidden += row_hidden[r];
-    visibility.seen.insert(visibility.seen.end(), row_seen[r].begin(), row_seen[r].end());
     visibility.uncertain.insert(visibility.uncertain.end(), row_uncertain[r].begin(), row_uncertain[r].end());
+    if (by_row) continue;
+    visibility.seen.insert(visibility.seen.end(), row_seen[r].begin(), row_seen[r].end());
     std::vector<SeenCell>().swap(row_seen[r]);
   }
+  if (by_row) visibility.row_seen = std::move(row_seen);
   return visibility;
 }
 

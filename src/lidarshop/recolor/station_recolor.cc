@@ -111,15 +111,19 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     const Camera& camera = photos[i].camera;
     const Eigen::Vector3d center = camera.center_in_world();
     const recolor_internal::Visibility visibility =
-        recolor_internal::VisibleCells(scan, scene, camera, options.visibility);
+        recolor_internal::VisibleCells(scan, scene, camera, options.visibility, /*by_row=*/true);
     result.returns = visibility.returns;
     result.zbuffer_seconds += visibility.zbuffer_seconds;
+    // Row by row into one list: each row's place is the sum of the rows before it.
+    std::vector<size_t> row_start(scan.rows + 1, 0);
+    for (int r = 0; r < scan.rows; ++r) row_start[r + 1] = row_start[r] + visibility.row_seen[r].size();
     std::vector<PhotoSample>& list = seen_by[i];
-    list.resize(visibility.seen.size());
-    ParallelFor(
-        static_cast<int64_t>(list.size()),
-        [&](int64_t k) {
-          const recolor_internal::SeenCell& seen = visibility.seen[k];
+    list.resize(row_start[scan.rows]);
+    ParallelFor(scan.rows, [&](int64_t row) {
+      for (size_t j = 0; j < visibility.row_seen[row].size(); ++j) {
+        const size_t k = row_start[row] + j;
+        {
+          const recolor_internal::SeenCell& seen = visibility.row_seen[row][j];
           const int r = static_cast<int>(seen.cell / scan.cols), c = static_cast<int>(seen.cell % scan.cols);
           double cos_angle = 1;
           if (has_normals) {
@@ -138,8 +142,9 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
                                    ? 1 / std::max(seen.distance_m, 1e-3)
                                    : cos_angle * border_factor / std::max(seen.distance_m, 1e-3);
           list[k] = {seen.cell, SamplePhoto(photos[i].image, seen.pixel), static_cast<float>(score)};
-        },
-        4096);
+        }
+      }
+    });
   }
   result.visibility_seconds = since(visibility_start);
   result.projection_seconds = result.visibility_seconds - result.zbuffer_seconds;

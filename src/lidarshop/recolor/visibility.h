@@ -44,7 +44,10 @@ struct SeenCell {
 };
 
 struct Visibility {
-  std::vector<SeenCell> seen;      // in row-major cell order
+  std::vector<SeenCell> seen;  // in row-major cell order (empty when asked for `row_seen`)
+  // With VisibleCells(..., by_row = true): the seen cells row by row instead (rows x their cells), not joined
+  // into one list (a 10-megapoint station's photo sees ~2 million cells: 100 MB not copied).
+  std::vector<std::vector<SeenCell>> row_seen;
   std::vector<int64_t> uncertain;  // cells by an occluding edge (RecolorOptions::edge_guard): not coloured
   int64_t returns = 0;             // valid cells
   int64_t outside_image = 0;       // behind the camera or projected outside the image
@@ -58,6 +61,6 @@ struct Visibility {
 };
 
 Visibility VisibleCells(const Scan& scan, const OcclusionScene& scene, const Camera& camera,
-                        const RecolorOptions& options);
+                        const RecolorOptions& options, bool by_row = false);
 
 }  // namespace lidarshop::recolor_internal
