@@ -14,7 +14,7 @@
 namespace lidarshop::segment_internal {
 namespace {
 
-// Model samples are thinned to about this many cells per side: the mixtures fit as well and in bounded time.
+// Model samples are thinned to about this many cells per side, so that fitting the mixtures takes a bounded time.
 constexpr size_t kMaxModelSamples = 40000;
 
 cv::Mat Morph(const cv::Mat& mask, int op, int radius) {
