@@ -154,5 +154,23 @@ TEST(CoarseToFineTest, AStrokeTheLevelCannotSeeStillHolds) {
   EXPECT_GT(ScoreMask(cut.mask, TruthMask(scan), scan.valid).iou, 0.95);
 }
 
+TEST(CoarseToFineTest, LargeFactorsGoDownAPyramid) {
+  // f = 8: a level of every 4th ray, cut on a level of every 2nd of its rays in turn; each band re-cut is a
+  // few rays of its own level wide.
+  const Scan scan = MakeScene();
+  const cv::Mat strokes = Strokes(scan), truth = TruthMask(scan);
+  const SegmentResult full = SegmentObject(scan, strokes, CoarseAbove(0));
+  const SegmentResult pyramid = SegmentObject(scan, strokes, CoarseAbove(6000));
+  ASSERT_EQ(pyramid.coarse_factor, 8);
+  EXPECT_GT(ScoreMask(pyramid.mask, truth, scan.valid).iou, 0.97);
+  EXPECT_GT(ScoreMask(pyramid.mask, full.mask).iou, 0.97);
+  // The full-resolution band is the outline times (2 · kBandCoarseCells + 2) · 4 rays (band and rim at the
+  // lower level's step of 4), not · 8 as one step of 8 would make it.
+  const cv::Rect box = cv::boundingRect(truth);
+  const int one_step_of_eight =
+      2 * (box.width + box.height) * (2 * segment_internal::kBandCoarseCells + 2) * 8;
+  EXPECT_LT(pyramid.graph_nodes, one_step_of_eight * 2 / 3);
+}
+
 }  // namespace
 }  // namespace lidarshop
