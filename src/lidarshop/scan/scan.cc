@@ -119,22 +119,8 @@ void CheckWindow(const Scan& scan, const cv::Rect& window, const char* what) {
 Scan CropScan(const Scan& scan, const cv::Rect& window) {
   CheckScan(scan);
   CheckWindow(scan, window, "CropScan");
-  Scan part;
-  part.rows = window.height;
-  part.cols = window.width;
-  part.world_from_scanner = scan.world_from_scanner;
-  part.name = scan.name;
-  part.source_records = scan.source_records;
-  part.source_metadata = scan.source_metadata;
-  // Pairs the channels of `scan` and `part` in the same order.
-  std::vector<cv::Mat*> targets;
-  ForEachChannel(part, [&](cv::Mat& channel, const cv::Scalar&) { targets.push_back(&channel); });
-  size_t i = 0;
-  ForEachChannel(scan, [&](const cv::Mat& channel, const cv::Scalar&) {
-    if (!channel.empty()) *targets[i] = channel(window).clone();
-    ++i;
-  });
-  for (const auto& [name, values] : scan.attributes) part.attributes[name] = values(window).clone();
+  Scan part = scan_internal::ResampledScan(scan, window.height, window.width,
+                                           [&](const cv::Mat& channel) { return channel(window).clone(); });
   if (static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
       static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
     part.grid = scan.grid;

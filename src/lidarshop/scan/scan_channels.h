@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -26,6 +27,30 @@ void ForEachChannel(ScanT& scan, Visit visit) {
   visit(scan.true_range, cv::Scalar(0));
   visit(scan.synthesized, cv::Scalar(0));
   visit(scan.from_station, cv::Scalar(0));
+}
+
+// A scan of rows x cols with `scan`'s pose, name and file-level records, and every channel and attribute
+// `scan` has made by `resample(channel)` (a rows x cols matrix of the channel's type). The grid is left to
+// the caller.
+template <typename Resample>
+Scan ResampledScan(const Scan& scan, int rows, int cols, Resample resample) {
+  Scan out;
+  out.rows = rows;
+  out.cols = cols;
+  out.world_from_scanner = scan.world_from_scanner;
+  out.name = scan.name;
+  out.source_records = scan.source_records;
+  out.source_metadata = scan.source_metadata;
+  // Pairs the channels of `scan` and `out` in the same order.
+  std::vector<cv::Mat*> targets;
+  ForEachChannel(out, [&](cv::Mat& channel, const cv::Scalar&) { targets.push_back(&channel); });
+  size_t i = 0;
+  ForEachChannel(scan, [&](const cv::Mat& channel, const cv::Scalar&) {
+    if (!channel.empty()) *targets[i] = resample(channel);
+    ++i;
+  });
+  for (const auto& [name, values] : scan.attributes) out.attributes[name] = resample(values);
+  return out;
 }
 
 }  // namespace lidarshop::scan_internal

@@ -69,13 +69,6 @@ cv::Mat DecimatedCells(const Scan& scan, int factor) {
 Scan DecimateScan(const Scan& scan, int factor) {
   CheckScan(scan);
   const cv::Mat cells = DecimatedCells(scan, factor);
-  Scan level;
-  level.rows = cells.rows;
-  level.cols = cells.cols;
-  level.world_from_scanner = scan.world_from_scanner;
-  level.name = scan.name;
-  level.source_records = scan.source_records;
-  level.source_metadata = scan.source_metadata;
   const auto gather = [&](const cv::Mat& from) {
     cv::Mat to(cells.rows, cells.cols, from.type());
     const size_t bytes = from.elemSize();
@@ -88,15 +81,7 @@ Scan DecimateScan(const Scan& scan, int factor) {
     });
     return to;
   };
-  std::vector<cv::Mat*> targets;
-  scan_internal::ForEachChannel(level,
-                                [&](cv::Mat& channel, const cv::Scalar&) { targets.push_back(&channel); });
-  size_t i = 0;
-  scan_internal::ForEachChannel(scan, [&](const cv::Mat& channel, const cv::Scalar&) {
-    if (!channel.empty()) *targets[i] = gather(channel);
-    ++i;
-  });
-  for (const auto& [name, values] : scan.attributes) level.attributes[name] = gather(values);
+  Scan level = scan_internal::ResampledScan(scan, cells.rows, cells.cols, gather);
   if (static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
       static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
     level.grid = scan.grid;

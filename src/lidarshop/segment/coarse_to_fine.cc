@@ -14,7 +14,7 @@
 namespace lidarshop::segment_internal {
 namespace {
 
-// Model samples are thinned to about this many cells per side: the mixtures fit as well and in bounded time.
+// Model samples are thinned to about this many cells per side, so that fitting the mixtures takes a bounded time.
 constexpr size_t kMaxModelSamples = 40000;
 
 cv::Mat Morph(const cv::Mat& mask, int op, int radius) {
@@ -98,7 +98,25 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   const auto in_window = [&](const cv::Mat& level_mask) {
     return FullResolution(level_mask(coarse_box), factor, window.size());
   };
-  const cv::Mat inside_w = in_window(inside), band_w = in_window(band), graph_w = in_window(graph_cells);
+  cv::Mat inside_w = in_window(inside), band_w = in_window(band), graph_w = in_window(graph_cells);
+  const cv::Mat stroke_w = strokes(window);
+  {
+    // Strokes the level did not follow (on a part thinner than a level cell, whose block's ray lies on the
+    // surface behind it): the cells around them are cut at full resolution too, so that every stroke holds.
+    const cv::Mat against = ((stroke_w == kStrokeBackground) & (inside_w != 0)) |
+                            ((stroke_w == kStrokeObject) & (inside_w == 0) & (band_w == 0));
+    const cv::Rect box = cv::boundingRect(against);
+    if (!box.empty()) {
+      const int radius = kBandCoarseCells * factor;
+      const cv::Rect grown = cv::Rect(box.x - radius - 1, box.y - radius - 1, box.width + 2 * radius + 2,
+                                      box.height + 2 * radius + 2) &
+                             cv::Rect(0, 0, window.width, window.height);
+      const cv::Mat free_cells = Morph(against(grown), cv::MORPH_DILATE, radius);
+      cv::Mat band_part = band_w(grown), graph_part = graph_w(grown);
+      band_part |= free_cells;
+      graph_part |= Morph(free_cells, cv::MORPH_DILATE, 1);
+    }
+  }
   // Model samples: the level's representatives of the inside and of the surroundings.
   std::vector<int32_t> object_cells, background_cells;
   for (int r = coarse_box.y; r < coarse_box.y + coarse_box.height; ++r) {
@@ -174,8 +192,8 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   result->flow = flow;
   result->graph_nodes = static_cast<int64_t>(cut.node_of_local.size());
   timer.Restart();
-  // The object: inside (its cells with a return), and the band's cells the cut gave the object.
-  cv::Mat object_w = inside_w & (scan.valid(window) != 0);
+  // The object: inside and not in the band (its cells with a return), and the band's cells the cut gave it.
+  cv::Mat object_w = inside_w & (band_w == 0) & (scan.valid(window) != 0);
   for (size_t k = 0; k < cut.node_of_local.size(); ++k) {
     if (cut.graph->what_segment(static_cast<int>(k), Graph::SINK) == Graph::SOURCE)
       object_w.data[nodes.cell_of_node[cut.node_of_local[k]]] = 255;
@@ -184,7 +202,6 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
   cv::Mat labels;
   const int count = cv::connectedComponents(object_w, labels, 4, CV_32S);
   std::vector<uint8_t> keep(static_cast<size_t>(count), 0);
-  const cv::Mat stroke_w = strokes(window);
   for (int row = 0; row < window.height; ++row) {
     const uint8_t *o = object_w.ptr<uint8_t>(row), *in = inside_w.ptr<uint8_t>(row),
                   *st = stroke_w.ptr<uint8_t>(row);

@@ -32,6 +32,11 @@ cv::Mat FullResolution(const cv::Mat& coarse_mask, int factor, cv::Size full);
 // Coarse cells within this many cells of the level's outline are cut again at full resolution.
 constexpr int kBandCoarseCells = 2;
 
+// A level is at most this much coarser than the scan it comes from; a scan that needs more goes down a
+// pyramid (its level is cut coarse to fine in turn), so that each band re-cut is a few rays wide, not
+// 2·kBandCoarseCells·f (at 100 M rays f is 16).
+constexpr int kMaxLevelStep = 4;
+
 // The object at full resolution from the level's cut `coarse_mask`: the cells deeper inside than the band are
 // object, those farther outside background, and the band between is one colour-dominant cut (the depth cut's
 // weights when the scan has neither colour nor intensity) on the full-resolution cells, its models learnt

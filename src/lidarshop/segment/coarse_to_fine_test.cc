@@ -129,5 +129,48 @@ TEST(CoarseToFineTest, RefinementsKeepTheirRules) {
   EXPECT_LT(cv::boundingRect(lost).x + cv::boundingRect(lost).width, box.x + box.width / 2);
 }
 
+TEST(CoarseToFineTest, AStrokeTheLevelCannotSeeStillHolds) {
+  // A pole one ray wide 1 m before the box, on columns the level never takes (every 4th column from the
+  // third: the level's rays are the second of each block), stroked as background from top to bottom of the
+  // box: the level sees only the box behind it, yet no stroked cell may end in the object.
+  Scan scan = MakeScene();
+  const cv::Rect box = cv::boundingRect(TruthMask(scan));
+  const int pole_col = box.x + box.width / 2 + (3 - (box.x + box.width / 2) % 4);
+  cv::Mat strokes = Strokes(scan);
+  for (int row = box.y; row < box.y + box.height; ++row) {
+    scan.range.at<float>(row, pole_col) -= 1.0f;
+    scan.point.at<cv::Vec3f>(row, pole_col) =
+        scan.direction.at<cv::Vec3f>(row, pole_col) * scan.range.at<float>(row, pole_col);
+    scan.color.at<cv::Vec3b>(row, pole_col) = cv::Vec3b(40, 40, 200);
+    scan.label.at<int32_t>(row, pole_col) = 2;
+    strokes.at<uint8_t>(row, pole_col) = kStrokeBackground;
+  }
+  const cv::Mat cells = DecimatedCells(scan, 4);
+  for (int r = 0; r < cells.rows; ++r)
+    for (int c = 0; c < cells.cols; ++c) ASSERT_NE(cells.at<int32_t>(r, c) % scan.cols, pole_col);
+  const SegmentResult cut = SegmentObject(scan, strokes, CoarseAbove(30000));
+  ASSERT_EQ(cut.coarse_factor, 4);
+  EXPECT_EQ(cv::countNonZero(cut.mask & (strokes == kStrokeBackground)), 0);
+  EXPECT_GT(ScoreMask(cut.mask, TruthMask(scan), scan.valid).iou, 0.95);
+}
+
+TEST(CoarseToFineTest, LargeFactorsGoDownAPyramid) {
+  // f = 8: a level of every 4th ray, cut on a level of every 2nd of its rays in turn; each band re-cut is a
+  // few rays of its own level wide.
+  const Scan scan = MakeScene();
+  const cv::Mat strokes = Strokes(scan), truth = TruthMask(scan);
+  const SegmentResult full = SegmentObject(scan, strokes, CoarseAbove(0));
+  const SegmentResult pyramid = SegmentObject(scan, strokes, CoarseAbove(6000));
+  ASSERT_EQ(pyramid.coarse_factor, 8);
+  EXPECT_GT(ScoreMask(pyramid.mask, truth, scan.valid).iou, 0.97);
+  EXPECT_GT(ScoreMask(pyramid.mask, full.mask).iou, 0.97);
+  // The full-resolution band is the outline times (2 · kBandCoarseCells + 2) · 4 rays (band and rim at the
+  // lower level's step of 4), not · 8 as one step of 8 would make it.
+  const cv::Rect box = cv::boundingRect(truth);
+  const int one_step_of_eight =
+      2 * (box.width + box.height) * (2 * segment_internal::kBandCoarseCells + 2) * 8;
+  EXPECT_LT(pyramid.graph_nodes, one_step_of_eight * 2 / 3);
+}
+
 }  // namespace
 }  // namespace lidarshop

@@ -172,7 +172,9 @@ struct SegmentOptions {
   // with the same options (cell counts are the level's: they were chosen for scans of about this size); its
   // object is taken to full resolution and the cells within two coarse cells of its outline are cut again
   // there (one colour-dominant cut: models from the level's object and its surroundings, every stroke hard).
-  // Refine() refines the level's cut and re-cuts the outline likewise. 0 = always full resolution.
+  // A level is at most 4 times coarser than the scan it comes from; beyond that the level is cut coarse to
+  // fine in turn (a pyramid). Refine() refines the level's cut and re-cuts the outline likewise. 0 = always
+  // full resolution.
   int coarse_max_cells = 1000000;  // cells (>= 0)
 
   // Scale to the data: the range-model lengths below (depth_bin_m, depth_smoothing_m) are given for a ray

@@ -99,7 +99,7 @@ struct SegmentSession::Impl {
     result.window_rows = window.height;
     result.window_cols = window.width;
     result.window_growths = at_level.window_growths;
-    result.coarse_factor = factor;
+    result.coarse_factor = factor * at_level.coarse_factor;
     result.warnings = at_level.warnings;
     result.timings.total_s = total.Seconds() + stats_s;
     return result;
@@ -358,12 +358,11 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
   Timer timer;
   impl_->scan = scan;
   impl_->given = impl_->options = options;
-  impl_->factor = CoarseFactor(scan.rows, scan.cols, options.coarse_max_cells);
+  impl_->factor = std::min(kMaxLevelStep, CoarseFactor(scan.rows, scan.cols, options.coarse_max_cells));
   if (impl_->factor > 1) {
     // The level is cut by the whole method; here only its outline is, so every 4·f-th row suffices for the
     // standardization and σ² (a 16th of the rows of a 2250 x 3600 station: half a million cells).
     SegmentOptions at_level = options;
-    at_level.coarse_max_cells = 0;
     impl_->level = std::make_unique<SegmentSession>(DecimateScan(scan, impl_->factor), at_level);
     impl_->level_cells = DecimatedCells(scan, impl_->factor);
     impl_->stats = ComputeScanStats(scan, 4 * impl_->factor);
