@@ -195,16 +195,14 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
   result.choice_seconds = since(choice_start);
   const auto gain_start = std::chrono::steady_clock::now();
   // The gains, channel by channel, from the overlaps and from neighbours coloured by different photos.
-  std::vector<std::pair<std::pair<int, int>, double>> rows[3];
-  const auto add = [&](const Sample& a, const Sample& b) {
-    if (a.photo == b.photo) return;
-    for (int ch = 0; ch < 3; ++ch) {
-      const double u = a.rgb[ch], v = b.rgb[ch];
-      if (u < kDarkest || v < kDarkest || u > kBrightest || v > kBrightest) continue;
-      rows[ch].push_back({{a.photo, b.photo}, std::log(u) - std::log(v)});
-    }
-    ++result.constraints;
+  // Blocks of rows in parallel, each into its own rows, joined in block order: the rows in cell order as a serial
+  // pass would give them (the same sums on any thread count).
+  using GainRow = std::pair<std::pair<int, int>, double>;
+  struct BlockRows {
+    std::vector<GainRow> rows[3];
+    int64_t constraints = 0;
   };
+  std::vector<BlockRows> block_rows(blocks);
   const auto sample_of = [&](int64_t cell, int photo) -> const Sample* {
     for (auto [s, end] = samples_of(cell); s != end; ++s) {
       if (s->photo == photo) return s;
@@ -212,19 +210,38 @@ PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<Camera
     return nullptr;
   };
   const auto chosen = [&](int64_t cell) { return best[cell] < 0 ? nullptr : sample_of(cell, best[cell]); };
-  for (int64_t cell = 0; cell < cells; ++cell) {
-    const auto [begin, end] = samples_of(cell);
-    for (const Sample* a = begin; a != end; ++a) {
-      for (const Sample* b = a + 1; b != end; ++b) add(*a, *b);
+  ParallelFor(blocks, [&](int64_t block) {
+    BlockRows& out = block_rows[block];
+    const auto add = [&](const Sample& a, const Sample& b) {
+      if (a.photo == b.photo) return;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double u = a.rgb[ch], v = b.rgb[ch];
+        if (u < kDarkest || v < kDarkest || u > kBrightest || v > kBrightest) continue;
+        out.rows[ch].push_back({{a.photo, b.photo}, std::log(u) - std::log(v)});
+      }
+      ++out.constraints;
+    };
+    const int64_t block_end = std::min(cells, (block + 1) * block_cells);
+    for (int64_t cell = block * block_cells; cell < block_end; ++cell) {
+      const auto [begin, end] = samples_of(cell);
+      for (const Sample* a = begin; a != end; ++a) {
+        for (const Sample* b = a + 1; b != end; ++b) add(*a, *b);
+      }
+      const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
+      const Sample* mine = chosen(cell);
+      if (mine == nullptr) continue;
+      for (const int64_t other :
+           {c + 1 < scan.cols ? cell + 1 : -1, r + 1 < scan.rows ? cell + scan.cols : -1}) {
+        if (other < 0 || best[other] < 0 || best[other] == best[cell]) continue;
+        add(*mine, *chosen(other));
+      }
     }
-    const int r = static_cast<int>(cell / scan.cols), c = static_cast<int>(cell % scan.cols);
-    const Sample* mine = chosen(cell);
-    if (mine == nullptr) continue;
-    for (const int64_t other :
-         {c + 1 < scan.cols ? cell + 1 : -1, r + 1 < scan.rows ? cell + scan.cols : -1}) {
-      if (other < 0 || best[other] < 0 || best[other] == best[cell]) continue;
-      add(*mine, *chosen(other));
-    }
+  });
+  std::vector<GainRow> rows[3];
+  for (BlockRows& block : block_rows) {
+    for (int ch = 0; ch < 3; ++ch)
+      rows[ch].insert(rows[ch].end(), block.rows[ch].begin(), block.rows[ch].end());
+    result.constraints += block.constraints;
   }
   result.gains.assign(photos.size(), cv::Vec3d(1, 1, 1));
   if (options.equalize_exposure) {
