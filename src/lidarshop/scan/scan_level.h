@@ -16,9 +16,8 @@ namespace lidarshop {
 // factor >= 1 (1 = a copy).
 Scan DecimateScan(const Scan& scan, int factor);
 
-// The cell of `scan` that DecimateScan(scan, factor) took for each coarse cell, as row * scan.cols + col
-// (CV_64F would lose nothing but is wasteful: CV_32S when the scan has fewer than 2^31 cells, which
-// DecimateScan requires). ceil(rows / factor) x ceil(cols / factor).
+// The cell of `scan` that DecimateScan(scan, factor) takes for each coarse cell, as row * scan.cols + col:
+// CV_32S, ceil(rows / factor) x ceil(cols / factor). Both refuse scans of 2^31 cells or more.
 cv::Mat DecimatedCells(const Scan& scan, int factor);
 
 }  // namespace lidarshop

@@ -41,9 +41,11 @@ constexpr int kMaxLevelStep = 4;
 // object, those farther outside background, and the band between is one colour-dominant cut (the depth cut's
 // weights when the scan has neither colour nor intensity) on the full-resolution cells, its models learnt
 // from the level's object and from its surroundings (within four bands), every cell of `strokes` (full
-// resolution, kStroke*) a hard label. `coarse_cells` is DecimatedCells(scan, factor). Keeps the 4-connected
-// parts of the result that hold an inside cell or an object stroke. Adds its times to `timings` and sets
-// `graph_nodes` and `flow`. CV_8U 255/0, the scan's size.
+// resolution, kStroke*) a hard label; a stroke that contradicts the level (a background stroke inside, an
+// object stroke outside) frees the cells within the band's width around it. `coarse_cells` is
+// DecimatedCells(scan, factor). Keeps the 4-connected parts of the result that hold an inside cell or an
+// object stroke. Adds its times to result->timings and sets result->graph_nodes and result->flow. CV_8U
+// 255/0, the scan's size.
 cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, const cv::Mat& coarse_mask,
                                    const cv::Mat& coarse_cells, int factor, const cv::Mat& strokes,
                                    const SegmentOptions& options, bool has_appearance, SegmentResult* result);
