@@ -22,7 +22,8 @@ std::string SegmentResult::Summary() const {
       object_cells, flow, timings.total_s, timings.features_s, timings.models_s, timings.graph_s,
       timings.maxflow_s);
   if (coarse_factor > 1)
-    summary += fmt::format(", cut on every {}th ray, outline re-cut at full resolution", coarse_factor);
+    summary += fmt::format(", cut on a level of 1 in {} rays each way, outline re-cut at full resolution",
+                           coarse_factor);
   return summary;
 }
 
