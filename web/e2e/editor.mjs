@@ -112,7 +112,11 @@ try {
     fail(`the token stayed in the page's URL: ${page.url()}`);
   if ((await page.evaluate(() => document.cookie)).includes('lidarshop_token'))
     fail('page scripts can read the token cookie');
-  // E57 first: the save defaults to the format that keeps everything the editor makes.
+  // E57 first: the save defaults to the format that keeps everything the editor makes. (The page lists the
+  // formats when the server has answered /api/formats, after the load event: seen empty in CI.)
+  await waitForFunction(page, () => document.getElementById('format').options.length > 0, null, {
+    timeout: 30000,
+  });
   if ((await page.inputValue('#format')) !== 'e57')
     fail(`the save format defaults to ${await page.inputValue('#format')}, not e57`);
   await page.selectOption('#scene', 'parking_lot');
