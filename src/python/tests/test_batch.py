@@ -118,11 +118,14 @@ def test_resume_redoes_only_what_is_missing(scans, tmp_path):
     subset = scans[:6]
     out = str(tmp_path / "out")
     pipeline = write_pipeline(str(tmp_path))
-    # An interrupted run: the driver killed after two scans.
-    driver = subprocess.Popen(DRIVER + ["--lidarshop", CLI, "--quiet", pipeline] + subset + ["--out", out, "--serial"])
+    # An interrupted run: the driver and the command it runs killed after two scans, as an interrupt from the
+    # terminal kills the process group (killing the driver alone left its CLI child writing an output after
+    # the second run had recorded it, which the third run then rightly redid: seen in CI).
+    driver = subprocess.Popen(DRIVER + ["--lidarshop", CLI, "--quiet", pipeline] + subset + ["--out", out, "--serial"],
+                              start_new_session=True)
     while len(glob.glob(os.path.join(out, "records", "*.json"))) < 2 and driver.poll() is None:
         time.sleep(0.01)
-    driver.kill()
+    os.killpg(driver.pid, signal.SIGKILL)
     driver.wait()
     first = records(out)
     assert 2 <= len(first) < 6
