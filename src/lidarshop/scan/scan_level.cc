@@ -68,7 +68,10 @@ cv::Mat DecimatedCells(const Scan& scan, int factor) {
 
 Scan DecimateScan(const Scan& scan, int factor) {
   CheckScan(scan);
-  const cv::Mat cells = DecimatedCells(scan, factor);
+  return DecimateScan(scan, DecimatedCells(scan, factor), factor);
+}
+
+Scan DecimateScan(const Scan& scan, const cv::Mat& cells, int factor) {
   const auto gather = [&](const cv::Mat& from) {
     cv::Mat to(cells.rows, cells.cols, from.type());
     const size_t bytes = from.elemSize();

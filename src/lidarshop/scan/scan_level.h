@@ -15,6 +15,8 @@ namespace lidarshop {
 // channel and attribute is taken from that cell; the grid's angles are the blocks' centre columns and rows.
 // factor >= 1 (1 = a copy).
 Scan DecimateScan(const Scan& scan, int factor);
+// The same with the cells DecimatedCells(scan, factor) gave, for a caller that keeps them.
+Scan DecimateScan(const Scan& scan, const cv::Mat& cells, int factor);
 
 // The cell of `scan` that DecimateScan(scan, factor) takes for each coarse cell, as row * scan.cols + col:
 // CV_32S, ceil(rows / factor) x ceil(cols / factor). Both refuse scans of 2^31 cells or more.

@@ -363,8 +363,9 @@ SegmentSession::SegmentSession(const Scan& scan, const SegmentOptions& options)
     // The level is cut by the whole method; here only its outline is, so every 4·f-th row suffices for the
     // standardization and σ² (a 16th of the rows of a 2250 x 3600 station: half a million cells).
     SegmentOptions at_level = options;
-    impl_->level = std::make_unique<SegmentSession>(DecimateScan(scan, impl_->factor), at_level);
     impl_->level_cells = DecimatedCells(scan, impl_->factor);
+    impl_->level =
+        std::make_unique<SegmentSession>(DecimateScan(scan, impl_->level_cells, impl_->factor), at_level);
     impl_->stats = ComputeScanStats(scan, 4 * impl_->factor);
   } else {
     // The whole scan's statistics once; the nodes of a window at each Run().
