@@ -32,10 +32,9 @@ int BitsForRange(int64_t minimum, int64_t maximum) {
   return 64 - std::countl_zero(span);  // bits to hold values 0..span
 }
 
-void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, int64_t count, double* out,
-                 const std::string& where) {
+void CheckStreamHolds(const Field& field, uint64_t stream_size, int64_t count, const std::string& where) {
   if (count <= 0) return;
-  const uint64_t available_bits = uint64_t{stream_size} * 8;
+  const uint64_t available_bits = stream_size * 8;
   const uint64_t needed_bits = static_cast<uint64_t>(count) * static_cast<uint64_t>(field.bits);
   if (field.bits > 0 && (needed_bits / static_cast<uint64_t>(field.bits) != static_cast<uint64_t>(count) ||
                          needed_bits > available_bits)) {
@@ -43,6 +42,12 @@ void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, 
                     fmt::format("bytestream holds {} values of {} bits, the record count needs {}",
                                 available_bits / field.bits, field.bits, count));
   }
+}
+
+void DecodeField(const Field& field, const uint8_t* stream, size_t stream_size, int64_t count, double* out,
+                 const std::string& where) {
+  if (count <= 0) return;
+  CheckStreamHolds(field, stream_size, count, where);
   switch (field.type) {
     case Field::Type::kFloat:
       for (int64_t i = 0; i < count; ++i) out[i] = LoadLe<float>(stream + 4 * i);

@@ -68,6 +68,45 @@ std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector
 // are never held whole (a 100-million-point station's E57 is gigabytes).
 std::vector<uint8_t> LogicalFromPageFile(const std::string& path);
 
+// The logical bytes of an E57 file, held in memory or read from the file a range at a time. Opening a file
+// checks every page's CRC, as reading it whole does, without keeping the bytes; each later read checks its
+// pages again, so a file changed meanwhile is refused rather than misread. A station's E57 is gigabytes: the
+// reader holds the ranges it decodes, not the file. Not thread-safe (one reader at a time).
+class LogicalBytes {
+ public:
+  explicit LogicalBytes(std::vector<uint8_t> logical) : memory_(std::move(logical)), size_(memory_.size()) {}
+  // Throws InputError naming `path` (and the page) when it cannot be read or a checksum does not match.
+  static LogicalBytes OpenFile(const std::string& path);
+  LogicalBytes(LogicalBytes&& other) noexcept;
+  LogicalBytes& operator=(LogicalBytes&&) = delete;
+  LogicalBytes(const LogicalBytes&) = delete;
+  ~LogicalBytes();
+
+  uint64_t size() const { return size_; }
+  // Copies bytes [offset, offset + n) to `out`; the range must lie within size() (callers check offsets
+  // taken from the file first).
+  void Read(uint64_t offset, uint64_t n, uint8_t* out) const;
+  std::vector<uint8_t> Bytes(uint64_t offset, uint64_t n) const {
+    std::vector<uint8_t> bytes(n);
+    Read(offset, n, bytes.data());
+    return bytes;
+  }
+  template <typename T>
+  T Load(uint64_t offset) const {
+    T value;
+    Read(offset, sizeof(T), reinterpret_cast<uint8_t*>(&value));  // little-endian, as LoadLe
+    return value;
+  }
+
+ private:
+  LogicalBytes() = default;
+  std::string path_;
+  std::vector<uint8_t> memory_;
+  int fd_ = -1;
+  uint64_t size_ = 0;
+  mutable std::vector<uint8_t> pages_;  // scratch for the pages of one read
+};
+
 // E57's XML is UTF-8 (E2807 8.4): throws InputError naming `path` and the byte of the XML section where the
 // `size` bytes at `xml` are not (a Latin-1 scan name), before pugixml, which does not check, passes them on
 // to JSON output and written files.
@@ -118,6 +157,10 @@ struct Field {
 
 // Bits needed for an integer in [minimum, maximum] (0 when minimum == maximum).
 int BitsForRange(int64_t minimum, int64_t maximum);
+
+// Throws InputError (naming `where`) when a bytestream of `stream_size` bytes holds fewer than `count` values
+// of `field`.
+void CheckStreamHolds(const Field& field, uint64_t stream_size, int64_t count, const std::string& where);
 
 // Decodes `count` values of `field` from its bytestream into `out` (as doubles: scaled integers are scaled).
 // Throws InputError (naming `where`) when the stream holds fewer values.

@@ -4,6 +4,10 @@
 #include <cstring>
 #include <fstream>
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "lidarshop/io/e57_format.h"
@@ -163,6 +167,65 @@ std::vector<uint8_t> LogicalFromPageFile(const std::string& path) {
     CopyPayloads(path, chunk.data(), first, count, logical.data());
   }
   return logical;
+}
+
+LogicalBytes LogicalBytes::OpenFile(const std::string& path) {
+  LogicalBytes bytes;
+  bytes.path_ = path;
+  bytes.fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (bytes.fd_ < 0) ThrowInputError(path, "", "", "cannot open for reading");
+  struct stat info {};
+  if (::fstat(bytes.fd_, &info) != 0) ThrowInputError(path, "", "", "cannot determine the file size");
+  const uint64_t size = static_cast<uint64_t>(info.st_size);
+  CheckWholePages(path, size);
+  const uint64_t pages = size / kPageSize;
+  std::vector<uint8_t> chunk(std::min(pages, kPagesPerChunk) * kPageSize);
+  for (uint64_t first = 0; first < pages; first += kPagesPerChunk) {
+    const uint64_t count = std::min(kPagesPerChunk, pages - first);
+    const ssize_t got =
+        ::pread(bytes.fd_, chunk.data(), count * kPageSize, static_cast<off_t>(first * kPageSize));
+    if (got != static_cast<ssize_t>(count * kPageSize)) {
+      ThrowInputError(path, fmt::format("page {} (byte offset {})", first, first * kPageSize), "",
+                      "read failed (the file changed while it was read?)");
+    }
+    for (uint64_t p = 0; p < count; ++p) CheckPageCrc(path, chunk.data() + p * kPageSize, first + p);
+  }
+  bytes.size_ = pages * kPagePayload;
+  return bytes;
+}
+
+LogicalBytes::LogicalBytes(LogicalBytes&& other) noexcept
+    : path_(std::move(other.path_)), memory_(std::move(other.memory_)), fd_(other.fd_), size_(other.size_) {
+  other.fd_ = -1;
+}
+
+LogicalBytes::~LogicalBytes() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void LogicalBytes::Read(uint64_t offset, uint64_t n, uint8_t* out) const {
+  if (n == 0) return;
+  LIDARSHOP_CHECK(offset <= size_ && n <= size_ - offset);
+  if (fd_ < 0) {
+    std::memcpy(out, memory_.data() + offset, n);
+    return;
+  }
+  const uint64_t first = offset / kPagePayload, last = (offset + n - 1) / kPagePayload;
+  pages_.resize((last - first + 1) * kPageSize);
+  const ssize_t got = ::pread(fd_, pages_.data(), pages_.size(), static_cast<off_t>(first * kPageSize));
+  if (got != static_cast<ssize_t>(pages_.size())) {
+    ThrowInputError(path_, fmt::format("page {} (byte offset {})", first, first * kPageSize), "",
+                    "read failed (the file changed while it was read?)");
+  }
+  uint64_t at = offset;
+  for (uint64_t p = first; p <= last; ++p) {
+    const uint8_t* page = pages_.data() + (p - first) * kPageSize;
+    CheckPageCrc(path_, page, p);
+    const uint64_t from = at - p * kPagePayload;
+    const uint64_t take = std::min(kPagePayload - from, offset + n - at);
+    std::memcpy(out + (at - offset), page + from, take);
+    at += take;
+  }
 }
 
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical) {

@@ -31,11 +31,12 @@ namespace {
 
 struct Context {
   const std::string& path;
-  const std::vector<uint8_t>& logical;
+  const LogicalBytes& logical;
 };
 
-// What the reader holds per record while it places a scan's records (coordinates, state, layer, cell and
-// row index, one decoded field) on top of the scan's own channels.
+// What the reader holds per record while it places a scan's records (coordinates 12, state and layer 2,
+// cell 8, one decoded field 8 and the bytestream it came from, up to 8, a claimed cell 1) on top of the scan's
+// own channels: 39; the budget check keeps its earlier, larger bound.
 constexpr int64_t kReaderBytesPerRecord = 64;
 
 std::string ElementPath(pugi::xml_node node) {
@@ -199,13 +200,42 @@ uint64_t OffsetAttribute(const Context& ctx, pugi::xml_node node, const char* na
   return static_cast<uint64_t>(v);
 }
 
-// Reads the bytestreams of a compressed vector section, concatenating each stream's chunks over the data
-// packets. Stops once every stream holds `needed_bytes[i]`.
-std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_node cv_node,
-                                                  const std::vector<uint64_t>& needed_bytes) {
+// Where each bytestream of a compressed vector section lies: per stream, its chunks over the data packets as
+// (logical offset, length). Fields are decoded a block of records at a time straight from these chunks, so
+// the reader never holds a field's whole stream nor its decoded values (on a station, 20 bytes and more a
+// record beside the scan).
+struct Bytestreams {
+  std::vector<std::vector<std::pair<uint64_t, uint32_t>>> chunks;  // one list per stream
+  std::vector<std::vector<uint64_t>> starts;                       // each chunk's offset in its stream
+  std::vector<uint64_t> sizes;                                     // bytes per stream, summed over its chunks
+
+  // Bytes [begin, end) of stream `i` (end <= sizes[i]) into `out`.
+  void Gather(const LogicalBytes& logical, size_t i, uint64_t begin, uint64_t end,
+              std::vector<uint8_t>* out) const {
+    out->resize(end - begin);
+    const std::vector<uint64_t>& at = starts[i];
+    size_t k = std::upper_bound(at.begin(), at.end(), begin) - at.begin();
+    k = k == 0 ? 0 : k - 1;
+    for (; k < chunks[i].size() && at[k] < end; ++k) {
+      const auto [offset, length] = chunks[i][k];
+      const uint64_t from = std::max(begin, at[k]) - at[k];
+      const uint64_t to = std::min<uint64_t>(end - at[k], length);
+      if (to > from) logical.Read(offset + from, to - from, out->data() + (at[k] + from - begin));
+    }
+  }
+};
+
+// Locates the bytestreams of a compressed vector section over its data packets, checking every packet. Stops
+// once every stream holds `needed_bytes[i]`.
+Bytestreams LocateBytestreams(const Context& ctx, pugi::xml_node cv_node,
+                              const std::vector<uint64_t>& needed_bytes) {
   const size_t n = needed_bytes.size();
-  std::vector<std::vector<uint8_t>> streams(n);
-  const std::vector<uint8_t>& L = ctx.logical;
+  Bytestreams located;
+  located.chunks.resize(n);
+  located.starts.resize(n);
+  located.sizes.assign(n, 0);
+  std::vector<uint64_t>& sizes = located.sizes;
+  const LogicalBytes& L = ctx.logical;
   const uint64_t phys = OffsetAttribute(ctx, cv_node, "fileOffset");
   const uint64_t start = LogicalOffset(ctx, cv_node, phys);
   auto where = [&](uint64_t logical) {
@@ -213,12 +243,12 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
                        PhysicalFromLogical(logical));
   };
   if (start + 32 > L.size()) ThrowInputError(ctx.path, where(start), "section header", "truncated");
-  if (L[start] != 1) {
+  if (const uint8_t section_id = L.Load<uint8_t>(start); section_id != 1) {
     ThrowInputError(ctx.path, where(start), "sectionId",
-                    fmt::format("{} is not a compressed vector section (expected 1)", int{L[start]}));
+                    fmt::format("{} is not a compressed vector section (expected 1)", int{section_id}));
   }
-  const uint64_t section_length = LoadLe<uint64_t>(&L[start + 8]);
-  const uint64_t data_physical = LoadLe<uint64_t>(&L[start + 16]);
+  const uint64_t section_length = L.Load<uint64_t>(start + 8);
+  const uint64_t data_physical = L.Load<uint64_t>(start + 16);
   if (section_length < 32 || section_length > L.size() - start) {
     ThrowInputError(ctx.path, where(start), "sectionLogicalLength",
                     fmt::format("{} does not fit in the file", section_length));
@@ -226,7 +256,7 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
   const uint64_t end = start + section_length;
   auto done = [&] {
     for (size_t i = 0; i < n; ++i) {
-      if (streams[i].size() < needed_bytes[i]) return false;
+      if (sizes[i] < needed_bytes[i]) return false;
     }
     return true;
   };
@@ -234,16 +264,16 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
   // would otherwise read as an empty or partial scan).
   auto refuse_more_data = [&](uint64_t at) {
     while (at + 6 <= end) {
-      const uint64_t length = uint64_t{LoadLe<uint16_t>(&L[at + 2])} + 1;
-      if (L[at] == 1) {
-        const size_t count = std::min<size_t>(LoadLe<uint16_t>(&L[at + 4]), (end - at - 6) / 2);
+      const uint64_t length = uint64_t{L.Load<uint16_t>(at + 2)} + 1;
+      if (L.Load<uint8_t>(at) == 1) {
+        const size_t count = std::min<size_t>(L.Load<uint16_t>(at + 4), (end - at - 6) / 2);
         for (size_t i = 0; i < count; ++i) {
-          if (LoadLe<uint16_t>(&L[at + 6 + 2 * i]) > 0) {
+          if (L.Load<uint16_t>(at + 6 + 2 * i) > 0) {
             ThrowInputError(ctx.path, where(at), "recordCount",
                             "the section holds more data than recordCount records (wrong count?)");
           }
         }
-      } else if (L[at] != 0 && L[at] != 2) {
+      } else if (const uint8_t type = L.Load<uint8_t>(at); type != 0 && type != 2) {
         return;
       }
       at += length;
@@ -254,7 +284,7 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
       const uint64_t first = LogicalFromPhysical(data_physical);
       if (first >= start + 32 && first <= end) refuse_more_data(first);
     }
-    return streams;
+    return located;
   }
   if (data_physical % kPageSize >= kPagePayload) {
     ThrowInputError(ctx.path, where(start), "dataPhysicalOffset", "points into a page checksum");
@@ -272,15 +302,15 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
       ThrowInputError(ctx.path, where(pos), "packet",
                       "the section ends before every bytestream holds its records (truncated data)");
     }
-    const uint8_t type = L[pos];
-    const uint64_t length = uint64_t{LoadLe<uint16_t>(&L[pos + 2])} + 1;
+    const uint8_t type = L.Load<uint8_t>(pos);
+    const uint64_t length = uint64_t{L.Load<uint16_t>(pos + 2)} + 1;
     if (length > end - pos) {
       ThrowInputError(ctx.path, where(pos), "packetLogicalLengthMinus1",
                       fmt::format("packet of {} bytes runs past the end of its section", length));
     }
     if (type == 1) {
       if (length < 6) ThrowInputError(ctx.path, where(pos), "data packet", "shorter than its header");
-      const size_t count = LoadLe<uint16_t>(&L[pos + 4]);
+      const size_t count = L.Load<uint16_t>(pos + 4);
       if (count != n) {
         ThrowInputError(ctx.path, where(pos), "bytestreamCount",
                         fmt::format("{} bytestreams, the prototype has {} fields", count, n));
@@ -288,13 +318,18 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
       uint64_t at = pos + 6 + 2 * uint64_t{count};
       if (at > pos + length)
         ThrowInputError(ctx.path, where(pos), "data packet", "header longer than the packet");
-      for (size_t i = 0; i < n; ++i) lengths[i] = LoadLe<uint16_t>(&L[pos + 6 + 2 * i]);
+      const std::vector<uint8_t> header = L.Bytes(pos + 6, 2 * n);  // one read for the packet's lengths
+      for (size_t i = 0; i < n; ++i) lengths[i] = LoadLe<uint16_t>(header.data() + 2 * i);
       for (size_t i = 0; i < n; ++i) {
         if (lengths[i] > pos + length - at) {
           ThrowInputError(ctx.path, where(pos), fmt::format("bytestream {}", i),
                           "buffer lengths exceed the packet length");
         }
-        streams[i].insert(streams[i].end(), L.begin() + at, L.begin() + at + lengths[i]);
+        if (lengths[i] > 0) {
+          located.chunks[i].emplace_back(at, static_cast<uint32_t>(lengths[i]));
+          located.starts[i].push_back(sizes[i]);
+        }
+        sizes[i] += lengths[i];
         at += lengths[i];
       }
     } else if (type != 0 && type != 2) {
@@ -307,13 +342,13 @@ std::vector<std::vector<uint8_t>> ReadBytestreams(const Context& ctx, pugi::xml_
   // A writer may round each packet's bytestreams up to whole bytes; more than that is records recordCount
   // does not count.
   for (size_t i = 0; i < n; ++i) {
-    if (streams[i].size() > needed_bytes[i] + static_cast<uint64_t>(packets) + 8) {
+    if (sizes[i] > needed_bytes[i] + static_cast<uint64_t>(packets) + 8) {
       ThrowInputError(ctx.path, where(start), "recordCount",
                       fmt::format("bytestream {} holds {} bytes, recordCount needs {} (wrong count?)", i,
-                                  streams[i].size(), needed_bytes[i]));
+                                  sizes[i], needed_bytes[i]));
     }
   }
-  return streams;
+  return located;
 }
 
 struct Limits {
@@ -382,23 +417,38 @@ struct PointRecords {
   int64_t count = 0;  // recordCount
   std::vector<Field> fields;
   std::unordered_map<std::string, int> field_index;
-  std::vector<std::vector<uint8_t>> streams;  // one per field
-  std::string where;                          // "file: data3D/.../points", for decoding errors
+  Bytestreams streams;  // one per field
+  std::string where;    // "file: data3D/.../points", for decoding errors
   bool cartesian = false, spherical = false, structured = false;
-  mutable std::vector<double> buffer;
 
   const Field* Find(const char* name) const {
     const auto it = field_index.find(name);
     return it == field_index.end() ? nullptr : &fields[it->second];
   }
-  // The `count` values of `field` (not null); valid until the next call.
-  const std::vector<double>& Decode(const Field* field) const {
+  // Calls visit(first, n, values) for the records of `field` (not null) a block at a time, in order: values
+  // holds records [first, first + n), valid during the call. Throws InputError (naming `where`) first when the
+  // field's stream holds fewer than `count` values.
+  template <typename Visit>
+  void ForEachBlock(const Field* field, Visit&& visit) const {
     LIDARSHOP_CHECK(field != nullptr);
-    buffer.resize(count);
-    const auto& stream = streams[field - fields.data()];
-    DecodeField(*field, stream.data(), stream.size(), count, buffer.data(), where);
-    return buffer;
+    const size_t index = field - fields.data();
+    // The whole stream is checked before the first block, with the message decoding it whole would give.
+    CheckStreamHolds(*field, streams.sizes[index], count, where);
+    std::vector<uint8_t> bytes;
+    std::vector<double> values;
+    const uint64_t bits = static_cast<uint64_t>(field->bits);
+    for (int64_t first = 0; first < count; first += kRecordsPerBlock) {
+      const int64_t n = std::min(kRecordsPerBlock, count - first);
+      // kRecordsPerBlock is a multiple of 8: every block starts on a whole byte.
+      const uint64_t begin = static_cast<uint64_t>(first) * bits / 8;
+      const uint64_t end = std::min(streams.sizes[index], (static_cast<uint64_t>(first + n) * bits + 7) / 8);
+      streams.Gather(ctx.logical, index, begin, end, &bytes);
+      values.resize(n);
+      DecodeField(*field, bytes.data(), bytes.size(), n, values.data(), where);
+      visit(first, n, values.data());
+    }
   }
+  static constexpr int64_t kRecordsPerBlock = int64_t{1} << 16;
 };
 
 PointRecords ReadPointRecords(const Context& ctx, pugi::xml_node child) {
@@ -436,9 +486,13 @@ PointRecords ReadPointRecords(const Context& ctx, pugi::xml_node child) {
              fmt::format("recordCount {} needs {} bytes of bytestreams, the file has {}", record_count,
                          needed_total, ctx.logical.size()));
   }
-  records.streams = record_count > 0 || points.attribute("fileOffset")
-                        ? ReadBytestreams(ctx, points, needed)
-                        : std::vector<std::vector<uint8_t>>(fields.size());
+  if (record_count > 0 || points.attribute("fileOffset")) {
+    records.streams = LocateBytestreams(ctx, points, needed);
+  } else {
+    records.streams.chunks.resize(fields.size());
+    records.streams.starts.resize(fields.size());
+    records.streams.sizes.assign(fields.size(), 0);
+  }
   records.where = fmt::format("{}: {}", ctx.path, ElementPath(points));
   return records;
 }
@@ -447,8 +501,11 @@ PointRecords ReadPointRecords(const Context& ctx, pugi::xml_node child) {
 // it from rowIndex / columnIndex (and indexBounds); unstructured ones are one row of records.
 struct RecordGrid {
   int64_t rows = 0, cols = 0;
-  std::vector<int64_t> cell;  // per record; set to -1 below for records that give the scan nothing
+  // Per record; set to -1 below for records that give the scan nothing. 32 bits: a scan has at most
+  // kMaxScanCells cells.
+  std::vector<int32_t> cell;
 };
+static_assert(kMaxScanCells <= std::numeric_limits<int32_t>::max());
 
 RecordGrid ReadRecordGrid(const Context& ctx, pugi::xml_node child, const PointRecords& records) {
   const int64_t record_count = records.count;
@@ -458,31 +515,30 @@ RecordGrid ReadRecordGrid(const Context& ctx, pugi::xml_node child, const PointR
   if (!records.structured) {
     grid.rows = record_count > 0 ? 1 : 0;
     grid.cols = record_count;
-    for (int64_t i = 0; i < record_count; ++i) grid.cell[i] = i;
+    for (int64_t i = 0; i < record_count; ++i) grid.cell[i] = static_cast<int32_t>(i);
     return grid;
   }
-  std::vector<int64_t> row(record_count);
+  // grid.cell holds each record's row until the columns are known; the column indices are decoded twice
+  // rather than held.
   int64_t max_row = -1, max_col = -1;
-  {
-    const auto& r = records.Decode(records.Find("rowIndex"));
-    for (int64_t i = 0; i < record_count; ++i) {
-      if (!(r[i] >= 0 && r[i] < 2147483647.0)) {
-        XmlError(ctx, points, fmt::format("record {}: rowIndex {} is out of range", i, r[i]));
+  records.ForEachBlock(records.Find("rowIndex"), [&](int64_t first, int64_t n, const double* r) {
+    for (int64_t j = 0; j < n; ++j) {
+      if (!(r[j] >= 0 && r[j] < 2147483647.0)) {
+        XmlError(ctx, points, fmt::format("record {}: rowIndex {} is out of range", first + j, r[j]));
       }
-      row[i] = static_cast<int64_t>(r[i]);
-      max_row = std::max(max_row, row[i]);
+      grid.cell[first + j] = static_cast<int32_t>(r[j]);
+      max_row = std::max<int64_t>(max_row, grid.cell[first + j]);
     }
-  }
-  {
-    const auto& c = records.Decode(records.Find("columnIndex"));
-    for (int64_t i = 0; i < record_count; ++i) {
-      if (!(c[i] >= 0 && c[i] < 2147483647.0)) {
-        XmlError(ctx, points, fmt::format("record {}: columnIndex {} is out of range", i, c[i]));
+  });
+  const Field* column_field = records.Find("columnIndex");
+  records.ForEachBlock(column_field, [&](int64_t first, int64_t n, const double* c) {
+    for (int64_t j = 0; j < n; ++j) {
+      if (!(c[j] >= 0 && c[j] < 2147483647.0)) {
+        XmlError(ctx, points, fmt::format("record {}: columnIndex {} is out of range", first + j, c[j]));
       }
-      grid.cell[i] = static_cast<int64_t>(c[i]);
-      max_col = std::max(max_col, grid.cell[i]);
+      max_col = std::max(max_col, static_cast<int64_t>(c[j]));
     }
-  }
+  });
   const pugi::xml_node bounds = child.child("indexBounds");
   if (bounds) {
     max_row = std::max(max_row, BoundedInteger(ctx, bounds.child("rowMaximum"), -1, -1, 2147483646));
@@ -495,70 +551,106 @@ RecordGrid ReadRecordGrid(const Context& ctx, pugi::xml_node child, const PointR
   }
   io_internal::CheckGridFromData(rows, cols, static_cast<int64_t>(ctx.logical.size()), ctx.path,
                                  "data3D points");
-  for (int64_t i = 0; i < record_count; ++i) grid.cell[i] += row[i] * cols;
+  records.ForEachBlock(column_field, [&](int64_t first, int64_t n, const double* c) {
+    for (int64_t j = 0; j < n; ++j) {
+      grid.cell[first + j] = static_cast<int32_t>(grid.cell[first + j] * cols + static_cast<int64_t>(c[j]));
+    }
+  });
   grid.rows = rows;
   grid.cols = cols;
   return grid;
 }
 
-// The invalid state of each record: 0 = valid point, 1 = direction only, 2 = nothing meaningful.
-std::vector<uint8_t> ReadInvalidState(const PointRecords& records) {
-  std::vector<uint8_t> state(records.count, 0);
-  const Field* state_field =
-      records.cartesian ? records.Find("cartesianInvalidState") : records.Find("sphericalInvalidState");
-  if (state_field) {
-    const auto& s = records.Decode(state_field);
-    for (int64_t i = 0; i < records.count; ++i) state[i] = s[i] == 0.0 ? 0 : s[i] == 1.0 ? 1 : 2;
-  }
-  return state;
-}
-
-// The records' coordinates as floats, x y z per record (3 x count); spherical ones converted to cartesian.
-// A spherical record at range 0 or of state 1 gives its unit direction; a "valid" one at range 0 gets state 2.
-std::vector<float> ReadCoordinates(const PointRecords& records, std::vector<uint8_t>* state_in_out) {
-  const int64_t record_count = records.count;
-  std::vector<uint8_t>& state = *state_in_out;
-  std::vector<float> xyz(3 * record_count);
-  if (record_count == 0) return xyz;  // else cartesian || spherical (checked by ReadPointRecords)
-  const bool cartesian = records.cartesian;
-  const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
-  if (!cartesian) names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
-  if (cartesian) {
-    // One axis at a time, straight into the floats: three whole double copies are 24 bytes a record.
-    for (int k = 0; k < 3; ++k) {
-      const std::vector<double>& axis = records.Decode(records.Find(names[k]));
-      for (int64_t i = 0; i < record_count; ++i) xyz[3 * i + k] = static_cast<float>(axis[i]);
-    }
-    return xyz;
-  }
-  std::vector<double> a[3];
-  for (int k = 0; k < 3; ++k) a[k] = records.Decode(records.Find(names[k]));
-  for (int64_t i = 0; i < record_count; ++i) {
-    double x, y, z;
-    // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
-    const double r = a[0][i], az = a[1][i], el = a[2][i];
-    if (state[i] == 1 || r == 0.0) {
-      x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
-      if (state[i] == 0) state[i] = 2;  // a valid point at range 0 is no return
-    } else {
-      x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
-    }
-    xyz[3 * i] = static_cast<float>(x), xyz[3 * i + 1] = static_cast<float>(y),
-            xyz[3 * i + 2] = static_cast<float>(z);
-  }
-  return xyz;
-}
-
 // The layer of each record of a structured scan from its returnIndex: 0 (first return) goes to the scan, 1
-// to the layer behind, 2 (third and later returns) is left out. All 0 without returnIndex.
+// to the layer behind, 2 (third and later returns) is left out. Empty (all 0) without returnIndex.
 std::vector<uint8_t> ReadReturnLayers(const PointRecords& records) {
-  std::vector<uint8_t> layer(records.count, 0);
+  std::vector<uint8_t> layer;
   if (records.structured && records.Find("returnIndex") != nullptr) {
-    const auto& v = records.Decode(records.Find("returnIndex"));
-    for (int64_t i = 0; i < records.count; ++i) layer[i] = v[i] <= 0.0 ? 0 : v[i] == 1.0 ? 1 : 2;
+    layer.resize(records.count);
+    records.ForEachBlock(records.Find("returnIndex"), [&](int64_t first, int64_t n, const double* v) {
+      for (int64_t j = 0; j < n; ++j) layer[first + j] = v[j] <= 0.0 ? 0 : v[j] == 1.0 ? 1 : 2;
+    });
   }
   return layer;
 }
+
+// One block of records' coordinates as floats, x y z per record; spherical ones converted to cartesian. A
+// spherical record at range 0 or of state 1 gives its unit direction; a "valid" one at range 0 gets state 2.
+// `state` holds the block's invalid states (0 = valid point, 1 = direction only, 2 = nothing meaningful).
+class CoordinateBlocks {
+ public:
+  explicit CoordinateBlocks(const PointRecords& records) : records_(records) {
+    const char* names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
+    if (!records.cartesian)
+      names[0] = "sphericalRange", names[1] = "sphericalAzimuth", names[2] = "sphericalElevation";
+    for (int k = 0; k < 3; ++k) fields_[k] = records.Find(names[k]);
+    state_field_ =
+        records.cartesian ? records.Find("cartesianInvalidState") : records.Find("sphericalInvalidState");
+  }
+
+  // Calls visit(first, n, xyz, state) for every block of records, in order.
+  template <typename Visit>
+  void ForEachBlock(Visit&& visit) {
+    const int64_t count = records_.count;
+    if (count == 0) return;  // else cartesian || spherical (checked by ReadPointRecords)
+    // The whole streams are checked first, in the order decoding them whole did.
+    if (state_field_) CheckWhole(state_field_);
+    for (const Field* field : fields_) CheckWhole(field);
+    for (int64_t first = 0; first < count; first += PointRecords::kRecordsPerBlock) {
+      const int64_t n = std::min(PointRecords::kRecordsPerBlock, count - first);
+      state_.assign(n, 0);
+      if (state_field_) {
+        Decode(state_field_, first, n, &values_[0]);
+        for (int64_t j = 0; j < n; ++j) state_[j] = values_[0][j] == 0.0 ? 0 : values_[0][j] == 1.0 ? 1 : 2;
+      }
+      for (int k = 0; k < 3; ++k) Decode(fields_[k], first, n, &values_[k]);
+      xyz_.resize(3 * n);
+      for (int64_t j = 0; j < n; ++j) {
+        if (records_.cartesian) {
+          for (int k = 0; k < 3; ++k) xyz_[3 * j + k] = static_cast<float>(values_[k][j]);
+          continue;
+        }
+        double x, y, z;
+        // E57 spherical: azimuth counter-clockwise from +x in the xy plane, elevation up from the xy plane.
+        const double r = values_[0][j], az = values_[1][j], el = values_[2][j];
+        if (state_[j] == 1 || r == 0.0) {
+          x = std::cos(el) * std::cos(az), y = std::cos(el) * std::sin(az), z = std::sin(el);
+          if (state_[j] == 0) state_[j] = 2;  // a valid point at range 0 is no return
+        } else {
+          x = r * std::cos(el) * std::cos(az), y = r * std::cos(el) * std::sin(az), z = r * std::sin(el);
+        }
+        xyz_[3 * j] = static_cast<float>(x), xyz_[3 * j + 1] = static_cast<float>(y),
+                 xyz_[3 * j + 2] = static_cast<float>(z);
+      }
+      visit(first, n, xyz_.data(), state_.data());
+    }
+  }
+
+ private:
+  void CheckWhole(const Field* field) const {
+    CheckStreamHolds(*field, records_.streams.sizes[field - records_.fields.data()], records_.count,
+                     records_.where);
+  }
+  // Records [first, first + n) of `field`.
+  void Decode(const Field* field, int64_t first, int64_t n, std::vector<double>* out) {
+    const size_t index = field - records_.fields.data();
+    const uint64_t bits = static_cast<uint64_t>(field->bits);
+    const uint64_t begin = static_cast<uint64_t>(first) * bits / 8;
+    const uint64_t end =
+        std::min(records_.streams.sizes[index], (static_cast<uint64_t>(first + n) * bits + 7) / 8);
+    records_.streams.Gather(records_.ctx.logical, index, begin, end, &bytes_);
+    out->resize(n);
+    DecodeField(*field, bytes_.data(), bytes_.size(), n, out->data(), records_.where);
+  }
+
+  const PointRecords& records_;
+  const Field* fields_[3] = {nullptr, nullptr, nullptr};
+  const Field* state_field_ = nullptr;
+  std::vector<double> values_[3];
+  std::vector<uint8_t> bytes_;
+  std::vector<uint8_t> state_;
+  std::vector<float> xyz_;
+};
 
 // What PlaceRecords left out, for the warnings.
 struct PlacedRecords {
@@ -568,16 +660,30 @@ struct PlacedRecords {
   std::vector<uint8_t> has_direction;
 };
 
+// The first record before record `before` whose grid indices name `cell`, for the message on a corrupt grid.
+int64_t FirstRecordOfCell(const PointRecords& records, int64_t cols, int64_t cell, int64_t before) {
+  std::vector<int64_t> rows_seen;
+  int64_t found = -1;
+  records.ForEachBlock(records.Find("rowIndex"), [&](int64_t first, int64_t n, const double* r) {
+    if (first >= before) return;
+    for (int64_t j = 0; j < n; ++j) rows_seen.push_back(static_cast<int64_t>(r[j]));
+  });
+  records.ForEachBlock(records.Find("columnIndex"), [&](int64_t first, int64_t n, const double* c) {
+    for (int64_t j = 0; j < n && found < 0 && first + j < before; ++j) {
+      if (rows_seen[first + j] * cols + static_cast<int64_t>(c[j]) == cell) found = first + j;
+    }
+  });
+  return found;
+}
+
 // Puts the records' points into `scan` (first returns) and `second` (returnIndex 1; a rows x cols scan when
 // any record has it, else untouched). Records that give no cell a point get grid->cell[i] = -1, so that
 // their intensity and colour are skipped. Throws InputError when two records claim one cell of a scan
 // without returnIndex (the grid indices are corrupt).
-PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, const std::vector<float>& xyz,
-                           const std::vector<uint8_t>& state, const std::vector<uint8_t>& layer,
+PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, const std::vector<uint8_t>& layer,
                            RecordGrid* grid, Scan* scan, Scan* second) {
-  const int64_t record_count = records.count;
   const int64_t rows = grid->rows, cols = grid->cols;
-  std::vector<int64_t>& cell = grid->cell;
+  std::vector<int32_t>& cell = grid->cell;
   PlacedRecords placed;
   if (std::find(layer.begin(), layer.end(), 1) != layer.end()) {
     const bool has_color =
@@ -591,65 +697,70 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
   // Several records of one grid cell are several returns of one ray, which E57 marks with returnIndex.
   // Without it, two records claiming the same rowIndex/columnIndex contradict the grid: the file is corrupt
   // (e.g. zeroed compressed-vector data), and guessing which record to keep would be a silent wrong answer.
+  // A byte per cell marks the cells a record claimed.
   const bool has_return_index = records.Find("returnIndex") != nullptr;
-  std::vector<int64_t> first_record_of_cell;
-  if (records.structured && !has_return_index)
-    first_record_of_cell.assign(static_cast<size_t>(rows * cols), -1);
-  for (int64_t i = 0; i < record_count; ++i) {
-    const int64_t c = cell[i];
-    if (!first_record_of_cell.empty()) {
-      if (first_record_of_cell[c] >= 0) {
-        XmlError(ctx, records.points,
-                 fmt::format("records {} and {} both claim row {}, column {} and the prototype has no "
-                             "returnIndex: the grid indices are corrupt",
-                             first_record_of_cell[c], i, c / std::max<int64_t>(cols, 1),
-                             c % std::max<int64_t>(cols, 1)));
+  std::vector<uint8_t> claimed;
+  if (records.structured && !has_return_index) claimed.assign(static_cast<size_t>(rows * cols), 0);
+  CoordinateBlocks coordinates(records);
+  coordinates.ForEachBlock([&](int64_t first, int64_t n, const float* xyz, const uint8_t* state) {
+    for (int64_t j = 0; j < n; ++j) {
+      const int64_t i = first + j;
+      const int64_t c = cell[i];
+      if (!claimed.empty()) {
+        if (claimed[c] != 0) {
+          XmlError(ctx, records.points,
+                   fmt::format("records {} and {} both claim row {}, column {} and the prototype has no "
+                               "returnIndex: the grid indices are corrupt",
+                               FirstRecordOfCell(records, cols, c, i), i, c / std::max<int64_t>(cols, 1),
+                               c % std::max<int64_t>(cols, 1)));
+        }
+        claimed[c] = 1;
       }
-      first_record_of_cell[c] = i;
-    }
-    const int r = static_cast<int>(c / std::max<int64_t>(cols, 1));
-    const int k = static_cast<int>(c % std::max<int64_t>(cols, 1));
-    const cv::Vec3f p(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-    const float range = static_cast<float>(cv::norm(p));
-    const bool finite = std::isfinite(range);
-    if (layer[i] > 1) {
-      ++placed.later_returns;
-      cell[i] = -1;
-      continue;
-    }
-    if (layer[i] == 1) {
-      // A second return: a point of the layer behind; its ray is the cell's (set from the grid later).
-      Scan& behind = *second;
-      if (state[i] == 0 && finite && range > 0.0f && behind.valid.at<uint8_t>(r, k) != kValid) {
-        behind.valid.at<uint8_t>(r, k) = kValid;
-        behind.point.at<cv::Vec3f>(r, k) = p;
-        behind.range.at<float>(r, k) = range;
-      } else {
-        placed.duplicates += behind.valid.at<uint8_t>(r, k) == kValid;
+      const int r = static_cast<int>(c / std::max<int64_t>(cols, 1));
+      const int k = static_cast<int>(c % std::max<int64_t>(cols, 1));
+      const cv::Vec3f p(xyz[3 * j], xyz[3 * j + 1], xyz[3 * j + 2]);
+      const float range = static_cast<float>(cv::norm(p));
+      const bool finite = std::isfinite(range);
+      const uint8_t record_layer = layer.empty() ? 0 : layer[i];
+      if (record_layer > 1) {
+        ++placed.later_returns;
         cell[i] = -1;
+        continue;
       }
-      continue;
-    }
-    if (scan->valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
-      ++placed.duplicates;
-      cell[i] = -1;
-      continue;
-    }
-    if (state[i] == 0 && finite && range > 0.0f) {
-      scan->valid.at<uint8_t>(r, k) = kValid;
-      scan->point.at<cv::Vec3f>(r, k) = p;
-      scan->range.at<float>(r, k) = range;
-      scan->direction.at<cv::Vec3f>(r, k) = p / range;
-      placed.has_direction[c] = 1;
-    } else {
-      if (state[i] != 2 && finite && range > 0.0f) {
-        // Keep a stored unit direction bit for bit (renormalizing would change its last bits).
-        scan->direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
-        placed.has_direction[c] = 2;
+      if (record_layer == 1) {
+        // A second return: a point of the layer behind; its ray is the cell's (set from the grid later).
+        Scan& behind = *second;
+        if (state[j] == 0 && finite && range > 0.0f && behind.valid.at<uint8_t>(r, k) != kValid) {
+          behind.valid.at<uint8_t>(r, k) = kValid;
+          behind.point.at<cv::Vec3f>(r, k) = p;
+          behind.range.at<float>(r, k) = range;
+        } else {
+          placed.duplicates += behind.valid.at<uint8_t>(r, k) == kValid;
+          cell[i] = -1;
+        }
+        continue;
       }
-      cell[i] = -1;  // no return: intensity and colour stay at their no-return values
+      if (scan->valid.at<uint8_t>(r, k) == kValid) {  // a later return of the same cell: keep the first
+        ++placed.duplicates;
+        cell[i] = -1;
+        continue;
+      }
+      if (state[j] == 0 && finite && range > 0.0f) {
+        scan->valid.at<uint8_t>(r, k) = kValid;
+        scan->point.at<cv::Vec3f>(r, k) = p;
+        scan->range.at<float>(r, k) = range;
+        scan->direction.at<cv::Vec3f>(r, k) = p / range;
+        placed.has_direction[c] = 1;
+      } else {
+        if (state[j] != 2 && finite && range > 0.0f) {
+          // Keep a stored unit direction bit for bit (renormalizing would change its last bits).
+          scan->direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
+          placed.has_direction[c] = 2;
+        }
+        cell[i] = -1;  // no return: intensity and colour stay at their no-return values
+      }
     }
-  }
+  });
   return placed;
 }
 
@@ -669,24 +780,26 @@ void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std:
   std::vector<int64_t> cells(records.count);
   for (const char* name : {"rowIndex", "columnIndex"}) {
     const int64_t bound = name[0] == 'r' ? grid.rows : grid.cols;
-    const auto& v = records.Decode(records.Find(name));
-    for (int64_t i = 0; i < records.count; ++i) {
-      if (!(v[i] >= 0 && v[i] < static_cast<double>(bound))) {
-        XmlError(ctx, records.points,
-                 fmt::format("record {}: {} {} is outside the scan's {} x {} grid", i, name, v[i], grid.rows,
-                             grid.cols));
+    records.ForEachBlock(records.Find(name), [&](int64_t first, int64_t n, const double* v) {
+      for (int64_t j = 0; j < n; ++j) {
+        const int64_t i = first + j;
+        if (!(v[j] >= 0 && v[j] < static_cast<double>(bound))) {
+          XmlError(ctx, records.points,
+                   fmt::format("record {}: {} {} is outside the scan's {} x {} grid", i, name, v[j],
+                               grid.rows, grid.cols));
+        }
+        cells[i] =
+            name[0] == 'r' ? static_cast<int64_t>(v[j]) * grid.cols : cells[i] + static_cast<int64_t>(v[j]);
       }
-      cells[i] =
-          name[0] == 'r' ? static_cast<int64_t>(v[i]) * grid.cols : cells[i] + static_cast<int64_t>(v[i]);
-    }
+    });
   }
   cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>();
   const uint8_t* valid = scan->valid.ptr<uint8_t>();
   for (int axis = 0; axis < 3; ++axis) {
-    const auto& v = records.Decode(records.Find(axis == 0   ? "cartesianX"
-                                                : axis == 1 ? "cartesianY"
-                                                            : "cartesianZ"));
-    for (int64_t i = 0; i < records.count; ++i) direction[cells[i]][axis] = static_cast<float>(v[i]);
+    const Field* field = records.Find(axis == 0 ? "cartesianX" : axis == 1 ? "cartesianY" : "cartesianZ");
+    records.ForEachBlock(field, [&](int64_t first, int64_t n, const double* v) {
+      for (int64_t j = 0; j < n; ++j) direction[cells[first + j]][axis] = static_cast<float>(v[j]);
+    });
   }
   for (int64_t i = 0; i < records.count; ++i) {
     cv::Vec3f& d = direction[cells[i]];
@@ -702,16 +815,20 @@ void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std:
   }
 }
 
+// The scan of record i's layer (layer empty: every record is a first return).
+inline Scan* LayerOf(Scan* const layers[2], const std::vector<uint8_t>& layer, int64_t i) {
+  return layers[layer.empty() ? 0 : layer[i]];
+}
+
 // Intensities of the placed records (grid.cell[i] >= 0), scaled to [0, 1] by intensityLimits (or by the
 // returned values when the file gives none).
 void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords& records,
                    const RecordGrid& grid, const std::vector<uint8_t>& layer, Scan* const layers[2]) {
   const Field* intensity_field = records.Find("intensity");
   if (!intensity_field) return;
-  const std::vector<int64_t>& cell = grid.cell;
+  const std::vector<int32_t>& cell = grid.cell;
   Limits l = LimitsFrom(ctx, child.child("intensityLimits"), "intensityMinimum", "intensityMaximum",
                         intensity_field);
-  const auto& v = records.Decode(intensity_field);
   if (l.known && l.maximum > l.minimum) {
     // Pictures show intensity in the file's units (render/render.h): 0 and 1 stand for the limits.
     for (Scan* scan : {layers[0], layers[1]}) {
@@ -723,20 +840,25 @@ void ReadIntensity(const Context& ctx, pugi::xml_node child, const PointRecords&
   if (!l.known) {
     // Float intensities without limits: take them as [0, 1] when they are, else stretch the returned range.
     double lo = 0, hi = 1;
-    for (int64_t i = 0; i < records.count; ++i) {
-      if (cell[i] < 0 || !std::isfinite(v[i])) continue;
-      lo = std::min(lo, v[i]);
-      hi = std::max(hi, v[i]);
-    }
+    records.ForEachBlock(intensity_field, [&](int64_t first, int64_t n, const double* v) {
+      for (int64_t j = 0; j < n; ++j) {
+        if (cell[first + j] < 0 || !std::isfinite(v[j])) continue;
+        lo = std::min(lo, v[j]);
+        hi = std::max(hi, v[j]);
+      }
+    });
     l = {lo, hi, true};
   }
   const double span = l.maximum - l.minimum;
-  for (int64_t i = 0; i < records.count; ++i) {
-    if (cell[i] < 0) continue;
-    const double t = span > 0 ? (v[i] - l.minimum) / span : 0.5;
-    layers[layer[i]]->intensity.ptr<float>()[cell[i]] =
-        std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
-  }
+  records.ForEachBlock(intensity_field, [&](int64_t first, int64_t n, const double* v) {
+    for (int64_t j = 0; j < n; ++j) {
+      const int64_t i = first + j;
+      if (cell[i] < 0) continue;
+      const double t = span > 0 ? (v[j] - l.minimum) / span : 0.5;
+      LayerOf(layers, layer, i)->intensity.ptr<float>()[cell[i]] =
+          std::isfinite(t) ? static_cast<float>(std::clamp(t, 0.0, 1.0)) : 0.5f;
+    }
+  });
 }
 
 // Colours of the placed records, scaled to 0..255 by colorLimits (0..255 when absent). Needs all three of
@@ -753,14 +875,35 @@ void ReadColor(const Context& ctx, pugi::xml_node child, const PointRecords& rec
     Limits l = LimitsFrom(ctx, limits, min_names[ch], max_names[ch], channel_fields[ch]);
     if (!l.known) l = {0.0, 255.0, true};
     const double span = l.maximum - l.minimum;
-    const auto& v = records.Decode(channel_fields[ch]);
-    for (int64_t i = 0; i < records.count; ++i) {
-      if (grid.cell[i] < 0) continue;
-      const double t = span > 0 ? (v[i] - l.minimum) / span : 0.0;
-      layers[layer[i]]->color.ptr<uint8_t>()[3 * grid.cell[i] + ch] =
-          std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
-    }
+    records.ForEachBlock(channel_fields[ch], [&](int64_t first, int64_t n, const double* v) {
+      for (int64_t j = 0; j < n; ++j) {
+        const int64_t i = first + j;
+        if (grid.cell[i] < 0) continue;
+        const double t = span > 0 ? (v[j] - l.minimum) / span : 0.0;
+        LayerOf(layers, layer, i)->color.ptr<uint8_t>()[3 * int64_t{grid.cell[i]} + ch] =
+            std::isfinite(t) ? static_cast<uint8_t>(std::lround(std::clamp(t, 0.0, 1.0) * 255.0)) : 0;
+      }
+    });
   }
+}
+
+// An 8-bit flag channel of both layers (`channel` picks it), 0 everywhere, then `value(v)` of each placed
+// record's value of `field` where it is not 0: lidarshop's synthesized and fromStation extension fields.
+template <typename Value>
+void ReadFlagField(const PointRecords& records, const Field* field, const RecordGrid& grid,
+                   const std::vector<uint8_t>& layer, Scan* const layers[2], cv::Mat Scan::*channel,
+                   Value&& value) {
+  for (int l = 0; l < 2; ++l) {
+    Scan* s = layers[l];
+    if (s != nullptr && s->num_cells() > 0) s->*channel = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
+  }
+  records.ForEachBlock(field, [&](int64_t first, int64_t n, const double* v) {
+    for (int64_t j = 0; j < n; ++j) {
+      const int64_t i = first + j;
+      const uint8_t flag = grid.cell[i] >= 0 ? value(v[j]) : 0;
+      if (flag != 0) (LayerOf(layers, layer, i)->*channel).ptr<uint8_t>()[grid.cell[i]] = flag;
+    }
+  });
 }
 
 // lidarshop's extension field (`synthesized_field`, "" when the file does not declare the namespace) into
@@ -769,14 +912,8 @@ void ReadSynthesized(const PointRecords& records, const std::string& synthesized
                      const RecordGrid& grid, const std::vector<uint8_t>& layer, Scan* const layers[2]) {
   const Field* flag = synthesized_field.empty() ? nullptr : records.Find(synthesized_field.c_str());
   if (!flag) return;
-  const auto& v = records.Decode(flag);
-  for (int l = 0; l < 2; ++l) {
-    Scan* s = layers[l];
-    if (s != nullptr && s->num_cells() > 0) s->synthesized = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
-  }
-  for (int64_t i = 0; i < records.count; ++i) {
-    if (grid.cell[i] >= 0 && v[i] != 0.0) layers[layer[i]]->synthesized.ptr<uint8_t>()[grid.cell[i]] = kValid;
-  }
+  ReadFlagField(records, flag, grid, layer, layers, &Scan::synthesized,
+                [](double v) { return v != 0.0 ? kValid : uint8_t{0}; });
 }
 
 // lidarshop's `fromStation` extension field ("" when the file does not declare the namespace) into the layers'
@@ -785,16 +922,9 @@ void ReadFromStation(const PointRecords& records, const std::string& field_name,
                      const std::vector<uint8_t>& layer, Scan* const layers[2]) {
   const Field* field = field_name.empty() ? nullptr : records.Find(field_name.c_str());
   if (!field) return;
-  const auto& v = records.Decode(field);
-  for (int l = 0; l < 2; ++l) {
-    Scan* s = layers[l];
-    if (s != nullptr && s->num_cells() > 0) s->from_station = cv::Mat(s->rows, s->cols, CV_8U, cv::Scalar(0));
-  }
-  for (int64_t i = 0; i < records.count; ++i) {
-    if (grid.cell[i] >= 0 && std::isfinite(v[i]) && v[i] > 0.0)
-      layers[layer[i]]->from_station.ptr<uint8_t>()[grid.cell[i]] =
-          static_cast<uint8_t>(std::min(v[i], 255.0));
-  }
+  ReadFlagField(records, field, grid, layer, layers, &Scan::from_station, [](double v) {
+    return std::isfinite(v) && v > 0.0 ? static_cast<uint8_t>(std::min(v, 255.0)) : uint8_t{0};
+  });
 }
 
 // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turns the
@@ -817,13 +947,15 @@ void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* 
     cv::flip(d, d, code);
   }
   if (scan->CountValid() > 0) {
-    const cv::Mat stored = scan->direction.clone();
-    FitGrid(scan);
-    const cv::Vec3f* from = stored.ptr<cv::Vec3f>();
-    cv::Vec3f* to = scan->direction.ptr<cv::Vec3f>();
+    // Only the stored rays of no-return cells are kept aside, not a copy of every direction.
+    std::vector<std::pair<int64_t, cv::Vec3f>> stored;
+    const cv::Vec3f* from = scan->direction.ptr<cv::Vec3f>();
     for (int64_t c = 0; c < scan->num_cells(); ++c) {
-      if (has_direction[c] == 2) to[c] = from[c];
+      if (has_direction[c] == 2) stored.emplace_back(c, from[c]);
     }
+    FitGrid(scan);
+    cv::Vec3f* to = scan->direction.ptr<cv::Vec3f>();
+    for (const auto& [c, direction] : stored) to[c] = direction;
   }
   if (second->num_cells() > 0) {
     second->direction = scan->direction.clone();  // the same rays
@@ -856,51 +988,59 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
     const pugi::xml_node value = child.child(element).child("dateTimeValue");
     if (value) scan.source_metadata[key] = fmt::format("{}", NumberValue(ctx, value, 0.0));
   }
-  std::vector<uint8_t> state = ReadInvalidState(records);
-  const std::vector<float> xyz = ReadCoordinates(records, &state);
-  const std::vector<uint8_t> layer = ReadReturnLayers(records);
-  PlacedRecords placed = PlaceRecords(ctx, records, xyz, state, layer, &grid, &scan, second);
-  ReadNoReturnDirections(
-      ctx, child, extension_prefix.empty() ? "" : extension_prefix + ":" + kNoReturnDirectionsLocalName, grid,
-      &scan, &placed.has_direction);
-  if (placed.duplicates > 0) {
-    warnings->push_back(fmt::format(
-        "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
-        ctx.path, index, scan.name, placed.duplicates));
+  PlacedRecords placed;
+  {
+    // The per-record arrays (each record's cell and layer) end here, before the grid is fitted.
+    const std::vector<uint8_t> layer = ReadReturnLayers(records);
+    placed = PlaceRecords(ctx, records, layer, &grid, &scan, second);
+    ReadNoReturnDirections(
+        ctx, child, extension_prefix.empty() ? "" : extension_prefix + ":" + kNoReturnDirectionsLocalName,
+        grid, &scan, &placed.has_direction);
+    if (placed.duplicates > 0) {
+      warnings->push_back(fmt::format(
+          "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
+          ctx.path, index, scan.name, placed.duplicates));
+    }
+    if (placed.later_returns > 0) {
+      warnings->push_back(
+          fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
+                      "returns) are not kept",
+                      ctx.path, index, scan.name, placed.later_returns));
+    }
+    Scan* const layers[2] = {&scan, second};
+    ReadIntensity(ctx, child, records, grid, layer, layers);
+    ReadColor(ctx, child, records, grid, layer, layers);
+    ReadSynthesized(records, synthesized_field, grid, layer, layers);
+    ReadFromStation(records, extension_prefix.empty() ? "" : extension_prefix + ":" + kFromStationLocalName,
+                    grid, layer, layers);
+    std::vector<int32_t>().swap(grid.cell);
   }
-  if (placed.later_returns > 0) {
-    warnings->push_back(
-        fmt::format("{}: scan {} ('{}'): {} records with returnIndex >= 2 (third and later "
-                    "returns) are not kept",
-                    ctx.path, index, scan.name, placed.later_returns));
-  }
-  Scan* const layers[2] = {&scan, second};
-  ReadIntensity(ctx, child, records, grid, layer, layers);
-  ReadColor(ctx, child, records, grid, layer, layers);
-  ReadSynthesized(records, synthesized_field, grid, layer, layers);
-  ReadFromStation(records, extension_prefix.empty() ? "" : extension_prefix + ":" + kFromStationLocalName,
-                  grid, layer, layers);
   if (records.structured && scan.num_cells() > 0)
     OrientStructuredScan(std::move(placed.has_direction), &scan, second);
   return scan;
 }
 
-// The bytes of a Blob element.
-std::pair<const uint8_t*, size_t> BlobBytes(const Context& ctx, pugi::xml_node blob) {
+// A Blob element: its bytes and where they start in the logical file (the key of ImageCache).
+struct Blob {
+  std::vector<uint8_t> bytes;
+  uint64_t start = 0;
+};
+
+Blob BlobBytes(const Context& ctx, pugi::xml_node blob) {
   const uint64_t phys = OffsetAttribute(ctx, blob, "fileOffset");
   const uint64_t length = OffsetAttribute(ctx, blob, "length");
   const uint64_t start = LogicalOffset(ctx, blob, phys);
-  const auto& L = ctx.logical;
+  const LogicalBytes& L = ctx.logical;
   if (start + 16 > L.size()) XmlError(ctx, blob, "blob section header is truncated");
-  if (L[start] != 0)
-    XmlError(ctx, blob, fmt::format("sectionId {} is not a blob section (expected 0)", int{L[start]}));
-  const uint64_t section_length = LoadLe<uint64_t>(&L[start + 8]);
+  if (const uint8_t section_id = L.Load<uint8_t>(start); section_id != 0)
+    XmlError(ctx, blob, fmt::format("sectionId {} is not a blob section (expected 0)", int{section_id}));
+  const uint64_t section_length = L.Load<uint64_t>(start + 8);
   if (section_length < 16 || section_length > L.size() - start || length > section_length - 16) {
     XmlError(ctx, blob,
              fmt::format("blob of {} bytes does not fit its section of {} bytes in the file", length,
                          section_length));
   }
-  return {L.data() + start + 16, static_cast<size_t>(length)};
+  return {L.Bytes(start + 16, length), start + 16};
 }
 
 // The photos read so far: a blob listed by several images2D entries is decoded once (the entries share the
@@ -911,7 +1051,7 @@ struct ImageCache {
     cv::Mat image;
     std::string error;
   };
-  std::map<std::pair<const uint8_t*, size_t>, Decoded> decoded;  // by the blob's bytes
+  std::map<std::pair<uint64_t, size_t>, Decoded> decoded;  // by the blob's place in the file and size
   int64_t bytes = 0;
 };
 
@@ -954,19 +1094,21 @@ void ReadImage(const Context& ctx, pugi::xml_node child, const std::vector<std::
       image.radius_m = NumberValue(ctx, rep.child("radius"), 0.0);
     }
     if (const pugi::xml_node mask = rep.child("imageMask")) {
-      const auto [mask_bytes, mask_size] = BlobBytes(ctx, mask);
-      cache->bytes += static_cast<int64_t>(mask_size);
+      // Checked against the file first; its bytes (at most the file's) are counted before they are kept.
+      image.mask_encoded = BlobBytes(ctx, mask).bytes;
+      cache->bytes += static_cast<int64_t>(image.mask_encoded.size());
       CheckMemoryBudget(cache->bytes, fmt::format("{}: {}: the images2D blobs", ctx.path, ElementPath(mask)));
-      image.mask_encoded.assign(mask_bytes, mask_bytes + mask_size);
     }
     image.width_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageWidth"), 0, 0, 1 << 30));
     image.height_px = static_cast<int>(BoundedInteger(ctx, rep.child("imageHeight"), 0, 0, 1 << 30));
-    const auto [bytes, size] = BlobBytes(ctx, blob);
-    cache->bytes += static_cast<int64_t>(size);  // at most the file's size per entry
+    Blob encoded = BlobBytes(ctx, blob);
+    image.encoded = std::move(encoded.bytes);
+    cache->bytes += static_cast<int64_t>(image.encoded.size());  // at most the file's size per entry
     CheckMemoryBudget(cache->bytes, fmt::format("{}: {}: the images2D blobs", ctx.path, ElementPath(blob)));
-    image.encoded.assign(bytes, bytes + size);
     image.encoding = std::string(blob.name()) == "jpegImage" ? "jpeg" : "png";
-    const auto key = std::make_pair(bytes, size);
+    const uint8_t* bytes = image.encoded.data();
+    const size_t size = image.encoded.size();
+    const auto key = std::make_pair(encoded.start, size);
     const auto found = cache->decoded.find(key);
     if (found != cache->decoded.end()) {
       image.image = found->second.image;
@@ -996,8 +1138,8 @@ void ReadImage(const Context& ctx, pugi::xml_node child, const std::vector<std::
 
 }  // namespace
 
-E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical) {
-  const Header header = ParseHeader(path, logical);
+E57File ReadLogical(const std::string& path, const LogicalBytes& logical) {
+  const Header header = ParseHeader(path, logical.Bytes(0, std::min<uint64_t>(logical.size(), kHeaderSize)));
   const Context ctx{path, logical};
   const uint64_t physical_size = logical.size() / kPagePayload * kPageSize;
   if (header.file_physical_length != physical_size) {
@@ -1014,10 +1156,11 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
                     fmt::format("XML section ({} bytes at {}) runs past the end of the file",
                                 header.xml_logical_length, header.xml_physical_offset));
   }
-  CheckXmlUtf8(path, reinterpret_cast<const char*>(logical.data() + xml_start), header.xml_logical_length);
+  const std::vector<uint8_t> xml = logical.Bytes(xml_start, header.xml_logical_length);
+  CheckXmlUtf8(path, reinterpret_cast<const char*>(xml.data()), xml.size());
   pugi::xml_document doc;
-  const pugi::xml_parse_result parsed = doc.load_buffer(logical.data() + xml_start, header.xml_logical_length,
-                                                        pugi::parse_default, pugi::encoding_utf8);
+  const pugi::xml_parse_result parsed =
+      doc.load_buffer(xml.data(), xml.size(), pugi::parse_default, pugi::encoding_utf8);
   if (!parsed) {
     ThrowInputError(path, fmt::format("XML section, byte {} of {}", parsed.offset, header.xml_logical_length),
                     "", fmt::format("malformed XML: {}", parsed.description()));
@@ -1069,12 +1212,12 @@ E57File ReadLogical(const std::string& path, const std::vector<uint8_t>& logical
 }  // namespace e57
 
 E57File ReadE57Bytes(const std::vector<uint8_t>& file_bytes, const std::string& name) {
-  return e57::ReadLogical(name, e57::LogicalFromPages(name, file_bytes));
+  return e57::ReadLogical(name, e57::LogicalBytes(e57::LogicalFromPages(name, file_bytes)));
 }
 
 E57File ReadE57(const std::string& path) {
   CheckRegularFile(path);
-  E57File file = e57::ReadLogical(path, e57::LogicalFromPageFile(path));
+  E57File file = e57::ReadLogical(path, e57::LogicalBytes::OpenFile(path));
   // The same number checks as ReadScanFile: `info` and `images` read E57 files here directly.
   for (size_t i = 0; i < file.scans.size(); ++i) {
     io_internal::CheckScanNumbers(file.scans[i], path, fmt::format("scan {}", i));

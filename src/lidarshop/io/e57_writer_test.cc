@@ -314,6 +314,43 @@ TEST(E57Writer, AWholeFileKeepsSecondReturnsAndTheirFlags) {
             second.CountValid());
 }
 
+TEST(E57Reader, RecordsOverSeveralDecodingBlocksComeBackExactly) {
+  // The reader decodes 65,536 records at a time: 137,557 cells of 9-bit row and column indices (blocks that
+  // start inside the packets' chunks), with second returns on every 5th row, must come back cell for cell.
+  const Scan front = SyntheticScan(301, 457, 12, true);
+  Scan second = MakeScan(front.rows, front.cols, true);
+  second.world_from_scanner = front.world_from_scanner;
+  second.name = front.name;
+  second.direction = front.direction.clone();
+  for (int r = 0; r < front.rows; r += 5) {
+    for (int c = 0; c < front.cols; ++c) {
+      if (!front.valid.at<uint8_t>(r, c)) continue;
+      const cv::Vec3f p = front.point.at<cv::Vec3f>(r, c) * 1.25f;
+      second.valid.at<uint8_t>(r, c) = kValid;
+      second.point.at<cv::Vec3f>(r, c) = p;
+      second.range.at<float>(r, c) = static_cast<float>(cv::norm(p));
+      second.intensity.at<float>(r, c) = 0.25f;
+      second.color.at<cv::Vec3b>(r, c) = cv::Vec3b(r & 255, c & 255, 9);
+    }
+  }
+  ASSERT_GT(front.num_cells() + second.CountValid(), 2 * 65536);
+  E57File file;
+  file.scans = {front};
+  file.second_returns = {second};
+  const E57File back = ReadE57Bytes(EncodeE57(file, {}), "blocks.e57");
+  ASSERT_EQ(back.scans.size(), 1u);
+  ExpectSameScan(front, back.scans[0], 0.0);
+  ASSERT_EQ(back.second_returns.size(), 1u);
+  const Scan& layer = back.second_returns[0];
+  ASSERT_EQ(layer.CountValid(), second.CountValid());
+  for (int64_t c = 0; c < second.num_cells(); ++c) {
+    if (!second.valid.ptr<uint8_t>()[c]) continue;
+    ASSERT_EQ(layer.point.ptr<cv::Vec3f>()[c], second.point.ptr<cv::Vec3f>()[c]) << "cell " << c;
+    ASSERT_EQ(layer.intensity.ptr<float>()[c], 0.25f) << "cell " << c;
+    ASSERT_EQ(layer.color.ptr<cv::Vec3b>()[c], second.color.ptr<cv::Vec3b>()[c]) << "cell " << c;
+  }
+}
+
 TEST(E57Reader, TurnsBottomUpAndMirroredGridsIntoImageOrientation) {
   // A file whose rowIndex 0 is the bottom row (like pumpA) and whose columns run against our azimuth.
   const Scan scan = SyntheticScan(30, 50, 11, true);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -144,8 +145,13 @@ void LasWriteOptions::Check() const { Validate(*this); }
 
 std::string LazNotWrittenMessage() { return std::string(FindScanFormat("laz")->write_refusal); }
 
-std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,
-                      const std::string& file) {
+namespace {
+
+// Writes the LAS file of `scans` to `sink` as it is made: the header and records first, a chunk of records at a
+// time, then the header again with the counts and bounds the records gave (the sink must seek). Holds the
+// header and one chunk, not the file: a station's LAS is gigabytes.
+void EncodeLasTo(const std::vector<Scan>& scans, const LasWriteOptions& options, const std::string& file,
+                 std::ostream& sink) {
   options.Check();
   const int format = ChooseLasPointFormat(scans, options);
   const int base_record = las::PointRecordSize(format);
@@ -175,17 +181,16 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
     count += scan.CountValid();
   }
   if (count == 0) ThrowInputError(file, "", "", "no point with a return to write");
-  std::vector<Eigen::Vector3d> world;
-  world.reserve(static_cast<size_t>(count));
+  // The world points are computed again where the records are written rather than held (24 bytes a point).
   Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d high = -low;
   for (const Scan& scan : scans) {
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
-        world.push_back(WorldPointOfCell(scan, row, col));
-        low = low.cwiseMin(world.back());
-        high = high.cwiseMax(world.back());
+        const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
+        low = low.cwiseMin(p);
+        high = high.cwiseMax(p);
       }
     }
   }
@@ -235,7 +240,8 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
   for (const SourceRecord& r : records)
     records_size += las::kVlrHeaderSize + static_cast<int64_t>(r.payload.size());
   const int64_t offset_to_points = header_size + records_size;
-  std::string bytes(static_cast<size_t>(offset_to_points) + static_cast<size_t>(count) * record, '\0');
+  std::string bytes(static_cast<size_t>(offset_to_points),
+                    '\0');  // the header and the records before the points
   char* h = bytes.data();
   std::memcpy(h + las::header::kSignature, "LASF", 4);
   const std::string source_encoding = Common(scans, "las.global_encoding");
@@ -288,8 +294,15 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
   uint64_t by_return[15] = {};
   Eigen::Vector3d stored_low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d stored_high = -stored_low;
-  char* out = bytes.data() + offset_to_points;
-  size_t index = 0;
+  sink.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));  // rewritten below
+  constexpr int64_t kRecordsPerChunk = int64_t{1} << 16;
+  std::string chunk(static_cast<size_t>(std::min(count, kRecordsPerChunk) * record), '\0');
+  char* out = chunk.data();
+  auto flush = [&] {
+    sink.write(chunk.data(), out - chunk.data());
+    std::fill(chunk.begin(), chunk.end(), '\0');
+    out = chunk.data();
+  };
   for (size_t k = 0; k < scans.size(); ++k) {
     const Scan& scan = scans[k];
     const bool from_las = FromLas(scan);
@@ -302,7 +315,8 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
     for (int row = 0; row < scan.rows; ++row) {
       for (int col = 0; col < scan.cols; ++col) {
         if (!scan.valid.at<uint8_t>(row, col)) continue;
-        const Eigen::Vector3d& p = world[index++];
+        if (out == chunk.data() + chunk.size()) flush();
+        const Eigen::Vector3d p = WorldPointOfCell(scan, row, col);
         for (int axis = 0; axis < 3; ++axis) {
           const double steps = std::round((p[axis] - offset[axis]) / scale[axis]);
           las::Store<int32_t>(out + las::point::kX + 4 * axis, static_cast<int32_t>(steps));
@@ -391,7 +405,18 @@ std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& opt
     las::Store<double>(h + las::header::kMaxX + 16 * axis, stored_high[axis]);
     las::Store<double>(h + las::header::kMaxX + 16 * axis + 8, stored_low[axis]);
   }
-  return bytes;
+  flush();
+  sink.seekp(0);
+  sink.write(bytes.data(), static_cast<std::streamsize>(header_size));
+}
+
+}  // namespace
+
+std::string EncodeLas(const std::vector<Scan>& scans, const LasWriteOptions& options,
+                      const std::string& file) {
+  std::stringstream bytes;
+  EncodeLasTo(scans, options, file, bytes);
+  return std::move(bytes).str();
 }
 
 void WriteLas(const std::string& path, const std::vector<Scan>& scans, const LasWriteOptions& options) {
@@ -399,8 +424,7 @@ void WriteLas(const std::string& path, const std::vector<Scan>& scans, const Las
     ThrowInputError(path, "", "",
                     fmt::format("{} scans: a LAS point source ID holds at most 65535", scans.size()));
   }
-  const std::string bytes = EncodeLas(scans, options, path);
-  WriteFileAtomically(path, [&](std::ostream& stream) { stream.write(bytes.data(), bytes.size()); });
+  WriteFileAtomically(path, [&](std::ostream& stream) { EncodeLasTo(scans, options, path, stream); });
 }
 
 }  // namespace lidarshop

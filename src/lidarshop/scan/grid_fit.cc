@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/scan/scan_channels.h"
 #include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
@@ -136,34 +137,40 @@ std::vector<double> FitAxis(std::vector<double> medians, const std::vector<int>&
 void FitGrid(Scan* scan) {
   CheckScan(*scan);
   const int rows = scan->rows, cols = scan->cols;
-  std::vector<std::vector<double>> column_azimuths(cols), row_elevations(rows);
-  {
-    // The angles row by row in parallel (a big station has tens of millions of points), then gathered per
-    // column in row order: the samples, and so every value below, are those of a serial pass.
-    std::vector<std::vector<std::pair<int, double>>> row_azimuths(rows);
-    ParallelFor(rows, [&](int64_t r) {
-      const int row = static_cast<int>(r);
+  // What the fit holds beside the scan is one azimuth per return (8 bytes; a station has tens of millions):
+  // rows are read in bands, in parallel, their elevation medians taken at once and their azimuths appended
+  // to the columns in row order, so the samples, and every value below, are those of a serial pass.
+  std::vector<std::vector<double>> column_azimuths(cols);
+  std::vector<double> azimuth_medians(cols, kNaN), elevation_medians(rows, kNaN);
+  std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
+  constexpr int kBandRows = 256;
+  std::vector<std::vector<std::pair<int, double>>> row_azimuths(kBandRows);
+  for (int band = 0; band < rows; band += kBandRows) {
+    const int band_rows = std::min(kBandRows, rows - band);
+    ParallelFor(band_rows, [&](int64_t r) {
+      const int row = band + static_cast<int>(r);
       const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
       const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+      std::vector<double> elevations;
       for (int col = 0; col < cols; ++col) {
         if (!valid[col]) continue;
         const double x = point[col][0], y = point[col][1], z = point[col][2];
         const double horizontal = std::hypot(x, y);
         if (horizontal == 0 && z == 0) continue;
-        row_elevations[row].push_back(std::atan2(z, horizontal));
+        elevations.push_back(std::atan2(z, horizontal));
         if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
-          row_azimuths[row].push_back({col, std::atan2(x, y)});
+          row_azimuths[r].push_back({col, std::atan2(x, y)});
         }
       }
+      elevation_counts[row] = static_cast<int>(elevations.size());
+      elevation_medians[row] = Median(&elevations);
     });
-    for (int row = 0; row < rows; ++row) {
-      for (const auto& [col, azimuth] : row_azimuths[row]) column_azimuths[col].push_back(azimuth);
-      std::vector<std::pair<int, double>>().swap(row_azimuths[row]);
+    for (int r = 0; r < band_rows; ++r) {
+      for (const auto& [col, azimuth] : row_azimuths[r]) column_azimuths[col].push_back(azimuth);
+      row_azimuths[r].clear();
     }
   }
 
-  std::vector<double> azimuth_medians(cols, kNaN), elevation_medians(rows, kNaN);
-  std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
   ParallelFor(cols, [&](int64_t c) {  // columns are independent
     const int col = static_cast<int>(c);
     std::vector<double>& samples = column_azimuths[col];
@@ -177,6 +184,7 @@ void FitGrid(Scan* scan) {
     const double reference = std::atan2(sum_sin, sum_cos);
     for (double& angle : samples) angle = WrapAngle(angle - reference);
     azimuth_medians[col] = reference + Median(&samples);
+    std::vector<double>().swap(samples);
   });
   // Unwrap across columns so that a scan crossing θ = ±π stays continuous.
   int previous = -1;
@@ -188,10 +196,6 @@ void FitGrid(Scan* scan) {
     }
     previous = col;
   }
-  ParallelFor(rows, [&](int64_t row) {
-    elevation_counts[row] = static_cast<int>(row_elevations[row].size());
-    elevation_medians[row] = Median(&row_elevations[row]);
-  });
 
   double azimuth_step = MedianStep(azimuth_medians);
   double elevation_step = MedianStep(elevation_medians);
@@ -204,7 +208,7 @@ void FitGrid(Scan* scan) {
   grid.elevation_rad = FitAxis(elevation_medians, elevation_counts, elevation_step);
   if (grid.azimuth_rad.empty() || grid.elevation_rad.empty()) return;  // no usable return: nothing to fit
   grid.fitted = true;
-  scan->direction = DirectionsFromGrid(grid);
+  scan_internal::FillDirectionsFromGrid(grid, &scan->direction);  // in place: no second direction image
 
   // The residual angles row by row in parallel, summed in cell order (the same sum as a serial pass).
   std::vector<std::vector<double>> row_residuals(rows);

@@ -9,6 +9,7 @@
 #include "lidarshop/scan/rgbd_cell.h"
 #include "lidarshop/scan/scan_channels.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
 
@@ -228,17 +229,32 @@ ScanGrid UniformGrid(int rows, int cols, double azimuth_min_rad, double azimuth_
   return grid;
 }
 
-cv::Mat DirectionsFromGrid(const ScanGrid& grid) {
+void scan_internal::FillDirectionsFromGrid(const ScanGrid& grid, cv::Mat* directions) {
   const int rows = static_cast<int>(grid.elevation_rad.size());
   const int cols = static_cast<int>(grid.azimuth_rad.size());
-  cv::Mat directions(rows, cols, CV_32FC3);
-  for (int row = 0; row < rows; ++row) {
-    auto* out = directions.ptr<cv::Vec3f>(row);
-    for (int col = 0; col < cols; ++col) {
-      const Eigen::Vector3f direction = DirectionFromAngles(grid.azimuth_rad[col], grid.elevation_rad[row]);
-      out[col] = cv::Vec3f(direction.x(), direction.y(), direction.z());
-    }
+  directions->create(rows, cols, CV_32FC3);
+  // DirectionFromAngles' products from tables of the angles' sines and cosines: the same doubles, so the
+  // same floats, without four trigonometric calls a cell.
+  std::vector<double> sin_azimuth(cols), cos_azimuth(cols);
+  for (int col = 0; col < cols; ++col) {
+    sin_azimuth[col] = std::sin(grid.azimuth_rad[col]);
+    cos_azimuth[col] = std::cos(grid.azimuth_rad[col]);
   }
+  ParallelFor(rows, [&](int64_t r) {
+    const int row = static_cast<int>(r);
+    const double cos_elevation = std::cos(grid.elevation_rad[row]);
+    const float sin_elevation = static_cast<float>(std::sin(grid.elevation_rad[row]));
+    auto* out = directions->ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      out[col] = cv::Vec3f(static_cast<float>(cos_elevation * sin_azimuth[col]),
+                           static_cast<float>(cos_elevation * cos_azimuth[col]), sin_elevation);
+    }
+  });
+}
+
+cv::Mat DirectionsFromGrid(const ScanGrid& grid) {
+  cv::Mat directions;
+  scan_internal::FillDirectionsFromGrid(grid, &directions);
   return directions;
 }
 

@@ -12,6 +12,10 @@
 
 namespace lidarshop::scan_internal {
 
+// DirectionsFromGrid written into `directions`, reusing its buffer when it has the grid's size and type
+// (FitGrid replaces a station's directions without a second direction image).
+void FillDirectionsFromGrid(const ScanGrid& grid, cv::Mat* directions);
+
 // Visits every per-cell channel of `scan` with its no-return value (MaskScan's).
 template <typename ScanT, typename Visit>
 void ForEachChannel(ScanT& scan, Visit visit) {
