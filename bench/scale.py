@@ -155,7 +155,11 @@ def main():
     parser.add_argument("--sizes", default="1,4,16", help="millions of rays, comma-separated (default 1,4,16)")
     parser.add_argument("--work", default="/tmp/lidarshop_scale", help="working folder (large files)")
     parser.add_argument("--markdown", help="also write the tables to this file")
+    parser.add_argument("--binary", default=str(CLI),
+                        help="the lidarshop executable to measure (default build/release/lidarshop)")
     args = parser.parse_args()
+    global CLI
+    CLI = pathlib.Path(args.binary)
     if not CLI.exists():
         sys.exit(f"{CLI} not found: build it first (bash scripts/build.sh)")
     work = pathlib.Path(args.work)

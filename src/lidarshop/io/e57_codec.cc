@@ -119,6 +119,18 @@ void BitWriter::PutRaw(uint64_t value, int bits) {
   }
 }
 
+void BitWriter::FlushPartialByte() {
+  if (pending_ > 0) bytes_.push_back(static_cast<uint8_t>(accumulator_ & 0xFF));
+  accumulator_ = 0;
+  pending_ = 0;
+}
+
+void BitWriter::TakeFront(size_t n, uint8_t* out) {
+  LIDARSHOP_CHECK(n <= bytes_.size());
+  std::memcpy(out, bytes_.data(), n);
+  bytes_.erase(bytes_.begin(), bytes_.begin() + static_cast<std::ptrdiff_t>(n));
+}
+
 std::vector<uint8_t> BitWriter::Finish() {
   if (pending_ > 0) bytes_.push_back(static_cast<uint8_t>(accumulator_ & 0xFF));
   accumulator_ = 0;

@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -49,6 +50,7 @@ extern int64_t g_max_cells;
 // else Crc32cPortable (slicing-by-8); the same value either way (e57_writer_test).
 uint32_t Crc32c(const uint8_t* data, size_t size);
 uint32_t Crc32cPortable(const uint8_t* data, size_t size);
+uint32_t Crc32cPortableFrom(uint32_t previous, const uint8_t* data, size_t size);
 
 // Checks one physical page's stored CRC against its payload; throws InputError naming `path`, the page index
 // and its byte offset on a mismatch.
@@ -179,6 +181,11 @@ class BitWriter {
   void PutDouble(double value) { PutRaw(BitsOf(value), 64); }
   // The stream, flushed to whole bytes.
   std::vector<uint8_t> Finish();
+  // Streaming use: the whole bytes packed and not yet taken, the last partial byte flushed (once all values
+  // are put), and the first `n` of them moved to `out`.
+  size_t available() const { return bytes_.size(); }
+  void FlushPartialByte();
+  void TakeFront(size_t n, uint8_t* out);
 
  private:
   template <typename F>
@@ -213,6 +220,57 @@ Field IntegerField(const char* name, int64_t minimum, int64_t maximum);
 // packets of at most 64 KiB, no index packets) and returns its physical offset.
 uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
                                 std::vector<uint8_t>* logical);
+
+// The logical bytes of a file being written, kept in memory or written to a stream as pages with their CRCs
+// as soon as each page is full (page 0, which holds the header, is written last). Keeps the CRC of every byte
+// and the last 4096 bytes, which the writer's guids are made of.
+class LogicalSink {
+ public:
+  explicit LogicalSink(std::vector<uint8_t>* memory) : memory_(memory) {
+    for (uint8_t b : *memory) Keep(&b, 1);
+  }
+  // Page 0 is written as zeros first and again at Finish.
+  explicit LogicalSink(std::ostream* pages) : pages_(pages) {
+    const char zeros[kPageSize] = {};
+    pages_->write(zeros, kPageSize);
+  }
+  uint64_t size() const { return size_; }
+  void Append(const uint8_t* data, size_t n);
+  void AppendZeros(size_t n);
+  void AlignTo8() { AppendZeros((8 - size_ % 8) % 8); }
+  uint32_t crc() const { return crc_; }  // Crc32c of every byte appended
+  // Crc32c of the last min(n, size()) bytes; n <= 4096.
+  uint32_t TailCrc(size_t n) const;
+  // Overwrites the first 48 bytes (the file header; written with page 0 at Finish).
+  void StoreFileHeader(const Header& header);
+  // Writes what is left: the last page (zero-padded) and page 0.
+  void Finish();
+
+ private:
+  void Keep(const uint8_t* data, size_t n);  // the CRC and the tail
+  void WritePage(uint64_t index, const uint8_t* payload, size_t n);
+  std::vector<uint8_t>* memory_ = nullptr;
+  std::ostream* pages_ = nullptr;
+  uint64_t size_ = 0;
+  uint32_t crc_ = 0;
+  std::vector<uint8_t> tail_ = std::vector<uint8_t>(4096);  // a ring of the last bytes
+  std::vector<uint8_t> first_page_;                         // page 0's payload (pages_ only)
+  std::vector<uint8_t> page_;                               // the page being filled (pages_ only)
+};
+
+// Crc32c of `data` following bytes whose Crc32c was `crc` (0 for none).
+uint32_t Crc32cExtend(uint32_t crc, const uint8_t* data, size_t size);
+
+// A bytestream made as the packets take it: `put(first, count, writer)` packs the values of records [first,
+// first + count), called in record order. Holds one packet's worth of bytes, not the stream.
+struct StreamSource {
+  Field field;
+  std::function<void(int64_t first, int64_t count, BitWriter* writer)> put;
+};
+
+// AppendCompressedVector of streams made as they are written (a station's streams are hundreds of MB).
+uint64_t AppendCompressedVector(const std::vector<StreamSource>& sources, int64_t record_count,
+                                LogicalSink* sink);
 
 // A data3D entry's metadata that ReadE57 keeps in Scan::source_metadata and the writers write back, so that
 // E57 -> edit -> E57 keeps the scan's identity and date: {E57 element, source_metadata key}. The times are

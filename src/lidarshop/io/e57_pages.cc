@@ -54,8 +54,9 @@ namespace {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 // SSE 4.2's CRC32 instruction computes CRC-32C itself (the same polynomial, reflected): 8 bytes an instruction,
 // several times the tables' speed on the hundreds of MB of a big station's pages.
-__attribute__((target("sse4.2"))) uint32_t Crc32cHardware(const uint8_t* data, size_t size) {
-  uint64_t crc = 0xFFFFFFFFu;
+__attribute__((target("sse4.2"))) uint32_t Crc32cHardware(const uint8_t* data, size_t size,
+                                                          uint32_t previous = 0) {
+  uint64_t crc = previous ^ 0xFFFFFFFFu;
   while (size >= 8) {
     uint64_t word;
     std::memcpy(&word, data, 8);
@@ -72,15 +73,17 @@ bool HasCrc32Instruction() {
   return has;
 }
 #else
-uint32_t Crc32cHardware(const uint8_t*, size_t) { return 0; }
+uint32_t Crc32cHardware(const uint8_t*, size_t, uint32_t = 0) { return 0; }
 bool HasCrc32Instruction() { return false; }
 #endif
 
 }  // namespace
 
-uint32_t Crc32cPortable(const uint8_t* data, size_t size) {
+uint32_t Crc32cPortable(const uint8_t* data, size_t size) { return Crc32cPortableFrom(0, data, size); }
+
+uint32_t Crc32cPortableFrom(uint32_t previous, const uint8_t* data, size_t size) {
   const auto& t = Tables().t;
-  uint32_t crc = 0xFFFFFFFFu;
+  uint32_t crc = previous ^ 0xFFFFFFFFu;
   while (size >= 8) {
     const uint32_t lo = LoadLe<uint32_t>(data) ^ crc;
     const uint32_t hi = LoadLe<uint32_t>(data + 4);
@@ -93,8 +96,80 @@ uint32_t Crc32cPortable(const uint8_t* data, size_t size) {
   return crc ^ 0xFFFFFFFFu;
 }
 
-uint32_t Crc32c(const uint8_t* data, size_t size) {
-  return HasCrc32Instruction() ? Crc32cHardware(data, size) : Crc32cPortable(data, size);
+uint32_t Crc32c(const uint8_t* data, size_t size) { return Crc32cExtend(0, data, size); }
+
+uint32_t Crc32cExtend(uint32_t crc, const uint8_t* data, size_t size) {
+  return HasCrc32Instruction() ? Crc32cHardware(data, size, crc) : Crc32cPortableFrom(crc, data, size);
+}
+
+void LogicalSink::Keep(const uint8_t* data, size_t n) {
+  crc_ = Crc32cExtend(crc_, data, n);
+  const size_t ring = tail_.size();
+  const size_t skip = n > ring ? n - ring : 0;
+  for (size_t i = skip; i < n; ++i) tail_[(size_ + i) % ring] = data[i];
+  size_ += n;
+}
+
+uint32_t LogicalSink::TailCrc(size_t n) const {
+  LIDARSHOP_CHECK(n <= tail_.size());
+  n = static_cast<size_t>(std::min<uint64_t>(n, size_));
+  std::vector<uint8_t> last(n);
+  for (size_t i = 0; i < n; ++i) last[i] = tail_[(size_ - n + i) % tail_.size()];
+  return Crc32c(last.data(), n);
+}
+
+void LogicalSink::WritePage(uint64_t index, const uint8_t* payload, size_t n) {
+  uint8_t page[kPageSize] = {};
+  std::memcpy(page, payload, n);
+  const uint32_t crc = Crc32c(page, kPagePayload);
+  page[1020] = crc >> 24;
+  page[1021] = (crc >> 16) & 0xFF;
+  page[1022] = (crc >> 8) & 0xFF;
+  page[1023] = crc & 0xFF;
+  if (index == 0) pages_->seekp(0);  // the other pages follow each other
+  pages_->write(reinterpret_cast<const char*>(page), kPageSize);
+}
+
+void LogicalSink::Append(const uint8_t* data, size_t n) {
+  if (memory_ != nullptr) {
+    memory_->insert(memory_->end(), data, data + n);
+    Keep(data, n);
+    return;
+  }
+  while (n > 0) {
+    std::vector<uint8_t>& target = size_ < kPagePayload ? first_page_ : page_;
+    const size_t take = std::min<size_t>(n, kPagePayload - size_ % kPagePayload);
+    target.insert(target.end(), data, data + take);
+    Keep(data, take);
+    data += take;
+    n -= take;
+    if (size_ % kPagePayload == 0 && size_ > kPagePayload) {  // a full page past page 0
+      WritePage(size_ / kPagePayload - 1, page_.data(), page_.size());
+      page_.clear();
+    }
+  }
+}
+
+void LogicalSink::AppendZeros(size_t n) {
+  const uint8_t zeros[64] = {};
+  while (n > 0) {
+    const size_t take = std::min<size_t>(n, sizeof(zeros));
+    Append(zeros, take);
+    n -= take;
+  }
+}
+
+void LogicalSink::StoreFileHeader(const Header& header) {
+  std::vector<uint8_t>& target = memory_ != nullptr ? *memory_ : first_page_;
+  LIDARSHOP_CHECK(target.size() >= kHeaderSize);
+  e57::StoreHeader(header, target.data());
+}
+
+void LogicalSink::Finish() {
+  if (memory_ != nullptr) return;
+  if (!page_.empty()) WritePage((size_ - 1) / kPagePayload, page_.data(), page_.size());
+  WritePage(0, first_page_.data(), first_page_.size());
+  pages_->seekp(0, std::ios::end);
 }
 
 namespace {

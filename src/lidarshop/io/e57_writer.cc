@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -72,6 +73,46 @@ struct Record {
   uint8_t layer = 0;  // returnIndex
 };
 
+// The records of a scan and its second layer in file order, made one at a time (a station has tens of
+// millions): the valid cells and after each cell its second return. A cell without a return has no record
+// (as scanners write them: readers that ignore cartesianInvalidState see no junk), except before a second
+// return, where a record at zero coordinates with cartesianInvalidState 2 keeps the cell's first return index.
+class RecordCursor {
+ public:
+  RecordCursor(const Scan& scan, const uint8_t* behind_valid) : scan_(&scan), behind_valid_(behind_valid) {}
+  // The next record; call only while records remain.
+  Record Next() {
+    while (head_ == size_) {
+      head_ = size_ = 0;
+      const int64_t c = cell_++;
+      const bool has_second = behind_valid_ != nullptr && behind_valid_[c];
+      if (scan_->valid.at<uint8_t>(static_cast<int>(c / scan_->cols), static_cast<int>(c % scan_->cols))) {
+        queue_[size_++] = {c, 0, 0};
+      } else if (has_second) {
+        queue_[size_++] = {c, 2, 0};
+      }
+      if (has_second) queue_[size_++] = {c, 0, 1};
+    }
+    return queue_[head_++];
+  }
+
+ private:
+  const Scan* scan_;
+  const uint8_t* behind_valid_;
+  int64_t cell_ = 0;
+  Record queue_[2];
+  int head_ = 0, size_ = 0;
+};
+
+// A stream of one value per record, packed as the packets take it: `value(record, writer)` puts one value.
+template <typename PutValue>
+StreamSource RecordStream(Field field, const Scan& scan, const uint8_t* behind_valid, PutValue put_value) {
+  RecordCursor cursor(scan, behind_valid);
+  return {std::move(field), [cursor, put_value](int64_t, int64_t count, BitWriter* writer) mutable {
+            for (int64_t i = 0; i < count; ++i) put_value(cursor.Next(), writer);
+          }};
+}
+
 // The E57 pose (unit quaternion with w >= 0, translation) of `transform` under `parent`.
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
 
@@ -79,47 +120,48 @@ void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
 // holding a `points` CompressedVector of one record per cell without a return (`cells`, row-major image
 // order): rowIndex, columnIndex as in the scan's points, and the cell's unit ray as cartesianX/Y/Z in single
 // floats (bit-exact). Readers that do not know the namespace skip it.
-void AppendNoReturnDirections(const Scan& scan, const std::vector<int64_t>& cells,
-                              std::vector<uint8_t>* logical, pugi::xml_node child) {
-  const int64_t m = static_cast<int64_t>(cells.size());
-  std::vector<Stream> streams(5);
-  streams[0].field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
-  streams[1].field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
-  BitWriter wr(streams[0].field.bits), wc(streams[1].field.bits);
-  wr.Reserve(static_cast<int64_t>(cells.size()));
-  wc.Reserve(static_cast<int64_t>(cells.size()));
-  for (int64_t c : cells) {
-    wr.PutInteger(c / scan.cols, 0);
-    wc.PutInteger(c % scan.cols, 0);
-  }
-  streams[0].bytes = wr.Finish();
-  streams[1].bytes = wc.Finish();
+void AppendNoReturnDirections(const Scan& scan, const std::function<bool(int64_t)>& has_direction, int64_t m,
+                              LogicalSink* sink, pugi::xml_node child) {
+  // Each stream walks the cells that have a direction, in order.
+  auto cell_stream = [&](Field field, auto put_value) {
+    int64_t next = 0;
+    return StreamSource{std::move(field), [&scan, &has_direction, next, put_value](
+                                              int64_t, int64_t count, BitWriter* writer) mutable {
+                          for (int64_t i = 0; i < count; ++i) {
+                            while (!has_direction(next)) ++next;
+                            put_value(next++, writer);
+                          }
+                        }};
+  };
+  std::vector<StreamSource> streams;
+  streams.push_back(cell_stream(IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0)),
+                                [&scan](int64_t c, BitWriter* w) { w->PutInteger(c / scan.cols, 0); }));
+  streams.push_back(cell_stream(IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0)),
+                                [&scan](int64_t c, BitWriter* w) { w->PutInteger(c % scan.cols, 0); }));
   const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
   const cv::Vec3f* direction = scan.direction.ptr<cv::Vec3f>();
   for (int axis = 0; axis < 3; ++axis) {
-    Stream& s = streams[2 + axis];
-    s.field.name = axis_names[axis];
-    s.field.type = Field::Type::kFloat;
-    s.field.bits = 32;
-    BitWriter w(32);
-    w.Reserve(static_cast<int64_t>(cells.size()));
-    for (int64_t c : cells) w.PutFloat(direction[c][axis]);
-    s.bytes = w.Finish();
+    Field field;
+    field.name = axis_names[axis];
+    field.type = Field::Type::kFloat;
+    field.bits = 32;
+    streams.push_back(
+        cell_stream(field, [direction, axis](int64_t c, BitWriter* w) { w->PutFloat(direction[c][axis]); }));
   }
-  const uint64_t offset = AppendCompressedVector(streams, m, logical);
+  const uint64_t offset = AppendCompressedVector(streams, m, sink);
   pugi::xml_node extension = AddTyped(child, kNoReturnDirectionsField, "Structure");
   pugi::xml_node points = AddTyped(extension, "points", "CompressedVector");
   points.append_attribute("fileOffset") = std::to_string(offset).c_str();
   points.append_attribute("recordCount") = std::to_string(m).c_str();
   pugi::xml_node prototype = AddTyped(points, "prototype", "Structure");
-  for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
+  for (const StreamSource& s : streams) AddPrototypeField(prototype, s.field);
   AddTyped(points, "codecs", "Vector").append_attribute("allowHeterogeneousChildren") = "1";
 }
 
 // Appends one data3D entry; `behind` (may be null) is a second layer of the same grid whose valid cells
 // become second returns. Returns whether lidarshop's extension (namespace) is used.
 bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteOptions& options,
-                std::vector<uint8_t>* logical, pugi::xml_node data3d) {
+                LogicalSink* sink, pugi::xml_node data3d) {
   CheckScan(scan);
   if (!IsRigid(scan.world_from_scanner, 1e-6)) {
     throw InputError(
@@ -131,191 +173,143 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
     CheckScan(*behind);
     LIDARSHOP_CHECK(behind->rows == scan.rows && behind->cols == scan.cols);
   }
-  // The records: the valid cells and after each cell its second return from `behind`. A cell without a
-  // return has no record (as scanners write them: readers that ignore cartesianInvalidState see no junk),
-  // except before a second return, where a record at zero coordinates with cartesianInvalidState 2 keeps
-  // the cell's first return index. The rays of no-return cells go to lidarshop's extension (below).
-  std::vector<Record> records;
-  records.reserve(static_cast<size_t>(scan.CountValid()));
-  std::vector<int64_t> direction_cells;  // no-return cells with a direction, row-major
+  // One pass over the records (RecordCursor's order) for what the prototype and the XML need before the
+  // streams are made: their count, the valid points' bounds, whether any record is a placeholder.
   const uint8_t* behind_valid = behind != nullptr ? behind->valid.ptr<uint8_t>() : nullptr;
+  int64_t n = 0, direction_count = 0;
+  bool any_invalid = false;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo[3] = {kInf, kInf, kInf},
+         hi[3] = {-kInf, -kInf, -kInf};  // over valid points; 0 when there are none
+  auto extend = [&](const cv::Vec3f& p) {
+    for (int axis = 0; axis < 3; ++axis) {
+      lo[axis] = std::min(lo[axis], static_cast<double>(p[axis]));
+      hi[axis] = std::max(hi[axis], static_cast<double>(p[axis]));
+    }
+  };
+  // The rays of no-return cells go to lidarshop's extension (below).
+  const std::function<bool(int64_t)> has_direction = [&scan, &options](int64_t c) {
+    const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
+    if (scan.valid.at<uint8_t>(r, k) || !options.write_no_return_directions) return false;
+    const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
+    return d.dot(d) > 0.0f && std::isfinite(d.dot(d));
+  };
   for (int64_t c = 0; c < scan.num_cells(); ++c) {
     const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
     const bool has_second = behind_valid != nullptr && behind_valid[c];
     if (scan.valid.at<uint8_t>(r, k)) {
-      records.push_back({c, 0, 0});
+      ++n;
+      extend(scan.point.ptr<cv::Vec3f>()[c]);
     } else {
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
-      if (options.write_no_return_directions && d.dot(d) > 0.0f && std::isfinite(d.dot(d)))
-        direction_cells.push_back(c);
-      if (has_second) records.push_back({c, 2, 0});
+      direction_count += has_direction(c);
+      if (has_second) ++n, any_invalid = true;
     }
-    if (has_second) records.push_back({c, 0, 1});
+    if (has_second) ++n, extend(behind->point.ptr<cv::Vec3f>()[c]);
   }
-  const int64_t n = static_cast<int64_t>(records.size());
-  auto layer_of = [&](int64_t i) -> const Scan& { return records[i].layer == 0 ? scan : *behind; };
-  auto xyz_of = [&](int64_t i, int axis) {
-    return records[i].state == 0 ? layer_of(i).point.ptr<cv::Vec3f>()[records[i].cell][axis] : 0.0f;
+  auto layer_of = [&scan, behind](const Record& record) -> const Scan& {
+    return record.layer == 0 ? scan : *behind;
+  };
+  auto xyz_of = [layer_of](const Record& record, int axis) {
+    return record.state == 0 ? layer_of(record).point.ptr<cv::Vec3f>()[record.cell][axis] : 0.0f;
   };
 
-  std::vector<Stream> streams;
+  std::vector<StreamSource> streams;
+  auto add = [&](Field field, auto put_value) {
+    streams.push_back(RecordStream(std::move(field), scan, behind_valid, put_value));
+  };
   const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  double lo[3] = {kInf, kInf, kInf},
-         hi[3] = {-kInf, -kInf, -kInf};  // over valid points; 0 when there are none
   for (int axis = 0; axis < 3; ++axis) {
-    Stream s;
-    s.field.name = axis_names[axis];
+    Field field;
+    field.name = axis_names[axis];
     if (options.coordinate_scale_m > 0) {
-      std::vector<int64_t> raw(n);
+      const double step = options.coordinate_scale_m;
       int64_t raw_min = 0, raw_max = 0;
+      RecordCursor cursor(scan, behind_valid);
       for (int64_t i = 0; i < n; ++i) {
-        const double v = xyz_of(i, axis);
-        if (!std::isfinite(v) || std::abs(v / options.coordinate_scale_m) > 4e18) {
+        const double v = xyz_of(cursor.Next(), axis);
+        if (!std::isfinite(v) || std::abs(v / step) > 4e18) {
           throw InputError(fmt::format("scan {}: coordinate {} does not fit a scaled integer", index, v));
         }
-        raw[i] = std::llround(v / options.coordinate_scale_m);
-        raw_min = i == 0 ? raw[i] : std::min(raw_min, raw[i]);
-        raw_max = i == 0 ? raw[i] : std::max(raw_max, raw[i]);
+        const int64_t raw = std::llround(v / step);
+        raw_min = i == 0 ? raw : std::min(raw_min, raw);
+        raw_max = i == 0 ? raw : std::max(raw_max, raw);
       }
-      s.field.type = Field::Type::kScaledInteger;
-      s.field.scale = options.coordinate_scale_m;
-      s.field.minimum = raw_min;
-      s.field.maximum = raw_max;
-      s.field.bits = BitsForRange(raw_min, raw_max);
-      BitWriter w(s.field.bits);
-      w.Reserve(n);
-      for (int64_t i = 0; i < n; ++i) w.PutInteger(raw[i], raw_min);
-      s.bytes = w.Finish();
+      field.type = Field::Type::kScaledInteger;
+      field.scale = step;
+      field.minimum = raw_min;
+      field.maximum = raw_max;
+      field.bits = BitsForRange(raw_min, raw_max);
+      add(field, [xyz_of, axis, step, raw_min](const Record& record, BitWriter* w) {
+        w->PutInteger(std::llround(xyz_of(record, axis) / step), raw_min);
+      });
     } else {
-      s.field.type = Field::Type::kFloat;
-      s.field.bits = 32;
-      BitWriter w(32);
-      w.Reserve(n);
-      for (int64_t i = 0; i < n; ++i) w.PutFloat(xyz_of(i, axis));
-      s.bytes = w.Finish();
+      field.type = Field::Type::kFloat;
+      field.bits = 32;
+      add(field, [xyz_of, axis](const Record& record, BitWriter* w) { w->PutFloat(xyz_of(record, axis)); });
     }
-    for (int64_t i = 0; i < n; ++i) {
-      if (records[i].state != 0) continue;
-      const double v = xyz_of(i, axis);
-      lo[axis] = std::min(lo[axis], v);
-      hi[axis] = std::max(hi[axis], v);
-    }
-    streams.push_back(std::move(s));
   }
   if (scan.has_intensity()) {  // no intensity field for a scan without intensity
-    Stream s;
-    s.field.name = "intensity";
-    s.field.type = Field::Type::kFloat;
-    s.field.bits = 32;
-    BitWriter w(32);
-    w.Reserve(n);
-    for (int64_t i = 0; i < n; ++i) {
-      const Scan& from = layer_of(i);  // a layer without intensity gets the no-information value
-      w.PutFloat(from.has_intensity() ? from.intensity.ptr<float>()[records[i].cell] : 0.5f);
-    }
-    s.bytes = w.Finish();
-    streams.push_back(std::move(s));
+    Field field;
+    field.name = "intensity";
+    field.type = Field::Type::kFloat;
+    field.bits = 32;
+    add(field, [layer_of](const Record& record, BitWriter* w) {
+      const Scan& from = layer_of(record);  // a layer without intensity gets the no-information value
+      w->PutFloat(from.has_intensity() ? from.intensity.ptr<float>()[record.cell] : 0.5f);
+    });
   }
   if (scan.has_color()) {
     const char* names[3] = {"colorRed", "colorGreen", "colorBlue"};
     for (int ch = 0; ch < 3; ++ch) {
-      Stream s;
-      s.field = IntegerField(names[ch], 0, 255);
-      BitWriter w(s.field.bits);
-      w.Reserve(n);
-      for (int64_t i = 0; i < n; ++i) {
-        const Scan& from = layer_of(i);  // a layer without colour is written black
-        w.PutInteger(from.has_color() ? from.color.ptr<uint8_t>()[3 * records[i].cell + ch] : 0, 0);
-      }
-      s.bytes = w.Finish();
-      streams.push_back(std::move(s));
+      add(IntegerField(names[ch], 0, 255), [layer_of, ch](const Record& record, BitWriter* w) {
+        const Scan& from = layer_of(record);  // a layer without colour is written black
+        w->PutInteger(from.has_color() ? from.color.ptr<uint8_t>()[3 * record.cell + ch] : 0, 0);
+      });
     }
   }
-  {
-    Stream row, col;
-    row.field = IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0));
-    col.field = IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0));
-    BitWriter wr(row.field.bits), wc(col.field.bits);
-    wr.Reserve(n);
-    wc.Reserve(n);
-    for (int64_t i = 0; i < n; ++i) {
-      wr.PutInteger(records[i].cell / scan.cols, 0);
-      wc.PutInteger(records[i].cell % scan.cols, 0);
-    }
-    row.bytes = wr.Finish();
-    col.bytes = wc.Finish();
-    streams.push_back(std::move(row));
-    streams.push_back(std::move(col));
-  }
-  {
-    const bool any_invalid =
-        std::any_of(records.begin(), records.end(), [](const Record& r) { return r.state != 0; });
-    Stream s;
-    s.field = IntegerField("cartesianInvalidState", 0, any_invalid ? 2 : 0);
-    BitWriter w(s.field.bits);
-    w.Reserve(n);
-    for (int64_t i = 0; i < n; ++i) w.PutInteger(records[i].state, 0);
-    s.bytes = w.Finish();
-    streams.push_back(std::move(s));
-  }
+  const int64_t cols = scan.cols;
+  add(IntegerField("rowIndex", 0, std::max(scan.rows - 1, 0)),
+      [cols](const Record& record, BitWriter* w) { w->PutInteger(record.cell / cols, 0); });
+  add(IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0)),
+      [cols](const Record& record, BitWriter* w) { w->PutInteger(record.cell % cols, 0); });
+  add(IntegerField("cartesianInvalidState", 0, any_invalid ? 2 : 0),
+      [](const Record& record, BitWriter* w) { w->PutInteger(record.state, 0); });
   if (behind != nullptr) {
     // Only files with a second layer carry return fields, so single-layer files stay as they were.
-    Stream index_stream, count_stream;
-    index_stream.field = IntegerField("returnIndex", 0, 1);
-    count_stream.field = IntegerField("returnCount", 1, 2);
-    BitWriter wi(index_stream.field.bits), wn(count_stream.field.bits);
-    wi.Reserve(n);
-    wn.Reserve(n);
-    for (int64_t i = 0; i < n; ++i) {
-      wi.PutInteger(records[i].layer, 0);
-      wn.PutInteger(behind_valid[records[i].cell] ? 2 : 1, 1);
-    }
-    index_stream.bytes = wi.Finish();
-    count_stream.bytes = wn.Finish();
-    streams.push_back(std::move(index_stream));
-    streams.push_back(std::move(count_stream));
+    add(IntegerField("returnIndex", 0, 1),
+        [](const Record& record, BitWriter* w) { w->PutInteger(record.layer, 0); });
+    add(IntegerField("returnCount", 1, 2), [behind_valid](const Record& record, BitWriter* w) {
+      w->PutInteger(behind_valid[record.cell] ? 2 : 1, 1);
+    });
   }
   const bool write_synthesized = behind != nullptr || !scan.synthesized.empty();
   if (write_synthesized) {
     // The front scan says per cell; the second layer too when it has the channel, else it is synthesized by
     // definition (the layer behind a kept object).
-    Stream s;
-    s.field = IntegerField(kSynthesizedField, 0, 1);
-    BitWriter w(s.field.bits);
-    w.Reserve(n);
     const uint8_t* flags = scan.synthesized.empty() ? nullptr : scan.synthesized.ptr<uint8_t>();
     const uint8_t* behind_flags =
         behind == nullptr || behind->synthesized.empty() ? nullptr : behind->synthesized.ptr<uint8_t>();
-    for (int64_t i = 0; i < n; ++i) {
-      const int64_t c = records[i].cell;
-      const bool synthesized = records[i].layer == 1 ? (behind_flags == nullptr || behind_flags[c] != 0)
-                                                     : (flags != nullptr && flags[c] != 0);
-      w.PutInteger(synthesized ? 1 : 0, 0);
-    }
-    s.bytes = w.Finish();
-    streams.push_back(std::move(s));
+    add(IntegerField(kSynthesizedField, 0, 1), [flags, behind_flags](const Record& record, BitWriter* w) {
+      const int64_t c = record.cell;
+      const bool synthesized = record.layer == 1 ? (behind_flags == nullptr || behind_flags[c] != 0)
+                                                 : (flags != nullptr && flags[c] != 0);
+      w->PutInteger(synthesized ? 1 : 0, 0);
+    });
   }
   // The cells taken from another station's measurement (site/from_stations.h), per layer when it has them.
   const bool write_from_station =
       !scan.from_station.empty() || (behind != nullptr && !behind->from_station.empty());
   if (write_from_station) {
-    Stream s;
-    s.field = IntegerField(kFromStationField, 0, 255);
-    BitWriter w(s.field.bits);
-    w.Reserve(n);
-    for (int64_t i = 0; i < n; ++i) {
-      const Scan& from = layer_of(i);
-      w.PutInteger(from.from_station.empty() ? 0 : from.from_station.ptr<uint8_t>()[records[i].cell], 0);
-    }
-    s.bytes = w.Finish();
-    streams.push_back(std::move(s));
+    add(IntegerField(kFromStationField, 0, 255), [layer_of](const Record& record, BitWriter* w) {
+      const Scan& from = layer_of(record);
+      w->PutInteger(from.from_station.empty() ? 0 : from.from_station.ptr<uint8_t>()[record.cell], 0);
+    });
   }
 
   for (int axis = 0; axis < 3; ++axis) {
     if (lo[axis] > hi[axis]) lo[axis] = hi[axis] = 0.0;
   }
-  const uint64_t offset = AppendCompressedVector(streams, n, logical);
+  const uint64_t offset = AppendCompressedVector(streams, n, sink);
 
   pugi::xml_node child = AddTyped(data3d, "vectorChild", "Structure");
   const auto kept = [&scan](const char* key) {
@@ -326,11 +320,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   const std::string guid = kept("e57.guid");
   AddString(
       child, "guid",
-      !guid.empty()
-          ? guid
-          : fmt::format("{{lidarshop-scan-{:04d}-{:08x}}}", index,
-                        Crc32c(logical->data() + logical->size() - std::min<size_t>(logical->size(), 4096),
-                               std::min<size_t>(logical->size(), 4096))));
+      !guid.empty() ? guid : fmt::format("{{lidarshop-scan-{:04d}-{:08x}}}", index, sink->TailCrc(4096)));
   AddString(child, "name", scan.name.empty() ? fmt::format("scan{:03d}", index) : scan.name);
   AddString(child, "description", "written by lidarshop");
   for (const auto& [element, key] : kE57MetadataStrings) {
@@ -382,11 +372,11 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   points.append_attribute("fileOffset") = std::to_string(offset).c_str();
   points.append_attribute("recordCount") = std::to_string(n).c_str();
   pugi::xml_node prototype = AddTyped(points, "prototype", "Structure");
-  for (const Stream& s : streams) AddPrototypeField(prototype, s.field);
+  for (const StreamSource& s : streams) AddPrototypeField(prototype, s.field);
   pugi::xml_node codecs = AddTyped(points, "codecs", "Vector");
   codecs.append_attribute("allowHeterogeneousChildren") = "1";
-  if (!direction_cells.empty()) {
-    AppendNoReturnDirections(scan, direction_cells, logical, child);
+  if (direction_count > 0) {
+    AppendNoReturnDirections(scan, has_direction, direction_count, sink, child);
     return true;
   }
   return write_synthesized || write_from_station;
@@ -409,19 +399,19 @@ void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform) {
 }
 
 // Appends a blob section holding `bytes` and returns its logical offset.
-uint64_t AppendBlob(const std::vector<uint8_t>& bytes, std::vector<uint8_t>* logical) {
-  while (logical->size() % 8) logical->push_back(0);
-  const uint64_t start = logical->size();
-  logical->resize(start + 16, 0);  // sectionId 0 (blob), reserved, sectionLogicalLength
+uint64_t AppendBlob(const std::vector<uint8_t>& bytes, LogicalSink* sink) {
+  sink->AlignTo8();
+  const uint64_t start = sink->size();
+  uint8_t header[16] = {};  // sectionId 0 (blob), reserved, sectionLogicalLength
   const uint64_t section_length = 16 + bytes.size();
-  std::memcpy(logical->data() + start + 8, &section_length, 8);
-  logical->insert(logical->end(), bytes.begin(), bytes.end());
+  std::memcpy(header + 8, &section_length, 8);
+  sink->Append(header, sizeof(header));
+  sink->Append(bytes.data(), bytes.size());
   return start;
 }
 
-void AddBlob(pugi::xml_node parent, const char* name, const std::vector<uint8_t>& bytes,
-             std::vector<uint8_t>* logical) {
-  const uint64_t start = AppendBlob(bytes, logical);
+void AddBlob(pugi::xml_node parent, const char* name, const std::vector<uint8_t>& bytes, LogicalSink* sink) {
+  const uint64_t start = AppendBlob(bytes, sink);
   pugi::xml_node blob = AddTyped(parent, name, "Blob");
   blob.append_attribute("fileOffset") = std::to_string(PhysicalFromLogical(start)).c_str();
   blob.append_attribute("length") = std::to_string(bytes.size()).c_str();
@@ -430,7 +420,7 @@ void AddBlob(pugi::xml_node parent, const char* name, const std::vector<uint8_t>
 // Appends one images2D entry: blob sections with the photo's bytes (and its mask's) and its XML element.
 // `scan_guids` are the guids of the data3D entries written (associatedData3DGuid).
 void AppendImage(const E57Image& image, int index, const std::vector<std::string>& scan_guids,
-                 std::vector<uint8_t>* logical, pugi::xml_node images2d) {
+                 LogicalSink* sink, pugi::xml_node images2d) {
   std::vector<uint8_t> bytes = image.encoded;
   std::string encoding = image.encoding;
   if (bytes.empty()) {
@@ -460,8 +450,8 @@ void AppendImage(const E57Image& image, int index, const std::vector<std::string
     AddString(child, "associatedData3DGuid", scan_guids[image.associated_scan]);
   AddPose(child, image.world_from_camera);
   pugi::xml_node rep = AddTyped(child, element, "Structure");
-  AddBlob(rep, encoding == "jpeg" ? "jpegImage" : "pngImage", bytes, logical);
-  if (!image.mask_encoded.empty()) AddBlob(rep, "imageMask", image.mask_encoded, logical);
+  AddBlob(rep, encoding == "jpeg" ? "jpegImage" : "pngImage", bytes, sink);
+  if (!image.mask_encoded.empty()) AddBlob(rep, "imageMask", image.mask_encoded, sink);
   AddInteger(rep, "imageWidth", image.width_px ? image.width_px : image.image.cols);
   AddInteger(rep, "imageHeight", image.height_px ? image.height_px : image.image.rows);
   if (image.projection == "pinhole") {
@@ -489,12 +479,12 @@ void E57WriteOptions::Check() const { Validate(*this); }
 namespace e57 {
 namespace {
 
-// The logical bytes (without the pages' checksums) of the file of `scans` and `image_list`; `behind` (may be
-// null, else one per scan, 0 x 0 = none) holds the second layer of each scan.
-std::vector<uint8_t> EncodeLogical(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
-                                   const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
+// The file of `scans` and `image_list` into `sink`; `behind` (may be null, else one per scan, 0 x 0 = none)
+// holds the second layer of each scan.
+void EncodeTo(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
+              const std::vector<E57Image>& image_list, const E57WriteOptions& options, LogicalSink* sink) {
   options.Check();
-  std::vector<uint8_t> logical(kHeaderSize, 0);
+  sink->AppendZeros(kHeaderSize);
   pugi::xml_document doc;
   pugi::xml_node decl = doc.append_child(pugi::node_declaration);
   decl.append_attribute("version") = "1.0";
@@ -511,7 +501,7 @@ std::vector<uint8_t> EncodeLogical(const std::vector<Scan>& scans, const std::ve
   for (size_t i = 0; i < scans.size(); ++i) {
     const Scan* layer = behind != nullptr ? (*behind)[i] : nullptr;
     if (layer != nullptr && layer->num_cells() == 0) layer = nullptr;
-    extension |= AppendScan(scans[i], layer, static_cast<int>(i), options, &logical, data3d);
+    extension |= AppendScan(scans[i], layer, static_cast<int>(i), options, sink, data3d);
   }
   // E2807 declares extensions by an XML namespace on e57Root; readers that do not know it skip its fields.
   if (extension) root.append_attribute(kExtensionXmlns) = kLidarshopE57Namespace;
@@ -521,40 +511,43 @@ std::vector<uint8_t> EncodeLogical(const std::vector<Scan>& scans, const std::ve
   for (pugi::xml_node scan : root.child("data3D").children("vectorChild"))
     scan_guids.push_back(scan.child("guid").text().get());
   for (size_t i = 0; i < image_list.size(); ++i)
-    AppendImage(image_list[i], static_cast<int>(i), scan_guids, &logical, images);
+    AppendImage(image_list[i], static_cast<int>(i), scan_guids, sink, images);
   // The file guid: a checksum of the binary sections, so that the same scans give the same bytes.
   pugi::xml_node guid = AddTyped(root, "guid", "String");
   guid.append_child(pugi::node_cdata)
-      .set_value(fmt::format("{{lidarshop-{:08x}-{:016x}}}", Crc32c(logical.data(), logical.size()),
-                             static_cast<uint64_t>(logical.size()))
-                     .c_str());
+      .set_value(fmt::format("{{lidarshop-{:08x}-{:016x}}}", sink->crc(), sink->size()).c_str());
   root.insert_move_after(guid, root.child("formatName"));
 
   std::ostringstream xml;
   doc.save(xml, "  ", pugi::format_default, pugi::encoding_utf8);
   const std::string text = xml.str();
-  while (logical.size() % 8) logical.push_back(0);
+  sink->AlignTo8();
   Header header;
-  header.xml_physical_offset = PhysicalFromLogical(logical.size());
+  header.xml_physical_offset = PhysicalFromLogical(sink->size());
   header.xml_logical_length = text.size();
-  logical.insert(logical.end(), text.begin(), text.end());
-  const uint64_t pages = (logical.size() + kPagePayload - 1) / kPagePayload;
+  sink->Append(reinterpret_cast<const uint8_t*>(text.data()), text.size());
+  const uint64_t pages = (sink->size() + kPagePayload - 1) / kPagePayload;
   header.file_physical_length = pages * kPageSize;
-  StoreHeader(header, logical.data());
-  return logical;
+  sink->StoreFileHeader(header);
+  sink->Finish();
 }
 
 std::vector<uint8_t> Encode(const std::vector<Scan>& scans, const std::vector<const Scan*>* behind,
                             const std::vector<E57Image>& image_list, const E57WriteOptions& options) {
-  return PagesFromLogical(EncodeLogical(scans, behind, image_list, options));
+  std::vector<uint8_t> logical;
+  LogicalSink sink(&logical);
+  EncodeTo(scans, behind, image_list, options, &sink);
+  return PagesFromLogical(logical);
 }
 
-// Writes the file's pages as they are made: the logical bytes are the one whole copy held.
+// Writes the file's pages as they are made: neither the file nor its bytestreams are held whole.
 void WriteFile(const std::string& path, const std::vector<Scan>& scans,
                const std::vector<const Scan*>* behind, const std::vector<E57Image>& image_list,
                const E57WriteOptions& options) {
-  const std::vector<uint8_t> logical = EncodeLogical(scans, behind, image_list, options);
-  WriteFileAtomically(path, [&](std::ostream& out) { WritePages(logical, out); });
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    LogicalSink sink(&out);
+    EncodeTo(scans, behind, image_list, options, &sink);
+  });
 }
 
 }  // namespace
