@@ -388,6 +388,57 @@ TEST(E57Writer, SameInputSameBytesAndManyPackets) {
   ExpectSameScan(scan, f.scans[0], 0.0);
 }
 
+TEST(E57Writer, AFileWrittenPageByPageEqualsTheBytesInMemory) {
+  // WriteE57 writes pages as they fill (page 0, the header's, last); EncodeE57 builds the bytes in memory.
+  const Scan scan = SyntheticScan(300, 400, 8, true);
+  const std::string path = TempPath("pages.e57");
+  WriteE57(path, {scan});
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<uint8_t> written((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(written, EncodeE57({scan}));
+  EXPECT_GT(written.size(), 100 * e57::kPageSize);
+  std::filesystem::remove(path);
+}
+
+TEST(E57Codec, StreamedCompressedVectorEqualsThePackedOne) {
+  // A compressed vector packed as its packets take it equals the one of whole bytestreams, for fields of 0,
+  // 1, 7, 13, 32 and 64 bits over several packets.
+  std::mt19937_64 rng(21);
+  const int64_t n = 70001;
+  const int widths[] = {0, 1, 7, 13, 32, 64};
+  std::vector<e57::Stream> packed;
+  std::vector<std::vector<int64_t>> values;
+  for (int bits : widths) {
+    e57::Field field = bits == 0    ? e57::IntegerField("f0", 5, 5)
+                       : bits == 64 ? e57::IntegerField("f64", std::numeric_limits<int64_t>::min(),
+                                                        std::numeric_limits<int64_t>::max())
+                                    : e57::IntegerField("f", 0, (int64_t{1} << bits) - 1);
+    std::vector<int64_t> v(n);
+    for (int64_t& x : v)
+      x = bits == 0 ? 5 : bits == 64 ? static_cast<int64_t>(rng()) : rng() % (field.maximum + 1);
+    e57::BitWriter writer(field.bits);
+    for (int64_t x : v) writer.PutInteger(x, field.minimum);
+    packed.push_back({field, writer.Finish()});
+    values.push_back(std::move(v));
+  }
+  std::vector<uint8_t> whole(48, 0);
+  e57::AppendCompressedVector(packed, n, &whole);
+  std::vector<e57::StreamSource> sources;
+  for (size_t i = 0; i < packed.size(); ++i) {
+    const std::vector<int64_t>* v = &values[i];
+    const int64_t minimum = packed[i].field.minimum;
+    sources.push_back({packed[i].field, [v, minimum](int64_t first, int64_t count, e57::BitWriter* w) {
+                         for (int64_t k = first; k < first + count; ++k) w->PutInteger((*v)[k], minimum);
+                       }});
+  }
+  std::vector<uint8_t> streamed;
+  e57::LogicalSink sink(&streamed);
+  sink.AppendZeros(48);
+  e57::AppendCompressedVector(sources, n, &sink);
+  EXPECT_GT(whole.size(), 4 * e57::kMaxPacketSize);
+  EXPECT_EQ(streamed, whole);
+}
+
 TEST(E57Writer, NoScansAndRejectsNonRigidPose) {
   const E57File f = ReadE57Bytes(EncodeE57({}), "none.e57");
   EXPECT_TRUE(f.scans.empty());
