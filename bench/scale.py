@@ -151,6 +151,7 @@ def markdown(rows, load_before, load_after):
 
 
 def main():
+    global CLI
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes", default="1,4,16", help="millions of rays, comma-separated (default 1,4,16)")
     parser.add_argument("--work", default="/tmp/lidarshop_scale", help="working folder (large files)")
@@ -158,7 +159,6 @@ def main():
     parser.add_argument("--binary", default=str(CLI),
                         help="the lidarshop executable to measure (default build/release/lidarshop)")
     args = parser.parse_args()
-    global CLI
     CLI = pathlib.Path(args.binary)
     if not CLI.exists():
         sys.exit(f"{CLI} not found: build it first (bash scripts/build.sh)")
