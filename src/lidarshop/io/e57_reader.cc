@@ -947,15 +947,21 @@ void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* 
     cv::flip(d, d, code);
   }
   if (scan->CountValid() > 0) {
-    // Only the stored rays of no-return cells are kept aside, not a copy of every direction.
-    std::vector<std::pair<int64_t, cv::Vec3f>> stored;
+    // Only the stored rays of no-return cells are kept aside (16 bytes each, counted first), not a copy of
+    // every direction.
+    struct StoredRay {
+      int32_t cell;  // < kMaxScanCells
+      cv::Vec3f direction;
+    };
+    std::vector<StoredRay> stored;
+    stored.reserve(std::count(has_direction.begin(), has_direction.end(), uint8_t{2}));
     const cv::Vec3f* from = scan->direction.ptr<cv::Vec3f>();
     for (int64_t c = 0; c < scan->num_cells(); ++c) {
-      if (has_direction[c] == 2) stored.emplace_back(c, from[c]);
+      if (has_direction[c] == 2) stored.push_back({static_cast<int32_t>(c), from[c]});
     }
     FitGrid(scan);
     cv::Vec3f* to = scan->direction.ptr<cv::Vec3f>();
-    for (const auto& [c, direction] : stored) to[c] = direction;
+    for (const StoredRay& ray : stored) to[ray.cell] = ray.direction;
   }
   if (second->num_cells() > 0) {
     second->direction = scan->direction.clone();  // the same rays

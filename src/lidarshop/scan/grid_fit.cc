@@ -22,16 +22,16 @@ constexpr double kTwoPi = 2.0 * M_PI;
 // Points closer than this to the zenith or nadir (|cos φ| below it) carry no usable azimuth.
 constexpr double kMinCosElevationForAzimuth = 0.1;
 
-double Median(std::vector<double>* values) {
-  if (values->empty()) return kNaN;
-  const size_t middle = values->size() / 2;
-  std::nth_element(values->begin(), values->begin() + middle, values->end());
-  double median = (*values)[middle];
-  if (values->size() % 2 == 0) {
-    median = 0.5 * (median + *std::max_element(values->begin(), values->begin() + middle));
-  }
+// The median of [begin, end) (reordered).
+double Median(double* begin, double* end) {
+  if (begin == end) return kNaN;
+  const size_t middle = static_cast<size_t>(end - begin) / 2;
+  std::nth_element(begin, begin + middle, end);
+  double median = begin[middle];
+  if ((end - begin) % 2 == 0) median = 0.5 * (median + *std::max_element(begin, begin + middle));
   return median;
 }
+double Median(std::vector<double>* values) { return Median(values->data(), values->data() + values->size()); }
 
 // Weighted pool-adjacent-violators: the non-decreasing sequence closest to
 // `values` in weighted least squares.
@@ -137,55 +137,75 @@ std::vector<double> FitAxis(std::vector<double> medians, const std::vector<int>&
 void FitGrid(Scan* scan) {
   CheckScan(*scan);
   const int rows = scan->rows, cols = scan->cols;
-  // What the fit holds beside the scan is one azimuth per return (8 bytes; a station has tens of millions):
-  // rows are read in bands, in parallel, their elevation medians taken at once and their azimuths appended
-  // to the columns in row order, so the samples, and every value below, are those of a serial pass.
-  std::vector<std::vector<double>> column_azimuths(cols);
+  // What the fit holds beside the scan is one azimuth per return (8 bytes; a station has tens of millions),
+  // column by column in one array: rows are read in bands, in parallel, twice — once for their elevation
+  // medians and the number of azimuths of each column, once to put the azimuths in place in row order — so the
+  // samples, and every value below, are those of a serial pass.
   std::vector<double> azimuth_medians(cols, kNaN), elevation_medians(rows, kNaN);
   std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
   constexpr int kBandRows = 256;
   std::vector<std::vector<std::pair<int, double>>> row_azimuths(kBandRows);
+  // The returns of one row: its elevation angles (when `elevations` is not null) and its (column, azimuth).
+  auto row_angles = [&](int row, std::vector<double>* elevations,
+                        std::vector<std::pair<int, double>>* azimuths) {
+    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < cols; ++col) {
+      if (!valid[col]) continue;
+      const double x = point[col][0], y = point[col][1], z = point[col][2];
+      const double horizontal = std::hypot(x, y);
+      if (horizontal == 0 && z == 0) continue;
+      if (elevations != nullptr) elevations->push_back(std::atan2(z, horizontal));
+      if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
+        azimuths->push_back({col, std::atan2(x, y)});
+      }
+    }
+  };
   for (int band = 0; band < rows; band += kBandRows) {
     const int band_rows = std::min(kBandRows, rows - band);
     ParallelFor(band_rows, [&](int64_t r) {
       const int row = band + static_cast<int>(r);
-      const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
-      const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
       std::vector<double> elevations;
-      for (int col = 0; col < cols; ++col) {
-        if (!valid[col]) continue;
-        const double x = point[col][0], y = point[col][1], z = point[col][2];
-        const double horizontal = std::hypot(x, y);
-        if (horizontal == 0 && z == 0) continue;
-        elevations.push_back(std::atan2(z, horizontal));
-        if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
-          row_azimuths[r].push_back({col, std::atan2(x, y)});
-        }
-      }
+      row_angles(row, &elevations, &row_azimuths[r]);
       elevation_counts[row] = static_cast<int>(elevations.size());
       elevation_medians[row] = Median(&elevations);
     });
     for (int r = 0; r < band_rows; ++r) {
-      for (const auto& [col, azimuth] : row_azimuths[r]) column_azimuths[col].push_back(azimuth);
+      for (const auto& [col, azimuth] : row_azimuths[r]) ++azimuth_counts[col];
       row_azimuths[r].clear();
+    }
+  }
+  std::vector<int64_t> column_start(cols + 1, 0);
+  for (int col = 0; col < cols; ++col) column_start[col + 1] = column_start[col] + azimuth_counts[col];
+  std::vector<double> azimuths(static_cast<size_t>(column_start[cols]));
+  {
+    std::vector<int64_t> next(column_start.begin(), column_start.end() - 1);
+    for (int band = 0; band < rows; band += kBandRows) {
+      const int band_rows = std::min(kBandRows, rows - band);
+      ParallelFor(band_rows,
+                  [&](int64_t r) { row_angles(band + static_cast<int>(r), nullptr, &row_azimuths[r]); });
+      for (int r = 0; r < band_rows; ++r) {
+        for (const auto& [col, azimuth] : row_azimuths[r]) azimuths[next[col]++] = azimuth;
+        row_azimuths[r].clear();
+      }
     }
   }
 
   ParallelFor(cols, [&](int64_t c) {  // columns are independent
     const int col = static_cast<int>(c);
-    std::vector<double>& samples = column_azimuths[col];
-    azimuth_counts[col] = static_cast<int>(samples.size());
-    if (samples.empty()) return;
+    double* samples = azimuths.data() + column_start[col];
+    double* samples_end = azimuths.data() + column_start[col + 1];
+    if (samples == samples_end) return;
     double sum_sin = 0, sum_cos = 0;
-    for (double angle : samples) {
-      sum_sin += std::sin(angle);
-      sum_cos += std::cos(angle);
+    for (const double* angle = samples; angle != samples_end; ++angle) {
+      sum_sin += std::sin(*angle);
+      sum_cos += std::cos(*angle);
     }
     const double reference = std::atan2(sum_sin, sum_cos);
-    for (double& angle : samples) angle = WrapAngle(angle - reference);
-    azimuth_medians[col] = reference + Median(&samples);
-    std::vector<double>().swap(samples);
+    for (double* angle = samples; angle != samples_end; ++angle) *angle = WrapAngle(*angle - reference);
+    azimuth_medians[col] = reference + Median(samples, samples_end);
   });
+  std::vector<double>().swap(azimuths);
   // Unwrap across columns so that a scan crossing θ = ±π stays continuous.
   int previous = -1;
   for (int col = 0; col < cols; ++col) {
