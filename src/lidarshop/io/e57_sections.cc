@@ -17,6 +17,21 @@ Field IntegerField(const char* name, int64_t minimum, int64_t maximum) {
   return f;
 }
 
+namespace {
+
+// Records per packet so that every packet (header + one chunk per stream of `bits` per value + rounding) fits
+// in 64 KiB.
+int64_t RecordsPerPacket(const std::vector<int>& bits, int64_t record_count) {
+  const uint64_t n = bits.size();
+  uint64_t bits_per_record = 0;
+  for (int b : bits) bits_per_record += static_cast<uint64_t>(b);
+  const uint64_t budget = kMaxPacketSize - 6 - 2 * n - n - 4;
+  return bits_per_record == 0 ? std::max<int64_t>(record_count, 1)
+                              : std::max<int64_t>(1, static_cast<int64_t>(budget * 8 / bits_per_record));
+}
+
+}  // namespace
+
 uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t record_count,
                                 std::vector<uint8_t>* logical) {
   while (logical->size() % 8) logical->push_back(0);
@@ -25,13 +40,9 @@ uint64_t AppendCompressedVector(const std::vector<Stream>& streams, int64_t reco
   (*logical)[start] = 1;  // sectionId: compressed vector
   const uint64_t data_start = logical->size();
   const size_t n = streams.size();
-  uint64_t bits_per_record = 0;
-  for (const Stream& s : streams) bits_per_record += s.field.bits;
-  // Records per packet so that every packet (header + one chunk per stream + rounding) fits in 64 KiB.
-  const uint64_t budget = kMaxPacketSize - 6 - 2 * n - n - 4;
-  const int64_t per_packet = bits_per_record == 0
-                                 ? std::max<int64_t>(record_count, 1)
-                                 : std::max<int64_t>(1, static_cast<int64_t>(budget * 8 / bits_per_record));
+  std::vector<int> bits(n);
+  for (size_t i = 0; i < n; ++i) bits[i] = streams[i].field.bits;
+  const int64_t per_packet = RecordsPerPacket(bits, record_count);
   auto byte_at = [&](const Stream& s, int64_t record) {
     return std::min<uint64_t>(s.bytes.size(), (static_cast<uint64_t>(record) * s.field.bits + 7) / 8);
   };
@@ -76,12 +87,9 @@ uint64_t AppendCompressedVector(const std::vector<StreamSource>& sources, int64_
   sink->AlignTo8();
   const uint64_t start = sink->size();
   const size_t n = sources.size();
-  uint64_t bits_per_record = 0;
-  for (const StreamSource& s : sources) bits_per_record += s.field.bits;
-  const uint64_t budget = kMaxPacketSize - 6 - 2 * n - n - 4;
-  const int64_t per_packet = bits_per_record == 0
-                                 ? std::max<int64_t>(record_count, 1)
-                                 : std::max<int64_t>(1, static_cast<int64_t>(budget * 8 / bits_per_record));
+  std::vector<int> bits(n);
+  for (size_t i = 0; i < n; ++i) bits[i] = sources[i].field.bits;
+  const int64_t per_packet = RecordsPerPacket(bits, record_count);
   std::vector<uint64_t> total(n);
   for (size_t i = 0; i < n; ++i) {
     total[i] = (static_cast<uint64_t>(record_count) * sources[i].field.bits + 7) / 8;
