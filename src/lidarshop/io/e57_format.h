@@ -66,9 +66,6 @@ inline uint64_t PhysicalFromLogical(uint64_t logical) {
 // Verifies every page's CRC and returns the logical bytes. Throws InputError naming `path`, the page index
 // and its byte offset when a checksum does not match or the size is not whole pages.
 std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector<uint8_t>& physical);
-// The same from a file, read a few pages at a time straight into the logical bytes: the file's physical bytes
-// are never held whole (a 100-million-point station's E57 is gigabytes).
-std::vector<uint8_t> LogicalFromPageFile(const std::string& path);
 
 // The logical bytes of an E57 file, held in memory or read from the file a range at a time. Opening a file
 // checks every page's CRC, as reading it whole does, without keeping the bytes; each later read checks its
@@ -116,8 +113,6 @@ void CheckXmlUtf8(const std::string& path, const char* xml, size_t size);
 
 // Splits logical bytes into pages with their CRCs (the last page is zero-padded).
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical);
-// The same written to `out` a few pages at a time, without a second whole copy.
-void WritePages(const std::vector<uint8_t>& logical, std::ostream& out);
 
 // The 48-byte file header.
 struct Header {

@@ -118,14 +118,24 @@ uint32_t LogicalSink::TailCrc(size_t n) const {
   return Crc32c(last.data(), n);
 }
 
-void LogicalSink::WritePage(uint64_t index, const uint8_t* payload, size_t n) {
-  uint8_t page[kPageSize] = {};
-  std::memcpy(page, payload, n);
+namespace {
+
+// A page of `n` <= kPagePayload payload bytes, zero-padded, with its CRC, into `page` (kPageSize bytes).
+void MakePage(const uint8_t* payload, size_t n, uint8_t* page) {
+  std::memset(page, 0, kPageSize);
+  if (n) std::memcpy(page, payload, n);
   const uint32_t crc = Crc32c(page, kPagePayload);
   page[1020] = crc >> 24;
   page[1021] = (crc >> 16) & 0xFF;
   page[1022] = (crc >> 8) & 0xFF;
   page[1023] = crc & 0xFF;
+}
+
+}  // namespace
+
+void LogicalSink::WritePage(uint64_t index, const uint8_t* payload, size_t n) {
+  uint8_t page[kPageSize];
+  MakePage(payload, n, page);
   if (index == 0) pages_->seekp(0);  // the other pages follow each other
   pages_->write(reinterpret_cast<const char*>(page), kPageSize);
 }
@@ -193,24 +203,11 @@ void CopyPayloads(const std::string& path, const uint8_t* pages, uint64_t first,
   }
 }
 
-// Page `p` of the logical bytes with its CRC, into `page` (kPageSize bytes; the last page zero-padded).
-void MakePage(const std::vector<uint8_t>& logical, uint64_t p, uint8_t* page) {
-  const size_t begin = p * kPagePayload;
-  const size_t n = std::min<size_t>(kPagePayload, logical.size() - std::min(begin, logical.size()));
-  std::memset(page, 0, kPageSize);
-  if (n) std::memcpy(page, logical.data() + begin, n);
-  const uint32_t crc = Crc32c(page, kPagePayload);
-  page[1020] = crc >> 24;
-  page[1021] = (crc >> 16) & 0xFF;
-  page[1022] = (crc >> 8) & 0xFF;
-  page[1023] = crc & 0xFF;
-}
-
 uint64_t PageCount(const std::vector<uint8_t>& logical) {
   return std::max<uint64_t>(1, (logical.size() + kPagePayload - 1) / kPagePayload);
 }
 
-constexpr uint64_t kPagesPerChunk = 1024;  // 1 MiB of file read or written at a time
+constexpr uint64_t kPagesPerChunk = 1024;  // 1 MiB of file read at a time when a file is opened
 
 }  // namespace
 
@@ -219,28 +216,6 @@ std::vector<uint8_t> LogicalFromPages(const std::string& path, const std::vector
   const uint64_t pages = physical.size() / kPageSize;
   std::vector<uint8_t> logical(pages * kPagePayload);
   CopyPayloads(path, physical.data(), 0, pages, logical.data());
-  return logical;
-}
-
-std::vector<uint8_t> LogicalFromPageFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) ThrowInputError(path, "", "", "cannot open for reading");
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) ThrowInputError(path, "", "", "cannot determine the file size");
-  in.seekg(0);
-  CheckWholePages(path, static_cast<uint64_t>(size));
-  const uint64_t pages = static_cast<uint64_t>(size) / kPageSize;
-  std::vector<uint8_t> logical(pages * kPagePayload);
-  std::vector<uint8_t> chunk(std::min(pages, kPagesPerChunk) * kPageSize);
-  for (uint64_t first = 0; first < pages; first += kPagesPerChunk) {
-    const uint64_t count = std::min(kPagesPerChunk, pages - first);
-    if (!in.read(reinterpret_cast<char*>(chunk.data()), static_cast<std::streamsize>(count * kPageSize))) {
-      ThrowInputError(path, fmt::format("page {} (byte offset {})", first, first * kPageSize), "",
-                      "read failed (the file changed while it was read?)");
-    }
-    CopyPayloads(path, chunk.data(), first, count, logical.data());
-  }
   return logical;
 }
 
@@ -306,18 +281,12 @@ void LogicalBytes::Read(uint64_t offset, uint64_t n, uint8_t* out) const {
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical) {
   const uint64_t pages = PageCount(logical);
   std::vector<uint8_t> physical(pages * kPageSize);
-  for (uint64_t p = 0; p < pages; ++p) MakePage(logical, p, physical.data() + p * kPageSize);
-  return physical;
-}
-
-void WritePages(const std::vector<uint8_t>& logical, std::ostream& out) {
-  const uint64_t pages = PageCount(logical);
-  std::vector<uint8_t> chunk(std::min(pages, kPagesPerChunk) * kPageSize);
-  for (uint64_t first = 0; first < pages; first += kPagesPerChunk) {
-    const uint64_t count = std::min(kPagesPerChunk, pages - first);
-    for (uint64_t p = 0; p < count; ++p) MakePage(logical, first + p, chunk.data() + p * kPageSize);
-    out.write(reinterpret_cast<const char*>(chunk.data()), static_cast<std::streamsize>(count * kPageSize));
+  for (uint64_t p = 0; p < pages; ++p) {
+    const size_t begin = p * kPagePayload;
+    const size_t n = std::min<size_t>(kPagePayload, logical.size() - std::min(begin, logical.size()));
+    MakePage(logical.data() + begin, n, physical.data() + p * kPageSize);
   }
+  return physical;
 }
 
 Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical) {
