@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The scaling benchmark of issue #34: every command of a session on the built-in parking lot at growing sizes.
 
-    /usr/bin/python3 bench/scale.py [--sizes 1,4,16] [--work DIR] [--markdown FILE]
+    /usr/bin/python3 bench/scale.py [--sizes 1,4,16] [--work DIR] [--markdown FILE] [--binary PATH]
 
 Sizes are in millions of rays (a square grid: 4 = 2000 x 2000). For each size the script scans the parking lot to
 E57 and then runs, each as its own process under /usr/bin/time (wall seconds and peak resident memory):
@@ -9,7 +9,9 @@ E57 and then runs, each as its own process under /usr/bin/time (wall seconds and
 200 x 200-cell hole at every size, centred on the hatchback), `remove` (the same strokes) and `convert` to LAS.
 The last table gives each command's cost exponent k (time ~ rays^k, a least-squares fit of log time on log rays
 over the sizes run). The machine's CPU and load are printed with the results: read the times of one run as
-ratios. Needs the built CLI (build/release/lidarshop) and its Python module (build/release/python).
+ratios. A command that fails (the memory budget refusing it) is reported in the table with its message. Needs
+the built CLI (build/release/lidarshop, or --binary) and its Python module (build/release/python); 100 M rays
+need about 22 GB of memory for `remove` and about 7 GB of disk.
 """
 import argparse
 import json
