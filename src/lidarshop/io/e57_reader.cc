@@ -431,22 +431,30 @@ struct PointRecords {
   template <typename Visit>
   void ForEachBlock(const Field* field, Visit&& visit) const {
     LIDARSHOP_CHECK(field != nullptr);
-    const size_t index = field - fields.data();
-    // The whole stream is checked before the first block, with the message decoding it whole would give.
-    CheckStreamHolds(*field, streams.sizes[index], count, where);
+    CheckHolds(field);
     std::vector<uint8_t> bytes;
     std::vector<double> values;
-    const uint64_t bits = static_cast<uint64_t>(field->bits);
     for (int64_t first = 0; first < count; first += kRecordsPerBlock) {
       const int64_t n = std::min(kRecordsPerBlock, count - first);
-      // kRecordsPerBlock is a multiple of 8: every block starts on a whole byte.
-      const uint64_t begin = static_cast<uint64_t>(first) * bits / 8;
-      const uint64_t end = std::min(streams.sizes[index], (static_cast<uint64_t>(first + n) * bits + 7) / 8);
-      streams.Gather(ctx.logical, index, begin, end, &bytes);
-      values.resize(n);
-      DecodeField(*field, bytes.data(), bytes.size(), n, values.data(), where);
+      DecodeBlock(field, first, n, &bytes, &values);
       visit(first, n, values.data());
     }
+  }
+  // The whole stream of `field` is checked before its first block, with the message decoding it whole gave.
+  void CheckHolds(const Field* field) const {
+    CheckStreamHolds(*field, streams.sizes[field - fields.data()], count, where);
+  }
+  // Records [first, first + n) of `field` into `values` (`bytes`: scratch); `first` is a multiple of
+  // kRecordsPerBlock, a multiple of 8, so every block starts on a whole byte.
+  void DecodeBlock(const Field* field, int64_t first, int64_t n, std::vector<uint8_t>* bytes,
+                   std::vector<double>* values) const {
+    const size_t index = field - fields.data();
+    const uint64_t bits = static_cast<uint64_t>(field->bits);
+    const uint64_t begin = static_cast<uint64_t>(first) * bits / 8;
+    const uint64_t end = std::min(streams.sizes[index], (static_cast<uint64_t>(first + n) * bits + 7) / 8);
+    streams.Gather(ctx.logical, index, begin, end, bytes);
+    values->resize(n);
+    DecodeField(*field, bytes->data(), bytes->size(), n, values->data(), where);
   }
   static constexpr int64_t kRecordsPerBlock = int64_t{1} << 16;
 };
@@ -594,16 +602,16 @@ class CoordinateBlocks {
     const int64_t count = records_.count;
     if (count == 0) return;  // else cartesian || spherical (checked by ReadPointRecords)
     // The whole streams are checked first, in the order decoding them whole did.
-    if (state_field_) CheckWhole(state_field_);
-    for (const Field* field : fields_) CheckWhole(field);
+    if (state_field_) records_.CheckHolds(state_field_);
+    for (const Field* field : fields_) records_.CheckHolds(field);
     for (int64_t first = 0; first < count; first += PointRecords::kRecordsPerBlock) {
       const int64_t n = std::min(PointRecords::kRecordsPerBlock, count - first);
       state_.assign(n, 0);
       if (state_field_) {
-        Decode(state_field_, first, n, &values_[0]);
+        records_.DecodeBlock(state_field_, first, n, &bytes_, &values_[0]);
         for (int64_t j = 0; j < n; ++j) state_[j] = values_[0][j] == 0.0 ? 0 : values_[0][j] == 1.0 ? 1 : 2;
       }
-      for (int k = 0; k < 3; ++k) Decode(fields_[k], first, n, &values_[k]);
+      for (int k = 0; k < 3; ++k) records_.DecodeBlock(fields_[k], first, n, &bytes_, &values_[k]);
       xyz_.resize(3 * n);
       for (int64_t j = 0; j < n; ++j) {
         if (records_.cartesian) {
@@ -627,22 +635,6 @@ class CoordinateBlocks {
   }
 
  private:
-  void CheckWhole(const Field* field) const {
-    CheckStreamHolds(*field, records_.streams.sizes[field - records_.fields.data()], records_.count,
-                     records_.where);
-  }
-  // Records [first, first + n) of `field`.
-  void Decode(const Field* field, int64_t first, int64_t n, std::vector<double>* out) {
-    const size_t index = field - records_.fields.data();
-    const uint64_t bits = static_cast<uint64_t>(field->bits);
-    const uint64_t begin = static_cast<uint64_t>(first) * bits / 8;
-    const uint64_t end =
-        std::min(records_.streams.sizes[index], (static_cast<uint64_t>(first + n) * bits + 7) / 8);
-    records_.streams.Gather(records_.ctx.logical, index, begin, end, &bytes_);
-    out->resize(n);
-    DecodeField(*field, bytes_.data(), bytes_.size(), n, out->data(), records_.where);
-  }
-
   const PointRecords& records_;
   const Field* fields_[3] = {nullptr, nullptr, nullptr};
   const Field* state_field_ = nullptr;

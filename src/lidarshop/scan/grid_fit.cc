@@ -145,7 +145,8 @@ void FitGrid(Scan* scan) {
   std::vector<int> azimuth_counts(cols, 0), elevation_counts(rows, 0);
   constexpr int kBandRows = 256;
   std::vector<std::vector<std::pair<int, double>>> row_azimuths(kBandRows);
-  // The returns of one row: its elevation angles (when `elevations` is not null) and its (column, azimuth).
+  // The returns of one row: the counting pass (`elevations` not null) gets its elevation angles and the
+  // columns of its azimuths, the placing pass (null) its (column, azimuth).
   auto row_angles = [&](int row, std::vector<double>* elevations,
                         std::vector<std::pair<int, double>>* azimuths) {
     const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
@@ -157,7 +158,8 @@ void FitGrid(Scan* scan) {
       if (horizontal == 0 && z == 0) continue;
       if (elevations != nullptr) elevations->push_back(std::atan2(z, horizontal));
       if (horizontal > kMinCosElevationForAzimuth * std::hypot(horizontal, z)) {
-        azimuths->push_back({col, std::atan2(x, y)});
+        // The counting pass needs the column only.
+        azimuths->push_back({col, elevations != nullptr ? 0.0 : std::atan2(x, y)});
       }
     }
   };
