@@ -169,6 +169,27 @@ Returns a SegmentResult (mask: uint8 255 = object).)doc");
 hole_mask: (rows, cols), non-zero or True = fill this cell. options: a FillOptions, a dict or keywords.
 Returns a FillResult: .scan (the filled Scan, synthesized cells flagged), .filled, counts and .timings.)doc");
   m.def(
+      "fill_window",
+      [](const Scan& scan, const py::object& hole, const py::object& options, const py::kwargs& kwargs) {
+        const cv::Mat hole_mask = MaskOf(hole, scan, "hole_mask");
+        const FillOptions fill_options = OptionsOf<FillOptions>(options, kwargs);
+        py::gil_scoped_release release;
+        return FillScanWindow(scan, hole_mask, fill_options);
+      },
+      py::arg("scan"), py::arg("hole_mask"), py::arg("options") = py::none(),
+      R"doc(fill() without the whole scan in its result: .scan and the per-cell images cover the window the fill
+worked in (.window_row, .window_col, .window_rows, .window_cols), so a fill in a 100 M-ray station costs what
+its hole costs. apply_fill(result, scan) writes it into the scan.)doc");
+  m.def(
+      "apply_fill",
+      [](const FillResult& fill, Scan& scan) {
+        py::gil_scoped_release release;
+        ApplyFill(fill, &scan);
+      },
+      py::arg("fill"), py::arg("scan"),
+      R"doc(Writes a fill_window() result into the scan it was computed from, in place: the scan then equals
+fill()'s .scan.)doc");
+  m.def(
       "remove_object",
       [](const Scan& scan, const py::object& strokes, const py::object& options,
          const std::optional<std::vector<Scan>>& stations, const py::kwargs& kwargs) -> py::object {

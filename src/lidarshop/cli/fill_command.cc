@@ -244,10 +244,15 @@ int RunFill(int argc, char** argv) {
           return 0;
         }
         auto progress = Progress::ForTerminal("fill", cv::countNonZero(hole), quiet);
-        const FillResult result = FillScan(scan, hole, options, progress.get());
+        // The fill's window pasted into the scan read here: no copy of the whole scan (FillScanWindow).
+        FillResult result = FillScanWindow(scan, hole, options, progress.get());
         if (progress) progress->Finish();
-        WriteScanFile(output_path, {result.scan});
-        WarnFromStationDropped(output_path, result.scan);
+        Scan filled = scan;  // shares the file's buffers, which nothing else reads
+        ApplyFill(result, &filled);
+        WriteScanFile(output_path, {filled});
+        WarnFromStationDropped(output_path, filled);
+        if (!synthesized_mask_path.empty() || !debug_dir.empty())
+          PadFillImages(scan.rows, scan.cols, &result);
         if (!synthesized_mask_path.empty()) WriteImage(synthesized_mask_path, result.filled);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         if (!debug_dir.empty()) WriteDebug(debug_dir, result, hole);
@@ -346,7 +351,7 @@ int RunRemove(int argc, char** argv) {
           return 0;
         }
         auto progress = Progress::ForTerminal("segment", 1, quiet);  // RemoveObject restarts it for the fill
-        const RemoveResult removed = RemoveObject(scan, strokes, remove, progress.get());
+        const RemoveResult removed = RemoveObjectWindow(scan, strokes, remove, progress.get());
         if (progress) progress->Finish();
         const FillResult& result = removed.fill;
         const cv::Mat& hole = removed.hole;
@@ -354,8 +359,10 @@ int RunRemove(int argc, char** argv) {
         if (remove.keep_object) {
           WriteScanWithLayer(output_path, scan, removed.behind);
         } else {
-          WriteScanFile(output_path, {result.scan});
-          WarnFromStationDropped(output_path, result.scan);
+          Scan without = scan;  // shares the file's buffers, which nothing reads after this
+          ApplyFill(result, &without);
+          WriteScanFile(output_path, {without});
+          WarnFromStationDropped(output_path, without);
         }
         if (!mask_out_path.empty()) WriteImage(mask_out_path, hole);
         WriteJsonOutput(json_path, CommandJson(ToJson(remove), ToJson(removed)));

@@ -584,13 +584,12 @@ Scan PlaceAlongRays(const Inputs& in, const HoleValues& values, FillResult* resu
 
 namespace {
 
-// The window of FillOptions::window_margin: the hole's bounding box grown, then doubled until it holds enough
-// known returns (the whole scan at most).
-cv::Rect FillWindow(const Scan& scan, const cv::Mat& hole, const cv::Mat& known_valid, int64_t hole_cells,
+// The window of FillOptions::window_margin: the hole's bounding box `box` grown, then doubled until it holds
+// enough known returns (the whole scan at most). Only the windows tried are read.
+cv::Rect FillWindow(const Scan& scan, const cv::Mat& hole, const cv::Rect& box, int64_t hole_cells,
                     const FillOptions& options) {
   const cv::Rect whole(0, 0, scan.cols, scan.rows);
   if (options.window_margin <= 0) return whole;
-  const cv::Rect box = cv::boundingRect(hole);
   int64_t margin = std::max<int64_t>(
       options.window_min_margin_cells,
       static_cast<int64_t>(std::ceil(options.window_margin * std::max(box.width, box.height))));
@@ -601,72 +600,20 @@ cv::Rect FillWindow(const Scan& scan, const cv::Mat& hole, const cv::Mat& known_
     const cv::Rect window(static_cast<int>(x0), static_cast<int>(y0), static_cast<int>(x1 - x0),
                           static_cast<int>(y1 - y0));
     if (window == whole) return whole;
-    if (cv::countNonZero(known_valid(window)) >= options.window_min_known_ratio * hole_cells) return window;
+    const int64_t known = cv::countNonZero((scan.valid(window) != 0) & (hole(window) == 0));
+    if (known >= options.window_min_known_ratio * hole_cells) return window;
     margin *= 2;
   }
 }
 
-// `windowed`, the fill of the window `window` of `scan`, as the fill of the whole scan: the cells outside the
-// window copied, the per-cell images padded with their "not in the hole" values.
-FillResult ExpandWindowedFill(FillResult windowed, const Scan& scan, const cv::Rect& window) {
-  FillResult result = std::move(windowed);
-  Scan whole = Clone(scan);
-  PasteScan(result.scan, window, &whole);
-  result.scan = std::move(whole);
-  auto pad = [&](cv::Mat* image, const cv::Scalar& outside) {
-    if (image->empty()) return;
-    cv::Mat full(scan.rows, scan.cols, image->type(), outside);
-    image->copyTo(full(window));
-    *image = full;
-  };
-  pad(&result.filled, cv::Scalar(0));
-  pad(&result.gradient_magnitude_before, cv::Scalar(0));
-  pad(&result.gradient_magnitude_after, cv::Scalar(0));
-  pad(&result.fill_order, cv::Scalar(-1));
-  if (!result.source_cell.empty()) {
-    result.source_cell.forEach<cv::Vec2i>([&](cv::Vec2i& source, const int*) {
-      if (source[0] >= 0) source += cv::Vec2i(window.y, window.x);
-    });
-  }
-  pad(&result.source_cell, cv::Scalar(-1, -1));
-  result.window_row = window.y;
-  result.window_col = window.x;
-  result.window_rows = window.height;
-  result.window_cols = window.width;
-  return result;
-}
-
-}  // namespace
-
-FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options,
-                    Progress* progress) {
-  options.Check();
-  CheckInputs(scan, hole_in);
-  Timer total;
-  FillResult result;
-  Inputs in;
-  in.scan = &scan;
-  in.hole = hole_in != 0;
-  result.hole_cells = cv::countNonZero(in.hole);
-  if (result.hole_cells == 0) {
-    result.scan = Clone(scan);
-    result.filled = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
-    result.warnings.push_back(
-        "the hole mask is empty (no non-zero cell): nothing was filled, the output is a copy "
-        "of the scan");
-    result.timings.total_s = total.Seconds();
-    return result;
-  }
-  in.known_valid = (scan.valid != 0) & (in.hole == 0);
-  if (cv::countNonZero(in.known_valid) == 0) {
-    throw InputError(
-        "the hole mask leaves no known cell with a return: there is nothing to fill it from (the mask covers "
-        "every return of the scan)");
-  }
-  for (int y = 0; y < scan.rows; ++y) {
-    for (int x = 0; x < scan.cols; ++x) {
-      if (!in.hole.at<uint8_t>(y, x)) continue;
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(y, x);
+// Throws InputError when a cell of the hole (inside `box`) has no ray direction.
+void CheckHoleDirections(const Scan& scan, const cv::Mat& hole, const cv::Rect& box) {
+  for (int y = box.y; y < box.y + box.height; ++y) {
+    const uint8_t* in_hole = hole.ptr<uint8_t>(y);
+    const cv::Vec3f* direction = scan.direction.ptr<cv::Vec3f>(y);
+    for (int x = box.x; x < box.x + box.width; ++x) {
+      if (!in_hole[x]) continue;
+      const cv::Vec3f d = direction[x];
       if (!(std::abs(d.dot(d) - 1.0f) < 1e-2f)) {
         throw InputError(fmt::format(
             "cell (row {}, col {}) of the hole has no ray direction: the scan's grid is unknown there", y,
@@ -674,15 +621,88 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole_in, const FillOptions&
       }
     }
   }
-  if (const cv::Rect window = FillWindow(scan, in.hole, in.known_valid, result.hole_cells, options);
-      window.area() < scan.rows * scan.cols) {
-    FillOptions whole_window = options;
-    whole_window.window_margin = 0;
-    FillResult windowed = FillScan(CropScan(scan, window), hole_in(window), whole_window, progress);
-    result = ExpandWindowedFill(std::move(windowed), scan, window);
+}
+
+}  // namespace
+
+void PadFillImages(int rows, int cols, FillResult* fill) {
+  const cv::Rect window = fill->Window();
+  auto pad = [&](cv::Mat* image, const cv::Scalar& outside) {
+    if (image->rows == rows && image->cols == cols) return;
+    cv::Mat full(rows, cols, image->empty() ? CV_8U : image->type(), outside);
+    if (!image->empty()) image->copyTo(full(window));
+    *image = full;
+  };
+  pad(&fill->filled, cv::Scalar(0));  // always: an empty hole's fill has filled nothing
+  auto pad_debug = [&](cv::Mat* image, const cv::Scalar& outside) {
+    if (!image->empty()) pad(image, outside);
+  };
+  pad_debug(&fill->gradient_magnitude_before, cv::Scalar(0));
+  pad_debug(&fill->gradient_magnitude_after, cv::Scalar(0));
+  pad_debug(&fill->fill_order, cv::Scalar(-1));
+  pad_debug(&fill->source_cell, cv::Scalar(-1, -1));
+}
+
+void ApplyFill(const FillResult& fill, Scan* scan) {
+  const cv::Rect window = fill.Window();
+  if (window.area() == 0) return;
+  PasteScan(fill.scan, window, scan);
+}
+
+FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& options, Progress* progress) {
+  Timer total;
+  FillResult result = FillScanWindow(scan, hole, options, progress);
+  if (result.Window() == cv::Rect(0, 0, scan.cols, scan.rows)) return result;
+  Scan whole = Clone(scan);
+  ApplyFill(result, &whole);
+  result.scan = std::move(whole);
+  PadFillImages(scan.rows, scan.cols, &result);
+  result.timings.total_s = total.Seconds();
+  return result;
+}
+
+FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOptions& options,
+                          Progress* progress) {
+  options.Check();
+  CheckInputs(scan, hole_in);
+  Timer total;
+  FillResult result;
+  const cv::Rect hole_box = cv::boundingRect(hole_in);
+  result.hole_cells = hole_box.empty() ? 0 : cv::countNonZero(hole_in(hole_box));
+  if (result.hole_cells == 0) {
+    result.warnings.push_back(
+        "the hole mask is empty (no non-zero cell): nothing was filled, the output is a copy "
+        "of the scan");
     result.timings.total_s = total.Seconds();
     return result;
   }
+  const cv::Rect whole(0, 0, scan.cols, scan.rows);
+  if (const cv::Rect window = FillWindow(scan, hole_in, hole_box, result.hole_cells, options);
+      window != whole) {
+    CheckHoleDirections(scan, hole_in, hole_box);
+    FillOptions whole_window = options;
+    whole_window.window_margin = 0;
+    result = FillScanWindow(CropScan(scan, window), hole_in(window), whole_window, progress);
+    result.window_row = window.y;
+    result.window_col = window.x;
+    if (!result.source_cell.empty()) {
+      result.source_cell.forEach<cv::Vec2i>([&](cv::Vec2i& source, const int*) {
+        if (source[0] >= 0) source += cv::Vec2i(window.y, window.x);
+      });
+    }
+    result.timings.total_s = total.Seconds();
+    return result;
+  }
+  Inputs in;
+  in.scan = &scan;
+  in.hole = hole_in != 0;
+  in.known_valid = (scan.valid != 0) & (in.hole == 0);
+  if (cv::countNonZero(in.known_valid) == 0) {
+    throw InputError(
+        "the hole mask leaves no known cell with a return: there is nothing to fill it from (the mask covers "
+        "every return of the scan)");
+  }
+  CheckHoleDirections(scan, in.hole, hole_box);
   result.window_rows = scan.rows;
   result.window_cols = scan.cols;
   in.range = RangeImage(scan);

@@ -166,6 +166,7 @@ struct FillResult {
   // The window the fill worked in (FillOptions::window_margin): first row and column, rows and columns; the
   // whole scan when not windowed.
   int window_row = 0, window_col = 0, window_rows = 0, window_cols = 0;
+  cv::Rect Window() const { return {window_col, window_row, window_cols, window_rows}; }
   int64_t candidates_evaluated = 0;
   // Debug images (patch methods; empty otherwise), CV_32F / CV_32S rows x cols:
   cv::Mat gradient_magnitude_before;  // |∇r| of the input, metres per cell, 0 in the hole
@@ -188,6 +189,24 @@ const StructInfo& InfoOf<FillResult>();
 // An empty mask returns a copy of the scan, with a warning.
 FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
                     Progress* progress = nullptr);
+
+// FillScan without the whole scan in its result, so that what a fill costs follows the hole: `scan` and the
+// per-cell images (filled, gradient magnitudes, fill order, source cells) cover the window the fill worked in
+// (FillResult::Window()), not the scan; `source_cell` holds the scan's rows and columns. Every number is FillScan's, every
+// cell of the window too. An empty mask gives an empty window. A caller that owns the scan applies the result
+// with ApplyFill; FillScan is this, then a copy of the scan with the window pasted in (at 100 M rays that copy
+// and the padded images cost 31 of its 33 s, bench/results/scale.md). Throws as FillScan.
+FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
+                          Progress* progress = nullptr);
+
+// Writes a FillScanWindow result into the scan it was computed from (PasteScan of its window): `*scan` then
+// equals FillScan's `scan`. Throws std::logic_error when the window does not fit the scan.
+void ApplyFill(const FillResult& fill, Scan* scan);
+
+// The per-cell images of a FillScanWindow result brought to the scan's size (rows x cols), with FillScan's
+// values outside the window (filled 0, gradients 0, fill order −1, source (−1, −1)); `scan` is left as it is.
+// For writers of masks and debug pictures: 21 bytes a cell.
+void PadFillImages(int rows, int cols, FillResult* fill);
 
 // The hole grown by `margin_cells` (a disc), e.g. an object mask grown so that mixed pixels at its silhouette
 // are filled too. CV_8U 255/0.

@@ -220,6 +220,66 @@ TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
   EXPECT_GT(sources, 0);
 }
 
+TEST(FillScanWindow, HoldsTheWindowOnlyAndAppliedEqualsFillScan) {
+  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  FillOptions options;
+  options.window_min_margin_cells = 64;
+  const FillResult whole = FillScan(c.scan, c.hole, options);
+  FillResult windowed = FillScanWindow(c.scan, c.hole, options);
+  const cv::Rect window = windowed.Window();
+  ASSERT_EQ(window, whole.Window());
+  ASSERT_LT(window.area(), c.scan.rows * c.scan.cols);
+  // Everything per cell covers the window, not the scan.
+  EXPECT_EQ(windowed.scan.rows, window.height);
+  EXPECT_EQ(windowed.scan.cols, window.width);
+  for (const cv::Mat* image :
+       {&windowed.filled, &windowed.gradient_magnitude_before, &windowed.gradient_magnitude_after,
+        &windowed.fill_order, &windowed.source_cell})
+    EXPECT_EQ(image->size(), window.size());
+  EXPECT_EQ(windowed.synthesized_cells, whole.synthesized_cells);
+  EXPECT_EQ(windowed.patches, whole.patches);
+  // Applied to a copy of the input it is FillScan's scan, channel by channel.
+  Scan applied = Clone(c.scan);
+  ApplyFill(windowed, &applied);
+  auto same = [](const cv::Mat& a, const cv::Mat& b) {
+    return a.size() == b.size() && a.type() == b.type() &&
+           (a.empty() || cv::norm(a.reshape(1), b.reshape(1), cv::NORM_INF) == 0.0);
+  };
+  EXPECT_TRUE(same(applied.range, whole.scan.range));
+  EXPECT_TRUE(same(applied.point, whole.scan.point));
+  EXPECT_TRUE(same(applied.valid, whole.scan.valid));
+  EXPECT_TRUE(same(applied.color, whole.scan.color));
+  EXPECT_TRUE(same(applied.label, whole.scan.label));
+  EXPECT_TRUE(same(applied.synthesized, whole.scan.synthesized));
+  EXPECT_TRUE(same(applied.direction, whole.scan.direction));
+  // Padded, the images are FillScan's (source cells in the scan's rows and columns in both).
+  PadFillImages(c.scan.rows, c.scan.cols, &windowed);
+  EXPECT_TRUE(same(windowed.filled, whole.filled));
+  EXPECT_TRUE(same(windowed.fill_order, whole.fill_order));
+  EXPECT_TRUE(same(windowed.source_cell, whole.source_cell));
+  EXPECT_TRUE(same(windowed.gradient_magnitude_after, whole.gradient_magnitude_after));
+}
+
+TEST(FillScanWindow, AnEmptyMaskGivesAnEmptyWindowThatChangesNothing) {
+  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const cv::Mat nothing = cv::Mat::zeros(c.scan.rows, c.scan.cols, CV_8U);
+  FillResult result = FillScanWindow(c.scan, nothing);
+  EXPECT_EQ(result.Window().area(), 0);
+  EXPECT_EQ(result.hole_cells, 0);
+  ASSERT_EQ(result.warnings.size(), 1u);
+  Scan applied = Clone(c.scan);
+  ApplyFill(result, &applied);
+  EXPECT_EQ(cv::norm(applied.range, c.scan.range, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(applied.synthesized.empty());
+  PadFillImages(c.scan.rows, c.scan.cols, &result);
+  ASSERT_EQ(result.filled.size(), c.scan.range.size());
+  EXPECT_EQ(cv::countNonZero(result.filled), 0);
+  // FillScan of the same mask: a copy of the scan, nothing filled.
+  const FillResult copy = FillScan(c.scan, nothing);
+  EXPECT_EQ(cv::countNonZero(copy.filled), 0);
+  EXPECT_EQ(cv::norm(copy.scan.range, c.scan.range, cv::NORM_INF), 0.0);
+}
+
 TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
   const Case c = MakeCase(WideWallScene().c_str(), 2);
   FillOptions options;

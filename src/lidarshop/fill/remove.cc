@@ -11,8 +11,8 @@ namespace lidarshop {
 
 void RemoveOptions::Check() const { Validate(*this); }
 
-RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options,
-                          Progress* progress) {
+RemoveResult RemoveObjectWindow(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options,
+                                Progress* progress) {
   options.Check();
   RemoveResult result;
   result.cut = SegmentObject(scan, strokes, options.segment);
@@ -21,11 +21,33 @@ RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const Remove
   if (options.fill_enclosed_no_return) object |= EnclosedNoReturnCells(object, scan.valid);
   result.hole = GrowHole(object, options.margin_cells);
   if (progress) progress->Restart("fill", cv::countNonZero(result.hole));
-  result.fill = FillScan(scan, result.hole, options.fill, progress);
-  if (options.keep_object)
-    result.behind = MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask != 0));
+  result.fill = FillScanWindow(scan, result.hole, options.fill, progress);
+  if (options.keep_object) {
+    const cv::Rect window = result.fill.Window();
+    if (window == cv::Rect(0, 0, scan.cols, scan.rows)) {
+      result.behind = MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask != 0));
+    } else {  // the scan without returns, the window's filled cells of the object pasted in
+      result.behind = MaskScan(scan, cv::Mat::zeros(scan.rows, scan.cols, CV_8U));
+      if (window.area() > 0) {
+        PasteScan(MaskScan(result.fill.scan, result.fill.filled & (result.cut.mask(window) != 0)), window,
+                  &result.behind);
+      }
+    }
+  }
   result.warnings = result.cut.warnings;
   result.warnings.insert(result.warnings.end(), result.fill.warnings.begin(), result.fill.warnings.end());
+  return result;
+}
+
+RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options,
+                          Progress* progress) {
+  RemoveResult result = RemoveObjectWindow(scan, strokes, options, progress);
+  if (result.fill.Window() != cv::Rect(0, 0, scan.cols, scan.rows)) {
+    Scan whole = Clone(scan);
+    ApplyFill(result.fill, &whole);
+    result.fill.scan = std::move(whole);
+    PadFillImages(scan.rows, scan.cols, &result.fill);
+  }
   return result;
 }
 

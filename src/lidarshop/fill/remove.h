@@ -29,7 +29,7 @@ const StructInfo& InfoOf<RemoveOptions>();
 struct RemoveResult {
   SegmentResult cut;  // the object's mask and the cut's numbers
   cv::Mat hole;       // CV_8U 255 = the object's cells (and enclosed no-return cells) grown by the margin
-  FillResult fill;    // fill.scan: the scan without the object
+  FillResult fill;    // fill.scan: the scan without the object (RemoveObjectWindow: its window)
   // keep_object: the filled background behind the object's own cells only (the margin ring is background in
   // front already), every other cell without a return, flagged synthesized; empty otherwise.
   Scan behind;
@@ -43,5 +43,10 @@ const StructInfo& InfoOf<RemoveResult>();
 // Throws InputError for strokes of another size or without object / background cells (as SegmentObject).
 RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options = {},
                           Progress* progress = nullptr);
+
+// RemoveObject whose `fill` is FillScanWindow's: the window around the hole, not the whole scan (`behind` is
+// the same); ApplyFill(result.fill, &scan) gives RemoveObject's fill.scan in a scan the caller owns.
+RemoveResult RemoveObjectWindow(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options = {},
+                                Progress* progress = nullptr);
 
 }  // namespace lidarshop

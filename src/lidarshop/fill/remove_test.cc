@@ -88,6 +88,33 @@ TEST(RemoveObject, KeepObjectGivesTheFillAsALayerBehindTheObjectOnly) {
   EXPECT_GT(well_behind, box_cells * 3 / 4);
 }
 
+TEST(RemoveObjectWindow, ItsFillAppliedAndItsLayerBehindAreRemoveObjects) {
+  const Case c = MakeCase();
+  RemoveOptions options;
+  options.keep_object = true;
+  options.fill.window_min_margin_cells = 8;  // a window smaller than this small scan
+  options.fill.window_margin = 0.5;
+  options.fill.window_min_known_ratio = 1.0;
+  const RemoveResult whole = RemoveObject(c.scan, c.strokes, options);
+  const RemoveResult windowed = RemoveObjectWindow(c.scan, c.strokes, options);
+  const cv::Rect window = windowed.fill.Window();
+  ASSERT_LT(window.area(), c.scan.rows * c.scan.cols);
+  EXPECT_EQ(windowed.fill.scan.range.size(), window.size());
+  EXPECT_EQ(cv::countNonZero(windowed.hole != whole.hole), 0);
+  Scan applied = Clone(c.scan);
+  ApplyFill(windowed.fill, &applied);
+  EXPECT_EQ(cv::norm(applied.range, whole.fill.scan.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(applied.synthesized, whole.fill.scan.synthesized, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(applied.color.reshape(1), whole.fill.scan.color.reshape(1), cv::NORM_INF), 0.0);
+  // The layer behind is the same scan either way: the window's filled object cells, no return elsewhere.
+  EXPECT_GT(cv::countNonZero(whole.behind.valid), 0);
+  EXPECT_EQ(cv::norm(windowed.behind.valid, whole.behind.valid, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(windowed.behind.range, whole.behind.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(windowed.behind.synthesized, whole.behind.synthesized, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(windowed.behind.direction.reshape(1), whole.behind.direction.reshape(1), cv::NORM_INF),
+            0.0);
+}
+
 TEST(RemoveObject, EnclosedNoReturnCellsJoinTheHole) {
   // A ring-shaped object with a no-return cell inside it, one inside its ring band, and one outside.
   cv::Mat mask(9, 9, CV_8U, cv::Scalar(0));

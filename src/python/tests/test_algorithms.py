@@ -66,6 +66,24 @@ def test_fill_gives_synthesized_cells(scan):
     assert "synthesized" in result.summary() or result.summary()
 
 
+def test_fill_window_applied_equals_fill(scan):
+    hole = lidarshop.grow_hole((scan.label == 2).astype(np.uint8), 2) > 0
+    options = lidarshop.FillOptions(patch_radius=3, window_margin=0.5, window_min_margin_cells=4,
+                                    window_min_known_ratio=1.0)
+    whole = lidarshop.fill(scan, hole, options)
+    windowed = lidarshop.fill_window(scan, hole, options)
+    shape = (windowed.window_rows, windowed.window_cols)
+    assert shape[0] * shape[1] < scan.rows * scan.cols
+    assert windowed.scan.range.shape == shape and windowed.filled.shape == shape
+    assert windowed.synthesized_cells == whole.synthesized_cells
+    applied = scan.clone()
+    lidarshop.apply_fill(windowed, applied)
+    np.testing.assert_array_equal(applied.range, whole.scan.range)
+    np.testing.assert_array_equal(applied.synthesized, whole.scan.synthesized)
+    np.testing.assert_array_equal(applied.color, whole.scan.color)
+    assert not np.array_equal(applied.range, scan.range)  # the clone changed, the fixture did not
+
+
 def test_remove_object(scan):
     result = lidarshop.remove_object(scan, box_strokes(scan), margin_cells=1)
     assert result.cut.object_cells > 0
