@@ -12,8 +12,10 @@
 #include "lidarshop/fill/foreground.h"
 #include "lidarshop/fill/range_gradient.h"
 #include "lidarshop/fill/return_acceptance.h"
+#include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/pointset/normals.h"
+#include "lidarshop/scan/scan_window.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/util/timer.h"
@@ -176,10 +178,12 @@ void CopyFromSources(const Inputs& in, const cv::Mat& source, HoleValues* out) {
 
 // The joint image of the patch fill: the guide, `structure` channels (already scaled to grey levels), and the
 // has-return channel; zero in the hole.
-cv::Mat JointImage(const Inputs& in, const std::vector<cv::Mat>& structure) {
+// The structure channels are taken (zeroed in the hole in place) and released once merged.
+cv::Mat JointImage(const Inputs& in, std::vector<cv::Mat> structure) {
   std::vector<cv::Mat> planes;
   cv::split(in.guide, planes);
-  for (const cv::Mat& s : structure) planes.push_back(s.clone());
+  for (cv::Mat& s : structure) planes.push_back(std::move(s));
+  structure.clear();
   cv::Mat has_return;
   in.scan->valid.convertTo(has_return, CV_32F, 255.0 / 255.0);
   planes.push_back(has_return);
@@ -203,7 +207,7 @@ cv::Mat ScaledChannel(const cv::Mat& values, double scale) {
   return scaled;
 }
 
-InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure, const FillOptions& options,
+InpaintResult PatchFill(const Inputs& in, std::vector<cv::Mat> structure, const FillOptions& options,
                         Progress* progress, FillResult* result_counts) {
   // The fill's inpainting as described (FillOptions::inpaint), with the search and the channel weights that
   // the fill decides.
@@ -221,18 +225,26 @@ InpaintResult PatchFill(const Inputs& in, const std::vector<cv::Mat>& structure,
   for (size_t k = 0; k < structure.size(); ++k)
     inpaint.channel_weights.push_back(static_cast<float>(options.gradient_weight));
   inpaint.channel_weights.push_back(static_cast<float>(options.return_weight));
-  const cv::Mat joint = JointImage(in, structure);
+  cv::Mat joint = JointImage(in, std::move(structure));
   // The acceptance tests, and no sky brought into a patch whose known cells all returned
   // (fill/return_acceptance.h); the has-return channel is the joint image's last.
+  const int has_return_channel = joint.channels() - 1;
   auto strategies = [&] {
     InpaintStrategies chosen;
     if (inpaint.acceptance.enabled) {
       chosen.acceptance = std::make_unique<fill_internal::ReturnConsistentAcceptance>(
-          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), joint.channels() - 1, in.front);
+          MakeAcceptance(inpaint.acceptance, inpaint.channel_weights), has_return_channel, in.front);
     }
     return chosen;
   };
-  if (!options.offset_completion) return Inpaint(joint, in.hole, inpaint, strategies(), progress);
+  if (!options.offset_completion) {
+    // Inpaint() without two copies of the window: the session holds the joint image (ours is released) and
+    // the inpainted image is not made (the fill copies its channels from the sources).
+    InpaintSession session(joint, in.hole, inpaint, strategies(), progress);
+    joint.release();
+    session.Run();
+    return session.ResultWithoutImage();
+  }
 
   OffsetCompletionOptions offsets = options.offsets;
   if (offsets.channel_weights.empty()) offsets.channel_weights = inpaint.channel_weights;
@@ -302,15 +314,20 @@ void GradientFill(const Inputs& in, const FillOptions& options, Progress* progre
   }
   const auto gradient = OneSidedRangeGradient(field, in.known_valid);
   // Patches are matched on the range gradients (they tell a wall from the ground more sharply than those of
-  // 1/r), and the gradients of `field` are copied.
-  const auto matched = options.inverse_range ? OneSidedRangeGradient(in.range, in.known_valid) : gradient;
-  const double scale = std::max(AbsQuantile(matched.gx, in.known_valid, 0.9, 1e-9),
-                                AbsQuantile(matched.gy, in.known_valid, 0.9, 1e-9));
+  // 1/r), and the gradients of `field` are copied. Only the scaled channels outlive this block: the patch
+  // fill's peak holds no more than it needs (a window of a large station).
+  std::vector<cv::Mat> structure;
+  {
+    const auto matched = options.inverse_range ? OneSidedRangeGradient(in.range, in.known_valid) : gradient;
+    const double scale = std::max(AbsQuantile(matched.gx, in.known_valid, 0.9, 1e-9),
+                                  AbsQuantile(matched.gy, in.known_valid, 0.9, 1e-9));
+    structure.push_back(ScaledChannel(matched.gx, scale));
+    structure.push_back(ScaledChannel(matched.gy, scale));
+  }
   result->timings.gradients_s = timer.Seconds();
 
   timer.Restart();
-  const InpaintResult patches = PatchFill(
-      in, {ScaledChannel(matched.gx, scale), ScaledChannel(matched.gy, scale)}, options, progress, result);
+  const InpaintResult patches = PatchFill(in, std::move(structure), options, progress, result);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;
@@ -421,8 +438,10 @@ void DepthPatchFill(const Inputs& in, const FillOptions& options, Progress* prog
   const double high = AbsQuantile(in.range, in.known_valid, 0.95, low + 1e-3);
   cv::Mat shifted;
   in.range.convertTo(shifted, CV_32F, 1.0, -low);
-  const InpaintResult patches =
-      PatchFill(in, {ScaledChannel(shifted, high - low)}, options, progress, result);
+  std::vector<cv::Mat> structure;
+  structure.push_back(ScaledChannel(shifted, high - low));
+  shifted.release();
+  const InpaintResult patches = PatchFill(in, std::move(structure), options, progress, result);
   result->timings.inpaint_s = timer.Seconds();
   result->patches = patches.iterations;
   result->candidates_evaluated = patches.candidates_evaluated;
@@ -682,7 +701,8 @@ FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOp
     CheckHoleDirections(scan, hole_in, hole_box);
     FillOptions whole_window = options;
     whole_window.window_margin = 0;
-    result = FillScanWindow(CropScan(scan, window), hole_in(window), whole_window, progress);
+    // The window is read in place (CropScanView): no copy of its cells.
+    result = FillScanWindow(CropScanView(scan, window), hole_in(window), whole_window, progress);
     result.window_row = window.y;
     result.window_col = window.x;
     if (!result.source_cell.empty()) {

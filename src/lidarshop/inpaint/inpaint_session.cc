@@ -192,10 +192,15 @@ void InpaintSession::SetProgress(Progress* progress) {
 const std::vector<ReviewDecision>& InpaintSession::decisions() const { return state_->decisions; }
 
 InpaintResult InpaintSession::Result() const {
+  InpaintResult result = ResultWithoutImage();
+  result.image = state_->canvas.Image();
+  return result;
+}
+
+InpaintResult InpaintSession::ResultWithoutImage() const {
   const State& s = *state_;
   InpaintResult result = s.result;
   result.complete = !s.pending;
-  result.image = s.canvas.Image();
   result.fill_iteration = s.canvas.fill_iteration().clone();
   result.source_pixel = s.canvas.source_pixel().clone();
   result.candidates_evaluated = s.chooser->evaluations();

@@ -49,6 +49,9 @@ class InpaintSession {
   const std::vector<ReviewDecision>& decisions() const;
   // The fill as it stands (partial when stopped: complete = false and review set).
   InpaintResult Result() const;
+  // Result() with `image` left empty: for a caller that needs only where each pixel came from (the scan fill
+  // copies its channels from the sources), one copy of the image less while the session's own is held.
+  InpaintResult ResultWithoutImage() const;
 
  private:
   struct State;

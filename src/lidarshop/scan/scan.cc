@@ -8,6 +8,7 @@
 
 #include "lidarshop/scan/rgbd_cell.h"
 #include "lidarshop/scan/scan_channels.h"
+#include "lidarshop/scan/scan_window.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/parallel.h"
 
@@ -117,11 +118,15 @@ void CheckWindow(const Scan& scan, const cv::Rect& window, const char* what) {
 
 }  // namespace
 
-Scan CropScan(const Scan& scan, const cv::Rect& window) {
+namespace {
+
+// CropScan's cells as copies (`copy`) or as regions of the scan's buffers.
+Scan CropCells(const Scan& scan, const cv::Rect& window, bool copy, const char* caller) {
   CheckScan(scan);
-  CheckWindow(scan, window, "CropScan");
-  Scan part = scan_internal::ResampledScan(scan, window.height, window.width,
-                                           [&](const cv::Mat& channel) { return channel(window).clone(); });
+  CheckWindow(scan, window, caller);
+  Scan part = scan_internal::ResampledScan(scan, window.height, window.width, [&](const cv::Mat& channel) {
+    return copy ? channel(window).clone() : channel(window);
+  });
   if (static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
       static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
     part.grid = scan.grid;
@@ -131,6 +136,14 @@ Scan CropScan(const Scan& scan, const cv::Rect& window) {
                                    scan.grid.elevation_rad.begin() + window.y + window.height);
   }
   return part;
+}
+
+}  // namespace
+
+Scan CropScan(const Scan& scan, const cv::Rect& window) { return CropCells(scan, window, true, "CropScan"); }
+
+Scan CropScanView(const Scan& scan, const cv::Rect& window) {
+  return CropCells(scan, window, false, "CropScanView");
 }
 
 void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan) {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarshop/scan/scan_window.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -202,6 +203,29 @@ TEST(Scan, CropThenPasteGivesTheScanBack) {
   EXPECT_EQ(cv::norm(whole.label, scan.label, cv::NORM_INF), 0.0);
   EXPECT_THROW(CropScan(scan, cv::Rect(6, 0, 4, 2)), std::logic_error);
   EXPECT_THROW(PasteScan(part, cv::Rect(0, 0, 2, 2), &whole), std::logic_error);
+}
+
+TEST(Scan, ACropViewHasTheCropsCellsInTheScansOwnBuffers) {
+  Scan scan = MakeScan(6, 8, /*with_color=*/true);
+  scan.grid = UniformGrid(6, 8, -0.4, 0.4, -0.3, 0.3);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  for (int i = 0; i < 48; ++i) scan.range.at<float>(i / 8, i % 8) = 1.0f + i;
+  scan.attributes["gps_time"] = cv::Mat(6, 8, CV_64F, cv::Scalar(2.5));
+  const cv::Rect window(2, 1, 4, 3);
+  const Scan copy = CropScan(scan, window);
+  const Scan view = CropScanView(scan, window);
+  ASSERT_EQ(view.rows, 3);
+  ASSERT_EQ(view.cols, 4);
+  EXPECT_EQ(view.grid.azimuth_rad, copy.grid.azimuth_rad);
+  EXPECT_EQ(view.grid.elevation_rad, copy.grid.elevation_rad);
+  EXPECT_EQ(cv::norm(view.range, copy.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(view.direction.reshape(1), copy.direction.reshape(1), cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(view.attributes.at("gps_time"), copy.attributes.at("gps_time"), cv::NORM_INF), 0.0);
+  // No copy: the view's first cell is the scan's cell (1, 2), and its rows are the scan's rows.
+  EXPECT_EQ(view.range.ptr<float>(0), scan.range.ptr<float>(1) + 2);
+  EXPECT_EQ(view.color.ptr<cv::Vec3b>(2), scan.color.ptr<cv::Vec3b>(3) + 2);
+  EXPECT_FALSE(view.range.isContinuous());
+  EXPECT_THROW(CropScanView(scan, cv::Rect(6, 0, 4, 2)), std::logic_error);
 }
 
 }  // namespace
