@@ -19,7 +19,8 @@
 namespace lidarshop::server {
 namespace {
 
-constexpr int kRows = 600, kCols = 900;  // levels 0 (12 tiles of 256 px), 1 (4 x 2), 2 (one 225 x 150 tile)
+// Not a multiple of 4: the coarser levels' last blocks are completed by repeating the picture's edge.
+constexpr int kRows = 603, kCols = 901;  // levels 0 (12 tiles of 256 px), 1 (4 x 2), 2 (one 226 x 151 tile)
 
 class TilesTest : public ::testing::Test {
  protected:
@@ -111,8 +112,8 @@ TEST_F(TilesTest, LevelsHalveAndTilesHoldTheirFootprint) {
   EXPECT_EQ(info["cols"], kCols);
   EXPECT_EQ(info["tile_px"], 256);
   ASSERT_EQ(info["levels"].size(), 3u);
-  EXPECT_EQ(info["levels"][1]["cols"], 450);
-  EXPECT_EQ(info["levels"][1]["rows"], 300);
+  EXPECT_EQ(info["levels"][1]["cols"], 451);
+  EXPECT_EQ(info["levels"][1]["rows"], 302);
   EXPECT_EQ(info["levels"][0]["tiles_x"], 4);
   EXPECT_EQ(info["levels"][0]["tiles_y"], 3);
   EXPECT_EQ(info["levels"][2]["tiles_x"], 1);
@@ -137,9 +138,9 @@ TEST_F(TilesTest, LevelsHalveAndTilesHoldTheirFootprint) {
       }
     }
   }
-  // The last tile of level 0 is what is left of the picture: 900 - 768 by 600 - 512.
-  EXPECT_EQ(Get(id, 0, 3, 2, "range").image.size(), cv::Size(132, 88));
-  EXPECT_EQ(Get(id, 2, 0, 0, "range").image.size(), cv::Size(225, 150));
+  // The last tile of level 0 is what is left of the picture: 901 - 768 by 603 - 512.
+  EXPECT_EQ(Get(id, 0, 3, 2, "range").image.size(), cv::Size(133, 91));
+  EXPECT_EQ(Get(id, 2, 0, 0, "range").image.size(), cv::Size(226, 151));
 }
 
 TEST_F(TilesTest, CoordinatesNoPictureHasAreRefused) {
