@@ -126,6 +126,13 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
 // The PNG of an 8-bit RGB (3 channels) or grey image as the answer.
 void SendPng(httplib::Response& response, const cv::Mat& rgb_or_gray);
 
+// The cells of a stroke image (segment.h) holding object (1) and background (2) strokes, in one pass and without a
+// temporary image: `strokes == 1` of a 100 M-ray station allocated 100 MB twice and took 0.7 s of every reply.
+struct StrokeCounts {
+  int64_t object = 0, background = 0;
+};
+StrokeCounts CountStrokes(const cv::Mat& strokes);
+
 // Replaces the document's state with `next`, keeping the old one for undo (at most `undo_depth`); +1 version.
 // Throws DocumentLimitError (507), changing nothing, when the memory limit would be passed (Document::check_room).
 // Caller holds document.mutex.

@@ -270,12 +270,12 @@ void AddEditRoutes(State& state) {
                    FillPolygon(body, "hole_polygon", next.hole);
                  }
                  Commit(*document, std::move(next), state.options.undo_depth);
-                 SendJson(
-                     response,
-                     {{"version", document->version},
-                      {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
-                      {"object_stroke_cells", cv::countNonZero(document->now.strokes == 1)},
-                      {"background_stroke_cells", cv::countNonZero(document->now.strokes == 2)}});
+                 const StrokeCounts strokes = CountStrokes(document->now.strokes);
+                 SendJson(response, {{"version", document->version},
+                                     {"hole_cells",
+                                      document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
+                                     {"object_stroke_cells", strokes.object},
+                                     {"background_stroke_cells", strokes.background}});
                });
   PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
   PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);

@@ -313,6 +313,21 @@ std::shared_ptr<Document> State::FindDocument(const httplib::Request& request, h
   return found->second;
 }
 
+StrokeCounts CountStrokes(const cv::Mat& strokes) {
+  StrokeCounts counts;
+  for (int y = 0; y < strokes.rows; ++y) {
+    const uint8_t* row = strokes.ptr<uint8_t>(y);
+    int64_t object = 0, background = 0;
+    for (int x = 0; x < strokes.cols; ++x) {
+      object += row[x] == 1;
+      background += row[x] == 2;
+    }
+    counts.object += object;
+    counts.background += background;
+  }
+  return counts;
+}
+
 namespace {
 
 // The photos a document carries from its E57 file: {"index", "name", "width_px", "height_px", "usable"}
@@ -343,6 +358,7 @@ nlohmann::ordered_json DocumentJson(Document& document) {
     if (!image->empty()) channels.push_back(name);
   }
   std::vector<double> pose(scan.world_from_scanner.data(), scan.world_from_scanner.data() + 16);
+  const StrokeCounts strokes = CountStrokes(document.now.strokes);
   // Angular steps of the grid, for square angular pixels on screen (0 when the scan has no grid).
   const auto step_deg = [](const std::vector<double>& angles) {
     return angles.size() < 2 ? 0.0
@@ -358,8 +374,8 @@ nlohmann::ordered_json DocumentJson(Document& document) {
       {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
       {"object_cells", document.now.object_mask.empty() ? 0 : cv::countNonZero(document.now.object_mask)},
       {"hole_cells", document.now.hole.empty() ? 0 : cv::countNonZero(document.now.hole)},
-      {"object_stroke_cells", cv::countNonZero(document.now.strokes == 1)},
-      {"background_stroke_cells", cv::countNonZero(document.now.strokes == 2)},
+      {"object_stroke_cells", strokes.object},
+      {"background_stroke_cells", strokes.background},
       {"behind_cells", document.now.behind.valid.empty() ? 0 : cv::countNonZero(document.now.behind.valid)},
       {"world_from_scanner_column_major", pose},
       {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
