@@ -70,7 +70,8 @@ const Document::PointState* StateWithFirstVersion(const Document& document, int6
 }
 
 // Means of `factor` x `factor` blocks of `image` (INTER_AREA at an integer factor is exactly that), the last
-// column and row of blocks completed by repeating the image's edge. The whole blocks are averaged in place and
+// column and row of blocks completed by repeating the image's own edge (not pixels of a picture it is a region
+// of: BORDER_ISOLATED). The whole blocks are averaged in place and
 // only the edge strips are padded: the coarsest tile of a 100 M-ray station is the whole 300 MB picture, and a
 // padded copy of it was a third of its time.
 cv::Mat BlockMeans(const cv::Mat& image, int factor) {
@@ -83,7 +84,7 @@ cv::Mat BlockMeans(const cv::Mat& image, int factor) {
     cv::Mat source = image(part), padded, result;
     if (part.width != out.width * factor || part.height != out.height * factor) {
       cv::copyMakeBorder(source, padded, 0, out.height * factor - part.height, 0,
-                         out.width * factor - part.width, cv::BORDER_REPLICATE);
+                         out.width * factor - part.width, cv::BORDER_REPLICATE | cv::BORDER_ISOLATED);
       source = padded;
     }
     cv::resize(source, result, out.size(), 0, 0, cv::INTER_AREA);
