@@ -1,4 +1,7 @@
 // lidarshop — edit terrestrial LiDAR scans. `lidarshop <command> --help` for each command.
+#include <unistd.h>
+
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <new>
@@ -59,9 +62,30 @@ void PrintUsage(std::FILE* stream) {
   fmt::print(stream, "\n`lidarshop <command> --help` describes each command.\n");
 }
 
+// Large buffers on transparent huge pages: glibc's malloc does it with the tunable glibc.malloc.hugetlb=1, which
+// it reads only when a process starts, so the process starts itself once more with it set. A station's channels
+// are gigabytes touched once; in 4 KiB pages on the 2-core virtual machine of bench/results the first touch costs
+// 3.5 s a GiB (a fresh 1 GiB memset; 0.05 s the second time), and `info --stats` of the 100 M-ray station took
+// 34.9 s, 19.9 s with huge pages (docs/memory.md). Not done when GLIBC_TUNABLES is set already (the user's
+// choice, and the second start) or LIDARSHOP_HUGE_PAGES=0; if the start fails, the command runs as it is.
+void StartWithHugePages(char** argv) {
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || (__GLIBC__ == 2 && __GLIBC_MINOR__ >= 35))
+  if (std::getenv("GLIBC_TUNABLES") != nullptr) return;
+  if (const char* wanted = std::getenv("LIDARSHOP_HUGE_PAGES");
+      wanted != nullptr && std::strcmp(wanted, "0") == 0)
+    return;
+  if (setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1", 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  unsetenv("GLIBC_TUNABLES");  // not started again: go on without
+#else
+  (void)argv;
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  StartWithHugePages(argv);
   // Warnings go to stderr: stdout carries the JSON that scripts read (info, scan --stats).
   spdlog::set_default_logger(spdlog::stderr_color_mt("lidarshop"));
   if (argc < 2) {
