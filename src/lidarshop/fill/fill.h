@@ -192,10 +192,10 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& op
 
 // FillScan without the whole scan in its result, so that what a fill costs follows the hole: `scan` and the
 // per-cell images (filled, gradient magnitudes, fill order, source cells) cover the window the fill worked in
-// (FillResult::Window()), not the scan; `source_cell` holds the scan's rows and columns. Every number is FillScan's, every
-// cell of the window too. An empty mask gives an empty window. A caller that owns the scan applies the result
-// with ApplyFill; FillScan is this, then a copy of the scan with the window pasted in (at 100 M rays that copy
-// and the padded images cost 31 of its 33 s, bench/results/scale.md). Throws as FillScan.
+// (FillResult::Window()), not the scan; `source_cell` holds the scan's rows and columns. Every number is
+// FillScan's, every cell of the window too. An empty mask gives an empty window. A caller that owns the scan
+// applies the result with ApplyFill; FillScan is this, then a copy of the scan with the window pasted in (at
+// 100 M rays that copy and the padded images cost 31 of its 33 s, bench/results/scale.md). Throws as FillScan.
 FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
                           Progress* progress = nullptr);
 
