@@ -11,7 +11,7 @@ The last table gives each command's cost exponent k (time ~ rays^k, a least-squa
 over the sizes run). The machine's CPU and load are printed with the results: read the times of one run as
 ratios. A command that fails (the memory budget refusing it) is reported in the table with its message. Needs
 the built CLI (build/release/lidarshop, or --binary) and its Python module (build/release/python); 100 M rays
-need about 22 GB of memory for `remove` and about 7 GB of disk.
+need about 15 GB of memory for `remove` and about 7 GB of disk.
 """
 import argparse
 import json
