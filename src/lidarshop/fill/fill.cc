@@ -668,14 +668,18 @@ void ApplyFill(const FillResult& fill, Scan* scan) {
   PasteScan(fill.scan, window, scan);
 }
 
+void ExpandFill(const Scan& scan, FillResult* fill) {
+  if (fill->Window() == cv::Rect(0, 0, scan.cols, scan.rows)) return;
+  Scan whole = Clone(scan);
+  ApplyFill(*fill, &whole);
+  fill->scan = std::move(whole);
+  PadFillImages(scan.rows, scan.cols, fill);
+}
+
 FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& options, Progress* progress) {
   Timer total;
   FillResult result = FillScanWindow(scan, hole, options, progress);
-  if (result.Window() == cv::Rect(0, 0, scan.cols, scan.rows)) return result;
-  Scan whole = Clone(scan);
-  ApplyFill(result, &whole);
-  result.scan = std::move(whole);
-  PadFillImages(scan.rows, scan.cols, &result);
+  ExpandFill(scan, &result);
   result.timings.total_s = total.Seconds();
   return result;
 }

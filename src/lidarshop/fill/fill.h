@@ -194,14 +194,18 @@ FillResult FillScan(const Scan& scan, const cv::Mat& hole, const FillOptions& op
 // per-cell images (filled, gradient magnitudes, fill order, source cells) cover the window the fill worked in
 // (FillResult::Window()), not the scan; `source_cell` holds the scan's rows and columns. Every number is
 // FillScan's, every cell of the window too. An empty mask gives an empty window. A caller that owns the scan
-// applies the result with ApplyFill; FillScan is this, then a copy of the scan with the window pasted in (at
-// 100 M rays that copy and the padded images cost 31 of its 33 s, bench/results/scale.md). Throws as FillScan.
+// applies the result with ApplyFill; FillScan is this, then ExpandFill (at 100 M rays that copy, the padding
+// and the whole-scan passes took 31 of its 33 s, bench/results/scale.md). Throws as FillScan.
 FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole, const FillOptions& options = {},
                           Progress* progress = nullptr);
 
 // Writes a FillScanWindow result into the scan it was computed from (PasteScan of its window): `*scan` then
 // equals FillScan's `scan`. Throws std::logic_error when the window does not fit the scan.
 void ApplyFill(const FillResult& fill, Scan* scan);
+
+// A FillScanWindow result of `scan` made FillScan's: a copy of the scan with the window applied, the images
+// padded (nothing when the window is the whole scan).
+void ExpandFill(const Scan& scan, FillResult* fill);
 
 // The per-cell images of a FillScanWindow result brought to the scan's size (rows x cols), with FillScan's
 // values outside the window (filled 0, gradients 0, fill order −1, source (−1, −1)); `scan` is left as it is.

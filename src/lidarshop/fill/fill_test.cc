@@ -4,6 +4,7 @@
 #include <string>
 #include <utility>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -252,12 +253,54 @@ TEST(FillScanWindow, HoldsTheWindowOnlyAndAppliedEqualsFillScan) {
   EXPECT_TRUE(same(applied.label, whole.scan.label));
   EXPECT_TRUE(same(applied.synthesized, whole.scan.synthesized));
   EXPECT_TRUE(same(applied.direction, whole.scan.direction));
+  // Not through FillScan: the window's cells are the fill of a copy of the window (CropScan, not the view), the
+  // cells outside it the input's, and the source cells the window's plus its corner.
+  FillOptions in_window = options;
+  in_window.window_margin = 0;
+  const FillResult cropped = FillScan(CropScan(c.scan, window), c.hole(window), in_window);
+  EXPECT_EQ(cv::norm(windowed.scan.range, cropped.scan.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(applied.range(window), cropped.scan.range, cv::NORM_INF), 0.0);
+  cv::Mat outside_window(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(255));
+  outside_window(window).setTo(0);
+  EXPECT_EQ(cv::norm(applied.range, c.scan.range, cv::NORM_INF, outside_window), 0.0);
+  int differing_sources = 0;
+  for (int y = 0; y < window.height; ++y) {
+    for (int x = 0; x < window.width; ++x) {
+      cv::Vec2i expected = cropped.source_cell.at<cv::Vec2i>(y, x);
+      if (expected[0] >= 0) expected += cv::Vec2i(window.y, window.x);
+      differing_sources += windowed.source_cell.at<cv::Vec2i>(y, x) != expected;
+    }
+  }
+  EXPECT_EQ(differing_sources, 0);
   // Padded, the images are FillScan's (source cells in the scan's rows and columns in both).
   PadFillImages(c.scan.rows, c.scan.cols, &windowed);
+  EXPECT_EQ(cv::countNonZero(windowed.filled & outside_window), 0);
+  EXPECT_EQ(cv::countNonZero((windowed.fill_order != -1) & outside_window), 0);
   EXPECT_TRUE(same(windowed.filled, whole.filled));
   EXPECT_TRUE(same(windowed.fill_order, whole.fill_order));
   EXPECT_TRUE(same(windowed.source_cell, whole.source_cell));
   EXPECT_TRUE(same(windowed.gradient_magnitude_after, whole.gradient_magnitude_after));
+}
+
+TEST(FillScanWindow, AHoleCellWithoutADirectionIsNamedInTheScansRowsAndColumns) {
+  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  FillOptions options;
+  options.window_min_margin_cells = 64;
+  const cv::Rect window = FillScanWindow(c.scan, c.hole, options).Window();
+  ASSERT_LT(window.area(), c.scan.rows * c.scan.cols);
+  ASSERT_GT(window.x, 0);  // so that the window's own columns would name another cell
+  cv::Point cell;
+  cv::minMaxLoc(c.hole, nullptr, nullptr, nullptr, &cell);  // the first hole cell
+  Scan broken = Clone(c.scan);
+  broken.direction.at<cv::Vec3f>(cell) = cv::Vec3f(0, 0, 0);
+  try {
+    FillScanWindow(broken, c.hole, options);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(fmt::format("(row {}, col {})", cell.y, cell.x)),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 TEST(FillScanWindow, AnEmptyMaskGivesAnEmptyWindowThatChangesNothing) {

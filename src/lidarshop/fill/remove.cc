@@ -42,12 +42,7 @@ RemoveResult RemoveObjectWindow(const Scan& scan, const cv::Mat& strokes, const 
 RemoveResult RemoveObject(const Scan& scan, const cv::Mat& strokes, const RemoveOptions& options,
                           Progress* progress) {
   RemoveResult result = RemoveObjectWindow(scan, strokes, options, progress);
-  if (result.fill.Window() != cv::Rect(0, 0, scan.cols, scan.rows)) {
-    Scan whole = Clone(scan);
-    ApplyFill(result.fill, &whole);
-    result.fill.scan = std::move(whole);
-    PadFillImages(scan.rows, scan.cols, &result.fill);
-  }
+  ExpandFill(scan, &result.fill);
   return result;
 }
 
