@@ -144,12 +144,18 @@ environment_of_serve() {  # environment_of_serve OUT [VAR=VALUE ...]: the runnin
   shift
   env "$@" "$lidarshop" serve --port 0 --token t >"$work/serve.out" 2>"$work/serve.err" &
   local pid=$!
-  for _ in $(seq 100); do
+  for _ in $(seq 300); do
     grep -q "^http" "$work/serve.out" && break
     sleep 0.1
   done
   tr '\0' '\n' <"/proc/$pid/environ" >"$out"
-  kill "$pid"
+  # A TERM that arrives while serve is still starting may be missed: KILL after 5 s, so the test never hangs.
+  kill "$pid" 2>/dev/null
+  for _ in $(seq 50); do
+    kill -0 "$pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  kill -KILL "$pid" 2>/dev/null
   wait "$pid" 2>/dev/null
   grep -q "^http" "$work/serve.out"
 }
