@@ -137,33 +137,4 @@ check "the old flag still works" "$lidarshop" convert "$work/scan.ptx" "$work/sc
 fails_clearly "a negative precision is refused" "e57-precision-m" \
   "$lidarshop" convert "$work/scan.ptx" "$work/bad.e57" --e57-precision-m -1
 
-# The CLI restarts itself once with glibc's huge-page tunable (cli/main.cc): a running `serve` has it in its
-# environment; LIDARSHOP_HUGE_PAGES=0 leaves it out, and a GLIBC_TUNABLES the user set is kept as it is.
-environment_of_serve() {  # environment_of_serve OUT [VAR=VALUE ...]: the running serve's environment, one per line
-  local out=$1
-  shift
-  env "$@" "$lidarshop" serve --port 0 --token t >"$work/serve.out" 2>"$work/serve.err" &
-  local pid=$!
-  for _ in $(seq 300); do
-    grep -q "^http" "$work/serve.out" && break
-    sleep 0.1
-  done
-  tr '\0' '\n' <"/proc/$pid/environ" >"$out"
-  # A TERM that arrives while serve is still starting may be missed: KILL after 5 s, so the test never hangs.
-  kill "$pid" 2>/dev/null
-  for _ in $(seq 50); do
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.1
-  done
-  kill -KILL "$pid" 2>/dev/null
-  wait "$pid" 2>/dev/null
-  grep -q "^http" "$work/serve.out"
-}
-check "serve starts (huge pages)" environment_of_serve "$work/env_on"
-check "the restart set glibc's huge-page tunable" grep -qx "GLIBC_TUNABLES=glibc.malloc.hugetlb=1" "$work/env_on"
-check "serve starts (LIDARSHOP_HUGE_PAGES=0)" environment_of_serve "$work/env_off" LIDARSHOP_HUGE_PAGES=0
-check "LIDARSHOP_HUGE_PAGES=0: no tunable" sh -c "! grep -q '^GLIBC_TUNABLES=' '$work/env_off'"
-check "serve starts (the user's tunable)" environment_of_serve "$work/env_user" GLIBC_TUNABLES=glibc.malloc.arena_max=2
-check "the user's tunable is kept" grep -qx "GLIBC_TUNABLES=glibc.malloc.arena_max=2" "$work/env_user"
-
 finish

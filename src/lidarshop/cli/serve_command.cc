@@ -1,11 +1,16 @@
 // lidarshop serve: the editor in the browser (src/server, docs/api.md, web/).
 //
 //   lidarshop serve [SCAN...] [--scene NAME] [--port 8080] [--host 127.0.0.1] [--root DIR...] [--web DIR]
+#include <pthread.h>
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <mutex>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -21,10 +26,67 @@ namespace lidarshop::cli {
 
 namespace {
 
-server::EditorServer* running_server = nullptr;
+sigset_t StopSignals() {
+  sigset_t signals;
+  sigemptyset(&signals);
+  sigaddset(&signals, SIGINT);
+  sigaddset(&signals, SIGTERM);
+  return signals;
+}
 
-void StopOnSignal(int) {
-  if (running_server != nullptr) running_server->Stop();
+// SIGINT and SIGTERM are taken by one thread (sigwait), not by a handler: httplib's stop() is not
+// async-signal-safe, and a stop asked for before Run() has begun listening is not seen by httplib (a handler
+// calling it then left `serve` running for ever after a script's TERM). Before the server serves, a signal
+// ends the process as it would by default (a station may take a minute to read); once it serves, the thread
+// calls Stop() until Run() has returned. The signals must be blocked (BlockStopSignals) before any thread is
+// made, so that every thread inherits the block and only this one receives them.
+class StopOnSignals {
+ public:
+  explicit StopOnSignals(server::EditorServer& editor) : editor_(editor), thread_([this] { Wait(); }) {}
+  ~StopOnSignals() {
+    returned_ = true;
+    pthread_kill(thread_.native_handle(), SIGTERM);  // wakes the sigwait if no signal came
+    thread_.join();
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+  // From now on a signal stops the server instead of ending the process.
+  void Serving() {
+    std::lock_guard lock(mutex_);
+    serving_ = true;
+  }
+
+ private:
+  void Wait() {
+    const sigset_t signals = StopSignals();
+    int signal = 0;
+    if (sigwait(&signals, &signal) != 0 || returned_) return;
+    {
+      std::lock_guard lock(mutex_);
+      if (!serving_) {
+        std::signal(signal, SIG_DFL);
+        pthread_sigmask(SIG_UNBLOCK, &signals, nullptr);
+        raise(signal);  // delivered to this thread, whose mask no longer blocks it
+        return;
+      }
+    }
+    while (!returned_) {
+      editor_.Stop();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+  server::EditorServer& editor_;
+  std::mutex mutex_;
+  bool serving_ = false;  // guarded by mutex_
+  std::atomic<bool> returned_ = false;
+  std::thread thread_;  // last: it starts once the members it reads exist
+};
+
+void BlockStopSignals() {
+  const sigset_t signals = StopSignals();
+  pthread_sigmask(SIG_BLOCK, &signals, nullptr);
 }
 
 // The built front end: web/ beside the executable (the build copies it there), else the source tree's build.
@@ -67,6 +129,7 @@ int RunServe(int argc, char** argv) {
       files.rlim_cur = std::min<rlim_t>(files.rlim_max, 8192);
       setrlimit(RLIMIT_NOFILE, &files);
     }
+    BlockStopSignals();
     if (options.web_dir.empty()) options.web_dir = DefaultWebDir(argv[0]);
     for (const BuiltinScene& scene : BuiltinScenes()) options.builtin_scenes.push_back(scene.name);
     options.scan_builtin = [](const std::string& name) {
@@ -87,6 +150,7 @@ int RunServe(int argc, char** argv) {
       throw InputError(fmt::format("no built-in scene '{}'", name));
     };
     server::EditorServer editor(options);
+    StopOnSignals stop_on_signals(editor);
     for (const std::string& scan : scans) {
       std::vector<std::string> warnings;
       editor.OpenAtStart(scan, &warnings);
@@ -98,13 +162,10 @@ int RunServe(int argc, char** argv) {
       fmt::print(stderr,
                  "serve: no built front end found (run `bash scripts/build.sh`); the API alone is served\n");
     }
+    stop_on_signals.Serving();
     fmt::print("{}\n", editor.Url());
     std::fflush(stdout);
-    running_server = &editor;
-    std::signal(SIGINT, StopOnSignal);
-    std::signal(SIGTERM, StopOnSignal);
     editor.Run();
-    running_server = nullptr;
     return 0;
   });
 }
