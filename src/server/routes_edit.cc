@@ -3,6 +3,7 @@
 // with ?wait_ms=).
 #include <chrono>
 #include <cstdlib>
+#include <optional>
 
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
@@ -20,8 +21,11 @@ namespace lidarshop::server {
 namespace {
 
 // Cells [[row, col], ...] of `json[key]` painted with `value` as discs of `radius` into `strokes`.
-void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int radius, cv::Mat& strokes) {
-  if (!json.contains(key)) return;
+// Returns the box of the cells it painted (empty when none).
+cv::Rect PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int radius,
+                    cv::Mat& strokes) {
+  cv::Rect painted;
+  if (!json.contains(key)) return painted;
   const nlohmann::json& cells = json.at(key);
   if (!cells.is_array()) throw OptionsFieldError(key, "expected a list of [row, col] cells");
   if (cells.size() > 1000000) throw OptionsFieldError(key, "more than 1,000,000 cells in one request");
@@ -37,13 +41,16 @@ void PaintCells(const nlohmann::json& json, const char* key, uint8_t value, int 
                                                strokes.rows, strokes.cols));
     }
     cv::circle(strokes, cv::Point(col, row), radius, cv::Scalar(value), cv::FILLED);
+    painted |= cv::Rect(col - radius, row - radius, 2 * radius + 1, 2 * radius + 1) &
+               cv::Rect(0, 0, strokes.cols, strokes.rows);
   }
+  return painted;
 }
 
 // The polygon [[row, col], ...] of `json[key]` (a lasso), filled with 255 into `mask`.
 void FillPolygon(const nlohmann::json& json, const char* key, cv::Mat& mask) {
   if (!json.contains(key)) return;
-  cv::Mat vertices(mask.size(), CV_8U, cv::Scalar(0));
+  cv::Mat vertices = NewZeros(mask.size(), CV_8U);
   PaintCells(json, key, 255, 0, vertices);  // checks every vertex
   std::vector<cv::Point> polygon;
   for (const auto& cell : json.at(key)) polygon.emplace_back(cell[1].get<int>(), cell[0].get<int>());
@@ -75,29 +82,26 @@ void Segment(State& state, const std::shared_ptr<Document>& document, const nloh
           cut = document->cut;
         }
         progress.Restart("segment", 1);
-        // A refinement only adds constraints: strokes erased or undone since the cut need a full one.
-        const bool usable = cut && refine && cut->scan_data == start.scan.range.data &&
-                            ToJson(cut->options) == ToJson(options) &&
-                            cv::countNonZero((cut->strokes != 0) & (start.strokes != cut->strokes)) == 0;
+        // The session says whether the strokes only add to those of its cut (RefineTo); strokes erased or
+        // undone since then need a full cut, and so do other options or a scan edited since.
+        std::optional<SegmentResult> refined_result;
+        if (cut && refine && cut->scan_data == start.scan.range.data &&
+            ToJson(cut->options) == ToJson(options))
+          refined_result = cut->session.RefineTo(start.strokes, start.strokes_box);
+        const bool refined = refined_result.has_value();
         SegmentResult result;
-        bool refined = false;
-        if (usable) {
-          const cv::Mat extra = (start.strokes != cut->strokes) & (start.strokes != 0);
-          cv::Mat extra_strokes = cv::Mat::zeros(start.strokes.size(), CV_8U);
-          start.strokes.copyTo(extra_strokes, extra);
-          result = cut->session.Refine(extra_strokes);
-          refined = true;
+        if (refined) {
+          result = std::move(*refined_result);
         } else {
           cut = std::make_shared<SegmentCut>(
-              SegmentCut{SegmentSession(start.scan, options), options, {}, start.scan.range.data});
+              SegmentCut{SegmentSession(start.scan, options), options, start.scan.range.data});
           result = cut->session.Run(start.strokes);
         }
-        cut->strokes = start.strokes.clone();
         progress.Advance();
         std::lock_guard lock(document->mutex);
         document->cut = cut;
         Snapshot next = document->now;
-        next.object_mask = result.mask.clone();
+        SetObject(&next, result);
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
         json["refined"] = refined;
@@ -125,13 +129,14 @@ void Remove(State& state, const std::shared_ptr<Document>& document, const nlohm
         if (options.keep_object) {  // fill shadow: the object stays, the surface behind it is a second layer
           next.behind = result.behind;
           next.object_mask = result.cut.mask.clone();
+          next.object_box = cv::Rect(0, 0, next.object_mask.cols, next.object_mask.rows);
+          next.object_cells = cv::countNonZero(next.object_mask);
         } else {
           next.scan = result.fill.scan;
           next.object_mask = cv::Mat();
           next.behind = Scan();
         }
-        next.strokes =
-            NewZeros(cv::Size(next.scan.cols, next.scan.rows), CV_8U);  // a new buffer: see Snapshot
+        ClearStrokes(&next);  // a new buffer: see Snapshot
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);
         json["version"] = document->version;
@@ -250,33 +255,44 @@ void PostDocument(State& state, const std::string& pattern, DocumentHandler hand
 }
 
 void AddEditRoutes(State& state) {
-  PostDocument(state, R"(/api/docs/(\d+)/strokes)",
-               [](State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
-                  httplib::Response& response) {
-                 const int radius = body.value("radius", 2);
-                 if (radius < 0 || radius > 200) throw OptionsFieldError("radius", "out of range [0, 200]");
-                 std::lock_guard lock(document->mutex);
-                 Snapshot next = document->now;
-                 // New buffers for what this edit paints (Snapshot: the history shares the current ones).
-                 next.strokes =
-                     body.value("clear", false) ? NewZeros(next.strokes.size(), CV_8U) : next.strokes.clone();
-                 PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
-                 PaintCells(body, "background", 2, radius, next.strokes);
-                 PaintCells(body, "erase", 0, radius, next.strokes);
-                 if (body.contains("hole") || body.contains("hole_polygon") || body.contains("erase_hole")) {
-                   next.hole = next.hole.empty() ? NewZeros(next.strokes.size(), CV_8U) : next.hole.clone();
-                   PaintCells(body, "hole", 255, radius, next.hole);
-                   PaintCells(body, "erase_hole", 0, radius, next.hole);
-                   FillPolygon(body, "hole_polygon", next.hole);
-                 }
-                 Commit(*document, std::move(next), state.options.undo_depth);
-                 const StrokeCounts strokes = CountStrokes(document->now.strokes);
-                 SendJson(response, {{"version", document->version},
-                                     {"hole_cells",
-                                      document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
-                                     {"object_stroke_cells", strokes.object},
-                                     {"background_stroke_cells", strokes.background}});
-               });
+  PostDocument(
+      state, R"(/api/docs/(\d+)/strokes)",
+      [](State& state, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+         httplib::Response& response) {
+        const int radius = body.value("radius", 2);
+        if (radius < 0 || radius > 200) throw OptionsFieldError("radius", "out of range [0, 200]");
+        std::lock_guard lock(document->mutex);
+        Snapshot next = document->now;
+        // New buffers for what this edit paints (Snapshot: the history shares the current ones); the counts
+        // change only in the box painted.
+        const bool clear = body.value("clear", false);
+        if (clear)
+          ClearStrokes(&next);
+        else
+          next.strokes = CopyOfBox(next.strokes, next.strokes_box);
+        cv::Rect painted = PaintCells(body, "object", 1, radius, next.strokes);  // segment.h kStrokeObject
+        painted |= PaintCells(body, "background", 2, radius, next.strokes);
+        painted |= PaintCells(body, "erase", 0, radius, next.strokes);
+        next.strokes_box |= painted;
+        if (!painted.empty()) {
+          const StrokeCounts now = CountStrokes(next.strokes(painted));
+          const StrokeCounts was = clear ? StrokeCounts() : CountStrokes(document->now.strokes(painted));
+          next.object_stroke_cells += now.object - was.object;
+          next.background_stroke_cells += now.background - was.background;
+        }
+        if (body.contains("hole") || body.contains("hole_polygon") || body.contains("erase_hole")) {
+          next.hole = next.hole.empty() ? NewZeros(next.strokes.size(), CV_8U) : CopyOfMostlyZero(next.hole);
+          PaintCells(body, "hole", 255, radius, next.hole);
+          PaintCells(body, "erase_hole", 0, radius, next.hole);
+          FillPolygon(body, "hole_polygon", next.hole);
+        }
+        Commit(*document, std::move(next), state.options.undo_depth);
+        SendJson(response,
+                 {{"version", document->version},
+                  {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
+                  {"object_stroke_cells", document->now.object_stroke_cells},
+                  {"background_stroke_cells", document->now.background_stroke_cells}});
+      });
   PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
   PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);
   PostDocument(state, R"(/api/docs/(\d+)/fill)", Fill);

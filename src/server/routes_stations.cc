@@ -365,8 +365,7 @@ void FillFromOtherStations(State& state, const std::shared_ptr<Document>& docume
         Snapshot next = document->now;
         next.scan = filled.scan;
         if (which == "strokes") {
-          next.strokes =
-              NewZeros(cv::Size(next.scan.cols, next.scan.rows), CV_8U);  // a new buffer: see Snapshot
+          ClearStrokes(&next);  // a new buffer: see Snapshot
           next.object_mask = cv::Mat();
         } else {
           (which == "painted" ? next.hole : next.object_mask) = cv::Mat();

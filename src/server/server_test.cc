@@ -266,6 +266,58 @@ TEST_F(ServerTest, RemoveUndoRemoveKeepsTheStrokes) {
   EXPECT_EQ(Json(repainted)["object_stroke_cells"], object_strokes);
 }
 
+// The stroke counts are kept with the strokes and changed only where an edit paints (a station's strokes are
+// not counted again): after painting over other strokes, erasing, clearing and undo they equal a count of the
+// strokes the server holds (mask.png?layer=strokes), and the cropped overlay's box is the strokes' box.
+TEST_F(ServerTest, StrokeCountsFollowEveryPaint) {
+  const int id = OpenBox();
+  const std::string strokes = Api(fmt::format("/api/docs/{}/strokes", id));
+  const auto recount = [&](const std::string& what) {
+    const auto grey = client_->Get(Api(fmt::format("/api/docs/{}/mask.png?layer=strokes", id)));
+    ASSERT_EQ(grey->status, 200);
+    const cv::Mat held =
+        cv::imdecode(std::vector<uint8_t>(grey->body.begin(), grey->body.end()), cv::IMREAD_UNCHANGED);
+    const nlohmann::json document = Json(client_->Get(Api(fmt::format("/api/docs/{}", id))));
+    EXPECT_EQ(document["object_stroke_cells"], cv::countNonZero(held == 1)) << what;
+    EXPECT_EQ(document["background_stroke_cells"], cv::countNonZero(held == 2)) << what;
+    const auto cropped =
+        client_->Get(Api(fmt::format("/api/docs/{}/mask.png?layer=strokes&style=overlay&crop=1", id)));
+    ASSERT_EQ(cropped->status, 200);
+    const cv::Rect box = cv::boundingRect(held);
+    EXPECT_EQ(cropped->get_header_value("X-Lidarshop-Box"),
+              fmt::format("{},{},{},{}", box.x, box.y, box.width, box.height))
+        << what;
+  };
+  ASSERT_EQ(client_->Post(strokes, StrokesBody(), "application/json")->status, 200);
+  recount("painted");
+  const int rows = scan_->rows, cols = scan_->cols;
+  // Object strokes of radius 5 over background and object strokes alike, then an erased disc.
+  ASSERT_EQ(client_
+                ->Post(strokes,
+                       nlohmann::json{{"object", {{rows / 2, cols / 3}, {rows / 2 + 3, cols / 3 + 4}}},
+                                      {"radius", 5}}
+                           .dump(),
+                       "application/json")
+                ->status,
+            200);
+  recount("painted over");
+  ASSERT_EQ(client_
+                ->Post(strokes, nlohmann::json{{"erase", {{rows / 2, cols / 3}}}, {"radius", 4}}.dump(),
+                       "application/json")
+                ->status,
+            200);
+  recount("erased");
+  ASSERT_EQ(client_->Post(Api(fmt::format("/api/docs/{}/undo", id)), "", "application/json")->status, 200);
+  recount("undone");
+  ASSERT_EQ(
+      client_
+          ->Post(strokes, nlohmann::json{{"clear", true}, {"background", {{1, 1}}}, {"radius", 0}}.dump(),
+                 "application/json")
+          ->status,
+      200);
+  recount("cleared and painted");
+}
+
 // The points as a map from key (cell, + 2^31 for the layer behind a kept object) to the point's bytes (xyz,
 // rgb, flags): from a whole LSP1 answer, or an LSD1 delta applied to `points`.
 using PointMap = std::map<uint32_t, std::string>;

@@ -20,6 +20,7 @@
 
 #include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/scan/lazy_zeros.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/progress.h"
@@ -39,9 +40,17 @@ namespace lidarshop::server {
 // writes the zeros into m's existing buffer when the size matches, which the undo entry shares).
 struct Snapshot {
   Scan scan;
-  cv::Mat strokes;      // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
+  cv::Mat strokes;  // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
+  // The cells of `strokes` of each label, kept with it: counted again only where an edit paints (a station's
+  // strokes are 100 MB). Set together with `strokes` (NewStrokes, the strokes route).
+  int64_t object_stroke_cells = 0, background_stroke_cells = 0;
+  // Every stroke lies in this box (cells outside it are kStrokeNone): what a copy or a comparison of the
+  // strokes needs to read.
+  cv::Rect strokes_box;
   cv::Mat object_mask;  // CV_8U 255 = the object of the last segmentation (empty = none)
-  cv::Mat hole;         // CV_8U 255 = cells painted with the hole brush or lasso (empty = none)
+  cv::Rect object_box;  // every cell of object_mask lies in it (SegmentResult::object_box)
+  int64_t object_cells = 0;
+  cv::Mat hole;  // CV_8U 255 = cells painted with the hole brush or lasso (empty = none)
   // The surface completed behind a kept object (fill shadow): a second layer, every cell synthesized or
   // without a return; empty = none. Saved as a second return (E57) or extra points (PLY, PCD).
   Scan behind;
@@ -54,7 +63,6 @@ struct Snapshot {
 struct SegmentCut {
   SegmentSession session;
   SegmentOptions options;
-  cv::Mat strokes;                     // the strokes the cut has seen
   const uint8_t* scan_data = nullptr;  // the scan it was built on (its range buffer)
 };
 
@@ -75,7 +83,22 @@ struct ReviewSession {
 
 // A new zero-filled buffer of `size` and `type`, for a snapshot field (see Snapshot: not cv::Mat::zeros, a
 // cv::MatExpr whose assignment writes into the field's shared buffer).
-inline cv::Mat NewZeros(cv::Size size, int type) { return cv::Mat(size, type, cv::Scalar::all(0)); }
+// A new zero buffer; its memory is touched only where an edit writes (a station's strokes, scan/lazy_zeros.h).
+inline cv::Mat NewZeros(cv::Size size, int type) { return LazyZeros(size.height, size.width, type); }
+
+// The object of a cut: its mask (shared: SegmentSession never writes it again), box and count.
+inline void SetObject(Snapshot* snapshot, const SegmentResult& cut) {
+  snapshot->object_mask = cut.mask;
+  snapshot->object_box = cut.object_box;
+  snapshot->object_cells = cut.object_cells;
+}
+
+// No strokes: a new zero buffer of the scan's size, and counts of 0.
+inline void ClearStrokes(Snapshot* snapshot) {
+  snapshot->strokes = NewZeros(cv::Size(snapshot->scan.cols, snapshot->scan.rows), CV_8U);
+  snapshot->object_stroke_cells = snapshot->background_stroke_cells = 0;
+  snapshot->strokes_box = cv::Rect();
+}
 
 struct Document {
   int id = 0;

@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/render/strokes.h"
+#include "lidarshop/scan/lazy_zeros.h"
 #include "lidarshop/segment/appearance.h"
 #include "lidarshop/segment/segment_graph.h"
 #include "lidarshop/util/timer.h"
@@ -46,22 +47,34 @@ int CoarseFactor(int rows, int cols, int64_t max_cells) {
   return factor;
 }
 
-cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const cv::Mat& strokes, int factor) {
-  cv::Mat coarse(level_cells.rows, level_cells.cols, CV_8U, cv::Scalar(kStrokeNone));
-  const float* range = scan.range.ptr<float>();
+std::vector<StrokeCell> StrokeCells(const cv::Mat& strokes) {
+  std::vector<StrokeCell> cells;
   for (int row = 0; row < strokes.rows; ++row) {
     const uint8_t* s = strokes.ptr<uint8_t>(row);
-    uint8_t* out = coarse.ptr<uint8_t>(row / factor);
-    const int32_t* representative = level_cells.ptr<int32_t>(row / factor);
-    for (int col = 0; col < strokes.cols; ++col) {
-      if (s[col] == kStrokeNone || scan.valid.at<uint8_t>(row, col) == 0) continue;
-      const int32_t own = representative[col / factor];
-      if (scan.valid.data[own] == 0) continue;
-      const float r = range[static_cast<int64_t>(row) * scan.cols + col];
-      if (std::abs(range[own] - r) > kStrokeSurfaceFraction * r) continue;
-      uint8_t& c = out[col / factor];
-      if (c != kStrokeBackground) c = s[col];
-    }
+    for (int col = 0; col < strokes.cols; ++col)
+      if (s[col] != kStrokeNone) cells.push_back({static_cast<int64_t>(row) * strokes.cols + col, s[col]});
+  }
+  return cells;
+}
+
+cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const cv::Mat& strokes, int factor) {
+  return CoarseStrokes(scan, level_cells, StrokeCells(strokes), factor);
+}
+
+cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const std::vector<StrokeCell>& cells,
+                      int factor) {
+  cv::Mat coarse(level_cells.rows, level_cells.cols, CV_8U, cv::Scalar(kStrokeNone));
+  const float* range = scan.range.ptr<float>();
+  for (const StrokeCell& stroke : cells) {
+    if (stroke.label == kStrokeNone || scan.valid.data[stroke.cell] == 0) continue;
+    const int row = static_cast<int>(stroke.cell / scan.cols),
+              col = static_cast<int>(stroke.cell % scan.cols);
+    const int32_t own = level_cells.at<int32_t>(row / factor, col / factor);
+    if (scan.valid.data[own] == 0) continue;
+    const float r = range[stroke.cell];
+    if (std::abs(range[own] - r) > kStrokeSurfaceFraction * r) continue;
+    uint8_t& c = coarse.at<uint8_t>(row / factor, col / factor);
+    if (c != kStrokeBackground) c = stroke.label;
   }
   return coarse;
 }
@@ -74,12 +87,31 @@ cv::Mat FullResolution(const cv::Mat& coarse_mask, int factor, cv::Size full) {
   return up(cv::Rect(0, 0, full.width, full.height)).clone();
 }
 
+cv::Mat FullResolutionWithReturns(const cv::Mat& coarse_mask, int factor, const cv::Mat& valid) {
+  cv::Mat full = LazyZeros(valid.rows, valid.cols, CV_8U);
+  const cv::Rect box = cv::boundingRect(coarse_mask);
+  for (int level_row = box.y; level_row < box.y + box.height; ++level_row) {
+    const uint8_t* level = coarse_mask.ptr<uint8_t>(level_row);
+    for (int row = level_row * factor; row < std::min(valid.rows, (level_row + 1) * factor); ++row) {
+      const uint8_t* v = valid.ptr<uint8_t>(row);
+      uint8_t* out = full.ptr<uint8_t>(row);
+      for (int level_col = box.x; level_col < box.x + box.width; ++level_col) {
+        if (level[level_col] == 0) continue;
+        for (int col = level_col * factor; col < std::min(valid.cols, (level_col + 1) * factor); ++col)
+          if (v[col] != 0) out[col] = level[level_col];
+      }
+    }
+  }
+  return full;
+}
+
 cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, const cv::Mat& coarse_mask,
                                    const cv::Mat& coarse_cells, int factor, const cv::Mat& strokes,
                                    const SegmentOptions& options, bool has_appearance,
                                    SegmentResult* result) {
   Timer timer;
-  cv::Mat mask = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
+  cv::Mat mask = LazyZeros(scan.rows, scan.cols, CV_8U);  // written in the object's window only
+  result->object_box = cv::Rect();
   const cv::Mat object = (coarse_mask != 0);
   if (cv::countNonZero(object) == 0) return mask;
   // On the level: inside (deeper than the band), the band, the graph (the band and one level cell of hard rim
@@ -218,6 +250,7 @@ cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, con
       if (o[col] != 0 && !keep[static_cast<size_t>(label[col])]) o[col] = 0;
   }
   object_w.copyTo(mask(window));
+  result->object_box = window;
   result->timings.graph_s += timer.Seconds();
   return mask;
 }

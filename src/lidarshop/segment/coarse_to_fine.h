@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -26,8 +27,23 @@ int CoarseFactor(int rows, int cols, int64_t max_cells);
 constexpr double kStrokeSurfaceFraction = 0.02;
 cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const cv::Mat& strokes, int factor);
 
+// One stroked cell: its index in the scan (row · cols + col) and its kStroke* label.
+struct StrokeCell {
+  int64_t cell = 0;
+  uint8_t label = 0;
+};
+// The stroked cells of `strokes`, row by row.
+std::vector<StrokeCell> StrokeCells(const cv::Mat& strokes);
+// CoarseStrokes of the strokes `cells` (in row-major order): what a refinement adds, without an image of the
+// station's size.
+cv::Mat CoarseStrokes(const Scan& scan, const cv::Mat& level_cells, const std::vector<StrokeCell>& cells,
+                      int factor);
+
 // A mask of the level (CV_8U) at full resolution (`full` = rows x cols): every cell takes its block's value.
 cv::Mat FullResolution(const cv::Mat& coarse_mask, int factor, cv::Size full);
+// FullResolution(coarse_mask, factor, valid.size()) & (valid != 0), written only where the level's mask is
+// set (LazyZeros): a mask of a large station costs the memory of its object's blocks.
+cv::Mat FullResolutionWithReturns(const cv::Mat& coarse_mask, int factor, const cv::Mat& valid);
 
 // Coarse cells within this many cells of the level's outline are cut again at full resolution.
 constexpr int kBandCoarseCells = 2;
@@ -44,8 +60,9 @@ constexpr int kMaxLevelStep = 4;
 // resolution, kStroke*) a hard label; a stroke that contradicts the level (a background stroke inside, an
 // object stroke outside) frees the cells within the band's width around it. `coarse_cells` is
 // DecimatedCells(scan, factor). Keeps the 4-connected parts of the result that hold an inside cell or an
-// object stroke. Adds its times to result->timings and sets result->graph_nodes and result->flow. CV_8U
-// 255/0, the scan's size.
+// object stroke. Adds its times to result->timings and sets result->graph_nodes, result->flow and
+// result->object_box (the window it cut in). CV_8U 255/0, the scan's size, written only in that window
+// (LazyZeros).
 cv::Mat CutOutlineAtFullResolution(const Scan& scan, const ScanStats& stats, const cv::Mat& coarse_mask,
                                    const cv::Mat& coarse_cells, int factor, const cv::Mat& strokes,
                                    const SegmentOptions& options, bool has_appearance, SegmentResult* result);

@@ -3,6 +3,9 @@
 // taken to full resolution, and refinements keep the rules of Refine().
 #include "lidarshop/segment/coarse_to_fine.h"
 
+#include <optional>
+#include <vector>
+
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
@@ -127,6 +130,52 @@ TEST(CoarseToFineTest, RefinementsKeepTheirRules) {
   EXPECT_EQ(cv::countNonZero(removed.mask & (across == kStrokeBackground)), 0);
   const cv::Mat lost = added.mask & ~removed.mask;
   EXPECT_LT(cv::boundingRect(lost).x + cv::boundingRect(lost).width, box.x + box.width / 2);
+}
+
+// The live update (RefineTo): all the strokes now, the session finds what they add. On a level as on a scan
+// cut whole, its result is Refine()'s with the added strokes; strokes erased or relabelled since, or no Run()
+// yet, ask for a full cut (nullopt).
+TEST(CoarseToFineTest, RefineToIsRefineOfWhatTheStrokesAdd) {
+  const Scan scan = MakeScene();
+  for (const int64_t coarse_above : {int64_t{30000}, int64_t{0}}) {
+    SCOPED_TRACE(coarse_above);
+    const cv::Mat strokes = Strokes(scan);
+    SegmentSession by_refine(scan, CoarseAbove(coarse_above)), by_refine_to(scan, CoarseAbove(coarse_above));
+    EXPECT_FALSE(by_refine_to.RefineTo(strokes).has_value());  // no Run() yet
+    const SegmentResult first = by_refine.Run(strokes);
+    by_refine_to.Run(strokes);
+    EXPECT_EQ(first.coarse_factor, coarse_above > 0 ? 4 : 1);
+    EXPECT_EQ(by_refine_to.RefineTo(strokes)->object_cells, first.object_cells);  // nothing added
+    const cv::Rect box = cv::boundingRect(first.mask);
+    cv::Mat added(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
+    const int col = box.x + box.width / 8;
+    cv::line(added, cv::Point(col, box.y - 5), cv::Point(col, box.y + box.height + 5),
+             cv::Scalar(kStrokeBackground), 3);
+    cv::Mat now = strokes.clone();
+    added.copyTo(now, added != kStrokeNone);
+    const SegmentResult refined = by_refine.Refine(added);
+    const cv::Rect painted = cv::boundingRect(now);
+    const std::optional<SegmentResult> refined_to = by_refine_to.RefineTo(now, painted);
+    ASSERT_TRUE(refined_to.has_value());
+    EXPECT_LT(refined.object_cells, first.object_cells);
+    EXPECT_EQ(refined_to->object_cells, refined.object_cells);
+    EXPECT_EQ(cv::countNonZero(refined_to->mask != refined.mask), 0);
+    // The object's box holds the whole object, and the count is the mask's.
+    EXPECT_EQ(cv::countNonZero(refined_to->mask(refined_to->object_box)), refined_to->object_cells);
+    EXPECT_EQ(cv::countNonZero(refined_to->mask), refined_to->object_cells);
+    // An erased stroke cell (one of Run()'s) or a relabelled one: a full cut is needed.
+    cv::Mat erased = now.clone();
+    std::vector<cv::Point> object_stroke;
+    cv::findNonZero(strokes == kStrokeObject, object_stroke);
+    ASSERT_FALSE(object_stroke.empty());
+    const cv::Point stroked = object_stroke.front();
+    erased.at<uint8_t>(stroked) = kStrokeNone;
+    EXPECT_EQ(strokes.at<uint8_t>(stroked), kStrokeObject);
+    EXPECT_FALSE(by_refine_to.RefineTo(erased).has_value());
+    cv::Mat relabelled = now.clone();
+    relabelled.setTo(kStrokeObject, added == kStrokeBackground);
+    EXPECT_FALSE(by_refine_to.RefineTo(relabelled, painted).has_value());
+  }
 }
 
 TEST(CoarseToFineTest, AStrokeTheLevelCannotSeeStillHolds) {

@@ -41,6 +41,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -227,7 +228,10 @@ struct SegmentTimings {
 };
 
 struct SegmentResult {
-  cv::Mat mask;                 // CV_8U 255 = object, rows x cols; 0 where invalid unless enclosed (below)
+  cv::Mat mask;  // CV_8U 255 = object, rows x cols; 0 where invalid unless enclosed (below)
+  // Every object cell lies in this box (not always the tightest): what a reader of the mask of a large
+  // station needs to look at. Not part of the JSON.
+  cv::Rect object_box;
   cv::Mat step1_mask;           // two-step only: the depth-dominant cut, CV_8U 255/0 (else empty)
   cv::Mat inferred_background;  // two-step only: ring cells marked background in step 2, CV_8U 255/0
   int64_t object_cells = 0;
@@ -268,6 +272,16 @@ class SegmentSession {
   // Adds strokes (same format) to the last cut as hard constraints and re-runs its max-flow incrementally.
   // Run() must have been called.
   SegmentResult Refine(const cv::Mat& extra_strokes);
+  // The live update after a stroke: `strokes` are all the strokes now (same format). When they only add to
+  // the strokes of the last Run() and Refine()s — no stroke erased or relabelled — refines the last cut with
+  // what they add (Refine); otherwise, or before any Run(), returns nullopt: a full Run() is needed. Its cost
+  // follows the strokes and the object, not the scan (rows the strokes leave unchanged are compared whole).
+  std::optional<SegmentResult> RefineTo(const cv::Mat& strokes);
+  // The same when every stroke of `strokes` lies in `strokes_box` (the caller knows where it painted): only
+  // that box and the session's own strokes' box are compared.
+  std::optional<SegmentResult> RefineTo(const cv::Mat& strokes, const cv::Rect& strokes_box);
+  //
+  // The masks of a result are buffers the session does not write again: a caller may keep them without a copy.
 
  private:
   struct Impl;
@@ -321,6 +335,10 @@ double RayAngleAt(const Scan& scan, const cv::Mat& cells);
 // Cells without a return (valid == 0) enclosed by `mask`: not reachable from the image border through cells
 // outside the mask (4-connected). CV_8U 255/0.
 cv::Mat EnclosedNoReturnCells(const cv::Mat& mask, const cv::Mat& valid);
+// mask |= EnclosedNoReturnCells(mask, valid), written in place and only within the mask's bounding box.
+void AddEnclosedNoReturnCells(const cv::Mat& valid, cv::Mat* mask);
+// The same when every cell of the mask lies in `mask_box`: only that box is read.
+void AddEnclosedNoReturnCells(const cv::Mat& valid, const cv::Rect& mask_box, cv::Mat* mask);
 
 // The overlay picture: the scan's colour (or intensity as grey, or plain grey 128), object cells tinted and outlined in the
 // colour of ContrastingOverlayColor (yellow on most outdoor scenes, another on yellowish ones), object strokes

@@ -2,8 +2,11 @@
 // region of interest), its single-cut baselines and incremental refinement (segment.h), with the cuts' graphs
 // on a window around the strokes that grows while a cut reaches its edge (SegmentOptions::window_margin_cells).
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -30,22 +33,74 @@ namespace {
 // after a refinement from `previous`: object strokes alone only add, background strokes alone only remove the
 // 8-connected parts of the dropped cells that hold one of `background_cells` (scan cells of the new
 // background strokes). Mixed strokes keep the new cut.
-void KeepMonotone(const cv::Mat& previous, bool object_strokes, bool background_strokes,
-                  const std::vector<int64_t>& background_cells, cv::Mat* mask) {
+// `previous_box` and `mask_box` hold every cell of the two masks: on a large station both are a small part of
+// the scan, and only they are read and written (a mask read or written whole touches all its memory).
+void KeepMonotone(const cv::Mat& previous, const cv::Rect& previous_box, bool object_strokes,
+                  bool background_strokes, const std::vector<int64_t>& background_cells,
+                  const cv::Rect& mask_box, cv::Mat* mask) {
   if (previous.empty() || object_strokes == background_strokes) return;
+  const cv::Rect whole(0, 0, previous.cols, previous.rows);
+  const cv::Rect box = previous_box & whole;
   if (object_strokes) {
-    *mask |= previous;
+    if (box.empty()) return;
+    cv::Mat in_box = (*mask)(box);
+    in_box |= previous(box);
     return;
   }
-  // Re-learnt models must not take away object parts elsewhere.
-  *mask &= previous;
-  cv::Mat dropped = previous & ~*mask, part;
+  // Re-learnt models must not take away object parts elsewhere: the new cut within the previous one.
+  const cv::Rect new_box = mask_box & whole;
+  for (int row = new_box.y; row < new_box.y + new_box.height; ++row) {
+    uint8_t* m = mask->ptr<uint8_t>(row);
+    const uint8_t* p = previous.ptr<uint8_t>(row);
+    for (int col = new_box.x; col < new_box.x + new_box.width; ++col)
+      if (m[col] != 0 && p[col] == 0) m[col] = 0;
+  }
+  if (box.empty()) return;
+  cv::Mat dropped = previous(box) & ~(*mask)(box), part;
   const int count = cv::connectedComponents(dropped, part, 8, CV_32S);
   std::vector<uint8_t> touched(static_cast<size_t>(count), 0);
-  const int32_t* label = reinterpret_cast<const int32_t*>(part.data);
-  for (int64_t cell : background_cells) touched[static_cast<size_t>(label[cell])] = 1;
-  for (int64_t cell = 0; cell < static_cast<int64_t>(part.total()); ++cell)
-    if (label[cell] != 0 && !touched[static_cast<size_t>(label[cell])]) mask->data[cell] = 255;
+  for (int64_t cell : background_cells) {
+    const int row = static_cast<int>(cell / previous.cols) - box.y;
+    const int col = static_cast<int>(cell % previous.cols) - box.x;
+    if (row >= 0 && col >= 0 && row < box.height && col < box.width)
+      touched[static_cast<size_t>(part.at<int32_t>(row, col))] = 1;
+  }
+  for (int row = 0; row < box.height; ++row) {
+    const int32_t* label = part.ptr<int32_t>(row);
+    uint8_t* m = mask->ptr<uint8_t>(box.y + row) + box.x;
+    for (int col = 0; col < box.width; ++col)
+      if (label[col] != 0 && !touched[static_cast<size_t>(label[col])]) m[col] = 255;
+  }
+}
+
+// The cells of `box` where `now` holds a stroke that `seen` does not, row by row, into `added`; false when a
+// stroke of `seen` is erased or relabelled in `now`. Rows that are equal are skipped whole (memcmp): a stroke
+// changes a few rows of a station.
+bool StrokesAdded(const cv::Mat& seen, const cv::Mat& now, const cv::Rect& box,
+                  std::vector<StrokeCell>* added) {
+  constexpr int kRowsPerBlock = 256;
+  const int blocks = (box.height + kRowsPerBlock - 1) / kRowsPerBlock;
+  std::vector<std::vector<StrokeCell>> found(static_cast<size_t>(blocks));
+  std::atomic<bool> taken_away = false;
+  ParallelFor(blocks, [&](int64_t block) {
+    const int end = box.y + std::min(box.height, static_cast<int>(block + 1) * kRowsPerBlock);
+    for (int row = box.y + static_cast<int>(block) * kRowsPerBlock; row < end && !taken_away; ++row) {
+      const uint8_t *was = seen.ptr<uint8_t>(row), *is = now.ptr<uint8_t>(row);
+      if (std::memcmp(was + box.x, is + box.x, static_cast<size_t>(box.width)) == 0) continue;
+      for (int col = box.x; col < box.x + box.width; ++col) {
+        if (is[col] == was[col]) continue;
+        if (was[col] != kStrokeNone) {
+          taken_away = true;
+          break;
+        }
+        found[static_cast<size_t>(block)].push_back({static_cast<int64_t>(row) * now.cols + col, is[col]});
+      }
+    }
+  });
+  if (taken_away) return false;
+  added->clear();
+  for (const std::vector<StrokeCell>& cells : found) added->insert(added->end(), cells.begin(), cells.end());
+  return true;
 }
 
 }  // namespace
@@ -69,26 +124,58 @@ struct SegmentSession::Impl {
   cv::Mat stroked_part;  // Run(): the part of the step-1 cut the object strokes lie on (cut_checks.h)
   bool ran = false;
   // Coarse to fine (SegmentOptions::coarse_max_cells): the level's factor, session and cells
-  // (DecimatedCells), and every stroke so far at full resolution (the outline's cut takes them all).
+  // (DecimatedCells).
   int factor = 1;
   std::unique_ptr<SegmentSession> level;
   cv::Mat level_cells;
+  // Every stroke so far at full resolution: Run()'s, and the cells with a return of each refinement's. The
+  // outline's cut takes them all (coarse to fine); RefineTo() compares with them.
   cv::Mat strokes_so_far;
+  cv::Rect strokes_so_far_box;  // every stroke of strokes_so_far lies in it
+
+  // Refine() of a session cut on a level: the strokes `added` at full resolution.
+  SegmentResult RefineOnLevel(const std::vector<StrokeCell>& added) {
+    Timer total;
+    bool object_strokes = false, background_strokes = false;
+    std::vector<int64_t> background_cells;
+    for (const StrokeCell& stroke : added) {
+      if (stroke.label == kStrokeNone || scan.valid.data[stroke.cell] == 0) continue;
+      strokes_so_far.data[stroke.cell] = stroke.label;
+      strokes_so_far_box |= cv::Rect(static_cast<int>(stroke.cell % scan.cols),
+                                     static_cast<int>(stroke.cell / scan.cols), 1, 1);
+      if (stroke.label == kStrokeObject) {
+        object_strokes = true;
+      } else {
+        background_strokes = true;
+        background_cells.push_back(stroke.cell);
+      }
+    }
+    const SegmentResult at_level = level->Refine(CoarseStrokes(scan, level_cells, added, factor));
+    SegmentResult result = FromLevel(at_level, total, 0);
+    if (given.refine_monotone) {
+      KeepMonotone(last_result.mask, last_result.object_box, object_strokes, background_strokes,
+                   background_cells, result.object_box, &result.mask);
+      result.object_box |= last_result.object_box;
+    }
+    result.object_cells = result.object_box.empty() ? 0 : cv::countNonZero(result.mask(result.object_box));
+    last_result = result;
+    return result;
+  }
 
   // The result at full resolution of the level's cut `at_level`: its outline re-cut (coarse_to_fine.h).
   SegmentResult FromLevel(const SegmentResult& at_level, const Timer& total, double stats_s) const {
     SegmentResult result;
     result.timings = at_level.timings;
-    const cv::Size full(scan.cols, scan.rows);
     result.mask = CutOutlineAtFullResolution(scan, stats, at_level.mask, level_cells, factor, strokes_so_far,
                                              given, has_appearance, &result);
-    const cv::Mat valid = scan.valid != 0;
     if (!at_level.step1_mask.empty())
-      result.step1_mask = FullResolution(at_level.step1_mask, factor, full) & valid;
+      result.step1_mask = FullResolutionWithReturns(at_level.step1_mask, factor, scan.valid);
     if (!at_level.inferred_background.empty())
-      result.inferred_background = FullResolution(at_level.inferred_background, factor, full) & valid;
-    if (given.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, scan.valid);
-    result.object_cells = cv::countNonZero(result.mask);
+      result.inferred_background =
+          FullResolutionWithReturns(at_level.inferred_background, factor, scan.valid);
+    if (given.include_enclosed_no_return)
+      AddEnclosedNoReturnCells(scan.valid, result.object_box, &result.mask);
+    result.object_cells = result.object_box.empty() ? 0 : cv::countNonZero(result.mask(result.object_box));
     result.ray_spacing_m = at_level.ray_spacing_m;
     result.length_scale = at_level.length_scale;
     const cv::Rect window = cv::Rect(at_level.window_col * factor, at_level.window_row * factor,
@@ -387,8 +474,9 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
   SegmentTimings timings;
   timings.features_s = s.features_s;
   s.features_s = 0;  // counted once
+  s.strokes_so_far = strokes.clone();
+  s.strokes_so_far_box = cv::boundingRect(s.strokes_so_far);
   if (s.level) {
-    s.strokes_so_far = strokes.clone();
     const SegmentResult at_level = s.level->Run(CoarseStrokes(s.scan, s.level_cells, strokes, s.factor));
     s.last_result = s.FromLevel(at_level, total, stats_s);
     s.last_result.timings.features_s += timings.features_s;
@@ -546,7 +634,8 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
       result.mask = s.stroked_part.clone();
     }
   }
-  if (o.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
+  if (o.include_enclosed_no_return) AddEnclosedNoReturnCells(s.scan.valid, &result.mask);
+  result.object_box = s.WholeScan();  // a scan cut whole is small
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
   {
@@ -565,28 +654,14 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   if (!s.ran) throw std::logic_error("SegmentSession::Refine called before Run");
   Timer total;
   s.CheckStrokes(extra_strokes, "extra strokes");
-  if (s.level) {
-    bool object_strokes = false, background_strokes = false;
-    std::vector<int64_t> background_cells;
+  if (s.level) return s.RefineOnLevel(StrokeCells(extra_strokes));
+  {
     const uint8_t* extra = extra_strokes.ptr<uint8_t>();
-    for (int64_t cell = 0; cell < static_cast<int64_t>(extra_strokes.total()); ++cell) {
-      if (extra[cell] == kStrokeNone || s.scan.valid.data[cell] == 0) continue;
-      s.strokes_so_far.data[cell] = extra[cell];
-      if (extra[cell] == kStrokeObject) {
-        object_strokes = true;
-      } else {
-        background_strokes = true;
-        background_cells.push_back(cell);
-      }
-    }
-    const SegmentResult at_level =
-        s.level->Refine(CoarseStrokes(s.scan, s.level_cells, extra_strokes, s.factor));
-    SegmentResult result = s.FromLevel(at_level, total, 0);
-    if (s.given.refine_monotone)
-      KeepMonotone(s.last_result.mask, object_strokes, background_strokes, background_cells, &result.mask);
-    result.object_cells = cv::countNonZero(result.mask);
-    s.last_result = result;
-    return result;
+    const int64_t cells = static_cast<int64_t>(extra_strokes.total());
+    for (int64_t cell = 0; cell < cells; ++cell)
+      if (extra[cell] != kStrokeNone && s.scan.valid.data[cell] != 0)
+        s.strokes_so_far.data[cell] = extra[cell];
+    s.strokes_so_far_box |= cv::boundingRect(extra_strokes);
   }
   SegmentResult result = s.last_result;
   result.timings = SegmentTimings();
@@ -617,14 +692,16 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     std::vector<int64_t> background_cells;
     for (int i = 0; i < s.nodes.num(); ++i)
       if (extra[i] == kHardBackground) background_cells.push_back(s.nodes.ScanCell(i));
-    KeepMonotone(previous_mask, object_strokes, background_strokes, background_cells, mask);
+    KeepMonotone(previous_mask, s.WholeScan(), object_strokes, background_strokes, background_cells,
+                 s.WholeScan(), mask);
   };
   if (outside) {
     // A stroke outside the last cut's region of interest or window: re-run that cut on the whole window with
     // every hard cell so far.
     result.mask = s.RerunLastCut(&result);
     keep_monotone(&result.mask);
-    if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
+    if (s.options.include_enclosed_no_return) AddEnclosedNoReturnCells(s.scan.valid, &result.mask);
+    result.object_box = s.WholeScan();  // a scan cut whole is small
     result.object_cells = cv::countNonZero(result.mask);
     result.graph_nodes = s.last.num_local(s.nodes.num());
     // New object strokes ask for more object: the growth is the user's, only the borders are checked.
@@ -686,7 +763,8 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
     result.mask = s.RerunLastCut(&result);
   }
   keep_monotone(&result.mask);
-  if (s.options.include_enclosed_no_return) result.mask |= EnclosedNoReturnCells(result.mask, s.scan.valid);
+  if (s.options.include_enclosed_no_return) AddEnclosedNoReturnCells(s.scan.valid, &result.mask);
+  result.object_box = s.WholeScan();  // a scan cut whole is small
   result.object_cells = cv::countNonZero(result.mask);
   result.graph_nodes = s.last.num_local(s.nodes.num());
   result.warnings =
@@ -695,6 +773,24 @@ SegmentResult SegmentSession::Refine(const cv::Mat& extra_strokes) {
   s.Report(&result);
   s.last_result = result;
   return result;
+}
+
+std::optional<SegmentResult> SegmentSession::RefineTo(const cv::Mat& strokes) {
+  return RefineTo(strokes, cv::Rect(0, 0, strokes.cols, strokes.rows));
+}
+
+std::optional<SegmentResult> SegmentSession::RefineTo(const cv::Mat& strokes, const cv::Rect& strokes_box) {
+  Impl& s = *impl_;
+  if (!s.ran) return std::nullopt;
+  s.CheckStrokes(strokes, "strokes");
+  std::vector<StrokeCell> added;
+  const cv::Rect compared = (strokes_box | s.strokes_so_far_box) & s.WholeScan();
+  if (!StrokesAdded(s.strokes_so_far, strokes, compared, &added)) return std::nullopt;
+  if (s.level) return s.RefineOnLevel(added);
+  // A scan cut whole is small: its refinement takes the added strokes as an image.
+  cv::Mat extra = cv::Mat::zeros(strokes.size(), CV_8U);
+  for (const StrokeCell& stroke : added) extra.data[stroke.cell] = stroke.label;
+  return Refine(extra);
 }
 
 SegmentResult SegmentObject(const Scan& scan, const cv::Mat& strokes, const SegmentOptions& options) {

@@ -174,6 +174,37 @@ TEST(SegmentTest, EnclosedNoReturnCellsOnlyInsideTheOutline) {
   EXPECT_EQ(cv::countNonZero(enclosed(cv::Rect(4, 4, 2, 2))), 4);
 }
 
+// The flood within the mask's box equals the flood of the whole image (the earlier implementation, written
+// here as the reference) on random masks and returns, objects touching the border included; and the in-place
+// form with a box adds exactly those cells.
+TEST(SegmentTest, EnclosedNoReturnCellsInTheBoxEqualTheWholeImagesFlood) {
+  const auto reference = [](const cv::Mat& mask, const cv::Mat& valid) {
+    cv::Mat outside = (mask == 0) / 255, padded;
+    cv::copyMakeBorder(outside, padded, 1, 1, 1, 1, cv::BORDER_CONSTANT, cv::Scalar(1));
+    cv::floodFill(padded, cv::Point(0, 0), cv::Scalar(2), nullptr, cv::Scalar(0), cv::Scalar(0), 4);
+    return cv::Mat((padded(cv::Rect(1, 1, mask.cols, mask.rows)) == 1) & (valid == 0));
+  };
+  cv::RNG rng(20261128);
+  int with_enclosed = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const int rows = 20 + trial % 17, cols = 25 + trial % 13;
+    cv::Mat valid(rows, cols, CV_8U), mask = cv::Mat::zeros(rows, cols, CV_8U);
+    rng.fill(valid, cv::RNG::UNIFORM, 0, 4);  // a quarter without a return
+    valid = valid != 0;
+    const cv::Point center(rng.uniform(0, cols), rng.uniform(0, rows));
+    cv::ellipse(mask, center, cv::Size(rng.uniform(2, cols / 2), rng.uniform(2, rows / 2)), 0, 0, 360,
+                cv::Scalar(255), cv::FILLED);
+    mask.setTo(0, valid == 0);
+    const cv::Mat expected = reference(mask, valid);
+    with_enclosed += cv::countNonZero(expected) > 0;
+    EXPECT_EQ(cv::countNonZero(EnclosedNoReturnCells(mask, valid) != expected), 0) << "trial " << trial;
+    cv::Mat in_place = mask.clone();
+    AddEnclosedNoReturnCells(valid, cv::boundingRect(mask), &in_place);
+    EXPECT_EQ(cv::countNonZero(in_place != (mask | expected)), 0) << "trial " << trial;
+  }
+  EXPECT_GT(with_enclosed, 20);  // the trials do enclose cells
+}
+
 TEST(SegmentTest, NoReturnCellsInsideTheObjectJoinTheMask) {
   Scan scan = MakeBoxOnGround(120, 160, cv::Vec3b(40, 60, 200), 9);
   const cv::Rect box = cv::boundingRect(TruthMask(scan));
