@@ -318,6 +318,35 @@ TEST_F(ServerTest, StrokeCountsFollowEveryPaint) {
   recount("cleared and painted");
 }
 
+// The first stroke has a job build the cut's session in the background (PrepareCut): it is queued before the
+// cut a stroke later, ends before it, and the cut that uses it equals a full cut with a session made then.
+TEST_F(ServerTest, TheFirstCutUsesTheSessionPreparedAtTheFirstStroke) {
+  const int id = OpenBox();
+  const auto painted =
+      client_->Post(Api(fmt::format("/api/docs/{}/strokes", id)), StrokesBody(), "application/json");
+  ASSERT_EQ(painted->status, 200);
+  const std::string segment = Api(fmt::format("/api/docs/{}/segment", id));
+  const nlohmann::json first = Json(client_->Post(segment, R"({"refine": true})", "application/json"));
+  const nlohmann::json prepared =
+      Json(client_->Get(Api(fmt::format("/api/jobs/{}", first["id"].get<int>() - 1))));
+  EXPECT_EQ(prepared["kind"], "prepare segment");
+  EXPECT_EQ(prepared["document"], id);
+  const nlohmann::json cut = Wait(first);
+  ASSERT_EQ(cut["state"], "done") << cut.dump();
+  EXPECT_EQ(Json(client_->Get(Api(fmt::format("/api/jobs/{}", prepared["id"].get<int>()))))["state"], "done");
+  EXPECT_FALSE(cut["result"]["refined"].get<bool>());
+  EXPECT_TRUE(cut["result"]["prepared"].get<bool>());
+  const auto mask = [&] { return client_->Get(Api(fmt::format("/api/docs/{}/mask.png", id)))->body; };
+  const std::string prepared_mask = mask();
+  // A full cut (not a refinement) makes its own session: the same strokes give the same object.
+  const nlohmann::json again = Wait(Json(client_->Post(segment, R"({"refine": false})", "application/json")));
+  ASSERT_EQ(again["state"], "done") << again.dump();
+  EXPECT_FALSE(again["result"]["prepared"].get<bool>());
+  EXPECT_EQ(again["result"]["object_cells"], cut["result"]["object_cells"]);
+  EXPECT_GT(cut["result"]["object_cells"].get<int>(), 50);
+  EXPECT_EQ(mask(), prepared_mask);
+}
+
 // The points as a map from key (cell, + 2^31 for the layer behind a kept object) to the point's bytes (xyz,
 // rgb, flags): from a whole LSP1 answer, or an LSD1 delta applied to `points`.
 using PointMap = std::map<uint32_t, std::string>;

@@ -64,6 +64,7 @@ struct SegmentCut {
   SegmentSession session;
   SegmentOptions options;
   const uint8_t* scan_data = nullptr;  // the scan it was built on (its range buffer)
+  bool ran = false;                    // false: built ahead of the first cut (PrepareCut), not run yet
 };
 
 struct Job;
@@ -82,8 +83,8 @@ struct ReviewSession {
 };
 
 // A new zero-filled buffer of `size` and `type`, for a snapshot field (see Snapshot: not cv::Mat::zeros, a
-// cv::MatExpr whose assignment writes into the field's shared buffer).
-// A new zero buffer; its memory is touched only where an edit writes (a station's strokes, scan/lazy_zeros.h).
+// cv::MatExpr whose assignment writes into the field's shared buffer). Its memory is touched only where an
+// edit writes (a station's strokes: scan/lazy_zeros.h).
 inline cv::Mat NewZeros(cv::Size size, int type) { return LazyZeros(size.height, size.width, type); }
 
 // The object of a cut: its mask (shared: SegmentSession never writes it again), box and count.
@@ -132,6 +133,7 @@ struct Document {
   // The scan prepared for verification (verify/), rebuilt when the version changes.
   std::shared_ptr<const PreparedScan> prepared;
   std::shared_ptr<SegmentCut> cut;  // the last segmentation's session (null = none yet)
+  bool preparing_cut = false;       // a job is building a session for the first cut (PrepareCut)
   // The photos (images2D) of the E57 file it was opened from that belong to its scan or to none
   // (associated_scan 0 or -1): a save as E57 writes them back, the recolour tool can use them.
   std::vector<E57Image> e57_images;
