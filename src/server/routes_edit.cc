@@ -166,7 +166,7 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
   {
     std::lock_guard lock(document->mutex);
     const cv::Mat& mask = painted ? document->now.hole : document->now.object_mask;
-    if (mask.empty() || cv::countNonZero(mask) == 0) {
+    if (mask.empty() || (painted ? cv::countNonZero(mask) : document->now.object_cells) == 0) {
       throw OptionsFieldError("hole", painted ? "paint a hole first (hole brush or lasso)"
                                               : "segment an object first: the fill fills the object's cells");
     }
@@ -180,11 +180,23 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
           std::lock_guard lock(document->mutex);
           start = document->now;
         }
-        const cv::Mat hole = painted ? start.hole : GrowHole(start.object_mask, margin);
-        const FillResult result = FillScan(start.scan, hole, options, &progress);
+        cv::Mat hole = start.hole;
+        if (!painted) {  // the object grown by the margin, read and written in the object's box only
+          hole = NewZeros(start.object_mask.size(), CV_8U);
+          const cv::Rect box =
+              cv::Rect(start.object_box.x - margin, start.object_box.y - margin,
+                       start.object_box.width + 2 * margin, start.object_box.height + 2 * margin) &
+              cv::Rect(0, 0, hole.cols, hole.rows);
+          if (!box.empty()) GrowHole(start.object_mask(box), margin).copyTo(hole(box));
+        }
+        // The fill's window pasted into the scan, sharing with the history every channel it leaves as it was
+        // (the ray directions): no whole copy of the station, nor its per-cell images padded to it.
+        const FillResult result = FillScanWindow(start.scan, hole, options, &progress);
+        Scan filled = start.scan;
+        if (result.Window().area() > 0) PasteScanCopyOnWrite(result.scan, result.Window(), &filled);
         std::lock_guard lock(document->mutex);
         Snapshot next = document->now;
-        next.scan = result.scan;
+        next.scan = std::move(filled);
         (painted ? next.hole : next.object_mask) = cv::Mat();
         Commit(*document, std::move(next), undo_depth);
         nlohmann::ordered_json json = ToJson(result);

@@ -1,6 +1,7 @@
 #include "lidarshop/scan/scan.h"
 
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <utility>
 
@@ -165,6 +166,37 @@ void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan) {
     if (target.empty()) target = cv::Mat(scan->rows, scan->cols, values.type(), cv::Scalar::all(0));
     values.copyTo(target(window));
   }
+}
+
+void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan) {
+  CheckWindow(*scan, window, "PasteScanCopyOnWrite");
+  if (part.rows != window.height || part.cols != window.width)
+    throw std::logic_error("PasteScanCopyOnWrite: the part's size differs from the window's");
+  const auto paste = [&](const cv::Mat& values, cv::Mat* target, const cv::Scalar& none) {
+    if (values.empty()) return;
+    if (target->empty()) {
+      *target = cv::Mat(scan->rows, scan->cols, values.type(), none);
+    } else {
+      const cv::Mat current = (*target)(window);
+      // Equal bytes (a NaN equals itself here, unlike cv::compare): nothing to write, the buffer stays shared.
+      bool same = current.type() == values.type();
+      for (int row = 0; same && row < window.height; ++row)
+        same = std::memcmp(current.ptr(row), values.ptr(row), values.cols * values.elemSize()) == 0;
+      if (same) return;
+      *target = target->clone();
+    }
+    values.copyTo((*target)(window));
+  };
+  std::vector<std::pair<cv::Mat*, cv::Scalar>> targets;
+  ForEachChannel(*scan,
+                 [&](cv::Mat& channel, const cv::Scalar& none) { targets.emplace_back(&channel, none); });
+  size_t i = 0;
+  ForEachChannel(part, [&](const cv::Mat& channel, const cv::Scalar&) {
+    auto& [target, none] = targets[i++];
+    paste(channel, target, none);
+  });
+  for (const auto& [name, values] : part.attributes)
+    paste(values, &scan->attributes[name], cv::Scalar::all(0));
 }
 
 Scan MakeScan(int rows, int cols, bool with_color, bool with_intensity) {

@@ -147,6 +147,12 @@ Scan CropScan(const Scan& scan, const cv::Rect& window);
 // std::logic_error when the sizes differ or `window` is not inside the scan.
 void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan);
 
+// PasteScan for a scan whose buffers others share (a shallow copy of a scan kept for undo): a channel whose
+// window already holds `part`'s values stays shared; any other is copied before it is written (copy on
+// write per channel). A fill leaves the ray directions as they were, so the filled station shares them: a
+// third of a station's bytes not copied. Never writes into a buffer it found in `scan`.
+void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan);
+
 // A scan with every required channel allocated (no returns, directions zero), intensity (0.5 everywhere) unless
 // `with_intensity` is false, colour (0) when `with_color`, no other optional channel.
 Scan MakeScan(int rows, int cols, bool with_color = false, bool with_intensity = true);

@@ -228,5 +228,40 @@ TEST(Scan, ACropViewHasTheCropsCellsInTheScansOwnBuffers) {
   EXPECT_THROW(CropScanView(scan, cv::Rect(6, 0, 4, 2)), std::logic_error);
 }
 
+// Copy on write per channel: the channels the part changes are new buffers holding PasteScan's result, the
+// others stay the scan's; the scan the copy came from is never written.
+TEST(Scan, PasteCopyOnWriteSharesTheChannelsThePartLeavesAsTheyWere) {
+  Scan scan = MakeScan(6, 8, /*with_color=*/true);
+  scan.grid = UniformGrid(6, 8, -0.4, 0.4, -0.3, 0.3);
+  scan.direction = DirectionsFromGrid(scan.grid);
+  for (int i = 0; i < 48; ++i) scan.range.at<float>(i / 8, i % 8) = 1.0f + i;
+  scan.attributes["gps_time"] = cv::Mat(6, 8, CV_64F, cv::Scalar(2.5));
+  const Scan before = Clone(scan);
+  const cv::Rect window(2, 1, 4, 3);
+  Scan part = CropScan(scan, window);
+  part.range.setTo(7.0f);
+  part.color.setTo(cv::Scalar(1, 2, 3));
+  part.synthesized = cv::Mat(3, 4, CV_8U, cv::Scalar(1));  // a channel the scan does not have
+  Scan shared = scan;                                      // shallow, as a snapshot kept for undo
+  PasteScanCopyOnWrite(part, window, &shared);
+  Scan expected = Clone(scan);
+  PasteScan(part, window, &expected);
+  EXPECT_EQ(cv::norm(shared.range, expected.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(shared.color, expected.color, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(shared.synthesized, expected.synthesized, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(shared.direction.reshape(1), expected.direction.reshape(1), cv::NORM_INF), 0.0);
+  // Changed: new buffers; unchanged: the scan's own.
+  EXPECT_NE(shared.range.data, scan.range.data);
+  EXPECT_NE(shared.color.data, scan.color.data);
+  EXPECT_EQ(shared.direction.data, scan.direction.data);
+  EXPECT_EQ(shared.point.data, scan.point.data);
+  EXPECT_EQ(shared.attributes.at("gps_time").data, scan.attributes.at("gps_time").data);
+  // The scan itself is as it was.
+  EXPECT_EQ(cv::norm(scan.range, before.range, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(scan.color, before.color, cv::NORM_INF), 0.0);
+  EXPECT_TRUE(scan.synthesized.empty());
+  EXPECT_THROW(PasteScanCopyOnWrite(part, cv::Rect(6, 0, 4, 3), &shared), std::logic_error);
+}
+
 }  // namespace
 }  // namespace lidarshop
