@@ -460,26 +460,6 @@ bool IsFloatPicture(const std::string& path) {
   return extension == "exr" || extension == "tif" || extension == "tiff";
 }
 
-nlohmann::ordered_json LayoutJson(const PictureLayout& layout) {
-  nlohmann::ordered_json json;
-  json["view"] = ToString(layout.view);
-  json["description"] = layout.Describe();
-  json["pixel_width"] = layout.pixel_width;
-  json["pixel_height"] = layout.pixel_height;
-  json["pixel_unit"] = layout.pixel_unit;
-  json["source_rows"] = layout.cells.rows;
-  json["source_cols"] = layout.cells.cols;
-  if (layout.view != PictureView::kGrid) {
-    json["points"] = layout.points;
-    json["points_kept"] = layout.points_kept;
-  }
-  if (layout.splat_px > 0) {
-    json["point_size_px"] = layout.splat_px;
-    json["point_size"] = layout.splat_automatic ? "twice the local point spacing (median)" : "--point-size";
-  }
-  return json;
-}
-
 int RunRender(int argc, char** argv) {
   CLI::App app{
       "Render a channel of a scan as a picture, row 0 = top (highest elevation): square angular pixels by "
@@ -711,7 +691,7 @@ int RunRender(int argc, char** argv) {
           if (!result.legend_lines.empty()) json["legend"] = result.legend_lines;
           layout = std::move(result.layout);
         }
-        json["layout"] = LayoutJson(layout);
+        json["layout"] = ToJson(SummarizeLayout(layout));
         // The layout beside the picture: what strokes and masks painted on it map onto (picture_mapping.h).
         const std::string layout_path = LayoutFilePath(output);
         WriteJsonOutput(layout_path, LayoutFileJson(layout, scan, image_size));

@@ -62,25 +62,6 @@ void ToDisplay(const cv::Mat& image, int depth, cv::Mat* display) {
   }
 }
 
-// The numbers of a fill (InpaintResult has no described JSON form: its images are not JSON).
-nlohmann::ordered_json ResultJson(const InpaintResult& result) {
-  nlohmann::ordered_json json;
-  json["complete"] = result.complete;
-  json["hole_pixels"] = result.hole_pixels;
-  json["iterations"] = result.iterations;
-  json["candidates_evaluated"] = result.candidates_evaluated;
-  json["acceptance_fallbacks"] = result.acceptance_fallbacks;
-  json["rejected"] = result.rejected;
-  json["global_searches"] = result.global_searches;
-  json["seconds"] = result.seconds;
-  if (result.review) {
-    json["review"] = {{"iteration", result.review->iteration},
-                      {"target", {result.review->target.row, result.review->target.col}},
-                      {"candidates", result.review->candidates.size()}};
-  }
-  return json;
-}
-
 }  // namespace
 
 int RunInpaint(int argc, char** argv) {
@@ -197,7 +178,7 @@ int RunInpaint(int argc, char** argv) {
               result.review->iteration, result.review->target.row, result.review->target.col,
               result.review->candidates.size(), result.review->cluster_representative.size(), review_dir,
               review_dir);
-          WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
+          WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
           return 0;
         }
         cv::Mat output;
@@ -225,7 +206,7 @@ int RunInpaint(int argc, char** argv) {
             }
           });
         }
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), ResultJson(result)));
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         Summarize(result.Summary());
         return 0;
       },

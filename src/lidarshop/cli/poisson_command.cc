@@ -112,12 +112,10 @@ int RunPoisson(int argc, char** argv) {
             "--json", json_path, {},
             {image_path, mask_path, source_path, target_path, gx_path, gy_path, boundary_path, output_path});
         PoissonResult result;
-        int unknowns = 0;
         if (*fill) {
           const cv::Mat image = ReadImage(image_path);
           const cv::Mat mask = ReadMask(mask_path, image.size(), image_path);
           const PoissonSystem system = PreparePoisson(mask, options);
-          unknowns = system.NumUnknowns();
           cv::Mat input;
           image.convertTo(input, CV_32F);
           result = FillLaplace(system, input);
@@ -132,7 +130,6 @@ int RunPoisson(int argc, char** argv) {
                             fmt::format("the target has {} channel(s), the source {} has {}",
                                         target.channels(), source_path, source.channels()));
           }
-          unknowns = cv::countNonZero(mask);
           cv::Mat source_float, target_float;
           source.convertTo(source_float, CV_32F);
           target.convertTo(target_float, CV_32F);
@@ -151,22 +148,13 @@ int RunPoisson(int argc, char** argv) {
           }
           const cv::Mat mask = ReadMask(mask_path, boundary.size(), boundary_path);
           const PoissonSystem system = PreparePoisson(mask, options);
-          unknowns = system.NumUnknowns();
           cv::Mat boundary_float;
           boundary.convertTo(boundary_float, CV_32F);
           result = ReconstructFromGradients(system, boundary_float, gx, gy);
           WriteResult(output_path, result.image, IntegerDepth(boundary));
         }
-        Summarize(fmt::format("{} unknowns; {}", unknowns, result.Summary()));
-        nlohmann::ordered_json json;
-        json["operation"] = *fill ? "fill" : *clone ? "clone" : "reconstruct";
-        json["unknowns"] = unknowns;
-        json["solver"] = ToString(result.solver);
-        json["channels"] = result.channels;
-        json["iterations"] = result.iterations;
-        json["relative_residual"] = result.relative_residual;
-        json["seconds"] = result.seconds;
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        Summarize(fmt::format("{} unknowns; {}", result.unknowns, result.Summary()));
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         return 0;
       },
       &binder);

@@ -13,6 +13,7 @@
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/points_operations.h"
 #include "lidarshop/fill/fill_metrics.h"
+#include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
@@ -50,9 +51,12 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            OptionsType<LasWriteOptions>(),          // LAS output
            OptionsType<PointViewOptions>(),         // render
            OptionsType<PictureLayoutOptions>(),     // render
+           ResultType<PictureLayoutSummary>(),      // render --json's "layout"
            OptionsType<VerifyOptions>(),            // verify, sweep
            OptionsType<SweepOptions>(),             // sweep
+           ResultType<InpaintResult>(),             // inpaint
            OptionsType<PoissonOptions>(),           // poisson
+           ResultType<PoissonResult>(),             // poisson
            OptionsType<FillMetricsOptions>(),       // fill_eval
            OptionsType<ResectionOptions>(),         // resection, recolor
            OptionsType<AutoResectionOptions>(),     // resection --auto

@@ -111,6 +111,8 @@ struct FillStep {
   double margin = 0.0;      // acceptance margin of the chosen candidate (0 without acceptance)
 };
 
+// Described (its counts, then review_stop as "review": the keys of `lidarshop inpaint --json`); the images,
+// steps and the review itself are not JSON.
 struct InpaintResult {
   cv::Mat image;           // H x W CV_32FC(C), hole filled
   cv::Mat fill_iteration;  // H x W CV_32S: iteration that filled each pixel, -1 = known from the start
@@ -123,10 +125,14 @@ struct InpaintResult {
   int rejected = 0;                  // candidates rejected by the acceptance over the whole fill
   int global_searches = 0;  // targets whose local window held no accepted candidate (acceptance only)
   bool complete = true;     // false: stopped for a review; image holds the partial fill
-  std::optional<InpaintReview> review;  // set when stopped for a review
-  double seconds = 0.0;                 // wall-clock time of the fill
-  std::string Summary() const;          // one line
+  std::optional<InpaintReview> review;    // set when stopped for a review
+  std::optional<ReviewStop> review_stop;  // set with review: where it stopped, in brief
+  double seconds = 0.0;                   // wall-clock time of the fill
+  std::string Summary() const;            // one line
 };
+
+template <>
+const StructInfo& InfoOf<InpaintResult>();
 
 // Fills the hole. Throws InputError on mismatched or invalid inputs, when no source patch exists and when a
 // review decision does not fit the fill (another target, or a source that is not a source centre).

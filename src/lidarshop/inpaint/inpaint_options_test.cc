@@ -16,6 +16,29 @@ TEST(InpaintOptionsInfo, ExactRoundTrips) {
   ExpectExactRoundTrip<OffsetCompletionOptions>();
 }
 
+// The result's JSON keys in the order `lidarshop inpaint --json` has always written them; "review" only when
+// the fill stopped for one.
+TEST(InpaintOptionsInfo, ResultKeys) {
+  ExpectExactRoundTrip<InpaintResult>();
+  ExpectExactRoundTrip<ReviewStop>();
+  EXPECT_EQ(
+      InfoOf<InpaintResult>().Keys(),
+      (std::vector<std::string>{"complete", "hole_pixels", "iterations", "candidates_evaluated",
+                                "acceptance_fallbacks", "rejected", "global_searches", "seconds", "review"}));
+  InpaintResult result;
+  result.hole_pixels = 9;
+  EXPECT_EQ(ToJson(result).dump(),
+            R"({"complete":true,"hole_pixels":9,"iterations":0,"candidates_evaluated":0,)"
+            R"("acceptance_fallbacks":0,"rejected":0,"global_searches":0,"seconds":0.0})");
+  InpaintReview review;
+  review.iteration = 4;
+  review.target = {10, 20};
+  review.candidates.resize(3);
+  result.complete = false;
+  result.review_stop = StopOf(review);
+  EXPECT_EQ(ToJson(result)["review"].dump(), R"({"iteration":4,"target":[10,20],"candidates":3})");
+}
+
 TEST(InpaintOptionsInfo, Errors) {
   ExpectRejected<InpaintOptions>({{"patch_radius", 65}}, "patch_radius", "out of range [1, 64]");
   ExpectRejected<InpaintOptions>({{"search", "patch-match"}}, "search", "did you mean 'patchmatch'");

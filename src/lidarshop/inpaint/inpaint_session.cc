@@ -151,6 +151,7 @@ bool InpaintSession::Run() {
                      s.strategies.acceptance.get(), options.review_cluster_rms, options.channel_weights);
       review.review_point = s.review_points;
       review.iteration = s.result.iterations;
+      s.result.review_stop = StopOf(review);
       s.result.review = std::move(review);
       s.pending = decision;
       s.seconds += timer.Seconds();
@@ -179,6 +180,7 @@ void InpaintSession::Decide(Pixel source) {
   const TargetDecision decision = *s.pending;
   s.pending.reset();
   s.result.review.reset();
+  s.result.review_stop.reset();
   s.Fill(decision, chosen, s.review_points);
   s.decisions.push_back(made);
   ++s.review_points;

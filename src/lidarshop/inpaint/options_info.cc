@@ -232,4 +232,38 @@ const StructInfo& InfoOf<OffsetCompletionOptions>() {
   return info;
 }
 
+template <>
+const StructInfo& InfoOf<ReviewStop>() {
+  static const StructInfo info = [] {
+    StructBuilder<ReviewStop> b("ReviewStop", "where a fill stopped for a review");
+    b.Field(&ReviewStop::iteration, "iteration", "fill iteration at which the fill stopped");
+    b.Field(&ReviewStop::target, "target", "[row, col] of the target patch no candidate passed").Unit("px");
+    b.Field(&ReviewStop::candidates, "candidates", "candidates ranked for it (the review lists them)");
+    return b.Build();
+  }();
+  return info;
+}
+
+// In the order `lidarshop inpaint --json` has always written them.
+template <>
+const StructInfo& InfoOf<InpaintResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<InpaintResult> b("InpaintResult", "counts of an inpainting (the images are not JSON)");
+    b.Field(&InpaintResult::complete, "complete", "false: stopped for a review, the image is a partial fill");
+    b.Field(&InpaintResult::hole_pixels, "hole_pixels", "pixels of the hole").Unit("px");
+    b.Field(&InpaintResult::iterations, "iterations", "patches copied");
+    b.Field(&InpaintResult::candidates_evaluated, "candidates_evaluated",
+            "patch differences evaluated (including early-terminated ones)");
+    b.Field(&InpaintResult::acceptance_fallbacks, "acceptance_fallbacks",
+            "steps where no offered candidate was accepted (the best was used)");
+    b.Field(&InpaintResult::rejected, "rejected", "candidates rejected by the acceptance tests");
+    b.Field(&InpaintResult::global_searches, "global_searches",
+            "targets whose local window held no accepted candidate");
+    b.Field(&InpaintResult::seconds, "seconds", "wall-clock time of the fill").Unit("s");
+    b.Field(&InpaintResult::review_stop, "review", "where the fill stopped for a review (only then)");
+    return b.Build();
+  }();
+  return info;
+}
+
 }  // namespace lidarshop

@@ -63,6 +63,11 @@ std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
   return cluster;
 }
 
+ReviewStop StopOf(const InpaintReview& review) {
+  return {
+      review.iteration, {review.target.row, review.target.col}, static_cast<int>(review.candidates.size())};
+}
+
 InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<SourceCandidate> candidates,
                          const PatchAcceptance* acceptance, double cluster_max_rms,
                          const std::vector<float>& channel_weights) {

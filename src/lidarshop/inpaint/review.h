@@ -18,6 +18,7 @@
 #include "lidarshop/inpaint/acceptance.h"
 #include "lidarshop/inpaint/canvas.h"
 #include "lidarshop/inpaint/search.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -38,6 +39,19 @@ struct InpaintReview {
   cv::Mat tentative_image;  // H x W CV_32FC(C): the fill so far with candidates[0] pasted into Ψtarget
   cv::Mat known;            // H x W CV_8U, 1 = known before the paste
 };
+
+// Where a fill stopped for a review, in brief: InpaintResult::review_stop, the "review" of `lidarshop inpaint
+// --json` (the review itself, with its candidates and images, is InpaintResult::review and review.json).
+// Described.
+struct ReviewStop {
+  int iteration = 0;        // fill iteration at which the fill stopped
+  std::vector<int> target;  // [row, col] of the failing target patch's centre
+  int candidates = 0;       // candidates ranked for it
+};
+ReviewStop StopOf(const InpaintReview& review);
+
+template <>
+const StructInfo& InfoOf<ReviewStop>();
 
 // Groups ranked candidates: each joins the first cluster whose representative's descriptor differs from its
 // own by at most max_rms, or starts a new one. The descriptor of a source patch is, per channel, the mean of

@@ -24,6 +24,16 @@ const EnumInfo& EnumInfoOf<PoissonDirectBackend>() {
 }
 
 template <>
+const EnumInfo& EnumInfoOf<PoissonOperation>() {
+  static const EnumInfo info = MakeEnumInfo<PoissonOperation>(
+      "Poisson operation", {{PoissonOperation::kSolve, "solve", "a given divergence (SolvePoisson)"},
+                            {PoissonOperation::kFill, "fill", "Laplace hole filling"},
+                            {PoissonOperation::kClone, "clone", "seamless cloning"},
+                            {PoissonOperation::kReconstruct, "reconstruct", "from a gradient field"}});
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<PoissonOptions>() {
   static const StructInfo info = [] {
     StructBuilder<PoissonOptions> b("PoissonOptions", "Poisson / Laplace solves on masked domains");
@@ -45,6 +55,25 @@ const StructInfo& InfoOf<PoissonOptions>() {
         .Unit("unknowns")
         .Min(1);
     b.Field(&PoissonOptions::max_levels, "max_levels", "multigrid: levels including the finest").Min(1);
+    return b.Build();
+  }();
+  return info;
+}
+
+// In the order `lidarshop poisson --json` has always written them.
+template <>
+const StructInfo& InfoOf<PoissonResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<PoissonResult> b("PoissonResult", "a Poisson solve (the image is not JSON)");
+    b.Field(&PoissonResult::operation, "operation", "the equation solved");
+    b.Field(&PoissonResult::unknowns, "unknowns", "pixels of the domain solved for").Unit("px");
+    b.Field(&PoissonResult::solver, "solver", "the solver that ran");
+    b.Field(&PoissonResult::channels, "channels", "right-hand sides solved");
+    b.Field(&PoissonResult::iterations, "iterations",
+            "CG iterations, the maximum over channels (0 for the direct solver)");
+    b.Field(&PoissonResult::relative_residual, "relative_residual",
+            "||b - A x|| / ||b||, the maximum over channels");
+    b.Field(&PoissonResult::seconds, "seconds", "wall-clock time of the solve").Unit("s");
     return b.Build();
   }();
   return info;

@@ -385,6 +385,7 @@ PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& bo
   if (!divergence.empty())
     RefuseNonFinite(divergence, system_handle.Mask(), /*inside=*/true, "the divergence");
   PoissonResult result;
+  result.unknowns = static_cast<int>(system.unknown_pixels.size());
   result.solver = system.solver;
   result.channels = n;
   result.image = boundary;
@@ -400,12 +401,16 @@ PoissonResult SolvePoisson(const PoissonSystem& system_handle, const cv::Mat& bo
 }
 
 PoissonResult FillLaplace(const PoissonSystem& system, const cv::Mat& image) {
-  return SolvePoisson(system, image, cv::Mat());
+  PoissonResult result = SolvePoisson(system, image, cv::Mat());
+  result.operation = PoissonOperation::kFill;
+  return result;
 }
 
 PoissonResult ReconstructFromGradients(const PoissonSystem& system, const cv::Mat& boundary,
                                        const cv::Mat& gx, const cv::Mat& gy) {
-  return SolvePoisson(system, boundary, BackwardDivergence(gx, gy));
+  PoissonResult result = SolvePoisson(system, boundary, BackwardDivergence(gx, gy));
+  result.operation = PoissonOperation::kReconstruct;
+  return result;
 }
 
 cv::Mat CloneMaskInTarget(const cv::Mat& source_mask, cv::Size target_size, cv::Point offset) {
@@ -466,6 +471,7 @@ PoissonResult SeamlessClone(const cv::Mat& source, const cv::Mat& source_mask, c
       CloneMaskInTarget(source_mask, target.size(), offset);  // validates placement
   const cv::Rect region = cv::boundingRect(target_mask_check);
   PoissonResult result;
+  result.operation = PoissonOperation::kClone;
   cv::Mat output;
   target.convertTo(output, depth);
   if (region.area() == 0) {
@@ -484,6 +490,7 @@ PoissonResult SeamlessClone(const cv::Mat& source, const cv::Mat& source_mask, c
   Laplacian5(source_window).copyTo(divergence(placed), window_mask(placed));
   const PoissonSystem system = PreparePoisson(window_mask, options);
   result = SolvePoisson(system, output(window), divergence);
+  result.operation = PoissonOperation::kClone;
   result.image.copyTo(output(window));
   result.image = output;
   return result;

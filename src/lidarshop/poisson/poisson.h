@@ -130,8 +130,20 @@ struct PoissonLinks {
 };
 PoissonSystem PreparePoisson(const cv::Mat& mask, const PoissonOptions& options, const PoissonLinks& links);
 
+// The equation a PoissonResult solved: the entry point that made it.
+enum class PoissonOperation {
+  kSolve,        // SolvePoisson: a given divergence
+  kFill,         // FillLaplace
+  kClone,        // SeamlessClone
+  kReconstruct,  // ReconstructFromGradients
+};
+
+// Described (operation, unknowns, solver, channels, iterations, relative_residual, seconds: the order of
+// `lidarshop poisson --json`); the image is not JSON.
 struct PoissonResult {
   cv::Mat image;  // H x W x n: the boundary image with Ω replaced by the solution
+  PoissonOperation operation = PoissonOperation::kSolve;  // the entry point that made it
+  int unknowns = 0;                                       // pixels of Ω solved for (each channel)
   PoissonSolverKind solver = PoissonSolverKind::kDirect;  // the solver that ran
   int channels = 0;                                       // right-hand sides solved
   int iterations = 0;              // CG iterations, the maximum over channels (0 for the direct solver)
@@ -140,6 +152,11 @@ struct PoissonResult {
 
   std::string Summary() const;  // one line: solver, unknowns/channels, iterations, residual, seconds
 };
+
+template <>
+const EnumInfo& EnumInfoOf<PoissonOperation>();
+template <>
+const StructInfo& InfoOf<PoissonResult>();
 
 // Solves the system for every channel:
 //   boundary    H x W x n (any depth; CV_64F stays double, everything else is solved in double and

@@ -96,4 +96,28 @@ const StructInfo& InfoOf<PointViewOptions>() {
   return info;
 }
 
+// In the order `lidarshop render --json` has always written its "layout".
+template <>
+const StructInfo& InfoOf<PictureLayoutSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<PictureLayoutSummary> b("PictureLayoutSummary", "what a picture of a scan shows");
+    b.Field(&PictureLayoutSummary::view, "view", "the view drawn");
+    b.Field(&PictureLayoutSummary::description, "description", "one line saying what was done");
+    b.Field(&PictureLayoutSummary::pixel_width, "pixel_width", "size of a pixel across (pixel_unit)");
+    b.Field(&PictureLayoutSummary::pixel_height, "pixel_height", "size of a pixel down (pixel_unit)");
+    b.Field(&PictureLayoutSummary::pixel_unit, "pixel_unit", "deg (grid, sphere) or m (top, front, side)");
+    b.Field(&PictureLayoutSummary::source_rows, "source_rows", "rows of the grid coloured").Unit("cells");
+    b.Field(&PictureLayoutSummary::source_cols, "source_cols", "columns of the grid coloured").Unit("cells");
+    b.Field(&PictureLayoutSummary::points, "points", "projections: points projected");
+    b.Field(&PictureLayoutSummary::points_kept, "points_kept",
+            "projections: points kept (the nearest of each cell, or shown on a pixel)");
+    b.Field(&PictureLayoutSummary::point_size_px, "point_size_px",
+            "orthographic views: the median side of the squares drawn")
+        .Unit("px");
+    b.Field(&PictureLayoutSummary::point_size, "point_size", "orthographic views: where that size came from");
+    return b.Build();
+  }();
+  return info;
+}
+
 }  // namespace lidarshop

@@ -459,6 +459,26 @@ PictureLayout LayOutPicture(const Scan& scan, const PictureLayoutOptions& option
   return LayOutGrid(scan, options);
 }
 
+PictureLayoutSummary SummarizeLayout(const PictureLayout& layout) {
+  PictureLayoutSummary summary;
+  summary.view = layout.view;
+  summary.description = layout.Describe();
+  summary.pixel_width = layout.pixel_width;
+  summary.pixel_height = layout.pixel_height;
+  summary.pixel_unit = layout.pixel_unit;
+  summary.source_rows = layout.cells.rows;
+  summary.source_cols = layout.cells.cols;
+  if (layout.view != PictureView::kGrid) {
+    summary.points = layout.points;
+    summary.points_kept = layout.points_kept;
+  }
+  if (layout.splat_px > 0) {
+    summary.point_size_px = layout.splat_px;
+    summary.point_size = layout.splat_automatic ? "twice the local point spacing (median)" : "--point-size";
+  }
+  return summary;
+}
+
 std::string PictureLayout::Describe() const {
   const std::string size = fmt::format("{} x {}", picture_size.width, picture_size.height);
   const std::string pixel = pixel_unit == "deg"

@@ -29,6 +29,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -91,6 +92,25 @@ struct PictureLayout {
   double left_m = 0, top_m = 0;
   std::string Describe() const;  // one line saying what was done, for stderr and --json
 };
+
+// A picture's layout in brief: the "layout" of `lidarshop render --json`, in its order. Described.
+struct PictureLayoutSummary {
+  PictureView view = PictureView::kGrid;
+  std::string description;  // PictureLayout::Describe()
+  double pixel_width = 0, pixel_height = 0;
+  std::string pixel_unit;
+  int source_rows = 0, source_cols = 0;  // PictureLayout::cells: the grid coloured
+  // Projections (every view but the grid): points projected and kept.
+  std::optional<int64_t> points, points_kept;
+  // Orthographic views: the median side of the squares drawn, and where it came from (the local spacing, or
+  // the size asked for: "--point-size", the flag that sets PictureLayoutOptions::point_size_px).
+  std::optional<double> point_size_px;
+  std::optional<std::string> point_size;
+};
+PictureLayoutSummary SummarizeLayout(const PictureLayout& layout);
+
+template <>
+const StructInfo& InfoOf<PictureLayoutSummary>();
 
 // True for a cloud without a ray grid: a 1 x N (or N x 1) scan without a fitted grid, as readers make of an
 // E57 without row/column indices, an unorganized PCD/PLY, LAS and XYZ.

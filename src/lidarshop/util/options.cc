@@ -222,6 +222,7 @@ void RunCheck(const StructInfo& info, const void* object, const std::string& pat
 
 void ValidateStruct(const StructInfo& info, const void* object, const std::string& path) {
   for (const FieldInfo& field : info.fields) {
+    if (field.present && !field.present(object)) continue;
     if (field.kind == FieldKind::kStruct) {
       ValidateStruct(*field.nested, field.nested_of(const_cast<void*>(object)), Join(path, field.key));
       continue;
@@ -320,7 +321,10 @@ const FieldInfo* FindFieldPath(const StructInfo& info, const std::string& key_pa
 
 nlohmann::ordered_json StructToJson(const StructInfo& info, const void* object) {
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
-  for (const FieldInfo& field : info.fields) json[field.key] = field.get(object);
+  for (const FieldInfo& field : info.fields) {
+    if (field.present && !field.present(object)) continue;  // an optional member holding nothing
+    json[field.key] = field.get(object);
+  }
   return json;
 }
 

@@ -18,6 +18,9 @@
 // and declares `template <> const StructInfo& InfoOf<FillOptions>();` next to the struct. Enums are described
 // the same way by `EnumInfoOf<E>()` (util/enum_names.h), and convert to and from strings only through it.
 //
+// A result's part that only some runs have is a std::optional member (InpaintResult::review_stop, where a fill
+// stopped for a review): ToJson leaves its key out when it holds nothing (FieldInfo::present).
+//
 // A struct that holds another's options nests it (`InpaintOptions inpaint;` in FillOptions, described by
 // `b.Field(&FillOptions::inpaint, ...)`) instead of copying its fields. Where fields used to be flat, the old
 // keys stay as aliases (`b.Alias("patch_radius", "inpaint.patch_radius")`): JSON, the CLI's flags and Python's
@@ -50,6 +53,10 @@ template <class T>
 struct IsVector : std::false_type {};
 template <class T>
 struct IsVector<std::vector<T>> : std::true_type {};
+template <class T>
+struct IsOptional : std::false_type {};
+template <class T>
+struct IsOptional<std::optional<T>> : std::true_type {};
 
 struct StructInfo;
 
@@ -70,6 +77,9 @@ struct FieldInfo {
   std::function<nlohmann::ordered_json(const void*)> get;
   std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
   std::function<void*(void*)> nested_of;                  // kStruct: the member's address
+  // A std::optional member: whether it holds a value. ToJson leaves the key out when it does not (get then gives
+  // the value a default T would have, which set or nested_of fill in); empty for every other field.
+  std::function<bool(const void*)> present;
   // An alias (StructInfo::aliases): the key path of the field it stands for ("inpaint.patch_radius"), and
   // how many fields of its struct were described before it (where its flag goes in the CLI's help). Its
   // get / set / nested_of reach that field from the alias's own struct.
@@ -185,19 +195,7 @@ class StructBuilder {
     field.key = std::move(key);
     field.doc = std::move(doc);
     field.get = [member](const void* object) -> nlohmann::ordered_json {
-      const T& value = static_cast<const S*>(object)->*member;
-      if constexpr (std::is_enum_v<T>) {
-        return std::string(ToString(value));
-      } else if constexpr (std::is_floating_point_v<T>) {
-        // NaN ("none", e.g. a consistency with nothing to compare) is JSON null.
-        return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
-      } else if constexpr (IsVector<T>::value) {
-        return nlohmann::ordered_json(value);
-      } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
-        return StructToJson(InfoOf<T>(), &value);
-      } else {
-        return value;
-      }
+      return ValueJson(static_cast<const S*>(object)->*member);
     };
     if constexpr (std::is_same_v<T, std::vector<std::string>>) {
       field.kind = FieldKind::kStringList;
@@ -241,6 +239,48 @@ class StructBuilder {
     return info_.fields.back();
   }
 
+  // A member present in some results only (written when it holds a value): a described struct, a bool, a
+  // number, an enum or a string.
+  template <class T>
+  FieldInfo& Field(std::optional<T> S::*member, std::string key, std::string doc) {
+    static_assert(!IsVector<T>::value, "an optional field holds a struct or one value");
+    FieldInfo field;
+    field.key = std::move(key);
+    field.doc = std::move(doc);
+    field.present = [member](const void* object) {
+      return (static_cast<const S*>(object)->*member).has_value();
+    };
+    field.get = [member](const void* object) -> nlohmann::ordered_json {
+      const std::optional<T>& value = static_cast<const S*>(object)->*member;
+      return ValueJson(value ? *value : T{});
+    };
+    if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
+      field.kind = FieldKind::kStruct;
+      field.nested = &InfoOf<T>();
+      field.nested_of = [member](void* object) -> void* {
+        std::optional<T>& value = static_cast<S*>(object)->*member;
+        if (!value) value.emplace();
+        return &*value;
+      };
+    } else {
+      field.kind = KindOf<T>();
+      if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, uint64_t>) {
+        field.integer_low = std::numeric_limits<T>::min();
+        field.integer_high = std::numeric_limits<T>::max();
+      }
+      if constexpr (std::is_enum_v<T>) field.choices = &EnumInfoOf<T>();
+      field.set = [member](void* object, const nlohmann::json& json) {
+        if constexpr (std::is_enum_v<T>) {
+          static_cast<S*>(object)->*member = ParseEnum<T>(json.get<std::string>());
+        } else {
+          static_cast<S*>(object)->*member = json.get<T>();
+        }
+      };
+    }
+    info_.fields.push_back(std::move(field));
+    return info_.fields.back();
+  }
+
   // `key` kept as an alias of the nested field at `target_path` ("patch_radius" for "inpaint.patch_radius"),
   // described after that struct's field. It has the target's kind, doc, unit and range; a narrower Range()
   // applies to the nested field inside this struct (FillOptions takes patches up to 15 cells, InpaintOptions
@@ -258,6 +298,23 @@ class StructBuilder {
   StructInfo Build() { return std::move(info_); }
 
  private:
+  // The JSON form of one member's value.
+  template <class T>
+  static nlohmann::ordered_json ValueJson(const T& value) {
+    if constexpr (std::is_enum_v<T>) {
+      return std::string(ToString(value));
+    } else if constexpr (std::is_floating_point_v<T>) {
+      // NaN ("none", e.g. a consistency with nothing to compare) is JSON null.
+      return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+    } else if constexpr (IsVector<T>::value) {
+      return nlohmann::ordered_json(value);
+    } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
+      return StructToJson(InfoOf<T>(), &value);
+    } else {
+      return value;
+    }
+  }
+
   template <class T>
   static constexpr FieldKind KindOf() {
     if constexpr (std::is_same_v<T, bool>) {

@@ -110,8 +110,9 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
                    : "| key | type | unit | doc |\n|---|---|---|---|\n";
     for (const FieldInfo& field : info.fields) {
       if (!options) {
-        out += fmt::format("| `{}` | {} | {} | {} |\n", field.key, Cell(TypeText(field)), Cell(field.unit),
-                           Cell(field.doc));
+        // An optional part (FieldInfo::present) is left out of the JSON when the result has none.
+        out += fmt::format("| `{}` | {}{} | {} | {} |\n", field.key, Cell(TypeText(field)),
+                           field.present ? ", or absent" : "", Cell(field.unit), Cell(field.doc));
         if (field.kind == FieldKind::kStruct) push({field.nested, nullptr, true});
         continue;
       }

@@ -147,6 +147,66 @@ TEST(Options, FindFieldPathThroughAliases) {
   EXPECT_EQ(FindFieldPath(info, "nothing", &o, &owner, &canonical), nullptr);
 }
 
+// A result whose parts only some runs have: std::optional members, left out of ToJson when empty.
+struct PartialResult {
+  int count = 0;
+  std::optional<InnerOptions> stop;
+  std::optional<int64_t> points;
+  std::optional<double> size_px;
+  std::optional<std::string> origin;
+  std::optional<Flavour> flavour;
+  double seconds = 0;
+};
+
+template <>
+const StructInfo& InfoOf<PartialResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<PartialResult> b("PartialResult", "partial");
+    b.Field(&PartialResult::count, "count", "count");
+    b.Field(&PartialResult::stop, "stop", "where it stopped");
+    b.Field(&PartialResult::points, "points", "points").Min(0);
+    b.Field(&PartialResult::size_px, "size_px", "size").Unit("px");
+    b.Field(&PartialResult::origin, "origin", "origin");
+    b.Field(&PartialResult::flavour, "flavour", "flavour");
+    b.Field(&PartialResult::seconds, "seconds", "time").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(Options, OptionalFieldsAreWrittenOnlyWhenSet) {
+  PartialResult result;
+  result.count = 3;
+  EXPECT_EQ(ToJson(result).dump(), R"({"count":3,"seconds":0.0})");
+  result.stop = InnerOptions{5, true};
+  result.points = 7;
+  result.size_px = 2.5;
+  result.origin = "spacing";
+  result.flavour = Flavour::kSmoked;
+  EXPECT_EQ(ToJson(result).dump(),
+            R"({"count":3,"stop":{"band_px":5,"enabled":true},"points":7,"size_px":2.5,"origin":"spacing",)"
+            R"("flavour":"smoked","seconds":0.0})");
+  // Back from JSON: given keys set the member, absent ones leave it empty.
+  const PartialResult back = FromJson<PartialResult>(nlohmann::json::parse(ToJson(result).dump()));
+  EXPECT_EQ(ToJson(back).dump(), ToJson(result).dump());
+  const PartialResult some = FromJson<PartialResult>({{"points", 4}, {"stop", {{"band_px", 3}}}});
+  EXPECT_EQ(some.points, 4);
+  ASSERT_TRUE(some.stop.has_value());
+  EXPECT_EQ(some.stop->band_px, 3);
+  EXPECT_FALSE(some.size_px.has_value());
+  EXPECT_FALSE(some.flavour.has_value());
+  // Ranges apply when a value is there.
+  ExpectRejected<PartialResult>({{"points", -1}}, "points", "out of range");
+  ExpectRejected<PartialResult>({{"stop", {{"band_px", 0}}}}, "stop.band_px", "out of range [1, 64]");
+  PartialResult bad;
+  EXPECT_NO_THROW(Validate(bad));
+  bad.stop = InnerOptions{0, false};
+  EXPECT_THROW(Validate(bad), OptionsFieldError);
+  EXPECT_TRUE(InfoOf<PartialResult>().Find("stop")->present != nullptr);
+  EXPECT_FALSE(InfoOf<PartialResult>().Find("count")->present != nullptr);
+  ExpectExactRoundTrip<PartialResult>();
+}
+
 TEST(Options, RoundTripIsExact) {
   ExpectExactRoundTrip<OuterOptions>();
   OuterOptions o;

@@ -94,13 +94,15 @@ std::string MemberComment(const FieldInfo& field, const nlohmann::ordered_json* 
 }
 
 // One member as Prettier prints it: on one line when it fits, else a union broken before each '|'.
+// An optional member (FieldInfo::present) is `key?:`, absent from the JSON when the result has none.
 void AppendMember(const FieldInfo& field, const std::vector<std::string>& alternatives, std::string* out) {
-  std::string one_line = fmt::format("  {}: {};", field.key, fmt::join(alternatives, " | "));
+  const std::string key = field.present ? field.key + "?" : field.key;
+  std::string one_line = fmt::format("  {}: {};", key, fmt::join(alternatives, " | "));
   if (one_line.size() <= kPrintWidth || alternatives.size() == 1) {
     *out += one_line + "\n";
     return;
   }
-  *out += fmt::format("  {}:\n", field.key);
+  *out += fmt::format("  {}:\n", key);
   for (size_t i = 0; i < alternatives.size(); ++i) {
     *out += fmt::format("    | {}{}\n", alternatives[i], i + 1 == alternatives.size() ? ";" : "");
   }
@@ -164,6 +166,7 @@ nlohmann::ordered_json DescriptionJson(const StructInfo& info) {
       for (const EnumInfo::Choice& choice : field.choices->choices) names.push_back(choice.name);
       json["choices"] = names;
     }
+    if (field.present) json["optional"] = true;  // left out of the JSON when absent
     if (field.nested != nullptr) json["struct"] = DescriptionJson(*field.nested);
     fields.push_back(std::move(json));
   }

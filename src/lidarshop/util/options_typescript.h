@@ -47,9 +47,9 @@ TypeScriptStruct ResultType() {
 // name. `header` (comment lines, each starting with "//") opens the file.
 std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs, std::string_view header);
 
-// The description of `info` and its nested structs as JSON (for tools and tests): {"name", "doc", "fields":
-// [{"key", "kind", "doc", "unit", "range", "choices", "struct"}]}, and "aliases": [{"key", "alias_of", "range"}]
-// when it has some.
+// The description of `info` and its nested structs as JSON (for tools and tests): {"name", "doc", "fields": [{"key",
+// "kind", "doc", "unit", "range", "choices", "optional" (true for a std::optional member), "struct"}]}, and
+// "aliases": [{"key", "alias_of", "range"}] when it has some.
 nlohmann::ordered_json DescriptionJson(const StructInfo& info);
 
 }  // namespace lidarshop

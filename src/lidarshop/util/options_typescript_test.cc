@@ -1,5 +1,6 @@
 #include "lidarshop/util/options_typescript.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@ struct TreeOptions {
 struct TreeResult {
   double rms_m = 0;
   std::vector<std::string> warnings;
+  std::optional<LeafOptions> fallen;  // some results only
 };
 
 template <>
@@ -60,6 +62,7 @@ const StructInfo& InfoOf<TreeResult>() {
     StructBuilder<TreeResult> b("TreeResult", "what came out");
     b.Field(&TreeResult::rms_m, "rms_m", "fit").Unit("m");
     b.Field(&TreeResult::warnings, "warnings", "one sentence each");
+    b.Field(&TreeResult::fallen, "fallen", "a leaf that fell (some results only)");
     return b.Build();
   }();
   return info;
@@ -87,6 +90,8 @@ TEST(OptionsTypeScript, InterfacesFromTheDescriptions) {
             "  rms_m: number | null;\n"
             "  // one sentence each\n"
             "  warnings: string[];\n"
+            "  // a leaf that fell (some results only)\n"
+            "  fallen?: LeafOptions;\n"
             "}\n"
             "\n// a leaf (C++ LeafOptions)\n"
             "export interface LeafOptions {\n"
@@ -120,6 +125,14 @@ TEST(OptionsTypeScript, DescriptionJsonNestsStructs) {
   EXPECT_EQ(json["fields"][0]["choices"], nlohmann::ordered_json::array({"light", "dark"}));
   EXPECT_EQ(json["fields"][1]["range"], "> 0");
   EXPECT_EQ(json["fields"][3]["struct"]["fields"][0]["key"], "band_px");
+}
+
+// A std::optional member is marked optional (left out of the JSON when absent); the others have no such key.
+TEST(OptionsTypeScript, DescriptionJsonMarksOptionalFields) {
+  const nlohmann::ordered_json json = DescriptionJson(InfoOf<TreeResult>());
+  EXPECT_FALSE(json["fields"][0].contains("optional"));
+  EXPECT_EQ(json["fields"][2]["optional"], true);
+  EXPECT_EQ(json["fields"][2]["struct"]["name"], "LeafOptions");
 }
 
 }  // namespace lidarshop
