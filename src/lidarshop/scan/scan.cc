@@ -147,36 +147,20 @@ Scan CropScanView(const Scan& scan, const cv::Rect& window) {
   return CropCells(scan, window, false, "CropScanView");
 }
 
-void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan) {
-  CheckWindow(*scan, window, "PasteScan");
-  if (part.rows != window.height || part.cols != window.width)
-    throw std::logic_error("PasteScan: the part's size differs from the window's");
-  std::vector<std::pair<cv::Mat*, cv::Scalar>> targets;
-  ForEachChannel(*scan,
-                 [&](cv::Mat& channel, const cv::Scalar& none) { targets.emplace_back(&channel, none); });
-  size_t i = 0;
-  ForEachChannel(part, [&](const cv::Mat& channel, const cv::Scalar&) {
-    auto& [target, none] = targets[i++];
-    if (channel.empty()) return;
-    if (target->empty()) *target = cv::Mat(scan->rows, scan->cols, channel.type(), none);
-    channel.copyTo((*target)(window));
-  });
-  for (const auto& [name, values] : part.attributes) {
-    cv::Mat& target = scan->attributes[name];
-    if (target.empty()) target = cv::Mat(scan->rows, scan->cols, values.type(), cv::Scalar::all(0));
-    values.copyTo(target(window));
-  }
-}
+namespace {
 
-void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan) {
-  CheckWindow(*scan, window, "PasteScanCopyOnWrite");
+// PasteScan and PasteScanCopyOnWrite: with `copy_on_write` a channel whose window already holds the part's
+// values is left as it is, and any other is copied before it is written.
+void PasteChannels(const Scan& part, const cv::Rect& window, bool copy_on_write, const char* what,
+                   Scan* scan) {
+  CheckWindow(*scan, window, what);
   if (part.rows != window.height || part.cols != window.width)
-    throw std::logic_error("PasteScanCopyOnWrite: the part's size differs from the window's");
+    throw std::logic_error(fmt::format("{}: the part's size differs from the window's", what));
   const auto paste = [&](const cv::Mat& values, cv::Mat* target, const cv::Scalar& none) {
     if (values.empty()) return;
     if (target->empty()) {
       *target = cv::Mat(scan->rows, scan->cols, values.type(), none);
-    } else {
+    } else if (copy_on_write) {
       const cv::Mat current = (*target)(window);
       // Equal bytes (a NaN equals itself here, unlike cv::compare): nothing to write, the buffer stays shared.
       bool same = current.type() == values.type();
@@ -197,6 +181,16 @@ void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan) 
   });
   for (const auto& [name, values] : part.attributes)
     paste(values, &scan->attributes[name], cv::Scalar::all(0));
+}
+
+}  // namespace
+
+void PasteScan(const Scan& part, const cv::Rect& window, Scan* scan) {
+  PasteChannels(part, window, /*copy_on_write=*/false, "PasteScan", scan);
+}
+
+void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan) {
+  PasteChannels(part, window, /*copy_on_write=*/true, "PasteScanCopyOnWrite", scan);
 }
 
 Scan MakeScan(int rows, int cols, bool with_color, bool with_intensity) {
