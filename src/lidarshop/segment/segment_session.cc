@@ -787,9 +787,11 @@ std::optional<SegmentResult> SegmentSession::RefineTo(const cv::Mat& strokes, co
   const cv::Rect compared = (strokes_box | s.strokes_so_far_box) & s.WholeScan();
   if (!StrokesAdded(s.strokes_so_far, strokes, compared, &added)) return std::nullopt;
   if (s.level) return s.RefineOnLevel(added);
-  // A scan cut whole is small: its refinement takes the added strokes as an image.
+  // A scan cut whole is small: its refinement takes the added strokes as an image, those on cells with a
+  // return (the only ones Refine() keeps: a stroke on a cell without one stays "added" and is ignored again).
   cv::Mat extra = cv::Mat::zeros(strokes.size(), CV_8U);
-  for (const StrokeCell& stroke : added) extra.data[stroke.cell] = stroke.label;
+  for (const StrokeCell& stroke : added)
+    if (s.scan.valid.data[stroke.cell] != 0) extra.data[stroke.cell] = stroke.label;
   return Refine(extra);
 }
 
