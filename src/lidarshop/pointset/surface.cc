@@ -99,6 +99,23 @@ TriangleMesh ScaleSpaceSurface(const PointCloud& cloud, const SurfaceOptions& op
                                   static_cast<int>((*facet)[2]));
   }
   if (result.triangles.empty()) throw InputError("surface: the scale-space reconstruction found no surface");
+  // The advancing front orients the surface from the facet it starts at, which CGAL picks in an order that
+  // depends on memory addresses: the same input came back with every triangle reversed from run to run (a
+  // clean-clone CI failed on it). The triangles are turned to face away from the points' centroid (a
+  // positive signed volume), the way a scan's surfaces face the scanner's side.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3f& p : result.vertices) centroid += p.cast<double>();
+  centroid /= static_cast<double>(result.vertices.size());
+  double volume = 0;
+  for (const Eigen::Vector3i& t : result.triangles) {
+    const Eigen::Vector3d a = result.vertices[t[0]].cast<double>() - centroid;
+    const Eigen::Vector3d b = result.vertices[t[1]].cast<double>() - centroid;
+    const Eigen::Vector3d c = result.vertices[t[2]].cast<double>() - centroid;
+    volume += a.dot(b.cross(c));
+  }
+  if (volume < 0) {
+    for (Eigen::Vector3i& t : result.triangles) std::swap(t[1], t[2]);
+  }
   return result;
 }
 
