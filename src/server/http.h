@@ -190,6 +190,10 @@ void SendOverlay(httplib::Response& response, const cv::Mat& bgra, const cv::Rec
 
 // A job's JSON form (GET /api/jobs/ID).
 nlohmann::ordered_json JobJson(const Job& job);
+// Queues `run` on the document as a job of `kind` without answering (a job the server starts itself); null
+// when too many are queued.
+std::shared_ptr<Job> SubmitJob(State& state, const std::shared_ptr<Document>& document,
+                               const std::string& kind, std::function<nlohmann::ordered_json(Progress&)> run);
 // Starts `run` on the document as a job of `kind`; answers 202 with the job's JSON, or 503 (and returns null)
 // when too many are queued.
 std::shared_ptr<Job> StartJob(State& state, const std::shared_ptr<Document>& document,

@@ -358,7 +358,6 @@ nlohmann::ordered_json DocumentJson(Document& document) {
     if (!image->empty()) channels.push_back(name);
   }
   std::vector<double> pose(scan.world_from_scanner.data(), scan.world_from_scanner.data() + 16);
-
   // Angular steps of the grid, for square angular pixels on screen (0 when the scan has no grid).
   const auto step_deg = [](const std::vector<double>& angles) {
     return angles.size() < 2 ? 0.0
@@ -616,50 +615,46 @@ void AddScanRoutes(State& state) {
       SendError(response, 422, error.what());  // e.g. rgb of a scan without colour
     }
   });
-  http.Get(R"(/api/docs/(\d+)/mask.png)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             std::lock_guard lock(document->mutex);
-             const Scan& scan = document->now.scan;
-             const std::string layer = request.get_param_value("layer");
-             // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
-             const bool crop = request.get_param_value("crop") == "1";
-             if (layer == "strokes") {
-               // The strokes as the server holds them (the canvas draws these, not a list of its own): the
-               // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
-               // the values 0 / 1 / 2 as grey (segment.h kStroke*).
-               const cv::Mat& strokes = document->now.strokes;
-               if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
-               // Cropped: only the box of the painted cells is drawn (a large scan's overlay is mostly clear).
-               const cv::Rect& painted = document->now.strokes_box;  // every stroke lies in it
-               const cv::Rect box = !crop             ? cv::Rect(0, 0, strokes.cols, strokes.rows)
-                                    : painted.empty() ? cv::Rect()
-                                                      : cv::boundingRect(strokes(painted)) + painted.tl();
-               if (box.empty()) return SendOverlay(response, cv::Mat(), &box, strokes.size());
-               const cv::Mat part = strokes(box);
-               cv::Mat overlay(part.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-               overlay.setTo(cv::Scalar(60, 220, 60, 210), part == 1);
-               overlay.setTo(cv::Scalar(60, 60, 230, 210), part == 2);
-               return SendOverlay(response, overlay, crop ? &box : nullptr, strokes.size());
-             }
-             const bool hole = layer == "hole";
-             const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
-             cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
-             if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
-             // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
-             // (The object's cells lie in its box: only that is read, a station's mask is 100 MB.)
-             const cv::Rect within = !hole && !chosen.empty()
-                                         ? document->now.object_box & cv::Rect(0, 0, mask.cols, mask.rows)
-                                         : cv::Rect(0, 0, mask.cols, mask.rows);
-             const cv::Rect box = !crop            ? cv::Rect(0, 0, mask.cols, mask.rows)
-                                  : within.empty() ? cv::Rect()
-                                                   : cv::boundingRect(mask(within)) + within.tl();
-             if (box.empty()) return SendOverlay(response, cv::Mat(), &box, mask.size());
-             cv::Mat overlay(box.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
-             overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
-             SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());
-           });
+  http.Get(R"(/api/docs/(\d+)/mask.png)", [&state](const httplib::Request& request,
+                                                   httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    std::lock_guard lock(document->mutex);
+    const Scan& scan = document->now.scan;
+    const std::string layer = request.get_param_value("layer");
+    // crop=1: only the box of the drawn cells (headers X-Lidarshop-Box, X-Lidarshop-Size).
+    const bool crop = request.get_param_value("crop") == "1";
+    if (layer == "strokes") {
+      // The strokes as the server holds them (the canvas draws these, not a list of its own): the
+      // object's green, the background's red, half transparent; the rest clear (BGRA overlay), or
+      // the values 0 / 1 / 2 as grey (segment.h kStroke*).
+      const cv::Mat& strokes = document->now.strokes;
+      if (request.get_param_value("style") != "overlay") return SendPng(response, strokes);
+      // Cropped: only the box of the painted cells is drawn (a large scan's overlay is mostly clear).
+      // (Every stroke lies in strokes_box: only that is read.)
+      const cv::Rect box = crop ? NonZeroBoxWithin(strokes, document->now.strokes_box)
+                                : cv::Rect(0, 0, strokes.cols, strokes.rows);
+      if (box.empty()) return SendOverlay(response, cv::Mat(), &box, strokes.size());
+      const cv::Mat part = strokes(box);
+      cv::Mat overlay(part.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+      overlay.setTo(cv::Scalar(60, 220, 60, 210), part == 1);
+      overlay.setTo(cv::Scalar(60, 60, 230, 210), part == 2);
+      return SendOverlay(response, overlay, crop ? &box : nullptr, strokes.size());
+    }
+    const bool hole = layer == "hole";
+    const cv::Mat& chosen = hole ? document->now.hole : document->now.object_mask;
+    cv::Mat mask = chosen.empty() ? cv::Mat::zeros(scan.rows, scan.cols, CV_8U) : chosen;
+    if (request.get_param_value("style") != "overlay") return SendPng(response, mask);
+    // For drawing over the ray image: the object orange, the hole blue, half transparent; the rest clear (BGRA).
+    // (The object's cells lie in its box: only that is read, a station's mask is 100 MB.)
+    const cv::Rect whole(0, 0, mask.cols, mask.rows);
+    const cv::Rect box =
+        crop ? NonZeroBoxWithin(mask, !hole && !chosen.empty() ? document->now.object_box : whole) : whole;
+    if (box.empty()) return SendOverlay(response, cv::Mat(), &box, mask.size());
+    cv::Mat overlay(box.size(), CV_8UC4, cv::Scalar(0, 0, 0, 0));
+    overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
+    SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());
+  });
   http.Get(R"(/api/docs/(\d+)/points)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);

@@ -358,7 +358,8 @@ void FillFromOtherStations(State& state, const std::shared_ptr<Document>& docume
               RemoveObjectFromStations(start.scan, start.strokes, others, remove, options, &progress);
           filled = std::move(result.filled);
         } else {
-          const cv::Mat hole = which == "painted" ? start.hole : GrowHole(start.object_mask, margin);
+          const cv::Mat hole =
+              which == "painted" ? start.hole : GrowHole(start.object_mask, margin, start.object_box);
           filled = FillFromStations(start.scan, hole, others, options, &progress);
         }
         std::lock_guard lock(document->mutex);

@@ -42,7 +42,7 @@ struct Snapshot {
   Scan scan;
   cv::Mat strokes;  // CV_8U kStrokeNone / kStrokeObject / kStrokeBackground
   // The cells of `strokes` of each label, kept with it: counted again only where an edit paints (a station's
-  // strokes are 100 MB). Set together with `strokes` (NewStrokes, the strokes route).
+  // strokes are 100 MB). Set together with `strokes` (ClearStrokes, the strokes route).
   int64_t object_stroke_cells = 0, background_stroke_cells = 0;
   // Every stroke lies in this box (cells outside it are kStrokeNone): what a copy or a comparison of the
   // strokes needs to read.

@@ -15,6 +15,7 @@
 #include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/pointset/normals.h"
+#include "lidarshop/scan/lazy_zeros.h"
 #include "lidarshop/scan/scan_window.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -61,6 +62,18 @@ cv::Mat GrowHole(const cv::Mat& hole, int margin_cells) {
   cv::Mat grown;
   const int size = 2 * margin_cells + 1;
   cv::dilate(binary, grown, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(size, size)));
+  return grown;
+}
+
+cv::Mat GrowHole(const cv::Mat& hole, int margin_cells, const cv::Rect& hole_box) {
+  if (margin_cells < 0)
+    throw OptionsError(fmt::format("the hole margin must be >= 0 cells, got {}", margin_cells));
+  cv::Mat grown = LazyZeros(hole.rows, hole.cols, CV_8U);
+  if (hole_box.empty()) return grown;  // no cell
+  const cv::Rect box = cv::Rect(hole_box.x - margin_cells, hole_box.y - margin_cells,
+                                hole_box.width + 2 * margin_cells, hole_box.height + 2 * margin_cells) &
+                       cv::Rect(0, 0, hole.cols, hole.rows);
+  if (!box.empty()) GrowHole(hole(box), margin_cells).copyTo(grown(box));
   return grown;
 }
 

@@ -215,5 +215,9 @@ void PadFillImages(int rows, int cols, FillResult* fill);
 // The hole grown by `margin_cells` (a disc), e.g. an object mask grown so that mixed pixels at its silhouette
 // are filled too. CV_8U 255/0.
 cv::Mat GrowHole(const cv::Mat& hole, int margin_cells);
+// The same when every cell of the hole lies in `hole_box` (a cut's SegmentResult::object_box): only that box
+// grown by the margin is read and written, the rest is a LazyZeros buffer, so a station's object grows at the
+// cost of its box.
+cv::Mat GrowHole(const cv::Mat& hole, int margin_cells, const cv::Rect& hole_box);
 
 }  // namespace lidarshop

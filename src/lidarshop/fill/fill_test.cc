@@ -64,6 +64,19 @@ Case MakeCase(const char* json, int margin) {
   return c;
 }
 
+// The hole grown in its box equals the hole grown whole, also where the grown box reaches the scan's edge.
+TEST(GrowHole, InItsBoxEqualsGrowingTheWholeMask) {
+  cv::Mat hole = cv::Mat::zeros(40, 50, CV_8U);
+  hole(cv::Rect(1, 2, 6, 5)).setTo(255);
+  hole(cv::Rect(30, 20, 9, 4)).setTo(255);
+  const cv::Rect box = cv::boundingRect(hole);
+  for (const int margin : {0, 2, 5}) {
+    EXPECT_EQ(cv::countNonZero(GrowHole(hole, margin, box) != GrowHole(hole, margin)), 0) << margin;
+  }
+  EXPECT_EQ(cv::countNonZero(GrowHole(hole, 3, cv::Rect())), 0);  // an empty box: an empty hole
+  EXPECT_THROW(GrowHole(hole, -1, box), OptionsError);
+}
+
 TEST(RangeGradient, OneSidedAtTheHoleAndZeroWhereIsolated) {
   // Row 0: 1 2 [hole] 5 ; row 1: 3 4 6 7, all with returns; (0, 3) isolated horizontally and vertically used.
   cv::Mat range = (cv::Mat_<float>(2, 4) << 1, 2, 0, 5, 3, 4, 6, 7.5f);

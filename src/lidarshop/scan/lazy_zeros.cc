@@ -3,6 +3,8 @@
 #include <cstdlib>
 #include <new>
 
+#include <opencv2/imgproc.hpp>
+
 namespace lidarshop {
 
 namespace {
@@ -63,6 +65,13 @@ cv::Mat CopyOfBox(const cv::Mat& image, const cv::Rect& box) {
   const cv::Rect inside = box & cv::Rect(0, 0, image.cols, image.rows);
   if (!inside.empty()) image(inside).copyTo(copy(inside));
   return copy;
+}
+
+cv::Rect NonZeroBoxWithin(const cv::Mat& mask, const cv::Rect& within) {
+  const cv::Rect inside = within & cv::Rect(0, 0, mask.cols, mask.rows);
+  if (inside.empty()) return cv::Rect();
+  const cv::Rect box = cv::boundingRect(mask(inside));
+  return box.empty() ? cv::Rect() : box + inside.tl();
 }
 
 cv::Mat CopyOfMostlyZero(const cv::Mat& image) {

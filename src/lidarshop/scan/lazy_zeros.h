@@ -19,6 +19,10 @@ cv::Mat LazyZeros(int rows, int cols, int type);
 // copied, so the copy costs the box's pages and reads nothing else.
 cv::Mat CopyOfBox(const cv::Mat& image, const cv::Rect& box);
 
+// The box of the non-zero cells of `mask` that lie in `within` (clipped to the mask; empty when none): the
+// bounding box of a station's mask whose cells are known to lie in `within`, reading only that.
+cv::Rect NonZeroBoxWithin(const cv::Mat& mask, const cv::Rect& within);
+
 // The same when the box is not known: every row that holds a non-zero value is copied (the whole image is
 // read).
 cv::Mat CopyOfMostlyZero(const cv::Mat& image);

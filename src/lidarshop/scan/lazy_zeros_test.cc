@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 namespace lidarshop {
 namespace {
@@ -47,6 +48,17 @@ TEST(LazyZeros, ACopyOfAMostlyZeroImageEqualsIt) {
   // Only the box is copied: a value outside it is not.
   EXPECT_EQ(cv::countNonZero(CopyOfBox(strokes, cv::Rect(20, 30, 100, 3))), 100 * 3);
   EXPECT_EQ(cv::countNonZero(CopyOfBox(strokes, cv::Rect())), 0);
+}
+
+TEST(LazyZeros, TheNonZeroBoxWithinABoxIsTheBoundingBoxOfWhatItHolds) {
+  cv::Mat mask = cv::Mat::zeros(20, 30, CV_8U);
+  mask(cv::Rect(4, 5, 3, 2)).setTo(255);
+  mask.at<uint8_t>(15, 25) = 255;
+  EXPECT_EQ(NonZeroBoxWithin(mask, cv::Rect(0, 0, 30, 20)), cv::boundingRect(mask));
+  EXPECT_EQ(NonZeroBoxWithin(mask, cv::Rect(2, 3, 10, 10)), cv::Rect(4, 5, 3, 2));
+  EXPECT_EQ(NonZeroBoxWithin(mask, cv::Rect(20, 10, 50, 50)), cv::Rect(25, 15, 1, 1));  // clipped to the mask
+  EXPECT_TRUE(NonZeroBoxWithin(mask, cv::Rect(10, 0, 5, 5)).empty());
+  EXPECT_TRUE(NonZeroBoxWithin(mask, cv::Rect()).empty());
 }
 
 // The point of it: a 1 GiB mask written in one window costs that window's pages, not the gigabyte

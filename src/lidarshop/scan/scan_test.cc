@@ -205,12 +205,18 @@ TEST(Scan, CropThenPasteGivesTheScanBack) {
   EXPECT_THROW(PasteScan(part, cv::Rect(0, 0, 2, 2), &whole), std::logic_error);
 }
 
-TEST(Scan, ACropViewHasTheCropsCellsInTheScansOwnBuffers) {
+// 6 x 8 rays on a regular grid with colour, a range per cell (1, 2, ... 48 m) and a GPS-time attribute.
+Scan MakeGriddedScan() {
   Scan scan = MakeScan(6, 8, /*with_color=*/true);
   scan.grid = UniformGrid(6, 8, -0.4, 0.4, -0.3, 0.3);
   scan.direction = DirectionsFromGrid(scan.grid);
   for (int i = 0; i < 48; ++i) scan.range.at<float>(i / 8, i % 8) = 1.0f + i;
   scan.attributes["gps_time"] = cv::Mat(6, 8, CV_64F, cv::Scalar(2.5));
+  return scan;
+}
+
+TEST(Scan, ACropViewHasTheCropsCellsInTheScansOwnBuffers) {
+  const Scan scan = MakeGriddedScan();
   const cv::Rect window(2, 1, 4, 3);
   const Scan copy = CropScan(scan, window);
   const Scan view = CropScanView(scan, window);
@@ -231,11 +237,7 @@ TEST(Scan, ACropViewHasTheCropsCellsInTheScansOwnBuffers) {
 // Copy on write per channel: the channels the part changes are new buffers holding PasteScan's result, the
 // others stay the scan's; the scan the copy came from is never written.
 TEST(Scan, PasteCopyOnWriteSharesTheChannelsThePartLeavesAsTheyWere) {
-  Scan scan = MakeScan(6, 8, /*with_color=*/true);
-  scan.grid = UniformGrid(6, 8, -0.4, 0.4, -0.3, 0.3);
-  scan.direction = DirectionsFromGrid(scan.grid);
-  for (int i = 0; i < 48; ++i) scan.range.at<float>(i / 8, i % 8) = 1.0f + i;
-  scan.attributes["gps_time"] = cv::Mat(6, 8, CV_64F, cv::Scalar(2.5));
+  const Scan scan = MakeGriddedScan();
   const Scan before = Clone(scan);
   const cv::Rect window(2, 1, 4, 3);
   Scan part = CropScan(scan, window);

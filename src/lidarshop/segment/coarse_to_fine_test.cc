@@ -20,6 +20,7 @@ namespace {
 using segment_internal::CoarseFactor;
 using segment_internal::CoarseStrokes;
 using segment_internal::FullResolution;
+using segment_internal::FullResolutionWithReturns;
 using segment_test::MakeBoxOnGround;
 using segment_test::TruthMask;
 
@@ -79,6 +80,14 @@ TEST(CoarseToFineTest, StrokesAndMasksBetweenTheLevels) {
   EXPECT_EQ(cv::countNonZero(full), 2);  // rows 2-3 x column 4: the block is cut by the scan's edge
   EXPECT_EQ(full.at<uint8_t>(2, 4), 255);
   EXPECT_EQ(full.at<uint8_t>(3, 4), 255);
+  // Written block by block where the level is set: the same as the whole level brought up and ANDed with the
+  // cells that returned, here with a level block cut by the scan's edge and cells without a return in it.
+  cv::Mat coarse_mask(3, 3, CV_8U, cv::Scalar(0)), valid(5, 5, CV_8U, cv::Scalar(1));
+  coarse_mask.at<uint8_t>(0, 0) = coarse_mask.at<uint8_t>(1, 2) = coarse_mask.at<uint8_t>(2, 2) = 255;
+  valid.at<uint8_t>(0, 1) = valid.at<uint8_t>(4, 4) = 0;
+  const cv::Mat expected = FullResolution(coarse_mask, 2, cv::Size(5, 5)) & (valid != 0);
+  EXPECT_EQ(cv::countNonZero(FullResolutionWithReturns(coarse_mask, 2, valid) != expected), 0);
+  EXPECT_EQ(cv::countNonZero(expected), 3 + 2);
 }
 
 TEST(CoarseToFineTest, TheOutlineCutMatchesTheFullResolutionCut) {

@@ -51,9 +51,7 @@ void AddEnclosedNoReturnCells(const cv::Mat& valid, cv::Mat* mask) {
 
 void AddEnclosedNoReturnCells(const cv::Mat& valid, const cv::Rect& mask_box, cv::Mat* mask) {
   LIDARSHOP_CHECK(mask->type() == CV_8U && valid.type() == CV_8U && mask->size() == valid.size());
-  const cv::Rect within = mask_box & cv::Rect(0, 0, mask->cols, mask->rows);
-  if (within.empty()) return;
-  const cv::Rect box = cv::boundingRect((*mask)(within)) + within.tl();
+  const cv::Rect box = NonZeroBoxWithin(*mask, mask_box);
   if (box.empty()) return;
   cv::Mat in_box = (*mask)(box);
   in_box |= EnclosedInBox(*mask, valid, box);

@@ -274,14 +274,13 @@ class SegmentSession {
   SegmentResult Refine(const cv::Mat& extra_strokes);
   // The live update after a stroke: `strokes` are all the strokes now (same format). When they only add to
   // the strokes of the last Run() and Refine()s — no stroke erased or relabelled — refines the last cut with
-  // what they add (Refine); otherwise, or before any Run(), returns nullopt: a full Run() is needed. Its cost
-  // follows the strokes and the object, not the scan (rows the strokes leave unchanged are compared whole).
+  // what they add (Refine); otherwise, or before any Run(), returns nullopt: a full Run() is needed. Rows
+  // the strokes leave unchanged are passed over (memcmp); on a level the refinement reads the object's box.
+  // The masks of a result are buffers the session does not write again: a caller may keep them without a copy.
   std::optional<SegmentResult> RefineTo(const cv::Mat& strokes);
   // The same when every stroke of `strokes` lies in `strokes_box` (the caller knows where it painted): only
-  // that box and the session's own strokes' box are compared.
+  // that box and the session's own strokes' box are compared, so the cost follows the strokes, not the scan.
   std::optional<SegmentResult> RefineTo(const cv::Mat& strokes, const cv::Rect& strokes_box);
-  //
-  // The masks of a result are buffers the session does not write again: a caller may keep them without a copy.
 
  private:
   struct Impl;
