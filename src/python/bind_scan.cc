@@ -11,6 +11,7 @@
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/scanner/builtin_scenes.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
@@ -129,7 +130,13 @@ channel's dtype; the shape must match). Optional channels are None when absent a
   for (const ChannelSpec& spec : kChannels) {
     const ChannelSpec* channel = &spec;
     scan.def_property(
-        spec.name, [channel](const Scan& s) { return MatToArray(s.*(channel->member)); },
+        spec.name,
+        [channel](Scan& s) {
+          // A scan read from a file may hold only its grid's rays (ray_directions.h): reading `direction`
+          // makes the image, so that the array is a view of the scan as every other channel is.
+          if (channel->member == &Scan::direction && s.direction.empty()) s.direction = DirectionImage(s);
+          return MatToArray(s.*(channel->member));
+        },
         [channel](Scan& s, const py::object& value) {
           if (value.is_none()) {
             if (channel->required)

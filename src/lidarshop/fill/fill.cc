@@ -16,6 +16,7 @@
 #include "lidarshop/inpaint/offset_completion.h"
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/scan/lazy_zeros.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/scan/scan_window.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -544,7 +545,7 @@ void CheckInputs(const Scan& scan, const cv::Mat& hole) {
   if (hole.depth() != CV_8U || hole.channels() != 1) {
     throw InputError("the hole mask must be a single-channel 8-bit image (white = fill)");
   }
-  if (scan.direction.empty()) {
+  if (!HasRayDirections(scan)) {
     throw InputError(
         "the scan has no ray directions (an unorganized cloud): only organized scans can be filled");
   }
@@ -640,12 +641,12 @@ cv::Rect FillWindow(const Scan& scan, const cv::Mat& hole, const cv::Rect& box, 
 
 // Throws InputError when a cell of the hole (inside `box`) has no ray direction.
 void CheckHoleDirections(const Scan& scan, const cv::Mat& hole, const cv::Rect& box) {
+  const RayDirections rays(scan);
   for (int y = box.y; y < box.y + box.height; ++y) {
     const uint8_t* in_hole = hole.ptr<uint8_t>(y);
-    const cv::Vec3f* direction = scan.direction.ptr<cv::Vec3f>(y);
     for (int x = box.x; x < box.x + box.width; ++x) {
       if (!in_hole[x]) continue;
-      const cv::Vec3f d = direction[x];
+      const cv::Vec3f d = rays(y, x);
       if (!(std::abs(d.dot(d) - 1.0f) < 1e-2f)) {
         throw InputError(fmt::format(
             "cell (row {}, col {}) of the hole has no ray direction: the scan's grid is unknown there", y,
@@ -730,8 +731,11 @@ FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOp
     result.timings.total_s = total.Seconds();
     return result;
   }
+  // The fill reads the window's rays as an image; a scan that holds none has its grid's (ray_directions.h).
+  Scan with_rays = scan;
+  with_rays.direction = DirectionImage(scan);
   Inputs in;
-  in.scan = &scan;
+  in.scan = &with_rays;
   in.hole = hole_in != 0;
   in.known_valid = (scan.valid != 0) & (in.hole == 0);
   if (cv::countNonZero(in.known_valid) == 0) {
@@ -807,6 +811,7 @@ FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOp
   if (!values.source.empty()) result.source_cell = values.source;
   Timer timer;
   result.scan = PlaceAlongRays(in, values, &result);
+  if (scan.direction.empty()) result.scan.direction.release();  // as it came: the rays are the grid's
   result.timings.placement_s = timer.Seconds();
   result.timings.total_s = total.Seconds();
   return result;

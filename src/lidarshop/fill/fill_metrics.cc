@@ -10,6 +10,7 @@
 
 #include "lidarshop/pointset/kdtree.h"
 #include "lidarshop/pointset/normals.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -85,8 +86,11 @@ double LocalSurfaceDistance(const Scan& truth, int y, int x, const Eigen::Vector
 
 }  // namespace
 
-FillMetrics MeasureFill(const Scan& filled, const Scan& truth, const cv::Mat& hole_in,
+FillMetrics MeasureFill(const Scan& filled, const Scan& truth_in, const cv::Mat& hole_in,
                         const FillMetricsOptions& options) {
+  // The truth's rays as an image (a truth read from a file may hold only its grid: ray_directions.h).
+  Scan truth = truth_in;
+  truth.direction = DirectionImage(truth_in);
   if (filled.rows != truth.rows || filled.cols != truth.cols || hole_in.rows != truth.rows ||
       hole_in.cols != truth.cols) {
     throw InputError(fmt::format("MeasureFill: the fill ({} x {}), truth ({} x {}) and hole ({} x {}) differ",

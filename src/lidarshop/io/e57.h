@@ -60,9 +60,14 @@ struct E57File {
 //   Scan::synthesized (255 / 0);
 // - the points prototype's `lidarshop:fromStation` (Integer 0..255: 1 + the index of the other station a
 //   cell's return was taken from, site/from_stations.h; 0 = not), read back into Scan::from_station;
+// - `lidarshop:angularGrid` under a data3D entry: a Structure holding `azimuth` (a Vector of one double Float
+//   per columnIndex) and `elevation` (one per rowIndex), radians in lidarshop's scanner frame (scan.h), and
+//   `fitted` (Integer 0..1): the scan's ScanGrid, read back bit for bit (a grid the points do not sit around,
+//   half a step off on the mean, is fitted again, with a warning). A scan read with it holds no image when every
+//   stored ray is the grid's (scan/ray_directions.h);
 // - `lidarshop:noReturnDirections` under a data3D entry: a Structure whose `points` CompressedVector holds
-//   one record per cell without a return (rowIndex, columnIndex, the unit ray as single-float
-//   cartesianX/Y/Z), read back into those cells' Scan::direction bit for bit.
+//   one record per cell without a return whose ray is not its grid ray (rowIndex, columnIndex, the unit ray
+//   as single-float cartesianX/Y/Z), read back into those cells' directions bit for bit.
 // Readers that do not know the namespace skip them (libE57Format does).
 constexpr char kLidarshopE57Namespace[] = "http://lidarshop.dev/e57/1.0";
 
@@ -85,9 +90,9 @@ struct E57WriteOptions {
   // with this step in metres (e.g. 1e-4 = 0.1 mm), using the fewest bits that hold the scan's extent.
   double coordinate_scale_m = 0.0;
   // Cells without a return are never records of `points` (a reader that ignores cartesianInvalidState would
-  // show their rays as points). true: their directions (rays) are written in lidarshop's extension
-  // `lidarshop:noReturnDirections`, so that they survive a round trip bit for bit; false: not at all (smaller
-  // files; the reader then gives them the fitted grid's directions). Files written by lidarshop before the
+  // show their rays as points). true: the scan's grid is written in `lidarshop:angularGrid` and the rays that
+  // are not the grid's in `lidarshop:noReturnDirections`, so that every ray survives a round trip bit for bit;
+  // false: neither (the reader then gives every cell the fitted grid's direction). Files written by lidarshop before the
   // extension carried these rays as `points` records of cartesianInvalidState 1 at unit distance; ReadE57
   // still reads them so.
   bool write_no_return_directions = true;

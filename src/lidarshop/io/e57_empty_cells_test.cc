@@ -1,16 +1,22 @@
-// Cells without a return in the E57 we write: no record in `points` (what other readers count and show), their
-// rays in lidarshop's extension (lidarshop:noReturnDirections), and files of the earlier layout (rays as
-// records of cartesianInvalidState 1 at unit distance) still read as before.
+// Cells without a return in the E57 we write: no record in `points` (what other readers count and show), the
+// scan's grid in lidarshop's extension (lidarshop:angularGrid) and the rays that are not the grid's beside it
+// (lidarshop:noReturnDirections), and files of the earlier layout (rays as records of cartesianInvalidState 1
+// at unit distance) still read as before.
 #include <algorithm>
+#include <cstring>
+#include <functional>
+#include <iterator>
 #include <random>
 #include <string>
 
+#include <fmt/format.h>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <pugixml.hpp>
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -29,7 +35,7 @@ Scan ScanWithHoles(int rows, int cols, uint32_t seed) {
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       if (u(rng) < 0.25f) continue;
-      const cv::Vec3f p = s.direction.at<cv::Vec3f>(r, c) * (2.0f + 10.0f * u(rng));
+      const cv::Vec3f p = DirectionImage(s).at<cv::Vec3f>(r, c) * (2.0f + 10.0f * u(rng));
       s.valid.at<uint8_t>(r, c) = kValid;
       s.point.at<cv::Vec3f>(r, c) = p;
       s.range.at<float>(r, c) = static_cast<float>(cv::norm(p));
@@ -55,21 +61,120 @@ void ExpectSameCells(const Scan& a, const Scan& b) {
   ASSERT_EQ(a.rows, b.rows);
   ASSERT_EQ(a.cols, b.cols);
   EXPECT_EQ(cv::countNonZero(a.valid != b.valid), 0);
+  const cv::Mat rays_a = DirectionImage(a), rays_b = DirectionImage(b);
   for (int64_t c = 0; c < a.num_cells(); ++c) {
     if (a.valid.ptr<uint8_t>()[c]) {
       ASSERT_EQ(a.point.ptr<cv::Vec3f>()[c], b.point.ptr<cv::Vec3f>()[c]) << "cell " << c;
       ASSERT_EQ(a.intensity.ptr<float>()[c], b.intensity.ptr<float>()[c]) << "cell " << c;
       ASSERT_EQ(a.color.ptr<cv::Vec3b>()[c], b.color.ptr<cv::Vec3b>()[c]) << "cell " << c;
     } else {  // the ray, bit for bit
-      ASSERT_EQ(a.direction.ptr<cv::Vec3f>()[c], b.direction.ptr<cv::Vec3f>()[c]) << "cell " << c;
+      ASSERT_EQ(rays_a.ptr<cv::Vec3f>()[c], rays_b.ptr<cv::Vec3f>()[c]) << "cell " << c;
     }
   }
 }
 
-TEST(E57EmptyCells, OnlyReturnsAreRecordsAndRaysGoToTheExtension) {
+TEST(E57EmptyCells, RaysOfTheGridAreWrittenAsTheGridAndReadWithoutAnImage) {
   const Scan scan = ScanWithHoles(23, 31, 1);
+  const std::vector<uint8_t> bytes = EncodeE57({scan});
+  const pugi::xml_document doc = XmlOf(bytes);
+  const pugi::xml_node entry = doc.child("e57Root").child("data3D").child("vectorChild");
+  EXPECT_FALSE(entry.child("lidarshop:noReturnDirections"));  // every ray is the grid's
+  const pugi::xml_node grid = entry.child("lidarshop:angularGrid");
+  ASSERT_TRUE(grid);
+  EXPECT_EQ(std::distance(grid.child("azimuth").begin(), grid.child("azimuth").end()), 31);
+  EXPECT_EQ(std::distance(grid.child("elevation").begin(), grid.child("elevation").end()), 23);
+  const Scan back = ReadE57Bytes(bytes, "grid.e57").scans[0];
+  EXPECT_TRUE(back.direction.empty());                      // 12 bytes a ray not held
+  EXPECT_EQ(back.grid.azimuth_rad, scan.grid.azimuth_rad);  // bit for bit
+  EXPECT_EQ(back.grid.elevation_rad, scan.grid.elevation_rad);
+  ExpectSameCells(scan, back);
+  const cv::Mat rays = DirectionImage(back);
+  EXPECT_EQ(std::memcmp(rays.data, scan.direction.data, scan.direction.total() * scan.direction.elemSize()),
+            0);
+  // Written again: the same bytes.
+  EXPECT_EQ(EncodeE57({back}), bytes);
+}
+
+// The file `bytes` with its XML section (the last section EncodeE57 writes) passed through `edit`.
+std::vector<uint8_t> WithEditedXml(const std::vector<uint8_t>& bytes,
+                                   const std::function<std::string(std::string)>& edit) {
+  std::vector<uint8_t> logical = e57::LogicalFromPages("x.e57", bytes);
+  e57::Header header = e57::ParseHeader("x.e57", logical);
+  const uint64_t start = e57::LogicalFromPhysical(header.xml_physical_offset);
+  const std::string xml =
+      edit(std::string(logical.begin() + start, logical.begin() + start + header.xml_logical_length));
+  logical.resize(start);
+  logical.insert(logical.end(), xml.begin(), xml.end());
+  header.xml_logical_length = xml.size();
+  header.file_physical_length = (logical.size() + e57::kPagePayload - 1) / e57::kPagePayload * e57::kPageSize;
+  e57::StoreHeader(header, logical.data());
+  return e57::PagesFromLogical(logical);
+}
+
+// `xml` with the values of the grid's `axis` vector replaced by `values` (numbers as text).
+std::string ReplaceAngles(std::string xml, const std::string& axis, const std::vector<std::string>& values) {
+  const size_t vector = xml.find("<" + axis + " ", xml.find("lidarshop:angularGrid"));
+  const size_t open = xml.find(">", vector) + 1, close = xml.find("</" + axis + ">", open);
+  std::string elements;
+  for (const std::string& value : values) elements += "<value type=\"Float\">" + value + "</value>";
+  return xml.replace(open, close - open, elements);
+}
+
+std::vector<std::string> AnglesAsText(const std::vector<double>& angles, double shift_rad) {
+  std::vector<std::string> text;
+  for (const double angle : angles) text.push_back(fmt::format("{}", angle + shift_rad));
+  return text;
+}
+
+TEST(E57EmptyCells, AStoredGridOfTheWrongSizeOrNotFiniteIsRefused) {
+  const Scan scan = ScanWithHoles(9, 11, 4);
+  const std::vector<uint8_t> bytes = EncodeE57({scan});
+  std::vector<std::string> short_azimuths = AnglesAsText(scan.grid.azimuth_rad, 0.0);
+  short_azimuths.pop_back();
+  try {
+    ReadE57Bytes(
+        WithEditedXml(bytes, [&](std::string xml) { return ReplaceAngles(xml, "azimuth", short_azimuths); }),
+        "short.e57");
+    FAIL() << "a grid with 10 azimuths for 11 columns was read";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("short.e57"));
+    EXPECT_THAT(e.what(), HasSubstr("holds 10 angles for the scan's 11 columns"));
+  }
+  std::vector<std::string> infinite = AnglesAsText(scan.grid.elevation_rad, 0.0);
+  infinite[3] = "inf";
+  EXPECT_THROW(
+      ReadE57Bytes(
+          WithEditedXml(bytes, [&](std::string xml) { return ReplaceAngles(xml, "elevation", infinite); }),
+          "inf.e57"),
+      InputError);
+}
+
+TEST(E57EmptyCells, AStoredGridThePointsAreNotOnIsFittedAgainWithAWarning) {
+  const Scan scan = ScanWithHoles(20, 24, 5);
+  // Every azimuth moved by one step: the points were not scanned on this grid.
+  const double step = scan.grid.azimuth_rad[1] - scan.grid.azimuth_rad[0];
+  const std::vector<uint8_t> bytes = WithEditedXml(EncodeE57({scan}), [&](std::string xml) {
+    return ReplaceAngles(xml, "azimuth", AnglesAsText(scan.grid.azimuth_rad, step));
+  });
+  const E57File back = ReadE57Bytes(bytes, "moved.e57");
+  ASSERT_EQ(back.warnings.size(), 1u);
+  EXPECT_THAT(back.warnings[0], HasSubstr("is not where the points are"));
+  EXPECT_TRUE(back.scans[0].grid.fitted);
+  EXPECT_LT(back.scans[0].grid.rms_residual_rad, 1e-4);
+}
+
+TEST(E57EmptyCells, OnlyReturnsAreRecordsAndRaysOffTheGridGoToTheExtension) {
+  Scan scan = ScanWithHoles(23, 31, 1);
   const int64_t returns = scan.CountValid();
   ASSERT_GT(scan.num_cells() - returns, 100);
+  // Every third no-return cell's ray a little off its grid ray (as a scanner's stored rays can be).
+  int64_t off_grid = 0, empty = 0;
+  for (int64_t c = 0; c < scan.num_cells(); ++c) {
+    if (scan.valid.ptr<uint8_t>()[c] || empty++ % 3 != 0) continue;
+    cv::Vec3f& d = scan.direction.ptr<cv::Vec3f>()[c];
+    d = cv::normalize(d + cv::Vec3f(1e-3f, -2e-3f, 1e-3f));
+    ++off_grid;
+  }
   for (double scale : {0.0, 1e-4}) {  // float and scaled-integer coordinates: the rays stay exact floats
     SCOPED_TRACE(scale);
     E57WriteOptions options;
@@ -82,7 +187,7 @@ TEST(E57EmptyCells, OnlyReturnsAreRecordsAndRaysGoToTheExtension) {
     EXPECT_EQ(entry.child("points").attribute("recordCount").as_llong(), returns);
     EXPECT_EQ(entry.child("indexBounds").child("rowMaximum").text().as_int(), 22);
     const pugi::xml_node rays = entry.child("lidarshop:noReturnDirections").child("points");
-    EXPECT_EQ(rays.attribute("recordCount").as_llong(), scan.num_cells() - returns);
+    EXPECT_EQ(rays.attribute("recordCount").as_llong(), off_grid);
     const E57File back = ReadE57Bytes(bytes, "holes.e57");
     ASSERT_EQ(back.scans.size(), 1u);
     if (scale == 0.0) {
@@ -90,7 +195,8 @@ TEST(E57EmptyCells, OnlyReturnsAreRecordsAndRaysGoToTheExtension) {
     } else {
       for (int64_t c = 0; c < scan.num_cells(); ++c) {
         if (scan.valid.ptr<uint8_t>()[c]) continue;
-        ASSERT_EQ(scan.direction.ptr<cv::Vec3f>()[c], back.scans[0].direction.ptr<cv::Vec3f>()[c]) << c;
+        ASSERT_EQ(DirectionImage(scan).ptr<cv::Vec3f>()[c], DirectionImage(back.scans[0]).ptr<cv::Vec3f>()[c])
+            << c;
       }
     }
   }
@@ -109,7 +215,9 @@ TEST(E57EmptyCells, WithoutDirectionsTheGridGivesThem) {
   const Scan back = ReadE57Bytes(bytes, "no_rays.e57").scans[0];
   EXPECT_EQ(cv::countNonZero(back.valid != scan.valid), 0);
   for (int64_t c = 0; c < scan.num_cells(); ++c) {  // from the fitted grid: close to the true rays
-    ASSERT_LT(cv::norm(back.direction.ptr<cv::Vec3f>()[c] - scan.direction.ptr<cv::Vec3f>()[c]), 1e-3) << c;
+    ASSERT_LT(cv::norm(DirectionImage(back).ptr<cv::Vec3f>()[c] - DirectionImage(scan).ptr<cv::Vec3f>()[c]),
+              1e-3)
+        << c;
   }
 }
 
@@ -120,7 +228,7 @@ TEST(E57EmptyCells, ACellWithOnlyASecondReturnKeepsAFirstRecordWithoutCoordinate
   behind.direction = front.direction.clone();
   int64_t behind_empty_front = 0;
   for (int64_t c = 0; c < front.num_cells(); c += 2) {
-    const cv::Vec3f p = front.direction.ptr<cv::Vec3f>()[c] * 15.0f;
+    const cv::Vec3f p = DirectionImage(front).ptr<cv::Vec3f>()[c] * 15.0f;
     behind.valid.ptr<uint8_t>()[c] = kValid;
     behind.point.ptr<cv::Vec3f>()[c] = p;
     behind.range.ptr<float>()[c] = static_cast<float>(cv::norm(p));
@@ -205,7 +313,7 @@ std::vector<uint8_t> EncodeEarlierLayout(const Scan& scan) {
                      {"rowIndex", {}},   {"columnIndex", {}}, {"cartesianInvalidState", {}}};
   for (int64_t c = 0; c < scan.num_cells(); ++c) {  // every cell has a direction here
     const bool valid = scan.valid.ptr<uint8_t>()[c] != 0;
-    const cv::Vec3f p = valid ? scan.point.ptr<cv::Vec3f>()[c] : scan.direction.ptr<cv::Vec3f>()[c];
+    const cv::Vec3f p = valid ? scan.point.ptr<cv::Vec3f>()[c] : DirectionImage(scan).ptr<cv::Vec3f>()[c];
     for (int axis = 0; axis < 3; ++axis) columns[axis].second.push_back(p[axis]);
     columns[3].second.push_back(static_cast<double>(c / scan.cols));
     columns[4].second.push_back(static_cast<double>(c % scan.cols));
@@ -231,14 +339,15 @@ TEST(E57EmptyCells, FilesOfTheEarlierLayoutReadAsBefore) {
     if (scan.valid.ptr<uint8_t>()[c]) {
       ASSERT_EQ(a.point.ptr<cv::Vec3f>()[c], scan.point.ptr<cv::Vec3f>()[c]) << c;
     } else {  // the stored unit direction, bit for bit
-      ASSERT_EQ(a.direction.ptr<cv::Vec3f>()[c], scan.direction.ptr<cv::Vec3f>()[c]) << c;
+      ASSERT_EQ(DirectionImage(a).ptr<cv::Vec3f>()[c], DirectionImage(scan).ptr<cv::Vec3f>()[c]) << c;
     }
   }
   // The same scan in today's layout reads to the same cells, rays included.
   const Scan b = ReadE57Bytes(EncodeE57({a}), "today.e57").scans[0];
   EXPECT_EQ(cv::countNonZero(a.valid != b.valid), 0);
+  const cv::Mat rays_a = DirectionImage(a), rays_b = DirectionImage(b);
   for (int64_t c = 0; c < a.num_cells(); ++c) {
-    ASSERT_EQ(a.direction.ptr<cv::Vec3f>()[c], b.direction.ptr<cv::Vec3f>()[c]) << c;
+    ASSERT_EQ(DirectionImage(a).ptr<cv::Vec3f>()[c], DirectionImage(b).ptr<cv::Vec3f>()[c]) << c;
     if (a.valid.ptr<uint8_t>()[c]) ASSERT_EQ(a.point.ptr<cv::Vec3f>()[c], b.point.ptr<cv::Vec3f>()[c]) << c;
   }
 }
@@ -277,8 +386,8 @@ TEST(E57EmptyCells, RaysOfACellWithAReturnOrOutsideTheGridAreRefused) {
   ASSERT_EQ(good.cols, 3);
   EXPECT_EQ(good.CountValid(), 1);
   // The rays survive whatever orientation the reader chose (one return: no flip), under the `ls` prefix.
-  EXPECT_EQ(good.direction.at<cv::Vec3f>(1, 2), cv::Vec3f(0.0f, 0.6f, 0.8f));
-  EXPECT_EQ(good.direction.at<cv::Vec3f>(0, 0), cv::Vec3f(0.0f, 0.6f, 0.8f));
+  EXPECT_EQ(DirectionImage(good).at<cv::Vec3f>(1, 2), cv::Vec3f(0.0f, 0.6f, 0.8f));
+  EXPECT_EQ(DirectionImage(good).at<cv::Vec3f>(0, 0), cv::Vec3f(0.0f, 0.6f, 0.8f));
   try {
     ReadE57Bytes(file({{0, 1}}), "ray_on_a_return.e57");
     FAIL();

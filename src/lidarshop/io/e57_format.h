@@ -41,6 +41,10 @@ constexpr char kFromStationLocalName[] = "fromStation";
 // CompressedVector of rowIndex, columnIndex and the unit ray as cartesianX/Y/Z.
 constexpr char kNoReturnDirectionsField[] = "lidarshop:noReturnDirections";
 constexpr char kNoReturnDirectionsLocalName[] = "noReturnDirections";
+// A scan's angular grid (e57.h): a Structure under the data3D entry holding `azimuth` (one double Float per
+// columnIndex) and `elevation` (one per rowIndex), radians in lidarshop's scanner frame, and `fitted` (0 / 1).
+constexpr char kAngularGridField[] = "lidarshop:angularGrid";
+constexpr char kAngularGridLocalName[] = "angularGrid";
 
 // The largest record count or grid (cells) a file may claim; kMaxScanCells unless lowered (the fuzzer does,
 // to keep its memory bounded). Not thread-safe to change while reading.

@@ -2,9 +2,12 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <map>
+#include <optional>
+#include <tuple>
 #include <unordered_map>
 
 #include <Eigen/Geometry>
@@ -17,6 +20,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/io_common.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
@@ -644,12 +648,18 @@ class CoordinateBlocks {
   std::vector<float> xyz_;
 };
 
-// What PlaceRecords left out, for the warnings.
+// A ray the file stored for a cell without a return (16 bytes), kept aside until the scan's grid is known.
+struct StoredRay {
+  int32_t cell;  // < kMaxScanCells
+  cv::Vec3f direction;
+};
+
+// What PlaceRecords left out, for the warnings, and the rays of structured scans' no-return cells (a
+// structured scan holds no direction image while it is read: its rays are its grid's, ray_directions.h).
 struct PlacedRecords {
-  int64_t duplicates = 0;     // records repeating a return of a cell that already has one
-  int64_t later_returns = 0;  // records with returnIndex >= 2
-  // Per cell: 1 = the direction of a valid point, 2 = a direction the file stored for a no-return cell.
-  std::vector<uint8_t> has_direction;
+  int64_t duplicates = 0;              // records repeating a return of a cell that already has one
+  int64_t later_returns = 0;           // records with returnIndex >= 2
+  std::vector<StoredRay> stored_rays;  // in record order; a later one of a cell wins
 };
 
 // The first record before record `before` whose grid indices name `cell`, for the message on a corrupt grid.
@@ -685,7 +695,6 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
     second->name = scan->name;
     second->world_from_scanner = scan->world_from_scanner;
   }
-  placed.has_direction.assign(static_cast<size_t>(rows * cols), 0);
   // Several records of one grid cell are several returns of one ray, which E57 marks with returnIndex.
   // Without it, two records claiming the same rowIndex/columnIndex contradict the grid: the file is corrupt
   // (e.g. zeroed compressed-vector data), and guessing which record to keep would be a silent wrong answer.
@@ -741,13 +750,16 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
         scan->valid.at<uint8_t>(r, k) = kValid;
         scan->point.at<cv::Vec3f>(r, k) = p;
         scan->range.at<float>(r, k) = range;
-        scan->direction.at<cv::Vec3f>(r, k) = p / range;
-        placed.has_direction[c] = 1;
+        if (!scan->direction.empty()) scan->direction.at<cv::Vec3f>(r, k) = p / range;
       } else {
         if (state[j] != 2 && finite && range > 0.0f) {
           // Keep a stored unit direction bit for bit (renormalizing would change its last bits).
-          scan->direction.at<cv::Vec3f>(r, k) = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
-          placed.has_direction[c] = 2;
+          const cv::Vec3f ray = std::abs(range - 1.0f) < 1e-6f ? p : p / range;
+          if (scan->direction.empty()) {
+            placed.stored_rays.push_back({static_cast<int32_t>(c), ray});
+          } else {
+            scan->direction.at<cv::Vec3f>(r, k) = ray;
+          }
         }
         cell[i] = -1;  // no return: intensity and colour stay at their no-return values
       }
@@ -758,10 +770,10 @@ PlacedRecords PlaceRecords(const Context& ctx, const PointRecords& records, cons
 
 // lidarshop's extension `<prefix>:noReturnDirections` of a data3D entry (`field_name`, "" when the file
 // does not declare the namespace): the rays of the cells without a return, as rowIndex / columnIndex and a
-// unit vector in cartesianX/Y/Z. Sets them bit for bit (`has_direction` 2). Files written before it carried
+// unit vector in cartesianX/Y/Z, kept bit for bit in `stored_rays`. Files written before it carried
 // these rays as records of state 1 instead (PlaceRecords reads those).
 void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std::string& field_name,
-                            const RecordGrid& grid, Scan* scan, std::vector<uint8_t>* has_direction) {
+                            const RecordGrid& grid, const Scan& scan, std::vector<StoredRay>* stored_rays) {
   const pugi::xml_node extension = field_name.empty() ? pugi::xml_node() : child.child(field_name.c_str());
   if (!extension) return;
   const PointRecords records = ReadPointRecords(ctx, extension);
@@ -785,16 +797,17 @@ void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std:
       }
     });
   }
-  cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>();
-  const uint8_t* valid = scan->valid.ptr<uint8_t>();
+  std::vector<cv::Vec3f> rays(static_cast<size_t>(records.count));
+  const uint8_t* valid = scan.valid.ptr<uint8_t>();
   for (int axis = 0; axis < 3; ++axis) {
     const Field* field = records.Find(axis == 0 ? "cartesianX" : axis == 1 ? "cartesianY" : "cartesianZ");
     records.ForEachBlock(field, [&](int64_t first, int64_t n, const double* v) {
-      for (int64_t j = 0; j < n; ++j) direction[cells[first + j]][axis] = static_cast<float>(v[j]);
+      for (int64_t j = 0; j < n; ++j) rays[first + j][axis] = static_cast<float>(v[j]);
     });
   }
+  stored_rays->reserve(stored_rays->size() + rays.size());
   for (int64_t i = 0; i < records.count; ++i) {
-    cv::Vec3f& d = direction[cells[i]];
+    cv::Vec3f& d = rays[i];
     const float norm = static_cast<float>(cv::norm(d));
     if (valid[cells[i]] || !(std::isfinite(norm) && norm > 0.0f)) {
       XmlError(
@@ -803,8 +816,40 @@ void ReadNoReturnDirections(const Context& ctx, pugi::xml_node child, const std:
                       valid[cells[i]] ? "the cell has a return" : "the direction is zero or not finite"));
     }
     if (!(std::abs(norm - 1.0f) < 1e-6f)) d /= norm;  // a stored unit vector is kept bit for bit
-    (*has_direction)[cells[i]] = 2;
+    stored_rays->push_back({static_cast<int32_t>(cells[i]), d});
   }
+}
+
+// lidarshop's extension `<prefix>:angularGrid` of a data3D entry (`field_name`, "" when the file does not
+// declare the namespace): the grid the writer's scan had, in the file's column and row order; nullopt when
+// absent. Throws InputError when its sizes differ from the scan's or an angle is not finite.
+std::optional<ScanGrid> ReadAngularGrid(const Context& ctx, pugi::xml_node child,
+                                        const std::string& field_name, const RecordGrid& grid) {
+  const pugi::xml_node extension = field_name.empty() ? pugi::xml_node() : child.child(field_name.c_str());
+  if (!extension) return std::nullopt;
+  ScanGrid result;
+  for (const auto& [name, count, angles] :
+       {std::tuple<const char*, int64_t, std::vector<double>*>{"azimuth", grid.cols, &result.azimuth_rad},
+        {"elevation", grid.rows, &result.elevation_rad}}) {
+    const pugi::xml_node vector = extension.child(name);
+    if (!vector) XmlError(ctx, extension, fmt::format("has no '{}'", name));
+    for (pugi::xml_node value = vector.first_child(); value; value = value.next_sibling()) {
+      if (static_cast<int64_t>(angles->size()) == count) {
+        XmlError(ctx, vector,
+                 fmt::format("holds more than the scan's {} {}", count, name[0] == 'a' ? "columns" : "rows"));
+      }
+      const double angle = NumberValue(ctx, value, 0.0);
+      if (!std::isfinite(angle)) XmlError(ctx, value, "the angle is not finite");
+      angles->push_back(angle);
+    }
+    if (static_cast<int64_t>(angles->size()) != count) {
+      XmlError(ctx, vector,
+               fmt::format("holds {} angles for the scan's {} {}", angles->size(), count,
+                           name[0] == 'a' ? "columns" : "rows"));
+    }
+  }
+  result.fitted = BoundedInteger(ctx, extension.child("fitted"), 0, 0, 1) == 1;
+  return result;
 }
 
 // The scan of record i's layer (layer empty: every record is a first return).
@@ -921,44 +966,90 @@ void ReadFromStation(const PointRecords& records, const std::string& field_name,
 
 // E57 does not say which way rowIndex / columnIndex run (pumpA's rowIndex 0 is its bottom row); turns the
 // grid of a structured scan (and its second layer) into image orientation (row 0 = highest elevation, our
-// azimuth increasing to the right) by the data, then gives no-return cells directions from the fitted
-// angular grid, keeping the directions the file stored (`has_direction` 2).
-void OrientStructuredScan(std::vector<uint8_t> has_direction, Scan* scan, Scan* second) {
+// azimuth increasing to the right) by the data. The grid is the one lidarshop stored (`file_grid`) or else
+// fitted to the points. The scan holds no direction image when every stored ray is its grid ray bit for bit
+// (ray_directions.h); else the image is the grid's with the stored rays in place. Returns a warning when the
+// stored grid disagrees with the points and was fitted again instead.
+std::string OrientStructuredScan(std::vector<StoredRay> stored_rays, std::optional<ScanGrid> file_grid,
+                                 Scan* scan, Scan* second) {
   Scan* layers[2] = {scan, second};
   const GridOrientation o = OrientationOf(*scan);
   if (o.flip_rows || o.flip_cols) {
     const int code = o.flip_rows && o.flip_cols ? -1 : o.flip_rows ? 0 : 1;
     for (Scan* s : layers) {
       if (s == nullptr || s->num_cells() == 0) continue;
-      for (cv::Mat* m : {&s->direction, &s->valid, &s->range, &s->point, &s->intensity, &s->color,
-                         &s->synthesized, &s->from_station}) {
+      for (cv::Mat* m :
+           {&s->valid, &s->range, &s->point, &s->intensity, &s->color, &s->synthesized, &s->from_station}) {
         if (!m->empty()) cv::flip(*m, *m, code);
       }
     }
-    cv::Mat d(scan->rows, scan->cols, CV_8U, has_direction.data());
-    cv::flip(d, d, code);
-  }
-  if (scan->CountValid() > 0) {
-    // Only the stored rays of no-return cells are kept aside (16 bytes each, counted first), not a copy of
-    // every direction.
-    struct StoredRay {
-      int32_t cell;  // < kMaxScanCells
-      cv::Vec3f direction;
-    };
-    std::vector<StoredRay> stored;
-    stored.reserve(std::count(has_direction.begin(), has_direction.end(), uint8_t{2}));
-    const cv::Vec3f* from = scan->direction.ptr<cv::Vec3f>();
-    for (int64_t c = 0; c < scan->num_cells(); ++c) {
-      if (has_direction[c] == 2) stored.push_back({static_cast<int32_t>(c), from[c]});
+    for (StoredRay& ray : stored_rays) {
+      int row = ray.cell / scan->cols, col = ray.cell % scan->cols;
+      if (o.flip_rows) row = scan->rows - 1 - row;
+      if (o.flip_cols) col = scan->cols - 1 - col;
+      ray.cell = row * scan->cols + col;
     }
-    FitGrid(scan);
+    if (file_grid) {
+      if (o.flip_rows) std::reverse(file_grid->elevation_rad.begin(), file_grid->elevation_rad.end());
+      if (o.flip_cols) std::reverse(file_grid->azimuth_rad.begin(), file_grid->azimuth_rad.end());
+    }
+  }
+  std::string warning;
+  if (file_grid) {
+    // A grid the points do not sit around is not this scan's (the points were changed by a tool that kept the
+    // extension): fitted again. The test is the points' mean offset from their rays (under half the grid's step:
+    // noise averages out, a grid off by a step does not) and their RMS angle (under ten steps: a dense
+    // station's noise across the ray can exceed its step, 1.8 steps in the 100 M-ray parking lot).
+    const GridResidual residual = MeasureGridResidual(*scan, *file_grid);
+    file_grid->rms_residual_rad = residual.rms_rad;
+    file_grid->max_residual_rad = residual.max_rad;
+    const auto step_of = [](const std::vector<double>& angles) {
+      return angles.size() > 1
+                 ? std::abs(angles.back() - angles.front()) / static_cast<double>(angles.size() - 1)
+                 : 0.0;
+    };
+    const double azimuth_step = step_of(file_grid->azimuth_rad),
+                 elevation_step = step_of(file_grid->elevation_rad);
+    const double step = std::max({azimuth_step, elevation_step, 1e-9});
+    if (residual.rms_rad > 10.0 * step ||
+        std::abs(residual.mean_east_rad) > 0.5 * std::max(azimuth_step, 1e-9) ||
+        std::abs(residual.mean_north_rad) > 0.5 * std::max(elevation_step, 1e-9)) {
+      warning = fmt::format(
+          "the stored angular grid is not where the points are (mean offset {:.3g} rad across, {:.3g} rad "
+          "up, RMS "
+          "{:.3g} rad, step {:.3g} rad); fitted again",
+          residual.mean_east_rad, residual.mean_north_rad, residual.rms_rad, step);
+    } else {
+      scan->grid = std::move(*file_grid);
+    }
+  }
+  if (!HasCompleteGrid(*scan) && scan->CountValid() > 0) FitGrid(scan);
+  // Rays of cells that returned after all are not stored rays (a later record of the cell).
+  const uint8_t* valid = scan->valid.ptr<uint8_t>();
+  std::erase_if(stored_rays, [valid](const StoredRay& ray) { return valid[ray.cell] != 0; });
+  bool rays_are_grid = HasCompleteGrid(*scan);
+  if (rays_are_grid && !stored_rays.empty()) {
+    const RayDirections grid_rays(*scan);
+    for (const StoredRay& ray : stored_rays) {
+      const cv::Vec3f g = grid_rays.At(ray.cell);
+      if (std::memcmp(&g, &ray.direction, sizeof(g)) != 0) {
+        rays_are_grid = false;
+        break;
+      }
+    }
+  }
+  if (!rays_are_grid) {
+    // The grid's rays (none without a grid: zero) with the stored ones in place.
+    scan->direction = HasCompleteGrid(*scan) ? DirectionsFromGrid(scan->grid)
+                                             : cv::Mat(scan->rows, scan->cols, CV_32FC3, cv::Scalar::all(0));
     cv::Vec3f* to = scan->direction.ptr<cv::Vec3f>();
-    for (const StoredRay& ray : stored) to[ray.cell] = ray.direction;
+    for (const StoredRay& ray : stored_rays) to[ray.cell] = ray.direction;
   }
   if (second->num_cells() > 0) {
-    second->direction = scan->direction.clone();  // the same rays
+    second->direction = scan->direction;  // the same rays (shared: nothing writes them)
     second->grid = scan->grid;
   }
+  return warning;
 }
 
 // The first returns of one data3D entry; records with returnIndex 1 go to `second` (left 0 x 0 when there are
@@ -972,8 +1063,13 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
   const PointRecords records = ReadPointRecords(ctx, child);
   RecordGrid grid = ReadRecordGrid(ctx, child, records);
   const bool has_color = records.Find("colorRed") && records.Find("colorGreen") && records.Find("colorBlue");
-  Scan scan = MakeScan(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color,
-                       /*with_intensity=*/records.Find("intensity") != nullptr);
+  // A structured scan's rays are its grid's (ray_directions.h): no direction image while it is read.
+  Scan scan =
+      records.structured
+          ? MakeScanWithoutDirections(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color,
+                                      /*with_intensity=*/records.Find("intensity") != nullptr)
+          : MakeScan(static_cast<int>(grid.rows), static_cast<int>(grid.cols), has_color,
+                     /*with_intensity=*/records.Find("intensity") != nullptr);
   scan.name = StringValue(child.child("name"));
   scan.world_from_scanner = PoseOf(ctx, child.child("pose"));
   // The entry's identity and provenance, which a save as E57 writes back (e57_writer.cc): guid, sensor,
@@ -993,7 +1089,7 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
     placed = PlaceRecords(ctx, records, layer, &grid, &scan, second);
     ReadNoReturnDirections(
         ctx, child, extension_prefix.empty() ? "" : extension_prefix + ":" + kNoReturnDirectionsLocalName,
-        grid, &scan, &placed.has_direction);
+        grid, scan, &placed.stored_rays);
     if (placed.duplicates > 0) {
       warnings->push_back(fmt::format(
           "{}: scan {} ('{}'): {} records repeat a return of a cell that already has one; the first is kept",
@@ -1013,8 +1109,14 @@ Scan ReadScan(const Context& ctx, pugi::xml_node child, int index, const std::st
                     grid, layer, layers);
     std::vector<int32_t>().swap(grid.cell);
   }
-  if (records.structured && scan.num_cells() > 0)
-    OrientStructuredScan(std::move(placed.has_direction), &scan, second);
+  if (records.structured && scan.num_cells() > 0) {
+    std::optional<ScanGrid> file_grid = ReadAngularGrid(
+        ctx, child, extension_prefix.empty() ? "" : extension_prefix + ":" + kAngularGridLocalName, grid);
+    const std::string warning =
+        OrientStructuredScan(std::move(placed.stored_rays), std::move(file_grid), &scan, second);
+    if (!warning.empty())
+      warnings->push_back(fmt::format("{}: scan {} ('{}'): {}", ctx.path, index, scan.name, warning));
+  }
   return scan;
 }
 

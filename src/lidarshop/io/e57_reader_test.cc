@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -67,8 +68,9 @@ TEST(E57Reader, PumpAIsAnOrganizedScanWithPhoto) {
   };
   EXPECT_GT(mean_elevation(0, s.rows / 4), mean_elevation(3 * s.rows / 4, s.rows) + 0.5);
   // Every cell has a unit direction (no-return cells from the fitted grid).
+  const cv::Mat rays = DirectionImage(s);
   for (int64_t c = 0; c < s.num_cells(); ++c) {
-    ASSERT_NEAR(cv::norm(s.direction.ptr<cv::Vec3f>()[c]), 1.0, 1e-4) << "cell " << c;
+    ASSERT_NEAR(cv::norm(rays.ptr<cv::Vec3f>()[c]), 1.0, 1e-4) << "cell " << c;
   }
   // images2D: one visual reference JPEG of 3072 x 2304.
   ASSERT_EQ(f.images.size(), 1u);
@@ -102,9 +104,9 @@ TEST(E57Reader, CartesianInvalidStates) {
   // The valid point is the cartesianBounds' maximum corner (-1, -2, -3).
   EXPECT_EQ(PointAt(s, 0), cv::Vec3f(-1, -2, -3));
   EXPECT_EQ(s.valid.ptr<uint8_t>()[1], 0);
-  EXPECT_NEAR(cv::norm(s.direction.ptr<cv::Vec3f>()[1]), 1.0, 1e-6);  // direction only
+  EXPECT_NEAR(cv::norm(DirectionImage(s).ptr<cv::Vec3f>()[1]), 1.0, 1e-6);  // direction only
   EXPECT_EQ(s.valid.ptr<uint8_t>()[2], 0);
-  EXPECT_EQ(s.direction.ptr<cv::Vec3f>()[2], cv::Vec3f(0, 0, 0));  // nothing known
+  EXPECT_EQ(DirectionImage(s).ptr<cv::Vec3f>()[2], cv::Vec3f(0, 0, 0));  // nothing known
 }
 
 TEST(E57Reader, EmptyFilesAreEmpty) {
@@ -203,7 +205,7 @@ TEST(E57Reader, SphericalCoordinates) {
   EXPECT_EQ(PointAt(s, 0), cv::Vec3f(1, 0, 0));
   // Record 359: direction at azimuth = elevation = 359 * 3.14 / 360 (counter-clockwise from +x, up from xy).
   const double a = 359.0 * (3.14 / 360.0);
-  const cv::Vec3f d = s.direction.ptr<cv::Vec3f>()[359];
+  const cv::Vec3f d = DirectionImage(s).ptr<cv::Vec3f>()[359];
   EXPECT_EQ(s.valid.ptr<uint8_t>()[359], 0);
   EXPECT_NEAR(d[0], std::cos(a) * std::cos(a), 1e-6);
   EXPECT_NEAR(d[1], std::cos(a) * std::sin(a), 1e-6);

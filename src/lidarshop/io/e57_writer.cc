@@ -5,6 +5,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include <Eigen/Geometry>
@@ -16,6 +17,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -116,12 +118,37 @@ StreamSource RecordStream(Field field, const Scan& scan, const uint8_t* behind_v
 // The E57 pose (unit quaternion with w >= 0, translation) of `transform` under `parent`.
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
 
+// The scan's grid alone, for the rays it gives.
+Scan GridOnly(const Scan& scan) {
+  Scan grid_only;
+  grid_only.rows = scan.rows;
+  grid_only.cols = scan.cols;
+  grid_only.grid = scan.grid;
+  return grid_only;
+}
+
+// lidarshop's extension element `lidarshop:angularGrid` under a data3D entry (e57.h): the azimuth of every
+// columnIndex and the elevation of every rowIndex in lidarshop's scanner frame, radians, as Vectors of double
+// Floats written in their shortest exact form, and whether the grid was fitted to measured points.
+void AddAngularGrid(pugi::xml_node child, const ScanGrid& grid) {
+  pugi::xml_node extension = AddTyped(child, kAngularGridField, "Structure");
+  for (const auto& [name, angles] :
+       {std::pair<const char*, const std::vector<double>*>{"azimuth", &grid.azimuth_rad},
+        {"elevation", &grid.elevation_rad}}) {
+    pugi::xml_node vector = AddTyped(extension, name, "Vector");
+    vector.append_attribute("allowHeterogeneousChildren") = "0";
+    for (const double angle : *angles) AddFloat(vector, "value", angle);
+  }
+  AddInteger(extension, "fitted", grid.fitted ? 1 : 0);
+}
+
 // lidarshop's extension element `lidarshop:noReturnDirections` under a data3D entry (`child`): a Structure
 // holding a `points` CompressedVector of one record per cell without a return (`cells`, row-major image
 // order): rowIndex, columnIndex as in the scan's points, and the cell's unit ray as cartesianX/Y/Z in single
 // floats (bit-exact). Readers that do not know the namespace skip it.
-void AppendNoReturnDirections(const Scan& scan, const std::function<bool(int64_t)>& has_direction, int64_t m,
-                              LogicalSink* sink, pugi::xml_node child) {
+void AppendNoReturnDirections(const Scan& scan, const RayDirections& rays,
+                              const std::function<bool(int64_t)>& has_direction, int64_t m, LogicalSink* sink,
+                              pugi::xml_node child) {
   // Each stream walks the cells that have a direction, in order.
   auto cell_stream = [&](Field field, auto put_value) {
     int64_t next = 0;
@@ -139,14 +166,13 @@ void AppendNoReturnDirections(const Scan& scan, const std::function<bool(int64_t
   streams.push_back(cell_stream(IntegerField("columnIndex", 0, std::max(scan.cols - 1, 0)),
                                 [&scan](int64_t c, BitWriter* w) { w->PutInteger(c % scan.cols, 0); }));
   const char* axis_names[3] = {"cartesianX", "cartesianY", "cartesianZ"};
-  const cv::Vec3f* direction = scan.direction.ptr<cv::Vec3f>();
   for (int axis = 0; axis < 3; ++axis) {
     Field field;
     field.name = axis_names[axis];
     field.type = Field::Type::kFloat;
     field.bits = 32;
     streams.push_back(
-        cell_stream(field, [direction, axis](int64_t c, BitWriter* w) { w->PutFloat(direction[c][axis]); }));
+        cell_stream(field, [&rays, axis](int64_t c, BitWriter* w) { w->PutFloat(rays.At(c)[axis]); }));
   }
   const uint64_t offset = AppendCompressedVector(streams, m, sink);
   pugi::xml_node extension = AddTyped(child, kNoReturnDirectionsField, "Structure");
@@ -187,11 +213,21 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
       hi[axis] = std::max(hi[axis], static_cast<double>(p[axis]));
     }
   };
-  // The rays of no-return cells go to lidarshop's extension (below).
-  const std::function<bool(int64_t)> has_direction = [&scan, &options](int64_t c) {
-    const int r = static_cast<int>(c / scan.cols), k = static_cast<int>(c % scan.cols);
-    if (scan.valid.at<uint8_t>(r, k) || !options.write_no_return_directions) return false;
-    const cv::Vec3f d = scan.direction.at<cv::Vec3f>(r, k);
+  // The grid goes to lidarshop's extension when complete (unless the file is to hold no ray: then readers fit
+  // it); the rays of no-return cells that are the grid's bit for bit need no record beside it, the others go
+  // to lidarshop's extension too (below).
+  const bool write_grid = options.write_no_return_directions && HasCompleteGrid(scan) && scan.num_cells() > 0;
+  std::optional<RayDirections> rays, grid_rays;
+  if (HasRayDirections(scan)) rays.emplace(scan);
+  if (write_grid) grid_rays.emplace(GridOnly(scan));
+  const std::function<bool(int64_t)> has_direction = [&scan, &options, &rays, &grid_rays](int64_t c) {
+    if (scan.valid.ptr<uint8_t>()[c] || !options.write_no_return_directions || !rays) return false;
+    if (grid_rays && rays->from_grid()) return false;
+    const cv::Vec3f d = rays->At(c);
+    if (grid_rays) {
+      const cv::Vec3f g = grid_rays->At(c);
+      if (std::memcmp(&d, &g, sizeof(d)) == 0) return false;
+    }
     return d.dot(d) > 0.0f && std::isfinite(d.dot(d));
   };
   for (int64_t c = 0; c < scan.num_cells(); ++c) {
@@ -375,11 +411,9 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   for (const StreamSource& s : streams) AddPrototypeField(prototype, s.field);
   pugi::xml_node codecs = AddTyped(points, "codecs", "Vector");
   codecs.append_attribute("allowHeterogeneousChildren") = "1";
-  if (direction_count > 0) {
-    AppendNoReturnDirections(scan, has_direction, direction_count, sink, child);
-    return true;
-  }
-  return write_synthesized || write_from_station;
+  if (write_grid) AddAngularGrid(child, scan.grid);
+  if (direction_count > 0) AppendNoReturnDirections(scan, *rays, has_direction, direction_count, sink, child);
+  return write_grid || direction_count > 0 || write_synthesized || write_from_station;
 }
 
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform) {

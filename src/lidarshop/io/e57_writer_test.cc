@@ -10,6 +10,7 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -34,7 +35,7 @@ Scan SyntheticScan(int rows, int cols, uint32_t seed, bool with_color) {
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       if (u(rng) < 0.2f) continue;  // no return: keeps its direction, intensity 0.5
-      const cv::Vec3f d = s.direction.at<cv::Vec3f>(r, c);
+      const cv::Vec3f d = DirectionImage(s).at<cv::Vec3f>(r, c);
       const cv::Vec3f p = d * (1.0f + 19.0f * u(rng)) + cv::Vec3f(u(rng), u(rng), u(rng)) * 0.002f;
       s.valid.at<uint8_t>(r, c) = kValid;
       s.point.at<cv::Vec3f>(r, c) = p;
@@ -58,8 +59,9 @@ void ExpectSameScan(const Scan& a, const Scan& b, double point_tolerance_m) {
   EXPECT_LT((a.world_from_scanner - b.world_from_scanner).cwiseAbs().maxCoeff(), 1e-12);
   EXPECT_EQ(cv::countNonZero(a.valid != b.valid), 0);
   ASSERT_EQ(a.has_color(), b.has_color());
+  const cv::Mat rays_a = DirectionImage(a), rays_b = DirectionImage(b);
   for (int64_t c = 0; c < a.num_cells(); ++c) {
-    const cv::Vec3f da = a.direction.ptr<cv::Vec3f>()[c], db = b.direction.ptr<cv::Vec3f>()[c];
+    const cv::Vec3f da = rays_a.ptr<cv::Vec3f>()[c], db = rays_b.ptr<cv::Vec3f>()[c];
     if (!a.valid.ptr<uint8_t>()[c]) {
       // Stored as cartesianInvalidState 1 at the coordinates' precision (renormalized when quantized).
       ASSERT_LE(cv::norm(da - db, cv::NORM_INF), 2 * point_tolerance_m) << "no-return direction, cell " << c;
@@ -204,7 +206,10 @@ TEST(E57Writer, OrganizedRoundTripIsExact) {
   const E57File f = ReadE57(path);
   ASSERT_EQ(f.scans.size(), 1u);
   ExpectSameScan(scan, f.scans[0], 0.0);
-  EXPECT_TRUE(f.scans[0].grid.fitted);
+  // The grid is the scan's (lidarshop:angularGrid), not fitted again.
+  EXPECT_EQ(f.scans[0].grid.fitted, scan.grid.fitted);
+  EXPECT_EQ(f.scans[0].grid.azimuth_rad, scan.grid.azimuth_rad);
+  EXPECT_EQ(f.scans[0].grid.elevation_rad, scan.grid.elevation_rad);
   // The XML's cartesianBounds are the valid points' bounds.
   const std::vector<uint8_t> logical = e57::LogicalFromPages(path, EncodeE57({scan}));
   const std::string text(logical.begin(), logical.end());

@@ -5,10 +5,12 @@
 #include <cmath>
 
 #include "lidarshop/geometry/transform.h"
+#include "lidarshop/scan/ray_directions.h"
 
 namespace lidarshop {
 
 TriangleMesh SilhouetteSkirts(const Scan& scan, const SilhouetteSkirtOptions& options) {
+  const RayDirections rays(scan);
   CheckScan(scan);
   const int rows = scan.rows, cols = scan.cols;
   const float ratio = static_cast<float>(options.max_range_jump_ratio);
@@ -66,7 +68,7 @@ TriangleMesh SilhouetteSkirts(const Scan& scan, const SilhouetteSkirtOptions& op
         std::array<Eigen::Vector3f, 4> front, back;
         bool usable = true;
         for (int i = 0; i < 4 && usable; ++i) {
-          const cv::Vec3f& d = scan.direction.at<cv::Vec3f>(cr[i], cc[i]);
+          const cv::Vec3f d = rays(cr[i], cc[i]);
           Eigen::Vector3f direction(d[0], d[1], d[2]);
           float near_range = 0;
           float limit = std::numeric_limits<float>::infinity();  // a farther return on this ray

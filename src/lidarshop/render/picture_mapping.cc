@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/io/image_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/json_input.h"
@@ -288,9 +289,10 @@ cv::Mat CellsFromPicture(const Scan& scan, const PictureMapping& mapping, const 
     radius_y =
         std::clamp(static_cast<int>(0.5 * steps[1] / mapping.elevation_step_rad), 0, kMaxFootprintRadiusPx);
   }
+  const RayDirections rays(scan);
   for (int row = 0; row < scan.rows; ++row) {
     for (int col = 0; col < scan.cols; ++col) {
-      cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+      cv::Vec3f d = rays(row, col);
       if (scan.valid.at<uint8_t>(row, col) && scan.range.at<float>(row, col) > 0) {
         d = scan.point.at<cv::Vec3f>(row, col);  // the projection of LayOutSphere: the point's own direction
       }

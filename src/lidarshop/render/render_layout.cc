@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
@@ -420,8 +421,9 @@ cv::Vec2d NativeStepsRad(const Scan& scan) {
   }
   // No grid: the median angle between neighbouring rays that both returned.
   std::vector<double> across, down;
+  const RayDirections rays(scan);
   auto direction = [&](int row, int col) {
-    const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+    const cv::Vec3f d = rays(row, col);
     return Eigen::Vector3f(d[0], d[1], d[2]);
   };
   for (int row = 0; row < scan.rows; ++row) {

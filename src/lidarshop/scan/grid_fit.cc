@@ -10,6 +10,7 @@
 #include <numeric>
 #include <vector>
 
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scan/scan_channels.h"
 #include "lidarshop/util/parallel.h"
@@ -134,8 +135,67 @@ std::vector<double> FitAxis(std::vector<double> medians, const std::vector<int>&
 
 }  // namespace
 
+GridResidual MeasureGridResidual(const Scan& scan, const ScanGrid& grid) {
+  // Row by row in parallel, each row's sums and maximum kept, the rows' sums added in row order: the same value
+  // on any thread count, and nothing held per return. The signed offsets are the unit point's components along
+  // the grid ray's local east (azimuth rising) and north (elevation rising) directions.
+  struct RowSums {
+    double squares = 0, max = 0, east = 0, north = 0;
+    int64_t count = 0;
+  };
+  std::vector<RowSums> rows(scan.rows);
+  Scan grid_only;
+  grid_only.rows = scan.rows;
+  grid_only.cols = scan.cols;
+  grid_only.grid = grid;
+  const RayDirections grid_rays(grid_only);
+  std::vector<double> sin_azimuth(scan.cols), cos_azimuth(scan.cols);
+  for (int col = 0; col < scan.cols; ++col) {
+    sin_azimuth[col] = std::sin(grid.azimuth_rad[col]);
+    cos_azimuth[col] = std::cos(grid.azimuth_rad[col]);
+  }
+  ParallelFor(scan.rows, [&](int64_t r) {
+    const int row = static_cast<int>(r);
+    const uint8_t* valid = scan.valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan.point.ptr<cv::Vec3f>(row);
+    const double sin_elevation = std::sin(grid.elevation_rad[row]),
+                 cos_elevation = std::cos(grid.elevation_rad[row]);
+    RowSums& sums = rows[row];
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!valid[col]) continue;
+      const cv::Vec3d p(point[col]), d(grid_rays(row, col));
+      const double angle = std::atan2(cv::norm(p.cross(d)), p.dot(d));
+      sums.squares += angle * angle;
+      sums.max = std::max(sums.max, angle);
+      const double norm = cv::norm(p);
+      if (norm > 0) {
+        sums.east += (p[0] * cos_azimuth[col] - p[1] * sin_azimuth[col]) / norm;
+        sums.north +=
+            (p[2] * cos_elevation - sin_elevation * (p[0] * sin_azimuth[col] + p[1] * cos_azimuth[col])) /
+            norm;
+      }
+      ++sums.count;
+    }
+  });
+  RowSums total;
+  for (const RowSums& row : rows) {
+    total.squares += row.squares;
+    total.max = std::max(total.max, row.max);
+    total.east += row.east;
+    total.north += row.north;
+    total.count += row.count;
+  }
+  GridResidual residual;
+  if (total.count == 0) return residual;
+  residual.rms_rad = std::sqrt(total.squares / total.count);
+  residual.max_rad = total.max;
+  residual.mean_east_rad = total.east / total.count;
+  residual.mean_north_rad = total.north / total.count;
+  return residual;
+}
+
 void FitGrid(Scan* scan) {
-  CheckScan(*scan);
+  CheckScan(*scan);  // `direction` may be empty: a reader that holds no direction image
   const int rows = scan->rows, cols = scan->cols;
   // What the fit holds beside the scan is one azimuth per return (8 bytes; a station has tens of millions),
   // column by column in one array: rows are read in bands, in parallel, twice — once for their elevation
@@ -230,33 +290,13 @@ void FitGrid(Scan* scan) {
   grid.elevation_rad = FitAxis(elevation_medians, elevation_counts, elevation_step);
   if (grid.azimuth_rad.empty() || grid.elevation_rad.empty()) return;  // no usable return: nothing to fit
   grid.fitted = true;
-  scan_internal::FillDirectionsFromGrid(grid, &scan->direction);  // in place: no second direction image
+  // A scan that holds directions gets the grid's in place (no second image); one that holds none has them
+  // from the grid (ray_directions.h).
+  if (!scan->direction.empty()) scan_internal::FillDirectionsFromGrid(grid, &scan->direction);
 
-  // The residual angles row by row in parallel, summed in cell order (the same sum as a serial pass).
-  std::vector<std::vector<double>> row_residuals(rows);
-  ParallelFor(rows, [&](int64_t r) {
-    const int row = static_cast<int>(r);
-    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
-    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
-    const cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
-    for (int col = 0; col < cols; ++col) {
-      if (!valid[col]) continue;
-      const cv::Vec3d p(point[col]), d(direction[col]);
-      row_residuals[row].push_back(std::atan2(cv::norm(p.cross(d)), p.dot(d)));
-    }
-  });
-  double sum_squares = 0, max_residual = 0;
-  int64_t count = 0;
-  for (std::vector<double>& residuals : row_residuals) {
-    for (const double angle : residuals) {
-      sum_squares += angle * angle;
-      max_residual = std::max(max_residual, angle);
-      ++count;
-    }
-    std::vector<double>().swap(residuals);
-  }
-  grid.rms_residual_rad = count > 0 ? std::sqrt(sum_squares / count) : 0.0;
-  grid.max_residual_rad = max_residual;
+  const GridResidual residual = MeasureGridResidual(*scan, grid);
+  grid.rms_residual_rad = residual.rms_rad;
+  grid.max_residual_rad = residual.max_rad;
   scan->grid = std::move(grid);
 }
 

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/scan/rgbd_cell.h"
 #include "lidarshop/scan/scan_channels.h"
 #include "lidarshop/scan/scan_window.h"
@@ -34,6 +35,8 @@ ScanGrid GridOf(const Scan& scan) {
       static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows) {
     return scan.grid;
   }
+  if (scan.direction.empty() && scan.num_cells() > 0)
+    throw InputError(fmt::format("scan '{}': no ray directions and no complete grid", scan.name));
   // The k-th cell out from the middle of `count`: middle, middle - 1, middle + 1, ... (wrapping).
   auto outward = [](int k, int count) {
     return (count / 2 + (k % 2 == 0 ? k / 2 : -(k + 1) / 2) + count) % count;
@@ -156,8 +159,11 @@ void PasteChannels(const Scan& part, const cv::Rect& window, bool copy_on_write,
   CheckWindow(*scan, window, what);
   if (part.rows != window.height || part.cols != window.width)
     throw std::logic_error(fmt::format("{}: the part's size differs from the window's", what));
+  // A scan that holds no direction image has its grid's rays (ray_directions.h): an edit never changes a ray,
+  // and a part's directions would otherwise become a station-sized image.
+  const bool rays_from_grid = scan->direction.empty() && HasCompleteGrid(*scan);
   const auto paste = [&](const cv::Mat& values, cv::Mat* target, const cv::Scalar& none) {
-    if (values.empty()) return;
+    if (values.empty() || (rays_from_grid && target == &scan->direction)) return;
     if (target->empty()) {
       *target = cv::Mat(scan->rows, scan->cols, values.type(), none);
     } else if (copy_on_write) {
@@ -219,7 +225,8 @@ void CheckScan(const Scan& scan) {
       throw std::logic_error(std::string("scan channel has the wrong size or type: ") + name);
     }
   };
-  check(scan.direction, CV_32FC3, "direction", true);
+  // Empty: the rays are the grid's (ray_directions.h), or not known yet to a reader that fits the grid.
+  check(scan.direction, CV_32FC3, "direction", false);
   check(scan.valid, CV_8U, "valid", true);
   check(scan.range, CV_32F, "range", true);
   check(scan.point, CV_32FC3, "point", true);
@@ -375,6 +382,7 @@ Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synth
   if (range.rows != scan.rows || range.cols != scan.cols || range.type() != CV_32F) {
     throw std::logic_error("WithRange: the range image must be CV_32F of the scan's size");
   }
+  const RayDirections rays(scan);
   Scan result = scan;
   result.valid = scan.valid.clone();
   result.range = range.clone();
@@ -395,7 +403,7 @@ Scan WithRange(const Scan& scan, const cv::Mat& range, const cv::Mat& mark_synth
         result.valid.at<uint8_t>(row, col) = 0;
         continue;
       }
-      cv::Vec3f ray = scan.direction.at<cv::Vec3f>(row, col);
+      cv::Vec3f ray = rays(row, col);
       if (scan.valid.at<uint8_t>(row, col)) {
         const cv::Vec3f& old_point = scan.point.at<cv::Vec3f>(row, col);
         const float old_range = static_cast<float>(cv::norm(old_point));

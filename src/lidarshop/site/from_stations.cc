@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/site/grid_lookup.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
@@ -335,7 +336,7 @@ FromStationsResult FillFromStations(const Scan& scan, const cv::Mat& hole_in,
   const cv::Mat hole = hole_in != 0;
   for (size_t i = 0; i < other_stations.size(); ++i) {
     CheckScan(other_stations[i]);
-    if (other_stations[i].direction.empty() || other_stations[i].rows < 2 || other_stations[i].cols < 2)
+    if (!HasRayDirections(other_stations[i]) || other_stations[i].rows < 2 || other_stations[i].cols < 2)
       throw InputError(fmt::format("station {} ('{}') has no grid: an unorganized cloud cannot fill a hole",
                                    i, other_stations[i].name));
   }
@@ -392,8 +393,9 @@ FromStationsResult FillFromStations(const Scan& scan, const cv::Mat& hole_in,
     scene.Commit();
     const double scan_step = scan_grid.step_rad();
     std::vector<Ray> rays(cells.size());
+    const RayDirections scan_rays(scan);
     for (size_t i = 0; i < cells.size(); ++i) {
-      const cv::Vec3f& d = scan.direction.at<cv::Vec3f>(cells[i]);
+      const cv::Vec3f d = scan_rays(cells[i].y, cells[i].x);
       Ray& ray = rays[i];
       ray.direction = Eigen::Vector3f(d[0], d[1], d[2]).normalized();
       const bool returned = scan.valid.at<uint8_t>(cells[i]) != 0;

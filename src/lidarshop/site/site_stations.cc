@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -26,7 +27,7 @@ StationSummary SummarizeStation(const Scan& station, int index) {
   summary.rows = station.rows;
   summary.cols = station.cols;
   summary.returns = station.CountValid();
-  summary.organized = station.rows > 1 && station.cols > 1 && !station.direction.empty();
+  summary.organized = station.rows > 1 && station.cols > 1 && HasRayDirections(station);
   return summary;
 }
 

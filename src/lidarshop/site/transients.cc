@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/site/from_stations.h"
 #include "lidarshop/site/grid_lookup.h"
 #include "lidarshop/util/error.h"
@@ -154,7 +155,7 @@ TransientResult FindTransients(const std::vector<Scan>& stations, const Transien
   std::vector<GridLookup> grids;
   for (size_t i = 0; i < stations.size(); ++i) {
     CheckScan(stations[i]);
-    if (stations[i].direction.empty() || stations[i].rows < 2 || stations[i].cols < 2)
+    if (!HasRayDirections(stations[i]) || stations[i].rows < 2 || stations[i].cols < 2)
       throw InputError(fmt::format("station {} ('{}') has no grid: an unorganized cloud cannot be compared",
                                    i, stations[i].name));
     grids.emplace_back(stations[i]);

@@ -1,0 +1,84 @@
+#include "lidarshop/scan/ray_directions.h"
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include "lidarshop/util/parallel.h"
+
+namespace lidarshop {
+
+bool HasCompleteGrid(const Scan& scan) {
+  return static_cast<int>(scan.grid.azimuth_rad.size()) == scan.cols &&
+         static_cast<int>(scan.grid.elevation_rad.size()) == scan.rows;
+}
+
+bool HasRayDirections(const Scan& scan) { return !scan.direction.empty() || HasCompleteGrid(scan); }
+
+cv::Mat DirectionImage(const Scan& scan) {
+  if (!scan.direction.empty()) return scan.direction;
+  if (!HasCompleteGrid(scan) || scan.num_cells() == 0) return {};
+  return DirectionsFromGrid(scan.grid);
+}
+
+RayDirections::RayDirections(const Scan& scan) : cols_(scan.cols) {
+  if (!scan.direction.empty()) {
+    image_ = scan.direction;
+    return;
+  }
+  if (!HasCompleteGrid(scan))
+    throw std::logic_error("RayDirections: the scan holds no directions and no grid");
+  sin_azimuth_.resize(scan.cols);
+  cos_azimuth_.resize(scan.cols);
+  for (int col = 0; col < scan.cols; ++col) {
+    sin_azimuth_[col] = std::sin(scan.grid.azimuth_rad[col]);
+    cos_azimuth_[col] = std::cos(scan.grid.azimuth_rad[col]);
+  }
+  cos_elevation_.resize(scan.rows);
+  sin_elevation_.resize(scan.rows);
+  for (int row = 0; row < scan.rows; ++row) {
+    cos_elevation_[row] = std::cos(scan.grid.elevation_rad[row]);
+    sin_elevation_[row] = static_cast<float>(std::sin(scan.grid.elevation_rad[row]));
+  }
+}
+
+bool ReleaseGridDirections(Scan* scan) {
+  if (scan->direction.empty()) return HasCompleteGrid(*scan);
+  if (!HasCompleteGrid(*scan)) return false;
+  Scan grid_only;
+  grid_only.rows = scan->rows;
+  grid_only.cols = scan->cols;
+  grid_only.grid = scan->grid;
+  const RayDirections from_grid(grid_only);
+  std::atomic<bool> same{true};
+  ParallelFor(scan->rows, [&](int64_t r) {
+    if (!same.load(std::memory_order_relaxed)) return;
+    const int row = static_cast<int>(r);
+    const cv::Vec3f* held = scan->direction.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < scan->cols; ++col) {
+      const cv::Vec3f expected = from_grid(row, col);
+      if (std::memcmp(&held[col], &expected, sizeof(expected)) != 0) {
+        same = false;
+        return;
+      }
+    }
+  });
+  if (same) scan->direction.release();
+  return same;
+}
+
+Scan MakeScanWithoutDirections(int rows, int cols, bool with_color, bool with_intensity) {
+  if (rows < 0 || cols < 0) throw std::logic_error("MakeScanWithoutDirections: negative size");
+  Scan scan;
+  scan.rows = rows;
+  scan.cols = cols;
+  scan.valid = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  scan.range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  scan.point = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  if (with_intensity) scan.intensity = cv::Mat(rows, cols, CV_32F, cv::Scalar(0.5));
+  if (with_color) scan.color = cv::Mat(rows, cols, CV_8UC3, cv::Scalar::all(0));
+  return scan;
+}
+
+}  // namespace lidarshop
