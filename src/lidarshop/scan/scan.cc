@@ -201,15 +201,8 @@ void PasteScanCopyOnWrite(const Scan& part, const cv::Rect& window, Scan* scan) 
 
 Scan MakeScan(int rows, int cols, bool with_color, bool with_intensity) {
   if (rows < 0 || cols < 0) throw std::logic_error("MakeScan: negative size");
-  Scan scan;
-  scan.rows = rows;
-  scan.cols = cols;
+  Scan scan = MakeScanWithoutDirections(rows, cols, with_color, with_intensity);
   scan.direction = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
-  scan.valid = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
-  scan.range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
-  scan.point = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
-  if (with_intensity) scan.intensity = cv::Mat(rows, cols, CV_32F, cv::Scalar(0.5));
-  if (with_color) scan.color = cv::Mat(rows, cols, CV_8UC3, cv::Scalar::all(0));
   return scan;
 }
 

@@ -9,7 +9,7 @@
 // (cos φ sin θ, cos φ cos θ, sin φ).
 //
 // Channels (cv::Mat, each rows x cols):
-//   direction   CV_32FC3  unit ray direction (scanner frame), known for EVERY cell, also without a return
+//   direction   CV_32FC3  unit ray of every cell, or EMPTY: the rays are the grid's (read them via ray_directions.h)
 //   valid       CV_8U     255 = the ray returned, 0 = no return
 //   range       CV_32F    metres from the scanner origin to the point; 0 where invalid
 //   point       CV_32FC3  x y z in the scanner frame, metres; 0 where invalid
