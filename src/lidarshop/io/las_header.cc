@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
+#include <string_view>
 
 #include <fmt/format.h>
 
@@ -37,22 +39,25 @@ std::string FixedText(const char* p, size_t width) {
 // offset).
 constexpr double kMinLasScale = 1e-12;
 
-// LAS 1.4's extended variable length records, after the points (coordinate systems as WKT live there).
-// Read only from a whole file; records that do not fit are left out with a warning.
-void ReadExtendedRecords(const std::string& bytes, const std::string& file, int64_t size, LasHeader* header) {
-  if (header->minor_version < 4 || static_cast<int64_t>(bytes.size()) != size) return;
-  const char* h = bytes.data();
-  const uint64_t first = las::Load<uint64_t>(h + las::header::kFirstEvlr);
-  const uint32_t count = las::Load<uint32_t>(h + las::header::kNumberOfEvlrs);
+// LAS 1.4's extended variable length records, after the points (coordinate systems as WKT live there), from
+// `region`: the file's bytes from `region_offset` to its end (`size`). Records that do not fit are left out with
+// a warning.
+void ReadExtendedRecordsIn(std::string_view region, int64_t region_offset, uint64_t first, uint32_t count,
+                           const std::string& file, int64_t size, LasHeader* header) {
   if (count == 0) return;
+  // The file's byte `position` (within the region: checked by `header_fits` before any read).
+  const auto at = [&](uint64_t position) {
+    return region.data() + (position - static_cast<uint64_t>(region_offset));
+  };
   uint64_t position = first;
   for (uint32_t i = 0; i < count; ++i) {
     // Both sides of each comparison stay within [0, size]: no unsigned wrap-around can let a record pass.
-    const bool header_fits = position >= static_cast<uint64_t>(header->offset_to_points) &&
-                             position <= static_cast<uint64_t>(size) &&
-                             static_cast<uint64_t>(size) - position >= las::kEvlrHeaderSize;
+    const bool header_fits =
+        position >= static_cast<uint64_t>(std::max(header->offset_to_points, region_offset)) &&
+        position <= static_cast<uint64_t>(size) &&
+        static_cast<uint64_t>(size) - position >= las::kEvlrHeaderSize;
     const uint64_t length =
-        header_fits ? las::Load<uint64_t>(h + position + las::vlr::kRecordLength) : uint64_t{0};
+        header_fits ? las::Load<uint64_t>(at(position) + las::vlr::kRecordLength) : uint64_t{0};
     if (!header_fits || length > static_cast<uint64_t>(size) - position - las::kEvlrHeaderSize) {
       header->warnings.push_back(fmt::format(
           "{}: extended variable length record {} at byte {} does not fit in the file ({} bytes); left out "
@@ -62,13 +67,20 @@ void ReadExtendedRecords(const std::string& bytes, const std::string& file, int6
     }
     SourceRecord record;
     record.format = "las";
-    record.user_id = FixedText(h + position + las::vlr::kUserId, 16);
-    record.record_id = las::Load<uint16_t>(h + position + las::vlr::kRecordId);
-    record.description = FixedText(h + position + 28, 32);
-    record.payload.assign(h + position + las::kEvlrHeaderSize, static_cast<size_t>(length));
+    record.user_id = FixedText(at(position) + las::vlr::kUserId, 16);
+    record.record_id = las::Load<uint16_t>(at(position) + las::vlr::kRecordId);
+    record.description = FixedText(at(position) + 28, 32);
+    record.payload.assign(at(position) + las::kEvlrHeaderSize, static_cast<size_t>(length));
     header->records.push_back(std::move(record));
     position += las::kEvlrHeaderSize + length;
   }
+}
+
+// The extended records of a whole file in `bytes`.
+void ReadExtendedRecords(const std::string& bytes, const std::string& file, int64_t size, LasHeader* header) {
+  if (header->minor_version < 4 || static_cast<int64_t>(bytes.size()) != size) return;
+  ReadExtendedRecordsIn(bytes, 0, las::Load<uint64_t>(bytes.data() + las::header::kFirstEvlr),
+                        las::Load<uint32_t>(bytes.data() + las::header::kNumberOfEvlrs), file, size, header);
 }
 
 }  // namespace
@@ -223,19 +235,42 @@ LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t
   return header;
 }
 
+std::string ReadHeaderPrefix(const std::string& path, int64_t file_size) {
+  std::string bytes = io_internal::ReadFilePrefix(path, kHeaderSize14);
+  if (static_cast<int64_t>(bytes.size()) >= kHeaderSize12) {
+    // The header and the variable length records up to the point data (both sizes checked by ParseHeader).
+    const int64_t needed = std::max<int64_t>(Load<uint32_t>(bytes.data() + header::kOffsetToPointData),
+                                             Load<uint16_t>(bytes.data() + header::kHeaderSize));
+    if (needed > static_cast<int64_t>(bytes.size()) && needed <= file_size)
+      bytes = io_internal::ReadFilePrefix(path, needed);
+  }
+  return bytes;
+}
+
+void ReadExtendedRecordsFromFile(const std::string& path, int64_t file_size, const std::string& prefix,
+                                 LasHeader* header) {
+  if (header->minor_version < 4 || static_cast<int64_t>(prefix.size()) < kHeaderSize14) return;
+  const uint64_t first = Load<uint64_t>(prefix.data() + header::kFirstEvlr);
+  const uint32_t count = Load<uint32_t>(prefix.data() + header::kNumberOfEvlrs);
+  if (count == 0) return;
+  if (first < static_cast<uint64_t>(header->offset_to_points) || first > static_cast<uint64_t>(file_size)) {
+    ReadExtendedRecordsIn({}, file_size, first, count, path, file_size, header);  // the warning
+    return;
+  }
+  std::ifstream in(path, std::ios::binary);
+  std::string tail(static_cast<size_t>(file_size - static_cast<int64_t>(first)), '\0');
+  in.seekg(static_cast<std::streamoff>(first));
+  if (!in.read(tail.data(), static_cast<std::streamsize>(tail.size())))
+    ThrowInputError(path, fmt::format("byte {}", first), "extended variable length records",
+                    "cannot be read");
+  ReadExtendedRecordsIn(tail, static_cast<int64_t>(first), first, count, path, file_size, header);
+}
+
 }  // namespace las
 
 ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   const int64_t file_size = CheckRegularFile(path);
-  std::string bytes = io_internal::ReadFilePrefix(path, las::kHeaderSize14);
-  if (static_cast<int64_t>(bytes.size()) >= las::kHeaderSize12) {
-    // The header and the variable length records up to the point data (both sizes checked by ParseHeader).
-    const int64_t needed =
-        std::max<int64_t>(las::Load<uint32_t>(bytes.data() + las::header::kOffsetToPointData),
-                          las::Load<uint16_t>(bytes.data() + las::header::kHeaderSize));
-    if (needed > static_cast<int64_t>(bytes.size()) && needed <= file_size)
-      bytes = io_internal::ReadFilePrefix(path, needed);
-  }
+  const std::string bytes = las::ReadHeaderPrefix(path, file_size);
   const las::LasHeader header = las::ParseHeader(bytes, path, file_size);
   if (header.count > 0) io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
   ScanFileHeader file;

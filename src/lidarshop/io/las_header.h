@@ -33,4 +33,12 @@ struct LasHeader {
 // from a whole file. Throws InputError naming the file, the header byte and the field.
 LasHeader ParseHeader(const std::string& bytes, const std::string& file, int64_t file_size = -1);
 
+// The start of the file `path` (of `file_size` bytes) up to its point data: the header and the variable length
+// records, what ParseHeader needs of a file not read whole.
+std::string ReadHeaderPrefix(const std::string& path, int64_t file_size);
+// LAS 1.4's extended records of a file parsed from its prefix (`prefix`): read from the file's tail into
+// header->records (warnings for those that do not fit). Throws InputError when the file cannot be read.
+void ReadExtendedRecordsFromFile(const std::string& path, int64_t file_size, const std::string& prefix,
+                                 LasHeader* header);
+
 }  // namespace lidarshop::las

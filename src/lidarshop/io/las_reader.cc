@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <limits>
 
 #include <fmt/format.h>
@@ -50,23 +51,93 @@ struct AttributeColumn {
 
 }  // namespace
 
+namespace {
+
+// The point records, a chunk at a time: from memory (a whole file, or LAZ's decoded records) or read from the
+// file, so that parsing a file of 100 M points holds one chunk of it, not the file. Parsing walks the records
+// in order, twice.
+class RecordChunks {
+ public:
+  RecordChunks(const char* records, int record_length) : memory_(records), record_length_(record_length) {}
+  RecordChunks(const std::string& path, int64_t offset, int64_t count, int record_length)
+      : path_(path),
+        in_(path, std::ios::binary),
+        offset_(offset),
+        count_(count),
+        record_length_(record_length) {
+    if (!in_) ThrowInputError(path, "the point records", "file", "cannot be opened");
+  }
+  const char* Record(int64_t i) {
+    if (memory_ != nullptr) return memory_ + i * record_length_;
+    if (i < first_ || i >= first_ + loaded_) Load(i);
+    return buffer_.data() + (i - first_) * record_length_;
+  }
+
+ private:
+  static constexpr int64_t kChunkRecords = 1 << 16;
+  void Load(int64_t i) {
+    first_ = i;
+    loaded_ = std::min(kChunkRecords, count_ - i);
+    buffer_.resize(static_cast<size_t>(loaded_ * record_length_));
+    in_.clear();
+    in_.seekg(static_cast<std::streamoff>(offset_ + i * record_length_));
+    if (!in_.read(buffer_.data(), static_cast<std::streamsize>(buffer_.size()))) {
+      // The header's count was checked against the file's size: the file changed while it was read.
+      ThrowInputError(path_, fmt::format("point {} (byte {})", i, offset_ + i * record_length_),
+                      "point record", "the file ended before its points did (it changed while it was read?)");
+    }
+  }
+  const char* memory_ = nullptr;
+  std::string path_;
+  std::ifstream in_;
+  int64_t offset_ = 0, count_ = 0;
+  int record_length_ = 0;
+  std::vector<char> buffer_;
+  int64_t first_ = 0, loaded_ = 0;
+};
+
+Scan ParsePoints(las::LasHeader header, RecordChunks& records, const std::string& file,
+                 std::vector<std::string>* warnings);
+
+}  // namespace
+
 Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std::string>* warnings) {
   las::LasHeader header = las::ParseHeader(bytes, file);
   if (header.count > 0) io_internal::CheckScanSize(1, header.count, file, "header: Number of Point Records");
-  const int64_t count = header.count;
-  const char* records = bytes.data() + header.offset_to_points;
   // LAZ: decoded into the records an uncompressed file would hold (error places are then point indices).
   std::string decoded;
   if (header.laz) {
-    decoded = laz::DecodeLazPoints(header.laszip_payload, bytes, header.offset_to_points, count,
+    decoded = laz::DecodeLazPoints(header.laszip_payload, bytes, header.offset_to_points, header.count,
                                    header.format, header.record_length, file);
-    records = decoded.data();
   }
+  RecordChunks records(header.laz ? decoded.data() : bytes.data() + header.offset_to_points,
+                       header.record_length);
+  return ParsePoints(std::move(header), records, file, warnings);
+}
+
+Scan ReadLas(const std::string& path, std::vector<std::string>* warnings) {
+  // A LAS file's points are read a chunk at a time (a LAZ file's are decoded from the whole file, as before):
+  // the header and its records first, the extended records from the tail, then the points in order.
+  const int64_t file_size = CheckRegularFile(path);
+  const std::string prefix = las::ReadHeaderPrefix(path, file_size);
+  las::LasHeader header = las::ParseHeader(prefix, path, file_size);
+  if (header.laz) return ParseLas(io_internal::ReadFileToString(path), path, warnings);
+  if (header.count > 0) io_internal::CheckScanSize(1, header.count, path, "header: Number of Point Records");
+  las::ReadExtendedRecordsFromFile(path, file_size, prefix, &header);
+  RecordChunks records(path, header.offset_to_points, header.count, header.record_length);
+  return ParsePoints(std::move(header), records, path, warnings);
+}
+
+namespace {
+
+Scan ParsePoints(las::LasHeader header, RecordChunks& records, const std::string& file,
+                 std::vector<std::string>* warnings) {
+  const int64_t count = header.count;
   const int format = header.format;
   const bool legacy = las::IsLegacyFormat(format);
   const bool rgb = las::HasRgb(format);
   const int extra_bytes = header.record_length - las::PointRecordSize(format);
-  auto record = [&](int64_t i) { return records + i * header.record_length; };
+  auto record = [&](int64_t i) { return records.Record(i); };
   auto coordinate = [&](const char* p, int axis) {
     return las::Load<int32_t>(p + las::point::kX + 4 * axis) * header.scale[axis] + header.offset[axis];
   };
@@ -248,8 +319,6 @@ Scan ParseLas(const std::string& bytes, const std::string& file, std::vector<std
   return scan;
 }
 
-Scan ReadLas(const std::string& path, std::vector<std::string>* warnings) {
-  return ParseLas(io_internal::ReadFileToString(path), path, warnings);
-}
+}  // namespace
 
 }  // namespace lidarshop

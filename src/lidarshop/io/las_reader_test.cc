@@ -279,6 +279,44 @@ TEST(LasTest, ExtendedRecordsAfterThePointsAreRead) {
   }
 }
 
+// A file read from disk is parsed a chunk of 65,536 records at a time (ReadLas), not held whole: the same scan
+// as parsing the whole file's bytes, over three chunks, with every attribute.
+TEST(LasTest, ReadingAChunkAtATimeEqualsParsingTheWholeFile) {
+  TempFolder folder;
+  const int n = 150'001;
+  Scan scan = MakeScan(1, n, /*with_color=*/true);
+  for (int i = 0; i < n; ++i) {
+    const cv::Vec3f p(0.001f * static_cast<float>(i % 1000), 0.01f * static_cast<float>(i / 1000),
+                      1.0f + 0.5f * static_cast<float>(i % 7));
+    scan.valid.at<uint8_t>(0, i) = kValid;
+    scan.point.at<cv::Vec3f>(0, i) = p;
+    scan.range.at<float>(0, i) = static_cast<float>(cv::norm(p));
+    scan.intensity.at<float>(0, i) = static_cast<float>(i % 251) / 250.0f;
+    scan.color.at<cv::Vec3b>(0, i) = cv::Vec3b(i % 256, (i / 256) % 256, 7);
+  }
+  const std::string path = folder.File("chunks.las");
+  WriteScanFile(path, {scan});
+  std::vector<std::string> streamed_warnings, whole_warnings;
+  const Scan streamed = ReadLas(path, &streamed_warnings);
+  const Scan whole = ParseLas(testing_io::ReadText(path), path, &whole_warnings);
+  EXPECT_EQ(streamed_warnings, whole_warnings);
+  ASSERT_EQ(streamed.cols, n);
+  EXPECT_EQ(cv::norm(streamed.point, whole.point, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(streamed.intensity, whole.intensity, cv::NORM_INF), 0.0);
+  EXPECT_EQ(cv::norm(streamed.color, whole.color, cv::NORM_INF), 0.0);
+  EXPECT_EQ(streamed.world_from_scanner, whole.world_from_scanner);
+  EXPECT_EQ(streamed.source_metadata, whole.source_metadata);
+  ASSERT_EQ(streamed.attributes.size(), whole.attributes.size());
+  for (const auto& [name, values] : whole.attributes)
+    EXPECT_EQ(cv::norm(streamed.attributes.at(name), values, cv::NORM_INF), 0.0) << name;
+  // The last chunk's last point, spelled out: the points are where they were written (to the file's step).
+  EXPECT_LT(cv::norm(streamed.point.at<cv::Vec3f>(0, n - 1) +
+                     cv::Vec3f(streamed.world_from_scanner(0, 3), streamed.world_from_scanner(1, 3),
+                               streamed.world_from_scanner(2, 3)) -
+                     scan.point.at<cv::Vec3f>(0, n - 1)),
+            1e-3);
+}
+
 TEST(LasTest, APointAtTheOriginIsAPoint) {
   TempFolder folder;
   HandLas las = ThreePoints(2, 0);
