@@ -16,6 +16,7 @@
 
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_format.h"
+#include "lidarshop/io/io_test_util.h"
 #include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
@@ -23,6 +24,7 @@ namespace lidarshop {
 namespace {
 
 using ::testing::HasSubstr;
+using testing_io::InputErrorOf;
 
 // A uniform grid with ~25 % no-return cells (each keeping its direction), intensity and colour.
 Scan ScanWithHoles(int rows, int cols, uint32_t seed) {
@@ -140,6 +142,24 @@ TEST(E57EmptyCells, AStoredGridOfTheWrongSizeOrNotFiniteIsRefused) {
     EXPECT_THAT(e.what(), HasSubstr("short.e57"));
     EXPECT_THAT(e.what(), HasSubstr("holds 10 angles for the scan's 11 columns"));
   }
+  std::vector<std::string> long_azimuths = AnglesAsText(scan.grid.azimuth_rad, 0.0);
+  long_azimuths.push_back("0.5");
+  EXPECT_THAT(InputErrorOf([&] {
+                ReadE57Bytes(
+                    WithEditedXml(
+                        bytes, [&](std::string xml) { return ReplaceAngles(xml, "azimuth", long_azimuths); }),
+                    "long.e57");
+              }),
+              HasSubstr("holds more than the scan's 11 columns"));
+  EXPECT_THAT(InputErrorOf([&] {
+                ReadE57Bytes(WithEditedXml(bytes,
+                                           [](std::string xml) {  // the element renamed
+                                             xml.replace(xml.find("<elevation "), 10, "<elevatio_");
+                                             return xml.replace(xml.find("</elevation>"), 12, "</elevatio_>");
+                                           }),
+                             "no_elevation.e57");
+              }),
+              HasSubstr("has no 'elevation'"));
   std::vector<std::string> infinite = AnglesAsText(scan.grid.elevation_rad, 0.0);
   infinite[3] = "inf";
   EXPECT_THROW(

@@ -118,15 +118,6 @@ StreamSource RecordStream(Field field, const Scan& scan, const uint8_t* behind_v
 // The E57 pose (unit quaternion with w >= 0, translation) of `transform` under `parent`.
 void AddPose(pugi::xml_node parent, const Eigen::Matrix4d& transform);
 
-// The scan's grid alone, for the rays it gives.
-Scan GridOnly(const Scan& scan) {
-  Scan grid_only;
-  grid_only.rows = scan.rows;
-  grid_only.cols = scan.cols;
-  grid_only.grid = scan.grid;
-  return grid_only;
-}
-
 // lidarshop's extension element `lidarshop:angularGrid` under a data3D entry (e57.h): the azimuth of every
 // columnIndex and the elevation of every rowIndex in lidarshop's scanner frame, radians, as Vectors of double
 // Floats written in their shortest exact form, and whether the grid was fitted to measured points.
@@ -219,7 +210,7 @@ bool AppendScan(const Scan& scan, const Scan* behind, int index, const E57WriteO
   const bool write_grid = options.write_no_return_directions && HasCompleteGrid(scan) && scan.num_cells() > 0;
   std::optional<RayDirections> rays, grid_rays;
   if (HasRayDirections(scan)) rays.emplace(scan);
-  if (write_grid) grid_rays.emplace(GridOnly(scan));
+  if (write_grid) grid_rays.emplace(scan.grid);
   const std::function<bool(int64_t)> has_direction = [&scan, &options, &rays, &grid_rays](int64_t c) {
     if (scan.valid.ptr<uint8_t>()[c] || !options.write_no_return_directions || !rays) return false;
     if (grid_rays && rays->from_grid()) return false;

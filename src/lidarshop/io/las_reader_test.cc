@@ -267,6 +267,14 @@ TEST(LasTest, ExtendedRecordsAfterThePointsAreRead) {
   EXPECT_THAT(cut.warnings,
               testing::Contains(AllOf(HasSubstr(path), HasSubstr("extended variable length record 0"),
                                       HasSubstr("does not fit"))));
+  // The first extended record said to start past the file's end: left out with a warning, nothing read.
+  std::string past_end = bytes + evlr + wkt;
+  Put<uint64_t>(&past_end, 235, past_end.size() + 100);
+  testing_io::WriteText(path, past_end);
+  const ScanFile beyond = ReadScanFile(path);
+  EXPECT_TRUE(beyond.scans.at(0).source_records.empty());
+  EXPECT_THAT(beyond.warnings, testing::Contains(AllOf(HasSubstr("extended variable length record 0"),
+                                                       HasSubstr("does not fit"))));
   // A record header that would start 1 to 59 bytes before the end (the las fuzzer's find: an unsigned
   // size - position - 60 wrapped around and let a length of 2^64 - 1 through) is left out too.
   for (const int short_by : {1, 30, 59}) {

@@ -144,11 +144,7 @@ GridResidual MeasureGridResidual(const Scan& scan, const ScanGrid& grid) {
     int64_t count = 0;
   };
   std::vector<RowSums> rows(scan.rows);
-  Scan grid_only;
-  grid_only.rows = scan.rows;
-  grid_only.cols = scan.cols;
-  grid_only.grid = grid;
-  const RayDirections grid_rays(grid_only);
+  const RayDirections grid_rays(grid);
   std::vector<double> sin_azimuth(scan.cols), cos_azimuth(scan.cols);
   for (int col = 0; col < scan.cols; ++col) {
     sin_azimuth[col] = std::sin(grid.azimuth_rad[col]);

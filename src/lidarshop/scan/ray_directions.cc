@@ -22,6 +22,21 @@ cv::Mat DirectionImage(const Scan& scan) {
   return DirectionsFromGrid(scan.grid);
 }
 
+RayDirections::RayDirections(const ScanGrid& grid) : cols_(static_cast<int>(grid.azimuth_rad.size())) {
+  sin_azimuth_.resize(grid.azimuth_rad.size());
+  cos_azimuth_.resize(grid.azimuth_rad.size());
+  for (size_t col = 0; col < grid.azimuth_rad.size(); ++col) {
+    sin_azimuth_[col] = std::sin(grid.azimuth_rad[col]);
+    cos_azimuth_[col] = std::cos(grid.azimuth_rad[col]);
+  }
+  cos_elevation_.resize(grid.elevation_rad.size());
+  sin_elevation_.resize(grid.elevation_rad.size());
+  for (size_t row = 0; row < grid.elevation_rad.size(); ++row) {
+    cos_elevation_[row] = std::cos(grid.elevation_rad[row]);
+    sin_elevation_[row] = static_cast<float>(std::sin(grid.elevation_rad[row]));
+  }
+}
+
 RayDirections::RayDirections(const Scan& scan) : cols_(scan.cols) {
   if (!scan.direction.empty()) {
     image_ = scan.direction;
@@ -29,28 +44,13 @@ RayDirections::RayDirections(const Scan& scan) : cols_(scan.cols) {
   }
   if (!HasCompleteGrid(scan))
     throw std::logic_error("RayDirections: the scan holds no directions and no grid");
-  sin_azimuth_.resize(scan.cols);
-  cos_azimuth_.resize(scan.cols);
-  for (int col = 0; col < scan.cols; ++col) {
-    sin_azimuth_[col] = std::sin(scan.grid.azimuth_rad[col]);
-    cos_azimuth_[col] = std::cos(scan.grid.azimuth_rad[col]);
-  }
-  cos_elevation_.resize(scan.rows);
-  sin_elevation_.resize(scan.rows);
-  for (int row = 0; row < scan.rows; ++row) {
-    cos_elevation_[row] = std::cos(scan.grid.elevation_rad[row]);
-    sin_elevation_[row] = static_cast<float>(std::sin(scan.grid.elevation_rad[row]));
-  }
+  *this = RayDirections(scan.grid);
 }
 
 bool ReleaseGridDirections(Scan* scan) {
   if (scan->direction.empty()) return HasCompleteGrid(*scan);
   if (!HasCompleteGrid(*scan)) return false;
-  Scan grid_only;
-  grid_only.rows = scan->rows;
-  grid_only.cols = scan->cols;
-  grid_only.grid = scan->grid;
-  const RayDirections from_grid(grid_only);
+  const RayDirections from_grid(scan->grid);
   std::atomic<bool> same{true};
   ParallelFor(scan->rows, [&](int64_t r) {
     if (!same.load(std::memory_order_relaxed)) return;

@@ -34,6 +34,8 @@ class RayDirections {
   // Throws std::logic_error when the scan knows no rays (HasRayDirections false). Keeps a view of
   // `scan.direction` when held; the scan's grid is copied into tables.
   explicit RayDirections(const Scan& scan);
+  // The rays of `grid` alone (its azimuths are the columns, its elevations the rows).
+  explicit RayDirections(const ScanGrid& grid);
   cv::Vec3f operator()(int row, int col) const {
     if (!image_.empty()) return image_.at<cv::Vec3f>(row, col);
     return cv::Vec3f(static_cast<float>(cos_elevation_[row] * sin_azimuth_[col]),
