@@ -11,6 +11,7 @@
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
@@ -124,7 +125,11 @@ void FinishScan(Scan* scan, bool fit_grid) {
       }
     }
   }
-  if (fit_grid) FitGrid(scan);
+  if (fit_grid) {
+    FitGrid(scan);
+    // FitGrid gave every cell its grid ray: the image holds nothing the grid does not (ray_directions.h).
+    if (HasCompleteGrid(*scan)) scan->direction.release();
+  }
 }
 
 Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {

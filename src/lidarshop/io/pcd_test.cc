@@ -12,6 +12,7 @@
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/io/scan_write_plan.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -136,7 +137,7 @@ Scan PosedScan(const Eigen::Vector3d& offset) {
       const float range = 5.0f + 0.3f * c + 0.1f * r;
       scan.valid.at<uint8_t>(r, c) = kValid;
       scan.range.at<float>(r, c) = range;
-      scan.point.at<cv::Vec3f>(r, c) = scan.direction.at<cv::Vec3f>(r, c) * range;
+      scan.point.at<cv::Vec3f>(r, c) = DirectionImage(scan).at<cv::Vec3f>(r, c) * range;
       scan.normal.at<cv::Vec3f>(r, c) = cv::Vec3f(0, -1, 0);
       scan.color.at<cv::Vec3b>(r, c) = cv::Vec3b(10 * r, 20 * c, 7);
     }
@@ -183,7 +184,7 @@ TEST(PcdTest, WritesWorldCoordinatesAndReadsTheScanBack) {
   EXPECT_LT(cv::norm(back.point, scan.point, cv::NORM_INF), 1e-5);
   EXPECT_LT(cv::norm(back.normal, scan.normal, cv::NORM_INF), 1e-6);
   EXPECT_EQ(cv::norm(back.color, scan.color, cv::NORM_INF), 0.0);
-  EXPECT_LT(cv::norm(back.direction, scan.direction, cv::NORM_INF), 1e-5);
+  EXPECT_LT(cv::norm(DirectionImage(back), DirectionImage(scan), cv::NORM_INF), 1e-5);
 
   // The coordinates in the file are the world's: read without the comments (as Open3D does, ignoring
   // VIEWPOINT) the world points are the scan's.

@@ -10,6 +10,7 @@
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -123,7 +124,7 @@ Scan SmallScan(double azimuth_offset) {
   for (int row = 0; row < 4; ++row) {
     for (int col = 0; col < 5; ++col) {
       if ((row + col) % 3 == 0) continue;  // no return
-      const cv::Vec3f d = scan.direction.at<cv::Vec3f>(row, col);
+      const cv::Vec3f d = DirectionImage(scan).at<cv::Vec3f>(row, col);
       const float range = 2.0f + row + 0.5f * col;
       scan.valid.at<uint8_t>(row, col) = kValid;
       scan.point.at<cv::Vec3f>(row, col) = d * range;
@@ -173,7 +174,7 @@ TEST(PlyTest, ScansKeepTheirGridPoseAndChannels) {
       }
     }
     // The fitted grid gives every cell, also the empty ones, its direction back.
-    EXPECT_LT(cv::norm(back.direction, scans[k].direction, cv::NORM_INF), 1e-5);
+    EXPECT_LT(cv::norm(DirectionImage(back), scans[k].direction, cv::NORM_INF), 1e-5);
   }
 }
 

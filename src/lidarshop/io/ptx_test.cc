@@ -6,6 +6,7 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -50,7 +51,7 @@ TEST(PtxTest, ReadsLayoutOrientationAndPose) {
   EXPECT_TRUE(scan.world_from_scanner.isApprox(expected)) << scan.world_from_scanner;
   // Every cell has a direction, also the one without a return, pointing up-left.
   ASSERT_TRUE(scan.grid.fitted);
-  const cv::Vec3f up_left = scan.direction.at<cv::Vec3f>(0, 0);
+  const cv::Vec3f up_left = DirectionImage(scan).at<cv::Vec3f>(0, 0);
   EXPECT_LT(up_left[0], 0);
   EXPECT_GT(up_left[2], 0);
   EXPECT_NEAR(cv::norm(up_left), 1.0, 1e-6);

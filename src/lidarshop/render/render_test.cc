@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
@@ -80,7 +81,7 @@ TEST(RenderTest, ValidLabelsNormalsAndMissingChannels) {
   // -direction, i.e. (n + 1) / 2 < 0.5 in y.
   options.channel = RenderChannel::kNormals;
   scan.valid.setTo(kValid);
-  scan.point = scan.direction * 3.0;
+  scan.point = DirectionImage(scan) * 3.0;
   const cv::Mat normals = EstimateGridNormals(scan);
   const cv::Vec3f n = normals.at<cv::Vec3f>(2, 1);
   EXPECT_LT(n[1], -0.95f);
