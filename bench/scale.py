@@ -7,6 +7,11 @@ Sizes are in millions of rays (a square grid: 4 = 2000 x 2000). For each size th
 E57 and then runs, each as its own process under /usr/bin/time (wall seconds and peak resident memory):
 `info --stats`, `render`, `segment` (two strokes made from the scanner's labels on the hatchback), `fill` (the same
 200 x 200-cell hole at every size, centred on the hatchback), `remove` (the same strokes) and `convert` to LAS.
+Then the editor (`--editor`, the default when web/dist is built and node and chromium are there): web/e2e/station.mjs
+serves the station and opens it in Debian's chromium, and the table gives how long `serve` took to read it, the
+first picture after page open and its bytes, the bytes of the whole opening (pictures and 3-D points up to the
+refined level), the server's peak memory at the first picture, the first stroke -> cut -> picture and the first
+picture after opening the station again in the running server.
 The last table gives each command's cost exponent k (time ~ rays^k, a least-squares fit of log time on log rays
 over the sizes run). The machine's CPU and load are printed with the results: read the times of one run as
 ratios. A command that fails (the memory budget refusing it) is reported in the table with its message. Needs
@@ -94,7 +99,31 @@ def strokes_and_hole(labels_png, strokes_json, hole_png):
     lidarshop.write_image(str(hole_png), hole)
 
 
-def run_size(millions, work):
+def editor_missing():
+    """Why the editor cannot be measured here, or None."""
+    if not (REPO / "web" / "dist" / "index.html").exists():
+        return "web/dist not built (cd web && npm ci && npm run build)"
+    if not (REPO / "web" / "node_modules" / "playwright-core").exists():
+        return "web/node_modules missing (cd web && npm ci)"
+    if not pathlib.Path(os.environ.get("CHROMIUM", "/usr/bin/chromium")).exists():
+        return "no chromium (apt-get install chromium)"
+    return None
+
+
+def run_editor(scan, folder):
+    """web/e2e/station.mjs on the station: its JSON line (the numbers it measured), or {"failed": reason}."""
+    log = folder / "editor.log"
+    command = ["node", "e2e/station.mjs", str(CLI), str(folder / "editor"), "--station", str(scan)]
+    with open(log, "w") as out:
+        result = subprocess.run(command, cwd=REPO / "web", stdout=out, stderr=subprocess.STDOUT)
+    lines = [line for line in log.read_text().splitlines() if line.startswith("e2e station: {")]
+    if result.returncode != 0 or not lines:
+        last = (log.read_text().strip().splitlines() or [""])[-1]
+        return {"failed": f"exit {result.returncode}: {last[:160]}"}
+    return json.loads(lines[-1][len("e2e station: "):])
+
+
+def run_size(millions, work, editor):
     side = int(round(math.sqrt(millions * 1e6)))
     folder = work / f"{millions}M"
     folder.mkdir(parents=True, exist_ok=True)
@@ -117,6 +146,8 @@ def run_size(millions, work):
     row["remove"] = timed(["remove", scan, "--strokes", strokes, "-o", folder / "removed.e57", "--json",
                            folder / "remove.json", "-q"] + budget, folder / "remove.log")
     row["convert to LAS"] = timed(["convert", scan, folder / "scan.las", "-q"] + budget, folder / "convert.log")
+    if editor:
+        row["editor"] = run_editor(scan, folder)
     for name in ("filled.e57", "removed.e57", "scan.las"):
         (folder / name).unlink(missing_ok=True)
     return row
@@ -155,7 +186,36 @@ def markdown(rows, load_before, load_after):
     lines += ["", "Cost exponent k (time ∝ rays^k, fitted over the sizes above):", "",
               "| " + " | ".join(COMMANDS) + " |", "|---" * len(COMMANDS) + "|",
               "| " + " | ".join(f"{fit_exponent(rows, c):.2f}" for c in COMMANDS) + " |"]
+    if any("editor" in r for r in rows):
+        lines += editor_markdown(rows)
     return "\n".join(lines) + "\n"
+
+
+def seconds(value):
+    return "–" if value is None else f"{value:.2f} s"
+
+
+def editor_markdown(rows):
+    lines = ["", "The editor (web/e2e/station.mjs: `serve STATION`, the page opened in chromium):", "",
+             "| rays | serve reads | first picture | its bytes | opening's bytes (refined points) | points held "
+             "/ budget | serve's peak at the first picture | stroke -> cut -> picture | opened again: read, "
+             "first picture |", "|---" * 9 + "|"]
+    for r in rows:
+        e = r.get("editor")
+        if e is None:
+            continue
+        if "failed" in e:
+            lines.append(f"| {r['rays'] / 1e6:.0f} M | failed: {e['failed']} |" + " |" * 7)
+            continue
+        cut = next((x for x in e.get("edits", []) if "first cut" in x.get("what", "")), {})
+        peak = e.get("first_picture_serve_peak_kib")
+        lines.append(
+            f"| {r['rays'] / 1e6:.0f} M | {e['serve_read_s']:.2f} s | {e['first_picture_s']:.2f} s | "
+            f"{e['first_picture_bytes']:,} B | {e['open_bytes']:,} B | {e['points_held']:,} / {e['point_budget']:,} | "
+            + (f"{peak / 1024:.0f} MB ({peak * 1024 / r['rays']:.0f} bytes a ray)" if peak else "–")
+            + f" | {seconds(cut.get('picture_s'))} | {e['reopen_read_s']:.2f} s, "
+            f"{e['reopen_first_picture_s']:.2f} s |")
+    return lines
 
 
 def main():
@@ -164,18 +224,26 @@ def main():
     parser.add_argument("--sizes", default="1,4,16", help="millions of rays, comma-separated (default 1,4,16)")
     parser.add_argument("--work", default="/tmp/lidarshop_scale", help="working folder (large files)")
     parser.add_argument("--markdown", help="also write the tables to this file")
+    parser.add_argument("--editor", choices=["auto", "yes", "no"], default="auto",
+                        help="measure the editor with web/e2e/station.mjs (auto: when it can run here)")
     parser.add_argument("--binary", default=str(CLI),
                         help="the lidarshop executable to measure (default build/release/lidarshop)")
     args = parser.parse_args()
     CLI = pathlib.Path(args.binary)
     if not CLI.exists():
         sys.exit(f"{CLI} not found: build it first (bash scripts/build.sh)")
+    missing = editor_missing()
+    if args.editor == "yes" and missing:
+        sys.exit(f"scale: the editor cannot be measured: {missing}")
+    editor = args.editor == "yes" or (args.editor == "auto" and missing is None)
+    if not editor:
+        print(f"scale: the editor is not measured ({missing or '--editor no'})", file=sys.stderr)
     work = pathlib.Path(args.work)
     load_before = os.getloadavg()[0]
     rows = []
     for size in args.sizes.split(","):
         started = time.time()
-        rows.append(run_size(int(size), work))
+        rows.append(run_size(int(size), work, editor))
         print(f"scale: {size} M rays done in {time.time() - started:.0f} s", file=sys.stderr)
     text = markdown(rows, load_before, os.getloadavg()[0])
     print(text)

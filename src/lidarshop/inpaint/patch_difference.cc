@@ -232,7 +232,7 @@ class WeightedSsdTarget : public TargetDifference {
 SsdKernel BestSsdKernel() {
   static const SsdKernel best = [] {
     if (BestSimdPath() != SimdPath::kAvx2) return SsdKernel::kBaseline;
-    return __builtin_cpu_supports("avx512f") ? SsdKernel::kAvx512 : SsdKernel::kAvx2;
+    return CpuMayUse("avx512f") ? SsdKernel::kAvx512 : SsdKernel::kAvx2;
   }();
   return best;
 }

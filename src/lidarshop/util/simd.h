@@ -18,8 +18,16 @@ enum class SimdPath { kScalar, kAvx2 };
 template <>
 const EnumInfo& EnumInfoOf<SimdPath>();
 
-// kAvx2 when the CPU has it (checked once; safe during static initialization).
+// kAvx2 when the CPU has it and LIDARSHOP_SIMD allows it (checked once; safe during static initialization).
 SimdPath BestSimdPath();
+
+// Whether the CPU has `feature` ("avx2" or "avx512f") and `cap` allows it. `cap` is the value of the
+// environment variable LIDARSHOP_SIMD: "baseline", "avx2" or "avx512"; null or empty: no cap. Every path gives
+// bit-identical results, so the cap changes only the speed: it measures on an AVX-512 machine what an AVX2-only
+// CPU takes. Throws std::invalid_argument for another value; BestSimdPath() then exits with the message.
+bool CpuMayUse(const char* feature, const char* cap);
+// CpuMayUse(feature, getenv("LIDARSHOP_SIMD")), read once.
+bool CpuMayUse(const char* feature);
 
 // Every lanes function is inlined, so no vector crosses a call: GCC's note on the AVX
 // calling convention does not apply.
