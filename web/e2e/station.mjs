@@ -362,14 +362,31 @@ try {
     await page.click(`#brush-${brush}`);
     await edit(what, () => drag([at(...from), at(...to)]), afterJob(await jobsFinished()));
   };
+  // Where a cut's time went: its requests (start-end, ms after page open). The browser keeps 250 resource
+  // timings by default: the buffer is cleared before each measured part.
+  const requestsSince = (since) =>
+    page.evaluate(
+      (t) =>
+        performance
+          .getEntriesByType('resource')
+          .filter((e) => e.name.includes('/api/') && e.startTime >= t)
+          .map(
+            (e) =>
+              `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+          ),
+      since,
+    );
+  const clearRequests = () =>
+    page.evaluate(() => {
+      performance.clearResourceTimings();
+      return performance.now();
+    });
+  const cutStart = await clearRequests();
   await cutStroke('background stroke -> first cut', 'background', [0.647, 0.402], [0.647, 0.592]);
+  result.first_cut_requests = await requestsSince(cutStart);
   const cut = await page.evaluate(() => window.lidarshop.current());
   if (!(cut.object_cells > 0)) fail('the live cut took no cell');
-  // (The browser keeps 250 resource timings by default: the buffer is full by now.)
-  const refineStart = await page.evaluate(() => {
-    performance.clearResourceTimings();
-    return performance.now();
-  });
+  const refineStart = await clearRequests();
   // Two refinements: an object stroke inside the cut (nothing changes), a background stroke across the car's
   // left end (the cut gives those cells up).
   await cutStroke('object stroke -> refined cut', 'object', [0.6, 0.47], [0.6, 0.53]);
@@ -379,18 +396,7 @@ try {
   if (!(refined.object_cells < cut.object_cells && refined.object_cells > cut.object_cells / 2))
     fail(`the background stroke took the cut from ${cut.object_cells} to ${refined.object_cells} cells`);
   result.cut_timings = segmentTimings;
-  // Where the refinement's time went: its requests (start-end, ms after page open).
-  result.refine_requests = await page.evaluate(
-    (since) =>
-      performance
-        .getEntriesByType('resource')
-        .filter((e) => e.name.includes('/api/') && e.startTime >= since)
-        .map(
-          (e) =>
-            `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
-        ),
-    refineStart,
-  );
+  result.refine_requests = await requestsSince(refineStart);
   await page.screenshot({ path: join(artefacts, 'station_cut.png') });
 
   // The station opened again in the running server: the time its read takes, then to its first picture.

@@ -41,6 +41,9 @@ TEST(PcdTest, ReadsTheSharedBinaryCompressedCloudAsAScan) {
   EXPECT_GT(scan.grid.elevation_rad.front(), scan.grid.elevation_rad.back());
   EXPECT_LT(scan.grid.azimuth_rad.front(), scan.grid.azimuth_rad.back());
   EXPECT_LT(scan.grid.rms_residual_rad, 0.01);
+  // Its rays are the fitted grid's: none held as an image (ray_directions.h).
+  EXPECT_TRUE(HasCompleteGrid(scan));
+  EXPECT_TRUE(scan.direction.empty());
   cv::Scalar mean_point = cv::mean(scan.point, scan.valid);
   EXPECT_GT(mean_point[1], 0.3);
 }

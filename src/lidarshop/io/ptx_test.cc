@@ -51,6 +51,9 @@ TEST(PtxTest, ReadsLayoutOrientationAndPose) {
   EXPECT_TRUE(scan.world_from_scanner.isApprox(expected)) << scan.world_from_scanner;
   // Every cell has a direction, also the one without a return, pointing up-left.
   ASSERT_TRUE(scan.grid.fitted);
+  // The fitted grid gives every ray: the read keeps no image of them (ray_directions.h).
+  EXPECT_TRUE(HasCompleteGrid(scan));
+  EXPECT_TRUE(scan.direction.empty());
   const cv::Vec3f up_left = DirectionImage(scan).at<cv::Vec3f>(0, 0);
   EXPECT_LT(up_left[0], 0);
   EXPECT_GT(up_left[2], 0);
