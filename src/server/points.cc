@@ -2,7 +2,10 @@
 // (LSP1), or only the cells that changed since a version the client holds (LSD1), so that an edit moves the
 // cells it changed and not the whole scan again.
 #include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
+#include <utility>
 
 #include "http.h"
 
@@ -98,16 +101,49 @@ std::string Encode(const uint32_t (&header)[N], const std::vector<uint32_t>& key
   return bytes;
 }
 
+// The rows or columns of the level `step` inside [first, first + count): the multiples of `step` there.
+struct Lattice {
+  int begin, end, step;
+};
+Lattice LatticeIn(int first, int count, int step) {
+  return {(first + step - 1) / step * step, first + count, step};
+}
+
+// The box's rows and columns of the level (the whole grid without a box).
+std::pair<Lattice, Lattice> LevelCells(const Scan& scan, int step, const std::optional<CellBox>& box) {
+  const CellBox b = box.value_or(CellBox{0, 0, scan.cols, scan.rows});
+  return {LatticeIn(b.row, std::min(b.height, scan.rows - b.row), step),
+          LatticeIn(b.col, std::min(b.width, scan.cols - b.col), step)};
+}
+
 }  // namespace
 
-std::string PointsBinary(const Document& document, int step) {
+std::optional<CellBox> ReadCellBox(const std::string& text, int rows, int cols) {
+  int64_t v[4];
+  const char* at = text.c_str();
+  for (int i = 0; i < 4; ++i) {
+    if (*at < '0' || *at > '9') return std::nullopt;  // no sign, no space
+    char* end = nullptr;
+    v[i] = std::strtoll(at, &end, 10);
+    if (v[i] > INT32_MAX || *end != (i < 3 ? ',' : '\0')) return std::nullopt;
+    at = end + 1;
+  }
+  const int64_t col = v[0], row = v[1], end_col = std::min<int64_t>(col + v[2], cols),
+                end_row = std::min<int64_t>(row + v[3], rows);
+  if (v[2] < 1 || v[3] < 1 || col >= end_col || row >= end_row) return std::nullopt;
+  return CellBox{static_cast<int>(col), static_cast<int>(row), static_cast<int>(end_col - col),
+                 static_cast<int>(end_row - row)};
+}
+
+std::string PointsBinary(const Document& document, int step, const std::optional<CellBox>& box) {
   std::vector<uint32_t> cells;
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
     const Scan& scan = behind ? document.now.behind : document.now.scan;
     if (scan.valid.empty()) continue;
-    for (int r = 0; r < scan.rows; r += step) {
-      for (int c = 0; c < scan.cols; c += step) {
+    const auto [rows, cols] = LevelCells(scan, step, box);
+    for (int r = rows.begin; r < rows.end; r += step) {
+      for (int c = cols.begin; c < cols.end; c += step) {
         PointRecord record = RecordAt(document.now, behind, r, c);
         if (!record.present) continue;
         records.push_back(record);
@@ -137,7 +173,8 @@ void RememberState(Document& document) {
   document.counted_bytes = DocumentBytes(document);
 }
 
-std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step) {
+std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step,
+                                             const std::optional<CellBox>& box) {
   const Snapshot* old = nullptr;
   for (const auto& state : document.recent) {
     if (state.first_version <= since && since <= state.last_version) old = &state.points;
@@ -150,10 +187,11 @@ std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t s
   }
   std::vector<uint32_t> keys;
   std::vector<PointRecord> records;
+  const auto [level_rows, level_cols] = LevelCells(now.scan, step, box);
   for (const bool behind : {false, true}) {
     if (SameBuffers(*old, now, behind)) continue;
-    for (int r = 0; r < rows; r += step) {
-      for (int c = 0; c < cols; c += step) {
+    for (int r = level_rows.begin; r < level_rows.end; r += step) {
+      for (int c = level_cols.begin; c < level_cols.end; c += step) {
         PointRecord record = RecordAt(now, behind, r, c);
         if (record == RecordAt(*old, behind, r, c)) continue;
         keys.push_back(static_cast<uint32_t>(r * cols + c) | (behind ? kBehindKey : 0));

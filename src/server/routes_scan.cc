@@ -655,34 +655,40 @@ void AddScanRoutes(State& state) {
     overlay.setTo(hole ? cv::Scalar(255, 120, 40, 150) : cv::Scalar(0, 140, 255, 150), mask(box));
     SendOverlay(response, overlay, crop ? &box : nullptr, mask.size());
   });
-  http.Get(R"(/api/docs/(\d+)/points)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             // ?since=V: only the cells that changed since the client's version V (LSD1), when that state is
-             // still kept; else (or without it) the whole points (LSP1). The client tells them by the magic.
-             int64_t since = -1;
-             if (!ReadSinceParam(request, response, &since)) return;
-             // ?step=K: the level of detail K (every K-th row and column), for a large scan's first view.
-             int step = 1;
-             if (request.has_param("step")) {
-               const std::string text = request.get_param_value("step");
-               char* end = nullptr;
-               const long value = std::strtol(text.c_str(), &end, 10);
-               if (text.empty() || *end != '\0' || value < 1 || value > 64)
-                 return SendError(response, 400, "step: expected a whole number in [1, 64]");
-               step = static_cast<int>(value);
-             }
-             std::lock_guard lock(document->mutex);
-             response.set_header("X-Lidarshop-Version", std::to_string(document->version));
-             response.set_header("X-Lidarshop-Step", std::to_string(step));
-             if (since >= 0) {
-               if (auto delta = PointsDeltaBinary(*document, since, step)) {
-                 return response.set_content(std::move(*delta), "application/octet-stream");
-               }
-             }
-             response.set_content(PointsBinary(*document, step), "application/octet-stream");
-           });
+  http.Get(R"(/api/docs/(\d+)/points)", [&state](const httplib::Request& request,
+                                                 httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    // ?since=V: only the cells that changed since the client's version V (LSD1), when that state is
+    // still kept; else (or without it) the whole points (LSP1). The client tells them by the magic.
+    int64_t since = -1;
+    if (!ReadSinceParam(request, response, &since)) return;
+    // ?step=K: the level of detail K (every K-th row and column), for a large scan's first view.
+    int64_t step = 1;
+    if (!ReadWholeNumberParam(request, response, "step", 1, 64, "a whole number in [1, 64]", &step)) return;
+    std::lock_guard lock(document->mutex);
+    // ?box=COL,ROW,WIDTH,HEIGHT: only the cells inside it (clipped to the grid; header X-Lidarshop-Box).
+    std::optional<CellBox> box;
+    if (request.has_param("box")) {
+      box = ReadCellBox(request.get_param_value("box"), document->now.scan.rows, document->now.scan.cols);
+      if (!box) {
+        return SendError(response, 400,
+                         fmt::format("box: expected COL,ROW,WIDTH,HEIGHT (whole numbers, width and "
+                                     "height >= 1) overlapping the scan's {} x {} cells",
+                                     document->now.scan.cols, document->now.scan.rows));
+      }
+      response.set_header("X-Lidarshop-Box",
+                          fmt::format("{},{},{},{}", box->col, box->row, box->width, box->height));
+    }
+    response.set_header("X-Lidarshop-Version", std::to_string(document->version));
+    response.set_header("X-Lidarshop-Step", std::to_string(step));
+    if (since >= 0) {
+      if (auto delta = PointsDeltaBinary(*document, since, static_cast<int>(step), box)) {
+        return response.set_content(std::move(*delta), "application/octet-stream");
+      }
+    }
+    response.set_content(PointsBinary(*document, static_cast<int>(step), box), "application/octet-stream");
+  });
   // The object labels of a synthetic scan: cells, bounding box and centre per label (the object list).
   http.Get(R"(/api/docs/(\d+)/labels)",
            [&state](const httplib::Request& request, httplib::Response& response) {

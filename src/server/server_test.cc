@@ -464,6 +464,80 @@ TEST_F(ServerTest, PointDeltasPatchToTheWholePoints) {
   EXPECT_EQ(get("/api/docs/{}/image.png?channel=range&since=-1")->status, 400);
 }
 
+// A level of detail (every step-th row and column) and a box of cells (a part of the scan seen closer): the
+// whole points' cells that the level and the box hold, whole and as a delta; a malformed or outside box is
+// refused.
+TEST_F(ServerTest, PointsOfALevelAndABox) {
+  const int id = OpenBox();
+  const auto get = [&](const std::string& path) {
+    return client_->Get(Api(fmt::format(fmt::runtime(path), id)));
+  };
+  const int rows = scan_->rows, cols = scan_->cols;
+  const auto kept = [&](const PointMap& all, int step, const cv::Rect& box) {
+    PointMap inside;
+    for (const auto& [key, bytes] : all) {
+      const int cell = static_cast<int>(key & 0x7fffffffu), r = cell / cols, c = cell % cols;
+      if (r % step == 0 && c % step == 0 && box.contains(cv::Point(c, r))) inside[key] = bytes;
+    }
+    return inside;
+  };
+  PointMap whole;
+  ApplyPoints(get("/api/docs/{}/points")->body, whole);
+  PointMap level;
+  const auto level_answer = get("/api/docs/{}/points?step=3");
+  EXPECT_EQ(level_answer->get_header_value("X-Lidarshop-Step"), "3");
+  EXPECT_FALSE(level_answer->has_header("X-Lidarshop-Box"));
+  ApplyPoints(level_answer->body, level);
+  EXPECT_TRUE(level == kept(whole, 3, cv::Rect(0, 0, cols, rows)));
+  EXPECT_GT(level.size(), whole.size() / 12);
+  EXPECT_LT(level.size(), whole.size() / 6);
+  // The box around the object (label 1), from an odd row and column: the level's first cells are inside it.
+  const cv::Rect object = cv::boundingRect((scan_->label == 1) & (scan_->valid != 0));
+  const cv::Rect box(object.x | 1, object.y | 1, object.width + 2, object.height + 2);
+  const std::string box_param = fmt::format("box={},{},{},{}", box.x, box.y, box.width, box.height);
+  for (const int step : {1, 2}) {
+    const auto answer = get(fmt::format("/api/docs/{{}}/points?step={}&{}", step, box_param));
+    ASSERT_EQ(answer->status, 200) << answer->body;
+    EXPECT_EQ(answer->get_header_value("X-Lidarshop-Box"),
+              fmt::format("{},{},{},{}", box.x, box.y, box.width, box.height));
+    PointMap boxed;
+    ApplyPoints(answer->body, boxed);
+    EXPECT_TRUE(boxed == kept(whole, step, box)) << "step " << step;
+    EXPECT_FALSE(boxed.empty());
+  }
+  // A box past the grid's end is clipped to it.
+  const auto clipped = get(fmt::format("/api/docs/{{}}/points?box={},{},100,100", cols - 10, rows - 5));
+  ASSERT_EQ(clipped->status, 200);
+  EXPECT_EQ(clipped->get_header_value("X-Lidarshop-Box"), fmt::format("{},{},10,5", cols - 10, rows - 5));
+  // The box's delta after a cut: the box of the whole points after it.
+  PointMap client;
+  ApplyPoints(get("/api/docs/{}/points?step=2&" + box_param)->body, client);
+  const int64_t before = Json(get("/api/docs/{}"))["version"].get<int64_t>();
+  ASSERT_EQ(
+      client_->Post(Api(fmt::format("/api/docs/{}/strokes", id)), StrokesBody(), "application/json")->status,
+      200);
+  ASSERT_EQ(Wait(Json(client_->Post(Api(fmt::format("/api/docs/{}/segment", id)), "{}",
+                                    "application/json")))["state"],
+            "done");
+  const auto delta = get(fmt::format("/api/docs/{{}}/points?step=2&{}&since={}", box_param, before));
+  ASSERT_EQ(delta->body.substr(0, 4), "LSD1");
+  const PointMap held = client;
+  ApplyPoints(delta->body, client);
+  PointMap after;
+  ApplyPoints(get("/api/docs/{}/points")->body, after);
+  EXPECT_TRUE(client == kept(after, 2, box));
+  EXPECT_FALSE(client == held);  // the cut flagged the object's points
+  for (const char* bad :
+       {"1,2,3", "1,2,3,0", "-1,0,5,5", "0,0,5,5,", "a,b,c,d", " 1,2,3,4", "1,2,3,4x", "99999999999,0,5,5"}) {
+    EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?box={}", bad))->status, 400) << bad;
+  }
+  EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?box={},0,5,5", cols))->status, 400);  // outside
+  EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?box=0,{},5,5", rows))->status, 400);
+  for (const char* bad : {"0", "65", "2x", ""}) {
+    EXPECT_EQ(get(fmt::format("/api/docs/{{}}/points?step={}", bad))->status, 400) << "step " << bad;
+  }
+}
+
 // A scan opened from E57 and edited keeps its photo, scan guid and the file's other metadata when saved as
 // E57; the save plan of another format says the photo is lost; the recolour tool can take the photo.
 TEST_F(ServerTest, E57PhotoAndGuidSurviveAnEditAndASave) {
