@@ -176,11 +176,7 @@ try {
   await waitForFunction(
     page,
     () =>
-      window.lidarshop.pointLevel() ===
-      Math.max(
-        1,
-        Math.ceil(Math.sqrt(window.lidarshop.current().valid_cells / window.lidarshop.pointBudget)),
-      ),
+      window.lidarshop.pointLevel() === window.lidarshop.refinedLevel(window.lidarshop.current().valid_cells),
     null,
     { timeout: 240000 },
   );
@@ -192,6 +188,38 @@ try {
   result.point_budget = await page.evaluate(() => window.lidarshop.pointBudget);
   if (result.points_held > result.point_budget)
     fail(`the browser holds ${result.points_held} points (budget ${result.point_budget})`);
+  // The 3-D view refined where the camera looks: a zoom with the wheel over the view, and when it ends the box
+  // of cells around the point on the view's axis comes at full resolution beside the coarse level.
+  if (result.refined_level > 1) {
+    const view3d = await page.locator('#points canvas').boundingBox();
+    const zoomed = Date.now();
+    await page.mouse.move(view3d.x + view3d.width / 2, view3d.y + view3d.height / 2);
+    await page.mouse.wheel(0, -600);
+    await waitForFunction(page, () => window.lidarshop.detail() !== null, null, { timeout: 120000 });
+    await page.evaluate(() => window.lidarshop.settled());
+    result.detail_s = (Date.now() - zoomed) / 1000;
+    result.detail = await page.evaluate(() => window.lidarshop.detail());
+    result.points_held_with_detail = await page.evaluate(() => window.lidarshop.pointsHeld());
+    if (result.points_held_with_detail > result.point_budget)
+      fail(`with the detail the browser holds ${result.points_held_with_detail} points`);
+    // Full resolution in the box: cells off the coarse level's rows, and no cell outside the box.
+    const check = await page.evaluate((level) => {
+      const points = window.lidarshop.detailPoints();
+      const { box } = window.lidarshop.detail();
+      let offLevel = 0,
+        outside = 0;
+      for (let i = 0; i < points.count; ++i) {
+        const r = Math.floor(points.cells[i] / points.cols),
+          c = points.cells[i] % points.cols;
+        if (r % level !== 0 || c % level !== 0) ++offLevel;
+        if (r < box.row || r >= box.row + box.height || c < box.col || c >= box.col + box.width) ++outside;
+      }
+      return { offLevel, outside };
+    }, result.refined_level);
+    if (check.outside > 0 || check.offLevel < result.detail.count / 2)
+      fail(`the detail's points: ${JSON.stringify(check)} of ${result.detail.count}`);
+    await page.screenshot({ path: join(artefacts, 'station_detail.png') });
+  }
   console.log(`e2e station: opened: ${JSON.stringify(result)}`);
   // A station over the point budget comes coarse first (a smaller one, e.g. bench/scale.py's 1 M row, may not).
   if (result.first_level < 2 && doc.valid_cells > result.point_budget)
@@ -386,6 +414,13 @@ try {
   result.first_cut_requests = await requestsSince(cutStart);
   const cut = await page.evaluate(() => window.lidarshop.current());
   if (!(cut.object_cells > 0)) fail('the live cut took no cell');
+  if (result.detail) {
+    // The detail box follows the edits (its deltas, points?box=...&since=V).
+    await page.evaluate(() => window.lidarshop.settled());
+    const detail = await page.evaluate(() => window.lidarshop.detail());
+    if (detail.version !== cut.version)
+      fail(`the detail shows version ${detail.version}, the scan is at ${cut.version}`);
+  }
   const refineStart = await clearRequests();
   // Two refinements: an object stroke inside the cut (nothing changes), a background stroke across the car's
   // left end (the cut gives those cells up).

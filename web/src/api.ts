@@ -224,13 +224,16 @@ export class Api {
   // still holds that version, else the whole points (LSP1); `version` is the version they show
   // (X-Lidarshop-Version), `bytes` what travelled.
   // `step` > 1: the level of detail holding every step-th row and column (a large scan's 3-D view).
+  // `box` (COL,ROW,WIDTH,HEIGHT, detail.ts): only the cells inside that box of the grid.
   async pointsSince(
     id: number,
     since: number | null,
     step = 1,
+    box?: string,
   ): Promise<{ buffer: ArrayBuffer; version: number; bytes: number }> {
-    const params: Record<string, number> = since === null ? {} : { since };
+    const params: Record<string, number | string> = since === null ? {} : { since };
     if (step > 1) params.step = step;
+    if (box) params.box = box;
     const response = await fetch(this.url(`/api/docs/${id}/points`, params));
     if (!response.ok) throw new ApiError(response.status, `points: ${response.status}`);
     const buffer = await response.arrayBuffer();

@@ -25,6 +25,7 @@ import { StationsPanel } from './stations';
 import { PictureStore, loadOverlay } from './picture';
 import { VerifyResult } from './api_types.generated';
 import { TileStore } from './tiles';
+import { CellBox, boxParam, detailBox, lookedAtPoint, mergeDetail, nearBoxCentre } from './detail';
 
 const api = Api.fromLocation(window.location);
 const element = <T extends HTMLElement>(id: string) => document.getElementById(id) as T;
@@ -40,14 +41,38 @@ let picked: { row: number; col: number } | null = null;
 let openDocuments: DocumentInfo[] = []; // the server's open documents, for the list
 const gate = new VersionGate(); // answers are shown in version order
 // Per document: the points held, their version and level of detail (every step-th row and column).
-const heldPoints = new Map<number, { version: number; step: number; points: PointSet }>();
+// A large scan also holds a box of cells at full resolution where the camera looks (detail.ts); `shown` is
+// what the view draws (the coarse points outside the box and the detail).
+interface Detail {
+  box: CellBox;
+  version: number;
+  points: PointSet;
+}
+interface HeldPoints {
+  version: number;
+  step: number;
+  points: PointSet;
+  detail?: Detail;
+  shown?: PointSet;
+}
+const heldPoints = new Map<number, HeldPoints>();
 // Levels of detail of the 3-D view: the first download holds at most about FIRST_POINTS points, then it is
 // refined to at most about MOST_POINTS (the browser's budget, issue 34: 1-2 M points; a 1400-pixel-wide view
 // shows no more; deltas then name only those cells).
+// A scan over the budget keeps DETAIL_POINTS of it for the box at full resolution where the camera looks.
 const FIRST_POINTS = 1_000_000,
-  MOST_POINTS = 2_000_000;
-const pointsHeld = () => [...heldPoints.values()].reduce((sum, held) => sum + held.points.count, 0);
+  MOST_POINTS = 2_000_000,
+  DETAIL_POINTS = 500_000;
+const pointsHeld = () =>
+  [...heldPoints.values()].reduce(
+    (sum, held) => sum + held.points.count + (held.detail?.points.count ?? 0),
+    0,
+  );
 const stepFor = (returns: number, most: number) => Math.max(1, Math.ceil(Math.sqrt(returns / most)));
+// The level a scan's 3-D view is refined to: whole when it fits the budget, else coarse enough to leave room for
+// the detail.
+const refinedStep = (returns: number) =>
+  returns <= MOST_POINTS ? 1 : stepFor(returns, MOST_POINTS - DETAIL_POINTS);
 let pointsShown: { id: number; version: number; points: PointSet | null } = {
   id: -1,
   version: -1,
@@ -89,6 +114,14 @@ const stationsPanel = new StationsPanel(
   review: () => pending,
   pairs: () => pairsPanel,
   pointLevel: () => (doc ? (heldPoints.get(doc.id)?.step ?? 0) : 0),
+  refinedLevel: (returns: number) => refinedStep(returns),
+  // The box held at full resolution where the camera looks, and its points (null without one).
+  detail: () => {
+    const detail = doc ? heldPoints.get(doc.id)?.detail : undefined;
+    return detail ? { box: detail.box, version: detail.version, count: detail.points.count } : null;
+  },
+  detailPoints: () => (doc ? (heldPoints.get(doc.id)?.detail?.points ?? null) : null),
+  refineAt: (row: number, col: number) => (doc ? refineAt(doc.id, row, col) : Promise.resolve()),
   // Points the browser holds over every open scan (the budget is MOST_POINTS per scan shown).
   pointsHeld: () => pointsHeld(),
   pointBudget: MOST_POINTS,
@@ -105,56 +138,112 @@ const stationsPanel = new StationsPanel(
   jobsFinished: () => jobsFinished,
 };
 
+// The points of level `step` (only those inside `box` when given) at the server's current version: a delta from
+// `held` when the server still keeps its version, else the whole points.
+async function pointsUpToDate(
+  id: number,
+  held: { version: number; points: PointSet } | undefined,
+  step: number,
+  box?: CellBox,
+): Promise<{ version: number; points: PointSet }> {
+  const param = box ? boxParam(box) : undefined;
+  const answer = await api.pointsSince(id, held ? held.version : null, step, param);
+  pointBytes += answer.bytes;
+  const parsed = parsePointsAnswer(answer.buffer);
+  if ('whole' in parsed) return { version: answer.version, points: parsed.whole };
+  if (held && parsed.delta.from === held.version) {
+    const points = parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points;
+    return { version: parsed.delta.to, points };
+  }
+  const whole = await api.pointsSince(id, null, step, param);
+  pointBytes += whole.bytes;
+  return { version: whole.version, points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole };
+}
+
+// What the view draws of `next`: its coarse points, merged with its detail (the merge of `before` again when
+// neither moved).
+function shownPoints(next: HeldPoints, before: HeldPoints | undefined): PointSet {
+  if (!next.detail) return next.points;
+  if (before?.shown && before.points === next.points && before.detail?.points === next.detail.points)
+    return before.shown;
+  return mergeDetail(next.points, next.detail.points, next.detail.box);
+}
+
+// Shows the held points of `id` if it is the document shown; an edit that moved no point (a stroke, a cut that
+// changed no cell held) keeps the points shown: building the view's buffers again costs seconds at a million
+// points.
+function showHeld(id: number, held: HeldPoints, keepView: boolean) {
+  if (doc?.id !== id) return;
+  const points = held.shown ?? held.points;
+  if (pointsShown.id !== id || pointsShown.points !== points || !keepView) {
+    pointView.show(points, keepView && pointsShown.id === id);
+  }
+  pointsShown = { id, version: held.version, points };
+}
+
 // Brings the held points of document `id` to the server's current version: the cells changed since the held
-// version (a delta), or the whole points the first time; then shows them if the document is still shown.
-// `step`: a level of detail to download whole instead (a refinement); by default the one held, or for the first
-// download the coarsest that holds about FIRST_POINTS.
+// version (a delta), or the whole points the first time, and the same for the detail box; then shows them if
+// the document is still shown. `step`: a level of detail to download whole instead (a refinement); by default
+// the one held, or for the first download the coarsest that holds about FIRST_POINTS.
 function updatePoints(id: number, keepView: boolean, step?: number): Promise<void> {
   pointsChain = pointsChain.then(async () => {
     try {
-      let held = heldPoints.get(id);
-      if (held && step !== undefined && step !== held.step) held = undefined;
-      const level = held?.step ?? step ?? stepFor(doc?.id === id ? doc.valid_cells : 0, FIRST_POINTS);
-      const answer = await api.pointsSince(id, held ? held.version : null, level);
-      pointBytes += answer.bytes;
-      const parsed = parsePointsAnswer(answer.buffer);
-      if ('whole' in parsed) {
-        held = { version: answer.version, step: level, points: parsed.whole };
-      } else if (held && parsed.delta.from === held.version) {
-        held = {
-          version: parsed.delta.to,
-          step: level,
-          points: parsed.delta.count > 0 ? applyDelta(held.points, parsed.delta) : held.points,
-        };
-      } else {
-        const whole = await api.pointsSince(id, null, level);
-        pointBytes += whole.bytes;
-        held = {
-          version: whole.version,
-          step: level,
-          points: (parsePointsAnswer(whole.buffer) as { whole: PointSet }).whole,
-        };
+      const before = heldPoints.get(id);
+      const kept = before && (step === undefined || step === before.step) ? before : undefined;
+      const level = kept?.step ?? step ?? stepFor(doc?.id === id ? doc.valid_cells : 0, FIRST_POINTS);
+      const coarse = await pointsUpToDate(id, kept, level);
+      const next: HeldPoints = { ...coarse, step: level, detail: before?.detail };
+      if (next.detail && next.detail.version !== coarse.version) {
+        const box = next.detail.box;
+        next.detail = { box, ...(await pointsUpToDate(id, next.detail, 1, box)) };
       }
-      heldPoints.set(id, held);
+      next.shown = shownPoints(next, before);
+      heldPoints.set(id, next);
       // The browser's point budget holds over every open scan: other scans' points go first (fetched again
       // when shown again).
       for (const other of [...heldPoints.keys()]) {
         if (pointsHeld() <= MOST_POINTS) break;
         if (other !== id) heldPoints.delete(other);
       }
-      if (doc?.id !== id) return;
-      // An edit that moved no point (a stroke, a cut that changed no cell of this level) keeps the points
-      // shown: building the view's buffers again costs seconds at a million points.
-      if (pointsShown.id !== id || pointsShown.points !== held.points || !keepView) {
-        pointView.show(held.points, keepView && pointsShown.id === id);
-      }
-      pointsShown = { id, version: held.version, points: held.points };
+      showHeld(id, next, keepView);
     } catch (error) {
       status(`points: ${(error as Error).message}`);
     }
   });
   return pointsChain;
 }
+
+// Holds the box of cells around (row, col) at full resolution beside the coarse level (a scan refined to a
+// coarser level only), unless (row, col) is near the middle of the box held already.
+function refineAt(id: number, row: number, col: number): Promise<void> {
+  pointsChain = pointsChain.then(async () => {
+    try {
+      const held = heldPoints.get(id);
+      if (!held || held.step <= 1 || (held.detail && nearBoxCentre(held.detail.box, row, col))) return;
+      const box = detailBox(held.points.rows, held.points.cols, row, col, DETAIL_POINTS);
+      const next: HeldPoints = { ...held, detail: { box, ...(await pointsUpToDate(id, undefined, 1, box)) } };
+      next.shown = shownPoints(next, held);
+      heldPoints.set(id, next);
+      showHeld(id, next, true);
+      if (next.detail!.version !== held.version) void updatePoints(id, true); // an edit came in between
+    } catch (error) {
+      status(`points: ${(error as Error).message}`);
+    }
+  });
+  return pointsChain;
+}
+
+// When the camera stops moving: the detail where it now looks (the point nearest its view axis).
+pointView.onSettled = () => {
+  const held = doc ? heldPoints.get(doc.id) : undefined;
+  if (!doc || !held || held.step <= 1) return;
+  const shown = held.shown ?? held.points;
+  const { eye, direction } = pointView.view();
+  const index = lookedAtPoint(shown, eye, direction);
+  if (index < 0) return;
+  const cell = shown.cells[index];
+  void refineAt(doc.id, Math.floor(cell / shown.cols), cell % shown.cols);
+};
 
 // The list of open documents (the server's), the shown one selected.
 async function listDocuments() {
@@ -232,7 +321,7 @@ async function refresh(keepView: boolean, strokesOnly = false) {
     // after the first picture (its deltas then name the refined level's cells).
     const first = !heldPoints.has(id);
     const points = updatePoints(id, keepView);
-    const finer = stepFor(info.valid_cells, MOST_POINTS);
+    const finer = refinedStep(info.valid_cells);
     if (first && finer < stepFor(info.valid_cells, FIRST_POINTS)) {
       firstPictures.set(id, performance.now());
       void points.then(() => updatePoints(id, true, finer));
@@ -575,7 +664,8 @@ element('place').addEventListener('click', async () => {
     if (picked) {
       // The picked cell's point in the world frame (the scan's pose): the model stands there.
       await pointsChain;
-      const points = heldPoints.get(doc.id)?.points;
+      const held = heldPoints.get(doc.id);
+      const points = held?.shown ?? held?.points;
       const index = !points ? -1 : points.cells.indexOf(picked.row * doc.cols + picked.col);
       if (points && index >= 0) {
         const w = doc.world_from_scanner_column_major;

@@ -93,6 +93,8 @@ export function pointColours(points: PointSet, mode: PointColouring): Float32Arr
 
 export class PointView {
   onPick: (cell: number) => void = () => {};
+  // The user stopped moving the camera (an orbit, a pan or a zoom ended): main.ts then refines where it looks.
+  onSettled: () => void = () => {};
   private renderer: THREE.WebGLRenderer;
   private scene = new THREE.Scene();
   private camera = new THREE.PerspectiveCamera(60, 1, 0.05, 2000);
@@ -119,6 +121,7 @@ export class PointView {
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
     this.controls.target.set(0, 8, 0);
     this.controls.addEventListener('change', () => this.render());
+    this.controls.addEventListener('end', () => this.onSettled());
     this.marker.visible = false;
     this.scene.add(this.marker);
     this.renderer.domElement.addEventListener('dblclick', (event) => this.pickAt(event));
@@ -227,6 +230,14 @@ export class PointView {
         this.render();
       },
     };
+  }
+
+  // Where the camera is and the unit direction it looks along (scanner frame).
+  view(): { eye: [number, number, number]; direction: [number, number, number] } {
+    const direction = new THREE.Vector3();
+    this.camera.getWorldDirection(direction);
+    const eye = this.camera.position;
+    return { eye: [eye.x, eye.y, eye.z], direction: [direction.x, direction.y, direction.z] };
   }
 
   // Orbits the camera about the target by `degrees` (tests and the "orbit" of the closing screenshots).
