@@ -76,6 +76,27 @@ export interface PointSet {
   flags: Uint8Array;
 }
 
+// The points at indices `keep` of `points`, in that order.
+export function selectPoints(points: PointSet, keep: number[]): PointSet {
+  const n = keep.length;
+  const out: PointSet = {
+    count: n,
+    rows: points.rows,
+    cols: points.cols,
+    xyz: new Float32Array(3 * n),
+    cells: new Uint32Array(n),
+    rgb: new Uint8Array(3 * n),
+    flags: new Uint8Array(n),
+  };
+  keep.forEach((i, k) => {
+    out.xyz.set(points.xyz.subarray(3 * i, 3 * i + 3), 3 * k);
+    out.rgb.set(points.rgb.subarray(3 * i, 3 * i + 3), 3 * k);
+    out.cells[k] = points.cells[i];
+    out.flags[k] = points.flags[i];
+  });
+  return out;
+}
+
 export const FLAG_SYNTHESIZED = 1;
 export const FLAG_OBJECT = 2;
 // The point was filled from what another station of the site measured (real, not synthesized; issue 31 part 3).

@@ -1,7 +1,7 @@
 // Refining the 3-D view where the camera looks (issue 34): a large scan's points are held at a coarse level
 // everywhere and at full resolution in a box of cells around the point the camera looks at, both within the
 // browser's point budget. The server gives a box's points whole and as deltas (`points?box=`, docs/api.md).
-import { PointSet } from './api';
+import { PointSet, selectPoints } from './api';
 
 // Columns [col, col + width) and rows [row, row + height) of the scan's grid (the server's `box` parameter).
 export interface CellBox {
@@ -80,26 +80,26 @@ export function mergeDetail(coarse: PointSet, detail: PointSet, box: CellBox): P
     const cell = coarse.cells[i];
     if (!boxHolds(box, Math.floor(cell / coarse.cols), cell % coarse.cols)) keep.push(i);
   }
-  const n = keep.length + detail.count;
-  const out: PointSet = {
+  const outside = selectPoints(coarse, keep);
+  const n = outside.count + detail.count;
+  const grow = <T extends Float32Array | Uint32Array | Uint8Array>(
+    a: T,
+    b: T,
+    make: (n: number) => T,
+    k: number,
+  ) => {
+    const out = make(k * n);
+    out.set(a.subarray(0, k * outside.count));
+    out.set(b.subarray(0, k * detail.count), k * outside.count);
+    return out;
+  };
+  return {
     count: n,
     rows: coarse.rows,
     cols: coarse.cols,
-    xyz: new Float32Array(3 * n),
-    cells: new Uint32Array(n),
-    rgb: new Uint8Array(3 * n),
-    flags: new Uint8Array(n),
+    xyz: grow(outside.xyz, detail.xyz, (m) => new Float32Array(m), 3),
+    cells: grow(outside.cells, detail.cells, (m) => new Uint32Array(m), 1),
+    rgb: grow(outside.rgb, detail.rgb, (m) => new Uint8Array(m), 3),
+    flags: grow(outside.flags, detail.flags, (m) => new Uint8Array(m), 1),
   };
-  keep.forEach((i, k) => {
-    out.xyz.set(coarse.xyz.subarray(3 * i, 3 * i + 3), 3 * k);
-    out.rgb.set(coarse.rgb.subarray(3 * i, 3 * i + 3), 3 * k);
-    out.cells[k] = coarse.cells[i];
-    out.flags[k] = coarse.flags[i];
-  });
-  const at = keep.length;
-  out.xyz.set(detail.xyz.subarray(0, 3 * detail.count), 3 * at);
-  out.rgb.set(detail.rgb.subarray(0, 3 * detail.count), 3 * at);
-  out.cells.set(detail.cells.subarray(0, detail.count), at);
-  out.flags.set(detail.flags.subarray(0, detail.count), at);
-  return out;
 }

@@ -3,7 +3,7 @@
 // cell's point is marked.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
-import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet } from './api';
+import { FLAG_FROM_STATION, FLAG_OBJECT, FLAG_SYNTHESIZED, MeshData, PointSet, selectPoints } from './api';
 
 export type PointColouring = 'rgb' | 'layers' | 'height';
 export type Layer = 'original' | 'synthesized' | 'object' | 'from-stations';
@@ -21,23 +21,7 @@ export function visiblePoints(points: PointSet, hidden: Set<Layer>): PointSet {
   if (hidden.size === 0) return points;
   const keep: number[] = [];
   for (let i = 0; i < points.count; ++i) if (!hidden.has(layerOf(points.flags[i]))) keep.push(i);
-  const n = keep.length;
-  const out: PointSet = {
-    count: n,
-    rows: points.rows,
-    cols: points.cols,
-    xyz: new Float32Array(3 * n),
-    cells: new Uint32Array(n),
-    rgb: new Uint8Array(3 * n),
-    flags: new Uint8Array(n),
-  };
-  keep.forEach((i, k) => {
-    out.xyz.set(points.xyz.subarray(3 * i, 3 * i + 3), 3 * k);
-    out.rgb.set(points.rgb.subarray(3 * i, 3 * i + 3), 3 * k);
-    out.cells[k] = points.cells[i];
-    out.flags[k] = points.flags[i];
-  });
-  return out;
+  return selectPoints(points, keep);
 }
 
 // Where the ray image's centre looks: the point (scanner frame) of the cell nearest the image's centre cell
