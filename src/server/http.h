@@ -145,19 +145,18 @@ void RememberState(Document& document);
 // points.cc: the points of a document as typed arrays (docs/api.md "Points"), whole (LSP1) or the cells that
 // changed since an earlier version (LSD1). Caller holds document.mutex.
 // `step` > 1: a level of detail, only the cells whose row and column are multiples of it (a large scan's
-// first view; its deltas then name only those cells too). `box`: only the cells inside it (a part of the scan
-// seen closer, at a finer step than the rest); none: the whole grid.
-struct CellBox {
-  int col = 0, row = 0, width = 0, height = 0;  // columns [col, col + width), rows [row, row + height)
-};
+// first view; its deltas then name only those cells too). `box` (x columns, y rows): only the cells inside it
+// (a part of the scan seen closer, at a finer step than the rest); none: the whole grid.
 // The box of a `box=COL,ROW,WIDTH,HEIGHT` parameter clipped to a rows x cols grid; nullopt when the text is
 // not four whole numbers (width and height >= 1) or the box lies outside the grid.
-std::optional<CellBox> ReadCellBox(const std::string& text, int rows, int cols);
-std::string PointsBinary(const Document& document, int step = 1, const std::optional<CellBox>& box = {});
+std::optional<cv::Rect> ReadCellBox(const std::string& text, int rows, int cols);
+std::string PointsBinary(const Document& document, int step = 1, const std::optional<cv::Rect>& box = {});
 // The LSD1 delta from the state the document had at version `since` to now; nullopt when that state is no
 // longer kept (or the grid changed): the client then gets the whole points.
 std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step = 1,
-                                             const std::optional<CellBox>& box = {});
+                                             const std::optional<cv::Rect>& box = {});
+// Header X-Lidarshop-Box "col,row,width,height" (pictures, overlays and points of a box).
+void SetBoxHeader(httplib::Response& response, const cv::Rect& box);
 
 // pictures.cc: pictures that travel by what changed (docs/api.md "Pictures"). Caller holds document.mutex.
 // The ray image of `options` (`channel` names it): whole, or with `since` >= 0 a kept version's picture, only

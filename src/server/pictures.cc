@@ -56,10 +56,14 @@ cv::Rect ChangedBox(const cv::Mat& a, const cv::Mat& b) {
   return cv::boundingRect(any);
 }
 
+void SetBoxHeader(httplib::Response& response, const cv::Rect& box) {
+  response.set_header("X-Lidarshop-Box", fmt::format("{},{},{},{}", box.x, box.y, box.width, box.height));
+}
+
 namespace {
 
 void SetBox(httplib::Response& response, const cv::Rect& box, const cv::Size& size) {
-  response.set_header("X-Lidarshop-Box", fmt::format("{},{},{},{}", box.x, box.y, box.width, box.height));
+  SetBoxHeader(response, box);
   response.set_header("X-Lidarshop-Size", fmt::format("{},{}", size.width, size.height));
 }
 

@@ -110,15 +110,15 @@ Lattice LatticeIn(int first, int count, int step) {
 }
 
 // The box's rows and columns of the level (the whole grid without a box).
-std::pair<Lattice, Lattice> LevelCells(const Scan& scan, int step, const std::optional<CellBox>& box) {
-  const CellBox b = box.value_or(CellBox{0, 0, scan.cols, scan.rows});
-  return {LatticeIn(b.row, std::min(b.height, scan.rows - b.row), step),
-          LatticeIn(b.col, std::min(b.width, scan.cols - b.col), step)};
+std::pair<Lattice, Lattice> LevelCells(const Scan& scan, int step, const std::optional<cv::Rect>& box) {
+  const cv::Rect grid(0, 0, scan.cols, scan.rows);
+  const cv::Rect b = box.value_or(grid) & grid;
+  return {LatticeIn(b.y, b.height, step), LatticeIn(b.x, b.width, step)};
 }
 
 }  // namespace
 
-std::optional<CellBox> ReadCellBox(const std::string& text, int rows, int cols) {
+std::optional<cv::Rect> ReadCellBox(const std::string& text, int rows, int cols) {
   int64_t v[4];
   const char* at = text.c_str();
   for (int i = 0; i < 4; ++i) {
@@ -131,11 +131,11 @@ std::optional<CellBox> ReadCellBox(const std::string& text, int rows, int cols) 
   const int64_t col = v[0], row = v[1], end_col = std::min<int64_t>(col + v[2], cols),
                 end_row = std::min<int64_t>(row + v[3], rows);
   if (v[2] < 1 || v[3] < 1 || col >= end_col || row >= end_row) return std::nullopt;
-  return CellBox{static_cast<int>(col), static_cast<int>(row), static_cast<int>(end_col - col),
-                 static_cast<int>(end_row - row)};
+  return cv::Rect(static_cast<int>(col), static_cast<int>(row), static_cast<int>(end_col - col),
+                  static_cast<int>(end_row - row));
 }
 
-std::string PointsBinary(const Document& document, int step, const std::optional<CellBox>& box) {
+std::string PointsBinary(const Document& document, int step, const std::optional<cv::Rect>& box) {
   std::vector<uint32_t> cells;
   std::vector<PointRecord> records;
   for (const bool behind : {false, true}) {
@@ -174,7 +174,7 @@ void RememberState(Document& document) {
 }
 
 std::optional<std::string> PointsDeltaBinary(const Document& document, int64_t since, int step,
-                                             const std::optional<CellBox>& box) {
+                                             const std::optional<cv::Rect>& box) {
   const Snapshot* old = nullptr;
   for (const auto& state : document.recent) {
     if (state.first_version <= since && since <= state.last_version) old = &state.points;

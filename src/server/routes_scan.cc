@@ -668,7 +668,7 @@ void AddScanRoutes(State& state) {
     if (!ReadWholeNumberParam(request, response, "step", 1, 64, "a whole number in [1, 64]", &step)) return;
     std::lock_guard lock(document->mutex);
     // ?box=COL,ROW,WIDTH,HEIGHT: only the cells inside it (clipped to the grid; header X-Lidarshop-Box).
-    std::optional<CellBox> box;
+    std::optional<cv::Rect> box;
     if (request.has_param("box")) {
       box = ReadCellBox(request.get_param_value("box"), document->now.scan.rows, document->now.scan.cols);
       if (!box) {
@@ -677,8 +677,7 @@ void AddScanRoutes(State& state) {
                                      "height >= 1) overlapping the scan's {} x {} cells",
                                      document->now.scan.cols, document->now.scan.rows));
       }
-      response.set_header("X-Lidarshop-Box",
-                          fmt::format("{},{},{},{}", box->col, box->row, box->width, box->height));
+      SetBoxHeader(response, *box);
     }
     response.set_header("X-Lidarshop-Version", std::to_string(document->version));
     response.set_header("X-Lidarshop-Step", std::to_string(step));

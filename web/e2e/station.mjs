@@ -119,6 +119,25 @@ const budget = Number(option('--budget', 5));
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 800 } });
   page.on('pageerror', (error) => console.error(`page error: ${error.message}`));
+  // Where the time went: the page's API requests since `since` (start-end, ms after page open). The browser
+  // keeps 250 resource timings by default: the buffer is cleared before each measured part.
+  const requestsSince = (since) =>
+    page.evaluate(
+      (t) =>
+        performance
+          .getEntriesByType('resource')
+          .filter((e) => e.name.includes('/api/') && e.startTime >= t)
+          .map(
+            (e) =>
+              `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
+          ),
+      since,
+    );
+  const clearRequests = () =>
+    page.evaluate(() => {
+      performance.clearResourceTimings();
+      return performance.now();
+    });
   let apiBytes = 0;
   page.on('requestfinished', async (request) => {
     if (request.url().includes('/api/'))
@@ -129,16 +148,7 @@ try {
   await waitForFunction(page, () => window.lidarshop?.rayView.shownState().id > 0, null, { timeout: 120000 });
   result.first_picture_s = (Date.now() - opened) / 1000;
   // Where the time went: the page's requests until the first picture (start and end, ms after page open).
-  result.first_picture_requests = await page.evaluate(() =>
-    performance
-      .getEntriesByType('resource')
-      .filter((e) => e.name.includes('/api/'))
-      .slice(0, 12)
-      .map(
-        (e) =>
-          `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
-      ),
-  );
+  result.first_picture_requests = (await requestsSince(0)).slice(0, 12);
   result.page_loaded_ms = await page.evaluate(() =>
     Math.round(performance.getEntriesByType('navigation')[0]?.domContentLoadedEventEnd ?? -1),
   );
@@ -390,25 +400,6 @@ try {
     await page.click(`#brush-${brush}`);
     await edit(what, () => drag([at(...from), at(...to)]), afterJob(await jobsFinished()));
   };
-  // Where a cut's time went: its requests (start-end, ms after page open). The browser keeps 250 resource
-  // timings by default: the buffer is cleared before each measured part.
-  const requestsSince = (since) =>
-    page.evaluate(
-      (t) =>
-        performance
-          .getEntriesByType('resource')
-          .filter((e) => e.name.includes('/api/') && e.startTime >= t)
-          .map(
-            (e) =>
-              `${e.name.split('?')[0].replace(location.origin, '')} ${Math.round(e.startTime)}-${Math.round(e.responseEnd)}`,
-          ),
-      since,
-    );
-  const clearRequests = () =>
-    page.evaluate(() => {
-      performance.clearResourceTimings();
-      return performance.now();
-    });
   const cutStart = await clearRequests();
   await cutStroke('background stroke -> first cut', 'background', [0.647, 0.402], [0.647, 0.592]);
   result.first_cut_requests = await requestsSince(cutStart);

@@ -121,7 +121,6 @@ const stationsPanel = new StationsPanel(
     return detail ? { box: detail.box, version: detail.version, count: detail.points.count } : null;
   },
   detailPoints: () => (doc ? (heldPoints.get(doc.id)?.detail?.points ?? null) : null),
-  refineAt: (row: number, col: number) => (doc ? refineAt(doc.id, row, col) : Promise.resolve()),
   // Points the browser holds over every open scan (the budget is MOST_POINTS per scan shown).
   pointsHeld: () => pointsHeld(),
   pointBudget: MOST_POINTS,

@@ -103,33 +103,49 @@ void CheckScanNumbers(const Scan& scan, const std::string& file, const std::stri
   }
 }
 
+namespace {
+
+// Each valid cell's direction is its point's; a cell without a return has none (zero).
+void DirectionsFromPoints(Scan* scan) {
+  for (int row = 0; row < scan->rows; ++row) {
+    const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
+    const cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
+    const float* range = scan->range.ptr<float>(row);
+    cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
+    for (int col = 0; col < scan->cols; ++col) {
+      direction[col] = valid[col] && range[col] > 0 ? point[col] / range[col] : cv::Vec3f(0, 0, 0);
+    }
+  }
+}
+
+}  // namespace
+
 void FinishScan(Scan* scan, bool fit_grid) {
   for (int row = 0; row < scan->rows; ++row) {
     const uint8_t* valid = scan->valid.ptr<uint8_t>(row);
     cv::Vec3f* point = scan->point.ptr<cv::Vec3f>(row);
     float* range = scan->range.ptr<float>(row);
-    cv::Vec3f* direction = scan->direction.ptr<cv::Vec3f>(row);
     float* intensity = scan->intensity.empty() ? nullptr : scan->intensity.ptr<float>(row);
     cv::Vec3b* color = scan->color.empty() ? nullptr : scan->color.ptr<cv::Vec3b>(row);
     for (int col = 0; col < scan->cols; ++col) {
       if (valid[col]) {
-        const float norm = std::sqrt(point[col].dot(point[col]));
-        range[col] = norm;
-        direction[col] = norm > 0 ? point[col] / norm : cv::Vec3f(0, 0, 0);
+        range[col] = std::sqrt(point[col].dot(point[col]));
       } else {
         point[col] = cv::Vec3f(0, 0, 0);
         range[col] = 0;
         if (intensity != nullptr) intensity[col] = 0.5f;
-        direction[col] = cv::Vec3f(0, 0, 0);
         if (color != nullptr) color[col] = cv::Vec3b(0, 0, 0);
       }
     }
   }
   if (fit_grid) {
+    // A fitted grid gives every cell its ray (ray_directions.h): no image is kept, nor filled to be dropped.
+    scan->direction.release();
     FitGrid(scan);
-    // FitGrid gave every cell its grid ray: the image holds nothing the grid does not (ray_directions.h).
-    if (HasCompleteGrid(*scan)) scan->direction.release();
+    if (HasCompleteGrid(*scan)) return;
+    scan->direction.create(scan->rows, scan->cols, CV_32FC3);  // no usable return: the points' own directions
   }
+  DirectionsFromPoints(scan);
 }
 
 Eigen::Vector3d CloudOrigin(const Eigen::Vector3d& low, const Eigen::Vector3d& high) {

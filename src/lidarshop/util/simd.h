@@ -26,7 +26,7 @@ SimdPath BestSimdPath();
 // bit-identical results, so the cap changes only the speed: it measures on an AVX-512 machine what an AVX2-only
 // CPU takes. Throws std::invalid_argument for another value; BestSimdPath() then exits with the message.
 bool CpuMayUse(const char* feature, const char* cap);
-// CpuMayUse(feature, getenv("LIDARSHOP_SIMD")), read once.
+// CpuMayUse(feature, getenv("LIDARSHOP_SIMD")); BestSimdPath() and BestSsdKernel() keep their answers.
 bool CpuMayUse(const char* feature);
 
 // Every lanes function is inlined, so no vector crosses a call: GCC's note on the AVX

@@ -1,5 +1,6 @@
 #include "lidarshop/util/simd.h"
 
+#include <cstdlib>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -28,6 +29,17 @@ TEST(CpuMayUse, AnUnknownCapOrFeatureIsAnError) {
     EXPECT_NE(std::string(error.what()).find("LIDARSHOP_SIMD=sse9"), std::string::npos) << error.what();
   }
   EXPECT_THROW(CpuMayUse("neon", nullptr), std::invalid_argument);
+}
+
+// Read from the environment (the library's own check of its paths may run before main): a bad value ends the
+// process with exit code 2 and the message, not with a terminate.
+TEST(CpuMayUseDeathTest, ABadEnvironmentValueEndsTheProcessWithItsMessage) {
+  EXPECT_EXIT(
+      {
+        setenv("LIDARSHOP_SIMD", "sse9", 1);
+        CpuMayUse("avx2");
+      },
+      ::testing::ExitedWithCode(2), "LIDARSHOP_SIMD=sse9: expected baseline, avx2 or avx512");
 }
 
 }  // namespace
