@@ -31,6 +31,8 @@ std::string FieldDoc(const FieldInfo& field, const nlohmann::ordered_json& defau
     doc += fmt::format("\ndefault {}", PythonLiteral(default_value));
   } else if (field.kind == FieldKind::kStruct) {
     doc += fmt::format(" ({})", field.nested->name);
+  } else if (field.kind == FieldKind::kStructList) {
+    doc += fmt::format(" (a list of {})", field.nested->name);
   } else {
     doc += fmt::format(", default {}", PythonLiteral(default_value));
   }
@@ -72,7 +74,7 @@ std::string StructRepr(const StructInfo& info, const void* object) {
 
 void SetField(const StructInfo& info, const FieldInfo& field, void* object, const py::handle& value) {
   const nlohmann::json json = ToJsonValue(value);
-  if (field.kind == FieldKind::kStruct) {
+  if (field.kind == FieldKind::kStruct || field.kind == FieldKind::kStructList) {
     // An options object (to_dict) replaces every nested field; a dict sets the keys it names. Errors name
     // the key path ("poisson.tolerance: ...").
     nlohmann::json patch = nlohmann::json::object();
@@ -98,6 +100,14 @@ py::object GetField(const FieldInfo& field, void* object, py::handle parent) {
       return FromJsonValue(field.get(object));
     }
     return caster->second(field.nested_of(object), parent);
+  }
+  if (field.kind == FieldKind::kStructList) {
+    const auto caster = NestedCasters().find(field.nested);
+    if (caster == NestedCasters().end()) return FromJsonValue(field.get(object));  // a list of dicts
+    py::list list;
+    for (size_t i = 0; i < field.list_size(object); ++i)
+      list.append(caster->second(field.element_of(object, i), parent));
+    return list;
   }
   return FromJsonValue(field.get(object));
 }

@@ -123,6 +123,7 @@ nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
       return list;
     }
     case FieldKind::kStruct:
+    case FieldKind::kStructList:
       break;
   }
   throw OptionsError("a group of options has no flag of its own");
@@ -179,7 +180,8 @@ void OptionBinder::BindStruct(const StructInfo& info, void* object, const BindSe
     const auto add = [&](const FieldInfo& field) {
       const bool skipped =
           std::find(settings.skip.begin(), settings.skip.end(), field.key) != settings.skip.end();
-      if (field.kind != FieldKind::kStruct && !skipped) keys.push_back(field.key);
+      if (field.kind != FieldKind::kStruct && field.kind != FieldKind::kStructList && !skipped)
+        keys.push_back(field.key);
     };
     for (size_t i = 0; i <= info.fields.size(); ++i) {
       for (const FieldInfo& alias : info.aliases) {

@@ -136,6 +136,12 @@ void FieldInfo::CheckValue(const nlohmann::json& value) const {
     case FieldKind::kStruct:
       if (!value.is_object()) throw OptionsError(fmt::format("expected an object, got {}", value.dump()));
       return;
+    case FieldKind::kStructList:
+      if (!value.is_array() ||
+          std::any_of(value.begin(), value.end(), [](const auto& element) { return !element.is_object(); })) {
+        throw OptionsError(fmt::format("expected a list of objects, got {}", value.dump()));
+      }
+      return;
     case FieldKind::kNumberList:
       if (!value.is_array())
         throw OptionsError(fmt::format("expected a list of numbers, got {}", value.dump()));
@@ -225,6 +231,13 @@ void ValidateStruct(const StructInfo& info, const void* object, const std::strin
     if (field.present && !field.present(object)) continue;
     if (field.kind == FieldKind::kStruct) {
       ValidateStruct(*field.nested, field.nested_of(const_cast<void*>(object)), Join(path, field.key));
+      continue;
+    }
+    if (field.kind == FieldKind::kStructList) {
+      for (size_t i = 0; i < field.list_size(object); ++i) {
+        ValidateStruct(*field.nested, field.element_of(const_cast<void*>(object), i),
+                       fmt::format("{}[{}]", Join(path, field.key), i));
+      }
       continue;
     }
     try {
@@ -378,6 +391,12 @@ void StructFromJson(const StructInfo& info, const nlohmann::json& json, void* ob
     }
     if (field->kind == FieldKind::kStruct) {
       StructFromJson(*field->nested, value, field->nested_of(object), key_path);
+    } else if (field->kind == FieldKind::kStructList) {
+      try {
+        field->set(object, value);
+      } catch (const OptionsFieldError& error) {  // "[2].rms_px" inside the list
+        throw OptionsFieldError(key_path + error.key_path(), error.reason());
+      }
     } else {
       field->set(object, value);
     }
@@ -434,6 +453,13 @@ nlohmann::json SampleValue(const FieldInfo& field, const nlohmann::ordered_json&
       return nlohmann::json::array({0.1, 1.5, 2.0 / 3.0});
     case FieldKind::kStringList:
       return nlohmann::json::array({"sample one", "sample, two"});
+    case FieldKind::kStructList:  // one more element, of the element's defaults
+      if (field.nested->default_json) {
+        nlohmann::json list = current;
+        list.push_back(nlohmann::json::parse(field.nested->default_json().dump()));
+        return list;
+      }
+      break;
     case FieldKind::kStruct:
       break;
   }

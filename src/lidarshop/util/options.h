@@ -47,12 +47,30 @@ namespace lidarshop {
 
 // kNumberList: a std::vector of numbers (per-channel weights); the range applies to every element.
 // kStringList: a std::vector<std::string> (a result's warnings, one sentence each).
-enum class FieldKind { kBool, kInt, kUInt64, kDouble, kString, kEnum, kStruct, kNumberList, kStringList };
+// kStructList: a std::vector of a described struct (a resection's per-pair errors), a JSON array of objects.
+enum class FieldKind {
+  kBool,
+  kInt,
+  kUInt64,
+  kDouble,
+  kString,
+  kEnum,
+  kStruct,
+  kNumberList,
+  kStringList,
+  kStructList
+};
 
 template <class T>
 struct IsVector : std::false_type {};
 template <class T>
 struct IsVector<std::vector<T>> : std::true_type {};
+// A std::vector of a described struct (kStructList).
+template <class T>
+struct IsStructVector : std::false_type {};
+template <class T>
+struct IsStructVector<std::vector<T>>
+    : std::bool_constant<std::is_class_v<T> && !std::is_same_v<T, std::string>> {};
 template <class T>
 struct IsOptional : std::false_type {};
 template <class T>
@@ -72,11 +90,16 @@ struct FieldInfo {
           integer_high = INT64_MAX;    // kInt (and kNumberList of integers): type limits
   bool integer_elements = false;       // kNumberList of an integer type
   const EnumInfo* choices = nullptr;   // kEnum
-  const StructInfo* nested = nullptr;  // kStruct
+  const StructInfo* nested = nullptr;  // kStruct, kStructList: the (element's) description
   // Type-erased access to the field of a struct instance (`void*` = the struct described by the owner).
   std::function<nlohmann::ordered_json(const void*)> get;
   std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
   std::function<void*(void*)> nested_of;                  // kStruct: the member's address
+  // kStructList: how many elements the member holds and the address of one (validation, Python). `set`
+  // replaces the whole list from a JSON array, each element read with StructFromJson; its errors name the
+  // element ("[2].rms_px: ...").
+  std::function<size_t(const void*)> list_size;
+  std::function<void*(void*, size_t)> element_of;
   // A std::optional member: whether it holds a value. ToJson leaves the key out when it does not (get then gives
   // the value a default T would have, which set or nested_of fill in); empty for every other field.
   std::function<bool(const void*)> present;
@@ -202,9 +225,32 @@ class StructBuilder {
       field.set = [member](void* object, const nlohmann::json& json) {
         static_cast<S*>(object)->*member = json.get<T>();
       };
+    } else if constexpr (IsStructVector<T>::value) {
+      using Element = typename T::value_type;
+      field.kind = FieldKind::kStructList;
+      field.nested = &InfoOf<Element>();
+      field.list_size = [member](const void* object) {
+        return (static_cast<const S*>(object)->*member).size();
+      };
+      field.element_of = [member](void* object, size_t index) -> void* {
+        return &(static_cast<S*>(object)->*member)[index];
+      };
+      field.set = [member](void* object, const nlohmann::json& json) {
+        T list(json.size());
+        for (size_t i = 0; i < list.size(); ++i) {
+          try {
+            StructFromJson(InfoOf<Element>(), json[i], &list[i]);
+          } catch (const OptionsFieldError& error) {
+            throw OptionsFieldError("[" + std::to_string(i) + "]." + error.key_path(), error.reason());
+          } catch (const OptionsError& error) {
+            throw OptionsFieldError("[" + std::to_string(i) + "]", error.what());
+          }
+        }
+        static_cast<S*>(object)->*member = std::move(list);
+      };
     } else if constexpr (IsVector<T>::value) {
       using Element = typename T::value_type;
-      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers or strings");
+      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers, strings or described structs");
       field.kind = FieldKind::kNumberList;
       if constexpr (std::is_integral_v<Element>) {
         field.integer_elements = true;
@@ -306,6 +352,11 @@ class StructBuilder {
     } else if constexpr (std::is_floating_point_v<T>) {
       // NaN ("none", e.g. a consistency with nothing to compare) is JSON null.
       return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+    } else if constexpr (IsStructVector<T>::value) {
+      nlohmann::ordered_json list = nlohmann::ordered_json::array();
+      for (const auto& element : value)
+        list.push_back(StructToJson(InfoOf<typename T::value_type>(), &element));
+      return list;
     } else if constexpr (IsVector<T>::value) {
       return nlohmann::ordered_json(value);
     } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {

@@ -49,6 +49,8 @@ std::string TypeText(const FieldInfo& field) {
       return field.integer_elements ? "list of integers" : "list of numbers";
     case FieldKind::kStringList:
       return "list of strings";
+    case FieldKind::kStructList:
+      return fmt::format("list of [`{}`](#{})", field.nested->name, Anchor(field.nested->name));
   }
   return "";
 }
@@ -113,7 +115,8 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
         // An optional part (FieldInfo::present) is left out of the JSON when the result has none.
         out += fmt::format("| `{}` | {}{} | {} | {} |\n", field.key, Cell(TypeText(field)),
                            field.present ? ", or absent" : "", Cell(field.unit), Cell(field.doc));
-        if (field.kind == FieldKind::kStruct) push({field.nested, nullptr, true});
+        if (field.kind == FieldKind::kStruct || field.kind == FieldKind::kStructList)
+          push({field.nested, nullptr, true});
         continue;
       }
       std::string default_text;

@@ -207,6 +207,63 @@ TEST(Options, OptionalFieldsAreWrittenOnlyWhenSet) {
   ExpectExactRoundTrip<PartialResult>();
 }
 
+// A result holding a list of described structs (a resection's per-pair errors): a JSON array of objects.
+struct ListResult {
+  std::vector<InnerOptions> parts;
+  int count = 0;
+};
+
+template <>
+const StructInfo& InfoOf<ListResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<ListResult> b("ListResult", "a list");
+    b.Field(&ListResult::parts, "parts", "one per part");
+    b.Field(&ListResult::count, "count", "count");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(Options, ListsOfStructsAreArraysOfObjects) {
+  EXPECT_EQ(InfoOf<ListResult>().Find("parts")->kind, FieldKind::kStructList);
+  EXPECT_EQ(InfoOf<ListResult>().Find("parts")->nested, &InfoOf<InnerOptions>());
+  ListResult result;
+  EXPECT_EQ(ToJson(result).dump(), R"({"parts":[],"count":0})");
+  result.parts = {InnerOptions{3, true}, InnerOptions{}};
+  result.count = 2;
+  EXPECT_EQ(ToJson(result).dump(),
+            R"({"parts":[{"band_px":3,"enabled":true},{"band_px":2,"enabled":false}],"count":2})");
+  const ListResult back = FromJson<ListResult>(nlohmann::json::parse(ToJson(result).dump()));
+  ASSERT_EQ(back.parts.size(), 2u);
+  EXPECT_EQ(back.parts[0].band_px, 3);
+  EXPECT_TRUE(back.parts[0].enabled);
+  // An element's absent keys take the element's defaults, not the list's old element.
+  ListResult base;
+  base.parts = {InnerOptions{9, true}};
+  const ListResult partial =
+      FromJson<ListResult>(nlohmann::json::parse(R"({"parts":[{"enabled":true}]})"), base);
+  ASSERT_EQ(partial.parts.size(), 1u);
+  EXPECT_EQ(partial.parts[0].band_px, 2);
+  // Errors name the element and its key.
+  ExpectRejected<ListResult>(nlohmann::json::parse(R"({"parts":[{"band_px":1},{"band_px":0}]})"),
+                             "parts[1].band_px", "out of range [1, 64]");
+  ExpectRejected<ListResult>(nlohmann::json::parse(R"({"parts":[{"colour":1}]})"), "parts[0].colour",
+                             "unknown option");
+  ExpectRejected<ListResult>(nlohmann::json::parse(R"({"parts":[1,2]})"), "parts",
+                             "expected a list of objects");
+  ExpectRejected<ListResult>(nlohmann::json::parse(R"({"parts":{"band_px":1}})"), "parts",
+                             "expected a list of objects");
+  ListResult bad;
+  bad.parts = {InnerOptions{}, InnerOptions{100, false}};
+  try {
+    Validate(bad);
+    ADD_FAILURE() << "a bad element passed";
+  } catch (const OptionsFieldError& error) {
+    EXPECT_EQ(error.key_path(), "parts[1].band_px");
+  }
+  ExpectExactRoundTrip<ListResult>();
+}
+
 TEST(Options, RoundTripIsExact) {
   ExpectExactRoundTrip<OuterOptions>();
   OuterOptions o;

@@ -31,6 +31,8 @@ std::string KindName(FieldKind kind) {
       return "number_list";
     case FieldKind::kStringList:
       return "string_list";
+    case FieldKind::kStructList:
+      return "struct_list";
   }
   return "";
 }
@@ -69,6 +71,8 @@ std::vector<std::string> TypeAlternatives(const FieldInfo& field, bool answer) {
       return {answer && !field.integer_elements ? "(number | null)[]" : "number[]"};
     case FieldKind::kStringList:
       return {"string[]"};
+    case FieldKind::kStructList:
+      return {field.nested->name + "[]"};
   }
   return {"unknown"};
 }
@@ -87,7 +91,7 @@ std::string MemberComment(const FieldInfo& field, const nlohmann::ordered_json* 
     }
   }
   if (defaults != nullptr && defaults->is_object() && defaults->contains(field.key) &&
-      field.kind != FieldKind::kStruct) {
+      field.kind != FieldKind::kStruct && field.kind != FieldKind::kStructList) {
     text += ", default " + ValueText(defaults->at(field.key));
   }
   return text;
@@ -146,6 +150,8 @@ std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs,
         TypeScriptStruct nested{field.nested, nullptr, entry.answer};
         if (defaults != nullptr && defaults->contains(field.key)) nested.defaults = defaults->at(field.key);
         push(std::move(nested));
+      } else if (field.kind == FieldKind::kStructList) {
+        push(TypeScriptStruct{field.nested, nullptr, entry.answer});
       }
     }
     out += "}\n";

@@ -114,6 +114,30 @@ TEST(OptionsTypeScript, LongUnionsBreakAsPrettierDoes) {
   EXPECT_NE(text.find("    | 'choice-number-11';\n}"), std::string::npos) << text;
 }
 
+// A result with a list of described structs: `LeafOptions[]`, and the element's interface declared once.
+struct ForestResult {
+  std::vector<LeafOptions> leaves;
+};
+
+template <>
+const StructInfo& InfoOf<ForestResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<ForestResult> b("ForestResult", "a forest");
+    b.Field(&ForestResult::leaves, "leaves", "every leaf");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(OptionsTypeScript, ListsOfStructsAreArraysOfTheirInterface) {
+  const std::string out = TypeScriptDeclarations({ResultType<ForestResult>()}, "");
+  EXPECT_NE(out.find("  leaves: LeafOptions[];\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("export interface LeafOptions {"), std::string::npos) << out;
+  const nlohmann::ordered_json json = DescriptionJson(InfoOf<ForestResult>());
+  EXPECT_EQ(json["fields"][0]["kind"], "struct_list");
+  EXPECT_EQ(json["fields"][0]["struct"]["name"], "LeafOptions");
+}
+
 TEST(OptionsTypeScript, TwoStructsOfOneNameThrow) {
   StructInfo a{"Same", "a", {}, nullptr}, b{"Same", "b", {}, nullptr};
   EXPECT_THROW(TypeScriptDeclarations({{&a, nullptr, false}, {&b, nullptr, false}}, ""), OptionsError);
