@@ -104,7 +104,10 @@ void BindResults(py::module_& m) {
           "scan", [](const RemoveResult& r) { return r.fill.scan; },
           "the scan without the object (fill.scan)");
 
-  py::class_<InpaintResult>(m, "InpaintResult", "The outcome of inpaint().")
+  // The numbers come from the descriptions (inpaint/options_info.cc, poisson/options_info.cc), as the CLI's
+  // --json writes them; the images are added here.
+  BindStruct<ReviewStop>(m, true);
+  BindStruct<InpaintResult>(m, true)
       .def_property_readonly(
           "image", [](const InpaintResult& r) { return MatToArray(r.image); },
           "float32 (H, W) or (H, W, C), the hole filled")
@@ -114,23 +117,11 @@ void BindResults(py::module_& m) {
       .def_property_readonly(
           "source_pixel", [](const InpaintResult& r) { return MatToArray(r.source_pixel); },
           "int32 (H, W, 2): (row, col) each pixel was copied from, (-1, -1) = known")
-      .def_readonly("iterations", &InpaintResult::iterations)
-      .def_readonly("hole_pixels", &InpaintResult::hole_pixels)
-      .def_readonly("candidates_evaluated", &InpaintResult::candidates_evaluated)
-      .def_readonly("acceptance_fallbacks", &InpaintResult::acceptance_fallbacks)
-      .def_readonly("rejected", &InpaintResult::rejected)
-      .def_readonly("seconds", &InpaintResult::seconds)
       .def("summary", &InpaintResult::Summary);
-
-  py::class_<PoissonResult>(m, "PoissonResult",
-                            "The outcome of poisson_fill() / reconstruct_from_gradients().")
+  BindStruct<PoissonResult>(m, true)
       .def_property_readonly(
           "image", [](const PoissonResult& r) { return MatToArray(r.image); },
           "float32 (H, W) or (H, W, C) (float64 for float64 input): the solution in the mask")
-      .def_property_readonly("solver", [](const PoissonResult& r) { return ToString(r.solver); })
-      .def_readonly("iterations", &PoissonResult::iterations)
-      .def_readonly("relative_residual", &PoissonResult::relative_residual)
-      .def_readonly("seconds", &PoissonResult::seconds)
       .def("summary", &PoissonResult::Summary);
 }
 

@@ -276,314 +276,399 @@ Eigen::Matrix4d WorldFromScanner(const PcdHeader& header, const std::string& fil
   return header.height > 1 ? Eigen::Matrix4d(viewpoint * CameraFromScanner()) : viewpoint;
 }
 
-}  // namespace
+// ---- ParsePcd's steps ----
 
-Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std::string>* warnings) {
-  if (bytes.empty()) ThrowInputError(file, "byte 0", "", "the file is empty");
-  PcdHeader header = ParseHeader(bytes, file);
+// Room for `size` bytes of point records, within what lidarshop accepts and the memory budget allows.
+void AllocateRecords(int64_t size, const PcdHeader& header, const std::string& file,
+                     std::vector<char>* records) {
+  if (size > static_cast<int64_t>(kMaxScanCells) * 64) {
+    ThrowInputError(file, "header", "POINTS",
+                    fmt::format("{} bytes of point data is more than lidarshop accepts", size));
+  }
+  CheckMemoryBudget(
+      size, fmt::format("{}: header: POINTS: {} points of {} bytes", file, header.points, header.point_size));
+  records->resize(static_cast<size_t>(size));
+}
+
+// DATA binary: the records as the file holds them.
+std::vector<char> BinaryRecords(const std::string& bytes, const std::string& file, const PcdHeader& header) {
+  const int64_t data_size = header.points * header.point_size;
+  const size_t available = bytes.size() - header.data_offset;
+  if (static_cast<int64_t>(available) < data_size) {
+    ThrowInputError(file, fmt::format("byte {}", bytes.size()), "DATA",
+                    fmt::format("truncated: {} points of {} bytes need {} bytes, {} follow the header",
+                                header.points, header.point_size, data_size, available));
+  }
+  std::vector<char> records;
+  AllocateRecords(data_size, header, file, &records);
+  std::memcpy(records.data(), bytes.data() + header.data_offset, records.size());
+  return records;
+}
+
+// DATA binary_compressed: LZF of each field for all points (SoA), interleaved into records.
+std::vector<char> CompressedRecords(const std::string& bytes, const std::string& file,
+                                    const PcdHeader& header) {
   const int64_t points = header.points;
   const int64_t data_size = points * header.point_size;
   const size_t available = bytes.size() - header.data_offset;
-  // The point records in AoS layout (one record after the other), whatever the file used.
+  if (available < 8) {
+    ThrowInputError(file, fmt::format("byte {}", header.data_offset), "compressed size", "truncated");
+  }
+  uint32_t compressed_size = 0, uncompressed_size = 0;
+  std::memcpy(&compressed_size, bytes.data() + header.data_offset, 4);
+  std::memcpy(&uncompressed_size, bytes.data() + header.data_offset + 4, 4);
+  if (uncompressed_size != data_size) {
+    ThrowInputError(file, fmt::format("byte {}", header.data_offset + 4), "uncompressed size",
+                    fmt::format("{} but {} points of {} bytes need {}", uncompressed_size, points,
+                                header.point_size, data_size));
+  }
+  if (compressed_size > available - 8) {
+    ThrowInputError(
+        file, fmt::format("byte {}", header.data_offset), "compressed size",
+        fmt::format("truncated: {} compressed bytes claimed, {} follow", compressed_size, available - 8));
+  }
+  // LZF expands at most 264 bytes from a 3-byte back reference: a size past that ratio is refused before
+  // the buffer is zero-filled (a 172-byte file claimed 1.2 GB).
+  constexpr int64_t kLzfMaxBytesPerByte = 88;
+  if (data_size > (int64_t{compressed_size} + 3) * kLzfMaxBytesPerByte) {
+    ThrowInputError(
+        file, fmt::format("byte {}", header.data_offset + 4), "uncompressed size",
+        fmt::format("{} bytes cannot come from {} bytes of LZF data", data_size, compressed_size));
+  }
+  CheckMemoryBudget(SaturatingBytes(data_size, 2), fmt::format("{}: header: POINTS: {} points of {} bytes",
+                                                               file, points, header.point_size));
+  std::vector<char> planar(static_cast<size_t>(data_size));
+  const unsigned int decompressed =
+      data_size == 0 ? 0
+                     : lzf_decompress(bytes.data() + header.data_offset + 8, compressed_size, planar.data(),
+                                      static_cast<unsigned int>(planar.size()));
+  if (decompressed != static_cast<unsigned int>(data_size)) {
+    ThrowInputError(
+        file, fmt::format("byte {}", header.data_offset + 8), "compressed data",
+        fmt::format("LZF decompression gave {} bytes, expected {} (corrupt data)", decompressed, data_size));
+  }
   std::vector<char> records;
-  auto allocate = [&](int64_t size) {
-    if (size > static_cast<int64_t>(kMaxScanCells) * 64) {
-      ThrowInputError(file, "header", "POINTS",
-                      fmt::format("{} bytes of point data is more than lidarshop accepts", size));
-    }
-    CheckMemoryBudget(
-        size, fmt::format("{}: header: POINTS: {} points of {} bytes", file, points, header.point_size));
-    records.resize(static_cast<size_t>(size));
-  };
-  if (header.data == "binary") {
-    if (static_cast<int64_t>(available) < data_size) {
-      ThrowInputError(file, fmt::format("byte {}", bytes.size()), "DATA",
-                      fmt::format("truncated: {} points of {} bytes need {} bytes, {} follow the header",
-                                  points, header.point_size, data_size, available));
-    }
-    allocate(data_size);
-    std::memcpy(records.data(), bytes.data() + header.data_offset, records.size());
-  } else if (header.data == "binary_compressed") {
-    if (available < 8) {
-      ThrowInputError(file, fmt::format("byte {}", header.data_offset), "compressed size", "truncated");
-    }
-    uint32_t compressed_size = 0, uncompressed_size = 0;
-    std::memcpy(&compressed_size, bytes.data() + header.data_offset, 4);
-    std::memcpy(&uncompressed_size, bytes.data() + header.data_offset + 4, 4);
-    if (uncompressed_size != data_size) {
-      ThrowInputError(file, fmt::format("byte {}", header.data_offset + 4), "uncompressed size",
-                      fmt::format("{} but {} points of {} bytes need {}", uncompressed_size, points,
-                                  header.point_size, data_size));
-    }
-    if (compressed_size > available - 8) {
-      ThrowInputError(
-          file, fmt::format("byte {}", header.data_offset), "compressed size",
-          fmt::format("truncated: {} compressed bytes claimed, {} follow", compressed_size, available - 8));
-    }
-    // LZF expands at most 264 bytes from a 3-byte back reference: a size past that ratio is refused before
-    // the buffer is zero-filled (a 172-byte file claimed 1.2 GB).
-    constexpr int64_t kLzfMaxBytesPerByte = 88;
-    if (data_size > (int64_t{compressed_size} + 3) * kLzfMaxBytesPerByte) {
-      ThrowInputError(
-          file, fmt::format("byte {}", header.data_offset + 4), "uncompressed size",
-          fmt::format("{} bytes cannot come from {} bytes of LZF data", data_size, compressed_size));
-    }
-    CheckMemoryBudget(SaturatingBytes(data_size, 2), fmt::format("{}: header: POINTS: {} points of {} bytes",
-                                                                 file, points, header.point_size));
-    std::vector<char> planar(static_cast<size_t>(data_size));
-    const unsigned int decompressed =
-        data_size == 0 ? 0
-                       : lzf_decompress(bytes.data() + header.data_offset + 8, compressed_size, planar.data(),
-                                        static_cast<unsigned int>(planar.size()));
-    if (decompressed != static_cast<unsigned int>(data_size)) {
-      ThrowInputError(file, fmt::format("byte {}", header.data_offset + 8), "compressed data",
-                      fmt::format("LZF decompression gave {} bytes, expected {} (corrupt data)", decompressed,
-                                  data_size));
-    }
-    allocate(data_size);
-    // binary_compressed stores each field for all points (SoA); interleave into records.
-    int64_t plane = 0;
-    for (const PcdField& field : header.fields) {
-      const int64_t field_bytes = static_cast<int64_t>(field.size) * field.count;
-      for (int64_t i = 0; i < points; ++i) {
-        std::memcpy(records.data() + i * header.point_size + field.offset,
-                    planar.data() + plane + i * field_bytes, field_bytes);
-      }
-      plane += points * field_bytes;
-    }
-  } else {
-    // ascii: every value into a binary record of the declared type, except that F values are kept as doubles:
-    // the text holds the file's precision (UTM coordinates in a "SIZE 4" field, as PDAL writes them).
-    // Every value takes at least a digit and a separator.
-    int64_t values_per_point = 0;
-    for (const PcdField& field : header.fields) values_per_point += field.count;
-    if (static_cast<int64_t>(available) + 1 < SaturatingBytes(points, 2 * values_per_point)) {
-      ThrowInputError(file, fmt::format("line {}", header.data_line), "DATA",
-                      fmt::format("truncated: {} points of {} values claimed, only {} bytes follow", points,
-                                  values_per_point, available));
-    }
-    header.point_size = 0;
-    for (PcdField& field : header.fields) {
-      if (field.type == 'F') field.size = 8;
-      field.offset = header.point_size;
-      header.point_size += static_cast<int64_t>(field.size) * field.count;
-    }
-    allocate(points * header.point_size);
-    TextCursor cursor(std::string_view(bytes).substr(header.data_offset), file, header.data_line);
-    // Values separated by blanks (spaces or tabs) or by commas (PDAL's utm17_comma.pcd).
-    cursor.set_separator(',');
+  AllocateRecords(data_size, header, file, &records);
+  int64_t plane = 0;
+  for (const PcdField& field : header.fields) {
+    const int64_t field_bytes = static_cast<int64_t>(field.size) * field.count;
     for (int64_t i = 0; i < points; ++i) {
-      cursor.SkipEmptyLines();
-      if (cursor.AtEnd()) cursor.Fail("", fmt::format("truncated: {} points claimed, found {}", points, i));
-      for (const PcdField& field : header.fields) {
-        for (int k = 0; k < field.count; ++k) {
-          char* out = records.data() + i * header.point_size + field.offset + k * field.size;
-          const double value = cursor.Number<double>(field.name, /*allow_nonfinite=*/true);
-          if (field.type == 'F') {
-            std::memcpy(out, &value, 8);
-          } else {
-            if (!(std::abs(value) < 0x1p63)) cursor.Fail(field.name, "not an integer in range");
-            const int64_t integer = static_cast<int64_t>(value);
-            const uint64_t bits = static_cast<uint64_t>(integer);
-            std::memcpy(out, &bits, field.size);  // little-endian truncation
-          }
+      std::memcpy(records.data() + i * header.point_size + field.offset,
+                  planar.data() + plane + i * field_bytes, field_bytes);
+    }
+    plane += points * field_bytes;
+  }
+  return records;
+}
+
+// DATA ascii: every value into a binary record of the declared type, except that F values are kept as doubles
+// (*header's sizes and offsets are changed to say so): the text holds the file's precision (UTM coordinates in
+// a "SIZE 4" field, as PDAL writes them).
+std::vector<char> AsciiRecords(const std::string& bytes, const std::string& file, PcdHeader* header) {
+  const int64_t points = header->points;
+  const size_t available = bytes.size() - header->data_offset;
+  // Every value takes at least a digit and a separator.
+  int64_t values_per_point = 0;
+  for (const PcdField& field : header->fields) values_per_point += field.count;
+  if (static_cast<int64_t>(available) + 1 < SaturatingBytes(points, 2 * values_per_point)) {
+    ThrowInputError(file, fmt::format("line {}", header->data_line), "DATA",
+                    fmt::format("truncated: {} points of {} values claimed, only {} bytes follow", points,
+                                values_per_point, available));
+  }
+  header->point_size = 0;
+  for (PcdField& field : header->fields) {
+    if (field.type == 'F') field.size = 8;
+    field.offset = header->point_size;
+    header->point_size += static_cast<int64_t>(field.size) * field.count;
+  }
+  std::vector<char> records;
+  AllocateRecords(points * header->point_size, *header, file, &records);
+  TextCursor cursor(std::string_view(bytes).substr(header->data_offset), file, header->data_line);
+  // Values separated by blanks (spaces or tabs) or by commas (PDAL's utm17_comma.pcd).
+  cursor.set_separator(',');
+  for (int64_t i = 0; i < points; ++i) {
+    cursor.SkipEmptyLines();
+    if (cursor.AtEnd()) cursor.Fail("", fmt::format("truncated: {} points claimed, found {}", points, i));
+    for (const PcdField& field : header->fields) {
+      for (int k = 0; k < field.count; ++k) {
+        char* out = records.data() + i * header->point_size + field.offset + k * field.size;
+        const double value = cursor.Number<double>(field.name, /*allow_nonfinite=*/true);
+        if (field.type == 'F') {
+          std::memcpy(out, &value, 8);
+        } else {
+          if (!(std::abs(value) < 0x1p63)) cursor.Fail(field.name, "not an integer in range");
+          const int64_t integer = static_cast<int64_t>(value);
+          const uint64_t bits = static_cast<uint64_t>(integer);
+          std::memcpy(out, &bits, field.size);  // little-endian truncation
         }
       }
-      cursor.EndLine("the fields of a point");
     }
-    cursor.SkipEmptyLines();
-    if (!cursor.AtEnd()) cursor.Fail("POINTS", fmt::format("more point lines than the {} claimed", points));
+    cursor.EndLine("the fields of a point");
   }
+  cursor.SkipEmptyLines();
+  if (!cursor.AtEnd()) cursor.Fail("POINTS", fmt::format("more point lines than the {} claimed", points));
+  return records;
+}
 
-  const bool organized = header.height > 1;
-  const int rows = static_cast<int>(header.height), cols = static_cast<int>(header.width);
-  const auto& f = header.fields;
-  const int fx = header.Find("x"), fy = header.Find("y"), fz = header.Find("z");
-  auto record_of = [&](int64_t cell) { return records.data() + cell * header.point_size; };
+// The point records in AoS layout (one record after the other), whatever the file used, and the points they
+// hold.
+struct PcdRecords {
+  const PcdHeader& header;
+  const std::string& file;
+  std::vector<char> bytes;
+  bool organized = false;
+  int fx = -1, fy = -1, fz = -1;
+
+  const char* Record(int64_t cell) const { return bytes.data() + cell * header.point_size; }
+  double Value(int64_t cell, int field) const {
+    return LoadValue(Record(cell) + header.fields[field].offset, header.fields[field]);
+  }
   // The point of a cell as the file holds it (world frame); false for a missing point (NaN; (0, 0, 0) in an
   // organized cloud, the grid's no-return convention).
-  auto file_point = [&](int64_t cell, Eigen::Vector3d* point) {
-    const char* record = record_of(cell);
-    *point = Eigen::Vector3d(LoadValue(record + f[fx].offset, f[fx]), LoadValue(record + f[fy].offset, f[fy]),
-                             LoadValue(record + f[fz].offset, f[fz]));
+  bool Point(int64_t cell, Eigen::Vector3d* point) const {
+    *point = Eigen::Vector3d(Value(cell, fx), Value(cell, fy), Value(cell, fz));
     if (!point->allFinite()) return false;
     for (int axis = 0; axis < 3; ++axis) {
       if (!(std::abs((*point)[axis]) <= kMaxCoordinateM)) {
-        ThrowInputError(file, fmt::format("point {}", cell), f[std::array{fx, fy, fz}[axis]].name,
+        ThrowInputError(file, fmt::format("point {}", cell), header.fields[std::array{fx, fy, fz}[axis]].name,
                         fmt::format("{} is not a coordinate within {} m", (*point)[axis], kMaxCoordinateM));
       }
     }
     return !(organized && point->isZero());
-  };
+  }
+};
 
-  int fcolor = header.Find("rgba");
-  if (fcolor < 0) fcolor = header.Find("rgb");
+// Which fields beside x, y, z the file has, and how their values scale into a scan's channels.
+struct PcdChannels {
+  int packed_color = -1;  // rgb / rgba, packed as PCL does
   // PDAL writes colour as three fields Red Green Blue (16-bit); PCL packs it into one rgb/rgba field.
-  const int fred = header.Find("red"), fgreen = header.Find("green"), fblue = header.Find("blue");
-  const bool split_color = fcolor < 0 && fred >= 0 && fgreen >= 0 && fblue >= 0;
+  int red = -1, green = -1, blue = -1;
+  bool split_color = false;
   double split_color_scale = 1.0;
-  if (split_color) {
-    double highest = 0;
-    for (int64_t cell = 0; cell < points; ++cell) {
-      for (int field : {fred, fgreen, fblue})
-        highest = std::max(highest, LoadValue(record_of(cell) + f[field].offset, f[field]));
-    }
-    if (highest > 255) split_color_scale = 1.0 / 257.0;  // 16-bit colour, 65535 -> 255
-  }
-  const int fintensity = header.Find("intensity");
-  // Integer intensities (PDAL writes LAS's 16-bit ones) are scaled by their type's range to [0, 1].
+  int intensity = -1;
   double intensity_scale = 1.0;
-  if (fintensity >= 0 && f[fintensity].type != 'F') {
-    const int bits = 8 * f[fintensity].size - (f[fintensity].type == 'I' ? 1 : 0);
-    intensity_scale = 1.0 / (std::ldexp(1.0, bits) - 1.0);
-  }
-  const int flabel = header.Find("label");
-  const int fnx = header.Find("normal_x"), fny = header.Find("normal_y"), fnz = header.Find("normal_z");
-  const int fcurvature = header.Find("curvature");
-  const int fsynth = header.Find("synthesized");
-  const int ftrue = header.Find("true_range");
-  const int ffrom = header.Find("from_station");
-  const bool with_color = fcolor >= 0 || split_color;
-  const bool normals = fnx >= 0 && fny >= 0 && fnz >= 0;
+  int label = -1, normal_x = -1, normal_y = -1, normal_z = -1, curvature = -1;
+  int synthesized = -1, true_range = -1, from_station = -1;
 
-  // The file's numbers are the points in the world frame; VIEWPOINT is the sensor's pose in that frame
-  // (PCL's sensor_origin_ / sensor_orientation_, which PCL, Open3D and CloudCompare do not apply to the
-  // points). The scan keeps both: WorldPointOfCell gives the file's numbers, world_from_scanner the pose.
-  Scan scan;
-  if (!organized) {
-    std::vector<Eigen::Vector3d> world(static_cast<size_t>(points));
-    std::vector<uint8_t> valid(static_cast<size_t>(points), 0);
-    for (int64_t cell = 0; cell < points; ++cell) valid[cell] = file_point(cell, &world[cell]) ? 1 : 0;
-    const Eigen::Matrix4d preferred =
-        header.has_scanner_pose ? header.world_from_scanner : Viewpoint(header, file);
-    scan = io_internal::UnorganizedScan(world, valid, with_color, fintensity >= 0, preferred);
-    // Worth a word only when the file gives a sensor pose (an identity VIEWPOINT is PCL's "unknown").
-    if (warnings != nullptr && !header.has_scanner_pose && !preferred.isIdentity() &&
-        !scan.world_from_scanner.topRightCorner<3, 1>().isApprox(preferred.topRightCorner<3, 1>())) {
-      warnings->push_back(
-          fmt::format("{}: the points lie more than {} m from the VIEWPOINT position; the scan's origin is "
-                      "moved near them "
-                      "so that floats keep 0.1 mm (the points are unchanged)",
-                      file, io_internal::kCloudFloatSafeM));
+  bool color() const { return packed_color >= 0 || split_color; }
+  bool normals() const { return normal_x >= 0 && normal_y >= 0 && normal_z >= 0; }
+};
+
+PcdChannels FindChannels(const PcdRecords& records) {
+  const PcdHeader& header = records.header;
+  PcdChannels channels;
+  channels.packed_color = header.Find("rgba");
+  if (channels.packed_color < 0) channels.packed_color = header.Find("rgb");
+  channels.red = header.Find("red");
+  channels.green = header.Find("green");
+  channels.blue = header.Find("blue");
+  channels.split_color =
+      channels.packed_color < 0 && channels.red >= 0 && channels.green >= 0 && channels.blue >= 0;
+  if (channels.split_color) {
+    double highest = 0;
+    for (int64_t cell = 0; cell < header.points; ++cell) {
+      for (int field : {channels.red, channels.green, channels.blue})
+        highest = std::max(highest, records.Value(cell, field));
     }
-  } else {
-    scan = MakeScan(rows, cols, with_color, fintensity >= 0);
-    scan.world_from_scanner = WorldFromScanner(header, file);
-    if (!header.has_scanner_pose) {
-      // An organized cloud is a camera image: the sensor frame is an optical frame, x right, y down, z forward
-      // (PCL), or the OpenGL one, y up and z backward, which a VIEWPOINT turned half a turn about x gives
-      // (PCL's stereo data). The points lie in front of the camera: when most lie behind the optical frame
-      // the sensor frame is the OpenGL one. Either way row 0 is the top of the image, as scans have it.
-      const Eigen::Matrix4d file_from_viewpoint = Viewpoint(header, file).inverse();
-      int64_t front = 0, behind = 0;
-      for (int64_t cell = 0; cell < points; ++cell) {
-        Eigen::Vector3d point;
-        if (!file_point(cell, &point)) continue;
-        const double depth = file_from_viewpoint.row(2).head<3>().dot(point) + file_from_viewpoint(2, 3);
-        (depth < 0 ? behind : front) += 1;
-      }
-      if (behind > 9 * front) {
-        Eigen::Matrix4d flip = Eigen::Matrix4d::Identity();  // OpenGL from optical: half a turn about x
-        flip(1, 1) = flip(2, 2) = -1;
-        scan.world_from_scanner = Viewpoint(header, file) * flip * CameraFromScanner();
-      }
-    }
-    const Eigen::Matrix4d scanner_from_world = scan.world_from_scanner.inverse();
-    const Eigen::Matrix3d rotate = scanner_from_world.topLeftCorner<3, 3>();
-    const Eigen::Vector3d shift = scanner_from_world.topRightCorner<3, 1>();
-    // Points beyond kScanRangeKeptM of the sensor: a local origin held in the pose (io_common.h).
-    std::vector<Eigen::Vector3d> in_scanner(static_cast<size_t>(points));
-    std::vector<uint8_t> valid(static_cast<size_t>(points), 0);
-    Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
-    for (int64_t cell = 0; cell < points; ++cell) {
-      Eigen::Vector3d point;
-      if (!file_point(cell, &point)) continue;
-      valid[cell] = 1;
-      in_scanner[cell] = rotate * point + shift;
-      low = low.cwiseMin(in_scanner[cell]);
-      high = high.cwiseMax(in_scanner[cell]);
-    }
-    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-    if ((low.array() <= high.array()).all()) origin = io_internal::FarScanOrigin(low, high);
-    if (!origin.isZero()) {
-      origin = io_internal::OriginClearOfPoints(origin, in_scanner, valid);
-      scan.world_from_scanner.topRightCorner<3, 1>() +=
-          scan.world_from_scanner.topLeftCorner<3, 3>() * origin;
-      if (warnings != nullptr) {
-        warnings->push_back(fmt::format(
-            "{}: the points lie more than {} m from the sensor (VIEWPOINT): they are not read as its rays "
-            "but "
-            "relative to a local origin, so that floats keep 0.1 mm; the directions are from that origin",
-            file, io_internal::kScanRangeKeptM));
-      }
-    }
-    for (int64_t cell = 0; cell < points; ++cell) {
-      if (!valid[cell]) continue;
-      const Eigen::Vector3f p = (in_scanner[cell] - origin).cast<float>();
-      scan.valid.at<uint8_t>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) = kValid;
-      scan.point.at<cv::Vec3f>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) =
-          cv::Vec3f(p.x(), p.y(), p.z());
+    if (highest > 255) channels.split_color_scale = 1.0 / 257.0;  // 16-bit colour, 65535 -> 255
+  }
+  channels.intensity = header.Find("intensity");
+  // Integer intensities (PDAL writes LAS's 16-bit ones) are scaled by their type's range to [0, 1].
+  if (channels.intensity >= 0 && header.fields[channels.intensity].type != 'F') {
+    const PcdField& field = header.fields[channels.intensity];
+    const int bits = 8 * field.size - (field.type == 'I' ? 1 : 0);
+    channels.intensity_scale = 1.0 / (std::ldexp(1.0, bits) - 1.0);
+  }
+  channels.label = header.Find("label");
+  channels.normal_x = header.Find("normal_x");
+  channels.normal_y = header.Find("normal_y");
+  channels.normal_z = header.Find("normal_z");
+  channels.curvature = header.Find("curvature");
+  channels.synthesized = header.Find("synthesized");
+  channels.true_range = header.Find("true_range");
+  channels.from_station = header.Find("from_station");
+  return channels;
+}
+
+// The file's numbers are the points in the world frame; VIEWPOINT is the sensor's pose in that frame (PCL's
+// sensor_origin_ / sensor_orientation_, which PCL, Open3D and CloudCompare do not apply to the points). The
+// scan keeps both: WorldPointOfCell gives the file's numbers, world_from_scanner the pose.
+Scan UnorganizedPcdScan(const PcdRecords& records, const PcdChannels& channels,
+                        std::vector<std::string>* warnings) {
+  const PcdHeader& header = records.header;
+  std::vector<Eigen::Vector3d> world(static_cast<size_t>(header.points));
+  std::vector<uint8_t> valid(static_cast<size_t>(header.points), 0);
+  for (int64_t cell = 0; cell < header.points; ++cell)
+    valid[cell] = records.Point(cell, &world[cell]) ? 1 : 0;
+  const Eigen::Matrix4d preferred =
+      header.has_scanner_pose ? header.world_from_scanner : Viewpoint(header, records.file);
+  Scan scan =
+      io_internal::UnorganizedScan(world, valid, channels.color(), channels.intensity >= 0, preferred);
+  // Worth a word only when the file gives a sensor pose (an identity VIEWPOINT is PCL's "unknown").
+  if (warnings != nullptr && !header.has_scanner_pose && !preferred.isIdentity() &&
+      !scan.world_from_scanner.topRightCorner<3, 1>().isApprox(preferred.topRightCorner<3, 1>())) {
+    warnings->push_back(
+        fmt::format("{}: the points lie more than {} m from the VIEWPOINT position; the scan's origin is "
+                    "moved near them "
+                    "so that floats keep 0.1 mm (the points are unchanged)",
+                    records.file, io_internal::kCloudFloatSafeM));
+  }
+  return scan;
+}
+
+// An organized cloud is a camera image: the sensor frame is an optical frame, x right, y down, z forward (PCL),
+// or the OpenGL one, y up and z backward, which a VIEWPOINT turned half a turn about x gives (PCL's stereo
+// data). The points lie in front of the camera: when most lie behind the optical frame the sensor frame is
+// the OpenGL one. Either way row 0 is the top of the image, as scans have it.
+Eigen::Matrix4d OrganizedWorldFromScanner(const PcdRecords& records) {
+  const PcdHeader& header = records.header;
+  if (header.has_scanner_pose) return WorldFromScanner(header, records.file);
+  const Eigen::Matrix4d file_from_viewpoint = Viewpoint(header, records.file).inverse();
+  int64_t front = 0, behind = 0;
+  for (int64_t cell = 0; cell < header.points; ++cell) {
+    Eigen::Vector3d point;
+    if (!records.Point(cell, &point)) continue;
+    const double depth = file_from_viewpoint.row(2).head<3>().dot(point) + file_from_viewpoint(2, 3);
+    (depth < 0 ? behind : front) += 1;
+  }
+  if (behind > 9 * front) {
+    Eigen::Matrix4d flip = Eigen::Matrix4d::Identity();  // OpenGL from optical: half a turn about x
+    flip(1, 1) = flip(2, 2) = -1;
+    return Viewpoint(header, records.file) * flip * CameraFromScanner();
+  }
+  return WorldFromScanner(header, records.file);
+}
+
+// The organized cloud's points in the sensor frame; points beyond kScanRangeKeptM of the sensor are read
+// relative to a local origin held in the pose (io_common.h).
+Scan OrganizedPcdScan(const PcdRecords& records, const PcdChannels& channels,
+                      std::vector<std::string>* warnings) {
+  const PcdHeader& header = records.header;
+  const int rows = static_cast<int>(header.height), cols = static_cast<int>(header.width);
+  Scan scan = MakeScan(rows, cols, channels.color(), channels.intensity >= 0);
+  scan.world_from_scanner = OrganizedWorldFromScanner(records);
+  const Eigen::Matrix4d scanner_from_world = scan.world_from_scanner.inverse();
+  const Eigen::Matrix3d rotate = scanner_from_world.topLeftCorner<3, 3>();
+  const Eigen::Vector3d shift = scanner_from_world.topRightCorner<3, 1>();
+  std::vector<Eigen::Vector3d> in_scanner(static_cast<size_t>(header.points));
+  std::vector<uint8_t> valid(static_cast<size_t>(header.points), 0);
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity()), high = -low;
+  for (int64_t cell = 0; cell < header.points; ++cell) {
+    Eigen::Vector3d point;
+    if (!records.Point(cell, &point)) continue;
+    valid[cell] = 1;
+    in_scanner[cell] = rotate * point + shift;
+    low = low.cwiseMin(in_scanner[cell]);
+    high = high.cwiseMax(in_scanner[cell]);
+  }
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  if ((low.array() <= high.array()).all()) origin = io_internal::FarScanOrigin(low, high);
+  if (!origin.isZero()) {
+    origin = io_internal::OriginClearOfPoints(origin, in_scanner, valid);
+    scan.world_from_scanner.topRightCorner<3, 1>() += scan.world_from_scanner.topLeftCorner<3, 3>() * origin;
+    if (warnings != nullptr) {
+      warnings->push_back(fmt::format(
+          "{}: the points lie more than {} m from the sensor (VIEWPOINT): they are not read as its rays "
+          "but "
+          "relative to a local origin, so that floats keep 0.1 mm; the directions are from that origin",
+          records.file, io_internal::kScanRangeKeptM));
     }
   }
-  if (flabel >= 0) scan.label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
-  if (normals) scan.normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
-  if (fcurvature >= 0) scan.curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
-  if (fsynth >= 0) scan.synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
-  if (ftrue >= 0) scan.true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
-  if (ffrom >= 0) scan.from_station = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  for (int64_t cell = 0; cell < header.points; ++cell) {
+    if (!valid[cell]) continue;
+    const Eigen::Vector3f p = (in_scanner[cell] - origin).cast<float>();
+    scan.valid.at<uint8_t>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) = kValid;
+    scan.point.at<cv::Vec3f>(static_cast<int>(cell / cols), static_cast<int>(cell % cols)) =
+        cv::Vec3f(p.x(), p.y(), p.z());
+  }
+  return scan;
+}
+
+// Colour, intensity, labels, normals (turned into the sensor frame) and lidarshop's own channels of every
+// cell with a return.
+void ReadChannels(const PcdRecords& records, const PcdChannels& channels, Scan* scan) {
+  const PcdHeader& header = records.header;
+  const int rows = static_cast<int>(header.height), cols = static_cast<int>(header.width);
+  if (channels.label >= 0) scan->label = cv::Mat(rows, cols, CV_32S, cv::Scalar(kNoLabel));
+  if (channels.normals()) scan->normal = cv::Mat(rows, cols, CV_32FC3, cv::Scalar::all(0));
+  if (channels.curvature >= 0) scan->curvature = cv::Mat(rows, cols, CV_32F, cv::Scalar(NAN));
+  if (channels.synthesized >= 0) scan->synthesized = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
+  if (channels.true_range >= 0) scan->true_range = cv::Mat(rows, cols, CV_32F, cv::Scalar(0));
+  if (channels.from_station >= 0) scan->from_station = cv::Mat(rows, cols, CV_8U, cv::Scalar(0));
   const Eigen::Matrix3d scanner_from_world_rotation =
-      scan.world_from_scanner.topLeftCorner<3, 3>().transpose();
+      scan->world_from_scanner.topLeftCorner<3, 3>().transpose();
   for (int row = 0; row < rows; ++row) {
     for (int col = 0; col < cols; ++col) {
-      if (!scan.valid.at<uint8_t>(row, col)) continue;
-      const char* record = record_of(static_cast<int64_t>(row) * cols + col);
-      if (fcolor >= 0) {
-        const uint32_t bits = PackedColor(record + f[fcolor].offset, f[fcolor]);
-        scan.color.at<cv::Vec3b>(row, col) = cv::Vec3b((bits >> 16) & 0xff, (bits >> 8) & 0xff, bits & 0xff);
-      } else if (split_color) {
-        cv::Vec3b& color = scan.color.at<cv::Vec3b>(row, col);
-        const int channels[3] = {fred, fgreen, fblue};
+      if (!scan->valid.at<uint8_t>(row, col)) continue;
+      const int64_t cell = static_cast<int64_t>(row) * cols + col;
+      if (channels.packed_color >= 0) {
+        const PcdField& field = header.fields[channels.packed_color];
+        const uint32_t bits = PackedColor(records.Record(cell) + field.offset, field);
+        scan->color.at<cv::Vec3b>(row, col) = cv::Vec3b((bits >> 16) & 0xff, (bits >> 8) & 0xff, bits & 0xff);
+      } else if (channels.split_color) {
+        cv::Vec3b& color = scan->color.at<cv::Vec3b>(row, col);
+        const int fields[3] = {channels.red, channels.green, channels.blue};
         for (int c = 0; c < 3; ++c) {
-          const double value = LoadValue(record + f[channels[c]].offset, f[channels[c]]) * split_color_scale;
+          const double value = records.Value(cell, fields[c]) * channels.split_color_scale;
           color[c] = static_cast<uint8_t>(std::clamp(std::round(value), 0.0, 255.0));
         }
       }
-      if (fintensity >= 0) {
-        const double value = LoadValue(record + f[fintensity].offset, f[fintensity]) * intensity_scale;
-        if (std::isfinite(value)) scan.intensity.at<float>(row, col) = static_cast<float>(value);
+      if (channels.intensity >= 0) {
+        const double value = records.Value(cell, channels.intensity) * channels.intensity_scale;
+        if (std::isfinite(value)) scan->intensity.at<float>(row, col) = static_cast<float>(value);
       }
-      if (flabel >= 0) {
-        scan.label.at<int32_t>(row, col) =
-            io_internal::ToInt32(LoadValue(record + f[flabel].offset, f[flabel]), kNoLabel);
+      if (channels.label >= 0) {
+        scan->label.at<int32_t>(row, col) =
+            io_internal::ToInt32(records.Value(cell, channels.label), kNoLabel);
       }
-      if (normals) {
-        const Eigen::Vector3d n(LoadValue(record + f[fnx].offset, f[fnx]),
-                                LoadValue(record + f[fny].offset, f[fny]),
-                                LoadValue(record + f[fnz].offset, f[fnz]));
+      if (channels.normals()) {
+        const Eigen::Vector3d n(records.Value(cell, channels.normal_x),
+                                records.Value(cell, channels.normal_y),
+                                records.Value(cell, channels.normal_z));
         if (n.allFinite()) {
           const Eigen::Vector3f m = (scanner_from_world_rotation * n).cast<float>();
-          scan.normal.at<cv::Vec3f>(row, col) = cv::Vec3f(m.x(), m.y(), m.z());
+          scan->normal.at<cv::Vec3f>(row, col) = cv::Vec3f(m.x(), m.y(), m.z());
         }
       }
-      if (fcurvature >= 0) {
-        scan.curvature.at<float>(row, col) =
-            static_cast<float>(LoadValue(record + f[fcurvature].offset, f[fcurvature]));
+      if (channels.curvature >= 0) {
+        scan->curvature.at<float>(row, col) = static_cast<float>(records.Value(cell, channels.curvature));
       }
-      if (fsynth >= 0 && LoadValue(record + f[fsynth].offset, f[fsynth]) != 0) {
-        scan.synthesized.at<uint8_t>(row, col) = kValid;
+      if (channels.synthesized >= 0 && records.Value(cell, channels.synthesized) != 0) {
+        scan->synthesized.at<uint8_t>(row, col) = kValid;
       }
-      if (ftrue >= 0) scan.true_range.at<float>(row, col) = LoadValue(record + f[ftrue].offset, f[ftrue]);
-      if (ffrom >= 0) {
-        const double from = LoadValue(record + f[ffrom].offset, f[ffrom]);
-        scan.from_station.at<uint8_t>(row, col) =
+      if (channels.true_range >= 0)
+        scan->true_range.at<float>(row, col) = records.Value(cell, channels.true_range);
+      if (channels.from_station >= 0) {
+        const double from = records.Value(cell, channels.from_station);
+        scan->from_station.at<uint8_t>(row, col) =
             std::isfinite(from) ? static_cast<uint8_t>(std::clamp(from, 0.0, 255.0)) : 0;
       }
     }
   }
   // Pictures show integer intensities in the file's units (render/render.h).
-  if (intensity_scale != 1.0)
-    scan.source_metadata["intensity.file_maximum"] = fmt::format("{}", 1.0 / intensity_scale);
-  io_internal::FinishScan(&scan, /*fit_grid=*/organized);
+  if (channels.intensity_scale != 1.0)
+    scan->source_metadata["intensity.file_maximum"] = fmt::format("{}", 1.0 / channels.intensity_scale);
+}
+
+}  // namespace
+
+Scan ParsePcd(const std::string& bytes, const std::string& file, std::vector<std::string>* warnings) {
+  if (bytes.empty()) ThrowInputError(file, "byte 0", "", "the file is empty");
+  PcdHeader header = ParseHeader(bytes, file);
+  std::vector<char> record_bytes = header.data == "binary" ? BinaryRecords(bytes, file, header)
+                                   : header.data == "binary_compressed"
+                                       ? CompressedRecords(bytes, file, header)
+                                       : AsciiRecords(bytes, file, &header);
+  PcdRecords records{header, file, std::move(record_bytes)};
+  records.organized = header.height > 1;
+  records.fx = header.Find("x");
+  records.fy = header.Find("y");
+  records.fz = header.Find("z");
+  const PcdChannels channels = FindChannels(records);
+  Scan scan = records.organized ? OrganizedPcdScan(records, channels, warnings)
+                                : UnorganizedPcdScan(records, channels, warnings);
+  ReadChannels(records, channels, &scan);
+  io_internal::FinishScan(&scan, /*fit_grid=*/records.organized);
   return scan;
 }
 

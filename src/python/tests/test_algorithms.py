@@ -103,11 +103,16 @@ def test_inpaint_and_poisson():
     assert result.image.shape == (rows, cols, 3)
     # A linear ramp is harmonic: the membrane fill reproduces it.
     np.testing.assert_allclose(result.image[hole > 0], image[hole > 0], atol=1e-3)
+    # The numbers are the described result's, as the CLI's poisson --json writes them.
+    assert list(result.to_dict()) == list(lidarshop.PoissonResult.fields)
+    assert result.operation == "fill" and result.unknowns == int((hole > 0).sum()) and result.channels == 3
     grey = (x % 10 < 5).astype(np.float32) * 100
     painted = lidarshop.inpaint(grey, hole, lidarshop.InpaintOptions(patch_radius=3))
     assert painted.image.shape == (rows, cols)
     assert painted.hole_pixels == int((hole > 0).sum())
     assert np.all((painted.fill_iteration >= 0) == (hole > 0))
+    assert painted.complete and "review" not in painted.to_dict()  # review: only when a fill stopped for one
+    assert list(painted.to_dict()) == [key for key in lidarshop.InpaintResult.fields if key != "review"]
     np.testing.assert_array_equal(painted.image[hole == 0], grey[hole == 0])
     gx = np.zeros_like(grey)
     gy = np.zeros_like(grey)
