@@ -3,9 +3,8 @@
 // `lidarshop batch` runs one of these per scan: the process starts once (the executable's libraries, OpenCV's
 // plugin on the first picture) instead of once per step, and a crash or a memory blow-up still ends only the
 // scan's process, not the batch's worker. What one command leaves in the process is reset before the next: the
-// memory budget (to what `steps` itself was given); the CLI11 app, its flags and the summary line are made anew
-// by every command already. The protected inputs (util/atomic_file.h: an --options file, the FILE of FILE#N)
-// stay protected for the later steps.
+// memory budget (to what `steps` itself was given) and the protected inputs (util/atomic_file.h: an --options
+// file, the FILE of FILE#N); the CLI11 app, its flags and the summary line are made anew by every command.
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -24,6 +23,7 @@
 
 #include "lidarshop/cli/command_line.h"
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
@@ -108,10 +108,10 @@ class StderrTap {
       active_ = nullptr;
       std::fflush(stderr);
       std::clog.flush();
-      dup2(saved_, 2);  // closes the pipe's write end: the thread reads to its end
+      dup2(saved_, 2);  // closes the pipe's write end: the thread copies the rest, then sees its end
+      thread_.join();
       close(saved_);
       saved_ = -1;
-      thread_.join();
       close(read_);
       EndLine();
     }
@@ -192,6 +192,7 @@ int RunSteps(int argc, char** argv) {
                                                               {"stderr_offset", stderr_offset}});
       if (to_file) WriteJsonOutput(json_path, report);
       SetMemoryBudgetBytes(budget);
+      ForgetProtectedInputs();
       std::vector<std::string> arguments = step;
       std::vector<char*> pointers;
       for (std::string& argument : arguments) pointers.push_back(argument.data());
