@@ -51,6 +51,30 @@ if "$lidarshop" batch --help >/dev/null 2>&1; then
   exits_with 2 "usage: batch names the pipeline's problem" "empty_pipeline.json: expected .*at least one step" \
     "$lidarshop" batch "$work/empty_pipeline.json" "$work/scan.ptx" --out "$work/batch2"
 fi
+# steps (what batch runs per scan): several commands in one process, nothing of one left to the next. The scan
+# runs after a step with a 1 MiB memory budget (alone with it, it fails: its triangles need about 5 MiB), and the
+# fill reads its --options from a file the last step then writes over (protected for the fill only).
+echo '{"method": "laplace"}' >"$work/steps_options.json"
+printf '{"steps": [["formats", "--json", "%s", "--max-memory", "1M"], ["scan", "%s", "-o", "%s"],
+  ["fill", "%s", "--mask", "%s", "-o", "%s", "--options", "%s"], ["formats", "--json", "%s"]]}' \
+  "$work/formats.json" "$work/scene/scene.json" "$work/steps_scan.ptx" "$work/steps_scan.ptx" "$work/mask.png" \
+  "$work/steps_filled.ply" "$work/steps_options.json" "$work/steps_options.json" >"$work/steps.json"
+check "steps" "$lidarshop" steps "$work/steps.json" --json "$work/steps_report.json" --quiet
+json_check "steps report" "$work/steps_report.json" \
+  "d['exit'] == 0 and [s['command'] for s in d['steps']] == ['formats', 'scan', 'fill', 'formats'] and \
+   all(s['exit'] == 0 and s['seconds'] >= 0 for s in d['steps']) and d['steps'][2]['message'].startswith('lidarshop fill: ')"
+json_check "... the last step wrote over the fill's options" "$work/steps_options.json" "'formats' in d"
+printf '{"steps": [["formats", "--json", "%s"], ["fill", "%s", "--mask", "%s", "-o", "%s", "--patch-radius", "0"],
+  ["formats"]]}' "$work/formats.json" "$work/scan.ptx" "$work/mask.png" "$work/x.ply" >"$work/steps_failing.json"
+exits_with 2 "steps: a failing step ends the run with its exit code and message" \
+  "^lidarshop fill: --patch-radius: 0 is out of range" \
+  "$lidarshop" steps "$work/steps_failing.json" --json "$work/steps_failing_report.json"
+json_check "... reported, the steps after it not run" "$work/steps_failing_report.json" \
+  "d['exit'] == 2 and [s['exit'] for s in d['steps']] == [0, 2] and \
+   d['steps'][1]['message'].startswith('lidarshop fill: --patch-radius: 0 is out of range')"
+echo '{"steps": [["formats"], ["batch", "p.json"]]}' >"$work/steps_nested.json"
+exits_with 1 "steps: batch cannot be a step" "steps\[1\].*'batch' cannot be a step" \
+  "$lidarshop" steps "$work/steps_nested.json"
 exits_with 2 "usage: did you mean" "unknown option --patch-radus \(did you mean --patch-radius\?\)" \
   "$lidarshop" fill "$work/scan.ptx" --mask "$work/mask.png" -o "$work/x.ply" --patch-radus 3
 exits_with 2 "usage: out of range names the flag" "^lidarshop fill: --patch-radius: 0 is out of range \[1, 15\]" \

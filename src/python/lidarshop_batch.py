@@ -17,8 +17,10 @@ step becomes a flag (`"strokes": ...` -> `--strokes ...`, `true` -> a bare flag)
 stem, and a relative value holding `{name}` is a per-scan input next to the scan file. `output` is relative to
 --out; a step without one writes to DIR/.work/.
 
-One scan is one task: its steps run one after the other; its record DIR/records/NAME.json (status, per-step
-seconds, error, and the key of what it was made from) is written last and atomically. A scan is skipped
+One scan is one task: its steps run one after the other in one `lidarshop steps` process (the argv's of the
+steps in a JSON file; it stops at the first step that fails and reports each step's exit code, seconds and last
+line on stderr); its record DIR/records/NAME.json (status, per-step seconds, error, and the key of what it was
+made from) is written last and atomically. A scan is skipped
 (resume) only when its record says "ok" and its key still holds: the same steps with the same options and
 flags, the same input files (the scan and its per-scan inputs, by size and modification time in ns), and its
 outputs as the run left them; anything else redoes it. A failed scan is recorded and the others go on (it is
@@ -27,8 +29,10 @@ so that a file there always describes the options of the runs that used it. At t
 DIR/summary.json (and one line on stderr): counts, failures, seconds, scans per minute. Exit 0 when every scan
 is done, 1 when any failed, 2 for a bad pipeline or arguments.
 
-Why the CLI per step: any command works with exactly its flags, checks and JSON options; a crash or memory
-blow-up of one scan fails that scan, not the worker; the library stays free of Dask.
+Why one CLI process per scan: any command works with exactly its flags, checks and JSON options (`steps` runs
+each through the same dispatch as `lidarshop COMMAND`); the process starts once per scan, not once per step (its
+libraries, OpenCV's plugin on the first picture); a crash or memory blow-up of one scan fails that scan, not the
+worker (a step that ends the process fails there, with the process's exit code); the library stays free of Dask.
 """
 import argparse
 import ctypes
@@ -41,6 +45,7 @@ import signal
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 
 # What lidarshop's --max-memory takes (util/memory_budget.cc ParseMemorySize; it has the last word).
@@ -212,7 +217,7 @@ def step_argv(lidarshop, step, index, input_path, output_path, name, scan_dir, o
 
 
 def die_with_parent():
-    """In the step's process: be killed when the worker that started it dies (Linux), so that no step of a
+    """In the scan's process: be killed when the worker that started it dies (Linux), so that no step of a
     lost task keeps writing while its re-run elsewhere writes the same files."""
     try:
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
@@ -231,8 +236,51 @@ def remove_stale_temporaries(output):
             pass
 
 
+def last_line(text):
+    """The last line of a command's stderr that is not blank, as a failed scan's error gives it."""
+    lines = [line for line in text.strip().splitlines() if line.strip()]
+    return lines[-1] if lines else "no message"
+
+
+def run_steps(lidarshop, argvs):
+    """Runs the steps (argv's without the executable) in one `lidarshop steps` process. Returns one
+    (exit code, seconds, message) per step that ran, the last the one that failed if any."""
+    with tempfile.TemporaryDirectory(prefix="lidarshop_steps_") as folder:
+        steps_path, report_path = os.path.join(folder, "steps.json"), os.path.join(folder, "report.json")
+        with open(steps_path, "w") as stream:
+            json.dump({"steps": argvs}, stream)
+        start = time.monotonic()
+        try:
+            process = subprocess.run([lidarshop, "steps", steps_path, "--json", report_path, "--quiet"],
+                                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, preexec_fn=die_with_parent)
+            returncode, stderr = process.returncode, process.stderr
+        except OSError as error:
+            returncode, stderr = -1, f"{lidarshop}: {error.strerror}".encode()
+        seconds = time.monotonic() - start
+        try:
+            with open(report_path) as stream:
+                entries = json.load(stream)["steps"]
+        except (OSError, ValueError, KeyError, TypeError):
+            entries = []  # the process did not start, or ended before its first step
+    if not entries:
+        return [(returncode or -1, seconds, last_line(stderr.decode(errors="replace")))]
+    results = []
+    for entry in entries:
+        if entry["exit"] is None:  # the process ended in this step (a crash, a kill): its code and last words
+            spent = max(seconds - sum(result[1] for result in results), 0.0)
+            words = stderr[entry["stderr_offset"]:].decode(errors="replace")
+            results.append((returncode if returncode != 0 else -1, spent, last_line(words)))
+            break
+        results.append((entry["exit"], entry["seconds"], entry["message"] or "no message"))
+    if len(results) < len(argvs) and results[-1][0] == 0:  # it ended between two steps (its report unwritable)
+        spent = max(seconds - sum(result[1] for result in results), 0.0)
+        results.append((returncode if returncode != 0 else -1, spent, last_line(stderr.decode(errors="replace"))))
+    return results
+
+
 def run_scan(job):
-    """One task: every step for one scan. Returns the record (also written to DIR/records/NAME.json)."""
+    """One task: every step for one scan, in one `lidarshop steps` process. Returns the record (also written to
+    DIR/records/NAME.json)."""
     pipeline, scan_path, out_dir, lidarshop = job["pipeline"], job["scan"], job["out"], job["lidarshop"]
     name = scan_name(scan_path)
     start = time.monotonic()
@@ -242,28 +290,21 @@ def run_scan(job):
     outputs = step_outputs(pipeline, name, out_dir, scan_path)
     for output in outputs:
         remove_stale_temporaries(output)
+    argvs = []
     input_path = scan_path
     for index, (step, output) in enumerate(zip(pipeline["steps"], outputs)):
         os.makedirs(os.path.dirname(output), exist_ok=True)
-        argv = step_argv(lidarshop, step, index, input_path, output, name, os.path.dirname(scan_path),
-                         os.path.join(out_dir, ".batch"), job.get("max_memory"))
-        step_start = time.monotonic()
-        try:
-            process = subprocess.run(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                                     preexec_fn=die_with_parent)
-            returncode, stderr = process.returncode, process.stderr
-        except OSError as error:
-            returncode, stderr = -1, f"{argv[0]}: {error.strerror}"
-        entry = {"command": step["command"], "output": output, "seconds": round(time.monotonic() - step_start, 3)}
-        record["steps"].append(entry)
-        if returncode != 0:
-            lines = [line for line in stderr.strip().splitlines() if line.strip()]
-            record.update(status="failed", failed_step=index,
-                          error=f"steps[{index}] ({step['command']}) exit {returncode}: "
-                                + (lines[-1] if lines else "no message"))
-            break
+        argvs.append(step_argv(lidarshop, step, index, input_path, output, name, os.path.dirname(scan_path),
+                               os.path.join(out_dir, ".batch"), job.get("max_memory"))[1:])
         if is_scan_file(output):  # the last scan goes on: a picture in the middle is a side result
             input_path = output
+    for index, (returncode, seconds, message) in enumerate(run_steps(lidarshop, argvs)):
+        step = pipeline["steps"][index]
+        record["steps"].append({"command": step["command"], "output": outputs[index], "seconds": round(seconds, 3)})
+        if returncode != 0:
+            record.update(status="failed", failed_step=index,
+                          error=f"steps[{index}] ({step['command']}) exit {returncode}: {message}")
+            break
     if record["status"] == "ok":
         record["outputs"] = kept_outputs(pipeline, name, out_dir, scan_path)
     else:

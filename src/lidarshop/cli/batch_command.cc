@@ -1,7 +1,8 @@
 // `lidarshop batch`: a pipeline of commands over many scans, locally or on a Dask cluster. The driver is
-// Python (src/python/lidarshop_batch.py, copied into build/<preset>/python): Dask is a Python library, and
-// each step runs this executable again, so the library stays free of it. This command only starts the driver
-// with this executable as the one to run.
+// Python (src/python/lidarshop_batch.py, copied into build/<preset>/python): Dask is a Python library, so the
+// library stays free of it. The driver runs this executable again once per scan, as `lidarshop steps`
+// (steps_command.cc: every step of the scan in that one process, each through the same dispatch as `lidarshop
+// COMMAND`). This command only starts the driver with this executable as the one to run.
 #include <unistd.h>
 
 #include <cerrno>

@@ -12,6 +12,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "lidarshop/cli/command_line.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/util/memory_budget.h"
 
@@ -49,6 +50,8 @@ const std::vector<Command>& Commands() {
       {"clean", lidarshop::cli::RunClean, "remove what moved between the stations of a site"},
       {"serve", lidarshop::cli::RunServe, "the editor in the browser: look, paint, segment, remove, save"},
       {"batch", lidarshop::cli::RunBatch, "a pipeline of commands over many scans (local or Dask cluster)"},
+      {"steps", lidarshop::cli::RunSteps,
+       "several commands one after the other in this process (batch's scans)"},
       {"schema", lidarshop::cli::RunSchema, "the editor's API structs as TypeScript or JSON descriptions"},
   };
   return commands;
@@ -84,6 +87,33 @@ void StartWithHugePages(char** argv) {
 
 }  // namespace
 
+namespace lidarshop::cli {
+
+int RunCommandLine(int argc, char** argv) {
+  const std::string name = argc > 0 ? argv[0] : "";
+  for (const Command& command : Commands()) {
+    if (name != command.name) continue;
+    // RunCommand turns every error into one line; this is the last resort for what escapes it (an allocation
+    // failing while an error is reported, a command that does not use RunCommand).
+    try {
+      return command.run(argc, argv);
+    } catch (const std::bad_alloc&) {
+      fmt::print(stderr,
+                 "lidarshop {}: out of memory: an allocation failed (memory budget {} MiB; --max-memory SIZE "
+                 "makes large requests fail up front)\n",
+                 name, MemoryBudgetBytes() >> 20);
+      return kExitBadInput;
+    } catch (const std::exception& error) {
+      fmt::print(stderr, "lidarshop {}: {}\n", name, error.what());
+      return kExitBadInput;
+    }
+  }
+  fmt::print(stderr, "lidarshop: unknown command '{}' (lidarshop --help lists the commands)\n", name);
+  return kExitUsage;
+}
+
+}  // namespace lidarshop::cli
+
 int main(int argc, char** argv) {
   StartWithHugePages(argv);
   // Warnings go to stderr: stdout carries the JSON that scripts read (info, scan --stats).
@@ -101,23 +131,5 @@ int main(int argc, char** argv) {
     fmt::print("lidarshop 0.1.0\n");
     return 0;
   }
-  for (const Command& command : Commands()) {
-    if (name != command.name) continue;
-    // RunCommand turns every error into one line; this is the last resort for what escapes it (an allocation
-    // failing while an error is reported, a command that does not use RunCommand).
-    try {
-      return command.run(argc - 1, argv + 1);
-    } catch (const std::bad_alloc&) {
-      fmt::print(stderr,
-                 "lidarshop {}: out of memory: an allocation failed (memory budget {} MiB; --max-memory SIZE "
-                 "makes large requests fail up front)\n",
-                 name, lidarshop::MemoryBudgetBytes() >> 20);
-      return lidarshop::cli::kExitBadInput;
-    } catch (const std::exception& error) {
-      fmt::print(stderr, "lidarshop {}: {}\n", name, error.what());
-      return lidarshop::cli::kExitBadInput;
-    }
-  }
-  fmt::print(stderr, "lidarshop: unknown command '{}' (lidarshop --help lists the commands)\n", name);
-  return 2;
+  return lidarshop::cli::RunCommandLine(argc - 1, argv + 1);
 }

@@ -223,6 +223,11 @@ void ProtectInput(const std::string& path) {
   ProtectedInputs().push_back(path);
 }
 
+void ForgetProtectedInputs() {
+  std::lock_guard lock(ProtectedMutex());
+  ProtectedInputs().clear();
+}
+
 bool IsAtomicTemporary(const std::string& name) {
   // ".STEM.tmpPID-N.EXT" or ".STEM.tmpPID-N" (a target without extension).
   if (name.empty() || name[0] != '.') return false;

@@ -33,6 +33,9 @@ void CheckOutputPath(const std::string& path, const std::vector<std::string>& ot
 // Marks `path` as an input of this process that no output may replace (the CLI's --options file): every later
 // CheckOutputPath refuses it, and WriteFileAtomically / WritePathAtomically refuse to write over it.
 void ProtectInput(const std::string& path);
+// Forgets every protected input: for a process that runs several commands one after another (`lidarshop
+// steps`), each with inputs of its own.
+void ForgetProtectedInputs();
 
 // True when `name` (a file name, no folder) has the form of a temporary of an atomic write
 // (".STEM.tmpPID-N.EXT"): listings of files for people (the server's file dialog) leave these out.

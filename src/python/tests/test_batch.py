@@ -267,17 +267,112 @@ def test_resume_redoes_a_scan_whose_inputs_or_steps_changed(scans, tmp_path):
     check_complete(out, ["scan00", "scan01"])
 
 
-def test_max_memory_reaches_every_step(scans, tmp_path):
-    # A lidarshop that logs its arguments, then runs the real one.
-    log = tmp_path / "argv.log"
+def logging_cli(tmp_path):
+    """A lidarshop that logs its arguments (and the steps of `lidarshop steps`), then runs the real one."""
+    log, steps = tmp_path / "argv.log", tmp_path / "steps.log"
     wrapper = tmp_path / "lidarshop"
-    wrapper.write_text(f'#!/bin/sh\necho "$@" >> "{log}"\nexec "{CLI}" "$@"\n')
+    wrapper.write_text(f'#!/bin/sh\necho "$@" >> "{log}"\n'
+                       f'if [ "$1" = steps ]; then cat "$2" >> "{steps}"; echo >> "{steps}"; fi\n'
+                       f'exec "{CLI}" "$@"\n')
     wrapper.chmod(0o755)
+    return wrapper, log, steps
+
+
+def test_max_memory_reaches_every_step(scans, tmp_path):
+    wrapper, log, steps = logging_cli(tmp_path)
     out = str(tmp_path / "out")
     result = run([write_pipeline(str(tmp_path))] + scans[:1] + ["--out", out, "--serial", "--max-memory", "3G",
                                                               "--lidarshop", str(wrapper)])
     assert result.returncode == 0, result.stderr
-    lines = log.read_text().splitlines()
-    assert len(lines) == 2 and all(line.endswith("--max-memory 3G") or "--max-memory 3G " in line for line in lines)
+    argvs = [" ".join(argv) for line in steps.read_text().splitlines() for argv in json.loads(line)["steps"]]
+    assert len(argvs) == 2 and all(argv.endswith("--max-memory 3G") or "--max-memory 3G " in argv for argv in argvs)
     result = run([write_pipeline(str(tmp_path))] + scans[:1] + ["--out", out, "--serial", "--max-memory", "lots"])
     assert result.returncode == 2 and "--max-memory" in result.stderr
+
+
+THREE_STEPS = {"steps": [
+    {"command": "fill", "options": {"method": "laplace", "poisson": {"solver": "direct"}},
+     "mask": "{name}_mask.png", "output": "{name}_filled.e57"},
+    {"command": "render", "output": "{name}_filled.png"},
+    {"command": "convert", "output": "{name}.ply"},
+]}
+
+
+def test_one_process_per_scan_runs_all_its_steps(scans, tmp_path):
+    wrapper, log, steps = logging_cli(tmp_path)
+    out = str(tmp_path / "out")
+    result = run([write_pipeline(str(tmp_path), THREE_STEPS)] + scans[:3] + ["--out", out, "--serial",
+                                                                            "--lidarshop", str(wrapper)])
+    assert result.returncode == 0, result.stderr
+    # One `lidarshop steps` per scan, holding the scan's three steps, each fed the last scan written.
+    invocations = log.read_text().splitlines()
+    assert len(invocations) == 3 and all(line.startswith("steps ") for line in invocations)
+    for line in steps.read_text().splitlines():
+        argvs = json.loads(line)["steps"]
+        assert [argv[0] for argv in argvs] == ["fill", "render", "convert"]
+        assert argvs[1][1] == argvs[2][1] == argvs[0][argvs[0].index("-o") + 1]
+    found = records(out)
+    assert sorted(found) == names_of(scans[:3])
+    for name, record in found.items():
+        assert record["status"] == "ok"
+        assert [step["command"] for step in record["steps"]] == ["fill", "render", "convert"]
+        assert [os.path.basename(step["output"]) for step in record["steps"]] == [
+            f"{name}_filled.e57", f"{name}_filled.png", f"{name}.ply"]
+        assert all(step["seconds"] > 0 for step in record["steps"])
+        assert os.path.getsize(os.path.join(out, f"{name}_filled.png")) > 0
+    check_complete(out, names_of(scans[:3]))
+
+
+def test_a_failing_middle_step_is_reported_as_the_command_says_it(scans, tmp_path):
+    out = str(tmp_path / "out")
+    assert run([write_pipeline(str(tmp_path), THREE_STEPS)] + scans[:1] + ["--out", out, "--serial"]).returncode == 0
+    name = names_of(scans[:1])[0]
+    failing = json.loads(json.dumps(THREE_STEPS))
+    failing["steps"][1]["channel"] = "nope"
+    result = run([write_pipeline(str(tmp_path), failing)] + scans[:1] + ["--out", out, "--serial"])
+    assert result.returncode == 1
+    record = records(out)[name]
+    # What the command alone says for the same arguments, as its last line on stderr.
+    alone = subprocess.run([CLI, "render", os.path.join(out, f"{name}_filled.e57"), "-o",
+                            os.path.join(out, f"{name}_filled.png"), "--channel", "nope"],
+                           capture_output=True, text=True, timeout=60)
+    assert alone.returncode == 2
+    said = alone.stderr.strip().splitlines()[-1]
+    assert said.startswith("lidarshop render: ") and "nope" in said
+    assert record["status"] == "failed" and record["failed_step"] == 1
+    assert record["error"] == f"steps[1] (render) exit 2: {said}"
+    assert [step["command"] for step in record["steps"]] == ["fill", "render"]
+    assert sorted(record) == sorted(["scan", "name", "status", "steps", "host", "pid", "key", "failed_step", "error",
+                                     "removed_stale_outputs", "seconds"])
+    # The outputs of the failed step and after it, from the first run, are gone; the fill's stays.
+    assert record["removed_stale_outputs"] == [os.path.join(out, f"{name}_filled.png"), os.path.join(out, f"{name}.ply")]
+    assert os.path.exists(os.path.join(out, f"{name}_filled.e57"))
+    assert summary(out)["failures"] == [{"name": name, "scan": scans[0], "error": record["error"]}]
+
+
+def test_a_step_that_ends_the_process_fails_its_scan_as_the_command_alone(scans, tmp_path):
+    """A step killed in the middle (here by the file size limit, SIGXFSZ, when the fill writes its scan) ends the
+    scan's process: the scan fails at that step with the signal, the steps before it as done, the next scan goes
+    on; the error is what the command alone ends with, not the earlier step's last line."""
+    limited = tmp_path / "lidarshop"
+    limited.write_text(f'#!/bin/sh\nulimit -f 24\nexec "{CLI}" "$@"\n')  # 12 or 24 KB: a PNG fits, an E57 not
+    limited.chmod(0o755)
+    pipeline = {"steps": [{"command": "render", "output": "{name}.png"}] + THREE_STEPS["steps"][:1]
+                + THREE_STEPS["steps"][2:]}
+    out = str(tmp_path / "out")
+    result = run([write_pipeline(str(tmp_path), pipeline)] + scans[:2] + ["--out", out, "--serial",
+                                                                         "--lidarshop", str(limited)])
+    assert result.returncode == 1
+    options = glob.glob(os.path.join(out, ".batch", "step1_options_*.json"))
+    alone = subprocess.run([str(limited), "fill", scans[0], "-o", str(tmp_path / "alone.e57"), "--options",
+                            options[0], "--mask", scans[0].replace(".ptx", "_mask.png")], capture_output=True,
+                           text=True, timeout=60)
+    assert alone.returncode == -signal.SIGXFSZ
+    lines = [line for line in alone.stderr.strip().splitlines() if line.strip()]
+    found = records(out)
+    assert sorted(found) == names_of(scans[:2])
+    for name, record in found.items():
+        assert record["status"] == "failed" and record["failed_step"] == 1
+        assert record["error"] == f"steps[1] (fill) exit {-signal.SIGXFSZ}: " + (lines[-1] if lines else "no message")
+        assert [step["command"] for step in record["steps"]] == ["render", "fill"]
+        assert os.path.getsize(os.path.join(out, f"{name}.png")) > 0
