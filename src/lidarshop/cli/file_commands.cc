@@ -52,13 +52,14 @@ void WriteSynthesizedMask(const std::string& path, const Scan& scan) {
 }
 
 nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
+  const ScanStatistics stats = ComputeScanStatistics(scan);
   nlohmann::ordered_json json;
   json["index"] = index;
   if (!scan.name.empty()) json["name"] = scan.name;
   json["rows"] = scan.rows;
   json["cols"] = scan.cols;
   json["cells"] = scan.num_cells();
-  json["valid"] = scan.CountValid();
+  json["valid"] = stats.valid;
   json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
   json["channels"] = ChannelNames(scan);
   if (!scan.attributes.empty()) {
@@ -66,57 +67,26 @@ nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
     for (const auto& [name, values] : scan.attributes) json["attributes"].push_back(name);
   }
   // Counts as `lasinfo` gives them, for clouds read from LAS: classes and return numbers of the returns.
-  if (scan.source_metadata.count("las.point_format")) {
-    auto counts = [&](const cv::Mat& values) {
-      std::map<int, int64_t> histogram;
-      for (int row = 0; row < scan.rows; ++row) {
-        for (int col = 0; col < scan.cols; ++col) {
-          if (!scan.valid.at<uint8_t>(row, col)) continue;
-          ++histogram[values.empty()            ? 0
-                      : values.type() == CV_32S ? values.at<int32_t>(row, col)
-                                                : values.at<uint8_t>(row, col)];
-        }
-      }
+  if (stats.from_las) {
+    auto counts = [](const std::map<int, int64_t>& histogram) {
       nlohmann::ordered_json json_counts = nlohmann::ordered_json::object();
       for (const auto& [value, n] : histogram) json_counts[std::to_string(value)] = n;
       return json_counts;
     };
-    json["classes"] = counts(scan.label);
-    const auto returns = scan.attributes.find(kLasReturnNumber);
-    json["returns"] = counts(returns == scan.attributes.end() ? cv::Mat() : returns->second);
+    json["classes"] = counts(stats.returns_by_class);
+    json["returns"] = counts(stats.returns_by_return_number);
     if (!scan.source_records.empty()) json["crs"] = LasCrsJson(scan.source_records);
   }
 
   // Bounds of the returns in the world frame, and range / intensity statistics.
-  Eigen::AlignedBox3d world_bounds;
-  double min_range = std::numeric_limits<double>::infinity(), max_range = 0, sum_range = 0;
-  double min_intensity = std::numeric_limits<double>::infinity(), max_intensity = -min_intensity;
-  int64_t count = 0;
-  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
-  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
-  for (int row = 0; row < scan.rows; ++row) {
-    for (int col = 0; col < scan.cols; ++col) {
-      if (!scan.valid.at<uint8_t>(row, col)) continue;
-      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
-      world_bounds.extend(rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation);
-      const double range = scan.range.at<float>(row, col);
-      min_range = std::min(min_range, range);
-      max_range = std::max(max_range, range);
-      sum_range += range;
-      if (scan.has_intensity()) {
-        const double intensity = scan.intensity.at<float>(row, col);
-        min_intensity = std::min(min_intensity, intensity);
-        max_intensity = std::max(max_intensity, intensity);
-      }
-      ++count;
-    }
-  }
-  if (count > 0) {
+  if (stats.valid > 0) {
+    const Eigen::AlignedBox3d& box = stats.bounds_in_world;
     json["bounds"] = {{"frame", "world"},
-                      {"min", {world_bounds.min().x(), world_bounds.min().y(), world_bounds.min().z()}},
-                      {"max", {world_bounds.max().x(), world_bounds.max().y(), world_bounds.max().z()}}};
-    json["range_m"] = {{"min", min_range}, {"max", max_range}, {"mean", sum_range / count}};
-    if (scan.has_intensity()) json["intensity"] = {{"min", min_intensity}, {"max", max_intensity}};
+                      {"min", {box.min().x(), box.min().y(), box.min().z()}},
+                      {"max", {box.max().x(), box.max().y(), box.max().z()}}};
+    json["range_m"] = {{"min", stats.min_range_m}, {"max", stats.max_range_m}, {"mean", stats.mean_range_m}};
+    if (stats.min_intensity)
+      json["intensity"] = {{"min", *stats.min_intensity}, {"max", *stats.max_intensity}};
   } else {
     json["bounds"] = nullptr;
   }
@@ -124,19 +94,11 @@ nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
   nlohmann::ordered_json grid;
   grid["fitted"] = scan.grid.fitted;
   grid["known"] = !scan.grid.azimuth_rad.empty();
-  if (!scan.grid.azimuth_rad.empty() && !scan.grid.elevation_rad.empty()) {
-    const auto [az_min, az_max] =
-        std::minmax_element(scan.grid.azimuth_rad.begin(), scan.grid.azimuth_rad.end());
-    const auto [el_min, el_max] =
-        std::minmax_element(scan.grid.elevation_rad.begin(), scan.grid.elevation_rad.end());
-    grid["azimuth_deg"] = {*az_min * kDegreesPerRadian, *az_max * kDegreesPerRadian};
-    grid["elevation_deg"] = {*el_min * kDegreesPerRadian, *el_max * kDegreesPerRadian};
-    if (scan.cols > 1) {
-      grid["azimuth_step_deg"] = (*az_max - *az_min) / (scan.cols - 1) * kDegreesPerRadian;
-    }
-    if (scan.rows > 1) {
-      grid["elevation_step_deg"] = (*el_max - *el_min) / (scan.rows - 1) * kDegreesPerRadian;
-    }
+  if (stats.min_azimuth_deg) {
+    grid["azimuth_deg"] = {*stats.min_azimuth_deg, *stats.max_azimuth_deg};
+    grid["elevation_deg"] = {*stats.min_elevation_deg, *stats.max_elevation_deg};
+    if (stats.azimuth_step_deg) grid["azimuth_step_deg"] = *stats.azimuth_step_deg;
+    if (stats.elevation_step_deg) grid["elevation_step_deg"] = *stats.elevation_step_deg;
   }
   grid["rms_residual_rad"] = scan.grid.rms_residual_rad;
   grid["max_residual_rad"] = scan.grid.max_residual_rad;
@@ -427,19 +389,9 @@ int RunConvert(int argc, char** argv) {
         PrintWarnings(plan.dropped);
         const size_t images_written = to_e57 ? images.size() : 0;
         Summarize(WrittenSummary(output, scans, images_written, plan));
-        nlohmann::ordered_json json;
-        json["input"] = input;
-        json["output"] = output;
-        json["format"] = FileExtension(output);
-        json["scans"] = scans.size();
-        int64_t returns = 0;
-        for (const Scan& scan : scans) returns += scan.CountValid();
-        json["returns"] = returns;
-        json["images"] = images_written;
-        json["channels"] = plan.channels;
-        json["dropped"] = plan.dropped;
-        if (drop_synthesized) json["synthesized_left_out"] = dropped_synthesized;
-        WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), json));
+        ScanWriteSummary summary = SummarizeScanWrite(input, output, scans, images_written, plan);
+        if (drop_synthesized) summary.synthesized_left_out = dropped_synthesized;
+        WriteJsonOutput(json_path, CommandJson(ToJson(e57_options), ToJson(summary)));
         return 0;
       },
       &binder);
@@ -564,7 +516,6 @@ int RunRender(int argc, char** argv) {
         CheckOutputFile("--json", json_path, {}, {input, around_path, camera_path, output});
         CheckOutputFile("--write-camera", write_camera_path, {"json"},
                         {input, around_path, camera_path, output, json_path});
-        nlohmann::ordered_json json;
         const int viewpoints = !eye.empty() + !std::isnan(orbit_deg) + !camera_path.empty();
         if (viewpoints > 1) throw OptionsError("give one of --eye, --orbit and --camera");
         if (viewpoints == 0 && !write_camera_path.empty()) {
@@ -580,6 +531,7 @@ int RunRender(int argc, char** argv) {
           if (!eye.empty() && target.size() != 3) throw OptionsError("--eye needs --target x,y,z");
           const ScanFile file = ReadScanFileAndWarn(input);
           const Scan& scan = PickScan(file, scan_index, "--scan");
+          PointViewResult result;
           if (!eye.empty()) {
             view.eye_in_world = Eigen::Vector3d(eye[0], eye[1], eye[2]);
             view.target_in_world = Eigen::Vector3d(target[0], target[1], target[2]);
@@ -596,9 +548,9 @@ int RunRender(int argc, char** argv) {
                 FindGround(scan, around_path.empty() ? cv::Mat() : region);
             const PointViewOptions side =
                 SideView(scan, region, orbit_deg, ground ? ground->normal_in_world : Eigen::Vector3d::Zero());
-            json["up_from"] = ground ? "ground" : "scan";
+            result.up_from = ground ? "ground" : "scan";
             if (ground) {
-              json["ground"] = {{"share", ground->share}, {"tilt_deg", ground->tilt_deg}};
+              result.ground = ViewGround{ground->share, ground->tilt_deg};
               if (!quiet) {
                 fmt::print(
                     stderr,
@@ -613,15 +565,14 @@ int RunRender(int argc, char** argv) {
           }
           const cv::Mat picture = RenderPointView(scan, view);
           WriteImage(output, picture);
-          const nlohmann::ordered_json camera = CameraJson(view, scan);
-          if (!write_camera_path.empty()) WriteJsonOutput(write_camera_path, camera, 2, true);
-          json["output"] = output;
-          json["width_px"] = picture.cols;
-          json["height_px"] = picture.rows;
-          json["eye_in_world"] = camera["eye"];
-          json["target_in_world"] = camera["target"];
-          json["up_in_world"] = camera["up"];
-          json["camera"] = camera;
+          result.camera = CameraOf(view, scan);
+          if (!write_camera_path.empty()) WriteJsonOutput(write_camera_path, ToJson(result.camera), 2, true);
+          result.output = output;
+          result.width_px = picture.cols;
+          result.height_px = picture.rows;
+          result.eye_in_world = result.camera.eye;
+          result.target_in_world = result.camera.target;
+          result.up_in_world = result.camera.up;
           if (!quiet) {
             auto xyz = [](const Eigen::Vector3d& v) {
               return fmt::format("{:.3f}, {:.3f}, {:.3f}", v.x(), v.y(), v.z());
@@ -632,7 +583,7 @@ int RunRender(int argc, char** argv) {
                        xyz(view.up_in_world.isZero(0) ? ScanUpInWorld(scan) : view.up_in_world), picture.cols,
                        picture.rows);
           }
-          WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+          WriteJsonOutput(json_path, CommandJson(ToJson(view), ToJson(result)));
           Summarize(fmt::format("{} x {} view from ({:.2f}, {:.2f}, {:.2f}) -> {}", picture.cols,
                                 picture.rows, view.eye_in_world.x(), view.eye_in_world.y(),
                                 view.eye_in_world.z(), output));
@@ -662,6 +613,7 @@ int RunRender(int argc, char** argv) {
         Scan scan = PickScan(file, scan_index, "--scan");
         // Errors about the scan's channels name the file (and the scan, when the file names it).
         scan.name = scan.name.empty() ? input : fmt::format("{} (scan '{}')", input, scan.name);
+        nlohmann::ordered_json json;
         json["output"] = output;
         json["channel"] = channel;
         PictureLayout layout;

@@ -17,6 +17,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/pointset/features.h"
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/site_registration.h"
@@ -48,10 +49,12 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            OptionsType<ScanMeshOptions>(),          // scan --mesh-jump, points mesh
            OptionsType<PtxReadOptions>(),           // reading PTX
            OptionsType<E57WriteOptions>(),          // convert, E57 output
+           ResultType<ScanWriteSummary>(),          // convert --json
            OptionsType<LasWriteOptions>(),          // LAS output
            OptionsType<PointViewOptions>(),         // render
            OptionsType<PictureLayoutOptions>(),     // render
            ResultType<PictureLayoutSummary>(),      // render --json's "layout"
+           ResultType<PointViewResult>(),           // render --eye, --orbit, --camera --json
            OptionsType<VerifyOptions>(),            // verify, sweep
            OptionsType<SweepOptions>(),             // sweep
            ResultType<InpaintResult>(),             // inpaint

@@ -4,6 +4,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -60,6 +61,29 @@ const StructInfo& InfoOf<LasWriteOptions>() {
       CheckOption(o.point_format < 6 || o.minor_version == 4,
                   fmt::format("point_format: {} needs LAS 1.4 (minor_version 4)", o.point_format));
     });
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanWriteSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScanWriteSummary> b("ScanWriteSummary", "what a conversion wrote (convert --json)");
+    b.Field(&ScanWriteSummary::input, "input", "the file read");
+    b.Field(&ScanWriteSummary::output, "output", "the file written");
+    b.Field(&ScanWriteSummary::format, "format", "the target format: its extension (ptx, e57, las, ...)");
+    b.Field(&ScanWriteSummary::scans, "scans", "scans written");
+    b.Field(&ScanWriteSummary::returns, "returns", "valid returns written, all scans together")
+        .Unit("points");
+    b.Field(&ScanWriteSummary::images, "images", "photos written (E57 images2D; 0 for other targets)");
+    b.Field(&ScanWriteSummary::channels, "channels",
+            "the channels written, in the target's words where it renames them (label→classification)");
+    b.Field(&ScanWriteSummary::dropped, "dropped",
+            "what the target cannot hold, one sentence each starting with the output path");
+    b.Field(&ScanWriteSummary::synthesized_left_out, "synthesized_left_out",
+            "with --drop-synthesized: the synthesized returns left out")
+        .Unit("points");
     return b.Build();
   }();
   return info;

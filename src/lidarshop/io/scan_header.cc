@@ -1,10 +1,13 @@
 #include "lidarshop/io/scan_header.h"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <limits>
 
 #include <fmt/format.h>
 
+#include "lidarshop/io/las.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
@@ -99,6 +102,76 @@ ScanFileHeader ReadScanHeader(const std::string& path) {
   file.format = format;
   file.file_size_bytes = size;
   return file;
+}
+
+ScanStatistics ComputeScanStatistics(const Scan& scan) {
+  ScanStatistics stats;
+  stats.valid = scan.CountValid();
+  if (scan.source_metadata.count("las.point_format")) {
+    stats.from_las = true;
+    auto counts = [&](const cv::Mat& values) {
+      std::map<int, int64_t> histogram;
+      for (int row = 0; row < scan.rows; ++row) {
+        for (int col = 0; col < scan.cols; ++col) {
+          if (!scan.valid.at<uint8_t>(row, col)) continue;
+          ++histogram[values.empty()            ? 0
+                      : values.type() == CV_32S ? values.at<int32_t>(row, col)
+                                                : values.at<uint8_t>(row, col)];
+        }
+      }
+      return histogram;
+    };
+    stats.returns_by_class = counts(scan.label);
+    const auto returns = scan.attributes.find(kLasReturnNumber);
+    stats.returns_by_return_number = counts(returns == scan.attributes.end() ? cv::Mat() : returns->second);
+  }
+
+  double min_range = std::numeric_limits<double>::infinity(), max_range = 0, sum_range = 0;
+  double min_intensity = std::numeric_limits<double>::infinity(), max_intensity = -min_intensity;
+  int64_t count = 0;
+  const Eigen::Matrix3d rotation = scan.world_from_scanner.topLeftCorner<3, 3>();
+  const Eigen::Vector3d translation = scan.world_from_scanner.topRightCorner<3, 1>();
+  for (int row = 0; row < scan.rows; ++row) {
+    for (int col = 0; col < scan.cols; ++col) {
+      if (!scan.valid.at<uint8_t>(row, col)) continue;
+      const cv::Vec3f& p = scan.point.at<cv::Vec3f>(row, col);
+      stats.bounds_in_world.extend(rotation * Eigen::Vector3d(p[0], p[1], p[2]) + translation);
+      const double range = scan.range.at<float>(row, col);
+      min_range = std::min(min_range, range);
+      max_range = std::max(max_range, range);
+      sum_range += range;
+      if (scan.has_intensity()) {
+        const double intensity = scan.intensity.at<float>(row, col);
+        min_intensity = std::min(min_intensity, intensity);
+        max_intensity = std::max(max_intensity, intensity);
+      }
+      ++count;
+    }
+  }
+  if (count > 0) {
+    stats.min_range_m = min_range;
+    stats.max_range_m = max_range;
+    stats.mean_range_m = sum_range / count;
+    if (scan.has_intensity()) {
+      stats.min_intensity = min_intensity;
+      stats.max_intensity = max_intensity;
+    }
+  }
+
+  const std::vector<double>& azimuth = scan.grid.azimuth_rad;
+  const std::vector<double>& elevation = scan.grid.elevation_rad;
+  if (!azimuth.empty() && !elevation.empty()) {
+    constexpr double kDegreesPerRadian = 180.0 / M_PI;
+    const auto [az_min, az_max] = std::minmax_element(azimuth.begin(), azimuth.end());
+    const auto [el_min, el_max] = std::minmax_element(elevation.begin(), elevation.end());
+    stats.min_azimuth_deg = *az_min * kDegreesPerRadian;
+    stats.max_azimuth_deg = *az_max * kDegreesPerRadian;
+    stats.min_elevation_deg = *el_min * kDegreesPerRadian;
+    stats.max_elevation_deg = *el_max * kDegreesPerRadian;
+    if (scan.cols > 1) stats.azimuth_step_deg = (*az_max - *az_min) / (scan.cols - 1) * kDegreesPerRadian;
+    if (scan.rows > 1) stats.elevation_step_deg = (*el_max - *el_min) / (scan.rows - 1) * kDegreesPerRadian;
+  }
+  return stats;
 }
 
 nlohmann::ordered_json ToJson(const ScanHeader& scan, int index) {

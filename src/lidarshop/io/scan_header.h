@@ -23,10 +23,13 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/scan/scan.h"
@@ -95,6 +98,30 @@ ScanFileHeader ReadScanHeader(const std::string& path);
 // The header of scans already read (what ReadScanFile gives), for formats without a header and for tests:
 // rows, cols, points = cells, channels = ChannelNames.
 ScanHeader ScanHeaderOf(const Scan& scan);
+
+// What reading every point of a scan adds to its header (`lidarshop info --stats`): the returns, their bounds
+// and range / intensity statistics, LAS counts as `lasinfo` gives them, and the angular grid. Every statistic
+// is over the valid cells.
+struct ScanStatistics {
+  int64_t valid = 0;  // returns (valid cells)
+  // Bounds of the returns in the world frame (world_from_scanner applied), metres; empty without returns.
+  Eigen::AlignedBox3d bounds_in_world;
+  double min_range_m = 0, max_range_m = 0, mean_range_m = 0;  // of the returns; 0 without returns
+  // Of the returns, in Scan::intensity's scale; only when the scan has an intensity channel and returns.
+  std::optional<double> min_intensity, max_intensity;
+  // Scans read from LAS (source_metadata "las.point_format"): returns per classification (Scan::label, 0
+  // without one) and per return number (the attribute kLasReturnNumber, 0 without one), ascending.
+  bool from_las = false;
+  std::map<int, int64_t> returns_by_class, returns_by_return_number;
+  // The angular grid (Scan::grid), in degrees: the extreme azimuth and elevation of its columns and rows and
+  // the mean step between neighbours; only when the grid's directions are known (steps: with 2 columns /
+  // rows or more).
+  std::optional<double> min_azimuth_deg, max_azimuth_deg, min_elevation_deg, max_elevation_deg;
+  std::optional<double> azimuth_step_deg, elevation_step_deg;
+};
+
+// The statistics of `scan` (one pass over its cells).
+ScanStatistics ComputeScanStatistics(const Scan& scan);
 
 // The header as JSON, keys in reading order: file, format, format_version, size_bytes, guid, created,
 // scans [{index, name, organized, rows, cols, points, channels, world_from_scanner, e57 metadata}],

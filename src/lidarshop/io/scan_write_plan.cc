@@ -181,4 +181,19 @@ std::string WrittenSummary(const std::string& path, const std::vector<Scan>& sca
                      images, fmt::join(plan.channels, " "));
 }
 
+ScanWriteSummary SummarizeScanWrite(const std::string& input, const std::string& output,
+                                    const std::vector<Scan>& scans, size_t images_written,
+                                    const ScanWritePlan& plan) {
+  ScanWriteSummary summary;
+  summary.input = input;
+  summary.output = output;
+  summary.format = FileExtension(output);
+  summary.scans = static_cast<int64_t>(scans.size());
+  for (const Scan& scan : scans) summary.returns += scan.CountValid();
+  summary.images = static_cast<int64_t>(images_written);
+  summary.channels = plan.channels;
+  summary.dropped = plan.dropped;
+  return summary;
+}
+
 }  // namespace lidarshop

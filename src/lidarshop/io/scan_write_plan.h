@@ -10,11 +10,14 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lidarshop/io/las.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -38,6 +41,28 @@ ScanWritePlan PlanScanWrite(const std::string& path, const std::vector<Scan>& sc
 // label→classification" (plus ", 2 images" when `images_written` > 0).
 std::string WrittenSummary(const std::string& path, const std::vector<Scan>& scans, size_t images_written,
                            const ScanWritePlan& plan);
+
+// What a conversion wrote (`convert --json`): the files, the target and what it holds, as ScanWritePlan
+// planned it.
+struct ScanWriteSummary {
+  std::string input;                            // the file read
+  std::string output;                           // the file written
+  std::string format;                           // the target's extension: "ptx", "e57", "las", ...
+  int64_t scans = 0;                            // scans written
+  int64_t returns = 0;                          // valid returns written, all scans together
+  int64_t images = 0;                           // photos written (E57 images2D; 0 for every other target)
+  std::vector<std::string> channels;            // ScanWritePlan::channels
+  std::vector<std::string> dropped;             // ScanWritePlan::dropped, one sentence each
+  std::optional<int64_t> synthesized_left_out;  // with --drop-synthesized: synthesized returns not written
+};
+
+// The summary of writing `scans` read from `input` to `output` with `images_written` photos, as `plan` said.
+ScanWriteSummary SummarizeScanWrite(const std::string& input, const std::string& output,
+                                    const std::vector<Scan>& scans, size_t images_written,
+                                    const ScanWritePlan& plan);
+
+template <>
+const StructInfo& InfoOf<ScanWriteSummary>();
 
 // 1234567 -> "1,234,567".
 std::string WithThousandsSeparators(int64_t value);

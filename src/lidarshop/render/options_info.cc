@@ -96,6 +96,54 @@ const StructInfo& InfoOf<PointViewOptions>() {
   return info;
 }
 
+template <>
+const StructInfo& InfoOf<PointViewCamera>() {
+  static const StructInfo info = [] {
+    StructBuilder<PointViewCamera> b("PointViewCamera",
+                                     "a second viewpoint's camera (the camera file; world frame)");
+    b.Field(&PointViewCamera::eye, "eye", "camera centre x, y, z").Unit("m");
+    b.Field(&PointViewCamera::target, "target", "the point looked at x, y, z").Unit("m");
+    b.Field(&PointViewCamera::up, "up", "the picture's up x, y, z (any length)");
+    b.Field(&PointViewCamera::fov_deg, "fov_deg", "horizontal field of view").Unit("deg");
+    b.Field(&PointViewCamera::width, "width", "picture width").Unit("px");
+    b.Field(&PointViewCamera::height, "height", "picture height").Unit("px");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ViewGround>() {
+  static const StructInfo info = [] {
+    StructBuilder<ViewGround> b("ViewGround", "the ground whose normal a second viewpoint took as up");
+    b.Field(&ViewGround::share, "share", "share of the returns used that lie on the ground, (0, 1]");
+    b.Field(&ViewGround::tilt_deg, "tilt_deg", "angle between its normal and the scan's up").Unit("deg");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PointViewResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<PointViewResult> b("PointViewResult",
+                                     "what render --eye, --orbit or --camera drew (render --json)");
+    b.Field(&PointViewResult::up_from, "up_from",
+            "--orbit: ground (the ground's normal is up) or scan (the scan's up)");
+    b.Field(&PointViewResult::ground, "ground", "--orbit with a ground: the plane whose normal is up");
+    b.Field(&PointViewResult::output, "output", "the picture written");
+    b.Field(&PointViewResult::width_px, "width_px", "picture width").Unit("px");
+    b.Field(&PointViewResult::height_px, "height_px", "picture height").Unit("px");
+    b.Field(&PointViewResult::eye_in_world, "eye_in_world", "camera centre x, y, z (= camera.eye)").Unit("m");
+    b.Field(&PointViewResult::target_in_world, "target_in_world", "the point looked at (= camera.target)")
+        .Unit("m");
+    b.Field(&PointViewResult::up_in_world, "up_in_world", "the picture's up (= camera.up)");
+    b.Field(&PointViewResult::camera, "camera", "the camera drawn with, as --write-camera writes it");
+    return b.Build();
+  }();
+  return info;
+}
+
 // In the order `lidarshop render --json` has always written its "layout".
 template <>
 const StructInfo& InfoOf<PictureLayoutSummary>() {

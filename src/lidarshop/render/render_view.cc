@@ -177,19 +177,19 @@ PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_
 
 namespace {
 
-nlohmann::ordered_json VectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+std::vector<double> XyzList(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 }  // namespace
 
-nlohmann::ordered_json CameraJson(const PointViewOptions& view, const Scan& scan) {
-  nlohmann::ordered_json json;
-  json["eye"] = VectorJson(view.eye_in_world);
-  json["target"] = VectorJson(view.target_in_world);
-  json["up"] = VectorJson(view.up_in_world.isZero(0) ? ScanUpInWorld(scan) : view.up_in_world);
-  json["fov_deg"] = view.field_of_view_deg;
-  json["width"] = view.width_px;
-  json["height"] = view.height_px;
-  return json;
+PointViewCamera CameraOf(const PointViewOptions& view, const Scan& scan) {
+  PointViewCamera camera;
+  camera.eye = XyzList(view.eye_in_world);
+  camera.target = XyzList(view.target_in_world);
+  camera.up = XyzList(view.up_in_world.isZero(0) ? ScanUpInWorld(scan) : view.up_in_world);
+  camera.fov_deg = view.field_of_view_deg;
+  camera.width = view.width_px;
+  camera.height = view.height_px;
+  return camera;
 }
 
 void ParseCameraJson(const std::string& text, const std::string& what, PointViewOptions* view) {

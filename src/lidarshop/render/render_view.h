@@ -18,7 +18,9 @@
 // is the horizontal field of view. Unknown keys are refused (a misspelt key must not be ignored).
 #pragma once
 
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -65,9 +67,41 @@ cv::Mat RenderPointView(const Scan& scan, const PointViewOptions& options);
 PointViewOptions SideView(const Scan& scan, const cv::Mat& region, double angle_deg,
                           const Eigen::Vector3d& up_in_world = Eigen::Vector3d::Zero());
 
-// The camera file (see the top): the view's eye, target, up (resolved against `scan` when zero), field of
-// view and size.
-nlohmann::ordered_json CameraJson(const PointViewOptions& view, const Scan& scan);
+// The camera file (see the top) and `render --json`'s "camera": metres and degrees, world frame.
+struct PointViewCamera {
+  std::vector<double> eye;        // camera centre x, y, z, metres
+  std::vector<double> target;     // the point looked at x, y, z, metres
+  std::vector<double> up;         // the picture's up x, y, z (any length)
+  double fov_deg = 60.0;          // horizontal field of view, degrees
+  int width = 640, height = 480;  // picture size, pixels
+};
+template <>
+const StructInfo& InfoOf<PointViewCamera>();
+
+// The camera of `view`: its eye, target, up (resolved against `scan` when zero), field of view and size.
+PointViewCamera CameraOf(const PointViewOptions& view, const Scan& scan);
+
+// The ground whose normal a second viewpoint took as up (`render --orbit`, pointset/ground.h GroundPlane).
+struct ViewGround {
+  double share = 0;     // of the returns used that lie on the ground, (0, 1]
+  double tilt_deg = 0;  // angle between its normal and the scan's up, degrees
+};
+template <>
+const StructInfo& InfoOf<ViewGround>();
+
+// What `render --eye | --orbit | --camera` drew (its --json).
+struct PointViewResult {
+  std::optional<std::string> up_from;   // --orbit: "ground" (the ground's normal is up) or "scan" (its up)
+  std::optional<ViewGround> ground;     // --orbit with a ground: the plane whose normal is up
+  std::string output;                   // the picture written
+  int width_px = 0, height_px = 0;      // its size, pixels
+  std::vector<double> eye_in_world;     // = camera.eye, metres
+  std::vector<double> target_in_world;  // = camera.target, metres
+  std::vector<double> up_in_world;      // = camera.up
+  PointViewCamera camera;               // the camera drawn with (as --write-camera writes it)
+};
+template <>
+const StructInfo& InfoOf<PointViewResult>();
 // Parses a camera file's text into `view` (eye, target, up, field of view, size; the rest is kept). Throws
 // InputError naming `what` and the field.
 void ParseCameraJson(const std::string& text, const std::string& what, PointViewOptions* view);
