@@ -14,7 +14,11 @@ namespace lidarshop::server {
 
 std::vector<TypeScriptStruct> ApiTypes();
 
-// The generated file's text: ApiTypes() as TypeScript with its header.
+// The server's own replies and the keys its routes add beside a library result (replies.h): in the TypeScript
+// file after ApiTypes(); docs/api.md documents them (docs/options.md's reference lists ApiTypes() only).
+std::vector<TypeScriptStruct> ApiReplyTypes();
+
+// The generated file's text: ApiTypes() and ApiReplyTypes() as TypeScript with its header.
 std::string ApiTypesTypeScript();
 
 }  // namespace lidarshop::server

@@ -18,6 +18,9 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/util/options.h"
+#include "replies.h"
+
 namespace lidarshop::server {
 
 namespace {
@@ -274,7 +277,7 @@ void GatedServer::Wake() {
 void GatedServer::Refuse(int fd, int status, const std::string& message) {
   // Bytes that are not UTF-8 (a header value quoted in the message) are replaced, not thrown on.
   const std::string body =
-      nlohmann::json{{"error", message}}.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+      ToJson(ErrorReply{message}).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
   // The security headers every answer of the editor's server carries (security.cc), for these too.
   const std::string response = fmt::format(
       "HTTP/1.1 {} {}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n"

@@ -5,22 +5,6 @@
 
 namespace lidarshop::server {
 
-std::string ToString(JobState state) {
-  switch (state) {
-    case JobState::kQueued:
-      return "queued";
-    case JobState::kRunning:
-      return "running";
-    case JobState::kDone:
-      return "done";
-    case JobState::kFailed:
-      return "failed";
-    case JobState::kCancelled:
-      return "cancelled";
-  }
-  return "failed";
-}
-
 JobRunner::JobRunner(int workers, int max_queued) : max_queued_(max_queued) {
   for (int i = 0; i < workers; ++i) workers_.emplace_back([this] { Work(); });
 }

@@ -14,6 +14,7 @@
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "replies.h"
 #include "version_param.h"
 
 namespace lidarshop::server {
@@ -110,11 +111,8 @@ void Segment(State& state, const std::shared_ptr<Document>& document, const nloh
         Snapshot next = document->now;
         SetObject(&next, result);
         Commit(*document, std::move(next), undo_depth);
-        nlohmann::ordered_json json = ToJson(result);
-        json["refined"] = refined;
-        json["prepared"] = prepared;  // the session was built ahead (PrepareCut)
-        json["version"] = document->version;
-        return json;
+        // prepared: the session was built ahead (PrepareCut)
+        return Joined(ToJson(result), ToJson(SegmentReply{refined, prepared, document->version}));
       },
       response);
 }
@@ -144,9 +142,7 @@ void Remove(State& state, const std::shared_ptr<Document>& document, const nlohm
         }
         ClearStrokes(&next);  // a new buffer: see Snapshot
         Commit(*document, std::move(next), undo_depth);
-        nlohmann::ordered_json json = ToJson(result);
-        json["version"] = document->version;
-        return json;
+        return Joined(ToJson(result), ToJson(VersionReply{document->version}));
       },
       response);
 }
@@ -189,9 +185,7 @@ void Fill(State& state, const std::shared_ptr<Document>& document, const nlohman
         next.scan = std::move(filled);
         (painted ? next.hole : next.object_mask) = cv::Mat();
         Commit(*document, std::move(next), undo_depth);
-        nlohmann::ordered_json json = ToJson(result);
-        json["version"] = document->version;
-        return json;
+        return Joined(ToJson(result), ToJson(VersionReply{document->version}));
       },
       response);
 }
@@ -214,15 +208,18 @@ void Commit(Document& document, Snapshot next, int undo_depth) {
 constexpr long kMaxJobWaitMs = 2000;
 
 nlohmann::ordered_json JobJson(const Job& job) {
-  nlohmann::ordered_json json = {{"id", job.id},
-                                 {"kind", job.kind},
-                                 {"document", job.document},
-                                 {"state", ToString(job.state.load())},
-                                 {"label", job.progress.label()},
-                                 {"done", job.progress.done()},
-                                 {"total", job.progress.total()}};
+  JobReply reply{job.id,
+                 job.kind,
+                 job.document,
+                 job.state.load(),
+                 job.progress.label(),
+                 job.progress.done(),
+                 job.progress.total(),
+                 std::nullopt};
   std::lock_guard lock(const_cast<std::mutex&>(job.mutex));
-  if (!job.error.empty()) json["error"] = job.error;
+  if (!job.error.empty()) reply.error = job.error;
+  nlohmann::ordered_json json = ToJson(reply);
+  // The operation's own reply (a described struct's JSON form, or several joined): JobReply cannot name its type.
   if (!job.result.is_null()) json["result"] = job.result;
   return json;
 }
@@ -296,7 +293,7 @@ void PrepareCut(State& state, const std::shared_ptr<Document>& document) {
     std::lock_guard lock(document->mutex);
     document->preparing_cut = false;
     if (!document->cut || document->cut->scan_data != scan.range.data) document->cut = cut;
-    return nlohmann::ordered_json{{"prepared", document->cut == cut}};
+    return ToJson(PreparedReply{document->cut == cut});
   };
   document->preparing_cut = SubmitJob(state, document, "prepare segment", build) != nullptr;
 }
@@ -337,10 +334,9 @@ void AddEditRoutes(State& state) {
         if (document->now.object_stroke_cells + document->now.background_stroke_cells > 0)
           PrepareCut(state, document);
         SendJson(response,
-                 {{"version", document->version},
-                  {"hole_cells", document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole)},
-                  {"object_stroke_cells", document->now.object_stroke_cells},
-                  {"background_stroke_cells", document->now.background_stroke_cells}});
+                 ToJson(StrokesReply{
+                     document->version, document->now.hole.empty() ? 0 : cv::countNonZero(document->now.hole),
+                     document->now.object_stroke_cells, document->now.background_stroke_cells}));
       });
   PostDocument(state, R"(/api/docs/(\d+)/segment)", Segment);
   PostDocument(state, R"(/api/docs/(\d+)/remove)", Remove);
@@ -361,7 +357,7 @@ void AddEditRoutes(State& state) {
                    from.pop_back();
                    ++document->version;
                    RememberState(*document);
-                   SendJson(response, {{"version", document->version}});
+                   SendJson(response, ToJson(VersionReply{document->version}));
                  });
   }
   state.http.Get(R"(/api/jobs/(\d+))", [&state](const httplib::Request& request,

@@ -19,6 +19,7 @@
 #include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "replies.h"
 
 namespace lidarshop::server {
 
@@ -116,18 +117,10 @@ void Recolor(State& state, const std::shared_ptr<Document>& document, const nloh
         // What looks wrong (the resection's RMS, colours that disagree with the scan's own), one sentence each.
         std::vector<std::string> warnings = camera.warnings;
         warnings.insert(warnings.end(), recolored.warnings.begin(), recolored.warnings.end());
-        return nlohmann::ordered_json{{"inliers", camera.num_inliers},
-                                      {"pairs", pairs.size()},
-                                      {"rms_px", camera.rms_px},
-                                      {"reprojection_error_px", camera.reprojection_error_px},
-                                      {"inlier", camera.inlier},
-                                      {"recolored_count", recolored.recolored_count},
-                                      {"hidden", recolored.hidden},
-                                      {"uncertain", recolored.uncertain},
-                                      {"outside_image", recolored.outside_image},
-                                      {"summary", camera.Summary() + "; " + recolored.Summary()},
-                                      {"warnings", warnings},
-                                      {"version", document->version}};
+        return ToJson(RecolorReply{
+            camera.num_inliers, pairs.size(), camera.rms_px, camera.reprojection_error_px, camera.inlier,
+            recolored.recolored_count, recolored.hidden, recolored.uncertain, recolored.outside_image,
+            camera.Summary() + "; " + recolored.Summary(), warnings, document->version});
       },
       response);
 }
@@ -139,7 +132,7 @@ void RecolorStation(State& state, const std::shared_ptr<Document>& document, con
                     httplib::Response& response) {
   const PhotosRecolorOptions options;  // the library's defaults, as the CLI's (no JSON form of its own yet)
   std::vector<CameraPhoto> photos;
-  nlohmann::ordered_json used = nlohmann::ordered_json::array(), skipped = nlohmann::ordered_json::array();
+  std::vector<StationPhotoEntry> used, skipped;
   {
     std::lock_guard lock(document->mutex);
     E57File file;  // the document's photos, as the file's scan 0 holds them (ImagesOfScan)
@@ -147,15 +140,17 @@ void RecolorStation(State& state, const std::shared_ptr<Document>& document, con
     const E57StationPhotos station = StationPhotosOfE57(file, 0);  // as `recolor --from-e57-images`
     photos = station.photos;
     for (const int index : station.image_index)
-      used.push_back({{"index", index}, {"name", file.images[index].name}});
-    for (const auto& [index, why] : station.skipped)
-      skipped.push_back({{"index", index}, {"name", file.images[index].name}, {"why", why}});
+      used.push_back({index, file.images[index].name, std::nullopt});
+    for (const auto& [index, why] : station.skipped) skipped.push_back({index, file.images[index].name, why});
   }
   if (photos.empty()) {
+    nlohmann::ordered_json skipped_json = nlohmann::ordered_json::array();
+    for (const StationPhotoEntry& photo : skipped) skipped_json.push_back(ToJson(photo));
     throw OptionsFieldError(
-        "photos", fmt::format("none of the scan's {} E57 photo(s) holds a camera to colour "
-                              "from{}",
-                              skipped.size(), skipped.empty() ? "" : ": " + Excerpt(skipped.dump(), 300)));
+        "photos",
+        fmt::format("none of the scan's {} E57 photo(s) holds a camera to colour "
+                    "from{}",
+                    skipped.size(), skipped.empty() ? "" : ": " + Excerpt(skipped_json.dump(), 300)));
   }
   const int undo_depth = state.options.undo_depth;
   StartJob(
@@ -173,13 +168,8 @@ void RecolorStation(State& state, const std::shared_ptr<Document>& document, con
         Snapshot next = document->now;
         next.scan = result.scan;
         Commit(*document, std::move(next), undo_depth);
-        return nlohmann::ordered_json{{"returns", result.returns},
-                                      {"coloured", result.coloured},
-                                      {"constraints", result.constraints},
-                                      {"used", used},
-                                      {"skipped", skipped},
-                                      {"summary", result.Summary()},
-                                      {"version", document->version}};
+        return ToJson(RecolorStationReply{result.returns, result.coloured, result.constraints, used, skipped,
+                                          result.Summary(), document->version});
       },
       response);
 }
@@ -234,17 +224,15 @@ void Align(State& state, const std::shared_ptr<Document>& document, const nlohma
     }
     const LandmarkAlignment fit = AlignLandmarks(pairs, with_scale, "pairs");
     const Eigen::Matrix4d& t = fit.target_from_source;
-    nlohmann::ordered_json json = WithMatrix(ToJson(fit), "target_from_source_column_major",
-                                             std::vector<double>(t.data(), t.data() + 16));
-    json["applied"] = apply;
+    const nlohmann::ordered_json json = WithMatrix(ToJson(fit), "target_from_source_column_major",
+                                                   std::vector<double>(t.data(), t.data() + 16));
     if (apply) {
       Snapshot next = document->now;
       next.scan.world_from_scanner = t * document->now.scan.world_from_scanner;
       next.behind.world_from_scanner = next.scan.world_from_scanner;  // the second layer shares the pose
       Commit(*document, std::move(next), state.options.undo_depth);
     }
-    json["version"] = document->version;
-    SendJson(response, json);
+    SendJson(response, Joined(json, ToJson(AlignReply{apply, document->version})));
   } catch (const InputError& error) {
     throw OptionsError(error.what());  // cells without a return, too few or collinear landmarks
   }
@@ -314,35 +302,35 @@ void AddRecolorRoutes(State& state) {
         cv::Mat* slot = PhotoSlot(*document, request, response);
         if (!slot) return;
         *slot = rgb;
-        SendJson(response, {{"width_px", rgb.cols}, {"height_px", rgb.rows}});
+        SendJson(response, ToJson(PhotoReply{rgb.cols, rgb.rows, std::nullopt}));
       });
   // A photo the scan's E57 file carries (images2D; GET /api/docs/ID's "e57_images") as the photo to recolour
   // from or the second one: body {"image": K}, ?slot= as for an upload.
-  PostDocument(
-      state, R"(/api/docs/(\d+)/photo-from-e57)",
-      [](State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
-         httplib::Response& response) {
-        if (!body.contains("image") || !body["image"].is_number_integer())
-          throw OptionsFieldError("image", "expected the index of one of the scan's E57 photos");
-        const int64_t index = body["image"].get<int64_t>();
-        std::lock_guard lock(document->mutex);
-        if (index < 0 || index >= static_cast<int64_t>(document->e57_images.size())) {
-          throw OptionsFieldError("image", fmt::format("the scan's E57 file has {} photo(s); {} is none",
+  PostDocument(state, R"(/api/docs/(\d+)/photo-from-e57)",
+               [](State&, const std::shared_ptr<Document>& document, const nlohmann::json& body,
+                  httplib::Response& response) {
+                 if (!body.contains("image") || !body["image"].is_number_integer())
+                   throw OptionsFieldError("image", "expected the index of one of the scan's E57 photos");
+                 const int64_t index = body["image"].get<int64_t>();
+                 std::lock_guard lock(document->mutex);
+                 if (index < 0 || index >= static_cast<int64_t>(document->e57_images.size())) {
+                   throw OptionsFieldError("image",
+                                           fmt::format("the scan's E57 file has {} photo(s); {} is none",
                                                        document->e57_images.size(), index));
-        }
-        const E57Image& image = document->e57_images[index];
-        if (image.image.empty()) {
-          return SendError(response, 422,
-                           fmt::format("the E57 photo '{}' does not decode: {}", Excerpt(image.name, 100),
-                                       image.decode_error));
-        }
-        httplib::Request slot_request;  // the slot comes in the body here
-        slot_request.params.emplace("slot", body.value("slot", std::string("a")));
-        cv::Mat* slot = PhotoSlot(*document, slot_request, response);
-        if (!slot) return;
-        *slot = image.image;  // shared, never written: a photo slot is replaced, not edited
-        SendJson(response, {{"width_px", slot->cols}, {"height_px", slot->rows}, {"name", image.name}});
-      });
+                 }
+                 const E57Image& image = document->e57_images[index];
+                 if (image.image.empty()) {
+                   return SendError(response, 422,
+                                    fmt::format("the E57 photo '{}' does not decode: {}",
+                                                Excerpt(image.name, 100), image.decode_error));
+                 }
+                 httplib::Request slot_request;  // the slot comes in the body here
+                 slot_request.params.emplace("slot", body.value("slot", std::string("a")));
+                 cv::Mat* slot = PhotoSlot(*document, slot_request, response);
+                 if (!slot) return;
+                 *slot = image.image;  // shared, never written: a photo slot is replaced, not edited
+                 SendJson(response, ToJson(PhotoReply{slot->cols, slot->rows, image.name}));
+               });
   http.Get(R"(/api/docs/(\d+)/photo.png)",
            [&state](const httplib::Request& request, httplib::Response& response) {
              auto document = state.FindDocument(request, response);

@@ -13,6 +13,7 @@
 #include "lidarshop/inpaint/inpaint_session.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "replies.h"
 
 namespace lidarshop::server {
 
@@ -59,6 +60,34 @@ Scan WithChannel(const Scan& scan, const std::string& channel, const cv::Mat& im
   return next;
 }
 
+std::vector<int> PixelList(Pixel pixel) { return {pixel.row, pixel.col}; }
+
+// The decisions made so far (as inpaint/review.h DecisionsToJson writes them for `lidarshop inpaint --review`).
+std::vector<ReviewDecisionEntry> DecisionEntries(const std::vector<ReviewDecision>& decisions) {
+  std::vector<ReviewDecisionEntry> list;
+  for (const ReviewDecision& decision : decisions)
+    list.push_back({PixelList(decision.target), PixelList(decision.source)});
+  return list;
+}
+
+// A review point with its candidates' verdicts and their clusters (as inpaint/review.h ReviewToJson).
+ReviewDetail ReviewDetailOf(const InpaintReview& review, int patch_radius) {
+  ReviewDetail detail{review.review_point, review.iteration, PixelList(review.target), patch_radius, {}, {}};
+  for (size_t i = 0; i < review.candidates.size(); ++i) {
+    const AcceptanceVerdict verdict = i < review.verdicts.size() ? review.verdicts[i] : AcceptanceVerdict{};
+    detail.candidates.push_back({i, PixelList(review.candidates[i].source), review.candidates[i].difference,
+                                 review.cluster[i], verdict.accepted, verdict.test, verdict.value,
+                                 verdict.threshold, verdict.margin});
+  }
+  for (size_t c = 0; c < review.cluster_representative.size(); ++c) {
+    ReviewClusterEntry cluster{c, review.cluster_representative[c], {}};
+    for (size_t i = 0; i < review.cluster.size(); ++i)
+      if (review.cluster[i] == static_cast<int>(c)) cluster.members.push_back(i);
+    detail.clusters.push_back(std::move(cluster));
+  }
+  return detail;
+}
+
 // The review's display image as 8-bit RGB or grey.
 cv::Mat Display(const cv::Mat& image) {
   cv::Mat display;
@@ -100,28 +129,25 @@ std::shared_ptr<Job> FillingJob(State& state, const std::shared_ptr<Document>& d
     }
     if (!complete) {
       const InpaintReview& pending = *review->session->pending_review();
-      nlohmann::ordered_json json = {{"state", "review"},
-                                     {"review_point", pending.review_point},
-                                     {"target", {pending.target.row, pending.target.col}},
-                                     {"candidates", pending.candidates.size()},
-                                     {"clusters", pending.cluster_representative.size()}};
+      const ReviewPointReply reply{"review",
+                                   pending.review_point,
+                                   {pending.target.row, pending.target.col},
+                                   pending.candidates.size(),
+                                   pending.cluster_representative.size()};
       finish(true);
-      return json;
+      return ToJson(reply);
     }
     const InpaintResult result = review->session->Result();
     std::lock_guard lock(document->mutex);
     review->job = nullptr;
-    if (document->review != review) return nlohmann::ordered_json{{"state", "stopped"}};  // dropped meanwhile
+    if (document->review != review) return ToJson(ReviewStoppedReply{});  // dropped meanwhile
     document->review = nullptr;
     Snapshot next = document->now;
     next.scan = WithChannel(document->now.scan, review->channel, result.image, review->hole);
     if (review->painted) next.hole = cv::Mat();
     Commit(*document, std::move(next), undo_depth);
-    return nlohmann::ordered_json{{"state", "done"},
-                                  {"channel", review->channel},
-                                  {"decisions", DecisionsToJson(review->session->decisions())},
-                                  {"summary", result.Summary()},
-                                  {"version", document->version}};
+    return ToJson(ReviewDoneReply{"done", review->channel, DecisionEntries(review->session->decisions()),
+                                  result.Summary(), document->version});
   };
   return job;
 }
@@ -253,22 +279,19 @@ void AddReviewRoutes(State& state) {
   httplib::Server& http = state.http;
   PostDocument(state, R"(/api/docs/(\d+)/inpaint/review)", Start);
   PostDocument(state, R"(/api/docs/(\d+)/inpaint/review/decide)", Decide);
-  http.Get(R"(/api/docs/(\d+)/inpaint/review)",
-           [&state](const httplib::Request& request, httplib::Response& response) {
-             auto document = state.FindDocument(request, response);
-             if (!document) return;
-             std::lock_guard lock(document->mutex);
-             auto review = IdleReview(*document, response);
-             if (!review) return;
-             const InpaintReview& pending = *review->session->pending_review();
-             SendJson(response, {{"state", "review"},
-                                 {"channel", review->channel},
-                                 {"rows", review->hole.rows},
-                                 {"cols", review->hole.cols},
-                                 {"hole_cells", cv::countNonZero(review->hole)},
-                                 {"decisions", DecisionsToJson(review->session->decisions())},
-                                 {"review", ReviewToJson(pending, review->options.patch_radius)}});
-           });
+  http.Get(R"(/api/docs/(\d+)/inpaint/review)", [&state](const httplib::Request& request,
+                                                         httplib::Response& response) {
+    auto document = state.FindDocument(request, response);
+    if (!document) return;
+    std::lock_guard lock(document->mutex);
+    auto review = IdleReview(*document, response);
+    if (!review) return;
+    const InpaintReview& pending = *review->session->pending_review();
+    SendJson(response, ToJson(PendingReviewReply{"review", review->channel, review->hole.rows,
+                                                 review->hole.cols, cv::countNonZero(review->hole),
+                                                 DecisionEntries(review->session->decisions()),
+                                                 ReviewDetailOf(pending, review->options.patch_radius)}));
+  });
   // The pixels: the fill so far (`canvas`, candidates are cut from it) or with the best candidate pasted
   // (`tentative`), 8-bit, the ray image's size and orientation.
   http.Get(R"(/api/docs/(\d+)/inpaint/review/image.png)", [&state](const httplib::Request& request,
@@ -293,7 +316,7 @@ void AddReviewRoutes(State& state) {
                 if (!document->review) return SendError(response, 404, "no review in progress");
                 if (document->review->job) document->review->job->progress.Cancel();
                 document->review = nullptr;
-                SendJson(response, {{"closed", true}});
+                SendJson(response, ToJson(ReviewClosedReply{}));
               });
 }
 

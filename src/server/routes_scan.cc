@@ -27,6 +27,8 @@
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
+#include "replies.h"
 #include "version_param.h"
 
 namespace lidarshop::server {
@@ -37,8 +39,8 @@ void SendError(httplib::Response& response, int status, const std::string& messa
   response.status = status;
   // Cut (a message may quote the request) and with bytes that are not UTF-8 replaced (a path or header
   // quoted as sent), so that writing the answer cannot throw.
-  response.set_content(nlohmann::json{{"error", Excerpt(message, kMaxErrorBytes)}}.dump(
-                           -1, ' ', false, nlohmann::json::error_handler_t::replace),
+  response.set_content(ToJson(ErrorReply{Excerpt(message, kMaxErrorBytes)})
+                           .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace),
                        "application/json");
 }
 
@@ -330,21 +332,18 @@ StrokeCounts CountStrokes(const cv::Mat& strokes) {
 
 namespace {
 
-// The photos a document carries from its E57 file: {"index", "name", "width_px", "height_px", "usable"}
-// ("usable": decoded, so the recolour tool can take it).
-nlohmann::ordered_json E57ImagesJson(const std::vector<E57Image>& images) {
-  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+// The photos a document carries from its E57 file ("usable": decoded, so the recolour tool can take it).
+std::vector<E57ImageEntry> E57ImageEntries(const std::vector<E57Image>& images) {
+  std::vector<E57ImageEntry> list;
   for (size_t i = 0; i < images.size(); ++i) {
-    list.push_back({{"index", i},
-                    {"name", images[i].name},
-                    {"width_px", images[i].image.empty() ? images[i].width_px : images[i].image.cols},
-                    {"height_px", images[i].image.empty() ? images[i].height_px : images[i].image.rows},
-                    {"usable", !images[i].image.empty()}});
+    list.push_back({i, images[i].name, images[i].image.empty() ? images[i].width_px : images[i].image.cols,
+                    images[i].image.empty() ? images[i].height_px : images[i].image.rows,
+                    !images[i].image.empty()});
   }
   return list;
 }
 
-nlohmann::ordered_json DocumentJson(Document& document) {
+DocumentReply DocumentOf(Document& document) {
   std::lock_guard lock(document.mutex);
   const Scan& scan = document.now.scan;
   std::vector<std::string> channels;
@@ -363,27 +362,28 @@ nlohmann::ordered_json DocumentJson(Document& document) {
     return angles.size() < 2 ? 0.0
                              : std::abs(angles.back() - angles.front()) / (angles.size() - 1) * 180.0 / M_PI;
   };
-  return {
-      {"id", document.id},
-      {"name", document.name},
-      {"rows", scan.rows},
-      {"cols", scan.cols},
-      {"channels", channels},
-      {"valid_cells", scan.CountValid()},
-      {"synthesized_cells", scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized)},
-      {"object_cells", document.now.object_mask.empty() ? 0 : document.now.object_cells},
-      {"hole_cells", document.now.hole.empty() ? 0 : cv::countNonZero(document.now.hole)},
-      {"object_stroke_cells", document.now.object_stroke_cells},
-      {"background_stroke_cells", document.now.background_stroke_cells},
-      {"behind_cells", document.now.behind.valid.empty() ? 0 : cv::countNonZero(document.now.behind.valid)},
-      {"world_from_scanner_column_major", pose},
-      {"azimuth_step_deg", step_deg(scan.grid.azimuth_rad)},
-      {"elevation_step_deg", step_deg(scan.grid.elevation_rad)},
-      {"version", document.version},
-      {"can_undo", !document.undo.empty()},
-      {"can_redo", !document.redo.empty()},
-      {"e57_images", E57ImagesJson(document.e57_images)}};
+  return {document.id,
+          document.name,
+          scan.rows,
+          scan.cols,
+          channels,
+          scan.CountValid(),
+          scan.synthesized.empty() ? 0 : cv::countNonZero(scan.synthesized),
+          document.now.object_mask.empty() ? 0 : document.now.object_cells,
+          document.now.hole.empty() ? 0 : cv::countNonZero(document.now.hole),
+          document.now.object_stroke_cells,
+          document.now.background_stroke_cells,
+          document.now.behind.valid.empty() ? 0 : cv::countNonZero(document.now.behind.valid),
+          pose,
+          step_deg(scan.grid.azimuth_rad),
+          step_deg(scan.grid.elevation_rad),
+          document.version,
+          !document.undo.empty(),
+          !document.redo.empty(),
+          E57ImageEntries(document.e57_images)};
 }
+
+nlohmann::ordered_json DocumentJson(Document& document) { return ToJson(DocumentOf(document)); }
 
 void Open(State& state, const httplib::Request& request, httplib::Response& response) {
   if (request.has_param("scene")) {
@@ -421,9 +421,8 @@ void Open(State& state, const httplib::Request& request, httplib::Response& resp
     }
     const int id = state.AddDocument(fs::path(path).filename().string(), std::move(file.scans[index]),
                                      ImagesOfScan(opened.images, index));
-    nlohmann::ordered_json reply = DocumentJson(*state.Get(id));
-    reply["warnings"] = file.warnings;  // what the reader left out of the file
-    SendJson(response, reply);
+    // With what the reader left out of the file.
+    SendJson(response, Joined(DocumentJson(*state.Get(id)), ToJson(WarningsReply{file.warnings})));
   } catch (const DocumentLimitError& error) {
     SendError(response, error.status, error.what());
   } catch (const InputError& error) {
@@ -510,10 +509,8 @@ void SavePlan(Document& document, const httplib::Request& request, httplib::Resp
         fmt::format("{}: the {} photo(s) of the E57 file (images2D) are not written; E57 keeps them", format,
                     document.e57_images.size()));
   }
-  SendJson(response, {{"format", format},
-                      {"channels", plan.channels},
-                      {"dropped", dropped},
-                      {"refused", layer && !info->layer_behind ? LayerBehindRefusal(*info) : ""}});
+  SendJson(response, ToJson(SavePlanReply{format, plan.channels, dropped,
+                                          layer && !info->layer_behind ? LayerBehindRefusal(*info) : ""}));
 }
 
 }  // namespace
@@ -521,20 +518,22 @@ void SavePlan(Document& document, const httplib::Request& request, httplib::Resp
 void AddScanRoutes(State& state) {
   httplib::Server& http = state.http;
   http.Get("/api/health", [](const httplib::Request&, httplib::Response& response) {
-    SendJson(response, {{"ok", true}});
+    SendJson(response, ToJson(HealthReply{}));
   });
   // The scan formats the library reads and writes (the open and save dialogs offer these).
   http.Get("/api/formats", [](const httplib::Request&, httplib::Response& response) {
-    SendJson(response, {{"read", SupportedScanReadExtensions()},
-                        {"write", SupportedScanWriteExtensions()},
-                        {"formats", ScanFormatsJson()}});
+    // "formats": the registry as the library writes it (io/formats.h; its channels are false, true or a name).
+    nlohmann::ordered_json json =
+        ToJson(FormatsReply{SupportedScanReadExtensions(), SupportedScanWriteExtensions()});
+    json["formats"] = ScanFormatsJson();
+    SendJson(response, json);
   });
   http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
-    SendJson(response, {{"scenes", state.options.builtin_scenes}});
+    SendJson(response, ToJson(ScenesReply{state.options.builtin_scenes}));
   });
   // The file dialog: scan files under the roots (at most 2000, two folders deep).
   http.Get("/api/files", [&state](const httplib::Request&, httplib::Response& response) {
-    nlohmann::ordered_json files = nlohmann::ordered_json::array();
+    std::vector<FileEntry> files;
     const std::vector<std::string> readable = SupportedScanReadExtensions();
     for (const std::string& root : state.options.roots) {
       std::error_code error;
@@ -546,32 +545,28 @@ void AddScanRoutes(State& state) {
         if (IsAtomicTemporary(it->path().filename().string())) continue;
         const std::string extension = FileExtension(it->path().string());
         if (std::find(readable.begin(), readable.end(), extension) == readable.end()) continue;
-        files.push_back({{"path", it->path().string()}, {"bytes", it->file_size()}});
+        files.push_back({it->path().string(), it->file_size(), false, std::nullopt});
         if (files.size() >= 2000) break;
       }
     }
     // In name order, each with whether its header reads (io/scan_header.h: the header only, cheap), so that the
     // dialog offers the first file that opens rather than a broken one the folder happened to list first. A
     // file whose real path leaves the roots (a symlink) is not read: opening it is refused anyway.
-    std::sort(files.begin(), files.end(), [](const auto& a, const auto& b) {
-      return a["path"].template get<std::string>() < b["path"].template get<std::string>();
-    });
-    for (auto& file : files) {
-      const std::string path = file["path"].get<std::string>();
-      if (ResolveUnderRoots(state.options.roots, path).empty()) {
-        file["readable"] = false;
-        file["error"] = "outside the served folders";
+    std::sort(files.begin(), files.end(),
+              [](const FileEntry& a, const FileEntry& b) { return a.path < b.path; });
+    for (FileEntry& file : files) {
+      if (ResolveUnderRoots(state.options.roots, file.path).empty()) {
+        file.error = "outside the served folders";
         continue;
       }
       try {
-        ReadScanHeader(path);
-        file["readable"] = true;
+        ReadScanHeader(file.path);
+        file.readable = true;
       } catch (const std::exception& error) {
-        file["readable"] = false;
-        file["error"] = error.what();
+        file.error = error.what();
       }
     }
-    SendJson(response, {{"roots", state.options.roots}, {"files", files}});
+    SendJson(response, ToJson(FilesReply{state.options.roots, std::move(files)}));
   });
   http.Get("/api/open", [&state](const httplib::Request& request, httplib::Response& response) {
     Open(state, request, response);
@@ -582,9 +577,9 @@ void AddScanRoutes(State& state) {
       std::lock_guard lock(state.documents_mutex);
       for (const auto& [id, document] : state.documents) documents.push_back(document);
     }
-    nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const auto& document : documents) list.push_back(DocumentJson(*document));
-    SendJson(response, {{"documents", list}});
+    DocumentsReply reply;
+    for (const auto& document : documents) reply.documents.push_back(DocumentOf(*document));
+    SendJson(response, ToJson(reply));
   });
   http.Get(R"(/api/docs/(\d+))", [&state](const httplib::Request& request, httplib::Response& response) {
     if (auto document = state.FindDocument(request, response)) SendJson(response, DocumentJson(*document));
@@ -593,7 +588,7 @@ void AddScanRoutes(State& state) {
     if (auto document = state.FindDocument(request, response)) {
       std::lock_guard lock(state.documents_mutex);
       state.documents.erase(document->id);
-      SendJson(response, {{"closed", document->id}});
+      SendJson(response, ToJson(ClosedReply{document->id}));
     }
   });
   http.Get(R"(/api/docs/(\d+)/image.png)", [&state](const httplib::Request& request,
@@ -714,14 +709,10 @@ void AddScanRoutes(State& state) {
                  }
                }
              }
-             nlohmann::ordered_json labels = nlohmann::ordered_json::array();
-             for (const auto& [label, s] : stats) {
-               labels.push_back({{"label", label},
-                                 {"cells", s[0]},
-                                 {"box", {s[1], s[2], s[3], s[4]}},
-                                 {"center", {s[5] / s[0], s[6] / s[0]}}});
-             }
-             SendJson(response, {{"labels", labels}});
+             LabelsReply reply;
+             for (const auto& [label, s] : stats)
+               reply.labels.push_back({label, s[0], {s[1], s[2], s[3], s[4]}, {s[5] / s[0], s[6] / s[0]}});
+             SendJson(response, ToJson(reply));
            });
   http.Get(R"(/api/docs/(\d+)/save)", [&state](const httplib::Request& request, httplib::Response& response) {
     if (auto document = state.FindDocument(request, response)) Save(*document, request, response);

@@ -16,6 +16,7 @@
 #include "lidarshop/site/transients.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
+#include "replies.h"
 
 namespace lidarshop::server {
 
@@ -56,11 +57,10 @@ std::shared_ptr<Site> AddSite(State& state, std::string name, std::vector<int> d
   return site;
 }
 
-// {"site", "name", "station": the index of `current_document` (-1 = none), "stations": [the summary of
-// each (site_stations.h) with "document", "open", "current", and while open "version" and "removed_cells"]}.
-nlohmann::ordered_json SiteJson(State& state, const Site& site, int current_document) {
-  nlohmann::ordered_json stations = nlohmann::ordered_json::array();
-  int current = -1;
+// The site as the routes answer it: "station" is the index of `current_document` (-1 = none); each station's
+// summary (site_stations.h) with its document, and while that is open its version and removed cells.
+SiteReply SiteReplyOf(State& state, const Site& site, int current_document) {
+  SiteReply reply{site.id, site.name, -1, {}};
   for (size_t i = 0; i < site.documents.size(); ++i) {
     StationSummary summary = site.stations[i];
     const auto document = OpenDocumentOf(state, site.documents[i]);
@@ -71,18 +71,29 @@ nlohmann::ordered_json SiteJson(State& state, const Site& site, int current_docu
       version = document->version;
       removed = document->now.removed.empty() ? 0 : cv::countNonZero(document->now.removed);
     }
-    nlohmann::ordered_json json = StationSummaryJson(summary);
-    json["document"] = site.documents[i];
-    json["open"] = document != nullptr;
-    json["current"] = site.documents[i] == current_document;
+    const Eigen::Matrix4d& pose = summary.world_from_scanner;
+    StationEntry entry{summary.index,
+                       summary.name,
+                       {summary.position_m.x(), summary.position_m.y(), summary.position_m.z()},
+                       summary.heading_deg,
+                       std::vector<double>(pose.data(), pose.data() + 16),
+                       summary.rows,
+                       summary.cols,
+                       summary.returns,
+                       summary.organized,
+                       site.documents[i],
+                       document != nullptr,
+                       site.documents[i] == current_document,
+                       std::nullopt,
+                       std::nullopt};
     if (document) {
-      json["version"] = version;
-      json["removed_cells"] = removed;
+      entry.version = version;
+      entry.removed_cells = removed;
     }
-    if (site.documents[i] == current_document) current = static_cast<int>(i);
-    stations.push_back(std::move(json));
+    if (site.documents[i] == current_document) reply.station = static_cast<int>(i);
+    reply.stations.push_back(std::move(entry));
   }
-  return {{"site", site.id}, {"name", site.name}, {"station", current}, {"stations", stations}};
+  return reply;
 }
 
 // Opens `scans` as one document each, named `name#i` (or `name` for one); on any failure (too many open, no
@@ -176,10 +187,8 @@ void OpenSite(State& state, const nlohmann::json& body, httplib::Response& respo
     throw OptionsError("expected \"path\", \"scene\" or \"documents\": what the site is made of");
   }
   const auto site = AddSite(state, name, ids, std::move(summaries));
-  nlohmann::ordered_json json = SiteJson(state, *site, ids[station]);
-  json["document"] = ids[station];
-  json["warnings"] = warnings;
-  SendJson(response, json);
+  SendJson(response, Joined(ToJson(SiteReplyOf(state, *site, ids[station])),
+                            ToJson(OpenedSiteReply{ids[station], warnings})));
 }
 
 // POST /api/docs/ID/clean: {"options": CleanOptions, "stations": [indices] (default: all)}. One job; every
@@ -232,49 +241,45 @@ void Clean(State& state, const std::shared_ptr<Document>& document, const nlohma
           versions.push_back(station->version);
         }
         const CleanResult result = CleanStations(scans, options, &progress);
-        nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+        std::vector<CleanStationEntry> stations;
         int64_t removed_here = 0, version_here = -1;
         for (size_t i = 0; i < documents.size(); ++i) {
           Document& station = *documents[i];
           const StationTransients& found = result.transients.stations[i];
           std::lock_guard lock(station.mutex);
-          nlohmann::ordered_json json = {{"station", chosen[i]},
-                                         {"document", station.id},
-                                         {"removed", found.transient_cells},
-                                         {"seen_through", found.seen_through_cells},
-                                         {"confirmed", found.confirmed_cells},
-                                         {"filled", result.filled_cells[i]}};
+          CleanStationEntry entry{chosen[i],
+                                  station.id,
+                                  found.transient_cells,
+                                  found.seen_through_cells,
+                                  found.confirmed_cells,
+                                  result.filled_cells[i],
+                                  false,
+                                  std::nullopt,
+                                  0};
           if (station.version != versions[i]) {
-            json["changed"] = false;
-            json["why"] = "edited while the clean ran: left as it is (clean again)";
+            entry.why = "edited while the clean ran: left as it is (clean again)";
           } else if (found.transient_cells == 0) {
-            json["changed"] = false;
-            json["why"] = "nothing moved here";
+            entry.why = "nothing moved here";
           } else {
             Snapshot next = station.now;
             next.scan = result.stations[i];
             next.removed = found.transient.clone();  // a new buffer: see Snapshot
             try {
               Commit(station, std::move(next), undo_depth);
-              json["changed"] = true;
+              entry.changed = true;
             } catch (
                 const DocumentLimitError& error) {  // past the memory limit: this station stays as it was
-              json["changed"] = false;
-              json["why"] = error.what();
+              entry.why = error.what();
             }
           }
-          json["version"] = station.version;
+          entry.version = station.version;
           if (station.id == current_document) {
             removed_here = found.transient_cells;
             version_here = station.version;
           }
-          stations.push_back(std::move(json));
+          stations.push_back(std::move(entry));
         }
-        return nlohmann::ordered_json{{"station", current},
-                                      {"removed_cells", removed_here},
-                                      {"version", version_here},
-                                      {"stations", stations},
-                                      {"warnings", result.warnings}};
+        return ToJson(CleanReply{current, removed_here, version_here, std::move(stations), result.warnings});
       },
       response);
 }
@@ -372,20 +377,14 @@ void FillFromOtherStations(State& state, const std::shared_ptr<Document>& docume
           (which == "painted" ? next.hole : next.object_mask) = cv::Mat();
         }
         Commit(*document, std::move(next), undo_depth);
-        nlohmann::ordered_json stations = nlohmann::ordered_json::array();
+        std::vector<FillStationEntry> stations;
         for (size_t k = 0; k < chosen.size(); ++k) {
-          stations.push_back(
-              {{"station", chosen[k]},
-               {"document", documents[k]->id},
-               {"cells", k < filled.cells_per_station.size() ? filled.cells_per_station[k] : 0}});
+          stations.push_back({chosen[k], documents[k]->id,
+                              k < filled.cells_per_station.size() ? filled.cells_per_station[k] : 0});
         }
-        return nlohmann::ordered_json{{"hole_cells", filled.hole_cells},
-                                      {"from_station_cells", filled.from_station_cells},
-                                      {"synthesized_cells", filled.synthesized_cells},
-                                      {"no_return_cells", filled.no_return_cells},
-                                      {"stations", stations},
-                                      {"warnings", filled.warnings},
-                                      {"version", document->version}};
+        return ToJson(FillFromStationsReply{filled.hole_cells, filled.from_station_cells,
+                                            filled.synthesized_cells, filled.no_return_cells,
+                                            std::move(stations), filled.warnings, document->version});
       },
       response);
 }
@@ -415,23 +414,23 @@ void AddStationRoutes(State& state) {
       std::lock_guard lock(state.documents_mutex);
       for (const auto& [id, site] : state.sites) sites.push_back(site);
     }
-    nlohmann::ordered_json list = nlohmann::ordered_json::array();
-    for (const auto& site : sites) list.push_back(SiteJson(state, *site, -1));
-    SendJson(response, {{"sites", list}});
+    SitesReply reply;
+    for (const auto& site : sites) reply.sites.push_back(SiteReplyOf(state, *site, -1));
+    SendJson(response, ToJson(reply));
   });
   // The stations of the site a document belongs to ({"site": null, "station": -1, "stations": []} when none).
-  http.Get(R"(/api/docs/(\d+)/stations)", [&state](const httplib::Request& request,
-                                                   httplib::Response& response) {
-    const auto document = state.FindDocument(request, response);
-    if (!document) return;
-    const std::shared_ptr<Site> site = SiteOf(state, document->id).first;
-    if (!site) {
-      return SendJson(
-          response,
-          {{"site", nullptr}, {"name", ""}, {"station", -1}, {"stations", nlohmann::ordered_json::array()}});
-    }
-    SendJson(response, SiteJson(state, *site, document->id));
-  });
+  http.Get(R"(/api/docs/(\d+)/stations)",
+           [&state](const httplib::Request& request, httplib::Response& response) {
+             const auto document = state.FindDocument(request, response);
+             if (!document) return;
+             const std::shared_ptr<Site> site = SiteOf(state, document->id).first;
+             if (!site) {
+               nlohmann::ordered_json json = ToJson(SiteReply{});
+               json["site"] = nullptr;  // no site (a described int has no null)
+               return SendJson(response, json);
+             }
+             SendJson(response, ToJson(SiteReplyOf(state, *site, document->id)));
+           });
   // The cells the last Clean removed from this station, as it stands now: {"version", "cells": [row * cols +
   // col, ...]} (empty once the clean is undone).
   http.Get(R"(/api/docs/(\d+)/removed)",
@@ -451,7 +450,7 @@ void AddStationRoutes(State& state) {
                  }
                }
              }
-             SendJson(response, {{"version", version}, {"cells", cells}});
+             SendJson(response, ToJson(RemovedReply{version, cells}));
            });
   PostDocument(state, R"(/api/docs/(\d+)/clean)", Clean);
   PostDocument(state, R"(/api/docs/(\d+)/fill-from-stations)", FillFromOtherStations);

@@ -14,6 +14,7 @@
 #include "lidarshop/util/options.h"
 #include "lidarshop/verify/pose_text.h"
 #include "lidarshop/verify/verify.h"
+#include "replies.h"
 
 namespace lidarshop::server {
 
@@ -67,7 +68,7 @@ Eigen::Matrix4d PoseOfBody(const nlohmann::json& body) {
 void AddVerifyRoutes(State& state) {
   httplib::Server& http = state.http;
   http.Get("/api/models", [&state](const httplib::Request&, httplib::Response& response) {
-    nlohmann::ordered_json files = nlohmann::ordered_json::array();
+    std::vector<std::string> files;
     for (const std::string& root : state.options.roots) {
       std::error_code error;
       for (auto it = fs::recursive_directory_iterator(root, error);
@@ -80,7 +81,7 @@ void AddVerifyRoutes(State& state) {
         }
       }
     }
-    SendJson(response, {{"builtin", kBuiltinModels}, {"files", files}});
+    SendJson(response, ToJson(ModelsReply{kBuiltinModels, files}));
   });
   http.Post("/api/models", [&state](const httplib::Request& request, httplib::Response& response) {
     const auto body = BodyJson(request, response);
@@ -119,12 +120,12 @@ void AddVerifyRoutes(State& state) {
       entry->id = ++state.last_model;
       state.models[entry->id] = entry;
       const Eigen::Vector3f size = high - low;
-      SendJson(response, {{"id", entry->id},
-                          {"name", name},
-                          {"vertices", entry->mesh.vertices.size()},
-                          {"triangles", entry->mesh.triangles.size()},
-                          {"size_m", {size.x(), size.y(), size.z()}},
-                          {"warnings", warnings}});
+      SendJson(response, ToJson(ModelReply{entry->id,
+                                           name,
+                                           entry->mesh.vertices.size(),
+                                           entry->mesh.triangles.size(),
+                                           {size.x(), size.y(), size.z()},
+                                           warnings}));
     } catch (const OptionsError& error) {
       SendError(response, 400, error.what());
     } catch (const InputError& error) {
@@ -162,9 +163,7 @@ void AddVerifyRoutes(State& state) {
       }
       const VerifyResult result =
           VerifyPose(model->model, std::span<const PreparedScan>(prepared.get(), 1), world_from_model);
-      nlohmann::ordered_json json = ToJson(result);
-      json["summary"] = result.BriefReport();
-      SendJson(response, json);
+      SendJson(response, Joined(ToJson(result), ToJson(VerifyReply{result.BriefReport()})));
     } catch (const OptionsError& error) {
       SendError(response, 400, error.what());
     } catch (const InputError& error) {

@@ -1,5 +1,6 @@
-// The editor's server on a free loopback port for a test suite: the server tests (server_test,
-// server_stations_test, server_tiles_test) each start one with their own options.
+// The editor's server on a free loopback port for a test suite: the server tests (the route tests of
+// server_routes_test_util.h, server_stations_test, server_tiles_test, server_jobs_test, server_safety_test) each
+// start one with their own options.
 #pragma once
 
 #include <chrono>

@@ -208,6 +208,4 @@ class JobRunner {
   bool stopping_ = false;
 };
 
-std::string ToString(JobState state);
-
 }  // namespace lidarshop::server

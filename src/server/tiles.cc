@@ -21,6 +21,8 @@
 #include "lidarshop/render/render.h"
 #include "lidarshop/util/enum_names.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
+#include "replies.h"
 #include "version_param.h"
 
 namespace lidarshop::server {
@@ -142,14 +144,11 @@ nlohmann::ordered_json TilesInfo(Document& document, const RenderOptions& option
                                  int64_t since) {
   const Document::PointState& now = document.recent.back();
   const int rows = now.points.scan.rows, cols = now.points.scan.cols;
-  nlohmann::ordered_json levels = nlohmann::ordered_json::array();
+  std::vector<TileLevelEntry> levels;
   for (int level = 0; level <= TileLevels(rows, cols); ++level) {
     const int level_rows = CeilDiv(rows, 1 << level), level_cols = CeilDiv(cols, 1 << level);
-    levels.push_back({{"level", level},
-                      {"rows", level_rows},
-                      {"cols", level_cols},
-                      {"tiles_x", CeilDiv(level_cols, kTilePixels)},
-                      {"tiles_y", CeilDiv(level_rows, kTilePixels)}});
+    levels.push_back(
+        {level, level_rows, level_cols, CeilDiv(level_cols, kTilePixels), CeilDiv(level_rows, kTilePixels)});
   }
   cv::Rect changed(0, 0, cols, rows);
   if (since >= 0) {
@@ -157,12 +156,12 @@ nlohmann::ordered_json TilesInfo(Document& document, const RenderOptions& option
       changed = ChangedBetween(document, options, channel, *old, now);
     }
   }
-  return {{"version", document.version},
-          {"rows", rows},
-          {"cols", cols},
-          {"tile_px", kTilePixels},
-          {"levels", levels},
-          {"changed", {changed.x, changed.y, changed.width, changed.height}}};
+  return ToJson(TilesReply{document.version,
+                           rows,
+                           cols,
+                           kTilePixels,
+                           std::move(levels),
+                           {changed.x, changed.y, changed.width, changed.height}});
 }
 
 void SendTile(Document& document, const RenderOptions& options, const std::string& channel, int level, int tx,

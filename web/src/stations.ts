@@ -5,6 +5,7 @@
 // removed cells of the shown station highlighted). The server holds the site (POST /api/sites, docs/api.md).
 import * as THREE from 'three';
 import { Api, DocumentInfo, JobInfo, PointSet, inverseRigid, multiply } from './api';
+import type { CleanStationEntry } from './api_types.generated';
 
 export interface StationInfo {
   index: number;
@@ -85,19 +86,10 @@ export function pointsOfCells(points: PointSet, cells: Iterable<number>): Float3
   return new Float32Array(out);
 }
 
-interface CleanStationResult {
-  station: number;
-  document: number;
-  removed: number;
-  filled: number;
-  changed: boolean;
-  why?: string;
-}
-
 // The status line after a clean: the count here, then every station's, and who changed (each its own undo).
 export function cleanSummary(result: Record<string, unknown> | undefined): string {
   if (!result || !Array.isArray(result.stations)) return 'clean: no result';
-  const stations = result.stations as CleanStationResult[];
+  const stations = result.stations as CleanStationEntry[];
   const here = Number(result.removed_cells ?? 0);
   const station = Number(result.station ?? -1);
   const per = stations

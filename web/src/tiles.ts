@@ -4,17 +4,12 @@
 // comes first, so a station of millions of rays shows its first picture at once and is refined where the user
 // looks. After an edit, tiles.json?since=V names the box of pixels that changed since the version held: only
 // held tiles meeting it are dropped and fetched again. The browser never holds the full-resolution picture.
-// (Types of the tile API are kept in this file, apart from the ones generated from the options schema.)
+// (TilesInfo is kept here: its `changed` is a tuple; the levels are the generated TileLevelEntry.)
+import type { TileLevelEntry } from './api_types.generated';
 import type { ImageView } from './strokes';
 
-// One level of the pyramid (tiles.json "levels").
-export interface TileLevel {
-  level: number;
-  rows: number;
-  cols: number;
-  tiles_x: number;
-  tiles_y: number;
-}
+// One level of the pyramid (tiles.json "levels"), as the server describes it.
+export type TileLevel = TileLevelEntry;
 
 // GET /api/docs/ID/tiles.json[?channel=C&since=V].
 export interface TilesInfo {
