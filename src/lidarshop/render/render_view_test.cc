@@ -10,6 +10,7 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -138,7 +139,7 @@ TEST(RenderView, CameraFileRoundTripsAndRefusesNonsense) {
   view.width_px = 300;
   view.height_px = 200;
   PointViewOptions read;
-  ParseCameraJson(CameraJson(view, scan).dump(), "cam.json", &read);
+  ParseCameraJson(ToJson(CameraOf(view, scan)).dump(), "cam.json", &read);
   EXPECT_EQ(read.eye_in_world, view.eye_in_world);
   EXPECT_EQ(read.target_in_world, view.target_in_world);
   EXPECT_EQ(read.up_in_world, view.up_in_world);
