@@ -10,6 +10,7 @@ std::map<const StructInfo*, NestedCaster>& NestedCasters() {
 namespace {
 
 std::string PythonLiteral(const nlohmann::ordered_json& value) {
+  if (value.is_null()) return "None";
   if (value.is_boolean()) return value.get<bool>() ? "True" : "False";
   if (value.is_string()) return "'" + value.get<std::string>() + "'";
   return ValueText(value);
@@ -21,8 +22,11 @@ std::string FieldDoc(const FieldInfo& field, const nlohmann::ordered_json& defau
   std::string doc = field.doc;
   if (!field.unit.empty()) doc += fmt::format(" [{}]", field.unit);
   const std::string range = field.RangeText();
-  if (!range.empty())
-    doc += fmt::format(", {}{}", field.kind == FieldKind::kNumberList ? "each " : "", range);
+  const bool elements = field.kind == FieldKind::kNumberList || field.kind == FieldKind::kNumberMatrix;
+  if (!range.empty()) doc += fmt::format(", {}{}", elements ? "each " : "", range);
+  if (field.kind == FieldKind::kNumberMatrix)
+    doc += fmt::format(", a {} x {} matrix as a list of rows", field.matrix_rows, field.matrix_cols);
+  if (field.clear) doc += ", or None";
   if (field.kind == FieldKind::kEnum) {
     doc += fmt::format(", one of {}", field.choices->NamesText(", "));
     for (const EnumInfo::Choice& choice : field.choices->choices) {
@@ -62,7 +66,9 @@ std::string StructRepr(const StructInfo& info, const void* object) {
   for (const FieldInfo& field : info.fields) {
     text += first ? "" : ", ";
     first = false;
-    if (field.kind == FieldKind::kStruct) {
+    if (field.clear && !field.present(object)) {
+      text += field.key + "=None";
+    } else if (field.kind == FieldKind::kStruct) {
       text += field.key + "=" + StructRepr(*field.nested, field.nested_of(const_cast<void*>(object)));
     } else {
       const auto value = field.get(object);
@@ -73,6 +79,10 @@ std::string StructRepr(const StructInfo& info, const void* object) {
 }
 
 void SetField(const StructInfo& info, const FieldInfo& field, void* object, const py::handle& value) {
+  if (value.is_none() && field.clear) {  // an optional member: None empties it
+    field.clear(object);
+    return;
+  }
   const nlohmann::json json = ToJsonValue(value);
   if (field.kind == FieldKind::kStruct || field.kind == FieldKind::kStructList) {
     // An options object (to_dict) replaces every nested field; a dict sets the keys it names. Errors name
@@ -93,6 +103,7 @@ void SetField(const StructInfo& info, const FieldInfo& field, void* object, cons
 }
 
 py::object GetField(const FieldInfo& field, void* object, py::handle parent) {
+  if (field.clear && !field.present(object)) return py::none();  // an optional member holding nothing
   if (field.kind == FieldKind::kStruct) {
     const auto caster = NestedCasters().find(field.nested);
     if (caster == NestedCasters().end()) {

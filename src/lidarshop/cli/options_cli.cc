@@ -56,6 +56,10 @@ std::string TypeName(const FieldInfo& field) {
       return "N,N,...";
     case FieldKind::kStringList:
       return "TEXT,TEXT,...";
+    case FieldKind::kNumberMatrix:
+      return fmt::format("N,N,... ({} by rows)", field.matrix_rows * field.matrix_cols);
+    case FieldKind::kJson:
+      return "JSON";
     default:
       return "TEXT";
   }
@@ -122,6 +126,28 @@ nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
       }
       return list;
     }
+    case FieldKind::kNumberMatrix: {  // rows * columns numbers by rows, as a number list
+      FieldInfo as_list = field;
+      as_list.kind = FieldKind::kNumberList;
+      const nlohmann::json numbers = ParseFlagValue(as_list, text);
+      if (numbers.size() != size_t(field.matrix_rows) * size_t(field.matrix_cols)) {
+        throw OptionsError(fmt::format("'{}' is not {} comma-separated numbers (a {} x {} matrix by rows)", text,
+                                       field.matrix_rows * field.matrix_cols, field.matrix_rows,
+                                       field.matrix_cols));
+      }
+      nlohmann::json rows = nlohmann::json::array();
+      for (int r = 0; r < field.matrix_rows; ++r) {
+        rows.push_back(nlohmann::json(numbers.begin() + r * field.matrix_cols,
+                                      numbers.begin() + (r + 1) * field.matrix_cols));
+      }
+      return rows;
+    }
+    case FieldKind::kJson:
+      try {
+        return nlohmann::json::parse(text);
+      } catch (const nlohmann::json::parse_error& error) {
+        throw OptionsError(fmt::format("'{}' is not JSON: {}", text, error.what()));
+      }
     case FieldKind::kStruct:
     case FieldKind::kStructList:
       break;

@@ -109,6 +109,23 @@ FieldInfo& FieldInfo::Below(double high) {
   return *this;
 }
 
+FieldInfo& FieldInfo::NullWhenAbsent() {
+  LIDARSHOP_CHECK(clear && "NullWhenAbsent is for std::optional members");
+  null_when_absent = true;
+  return *this;
+}
+
+FieldInfo& FieldInfo::OmitWhenEmpty() {
+  LIDARSHOP_CHECK(!present && (kind == FieldKind::kString || kind == FieldKind::kNumberList ||
+                               kind == FieldKind::kStringList || kind == FieldKind::kStructList ||
+                               kind == FieldKind::kJson));
+  present = [get = get](const void* object) {
+    const nlohmann::ordered_json value = get(object);
+    return !(value.is_null() || ((value.is_array() || value.is_object() || value.is_string()) && value.empty()));
+  };
+  return *this;
+}
+
 std::string FieldInfo::RangeText() const {
   if (min && max) {
     return fmt::format("{}{}, {}{}", min_exclusive ? "(" : "[", *min, *max, max_exclusive ? ")" : "]");
@@ -161,6 +178,24 @@ void FieldInfo::CheckValue(const nlohmann::json& value) const {
           std::any_of(value.begin(), value.end(), [](const auto& element) { return !element.is_string(); })) {
         throw OptionsError(fmt::format("expected a list of strings, got {}", value.dump()));
       }
+      return;
+    case FieldKind::kNumberMatrix: {
+      const auto is_row = [this](const nlohmann::json& row) {
+        return row.is_array() && row.size() == size_t(matrix_cols) &&
+               std::all_of(row.begin(), row.end(), [](const nlohmann::json& element) {
+                 return element.is_number() && std::isfinite(element.get<double>());
+               });
+      };
+      if (!value.is_array() || value.size() != size_t(matrix_rows) ||
+          !std::all_of(value.begin(), value.end(), is_row)) {
+        throw OptionsError(fmt::format("expected {} rows of {} numbers, got {}", matrix_rows, matrix_cols,
+                                       value.dump()));
+      }
+      for (const auto& row : value)
+        for (const auto& element : row) CheckRange(element.get<double>(), element.dump());
+      return;
+    }
+    case FieldKind::kJson:
       return;
     case FieldKind::kUInt64:
       if (!value.is_number_unsigned() && !(value.is_number_integer() && value.get<int64_t>() >= 0)) {
@@ -335,7 +370,10 @@ const FieldInfo* FindFieldPath(const StructInfo& info, const std::string& key_pa
 nlohmann::ordered_json StructToJson(const StructInfo& info, const void* object) {
   nlohmann::ordered_json json = nlohmann::ordered_json::object();
   for (const FieldInfo& field : info.fields) {
-    if (field.present && !field.present(object)) continue;  // an optional member holding nothing
+    if (field.present && !field.present(object)) {  // an optional member holding nothing
+      if (field.null_when_absent) json[field.key] = nullptr;
+      continue;
+    }
     json[field.key] = field.get(object);
   }
   return json;
@@ -383,6 +421,10 @@ void StructFromJson(const StructInfo& info, const nlohmann::json& json, void* ob
       throw OptionsFieldError(
           key_path, fmt::format("unknown option{}",
                                 closest.empty() ? "" : fmt::format(" (did you mean '{}'?)", closest)));
+    }
+    if (value.is_null() && field->null_when_absent) {
+      field->clear(object);
+      continue;
     }
     try {
       field->CheckValue(value);
@@ -453,6 +495,21 @@ nlohmann::json SampleValue(const FieldInfo& field, const nlohmann::ordered_json&
       return nlohmann::json::array({0.1, 1.5, 2.0 / 3.0});
     case FieldKind::kStringList:
       return nlohmann::json::array({"sample one", "sample, two"});
+    case FieldKind::kNumberMatrix: {  // 1, 2, 3, ... by rows, where the range allows them
+      nlohmann::json rows = nlohmann::json::array();
+      for (int r = 0; r < field.matrix_rows; ++r) {
+        nlohmann::json row = nlohmann::json::array();
+        for (int c = 0; c < field.matrix_cols; ++c) {
+          const double value = 0.25 * (r * field.matrix_cols + c + 1);
+          if (!inside(value)) return current;
+          row.push_back(value);
+        }
+        rows.push_back(std::move(row));
+      }
+      return rows;
+    }
+    case FieldKind::kJson:
+      return nlohmann::json{{"sample", nlohmann::json::array({1, "two"})}};
     case FieldKind::kStructList:  // one more element, of the element's defaults
       if (field.nested->default_json) {
         nlohmann::json list = current;

@@ -19,7 +19,16 @@
 // the same way by `EnumInfoOf<E>()` (util/enum_names.h), and convert to and from strings only through it.
 //
 // A result's part that only some runs have is a std::optional member (InpaintResult::review_stop, where a fill
-// stopped for a review): ToJson leaves its key out when it holds nothing (FieldInfo::present).
+// stopped for a review): ToJson leaves its key out when it holds nothing (FieldInfo::present), or writes null
+// where the key has always been there (`.NullWhenAbsent()`). A list or string that is left out when empty says
+// `.OmitWhenEmpty()`.
+//
+// A fixed-size matrix member (Eigen::Matrix4d world_from_scanner) is a JSON array of rows; a member of type
+// nlohmann::ordered_json is free-form JSON (a job's result, whose type depends on the job).
+//
+// A result that has always been written flat although part of it is another described struct (`verify --json`:
+// the report's keys beside VerifyResult's) says `b.Flatten(&VerifyReport::result)`: the held struct's fields are
+// listed at the holder's level, each described once, where Flatten is called.
 //
 // A struct that holds another's options nests it (`InpaintOptions inpaint;` in FillOptions, described by
 // `b.Field(&FillOptions::inpaint, ...)`) instead of copying its fields. Where fields used to be flat, the old
@@ -48,6 +57,8 @@ namespace lidarshop {
 // kNumberList: a std::vector of numbers (per-channel weights); the range applies to every element.
 // kStringList: a std::vector<std::string> (a result's warnings, one sentence each).
 // kStructList: a std::vector of a described struct (a resection's per-pair errors), a JSON array of objects.
+// kNumberMatrix: a fixed-size matrix (Eigen::Matrix4d), a JSON array of rows; the range applies to every element.
+// kJson: an nlohmann::ordered_json member, any JSON value.
 enum class FieldKind {
   kBool,
   kInt,
@@ -58,7 +69,9 @@ enum class FieldKind {
   kStruct,
   kNumberList,
   kStringList,
-  kStructList
+  kStructList,
+  kNumberMatrix,
+  kJson
 };
 
 template <class T>
@@ -75,6 +88,16 @@ template <class T>
 struct IsOptional : std::false_type {};
 template <class T>
 struct IsOptional<std::optional<T>> : std::true_type {};
+// A fixed-size matrix (kNumberMatrix): Eigen's, or any type with RowsAtCompileTime, ColsAtCompileTime and
+// operator()(row, column).
+template <class T, class = void>
+struct HasMatrixShape : std::false_type {};
+template <class T>
+struct HasMatrixShape<T, std::void_t<decltype(T::RowsAtCompileTime), decltype(T::ColsAtCompileTime)>>
+    : std::true_type {};
+template <class T>
+inline constexpr bool kIsJsonValue =
+    std::is_same_v<T, nlohmann::ordered_json> || std::is_same_v<T, nlohmann::json>;
 
 struct StructInfo;
 
@@ -89,6 +112,7 @@ struct FieldInfo {
   int64_t integer_low = INT64_MIN,
           integer_high = INT64_MAX;    // kInt (and kNumberList of integers): type limits
   bool integer_elements = false;       // kNumberList of an integer type
+  int matrix_rows = 0, matrix_cols = 0;  // kNumberMatrix
   const EnumInfo* choices = nullptr;   // kEnum
   const StructInfo* nested = nullptr;  // kStruct, kStructList: the (element's) description
   // Type-erased access to the field of a struct instance (`void*` = the struct described by the owner).
@@ -103,6 +127,9 @@ struct FieldInfo {
   // A std::optional member: whether it holds a value. ToJson leaves the key out when it does not (get then gives
   // the value a default T would have, which set or nested_of fill in); empty for every other field.
   std::function<bool(const void*)> present;
+  // A std::optional member: empties it (JSON null where the field is NullWhenAbsent, None in Python).
+  std::function<void(void*)> clear;
+  bool null_when_absent = false;  // written as null, not left out, when absent (NullWhenAbsent)
   // An alias (StructInfo::aliases): the key path of the field it stands for ("inpaint.patch_radius"), and
   // how many fields of its struct were described before it (where its flag goes in the CLI's help). Its
   // get / set / nested_of reach that field from the alias's own struct.
@@ -115,6 +142,12 @@ struct FieldInfo {
   FieldInfo& Max(double high);
   FieldInfo& AboveZero();         // > 0
   FieldInfo& Below(double high);  // < high
+  // A std::optional member whose key is always written: null when it holds nothing (and null on input empties
+  // it). TypeScript `key: T | null`.
+  FieldInfo& NullWhenAbsent();
+  // A list, string or object left out of the JSON when empty (absent on input keeps it empty). TypeScript
+  // `key?: T`.
+  FieldInfo& OmitWhenEmpty();
   // "[1, 32]", "> 0", "[0, 1)" or "" when unbounded.
   std::string RangeText() const;
   // Throws OptionsError with a reason (no key) unless `value` is of this field's kind and inside its range.
@@ -214,117 +247,77 @@ class StructBuilder {
 
   template <class T>
   FieldInfo& Field(T S::*member, std::string key, std::string doc) {
-    FieldInfo field;
-    field.key = std::move(key);
-    field.doc = std::move(doc);
-    field.get = [member](const void* object) -> nlohmann::ordered_json {
-      return ValueJson(static_cast<const S*>(object)->*member);
-    };
-    if constexpr (std::is_same_v<T, std::vector<std::string>>) {
-      field.kind = FieldKind::kStringList;
-      field.set = [member](void* object, const nlohmann::json& json) {
-        static_cast<S*>(object)->*member = json.get<T>();
-      };
-    } else if constexpr (IsStructVector<T>::value) {
-      using Element = typename T::value_type;
-      field.kind = FieldKind::kStructList;
-      field.nested = &InfoOf<Element>();
-      field.list_size = [member](const void* object) {
-        return (static_cast<const S*>(object)->*member).size();
-      };
-      field.element_of = [member](void* object, size_t index) -> void* {
-        return &(static_cast<S*>(object)->*member)[index];
-      };
-      field.set = [member](void* object, const nlohmann::json& json) {
-        T list(json.size());
-        for (size_t i = 0; i < list.size(); ++i) {
-          try {
-            StructFromJson(InfoOf<Element>(), json[i], &list[i]);
-          } catch (const OptionsFieldError& error) {
-            throw OptionsFieldError("[" + std::to_string(i) + "]." + error.key_path(), error.reason());
-          } catch (const OptionsError& error) {
-            throw OptionsFieldError("[" + std::to_string(i) + "]", error.what());
-          }
-        }
-        static_cast<S*>(object)->*member = std::move(list);
-      };
-    } else if constexpr (IsVector<T>::value) {
-      using Element = typename T::value_type;
-      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers, strings or described structs");
-      field.kind = FieldKind::kNumberList;
-      if constexpr (std::is_integral_v<Element>) {
-        field.integer_elements = true;
-        field.integer_low = std::numeric_limits<Element>::min();
-        field.integer_high =
-            static_cast<int64_t>(std::min<uint64_t>(std::numeric_limits<Element>::max(), INT64_MAX));
-      }
-      field.set = [member](void* object, const nlohmann::json& json) {
-        static_cast<S*>(object)->*member = json.get<T>();
-      };
-    } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
-      field.kind = FieldKind::kStruct;
-      field.nested = &InfoOf<T>();
-      field.nested_of = [member](void* object) -> void* { return &(static_cast<S*>(object)->*member); };
-    } else {
-      field.kind = KindOf<T>();
-      if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, uint64_t>) {
-        field.integer_low = std::numeric_limits<T>::min();
-        field.integer_high = std::numeric_limits<T>::max();
-      }
-      if constexpr (std::is_enum_v<T>) field.choices = &EnumInfoOf<T>();
-      field.set = [member](void* object, const nlohmann::json& json) {
-        T& value = static_cast<S*>(object)->*member;
-        if constexpr (std::is_enum_v<T>) {
-          value = ParseEnum<T>(json.get<std::string>());
-        } else {
-          value = json.get<T>();
-        }
-      };
-    }
-    info_.fields.push_back(std::move(field));
-    return info_.fields.back();
+    FieldInfo& field = NewField(std::move(key), std::move(doc));
+    Describe<T>(
+        field, [member](const void* object) -> const T& { return static_cast<const S*>(object)->*member; },
+        [member](void* object) -> T& { return static_cast<S*>(object)->*member; });
+    return field;
   }
 
-  // A member present in some results only (written when it holds a value): a described struct, a bool, a
-  // number, an enum or a string.
+  // A member present in some results only: left out of the JSON when it holds nothing (or null, with
+  // NullWhenAbsent). Reading or setting a nested part of an empty one gives it a value first.
   template <class T>
   FieldInfo& Field(std::optional<T> S::*member, std::string key, std::string doc) {
-    static_assert(!IsVector<T>::value, "an optional field holds a struct or one value");
-    FieldInfo field;
-    field.key = std::move(key);
-    field.doc = std::move(doc);
+    FieldInfo& field = NewField(std::move(key), std::move(doc));
+    Describe<T>(
+        field,
+        [member](const void* object) -> const T& {
+          static const T empty = EmptyValue<T>();
+          const std::optional<T>& value = static_cast<const S*>(object)->*member;
+          return value ? *value : empty;
+        },
+        [member](void* object) -> T& {
+          std::optional<T>& value = static_cast<S*>(object)->*member;
+          if (!value) value.emplace(EmptyValue<T>());
+          return *value;
+        });
     field.present = [member](const void* object) {
       return (static_cast<const S*>(object)->*member).has_value();
     };
-    field.get = [member](const void* object) -> nlohmann::ordered_json {
-      const std::optional<T>& value = static_cast<const S*>(object)->*member;
-      return ValueJson(value ? *value : T{});
+    field.clear = [member](void* object) { (static_cast<S*>(object)->*member).reset(); };
+    return field;
+  }
+
+  // The fields of the described struct `member` listed here, at this struct's level (see the file comment).
+  // Each keeps its description; its accessors reach into the member. The held struct's aliases and cross-field
+  // check are not carried over. A key that is already a field here is a programming error.
+  template <class T>
+  void Flatten(T S::*member) {
+    const auto inner = [member](const void* object) -> const void* {
+      return &(static_cast<const S*>(object)->*member);
     };
-    if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
-      field.kind = FieldKind::kStruct;
-      field.nested = &InfoOf<T>();
-      field.nested_of = [member](void* object) -> void* {
-        std::optional<T>& value = static_cast<S*>(object)->*member;
-        if (!value) value.emplace();
-        return &*value;
-      };
-    } else {
-      field.kind = KindOf<T>();
-      if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, uint64_t>) {
-        field.integer_low = std::numeric_limits<T>::min();
-        field.integer_high = std::numeric_limits<T>::max();
+    const auto inner_mutable = [member](void* object) -> void* { return &(static_cast<S*>(object)->*member); };
+    for (FieldInfo field : InfoOf<T>().fields) {
+      LIDARSHOP_CHECK(info_.Find(field.key) == nullptr && "a flattened key is a field already");
+      field.get = [get = field.get, inner](const void* object) { return get(inner(object)); };
+      if (field.set) {
+        field.set = [set = field.set, inner_mutable](void* object, const nlohmann::json& json) {
+          set(inner_mutable(object), json);
+        };
       }
-      if constexpr (std::is_enum_v<T>) field.choices = &EnumInfoOf<T>();
-      field.set = [member](void* object, const nlohmann::json& json) {
-        if constexpr (std::is_enum_v<T>) {
-          static_cast<S*>(object)->*member = ParseEnum<T>(json.get<std::string>());
-        } else {
-          static_cast<S*>(object)->*member = json.get<T>();
-        }
-      };
+      if (field.nested_of) {
+        field.nested_of = [nested_of = field.nested_of, inner_mutable](void* object) {
+          return nested_of(inner_mutable(object));
+        };
+      }
+      if (field.list_size) {
+        field.list_size = [list_size = field.list_size, inner](const void* object) {
+          return list_size(inner(object));
+        };
+      }
+      if (field.element_of) {
+        field.element_of = [element_of = field.element_of, inner_mutable](void* object, size_t index) {
+          return element_of(inner_mutable(object), index);
+        };
+      }
+      if (field.present) {
+        field.present = [present = field.present, inner](const void* object) { return present(inner(object)); };
+      }
+      if (field.clear) {
+        field.clear = [clear = field.clear, inner_mutable](void* object) { clear(inner_mutable(object)); };
+      }
+      info_.fields.push_back(std::move(field));
     }
-    info_.fields.push_back(std::move(field));
-    return info_.fields.back();
   }
 
   // `key` kept as an alias of the nested field at `target_path` ("patch_radius" for "inpaint.patch_radius"),
@@ -344,6 +337,98 @@ class StructBuilder {
   StructInfo Build() { return std::move(info_); }
 
  private:
+  FieldInfo& NewField(std::string key, std::string doc) {
+    LIDARSHOP_CHECK(info_.Find(key) == nullptr && "a key is described twice");
+    FieldInfo& field = info_.fields.emplace_back();
+    field.key = std::move(key);
+    field.doc = std::move(doc);
+    return field;
+  }
+
+  // The value an empty optional reads as (a matrix of zeros: Eigen leaves a default one uninitialised).
+  template <class T>
+  static T EmptyValue() {
+    if constexpr (HasMatrixShape<T>::value) {
+      T matrix;
+      for (int r = 0; r < T::RowsAtCompileTime; ++r)
+        for (int c = 0; c < T::ColsAtCompileTime; ++c) matrix(r, c) = 0;
+      return matrix;
+    } else {
+      return T{};
+    }
+  }
+
+  // The kind, accessors and type limits of a member of type T, reached through `read` and `write`.
+  template <class T, class Read, class Write>
+  static void Describe(FieldInfo& field, Read read, Write write) {
+    field.get = [read](const void* object) -> nlohmann::ordered_json { return ValueJson(read(object)); };
+    if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+      field.kind = FieldKind::kStringList;
+      field.set = [write](void* object, const nlohmann::json& json) { write(object) = json.get<T>(); };
+    } else if constexpr (kIsJsonValue<T>) {
+      field.kind = FieldKind::kJson;
+      field.set = [write](void* object, const nlohmann::json& json) { write(object) = json; };
+    } else if constexpr (HasMatrixShape<T>::value) {
+      static_assert(T::RowsAtCompileTime > 0 && T::ColsAtCompileTime > 0, "matrix fields have a fixed size");
+      field.kind = FieldKind::kNumberMatrix;
+      field.matrix_rows = T::RowsAtCompileTime;
+      field.matrix_cols = T::ColsAtCompileTime;
+      field.set = [write](void* object, const nlohmann::json& json) {
+        T& matrix = write(object);
+        for (int r = 0; r < T::RowsAtCompileTime; ++r)
+          for (int c = 0; c < T::ColsAtCompileTime; ++c) matrix(r, c) = json[r][c].template get<double>();
+      };
+    } else if constexpr (IsStructVector<T>::value) {
+      using Element = typename T::value_type;
+      field.kind = FieldKind::kStructList;
+      field.nested = &InfoOf<Element>();
+      field.list_size = [read](const void* object) { return read(object).size(); };
+      field.element_of = [write](void* object, size_t index) -> void* { return &write(object)[index]; };
+      field.set = [write](void* object, const nlohmann::json& json) {
+        T list(json.size());
+        for (size_t i = 0; i < list.size(); ++i) {
+          try {
+            StructFromJson(InfoOf<Element>(), json[i], &list[i]);
+          } catch (const OptionsFieldError& error) {
+            throw OptionsFieldError("[" + std::to_string(i) + "]." + error.key_path(), error.reason());
+          } catch (const OptionsError& error) {
+            throw OptionsFieldError("[" + std::to_string(i) + "]", error.what());
+          }
+        }
+        write(object) = std::move(list);
+      };
+    } else if constexpr (IsVector<T>::value) {
+      using Element = typename T::value_type;
+      static_assert(std::is_arithmetic_v<Element>, "list fields hold numbers, strings or described structs");
+      field.kind = FieldKind::kNumberList;
+      if constexpr (std::is_integral_v<Element>) {
+        field.integer_elements = true;
+        field.integer_low = std::numeric_limits<Element>::min();
+        field.integer_high =
+            static_cast<int64_t>(std::min<uint64_t>(std::numeric_limits<Element>::max(), INT64_MAX));
+      }
+      field.set = [write](void* object, const nlohmann::json& json) { write(object) = json.get<T>(); };
+    } else if constexpr (std::is_class_v<T> && !std::is_same_v<T, std::string>) {
+      field.kind = FieldKind::kStruct;
+      field.nested = &InfoOf<T>();
+      field.nested_of = [write](void* object) -> void* { return &write(object); };
+    } else {
+      field.kind = KindOf<T>();
+      if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool> && !std::is_same_v<T, uint64_t>) {
+        field.integer_low = std::numeric_limits<T>::min();
+        field.integer_high = std::numeric_limits<T>::max();
+      }
+      if constexpr (std::is_enum_v<T>) field.choices = &EnumInfoOf<T>();
+      field.set = [write](void* object, const nlohmann::json& json) {
+        if constexpr (std::is_enum_v<T>) {
+          write(object) = ParseEnum<T>(json.get<std::string>());
+        } else {
+          write(object) = json.get<T>();
+        }
+      };
+    }
+  }
+
   // The JSON form of one member's value.
   template <class T>
   static nlohmann::ordered_json ValueJson(const T& value) {
@@ -352,6 +437,16 @@ class StructBuilder {
     } else if constexpr (std::is_floating_point_v<T>) {
       // NaN ("none", e.g. a consistency with nothing to compare) is JSON null.
       return std::isfinite(value) ? nlohmann::ordered_json(value) : nlohmann::ordered_json(nullptr);
+    } else if constexpr (kIsJsonValue<T>) {
+      return nlohmann::ordered_json(value);
+    } else if constexpr (HasMatrixShape<T>::value) {
+      nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+      for (int r = 0; r < T::RowsAtCompileTime; ++r) {
+        nlohmann::ordered_json row = nlohmann::ordered_json::array();
+        for (int c = 0; c < T::ColsAtCompileTime; ++c) row.push_back(ValueJson(double(value(r, c))));
+        rows.push_back(std::move(row));
+      }
+      return rows;
     } else if constexpr (IsStructVector<T>::value) {
       nlohmann::ordered_json list = nlohmann::ordered_json::array();
       for (const auto& element : value)

@@ -51,6 +51,10 @@ std::string TypeText(const FieldInfo& field) {
       return "list of strings";
     case FieldKind::kStructList:
       return fmt::format("list of [`{}`](#{})", field.nested->name, Anchor(field.nested->name));
+    case FieldKind::kNumberMatrix:
+      return fmt::format("{} × {} matrix (a list of rows)", field.matrix_rows, field.matrix_cols);
+    case FieldKind::kJson:
+      return "any JSON value";
   }
   return "";
 }
@@ -114,7 +118,7 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
       if (!options) {
         // An optional part (FieldInfo::present) is left out of the JSON when the result has none.
         out += fmt::format("| `{}` | {}{} | {} | {} |\n", field.key, Cell(TypeText(field)),
-                           field.present ? ", or absent" : "", Cell(field.unit), Cell(field.doc));
+                           field.null_when_absent ? ", or null" : field.present ? ", or absent" : "", Cell(field.unit), Cell(field.doc));
         if (field.kind == FieldKind::kStruct || field.kind == FieldKind::kStructList)
           push({field.nested, nullptr, true});
         continue;

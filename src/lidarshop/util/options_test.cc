@@ -264,6 +264,147 @@ TEST(Options, ListsOfStructsAreArraysOfObjects) {
   ExpectExactRoundTrip<ListResult>();
 }
 
+// A fixed-size matrix type as Eigen's looks to the description (RowsAtCompileTime, operator()).
+struct Matrix2x3 {
+  enum { RowsAtCompileTime = 2, ColsAtCompileTime = 3 };
+  double values[6] = {1, 0, 0, 0, 1, 0};
+  double& operator()(int r, int c) { return values[r * 3 + c]; }
+  double operator()(int r, int c) const { return values[r * 3 + c]; }
+};
+
+// A result with the parts the schema needs beyond plain fields: a matrix, a part that is null when absent, lists
+// and a string left out when empty, free-form JSON and a held struct listed flat.
+struct ShapedResult {
+  Matrix2x3 pose;
+  std::optional<Matrix2x3> fit;
+  std::optional<int> exit_code;
+  std::optional<InnerOptions> stop;
+  std::vector<std::string> warnings;
+  std::string note;
+  nlohmann::ordered_json payload;
+};
+
+struct FlatResult {
+  int count = 0;
+  InnerOptions inner;
+  double seconds = 0;
+};
+
+template <>
+const StructInfo& InfoOf<ShapedResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<ShapedResult> b("ShapedResult", "shaped");
+    b.Field(&ShapedResult::pose, "pose", "pose").Range(-10, 10);
+    b.Field(&ShapedResult::fit, "fit", "fitted pose");
+    b.Field(&ShapedResult::exit_code, "exit", "exit code").NullWhenAbsent();
+    b.Field(&ShapedResult::stop, "stop", "where it stopped").NullWhenAbsent();
+    b.Field(&ShapedResult::warnings, "warnings", "warnings").OmitWhenEmpty();
+    b.Field(&ShapedResult::note, "note", "note").OmitWhenEmpty();
+    b.Field(&ShapedResult::payload, "payload", "any value");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<FlatResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<FlatResult> b("FlatResult", "flat");
+    b.Field(&FlatResult::count, "count", "count");
+    b.Flatten(&FlatResult::inner);
+    b.Field(&FlatResult::seconds, "seconds", "time").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(Options, MatricesAreListsOfRows) {
+  const FieldInfo& pose = *InfoOf<ShapedResult>().Find("pose");
+  EXPECT_EQ(pose.kind, FieldKind::kNumberMatrix);
+  EXPECT_EQ(pose.matrix_rows, 2);
+  EXPECT_EQ(pose.matrix_cols, 3);
+  ShapedResult result;
+  result.pose(1, 2) = 2.5;
+  EXPECT_EQ(ToJson(result)["pose"].dump(), "[[1.0,0.0,0.0],[0.0,1.0,2.5]]");
+  const ShapedResult back = FromJson<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,6]]})"));
+  EXPECT_EQ(back.pose(1, 0), 4);
+  EXPECT_EQ(back.pose(0, 2), 3);
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3]]})"), "pose", "expected 2 rows of 3");
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5]]})"), "pose", "expected 2 rows");
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,"6"]]})"), "pose",
+                               "expected 2 rows");
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,60]]})"), "pose",
+                               "60 is out of range [-10, 10]");
+  // An optional matrix reads as zeros when empty, and is left out.
+  EXPECT_FALSE(ToJson(result).contains("fit"));
+  result.fit = Matrix2x3{};
+  EXPECT_EQ(ToJson(result)["fit"].dump(), "[[1.0,0.0,0.0],[0.0,1.0,0.0]]");
+}
+
+TEST(Options, NullableFieldsAreAlwaysWritten) {
+  ShapedResult result;
+  nlohmann::ordered_json json = ToJson(result);
+  ASSERT_TRUE(json.contains("exit"));
+  EXPECT_TRUE(json["exit"].is_null());
+  EXPECT_TRUE(json["stop"].is_null());
+  result.exit_code = 3;
+  result.stop = InnerOptions{5, true};
+  json = ToJson(result);
+  EXPECT_EQ(json["exit"], 3);
+  EXPECT_EQ(json["stop"]["band_px"], 5);
+  // null on input empties the member; a value sets it.
+  ShapedResult base = result;
+  const ShapedResult emptied = FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":null,"stop":null})"), base);
+  EXPECT_FALSE(emptied.exit_code.has_value());
+  EXPECT_FALSE(emptied.stop.has_value());
+  const ShapedResult set = FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":0,"stop":{"band_px":4}})"));
+  EXPECT_EQ(set.exit_code, 0);
+  EXPECT_EQ(set.stop->band_px, 4);
+  // Only a NullWhenAbsent field takes null.
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"fit":null})"), "fit", "expected 2 rows");
+}
+
+TEST(Options, EmptyListsAndStringsCanBeLeftOut) {
+  ShapedResult result;
+  EXPECT_FALSE(ToJson(result).contains("warnings"));
+  EXPECT_FALSE(ToJson(result).contains("note"));
+  result.warnings = {"one"};
+  result.note = "n";
+  EXPECT_EQ(ToJson(result)["warnings"].dump(), R"(["one"])");
+  EXPECT_EQ(ToJson(result)["note"], "n");
+  const FieldInfo& warnings = *InfoOf<ShapedResult>().Find("warnings");
+  EXPECT_TRUE(warnings.present != nullptr);
+  EXPECT_TRUE(warnings.clear == nullptr);  // not an optional member: absent reads as empty
+}
+
+TEST(Options, JsonFieldsHoldAnyValue) {
+  ShapedResult result;
+  EXPECT_TRUE(ToJson(result)["payload"].is_null());
+  result.payload = nlohmann::ordered_json::parse(R"({"z":1,"a":[true,"x"]})");
+  EXPECT_EQ(ToJson(result)["payload"].dump(), R"({"z":1,"a":[true,"x"]})");  // order kept
+  const ShapedResult back = FromJson<ShapedResult>(nlohmann::json::parse(R"({"payload":[1,{"k":null}]})"));
+  EXPECT_EQ(back.payload.dump(), R"([1,{"k":null}])");
+  EXPECT_EQ(InfoOf<ShapedResult>().Find("payload")->kind, FieldKind::kJson);
+  ExpectExactRoundTrip<ShapedResult>();
+}
+
+TEST(Options, FlattenListsTheHeldStructsFieldsAtTheHoldersLevel) {
+  EXPECT_EQ(InfoOf<FlatResult>().Keys(), (std::vector<std::string>{"count", "band_px", "enabled", "seconds"}));
+  FlatResult result;
+  result.count = 2;
+  result.inner.band_px = 7;
+  EXPECT_EQ(ToJson(result).dump(), R"({"count":2,"band_px":7,"enabled":false,"seconds":0.0})");
+  const FlatResult back = FromJson<FlatResult>(nlohmann::json::parse(R"({"enabled":true,"band_px":3})"));
+  EXPECT_TRUE(back.inner.enabled);
+  EXPECT_EQ(back.inner.band_px, 3);
+  // The held struct's descriptions (ranges) apply.
+  ExpectRejected<FlatResult>(nlohmann::json::parse(R"({"band_px":0})"), "band_px", "out of range [1, 64]");
+  FlatResult bad;
+  bad.inner.band_px = 100;
+  EXPECT_THROW(Validate(bad), OptionsFieldError);
+  ExpectExactRoundTrip<FlatResult>();
+}
+
 TEST(Options, RoundTripIsExact) {
   ExpectExactRoundTrip<OuterOptions>();
   OuterOptions o;

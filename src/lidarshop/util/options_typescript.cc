@@ -1,5 +1,6 @@
 #include "lidarshop/util/options_typescript.h"
 
+#include <algorithm>
 #include <deque>
 #include <map>
 
@@ -33,6 +34,10 @@ std::string KindName(FieldKind kind) {
       return "string_list";
     case FieldKind::kStructList:
       return "struct_list";
+    case FieldKind::kNumberMatrix:
+      return "number_matrix";
+    case FieldKind::kJson:
+      return "json";
   }
   return "";
 }
@@ -73,6 +78,10 @@ std::vector<std::string> TypeAlternatives(const FieldInfo& field, bool answer) {
       return {"string[]"};
     case FieldKind::kStructList:
       return {field.nested->name + "[]"};
+    case FieldKind::kNumberMatrix:
+      return {answer ? "(number | null)[][]" : "number[][]"};
+    case FieldKind::kJson:
+      return {"unknown"};
   }
   return {"unknown"};
 }
@@ -99,8 +108,11 @@ std::string MemberComment(const FieldInfo& field, const nlohmann::ordered_json* 
 
 // One member as Prettier prints it: on one line when it fits, else a union broken before each '|'.
 // An optional member (FieldInfo::present) is `key?:`, absent from the JSON when the result has none.
-void AppendMember(const FieldInfo& field, const std::vector<std::string>& alternatives, std::string* out) {
-  const std::string key = field.present ? field.key + "?" : field.key;
+// A NullWhenAbsent member is always there, `| null` when absent.
+void AppendMember(const FieldInfo& field, std::vector<std::string> alternatives, std::string* out) {
+  const std::string key = field.present && !field.null_when_absent ? field.key + "?" : field.key;
+  if (field.null_when_absent && std::find(alternatives.begin(), alternatives.end(), "null") == alternatives.end())
+    alternatives.push_back("null");
   std::string one_line = fmt::format("  {}: {};", key, fmt::join(alternatives, " | "));
   if (one_line.size() <= kPrintWidth || alternatives.size() == 1) {
     *out += one_line + "\n";
@@ -172,7 +184,12 @@ nlohmann::ordered_json DescriptionJson(const StructInfo& info) {
       for (const EnumInfo::Choice& choice : field.choices->choices) names.push_back(choice.name);
       json["choices"] = names;
     }
-    if (field.present) json["optional"] = true;  // left out of the JSON when absent
+    if (field.null_when_absent) {
+      json["nullable"] = true;  // null when absent
+    } else if (field.present) {
+      json["optional"] = true;  // left out of the JSON when absent
+    }
+    if (field.kind == FieldKind::kNumberMatrix) json["shape"] = {field.matrix_rows, field.matrix_cols};
     if (field.nested != nullptr) json["struct"] = DescriptionJson(*field.nested);
     fields.push_back(std::move(json));
   }

@@ -138,6 +138,48 @@ TEST(OptionsTypeScript, ListsOfStructsAreArraysOfTheirInterface) {
   EXPECT_EQ(json["fields"][0]["struct"]["name"], "LeafOptions");
 }
 
+// A matrix, a part that is null when absent, a list left out when empty and free-form JSON.
+struct Grid2x2 {
+  enum { RowsAtCompileTime = 2, ColsAtCompileTime = 2 };
+  double values[4] = {};
+  double& operator()(int r, int c) { return values[r * 2 + c]; }
+  double operator()(int r, int c) const { return values[r * 2 + c]; }
+};
+struct ShapesResult {
+  Grid2x2 pose;
+  std::optional<int> exit_code;
+  std::vector<std::string> warnings;
+  nlohmann::ordered_json payload;
+};
+
+template <>
+const StructInfo& InfoOf<ShapesResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<ShapesResult> b("ShapesResult", "shapes");
+    b.Field(&ShapesResult::pose, "pose", "pose");
+    b.Field(&ShapesResult::exit_code, "exit", "exit code").NullWhenAbsent();
+    b.Field(&ShapesResult::warnings, "warnings", "warnings").OmitWhenEmpty();
+    b.Field(&ShapesResult::payload, "payload", "any value");
+    return b.Build();
+  }();
+  return info;
+}
+
+TEST(OptionsTypeScript, MatricesNullablesOmittedListsAndJson) {
+  const std::string out = TypeScriptDeclarations({ResultType<ShapesResult>()}, "");
+  EXPECT_NE(out.find("  pose: (number | null)[][];\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  exit: number | null;\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  warnings?: string[];\n"), std::string::npos) << out;
+  EXPECT_NE(out.find("  payload: unknown;\n"), std::string::npos) << out;
+  const nlohmann::ordered_json json = DescriptionJson(InfoOf<ShapesResult>());
+  EXPECT_EQ(json["fields"][0]["kind"], "number_matrix");
+  EXPECT_EQ(json["fields"][0]["shape"].dump(), "[2,2]");
+  EXPECT_EQ(json["fields"][1]["nullable"], true);
+  EXPECT_FALSE(json["fields"][1].contains("optional"));
+  EXPECT_EQ(json["fields"][2]["optional"], true);
+  EXPECT_EQ(json["fields"][3]["kind"], "json");
+}
+
 TEST(OptionsTypeScript, TwoStructsOfOneNameThrow) {
   StructInfo a{"Same", "a", {}, nullptr}, b{"Same", "b", {}, nullptr};
   EXPECT_THROW(TypeScriptDeclarations({{&a, nullptr, false}, {&b, nullptr, false}}, ""), OptionsError);
