@@ -276,6 +276,8 @@ export interface SegmentResult {
   timings: SegmentTimings;
   // what looks wrong with the cut, one sentence each
   warnings: string[];
+  // extra strokes refined a first cut (where a caller says)
+  refined?: boolean;
 }
 
 // an object removal: the cut and the fill (C++ RemoveResult)

@@ -118,8 +118,9 @@ struct StationFlags {
                            .prefix = "from_stations"});
   }
 
-  // Every scan of the files given, but the scan being filled (same pose and grid size).
-  std::vector<Scan> Read(const Scan& scan, nlohmann::ordered_json* sources) const {
+  // Every scan of the files given, but the scan being filled (same pose and grid size), and where each came
+  // from: its file and index there (FromStationsSource's file and scan).
+  std::vector<Scan> Read(const Scan& scan, std::vector<FromStationsSource>* sources) const {
     std::vector<Scan> stations;
     for (const std::string& path : paths) {
       const ScanFile file = ReadScanFileAndWarn(path);
@@ -129,7 +130,7 @@ struct StationFlags {
             other.world_from_scanner == scan.world_from_scanner)
           continue;
         stations.push_back(other);
-        sources->push_back({{"station", stations.size()}, {"file", path}, {"scan", i}, {"name", other.name}});
+        sources->push_back({.file = path, .scan = static_cast<int64_t>(i)});
       }
     }
     if (stations.empty())
@@ -139,29 +140,12 @@ struct StationFlags {
   }
 };
 
-// The JSON of a fill from stations: the synthesis's result (FillResult's keys), with the counts of the whole
-// hole and of the cells taken from the stations.
-nlohmann::ordered_json FromStationsJson(const FromStationsResult& result,
-                                        const nlohmann::ordered_json& sources) {
-  nlohmann::ordered_json json = result.filled_rest ? ToJson(result.fill) : nlohmann::ordered_json::object();
-  json["hole_cells"] = result.hole_cells;
-  json["from_station_cells"] = result.from_station_cells;
-  json["synthesized_cells"] = result.synthesized_cells;
-  json["no_return_cells"] = result.no_return_cells;
-  nlohmann::ordered_json per_station = nlohmann::ordered_json::array();
-  for (size_t k = 0; k < result.cells_per_station.size(); ++k) {
-    nlohmann::ordered_json station = sources.at(k);
-    station["from_station_cells"] = result.cells_per_station[k];
-    station["object_cells"] = result.object_cells.at(k);
-    per_station.push_back(station);
+// The files and indices the stations were read from (StationFlags::Read), into the result's stations.
+void SetStationFiles(const std::vector<FromStationsSource>& sources, FromStationsResult* result) {
+  for (size_t k = 0; k < result->stations.size(); ++k) {
+    result->stations[k].file = sources.at(k).file;
+    result->stations[k].scan = sources.at(k).scan;
   }
-  json["stations"] = per_station;
-  json["rim_cells"] = result.rim_cells;
-  json["not_free_cells"] = result.not_free_cells;
-  json["stations_seconds"] = result.stations_seconds;
-  json["fill_seconds"] = result.fill_seconds;
-  json["warnings"] = result.warnings;
-  return json;
 }
 
 std::string FromStationsSummary(const FromStationsResult& result) {
@@ -222,14 +206,14 @@ int RunFill(int argc, char** argv) {
         const Scan& scan = PickScan(file, scan_index, ScanIndexFlag(app));
         const cv::Mat hole = ReadMaskForScan(mask_path, scan, layout_path, scan_path);
         if (!stations.paths.empty()) {
-          nlohmann::ordered_json sources = nlohmann::ordered_json::array();
+          std::vector<FromStationsSource> sources;
           const std::vector<Scan> others = stations.Read(scan, &sources);
           stations.options.fill = options;
           auto progress = Progress::ForTerminal(
               "fill from stations", static_cast<int64_t>(others.size()) + cv::countNonZero(hole) / 4096 + 1,
               quiet);
-          const FromStationsResult result =
-              FillFromStations(scan, hole, others, stations.options, progress.get());
+          FromStationsResult result = FillFromStations(scan, hole, others, stations.options, progress.get());
+          SetStationFiles(sources, &result);
           if (progress) progress->Finish();
           WriteScanFile(output_path, {result.scan});
           WarnFromStationDropped(output_path, result.scan);
@@ -237,7 +221,7 @@ int RunFill(int argc, char** argv) {
           if (!stations.mask_path.empty()) WriteImage(stations.mask_path, result.from_station != 0);
           nlohmann::ordered_json used = ToJson(options);
           used["from_stations"] = ToJson(stations.options);
-          WriteJsonOutput(json_path, CommandJson(used, FromStationsJson(result, sources)));
+          WriteJsonOutput(json_path, CommandJson(used, ToJson(result)));
           if (!debug_dir.empty() && result.filled_rest) WriteDebug(debug_dir, result.fill, hole);
           PrintResultWarnings(result.warnings);
           Summarize(fmt::format("{} -> {}", FromStationsSummary(result), output_path));
@@ -322,12 +306,13 @@ int RunRemove(int argc, char** argv) {
         const cv::Mat& strokes = painted.cells;
         if (!quiet) fmt::print(stderr, "{}\n", painted.Describe());
         if (!stations.paths.empty()) {
-          nlohmann::ordered_json sources = nlohmann::ordered_json::array();
+          std::vector<FromStationsSource> sources;
           const std::vector<Scan> others = stations.Read(scan, &sources);
           auto progress =
               Progress::ForTerminal("remove from stations", static_cast<int64_t>(others.size()) + 1, quiet);
-          const RemoveFromStationsResult removed =
+          RemoveFromStationsResult removed =
               RemoveObjectFromStations(scan, strokes, others, remove, stations.options, progress.get());
+          SetStationFiles(sources, &removed.filled);
           if (progress) progress->Finish();
           if (!quiet) fmt::print(stderr, "segment: {}\n", removed.cut.Summary());
           if (remove.keep_object) {
@@ -340,11 +325,7 @@ int RunRemove(int argc, char** argv) {
           if (!stations.mask_path.empty()) WriteImage(stations.mask_path, removed.filled.from_station != 0);
           nlohmann::ordered_json used = ToJson(remove);
           used["from_stations"] = ToJson(stations.options);
-          nlohmann::ordered_json json = nlohmann::ordered_json::object();
-          json["cut"] = ToJson(removed.cut);
-          json["fill"] = FromStationsJson(removed.filled, sources);
-          json["warnings"] = removed.warnings;
-          WriteJsonOutput(json_path, CommandJson(used, json));
+          WriteJsonOutput(json_path, CommandJson(used, ToJson(removed)));
           PrintResultWarnings(removed.warnings);
           Summarize(fmt::format("removed {} cells: {} -> {}", cv::countNonZero(removed.hole),
                                 FromStationsSummary(removed.filled), output_path));

@@ -16,7 +16,6 @@
 #include <optional>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
@@ -32,9 +31,11 @@
 #include "lidarshop/scanner/random_scene.h"
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
 #include "lidarshop/scanner/station_photos.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/parallel.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/util/timer.h"
@@ -300,76 +301,54 @@ int RunScan(int argc, char** argv) {
         size_t num_photos = 0;
         for (const auto& station_photos : photos) num_photos += station_photos.size();
         if (!json_path.empty()) {
-          nlohmann::ordered_json json;
-          json["scene"] = scene_path;
-          json["output"] = output_path;
+          SceneScanSummary summary;
+          summary.scene = scene_path;
+          summary.output = output_path;
           if (!labels_path.empty() && !site) {  // a site's are per station, under "stations"
-            json["labels"] = labels_path;
-            json["labels_color"] = labels_color_path;
+            summary.labels = labels_path;
+            summary.labels_color = labels_color_path;
           }
-          if (!write_scene_path.empty()) json["scene_file"] = write_scene_path;
-          if (scene.target_label >= 0) json["target_label"] = scene.target_label;
-          json["objects"] = scene.objects.size();
-          json["triangles"] = triangles;
-          json["rows"] = scan.rows;
-          json["columns"] = scan.cols;
-          json["rays"] = scan_stats.rays;
-          json["returns"] = scan_stats.returns;
-          json["mesh_triangles"] = mesh_triangles;
-          if (site) {
-            nlohmann::ordered_json list = nlohmann::ordered_json::array();
-            for (int i = 0; i < num_stations; ++i) {
-              const Eigen::Vector3d& position = station_scenes[i].scanner.position;
-              nlohmann::ordered_json entry = {{"index", i},
-                                              {"name", scans[i].name},
-                                              {"position", {position.x(), position.y(), position.z()}},
-                                              {"objects", station_scenes[i].objects.size()},
-                                              {"rows", scans[i].rows},
-                                              {"columns", scans[i].cols},
-                                              {"rays", station_stats[i].rays},
-                                              {"returns", station_stats[i].returns}};
-              if (split) entry["output"] = station_path(output_path, i);
-              if (!labels_path.empty()) {
-                entry["labels"] = station_path(labels_path, i);
-                entry["labels_color"] = ColorLabelsPath(station_path(labels_path, i));
-              }
-              if (!mesh_path.empty()) entry["mesh"] = station_path(mesh_path, i);
-              list.push_back(entry);
+          if (!write_scene_path.empty()) summary.scene_file = write_scene_path;
+          if (scene.target_label >= 0) summary.target_label = scene.target_label;
+          summary.objects = static_cast<int64_t>(scene.objects.size());
+          summary.triangles = triangles;
+          summary.rows = scan.rows;
+          summary.columns = scan.cols;
+          summary.rays = scan_stats.rays;
+          summary.returns = scan_stats.returns;
+          summary.mesh_triangles = mesh_triangles;
+          for (int i = 0; site && i < num_stations; ++i) {
+            StationScanSummary station =
+                SummarizeStationScan(i, station_scenes[i], scans[i], station_stats[i]);
+            if (split) station.output = station_path(output_path, i);
+            if (!labels_path.empty()) {
+              station.labels = station_path(labels_path, i);
+              station.labels_color = ColorLabelsPath(station_path(labels_path, i));
             }
-            json["stations"] = list;
+            if (!mesh_path.empty()) station.mesh = station_path(mesh_path, i);
+            summary.stations.push_back(std::move(station));
           }
-          if (num_photos > 0) {
-            nlohmann::ordered_json list = nlohmann::ordered_json::array();
-            for (int i = 0; i < num_stations; ++i) {
-              for (const StationPhoto& photo : photos[i]) {
-                nlohmann::ordered_json entry = {{"name", photo.name},
-                                                {"model", CameraModelName(photo.camera.model)},
-                                                {"width_px", photo.image.cols},
-                                                {"height_px", photo.image.rows},
-                                                {"gain", photo.gain}};
-                if (site) entry["station"] = i;
-                list.push_back(entry);
-              }
-            }
-            json["photos"] = list;
+          for (int i = 0; i < num_stations; ++i) {
+            for (const StationPhoto& photo : photos[i])
+              summary.photos.push_back(
+                  SummarizeStationPhoto(photo, site ? std::optional<int>(i) : std::nullopt));
           }
-          json["threads"] = threads;
-          json["seconds"] = {
-              {"loading", loading_seconds},
-              {"building", building_seconds},
-              {"casting", scan_stats.cast_seconds},
-              {"shading", scan_stats.shade_seconds},
-              {"scanning", scanning_seconds},
-              {"meshing", meshing_seconds},
-              {"photos", photo_seconds},
-              {"writing", writing_scan_seconds + writing_labels_seconds + writing_mesh_seconds},
-              {"writing_scan", writing_scan_seconds},
-              {"writing_labels", writing_labels_seconds},
-              {"writing_mesh", writing_mesh_seconds},
-              {"total", total.Seconds()}};
-          json["rays_per_second"] = scan_stats.rays / std::max(1e-9, scanning_seconds);
-          if (!mesh_path.empty()) json["mesh_options"] = ToJson(mesh_options);
-          WriteJsonOutput(json_path, CommandJson(ToJson(station_scenes[0].scanner), json));
+          summary.threads = threads;
+          summary.seconds = {.loading = loading_seconds,
+                             .building = building_seconds,
+                             .casting = scan_stats.cast_seconds,
+                             .shading = scan_stats.shade_seconds,
+                             .scanning = scanning_seconds,
+                             .meshing = meshing_seconds,
+                             .photos = photo_seconds,
+                             .writing = writing_scan_seconds + writing_labels_seconds + writing_mesh_seconds,
+                             .writing_scan = writing_scan_seconds,
+                             .writing_labels = writing_labels_seconds,
+                             .writing_mesh = writing_mesh_seconds,
+                             .total = total.Seconds()};
+          summary.rays_per_second = scan_stats.rays / std::max(1e-9, scanning_seconds);
+          if (!mesh_path.empty()) summary.mesh_options = mesh_options;
+          WriteJsonOutput(json_path, CommandJson(ToJson(station_scenes[0].scanner), ToJson(summary)));
         }
         Summarize(fmt::format("{}{} x {} scan{}, {} returns of {} rays{} -> {}",
                               site ? fmt::format("{} stations: ", num_stations) : std::string(), scan.rows,

@@ -30,6 +30,8 @@
 #include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
+#include "lidarshop/site/from_stations.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/options_markdown.h"
@@ -46,6 +48,9 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
   std::vector<TypeScriptStruct> structs = server::ApiTypes();
   for (const TypeScriptStruct& entry : {
            OptionsType<ScannerOptions>(),           // scan
+           ResultType<SceneScanSummary>(),          // scan --json
+           ResultType<FromStationsResult>(),        // fill --stations --json
+           ResultType<RemoveFromStationsResult>(),  // remove --stations --json
            OptionsType<ScanMeshOptions>(),          // scan --mesh-jump, points mesh
            OptionsType<PtxReadOptions>(),           // reading PTX
            OptionsType<E57WriteOptions>(),          // convert, E57 output

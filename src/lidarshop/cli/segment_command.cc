@@ -4,7 +4,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
@@ -111,9 +110,8 @@ int RunSegment(int argc, char** argv) {
         }
         if (!object_path.empty()) WriteScanFile(object_path, {MaskScan(scan, result.mask)});
         if (!rest_path.empty()) WriteScanFile(rest_path, {MaskScan(scan, result.mask == 0)});
-        nlohmann::ordered_json json = ToJson(result);
-        json["refined"] = !refine_path.empty();
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        result.refined = !refine_path.empty();
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(result)));
         return 0;
       },
       &binder);

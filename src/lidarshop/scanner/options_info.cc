@@ -4,6 +4,8 @@
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/scanner/site_scan.h"
+#include "lidarshop/scanner/station_photos.h"
 #include "lidarshop/scanner/texture.h"
 #include "lidarshop/util/options.h"
 
@@ -121,6 +123,107 @@ const StructInfo& InfoOf<FacadeMeshOptions>() {
         .min_exclusive = true;
     b.Field(&FacadeMeshOptions::floors, "floors", "floors").Range(1, 100);
     b.Field(&FacadeMeshOptions::windows_per_floor, "windows_per_floor", "windows per floor").Range(1, 200);
+    return b.Build();
+  }();
+  return info;
+}
+
+namespace {
+
+// A list written only when it holds something (FieldInfo::present, as for an optional member): a site's
+// stations, the photos.
+template <class S, class T>
+void AbsentWhenEmpty(FieldInfo& field, std::vector<T> S::*member) {
+  field.present = [member](const void* object) { return !(static_cast<const S*>(object)->*member).empty(); };
+}
+
+}  // namespace
+
+template <>
+const StructInfo& InfoOf<StationPhotoSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<StationPhotoSummary> b("StationPhotoSummary", "a station photo written with the scan");
+    b.Field(&StationPhotoSummary::name, "name",
+            "panorama, or the cube face: front, right, back, left, up, down");
+    b.Field(&StationPhotoSummary::model, "model", "camera model: spherical or pinhole");
+    b.Field(&StationPhotoSummary::width_px, "width_px", "image width").Unit("px");
+    b.Field(&StationPhotoSummary::height_px, "height_px", "image height").Unit("px");
+    b.Field(&StationPhotoSummary::gain, "gain", "exposure relative to photo 0");
+    b.Field(&StationPhotoSummary::station, "station", "the station it was taken at (a site's photos only)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<StationScanSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<StationScanSummary> b("StationScanSummary", "one station of a scanned site");
+    b.Field(&StationScanSummary::index, "index", "the station's index in the scene's stations");
+    b.Field(&StationScanSummary::name, "name", "its scan's name (station0, station1, ...)");
+    b.Field(&StationScanSummary::position, "position", "the scanner's centre (x, y, z), world frame")
+        .Unit("m");
+    b.Field(&StationScanSummary::objects, "objects", "objects of the scene at this station");
+    b.Field(&StationScanSummary::rows, "rows", "rows of its scan").Unit("cells");
+    b.Field(&StationScanSummary::columns, "columns", "columns of its scan").Unit("cells");
+    b.Field(&StationScanSummary::rays, "rays", "rays cast");
+    b.Field(&StationScanSummary::returns, "returns", "rays that hit something");
+    b.Field(&StationScanSummary::output, "output", "--split: its scan file");
+    b.Field(&StationScanSummary::labels, "labels", "--labels: its label image (16-bit PNG)");
+    b.Field(&StationScanSummary::labels_color, "labels_color", "--labels: its labels' colour picture");
+    b.Field(&StationScanSummary::mesh, "mesh", "--mesh: its mesh file");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SceneScanSeconds>() {
+  static const StructInfo info = [] {
+    StructBuilder<SceneScanSeconds> b("SceneScanSeconds", "wall-clock seconds per stage of a scan");
+    b.Field(&SceneScanSeconds::loading, "loading", "reading or generating the scene").Unit("s");
+    b.Field(&SceneScanSeconds::building, "building", "building the ray-casting scenes").Unit("s");
+    b.Field(&SceneScanSeconds::casting, "casting", "ray casting").Unit("s");
+    b.Field(&SceneScanSeconds::shading, "shading", "noise, colour, intensity and normals").Unit("s");
+    b.Field(&SceneScanSeconds::scanning, "scanning", "the whole scans").Unit("s");
+    b.Field(&SceneScanSeconds::meshing, "meshing", "meshing the scans (--mesh)").Unit("s");
+    b.Field(&SceneScanSeconds::photos, "photos", "rendering the station photos (--photos)").Unit("s");
+    b.Field(&SceneScanSeconds::writing, "writing", "writing every file").Unit("s");
+    b.Field(&SceneScanSeconds::writing_scan, "writing_scan", "writing the scan files").Unit("s");
+    b.Field(&SceneScanSeconds::writing_labels, "writing_labels", "writing the label pictures (--labels)")
+        .Unit("s");
+    b.Field(&SceneScanSeconds::writing_mesh, "writing_mesh", "writing the meshes (--mesh)").Unit("s");
+    b.Field(&SceneScanSeconds::total, "total", "the whole command").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SceneScanSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<SceneScanSummary> b("SceneScanSummary", "a synthetic scan: what was scanned and written");
+    b.Field(&SceneScanSummary::scene, "scene", "the scene file, built-in scene or 'random scene SEED'");
+    b.Field(&SceneScanSummary::output, "output", "the scan file");
+    b.Field(&SceneScanSummary::labels, "labels", "--labels (one station): the label image");
+    b.Field(&SceneScanSummary::labels_color, "labels_color", "--labels (one station): its colour picture");
+    b.Field(&SceneScanSummary::scene_file, "scene_file", "--write-scene: the random scene's JSON");
+    b.Field(&SceneScanSummary::target_label, "target_label", "label of the scene's target object, if any");
+    b.Field(&SceneScanSummary::objects, "objects", "objects in the scene");
+    b.Field(&SceneScanSummary::triangles, "triangles", "triangles of the largest ray-casting scene");
+    b.Field(&SceneScanSummary::rows, "rows", "rows of the (first) scan").Unit("cells");
+    b.Field(&SceneScanSummary::columns, "columns", "columns of the (first) scan").Unit("cells");
+    b.Field(&SceneScanSummary::rays, "rays", "rays cast, every station");
+    b.Field(&SceneScanSummary::returns, "returns", "rays that hit something, every station");
+    b.Field(&SceneScanSummary::mesh_triangles, "mesh_triangles", "triangles of the meshes written (--mesh)");
+    AbsentWhenEmpty(b.Field(&SceneScanSummary::stations, "stations", "a site's stations in order"),
+                    &SceneScanSummary::stations);
+    AbsentWhenEmpty(b.Field(&SceneScanSummary::photos, "photos", "the station photos written (--photos)"),
+                    &SceneScanSummary::photos);
+    b.Field(&SceneScanSummary::threads, "threads", "worker threads asked for (0 = all cores)");
+    b.Field(&SceneScanSummary::seconds, "seconds", "wall-clock seconds per stage");
+    b.Field(&SceneScanSummary::rays_per_second, "rays_per_second", "rays per second of scanning").Unit("1/s");
+    b.Field(&SceneScanSummary::mesh_options, "mesh_options", "--mesh: how the meshes were made");
     return b.Build();
   }();
   return info;

@@ -27,4 +27,19 @@ std::vector<Scan> ScanStations(const SceneDescription& scene, Progress* progress
   return scans;
 }
 
+StationScanSummary SummarizeStationScan(int index, const SceneDescription& station, const Scan& scan,
+                                        const ScanStats& stats) {
+  StationScanSummary summary;
+  summary.index = index;
+  summary.name = scan.name;
+  const Eigen::Vector3d& position = station.scanner.position;
+  summary.position = {position.x(), position.y(), position.z()};
+  summary.objects = static_cast<int64_t>(station.objects.size());
+  summary.rows = scan.rows;
+  summary.columns = scan.cols;
+  summary.rays = stats.rays;
+  summary.returns = stats.returns;
+  return summary;
+}
+
 }  // namespace lidarshop

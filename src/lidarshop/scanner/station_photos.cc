@@ -87,4 +87,15 @@ std::vector<E57Image> StationPhotosToE57(const std::vector<StationPhoto>& photos
   return images;
 }
 
+StationPhotoSummary SummarizeStationPhoto(const StationPhoto& photo, std::optional<int> station) {
+  StationPhotoSummary summary;
+  summary.name = photo.name;
+  summary.model = CameraModelName(photo.camera.model);
+  summary.width_px = photo.image.cols;
+  summary.height_px = photo.image.rows;
+  summary.gain = photo.gain;
+  summary.station = station;
+  return summary;
+}
+
 }  // namespace lidarshop

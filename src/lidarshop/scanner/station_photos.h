@@ -13,6 +13,7 @@
 // in [0, 1) from a hash of (seed, i). A pixel is round(gain · rendered colour), saturated to [0, 255].
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/scanner/scene.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -43,6 +45,20 @@ struct StationPhoto {
   cv::Mat image;     // CV_8UC3 RGB, with the gain applied
   double gain = 1;   // exposure relative to photo 0
 };
+
+// A photo as `lidarshop scan --json` lists it ("photos"): its name, camera model, size and exposure.
+struct StationPhotoSummary {
+  std::string name;                 // StationPhoto::name
+  std::string model;                // the camera model's name (CameraModelName): "spherical", "pinhole"
+  int width_px = 0, height_px = 0;  // the image's size, pixels
+  double gain = 1;                  // exposure relative to photo 0
+  std::optional<int> station;       // the station (index in the scene) it was taken at: a site's photos only
+};
+template <>
+const StructInfo& InfoOf<StationPhotoSummary>();
+
+// The summary of `photo`; `station` is the station's index for a site (nullopt for a one-station scene).
+StationPhotoSummary SummarizeStationPhoto(const StationPhoto& photo, std::optional<int> station);
 
 // Renders the station photos of a scanner at `scanner` (its pose) in `scene`.
 std::vector<StationPhoto> RenderStationPhotos(const SceneDescription& scene, const ScannerOptions& scanner,

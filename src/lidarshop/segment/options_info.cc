@@ -238,6 +238,7 @@ const StructInfo& InfoOf<SegmentResult>() {
             "factor applied to the metric lengths (scale_to_data)");
     b.Field(&SegmentResult::timings, "timings", "wall seconds per stage");
     b.Field(&SegmentResult::warnings, "warnings", "what looks wrong with the cut, one sentence each");
+    b.Field(&SegmentResult::refined, "refined", "extra strokes refined a first cut (where a caller says)");
     return b.Build();
   }();
   return info;

@@ -250,6 +250,9 @@ struct SegmentResult {
   // What looks wrong with the cut (segment/cut_checks.h: it grew far past its strokes' part, it touches two
   // borders), one sentence each; empty when nothing does. The mask is kept as it is.
   std::vector<std::string> warnings;
+  // Whether extra strokes refined a first cut (SegmentSession::Refine), said by a caller that offers both
+  // (segment --refine, the editor's live update); absent (and not in the JSON) otherwise.
+  std::optional<bool> refined;
   std::string Summary() const;  // one line
 };
 template <>

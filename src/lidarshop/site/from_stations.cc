@@ -85,6 +85,105 @@ const StructInfo& InfoOf<FromStationsOptions>() {
   return info;
 }
 
+template <>
+const StructInfo& InfoOf<FromStationsSource>() {
+  static const StructInfo info = [] {
+    StructBuilder<FromStationsSource> b("FromStationsSource", "another station a hole was filled from");
+    b.Field(&FromStationsSource::station, "station",
+            "1 + its index among the stations: its from_station tag");
+    b.Field(&FromStationsSource::file, "file", "the file it was read from");
+    b.Field(&FromStationsSource::scan, "scan", "its index in that file");
+    b.Field(&FromStationsSource::name, "name", "its scan's name");
+    b.Field(&FromStationsSource::from_station_cells, "from_station_cells", "hole cells filled from it")
+        .Unit("cells");
+    b.Field(&FromStationsSource::object_cells, "object_cells", "cells of the removed object seen in it")
+        .Unit("cells");
+    return b.Build();
+  }();
+  return info;
+}
+
+namespace {
+
+// A field of FillResult read through FromStationsResult::fill, written only when the synthesis ran
+// (filled_rest): the synthesis's numbers stand beside the whole hole's, in one object.
+FieldInfo SynthesisField(const FieldInfo& field) {
+  using Result = FromStationsResult;
+  FieldInfo through = field;
+  auto fill = [](const void* object) -> const void* { return &static_cast<const Result*>(object)->fill; };
+  auto fill_of = [](void* object) -> void* { return &static_cast<Result*>(object)->fill; };
+  through.get = [get = field.get, fill](const void* object) { return get(fill(object)); };
+  if (field.set)
+    through.set = [set = field.set, fill_of](void* o, const nlohmann::json& json) { set(fill_of(o), json); };
+  if (field.nested_of)
+    through.nested_of = [nested_of = field.nested_of, fill_of](void* o) { return nested_of(fill_of(o)); };
+  if (field.list_size)
+    through.list_size = [list_size = field.list_size, fill](const void* o) { return list_size(fill(o)); };
+  if (field.element_of) {
+    through.element_of = [element_of = field.element_of, fill_of](void* o, size_t i) {
+      return element_of(fill_of(o), i);
+    };
+  }
+  through.present = [present = field.present, fill](const void* object) {
+    return static_cast<const Result*>(object)->filled_rest && (!present || present(fill(object)));
+  };
+  return through;
+}
+
+}  // namespace
+
+template <>
+const StructInfo& InfoOf<FromStationsResult>() {
+  static const StructInfo info = [] {
+    using Result = FromStationsResult;
+    StructBuilder<Result> b(
+        "FromStationsResult",
+        "a fill from other stations: the synthesis's numbers (when it ran) and the hole's");
+    b.Field(&Result::hole_cells, "hole_cells", "cells of the hole").Unit("cells");
+    b.Field(&Result::synthesized_cells, "synthesized_cells", "hole cells the synthesis gave a return")
+        .Unit("cells");
+    b.Field(&Result::no_return_cells, "no_return_cells", "hole cells left without a return").Unit("cells");
+    b.Field(&Result::warnings, "warnings",
+            "the synthesis's warnings and what looks wrong, one sentence each");
+    b.Field(&Result::from_station_cells, "from_station_cells", "hole cells filled from another station")
+        .Unit("cells");
+    b.Field(&Result::stations, "stations", "the other stations, in order");
+    b.Field(&Result::rim_cells, "rim_cells",
+            "cells whose hit was a rim, unconfirmed or too oblique (left to the synthesis)")
+        .Unit("cells");
+    b.Field(&Result::not_free_cells, "not_free_cells", "cells whose hit failed the free-space check")
+        .Unit("cells");
+    b.Field(&Result::stations_seconds, "stations_seconds", "the cast into the other stations").Unit("s");
+    b.Field(&Result::fill_seconds, "fill_seconds", "the synthesis").Unit("s");
+    StructInfo own = b.Build();
+    // FillResult's order, its hole counts and warnings replaced by the whole hole's, then the rest.
+    std::vector<FieldInfo> fields;
+    for (const FieldInfo& field : InfoOf<FillResult>().fields) {
+      const FieldInfo* mine = own.Find(field.key);
+      fields.push_back(mine != nullptr ? *mine : SynthesisField(field));
+    }
+    for (const FieldInfo& field : own.fields) {
+      if (InfoOf<FillResult>().Find(field.key) == nullptr) fields.push_back(field);
+    }
+    own.fields = std::move(fields);
+    return own;
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RemoveFromStationsResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<RemoveFromStationsResult> b("RemoveFromStationsResult",
+                                              "an object removal filled from other stations first");
+    b.Field(&RemoveFromStationsResult::cut, "cut", "the object's cut");
+    b.Field(&RemoveFromStationsResult::filled, "fill", "the fill of its hole");
+    b.Field(&RemoveFromStationsResult::warnings, "warnings", "the cut's then the fill's, one sentence each");
+    return b.Build();
+  }();
+  return info;
+}
+
 namespace {
 
 constexpr double kMinFreeSpaceStep = 0.05;  // metres
@@ -516,6 +615,13 @@ FromStationsResult FillFromStations(const Scan& scan, const cv::Mat& hole_in,
   result.no_return_cells = result.hole_cells - result.from_station_cells - result.synthesized_cells;
   if (other_stations.empty())
     result.warnings.push_back("no other station was given: every hole cell was synthesized");
+  for (size_t k = 0; k < other_stations.size(); ++k) {
+    FromStationsSource& source = result.stations.emplace_back();
+    source.station = static_cast<int64_t>(k) + 1;
+    source.name = other_stations[k].name;
+    source.from_station_cells = result.cells_per_station[k];
+    source.object_cells = k < result.object_cells.size() ? result.object_cells[k] : 0;
+  }
   return result;
 }
 

@@ -89,6 +89,20 @@ struct FromStationsOptions {
 template <>
 const StructInfo& InfoOf<FromStationsOptions>();
 
+// One other station of a fill from stations as the result lists it: which scan it is and what it gave.
+struct FromStationsSource {
+  int64_t station = 0;             // 1 + its index in other_stations: its tag in from_station
+  std::string file;                // the file it was read from (set by the caller that read it)
+  int64_t scan = 0;                // its index in that file (set by the caller that read it)
+  std::string name;                // its scan's name
+  int64_t from_station_cells = 0;  // hole cells filled from it (cells_per_station)
+  int64_t object_cells = 0;  // cells of the removed object seen in it (object_cells; 0 for an empty hole)
+};
+template <>
+const StructInfo& InfoOf<FromStationsSource>();
+
+// Its JSON (InfoOf): the synthesis's numbers (FillResult's keys, when it ran) with the hole's own counts and
+// warnings in place of the synthesis's, then the counts of the cells taken from the stations.
 struct FromStationsResult {
   Scan scan;  // the input with the hole filled; every cell outside the hole is a copy
   // CV_8U rows x cols: 1 + k = filled from other_stations[k] (the same as scan.from_station), 0 = not.
@@ -109,7 +123,12 @@ struct FromStationsResult {
   FillResult fill;
   double stations_seconds = 0, fill_seconds = 0;  // wall seconds: the cast from the stations, the synthesis
   std::vector<std::string> warnings;  // the fill's warnings and what looks wrong, one sentence each
+  // Per other station, in order: cells_per_station and object_cells with the station's name; file and scan
+  // are the caller's to set.
+  std::vector<FromStationsSource> stations;
 };
+template <>
+const StructInfo& InfoOf<FromStationsResult>();
 
 // Fills `hole` (CV_8U rows x cols of `scan`, non-zero = fill) from `other_stations` first, then by FillScan.
 // Throws InputError when the mask's size differs, when a station has no grid (an unorganized cloud), and as
@@ -129,6 +148,8 @@ struct RemoveFromStationsResult {
   Scan behind;                        // keep_object: as RemoveResult::behind; empty otherwise
   std::vector<std::string> warnings;  // the cut's then the fill's
 };
+template <>
+const StructInfo& InfoOf<RemoveFromStationsResult>();
 RemoveFromStationsResult RemoveObjectFromStations(const Scan& scan, const cv::Mat& strokes,
                                                   const std::vector<Scan>& other_stations,
                                                   const RemoveOptions& remove, FromStationsOptions from = {},

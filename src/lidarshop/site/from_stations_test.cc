@@ -16,6 +16,7 @@
 #include "lidarshop/scanner/scanner.h"
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -276,6 +277,40 @@ TEST(FillFromStations, RefusesBadInput) {
   FromStationsOptions bad;
   bad.max_incidence_deg = 0;
   EXPECT_THROW(FillFromStations(stations[0], hole, {stations[1]}, bad), OptionsError);
+}
+
+// The JSON keys of `json`, in order.
+std::vector<std::string> Keys(const nlohmann::ordered_json& json) {
+  std::vector<std::string> keys;
+  for (const auto& item : json.items()) keys.push_back(item.key());
+  return keys;
+}
+
+TEST(FillFromStations, ResultJsonHoldsTheSynthesisNumbersOnlyWhenItRan) {
+  FromStationsResult result;
+  result.hole_cells = 9;
+  result.from_station_cells = 9;
+  result.fill.hole_cells = 4;  // the synthesis's own counts give way to the whole hole's
+  result.fill.warnings = {"the synthesis's"};
+  result.warnings = {"the fill's"};
+  result.stations.push_back({.station = 1, .file = "site.e57", .scan = 2, .name = "station2"});
+  EXPECT_EQ(Keys(ToJson(result)),
+            (std::vector<std::string>{"hole_cells", "synthesized_cells", "no_return_cells", "warnings",
+                                      "from_station_cells", "stations", "rim_cells", "not_free_cells",
+                                      "stations_seconds", "fill_seconds"}));
+  result.filled_rest = true;
+  const nlohmann::ordered_json json = ToJson(result);
+  std::vector<std::string> expected = InfoOf<FillResult>().Keys();
+  for (const char* key :
+       {"from_station_cells", "stations", "rim_cells", "not_free_cells", "stations_seconds", "fill_seconds"})
+    expected.push_back(key);
+  EXPECT_EQ(Keys(json), expected);
+  EXPECT_EQ(json["hole_cells"], 9);
+  EXPECT_EQ(json["warnings"], nlohmann::json::array({"the fill's"}));
+  EXPECT_EQ(json["timings"], ToJson(result.fill.timings));
+  EXPECT_EQ(json["stations"][0].dump(),
+            R"({"station":1,"file":"site.e57","scan":2,"name":"station2","from_station_cells":0,)"
+            R"("object_cells":0})");
 }
 
 }  // namespace
