@@ -278,20 +278,19 @@ void BindResection(py::module_& m) {
 }
 
 void BindAlign(py::module_& m) {
-  py::class_<LandmarkAlignment>(m, "LandmarkAlignment", "A rigid or similarity transform from landmarks.")
+  // The described fields (model, scale, rms_m, ...; to_dict() gives `lidarshop align --json`), with the
+  // per-pair lists as NumPy arrays and the matrices, which are not JSON.
+  BindStruct<LandmarkAlignment>(m, true)
       .def_readonly("target_from_source", &LandmarkAlignment::target_from_source)
-      .def_readonly("scale", &LandmarkAlignment::scale)
       .def_property_readonly(
           "residual_m", [](const LandmarkAlignment& a) { return VectorArray(a.residual_m); },
-          "per pair, metres")
-      .def_readonly("rms_m", &LandmarkAlignment::rms_m);
-  py::class_<PhotoPairModel>(m, "PhotoPairModel", "A homography or fundamental matrix between two photos.")
+          "per pair, metres");
+  BindStruct<PhotoPairModel>(m, true)
       .def_readonly("matrix", &PhotoPairModel::matrix)
       .def_property_readonly(
           "error_px", [](const PhotoPairModel& p) { return VectorArray(p.error_px); }, "per pair, pixels")
       .def_property_readonly(
-          "inlier", [](const PhotoPairModel& p) { return BoolArray(p.inlier); }, "bool per pair")
-      .def_readonly("rms_px", &PhotoPairModel::rms_px);
+          "inlier", [](const PhotoPairModel& p) { return BoolArray(p.inlier); }, "bool per pair");
   m.def(
       "align_landmarks",
       [](const py::object& source, const py::object& target, bool with_scale) {

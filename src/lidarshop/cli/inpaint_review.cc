@@ -11,6 +11,7 @@
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop::cli {
 
@@ -30,10 +31,8 @@ void WriteReviewFolder(const std::string& dir, const InpaintReview& review,
                        const std::vector<ReviewDecision>& decisions, const cv::Mat& tentative_display,
                        const cv::Mat& canvas_display, int patch_radius) {
   std::filesystem::create_directories(dir);
-  nlohmann::ordered_json doc;
-  doc["decisions"] = DecisionsToJson(decisions);
-  doc["review"] = ReviewToJson(review, patch_radius);
-  WriteFileAtomically(dir + "/review.json", [&](std::ostream& out) { out << doc.dump(1) << "\n"; });
+  const ReviewFolderSummary doc{SummarizeDecisions(decisions), SummarizeReview(review, patch_radius)};
+  WriteFileAtomically(dir + "/review.json", [&](std::ostream& out) { out << ToJson(doc).dump(1) << "\n"; });
 
   const int R = patch_radius, w = 2 * R + 1;
   cv::Mat tentative = tentative_display.clone();

@@ -74,26 +74,6 @@ ResectionResult RunResection(const Correspondences& pairs, const ResectionOption
   return ResectWithIntrinsics(pairs.pixel_point, ReadCameraJson(intrinsics_path), options, what);
 }
 
-nlohmann::ordered_json ResectionJson(const ResectionResult& result) {
-  nlohmann::ordered_json json;
-  json["inliers"] = result.num_inliers;
-  json["pairs"] = result.inlier.size();
-  json["rms_px"] = result.rms_px;
-  json["dlt_rms_px"] = result.dlt_rms_px;
-  json["ransac_sets"] = result.ransac_iterations;
-  json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
-  json["principal_point_px"] = {result.camera.cx_px, result.camera.cy_px};
-  json["k1"] = result.camera.k1;
-  json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
-                           result.camera.center_in_world().z()};
-  nlohmann::ordered_json per_pair = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < result.inlier.size(); ++i)
-    per_pair.push_back({{"error_px", result.reprojection_error_px[i]}, {"inlier", result.inlier[i] != 0}});
-  json["per_pair"] = per_pair;
-  json["warnings"] = result.warnings;
-  return json;
-}
-
 // The photo's size comes from the photo, --size or the correspondence file, not from flags.
 void AddResectionOptions(CLI::App& app, OptionBinder& binder, ResectionOptions* options,
                          std::string* intrinsics_path, const std::string& group) {
@@ -138,32 +118,6 @@ AutoResectionResult RunAutoResection(const Scan& scan, const cv::Mat& photo,
   return AutoResection(scan, photo, options, intrinsics, rough, what);
 }
 
-nlohmann::ordered_json AutoResectionJson(const AutoResectionResult& result) {
-  nlohmann::ordered_json json;
-  json["method"] = result.method;
-  json["inliers"] = result.inliers;
-  json["pairs"] = result.pairs.size();
-  json["inlier_share"] = result.inlier_share;
-  json["rms_px"] = result.rms_px;
-  json["rms_work_px"] = result.rms_work_px;
-  json["work_scale"] = result.work_scale;
-  json["rounds"] = result.rounds;
-  json["search_view"] = result.search_view;
-  json["search_inliers"] = result.search_inliers;
-  if (result.search_fov_deg > 0) json["search_fov_deg"] = result.search_fov_deg;
-  json["check_pairs"] = result.check_pairs;
-  json["check_agree"] = result.check_agree;
-  json["check_alt_inliers"] = result.check_alt_inliers;
-  if (result.method == "silhouettes") {
-    json["silhouette_edge_share"] = result.silhouette_edge_share;
-    json["silhouette_mutual_information"] = result.silhouette_mutual_information;
-  }
-  json["focal_px"] = {result.camera.fx_px, result.camera.fy_px};
-  json["camera_center"] = {result.camera.center_in_world().x(), result.camera.center_in_world().y(),
-                           result.camera.center_in_world().z()};
-  json["warnings"] = result.warnings;
-  return json;
-}
 }  // namespace
 
 nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
@@ -268,7 +222,8 @@ int RunResection(int argc, char** argv) {
           const AutoResectionResult result =
               RunAutoResection(scan, photo, auto_options, intrinsics_path, rough_path, photo_path);
           WriteCameraJson(output, result.camera);
-          WriteJsonOutput(json_path, CommandJson(ToJson(auto_options), AutoResectionJson(result)));
+          WriteJsonOutput(json_path,
+                          CommandJson(ToJson(auto_options), ToJson(SummarizeAutoResection(result))));
           PrintResultWarnings(result.warnings);
           Summarize(fmt::format("{} -> {}", result.Summary(), output));
           return 0;
@@ -292,7 +247,7 @@ int RunResection(int argc, char** argv) {
               "the photo's size is unknown: give --photo, --size W H or \"image_size_px\" in " + pairs_path);
         const ResectionResult result = RunResection(pairs, options, intrinsics_path, pairs_path);
         WriteCameraJson(output, result.camera);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), ResectionJson(result)));
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(SummarizeResection(result))));
         PrintResultWarnings(result.warnings);
         Summarize(fmt::format("{} -> {}", result.Summary(), output));
         return 0;
@@ -355,7 +310,8 @@ int RunRecolor(int argc, char** argv) {
   // photos belong with its scan; a recoloured E57 without them could not be coloured again).
   double read_seconds = 0;  // the scan file (and with --from-e57-images its photos) read and decoded
   const auto colour_station = [&](const Scan& scan, const std::vector<CameraPhoto>& photos,
-                                  nlohmann::ordered_json used, const nlohmann::ordered_json& skipped,
+                                  std::vector<RecolorPhotoUsed> used,
+                                  std::vector<RecolorPhotoSkipped> skipped,
                                   const std::vector<E57Image>& carried) {
     PhotosRecolorOptions photo_options;
     photo_options.visibility = options;
@@ -374,32 +330,10 @@ int RunRecolor(int argc, char** argv) {
     if (!photo_index_mask_path.empty()) WriteImage(photo_index_mask_path, result.photo_index);
     const double write_seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
-    nlohmann::ordered_json counts;
-    counts["returns"] = result.returns;
-    counts["coloured"] = result.coloured;
-    counts["constraints"] = result.constraints;
-    counts["seam_edges"] = result.seam_edges;
-    counts["blended"] = result.blended;
-    for (size_t i = 0; i < used.size(); ++i)
-      used[i]["gain"] = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
-    counts["photos"] = used;
-    counts["skipped"] = skipped;
-    // Wall clock per phase (issue 32 item 6); "colour" is RecolorFromPhotos as a whole, the others its parts;
-    // "colour_cpu" the process's CPU time during it (every thread).
-    counts["seconds"] = {{"read", read_seconds},
-                         {"colour", result.total_seconds},
-                         {"write", write_seconds},
-                         {"scene", result.scene_seconds},
-                         {"visibility", result.visibility_seconds},
-                         {"zbuffer", result.zbuffer_seconds},
-                         {"projection", result.projection_seconds},
-                         {"choice", result.choice_seconds},
-                         {"gains", result.gain_seconds},
-                         {"colours", result.colour_seconds},
-                         {"blend", result.blend_seconds},
-                         {"output", result.output_seconds},
-                         {"colour_cpu", result.cpu_seconds}};
-    WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+    PhotosRecolorSummary summary = SummarizePhotosRecolor(result, std::move(used), std::move(skipped));
+    summary.seconds.read = read_seconds;
+    summary.seconds.write = write_seconds;
+    WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(summary)));
     Summarize(fmt::format("{} -> {}", result.Summary(), output));
     return 0;
   };
@@ -444,7 +378,7 @@ int RunRecolor(int argc, char** argv) {
           const Scan scan = ReadOneScan(scan_path, scan_index, ScanIndexFlag(app));
           read_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_start).count();
           std::vector<CameraPhoto> photos;
-          nlohmann::ordered_json used = nlohmann::ordered_json::array();
+          std::vector<RecolorPhotoUsed> used;
           for (size_t i = 0; i < photo_paths.size(); ++i) {
             CameraPhoto photo{ReadImage(photo_paths[i]), ReadCameraModelJson(camera_paths[i])};
             if (photo.image.type() != CV_8UC3)
@@ -454,11 +388,12 @@ int RunRecolor(int argc, char** argv) {
                               fmt::format("the camera is {} x {} pixels, its photo {} is {} x {}",
                                           photo.camera.width_px(), photo.camera.height_px(), photo_paths[i],
                                           photo.image.cols, photo.image.rows));
-            used.push_back(
-                {{"index", i}, {"name", photo_paths[i]}, {"model", CameraModelName(photo.camera.model)}});
+            used.push_back({.index = static_cast<int>(i),
+                            .name = photo_paths[i],
+                            .model = CameraModelName(photo.camera.model)});
             photos.push_back(std::move(photo));
           }
-          return colour_station(scan, photos, used, nlohmann::ordered_json::array(), {});
+          return colour_station(scan, photos, std::move(used), {}, {});
         }
         if (camera_paths.size() > 1) throw OptionsError("several --camera need as many --photo");
         if (!photo_index_mask_path.empty() && !from_e57_images)
@@ -485,18 +420,16 @@ int RunRecolor(int argc, char** argv) {
                                            scan_index, scan_path, file.scans.size()));
           const E57StationPhotos station = StationPhotosOfE57(file, scan_index);
           const std::vector<CameraPhoto>& photos = station.photos;
-          nlohmann::ordered_json used = nlohmann::ordered_json::array(),
-                                 skipped = nlohmann::ordered_json::array();
+          std::vector<RecolorPhotoUsed> used;
+          std::vector<RecolorPhotoSkipped> skipped;
           for (size_t k = 0; k < photos.size(); ++k) {
             const int i = station.image_index[k];
-            used.push_back({{"index", i},
-                            {"name", file.images[i].name},
-                            {"model", CameraModelName(photos[k].camera.model)}});
+            used.push_back(
+                {.index = i, .name = file.images[i].name, .model = CameraModelName(photos[k].camera.model)});
           }
           for (const E57StationPhotos::Skipped& skip : station.skipped)
-            skipped.push_back({{"index", skip.image_index},
-                               {"name", file.images[skip.image_index].name},
-                               {"why", skip.why}});
+            skipped.push_back(
+                {.index = skip.image_index, .name = file.images[skip.image_index].name, .why = skip.why});
           if (photos.empty())
             ThrowInputError(scan_path, "images2D", "",
                             fmt::format("no image of scan {} holds a photo with a camera ({} image(s); "
@@ -511,7 +444,7 @@ int RunRecolor(int argc, char** argv) {
           }
           const Scan scan = std::move(file.scans[scan_index]);
           file = E57File();
-          return colour_station(scan, photos, used, skipped, carried);
+          return colour_station(scan, photos, std::move(used), std::move(skipped), carried);
         }
         if (photo_path.empty() == image_key.empty())
           throw OptionsError("give exactly one of --photo and --image");
@@ -524,7 +457,8 @@ int RunRecolor(int argc, char** argv) {
         cv::Mat photo;
         PinholeCamera camera;
         bool have_camera = false;
-        nlohmann::ordered_json json;
+        std::optional<ResectionSummary> resection_summary;
+        std::optional<AutoResectionSummary> auto_summary;
         if (!image_key.empty()) {
           if (FileExtension(scan_path) != "e57") throw OptionsError("--image needs an E57 scan file");
           const E57File file = ReadE57(scan_path);  // ReadOneScan printed the warnings
@@ -548,8 +482,8 @@ int RunRecolor(int argc, char** argv) {
               RunAutoResection(scan, photo, auto_options, intrinsics_path, rough_path,
                                photo_path.empty() ? image_key : photo_path);
           fmt::print(stderr, "{}\n", result.Summary());
-          json["auto_resection"] = AutoResectionJson(result);
-          json["auto_resection"]["options"] = ToJson(auto_options);
+          auto_summary = SummarizeAutoResection(result);
+          auto_summary->options = auto_options;
           camera = result.camera;
           // The edge guard's margin follows the camera's accuracy, as with pairs.
           options.camera_uncertainty_px = std::max(options.camera_uncertainty_px, 2 * result.rms_px);
@@ -561,8 +495,8 @@ int RunRecolor(int argc, char** argv) {
               RunResection(ReadCorrespondences(pairs_path, &scan), resection, intrinsics_path, pairs_path);
           fmt::print(stderr, "resection: {}\n", result.Summary());
           PrintResultWarnings(result.warnings);
-          json["resection"] = ResectionJson(result);
-          json["resection"]["options"] = ToJson(resection);
+          resection_summary = SummarizeResection(result);
+          resection_summary->options = resection;
           camera = result.camera;
           // The edge guard's margin follows the resection: a camera is good to about twice its RMS.
           options.camera_uncertainty_px = std::max(options.camera_uncertainty_px, 2 * result.rms_px);
@@ -570,27 +504,12 @@ int RunRecolor(int argc, char** argv) {
           throw OptionsError("give --camera, --correspondences or --auto");
         }
         const RecolorResult result = RecolorScan(scan, photo, camera, options);
-        // The resection's warnings (its RMS) and the recolouring's (the colours disagree), in that order.
-        std::vector<std::string> warnings;
-        if (json.contains("resection"))
-          warnings = json["resection"]["warnings"].get<std::vector<std::string>>();
-        if (json.contains("auto_resection"))
-          warnings = json["auto_resection"]["warnings"].get<std::vector<std::string>>();
-        warnings.insert(warnings.end(), result.warnings.begin(), result.warnings.end());
         WriteScanFile(output, {result.scan});
         if (!mask_path.empty()) WriteImage(mask_path, result.recolored);
         if (!uncertain_path.empty()) WriteImage(uncertain_path, result.uncertain_mask);
-        nlohmann::ordered_json counts;
-        counts["returns"] = result.returns;
-        counts["recolored"] = result.recolored_count;
-        counts["outside_image"] = result.outside_image;
-        counts["hidden"] = result.hidden;
-        counts["uncertain"] = result.uncertain;
-        counts["edge_margin_px"] = result.edge_margin_px;
-        if (std::isfinite(result.disagreement)) counts["disagreement"] = result.disagreement;
-        counts["warnings"] = warnings;
-        if (json.is_object()) counts.update(json);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), counts));
+        // The resection's warnings (its RMS) and the recolouring's (the colours disagree), in that order.
+        const RecolorSummary summary = SummarizeRecolor(result, resection_summary, auto_summary);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(summary)));
         PrintResultWarnings(result.warnings);
         Summarize(fmt::format("{} -> {}", result.Summary(), output));
         return 0;
@@ -724,14 +643,10 @@ int RunPhoto(int argc, char** argv) {
         const Camera camera = ReadCameraModelJson(camera_path);
         const Photo photo = RenderPhoto(scene, camera, options);
         WriteImage(output, photo.image);
-        nlohmann::ordered_json json;
-        json["model"] = CameraModelName(camera.model);
-        json["width_px"] = photo.image.cols;
-        json["height_px"] = photo.image.rows;
-        json["scene_pixels"] = cv::countNonZero(photo.label != kNoLabel);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
-        Summarize(fmt::format("{} x {} photo, {} pixels see the scene -> {}", photo.image.cols,
-                              photo.image.rows, json["scene_pixels"].get<int64_t>(), output));
+        const PhotoSummary summary = SummarizePhoto(photo, camera);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(summary)));
+        Summarize(fmt::format("{} x {} photo, {} pixels see the scene -> {}", summary.width_px,
+                              summary.height_px, summary.scene_pixels, output));
         return 0;
       },
       &binder);

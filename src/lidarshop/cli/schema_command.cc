@@ -14,6 +14,7 @@
 #include "lidarshop/cli/points_operations.h"
 #include "lidarshop/fill/fill_metrics.h"
 #include "lidarshop/inpaint/inpaint.h"
+#include "lidarshop/inpaint/review.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
@@ -22,9 +23,11 @@
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/pointset/site_registration.h"
 #include "lidarshop/poisson/poisson.h"
+#include "lidarshop/recolor/align.h"
 #include "lidarshop/recolor/auto_resection.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/render/render_layout.h"
 #include "lidarshop/render/render_view.h"
 #include "lidarshop/scan/scan_mesh.h"
@@ -63,13 +66,22 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            OptionsType<VerifyOptions>(),            // verify, sweep
            OptionsType<SweepOptions>(),             // sweep
            ResultType<InpaintResult>(),             // inpaint
+           ResultType<ReviewFolderSummary>(),       // inpaint --review DIR: review.json
            OptionsType<PoissonOptions>(),           // poisson
            ResultType<PoissonResult>(),             // poisson
            OptionsType<FillMetricsOptions>(),       // fill_eval
            OptionsType<ResectionOptions>(),         // resection, recolor
+           ResultType<ResectionSummary>(),          // resection
            OptionsType<AutoResectionOptions>(),     // resection --auto
+           ResultType<AutoResectionSummary>(),      // resection --auto
            OptionsType<RecolorOptions>(),           // recolor
+           ResultType<RecolorSummary>(),            // recolor, one photo
+           ResultType<PhotosRecolorSummary>(),      // recolor, several photos
            OptionsType<PhotoOptions>(),             // photo
+           ResultType<PhotoSummary>(),              // photo
+           OptionsType<AlignOptions>(),             // align
+           ResultType<LandmarkAlignment>(),         // align, landmarks
+           ResultType<PhotoPairModel>(),            // align, photo pairs
            OptionsType<PointsOptions>(),            // points
            OptionsType<IcpOptions>(),               // register
            OptionsType<GlobalAlignOptions>(),       // register --global

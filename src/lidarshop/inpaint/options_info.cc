@@ -1,6 +1,7 @@
 // Descriptions of the inpainting options and enums (util/options.h): names, units, ranges, docs.
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/inpaint/offset_completion.h"
+#include "lidarshop/inpaint/review.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -239,6 +240,76 @@ const StructInfo& InfoOf<ReviewStop>() {
     b.Field(&ReviewStop::iteration, "iteration", "fill iteration at which the fill stopped");
     b.Field(&ReviewStop::target, "target", "[row, col] of the target patch no candidate passed").Unit("px");
     b.Field(&ReviewStop::candidates, "candidates", "candidates ranked for it (the review lists them)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ReviewCandidateSummary>() {
+  static const StructInfo info = [] {
+    using S = ReviewCandidateSummary;
+    StructBuilder<S> b("ReviewCandidateSummary", "a source candidate of a review");
+    b.Field(&S::index, "index", "its rank, 0 = best");
+    b.Field(&S::source, "source", "[row, col] of the source patch's centre").Unit("px");
+    b.Field(&S::difference, "difference", "its patch difference to the target");
+    b.Field(&S::cluster, "cluster", "its cluster's index");
+    b.Field(&S::accepted, "accepted", "the acceptance tests passed it");
+    b.Field(&S::test, "test", "the test that decided (the failing one, or the one with the least margin)");
+    b.Field(&S::value, "value", "that test's value");
+    b.Field(&S::threshold, "threshold", "that test's threshold");
+    b.Field(&S::margin, "margin", "that test's margin (negative: rejected)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ReviewClusterSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ReviewClusterSummary> b("ReviewClusterSummary", "a cluster of a review's candidates");
+    b.Field(&ReviewClusterSummary::index, "index", "the cluster's index");
+    b.Field(&ReviewClusterSummary::representative, "representative", "its best candidate's index");
+    b.Field(&ReviewClusterSummary::members, "members", "its candidates' indices");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ReviewSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ReviewSummary> b("ReviewSummary",
+                                   "a fill stopped for a review: the target and its candidates");
+    b.Field(&ReviewSummary::review_point, "review_point", "review points before this one");
+    b.Field(&ReviewSummary::iteration, "iteration", "fill iteration at which the fill stopped");
+    b.Field(&ReviewSummary::target, "target", "[row, col] of the target patch no candidate passed")
+        .Unit("px");
+    b.Field(&ReviewSummary::patch_radius, "patch_radius", "the fill's patch half-width").Unit("px");
+    b.Field(&ReviewSummary::candidates, "candidates", "the ranked candidates, best first");
+    b.Field(&ReviewSummary::clusters, "clusters", "the candidates grouped by look");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ReviewDecisionSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ReviewDecisionSummary> b("ReviewDecisionSummary", "a review's decision");
+    b.Field(&ReviewDecisionSummary::target, "target", "[row, col] of the reviewed target").Unit("px");
+    b.Field(&ReviewDecisionSummary::source, "source", "[row, col] of the source chosen for it").Unit("px");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ReviewFolderSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ReviewFolderSummary> b("ReviewFolderSummary", "review.json of an inpaint --review folder");
+    b.Field(&ReviewFolderSummary::decisions, "decisions", "the decisions so far, in order");
+    b.Field(&ReviewFolderSummary::review, "review", "the pending review");
     return b.Build();
   }();
   return info;

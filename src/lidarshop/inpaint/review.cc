@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "lidarshop/util/options.h"
+
 namespace lidarshop {
 
 std::vector<int> ClusterCandidates(const InpaintCanvas& canvas,
@@ -99,44 +101,52 @@ InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<
 
 namespace {
 
-nlohmann::ordered_json PixelJson(Pixel p) { return nlohmann::ordered_json::array({p.row, p.col}); }
+std::vector<int> PixelList(Pixel p) { return {p.row, p.col}; }
 
 }  // namespace
 
-nlohmann::ordered_json ReviewToJson(const InpaintReview& review, int patch_radius) {
-  nlohmann::ordered_json json;
-  json["review_point"] = review.review_point;
-  json["iteration"] = review.iteration;
-  json["target"] = PixelJson(review.target);
-  json["patch_radius"] = patch_radius;
-  json["candidates"] = nlohmann::ordered_json::array();
+ReviewSummary SummarizeReview(const InpaintReview& review, int patch_radius) {
+  ReviewSummary summary;
+  summary.review_point = review.review_point;
+  summary.iteration = review.iteration;
+  summary.target = PixelList(review.target);
+  summary.patch_radius = patch_radius;
   for (size_t i = 0; i < review.candidates.size(); ++i) {
     const AcceptanceVerdict verdict = i < review.verdicts.size() ? review.verdicts[i] : AcceptanceVerdict{};
-    json["candidates"].push_back({{"index", i},
-                                  {"source", PixelJson(review.candidates[i].source)},
-                                  {"difference", review.candidates[i].difference},
-                                  {"cluster", review.cluster[i]},
-                                  {"accepted", verdict.accepted},
-                                  {"test", verdict.test},
-                                  {"value", verdict.value},
-                                  {"threshold", verdict.threshold},
-                                  {"margin", verdict.margin}});
+    summary.candidates.push_back({.index = static_cast<int64_t>(i),
+                                  .source = PixelList(review.candidates[i].source),
+                                  .difference = review.candidates[i].difference,
+                                  .cluster = review.cluster[i],
+                                  .accepted = verdict.accepted,
+                                  .test = verdict.test,
+                                  .value = verdict.value,
+                                  .threshold = verdict.threshold,
+                                  .margin = verdict.margin});
   }
-  json["clusters"] = nlohmann::ordered_json::array();
   for (size_t c = 0; c < review.cluster_representative.size(); ++c) {
-    nlohmann::ordered_json members = nlohmann::ordered_json::array();
+    ReviewClusterSummary cluster{.index = static_cast<int64_t>(c),
+                                 .representative = review.cluster_representative[c]};
     for (size_t i = 0; i < review.cluster.size(); ++i)
-      if (review.cluster[i] == static_cast<int>(c)) members.push_back(i);
-    json["clusters"].push_back(
-        {{"index", c}, {"representative", review.cluster_representative[c]}, {"members", members}});
+      if (review.cluster[i] == static_cast<int>(c)) cluster.members.push_back(static_cast<int64_t>(i));
+    summary.clusters.push_back(std::move(cluster));
   }
-  return json;
+  return summary;
+}
+
+std::vector<ReviewDecisionSummary> SummarizeDecisions(const std::vector<ReviewDecision>& decisions) {
+  std::vector<ReviewDecisionSummary> list;
+  for (const ReviewDecision& d : decisions) list.push_back({PixelList(d.target), PixelList(d.source)});
+  return list;
+}
+
+nlohmann::ordered_json ReviewToJson(const InpaintReview& review, int patch_radius) {
+  return ToJson(SummarizeReview(review, patch_radius));
 }
 
 nlohmann::ordered_json DecisionsToJson(const std::vector<ReviewDecision>& decisions) {
   nlohmann::ordered_json json = nlohmann::ordered_json::array();
-  for (const ReviewDecision& d : decisions)
-    json.push_back({{"target", PixelJson(d.target)}, {"source", PixelJson(d.source)}});
+  for (const ReviewDecisionSummary& decision : SummarizeDecisions(decisions))
+    json.push_back(ToJson(decision));
   return json;
 }
 

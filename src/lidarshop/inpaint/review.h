@@ -10,6 +10,8 @@
 // review.json (`inpaint --review DIR`, `inpaint --resume DIR --choose N`).
 #pragma once
 
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -68,13 +70,62 @@ InpaintReview MakeReview(const InpaintCanvas& canvas, Pixel target, std::vector<
                          const PatchAcceptance* acceptance, double cluster_max_rms,
                          const std::vector<float>& channel_weights);
 
-// The JSON form of a review, shared by `inpaint --review` (review.json) and the editor's API (docs/api.md):
-//   {"review_point", "iteration", "target": [r, c], "patch_radius",
-//    "candidates": [{"index", "source": [r, c], "difference", "cluster", "accepted", "test", "value",
-//                    "threshold", "margin"}, ...],                       (best first)
-//    "clusters": [{"index", "representative", "members": [candidate indices]}, ...]}
+// A review's candidate as JSON lists it (ReviewSummary::candidates). Described.
+struct ReviewCandidateSummary {
+  int64_t index = 0;        // rank, 0 = best
+  std::vector<int> source;  // [row, col] of the source patch's centre
+  double difference = 0;    // SourceCandidate::difference
+  int cluster = 0;          // its cluster's index
+  // Its AcceptanceVerdict: accepted, the test that decided, its value, threshold and margin.
+  bool accepted = true;
+  std::string test;
+  double value = 0, threshold = 0, margin = 0;
+};
+template <>
+const StructInfo& InfoOf<ReviewCandidateSummary>();
+
+// A cluster of a review's candidates. Described.
+struct ReviewClusterSummary {
+  int64_t index = 0;
+  int representative = 0;        // its best candidate's index
+  std::vector<int64_t> members;  // its candidates' indices
+};
+template <>
+const StructInfo& InfoOf<ReviewClusterSummary>();
+
+// The JSON form of a review, shared by `inpaint --review` (review.json) and the editor's API (docs/api.md).
+// Described.
+struct ReviewSummary {
+  int review_point = 0, iteration = 0;             // InpaintReview's
+  std::vector<int> target;                         // [row, col] of the failing target patch's centre
+  int patch_radius = 0;                            // the fill's, cells
+  std::vector<ReviewCandidateSummary> candidates;  // best first
+  std::vector<ReviewClusterSummary> clusters;
+};
+ReviewSummary SummarizeReview(const InpaintReview& review, int patch_radius);
+template <>
+const StructInfo& InfoOf<ReviewSummary>();
+
+// A review decision as JSON: {"target": [r, c], "source": [r, c]}. Described.
+struct ReviewDecisionSummary {
+  std::vector<int> target, source;  // [row, col]
+};
+template <>
+const StructInfo& InfoOf<ReviewDecisionSummary>();
+
+// review.json of `inpaint --review`'s folder: the decisions so far and the pending review. Described.
+struct ReviewFolderSummary {
+  std::vector<ReviewDecisionSummary> decisions;
+  ReviewSummary review;
+};
+template <>
+const StructInfo& InfoOf<ReviewFolderSummary>();
+
+std::vector<ReviewDecisionSummary> SummarizeDecisions(const std::vector<ReviewDecision>& decisions);
+
+// ToJson(SummarizeReview(review, patch_radius)).
 nlohmann::ordered_json ReviewToJson(const InpaintReview& review, int patch_radius);
-// [{"target": [r, c], "source": [r, c]}, ...]
+// [{"target": [r, c], "source": [r, c]}, ...]: SummarizeDecisions as a JSON array.
 nlohmann::ordered_json DecisionsToJson(const std::vector<ReviewDecision>& decisions);
 
 }  // namespace lidarshop

@@ -432,6 +432,33 @@ void AutoResectionOptions::Check() const {
     throw OptionsError("min_patch_score must be in [-1, 1]");
 }
 
+AutoResectionSummary SummarizeAutoResection(const AutoResectionResult& result) {
+  AutoResectionSummary summary;
+  summary.method = result.method;
+  summary.inliers = result.inliers;
+  summary.pairs = static_cast<int64_t>(result.pairs.size());
+  summary.inlier_share = result.inlier_share;
+  summary.rms_px = result.rms_px;
+  summary.rms_work_px = result.rms_work_px;
+  summary.work_scale = result.work_scale;
+  summary.rounds = result.rounds;
+  summary.search_view = result.search_view;
+  summary.search_inliers = result.search_inliers;
+  if (result.search_fov_deg > 0) summary.search_fov_deg = result.search_fov_deg;
+  summary.check_pairs = result.check_pairs;
+  summary.check_agree = result.check_agree;
+  summary.check_alt_inliers = result.check_alt_inliers;
+  if (result.method == "silhouettes") {
+    summary.silhouette_edge_share = result.silhouette_edge_share;
+    summary.silhouette_mutual_information = result.silhouette_mutual_information;
+  }
+  summary.focal_px = {result.camera.fx_px, result.camera.fy_px};
+  const Eigen::Vector3d center = result.camera.center_in_world();
+  summary.camera_center = {center.x(), center.y(), center.z()};
+  summary.warnings = result.warnings;
+  return summary;
+}
+
 std::string AutoResectionResult::Summary() const {
   return fmt::format(
       "automatic resection ({}): {} of {} pairs inliers ({:.0f} %), RMS {:.2f} px ({:.2f} working px), {} "

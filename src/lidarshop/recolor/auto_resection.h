@@ -118,6 +118,28 @@ struct AutoResectionResult {
   std::string Summary() const;        // one line
 };
 
+// An automatic resection in brief: the result of `lidarshop resection --auto --json` (and recolor --auto's
+// "auto_resection"), in its order. Described.
+struct AutoResectionSummary {
+  std::string method;  // AutoResectionResult::method: "features" or "silhouettes"
+  int inliers = 0;
+  int64_t pairs = 0;  // the last round's pairs
+  double inlier_share = 0, rms_px = 0, rms_work_px = 0, work_scale = 1;
+  int rounds = 0, search_view = -1, search_inliers = 0;
+  std::optional<double> search_fov_deg;  // with searched intrinsics only (not given ones)
+  int check_pairs = 0, check_agree = 0, check_alt_inliers = 0;
+  // Method "silhouettes" only.
+  std::optional<double> silhouette_edge_share, silhouette_mutual_information;
+  std::vector<double> focal_px;       // fx, fy, pixels
+  std::vector<double> camera_center;  // x, y, z in the world frame, metres
+  std::vector<std::string> warnings;
+  // The options it ran with, where a command nests it in its own result (recolor --auto); empty elsewhere.
+  std::optional<AutoResectionOptions> options;
+};
+AutoResectionSummary SummarizeAutoResection(const AutoResectionResult& result);
+template <>
+const StructInfo& InfoOf<AutoResectionSummary>();
+
 // The camera of `photo` (CV_8UC3 RGB or CV_8UC1) from `scan` (colour or intensity, world_from_scanner).
 // `intrinsics`: known intrinsics and distortion (its pose and size are ignored; it is scaled to the photo's
 // size if its width differs); none = searched (see above). `rough_world_from_camera`: start there instead of

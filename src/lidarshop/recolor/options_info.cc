@@ -4,6 +4,7 @@
 #include "lidarshop/recolor/correspondences.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
+#include "lidarshop/recolor/station_recolor.h"
 #include "lidarshop/util/options.h"
 
 namespace lidarshop {
@@ -236,6 +237,167 @@ const StructInfo& InfoOf<PhotoPairModel>() {
             "per pair: |H a - b|, or the distance of b to the epipolar line F a")
         .Unit("px");
     b.Field(&PhotoPairModel::inlier, "inlier", "per pair: 1 = a RANSAC inlier, 0 = an outlier");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ResectionPairError>() {
+  static const StructInfo info = [] {
+    StructBuilder<ResectionPairError> b("ResectionPairError", "one pair of a resection");
+    b.Field(&ResectionPairError::error_px, "error_px", "reprojection error with the final camera").Unit("px");
+    b.Field(&ResectionPairError::inlier, "inlier", "RANSAC kept the pair");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ResectionSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ResectionSummary> b("ResectionSummary", "a photo's camera from its pairs, in brief");
+    b.Field(&ResectionSummary::inliers, "inliers", "pairs RANSAC kept");
+    b.Field(&ResectionSummary::pairs, "pairs", "pairs given");
+    b.Field(&ResectionSummary::rms_px, "rms_px", "RMS reprojection error of the inliers, final camera")
+        .Unit("px");
+    b.Field(&ResectionSummary::dlt_rms_px, "dlt_rms_px", "the same with the DLT camera (before refinement)")
+        .Unit("px");
+    b.Field(&ResectionSummary::ransac_sets, "ransac_sets", "RANSAC's minimal sets tried");
+    b.Field(&ResectionSummary::focal_px, "focal_px", "focal lengths fx, fy").Unit("px");
+    b.Field(&ResectionSummary::principal_point_px, "principal_point_px", "principal point cx, cy").Unit("px");
+    b.Field(&ResectionSummary::k1, "k1", "first radial distortion coefficient");
+    b.Field(&ResectionSummary::camera_center, "camera_center", "the camera centre x, y, z in the world frame")
+        .Unit("m");
+    b.Field(&ResectionSummary::per_pair, "per_pair", "every pair's error, in the pairs' order");
+    b.Field(&ResectionSummary::warnings, "warnings", "what looks wrong, one sentence each");
+    b.Field(&ResectionSummary::options, "options",
+            "the options, where a command's result nests the resection");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<AutoResectionSummary>() {
+  static const StructInfo info = [] {
+    using S = AutoResectionSummary;
+    StructBuilder<S> b("AutoResectionSummary", "a photo's camera found from the scan alone, in brief");
+    b.Field(&S::method, "method", "\"features\" (SIFT, PnP RANSAC) or \"silhouettes\" (the fallback)");
+    b.Field(&S::inliers, "inliers", "the last round's pairs that agree with the camera");
+    b.Field(&S::pairs, "pairs", "the last round's pairs");
+    b.Field(&S::inlier_share, "inlier_share", "inliers / pairs");
+    b.Field(&S::rms_px, "rms_px", "RMS reprojection error of the inliers, photo pixels").Unit("px");
+    b.Field(&S::rms_work_px, "rms_work_px", "the same in working pixels").Unit("px");
+    b.Field(&S::work_scale, "work_scale", "working pixels per photo pixel");
+    b.Field(&S::rounds, "rounds", "re-render, re-match, re-solve rounds run");
+    b.Field(&S::search_view, "search_view", "the winning search view (-1 with a rough camera)");
+    b.Field(&S::search_inliers, "search_inliers", "its PnP inliers");
+    b.Field(&S::search_fov_deg, "search_fov_deg", "field of view of the winning search (searched intrinsics)")
+        .Unit("deg");
+    b.Field(&S::check_pairs, "check_pairs", "independent check: SIFT pairs over the final rendering");
+    b.Field(&S::check_agree, "check_agree", "of those, the pairs the camera explains");
+    b.Field(&S::check_alt_inliers, "check_alt_inliers", "inliers of the best other camera of the check");
+    b.Field(&S::silhouette_edge_share, "silhouette_edge_share",
+            "silhouettes: share of the scan's outlines on a photo edge");
+    b.Field(&S::silhouette_mutual_information, "silhouette_mutual_information",
+            "silhouettes: mutual information of scan and photo")
+        .Unit("nats");
+    b.Field(&S::focal_px, "focal_px", "focal lengths fx, fy").Unit("px");
+    b.Field(&S::camera_center, "camera_center", "the camera centre x, y, z in the world frame").Unit("m");
+    b.Field(&S::warnings, "warnings", "what looks wrong, one sentence each");
+    b.Field(&S::options, "options", "the options, where a command's result nests the resection");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RecolorSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<RecolorSummary> b("RecolorSummary", "a recolouring from one photo, in brief");
+    b.Field(&RecolorSummary::returns, "returns", "valid cells").Unit("cells");
+    b.Field(&RecolorSummary::recolored, "recolored", "valid cells that took the photo's colour")
+        .Unit("cells");
+    b.Field(&RecolorSummary::outside_image, "outside_image", "behind the camera or outside the photo")
+        .Unit("cells");
+    b.Field(&RecolorSummary::hidden, "hidden", "inside the photo but occluded").Unit("cells");
+    b.Field(&RecolorSummary::uncertain, "uncertain", "seen, but kept near an occluding edge").Unit("cells");
+    b.Field(&RecolorSummary::edge_margin_px, "edge_margin_px", "the edge guard's margin (0: no guard)")
+        .Unit("px");
+    b.Field(&RecolorSummary::disagreement, "disagreement",
+            "share of the recoloured points whose photo colour disagrees with their own (when measurable)");
+    b.Field(&RecolorSummary::warnings, "warnings",
+            "the resection's, then the recolouring's, one sentence each");
+    b.Field(&RecolorSummary::resection, "resection", "the camera's resection (--correspondences)");
+    b.Field(&RecolorSummary::auto_resection, "auto_resection", "the camera's automatic resection (--auto)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RecolorPhotoUsed>() {
+  static const StructInfo info = [] {
+    StructBuilder<RecolorPhotoUsed> b("RecolorPhotoUsed", "a photo that coloured a scan");
+    b.Field(&RecolorPhotoUsed::index, "index", "its images2D index, or its --photo's position");
+    b.Field(&RecolorPhotoUsed::name, "name", "the images2D entry's name, or the photo's path");
+    b.Field(&RecolorPhotoUsed::model, "model", "the camera model");
+    b.Field(&RecolorPhotoUsed::gain, "gain", "R, G, B exposure gain relative to photo 0");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RecolorPhotoSkipped>() {
+  static const StructInfo info = [] {
+    StructBuilder<RecolorPhotoSkipped> b("RecolorPhotoSkipped", "an images2D entry left out of a colouring");
+    b.Field(&RecolorPhotoSkipped::index, "index", "its images2D index");
+    b.Field(&RecolorPhotoSkipped::name, "name", "its name");
+    b.Field(&RecolorPhotoSkipped::why, "why", "why it cannot colour the scan");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PhotosRecolorSeconds>() {
+  static const StructInfo info = [] {
+    using S = PhotosRecolorSeconds;
+    StructBuilder<S> b("PhotosRecolorSeconds", "wall clock per phase of a colouring from several photos");
+    b.Field(&S::read, "read", "reading and decoding the scan file (and its photos)").Unit("s");
+    b.Field(&S::colour, "colour", "the colouring as a whole (the phases below but write)").Unit("s");
+    b.Field(&S::write, "write", "writing the outputs").Unit("s");
+    b.Field(&S::scene, "scene", "the occlusion scene: scan mesh and skirts").Unit("s");
+    b.Field(&S::visibility, "visibility", "every photo's visibility and samples").Unit("s");
+    b.Field(&S::zbuffer, "zbuffer", "of visibility: the z-buffers").Unit("s");
+    b.Field(&S::projection, "projection", "of visibility: the cells projected and tested").Unit("s");
+    b.Field(&S::choice, "choice", "each cell's photo chosen").Unit("s");
+    b.Field(&S::gains, "gains", "the exposure gains fitted").Unit("s");
+    b.Field(&S::colours, "colours", "the corrected colours").Unit("s");
+    b.Field(&S::blend, "blend", "the seam blending").Unit("s");
+    b.Field(&S::output, "output", "the output scan made").Unit("s");
+    b.Field(&S::colour_cpu, "colour_cpu", "the process's CPU time during the colouring, every thread")
+        .Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PhotosRecolorSummary>() {
+  static const StructInfo info = [] {
+    using S = PhotosRecolorSummary;
+    StructBuilder<S> b("PhotosRecolorSummary", "a recolouring from several photos (a station's), in brief");
+    b.Field(&S::returns, "returns", "valid cells").Unit("cells");
+    b.Field(&S::coloured, "coloured", "valid cells some photo saw").Unit("cells");
+    b.Field(&S::constraints, "constraints", "overlap pairs used to fit the gains");
+    b.Field(&S::seam_edges, "seam_edges", "neighbouring coloured cells coloured by different photos");
+    b.Field(&S::blended, "blended", "cells solved again by the seam blending").Unit("cells");
+    b.Field(&S::photos, "photos", "the photos that coloured the scan, in order");
+    b.Field(&S::skipped, "skipped", "images2D entries left out, and why");
+    b.Field(&S::seconds, "seconds", "wall clock per phase");
     return b.Build();
   }();
   return info;

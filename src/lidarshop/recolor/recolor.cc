@@ -21,6 +21,24 @@ namespace lidarshop {
 
 void RecolorOptions::Check() const { Validate(*this); }
 
+RecolorSummary SummarizeRecolor(const RecolorResult& result, const std::optional<ResectionSummary>& resection,
+                                const std::optional<AutoResectionSummary>& auto_resection) {
+  RecolorSummary summary;
+  summary.returns = result.returns;
+  summary.recolored = result.recolored_count;
+  summary.outside_image = result.outside_image;
+  summary.hidden = result.hidden;
+  summary.uncertain = result.uncertain;
+  summary.edge_margin_px = result.edge_margin_px;
+  if (std::isfinite(result.disagreement)) summary.disagreement = result.disagreement;
+  if (resection) summary.warnings = resection->warnings;
+  if (auto_resection) summary.warnings = auto_resection->warnings;
+  summary.warnings.insert(summary.warnings.end(), result.warnings.begin(), result.warnings.end());
+  summary.resection = resection;
+  summary.auto_resection = auto_resection;
+  return summary;
+}
+
 std::string RecolorResult::Summary() const {
   return fmt::format(
       "{} of {} points recoloured; {} outside the photo, {} hidden from the camera{}{}", recolored_count,

@@ -43,12 +43,15 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera.h"
+#include "lidarshop/recolor/auto_resection.h"
+#include "lidarshop/recolor/resection.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/options_fwd.h"
 
@@ -123,6 +126,24 @@ inline constexpr double kRecolorDisagreementLimit = 0.5;
 // (evenly spread), enough for a fraction.
 double RecolorDisagreement(const Scan& before, const cv::Mat& after_color, const cv::Mat& recolored,
                            int64_t max_points = 200000);
+
+// A recolouring from one photo in brief: the result of `lidarshop recolor --json` (one photo), in its order.
+// Described.
+struct RecolorSummary {
+  int64_t returns = 0, recolored = 0, outside_image = 0, hidden = 0, uncertain = 0;  // RecolorResult's counts
+  double edge_margin_px = 0;
+  std::optional<double> disagreement;  // RecolorResult::disagreement when it is a number
+  // The resection's warnings (when the camera came from one), then the recolouring's.
+  std::vector<std::string> warnings;
+  // How the camera was found, when the command found it: from pairs, or automatically.
+  std::optional<ResectionSummary> resection;
+  std::optional<AutoResectionSummary> auto_resection;
+};
+RecolorSummary SummarizeRecolor(const RecolorResult& result,
+                                const std::optional<ResectionSummary>& resection = std::nullopt,
+                                const std::optional<AutoResectionSummary>& auto_resection = std::nullopt);
+template <>
+const StructInfo& InfoOf<RecolorSummary>();
 
 // `photo` is CV_8UC3 RGB of the camera's size (camera.width_px x camera.height_px), else InputError.
 RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,

@@ -32,6 +32,24 @@ std::string ResectionResult::Summary() const {
       num_inliers, inlier.size(), rms_px, dlt_rms_px, ransac_iterations);
 }
 
+ResectionSummary SummarizeResection(const ResectionResult& result) {
+  ResectionSummary summary;
+  summary.inliers = result.num_inliers;
+  summary.pairs = static_cast<int64_t>(result.inlier.size());
+  summary.rms_px = result.rms_px;
+  summary.dlt_rms_px = result.dlt_rms_px;
+  summary.ransac_sets = result.ransac_iterations;
+  summary.focal_px = {result.camera.fx_px, result.camera.fy_px};
+  summary.principal_point_px = {result.camera.cx_px, result.camera.cy_px};
+  summary.k1 = result.camera.k1;
+  const Eigen::Vector3d center = result.camera.center_in_world();
+  summary.camera_center = {center.x(), center.y(), center.z()};
+  for (size_t i = 0; i < result.inlier.size(); ++i)
+    summary.per_pair.push_back({result.reprojection_error_px[i], result.inlier[i] != 0});
+  summary.warnings = result.warnings;
+  return summary;
+}
+
 namespace {
 
 using Matrix34d = Eigen::Matrix<double, 3, 4>;

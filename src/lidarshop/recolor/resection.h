@@ -35,6 +35,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -108,6 +109,35 @@ struct ResectionResult {
 // pixel or two; beyond a few pixels a pair is wrong or the model (distortion) does not fit, and a recolouring
 // with it paints the edges of objects onto their neighbours.
 inline constexpr double kResectionRmsWarningPx = 3.0;
+
+// One pair's reprojection error with the final camera and whether RANSAC kept it. Described.
+struct ResectionPairError {
+  double error_px = 0;  // pixels
+  bool inlier = false;
+};
+template <>
+const StructInfo& InfoOf<ResectionPairError>();
+
+// A resection in brief: the result of `lidarshop resection --json` (and recolor's "resection"), in its order.
+// Described.
+struct ResectionSummary {
+  int inliers = 0;
+  int64_t pairs = 0;  // pairs given (inliers and outliers)
+  double rms_px = 0, dlt_rms_px = 0;
+  int ransac_sets = 0;                       // ResectionResult::ransac_iterations
+  std::vector<double> focal_px;              // fx, fy, pixels
+  std::vector<double> principal_point_px;    // cx, cy, pixels
+  double k1 = 0;                             // first radial distortion coefficient
+  std::vector<double> camera_center;         // x, y, z in the world frame, metres
+  std::vector<ResectionPairError> per_pair;  // one per pair, in the file's order
+  std::vector<std::string> warnings;
+  // The options it ran with, where a command nests the resection in its own result (recolor
+  // --correspondences); empty elsewhere (the command's "options" hold them).
+  std::optional<ResectionOptions> options;
+};
+ResectionSummary SummarizeResection(const ResectionResult& result);
+template <>
+const StructInfo& InfoOf<ResectionSummary>();
 
 // Thesis eqs. 3.1–3.6 with normalization: P (3x4, |P| = 1) from at least 6 pairs. No degeneracy check.
 Eigen::Matrix<double, 3, 4> NormalizedDlt(std::span<const PixelPointPair> pairs);

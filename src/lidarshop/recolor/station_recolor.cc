@@ -29,6 +29,34 @@ void PhotosRecolorOptions::Check() const {
         fmt::format("PhotosRecolorOptions.seam_depth_jump_m must be in [0, 1e6), got {}", seam_depth_jump_m));
 }
 
+PhotosRecolorSummary SummarizePhotosRecolor(const PhotosRecolorResult& result,
+                                            std::vector<RecolorPhotoUsed> photos,
+                                            std::vector<RecolorPhotoSkipped> skipped) {
+  PhotosRecolorSummary summary;
+  summary.returns = result.returns;
+  summary.coloured = result.coloured;
+  summary.constraints = result.constraints;
+  summary.seam_edges = result.seam_edges;
+  summary.blended = result.blended;
+  for (size_t i = 0; i < photos.size() && i < result.gains.size(); ++i)
+    photos[i].gain = {result.gains[i][0], result.gains[i][1], result.gains[i][2]};
+  summary.photos = std::move(photos);
+  summary.skipped = std::move(skipped);
+  PhotosRecolorSeconds& seconds = summary.seconds;
+  seconds.colour = result.total_seconds;
+  seconds.scene = result.scene_seconds;
+  seconds.visibility = result.visibility_seconds;
+  seconds.zbuffer = result.zbuffer_seconds;
+  seconds.projection = result.projection_seconds;
+  seconds.choice = result.choice_seconds;
+  seconds.gains = result.gain_seconds;
+  seconds.colours = result.colour_seconds;
+  seconds.blend = result.blend_seconds;
+  seconds.output = result.output_seconds;
+  seconds.colour_cpu = result.cpu_seconds;
+  return summary;
+}
+
 std::string PhotosRecolorResult::Summary() const {
   return fmt::format(
       "{} of {} points coloured from {} photo(s); gains fitted on {} overlap pairs; {} seam edges, {} cells "

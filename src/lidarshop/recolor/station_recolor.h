@@ -31,6 +31,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -82,6 +83,51 @@ struct PhotosRecolorResult {
   double cpu_seconds = 0;
   std::string Summary() const;  // one line
 };
+
+// A photo that coloured the scan (`lidarshop recolor --json`'s "photos"). Described.
+struct RecolorPhotoUsed {
+  int index = 0;             // the images2D index (--from-e57-images) or the --photo's position
+  std::string name;          // the images2D entry's name or the photo's path
+  std::string model;         // the camera model's name (geometry/camera_model.h)
+  std::vector<double> gain;  // RGB exposure gain relative to photo 0 (PhotosRecolorResult::gains)
+};
+template <>
+const StructInfo& InfoOf<RecolorPhotoUsed>();
+
+// An images2D entry left out of a station's colouring, and why ("skipped"). Described.
+struct RecolorPhotoSkipped {
+  int index = 0;  // the images2D index
+  std::string name;
+  std::string why;
+};
+template <>
+const StructInfo& InfoOf<RecolorPhotoSkipped>();
+
+// Wall clock per phase, seconds (issue 32 item 6): "colour" is RecolorFromPhotos as a whole, the others after
+// it its parts (PhotosRecolorResult's *_seconds); "read" and "write" the caller's file input and output;
+// "colour_cpu" the process's CPU time during the colouring (every thread). Described.
+struct PhotosRecolorSeconds {
+  double read = 0, colour = 0, write = 0, scene = 0, visibility = 0, zbuffer = 0, projection = 0, choice = 0,
+         gains = 0, colours = 0, blend = 0, output = 0, colour_cpu = 0;
+};
+template <>
+const StructInfo& InfoOf<PhotosRecolorSeconds>();
+
+// A recolouring from several photos in brief: the result of `lidarshop recolor --json` with
+// --from-e57-images or several --photo, in its order. Described.
+struct PhotosRecolorSummary {
+  int64_t returns = 0, coloured = 0, constraints = 0, seam_edges = 0, blended = 0;  // PhotosRecolorResult's
+  std::vector<RecolorPhotoUsed> photos;                                             // in the photos' order
+  std::vector<RecolorPhotoSkipped> skipped;
+  PhotosRecolorSeconds seconds;
+};
+template <>
+const StructInfo& InfoOf<PhotosRecolorSummary>();
+// `photos`: one per photo given to RecolorFromPhotos, their gains filled in here; `seconds.read` and
+// `seconds.write` stay 0 for the caller.
+PhotosRecolorSummary SummarizePhotosRecolor(const PhotosRecolorResult& result,
+                                            std::vector<RecolorPhotoUsed> photos,
+                                            std::vector<RecolorPhotoSkipped> skipped);
 
 // Throws InputError when a photo's image does not match its camera (naming the photo's index).
 PhotosRecolorResult RecolorFromPhotos(const Scan& scan, const std::vector<CameraPhoto>& photos,

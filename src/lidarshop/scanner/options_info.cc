@@ -100,6 +100,19 @@ const StructInfo& InfoOf<PhotoOptions>() {
 }
 
 template <>
+const StructInfo& InfoOf<PhotoSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<PhotoSummary> b("PhotoSummary", "a synthetic photo, in brief");
+    b.Field(&PhotoSummary::model, "model", "the camera model");
+    b.Field(&PhotoSummary::width_px, "width_px", "the photo's width").Unit("px");
+    b.Field(&PhotoSummary::height_px, "height_px", "the photo's height").Unit("px");
+    b.Field(&PhotoSummary::scene_pixels, "scene_pixels", "pixels whose centre sees the scene").Unit("px");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<CarMeshOptions>() {
   static const StructInfo info = [] {
     StructBuilder<CarMeshOptions> b("CarMeshOptions", "the procedural car (paint: C++ only)");

@@ -43,6 +43,15 @@ cv::Mat SampleDirections(const Camera& camera, int samples) {
 
 }  // namespace
 
+PhotoSummary SummarizePhoto(const Photo& photo, const Camera& camera) {
+  PhotoSummary summary;
+  summary.model = CameraModelName(camera.model);
+  summary.width_px = photo.image.cols;
+  summary.height_px = photo.image.rows;
+  summary.scene_pixels = cv::countNonZero(photo.label != kNoLabel);
+  return summary;
+}
+
 Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera, const PhotoOptions& options) {
   camera.Check("camera");
   return RenderPhoto(scene, CameraFromPinhole(camera), options);

@@ -9,6 +9,9 @@
 // Pixels without a ray (beyond a fisheye's reach, past a panorama's pole) are background.
 #pragma once
 
+#include <cstdint>
+#include <string>
+
 #include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/camera.h"
@@ -34,6 +37,16 @@ struct Photo {
   cv::Mat depth_m;  // CV_32F: distance from the camera centre to the surface seen by the pixel centre, +inf
                     // for background
 };
+
+// A synthetic photo in brief: the result of `lidarshop photo --json`. Described.
+struct PhotoSummary {
+  std::string model;  // the camera model's name
+  int width_px = 0, height_px = 0;
+  int64_t scene_pixels = 0;  // pixels whose centre sees the scene (not the background)
+};
+PhotoSummary SummarizePhoto(const Photo& photo, const Camera& camera);
+template <>
+const StructInfo& InfoOf<PhotoSummary>();
 
 // Renders the scene seen by `camera` (camera.Check() must pass; throws InputError otherwise).
 Photo RenderPhoto(const SceneDescription& scene, const PinholeCamera& camera,
