@@ -69,16 +69,15 @@ void WriteText(const fs::path& path, const std::string& text) {
   WriteFileAtomically(path.string(), [&](std::ostream& stream) { stream << text; });
 }
 
-json Number(double value) { return std::isfinite(value) ? json(value) : json(nullptr); }
-
-json VerifyEntry(const std::string& object, const std::string& pose_name, const VerifyResult& result) {
-  return {{"object", object},
-          {"pose", pose_name},
-          {"consistency", Number(result.consistency)},
-          {"comparable_pairs", result.comparable_pairs},
-          {"confidence", result.confidence},
-          {"icp_cost", Number(result.icp_cost_m)},
-          {"inlier_fraction", result.inlier_fraction}};
+DemoVerifyEntry VerifyEntry(const std::string& object, const std::string& pose_name,
+                            const VerifyResult& result) {
+  return {.object = object,
+          .pose = pose_name,
+          .consistency = result.consistency,
+          .comparable_pairs = result.comparable_pairs,
+          .confidence = result.confidence,
+          .icp_cost = result.icp_cost_m,
+          .inlier_fraction = result.inlier_fraction};
 }
 
 // A scene object as a verification model: its mesh, ModelOptions and world_from_model. A scene's uniform
@@ -119,12 +118,12 @@ bool IsStandingObject(const SceneObject& object) {
 
 // Step 2: every standing object at its true pose and at two wrong poses: 1 m towards
 // the scanner (in front of the seen surface: inconsistent) and 1 m away (in its shadow: consistent, unseen).
-json RunVerifyStep(const SceneDescription& scene, const Scan& scan, const fs::path& out_dir,
-                   Progress* progress) {
+std::vector<DemoVerifyEntry> RunVerifyStep(const SceneDescription& scene, const Scan& scan,
+                                           const fs::path& out_dir, Progress* progress) {
   const std::vector<PreparedScan> scans = {PrepareScan(scan)};
   const Eigen::Vector3d scanner_in_world = scan.world_from_scanner.topRightCorner<3, 1>();
   VerifyOptions options;
-  json entries = json::array();
+  std::vector<DemoVerifyEntry> entries;
   for (const SceneObject& object : scene.objects) {
     if (!IsStandingObject(object)) continue;
     const ObjectModel object_model = ObjectAsModel(object);
@@ -156,7 +155,9 @@ json RunVerifyStep(const SceneDescription& scene, const Scan& scan, const fs::pa
     }
     Advance(progress);
   }
-  WriteText(out_dir / "verify.json", entries.dump(2) + "\n");
+  json file = json::array();  // keys sorted, as summary.json's
+  for (const DemoVerifyEntry& entry : entries) file.push_back(json(ToJson(entry)));
+  WriteText(out_dir / "verify.json", file.dump(2) + "\n");
   return entries;
 }
 
@@ -177,8 +178,8 @@ std::optional<DemoSweep> SceneSweep(const SceneDescription& scene) {
   return sweep;
 }
 
-json RunSweepStep(const SceneDescription& scene, const Scan& scan, const DemoSweep& demo_sweep,
-                  const fs::path& out_dir, Progress* progress) {
+DemoSweepSummary RunSweepStep(const SceneDescription& scene, const Scan& scan, const DemoSweep& demo_sweep,
+                              const fs::path& out_dir, Progress* progress) {
   const SceneObject* model_object = nullptr;
   for (const SceneObject& object : scene.objects) {
     if (object.name == demo_sweep.object) model_object = &object;
@@ -199,24 +200,23 @@ json RunSweepStep(const SceneDescription& scene, const Scan& scan, const DemoSwe
              RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
                            demo_sweep.options.min_confidence));
   WriteText(out_dir / "sweep.csv", SweepCsv(sweep));
-  json detections = json::array();
-  for (const Detection& detection : sweep.detections) {
-    detections.push_back({{"x", detection.x_m},
-                          {"y", detection.y_m},
-                          {"yaw_deg", detection.yaw_deg},
-                          {"consistency", detection.consistency},
-                          {"confidence", detection.confidence}});
-  }
   const Eigen::Vector3d truth = model_object->world_from_object.topRightCorner<3, 1>();
-  return {{"model", demo_sweep.object},
-          {"true_position", {truth.x(), truth.y()}},
-          {"poses", sweep.poses.size() + static_cast<size_t>(sweep.refine_evaluations)},
-          {"detections", detections}};
+  DemoSweepSummary summary{.model = demo_sweep.object,
+                           .true_position = {truth.x(), truth.y()},
+                           .poses = sweep.poses.size() + static_cast<size_t>(sweep.refine_evaluations)};
+  for (const Detection& detection : sweep.detections) {
+    summary.detections.push_back({.x = detection.x_m,
+                                  .y = detection.y_m,
+                                  .yaw_deg = detection.yaw_deg,
+                                  .consistency = detection.consistency,
+                                  .confidence = detection.confidence});
+  }
+  return summary;
 }
 
 // Step 3: cut one object out from automatic strokes and score it against the scanner's labels.
-json RunSegmentStep(const SceneDescription& scene, const Scan& scan, const std::string& object_name,
-                    const fs::path& out_dir, cv::Mat* mask) {
+DemoSegmentSummary RunSegmentStep(const SceneDescription& scene, const Scan& scan,
+                                  const std::string& object_name, const fs::path& out_dir, cv::Mat* mask) {
   const SceneObject* target = nullptr;
   for (const SceneObject& object : scene.objects) {
     if (object.name == object_name) target = &object;
@@ -232,20 +232,21 @@ json RunSegmentStep(const SceneDescription& scene, const Scan& scan, const std::
   WriteImage((out_dir / "segment_strokes.png").string(), StrokesToImage(strokes));
   WriteImage((out_dir / "segment_overlay.png").string(), SegmentOverlay(scan, result.mask, strokes));
   *mask = result.mask;
-  return {{"object", object_name},
-          {"label", target->label},
-          {"iou", scores.iou},
-          {"precision", scores.precision},
-          {"recall", scores.recall},
-          {"object_cells", result.object_cells},
-          {"seconds", result.timings.total_s}};
+  return {.object = object_name,
+          .label = target->label,
+          .iou = scores.iou,
+          .precision = scores.precision,
+          .recall = scores.recall,
+          .object_cells = result.object_cells,
+          .seconds = result.timings.total_s};
 }
 
 // Step 4: remove the cut-out object — fill its cells grown by 2 — and score the fill against the scene
 // scanned again without the object (the scanner's noise is a function of the cell and the seed, so
 // every other cell is the same).
-json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::string& object_name,
-                   const cv::Mat& object_mask, const fs::path& out_dir, Progress* progress) {
+DemoRemoveSummary RunRemoveStep(const SceneDescription& scene, const Scan& scan,
+                                const std::string& object_name, const cv::Mat& object_mask,
+                                const fs::path& out_dir, Progress* progress) {
   SceneDescription without = scene;
   std::erase_if(without.objects, [&](const SceneObject& object) { return object.name == object_name; });
   const cv::Mat hole = GrowHole(object_mask, 2);
@@ -265,17 +266,17 @@ json RunRemoveStep(const SceneDescription& scene, const Scan& scan, const std::s
   WriteImage((out_dir / "remove_view_truth.png").string(), RenderPointView(truth, view));
   view.synthesized_tint = 0.4;
   WriteImage((out_dir / "remove_view_filled.png").string(), RenderPointView(fill.scan, view));
-  return {{"object", object_name},
-          {"hole_cells", fill.hole_cells},
-          {"synthesized_points", fill.synthesized_cells},
-          {"no_return_cells", fill.no_return_cells},
-          {"range_rmse_mm", m.range_rmse_mm},
-          {"range_mae_mm", m.range_mae_mm},
-          {"within_20mm", m.within_share},
-          {"floating_points", m.floating_share},
-          {"return_accuracy", m.return_accuracy},
-          {"color_psnr_db", m.color_psnr_db},
-          {"seconds", fill.timings.total_s}};
+  return {.object = object_name,
+          .hole_cells = fill.hole_cells,
+          .synthesized_points = fill.synthesized_cells,
+          .no_return_cells = fill.no_return_cells,
+          .range_rmse_mm = m.range_rmse_mm,
+          .range_mae_mm = m.range_mae_mm,
+          .within_20mm = m.within_share,
+          .floating_points = m.floating_share,
+          .return_accuracy = m.return_accuracy,
+          .color_psnr_db = m.color_psnr_db,
+          .seconds = fill.timings.total_s};
 }
 
 // The scan with its colour showing where each filled cell came from: another station's measurement cyan,
@@ -288,14 +289,16 @@ Scan ColoredBySource(const Scan& scan) {
   return shown;
 }
 
-// Step 4b: the object removed from station 0 of the scene's site, its hole filled from station 2 first.
-json RunStationsStep(const std::string& site_name, const std::string& object_name, const cv::Mat& object_mask,
-                     const fs::path& out_dir, Progress* progress) {
+// Step 4b: the object removed from station 0 of the scene's site, its hole filled from station 2 first (none
+// when the site lacks the object or a station 2).
+std::optional<DemoStationsSummary> RunStationsStep(const std::string& site_name,
+                                                   const std::string& object_name, const cv::Mat& object_mask,
+                                                   const fs::path& out_dir, Progress* progress) {
   const SceneDescription site = LoadSceneOrBuiltin(site_name);
   const SceneObject* target = nullptr;
   for (const SceneObject& object : site.objects)
     if (object.name == object_name) target = &object;
-  if (target == nullptr || site.NumStations() < 3) return json();
+  if (target == nullptr || site.NumStations() < 3) return std::nullopt;
   progress->Restart("demo: filling from station 2", 4);
   const Scan station0 = SynthesizeScan(SceneAtStation(site, 0));
   const Scan station2 = SynthesizeScan(SceneAtStation(site, 2));
@@ -333,16 +336,16 @@ json RunStationsStep(const std::string& site_name, const std::string& object_nam
   rgb.channel = RenderChannel::kRgb;
   WriteImage((out_dir / "stations_rays.png").string(),
              RenderPicture(ColoredBySource(filled.scan), rgb, {}).image);
-  return {{"object", object_name},
-          {"site", site_name},
-          {"hole_cells", filled.hole_cells},
-          {"from_station_cells", filled.from_station_cells},
-          {"synthesized_cells", filled.synthesized_cells},
-          {"no_return_cells", filled.no_return_cells},
-          {"from_station_rmse_mm", compared > 0 ? 1000 * std::sqrt(sum / compared) : 0.0},
-          {"range_rmse_mm", m.range_rmse_mm},
-          {"floating_points", m.floating_share},
-          {"seconds", filled.stations_seconds + filled.fill_seconds}};
+  return DemoStationsSummary{.object = object_name,
+                             .site = site_name,
+                             .hole_cells = filled.hole_cells,
+                             .from_station_cells = filled.from_station_cells,
+                             .synthesized_cells = filled.synthesized_cells,
+                             .no_return_cells = filled.no_return_cells,
+                             .from_station_rmse_mm = compared > 0 ? 1000 * std::sqrt(sum / compared) : 0.0,
+                             .range_rmse_mm = m.range_rmse_mm,
+                             .floating_points = m.floating_share,
+                             .seconds = filled.stations_seconds + filled.fill_seconds};
 }
 
 // Step 1's pictures: every channel with its legend (square angular pixels), the range as float metres, and
@@ -389,24 +392,22 @@ int RunDemoSteps(const DemoSettings& settings) {
   const fs::path out_dir(settings.out_dir);
   fs::create_directories(out_dir);
   const std::string scene_name = SceneName(settings.scene);
-  json summary = {{"scene", scene_name}};
-  json seconds = json::object();
+  DemoSummary summary{.scene = scene_name};
+  DemoSeconds& seconds = summary.seconds;
   auto progress = Progress::ForTerminal("demo: loading", 1, settings.quiet);
 
   Timer timer;
   const SceneDescription scene = LoadSceneOrBuiltin(settings.scene);
   PrintWarnings(scene.warnings);
   const SyntheticScanner scanner(scene);
-  seconds["load"] = timer.Seconds();
+  seconds.load = timer.Seconds();
 
   timer.Restart();
   progress->Restart("demo: scanning", scene.scanner.rows);
   const Scan scan = scanner.Acquire(scene.scanner, progress.get());
-  seconds["scan"] = timer.Seconds();
-  summary["scan"] = {{"rows", scan.rows},
-                     {"cols", scan.cols},
-                     {"valid", scan.CountValid()},
-                     {"triangles", scanner.num_triangles()}};
+  seconds.scan = timer.Seconds();
+  summary.scan = {
+      .rows = scan.rows, .cols = scan.cols, .valid = scan.CountValid(), .triangles = scanner.num_triangles()};
 
   timer.Restart();
   progress->Restart("demo: writing the scan", 4);
@@ -417,21 +418,21 @@ int RunDemoSteps(const DemoSettings& settings) {
   WriteImage((out_dir / "labels.png").string(), LabelImage16(scan));
   WriteScanPictures(scene, scan, out_dir);
   progress->Advance(2);
-  seconds["write"] = timer.Seconds();
+  seconds.write = timer.Seconds();
 
   timer.Restart();
   int objects_to_verify = 0;
   for (const SceneObject& object : scene.objects) objects_to_verify += IsStandingObject(object) ? 1 : 0;
   progress->Restart("demo: verifying", objects_to_verify);
-  summary["verify"] = RunVerifyStep(scene, scan, out_dir, progress.get());
-  seconds["verify"] = timer.Seconds();
+  summary.verify = RunVerifyStep(scene, scan, out_dir, progress.get());
+  seconds.verify = timer.Seconds();
 
   if (const std::optional<DemoSweep> demo_sweep = SceneSweep(scene)) {
     timer.Restart();
     progress->Restart("demo: sweeping", 1);
-    summary["sweep"] = RunSweepStep(scene, scan, *demo_sweep, out_dir, nullptr);
+    summary.sweep = RunSweepStep(scene, scan, *demo_sweep, out_dir, nullptr);
     progress->Advance();
-    seconds["sweep"] = timer.Seconds();
+    seconds.sweep = timer.Seconds();
   }
 
   const std::string segment_object =
@@ -440,27 +441,26 @@ int RunDemoSteps(const DemoSettings& settings) {
     timer.Restart();
     progress->Restart("demo: segmenting", 1);
     cv::Mat object_mask;
-    summary["segment"] = RunSegmentStep(scene, scan, segment_object, out_dir, &object_mask);
+    summary.segment = RunSegmentStep(scene, scan, segment_object, out_dir, &object_mask);
     progress->Advance();
-    seconds["segment"] = timer.Seconds();
+    seconds.segment = timer.Seconds();
     timer.Restart();
-    summary["remove"] = RunRemoveStep(scene, scan, segment_object, object_mask, out_dir, progress.get());
-    seconds["remove"] = timer.Seconds();
+    summary.remove = RunRemoveStep(scene, scan, segment_object, object_mask, out_dir, progress.get());
+    seconds.remove = timer.Seconds();
     if (const std::string& site = scene.demo.site; !site.empty()) {
       timer.Restart();
-      const json stations = RunStationsStep(site, segment_object, object_mask, out_dir, progress.get());
-      if (!stations.is_null()) {
-        summary["stations"] = stations;
-        seconds["stations"] = timer.Seconds();
+      summary.stations = RunStationsStep(site, segment_object, object_mask, out_dir, progress.get());
+      if (summary.stations) {
+        seconds.stations = timer.Seconds();
       }
     }
   }
   progress->Finish();
 
-  summary["seconds"] = seconds;
-  WriteText(out_dir / "summary.json", summary.dump(2) + "\n");
+  const json summary_json = DemoSummaryJson(summary);
+  WriteText(out_dir / "summary.json", summary_json.dump(2) + "\n");
   WriteText(out_dir / "index.html", DemoPage(scene_name, summary));
-  WriteJsonOutput(settings.json_path, summary);
+  WriteJsonOutput(settings.json_path, summary_json);
   Summarize(fmt::format("scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)", scene_name,
                         scan.rows, scan.cols, scan.CountValid(), out_dir.string()));
   return 0;

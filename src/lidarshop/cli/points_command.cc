@@ -261,7 +261,7 @@ int RunPoints(int argc, char** argv) {
         flags.polygon = ParseNumbers(polygon_text, "--polygon");
         if (!flags.box.empty() && flags.box.size() != 6)
           throw OptionsError("--box needs 6 numbers: xmin,ymin,zmin,xmax,ymax,zmax");
-        nlohmann::ordered_json summary = {{"operation", op.name}};
+        PointsRead read{.operation = op.name};
         Gathered g;
         TriangleMesh mesh_in;
         if (op.reads_mesh) {
@@ -275,27 +275,25 @@ int RunPoints(int argc, char** argv) {
         } else {
           const Timer read_timer;
           g = GatherScans(inputs);
-          summary["input_points"] = g.cloud.size();
-          summary["scans"] = g.scans.size();
-          summary["read_seconds"] = read_timer.Seconds();
+          read.input_points = static_cast<int64_t>(g.cloud.size());
+          read.scans = g.scans.size();
+          read.read_seconds = read_timer.Seconds();
         }
         const Timer timer;  // the operation alone, without reading and writing
-        const PointsOutput out = op.run(g, mesh_in, points, flags, &summary);
-        summary["seconds"] = timer.Seconds();
+        const PointsOutput out = op.run(g, mesh_in, points, flags, read, timer);
         switch (op.writes) {
           case PointsOutputKind::kScans:
             WriteScanFile(output_path, out.scans);
             break;
           case PointsOutputKind::kCloud:
             WritePointCloud(output_path, out.cloud);
-            summary["output_points"] = out.cloud.size();
             break;
           case PointsOutputKind::kMesh:
             WriteMesh(output_path, out.mesh);
             break;
         }
-        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, op, flags), summary));
-        Summarize(PointsSummary(summary, output_path));
+        WriteJsonOutput(json_path, CommandJson(UsedOptions(points, op, flags), out.report));
+        Summarize(PointsSummary(out.report, output_path));
         return 0;
       },
       &binder);

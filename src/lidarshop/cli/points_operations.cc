@@ -10,12 +10,181 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/flat_fields.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/verify/pose_text.h"
+
+namespace lidarshop {
+namespace {
+
+// A report's description with PointsRead's keys first (flat).
+template <class R>
+StructInfo WithReadFirst(StructBuilder<R>& b) {
+  StructInfo info = b.Build();
+  const std::vector<FieldInfo> read = FlatFields(&R::read);
+  info.fields.insert(info.fields.begin(), read.begin(), read.end());
+  return info;
+}
+
+constexpr const char* kSecondsDoc = "wall time of the operation alone";
+
+}  // namespace
+
+template <>
+const StructInfo& InfoOf<cli::PointsRead>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsRead> b("PointsRead", "a points operation and the scans it read");
+    b.Field(&cli::PointsRead::operation, "operation", "the operation's name");
+    b.Field(&cli::PointsRead::input_points, "input_points", "points of every input scan");
+    b.Field(&cli::PointsRead::scans, "scans", "input scans");
+    b.Field(&cli::PointsRead::read_seconds, "read_seconds", "wall time reading them").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsKeptReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsKeptReport> b("PointsKeptReport", "points outliers | sample | crop --json");
+    b.Field(&cli::PointsKeptReport::output_points, "output_points", "points kept");
+    b.Field(&cli::PointsKeptReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsCloudReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsCloudReport> b("PointsCloudReport", "points voxel | merge --json");
+    b.Field(&cli::PointsCloudReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    b.Field(&cli::PointsCloudReport::output_points, "output_points", "points of the cloud written");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsScansReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsScansReport> b("PointsScansReport", "points transform | normals --json");
+    b.Field(&cli::PointsScansReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsPlane>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsPlane> b("PointsPlane", "a plane found (normal · x + offset_m = 0)");
+    b.Field(&cli::PointsPlane::normal, "normal", "unit normal, world frame");
+    b.Field(&cli::PointsPlane::offset_m, "offset_m", "offset along the normal").Unit("m");
+    b.Field(&cli::PointsPlane::inliers, "inliers", "points within the distance threshold");
+    b.Field(&cli::PointsPlane::rms_m, "rms_m", "RMS distance of the inliers to the plane").Unit("m");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsPlanesReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsPlanesReport> b("PointsPlanesReport", "points planes --json");
+    b.Field(&cli::PointsPlanesReport::planes, "planes", "the planes, labels 0, 1, ... in the scans");
+    b.Field(&cli::PointsPlanesReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsClusterReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsClusterReport> b("PointsClusterReport", "points cluster --json");
+    b.Field(&cli::PointsClusterReport::clusters, "clusters", "clusters found");
+    b.Field(&cli::PointsClusterReport::cluster_sizes, "cluster_sizes", "points per cluster, largest first");
+    b.Field(&cli::PointsClusterReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsKMeansReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsKMeansReport> b("PointsKMeansReport", "points kmeans --json");
+    b.Field(&cli::PointsKMeansReport::inertia_m2, "inertia_m2", "sum of squared distances to the centres")
+        .Unit("m2");
+    b.Field(&cli::PointsKMeansReport::iterations, "iterations", "Lloyd iterations run");
+    b.Field(&cli::PointsKMeansReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsMeshReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsMeshReport> b("PointsMeshReport", "points mesh --json");
+    b.Field(&cli::PointsMeshReport::method, "method", "grid, poisson or scale-space");
+    b.Field(&cli::PointsMeshReport::normals, "normals", "poisson: estimated or input");
+    b.Field(&cli::PointsMeshReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    b.Field(&cli::PointsMeshReport::vertices, "vertices", "vertices of the mesh written");
+    b.Field(&cli::PointsMeshReport::triangles, "triangles", "triangles of the mesh written");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsRegionsReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsRegionsReport> b("PointsRegionsReport", "points regions --json");
+    b.Field(&cli::PointsRegionsReport::regions, "regions", "regions over every scan's grid");
+    b.Field(&cli::PointsRegionsReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsSuperpixelsReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsSuperpixelsReport> b("PointsSuperpixelsReport", "points superpixels --json");
+    b.Field(&cli::PointsSuperpixelsReport::superpixels, "superpixels", "superpixels over every scan's grid");
+    b.Field(&cli::PointsSuperpixelsReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return WithReadFirst(b);
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::PointsSampleMeshReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::PointsSampleMeshReport> b("PointsSampleMeshReport", "points sample-mesh --json");
+    b.Field(&cli::PointsSampleMeshReport::operation, "operation", "sample-mesh");
+    b.Field(&cli::PointsSampleMeshReport::triangles, "triangles", "triangles of the input mesh");
+    b.Field(&cli::PointsSampleMeshReport::output_points, "output_points", "points drawn");
+    b.Field(&cli::PointsSampleMeshReport::seconds, "seconds", kSecondsDoc).Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop
 
 namespace lidarshop::cli {
 namespace {
 
-using Json = nlohmann::ordered_json;
+// `out` with the operation's report, timed now.
+template <class R>
+PointsOutput Reported(PointsOutput out, R report, const Timer& timer) {
+  report.seconds = timer.Seconds();
+  out.report = ToJson(report);
+  return out;
+}
 
 std::vector<Scan> KeepCells(const Gathered& g, const std::vector<uint8_t>& keep) {
   std::vector<Scan> out;
@@ -91,100 +260,115 @@ PointCloud WithOrientedNormals(const Gathered& g, int neighbors, bool* estimated
 }
 
 // Operations that keep or drop points: the kept cells of every scan.
-PointsOutput Kept(const Gathered& g, const std::vector<uint8_t>& keep, Json* summary) {
-  (*summary)["output_points"] = std::count(keep.begin(), keep.end(), 1);
-  return {.scans = KeepCells(g, keep)};
+PointsOutput Kept(const Gathered& g, const std::vector<uint8_t>& keep, const PointsRead& r, const Timer& t) {
+  const int64_t kept = std::count(keep.begin(), keep.end(), 1);
+  return Reported({.scans = KeepCells(g, keep)}, PointsKeptReport{.read = r, .output_points = kept}, t);
 }
 
 PointsOutput Outliers(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
-                      Json* s) {
+                      const PointsRead& r, const Timer& t) {
   if (f.method.empty() || f.method == "statistical")
-    return Kept(g, StatisticalOutlierInliers(g.cloud, o.statistical), s);
-  if (f.method == "radius") return Kept(g, RadiusOutlierInliers(g.cloud, o.radius), s);
+    return Kept(g, StatisticalOutlierInliers(g.cloud, o.statistical), r, t);
+  if (f.method == "radius") return Kept(g, RadiusOutlierInliers(g.cloud, o.radius), r, t);
   throw OptionsError(fmt::format("--method '{}': expected statistical or radius", f.method));
 }
 
-PointsOutput Sample(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
-  return Kept(g, RandomSampleInliers(g.cloud, f.count, o.planes.seed), s);
+PointsOutput Sample(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
+                    const PointsRead& r, const Timer& t) {
+  return Kept(g, RandomSampleInliers(g.cloud, f.count, o.planes.seed), r, t);
 }
 
-PointsOutput Crop(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
+PointsOutput Crop(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
+                  const PointsRead& r, const Timer& t) {
   if (!f.box.empty())
     o.crop.box = Eigen::AlignedBox3f(Eigen::Vector3f(f.box[0], f.box[1], f.box[2]),
                                      Eigen::Vector3f(f.box[3], f.box[4], f.box[5]));
   if (f.polygon.size() % 2) throw OptionsError("--polygon needs x y pairs");
   for (size_t i = 0; i + 1 < f.polygon.size(); i += 2)
     o.crop.polygon.emplace_back(f.polygon[i], f.polygon[i + 1]);
-  return Kept(g, CropInliers(g.cloud, o.crop), s);
+  return Kept(g, CropInliers(g.cloud, o.crop), r, t);
 }
 
-PointsOutput Voxel(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags& f, Json*) {
-  return {.cloud = VoxelDownsample(g.cloud, f.voxel_m)};
+// Operations that write a plain cloud.
+PointsOutput Cloud(PointCloud cloud, const PointsRead& r, const Timer& t) {
+  const uint64_t points = cloud.size();
+  return Reported({.cloud = std::move(cloud)}, PointsCloudReport{.read = r, .output_points = points}, t);
 }
 
-PointsOutput Merge(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags&, Json*) {
-  return {.cloud = g.cloud};
+PointsOutput Voxel(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags& f,
+                   const PointsRead& r, const Timer& t) {
+  return Cloud(VoxelDownsample(g.cloud, f.voxel_m), r, t);
 }
 
-PointsOutput Transform(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags& f, Json*) {
+PointsOutput Merge(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags&,
+                   const PointsRead& r, const Timer& t) {
+  return Cloud(g.cloud, r, t);
+}
+
+PointsOutput Transform(const Gathered& g, const TriangleMesh&, PointsOptions&, const PointsFlags& f,
+                       const PointsRead& r, const Timer& t) {
   if (f.matrix_text.empty()) throw OptionsError("transform needs --matrix");
   const Eigen::Matrix4d new_from_world = lidarshop::ParsePose(f.matrix_text, "--matrix");
   PointsOutput out;
   for (const Scan& scan : g.scans) out.scans.push_back(TransformScan(scan, new_from_world));
-  return out;
+  return Reported(std::move(out), PointsScansReport{.read = r}, t);
 }
 
-PointsOutput Normals(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json*) {
+PointsOutput Normals(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
+                     const PointsRead& r, const Timer& t) {
   PointsOutput out;
   if (f.grid_normals) {
     for (const Scan& scan : g.scans) out.scans.push_back(WithGridNormals(scan, o.normals));
   } else {
     out.scans = WithNormals(g, EstimateNormals(g.cloud, o.normals));
   }
-  return out;
+  return Reported(std::move(out), PointsScansReport{.read = r}, t);
 }
 
-PointsOutput Planes(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
+PointsOutput Planes(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
+                    const PointsRead& r, const Timer& t) {
   o.hough.distance_step_m = 2.0 * o.planes.distance_threshold_m;  // inliers within half a cell
   o.hough.max_planes = o.planes.max_planes;
   o.hough.min_inliers = std::max<int64_t>(3, o.planes.min_inliers);
   const std::vector<PlaneFit> fits =
       f.hough ? DetectPlanesHough(g.cloud, o.hough) : DetectPlanesRansac(g.cloud, o.planes);
   std::vector<int32_t> labels(g.cloud.size(), kNoLabel);
-  (*s)["planes"] = Json::array();
+  PointsPlanesReport report{.read = r};
   for (size_t p = 0; p < fits.size(); ++p) {
     for (uint32_t i : fits[p].inliers) labels[i] = static_cast<int32_t>(p);
-    (*s)["planes"].push_back({{"normal", {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()}},
-                              {"offset_m", fits[p].offset_m},
-                              {"inliers", fits[p].inliers.size()},
-                              {"rms_m", fits[p].rms_m}});
+    report.planes.push_back({.normal = {fits[p].normal.x(), fits[p].normal.y(), fits[p].normal.z()},
+                             .offset_m = fits[p].offset_m,
+                             .inliers = fits[p].inliers.size(),
+                             .rms_m = fits[p].rms_m});
   }
-  return {.scans = WithLabels(g, labels)};
+  return Reported({.scans = WithLabels(g, labels)}, std::move(report), t);
 }
 
-PointsOutput Cluster(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags&, Json* s) {
+PointsOutput Cluster(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags&,
+                     const PointsRead& r, const Timer& t) {
   const ClusterResult result = EuclideanClusters(g.cloud, o.cluster);
-  (*s)["clusters"] = result.num_clusters();
-  (*s)["cluster_sizes"] = result.sizes;
-  return {.scans = WithLabels(g, result.labels)};
+  return Reported(
+      {.scans = WithLabels(g, result.labels)},
+      PointsClusterReport{.read = r, .clusters = result.num_clusters(), .cluster_sizes = result.sizes}, t);
 }
 
 PointsOutput KMeansOperation(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags&,
-                             Json* s) {
+                             const PointsRead& r, const Timer& t) {
   const KMeansResult result = KMeans(g.cloud, o.kmeans);
-  (*s)["inertia_m2"] = result.inertia_m2;
-  (*s)["iterations"] = result.iterations;
-  return {.scans = WithLabels(g, result.labels)};
+  return Reported(
+      {.scans = WithLabels(g, result.labels)},
+      PointsKMeansReport{.read = r, .inertia_m2 = result.inertia_m2, .iterations = result.iterations}, t);
 }
 
 std::string MeshMethod(const PointsFlags& f) { return f.method.empty() ? "grid" : f.method; }
 
 // grid: the grid mesh of any organized scan, real ones included (scan/scan_mesh.h); otherwise a surface
 // reconstructed from all the points in the world frame (pointset/surface.h).
-PointsOutput Mesh(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
+PointsOutput Mesh(const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f,
+                  const PointsRead& r, const Timer& t) {
   const std::string method = MeshMethod(f);
   PointsOutput out;
-  (*s)["method"] = method;
+  PointsMeshReport report{.read = r, .method = method};
   if (method == "grid") {
     for (const Scan& scan : g.scans) AppendMesh(ScanToMesh(scan, o.mesh), &out.mesh);
     if (out.mesh.empty()) {
@@ -196,19 +380,19 @@ PointsOutput Mesh(const Gathered& g, const TriangleMesh&, PointsOptions& o, cons
   } else if (o.surface.method == SurfaceMethod::kPoisson) {
     bool estimated = false;
     const PointCloud cloud = WithOrientedNormals(g, o.surface.normal_neighbors, &estimated);
-    (*s)["normals"] = estimated ? "estimated" : "input";
+    report.normals = estimated ? "estimated" : "input";
     out.mesh = ReconstructSurface(cloud, o.surface);
   } else {
     out.mesh = ReconstructSurface(g.cloud, o.surface);
   }
-  (*s)["seconds"] = 0.0;  // its place in the JSON, before the counts; the command sets the time
-  (*s)["vertices"] = out.mesh.num_vertices();
-  (*s)["triangles"] = out.mesh.num_triangles();
-  return out;
+  report.vertices = out.mesh.num_vertices();
+  report.triangles = out.mesh.num_triangles();
+  return Reported(std::move(out), std::move(report), t);
 }
 
 // Per scan, over its grid: labels into the scan's label channel.
-PointsOutput GridLabels(const Gathered& g, PointsOptions& o, const PointsFlags& f, Json* s, bool regions) {
+PointsOutput GridLabels(const Gathered& g, PointsOptions& o, const PointsFlags& f, const PointsRead& r,
+                        const Timer& t, bool regions) {
   PointsOutput out;
   int total = 0;
   for (const Scan& scan : g.scans) {
@@ -224,20 +408,20 @@ PointsOutput GridLabels(const Gathered& g, PointsOptions& o, const PointsFlags& 
     total += count;
     out.scans.push_back(labelled);
   }
-  (*s)[regions ? "regions" : "superpixels"] = total;
-  return out;
+  if (regions) return Reported(std::move(out), PointsRegionsReport{.read = r, .regions = total}, t);
+  return Reported(std::move(out), PointsSuperpixelsReport{.read = r, .superpixels = total}, t);
 }
 
 // Uniform (area-weighted) samples of a triangle mesh (pointset/sampling.h), with the triangles' normals.
 PointsOutput SampleMesh(const Gathered&, const TriangleMesh& mesh, PointsOptions& o, const PointsFlags& f,
-                        Json* s) {
+                        const PointsRead& r, const Timer& t) {
   SurfaceSamples samples = SampleSurface(mesh, f.count, o.planes.seed);
   PointsOutput out;
   out.cloud.points = std::move(samples.points);
   out.cloud.normals = std::move(samples.normals);
-  (*s)["triangles"] = mesh.num_triangles();
-  (*s)["output_points"] = out.cloud.size();
-  return out;
+  const PointsSampleMeshReport report{
+      .operation = r.operation, .triangles = mesh.num_triangles(), .output_points = out.cloud.size()};
+  return Reported(std::move(out), report, t);
 }
 
 }  // namespace
@@ -260,16 +444,14 @@ const std::vector<PointsOperation>& PointsOperations() {
        K::kScans,
        false,
        {"regions", "normals"},
-       [](const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
-         return GridLabels(g, o, f, s, /*regions=*/true);
-       }},
+       [](const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, const PointsRead& r,
+          const Timer& t) { return GridLabels(g, o, f, r, t, /*regions=*/true); }},
       {"superpixels",
        K::kScans,
        false,
        {"superpixels"},
-       [](const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, Json* s) {
-         return GridLabels(g, o, f, s, /*regions=*/false);
-       }},
+       [](const Gathered& g, const TriangleMesh&, PointsOptions& o, const PointsFlags& f, const PointsRead& r,
+          const Timer& t) { return GridLabels(g, o, f, r, t, /*regions=*/false); }},
       {"sample-mesh", K::kCloud, true, {}, SampleMesh},
   };
   return operations;

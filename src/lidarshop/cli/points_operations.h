@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/scan/scan_mesh.h"
 #include "lidarshop/util/options_fwd.h"
+#include "lidarshop/util/timer.h"
 
 namespace lidarshop::cli {
 
@@ -77,10 +79,98 @@ struct Gathered {
 // What an operation writes: scans (their grids kept), a plain cloud, or a triangle mesh (each as .ply but scans).
 enum class PointsOutputKind { kScans, kCloud, kMesh };
 
+// What `lidarshop points OPERATION --json` reports (docs/points.md): one described struct per kind of
+// operation, each holding its keys in the order the command has always written them. The inputs come first
+// (PointsRead, written flat), `seconds` is the operation alone, without reading and writing.
+struct PointsRead {
+  std::string operation;
+  int64_t input_points = 0;  // points of every input scan
+  uint64_t scans = 0;        // input scans
+  double read_seconds = 0;   // wall seconds reading them
+};
+
+// outliers, sample, crop: the points kept.
+struct PointsKeptReport {
+  PointsRead read;
+  int64_t output_points = 0;
+  double seconds = 0;
+};
+
+// voxel, merge: the plain cloud written.
+struct PointsCloudReport {
+  PointsRead read;
+  double seconds = 0;
+  uint64_t output_points = 0;
+};
+
+// transform, normals: the scans written, with their grids.
+struct PointsScansReport {
+  PointsRead read;
+  double seconds = 0;
+};
+
+// A plane found by planes (pointset/planes.h PlaneFit without its inliers' indices).
+struct PointsPlane {
+  std::vector<double> normal;  // unit normal, world frame
+  double offset_m = 0;         // plane: normal · x + offset_m = 0
+  uint64_t inliers = 0;        // points within the distance threshold
+  double rms_m = 0;            // RMS distance of the inliers to the plane
+};
+
+struct PointsPlanesReport {
+  PointsRead read;
+  std::vector<PointsPlane> planes;  // labels 0, 1, ... in the scans
+  double seconds = 0;
+};
+
+struct PointsClusterReport {
+  PointsRead read;
+  int clusters = 0;
+  std::vector<int64_t> cluster_sizes;  // points per cluster, largest first
+  double seconds = 0;
+};
+
+struct PointsKMeansReport {
+  PointsRead read;
+  double inertia_m2 = 0;  // square metres, sum of squared distances to the assigned centres
+  int iterations = 0;
+  double seconds = 0;
+};
+
+struct PointsMeshReport {
+  PointsRead read;
+  std::string method;                  // grid, poisson or scale-space
+  std::optional<std::string> normals;  // poisson: "estimated" or "input"
+  double seconds = 0;
+  uint64_t vertices = 0, triangles = 0;
+};
+
+// regions, superpixels: labels over every scan's grid.
+struct PointsRegionsReport {
+  PointsRead read;
+  int regions = 0;
+  double seconds = 0;
+};
+
+struct PointsSuperpixelsReport {
+  PointsRead read;
+  int superpixels = 0;
+  double seconds = 0;
+};
+
+// sample-mesh: points drawn from a triangle mesh (no scans read).
+struct PointsSampleMeshReport {
+  std::string operation;
+  uint64_t triangles = 0;      // of the input mesh
+  uint64_t output_points = 0;  // drawn
+  double seconds = 0;
+};
+
 struct PointsOutput {
   std::vector<Scan> scans;
   PointCloud cloud;
   TriangleMesh mesh;
+  nlohmann::ordered_json report;  // ToJson of the operation's report (the --json without "options")
 };
 
 struct PointsOperation {
@@ -88,10 +178,11 @@ struct PointsOperation {
   PointsOutputKind writes = PointsOutputKind::kScans;
   bool reads_mesh = false;           // its one input is a triangle mesh (sample-mesh), not scans
   std::vector<std::string> options;  // the PointsOptions members it uses, as in --json's "options"
-  // Runs the operation on the gathered inputs (or, when reads_mesh, on `mesh`), adds its results to
-  // `summary`, and returns what to write. Throws OptionsError for flags it cannot use, InputError for data.
+  // Runs the operation on the gathered inputs (read as `read` says; or, when reads_mesh, on `mesh`), and
+  // returns what to write with its report, whose seconds are `timer`'s when it is done. Throws OptionsError
+  // for flags it cannot use, InputError for data.
   std::function<PointsOutput(const Gathered& inputs, const TriangleMesh& mesh, PointsOptions& options,
-                             const PointsFlags& flags, nlohmann::ordered_json* summary)>
+                             const PointsFlags& flags, const PointsRead& read, const Timer& timer)>
       run;
 };
 
@@ -108,3 +199,31 @@ std::string PointsOperationNames(const std::string& separator);
 Gathered GatherScans(const std::vector<std::string>& paths);
 
 }  // namespace lidarshop::cli
+
+namespace lidarshop {
+// points_operations.cc
+template <>
+const StructInfo& InfoOf<cli::PointsRead>();
+template <>
+const StructInfo& InfoOf<cli::PointsKeptReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsCloudReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsScansReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsPlane>();
+template <>
+const StructInfo& InfoOf<cli::PointsPlanesReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsClusterReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsKMeansReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsMeshReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsRegionsReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsSuperpixelsReport>();
+template <>
+const StructInfo& InfoOf<cli::PointsSampleMeshReport>();
+}  // namespace lidarshop

@@ -11,6 +11,7 @@
 
 #include "api_types.h"
 #include "lidarshop/cli/commands.h"
+#include "lidarshop/cli/demo_page.h"
 #include "lidarshop/cli/points_operations.h"
 #include "lidarshop/fill/fill_metrics.h"
 #include "lidarshop/inpaint/inpaint.h"
@@ -65,6 +66,20 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            ResultType<PointViewResult>(),           // render --eye, --orbit, --camera --json
            OptionsType<VerifyOptions>(),            // verify, sweep
            OptionsType<SweepOptions>(),             // sweep
+           ResultType<VerifyReport>(),              // verify --json
+           ResultType<SweepReport>(),               // sweep --json
+           ResultType<SweepSummary>(),              // sweep's detections.json
+           ResultType<DemoSummary>(),               // demo's summary.json, demo --json
+           ResultType<PointsKeptReport>(),          // points outliers | sample | crop --json
+           ResultType<PointsCloudReport>(),         // points voxel | merge --json
+           ResultType<PointsScansReport>(),         // points transform | normals --json
+           ResultType<PointsPlanesReport>(),        // points planes --json
+           ResultType<PointsClusterReport>(),       // points cluster --json
+           ResultType<PointsKMeansReport>(),        // points kmeans --json
+           ResultType<PointsMeshReport>(),          // points mesh --json
+           ResultType<PointsRegionsReport>(),       // points regions --json
+           ResultType<PointsSuperpixelsReport>(),   // points superpixels --json
+           ResultType<PointsSampleMeshReport>(),    // points sample-mesh --json
            ResultType<InpaintResult>(),             // inpaint
            ResultType<ReviewFolderSummary>(),       // inpaint --review DIR: review.json
            OptionsType<PoissonOptions>(),           // poisson

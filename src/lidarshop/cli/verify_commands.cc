@@ -15,7 +15,6 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/atomic_file.h"
-#include "lidarshop/util/enum_names.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/progress.h"
 #include "lidarshop/verify/pose_text.h"
@@ -35,25 +34,26 @@ std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
   return scans;
 }
 
-nlohmann::ordered_json NumberOrNull(double value) {
-  return std::isnan(value) ? nlohmann::ordered_json() : nlohmann::ordered_json(value);
+// `json` with the key `key` = `value` inserted before `before` (at the end when there is none).
+nlohmann::ordered_json InsertBefore(const nlohmann::ordered_json& json, const std::string& before,
+                                    const std::string& key, const nlohmann::ordered_json& value) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::object();
+  for (const auto& [name, item] : json.items()) {
+    if (name == before) out[key] = value;
+    out[name] = item;
+  }
+  if (!out.contains(key)) out[key] = value;
+  return out;
 }
 
-// The result's described JSON form (VerifyResult), with the older key "icp_cost" (= icp_cost_m) and the
-// per-scan numbers.
-nlohmann::ordered_json ResultJson(const VerifyResult& result, const std::vector<std::string>& scan_names) {
-  nlohmann::ordered_json json = ToJson(result);
-  json["icp_cost"] = NumberOrNull(result.icp_cost_m);
-  json["per_scan"] = nlohmann::ordered_json::array();
-  for (size_t s = 0; s < result.per_scan.size(); ++s) {
-    const ScanVerifyStats& stats = result.per_scan[s];
-    json["per_scan"].push_back({{"scan", s < scan_names.size() ? scan_names[s] : std::to_string(s)},
-                                {"consistency", NumberOrNull(stats.consistency)},
-                                {"comparable_pairs", stats.comparable_pairs},
-                                {"consistent_pairs", stats.consistent_pairs},
-                                {"confidence", stats.confidence},
-                                {"footprint_cells", stats.footprint_cells},
-                                {"rays_cast", stats.rays_cast}});
+// The described JSON form of a sweep's summary or report with each detection's pose (4 rows of 4; the
+// schema has no kind for a matrix yet) in its place among the detection's sorted keys.
+nlohmann::ordered_json WithDetectionPoses(nlohmann::ordered_json json,
+                                          const std::vector<Detection>& detections) {
+  for (size_t i = 0; i < detections.size(); ++i) {
+    nlohmann::json sorted = json["detections"][i];
+    sorted["world_from_model"] = MatrixJson(detections[i].world_from_model);
+    json["detections"][i] = sorted;
   }
   return json;
 }
@@ -206,13 +206,10 @@ int RunVerify(int argc, char** argv) {
         VerifyOptions options = common.verify;
         options.keep_details = !scene_ply.empty() || !model_ply.empty();
         const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
-        std::vector<std::string> names;
-        for (const PreparedScan& scan : scans) names.push_back(scan.scan.name);
         Summarize(result.BriefReport());
-        nlohmann::ordered_json json = ResultJson(result, names);
-        json["world_from_model"] = MatrixJson(world_from_model);
-        json["model_points"] = model.num_points();
-        json["model_options"] = ToJson(common.model_options);
+        const VerifyReport report = MakeVerifyReport(result, model, common.model_options);
+        const nlohmann::ordered_json json =
+            InsertBefore(ToJson(report), "model_points", "world_from_model", MatrixJson(world_from_model));
         WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
         if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
         if (!model_ply.empty())
@@ -288,37 +285,12 @@ int RunSweep(int argc, char** argv) {
                    RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
                                  sweep_options.min_confidence));
         WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
-        nlohmann::json json;
-        json["detections"] = nlohmann::json::array();
-        for (const Detection& d : sweep.detections) {
-          json["detections"].push_back({{"x_m", d.x_m},
-                                        {"y_m", d.y_m},
-                                        {"z_m", d.z_m},
-                                        {"yaw_deg", d.yaw_deg},
-                                        {"consistency", d.consistency},
-                                        {"confidence", d.confidence},
-                                        {"comparable_pairs", d.comparable_pairs},
-                                        {"icp_cost", NumberOrNull(d.icp_cost_m)},
-                                        {"inlier_fraction", d.inlier_fraction},
-                                        {"world_from_model", MatrixJson(d.world_from_model)}});
-        }
-        json["thresholds"] = {{"min_consistency", sweep_options.min_consistency},
-                              {"min_confidence", sweep_options.min_confidence},
-                              {"min_comparable_pairs", sweep_options.min_comparable_pairs},
-                              {"nms_radius_m", sweep.nms_radius_m}};
-        json["grid"] = {{"x_count", sweep.xs_m.size()},
-                        {"y_count", sweep.ys_m.size()},
-                        {"yaws_deg", sweep.yaws_deg},
-                        {"poses", sweep.poses.size()},
-                        {"refined_seeds", sweep.refined.size()},
-                        {"refine_evaluations", sweep.refine_evaluations},
-                        {"search", ToString(sweep_options.search)},
-                        {"evaluated_poses", sweep.evaluated_poses},
-                        {"bound_evaluations", sweep.bound_evaluations}};
-        WriteText((out / "detections.json").string(), json.dump(2) + "\n");
-        nlohmann::ordered_json result = json;
-        result["verify_options"] = ToJson(common.verify);
-        result["model_options"] = ToJson(common.model_options);
+        const SweepReport report{.summary = SummarizeSweep(sweep, sweep_options),
+                                 .verify_options = common.verify,
+                                 .model_options = common.model_options};
+        WriteText((out / "detections.json").string(),
+                  WithDetectionPoses(ToJson(report.summary), sweep.detections).dump(2) + "\n");
+        const nlohmann::ordered_json result = WithDetectionPoses(ToJson(report), sweep.detections);
         WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
         if (!common.quiet) {
           for (const Detection& d : sweep.detections) {

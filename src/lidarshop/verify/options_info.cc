@@ -1,4 +1,5 @@
 // Descriptions of the verification options, enums and result (util/options.h).
+#include "lidarshop/util/flat_fields.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
@@ -157,6 +158,125 @@ const StructInfo& InfoOf<VerifyResult>() {
     b.Field(&VerifyResult::icp_candidates, "icp_candidates",
             "scene points in the model's grown bounding box");
     return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanVerifyStats>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScanVerifyStats> b("ScanVerifyStats",
+                                     "one scan's share of a verified pose, as if it were alone");
+    b.Field(&ScanVerifyStats::scan, "scan", "the scan's name");
+    b.Field(&ScanVerifyStats::consistency, "consistency",
+            "share of its comparable pairs that agree; null = none");
+    b.Field(&ScanVerifyStats::comparable_pairs, "comparable_pairs",
+            "its valid points whose ray meets the model");
+    b.Field(&ScanVerifyStats::consistent_pairs, "consistent_pairs", "of which consistent");
+    b.Field(&ScanVerifyStats::confidence, "confidence", "information of the model seen by this scan, [0, 1]");
+    b.Field(&ScanVerifyStats::footprint_cells, "footprint_cells",
+            "cells of the model's angular footprint visited")
+        .Unit("cells");
+    b.Field(&ScanVerifyStats::rays_cast, "rays_cast", "rays cast against the model");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<VerifyReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<VerifyReport> b("VerifyReport",
+                                  "lidarshop verify --json: VerifyResult's keys, per scan, and the model "
+                                  "(world_from_model, 4 rows of 4, follows per_scan)");
+    b.Field(&VerifyReport::icp_cost, "icp_cost", "= icp_cost_m (older key)").Unit("m");
+    b.Field(&VerifyReport::per_scan, "per_scan", "each scan's numbers, in the order of --scan");
+    b.Field(&VerifyReport::model_points, "model_points", "model points verified");
+    b.Field(&VerifyReport::model_options, "model_options", "how the model points were made");
+    StructInfo built = b.Build();
+    const std::vector<FieldInfo> result = FlatFields(&VerifyReport::result);
+    built.fields.insert(built.fields.begin(), result.begin(), result.end());
+    return built;
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<Detection>() {
+  static const StructInfo info = [] {
+    StructBuilder<Detection> b("Detection",
+                               "a sweep's pose that passed both thresholds (world_from_model, 4 rows of 4, "
+                               "follows inlier_fraction)");
+    b.Field(&Detection::comparable_pairs, "comparable_pairs", "scan point / model pairs compared");
+    b.Field(&Detection::confidence, "confidence", "information of the model seen by the scans, [0, 1]");
+    b.Field(&Detection::consistency, "consistency", "share of comparable pairs that agree");
+    b.Field(&Detection::icp_cost_m, "icp_cost", "trimmed ICP cost; null = no inlier pair").Unit("m");
+    b.Field(&Detection::inlier_fraction, "inlier_fraction", "inliers / scene points near the model");
+    b.Field(&Detection::x_m, "x_m", "world x of the model origin").Unit("m");
+    b.Field(&Detection::y_m, "y_m", "world y of the model origin").Unit("m");
+    b.Field(&Detection::yaw_deg, "yaw_deg", "yaw about +z").Unit("deg");
+    b.Field(&Detection::z_m, "z_m", "world z of the model origin").Unit("m");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SweepThresholds>() {
+  static const StructInfo info = [] {
+    StructBuilder<SweepThresholds> b("SweepThresholds", "what a sweep's detections passed");
+    b.Field(&SweepThresholds::min_comparable_pairs, "min_comparable_pairs",
+            "at least this many comparable pairs");
+    b.Field(&SweepThresholds::min_confidence, "min_confidence", "confidence above this");
+    b.Field(&SweepThresholds::min_consistency, "min_consistency", "consistency above this");
+    b.Field(&SweepThresholds::nms_radius_m, "nms_radius_m", "non-maximum suppression radius used").Unit("m");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SweepGridSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<SweepGridSummary> b("SweepGridSummary", "the grid a sweep covered and what it verified");
+    b.Field(&SweepGridSummary::bound_evaluations, "bound_evaluations",
+            "blocks whose confidence was bounded (coarse-to-fine)");
+    b.Field(&SweepGridSummary::evaluated_poses, "evaluated_poses", "grid poses verified");
+    b.Field(&SweepGridSummary::poses, "poses", "grid poses");
+    b.Field(&SweepGridSummary::refine_evaluations, "refine_evaluations", "poses verified during refinement");
+    b.Field(&SweepGridSummary::refined_seeds, "refined_seeds", "grid poses refined");
+    b.Field(&SweepGridSummary::search, "search", "how the grid was searched");
+    b.Field(&SweepGridSummary::x_count, "x_count", "grid positions along x");
+    b.Field(&SweepGridSummary::y_count, "y_count", "grid positions along y");
+    b.Field(&SweepGridSummary::yaws_deg, "yaws_deg", "yaws tried at every position").Unit("deg");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SweepSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<SweepSummary> b("SweepSummary", "a sweep's detections and grid (detections.json)");
+    b.Field(&SweepSummary::detections, "detections", "by decreasing confidence");
+    b.Field(&SweepSummary::grid, "grid", "the grid and how much of it was verified");
+    b.Field(&SweepSummary::thresholds, "thresholds", "what the detections passed");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SweepReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<SweepReport> b("SweepReport",
+                                 "lidarshop sweep --json: SweepSummary's keys and both sides' options");
+    b.Field(&SweepReport::verify_options, "verify_options", "how the poses were verified");
+    b.Field(&SweepReport::model_options, "model_options", "how the model points were made");
+    StructInfo built = b.Build();
+    const std::vector<FieldInfo> summary = FlatFields(&SweepReport::summary);
+    built.fields.insert(built.fields.begin(), summary.begin(), summary.end());
+    return built;
   }();
   return info;
 }

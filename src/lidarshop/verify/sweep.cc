@@ -357,6 +357,25 @@ SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scan
   return sweep;
 }
 
+SweepSummary SummarizeSweep(const SweepResult& sweep, const SweepOptions& options) {
+  SweepSummary summary;
+  summary.detections = sweep.detections;
+  summary.thresholds = {.min_comparable_pairs = options.min_comparable_pairs,
+                        .min_confidence = options.min_confidence,
+                        .min_consistency = options.min_consistency,
+                        .nms_radius_m = sweep.nms_radius_m};
+  summary.grid = {.bound_evaluations = sweep.bound_evaluations,
+                  .evaluated_poses = sweep.evaluated_poses,
+                  .poses = sweep.poses.size(),
+                  .refine_evaluations = sweep.refine_evaluations,
+                  .refined_seeds = sweep.refined.size(),
+                  .search = options.search,
+                  .x_count = sweep.xs_m.size(),
+                  .y_count = sweep.ys_m.size(),
+                  .yaws_deg = sweep.yaws_deg};
+  return summary;
+}
+
 std::string SweepCsv(const SweepResult& sweep) {
   std::string csv = "x_m,y_m,yaw_deg,consistency,confidence,comparable_pairs,icp_cost_m,inlier_fraction\n";
   for (const SweepPose& pose : sweep.poses) {

@@ -103,6 +103,55 @@ struct SweepResult {
   double nms_radius_m = 0;            // the radius used
 };
 
+// Described (keys in alphabetical order, as detections.json has always been written):
+template <>
+const StructInfo& InfoOf<Detection>();  // without world_from_model: the schema has no kind for a matrix yet
+
+// The thresholds a sweep's detections passed.
+struct SweepThresholds {
+  int64_t min_comparable_pairs = 0;  // SweepOptions::min_comparable_pairs
+  double min_confidence = 0;         // SweepOptions::min_confidence
+  double min_consistency = 0;        // SweepOptions::min_consistency
+  double nms_radius_m = 0;           // metres, the radius used (SweepResult::nms_radius_m)
+};
+template <>
+const StructInfo& InfoOf<SweepThresholds>();
+
+// The grid a sweep covered and how much of it was verified.
+struct SweepGridSummary {
+  int64_t bound_evaluations = 0;   // blocks whose confidence was bounded (coarse-to-fine)
+  int64_t evaluated_poses = 0;     // grid poses verified
+  uint64_t poses = 0;              // grid poses, #X * #Y * #yaws
+  int64_t refine_evaluations = 0;  // poses verified during refinement
+  uint64_t refined_seeds = 0;      // grid poses refined
+  SweepSearch search = SweepSearch::kCoarseToFine;
+  uint64_t x_count = 0, y_count = 0;  // grid positions along x and y
+  std::vector<double> yaws_deg;       // degrees, the yaws tried
+};
+template <>
+const StructInfo& InfoOf<SweepGridSummary>();
+
+// A sweep's outcome without its pictures and poses (detections.json; the detections' world_from_model is
+// added by the command).
+struct SweepSummary {
+  std::vector<Detection> detections;  // by decreasing confidence
+  SweepGridSummary grid;
+  SweepThresholds thresholds;
+};
+template <>
+const StructInfo& InfoOf<SweepSummary>();
+
+// What `lidarshop sweep --json` reports: SweepSummary's keys, then the options of both sides.
+struct SweepReport {
+  SweepSummary summary;  // written flat: detections, grid, thresholds
+  VerifyOptions verify_options;
+  ModelOptions model_options;
+};
+template <>
+const StructInfo& InfoOf<SweepReport>();
+
+SweepSummary SummarizeSweep(const SweepResult& sweep, const SweepOptions& options);
+
 SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scans,
                   const SweepOptions& sweep_options, const VerifyOptions& verify_options,
                   Progress* progress = nullptr);

@@ -498,6 +498,7 @@ VerifyResult VerifyPose(const VerifierModel& model, std::span<const PreparedScan
     const PreparedScan& prepared = scans[s];
     const Scan& scan = prepared.scan;
     ScanVerifyStats& stats = result.per_scan[s];
+    stats.scan = scan.name;
     if (options.keep_details) result.scene_status[s] = cv::Mat::zeros(scan.rows, scan.cols, CV_8U);
     const bool separate = scans.size() > 1;
     if (separate) scan_sum.assign(n, 0.0f);
@@ -559,6 +560,20 @@ std::vector<VerifyResult> VerifyPoses(const VerifierModel& model, std::span<cons
       },
       4);
   return results;
+}
+
+VerifyReport MakeVerifyReport(const VerifyResult& result, const VerifierModel& model,
+                              const ModelOptions& model_options) {
+  VerifyReport report;
+  report.result = result;
+  report.result.per_scan.clear();
+  report.result.scene_status.clear();
+  report.result.observed_information.clear();
+  report.icp_cost = result.icp_cost_m;
+  report.per_scan = result.per_scan;
+  report.model_points = static_cast<int64_t>(model.num_points());
+  report.model_options = model_options;
+  return report;
 }
 
 std::string VerifyResult::BriefReport() const {

@@ -188,6 +188,7 @@ const StructInfo& InfoOf<VerifyOptions>();
 
 // The outcome for one scan alone (consistency and confidence as if it were the only scan).
 struct ScanVerifyStats {
+  std::string scan;              // the scan's name (Scan::name)
   int64_t comparable_pairs = 0;  // valid points whose ray meets the posed model
   int64_t consistent_pairs = 0;  // of those, (d_m + a) − d_s ≥ 0
   double consistency = std::numeric_limits<double>::quiet_NaN();  // NaN when comparable_pairs == 0
@@ -220,6 +221,25 @@ struct VerifyResult {
 };
 template <>
 const StructInfo& InfoOf<VerifyResult>();
+template <>
+const StructInfo& InfoOf<ScanVerifyStats>();
+
+// What `lidarshop verify --json` reports: the pose's VerifyResult (its keys at the report's own level), each
+// scan's numbers and the model's. The pose itself ("world_from_model", 4 rows of 4) is written by the command
+// after per_scan: the schema has no kind for a matrix yet.
+struct VerifyReport {
+  VerifyResult result;                                         // written flat: consistency ... icp_candidates
+  double icp_cost = std::numeric_limits<double>::quiet_NaN();  // metres, = result.icp_cost_m (older key)
+  std::vector<ScanVerifyStats> per_scan;                       // = result.per_scan, by scan
+  int64_t model_points = 0;                                    // VerifierModel::num_points()
+  ModelOptions model_options;                                  // how the model points were made
+};
+template <>
+const StructInfo& InfoOf<VerifyReport>();
+
+// The report of `result`, verified against `model` made with `model_options`.
+VerifyReport MakeVerifyReport(const VerifyResult& result, const VerifierModel& model,
+                              const ModelOptions& model_options);
 
 // Verifies one pose. `world_from_model` is a rotation times one uniform scale s plus a translation
 // (geometry/transform.h PoseProblem; std::invalid_argument otherwise). Every distance of the measures stays
