@@ -10,21 +10,11 @@
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/pointset/sampling.h"
 #include "lidarshop/util/error.h"
-#include "lidarshop/util/flat_fields.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/verify/pose_text.h"
 
 namespace lidarshop {
 namespace {
-
-// A report's description with PointsRead's keys first (flat).
-template <class R>
-StructInfo WithReadFirst(StructBuilder<R>& b) {
-  StructInfo info = b.Build();
-  const std::vector<FieldInfo> read = FlatFields(&R::read);
-  info.fields.insert(info.fields.begin(), read.begin(), read.end());
-  return info;
-}
 
 constexpr const char* kSecondsDoc = "wall time of the operation alone";
 
@@ -47,9 +37,10 @@ template <>
 const StructInfo& InfoOf<cli::PointsKeptReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsKeptReport> b("PointsKeptReport", "points outliers | sample | crop --json");
+    b.Flatten(&cli::PointsKeptReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsKeptReport::output_points, "output_points", "points kept");
     b.Field(&cli::PointsKeptReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -58,9 +49,10 @@ template <>
 const StructInfo& InfoOf<cli::PointsCloudReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsCloudReport> b("PointsCloudReport", "points voxel | merge --json");
+    b.Flatten(&cli::PointsCloudReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsCloudReport::seconds, "seconds", kSecondsDoc).Unit("s");
     b.Field(&cli::PointsCloudReport::output_points, "output_points", "points of the cloud written");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -69,8 +61,9 @@ template <>
 const StructInfo& InfoOf<cli::PointsScansReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsScansReport> b("PointsScansReport", "points transform | normals --json");
+    b.Flatten(&cli::PointsScansReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsScansReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -92,9 +85,10 @@ template <>
 const StructInfo& InfoOf<cli::PointsPlanesReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsPlanesReport> b("PointsPlanesReport", "points planes --json");
+    b.Flatten(&cli::PointsPlanesReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsPlanesReport::planes, "planes", "the planes, labels 0, 1, ... in the scans");
     b.Field(&cli::PointsPlanesReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -103,10 +97,11 @@ template <>
 const StructInfo& InfoOf<cli::PointsClusterReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsClusterReport> b("PointsClusterReport", "points cluster --json");
+    b.Flatten(&cli::PointsClusterReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsClusterReport::clusters, "clusters", "clusters found");
     b.Field(&cli::PointsClusterReport::cluster_sizes, "cluster_sizes", "points per cluster, largest first");
     b.Field(&cli::PointsClusterReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -115,11 +110,12 @@ template <>
 const StructInfo& InfoOf<cli::PointsKMeansReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsKMeansReport> b("PointsKMeansReport", "points kmeans --json");
+    b.Flatten(&cli::PointsKMeansReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsKMeansReport::inertia_m2, "inertia_m2", "sum of squared distances to the centres")
         .Unit("m2");
     b.Field(&cli::PointsKMeansReport::iterations, "iterations", "Lloyd iterations run");
     b.Field(&cli::PointsKMeansReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -128,12 +124,13 @@ template <>
 const StructInfo& InfoOf<cli::PointsMeshReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsMeshReport> b("PointsMeshReport", "points mesh --json");
+    b.Flatten(&cli::PointsMeshReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsMeshReport::method, "method", "grid, poisson or scale-space");
     b.Field(&cli::PointsMeshReport::normals, "normals", "poisson: estimated or input");
     b.Field(&cli::PointsMeshReport::seconds, "seconds", kSecondsDoc).Unit("s");
     b.Field(&cli::PointsMeshReport::vertices, "vertices", "vertices of the mesh written");
     b.Field(&cli::PointsMeshReport::triangles, "triangles", "triangles of the mesh written");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -142,9 +139,10 @@ template <>
 const StructInfo& InfoOf<cli::PointsRegionsReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsRegionsReport> b("PointsRegionsReport", "points regions --json");
+    b.Flatten(&cli::PointsRegionsReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsRegionsReport::regions, "regions", "regions over every scan's grid");
     b.Field(&cli::PointsRegionsReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }
@@ -153,9 +151,10 @@ template <>
 const StructInfo& InfoOf<cli::PointsSuperpixelsReport>() {
   static const StructInfo info = [] {
     StructBuilder<cli::PointsSuperpixelsReport> b("PointsSuperpixelsReport", "points superpixels --json");
+    b.Flatten(&cli::PointsSuperpixelsReport::read);  // PointsRead's keys first
     b.Field(&cli::PointsSuperpixelsReport::superpixels, "superpixels", "superpixels over every scan's grid");
     b.Field(&cli::PointsSuperpixelsReport::seconds, "seconds", kSecondsDoc).Unit("s");
-    return WithReadFirst(b);
+    return b.Build();
   }();
   return info;
 }

@@ -1,5 +1,4 @@
 // Descriptions of the verification options, enums and result (util/options.h).
-#include "lidarshop/util/flat_fields.h"
 #include "lidarshop/util/options.h"
 #include "lidarshop/verify/sweep.h"
 #include "lidarshop/verify/verify.h"
@@ -189,14 +188,12 @@ const StructInfo& InfoOf<VerifyReport>() {
     StructBuilder<VerifyReport> b("VerifyReport",
                                   "lidarshop verify --json: VerifyResult's keys, per scan, and the model "
                                   "(world_from_model, 4 rows of 4, follows per_scan)");
+    b.Flatten(&VerifyReport::result);
     b.Field(&VerifyReport::icp_cost, "icp_cost", "= icp_cost_m (older key)").Unit("m");
     b.Field(&VerifyReport::per_scan, "per_scan", "each scan's numbers, in the order of --scan");
     b.Field(&VerifyReport::model_points, "model_points", "model points verified");
     b.Field(&VerifyReport::model_options, "model_options", "how the model points were made");
-    StructInfo built = b.Build();
-    const std::vector<FieldInfo> result = FlatFields(&VerifyReport::result);
-    built.fields.insert(built.fields.begin(), result.begin(), result.end());
-    return built;
+    return b.Build();
   }();
   return info;
 }
@@ -271,12 +268,10 @@ const StructInfo& InfoOf<SweepReport>() {
   static const StructInfo info = [] {
     StructBuilder<SweepReport> b("SweepReport",
                                  "lidarshop sweep --json: SweepSummary's keys and both sides' options");
+    b.Flatten(&SweepReport::summary);
     b.Field(&SweepReport::verify_options, "verify_options", "how the poses were verified");
     b.Field(&SweepReport::model_options, "model_options", "how the model points were made");
-    StructInfo built = b.Build();
-    const std::vector<FieldInfo> summary = FlatFields(&SweepReport::summary);
-    built.fields.insert(built.fields.begin(), summary.begin(), summary.end());
-    return built;
+    return b.Build();
   }();
   return info;
 }
