@@ -389,7 +389,6 @@ void GatedServer::ReadInto(Connection& connection) {
 }
 
 bool GatedServer::CheckHeaders(Connection& connection) {
-  const int fd = connection.fd;
   std::string& buffer = connection.buffer;
   const size_t end = buffer.find("\r\n\r\n");
   if (end > options_.max_header_bytes) {
