@@ -144,7 +144,7 @@ StationColourScore ScoreStationColours(const Scan& truth, const PhotosRecolorRes
       ++score.coloured;
       const cv::Vec3i a = truth.color.at<cv::Vec3b>(r, c), b = colour.at<cv::Vec3b>(r, c);
       errors.push_back((std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2])) / 3.0);
-      for (const auto [rn, cn] : {std::pair{r, c + 1}, std::pair{r + 1, c}}) {
+      for (const auto& [rn, cn] : {std::pair{r, c + 1}, std::pair{r + 1, c}}) {
         if (rn >= truth.rows || cn >= truth.cols) continue;
         const uint16_t there = photo.at<uint16_t>(rn, cn);
         if (there == 0) continue;
