@@ -121,8 +121,9 @@ FieldInfo& FieldInfo::OmitWhenEmpty() {
                                kind == FieldKind::kJson));
   present = [get = get](const void* object) {
     const nlohmann::ordered_json value = get(object);
-    return !(value.is_null() ||
-             ((value.is_array() || value.is_object() || value.is_string()) && value.empty()));
+    // nlohmann's empty() is false for every string: a string is a value, not a container.
+    if (value.is_string()) return !value.get_ref<const std::string&>().empty();
+    return !(value.is_null() || ((value.is_array() || value.is_object()) && value.empty()));
   };
   return *this;
 }
