@@ -451,9 +451,9 @@ void BindRegistration(py::module_& m) {
           Scan moved = stations[i];  // shares the buffers; only the pose changes
           moved.world_from_scanner = result.stations[i].world_from_scanner;
           registered.append(moved);
-          per_station.append(FromJsonValue(SiteStationJson(result.stations[i])));
+          per_station.append(FromJsonValue(ToJson(result.stations[i])));
         }
-        for (const SitePair& pair : result.pairs) per_pair.append(FromJsonValue(SitePairJson(pair)));
+        for (const SitePair& pair : result.pairs) per_pair.append(FromJsonValue(ToJson(pair)));
         return py::make_tuple(registered, per_station, per_pair);
       },
       py::arg("stations"), py::arg("fixed") = 0, py::arg("icp") = py::none(), py::arg("options") = py::none(),

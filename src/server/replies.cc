@@ -142,10 +142,8 @@ const StructInfo& InfoOf<PreparedReply>() {
 template <>
 const StructInfo& InfoOf<JobReply>() {
   static const StructInfo info = [] {
-    StructBuilder<JobReply> b(
-        "JobReply",
-        "GET /api/jobs/ID: a job (its \"result\", the operation's reply, follows when it "
-        "has one)");
+    StructBuilder<JobReply> b("JobReply",
+                              "GET /api/jobs/ID: a job and, once it has one, the operation's reply");
     b.Field(&JobReply::id, "id", "the job's id");
     b.Field(&JobReply::kind, "kind", "the operation (\"segment\", \"remove\", \"fill\", ...)");
     b.Field(&JobReply::document, "document", "the id of its scan");
@@ -154,6 +152,8 @@ const StructInfo& InfoOf<JobReply>() {
     b.Field(&JobReply::done, "done", "steps done");
     b.Field(&JobReply::total, "total", "steps in all");
     b.Field(&JobReply::error, "error", "why it failed");
+    b.Field(&JobReply::result, "result",
+            "the operation's own reply, once it has one (its type follows the kind)");
     return b.Build();
   }();
   return info;
@@ -416,10 +416,12 @@ const StructInfo& InfoOf<LabelsReply>() {
 template <>
 const StructInfo& InfoOf<FormatsReply>() {
   static const StructInfo info = [] {
-    StructBuilder<FormatsReply> b("FormatsReply",
-                                  "GET /api/formats (with the library's \"formats\" after it)");
+    StructBuilder<FormatsReply> b("FormatsReply", "GET /api/formats");
     b.Field(&FormatsReply::read, "read", "the extensions the library reads");
     b.Field(&FormatsReply::write, "write", "the extensions it writes");
+    b.Field(&FormatsReply::formats, "formats",
+            "the library's table of formats (io/formats.h): one object per format, a channel false, true or "
+            "the format's name for it");
     return b.Build();
   }();
   return info;
@@ -602,9 +604,8 @@ const StructInfo& InfoOf<StationEntry>() {
 template <>
 const StructInfo& InfoOf<SiteReply>() {
   static const StructInfo info = [] {
-    StructBuilder<SiteReply> b(
-        "SiteReply", "a site: GET /api/docs/ID/stations (site null for a scan in none), GET /api/sites");
-    b.Field(&SiteReply::site, "site", "the site's id");
+    StructBuilder<SiteReply> b("SiteReply", "a site: GET /api/docs/ID/stations, GET /api/sites");
+    b.Field(&SiteReply::site, "site", "the site's id; null for a scan in none").NullWhenAbsent();
     b.Field(&SiteReply::name, "name", "its name");
     b.Field(&SiteReply::station, "station", "the document's station (-1: none)");
     b.Field(&SiteReply::stations, "stations", "its stations");

@@ -84,6 +84,9 @@ struct JobReply {
   int64_t done = 0;
   int64_t total = 0;
   std::optional<std::string> error;
+  // The operation's own reply (a described struct's JSON form, or several joined), once it has one: its type
+  // depends on the job's kind.
+  std::optional<nlohmann::ordered_json> result;
 };
 
 // POST /api/docs/ID/photo and .../photo-from-e57.
@@ -230,10 +233,13 @@ struct LabelsReply {
   std::vector<LabelEntry> labels;
 };
 
-// GET /api/formats (beside the library's "formats", io/formats.h ScanFormatsJson).
+// GET /api/formats.
 struct FormatsReply {
   std::vector<std::string> read;
   std::vector<std::string> write;
+  // The library's table of formats (io/formats.h ScanFormatsJson): one object per format, whose channels are
+  // false, true or a name.
+  nlohmann::ordered_json formats;
 };
 
 // One level of the tile pyramid.
@@ -349,7 +355,7 @@ struct StationEntry {
 
 // A site: GET /api/docs/ID/stations, GET /api/sites.
 struct SiteReply {
-  int site = 0;  // null for a scan in no site
+  std::optional<int> site;  // null for a scan in no site
   std::string name;
   int station = -1;  // the document's station (-1: none)
   std::vector<StationEntry> stations;

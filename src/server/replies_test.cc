@@ -82,12 +82,42 @@ TEST(Replies, RecolorReplyKeepsNoneAsNull) {
 }
 
 TEST(Replies, JobStateByName) {
-  JobReply job{4, "segment", 1, JobState::kCancelled, "segment", 1, 1, std::nullopt};
+  JobReply job{4, "segment", 1, JobState::kCancelled, "segment", 1, 1, std::nullopt, std::nullopt};
   EXPECT_EQ(
       Dump(ToJson(job)),
       R"({"id":4,"kind":"segment","document":1,"state":"cancelled","label":"segment","done":1,"total":1})");
   job.error = "stopped";
   EXPECT_EQ(Dump(ToJson(job)).substr(Dump(ToJson(job)).size() - 19), R"(,"error":"stopped"})");
+}
+
+TEST(Replies, JobResultFollowsAsTheRouteAddedIt) {
+  JobReply job{4, "segment", 1, JobState::kDone, "segment", 1, 1, std::nullopt, std::nullopt};
+  nlohmann::ordered_json by_hand = ToJson(job);
+  const nlohmann::ordered_json result = {{"object_cells", 10}, {"refined", false}};
+  by_hand["result"] = result;
+  job.result = result;
+  EXPECT_EQ(Dump(ToJson(job)), Dump(by_hand));
+  EXPECT_EQ(Dump(ToJson(job)).substr(Dump(ToJson(job)).find("\"result\"")),
+            R"("result":{"object_cells":10,"refined":false}})");
+}
+
+TEST(Replies, NoSiteIsNull) {
+  nlohmann::ordered_json by_hand = {
+      {"site", 0}, {"name", ""}, {"station", -1}, {"stations", nlohmann::ordered_json::array()}};
+  by_hand["site"] = nullptr;
+  EXPECT_EQ(Dump(ToJson(SiteReply{})), Dump(by_hand));
+  EXPECT_EQ(Dump(ToJson(SiteReply{})), R"({"site":null,"name":"","station":-1,"stations":[]})");
+  EXPECT_EQ(Dump(ToJson(SiteReply{3, "yard", 1, {}})),
+            R"({"site":3,"name":"yard","station":1,"stations":[]})");
+}
+
+TEST(Replies, FormatsHoldTheLibrarysTable) {
+  const nlohmann::ordered_json formats =
+      nlohmann::ordered_json::array({{{"extension", "ptx"}, {"label", false}, {"color", true}},
+                                     {{"extension", "las"}, {"label", "classification"}}});
+  nlohmann::ordered_json by_hand = {{"read", {"ptx", "las"}}, {"write", {"ptx"}}};
+  by_hand["formats"] = formats;
+  EXPECT_EQ(Dump(ToJson(FormatsReply{{"ptx", "las"}, {"ptx"}, formats})), Dump(by_hand));
 }
 
 TEST(Replies, JoinedKeepsTheResultsKeysFirstAndRefusesAKeyTwice) {

@@ -215,13 +215,12 @@ nlohmann::ordered_json JobJson(const Job& job) {
                  job.progress.label(),
                  job.progress.done(),
                  job.progress.total(),
+                 std::nullopt,
                  std::nullopt};
   std::lock_guard lock(const_cast<std::mutex&>(job.mutex));
   if (!job.error.empty()) reply.error = job.error;
-  nlohmann::ordered_json json = ToJson(reply);
-  // The operation's own reply (a described struct's JSON form, or several joined): JobReply cannot name its type.
-  if (!job.result.is_null()) json["result"] = job.result;
-  return json;
+  if (!job.result.is_null()) reply.result = job.result;
+  return ToJson(reply);
 }
 
 std::shared_ptr<Job> SubmitJob(State& state, const std::shared_ptr<Document>& document,

@@ -522,11 +522,8 @@ void AddScanRoutes(State& state) {
   });
   // The scan formats the library reads and writes (the open and save dialogs offer these).
   http.Get("/api/formats", [](const httplib::Request&, httplib::Response& response) {
-    // "formats": the registry as the library writes it (io/formats.h; its channels are false, true or a name).
-    nlohmann::ordered_json json =
-        ToJson(FormatsReply{SupportedScanReadExtensions(), SupportedScanWriteExtensions()});
-    json["formats"] = ScanFormatsJson();
-    SendJson(response, json);
+    SendJson(response, ToJson(FormatsReply{SupportedScanReadExtensions(), SupportedScanWriteExtensions(),
+                                           ScanFormatsJson()}));
   });
   http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
     SendJson(response, ToJson(ScenesReply{state.options.builtin_scenes}));

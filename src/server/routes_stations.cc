@@ -424,11 +424,7 @@ void AddStationRoutes(State& state) {
              const auto document = state.FindDocument(request, response);
              if (!document) return;
              const std::shared_ptr<Site> site = SiteOf(state, document->id).first;
-             if (!site) {
-               nlohmann::ordered_json json = ToJson(SiteReply{});
-               json["site"] = nullptr;  // no site (a described int has no null)
-               return SendJson(response, json);
-             }
+             if (!site) return SendJson(response, ToJson(SiteReply{}));
              SendJson(response, ToJson(SiteReplyOf(state, *site, document->id)));
            });
   // The cells the last Clean removed from this station, as it stands now: {"version", "cells": [row * cols +

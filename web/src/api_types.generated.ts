@@ -448,7 +448,7 @@ export interface PreparedReply {
   prepared: boolean;
 }
 
-// GET /api/jobs/ID: a job (its "result", the operation's reply, follows when it has one) (C++ JobReply)
+// GET /api/jobs/ID: a job and, once it has one, the operation's reply (C++ JobReply)
 export interface JobReply {
   // the job's id
   id: number;
@@ -466,6 +466,8 @@ export interface JobReply {
   total: number;
   // why it failed
   error?: string;
+  // the operation's own reply, once it has one (its type follows the kind)
+  result?: unknown;
 }
 
 // POST /api/docs/ID/photo and .../photo-from-e57: the photo taken (C++ PhotoReply)
@@ -646,12 +648,14 @@ export interface LabelsReply {
   labels: LabelEntry[];
 }
 
-// GET /api/formats (with the library's "formats" after it) (C++ FormatsReply)
+// GET /api/formats (C++ FormatsReply)
 export interface FormatsReply {
   // the extensions the library reads
   read: string[];
   // the extensions it writes
   write: string[];
+  // the library's table of formats (io/formats.h): one object per format, a channel false, true or the format's name for it
+  formats: unknown;
 }
 
 // GET /api/docs/ID/tiles.json (C++ TilesReply)
@@ -720,10 +724,10 @@ export interface ReviewDoneReply {
   version: number;
 }
 
-// a site: GET /api/docs/ID/stations (site null for a scan in none), GET /api/sites (C++ SiteReply)
+// a site: GET /api/docs/ID/stations, GET /api/sites (C++ SiteReply)
 export interface SiteReply {
-  // the site's id
-  site: number;
+  // the site's id; null for a scan in none
+  site: number | null;
   // its name
   name: string;
   // the document's station (-1: none)

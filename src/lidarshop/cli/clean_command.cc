@@ -6,7 +6,6 @@
 #include <vector>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/options_cli.h"
@@ -97,38 +96,28 @@ int RunClean(int argc, char** argv) {
         auto progress = Progress::ForTerminal("clean", pairs, quiet);
         const CleanResult result = CleanStations(stations, options, progress.get());
         if (progress) progress->Finish();
-        nlohmann::ordered_json per_station = nlohmann::ordered_json::array();
+        CleanSummary summary = SummarizeClean(stations, result);
         size_t next = 0;
-        int64_t removed = 0;
         for (size_t f = 0; f < files.size(); ++f) {
           std::vector<Scan> cleaned;
           for (size_t s = 0; s < files[f].scans.size(); ++s, ++next) {
             cleaned.push_back(result.stations[next]);
-            const StationTransients& found = result.transients.stations[next];
-            removed += found.transient_cells;
-            const std::string stem = fs::path(StationOutputName(inputs[f])).stem().string();
-            const std::string mask_path =
-                removed_masks ? MaskPath(out_dir, stem, s, files[f].scans.size()) : "";
-            if (removed_masks) WriteImage(mask_path, found.seen_through_by);
-            per_station.push_back({{"file", inputs[f]},
-                                   {"scan", s},
-                                   {"output", outputs[f]},
-                                   {"returns", stations[next].CountValid()},
-                                   {"removed", found.transient_cells},
-                                   {"seen_through", found.seen_through_cells},
-                                   {"confirmed", found.confirmed_cells},
-                                   {"filled", result.filled_cells[next]},
-                                   {"from_station", result.from_station_cells[next]},
-                                   {"removed_mask", mask_path}});
+            CleanStationSummary& station = summary.stations[next];
+            station.file = inputs[f];
+            station.scan = s;
+            station.output = outputs[f];
+            if (removed_masks) {
+              const std::string stem = fs::path(StationOutputName(inputs[f])).stem().string();
+              station.removed_mask = MaskPath(out_dir, stem, s, files[f].scans.size());
+              WriteImage(station.removed_mask, result.transients.stations[next].seen_through_by);
+            }
           }
           WriteScanFile(outputs[f], cleaned);
         }
         PrintResultWarnings(result.warnings);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), {{"stations", per_station},
-                                                                 {"removed", removed},
-                                                                 {"warnings", result.warnings}}));
-        Summarize(
-            fmt::format("{} stations: {} transient points removed -> {}", stations.size(), removed, out_dir));
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(summary)));
+        Summarize(fmt::format("{} stations: {} transient points removed -> {}", stations.size(),
+                              summary.removed, out_dir));
         return 0;
       },
       &binder);

@@ -12,6 +12,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/mesh_io.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop::cli {
 
@@ -76,7 +77,12 @@ void PrintResultWarnings(const std::vector<std::string>& warnings);
 // Commands whose JSON went to stdout before --json existed (info, images, resection, recolor, align) start
 // with *path = "-".
 CLI::Option* AddJsonOption(CLI::App& app, std::string* path, const std::string& names = "--json");
-// The JSON form of a command's run: the result's keys, then "options" (what it ran with).
+// What every command's --json ends with: the options it ran with (the JSON form of its options struct, or of
+// several: `register` with several MOVING gives RegisterSiteOptions').
+struct CommandOptions {
+  nlohmann::ordered_json options;
+};
+// The JSON form of a command's run: the result's keys, then CommandOptions' "options".
 nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
                                    const nlohmann::ordered_json& result);
 // Writes `json` to `path` ("-" = stdout, else atomically); nothing when `path` is empty. `indent` -1 = one line.
@@ -122,3 +128,8 @@ void AddMemoryOption(CLI::App& app);
 void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help);
 
 }  // namespace lidarshop::cli
+
+namespace lidarshop {
+template <>
+const StructInfo& InfoOf<cli::CommandOptions>();  // common.cc
+}  // namespace lidarshop

@@ -133,7 +133,7 @@ int RunCommand(CLI::App& app, int argc, char** argv, const std::function<int()>&
 nlohmann::ordered_json CommandJson(const nlohmann::ordered_json& options,
                                    const nlohmann::ordered_json& result) {
   nlohmann::ordered_json json = result;
-  json["options"] = options;
+  json.update(ToJson(CommandOptions{options}));  // after the result's keys (in its place if it had one)
   return json;
 }
 
@@ -313,3 +313,19 @@ void AddSeedOption(CLI::App& app, uint64_t* seed, const std::string& help) {
 }
 
 }  // namespace lidarshop::cli
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<cli::CommandOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::CommandOptions> b("CommandOptions", "the end of every command's --json");
+    b.Field(&cli::CommandOptions::options, "options",
+            "the options it ran with: its options struct's JSON form (docs/options.md, \"What each command "
+            "accepts\")");
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

@@ -28,12 +28,6 @@
 namespace lidarshop::cli {
 namespace {
 
-std::vector<std::vector<double>> MatrixRows(const Eigen::Matrix4d& matrix) {
-  std::vector<std::vector<double>> rows;
-  for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
-  return rows;
-}
-
 // The site: FIXED and every MOVING registered together; DIR receives the moved stations.
 int RegisterSiteCommand(const std::string& fixed_path, const std::vector<std::string>& moving_paths,
                         const std::string& output_dir, const std::string& json_path, const IcpOptions& icp,
@@ -86,41 +80,19 @@ int RegisterSiteCommand(const std::string& fixed_path, const std::vector<std::st
     moved.world_from_scanner = result.stations[k].world_from_scanner;
     WriteScanFile(outputs[k - 1], {moved});
   }
-  const double writing_seconds = writing.Seconds();
-
-  nlohmann::ordered_json station_list = nlohmann::ordered_json::array();
+  SiteRegistrationSummary summary = SummarizeSiteRegistration(result, 0);
+  summary.seconds.reading = reading_seconds;
+  summary.seconds.writing = writing.Seconds();
   double worst_rms = 0;
   for (size_t k = 0; k < stations.size(); ++k) {
-    const SiteStation& station = result.stations[k];
-    worst_rms = std::max(worst_rms, station.rms_m);
-    nlohmann::ordered_json entry = {
-        {"index", k},
-        {"input", inputs[k]},
-        {"output", k == 0 ? nlohmann::ordered_json(nullptr) : nlohmann::ordered_json(outputs[k - 1])},
-        {"fixed", k == 0}};
-    entry.update(SiteStationJson(station));
-    station_list.push_back(std::move(entry));
+    summary.stations[k].input = inputs[k];
+    if (k > 0) summary.stations[k].output = outputs[k - 1];
+    worst_rms = std::max(worst_rms, result.stations[k].rms_m);
   }
-  nlohmann::ordered_json pair_list = nlohmann::ordered_json::array();
   int in_graph = 0;
-  for (const SitePair& pair : result.pairs) {
-    in_graph += pair.in_graph;
-    pair_list.push_back(SitePairJson(pair));
-  }
-  nlohmann::ordered_json json = {{"stations", station_list},
-                                 {"pairs", pair_list},
-                                 {"graph_iterations", result.graph_iterations},
-                                 {"seconds",
-                                  {{"reading", reading_seconds},
-                                   {"overlap", result.seconds_overlap},
-                                   {"coarse", result.seconds_coarse},
-                                   {"fine", result.seconds_fine},
-                                   {"graph", result.seconds_graph},
-                                   {"writing", writing_seconds},
-                                   {"total", timer.Seconds()}}}};
-  nlohmann::ordered_json options = ToJson(icp);
-  options["site"] = ToJson(site);
-  WriteJsonOutput(json_path, CommandJson(options, json));
+  for (const SitePair& pair : result.pairs) in_graph += pair.in_graph;
+  summary.seconds.total = timer.Seconds();
+  WriteJsonOutput(json_path, CommandJson(ToJson(RegisterSiteOptions{icp, site}), ToJson(summary)));
   Summarize(
       fmt::format("site of {} stations registered onto {}: {} pairs in the graph, worst station RMS {:.4f} "
                   "m -> {}",
@@ -208,15 +180,9 @@ int RunRegister(int argc, char** argv) {
         const ScanRegistration result =
             RegisterScans(fixed.scans[0], moving.scans[0], options, use_global ? &global : nullptr);
         WriteScanFile(output_path, {result.registered});
-        nlohmann::ordered_json json = {
-            {"world_from_scanner", MatrixRows(result.registered.world_from_scanner)},
-            {"rms_m", result.icp.rms_m},
-            {"fitness", result.icp.fitness},
-            {"iterations", result.icp.iterations},
-            {"converged", result.icp.converged},
-            {"seconds", timer.Seconds()}};
-        if (use_global) json["global_options"] = ToJson(global);
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        ScanRegistrationSummary summary = SummarizeScanRegistration(result, use_global ? &global : nullptr);
+        summary.seconds = timer.Seconds();
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(summary)));
         Summarize(fmt::format("{} registered onto {}: RMS {:.4f} m, fitness {:.3f}, {} iterations{} -> {}",
                               moving_path, fixed_path, result.icp.rms_m, result.icp.fitness,
                               result.icp.iterations, result.icp.converged ? "" : " (not converged)",

@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "api_types.h"
+#include "lidarshop/cli/command_line.h"
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/cli/demo_page.h"
 #include "lidarshop/cli/points_operations.h"
@@ -36,6 +37,7 @@
 #include "lidarshop/scanner/scene.h"
 #include "lidarshop/scanner/site_scan.h"
 #include "lidarshop/site/from_stations.h"
+#include "lidarshop/site/transients.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/options_markdown.h"
@@ -100,7 +102,13 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            OptionsType<PointsOptions>(),            // points
            OptionsType<IcpOptions>(),               // register
            OptionsType<GlobalAlignOptions>(),       // register --global
+           ResultType<ScanRegistrationSummary>(),   // register --json
            OptionsType<SiteRegistrationOptions>(),  // register, several MOVING
+           OptionsType<RegisterSiteOptions>(),      // register, several MOVING: --json's "options"
+           ResultType<SiteRegistrationSummary>(),   // register, several MOVING --json
+           ResultType<CleanSummary>(),              // clean --json
+           ResultType<cli::StepsReport>(),          // steps --json
+           ResultType<cli::CommandOptions>(),       // every command's --json: "options"
        }) {
     structs.push_back(entry);
   }

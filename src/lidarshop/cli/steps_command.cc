@@ -27,6 +27,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
 #include "lidarshop/util/memory_budget.h"
+#include "lidarshop/util/options.h"
 #include "lidarshop/util/timer.h"
 
 namespace lidarshop::cli {
@@ -179,18 +180,15 @@ int RunSteps(int argc, char** argv) {
     CheckOutputFile("--json", json_path, {"json"}, {steps_path});
     const std::vector<std::vector<std::string>> steps = ReadSteps(steps_path);
     const int64_t budget = MemoryBudgetBytes();  // `steps`' own --max-memory, or the default
-    nlohmann::ordered_json report = {{"steps", nlohmann::ordered_json::array()}, {"exit", nullptr}};
+    StepsReport report;
     const bool to_file = json_path != "-";
     int64_t stderr_offset = 0;
     int code = kExitOk;
     for (const std::vector<std::string>& step : steps) {
-      nlohmann::ordered_json& entry =
-          report["steps"].emplace_back(nlohmann::ordered_json{{"command", step[0]},
-                                                              {"exit", nullptr},
-                                                              {"seconds", nullptr},
-                                                              {"message", nullptr},
-                                                              {"stderr_offset", stderr_offset}});
-      if (to_file) WriteJsonOutput(json_path, report);
+      StepReport& entry = report.steps.emplace_back();
+      entry.command = step[0];
+      entry.stderr_offset = stderr_offset;
+      if (to_file) WriteJsonOutput(json_path, ToJson(report));
       SetMemoryBudgetBytes(budget);
       ForgetProtectedInputs();
       std::vector<std::string> arguments = step;
@@ -201,17 +199,50 @@ int RunSteps(int argc, char** argv) {
       StderrTap tap;
       code = RunCommandLine(static_cast<int>(arguments.size()), pointers.data());
       const std::string message = tap.Finish();
-      entry["exit"] = code;
-      entry["seconds"] = timer.Seconds();
-      entry["message"] = message;
+      entry.exit = code;
+      entry.seconds = timer.Seconds();
+      entry.message = message;
       stderr_offset += tap.bytes();
       if (code != kExitOk) break;
     }
-    report["exit"] = code;
-    WriteJsonOutput(json_path, report);
+    report.exit = code;
+    WriteJsonOutput(json_path, ToJson(report));
     if (code == kExitOk) Summarize(fmt::format("ran {} step(s)", steps.size()));
     return code;
   });
 }
 
 }  // namespace lidarshop::cli
+
+namespace lidarshop {
+
+template <>
+const StructInfo& InfoOf<cli::StepReport>() {
+  static const StructInfo info = [] {
+    using Step = cli::StepReport;
+    StructBuilder<Step> b("StepReport", "a step of steps --json (null: it has not ended)");
+    b.Field(&Step::command, "command", "the step's command");
+    b.Field(&Step::exit, "exit", "its exit code").NullWhenAbsent();
+    b.Field(&Step::seconds, "seconds", "its wall time").Unit("s").NullWhenAbsent();
+    b.Field(&Step::message, "message", "its last line on stderr that is not blank").NullWhenAbsent();
+    b.Field(&Step::stderr_offset, "stderr_offset", "bytes this process had written to stderr before it")
+        .Unit("bytes");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<cli::StepsReport>() {
+  static const StructInfo info = [] {
+    StructBuilder<cli::StepsReport> b("StepsReport", "the --json of steps: the steps run so far");
+    b.Field(&cli::StepsReport::steps, "steps", "the steps started, in order");
+    b.Field(&cli::StepsReport::exit, "exit",
+            "the failed step's exit code, 0 when all succeeded; null until the end")
+        .NullWhenAbsent();
+    return b.Build();
+  }();
+  return info;
+}
+
+}  // namespace lidarshop

@@ -11,7 +11,6 @@
 #include "lidarshop/cli/options_cli.h"
 #include "lidarshop/io/image_io.h"
 #include "lidarshop/io/mesh_io.h"
-#include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/scanner/primitives.h"
 #include "lidarshop/util/atomic_file.h"
@@ -32,30 +31,6 @@ std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
     for (const Scan& scan : file.scans) scans.push_back(PrepareScan(scan));
   }
   return scans;
-}
-
-// `json` with the key `key` = `value` inserted before `before` (at the end when there is none).
-nlohmann::ordered_json InsertBefore(const nlohmann::ordered_json& json, const std::string& before,
-                                    const std::string& key, const nlohmann::ordered_json& value) {
-  nlohmann::ordered_json out = nlohmann::ordered_json::object();
-  for (const auto& [name, item] : json.items()) {
-    if (name == before) out[key] = value;
-    out[name] = item;
-  }
-  if (!out.contains(key)) out[key] = value;
-  return out;
-}
-
-// The described JSON form of a sweep's summary or report with each detection's pose (4 rows of 4; the
-// schema has no kind for a matrix yet) in its place among the detection's sorted keys.
-nlohmann::ordered_json WithDetectionPoses(nlohmann::ordered_json json,
-                                          const std::vector<Detection>& detections) {
-  for (size_t i = 0; i < detections.size(); ++i) {
-    nlohmann::json sorted = json["detections"][i];
-    sorted["world_from_model"] = MatrixJson(detections[i].world_from_model);
-    json["detections"][i] = sorted;
-  }
-  return json;
 }
 
 void WriteText(const std::string& path, const std::string& text) {
@@ -207,10 +182,8 @@ int RunVerify(int argc, char** argv) {
         options.keep_details = !scene_ply.empty() || !model_ply.empty();
         const VerifyResult result = VerifyPose(model, scans, world_from_model, options);
         Summarize(result.BriefReport());
-        const VerifyReport report = MakeVerifyReport(result, model, common.model_options);
-        const nlohmann::ordered_json json =
-            InsertBefore(ToJson(report), "model_points", "world_from_model", MatrixJson(world_from_model));
-        WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
+        const VerifyReport report = MakeVerifyReport(result, model, common.model_options, world_from_model);
+        WriteJsonOutput(json_path, CommandJson(ToJson(options), ToJson(report)));
         if (!scene_ply.empty()) WritePointCloud(scene_ply, SceneStatusCloud(scans, result));
         if (!model_ply.empty())
           WritePointCloud(model_ply, ObservedModelCloud(model, world_from_model, result));
@@ -288,10 +261,8 @@ int RunSweep(int argc, char** argv) {
         const SweepReport report{.summary = SummarizeSweep(sweep, sweep_options),
                                  .verify_options = common.verify,
                                  .model_options = common.model_options};
-        WriteText((out / "detections.json").string(),
-                  WithDetectionPoses(ToJson(report.summary), sweep.detections).dump(2) + "\n");
-        const nlohmann::ordered_json result = WithDetectionPoses(ToJson(report), sweep.detections);
-        WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), result));
+        WriteText((out / "detections.json").string(), ToJson(report.summary).dump(2) + "\n");
+        WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), ToJson(report)));
         if (!common.quiet) {
           for (const Detection& d : sweep.detections) {
             fmt::print(stderr,

@@ -76,4 +76,18 @@ std::string PoseProblem(const Eigen::Matrix4d& pose, bool allow_uniform_scale) {
   return "";
 }
 
+Eigen::Matrix4d RoundedPose(const Eigen::Matrix4d& pose) {
+  constexpr double kStep = 1e-9;
+  Eigen::Matrix4d rounded = pose;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      const double value = pose(r, c);
+      if (!std::isfinite(value)) continue;
+      rounded(r, c) = std::round(value / kStep) * kStep;
+      if (rounded(r, c) == 0.0) rounded(r, c) = 0.0;  // no -0
+    }
+  }
+  return rounded;
+}
+
 }  // namespace lidarshop

@@ -48,4 +48,9 @@ constexpr double kMaxCoordinateM = 1e7;
 // [1e-6, 1e6] when `allow_uniform_scale`, else a rotation within 1e-4.
 std::string PoseProblem(const Eigen::Matrix4d& pose, bool allow_uniform_scale);
 
+// `pose` as results report it to people: every entry rounded to a multiple of 1e-9 (a nanometre for the
+// translation), which also drops a rotation's 1e-17 noise (1.0000000000000002 becomes 1), and -0 made 0;
+// non-finite entries stay. The same numbers as io's MatrixJson (io/scan_header.h) writes.
+Eigen::Matrix4d RoundedPose(const Eigen::Matrix4d& pose);
+
 }  // namespace lidarshop

@@ -104,6 +104,142 @@ const StructInfo& InfoOf<SiteRegistrationOptions>() {
 }
 
 template <>
+const StructInfo& InfoOf<IcpResult>() {
+  static const StructInfo info = [] {
+    StructBuilder<IcpResult> b("IcpResult", "a point-to-plane ICP's numbers");
+    b.Field(&IcpResult::rms_m, "rms_m", "point-to-plane RMS of the last correspondences").Unit("m");
+    b.Field(&IcpResult::fitness, "fitness", "share of the moving points with a correspondence at the end");
+    b.Field(&IcpResult::correspondences, "correspondences", "point pairs at the end");
+    b.Field(&IcpResult::iterations, "iterations", "iterations run");
+    b.Field(&IcpResult::converged, "converged", "the last update moved and turned less than the thresholds");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanRegistrationSummary>() {
+  static const StructInfo info = [] {
+    using Summary = ScanRegistrationSummary;
+    StructBuilder<Summary> b("ScanRegistrationSummary",
+                             "the --json of register FIXED MOVING: MOVING's new pose and its ICP");
+    b.Field(&Summary::world_from_scanner, "world_from_scanner",
+            "the moving scan's registered pose, 4 rows of 4 (scanner to world)");
+    b.Field(&Summary::rms_m, "rms_m", "point-to-plane RMS of the last correspondences").Unit("m");
+    b.Field(&Summary::fitness, "fitness", "share of the moving points with a correspondence at the end");
+    b.Field(&Summary::iterations, "iterations", "ICP iterations run");
+    b.Field(&Summary::converged, "converged", "the last update moved and turned less than the thresholds");
+    b.Field(&Summary::seconds, "seconds", "reading the scans and registering them").Unit("s");
+    b.Field(&Summary::global_options, "global_options", "the global alignment's options (--global only)");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RegisterSiteOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RegisterSiteOptions> b(
+        "RegisterSiteOptions", "a site's registration: the pairs' ICP (its keys here) and the site's");
+    b.Flatten(&RegisterSiteOptions::icp);
+    b.Field(&RegisterSiteOptions::site, "site", "the site's options");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SiteStation>() {
+  static const StructInfo info = [] {
+    StructBuilder<SiteStation> b("SiteStation", "a station of a registered site");
+    b.Field(&SiteStation::world_from_scanner, "world_from_scanner",
+            "its registered pose, 4 rows of 4 (scanner to world)");
+    b.Field(&SiteStation::moved_m, "moved_m", "how far the registration moved the scanner's origin")
+        .Unit("m");
+    b.Field(&SiteStation::turned_deg, "turned_deg", "and turned it").Unit("deg");
+    b.Field(&SiteStation::pairs, "pairs", "its pairs in the graph");
+    b.Field(&SiteStation::rms_m, "rms_m", "point-to-plane RMS over its pairs in the graph").Unit("m");
+    b.Field(&SiteStation::graph_translation_m, "graph_translation_m",
+            "the largest disagreement of its pairs with the graph")
+        .Unit("m");
+    b.Field(&SiteStation::graph_rotation_deg, "graph_rotation_deg", "and in rotation").Unit("deg");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SitePair>() {
+  static const StructInfo info = [] {
+    StructBuilder<SitePair> b("SitePair", "a pair of overlapping stations, registered by the fine pass");
+    b.Field(&SitePair::a, "a", "its first station's index");
+    b.Field(&SitePair::b, "b", "its second station's index, > a");
+    b.Field(&SitePair::overlap, "overlap", "share of b's sampled points near a's at the poses given");
+    b.Field(&SitePair::in_graph, "in_graph", "its fitness reached min_fitness: the pose graph uses it");
+    b.Flatten(&SitePair::icp);
+    b.Field(&SitePair::graph_translation_m, "graph_translation_m",
+            "after the graph: how far the poses disagree with the measurement")
+        .Unit("m");
+    b.Field(&SitePair::graph_rotation_deg, "graph_rotation_deg", "and by how much they turn from it")
+        .Unit("deg");
+    b.Field(&SitePair::a_from_b_measured, "a_from_b",
+            "the measured pose, 4 rows of 4 (scanner b to scanner a)");
+    b.Field(&SitePair::seconds, "seconds", "the pair's ICP").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SiteStationSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<SiteStationSummary> b("SiteStationSummary",
+                                        "a station of register --json: its files, then its "
+                                        "registration (SiteStation's keys)");
+    b.Field(&SiteStationSummary::index, "index", "its index, from 0 (0: FIXED)");
+    b.Field(&SiteStationSummary::input, "input", "the scan read (FILE or FILE#N)");
+    b.Field(&SiteStationSummary::output, "output", "the scan written; null for the fixed station")
+        .NullWhenAbsent();
+    b.Field(&SiteStationSummary::fixed, "fixed", "the station held");
+    b.Flatten(&SiteStationSummary::registration);
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SiteRegistrationSeconds>() {
+  static const StructInfo info = [] {
+    using Seconds = SiteRegistrationSeconds;
+    StructBuilder<Seconds> b("SiteRegistrationSeconds", "where a site's registration spent its time");
+    b.Field(&Seconds::reading, "reading", "reading the stations").Unit("s");
+    b.Field(&Seconds::overlap, "overlap", "finding the overlapping pairs").Unit("s");
+    b.Field(&Seconds::coarse, "coarse", "the coarse pass").Unit("s");
+    b.Field(&Seconds::fine, "fine", "the fine pass").Unit("s");
+    b.Field(&Seconds::graph, "graph", "the pose graph").Unit("s");
+    b.Field(&Seconds::writing, "writing", "writing the moved stations").Unit("s");
+    b.Field(&Seconds::total, "total", "everything").Unit("s");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<SiteRegistrationSummary>() {
+  static const StructInfo info = [] {
+    using Summary = SiteRegistrationSummary;
+    StructBuilder<Summary> b("SiteRegistrationSummary",
+                             "the --json of register FIXED MOVING1 MOVING2 ...: a site registered");
+    b.Field(&Summary::stations, "stations", "every station, in order");
+    b.Field(&Summary::pairs, "pairs", "every overlapping pair");
+    b.Field(&Summary::graph_iterations, "graph_iterations", "Gauss-Newton steps of the pose graph taken");
+    b.Field(&Summary::seconds, "seconds", "where the time went");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<EuclideanClusterOptions>() {
   static const StructInfo info = [] {
     StructBuilder<EuclideanClusterOptions> b("EuclideanClusterOptions", "Euclidean clustering");

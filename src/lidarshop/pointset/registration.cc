@@ -152,4 +152,16 @@ ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpO
   return out;
 }
 
+ScanRegistrationSummary SummarizeScanRegistration(const ScanRegistration& registration,
+                                                  const GlobalAlignOptions* global) {
+  ScanRegistrationSummary summary;
+  summary.world_from_scanner = registration.registered.world_from_scanner;
+  summary.rms_m = registration.icp.rms_m;
+  summary.fitness = registration.icp.fitness;
+  summary.iterations = registration.icp.iterations;
+  summary.converged = registration.icp.converged;
+  if (global != nullptr) summary.global_options = *global;
+  return summary;
+}
+
 }  // namespace lidarshop

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 
 #include <Eigen/Core>
 
@@ -42,6 +43,10 @@ struct IcpResult {
   int iterations = 0;
   bool converged = false;
 };
+// Described: its numbers (rms_m ... converged). fixed_from_moving is not: a result holding an IcpResult
+// reports the pose its caller knows (SitePair's a_from_b, ScanRegistrationSummary's world_from_scanner).
+template <>
+const StructInfo& InfoOf<IcpResult>();
 
 // Point-to-plane ICP. Uses fixed.normals when present (else estimates them). Throws InputError on empty or
 // degenerate clouds and when no correspondence is found within max_correspondence_m from the initial guess.
@@ -57,5 +62,24 @@ struct ScanRegistration {
 };
 ScanRegistration RegisterScans(const Scan& fixed, const Scan& moving, const IcpOptions& options,
                                const GlobalAlignOptions* global = nullptr);
+
+// What `lidarshop register FIXED MOVING --json` reports: the moving scan's registered pose and its ICP's
+// numbers.
+struct ScanRegistrationSummary {
+  Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();  // the moving scan's, registered
+  double rms_m = 0.0;                                                // IcpResult::rms_m, metres
+  double fitness = 0.0;                                              // IcpResult::fitness, [0, 1]
+  int iterations = 0;                                                // IcpResult::iterations
+  bool converged = false;                                            // IcpResult::converged
+  double seconds = 0.0;                              // the caller's: reading the scans and registering them
+  std::optional<GlobalAlignOptions> global_options;  // the global alignment's options, when it ran first
+};
+template <>
+const StructInfo& InfoOf<ScanRegistrationSummary>();
+
+// The summary of `registration`, made by RegisterScans with `global` (nullptr: no global alignment); seconds
+// is left 0.
+ScanRegistrationSummary SummarizeScanRegistration(const ScanRegistration& registration,
+                                                  const GlobalAlignOptions* global = nullptr);
 
 }  // namespace lidarshop

@@ -305,38 +305,21 @@ SiteRegistration RegisterSite(const std::vector<Scan>& stations, int fixed, cons
   return out;
 }
 
-namespace {
-std::vector<std::vector<double>> Rows(const Eigen::Matrix4d& matrix) {
-  std::vector<std::vector<double>> rows;
-  for (int r = 0; r < 4; ++r) rows.push_back({matrix(r, 0), matrix(r, 1), matrix(r, 2), matrix(r, 3)});
-  return rows;
-}
-}  // namespace
-
-nlohmann::ordered_json SiteStationJson(const SiteStation& station) {
-  return {{"world_from_scanner", Rows(station.world_from_scanner)},
-          {"moved_m", station.moved_m},
-          {"turned_deg", station.turned_deg},
-          {"pairs", station.pairs},
-          {"rms_m", station.rms_m},
-          {"graph_translation_m", station.graph_translation_m},
-          {"graph_rotation_deg", station.graph_rotation_deg}};
-}
-
-nlohmann::ordered_json SitePairJson(const SitePair& pair) {
-  return {{"a", pair.a},
-          {"b", pair.b},
-          {"overlap", pair.overlap},
-          {"in_graph", pair.in_graph},
-          {"rms_m", pair.icp.rms_m},
-          {"fitness", pair.icp.fitness},
-          {"correspondences", pair.icp.correspondences},
-          {"iterations", pair.icp.iterations},
-          {"converged", pair.icp.converged},
-          {"graph_translation_m", pair.graph_translation_m},
-          {"graph_rotation_deg", pair.graph_rotation_deg},
-          {"a_from_b", Rows(pair.a_from_b_measured)},
-          {"seconds", pair.seconds}};
+SiteRegistrationSummary SummarizeSiteRegistration(const SiteRegistration& registration, int fixed) {
+  SiteRegistrationSummary summary;
+  for (size_t k = 0; k < registration.stations.size(); ++k) {
+    SiteStationSummary& station = summary.stations.emplace_back();
+    station.index = static_cast<int>(k);
+    station.fixed = static_cast<int>(k) == fixed;
+    station.registration = registration.stations[k];
+  }
+  summary.pairs = registration.pairs;
+  summary.graph_iterations = registration.graph_iterations;
+  summary.seconds.overlap = registration.seconds_overlap;
+  summary.seconds.coarse = registration.seconds_coarse;
+  summary.seconds.fine = registration.seconds_fine;
+  summary.seconds.graph = registration.seconds_graph;
+  return summary;
 }
 
 }  // namespace lidarshop

@@ -18,11 +18,11 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
 #include "lidarshop/pointset/registration.h"
 #include "lidarshop/scan/scan.h"
 #include "lidarshop/util/options_fwd.h"
@@ -48,6 +48,15 @@ struct SiteRegistrationOptions {
 };
 template <>
 const StructInfo& InfoOf<SiteRegistrationOptions>();
+
+// The options RegisterSite takes, together: what `lidarshop register --json` reports as a site's "options"
+// (the ICP's keys, then "site").
+struct RegisterSiteOptions {
+  IcpOptions icp;                // the pairs' ICP
+  SiteRegistrationOptions site;  // the site's
+};
+template <>
+const StructInfo& InfoOf<RegisterSiteOptions>();
 
 // One registered pair (fine pass).
 struct SitePair {
@@ -78,12 +87,51 @@ struct SiteRegistration {
   double seconds_overlap = 0, seconds_coarse = 0, seconds_fine = 0, seconds_graph = 0;
 };
 
-// The JSON form of a station's and a pair's result, which `lidarshop register --json` and Python's register_site
-// give: a station's world_from_scanner (rows), moved_m, turned_deg, pairs, rms_m and graph residuals; a pair's a,
-// b, overlap, in_graph, its ICP (rms_m, fitness, correspondences, iterations, converged), graph residuals,
-// a_from_b (rows) and seconds.
-nlohmann::ordered_json SiteStationJson(const SiteStation& station);
-nlohmann::ordered_json SitePairJson(const SitePair& pair);
+// Described as `lidarshop register --json` and Python's register_site give them: a station's
+// world_from_scanner (rows), moved_m, turned_deg, pairs, rms_m and graph residuals; a pair's a, b, overlap,
+// in_graph, its ICP (rms_m, fitness, correspondences, iterations, converged), graph residuals, a_from_b
+// (rows) and seconds.
+template <>
+const StructInfo& InfoOf<SiteStation>();
+template <>
+const StructInfo& InfoOf<SitePair>();
+
+// One station as `lidarshop register --json` lists it: its index, the files it came from and went to, and
+// its registration (SiteStation's keys at this level).
+struct SiteStationSummary {
+  int index = 0;                      // in the list given to RegisterSite
+  std::string input;                  // the caller's: where it was read from
+  std::optional<std::string> output;  // the caller's: where it was written (none for the fixed station)
+  bool fixed = false;                 // the station held
+  SiteStation registration;
+};
+template <>
+const StructInfo& InfoOf<SiteStationSummary>();
+
+// Where a site's registration spent its time, seconds: RegisterSite's steps, and the caller's reading and
+// writing of the stations and its whole run.
+struct SiteRegistrationSeconds {
+  double reading = 0;  // the caller's
+  double overlap = 0, coarse = 0, fine = 0, graph = 0;
+  double writing = 0;  // the caller's
+  double total = 0;    // the caller's
+};
+template <>
+const StructInfo& InfoOf<SiteRegistrationSeconds>();
+
+// What `lidarshop register FIXED MOVING1 MOVING2 ... --json` reports (docs/stations.md).
+struct SiteRegistrationSummary {
+  std::vector<SiteStationSummary> stations;  // one per station, in order
+  std::vector<SitePair> pairs;               // every overlapping pair
+  int graph_iterations = 0;                  // Gauss-Newton steps of the pose graph taken
+  SiteRegistrationSeconds seconds;
+};
+template <>
+const StructInfo& InfoOf<SiteRegistrationSummary>();
+
+// The summary of `registration`, made by RegisterSite with station `fixed` held; the file names and the
+// caller's seconds are left empty.
+SiteRegistrationSummary SummarizeSiteRegistration(const SiteRegistration& registration, int fixed);
 
 // Registers `stations` (their world_from_scanner as the initial guess) with `stations[fixed]` held. Throws
 // InputError when a station overlaps no other (naming it), when the stations do not form one connected

@@ -69,6 +69,61 @@ const StructInfo& InfoOf<CleanOptions>() {
   return info;
 }
 
+template <>
+const StructInfo& InfoOf<CleanStationSummary>() {
+  static const StructInfo info = [] {
+    using Station = CleanStationSummary;
+    StructBuilder<Station> b("CleanStationSummary", "a station of clean --json");
+    b.Field(&Station::file, "file", "the file it was read from");
+    b.Field(&Station::scan, "scan", "its scan in that file, from 0");
+    b.Field(&Station::output, "output", "the file it was written to");
+    b.Field(&Station::returns, "returns", "cells with a return before the clean").Unit("cells");
+    b.Field(&Station::removed, "removed", "transient cells removed").Unit("cells");
+    b.Field(&Station::seen_through, "seen_through",
+            "cells another station saw through (before the region filter and growth)")
+        .Unit("cells");
+    b.Field(&Station::confirmed, "confirmed", "cells another station measured the same (static)")
+        .Unit("cells");
+    b.Field(&Station::filled, "filled", "hole cells the fill gave a synthesized return").Unit("cells");
+    b.Field(&Station::from_station, "from_station", "hole cells given another station's measurement")
+        .Unit("cells");
+    b.Field(&Station::removed_mask, "removed_mask",
+            "the picture of the removed cells (--removed-masks), \"\" for none");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<CleanSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<CleanSummary> b("CleanSummary", "the --json of clean: what moved, removed and filled");
+    b.Field(&CleanSummary::stations, "stations", "every station, in order");
+    b.Field(&CleanSummary::removed, "removed", "transient cells removed, every station").Unit("cells");
+    b.Field(&CleanSummary::warnings, "warnings",
+            "the fills' warnings, naming the station, one sentence each");
+    return b.Build();
+  }();
+  return info;
+}
+
+CleanSummary SummarizeClean(const std::vector<Scan>& stations, const CleanResult& result) {
+  CleanSummary summary;
+  for (size_t k = 0; k < stations.size(); ++k) {
+    const StationTransients& found = result.transients.stations[k];
+    CleanStationSummary& station = summary.stations.emplace_back();
+    station.returns = stations[k].CountValid();
+    station.removed = found.transient_cells;
+    station.seen_through = found.seen_through_cells;
+    station.confirmed = found.confirmed_cells;
+    station.filled = result.filled_cells[k];
+    station.from_station = result.from_station_cells[k];
+    summary.removed += found.transient_cells;
+  }
+  summary.warnings = result.warnings;
+  return summary;
+}
+
 namespace {
 
 constexpr uint8_t kNoEvidence = 0, kSeenThrough = 1, kConfirmed = 2;

@@ -94,4 +94,34 @@ struct CleanResult {
 CleanResult CleanStations(const std::vector<Scan>& stations, const CleanOptions& options = {},
                           Progress* progress = nullptr);
 
+// One station of a clean as `lidarshop clean --json` lists it: what was removed and filled, and where the
+// station came from and went to (the caller's: left empty by SummarizeClean).
+struct CleanStationSummary {
+  std::string file;          // the caller's: the file it was read from (FILE or FILE#N)
+  uint64_t scan = 0;         // the caller's: its scan in that file, from 0
+  std::string output;        // the caller's: the file it was written to
+  int64_t returns = 0;       // cells with a return before the clean
+  int64_t removed = 0;       // StationTransients::transient_cells
+  int64_t seen_through = 0;  // StationTransients::seen_through_cells
+  int64_t confirmed = 0;     // StationTransients::confirmed_cells
+  int64_t filled = 0;        // CleanResult::filled_cells
+  int64_t from_station = 0;  // CleanResult::from_station_cells
+  std::string removed_mask;  // the caller's: the picture of the removed cells written, "" for none
+};
+template <>
+const StructInfo& InfoOf<CleanStationSummary>();
+
+// What `lidarshop clean --json` reports.
+struct CleanSummary {
+  std::vector<CleanStationSummary> stations;  // one per station, in order
+  int64_t removed = 0;                        // transient cells removed, every station
+  std::vector<std::string> warnings;          // CleanResult::warnings
+};
+template <>
+const StructInfo& InfoOf<CleanSummary>();
+
+// The summary of `result`, the clean of `stations` (as given to CleanStations); the caller's fields left
+// empty.
+CleanSummary SummarizeClean(const std::vector<Scan>& stations, const CleanResult& result);
+
 }  // namespace lidarshop

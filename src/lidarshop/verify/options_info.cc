@@ -186,11 +186,13 @@ template <>
 const StructInfo& InfoOf<VerifyReport>() {
   static const StructInfo info = [] {
     StructBuilder<VerifyReport> b("VerifyReport",
-                                  "lidarshop verify --json: VerifyResult's keys, per scan, and the model "
-                                  "(world_from_model, 4 rows of 4, follows per_scan)");
+                                  "lidarshop verify --json: VerifyResult's keys, per scan, the pose and the "
+                                  "model");
     b.Flatten(&VerifyReport::result);
     b.Field(&VerifyReport::icp_cost, "icp_cost", "= icp_cost_m (older key)").Unit("m");
     b.Field(&VerifyReport::per_scan, "per_scan", "each scan's numbers, in the order of --scan");
+    b.Field(&VerifyReport::world_from_model, "world_from_model",
+            "the pose verified, 4 rows of 4 (model to world), rounded to 1e-9");
     b.Field(&VerifyReport::model_points, "model_points", "model points verified");
     b.Field(&VerifyReport::model_options, "model_options", "how the model points were made");
     return b.Build();
@@ -201,14 +203,14 @@ const StructInfo& InfoOf<VerifyReport>() {
 template <>
 const StructInfo& InfoOf<Detection>() {
   static const StructInfo info = [] {
-    StructBuilder<Detection> b("Detection",
-                               "a sweep's pose that passed both thresholds (world_from_model, 4 rows of 4, "
-                               "follows inlier_fraction)");
+    StructBuilder<Detection> b("Detection", "a sweep's pose that passed both thresholds");
     b.Field(&Detection::comparable_pairs, "comparable_pairs", "scan point / model pairs compared");
     b.Field(&Detection::confidence, "confidence", "information of the model seen by the scans, [0, 1]");
     b.Field(&Detection::consistency, "consistency", "share of comparable pairs that agree");
     b.Field(&Detection::icp_cost_m, "icp_cost", "trimmed ICP cost; null = no inlier pair").Unit("m");
     b.Field(&Detection::inlier_fraction, "inlier_fraction", "inliers / scene points near the model");
+    b.Field(&Detection::world_from_model, "world_from_model",
+            "the pose, 4 rows of 4 (model to world); rounded to 1e-9 in a sweep's summary");
     b.Field(&Detection::x_m, "x_m", "world x of the model origin").Unit("m");
     b.Field(&Detection::y_m, "y_m", "world y of the model origin").Unit("m");
     b.Field(&Detection::yaw_deg, "yaw_deg", "yaw about +z").Unit("deg");

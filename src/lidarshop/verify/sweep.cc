@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
@@ -360,6 +361,8 @@ SweepResult Sweep(const VerifierModel& model, std::span<const PreparedScan> scan
 SweepSummary SummarizeSweep(const SweepResult& sweep, const SweepOptions& options) {
   SweepSummary summary;
   summary.detections = sweep.detections;
+  for (Detection& detection : summary.detections)
+    detection.world_from_model = RoundedPose(detection.world_from_model);
   summary.thresholds = {.min_comparable_pairs = options.min_comparable_pairs,
                         .min_confidence = options.min_confidence,
                         .min_consistency = options.min_consistency,

@@ -103,9 +103,9 @@ struct SweepResult {
   double nms_radius_m = 0;            // the radius used
 };
 
-// Described (keys in alphabetical order, as detections.json has always been written):
+// Described with its keys in alphabetical order, as detections.json has always been written.
 template <>
-const StructInfo& InfoOf<Detection>();  // without world_from_model: the schema has no kind for a matrix yet
+const StructInfo& InfoOf<Detection>();
 
 // The thresholds a sweep's detections passed.
 struct SweepThresholds {
@@ -131,10 +131,10 @@ struct SweepGridSummary {
 template <>
 const StructInfo& InfoOf<SweepGridSummary>();
 
-// A sweep's outcome without its pictures and poses (detections.json; the detections' world_from_model is
-// added by the command).
+// A sweep's outcome without its pictures and poses (detections.json).
 struct SweepSummary {
-  std::vector<Detection> detections;  // by decreasing confidence
+  // By decreasing confidence; each world_from_model rounded as reported (geometry/transform.h RoundedPose).
+  std::vector<Detection> detections;
   SweepGridSummary grid;
   SweepThresholds thresholds;
 };

@@ -563,7 +563,7 @@ std::vector<VerifyResult> VerifyPoses(const VerifierModel& model, std::span<cons
 }
 
 VerifyReport MakeVerifyReport(const VerifyResult& result, const VerifierModel& model,
-                              const ModelOptions& model_options) {
+                              const ModelOptions& model_options, const Eigen::Matrix4d& world_from_model) {
   VerifyReport report;
   report.result = result;
   report.result.per_scan.clear();
@@ -571,6 +571,7 @@ VerifyReport MakeVerifyReport(const VerifyResult& result, const VerifierModel& m
   report.result.observed_information.clear();
   report.icp_cost = result.icp_cost_m;
   report.per_scan = result.per_scan;
+  report.world_from_model = RoundedPose(world_from_model);
   report.model_points = static_cast<int64_t>(model.num_points());
   report.model_options = model_options;
   return report;

@@ -225,21 +225,22 @@ template <>
 const StructInfo& InfoOf<ScanVerifyStats>();
 
 // What `lidarshop verify --json` reports: the pose's VerifyResult (its keys at the report's own level), each
-// scan's numbers and the model's. The pose itself ("world_from_model", 4 rows of 4) is written by the command
-// after per_scan: the schema has no kind for a matrix yet.
+// scan's numbers, the pose verified and the model's.
 struct VerifyReport {
   VerifyResult result;                                         // written flat: consistency ... icp_candidates
   double icp_cost = std::numeric_limits<double>::quiet_NaN();  // metres, = result.icp_cost_m (older key)
   std::vector<ScanVerifyStats> per_scan;                       // = result.per_scan, by scan
-  int64_t model_points = 0;                                    // VerifierModel::num_points()
-  ModelOptions model_options;                                  // how the model points were made
+  // The pose verified, rounded as reported (geometry/transform.h RoundedPose).
+  Eigen::Matrix4d world_from_model = Eigen::Matrix4d::Identity();
+  int64_t model_points = 0;    // VerifierModel::num_points()
+  ModelOptions model_options;  // how the model points were made
 };
 template <>
 const StructInfo& InfoOf<VerifyReport>();
 
-// The report of `result`, verified against `model` made with `model_options`.
+// The report of `result`, the pose `world_from_model` verified against `model` made with `model_options`.
 VerifyReport MakeVerifyReport(const VerifyResult& result, const VerifierModel& model,
-                              const ModelOptions& model_options);
+                              const ModelOptions& model_options, const Eigen::Matrix4d& world_from_model);
 
 // Verifies one pose. `world_from_model` is a rotation times one uniform scale s plus a translation
 // (geometry/transform.h PoseProblem; std::invalid_argument otherwise). Every distance of the measures stays
