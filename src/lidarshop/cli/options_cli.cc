@@ -131,8 +131,8 @@ nlohmann::json ParseFlagValue(const FieldInfo& field, const std::string& text) {
       as_list.kind = FieldKind::kNumberList;
       const nlohmann::json numbers = ParseFlagValue(as_list, text);
       if (numbers.size() != size_t(field.matrix_rows) * size_t(field.matrix_cols)) {
-        throw OptionsError(fmt::format("'{}' is not {} comma-separated numbers (a {} x {} matrix by rows)", text,
-                                       field.matrix_rows * field.matrix_cols, field.matrix_rows,
+        throw OptionsError(fmt::format("'{}' is not {} comma-separated numbers (a {} x {} matrix by rows)",
+                                       text, field.matrix_rows * field.matrix_cols, field.matrix_rows,
                                        field.matrix_cols));
       }
       nlohmann::json rows = nlohmann::json::array();

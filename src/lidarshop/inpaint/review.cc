@@ -124,9 +124,8 @@ ReviewSummary SummarizeReview(const InpaintReview& review, int patch_radius) {
                                   .margin = verdict.margin});
   }
   for (size_t c = 0; c < review.cluster_representative.size(); ++c) {
-    ReviewClusterSummary cluster{.index = static_cast<int64_t>(c),
-                                 .representative = review.cluster_representative[c],
-                                 .members = {}};
+    ReviewClusterSummary cluster{
+        .index = static_cast<int64_t>(c), .representative = review.cluster_representative[c], .members = {}};
     for (size_t i = 0; i < review.cluster.size(); ++i)
       if (review.cluster[i] == static_cast<int>(c)) cluster.members.push_back(static_cast<int64_t>(i));
     summary.clusters.push_back(std::move(cluster));

@@ -121,7 +121,9 @@ FieldInfo& FieldInfo::OmitWhenEmpty() {
                                kind == FieldKind::kJson));
   present = [get = get](const void* object) {
     const nlohmann::ordered_json value = get(object);
-    return !(value.is_null() || ((value.is_array() || value.is_object() || value.is_string()) && value.empty()));
+    // nlohmann's empty() is false for every string: a string is a value, not a container.
+    if (value.is_string()) return !value.get_ref<const std::string&>().empty();
+    return !(value.is_null() || ((value.is_array() || value.is_object()) && value.empty()));
   };
   return *this;
 }
@@ -188,8 +190,8 @@ void FieldInfo::CheckValue(const nlohmann::json& value) const {
       };
       if (!value.is_array() || value.size() != size_t(matrix_rows) ||
           !std::all_of(value.begin(), value.end(), is_row)) {
-        throw OptionsError(fmt::format("expected {} rows of {} numbers, got {}", matrix_rows, matrix_cols,
-                                       value.dump()));
+        throw OptionsError(
+            fmt::format("expected {} rows of {} numbers, got {}", matrix_rows, matrix_cols, value.dump()));
       }
       for (const auto& row : value)
         for (const auto& element : row) CheckRange(element.get<double>(), element.dump());

@@ -110,11 +110,11 @@ struct FieldInfo {
   std::optional<double> min, max;  // valid range, inclusive unless the *_exclusive flag says otherwise
   bool min_exclusive = false, max_exclusive = false;
   int64_t integer_low = INT64_MIN,
-          integer_high = INT64_MAX;    // kInt (and kNumberList of integers): type limits
-  bool integer_elements = false;       // kNumberList of an integer type
+          integer_high = INT64_MAX;      // kInt (and kNumberList of integers): type limits
+  bool integer_elements = false;         // kNumberList of an integer type
   int matrix_rows = 0, matrix_cols = 0;  // kNumberMatrix
-  const EnumInfo* choices = nullptr;   // kEnum
-  const StructInfo* nested = nullptr;  // kStruct, kStructList: the (element's) description
+  const EnumInfo* choices = nullptr;     // kEnum
+  const StructInfo* nested = nullptr;    // kStruct, kStructList: the (element's) description
   // Type-erased access to the field of a struct instance (`void*` = the struct described by the owner).
   std::function<nlohmann::ordered_json(const void*)> get;
   std::function<void(void*, const nlohmann::json&)> set;  // the value has passed CheckValue
@@ -286,7 +286,9 @@ class StructBuilder {
     const auto inner = [member](const void* object) -> const void* {
       return &(static_cast<const S*>(object)->*member);
     };
-    const auto inner_mutable = [member](void* object) -> void* { return &(static_cast<S*>(object)->*member); };
+    const auto inner_mutable = [member](void* object) -> void* {
+      return &(static_cast<S*>(object)->*member);
+    };
     for (FieldInfo field : InfoOf<T>().fields) {
       LIDARSHOP_CHECK(info_.Find(field.key) == nullptr && "a flattened key is a field already");
       field.get = [get = field.get, inner](const void* object) { return get(inner(object)); };
@@ -311,7 +313,9 @@ class StructBuilder {
         };
       }
       if (field.present) {
-        field.present = [present = field.present, inner](const void* object) { return present(inner(object)); };
+        field.present = [present = field.present, inner](const void* object) {
+          return present(inner(object));
+        };
       }
       if (field.clear) {
         field.clear = [clear = field.clear, inner_mutable](void* object) { clear(inner_mutable(object)); };

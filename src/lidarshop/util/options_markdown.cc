@@ -118,7 +118,10 @@ std::string MarkdownReference(const std::vector<TypeScriptStruct>& structs) {
       if (!options) {
         // An optional part (FieldInfo::present) is left out of the JSON when the result has none.
         out += fmt::format("| `{}` | {}{} | {} | {} |\n", field.key, Cell(TypeText(field)),
-                           field.null_when_absent ? ", or null" : field.present ? ", or absent" : "", Cell(field.unit), Cell(field.doc));
+                           field.null_when_absent ? ", or null"
+                           : field.present        ? ", or absent"
+                                                  : "",
+                           Cell(field.unit), Cell(field.doc));
         if (field.kind == FieldKind::kStruct || field.kind == FieldKind::kStructList)
           push({field.nested, nullptr, true});
         continue;

@@ -329,8 +329,10 @@ TEST(Options, MatricesAreListsOfRows) {
   const ShapedResult back = FromJson<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,6]]})"));
   EXPECT_EQ(back.pose(1, 0), 4);
   EXPECT_EQ(back.pose(0, 2), 3);
-  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3]]})"), "pose", "expected 2 rows of 3");
-  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5]]})"), "pose", "expected 2 rows");
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3]]})"), "pose",
+                               "expected 2 rows of 3");
+  ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5]]})"), "pose",
+                               "expected 2 rows");
   ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,"6"]]})"), "pose",
                                "expected 2 rows");
   ExpectRejected<ShapedResult>(nlohmann::json::parse(R"({"pose":[[1,2,3],[4,5,60]]})"), "pose",
@@ -354,10 +356,12 @@ TEST(Options, NullableFieldsAreAlwaysWritten) {
   EXPECT_EQ(json["stop"]["band_px"], 5);
   // null on input empties the member; a value sets it.
   ShapedResult base = result;
-  const ShapedResult emptied = FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":null,"stop":null})"), base);
+  const ShapedResult emptied =
+      FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":null,"stop":null})"), base);
   EXPECT_FALSE(emptied.exit_code.has_value());
   EXPECT_FALSE(emptied.stop.has_value());
-  const ShapedResult set = FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":0,"stop":{"band_px":4}})"));
+  const ShapedResult set =
+      FromJson<ShapedResult>(nlohmann::json::parse(R"({"exit":0,"stop":{"band_px":4}})"));
   EXPECT_EQ(set.exit_code, 0);
   EXPECT_EQ(set.stop->band_px, 4);
   // Only a NullWhenAbsent field takes null.
@@ -389,7 +393,8 @@ TEST(Options, JsonFieldsHoldAnyValue) {
 }
 
 TEST(Options, FlattenListsTheHeldStructsFieldsAtTheHoldersLevel) {
-  EXPECT_EQ(InfoOf<FlatResult>().Keys(), (std::vector<std::string>{"count", "band_px", "enabled", "seconds"}));
+  EXPECT_EQ(InfoOf<FlatResult>().Keys(),
+            (std::vector<std::string>{"count", "band_px", "enabled", "seconds"}));
   FlatResult result;
   result.count = 2;
   result.inner.band_px = 7;

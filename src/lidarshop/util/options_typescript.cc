@@ -111,7 +111,8 @@ std::string MemberComment(const FieldInfo& field, const nlohmann::ordered_json* 
 // A NullWhenAbsent member is always there, `| null` when absent.
 void AppendMember(const FieldInfo& field, std::vector<std::string> alternatives, std::string* out) {
   const std::string key = field.present && !field.null_when_absent ? field.key + "?" : field.key;
-  if (field.null_when_absent && std::find(alternatives.begin(), alternatives.end(), "null") == alternatives.end())
+  if (field.null_when_absent &&
+      std::find(alternatives.begin(), alternatives.end(), "null") == alternatives.end())
     alternatives.push_back("null");
   std::string one_line = fmt::format("  {}: {};", key, fmt::join(alternatives, " | "));
   if (one_line.size() <= kPrintWidth || alternatives.size() == 1) {

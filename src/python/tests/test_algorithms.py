@@ -113,6 +113,7 @@ def test_inpaint_and_poisson():
     assert np.all((painted.fill_iteration >= 0) == (hole > 0))
     assert painted.complete and "review" not in painted.to_dict()  # review: only when a fill stopped for one
     assert list(painted.to_dict()) == [key for key in lidarshop.InpaintResult.fields if key != "review"]
+    assert painted.review is None  # an optional part holding nothing reads as None
     np.testing.assert_array_equal(painted.image[hole == 0], grey[hole == 0])
     gx = np.zeros_like(grey)
     gy = np.zeros_like(grey)
