@@ -41,8 +41,8 @@ int RunBatch(int argc, char** argv);      // batch_command.cc
 int RunServe(int argc, char** argv);      // serve_command.cc
 int RunSchema(int argc, char** argv);     // schema_command.cc
 
-// The images2D entries of an E57 file as JSON (name, size, representation, pose, intrinsics); `images` and
-// `info` print it. recolor_commands.cc.
+// The images2D entries of an E57 file as JSON: ToJson of each E57ImageSummary (recolor/e57_camera.h:
+// SummarizeE57Images); `photos` prints it. recolor_commands.cc.
 nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
 
 class OptionBinder;

@@ -18,8 +18,10 @@
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/scan_header.h"
 #include "lidarshop/io/scan_io.h"
+#include "lidarshop/io/scan_summary.h"
 #include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/pointset/ground.h"
+#include "lidarshop/recolor/e57_camera.h"
 #include "lidarshop/render/picture_mapping.h"
 #include "lidarshop/render/render.h"
 #include "lidarshop/render/render_layout.h"
@@ -33,8 +35,6 @@
 
 namespace lidarshop::cli {
 namespace {
-
-constexpr double kDegreesPerRadian = 180.0 / M_PI;
 
 // `convert --synthesized-mask`: the scan's grid, 255 where a return is synthesized.
 void WriteSynthesizedMask(const std::string& path, const Scan& scan) {
@@ -51,163 +51,17 @@ void WriteSynthesizedMask(const std::string& path, const Scan& scan) {
   WriteImage(path, mask);
 }
 
-nlohmann::ordered_json ScanJson(const Scan& scan, int index) {
-  const ScanStatistics stats = ComputeScanStatistics(scan);
-  nlohmann::ordered_json json;
-  json["index"] = index;
-  if (!scan.name.empty()) json["name"] = scan.name;
-  json["rows"] = scan.rows;
-  json["cols"] = scan.cols;
-  json["cells"] = scan.num_cells();
-  json["valid"] = stats.valid;
-  json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
-  json["channels"] = ChannelNames(scan);
-  if (!scan.attributes.empty()) {
-    json["attributes"] = nlohmann::ordered_json::array();
-    for (const auto& [name, values] : scan.attributes) json["attributes"].push_back(name);
-  }
-  // Counts as `lasinfo` gives them, for clouds read from LAS: classes and return numbers of the returns.
-  if (stats.from_las) {
-    auto counts = [](const std::map<int, int64_t>& histogram) {
-      nlohmann::ordered_json json_counts = nlohmann::ordered_json::object();
-      for (const auto& [value, n] : histogram) json_counts[std::to_string(value)] = n;
-      return json_counts;
-    };
-    json["classes"] = counts(stats.returns_by_class);
-    json["returns"] = counts(stats.returns_by_return_number);
-    if (!scan.source_records.empty()) json["crs"] = LasCrsJson(scan.source_records);
-  }
-
-  // Bounds of the returns in the world frame, and range / intensity statistics.
-  if (stats.valid > 0) {
-    const Eigen::AlignedBox3d& box = stats.bounds_in_world;
-    json["bounds"] = {{"frame", "world"},
-                      {"min", {box.min().x(), box.min().y(), box.min().z()}},
-                      {"max", {box.max().x(), box.max().y(), box.max().z()}}};
-    json["range_m"] = {{"min", stats.min_range_m}, {"max", stats.max_range_m}, {"mean", stats.mean_range_m}};
-    if (stats.min_intensity)
-      json["intensity"] = {{"min", *stats.min_intensity}, {"max", *stats.max_intensity}};
-  } else {
-    json["bounds"] = nullptr;
-  }
-
-  nlohmann::ordered_json grid;
-  grid["fitted"] = scan.grid.fitted;
-  grid["known"] = !scan.grid.azimuth_rad.empty();
-  if (stats.min_azimuth_deg) {
-    grid["azimuth_deg"] = {*stats.min_azimuth_deg, *stats.max_azimuth_deg};
-    grid["elevation_deg"] = {*stats.min_elevation_deg, *stats.max_elevation_deg};
-    if (stats.azimuth_step_deg) grid["azimuth_step_deg"] = *stats.azimuth_step_deg;
-    if (stats.elevation_step_deg) grid["elevation_step_deg"] = *stats.elevation_step_deg;
-  }
-  grid["rms_residual_rad"] = scan.grid.rms_residual_rad;
-  grid["max_residual_rad"] = scan.grid.max_residual_rad;
-  grid["rms_residual_deg"] = scan.grid.rms_residual_rad * kDegreesPerRadian;
-  json["grid"] = grid;
-  json["grid_fit_rms_residual_rad"] = scan.grid.rms_residual_rad;
-  return json;
-}
-
-// Numbers as people read them, by what they are (the key that holds them): statistics of float32 points and
-// angles in degrees to 1e-6 (micrometres, microdegrees), residuals in radians to 6 significant digits,
-// everything else to 12 significant digits and |x| < 1e-12 to 0 (1.5, not 1.5000000000000002; UTM
-// coordinates keep 10 micrometres).
-double Significant(double value, int digits) {
-  return std::abs(value) < 1e-12 ? 0.0 : std::stod(fmt::format("{:.{}g}", value, digits));
-}
-
-void RoundNumbers(nlohmann::ordered_json* json, const std::string& key = "") {
-  auto ends_with = [&](const char* suffix) {
-    const std::string s(suffix);
-    return key.size() >= s.size() && key.compare(key.size() - s.size(), s.size(), s) == 0;
-  };
-  if (json->is_number_float()) {
-    const double value = json->get<double>();
-    if (!std::isfinite(value)) return;
-    if (ends_with("_rad")) {
-      *json = Significant(value, 6);
-    } else if (key == "min" || key == "max" || key == "mean" || ends_with("_deg")) {
-      const double rounded = std::round(value * 1e6) / 1e6;
-      *json = rounded == 0.0 ? 0.0 : rounded;
-    } else {
-      *json = Significant(value, 12);
-    }
-  } else if (json->is_object()) {
-    for (auto it = json->begin(); it != json->end(); ++it) RoundNumbers(&it.value(), it.key());
-  } else if (json->is_array()) {
-    for (auto& child : *json) RoundNumbers(&child, key);
-  }
-}
-
-// Adds the keys of `from` to `into`: a key `into` has keeps its place and takes the new value, unless it is
-// listed in `keep`.
-void MergeInto(const nlohmann::ordered_json& from, nlohmann::ordered_json* into,
-               const std::vector<std::string>& keep = {}) {
-  for (const auto& [key, value] : from.items()) {
-    if (into->contains(key) && std::find(keep.begin(), keep.end(), key) != keep.end()) continue;
-    (*into)[key] = value;
-  }
-}
-
-// `info`'s summary line: the file, its format and how much it holds.
-std::string InfoSummary(const nlohmann::ordered_json& json) {
-  int64_t points = 0;
-  for (const auto& scan : json.value("scans", nlohmann::ordered_json::array())) {
-    if (scan.contains("valid") && scan["valid"].is_number()) {
-      points += scan["valid"].get<int64_t>();
-    } else if (scan.contains("points") && scan["points"].is_number()) {
-      points += scan["points"].get<int64_t>();
-    }
-  }
-  const size_t stations = json.value("stations", nlohmann::ordered_json::array()).size();
-  return fmt::format("{}: {} file, {} scan(s){}, {} points, {} image(s)", json.value("file", std::string()),
-                     json.value("format_version", json.value("format", std::string())),
-                     json.value("scans", nlohmann::ordered_json::array()).size(),
-                     stations > 0 ? fmt::format(" at {} stations", stations) : std::string(), points,
-                     json.value("images", nlohmann::ordered_json::array()).size());
-}
-
-// A site's stations (several scans, each with its pose): index, name, position (world, metres) and heading
-// (degrees, the scanner's +y turned about the world z, positive to the left as rotate_deg's yaw); empty for a
-// file of one scan. From the scans' world_from_scanner (4 rows of 4) as `info` lists them.
-nlohmann::ordered_json StationsJson(const nlohmann::ordered_json& scans) {
-  nlohmann::ordered_json stations = nlohmann::ordered_json::array();
-  if (!scans.is_array() || scans.size() < 2) return stations;
-  for (size_t i = 0; i < scans.size(); ++i) {
-    const nlohmann::ordered_json& scan = scans[i];
-    nlohmann::ordered_json station = {{"index", i}, {"name", scan.value("name", std::string())}};
-    const auto it = scan.find("world_from_scanner");
-    if (it != scan.end() && it->is_array() && it->size() == 4 && (*it)[0].is_array() &&
-        (*it)[0].size() == 4) {
-      const auto& m = *it;
-      auto at = [&](int r, int c) { return m[r][c].is_number() ? m[r][c].get<double>() : 0.0; };
-      station["position"] = {at(0, 3), at(1, 3), at(2, 3)};
-      // The scanner's forward axis (+y) in the world is the second column; yaw = atan2(-x, y).
-      station["heading_deg"] = std::atan2(-at(0, 1), at(1, 1)) * 180.0 / M_PI;
-    }
-    stations.push_back(station);
-  }
-  return stations;
-}
-
-// FILE#N given to `info`: only scan N of the listing (and its images); OptionsError when out of range.
-void KeepOnlyScan(const ScanSelector& selector, nlohmann::ordered_json* json) {
+// FILE#N given to `info`: only scan N of the listing, no stations; OptionsError when out of range.
+template <class Summary>
+void KeepOnlyScan(const ScanSelector& selector, Summary* summary) {
   if (selector.index < 0) return;
-  nlohmann::ordered_json& scans = (*json)["scans"];
-  if (!scans.is_array() || selector.index >= static_cast<int>(scans.size())) {
+  if (selector.index >= static_cast<int>(summary->scans.size())) {
     throw OptionsError(fmt::format("{}#{}: scan {} is out of range: {} holds {} scan(s), numbered from 0",
                                    selector.path, selector.index, selector.index, selector.path,
-                                   scans.is_array() ? scans.size() : 0));
+                                   summary->scans.size()));
   }
-  scans = nlohmann::ordered_json::array({scans[selector.index]});
-}
-
-// `info`'s "stations" (several scans: StationsJson), then FILE#N's one scan (KeepOnlyScan).
-void AddStations(const ScanSelector& selector, nlohmann::ordered_json* json) {
-  nlohmann::ordered_json stations = StationsJson(json->value("scans", nlohmann::ordered_json::array()));
-  if (!stations.empty()) (*json)["stations"] = std::move(stations);
-  KeepOnlyScan(selector, json);
-  if (selector.index >= 0) json->erase("stations");
+  summary->scans = {summary->scans[selector.index]};
+  summary->stations.clear();
 }
 
 }  // namespace
@@ -240,11 +94,10 @@ int RunInfo(int argc, char** argv) {
       if (!stats) PrintWarnings(header.warnings);
     }
     if (!stats) {
-      nlohmann::ordered_json json = ToJson(header);
-      AddStations(selector, &json);
-      RoundNumbers(&json);
-      WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
-      Summarize(InfoSummary(json));
+      ScanFileSummary summary = SummarizeScanFile(header);
+      KeepOnlyScan(selector, &summary);
+      WriteJsonOutput(json_path, ToJson(summary), compact ? -1 : 2, /*inline_arrays=*/true);
+      Summarize(BriefReport(summary));
       return 0;
     }
     ScanFile file;
@@ -263,27 +116,10 @@ int RunInfo(int argc, char** argv) {
       header.file_size_bytes = CheckRegularFile(file_path);
       for (const Scan& scan : file.scans) header.scans.push_back(ScanHeaderOf(scan));
     }
-    nlohmann::ordered_json json = ToJson(header);
-    // The points decide what the header could not (an E57 grid without indexBounds): the full read's
-    // rows, cols and channels win; the header's pose, names and metadata stay.
-    auto& scans = json["scans"];
-    for (size_t i = 0; i < file.scans.size(); ++i) {
-      if (i >= scans.size()) scans.push_back(ToJson(ScanHeaderOf(file.scans[i]), static_cast<int>(i)));
-      MergeInto(ScanJson(file.scans[i], static_cast<int>(i)), &scans[i],
-                {"index", "name", "world_from_scanner"});
-    }
-    if (format == "e57") {
-      const nlohmann::ordered_json decoded = ImagesJson(images);
-      auto& list = json["images"];
-      for (size_t i = 0; i < decoded.size(); ++i) {
-        if (i >= list.size()) list.push_back(nlohmann::ordered_json::object());
-        MergeInto(decoded[i], &list[i], {"index", "name", "world_from_camera"});
-      }
-    }
-    AddStations(selector, &json);
-    RoundNumbers(&json);
-    WriteJsonOutput(json_path, json, compact ? -1 : 2, /*inline_arrays=*/true);
-    Summarize(InfoSummary(json));
+    ScanFileStatistics summary = SummarizeScanFileStatistics(header, file.scans, SummarizeE57Images(images));
+    KeepOnlyScan(selector, &summary);
+    WriteJsonOutput(json_path, ToJson(summary), compact ? -1 : 2, /*inline_arrays=*/true);
+    Summarize(BriefReport(summary));
     return 0;
   });
 }

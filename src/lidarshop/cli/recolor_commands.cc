@@ -31,12 +31,6 @@
 namespace lidarshop::cli {
 namespace {
 
-nlohmann::ordered_json Matrix4Json(const Eigen::Matrix4d& m) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (int r = 0; r < 4; ++r) rows.push_back({m(r, 0), m(r, 1), m(r, 2), m(r, 3)});
-  return rows;
-}
-
 // Refuses to write onto an input (inputs are never modified).
 void CheckNotInput(const std::string& output, const std::vector<std::string>& inputs) {
   for (const std::string& input : inputs) {
@@ -122,49 +116,7 @@ AutoResectionResult RunAutoResection(const Scan& scan, const cv::Mat& photo,
 
 nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < images.size(); ++i) {
-    const E57Image& image = images[i];
-    nlohmann::ordered_json json;
-    json["index"] = i;
-    json["name"] = image.name;
-    json["representation"] = image.projection;
-    json["width_px"] = image.width_px ? image.width_px : image.image.cols;
-    json["height_px"] = image.height_px ? image.height_px : image.image.rows;
-    json["decoded"] = !image.image.empty();
-    if (!image.decode_error.empty()) json["decode_error"] = image.decode_error;
-    json["world_from_camera"] = Matrix4Json(image.world_from_camera);
-    if (image.focal_length_m > 0) {
-      json["intrinsics"] = {{"focal_length_m", image.focal_length_m},
-                            {"pixel_width_m", image.pixel_width_m},
-                            {"pixel_height_m", image.pixel_height_m},
-                            {"principal_point_px", {image.principal_x_px, image.principal_y_px}}};
-    } else if (image.projection == "spherical") {
-      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
-                            {"pixel_height_rad", image.pixel_height_rad}};
-    } else if (image.projection == "cylindrical") {
-      json["intrinsics"] = {{"pixel_width_rad", image.pixel_width_rad},
-                            {"pixel_height_m", image.pixel_height_m},
-                            {"radius_m", image.radius_m},
-                            {"principal_y_px", image.principal_y_px}};
-    }
-    if (!image.description.empty()) json["description"] = image.description;
-    if (image.associated_scan >= 0) json["scan"] = image.associated_scan;
-    json["has_mask"] = !image.mask_encoded.empty();
-    // The camera model (io/e57_image_camera.h): null for a visual reference or an entry missing fields.
-    Camera model;
-    std::string model_why;
-    const std::string model_name = E57ImageModel(image);
-    json["model"] = model_name.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(model_name);
-    if (CameraModelOfE57Image(image, &model, &model_why)) {
-      json["camera"] = nlohmann::ordered_json::parse(CameraModelToJson(model));
-    } else if (!model_name.empty()) {
-      json["camera_error"] = model_why;
-    }
-    PinholeCamera camera;
-    std::string why;
-    json["recolor_ready"] = CameraFromE57Image(image, &camera, &why);
-    list.push_back(json);
-  }
+  for (const E57ImageSummary& image : SummarizeE57Images(images)) list.push_back(ToJson(image));
   return list;
 }
 

@@ -20,6 +20,7 @@
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
+#include "lidarshop/io/scan_summary.h"
 #include "lidarshop/io/scan_write_plan.h"
 #include "lidarshop/pointset/features.h"
 #include "lidarshop/pointset/registration.h"
@@ -58,6 +59,9 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            ResultType<FromStationsResult>(),        // fill --stations --json
            ResultType<RemoveFromStationsResult>(),  // remove --stations --json
            OptionsType<ScanMeshOptions>(),          // scan --mesh-jump, points mesh
+           ResultType<ScanFileSummary>(),           // info --json
+           ResultType<ScanFileStatistics>(),        // info --stats --json
+           ResultType<E57ImageSummary>(),           // images --json: one per photo
            OptionsType<PtxReadOptions>(),           // reading PTX
            OptionsType<E57WriteOptions>(),          // convert, E57 output
            ResultType<ScanWriteSummary>(),          // convert --json

@@ -296,33 +296,29 @@ ScanFileHeader io_internal::ReadLasHeader(const std::string& path) {
   }
   scan.channels = {"xyz", "range", "intensity", "valid", "direction"};
   if (las::HasRgb(header.format)) scan.channels.push_back("rgb");
-  nlohmann::ordered_json& facts = scan.las;
-  facts["version"] = fmt::format("1.{}", header.minor_version);
-  facts["point_format"] = header.format;
-  facts["record_length"] = header.record_length;
-  facts["extra_bytes"] = header.record_length - las::PointRecordSize(header.format);
-  facts["scale"] = {header.scale[0], header.scale[1], header.scale[2]};
-  facts["offset"] = {header.offset[0], header.offset[1], header.offset[2]};
-  facts["bounds"] = {{"min", {low[0], low[1], low[2]}}, {"max", {high[0], high[1], high[2]}}};
-  nlohmann::ordered_json by_return = nlohmann::ordered_json::array();
+  LasHeaderSummary& facts = scan.las.emplace();
+  facts.version = fmt::format("1.{}", header.minor_version);
+  facts.point_format = header.format;
+  facts.record_length = header.record_length;
+  facts.extra_bytes = header.record_length - las::PointRecordSize(header.format);
+  facts.scale = {header.scale[0], header.scale[1], header.scale[2]};
+  facts.offset = {header.offset[0], header.offset[1], header.offset[2]};
+  facts.bounds = {{low[0], low[1], low[2]}, {high[0], high[1], high[2]}};
   const bool extended = header.minor_version >= 4 && las::Load<uint64_t>(h + las::header::kPointCount) != 0;
   for (int r = 0; r < (extended ? 15 : 5); ++r) {
-    by_return.push_back(extended ? las::Load<uint64_t>(h + las::header::kPointsByReturn + 8 * r)
-                                 : las::Load<uint32_t>(h + las::header::kLegacyPointsByReturn + 4 * r));
+    facts.points_by_return.push_back(
+        extended ? las::Load<uint64_t>(h + las::header::kPointsByReturn + 8 * r)
+                 : las::Load<uint32_t>(h + las::header::kLegacyPointsByReturn + 4 * r));
   }
-  facts["points_by_return"] = by_return;
   if (las::HasGpsTime(header.format)) {
-    facts["gps_time"] = header.global_encoding & las::kGlobalEncodingGpsStandard ? "standard" : "week";
+    facts.gps_time = header.global_encoding & las::kGlobalEncodingGpsStandard ? "standard" : "week";
   }
-  facts["file_source_id"] = header.file_source_id;
-  facts["vlrs"] = nlohmann::ordered_json::array();
+  facts.file_source_id = header.file_source_id;
   for (const SourceRecord& record : header.records) {
-    facts["vlrs"].push_back({{"user_id", record.user_id},
-                             {"record_id", record.record_id},
-                             {"description", record.description},
-                             {"bytes", record.payload.size()}});
+    facts.vlrs.push_back(
+        {record.user_id, record.record_id, record.description, static_cast<int64_t>(record.payload.size())});
   }
-  facts["crs"] = LasCrsJson(header.records);
+  facts.crs = LasCrsJson(header.records);
   file.warnings = header.warnings;
   file.scans.push_back(scan);
   return file;

@@ -23,27 +23,6 @@ double Rounded(double value, double step = 1e-9) {
   return rounded == 0.0 ? 0.0 : rounded;  // no -0
 }
 
-// The E57 metadata keys the entry has (none when the file says nothing).
-nlohmann::ordered_json MetadataJson(const E57Metadata& m) {
-  nlohmann::ordered_json json = nlohmann::ordered_json::object();
-  auto put = [&](const char* key, const std::string& value) {
-    if (!value.empty()) json[key] = value;
-  };
-  put("guid", m.guid);
-  put("description", m.description);
-  put("sensor_vendor", m.sensor_vendor);
-  put("sensor_model", m.sensor_model);
-  put("sensor_serial_number", m.sensor_serial_number);
-  put("sensor_hardware_version", m.sensor_hardware_version);
-  put("sensor_software_version", m.sensor_software_version);
-  put("sensor_firmware_version", m.sensor_firmware_version);
-  put("acquisition_start_utc", m.acquisition_start_utc);
-  if (std::isfinite(m.acquisition_start_gps_s)) json["acquisition_start_gps_s"] = m.acquisition_start_gps_s;
-  put("acquisition_end_utc", m.acquisition_end_utc);
-  if (std::isfinite(m.acquisition_end_gps_s)) json["acquisition_end_gps_s"] = m.acquisition_end_gps_s;
-  return json;
-}
-
 }  // namespace
 
 std::string UtcFromGpsSeconds(double gps_seconds) {
@@ -172,59 +151,6 @@ ScanStatistics ComputeScanStatistics(const Scan& scan) {
     if (scan.rows > 1) stats.elevation_step_deg = (*el_max - *el_min) / (scan.rows - 1) * kDegreesPerRadian;
   }
   return stats;
-}
-
-nlohmann::ordered_json ToJson(const ScanHeader& scan, int index) {
-  nlohmann::ordered_json json;
-  json["index"] = index;
-  if (!scan.name.empty()) json["name"] = scan.name;
-  json["organized"] = scan.organized;
-  auto known = [](int64_t value) { return value >= 0 ? nlohmann::ordered_json(value) : nullptr; };
-  json["rows"] = known(scan.rows);
-  json["cols"] = known(scan.cols);
-  json["cells"] = scan.rows >= 0 && scan.cols >= 0 ? nlohmann::ordered_json(scan.rows * scan.cols) : nullptr;
-  json["points"] = known(scan.points);
-  json["channels"] = scan.channels;
-  if (!scan.coordinates.empty()) json["coordinates"] = scan.coordinates;
-  json["world_from_scanner"] = MatrixJson(scan.world_from_scanner);
-  const nlohmann::ordered_json metadata = MetadataJson(scan.e57);
-  if (!metadata.empty()) json["e57"] = metadata;
-  if (!scan.las.is_null()) json["las"] = scan.las;
-  return json;
-}
-
-nlohmann::ordered_json ToJson(const ScanFileHeader& header) {
-  nlohmann::ordered_json json;
-  json["file"] = header.path;
-  json["format"] = header.format;
-  if (!header.format_version.empty()) json["format_version"] = header.format_version;
-  json["size_bytes"] = header.file_size_bytes;
-  if (!header.guid.empty()) json["guid"] = header.guid;
-  if (!header.creation_utc.empty()) json["created_utc"] = header.creation_utc;
-  json["scans"] = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < header.scans.size(); ++i)
-    json["scans"].push_back(ToJson(header.scans[i], static_cast<int>(i)));
-  if (header.format == "e57") {
-    json["images"] = nlohmann::ordered_json::array();
-    for (size_t i = 0; i < header.images.size(); ++i) {
-      const ScanImageHeader& image = header.images[i];
-      nlohmann::ordered_json entry;
-      entry["index"] = i;
-      entry["name"] = image.name;
-      entry["representation"] = image.projection;
-      entry["width_px"] = image.width_px;
-      entry["height_px"] = image.height_px;
-      entry["encoding"] = image.encoding;
-      entry["encoded_bytes"] = image.encoded_bytes;
-      entry["scan"] = image.scan_index >= 0 ? nlohmann::ordered_json(image.scan_index) : nullptr;
-      entry["world_from_camera"] = MatrixJson(image.world_from_camera);
-      const nlohmann::ordered_json metadata = MetadataJson(image.e57);
-      if (!metadata.empty()) entry["e57"] = metadata;
-      json["images"].push_back(entry);
-    }
-  }
-  if (!header.warnings.empty()) json["warnings"] = header.warnings;
-  return json;
 }
 
 nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix) {

@@ -1,6 +1,6 @@
 // What a scan file says about itself without reading its points: the E57 XML section, the PTX scan headers,
-// the PLY / PCD / LAS headers. `lidarshop info` prints it (its --stats reads the points as well), the server
-// and the Python module can ask it before deciding to load a file.
+// the PLY / PCD / LAS headers. `lidarshop info` prints it (scan_summary.h: its --stats reads the points as
+// well), the server and the Python module can ask it before deciding to load a file.
 //
 // Per format, what comes from where (nothing else is read):
 //   .e57  the 48-byte file header and the XML section (its pages' CRCs checked): data3D entries (name, guid,
@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -49,6 +50,35 @@ struct E57Metadata {
   std::string acquisition_start_utc, acquisition_end_utc;
 };
 
+// One variable length record of a LAS file, as `lasinfo` lists it.
+struct LasRecordSummary {
+  std::string user_id;
+  int record_id = 0;
+  std::string description;
+  int64_t bytes = 0;  // the payload's length
+};
+
+// The bounds a LAS header states, metres in the file's coordinates.
+struct LasBoundsSummary {
+  std::vector<double> min, max;  // x, y, z
+};
+
+// A LAS file's public header block and VLRs as `pdal info` / `lasinfo` show them.
+struct LasHeaderSummary {
+  std::string version;  // "1.4"
+  int point_format = 0;
+  int record_length = 0;              // bytes per point record
+  int extra_bytes = 0;                // record_length beyond the point format's own fields
+  std::vector<double> scale, offset;  // x, y, z: coordinate = offset + scale x stored integer
+  LasBoundsSummary bounds;
+  std::vector<uint64_t> points_by_return;  // 5 counts (15 for LAS 1.4 with 64-bit counts)
+  std::string gps_time;                    // "standard" or "week" for point formats with a GPS time; else ""
+  int file_source_id = 0;
+  std::vector<LasRecordSummary> vlrs;
+  // The coordinate reference system (LasCrsJson: wkt and / or geotiff keys, in the file's order; {} without).
+  nlohmann::ordered_json crs;
+};
+
 // One scan of a file as its header describes it.
 struct ScanHeader {
   std::string name;        // E57 data3D name, else ""
@@ -57,14 +87,10 @@ struct ScanHeader {
   int64_t points = -1;           // records the file stores for this scan (rows x cols for PTX and organized
                                  // PCD, E57 recordCount, LAS/PLY point count); -1 when unknown
   Eigen::Matrix4d world_from_scanner = Eigen::Matrix4d::Identity();
-  std::vector<std::string> channels;  // as ChannelNames names them
-  std::string coordinates;            // E57: "cartesian" or "spherical"; else ""
-  E57Metadata e57;                    // E57 only
-  // LAS only, as `pdal info` / `lasinfo` show it: {"version", "point_format", "record_length",
-  // "extra_bytes", "scale", "offset", "bounds": {"min", "max"}, "points_by_return", "gps_time":
-  // "standard"|"week", "file_source_id", "vlrs": [{"user_id", "record_id", "description", "bytes"}],
-  // "crs" (LasCrsJson)}; null for other formats.
-  nlohmann::ordered_json las;
+  std::vector<std::string> channels;    // as ChannelNames names them
+  std::string coordinates;              // E57: "cartesian" or "spherical"; else ""
+  E57Metadata e57;                      // E57 only
+  std::optional<LasHeaderSummary> las;  // LAS only
 };
 
 // One images2D entry of an E57 file.
@@ -123,11 +149,9 @@ struct ScanStatistics {
 // The statistics of `scan` (one pass over its cells).
 ScanStatistics ComputeScanStatistics(const Scan& scan);
 
-// The header as JSON, keys in reading order: file, format, format_version, size_bytes, guid, created,
-// scans [{index, name, organized, rows, cols, points, channels, world_from_scanner, e57 metadata}],
-// images [...]. Numbers keep their precision; the CLI prints it.
+// The header as `lidarshop info` writes it: ToJson(SummarizeScanFile(header)) (io/scan_summary.h: keys in
+// reading order, numbers rounded as people read them).
 nlohmann::ordered_json ToJson(const ScanFileHeader& header);
-nlohmann::ordered_json ToJson(const ScanHeader& scan, int index);
 
 // A 4 x 4 pose (world_from_scanner, world_from_model, ...) as four JSON rows, every entry rounded to 1e-9 (a
 // nanometre: it also drops a rotation's 1e-17 noise, so 1.0000000000000002 prints as 1).
@@ -136,6 +160,13 @@ nlohmann::ordered_json MatrixJson(const Eigen::Matrix4d& matrix);
 // GPS seconds (since 1980-01-06T00:00:00Z, no leap seconds) as UTC text "YYYY-MM-DDThh:mm:ssZ"
 // (fractions of a second dropped), leap seconds up to 2017 applied; "" when not finite or before 1980.
 std::string UtcFromGpsSeconds(double gps_seconds);
+
+template <>
+const StructInfo& InfoOf<LasRecordSummary>();
+template <>
+const StructInfo& InfoOf<LasBoundsSummary>();
+template <>
+const StructInfo& InfoOf<LasHeaderSummary>();
 
 namespace io_internal {
 // The per-format header readers behind ReadScanHeader (each in its format's .cc).

@@ -36,4 +36,16 @@ bool CameraFromE57Image(const E57Image& image, PinholeCamera* camera, std::strin
   return true;
 }
 
+std::vector<E57ImageSummary> SummarizeE57Images(const std::vector<E57Image>& images) {
+  std::vector<E57ImageSummary> summaries;
+  for (size_t i = 0; i < images.size(); ++i) {
+    E57ImageSummary summary = SummarizeE57Image(images[i], static_cast<int>(i));
+    PinholeCamera camera;
+    std::string why;
+    summary.recolor_ready = CameraFromE57Image(images[i], &camera, &why);
+    summaries.push_back(std::move(summary));
+  }
+  return summaries;
+}
+
 }  // namespace lidarshop

@@ -5,14 +5,20 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "lidarshop/geometry/camera.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/scan_summary.h"
 
 namespace lidarshop {
 
 // True and `camera` filled when `image` is a pinhole entry with a decoded photo, a focal length and pixel
 // sizes; else false and `why` says what is missing.
 bool CameraFromE57Image(const E57Image& image, PinholeCamera* camera, std::string* why);
+
+// The photos of an E57 file as `lidarshop photos` lists them (io/scan_summary.h: SummarizeE57Image), each
+// with whether recolouring can use it as it is (CameraFromE57Image).
+std::vector<E57ImageSummary> SummarizeE57Images(const std::vector<E57Image>& images);
 
 }  // namespace lidarshop
