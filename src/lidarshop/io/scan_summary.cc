@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/e57_image_camera.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/util/options.h"
@@ -12,24 +13,18 @@
 namespace lidarshop {
 namespace {
 
-// A pose entry to the nanometre, as MatrixJson writes it.
-double Nanometre(double value) {
-  if (!std::isfinite(value)) return value;
-  const double rounded = std::round(value / 1e-9) * 1e-9;
-  return rounded == 0.0 ? 0.0 : rounded;  // no -0
-}
-
 double Significant(double value, int digits) {
   if (!std::isfinite(value)) return value;
   return std::abs(value) < 1e-12 ? 0.0 : std::stod(fmt::format("{:.{}g}", value, digits));
 }
 
-// A pose as `info` shows it: to the nanometre, then 12 significant digits.
-Eigen::Matrix4d RoundedPose(const Eigen::Matrix4d& pose) {
-  Eigen::Matrix4d rounded;
+// A pose as `info` shows it: to the nanometre (geometry's RoundedPose, as poses are reported everywhere), then
+// 12 significant digits.
+Eigen::Matrix4d ReadablePose(const Eigen::Matrix4d& pose) {
+  Eigen::Matrix4d readable = RoundedPose(pose);
   for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) rounded(r, c) = RoundValue(Nanometre(pose(r, c)));
-  return rounded;
+    for (int c = 0; c < 4; ++c) readable(r, c) = RoundValue(readable(r, c));
+  return readable;
 }
 
 std::vector<double> RoundedValues(std::vector<double> values, double (*round)(double)) {
@@ -75,7 +70,7 @@ ScanSummary SummarizeScan(const ScanHeader& scan, int index) {
   summary.points = known(scan.points);
   summary.channels = scan.channels;
   summary.coordinates = scan.coordinates;
-  summary.world_from_scanner = RoundedPose(scan.world_from_scanner);
+  summary.world_from_scanner = ReadablePose(scan.world_from_scanner);
   summary.e57 = SummarizeMetadata(scan.e57);
   summary.las = scan.las;
   if (summary.las) {
@@ -99,7 +94,7 @@ ScanImageSummary SummarizeImageHeader(const ScanImageHeader& image, int index) {
   summary.encoding = image.encoding;
   summary.encoded_bytes = image.encoded_bytes;
   if (image.scan_index >= 0) summary.scan = image.scan_index;
-  summary.world_from_camera = RoundedPose(image.world_from_camera);
+  summary.world_from_camera = ReadablePose(image.world_from_camera);
   summary.e57 = SummarizeMetadata(image.e57);
   return summary;
 }
@@ -116,8 +111,8 @@ std::vector<ScanStationSummary> SummarizeStations(const std::vector<ScanHeader>&
   std::vector<ScanStationSummary> stations;
   if (scans.size() < 2) return stations;
   for (size_t i = 0; i < scans.size(); ++i) {
-    const Eigen::Matrix4d& pose = scans[i].world_from_scanner;
-    auto at = [&](int r, int c) { return Nanometre(pose(r, c)); };
+    const Eigen::Matrix4d pose = RoundedPose(scans[i].world_from_scanner);
+    auto at = [&](int r, int c) { return pose(r, c); };
     ScanStationSummary station;
     station.index = static_cast<int>(i);
     station.name = scans[i].name;
