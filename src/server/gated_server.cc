@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/text.h"
 #include "replies.h"
 
 namespace lidarshop::server {
@@ -58,11 +59,6 @@ std::string StatusText(int status) {
     default:
       return "Error";
   }
-}
-
-std::string Lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
 }
 
 std::string Trim(const std::string& text) {
@@ -407,14 +403,14 @@ bool GatedServer::CheckHeaders(Connection& connection) {
     line_start = line_end + 2;
     const size_t colon = line.find(':');
     if (colon == std::string::npos) continue;  // httplib rejects it (400)
-    const std::string name = Lower(line.substr(0, colon));
+    const std::string name = AsciiLower(line.substr(0, colon));
     const std::string value = Trim(line.substr(colon + 1));
     if (name == "accept-encoding") {
       // No Brotli: httplib compresses with it at quality 11, which took 5 s for the editor's 0.5 MB script on a
       // loaded 2-core machine (the page's first picture waited for it); gzip takes 0.08 s. The token is blanked
       // in place (same length: the offsets into the buffer stay true).
       const size_t line_begin = line_start - 2 - line.size();
-      const std::string lower = Lower(line);
+      const std::string lower = AsciiLower(line);
       const auto separator = [&](size_t i) {
         return i >= line.size() || line[i] == ',' || line[i] == ' ' || line[i] == ';' || line[i] == ':';
       };
@@ -428,7 +424,7 @@ bool GatedServer::CheckHeaders(Connection& connection) {
       status = 411;
       problem =
           fmt::format("Transfer-Encoding '{}' is not accepted: send the body with a Content-Length", value);
-    } else if (name == "content-encoding" && Lower(value) != "identity") {
+    } else if (name == "content-encoding" && AsciiLower(value) != "identity") {
       status = 415;
       problem = fmt::format("Content-Encoding '{}' is not accepted: send the body uncompressed", value);
     }

@@ -419,9 +419,7 @@ const StructInfo& InfoOf<FormatsReply>() {
     StructBuilder<FormatsReply> b("FormatsReply", "GET /api/formats");
     b.Field(&FormatsReply::read, "read", "the extensions the library reads");
     b.Field(&FormatsReply::write, "write", "the extensions it writes");
-    b.Field(&FormatsReply::formats, "formats",
-            "the library's table of formats (io/formats.h): one object per format, a channel false, true or "
-            "the format's name for it");
+    b.Field(&FormatsReply::formats, "formats", "the library's table of formats, what each holds");
     return b.Build();
   }();
   return info;

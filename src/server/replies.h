@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "lidarshop/io/formats.h"
 #include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop::server {
@@ -237,9 +238,7 @@ struct LabelsReply {
 struct FormatsReply {
   std::vector<std::string> read;
   std::vector<std::string> write;
-  // The library's table of formats (io/formats.h ScanFormatsJson): one object per format, whose channels are
-  // false, true or a name.
-  nlohmann::ordered_json formats;
+  std::vector<ScanFormatSummary> formats;  // the library's table of formats (io/formats.h)
 };
 
 // One level of the tile pyramid.

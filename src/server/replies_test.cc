@@ -112,12 +112,15 @@ TEST(Replies, NoSiteIsNull) {
 }
 
 TEST(Replies, FormatsHoldTheLibrarysTable) {
-  const nlohmann::ordered_json formats =
-      nlohmann::ordered_json::array({{{"extension", "ptx"}, {"label", false}, {"color", true}},
-                                     {{"extension", "las"}, {"label", "classification"}}});
+  const std::vector<ScanFormatSummary> formats = SummarizeScanFormats();
   nlohmann::ordered_json by_hand = {{"read", {"ptx", "las"}}, {"write", {"ptx"}}};
-  by_hand["formats"] = formats;
+  by_hand["formats"] = nlohmann::ordered_json::array();
+  for (const ScanFormatSummary& format : formats) by_hand["formats"].push_back(ToJson(format));
   EXPECT_EQ(Dump(ToJson(FormatsReply{{"ptx", "las"}, {"ptx"}, formats})), Dump(by_hand));
+  // A channel is false, true or the format's own name for it.
+  const nlohmann::ordered_json reply = ToJson(FormatsReply{{}, {}, formats});
+  EXPECT_EQ(reply["formats"][0]["extension"], "ptx");
+  EXPECT_EQ(reply["formats"][0]["label"], false);
 }
 
 TEST(Replies, JoinedKeepsTheResultsKeysFirstAndRefusesAKeyTwice) {

@@ -28,6 +28,7 @@
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/memory_budget.h"
 #include "lidarshop/util/options.h"
+#include "lidarshop/util/text.h"
 #include "replies.h"
 #include "version_param.h"
 
@@ -88,7 +89,7 @@ std::optional<nlohmann::json> BodyJson(const httplib::Request& request, httplib:
   std::string type = request.get_header_value("Content-Type");
   type = type.substr(0, type.find(';'));
   type.erase(type.find_last_not_of(" \t") + 1);
-  std::transform(type.begin(), type.end(), type.begin(), [](unsigned char c) { return std::tolower(c); });
+  type = AsciiLower(type);
   if (type != "application/json") {
     SendError(response, 415,
               fmt::format("the request body must be JSON sent as Content-Type: application/json (was '{}')",
@@ -523,7 +524,7 @@ void AddScanRoutes(State& state) {
   // The scan formats the library reads and writes (the open and save dialogs offer these).
   http.Get("/api/formats", [](const httplib::Request&, httplib::Response& response) {
     SendJson(response, ToJson(FormatsReply{SupportedScanReadExtensions(), SupportedScanWriteExtensions(),
-                                           ScanFormatsJson()}));
+                                           SummarizeScanFormats()}));
   });
   http.Get("/api/scenes", [&state](const httplib::Request&, httplib::Response& response) {
     SendJson(response, ToJson(ScenesReply{state.options.builtin_scenes}));

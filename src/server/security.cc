@@ -6,21 +6,15 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 
 #include <fmt/format.h>
 
 #include "http.h"
+#include "lidarshop/util/text.h"
 
 namespace lidarshop::server {
 
 namespace {
-
-std::string Lower(std::string text) {
-  std::transform(text.begin(), text.end(), text.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return text;
-}
 
 bool IsIpv6Literal(const std::string& host) {
   in6_addr address{};
@@ -64,7 +58,7 @@ std::string BindWarning(const std::string& host) {
 
 std::vector<std::string> AllowedHosts(const std::string& host, int port) {
   std::vector<std::string> names = {"localhost", "127.0.0.1", "[::1]"};
-  if (!host.empty()) names.push_back(Lower(UrlHost(host)));
+  if (!host.empty()) names.push_back(AsciiLower(UrlHost(host)));
   if (IsWildcard(host)) {
     // Reachable at every address of the machine: each is a name a browser may use.
     ifaddrs* addresses = nullptr;
@@ -86,7 +80,7 @@ std::vector<std::string> AllowedHosts(const std::string& host, int port) {
       freeifaddrs(addresses);
     }
     char name[256] = {};
-    if (gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0') names.push_back(Lower(name));
+    if (gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0') names.push_back(AsciiLower(name));
   }
   std::vector<std::string> hosts;
   for (const std::string& name : names) {
@@ -101,7 +95,7 @@ std::vector<std::string> AllowedHosts(const std::string& host, int port) {
 namespace {
 
 bool Allowed(const std::vector<std::string>& allowed_hosts, const std::string& host) {
-  return std::find(allowed_hosts.begin(), allowed_hosts.end(), Lower(host)) != allowed_hosts.end();
+  return std::find(allowed_hosts.begin(), allowed_hosts.end(), AsciiLower(host)) != allowed_hosts.end();
 }
 
 }  // namespace
@@ -122,7 +116,7 @@ std::string RefusedOrigin(const httplib::Request& request, const std::vector<std
     return fmt::format("a request from another site ({}) is refused", Excerpt(site, 40));
   }
   if (request.has_header("Origin")) {
-    const std::string origin = Lower(request.get_header_value("Origin"));
+    const std::string origin = AsciiLower(request.get_header_value("Origin"));
     if (origin.rfind("http://", 0) != 0 || !Allowed(allowed_hosts, origin.substr(7))) {
       return fmt::format("a request from the page of another origin ('{}') is refused", Excerpt(origin, 100));
     }

@@ -654,8 +654,8 @@ export interface FormatsReply {
   read: string[];
   // the extensions it writes
   write: string[];
-  // the library's table of formats (io/formats.h): one object per format, a channel false, true or the format's name for it
-  formats: unknown;
+  // the library's table of formats, what each holds
+  formats: ScanFormatSummary[];
 }
 
 // GET /api/docs/ID/tiles.json (C++ TilesReply)
@@ -1034,6 +1034,50 @@ export interface LabelEntry {
   box: number[];
   // [row, col]
   center: number[];
+}
+
+// one scan format and what it holds (a channel: false, true or its name there) (C++ ScanFormatSummary)
+export interface ScanFormatSummary {
+  // lower case, no dot
+  extension: string;
+  // the format's name
+  name: string;
+  // one line
+  description: string;
+  // lidarshop reads it
+  read: boolean;
+  // lidarshop writes it
+  write: boolean;
+  // it holds rows x columns and the scanner's pose (an organized scan)
+  grid: boolean;
+  // scans per file: one, several or merged (their union in the world frame)
+  scans: string;
+  // read but not written: why, and what to write instead
+  write_refusal?: string;
+  // the file needs an intensity column (a scan without one gets the no-information value)
+  intensity_required: boolean;
+  // intensity: false, true or the format's name for it
+  intensity: unknown;
+  // colour: false, true or the format's name for it
+  color: unknown;
+  // labels: false, true or the format's name for them
+  label: unknown;
+  // normals: false, true or the format's name for them
+  normal: unknown;
+  // the range measured behind a filled cell: false, true or a name
+  true_range: unknown;
+  // the synthesized flag: false, true or the format's name for it
+  synthesized: unknown;
+  // the cells filled from another station: false, true or the format's name for them
+  from_station: unknown;
+  // photos with their poses (E57 images2D)
+  images: boolean;
+  // a second layer of cells behind the first (remove --keep-object)
+  layer_behind: boolean;
+  // how that layer is kept, or why it cannot be
+  layer_behind_how?: string;
+  // what the coordinates are stored as
+  precision: string;
 }
 
 // one level of the tile pyramid (C++ TileLevelEntry)

@@ -41,10 +41,6 @@ int RunBatch(int argc, char** argv);      // batch_command.cc
 int RunServe(int argc, char** argv);      // serve_command.cc
 int RunSchema(int argc, char** argv);     // schema_command.cc
 
-// The images2D entries of an E57 file as JSON: ToJson of each E57ImageSummary (recolor/e57_camera.h:
-// SummarizeE57Images); `photos` prints it. recolor_commands.cc.
-nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images);
-
 class OptionBinder;
 
 // Exit codes of every command (README "Exit codes").

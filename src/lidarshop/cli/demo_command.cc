@@ -65,10 +65,6 @@ struct DemoSettings {
 
 std::string SceneName(const std::string& scene) { return fs::path(scene).stem().string(); }
 
-void WriteText(const fs::path& path, const std::string& text) {
-  WriteFileAtomically(path.string(), [&](std::ostream& stream) { stream << text; });
-}
-
 DemoVerifyEntry VerifyEntry(const std::string& object, const std::string& pose_name,
                             const VerifyResult& result) {
   return {.object = object,
@@ -157,7 +153,7 @@ std::vector<DemoVerifyEntry> RunVerifyStep(const SceneDescription& scene, const 
   }
   json file = json::array();  // keys sorted, as summary.json's
   for (const DemoVerifyEntry& entry : entries) file.push_back(json(ToJson(entry)));
-  WriteText(out_dir / "verify.json", file.dump(2) + "\n");
+  WriteTextAtomically(out_dir / "verify.json", file.dump(2) + "\n");
   return entries;
 }
 
@@ -199,7 +195,7 @@ DemoSweepSummary RunSweepStep(const SceneDescription& scene, const Scan& scan, c
   WriteImage((out_dir / "sweep_confidence.png").string(),
              RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
                            demo_sweep.options.min_confidence));
-  WriteText(out_dir / "sweep.csv", SweepCsv(sweep));
+  WriteTextAtomically(out_dir / "sweep.csv", SweepCsv(sweep));
   const Eigen::Vector3d truth = model_object->world_from_object.topRightCorner<3, 1>();
   DemoSweepSummary summary{.model = demo_sweep.object,
                            .true_position = {truth.x(), truth.y()},
@@ -458,8 +454,8 @@ int RunDemoSteps(const DemoSettings& settings) {
   progress->Finish();
 
   const json summary_json = DemoSummaryJson(summary);
-  WriteText(out_dir / "summary.json", summary_json.dump(2) + "\n");
-  WriteText(out_dir / "index.html", DemoPage(scene_name, summary));
+  WriteTextAtomically(out_dir / "summary.json", summary_json.dump(2) + "\n");
+  WriteTextAtomically(out_dir / "index.html", DemoPage(scene_name, summary));
   WriteJsonOutput(settings.json_path, summary_json);
   Summarize(fmt::format("scene '{}', {} x {} rays, {} returns; results in {}/ (open index.html)", scene_name,
                         scan.rows, scan.cols, scan.CountValid(), out_dir.string()));

@@ -449,18 +449,14 @@ int RunRender(int argc, char** argv) {
         Scan scan = PickScan(file, scan_index, "--scan");
         // Errors about the scan's channels name the file (and the scan, when the file names it).
         scan.name = scan.name.empty() ? input : fmt::format("{} (scan '{}')", input, scan.name);
-        nlohmann::ordered_json json;
-        json["output"] = output;
-        json["channel"] = channel;
+        PictureSummary summary{.output = output, .channel = channel};
         PictureLayout layout;
         cv::Size image_size;
         if (float_picture) {
           ValuesResult values = RenderValues(scan, options.channel, layout_options);
           WriteImage(output, values.values);
           image_size = values.values.size();
-          json["width_px"] = values.values.cols;
-          json["height_px"] = values.values.rows;
-          json["values"] =
+          summary.values =
               options.channel == RenderChannel::kRange || options.channel == RenderChannel::kElevation
                   ? "float32 metres, NaN = no return"
                   : "float32, NaN = no return";
@@ -469,23 +465,21 @@ int RunRender(int argc, char** argv) {
           PictureResult result = RenderPicture(scan, options, layout_options);
           WriteImage(output, result.image);
           image_size = result.image.size();
-          json["width_px"] = result.image.cols;
-          json["height_px"] = result.image.rows;
           if (result.scale) {
-            json["scale"] = {{"min", result.scale->min_value},
-                             {"max", result.scale->max_value},
-                             {"unit", result.scale->unit}};
+            summary.scale = ColorScaleSummary{
+                .min = result.scale->min_value, .max = result.scale->max_value, .unit = result.scale->unit};
           }
-          if (!result.legend_lines.empty()) json["legend"] = result.legend_lines;
+          summary.legend = std::move(result.legend_lines);
           layout = std::move(result.layout);
         }
-        json["layout"] = ToJson(SummarizeLayout(layout));
+        summary.width_px = image_size.width;
+        summary.height_px = image_size.height;
+        summary.layout = SummarizeLayout(layout);
         // The layout beside the picture: what strokes and masks painted on it map onto (picture_mapping.h).
-        const std::string layout_path = LayoutFilePath(output);
-        WriteJsonOutput(layout_path, LayoutFileJson(layout, scan, image_size));
-        json["layout_file"] = layout_path;
+        summary.layout_file = LayoutFilePath(output);
+        WriteJsonOutput(summary.layout_file, LayoutFileJson(layout, scan, image_size));
         Summarize(layout.Describe());
-        WriteJsonOutput(json_path, CommandJson(ToJson(view), json));
+        WriteJsonOutput(json_path, CommandJson(ToJson(view), ToJson(summary)));
         return 0;
       },
       &binder);

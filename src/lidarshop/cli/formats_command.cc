@@ -7,6 +7,7 @@
 
 #include "lidarshop/cli/commands.h"
 #include "lidarshop/io/formats.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop::cli {
 
@@ -22,7 +23,7 @@ int RunFormats(int argc, char** argv) {
   app.add_flag("--markdown", markdown, "print the table as Markdown (as in docs/file-formats.md)");
   return RunCommand(app, argc, argv, [&]() {
     if (!json_path.empty()) {
-      WriteJsonOutput(json_path, {{"formats", ScanFormatsJson()}});
+      WriteJsonOutput(json_path, ToJson(ScanFormatsSummary{SummarizeScanFormats()}));
     } else if (markdown) {
       fmt::print("{}", ScanFormatsMarkdown());
     } else {

@@ -76,30 +76,6 @@ nlohmann::ordered_json UsedOptions(const PointsOptions& options, const PointsOpe
   return used;
 }
 
-// The summary line of a points operation, from its --json summary: what it kept or found, of how many points.
-std::string PointsSummary(const nlohmann::ordered_json& summary, const std::string& output_path) {
-  const std::string operation = summary["operation"].get<std::string>();
-  if (summary.contains("vertices")) {  // mesh
-    return fmt::format("mesh ({}): {} vertices, {} triangles from {} points -> {}",
-                       summary["method"].get<std::string>(), summary["vertices"].get<int64_t>(),
-                       summary["triangles"].get<int64_t>(), summary["input_points"].get<int64_t>(),
-                       output_path);
-  }
-  if (!summary.contains("input_points")) {  // sample-mesh
-    return fmt::format("{}: {} points from {} triangles -> {}", operation,
-                       summary["output_points"].get<int64_t>(), summary["triangles"].get<int64_t>(),
-                       output_path);
-  }
-  std::string what = fmt::format("{}: {} input points", operation, summary["input_points"].get<int64_t>());
-  if (summary.contains("output_points"))
-    what += fmt::format(", {} output points", summary["output_points"].get<int64_t>());
-  for (const char* key : {"clusters", "regions", "superpixels"}) {
-    if (summary.contains(key)) what += fmt::format(", {} {}", summary[key].get<int64_t>(), key);
-  }
-  if (summary.contains("planes")) what += fmt::format(", {} planes", summary["planes"].size());
-  return what + " -> " + output_path;
-}
-
 // "1,2.5,-3" as numbers; "" as none.
 std::vector<double> ParseNumbers(const std::string& text, const std::string& flag) {
   std::vector<double> numbers;
@@ -293,7 +269,7 @@ int RunPoints(int argc, char** argv) {
             break;
         }
         WriteJsonOutput(json_path, CommandJson(UsedOptions(points, op, flags), out.report));
-        Summarize(PointsSummary(out.report, output_path));
+        Summarize(out.summary_line + " -> " + output_path);
         return 0;
       },
       &binder);

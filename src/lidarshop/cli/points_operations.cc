@@ -177,11 +177,44 @@ const StructInfo& InfoOf<cli::PointsSampleMeshReport>() {
 namespace lidarshop::cli {
 namespace {
 
-// `out` with the operation's report, timed now.
+// The summary lines of the reports: what the operation kept or found, of how many points.
+std::string InputPoints(const PointsRead& read) {
+  return fmt::format("{}: {} input points", read.operation, read.input_points);
+}
+std::string SummaryLine(const PointsKeptReport& r) {
+  return fmt::format("{}, {} output points", InputPoints(r.read), r.output_points);
+}
+std::string SummaryLine(const PointsCloudReport& r) {
+  return fmt::format("{}, {} output points", InputPoints(r.read), r.output_points);
+}
+std::string SummaryLine(const PointsScansReport& r) { return InputPoints(r.read); }
+std::string SummaryLine(const PointsKMeansReport& r) { return InputPoints(r.read); }
+std::string SummaryLine(const PointsPlanesReport& r) {
+  return fmt::format("{}, {} planes", InputPoints(r.read), r.planes.size());
+}
+std::string SummaryLine(const PointsClusterReport& r) {
+  return fmt::format("{}, {} clusters", InputPoints(r.read), r.clusters);
+}
+std::string SummaryLine(const PointsRegionsReport& r) {
+  return fmt::format("{}, {} regions", InputPoints(r.read), r.regions);
+}
+std::string SummaryLine(const PointsSuperpixelsReport& r) {
+  return fmt::format("{}, {} superpixels", InputPoints(r.read), r.superpixels);
+}
+std::string SummaryLine(const PointsMeshReport& r) {
+  return fmt::format("mesh ({}): {} vertices, {} triangles from {} points", r.method, r.vertices, r.triangles,
+                     r.read.input_points);
+}
+std::string SummaryLine(const PointsSampleMeshReport& r) {
+  return fmt::format("{}: {} points from {} triangles", r.operation, r.output_points, r.triangles);
+}
+
+// `out` with the operation's report, timed now, and its summary line.
 template <class R>
 PointsOutput Reported(PointsOutput out, R report, const Timer& timer) {
   report.seconds = timer.Seconds();
   out.report = ToJson(report);
+  out.summary_line = SummaryLine(report);
   return out;
 }
 

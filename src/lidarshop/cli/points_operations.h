@@ -171,6 +171,7 @@ struct PointsOutput {
   PointCloud cloud;
   TriangleMesh mesh;
   nlohmann::ordered_json report;  // ToJson of the operation's report (the --json without "options")
+  std::string summary_line;  // what it kept or found, of how many points ("voxel: 120 input points, ...")
 };
 
 struct PointsOperation {

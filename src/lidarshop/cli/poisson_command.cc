@@ -3,7 +3,6 @@
 //   lidarshop poisson fill IMAGE --mask MASK -o OUT.png
 //   lidarshop poisson clone SOURCE --mask MASK --target TARGET --offset X,Y -o OUT.png
 //   lidarshop poisson reconstruct --gx GX.exr --gy GY.exr --boundary IMAGE --mask MASK -o OUT.exr
-#include <cctype>
 #include <sstream>
 #include <string>
 
@@ -17,6 +16,7 @@
 #include "lidarshop/poisson/poisson.h"
 #include "lidarshop/util/atomic_file.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/text.h"
 
 namespace lidarshop::cli {
 namespace {
@@ -31,11 +31,7 @@ cv::Mat ReadFloat(const std::string& path) {
 // Float results go to .exr / .tif(f) as 32-bit; other formats get `integer_depth` (8- or
 // 16-bit, rounded and saturated).
 void WriteResult(const std::string& path, const cv::Mat& image, int integer_depth) {
-  const std::string lower = [&] {
-    std::string s = path;
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-  }();
+  const std::string lower = AsciiLower(path);
   const bool float_format = lower.ends_with(".exr") || lower.ends_with(".tif") || lower.ends_with(".tiff");
   cv::Mat output;
   image.convertTo(output, float_format ? CV_32F : integer_depth);

@@ -114,12 +114,6 @@ AutoResectionResult RunAutoResection(const Scan& scan, const cv::Mat& photo,
 
 }  // namespace
 
-nlohmann::ordered_json ImagesJson(const std::vector<E57Image>& images) {
-  nlohmann::ordered_json list = nlohmann::ordered_json::array();
-  for (const E57ImageSummary& image : SummarizeE57Images(images)) list.push_back(ToJson(image));
-  return list;
-}
-
 int RunResection(int argc, char** argv) {
   CLI::App app{
       "Resection: the camera of a photo from pixel <-> point correspondences (normalized DLT, RANSAC, "
@@ -485,9 +479,7 @@ int RunImages(int argc, char** argv) {
     if (FileExtension(path) != "e57") throw OptionsError(path + " is not an .e57 file");
     CheckOutputFile("--json", json_path, {}, {path});
     const E57File file = ReadE57AndWarn(path);
-    nlohmann::ordered_json json;
-    json["file"] = path;
-    json["images"] = ImagesJson(file.images);
+    E57ImagesSummary summary{.file = path, .images = SummarizeE57Images(file.images)};
     if (!folder.empty()) {
       std::filesystem::create_directories(folder);
       for (size_t i = 0; i < file.images.size(); ++i) {
@@ -508,12 +500,13 @@ int RunImages(int argc, char** argv) {
           stream.write(reinterpret_cast<const char*>(image.encoded.data()),
                        static_cast<std::streamsize>(image.encoded.size()));
         });
-        json["images"][i]["extracted"] = out;
+        summary.images[i].extracted = out;
       }
     }
-    WriteJsonOutput(json_path, json);
-    int64_t extracted = 0;
-    for (const auto& image : json["images"]) extracted += image.contains("extracted");
+    WriteJsonOutput(json_path, ToJson(summary));
+    const auto extracted =
+        std::count_if(summary.images.begin(), summary.images.end(),
+                      [](const E57ImageSummary& image) { return !image.extracted.empty(); });
     Summarize(fmt::format("{}: {} image(s){}", path, file.images.size(),
                           folder.empty() ? "" : fmt::format(", {} written to {}", extracted, folder)));
     return 0;
@@ -561,7 +554,7 @@ int RunAlign(int argc, char** argv) {
         } else {
           ThrowInputError(pairs_path, "", "pairs", "pixel/point pairs: use `lidarshop resection`");
         }
-        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        WriteTextAtomically(output, text);
         WriteJsonOutput(json_path, CommandJson(ToJson(options), json));
         return 0;
       },

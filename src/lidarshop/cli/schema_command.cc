@@ -18,6 +18,7 @@
 #include "lidarshop/inpaint/inpaint.h"
 #include "lidarshop/inpaint/review.h"
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/scan_summary.h"
@@ -31,6 +32,7 @@
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/resection.h"
 #include "lidarshop/recolor/station_recolor.h"
+#include "lidarshop/render/render.h"
 #include "lidarshop/render/render_layout.h"
 #include "lidarshop/render/render_view.h"
 #include "lidarshop/scan/scan_mesh.h"
@@ -61,14 +63,15 @@ std::vector<TypeScriptStruct> DocumentedStructs() {
            OptionsType<ScanMeshOptions>(),          // scan --mesh-jump, points mesh
            ResultType<ScanFileSummary>(),           // info --json
            ResultType<ScanFileStatistics>(),        // info --stats --json
-           ResultType<E57ImageSummary>(),           // images --json: one per photo
+           ResultType<E57ImagesSummary>(),          // images --json
            OptionsType<PtxReadOptions>(),           // reading PTX
            OptionsType<E57WriteOptions>(),          // convert, E57 output
            ResultType<ScanWriteSummary>(),          // convert --json
+           ResultType<ScanFormatsSummary>(),        // formats --json
            OptionsType<LasWriteOptions>(),          // LAS output
            OptionsType<PointViewOptions>(),         // render
            OptionsType<PictureLayoutOptions>(),     // render
-           ResultType<PictureLayoutSummary>(),      // render --json's "layout"
+           ResultType<PictureSummary>(),            // render --json
            ResultType<PointViewResult>(),           // render --eye, --orbit, --camera --json
            OptionsType<VerifyOptions>(),            // verify, sweep
            OptionsType<SweepOptions>(),             // sweep
@@ -148,7 +151,7 @@ int RunSchema(int argc, char** argv) {
       if (output.empty()) {
         fmt::print("{}", text);
       } else {
-        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        WriteTextAtomically(output, text);
         Summarize(fmt::format("{} structs -> {}", server::ApiTypes().size(), output));
       }
     } else if (markdown) {
@@ -160,7 +163,7 @@ int RunSchema(int argc, char** argv) {
         CheckOutputFile("--output", output, {"md"}, {});
         const std::string page = ReadRegularFile(output);
         const std::string text = ReplaceGeneratedPart(page, reference);
-        WriteFileAtomically(output, [&](std::ostream& stream) { stream << text; });
+        WriteTextAtomically(output, text);
         Summarize(fmt::format("{} structs -> {}", DocumentedStructs().size(), output));
       }
     } else if (!json_path.empty()) {

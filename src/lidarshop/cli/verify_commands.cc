@@ -33,10 +33,6 @@ std::vector<PreparedScan> LoadScans(const std::vector<std::string>& paths) {
   return scans;
 }
 
-void WriteText(const std::string& path, const std::string& text) {
-  WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
-}
-
 // A mesh file, or "builtin:sedan" / "builtin:hatchback" / "builtin:van": the scanner module's procedural cars
 // (the ones of data/scenes/parking_lot.json), in their own frame (standing on z = 0, length along y).
 TriangleMesh LoadModel(const std::string& path) {
@@ -257,11 +253,11 @@ int RunSweep(int argc, char** argv) {
         WriteImage((out / "confidence.png").string(),
                    RenderHeatMap(sweep.confidence_map, sweep, "confidence (best over yaws)",
                                  sweep_options.min_confidence));
-        WriteText((out / "sweep.csv").string(), SweepCsv(sweep));
+        WriteTextAtomically((out / "sweep.csv").string(), SweepCsv(sweep));
         const SweepReport report{.summary = SummarizeSweep(sweep, sweep_options),
                                  .verify_options = common.verify,
                                  .model_options = common.model_options};
-        WriteText((out / "detections.json").string(), ToJson(report.summary).dump(2) + "\n");
+        WriteTextAtomically((out / "detections.json").string(), ToJson(report.summary).dump(2) + "\n");
         WriteJsonOutput(json_path, CommandJson(ToJson(sweep_options), ToJson(report)));
         if (!common.quiet) {
           for (const Detection& d : sweep.detections) {

@@ -33,7 +33,7 @@ class TopK {
   std::vector<SourceCandidate> best_;
 };
 
-uint64_t SplitMix64(uint64_t& state) {
+uint64_t NextSplitMix64(uint64_t& state) {
   uint64_t z = (state += 0x9e3779b97f4a7c15ull);
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
@@ -53,7 +53,7 @@ int RowFromMiddle(int row_begin, int row_end, int i) {
 }
 
 int UniformInt(uint64_t& state, int n) {
-  return static_cast<int>((SplitMix64(state) >> 11) % static_cast<uint64_t>(n));
+  return static_cast<int>((NextSplitMix64(state) >> 11) % static_cast<uint64_t>(n));
 }
 
 }  // namespace

@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include <pugixml.hpp>
+
 namespace lidarshop::e57 {
 
 constexpr uint64_t kPageSize = 1024;     // physical bytes per page
@@ -114,6 +116,9 @@ class LogicalBytes {
 // `size` bytes at `xml` are not (a Latin-1 scan name), before pugixml, which does not check, passes them on
 // to JSON output and written files.
 void CheckXmlUtf8(const std::string& path, const char* xml, size_t size);
+
+// The element names from the document's root down to `node`, joined by '/': where an XML error is.
+std::string ElementPath(pugi::xml_node node);
 
 // Splits logical bytes into pages with their CRCs (the last page is zero-padded).
 std::vector<uint8_t> PagesFromLogical(const std::vector<uint8_t>& logical);

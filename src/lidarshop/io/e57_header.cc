@@ -21,14 +21,6 @@ namespace {
 
 using namespace e57;  // NOLINT: the format's constants and helpers
 
-std::string ElementPath(pugi::xml_node node) {
-  std::string p;
-  for (pugi::xml_node n = node; n && n.type() == pugi::node_element; n = n.parent()) {
-    p = p.empty() ? std::string(n.name()) : std::string(n.name()) + "/" + p;
-  }
-  return p;
-}
-
 struct Xml {
   const std::string& path;
 

@@ -313,6 +313,14 @@ Header ParseHeader(const std::string& path, const std::vector<uint8_t>& logical)
   return h;
 }
 
+std::string ElementPath(pugi::xml_node node) {
+  std::string p;
+  for (pugi::xml_node n = node; n && n.type() == pugi::node_element; n = n.parent()) {
+    p = p.empty() ? std::string(n.name()) : std::string(n.name()) + "/" + p;
+  }
+  return p;
+}
+
 void CheckXmlUtf8(const std::string& path, const char* xml, size_t size) {
   const auto* b = reinterpret_cast<const uint8_t*>(xml);
   for (size_t i = 0; i < size;) {

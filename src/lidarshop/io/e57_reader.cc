@@ -43,14 +43,6 @@ struct Context {
 // own channels: 39; the budget check keeps its earlier, larger bound.
 constexpr int64_t kReaderBytesPerRecord = 64;
 
-std::string ElementPath(pugi::xml_node node) {
-  std::string p;
-  for (pugi::xml_node n = node; n && n.type() == pugi::node_element; n = n.parent()) {
-    p = p.empty() ? std::string(n.name()) : std::string(n.name()) + "/" + p;
-  }
-  return p;
-}
-
 [[noreturn]] void XmlError(const Context& ctx, pugi::xml_node node, const std::string& message) {
   ThrowInputError(ctx.path, "XML section", ElementPath(node), message);
 }

@@ -155,31 +155,34 @@ std::string LayerBehindRefusal(const ScanFormatInfo& format) {
                      FormatNamesWhere([](const ScanFormatInfo& f) { return f.write && f.layer_behind; }));
 }
 
-nlohmann::ordered_json ScanFormatsJson() {
+std::vector<ScanFormatSummary> SummarizeScanFormats() {
   auto channel = [](const ChannelHeld& held) -> nlohmann::ordered_json {
     if (!held.held) return false;
     if (held.name.empty()) return true;
     return std::string(held.name);
   };
-  nlohmann::ordered_json formats = nlohmann::ordered_json::array();
+  std::vector<ScanFormatSummary> formats;
   for (const ScanFormatInfo& f : kFormats) {
-    nlohmann::ordered_json format = {
-        {"extension", f.extension}, {"name", f.name}, {"description", f.description}, {"read", f.read},
-        {"write", f.write},         {"grid", f.grid}, {"scans", ScansCell(f.scans)}};
-    if (!f.write) format["write_refusal"] = f.write_refusal;
-    format["intensity_required"] = f.intensity_required;
-    format["intensity"] = channel(f.intensity);
-    format["color"] = channel(f.color);
-    format["label"] = channel(f.label);
-    format["normal"] = channel(f.normal);
-    format["true_range"] = channel(f.true_range);
-    format["synthesized"] = channel(f.synthesized);
-    format["from_station"] = channel(f.from_station);
-    format["images"] = f.images;
-    format["layer_behind"] = f.layer_behind;
-    if (!f.layer_behind_how.empty()) format["layer_behind_how"] = f.layer_behind_how;
-    format["precision"] = f.precision;
-    formats.push_back(std::move(format));
+    formats.push_back({.extension = std::string(f.extension),
+                       .name = std::string(f.name),
+                       .description = std::string(f.description),
+                       .read = f.read,
+                       .write = f.write,
+                       .grid = f.grid,
+                       .scans = std::string(ScansCell(f.scans)),
+                       .write_refusal = f.write ? "" : std::string(f.write_refusal),
+                       .intensity_required = f.intensity_required,
+                       .intensity = channel(f.intensity),
+                       .color = channel(f.color),
+                       .label = channel(f.label),
+                       .normal = channel(f.normal),
+                       .true_range = channel(f.true_range),
+                       .synthesized = channel(f.synthesized),
+                       .from_station = channel(f.from_station),
+                       .images = f.images,
+                       .layer_behind = f.layer_behind,
+                       .layer_behind_how = std::string(f.layer_behind_how),
+                       .precision = std::string(f.precision)});
   }
   return formats;
 }

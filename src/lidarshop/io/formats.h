@@ -8,8 +8,11 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
+
+#include "lidarshop/util/options_fwd.h"
 
 namespace lidarshop {
 
@@ -67,9 +70,32 @@ std::string LayerBehindRefusal(const ScanFormatInfo& format);
 // The table as Markdown (docs/file-formats.md holds it; formats_test checks that it is current).
 std::string ScanFormatsMarkdown();
 
-// The table as JSON, one object per format with the fields of ScanFormatInfo under the same names (a channel:
-// false, true or the target's name): the server's /api/formats and `lidarshop formats --json`.
-nlohmann::ordered_json ScanFormatsJson();
+// One format of the table as `lidarshop formats --json` and the server's /api/formats write it: the fields
+// of ScanFormatInfo under the same names, a channel false, true or the format's name for it.
+struct ScanFormatSummary {
+  std::string extension, name, description;
+  bool read = false, write = false;
+  bool grid = false;
+  std::string scans;          // one, several or merged
+  std::string write_refusal;  // left out when the format is written
+  bool intensity_required = false;
+  nlohmann::ordered_json intensity, color, label, normal, true_range, synthesized, from_station;
+  bool images = false, layer_behind = false;
+  std::string layer_behind_how;  // left out when ""
+  std::string precision;
+};
+template <>
+const StructInfo& InfoOf<ScanFormatSummary>();
+
+// `lidarshop formats --json`.
+struct ScanFormatsSummary {
+  std::vector<ScanFormatSummary> formats;
+};
+template <>
+const StructInfo& InfoOf<ScanFormatsSummary>();
+
+// The table, one summary per format in ScanFormats' order.
+std::vector<ScanFormatSummary> SummarizeScanFormats();
 
 // ---- implementation of the template ----
 

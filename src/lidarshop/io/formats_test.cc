@@ -11,6 +11,7 @@
 #include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
+#include "lidarshop/util/options.h"
 
 namespace lidarshop {
 namespace {
@@ -113,7 +114,7 @@ TEST(Formats, TheDocsHoldTheCurrentTable) {
 }
 
 TEST(Formats, JsonHasOneObjectPerFormatWithItsChannels) {
-  const nlohmann::ordered_json json = ScanFormatsJson();
+  const nlohmann::ordered_json json = ToJson(ScanFormatsSummary{SummarizeScanFormats()})["formats"];
   ASSERT_EQ(json.size(), ScanFormats().size());
   EXPECT_EQ(json[0]["extension"], "ptx");
   EXPECT_EQ(json[0]["label"], false);
@@ -122,6 +123,13 @@ TEST(Formats, JsonHasOneObjectPerFormatWithItsChannels) {
   ASSERT_NE(las, json.end());
   EXPECT_EQ((*las)["label"], "classification");
   EXPECT_EQ((*las)["scans"], "merged");
+  // A refusal only where the format is not written: LAZ is read, not written.
+  EXPECT_FALSE(json[0].contains("write_refusal"));
+  const auto laz =
+      std::find_if(json.begin(), json.end(), [](const auto& f) { return f["extension"] == "laz"; });
+  ASSERT_NE(laz, json.end());
+  EXPECT_EQ((*laz)["write"], false);
+  EXPECT_THAT((*laz)["write_refusal"].get<std::string>(), HasSubstr("LAZ"));
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "lidarshop/io/laz_arithmetic.h"
@@ -77,5 +78,14 @@ template <typename T>
 inline void StoreLe(uint8_t* p, T value) {
   std::memcpy(p, &value, sizeof(T));
 }
+
+// A symbol model made on first use, as LASzip does for its 256 per-value contexts.
+inline SymbolModel& Lazy(std::optional<SymbolModel>& model, uint32_t symbols) {
+  if (!model) model.emplace(symbols);
+  return *model;
+}
+
+// a * b with the 32-bit wrap-around LASzip's C++ relies on (signed overflow is undefined, unsigned wraps).
+inline uint32_t Times(int32_t a, int32_t b) { return static_cast<uint32_t>(a) * static_cast<uint32_t>(b); }
 
 }  // namespace lidarshop::laz

@@ -12,8 +12,6 @@ std::unique_ptr<PointwiseItemDecoder> MakePoint10Decoder(uint16_t version, Arith
 
 namespace {
 
-uint32_t Times(int32_t a, int32_t b) { return static_cast<uint32_t>(a) * static_cast<uint32_t>(b); }
-
 // GPS times are coded as the 64-bit integers of their doubles. Version 2 keeps four sequences (flight lines
 // merged finely interleave their times) with the last difference of each, and codes a time as a multiple of
 // that difference plus a corrector.

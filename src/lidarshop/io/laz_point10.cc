@@ -31,12 +31,6 @@ void AddToInt32(uint8_t* p, int32_t diff) {
   StoreLe<uint32_t>(p, LoadLe<uint32_t>(p) + static_cast<uint32_t>(diff));
 }
 
-// A symbol model made on first use, as LASzip does for its 256 per-value contexts.
-SymbolModel& Lazy(std::optional<SymbolModel>& model, uint32_t symbols) {
-  if (!model) model.emplace(symbols);
-  return *model;
-}
-
 // Version 2: the return counts pick the contexts of the coordinates and the intensity; x and y are predicted
 // by the median of the last five differences of the same return kind.
 // User data (bit 1 of `changed`) and point source ID (bit 0), decoded alike by POINT10 v1 and v2.

@@ -73,22 +73,17 @@ struct Point14 {
 };
 
 enum LayerIndex {
-  kXy,
-  kZ,
-  kClassification,
-  kFlags,
-  kIntensity,
-  kScanAngle,
-  kUserData,
-  kPointSource,
-  kGpsTime,
+  kLayerXy,
+  kLayerZ,
+  kLayerClassification,
+  kLayerFlags,
+  kLayerIntensity,
+  kLayerScanAngle,
+  kLayerUserData,
+  kLayerPointSource,
+  kLayerGpsTime,
   kLayers
 };
-
-SymbolModel& Lazy(std::optional<SymbolModel>& model, uint32_t symbols) {
-  if (!model) model.emplace(symbols);
-  return *model;
-}
 
 // The models and predictions of one scanner channel.
 struct Channel {
@@ -97,15 +92,15 @@ struct Channel {
                        SymbolModel(128), SymbolModel(128), SymbolModel(128), SymbolModel(128)},
         scanner_channel(3),
         return_number_gps_same(13),
-        dx(d[kXy], 32, 2),
-        dy(d[kXy], 32, 22),
-        z(d[kZ], 32, 20),
-        intensity(d[kIntensity], 16, 4),
-        scan_angle(d[kScanAngle], 16, 2),
-        point_source_id(d[kPointSource], 16),
+        dx(d[kLayerXy], 32, 2),
+        dy(d[kLayerXy], 32, 22),
+        z(d[kLayerZ], 32, 20),
+        intensity(d[kLayerIntensity], 16, 4),
+        scan_angle(d[kLayerScanAngle], 16, 2),
+        point_source_id(d[kLayerPointSource], 16),
         gpstime_multi(kMultiTotal),
         gpstime_0diff(5),
-        gpstime(d[kGpsTime], 32, 9),
+        gpstime(d[kLayerGpsTime], 32, 9),
         last(from) {
     last_z.fill(from.z);
     last_intensity.fill(from.intensity);
@@ -138,8 +133,6 @@ struct Channel {
   Point14 last;
 };
 
-uint32_t Times(int32_t a, int32_t b) { return static_cast<uint32_t>(a) * static_cast<uint32_t>(b); }
-
 class Point14V3 final : public LayeredItemDecoder {
  public:
   int LayerCount() const override { return kLayers; }
@@ -156,7 +149,7 @@ class Point14V3 final : public LayeredItemDecoder {
   }
 
   void Decode(uint8_t* item, uint32_t& context) override {
-    ArithmeticDecoder& xy = decoders_[kXy];
+    ArithmeticDecoder& xy = decoders_[kLayerXy];
     Channel* c = &*channels_[current_];
     // Context of the previous point (of any channel): first / last return, and whether its time changed.
     uint32_t lpr = (c->last.return_number == 1 ? 1 : 0) +
@@ -219,39 +212,39 @@ class Point14V3 final : public LayeredItemDecoder {
     last.y = static_cast<int32_t>(static_cast<uint32_t>(last.y) + static_cast<uint32_t>(dy));
     c->y_median[mc].Add(dy);
 
-    if (changed_[kZ]) {
+    if (changed_[kLayerZ]) {
       k_bits = (c->dx.k() + c->dy.k()) / 2;
       last.z = c->z.Decompress(c->last_z[l], (n == 1) + (k_bits < 18 ? (k_bits & ~1u) : 18));
       c->last_z[l] = last.z;
     }
-    if (changed_[kClassification]) {
+    if (changed_[kLayerClassification]) {
       const uint32_t ccc = ((last.classification & 0x1F) << 1) + (cpr == 3 ? 1 : 0);
-      last.classification =
-          static_cast<uint8_t>(decoders_[kClassification].DecodeSymbol(Lazy(c->classification[ccc], 256)));
+      last.classification = static_cast<uint8_t>(
+          decoders_[kLayerClassification].DecodeSymbol(Lazy(c->classification[ccc], 256)));
     }
-    if (changed_[kFlags]) {
+    if (changed_[kLayerFlags]) {
       const uint32_t last_flags = (last.edge << 5) | (last.scan_direction << 4) | last.classification_flags;
-      const uint32_t flags = decoders_[kFlags].DecodeSymbol(Lazy(c->flags[last_flags], 64));
+      const uint32_t flags = decoders_[kLayerFlags].DecodeSymbol(Lazy(c->flags[last_flags], 64));
       last.edge = (flags >> 5) & 1;
       last.scan_direction = (flags >> 4) & 1;
       last.classification_flags = flags & 15;
     }
-    if (changed_[kIntensity]) {
+    if (changed_[kLayerIntensity]) {
       const uint32_t ic = (cpr << 1) | (gps_time_change ? 1 : 0);
       last.intensity = static_cast<uint16_t>(c->intensity.Decompress(c->last_intensity[ic], cpr));
       c->last_intensity[ic] = last.intensity;
     }
-    if (changed_[kScanAngle] && scan_angle_change) {
+    if (changed_[kLayerScanAngle] && scan_angle_change) {
       last.scan_angle = static_cast<int16_t>(c->scan_angle.Decompress(last.scan_angle, gps_time_change));
     }
-    if (changed_[kUserData]) {
+    if (changed_[kLayerUserData]) {
       last.user_data = static_cast<uint8_t>(
-          decoders_[kUserData].DecodeSymbol(Lazy(c->user_data[last.user_data / 4], 256)));
+          decoders_[kLayerUserData].DecodeSymbol(Lazy(c->user_data[last.user_data / 4], 256)));
     }
-    if (changed_[kPointSource] && point_source_change) {
+    if (changed_[kLayerPointSource] && point_source_change) {
       last.point_source_id = static_cast<uint16_t>(c->point_source_id.Decompress(last.point_source_id));
     }
-    if (changed_[kGpsTime] && gps_time_change) {
+    if (changed_[kLayerGpsTime] && gps_time_change) {
       DecodeGpsTime(*c);
       last.gps_time = c->last_gpstime[c->last_seq];
     }
@@ -262,7 +255,7 @@ class Point14V3 final : public LayeredItemDecoder {
  private:
   // As GPSTIME11 version 2, without the "unchanged" case (the XY layer says whether the time changed).
   void DecodeGpsTime(Channel& c) {
-    ArithmeticDecoder& d = decoders_[kGpsTime];
+    ArithmeticDecoder& d = decoders_[kLayerGpsTime];
     for (int switches = 0;; ++switches) {
       if (switches > 1) throw LazCorrupt("the GPS time switches sequence twice for one point");
       uint32_t& last = c.last_seq;

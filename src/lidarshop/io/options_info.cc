@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/formats.h"
 #include "lidarshop/io/las.h"
 #include "lidarshop/io/ptx.h"
 #include "lidarshop/io/scan_summary.h"
@@ -351,6 +352,65 @@ const StructInfo& InfoOf<E57ImageSummary>() {
             "the camera model (its keys depend on the model), when the entry holds one");
     b.Field(&I::camera_error, "camera_error", "why the entry holds no full camera model").OmitWhenEmpty();
     b.Field(&I::recolor_ready, "recolor_ready", "recolour can use the photo as it is");
+    b.Field(&I::extracted, "extracted", "images --extract: the file the photo's stored bytes were written to")
+        .OmitWhenEmpty();
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanFormatSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScanFormatSummary> b(
+        "ScanFormatSummary", "one scan format and what it holds (a channel: false, true or its name there)");
+    using F = ScanFormatSummary;
+    b.Field(&F::extension, "extension", "lower case, no dot");
+    b.Field(&F::name, "name", "the format's name");
+    b.Field(&F::description, "description", "one line");
+    b.Field(&F::read, "read", "lidarshop reads it");
+    b.Field(&F::write, "write", "lidarshop writes it");
+    b.Field(&F::grid, "grid", "it holds rows x columns and the scanner's pose (an organized scan)");
+    b.Field(&F::scans, "scans", "scans per file: one, several or merged (their union in the world frame)");
+    b.Field(&F::write_refusal, "write_refusal", "read but not written: why, and what to write instead")
+        .OmitWhenEmpty();
+    b.Field(&F::intensity_required, "intensity_required",
+            "the file needs an intensity column (a scan without one gets the no-information value)");
+    b.Field(&F::intensity, "intensity", "intensity: false, true or the format's name for it");
+    b.Field(&F::color, "color", "colour: false, true or the format's name for it");
+    b.Field(&F::label, "label", "labels: false, true or the format's name for them");
+    b.Field(&F::normal, "normal", "normals: false, true or the format's name for them");
+    b.Field(&F::true_range, "true_range", "the range measured behind a filled cell: false, true or a name");
+    b.Field(&F::synthesized, "synthesized", "the synthesized flag: false, true or the format's name for it");
+    b.Field(&F::from_station, "from_station",
+            "the cells filled from another station: false, true or the format's name for them");
+    b.Field(&F::images, "images", "photos with their poses (E57 images2D)");
+    b.Field(&F::layer_behind, "layer_behind",
+            "a second layer of cells behind the first (remove --keep-object)");
+    b.Field(&F::layer_behind_how, "layer_behind_how", "how that layer is kept, or why it cannot be")
+        .OmitWhenEmpty();
+    b.Field(&F::precision, "precision", "what the coordinates are stored as");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<ScanFormatsSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ScanFormatsSummary> b("ScanFormatsSummary", "the scan formats (formats --json)");
+    b.Field(&ScanFormatsSummary::formats, "formats", "every format, in the order file dialogs list them");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<E57ImagesSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<E57ImagesSummary> b("E57ImagesSummary", "the photos of an E57 file (images --json)");
+    b.Field(&E57ImagesSummary::file, "file", "the E57 file");
+    b.Field(&E57ImagesSummary::images, "images", "its photos (images2D), in the file's order");
     return b.Build();
   }();
   return info;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <sstream>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <Eigen/LU>
@@ -20,6 +21,7 @@
 #include "lidarshop/io/xyz.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/input_file.h"
+#include "lidarshop/util/text.h"
 
 namespace lidarshop {
 namespace {
@@ -428,9 +430,7 @@ ScanFileHeader io_internal::ReadPlyScanHeader(const std::string& path) { return 
 std::string FileExtension(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
   if (!extension.empty() && extension[0] == '.') extension.erase(0, 1);
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
+  return AsciiLower(extension);
 }
 
 void CheckScanFileFormat(const std::string& path) { FormatFor(path, Access::kWrite); }
@@ -467,7 +467,7 @@ ScanFile ReadScanFile(const std::string& path) {
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
   const ScanCodec& format = FormatFor(path, Access::kWrite);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
-  if (format.extension == "e57" ||
+  if (std::string_view(format.extension) == "e57" ||
       std::none_of(scans.begin(), scans.end(), [](const Scan& s) { return s.num_cells() == 0; })) {
     format.write(path, scans);
     return;

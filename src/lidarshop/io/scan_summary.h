@@ -154,6 +154,13 @@ struct E57ImageSummary {
   std::optional<nlohmann::ordered_json> camera;
   std::string camera_error;
   bool recolor_ready = false;  // recolour can use it as it is (recolor/e57_camera.h: SummarizeE57Images)
+  std::string extracted;       // `images --extract`: the file its stored bytes went to; left out when ""
+};
+
+// The photos of an E57 file (`lidarshop images --json`).
+struct E57ImagesSummary {
+  std::string file;
+  std::vector<E57ImageSummary> images;
 };
 
 // One photo of `info --stats`: the header's keys (representation, size and scan as the full read found them),
@@ -245,6 +252,8 @@ template <>
 const StructInfo& InfoOf<E57ImageIntrinsics>();
 template <>
 const StructInfo& InfoOf<E57ImageSummary>();
+template <>
+const StructInfo& InfoOf<E57ImagesSummary>();
 template <>
 const StructInfo& InfoOf<ScanImageStatisticsSummary>();
 template <>

@@ -21,6 +21,7 @@
 namespace lidarshop {
 namespace {
 
+using auto_resection_internal::kDegPerRad;
 using auto_resection_internal::Median;
 using auto_resection_internal::Render;
 using auto_resection_internal::SamplesOf;
@@ -29,7 +30,6 @@ using auto_resection_internal::ScanSamples;
 using auto_resection_internal::SetPose;
 using auto_resection_internal::View;
 
-constexpr double kDegPerRad = 180.0 / M_PI;
 // A camera whose last round moved it less than this has settled (a supported camera must have).
 constexpr double kSettledMoveM = 0.01, kSettledTurnDeg = 0.05;
 // The check: a camera is ambiguous when another explains at least kMinCheckInliers and kCheckMargin x as many

@@ -12,7 +12,6 @@
 
 namespace lidarshop::auto_resection_internal {
 namespace {
-constexpr double kDegPerRad = 180.0 / M_PI;
 
 // The median angle between neighbouring columns and rows of the scan's grid, radians.
 double CellAngleRad(const Scan& scan) {

@@ -2,6 +2,7 @@
 // silhouette alignment (silhouette_alignment.h): internal to the recolor module.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@
 #include "lidarshop/scan/scan.h"
 
 namespace lidarshop::auto_resection_internal {
+
+inline constexpr double kDegPerRad = 180.0 / M_PI;
 
 // Which channel of the scan a rendering shows (as grey).
 enum class Shade { kColorElseIntensity, kIntensityElseColor };

@@ -144,6 +144,41 @@ const StructInfo& InfoOf<PointViewResult>() {
   return info;
 }
 
+template <>
+const StructInfo& InfoOf<ColorScaleSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<ColorScaleSummary> b("ColorScaleSummary", "the values a picture's colours stand for");
+    b.Field(&ColorScaleSummary::min, "min", "the value of the scale's first colour (unit)");
+    b.Field(&ColorScaleSummary::max, "max", "the value of its last colour (unit)");
+    b.Field(&ColorScaleSummary::unit, "unit", "m, or the intensity's unit in the file");
+    return b.Build();
+  }();
+  return info;
+}
+
+// In the order `lidarshop render --json` has always written it.
+template <>
+const StructInfo& InfoOf<PictureSummary>() {
+  static const StructInfo info = [] {
+    StructBuilder<PictureSummary> b(
+        "PictureSummary", "what render drew on the scan's grid or an orthographic view (render --json)");
+    b.Field(&PictureSummary::output, "output", "the picture written");
+    b.Field(&PictureSummary::channel, "channel", "the channel drawn");
+    b.Field(&PictureSummary::width_px, "width_px", "picture width").Unit("px");
+    b.Field(&PictureSummary::height_px, "height_px", "picture height").Unit("px");
+    b.Field(&PictureSummary::values, "values", "float pictures (EXR, TIFF): what a pixel holds")
+        .OmitWhenEmpty();
+    b.Field(&PictureSummary::scale, "scale", "8-bit pictures of metric channels: the values of the colours");
+    b.Field(&PictureSummary::legend, "legend", "the swatch legend's lines, top to bottom (labels, classes)")
+        .OmitWhenEmpty();
+    b.Field(&PictureSummary::layout, "layout", "what the picture shows");
+    b.Field(&PictureSummary::layout_file, "layout_file",
+            "the layout written beside the picture: where strokes and masks painted on it fall on the scan");
+    return b.Build();
+  }();
+  return info;
+}
+
 // In the order `lidarshop render --json` has always written its "layout".
 template <>
 const StructInfo& InfoOf<PictureLayoutSummary>() {

@@ -85,6 +85,30 @@ struct PictureResult {
 PictureResult RenderPicture(const Scan& scan, const RenderOptions& options,
                             const PictureLayoutOptions& layout_options);
 
+// The values a picture's colours stand for, as `render --json` writes them (a ColorScale without its map).
+struct ColorScaleSummary {
+  double min = 0.0;  // the value of the scale's first colour, in `unit`
+  double max = 0.0;  // the value of its last colour
+  std::string unit;  // "m", or the intensity's unit in the file
+};
+template <>
+const StructInfo& InfoOf<ColorScaleSummary>();
+
+// What `render` drew on the scan's grid or an orthographic view (its --json, after the options; the other
+// viewpoints write PointViewResult).
+struct PictureSummary {
+  std::string output;                      // the picture written
+  std::string channel;                     // the channel drawn
+  int width_px = 0, height_px = 0;         // its size, pixels
+  std::string values;                      // float pictures: what a pixel holds; "" for 8-bit pictures
+  std::optional<ColorScaleSummary> scale;  // 8-bit pictures of metric channels: the colours' values
+  std::vector<std::string> legend;         // the swatch legend's lines (labels, classes)
+  PictureLayoutSummary layout;             // what the picture shows
+  std::string layout_file;                 // the layout written beside the picture (picture_mapping.h)
+};
+template <>
+const StructInfo& InfoOf<PictureSummary>();
+
 // The values in the file's units that Scan::intensity 0 and 1 stand for: intensity i was the file's
 // first + i * (second - first). Readers that scale intensities to [0, 1] say from what in
 // source_metadata["intensity.file_minimum"] (0 when absent) and ["intensity.file_maximum"]: LAS 0-65535, PCD

@@ -17,7 +17,7 @@ namespace {
 
 using Eigen::Vector2d;
 using Eigen::Vector3d;
-using json = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 using random_scene::Part;
 using random_scene::Rng;
 using random_scene::Thing;
@@ -28,8 +28,8 @@ constexpr double kDeg = M_PI / 180.0;
 // it) does not carry the last bits of sin / cos / atan2, which may differ between C libraries.
 double Metres(double v) { return std::round(v * 1e4) / 1e4; }
 double Degrees(double v) { return std::round(v * 1e3) / 1e3; }
-json Array3(const Vector3d& v) { return {Metres(v.x()), Metres(v.y()), Metres(v.z())}; }
-json Color(Rgb8 c) { return {c[0], c[1], c[2]}; }
+OrderedJson Array3(const Vector3d& v) { return {Metres(v.x()), Metres(v.y()), Metres(v.z())}; }
+OrderedJson Color(Rgb8 c) { return {c[0], c[1], c[2]}; }
 
 // An object placed in the world: position of its frame's origin (footprint centre on its base), yaw.
 struct Placed {
@@ -81,16 +81,16 @@ bool Overlap(const std::array<Vector2d, 4>& a, const std::array<Vector2d, 4>& b)
   return true;
 }
 
-void Emit(const Placed& placed, json* objects) {
+void Emit(const Placed& placed, OrderedJson* objects) {
   for (const Part& part : placed.thing.parts) {
     const Vector2d xy = placed.ToWorld(part.center.head<2>());
-    json object;
+    OrderedJson object;
     object["name"] = placed.name + "/" + part.name;
     object["primitive"] = part.primitive;
     for (const auto& [key, value] : part.parameters.items()) {
-      object[key] = value.is_number_float() ? json(Metres(value.get<double>())) : value;
+      object[key] = value.is_number_float() ? OrderedJson(Metres(value.get<double>())) : value;
       if (key == "size") {
-        object[key] = json::array();
+        object[key] = OrderedJson::array();
         for (const auto& v : value) object[key].push_back(Metres(v.get<double>()));
       }
     }
@@ -103,8 +103,8 @@ void Emit(const Placed& placed, json* objects) {
 }
 
 // A background part (ground, wall, ...) as one scene object.
-json Background(const std::string& name, const std::string& primitive, int32_t label, Rgb8 color) {
-  json object;
+OrderedJson Background(const std::string& name, const std::string& primitive, int32_t label, Rgb8 color) {
+  OrderedJson object;
   object["name"] = name;
   object["primitive"] = primitive;
   object["label"] = label;
@@ -113,7 +113,7 @@ json Background(const std::string& name, const std::string& primitive, int32_t l
 }
 
 struct Draft {
-  json root;
+  OrderedJson root;
   int32_t target_label = 0;
   std::string target_kind;
   double target_distance_m = 0;
@@ -122,7 +122,7 @@ struct Draft {
 Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
   const bool indoor = rng->Chance(o.indoor_share);
   int32_t next_label = 1;
-  json objects = json::array();
+  OrderedJson objects = OrderedJson::array();
 
   // The target: its kind, its distance (log-uniform, at least twice its size), its bearing and yaw.
   Placed target;
@@ -199,7 +199,8 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
   // Ground.
   const double ground_size = 2 * std::max(distance, back ? back_y : distance) + 80.0;
   {
-    json ground = Background(fmt::format("ground_{}", next_label), "plane", next_label, Rgb8(120, 120, 120));
+    OrderedJson ground =
+        Background(fmt::format("ground_{}", next_label), "plane", next_label, Rgb8(120, 120, 120));
     ground["size"] = {Metres(ground_size), Metres(ground_size)};
     ground["translate"] = Array3(Vector3d(0, distance, 0));
     const int look = rng->Int(0, 3);
@@ -230,21 +231,21 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
     objects.push_back(ground);
     ++next_label;
   }
-  const json ground_color = objects.back()["color"];
+  const OrderedJson ground_color = objects.back()["color"];
 
   if (kerb) {  // the pavement: a slab from the kerb back (to the wall or 8 m), its front face the kerb
     double x0, x1;
     const double depth = back ? back_y - kerb_y : 8.0;
     x_range(kerb_y + depth, &x0, &x1);
     const int32_t label = next_label++;
-    json pavement = Background(fmt::format("kerb_{}", label), "box", label, rng->Color());
+    OrderedJson pavement = Background(fmt::format("kerb_{}", label), "box", label, rng->Color());
     pavement["size"] = {Metres(x1 - x0 + 4), Metres(depth), Metres(kerb_height)};
     pavement["translate"] = Array3(Vector3d((x0 + x1) / 2, kerb_y + depth / 2, kerb_height / 2));
     if (rng->Chance(0.5)) pavement["texture"] = "checker", pavement["texture_scale"] = 0.3;
     objects.push_back(pavement);
   }
 
-  json wall_color = ground_color;
+  OrderedJson wall_color = ground_color;
   if (back) {
     double x0, x1;
     x_range(back_y, &x0, &x1);
@@ -255,7 +256,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
     wall_color = Color(color);
     if (style == 0) {  // a façade with recessed windows
       const double wall_height = indoor ? rng->Uniform(2.5, 3.5) : rng->Uniform(3.0, 12.0);
-      json facade = Background(fmt::format("facade_{}", label), "facade", label, color);
+      OrderedJson facade = Background(fmt::format("facade_{}", label), "facade", label, color);
       facade["size"] = {Metres(width), 0.5, Metres(wall_height)};
       facade["floors"] = std::max(1, static_cast<int>(wall_height / 3.0));
       facade["windows_per_floor"] = std::clamp(static_cast<int>(width / rng->Uniform(2.5, 5.0)), 1, 16);
@@ -263,7 +264,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
       objects.push_back(facade);
     } else if (style == 1) {  // a free-standing wall, often brick
       const double wall_height = indoor ? rng->Uniform(2.5, 3.5) : rng->Uniform(1.0, 3.0);
-      json wall = Background(fmt::format("wall_{}", label), "wall", label, color);
+      OrderedJson wall = Background(fmt::format("wall_{}", label), "wall", label, color);
       wall["size"] = {Metres(width), 0.3, Metres(wall_height)};
       wall["translate"] = Array3(Vector3d(center_x, back_y + 0.15, 0));
       if (rng->Chance(0.6)) wall["texture"] = "brick";
@@ -274,7 +275,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
       const double recess_x = target.position.x() + rng->Uniform(-2.0, 2.0);
       const double left = recess_x - recess_width / 2, right = recess_x + recess_width / 2;
       auto slab = [&](const std::string& part, double xa, double xb, double y_front, double thickness) {
-        json box = Background(fmt::format("wall_{}/{}", label, part), "box", label, color);
+        OrderedJson box = Background(fmt::format("wall_{}/{}", label, part), "box", label, color);
         box["size"] = {Metres(xb - xa), Metres(thickness), Metres(wall_height)};
         box["translate"] = Array3(Vector3d((xa + xb) / 2, y_front + thickness / 2, wall_height / 2));
         objects.push_back(box);
@@ -282,7 +283,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
       slab("left", std::min(x0, left - 1), left, back_y, 0.3);
       slab("right", right, std::max(x1, right + 1), back_y, 0.3);
       slab("recess", left, right, back_y + recess_depth, 0.3);
-      json window = Background(fmt::format("wall_{}/window", label), "box", label, rng->Color());
+      OrderedJson window = Background(fmt::format("wall_{}/window", label), "box", label, rng->Color());
       const double window_height = wall_height * rng->Uniform(0.3, 0.6);
       window["size"] = {Metres(recess_width * 0.7), 0.02, Metres(window_height)};
       window["translate"] = Array3(Vector3d(recess_x, back_y + recess_depth - 0.01, wall_height * 0.55));
@@ -294,7 +295,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
       const int32_t steps_label = next_label++;
       const Rgb8 steps_color = rng->Color();
       for (int i = 0; i < steps; ++i) {
-        json step_box =
+        OrderedJson step_box =
             Background(fmt::format("steps_{}/step{}", steps_label, i), "box", steps_label, steps_color);
         const double depth = (steps - i) * tread;
         step_box["size"] = {Metres(steps_width), Metres(depth), Metres(rise)};
@@ -306,7 +307,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
       const bool right = rng->Chance(0.5);
       const double x = right ? tx1 + rng->Uniform(0.3, 3.0) + 0.1 : tx0 - rng->Uniform(0.3, 3.0) - 0.1;
       const double y0 = std::max(0.5, ty0 - 8.0), wall_height = rng->Uniform(2.5, 3.5);
-      json side = Background(fmt::format("wall_{}", next_label), "box", next_label, rng->Color());
+      OrderedJson side = Background(fmt::format("wall_{}", next_label), "box", next_label, rng->Color());
       ++next_label;
       side["size"] = {0.2, Metres(back_y - y0), Metres(wall_height)};
       side["translate"] = Array3(Vector3d(x, (y0 + back_y) / 2, wall_height / 2));
@@ -314,7 +315,8 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
     }
     if (indoor && height < 2.4 && rng->Chance(0.5)) {  // a ceiling
       const double ceiling = rng->Uniform(std::max(2.5, height + 0.5), 3.5);
-      json plane = Background(fmt::format("ceiling_{}", next_label), "plane", next_label, rng->Color());
+      OrderedJson plane =
+          Background(fmt::format("ceiling_{}", next_label), "plane", next_label, rng->Color());
       ++next_label;
       plane["size"] = {60, 60};
       plane["translate"] = Array3(Vector3d(0, back_y - 20, ceiling));
@@ -324,7 +326,7 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
 
   // Colour the target like its background (the wall behind it, or the ground) in a quarter of the scenes.
   if (rng->Chance(0.25)) {
-    const json& like = back && rng->Chance(0.6) ? wall_color : ground_color;
+    const OrderedJson& like = back && rng->Chance(0.6) ? wall_color : ground_color;
     const Rgb8 color(like[0].get<uint8_t>(), like[1].get<uint8_t>(), like[2].get<uint8_t>());
     for (Part& part : target.thing.parts) {
       if (part.main) part.color = color;
@@ -378,12 +380,12 @@ Draft Draw(Rng* rng, const RandomSceneOptions& o, uint64_t seed) {
   draft.target_label = target.label;
   draft.target_kind = target.thing.kind;
   draft.target_distance_m = distance;
-  json& root = draft.root;
+  OrderedJson& root = draft.root;
   root["name"] = fmt::format("random_{}", seed);
   root["description"] = fmt::format(
       "Random {} scene (scanner/random_scene.h), seed {}: the target is {} (label {}) at {:.1f} m.",
       indoor ? "indoor" : "street", seed, target.name, target.label, distance);
-  json scanner;
+  OrderedJson scanner;
   scanner["position"] = Array3(Vector3d(0, 0, height));
   scanner["azimuth_deg"] = {Degrees(window_az0), Degrees(window_az0 + az_span)};
   scanner["elevation_deg"] = {Degrees(window_el0), Degrees(window_el1)};
@@ -440,9 +442,9 @@ std::string RandomSceneJson(uint64_t seed, const RandomSceneOptions& options) {
       }
     }
     if (cells[draft.target_label] < options.min_target_cells) continue;
-    json& objects = draft.root["objects"];
-    json kept = json::array();
-    for (const json& object : objects) {
+    OrderedJson& objects = draft.root["objects"];
+    OrderedJson kept = OrderedJson::array();
+    for (const OrderedJson& object : objects) {
       if (cells[object["label"].get<int32_t>()] >= options.min_visible_cells) kept.push_back(object);
     }
     objects = kept;

@@ -11,18 +11,18 @@ namespace lidarshop::random_scene {
 namespace {
 
 using Eigen::Vector3d;
-using json = nlohmann::ordered_json;
+using OrderedJson = nlohmann::ordered_json;
 
 Part Box(const std::string& name, const Vector3d& size, const Vector3d& center, Rgb8 color,
          bool main = true) {
-  Part part{name, "box", json::object(), center, color, main};
+  Part part{name, "box", OrderedJson::object(), center, color, main};
   part.parameters["size"] = {size.x(), size.y(), size.z()};
   return part;
 }
 
 Part Round(const std::string& name, const std::string& primitive, double radius, double height,
            const Vector3d& center, Rgb8 color, bool main = true) {
-  Part part{name, primitive, json::object(), center, color, main};
+  Part part{name, primitive, OrderedJson::object(), center, color, main};
   part.parameters["radius"] = radius;
   if (primitive != "sphere") part.parameters["height"] = height;
   part.parameters["segments"] = primitive == "sphere" ? 32 : 24;
@@ -185,7 +185,7 @@ Thing Bollard(Rng* rng) {
            Round("cap", "sphere", r, 0, Vector3d(0, 0, h), rng->Chance(0.5) ? color : rng->Color())}};
 }
 
-Thing Composite(const std::string& kind, const std::string& primitive, json parameters, Rgb8 color) {
+Thing Composite(const std::string& kind, const std::string& primitive, OrderedJson parameters, Rgb8 color) {
   Part part{kind, primitive, std::move(parameters), Vector3d::Zero(), color, true};
   return {kind, {part}};
 }
@@ -253,9 +253,9 @@ Thing MakeThing(const std::string& kind, Rng* rng) {
     const std::string style = rng->Pick<std::string>({"sedan", "hatchback", "van"});
     thing = Composite("car", "car", {{"style", style}}, rng->Color());
   } else if (kind == "cabinet") {
-    thing = Composite("cabinet", "electric_box", json::object(), rng->Color());
+    thing = Composite("cabinet", "electric_box", OrderedJson::object(), rng->Color());
   } else if (kind == "mailbox") {
-    thing = Composite("mailbox", "mailbox", json::object(), rng->Color());
+    thing = Composite("mailbox", "mailbox", OrderedJson::object(), rng->Color());
   } else if (kind == "lamp_post") {
     const double height = rng->Uniform(4.0, 7.0);
     thing = Composite("lamp_post", "lamp_post", {{"height", height}}, Metal(rng));

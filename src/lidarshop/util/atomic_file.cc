@@ -186,6 +186,10 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
   });
 }
 
+void WriteTextAtomically(const std::string& path, const std::string& text) {
+  WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
+}
+
 void WritePathAtomically(const std::string& path, const std::function<bool(const std::string&)>& write) {
   if (path.empty()) ThrowInputError("", "", "", "empty output path");
   const std::string input = ProtectedInputAt(path);

@@ -19,6 +19,9 @@ namespace lidarshop {
 // removed. Temporaries of an earlier write of the same target whose writer is gone (killed) are removed first.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
+// WriteFileAtomically of `text`, as it is.
+void WriteTextAtomically(const std::string& path, const std::string& text);
+
 // For writers that need a path (OpenCV's imwrite, a C library): `write(temporary_path)` must create the file
 // at temporary_path, which keeps the target's extension so that format detection still works; it is then
 // renamed to `path`. `write` returns false (or throws) on failure.
