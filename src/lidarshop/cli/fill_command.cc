@@ -219,9 +219,8 @@ int RunFill(int argc, char** argv) {
           WarnFromStationDropped(output_path, result.scan);
           if (!synthesized_mask_path.empty()) WriteImage(synthesized_mask_path, result.synthesized);
           if (!stations.mask_path.empty()) WriteImage(stations.mask_path, result.from_station != 0);
-          nlohmann::ordered_json used = ToJson(options);
-          used["from_stations"] = ToJson(stations.options);
-          WriteJsonOutput(json_path, CommandJson(used, ToJson(result)));
+          const FillWithStationsOptions used{.fill = options, .from_stations = stations.options};
+          WriteJsonOutput(json_path, CommandJson(ToJson(used), ToJson(result)));
           if (!debug_dir.empty() && result.filled_rest) WriteDebug(debug_dir, result.fill, hole);
           PrintResultWarnings(result.warnings);
           Summarize(fmt::format("{} -> {}", FromStationsSummary(result), output_path));
@@ -323,9 +322,8 @@ int RunRemove(int argc, char** argv) {
           }
           if (!mask_out_path.empty()) WriteImage(mask_out_path, removed.hole);
           if (!stations.mask_path.empty()) WriteImage(stations.mask_path, removed.filled.from_station != 0);
-          nlohmann::ordered_json used = ToJson(remove);
-          used["from_stations"] = ToJson(stations.options);
-          WriteJsonOutput(json_path, CommandJson(used, ToJson(removed)));
+          const RemoveWithStationsOptions used{.remove = remove, .from_stations = stations.options};
+          WriteJsonOutput(json_path, CommandJson(ToJson(used), ToJson(removed)));
           PrintResultWarnings(removed.warnings);
           Summarize(fmt::format("removed {} cells: {} -> {}", cv::countNonZero(removed.hole),
                                 FromStationsSummary(removed.filled), output_path));

@@ -172,6 +172,30 @@ const StructInfo& InfoOf<FromStationsResult>() {
 }
 
 template <>
+const StructInfo& InfoOf<FillWithStationsOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<FillWithStationsOptions> b(
+        "FillWithStationsOptions", "what fill --stations used: the fill's options and the stations'");
+    b.Flatten(&FillWithStationsOptions::fill);
+    b.Field(&FillWithStationsOptions::from_stations, "from_stations", "the fill from the other stations");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<RemoveWithStationsOptions>() {
+  static const StructInfo info = [] {
+    StructBuilder<RemoveWithStationsOptions> b(
+        "RemoveWithStationsOptions", "what remove --stations used: the removal's options and the stations'");
+    b.Flatten(&RemoveWithStationsOptions::remove);
+    b.Field(&RemoveWithStationsOptions::from_stations, "from_stations", "the fill from the other stations");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
 const StructInfo& InfoOf<RemoveFromStationsResult>() {
   static const StructInfo info = [] {
     StructBuilder<RemoveFromStationsResult> b("RemoveFromStationsResult",

@@ -89,6 +89,21 @@ struct FromStationsOptions {
 template <>
 const StructInfo& InfoOf<FromStationsOptions>();
 
+// The options `fill --stations` and `remove --stations` used, as their --json's "options" holds them: the
+// command's own options with the stations' under "from_stations" (whose `fill` is the command's fill).
+struct FillWithStationsOptions {
+  FillOptions fill;
+  FromStationsOptions from_stations;
+};
+template <>
+const StructInfo& InfoOf<FillWithStationsOptions>();
+struct RemoveWithStationsOptions {
+  RemoveOptions remove;
+  FromStationsOptions from_stations;
+};
+template <>
+const StructInfo& InfoOf<RemoveWithStationsOptions>();
+
 // One other station of a fill from stations as the result lists it: which scan it is and what it gave.
 struct FromStationsSource {
   int64_t station = 0;             // 1 + its index in other_stations: its tag in from_station
