@@ -201,7 +201,7 @@ PinholeCamera ReadCameraJson(const std::string& path) { return ParseCameraJson(R
 
 void WriteCameraJson(const std::string& path, const PinholeCamera& camera) {
   const std::string text = CameraToJson(camera);
-  WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
+  WriteTextAtomically(path, text);
 }
 
 }  // namespace lidarshop

@@ -353,7 +353,7 @@ Camera ReadCameraModelJson(const std::string& path) {
 
 void WriteCameraModelJson(const std::string& path, const Camera& camera) {
   const std::string text = CameraModelToJson(camera);
-  WriteFileAtomically(path, [&](std::ostream& stream) { stream << text; });
+  WriteTextAtomically(path, text);
 }
 
 }  // namespace lidarshop

@@ -344,7 +344,7 @@ ScanFileHeader PlyFileHeader(const std::string& path) {
 // The reader and writer of each format of the registry (io/formats.h), which says what each holds and which
 // are read and written; formats_test checks that the two tables agree.
 struct ScanCodec {
-  const char* extension;
+  std::string_view extension;
   // Reads the scans of a file, adding what it left out to `warnings`.
   std::vector<Scan> (*read)(const std::string& path, std::vector<std::string>* warnings);
   void (*write)(const std::string& path, const std::vector<Scan>& scans);
@@ -455,7 +455,7 @@ ScanFile ReadScanFile(const std::string& path) {
   const ScanCodec& format = FormatFor(path, Access::kRead);
   ScanFile file;
   file.path = path;
-  file.format = format.extension;
+  file.format = std::string(format.extension);
   CheckRegularFile(path);  // a FIFO would block the reader, a folder has no bytes to check counts against
   file.scans = format.read(path, &file.warnings);
   for (size_t i = 0; i < file.scans.size(); ++i) {
@@ -467,7 +467,7 @@ ScanFile ReadScanFile(const std::string& path) {
 void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
   const ScanCodec& format = FormatFor(path, Access::kWrite);
   if (scans.empty()) ThrowInputError(path, "", "", "no scan to write");
-  if (std::string_view(format.extension) == "e57" ||
+  if (format.extension == "e57" ||
       std::none_of(scans.begin(), scans.end(), [](const Scan& s) { return s.num_cells() == 0; })) {
     format.write(path, scans);
     return;
@@ -482,7 +482,7 @@ void WriteScanFile(const std::string& path, const std::vector<Scan>& scans) {
 }
 
 void WriteScanWithLayer(const std::string& path, const Scan& front, const Scan& behind) {
-  const std::string extension = FormatFor(path, Access::kWrite).extension;
+  const std::string extension(FormatFor(path, Access::kWrite).extension);
   CheckScan(front);
   CheckScan(behind);
   if (front.rows != behind.rows || front.cols != behind.cols) {
