@@ -12,7 +12,7 @@
 # hold about that much; libFuzzer's -rss_limit_mb is that budget + 200 MB + what AddressSanitizer adds (its
 # shadow and a quarantine capped at 64 MB), and -malloc_limit_mb the budget + 200 MB for one allocation: an
 # input that takes more went past the budget, and libFuzzer reports it as out-of-memory — a failure here.
-# Same work on every machine: scripts/test.sh (and so CI) runs a fixed number of inputs per reader
+# Same work on every machine: scripts/test.sh --long (and so CI) runs a fixed number of inputs per reader
 # (LIDARSHOP_FUZZ_RUNS=ci, the table in runs_of, about 15 s a reader on an idle 2-core machine) from the seed
 # corpus alone with LIDARSHOP_FUZZ_SEED=1; SECONDS only caps the time. A time budget alone ran 242 scene inputs
 # here under load and 5,504 on CI's machine, so CI found what no local run had tried. Reproduce CI's run with
@@ -33,9 +33,11 @@ build=build/fuzz
 export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=true
 
 # The fuzz preset (CMakePresets.json): build/fuzz, clang++-14, LIDARSHOP_BUILD_FUZZ=ON, no tests or benchmarks.
+build_started=$(date +%s)
 cmake --preset fuzz >/dev/null || exit 1
 cmake --build "$build" -j "$(nproc)" --target "${readers[@]/%/_fuzz}" >"$build/build.log" 2>&1 ||
   { tail -30 "$build/build.log"; exit 1; }
+echo "fuzz.sh: the fuzz targets built in $(($(date +%s) - build_started)) s"
 
 # Inputs per reader for LIDARSHOP_FUZZ_RUNS=ci: about 15 s each on an idle 2-core Xeon (AVX-512).
 runs_of() {
