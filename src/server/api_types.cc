@@ -46,6 +46,7 @@ std::vector<TypeScriptStruct> ApiReplyTypes() {
       ResultType<PhotoReply>(),             // /api/docs/ID/photo, .../photo-from-e57
       ResultType<RecolorReply>(),           // /api/docs/ID/recolor's job
       ResultType<AlignReply>(),             // beside LandmarkAlignment
+      ResultType<PhotoMatchReply>(),        // beside PhotoPairModel
       ResultType<ReviewPointReply>(),       // /api/docs/ID/inpaint/review's job at a review point
       ResultType<ReviewStoppedReply>(),     // the same, its review dropped
       ResultType<ReviewClosedReply>(),      // DELETE /api/docs/ID/inpaint/review

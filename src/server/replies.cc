@@ -201,9 +201,23 @@ template <>
 const StructInfo& InfoOf<AlignReply>() {
   static const StructInfo info = [] {
     StructBuilder<AlignReply> b("AlignReply", "beside a LandmarkAlignment (POST /api/docs/ID/align)");
+    b.Field(&AlignReply::target_from_source_column_major, "target_from_source_column_major",
+            "the transform fitted, 16 numbers column-major");
     b.Field(&AlignReply::applied, "applied",
             "the scan's pose became target_from_source · world_from_scanner");
     b.Field(&AlignReply::version, "version", "the document's version");
+    return b.Build();
+  }();
+  return info;
+}
+
+template <>
+const StructInfo& InfoOf<PhotoMatchReply>() {
+  static const StructInfo info = [] {
+    StructBuilder<PhotoMatchReply> b("PhotoMatchReply",
+                                     "beside a PhotoPairModel (POST /api/docs/ID/photo-match)");
+    b.Field(&PhotoMatchReply::matrix_row_major, "matrix_row_major",
+            "H (b = H a) or F (b^T F a = 0), 9 numbers by rows, pixel coordinates");
     return b.Build();
   }();
   return info;

@@ -113,10 +113,17 @@ struct RecolorReply {
   int64_t version = 0;
 };
 
-// Beside a LandmarkAlignment (POST /api/docs/ID/align).
+// Beside a LandmarkAlignment (POST /api/docs/ID/align): its matrix (not a described field of the library's
+// struct) as the 16 numbers the editor multiplies poses with.
 struct AlignReply {
+  std::vector<double> target_from_source_column_major;
   bool applied = false;
   int64_t version = 0;
+};
+
+// Beside a PhotoPairModel (POST /api/docs/ID/photo-match): its 3 x 3 matrix by rows.
+struct PhotoMatchReply {
+  std::vector<double> matrix_row_major;
 };
 
 // The result of a review job stopped at a review point.
@@ -443,6 +450,8 @@ template <>
 const StructInfo& InfoOf<server::RecolorReply>();
 template <>
 const StructInfo& InfoOf<server::AlignReply>();
+template <>
+const StructInfo& InfoOf<server::PhotoMatchReply>();
 template <>
 const StructInfo& InfoOf<server::ReviewPointReply>();
 template <>

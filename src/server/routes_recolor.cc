@@ -25,18 +25,6 @@ namespace lidarshop::server {
 
 namespace {
 
-// A fit's described JSON with its matrix (not a described field) right after "model", where the answers have
-// always had it.
-nlohmann::ordered_json WithMatrix(const nlohmann::ordered_json& fit, const std::string& key,
-                                  const std::vector<double>& matrix) {
-  nlohmann::ordered_json json;
-  for (const auto& [name, value] : fit.items()) {
-    json[name] = value;
-    if (name == "model") json[key] = matrix;
-  }
-  return json;
-}
-
 // ?slot=a (the photo to recolour from, the default) or ?slot=b (the second photo of photo <-> photo pairs).
 cv::Mat* PhotoSlot(Document& document, const httplib::Request& request, httplib::Response& response) {
   const std::string slot = request.has_param("slot") ? request.get_param_value("slot") : std::string("a");
@@ -224,15 +212,14 @@ void Align(State& state, const std::shared_ptr<Document>& document, const nlohma
     }
     const LandmarkAlignment fit = AlignLandmarks(pairs, with_scale, "pairs");
     const Eigen::Matrix4d& t = fit.target_from_source;
-    const nlohmann::ordered_json json = WithMatrix(ToJson(fit), "target_from_source_column_major",
-                                                   std::vector<double>(t.data(), t.data() + 16));
     if (apply) {
       Snapshot next = document->now;
       next.scan.world_from_scanner = t * document->now.scan.world_from_scanner;
       next.behind.world_from_scanner = next.scan.world_from_scanner;  // the second layer shares the pose
       Commit(*document, std::move(next), state.options.undo_depth);
     }
-    SendJson(response, Joined(json, ToJson(AlignReply{apply, document->version})));
+    SendJson(response, Joined(ToJson(fit), ToJson(AlignReply{std::vector<double>(t.data(), t.data() + 16),
+                                                             apply, document->version})));
   } catch (const InputError& error) {
     throw OptionsError(error.what());  // cells without a return, too few or collinear landmarks
   }
@@ -257,10 +244,10 @@ void MatchPhotos(State&, const std::shared_ptr<Document>& document, const nlohma
       CheckInside(pairs.pixel_pixel[i].pixel_b, document->photo_b, fmt::format("pairs[{}].pixel_b", i));
     }
     const PhotoPairModel fit = EstimatePhotoModel(pairs.pixel_pixel, options, "pairs");
-    std::vector<double> rows;
+    PhotoMatchReply reply;
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) rows.push_back(fit.matrix(r, c));
-    SendJson(response, WithMatrix(ToJson(fit), "matrix_row_major", rows));
+      for (int c = 0; c < 3; ++c) reply.matrix_row_major.push_back(fit.matrix(r, c));
+    SendJson(response, Joined(ToJson(fit), ToJson(reply)));
   } catch (const InputError& error) {
     throw OptionsError(error.what());  // too few pairs, no model found
   }

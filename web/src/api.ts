@@ -2,50 +2,35 @@
 // HttpOnly cookie on the first page load and reloads the page without it, so the calls normally carry only the
 // cookie; a page opened with ?token= still puts it on every URL (the server accepts either).
 
-export interface DocumentInfo {
-  id: number;
-  name: string;
-  rows: number;
-  cols: number;
-  channels: string[];
-  valid_cells: number;
-  synthesized_cells: number;
-  object_cells: number;
-  hole_cells: number;
-  object_stroke_cells: number;
-  background_stroke_cells: number;
-  behind_cells: number;
-  world_from_scanner_column_major: number[];
-  azimuth_step_deg: number;
-  elevation_step_deg: number;
-  version: number;
-  can_undo: boolean;
-  can_redo: boolean;
-  // The photos of the E57 file the scan was opened from (images2D); absent from older servers.
-  e57_images?: { index: number; name: string; width_px: number; height_px: number; usable: boolean }[];
+import type { DocumentReply, FileEntry, JobReply } from './api_types.generated';
+
+// The replies' types are generated from the server's descriptions (api_types.generated.ts, `lidarshop schema
+// --typescript`); the editor narrows only what the description cannot say: a pair as a tuple, a fixed string as a
+// union, a number that is never null. A result's number is `number | null` there (the server writes a NaN as
+// null); a document's pose and grid steps are finite (the readers refuse a pose that is not).
+// Narrowed<T, U>: T with U's fields in place of its own. A key T lacks, or a type T's field does not admit, fails
+// to compile, so a field renamed or retyped on the server fails the editor's build (tsc in scripts/web.sh).
+export type Narrowed<T, U extends { [K in keyof U]: K extends keyof T ? T[K] : never }> = Omit<T, keyof U> &
+  U;
+
+export type DocumentInfo = Narrowed<
+  DocumentReply,
+  { world_from_scanner_column_major: number[]; azimuth_step_deg: number; elevation_step_deg: number }
+>;
+
+// A number of a reply to `digits` significant digits; "none" for null (a NaN on the server).
+export function precision(value: number | null, digits: number): string {
+  return value === null ? 'none' : value.toPrecision(digits);
 }
 
-export interface JobInfo {
-  id: number;
-  kind: string;
-  state: 'queued' | 'running' | 'done' | 'failed' | 'cancelled';
-  label: string;
-  done: number;
-  total: number;
-  error?: string;
-  result?: Record<string, unknown>;
-}
+// A job's `result` is the operation's own reply, an object whose type follows the kind.
+export type JobInfo = Narrowed<JobReply, { result?: Record<string, unknown> }>;
 
 // One entry of GET /api/files: a scan file under the served folders; `readable` false (with `error`) when its
 // header does not read.
-export interface ScanFileEntry {
-  path: string;
-  bytes?: number;
-  readable?: boolean;
-  error?: string;
-}
+export type ScanFileEntry = FileEntry;
 
-// The file the dialog starts on: the first that reads (a server without `readable` marks none broken).
+// The file the dialog starts on: the first that reads.
 export function firstReadableFile(files: ScanFileEntry[]): ScanFileEntry | undefined {
   return files.find((file) => file.readable !== false);
 }

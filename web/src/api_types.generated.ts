@@ -510,10 +510,18 @@ export interface RecolorReply {
 
 // beside a LandmarkAlignment (POST /api/docs/ID/align) (C++ AlignReply)
 export interface AlignReply {
+  // the transform fitted, 16 numbers column-major
+  target_from_source_column_major: (number | null)[];
   // the scan's pose became target_from_source · world_from_scanner
   applied: boolean;
   // the document's version
   version: number;
+}
+
+// beside a PhotoPairModel (POST /api/docs/ID/photo-match) (C++ PhotoMatchReply)
+export interface PhotoMatchReply {
+  // H (b = H a) or F (b^T F a = 0), 9 numbers by rows, pixel coordinates
+  matrix_row_major: (number | null)[];
 }
 
 // the result of a review job stopped at a review point (C++ ReviewPointReply)

@@ -5,8 +5,8 @@ import {
   DocumentInfo,
   JobInfo,
   MeshData,
+  Narrowed,
   PointSet,
-  ScanFileEntry,
   fileLabel,
   firstReadableFile,
   inverseRigid,
@@ -23,7 +23,17 @@ import { Cell, toCellList } from './strokes';
 import { VersionGate, applyDelta, parsePointsAnswer } from './delta';
 import { StationsPanel } from './stations';
 import { PictureStore, loadOverlay } from './picture';
-import { VerifyResult } from './api_types.generated';
+import type {
+  DocumentsReply,
+  FilesReply,
+  FormatsReply,
+  ModelReply,
+  ModelsReply,
+  SavePlanReply,
+  ScenesReply,
+  VerifyReply,
+  VerifyResult,
+} from './api_types.generated';
 import { TileStore } from './tiles';
 import { CellBox, boxParam, detailBox, lookedAtPoint, mergeDetail, nearBoxCentre } from './detail';
 
@@ -246,7 +256,7 @@ pointView.onSettled = () => {
 
 // The list of open documents (the server's), the shown one selected.
 async function listDocuments() {
-  const { documents } = await api.json<{ documents: DocumentInfo[] }>('/api/docs');
+  const { documents } = await api.json<Narrowed<DocumentsReply, { documents: DocumentInfo[] }>>('/api/docs');
   openDocuments = documents;
   const select = element<HTMLSelectElement>('documents');
   select.replaceChildren(
@@ -594,7 +604,7 @@ element('save').addEventListener('click', async () => {
   const format = element<HTMLSelectElement>('format').value;
   // Ask first what the format would drop: nothing is lost without a word.
   try {
-    const plan = await api.json<{ dropped: string[]; refused: string }>(`/api/docs/${doc.id}/save-plan`, {
+    const plan = await api.json<SavePlanReply>(`/api/docs/${doc.id}/save-plan`, {
       format,
     });
     if (plan.refused) {
@@ -629,7 +639,7 @@ async function verify() {
   if (!doc || !placed) return;
   const [x, y, z, yaw] = poseInputs.map((input) => Number(input.value));
   try {
-    const result = await api.json<VerifyResult & { summary: string }>(
+    const result = await api.json<VerifyResult & VerifyReply>(
       `/api/docs/${doc.id}/verify`,
       {},
       { model: placed.id, pose: { x_m: x, y_m: y, z_m: z, yaw_deg: yaw } },
@@ -654,7 +664,7 @@ for (const input of poseInputs) {
 element('place').addEventListener('click', async () => {
   if (!doc) return status('open a scan first');
   try {
-    const model = await api.json<{ id: number }>(
+    const model = await api.json<ModelReply>(
       '/api/models',
       {},
       { model: element<HTMLSelectElement>('model').value },
@@ -773,13 +783,13 @@ element('review-stop').addEventListener('click', async () => {
 
 async function start() {
   try {
-    const { scenes } = await api.json<{ scenes: string[] }>('/api/scenes');
-    const formats = await api.json<{ write: string[] }>('/api/formats');
+    const { scenes } = await api.json<ScenesReply>('/api/scenes');
+    const formats = await api.json<FormatsReply>('/api/formats');
     // E57 first: the format that holds everything the editor makes (synthesized flags, photos, two layers).
     const writable = [...formats.write].sort((a, b) => Number(b === 'e57') - Number(a === 'e57'));
     element('format').replaceChildren(...writable.map((name) => new Option(name, name)));
     element('scene').replaceChildren(...scenes.map((name) => new Option(name, name)));
-    const { files } = await api.json<{ files: ScanFileEntry[] }>('/api/files');
+    const { files } = await api.json<FilesReply>('/api/files');
     const fileSelect = element<HTMLSelectElement>('file');
     fileSelect.replaceChildren(
       ...files.map((file) => {
@@ -792,7 +802,7 @@ async function start() {
     // The dialog starts on the first file that opens (the server lists them in name order, broken ones too).
     const first = firstReadableFile(files);
     if (first) fileSelect.value = first.path;
-    const models = await api.json<{ builtin: string[]; files: string[] }>('/api/models');
+    const models = await api.json<ModelsReply>('/api/models');
     element('model').replaceChildren(
       ...models.builtin.map((name) => new Option(name, name)),
       ...models.files.map((path) => new Option(path.split('/').pop()!, path)),

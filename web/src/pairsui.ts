@@ -1,8 +1,15 @@
 // The correspondence panel: the mode (photo <-> scan, scan <-> scan, photo <-> photo), the pictures the clicks
 // go to (the photo, the second photo, the other scan's ray image) and the button that sends the pairs to the
 // mode's route (docs/api.md). The clicks in the editor's own ray image and 3-D view arrive through pickCell.
-import { Api, DocumentInfo, JobInfo } from './api';
-import { AlignOptions, LandmarkAlignment, PhotoPairModel } from './api_types.generated';
+import { Api, DocumentInfo, JobInfo, Narrowed, precision } from './api';
+import {
+  AlignOptions,
+  AlignReply,
+  DocumentsReply,
+  LandmarkAlignment,
+  PhotoMatchReply,
+  PhotoPairModel,
+} from './api_types.generated';
 import { MODES, PairCollector, PairMode, Point2 } from './pairs';
 import { RayView } from './rayview';
 
@@ -90,7 +97,8 @@ export class PairsPanel {
   // The other open scans, for landmarks.
   async listTargets() {
     const doc = this.context.doc();
-    const { documents } = await this.context.api.json<{ documents: DocumentInfo[] }>('/api/docs');
+    const { documents } =
+      await this.context.api.json<Narrowed<DocumentsReply, { documents: DocumentInfo[] }>>('/api/docs');
     const others = documents.filter((d) => d.id !== doc?.id);
     const select = element<HTMLSelectElement>('align-target');
     const keep = select.value;
@@ -234,7 +242,7 @@ export class PairsPanel {
         }
       } else if (mode === 'scan-scan') {
         const target = Number(element<HTMLSelectElement>('align-target').value);
-        const result = await api.json<LandmarkAlignment & { target_from_source_column_major: number[] }>(
+        const result = await api.json<LandmarkAlignment & AlignReply>(
           `/api/docs/${doc.id}/align`,
           {},
           this.pairs.body({ target }),
@@ -245,7 +253,7 @@ export class PairsPanel {
         );
       } else {
         const model = element<HTMLSelectElement>('photo-model').value as AlignOptions['model'];
-        const result = await api.json<PhotoPairModel & { matrix_row_major: number[] }>(
+        const result = await api.json<PhotoPairModel & PhotoMatchReply>(
           `/api/docs/${doc.id}/photo-match`,
           {},
           this.pairs.body({ model }),
@@ -254,7 +262,7 @@ export class PairsPanel {
         this.draw();
         const outliers = result.inlier.filter((v) => !v).length;
         this.context.status(
-          `${model}: RMS ${(result.rms_px ?? NaN).toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => v.toPrecision(4)).join(' ')}`,
+          `${model}: RMS ${(result.rms_px ?? NaN).toFixed(2)} px over the inliers, ${outliers} outlier pairs (red); matrix ${result.matrix_row_major.map((v) => precision(v, 4)).join(' ')}`,
         );
       }
     } catch (error) {

@@ -2,40 +2,29 @@
 // grouped for display. The server lists the candidates best first with their cluster; the panel shows one tile
 // per cluster (its representative, the best member) and accepts a candidate by index.
 
-export interface ReviewCandidate {
-  index: number;
-  source: [number, number]; // [row, col] of the source patch's centre
-  difference: number;
-  cluster: number;
-  accepted: boolean;
-  test: string; // the acceptance test that decided
-  value: number;
-  threshold: number;
-  margin: number;
-}
+import type {
+  PendingReviewReply,
+  ReviewCandidateEntry,
+  ReviewClusterEntry,
+  ReviewDetail,
+} from './api_types.generated';
+import { type Narrowed, precision } from './api';
 
-export interface ReviewCluster {
-  index: number;
-  representative: number;
-  members: number[];
-}
+// The server's types (api_types.generated.ts, narrowed as api.ts says): the cells as [row, col] tuples, the fixed
+// strings as unions. A candidate's numbers stay `number | null`: a NaN (a test that measured nothing) is null.
+export type ReviewCandidate = Narrowed<ReviewCandidateEntry, { source: [number, number] }>;
 
-export interface PendingReview {
-  state: 'review';
-  channel: 'color' | 'intensity';
-  rows: number;
-  cols: number;
-  hole_cells: number;
-  decisions: { target: [number, number]; source: [number, number] }[];
-  review: {
-    review_point: number;
-    iteration: number;
-    target: [number, number];
-    patch_radius: number;
-    candidates: ReviewCandidate[];
-    clusters: ReviewCluster[];
-  };
-}
+export type ReviewCluster = ReviewClusterEntry;
+
+export type PendingReview = Narrowed<
+  PendingReviewReply,
+  {
+    state: 'review';
+    channel: 'color' | 'intensity';
+    decisions: { target: [number, number]; source: [number, number] }[];
+    review: Narrowed<ReviewDetail, { target: [number, number]; candidates: ReviewCandidate[] }>;
+  }
+>;
 
 export interface ClusterGroup {
   cluster: number;
@@ -65,7 +54,7 @@ export function groupCandidates(pending: PendingReview): ClusterGroup[] {
 // "passes" or "rejected by histogram: 0.31 > 0.15".
 export function verdictText(candidate: ReviewCandidate): string {
   if (candidate.accepted) return 'passes';
-  return `rejected by ${candidate.test}: ${candidate.value.toPrecision(2)} > ${candidate.threshold.toPrecision(2)}`;
+  return `rejected by ${candidate.test}: ${precision(candidate.value, 2)} > ${precision(candidate.threshold, 2)}`;
 }
 
 // The patch centred at [row, col] as a rectangle of the ray image, pixels: (2R + 1)² from (col − R, row − R).

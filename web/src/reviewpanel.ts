@@ -2,6 +2,7 @@
 // patch) and one tile per cluster of candidates (its best member, enlarged, with its verdict and the number
 // of near-identical members). Clicking a tile accepts that candidate; "place by hand" lets the next pick in
 // the ray image choose the source patch's centre.
+import { precision } from './api';
 import { ClusterGroup, PendingReview, groupCandidates, patchRect, verdictText } from './review';
 
 export class ReviewPanel {
@@ -58,7 +59,7 @@ export class ReviewPanel {
     context.drawImage(canvas, rect.x, rect.y, size, size, 0, 0, size * zoom, size * zoom);
     const label = document.createElement('span');
     label.textContent = `#${group.rank} ×${group.members.length}`;
-    button.title = `candidate ${group.representative.index} at row ${group.representative.source[0]}, column ${group.representative.source[1]}; difference ${group.representative.difference.toPrecision(3)}; ${verdictText(group.representative)}; ${group.members.length} similar`;
+    button.title = `candidate ${group.representative.index} at row ${group.representative.source[0]}, column ${group.representative.source[1]}; difference ${precision(group.representative.difference, 3)}; ${verdictText(group.representative)}; ${group.members.length} similar`;
     button.append(picture, label);
     button.addEventListener('click', () => this.onAccept(group.representative.index));
     return button;

@@ -4,35 +4,25 @@
 // use them: Clean (what moved between the stations, removed and filled: one undoable edit per station, the
 // removed cells of the shown station highlighted). The server holds the site (POST /api/sites, docs/api.md).
 import * as THREE from 'three';
-import { Api, DocumentInfo, JobInfo, PointSet, inverseRigid, multiply } from './api';
-import type { CleanStationEntry } from './api_types.generated';
+import { Api, DocumentInfo, JobInfo, Narrowed, PointSet, inverseRigid, multiply } from './api';
+import type {
+  CleanStationEntry,
+  OpenedSiteReply,
+  RemovedReply,
+  SiteReply,
+  StationEntry,
+} from './api_types.generated';
 
-export interface StationInfo {
-  index: number;
-  name: string;
-  position_m: [number, number, number];
-  heading_deg: number;
-  world_from_scanner_column_major: number[];
-  rows: number;
-  cols: number;
-  returns: number;
-  organized: boolean;
-  document: number;
-  open: boolean;
-  current: boolean;
-  version?: number;
-  removed_cells?: number;
-}
+// A station as GET /api/docs/ID/stations lists it: its position and heading come from its pose, which is finite
+// (api.ts), so they are numbers here.
+export type StationInfo = Narrowed<
+  StationEntry,
+  { position_m: [number, number, number]; heading_deg: number; world_from_scanner_column_major: number[] }
+>;
 
-// GET /api/docs/ID/stations and POST /api/sites: site null when the scan is in none.
-export interface SiteInfo {
-  site: number | null;
-  name: string;
-  station: number; // the shown scan's station (-1 = none)
-  stations: StationInfo[];
-  document?: number; // POST /api/sites: the scan to show
-  warnings?: string[];
-}
+// GET /api/docs/ID/stations (site null when the scan is in none) and POST /api/sites, which adds the scan to
+// show and the reader's warnings.
+export type SiteInfo = Narrowed<SiteReply, { stations: StationInfo[] }> & Partial<OpenedSiteReply>;
 
 // One line of the list: "2 · station2 · (8.0, 2.0, 1.6) m · 30°".
 export function stationLabel(station: StationInfo): string {
@@ -257,9 +247,7 @@ export class StationsPanel {
     this.removedShown = 0;
     const here = this.site?.stations.find((s) => s.current);
     if (!here || !here.removed_cells || !points) return;
-    const { cells } = await this.host.api.json<{ version: number; cells: number[] }>(
-      `/api/docs/${doc.id}/removed`,
-    );
+    const { cells } = await this.host.api.json<RemovedReply>(`/api/docs/${doc.id}/removed`);
     const xyz = pointsOfCells(points, cells);
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.BufferAttribute(xyz, 3));

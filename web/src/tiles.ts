@@ -4,22 +4,16 @@
 // comes first, so a station of millions of rays shows its first picture at once and is refined where the user
 // looks. After an edit, tiles.json?since=V names the box of pixels that changed since the version held: only
 // held tiles meeting it are dropped and fetched again. The browser never holds the full-resolution picture.
-// (TilesInfo is kept here: its `changed` is a tuple; the levels are the generated TileLevelEntry.)
-import type { TileLevelEntry } from './api_types.generated';
+import type { TileLevelEntry, TilesReply } from './api_types.generated';
+import type { Narrowed } from './api';
 import type { ImageView } from './strokes';
 
 // One level of the pyramid (tiles.json "levels"), as the server describes it.
 export type TileLevel = TileLevelEntry;
 
-// GET /api/docs/ID/tiles.json[?channel=C&since=V].
-export interface TilesInfo {
-  version: number;
-  rows: number;
-  cols: number;
-  tile_px: number;
-  levels: TileLevel[];
-  changed: [number, number, number, number]; // col, row, width, height of level-0 pixels (0 0 0 0: none)
-}
+// GET /api/docs/ID/tiles.json[?channel=C&since=V]: `changed` is col, row, width, height of level-0 pixels
+// (0 0 0 0: none).
+export type TilesInfo = Narrowed<TilesReply, { changed: [number, number, number, number] }>;
 
 // A box of level-0 cells.
 export interface CellBox {

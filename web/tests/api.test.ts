@@ -4,11 +4,14 @@ import {
   FLAG_OBJECT,
   FLAG_SYNTHESIZED,
   JobInfo,
+  Narrowed,
+  ScanFileEntry,
   fileLabel,
   firstReadableFile,
   parsePoints,
   resultWarnings,
 } from '../src/api';
+import type { TilesReply } from '../src/api_types.generated';
 import { pointColours } from '../src/pointview';
 
 function encode(points: { xyz: number[]; cell: number; rgb: number[]; flag: number }[], rows = 4, cols = 5) {
@@ -101,6 +104,7 @@ describe('resultWarnings', () => {
   const job = (result?: Record<string, unknown>): JobInfo => ({
     id: 1,
     kind: 'fill',
+    document: 1,
     state: 'done',
     label: '',
     done: 1,
@@ -121,18 +125,37 @@ describe('resultWarnings', () => {
 });
 
 describe('the file dialog', () => {
-  const files = [
-    { path: '/data/a_broken.e57', readable: false, error: 'a_broken.e57: not an E57 file' },
-    { path: '/data/b_scan.ptx', readable: true },
-    { path: '/data/c_scan.ply', readable: true },
+  const files: ScanFileEntry[] = [
+    { path: '/data/a_broken.e57', bytes: 4, readable: false, error: 'a_broken.e57: not an E57 file' },
+    { path: '/data/b_scan.ptx', bytes: 900, readable: true },
+    { path: '/data/c_scan.ply', bytes: 700, readable: true },
   ];
   it('starts on the first file that opens, not on a broken one', () => {
     expect(firstReadableFile(files)?.path).toBe('/data/b_scan.ptx');
     expect(firstReadableFile([files[0]])).toBeUndefined();
-    expect(firstReadableFile([{ path: '/x.ptx' }])?.path).toBe('/x.ptx'); // an older server: nothing marked
   });
   it('labels a broken file', () => {
     expect(fileLabel(files[0])).toBe('a_broken.e57 (does not open)');
     expect(fileLabel(files[1])).toBe('b_scan.ptx');
+  });
+});
+
+// The editor's reply types narrow the generated ones; a narrowing the server's reply does not admit must not
+// compile (tsc over tests/ in scripts/web.sh fails on an unused @ts-expect-error).
+describe('Narrowed', () => {
+  it('refuses a field the reply lacks and a type its field does not admit', () => {
+    // @ts-expect-error: TilesReply has no such field
+    const lacking: Narrowed<TilesReply, { no_such_field: number }> | null = null;
+    // @ts-expect-error: its tile size is a number
+    const retyped: Narrowed<TilesReply, { tile_px: string }> | null = null;
+    const narrowed: Narrowed<TilesReply, { changed: [number, number, number, number] }> = {
+      version: 1,
+      rows: 2,
+      cols: 3,
+      tile_px: 256,
+      levels: [],
+      changed: [0, 0, 3, 2],
+    };
+    expect([lacking, retyped, narrowed.changed.length]).toEqual([null, null, 4]);
   });
 });
