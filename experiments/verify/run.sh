@@ -9,14 +9,16 @@ cd "$(dirname "$0")/../.."
 BUILD=${1:-build/verify}
 OUT=${2:-out/verify}
 mkdir -p "$OUT"
-ninja -C "$BUILD" -j2 lidarshop_cli verify_analytic_test verify_multiscan_test verify_parking_lot_test >/dev/null
+ninja -C "$BUILD" -j2 lidarshop_cli lidarshop_verify_tests >/dev/null
+# The verify module's test program; each test file's suites (verify_analytic_test.cc, ...) by filter.
+tests() { "$BUILD/src/lidarshop/verify/lidarshop_verify_tests" --gtest_brief=1 --gtest_filter="$1"; }
 
 echo "== analytic (box seen from the front) =="
-"$BUILD/src/lidarshop/verify/verify_analytic_test" --gtest_brief=1 | tail -n 3 || echo "(failures above)"
+tests "VerifyAnalyticTest.*:VerifyModelTest.*:VerifyOptionsTest.*" | tail -n 3 || echo "(failures above)"
 echo "== several scans, smaller model, occlusion =="
-"$BUILD/src/lidarshop/verify/verify_multiscan_test" --gtest_brief=1 | grep -E "vehicle|model|open|fenced|PASSED|FAILED" || echo "(failures above)"
+tests "VerifyMultiScanTest.*:VerifyOcclusionTest.*" | grep -E "vehicle|model|open|fenced|PASSED|FAILED" || echo "(failures above)"
 echo "== parking lot (tests) =="
-"$BUILD/src/lidarshop/verify/verify_parking_lot_test" --gtest_brief=1 | grep -E "truth|PASSED|FAILED" || echo "(failures above)"
+tests "ParkingLotTest.*" | grep -E "truth|PASSED|FAILED" || echo "(failures above)"
 
 echo "== parking lot (CLI) =="
 L="$BUILD/lidarshop"

@@ -18,16 +18,16 @@
 namespace lidarshop {
 namespace {
 
-struct Case {
+struct SurroundingsCase {
   Scan scan, truth;
   cv::Mat hole;
 };
 
-Case MakeCase(const std::string& json, int margin) {
+SurroundingsCase MakeSurroundingsCase(const std::string& json, int margin) {
   const SceneDescription scene = ParseScene(json, "test scene", ".");
   SceneDescription without = scene;
   std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
-  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  SurroundingsCase c{SynthesizeScan(scene), SynthesizeScan(without), {}};
   c.hole = GrowHole((c.scan.label == 1) & (c.scan.valid != 0), margin);
   return c;
 }
@@ -50,7 +50,7 @@ constexpr const char* kKerbScene = R"({
 })";
 
 TEST(FillSurroundings, AKerbFaceBehindABoxIsContinuedNotFloated) {
-  const Case c = MakeCase(kKerbScene, 2);
+  const SurroundingsCase c = MakeSurroundingsCase(kKerbScene, 2);
   const FillResult result = FillScan(c.scan, c.hole);
   const FillMetrics m = MeasureFill(result.scan, c.truth, c.hole);
   // Before the face was found (main ff9d1df): 4.4 % floating, RMSE 53.5 mm.
@@ -62,7 +62,7 @@ TEST(FillSurroundings, AKerbFaceBehindABoxIsContinuedNotFloated) {
 // The kerb's face is found as a plane of its own among the planes of the band around the hole, and RANSAC's
 // plane through the road and the pavement at once (2° apart) is not kept.
 TEST(FillSurroundings, TheBandHoldsTheKerbFaceAndNoPlaneThroughTwoLevels) {
-  const Case c = MakeCase(kKerbScene, 2);
+  const SurroundingsCase c = MakeSurroundingsCase(kKerbScene, 2);
   cv::Mat ids, stats, centroids;
   ASSERT_EQ(cv::connectedComponentsWithStats(c.hole, ids, stats, centroids, 8, CV_32S), 2);
   const cv::Mat range = RangeImage(c.scan);
@@ -91,17 +91,17 @@ TEST(FillSurroundings, TheBandHoldsTheKerbFaceAndNoPlaneThroughTwoLevels) {
 // within the inlier distance than any one tread), and the fill put the treads' cells on it: 12.8 mm RMSE
 // became 22.8 mm when the band's planes were refitted (b7b6b08). The planes come from cells that face their
 // way (fill/surface_planes.cc, FacingPlaneCells).
-Case KerbStepsCase() {
+SurroundingsCase KerbStepsCase() {
   SceneDescription scene = LoadScene(LIDARSHOP_SOURCE_DIR "/data/fill_eval/kerb_steps.json");
   SceneDescription without = scene;
   std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
-  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  SurroundingsCase c{SynthesizeScan(scene), SynthesizeScan(without), {}};
   c.hole = GrowHole((c.scan.label == 1) & (c.scan.valid != 0), 2);
   return c;
 }
 
 TEST(FillSurroundings, AFlightOfStepsGivesItsTreadsAndRisersNotThePlaneThroughItsNosings) {
-  const Case c = KerbStepsCase();
+  const SurroundingsCase c = KerbStepsCase();
   cv::Mat ids, stats, centroids;
   ASSERT_EQ(cv::connectedComponentsWithStats(c.hole, ids, stats, centroids, 8, CV_32S), 2);
   const cv::Mat range = RangeImage(c.scan);
@@ -122,7 +122,7 @@ TEST(FillSurroundings, AFlightOfStepsGivesItsTreadsAndRisersNotThePlaneThroughIt
 }
 
 TEST(FillSurroundings, KerbStepsKeepsItsScore) {
-  const Case c = KerbStepsCase();
+  const SurroundingsCase c = KerbStepsCase();
   double rmse_mm = 0, within = 0;
   for (uint64_t seed = 0; seed < 3; ++seed) {  // fill_eval's three fills
     FillOptions options;
@@ -138,11 +138,11 @@ TEST(FillSurroundings, KerbStepsKeepsItsScore) {
 }
 
 // A random scene (scanner/random_scene.h), its target removed as fill_eval --random-seeds does.
-Case RandomCase(uint64_t seed) {
+SurroundingsCase RandomCase(uint64_t seed) {
   const SceneDescription scene = RandomScene(seed);
   SceneDescription without = scene;
   std::erase_if(without.objects, [&](const SceneObject& o) { return o.label == scene.target_label; });
-  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  SurroundingsCase c{SynthesizeScan(scene), SynthesizeScan(without), {}};
   c.hole = GrowHole((c.scan.label == scene.target_label) & (c.scan.valid != 0), 2);
   return c;
 }
@@ -152,7 +152,7 @@ Case RandomCase(uint64_t seed) {
 // patches and stood 0.23 m before it: 24.5 % of the filled points floated. The cells around the hole, above
 // and below or left and right, agree on the recess.
 TEST(FillSurroundings, ARecessBehindAPersonKeepsTheDepthTheCellsAroundTheHoleShow) {
-  const Case c = RandomCase(1);
+  const SurroundingsCase c = RandomCase(1);
   const FillMetrics m = MeasureFill(FillScan(c.scan, c.hole).scan, c.truth, c.hole);
   EXPECT_LT(m.floating_share, 0.05) << "RMSE " << m.range_rmse_mm << " mm";
   EXPECT_LT(m.range_rmse_mm, 60.0);  // before: 111 mm
@@ -162,7 +162,7 @@ TEST(FillSurroundings, ARecessBehindAPersonKeepsTheDepthTheCellsAroundTheHoleSho
 // column (8 cells with the margin) took the door's relief from its patches, 0.15 m behind the facade the
 // cells beside it show: 25.3 % floating. A narrow gap between two cells on one plane continues that plane.
 TEST(FillSurroundings, AThinPostsColumnContinuesTheFacadeBesideIt) {
-  const Case c = RandomCase(27);
+  const SurroundingsCase c = RandomCase(27);
   const FillMetrics m = MeasureFill(FillScan(c.scan, c.hole).scan, c.truth, c.hole);
   EXPECT_LT(m.floating_share, 0.05) << "RMSE " << m.range_rmse_mm << " mm";
   EXPECT_LT(m.range_rmse_mm, 40.0);  // before: 78 mm
@@ -185,7 +185,7 @@ constexpr const char* kTouchingScene = R"({
 })";
 
 TEST(FillSurroundings, ATouchingPersonIsNeitherCopiedNorTheHolesBorder) {
-  const Case c = MakeCase(kTouchingScene, 2);
+  const SurroundingsCase c = MakeSurroundingsCase(kTouchingScene, 2);
   const FillResult result = FillScan(c.scan, c.hole);
   FillOptions old;
   old.background_only = false;

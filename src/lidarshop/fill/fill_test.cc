@@ -50,16 +50,16 @@ constexpr const char* kSkyScene = R"({
   ]
 })";
 
-struct Case {
+struct FillCase {
   Scan scan, truth;
   cv::Mat hole;
 };
 
-Case MakeCase(const char* json, int margin) {
+FillCase MakeFillCase(const char* json, int margin) {
   const SceneDescription scene = ParseScene(json, "test scene", ".");
   SceneDescription without = scene;
   std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
-  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  FillCase c{SynthesizeScan(scene), SynthesizeScan(without), {}};
   c.hole = GrowHole((c.scan.label == 1) & (c.scan.valid != 0), margin);
   return c;
 }
@@ -191,7 +191,7 @@ std::string WideWallScene() {
 }
 
 TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
-  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const FillCase c = MakeFillCase(WideWallScene().c_str(), 2);
   const int64_t hole_cells = cv::countNonZero(c.hole);
   ASSERT_GT(hole_cells, 500);
   FillOptions options;
@@ -235,7 +235,7 @@ TEST(FillScan, WorksInAWindowAroundTheHoleAsWellAsOnTheWholeScan) {
 }
 
 TEST(FillScanWindow, HoldsTheWindowOnlyAndAppliedEqualsFillScan) {
-  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const FillCase c = MakeFillCase(WideWallScene().c_str(), 2);
   FillOptions options;
   options.window_min_margin_cells = 64;
   const FillResult whole = FillScan(c.scan, c.hole, options);
@@ -296,7 +296,7 @@ TEST(FillScanWindow, HoldsTheWindowOnlyAndAppliedEqualsFillScan) {
 }
 
 TEST(FillScanWindow, AHoleCellWithoutADirectionIsNamedInTheScansRowsAndColumns) {
-  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const FillCase c = MakeFillCase(WideWallScene().c_str(), 2);
   FillOptions options;
   options.window_min_margin_cells = 64;
   const cv::Rect window = FillScanWindow(c.scan, c.hole, options).Window();
@@ -317,7 +317,7 @@ TEST(FillScanWindow, AHoleCellWithoutADirectionIsNamedInTheScansRowsAndColumns) 
 }
 
 TEST(FillScanWindow, AnEmptyMaskGivesAnEmptyWindowThatChangesNothing) {
-  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const FillCase c = MakeFillCase(WideWallScene().c_str(), 2);
   const cv::Mat nothing = cv::Mat::zeros(c.scan.rows, c.scan.cols, CV_8U);
   FillResult result = FillScanWindow(c.scan, nothing);
   EXPECT_EQ(result.Window().area(), 0);
@@ -337,7 +337,7 @@ TEST(FillScanWindow, AnEmptyMaskGivesAnEmptyWindowThatChangesNothing) {
 }
 
 TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
-  const Case c = MakeCase(WideWallScene().c_str(), 2);
+  const FillCase c = MakeFillCase(WideWallScene().c_str(), 2);
   FillOptions options;
   options.window_min_margin_cells = 64;
   options.window_min_known_ratio = 1e5;  // more than the whole scan holds: the window becomes the scan
@@ -347,7 +347,7 @@ TEST(FillScan, TheWindowGrowsUntilItHoldsEnoughKnownReturns) {
 }
 
 TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
-  const Case c = MakeCase(kWallScene, 2);
+  const FillCase c = MakeFillCase(kWallScene, 2);
   ASSERT_GT(cv::countNonZero(c.hole), 500);
   FillOptions options;
   const FillResult gradient = FillScan(c.scan, c.hole, options);
@@ -403,7 +403,7 @@ TEST(FillScan, GradientFillBeatsTheMembraneBehindABoxAndKeepsEverythingElse) {
 }
 
 TEST(FillScan, ThePlanesAroundTheHoleTakeTheDriftOutOfTheReconstruction) {
-  const Case c = MakeCase(kWallScene, 2);
+  const FillCase c = MakeFillCase(kWallScene, 2);
   FillOptions options;
   const FillResult with_planes = FillScan(c.scan, c.hole, options);
   options.planes.enabled = false;
@@ -421,7 +421,7 @@ TEST(FillScan, ThePlanesAroundTheHoleTakeTheDriftOutOfTheReconstruction) {
 // Offset completion (opt-in): shifted copies of the scan fill the hole behind the box, the greedy fill only what
 // no offset reaches; the result is as good as the default's and leaves every cell outside the hole alone.
 TEST(FillScan, OffsetCompletionFillsBehindTheBox) {
-  const Case c = MakeCase(kWallScene, 2);
+  const FillCase c = MakeFillCase(kWallScene, 2);
   FillOptions options;
   options.offset_completion = true;
   const FillResult offsets = FillScan(c.scan, c.hole, options);
@@ -452,7 +452,7 @@ TEST(FillScan, OffsetCompletionFillsBehindTheBox) {
 // PatchMatch gives way to the exact search where that is affordable (FillOptions::exact_search_max_cost): the
 // same fill as asking for it, and PatchMatch's own with a budget of 0.
 TEST(FillScan, SmallHolesGetTheExactSearch) {
-  const Case c = MakeCase(kWallScene, 2);
+  const FillCase c = MakeFillCase(kWallScene, 2);
   FillOptions options;
   const FillResult automatic = FillScan(c.scan, c.hole, options);
   EXPECT_TRUE(automatic.exact_search);
@@ -470,7 +470,7 @@ TEST(FillScan, SmallHolesGetTheExactSearch) {
 }
 
 TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
-  const Case c = MakeCase(kSkyScene, 1);
+  const FillCase c = MakeFillCase(kSkyScene, 1);
   int sky = 0;
   for (int y = 0; y < c.scan.rows; ++y)
     for (int x = 0; x < c.scan.cols; ++x) sky += c.hole.at<uint8_t>(y, x) && !c.truth.valid.at<uint8_t>(y, x);
@@ -490,7 +490,7 @@ TEST(FillScan, CellsWithNothingBehindStayWithoutAReturn) {
 // leaves a hole whose upper rows have no return on either side of it in their row, and must stay without one
 // (a patch copied from lower down would bring ground).
 TEST(FillScan, RowsWithoutAReturnOnBothSidesOfTheHoleStayWithoutOne) {
-  const Case c = MakeCase(R"({
+  const FillCase c = MakeFillCase(R"({
     "scanner": {"position": [0, 0, 1.5], "azimuth_deg": [-35, 35], "elevation_deg": [-25, -2], "columns": 200,
                 "rows": 100, "max_range": 60, "seed": 7},
     "objects": [
@@ -499,7 +499,7 @@ TEST(FillScan, RowsWithoutAReturnOnBothSidesOfTheHoleStayWithoutOne) {
       {"primitive": "box", "size": [3.0, 0.8, 2.0], "translate": [0.3, 5, 1.0], "label": 1, "color": [40, 60, 200]}
     ]
   })",
-                          2);
+                                  2);
   // Hole cells whose nearest known cells left and right in the row both lack a return.
   cv::Mat between = cv::Mat::zeros(c.hole.size(), CV_8U);
   for (int y = 0; y < c.hole.rows; ++y)
@@ -524,7 +524,7 @@ TEST(FillScan, RowsWithoutAReturnOnBothSidesOfTheHoleStayWithoutOne) {
 
 TEST(FillScan, EveryMethodRunsOnAScanWithoutIntensityOrColourAndInventsNone) {
   // A PCD or E57 without intensity (and here without colour): the fill has only the range to go by.
-  Case c = MakeCase(kWallScene, 1);
+  FillCase c = MakeFillCase(kWallScene, 1);
   c.scan.intensity = cv::Mat();
   c.scan.color = cv::Mat();
   for (FillMethod method :
@@ -540,7 +540,7 @@ TEST(FillScan, EveryMethodRunsOnAScanWithoutIntensityOrColourAndInventsNone) {
 }
 
 TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
-  const Case c = MakeCase(kWallScene, 2);
+  const FillCase c = MakeFillCase(kWallScene, 2);
   FillOptions options;
   options.method = FillMethod::kDepthPatch;
   const FillMetrics d = MeasureFill(FillScan(c.scan, c.hole, options).scan, c.truth, c.hole);
@@ -550,7 +550,7 @@ TEST(FillScan, DepthPatchesFloatWhereGradientsDoNot) {
 }
 
 TEST(FillScan, SameSeedSameFillOnAnyThreadCount) {
-  const Case c = MakeCase(kWallScene, 1);
+  const FillCase c = MakeFillCase(kWallScene, 1);
   FillOptions options;
   options.inpaint.seed = 3;
   const FillResult a = FillScan(c.scan, c.hole, options);
@@ -571,7 +571,7 @@ TEST(FillScan, SameSeedSameFillOnAnyThreadCount) {
 }
 
 TEST(FillScan, BadAndEdgeCaseMasks) {
-  Case c = MakeCase(kWallScene, 1);
+  FillCase c = MakeFillCase(kWallScene, 1);
   EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows + 1, c.scan.cols, CV_8U, cv::Scalar(0))), InputError);
   EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_8U, cv::Scalar(255))), InputError);
   EXPECT_THROW(FillScan(c.scan, cv::Mat(c.scan.rows, c.scan.cols, CV_32F, cv::Scalar(1))), InputError);

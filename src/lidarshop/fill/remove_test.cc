@@ -21,16 +21,16 @@ constexpr const char* kScene = R"({
   ]
 })";
 
-struct Case {
+struct RemoveCase {
   Scan scan, truth;
   cv::Mat strokes;
 };
 
-Case MakeCase() {
+RemoveCase MakeRemoveCase() {
   const SceneDescription scene = ParseScene(kScene, "test scene", ".");
   SceneDescription without = scene;
   std::erase_if(without.objects, [](const SceneObject& o) { return o.label == 1; });
-  Case c{SynthesizeScan(scene), SynthesizeScan(without), {}};
+  RemoveCase c{SynthesizeScan(scene), SynthesizeScan(without), {}};
   // Object stroke: the box's cells eroded; background stroke: a ring of cells well outside it.
   const cv::Mat box = (c.scan.label == 1) & (c.scan.valid != 0);
   cv::Mat inner, outer;
@@ -46,7 +46,7 @@ Case MakeCase() {
 }
 
 TEST(RemoveObject, CutsTheBoxAndFillsBehindIt) {
-  const Case c = MakeCase();
+  const RemoveCase c = MakeRemoveCase();
   const RemoveResult removed = RemoveObject(c.scan, c.strokes);
   const cv::Mat box = (c.scan.label == 1) & (c.scan.valid != 0);
   EXPECT_EQ(cv::countNonZero(box & ~removed.hole), 0);  // every box cell is in the hole
@@ -58,7 +58,7 @@ TEST(RemoveObject, CutsTheBoxAndFillsBehindIt) {
 }
 
 TEST(RemoveObject, KeepObjectGivesTheFillAsALayerBehindTheObjectOnly) {
-  const Case c = MakeCase();
+  const RemoveCase c = MakeRemoveCase();
   RemoveOptions options;
   options.keep_object = true;
   const RemoveResult removed = RemoveObject(c.scan, c.strokes, options);
@@ -89,7 +89,7 @@ TEST(RemoveObject, KeepObjectGivesTheFillAsALayerBehindTheObjectOnly) {
 }
 
 TEST(RemoveObjectWindow, ItsFillAppliedAndItsLayerBehindAreRemoveObjects) {
-  const Case c = MakeCase();
+  const RemoveCase c = MakeRemoveCase();
   RemoveOptions options;
   options.keep_object = true;
   options.fill.window_min_margin_cells = 8;  // a window smaller than this small scan
@@ -128,7 +128,7 @@ TEST(RemoveObject, EnclosedNoReturnCellsJoinTheHole) {
 }
 
 TEST(RemoveObject, BadOptionsAndStrokes) {
-  const Case c = MakeCase();
+  const RemoveCase c = MakeRemoveCase();
   RemoveOptions options;
   options.margin_cells = -1;
   EXPECT_THROW(RemoveObject(c.scan, c.strokes, options), OptionsError);

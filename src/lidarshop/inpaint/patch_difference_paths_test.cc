@@ -19,7 +19,7 @@ namespace {
 #define REQUIRE_AVX2() \
   if (BestSimdPath() != SimdPath::kAvx2) GTEST_SKIP() << "this CPU has no AVX2"
 
-cv::Mat RandomImage(int rows, int cols, int channels, uint64_t seed) {
+cv::Mat RandomSignedImage(int rows, int cols, int channels, uint64_t seed) {
   cv::Mat image(rows, cols, CV_32FC(channels));
   cv::RNG rng(seed);
   rng.fill(image, cv::RNG::UNIFORM, -50.0, 255.0);
@@ -63,7 +63,7 @@ TEST(PatchDifferencePaths, EveryKernelBitIdentical) {
   for (int channels = 1; channels <= 7; ++channels) {
     for (int radius : {1, 2, 3, 4}) {  // rows of 3..9 pixels: 3..63 floats, mostly not multiples of 8
       const int rows = 31, cols = 37;
-      const cv::Mat image = RandomImage(rows, cols, channels, 100 * channels + radius);
+      const cv::Mat image = RandomSignedImage(rows, cols, channels, 100 * channels + radius);
       const InpaintCanvas canvas(image, Holes(rows, cols), radius);
       std::vector<float> weights;  // all 1, unequal, and one zero weight in turn
       if (channels > 1 && radius % 2 == 0) {
@@ -123,7 +123,7 @@ TEST(PatchDifferencePaths, EveryKernelBitIdentical) {
 TEST(PatchDifferencePaths, WholeFillBitIdentical) {
   REQUIRE_AVX2();
   for (int channels : {1, 3, 5}) {
-    const cv::Mat image = RandomImage(60, 70, channels, 7 + channels);
+    const cv::Mat image = RandomSignedImage(60, 70, channels, 7 + channels);
     cv::Mat smooth;
     cv::GaussianBlur(image, smooth, cv::Size(7, 7), 2.0);
     cv::Mat mask = cv::Mat::zeros(60, 70, CV_8U);

@@ -4,16 +4,17 @@
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/io/e57.h"
 #include "lidarshop/io/e57_image_camera.h"
+#include "lidarshop/io/io_test_util.h"
 #include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
 namespace {
 
-const std::string kDir = LIDARSHOP_SHARED_DATA_DIR "/e57/";
+using testing_io::kE57Dir;
 
 TEST(E57Images, PumpAPhotoSurvivesARoundTrip) {
-  const E57File file = ReadE57(kDir + "pumpA.e57");
+  const E57File file = ReadE57(kE57Dir + "pumpA.e57");
   ASSERT_EQ(file.images.size(), 1u);
   EXPECT_EQ(file.images[0].encoding, "jpeg");
   const E57File back = ReadE57Bytes(EncodeE57(file.scans, file.images, {}), "round_trip.e57");
@@ -97,7 +98,7 @@ TEST(E57Images, EveryRepresentationRoundTrips) {
     // Stored bytes (any bytes: the writer copies them) for the mask.
     image.mask_encoded = {0x89, 'P', 'N', 'G', static_cast<uint8_t>(i), 1, 2, 3};
   }
-  const std::vector<Scan> scans = ReadE57(kDir + "tinyCartesianFloatRgb.e57").scans;
+  const std::vector<Scan> scans = ReadE57(kE57Dir + "tinyCartesianFloatRgb.e57").scans;
   ASSERT_EQ(scans.size(), 1u);
   const E57File first = ReadE57Bytes(EncodeE57(scans, images, {}), "all.e57");
   ASSERT_EQ(first.images.size(), 4u);
@@ -194,10 +195,10 @@ TEST(E57Images, CamerasRoundTripThroughTheirEntries) {
 
 // The real files with images read as before, and their entries name their models.
 TEST(E57Images, RealFilesListTheirImages) {
-  const E57File pump = ReadE57(kDir + "pumpA.e57");
+  const E57File pump = ReadE57(kE57Dir + "pumpA.e57");
   ASSERT_EQ(pump.images.size(), 1u);
   EXPECT_EQ(E57ImageModel(pump.images[0]), "");
-  const E57File tiny = ReadE57(kDir + "tiny_pc_and_images.e57");
+  const E57File tiny = ReadE57(kE57Dir + "tiny_pc_and_images.e57");
   EXPECT_FALSE(tiny.images.empty());
   const E57File distortion =
       ReadE57(LIDARSHOP_SHARED_DATA_DIR "/interop/e57/libe57_PinholeImageWithDistortionParameters.e57");
@@ -223,7 +224,7 @@ TEST(E57Images, RealFilesListTheirImages) {
 // A scan read from E57 keeps its entry's guid, sensor and acquisition times (Scan::source_metadata) and the
 // writer writes them back: an edited scan saved as E57 is still that scan, of that date.
 TEST(E57Images, ScanGuidSensorAndDatesSurviveASave) {
-  const E57File pump = ReadE57(kDir + "pumpA.e57");
+  const E57File pump = ReadE57(kE57Dir + "pumpA.e57");
   ASSERT_EQ(pump.scans[0].source_metadata.count("e57.guid"), 1u);
   EXPECT_EQ(pump.scans[0].source_metadata.at("e57.guid"), "{116B6772-AC46-41B3-B70C-0C63CC671447}");
   const E57File back = ReadE57Bytes(EncodeE57(pump, {}), "back.e57");

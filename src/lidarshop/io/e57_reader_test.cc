@@ -5,13 +5,14 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/io/e57.h"
+#include "lidarshop/io/io_test_util.h"
 #include "lidarshop/scan/ray_directions.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop {
 namespace {
 
-const std::string kDir = LIDARSHOP_SHARED_DATA_DIR "/e57/";
+using testing_io::kE57Dir;
 
 cv::Vec3f PointAt(const Scan& s, int64_t cell) { return s.point.ptr<cv::Vec3f>()[cell]; }
 
@@ -28,7 +29,7 @@ void ExpectInsideBounds(const Scan& s, const Eigen::Vector3d& lo, const Eigen::V
 }
 
 TEST(E57Reader, PumpAIsAnOrganizedScanWithPhoto) {
-  const E57File f = ReadE57(kDir + "pumpA.e57");
+  const E57File f = ReadE57(kE57Dir + "pumpA.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   const Scan& s = f.scans[0];
   CheckScan(s);
@@ -82,7 +83,7 @@ TEST(E57Reader, PumpAIsAnOrganizedScanWithPhoto) {
 }
 
 TEST(E57Reader, BunnyFloatIsUnstructured) {
-  const E57File f = ReadE57(kDir + "bunnyFloat.e57");
+  const E57File f = ReadE57(kE57Dir + "bunnyFloat.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   const Scan& s = f.scans[0];
   EXPECT_EQ(s.rows, 1);
@@ -95,7 +96,7 @@ TEST(E57Reader, BunnyFloatIsUnstructured) {
 
 TEST(E57Reader, CartesianInvalidStates) {
   // Three records, cartesianInvalidState stored as a Float: 0 (valid), 1 (direction only), 2 (invalid).
-  const E57File f = ReadE57(kDir + "cartesian_invalid_state_single.e57");
+  const E57File f = ReadE57(kE57Dir + "cartesian_invalid_state_single.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   const Scan& s = f.scans[0];
   ASSERT_EQ(s.num_cells(), 3);
@@ -110,10 +111,10 @@ TEST(E57Reader, CartesianInvalidStates) {
 }
 
 TEST(E57Reader, EmptyFilesAreEmpty) {
-  const E57File empty = ReadE57(kDir + "empty.e57");
+  const E57File empty = ReadE57(kE57Dir + "empty.e57");
   EXPECT_TRUE(empty.scans.empty());
   EXPECT_TRUE(empty.images.empty());
-  const E57File empty_pc = ReadE57(kDir + "empty_pc.e57");
+  const E57File empty_pc = ReadE57(kE57Dir + "empty_pc.e57");
   ASSERT_EQ(empty_pc.scans.size(), 1u);  // one data3D entry with recordCount 0
   EXPECT_EQ(empty_pc.scans[0].num_cells(), 0);
 }
@@ -121,7 +122,7 @@ TEST(E57Reader, EmptyFilesAreEmpty) {
 TEST(E57Reader, IntensityLimits) {
   for (const char* name : {"integer_intensity.e57", "scaled_integer_intensity.e57"}) {
     SCOPED_TRACE(name);
-    const E57File f = ReadE57(kDir + name);
+    const E57File f = ReadE57(kE57Dir + name);
     ASSERT_EQ(f.scans.size(), 1u);
     const Scan& s = f.scans[0];
     ASSERT_EQ(s.num_cells(), 2);  // recordCount 2
@@ -130,7 +131,7 @@ TEST(E57Reader, IntensityLimits) {
     EXPECT_FLOAT_EQ(s.intensity.ptr<float>()[0], 0.0f);
     EXPECT_FLOAT_EQ(s.intensity.ptr<float>()[1], 1.0f);
   }
-  const E57File f = ReadE57(kDir + "float_intensity_without_min_max.e57");
+  const E57File f = ReadE57(kE57Dir + "float_intensity_without_min_max.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   ASSERT_EQ(f.scans[0].num_cells(), 1);
   EXPECT_EQ(PointAt(f.scans[0], 0), cv::Vec3f(1, 1, 1));  // cartesianBounds 1..1 on every axis
@@ -139,7 +140,7 @@ TEST(E57Reader, IntensityLimits) {
 }
 
 TEST(E57Reader, UnknownFieldsAreIgnored) {
-  const E57File f = ReadE57(kDir + "no_ext_namespace.e57");  // a 'classification' field without namespace
+  const E57File f = ReadE57(kE57Dir + "no_ext_namespace.e57");  // a 'classification' field without namespace
   ASSERT_EQ(f.scans.size(), 1u);
   ASSERT_EQ(f.scans[0].num_cells(), 1);
   EXPECT_EQ(f.scans[0].CountValid(), 1);
@@ -147,7 +148,7 @@ TEST(E57Reader, UnknownFieldsAreIgnored) {
 }
 
 TEST(E57Reader, TinyCartesianFloatRgb) {
-  const E57File f = ReadE57(kDir + "tinyCartesianFloatRgb.e57");
+  const E57File f = ReadE57(kE57Dir + "tinyCartesianFloatRgb.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   const Scan& s = f.scans[0];
   EXPECT_EQ(s.name, "exp2.fls.subsampled");
@@ -162,7 +163,7 @@ TEST(E57Reader, TinyCartesianFloatRgb) {
 }
 
 TEST(E57Reader, ImagesWithRepresentationsAndPose) {
-  const E57File f = ReadE57(kDir + "tiny_pc_and_images.e57");
+  const E57File f = ReadE57(kE57Dir + "tiny_pc_and_images.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   EXPECT_EQ(f.scans[0].num_cells(), 2);
   ASSERT_EQ(f.images.size(), 4u);
@@ -196,7 +197,7 @@ TEST(E57Reader, ImagesWithRepresentationsAndPose) {
 
 TEST(E57Reader, SphericalCoordinates) {
   // 360 records; even ones valid (range 1), odd ones direction only (sphericalInvalidState 1).
-  const E57File f = ReadE57(kDir + "tiny_spherical.e57");
+  const E57File f = ReadE57(kE57Dir + "tiny_spherical.e57");
   ASSERT_EQ(f.scans.size(), 1u);
   const Scan& s = f.scans[0];
   ASSERT_EQ(s.num_cells(), 360);
@@ -215,7 +216,7 @@ TEST(E57Reader, SphericalCoordinates) {
 
 TEST(E57Reader, CorruptChecksumNamesThePage) {
   try {
-    ReadE57(kDir + "corrupt_crc.e57");
+    ReadE57(kE57Dir + "corrupt_crc.e57");
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("corrupt_crc.e57"));
@@ -228,7 +229,7 @@ TEST(E57Reader, ReadErrorFileFailsWithClearMessage) {
   // All checksums hold, but every one of its 2651 records claims row 0 / column 0 (zeroed data, as written by
   // the read bug this file reproduces) and the prototype has no returnIndex: the grid is contradictory.
   try {
-    ReadE57(kDir + "read_error.e57");
+    ReadE57(kE57Dir + "read_error.e57");
     FAIL() << "read_error.e57 was accepted";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("read_error.e57"));
@@ -237,7 +238,7 @@ TEST(E57Reader, ReadErrorFileFailsWithClearMessage) {
 }
 
 TEST(E57Reader, MissingFileAndNotE57) {
-  EXPECT_THROW(ReadE57(kDir + "does_not_exist.e57"), InputError);
+  EXPECT_THROW(ReadE57(kE57Dir + "does_not_exist.e57"), InputError);
   EXPECT_THROW(ReadE57(LIDARSHOP_SHARED_DATA_DIR "/SOURCES.md"), InputError);
 }
 

@@ -24,12 +24,9 @@ namespace {
 
 using testing::AllOf;
 using testing::HasSubstr;
+using testing_io::ScanError;
 using testing_io::TempFolder;
 using testing_io::WriteText;
-
-std::string ScanError(const std::string& path) {
-  return testing_io::InputErrorOf([&] { ReadScanFile(path); });
-}
 
 // A 2 x 2 PTX with the given printed matrix and first point.
 std::string Ptx(const std::string& matrix, const std::string& first_point = "0 1 0") {

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "lidarshop/io/scan_io.h"
 #include "lidarshop/util/error.h"
 
 namespace lidarshop::testing_io {
@@ -40,6 +41,14 @@ inline std::string InputErrorOf(const std::function<void()>& read) {
   }
   return "";
 }
+
+// The message of the InputError that reading `path` as a scan file throws ("" when it reads).
+inline std::string ScanError(const std::string& path) {
+  return InputErrorOf([&] { ReadScanFile(path); });
+}
+
+// The shared E57 files (../shared/data/e57, SOURCES.md there).
+inline const std::string kE57Dir = LIDARSHOP_SHARED_DATA_DIR "/e57/";
 
 inline void WriteText(const std::string& path, const std::string& text) {
   std::ofstream stream(path, std::ios::binary);

@@ -18,14 +18,12 @@ namespace {
 
 using testing::AllOf;
 using testing::HasSubstr;
+using testing_io::ScanError;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
 using testing_io::InputErrorOf;
 
-std::string ScanError(const std::string& path) {
-  return InputErrorOf([&] { ReadScanFile(path); });
-}
 std::string MeshError(const std::string& path) {
   return InputErrorOf([&] { ReadMesh(path); });
 }

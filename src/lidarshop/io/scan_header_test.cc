@@ -22,11 +22,10 @@ namespace {
 
 using ::testing::HasSubstr;
 using testing_io::InputErrorOf;
+using testing_io::kE57Dir;
 using testing_io::ReadText;
 using testing_io::TempFolder;
 using testing_io::WriteText;
-
-const std::string kE57Dir = LIDARSHOP_SHARED_DATA_DIR "/e57/";
 
 // A 5 x 7 scan with a hole, colour, labels, normals and synthesized cells, in a tilted pose far from the
 // origin (the LAS reader then picks an origin of its own).

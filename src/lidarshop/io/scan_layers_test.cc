@@ -73,7 +73,7 @@ Layers MakeLayers() {
   return layers;
 }
 
-std::string XmlOf(const std::vector<uint8_t>& file_bytes) {
+std::string XmlTextOf(const std::vector<uint8_t>& file_bytes) {
   const std::vector<uint8_t> logical = e57::LogicalFromPages("test.e57", file_bytes);
   const e57::Header header = e57::ParseHeader("test.e57", logical);
   const uint64_t start = e57::LogicalFromPhysical(header.xml_physical_offset);
@@ -102,7 +102,7 @@ TEST(E57Synthesized, FlagSurvivesARoundTripAsAnExtensionField) {
   scan.synthesized.at<uint8_t>(1, 3) = kValid;
   scan.synthesized.at<uint8_t>(5, 7) = kValid;
   const std::vector<uint8_t> bytes = EncodeE57({scan});
-  const std::string xml = XmlOf(bytes);
+  const std::string xml = XmlTextOf(bytes);
   EXPECT_THAT(xml, HasSubstr("xmlns:lidarshop=\"http://lidarshop.dev/e57/1.0\""));
   EXPECT_THAT(xml, HasSubstr("<lidarshop:synthesized type=\"Integer\" minimum=\"0\" maximum=\"1\""));
   EXPECT_THAT(xml, Not(HasSubstr("returnIndex")));  // one layer: no return fields
@@ -124,7 +124,7 @@ TEST(E57Synthesized, FilesWithoutTheFlagReadAsBefore) {
   const Scan scan = MakeLayers().front;  // no synthesized channel
   const std::vector<uint8_t> bytes = EncodeE57({scan});
   // No flag field (the namespace may still be declared for the no-return cells' rays).
-  EXPECT_THAT(XmlOf(bytes), Not(HasSubstr("lidarshop:synthesized")));
+  EXPECT_THAT(XmlTextOf(bytes), Not(HasSubstr("lidarshop:synthesized")));
   const E57File file = ReadE57Bytes(bytes, "plain.e57");
   EXPECT_TRUE(file.scans[0].synthesized.empty());
   EXPECT_EQ(file.scans[0].CountValid(), scan.CountValid());
@@ -153,7 +153,7 @@ TEST(ScanLayers, E57KeepsBothLayersAsFirstAndSecondReturns) {
   WriteScanWithLayer(path, layers.front, layers.behind);
   const std::vector<uint8_t> bytes = EncodeE57WithLayer(layers.front, layers.behind);
   EXPECT_EQ(bytes.size(), std::filesystem::file_size(path));  // the same bytes
-  const std::string xml = XmlOf(bytes);
+  const std::string xml = XmlTextOf(bytes);
   EXPECT_THAT(xml, HasSubstr("<returnIndex type=\"Integer\" minimum=\"0\" maximum=\"1\""));
   EXPECT_THAT(xml, HasSubstr("<returnCount type=\"Integer\" minimum=\"1\" maximum=\"2\""));
   EXPECT_THAT(xml, HasSubstr("<returnMaximum type=\"Integer\">1</returnMaximum>"));

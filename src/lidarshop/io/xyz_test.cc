@@ -22,7 +22,7 @@ using testing_io::InputErrorOf;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
-Scan SyntheticScan() {
+Scan SyntheticXyzScan() {
   test_scenes::GroundAndBoxOptions options;
   options.rows = 40;
   options.columns = 60;
@@ -60,7 +60,7 @@ double CompareClouds(const Scan& original, const Scan& back, double intensity_st
 
 TEST(XyzTest, RoundTrips) {
   TempFolder folder;
-  const Scan scan = SyntheticScan();
+  const Scan scan = SyntheticXyzScan();
   ASSERT_TRUE(scan.has_color());
   WriteScanFile(folder.File("scan.xyz"), {scan});
   WriteScanFile(folder.File("scan.pts"), {scan});
@@ -268,7 +268,7 @@ TEST(XyzTest, APointNextToTheCloudOriginIsRead) {
 // unmarked (what `convert` prints), as for every other thing a target cannot hold.
 TEST(XyzTest, SynthesizedPointsAreWrittenAndThePlanSaysTheyAreUnmarked) {
   TempFolder folder;
-  Scan scan = SyntheticScan();
+  Scan scan = SyntheticXyzScan();
   scan.synthesized = cv::Mat(scan.rows, scan.cols, CV_8U, cv::Scalar(0));
   scan.synthesized(cv::Rect(0, 30, 10, 2)).setTo(kValid);
   const int64_t synthesized = cv::countNonZero(scan.synthesized & scan.valid);

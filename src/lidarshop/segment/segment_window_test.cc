@@ -16,7 +16,7 @@ using segment_test::MakeBoxOnGround;
 using segment_test::TruthMask;
 
 // A scan much larger than the box (the box is about a fifth of it across).
-Scan MakeScene() { return MakeBoxOnGround(240, 400, cv::Vec3b(118, 138, 112), 11); }
+Scan MakeWindowScene() { return MakeBoxOnGround(240, 400, cv::Vec3b(118, 138, 112), 11); }
 
 // An object stroke across the box's middle third and a background stroke on the wall just above the box:
 // both inside the box's neighbourhood, so a small margin gives a window much smaller than the scan.
@@ -38,12 +38,12 @@ SegmentOptions WithMargin(int margin_cells, SegmentMethod method = SegmentMethod
   return options;
 }
 
-int Differing(const cv::Mat& a, const cv::Mat& b) { return cv::countNonZero(a != b); }
+int DifferingCells(const cv::Mat& a, const cv::Mat& b) { return cv::countNonZero(a != b); }
 
 int64_t WindowCells(const SegmentResult& r) { return int64_t{r.window_rows} * r.window_cols; }
 
 TEST(SegmentWindowTest, AWindowHoldingTheObjectGivesTheWholeScanCut) {
-  const Scan scan = MakeScene();
+  const Scan scan = MakeWindowScene();
   const cv::Mat strokes = NearStrokes(scan);
   for (SegmentMethod method :
        {SegmentMethod::kTwoStep, SegmentMethod::kDepth, SegmentMethod::kColor, SegmentMethod::kRgbd}) {
@@ -55,18 +55,18 @@ TEST(SegmentWindowTest, AWindowHoldingTheObjectGivesTheWholeScanCut) {
     EXPECT_LT(WindowCells(windowed), int64_t{scan.rows} * scan.cols / 2) << ToString(method);
     EXPECT_LT(windowed.graph_nodes, whole.graph_nodes) << ToString(method);
     EXPECT_GT(whole.object_cells, 0) << ToString(method);
-    EXPECT_EQ(Differing(windowed.mask, whole.mask), 0) << ToString(method);
+    EXPECT_EQ(DifferingCells(windowed.mask, whole.mask), 0) << ToString(method);
     EXPECT_EQ(windowed.object_cells, whole.object_cells) << ToString(method);
     if (method == SegmentMethod::kTwoStep) {
-      EXPECT_EQ(Differing(windowed.step1_mask, whole.step1_mask), 0);
-      EXPECT_EQ(Differing(windowed.inferred_background, whole.inferred_background), 0);
+      EXPECT_EQ(DifferingCells(windowed.step1_mask, whole.step1_mask), 0);
+      EXPECT_EQ(DifferingCells(windowed.inferred_background, whole.inferred_background), 0);
       EXPECT_GT(ScoreMask(windowed.mask, TruthMask(scan), scan.valid).iou, 0.9);
     }
   }
 }
 
 TEST(SegmentWindowTest, TheWindowGrowsUntilTheObjectIsInside) {
-  const Scan scan = MakeScene();
+  const Scan scan = MakeWindowScene();
   const cv::Mat strokes = NearStrokes(scan);
   const SegmentResult whole = SegmentObject(scan, strokes, WithMargin(0));
   // A margin of 2 cells: the first window holds the strokes and little more, the box reaches beyond it.
@@ -76,13 +76,13 @@ TEST(SegmentWindowTest, TheWindowGrowsUntilTheObjectIsInside) {
   const cv::Rect window(grown.window_col, grown.window_row, grown.window_cols, grown.window_rows);
   EXPECT_EQ(truth_box & window, truth_box);
   EXPECT_LT(WindowCells(grown), int64_t{scan.rows} * scan.cols);
-  EXPECT_EQ(Differing(grown.mask, whole.mask), 0);
+  EXPECT_EQ(DifferingCells(grown.mask, whole.mask), 0);
   EXPECT_GT(ScoreMask(grown.mask, TruthMask(scan), scan.valid).iou, 0.9);
 }
 
 TEST(SegmentWindowTest, TheWindowGrowsToTheWholeScanForAnObjectAcrossIt) {
   // The wall is the object: it runs across the whole scan, so every window but the whole scan is too small.
-  const Scan scan = MakeScene();
+  const Scan scan = MakeWindowScene();
   const cv::Mat wall = (scan.label == 0) & (scan.valid != 0);
   const cv::Rect box = cv::boundingRect(TruthMask(scan));
   cv::Mat strokes(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
@@ -100,16 +100,16 @@ TEST(SegmentWindowTest, TheWindowGrowsToTheWholeScanForAnObjectAcrossIt) {
     ASSERT_GT(cv::countNonZero(whole.mask.col(scan.cols - 1)), 0) << ToString(method);
     EXPECT_GT(grown.window_growths, 1) << ToString(method);
     EXPECT_EQ(grown.window_cols, scan.cols) << ToString(method);
-    EXPECT_EQ(Differing(grown.mask, whole.mask), 0) << ToString(method);
+    EXPECT_EQ(DifferingCells(grown.mask, whole.mask), 0) << ToString(method);
   }
 }
 
 TEST(SegmentWindowTest, RefinementsGiveWhatTheyGiveOnTheWholeScan) {
-  const Scan scan = MakeScene();
+  const Scan scan = MakeWindowScene();
   const cv::Mat strokes = NearStrokes(scan);
   SegmentSession whole(scan, WithMargin(0)), windowed(scan, WithMargin(30));
   const SegmentResult a0 = whole.Run(strokes), b0 = windowed.Run(strokes);
-  ASSERT_EQ(Differing(a0.mask, b0.mask), 0);
+  ASSERT_EQ(DifferingCells(a0.mask, b0.mask), 0);
   const cv::Rect first_window(b0.window_col, b0.window_row, b0.window_cols, b0.window_rows);
   ASSERT_LT(first_window.area(), scan.rows * scan.cols / 2);
   // A background stroke across the box's lower part, inside the window: incremental on both.
@@ -120,7 +120,7 @@ TEST(SegmentWindowTest, RefinementsGiveWhatTheyGiveOnTheWholeScan) {
            cv::Scalar(kStrokeBackground), 1);
   const SegmentResult a1 = whole.Refine(band), b1 = windowed.Refine(band);
   EXPECT_LT(a1.object_cells, a0.object_cells);
-  EXPECT_EQ(Differing(a1.mask, b1.mask), 0);
+  EXPECT_EQ(DifferingCells(a1.mask, b1.mask), 0);
   EXPECT_EQ(b1.window_growths, 0);
   // An object stroke on the wall far beyond the window: the window takes it in and the cut is re-run.
   cv::Mat far(scan.rows, scan.cols, CV_8U, cv::Scalar(kStrokeNone));
@@ -135,7 +135,7 @@ TEST(SegmentWindowTest, RefinementsGiveWhatTheyGiveOnTheWholeScan) {
   EXPECT_GT(b2.window_growths, 0);
   EXPECT_TRUE(cv::Rect(b2.window_col, b2.window_row, b2.window_cols, b2.window_rows).contains({5, far_row}));
   EXPECT_EQ(cv::countNonZero((far == kStrokeObject) & (b2.mask == 0)), 0);
-  EXPECT_EQ(Differing(a2.mask, b2.mask), 0);
+  EXPECT_EQ(DifferingCells(a2.mask, b2.mask), 0);
 }
 
 TEST(SegmentWindowTest, TheWindowIsAnOptionAndIsReported) {
@@ -145,7 +145,7 @@ TEST(SegmentWindowTest, TheWindowIsAnOptionAndIsReported) {
   SegmentOptions bad;
   bad.window_margin_cells = -1;
   EXPECT_THROW(bad.Check(), OptionsError);
-  const Scan scan = MakeScene();
+  const Scan scan = MakeWindowScene();
   const nlohmann::ordered_json result = ToJson(SegmentObject(scan, NearStrokes(scan), WithMargin(60)));
   for (const char* key : {"window_row", "window_col", "window_rows", "window_cols", "window_growths"})
     EXPECT_TRUE(result.contains(key)) << key;

@@ -20,7 +20,7 @@ namespace {
 
 using testing::HasSubstr;
 
-std::string Folder() {
+std::string InputFileFolder() {
   const std::string folder =
       std::filesystem::temp_directory_path() / ("input_file_test_" + std::to_string(getpid()));
   std::filesystem::create_directories(folder);
@@ -37,7 +37,7 @@ std::string ErrorOf(const std::string& path) {
 }
 
 TEST(InputFileTest, ReadsARegularFile) {
-  const std::string path = Folder() + "/a.txt";
+  const std::string path = InputFileFolder() + "/a.txt";
   std::ofstream(path) << "hello";
   EXPECT_EQ(CheckRegularFile(path), 5);
   EXPECT_EQ(ReadRegularFile(path), "hello");
@@ -45,7 +45,7 @@ TEST(InputFileTest, ReadsARegularFile) {
 }
 
 TEST(InputFileTest, RefusesAFifoWithoutBlocking) {
-  const std::string path = Folder() + "/x.ptx";
+  const std::string path = InputFileFolder() + "/x.ptx";
   std::filesystem::remove(path);
   ASSERT_EQ(mkfifo(path.c_str(), 0600), 0);
   // Opening a FIFO for reading waits for a writer: run on a thread so that a regression fails, not hangs.
@@ -57,7 +57,7 @@ TEST(InputFileTest, RefusesAFifoWithoutBlocking) {
 }
 
 TEST(InputFileTest, RefusesFoldersAndDevices) {
-  const std::string folder = Folder() + "/scan.ptx";
+  const std::string folder = InputFileFolder() + "/scan.ptx";
   std::filesystem::create_directories(folder);
   EXPECT_THAT(ErrorOf(folder), HasSubstr("is a folder"));
   EXPECT_THAT(ErrorOf("/dev/zero"), HasSubstr("device"));
@@ -65,7 +65,7 @@ TEST(InputFileTest, RefusesFoldersAndDevices) {
 }
 
 TEST(InputFileTest, RefusesFilesPastTheLimit) {
-  const std::string path = Folder() + "/big.json";
+  const std::string path = InputFileFolder() + "/big.json";
   std::ofstream(path) << std::string(100, 'x');
   EXPECT_THROW(ReadRegularFile(path, 99), InputError);
   EXPECT_EQ(ReadRegularFile(path, 100).size(), 100u);

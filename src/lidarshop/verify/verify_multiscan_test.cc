@@ -33,7 +33,7 @@ std::vector<PreparedScan> FourScans(const TriangleMesh& vehicle_in_world) {
   return scans;
 }
 
-TriangleMesh Car(CarStyle style, double scale = 1.0) {
+TriangleMesh CarMesh(CarStyle style, double scale = 1.0) {
   CarMeshOptions options;
   options.style = style;
   TriangleMesh mesh = MakeCarMesh(options);
@@ -42,8 +42,8 @@ TriangleMesh Car(CarStyle style, double scale = 1.0) {
 }
 
 TEST(VerifyMultiScanTest, EachVehicleIsConsistentWithItsOwnScansAndConfidenceNeverDecreases) {
-  const std::vector<TriangleMesh> vehicles = {Car(CarStyle::kSedan), Car(CarStyle::kHatchback),
-                                              Car(CarStyle::kVan), Car(CarStyle::kSedan, 0.8)};
+  const std::vector<TriangleMesh> vehicles = {CarMesh(CarStyle::kSedan), CarMesh(CarStyle::kHatchback),
+                                              CarMesh(CarStyle::kVan), CarMesh(CarStyle::kSedan, 0.8)};
   for (size_t v = 0; v < vehicles.size(); ++v) {
     const std::vector<PreparedScan> scans = FourScans(vehicles[v]);
     const VerifierModel model = PrepareModel(vehicles[v]);
@@ -65,8 +65,8 @@ TEST(VerifyMultiScanTest, EachVehicleIsConsistentWithItsOwnScansAndConfidenceNev
 }
 
 TEST(VerifyMultiScanTest, SmallerModelFitsALargerVehicleButNotTheReverse) {
-  const TriangleMesh large = Car(CarStyle::kSedan);
-  const TriangleMesh small = Car(CarStyle::kSedan, 0.8);
+  const TriangleMesh large = CarMesh(CarStyle::kSedan);
+  const TriangleMesh small = CarMesh(CarStyle::kSedan, 0.8);
   const std::vector<PreparedScan> large_scans = FourScans(large);
   const std::vector<PreparedScan> small_scans = FourScans(small);
   const VerifyResult small_in_large =
@@ -80,7 +80,7 @@ TEST(VerifyMultiScanTest, SmallerModelFitsALargerVehicleButNotTheReverse) {
 }
 
 TEST(VerifyOcclusionTest, FenceLowersConfidenceButKeepsConsistency) {
-  const TriangleMesh car = Car(CarStyle::kSedan);
+  const TriangleMesh car = CarMesh(CarStyle::kSedan);
   const Eigen::Matrix4d world_from_car = PoseFromXyzYaw(0, 8, 0, 90);
   const Eigen::Matrix4d world_from_scanner = PoseFromXyzYaw(0, 0, 1.5, 0);
   // A board fence 2 m in front of the car: 20 cm boards with 15 cm gaps, and one 10 cm rail. (A fine net with
