@@ -167,13 +167,7 @@ int RunSchema(int argc, char** argv) {
         Summarize(fmt::format("{} structs -> {}", DocumentedStructs().size(), output));
       }
     } else if (!json_path.empty()) {
-      nlohmann::ordered_json list = nlohmann::ordered_json::array();
-      for (const TypeScriptStruct& entry : server::ApiTypes()) {
-        nlohmann::ordered_json description = DescriptionJson(*entry.info);
-        description["result"] = entry.answer;
-        list.push_back(std::move(description));
-      }
-      WriteJsonOutput(json_path, {{"structs", list}});
+      WriteJsonOutput(json_path, SchemaJson(server::ApiTypes()));
     } else {
       throw OptionsError("give --typescript, --markdown or --json FILE");
     }

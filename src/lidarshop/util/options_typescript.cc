@@ -205,4 +205,14 @@ nlohmann::ordered_json DescriptionJson(const StructInfo& info) {
   return description;
 }
 
+nlohmann::ordered_json SchemaJson(const std::vector<TypeScriptStruct>& structs) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const TypeScriptStruct& entry : structs) {
+    nlohmann::ordered_json description = DescriptionJson(*entry.info);
+    description["result"] = entry.answer;
+    list.push_back(std::move(description));
+  }
+  return {{"structs", std::move(list)}};
+}
+
 }  // namespace lidarshop

@@ -52,4 +52,8 @@ std::string TypeScriptDeclarations(const std::vector<TypeScriptStruct>& structs,
 // "aliases": [{"key", "alias_of", "range"}] when it has some.
 nlohmann::ordered_json DescriptionJson(const StructInfo& info);
 
+// `lidarshop schema --json`: {"structs": [the DescriptionJson of each of `structs`, in order, with "result": true
+// for a result and false for options]}.
+nlohmann::ordered_json SchemaJson(const std::vector<TypeScriptStruct>& structs);
+
 }  // namespace lidarshop

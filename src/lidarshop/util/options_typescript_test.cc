@@ -193,6 +193,17 @@ TEST(OptionsTypeScript, DescriptionJsonNestsStructs) {
   EXPECT_EQ(json["fields"][3]["struct"]["fields"][0]["key"], "band_px");
 }
 
+// `schema --json`: the structs in the order given, each marked as a result or as options.
+TEST(OptionsTypeScript, SchemaJsonListsTheStructsAndMarksResults) {
+  const nlohmann::ordered_json json = SchemaJson({OptionsType<TreeOptions>(), ResultType<TreeResult>()});
+  ASSERT_EQ(json["structs"].size(), 2u);
+  EXPECT_EQ(json["structs"][0]["name"], "TreeOptions");
+  EXPECT_EQ(json["structs"][0]["result"], false);
+  EXPECT_EQ(json["structs"][1]["name"], "TreeResult");
+  EXPECT_EQ(json["structs"][1]["result"], true);
+  EXPECT_EQ(json["structs"][1]["fields"], DescriptionJson(InfoOf<TreeResult>())["fields"]);
+}
+
 // A std::optional member is marked optional (left out of the JSON when absent); the others have no such key.
 TEST(OptionsTypeScript, DescriptionJsonMarksOptionalFields) {
   const nlohmann::ordered_json json = DescriptionJson(InfoOf<TreeResult>());
