@@ -18,13 +18,13 @@ export type DocumentInfo = Narrowed<
   { world_from_scanner_column_major: number[]; azimuth_step_deg: number; elevation_step_deg: number }
 >;
 
+// A job's `result` is the operation's own reply, an object whose type follows the kind.
+export type JobInfo = Narrowed<JobReply, { result?: Record<string, unknown> }>;
+
 // A number of a reply to `digits` significant digits; "none" for null (a NaN on the server).
 export function precision(value: number | null, digits: number): string {
   return value === null ? 'none' : value.toPrecision(digits);
 }
-
-// A job's `result` is the operation's own reply, an object whose type follows the kind.
-export type JobInfo = Narrowed<JobReply, { result?: Record<string, unknown> }>;
 
 // One entry of GET /api/files: a scan file under the served folders; `readable` false (with `error`) when its
 // header does not read.

@@ -68,6 +68,8 @@ describe('review helpers', () => {
   it('words the verdict', () => {
     expect(verdictText(candidate(0, 0))).toBe('rejected by histogram: 0.31 > 0.15');
     expect(verdictText(candidate(0, 0, true))).toBe('passes');
+    // A test that measured nothing sends NaN, null in JSON: worded, not thrown on.
+    expect(verdictText({ ...candidate(0, 0), value: null })).toBe('rejected by histogram: none > 0.15');
   });
   it('places patches in image pixels', () => {
     expect(patchRect([44, 15], 4)).toEqual({ x: 11, y: 40, size: 9 });
