@@ -388,7 +388,7 @@ TEST(LasTest, HostileHeadersAreRefusedBeforeAllocating) {
   const std::string path = folder.File("bad.las");
   auto error_for = [&](const std::string& bytes) {
     testing_io::WriteText(path, bytes);
-    return InputErrorOf([&] { ReadScanFile(path); });
+    return testing_io::ScanError(path);
   };
   const std::string good = Build(ThreePoints(4, 6));
   ASSERT_EQ(error_for(good), "");

@@ -353,7 +353,7 @@ TEST(PcdTest, ReadsThePdalInteropFiles) {
   EXPECT_FLOAT_EQ(scan.intensity.at<float>(0, 0), 143.0f / 65535.0f);
 
   const std::string missing = LIDARSHOP_SHARED_DATA_DIR "/interop/pcd/missingheader.pcd";
-  EXPECT_THAT(testing_io::InputErrorOf([&] { ReadScanFile(missing); }),
+  EXPECT_THAT(testing_io::ScanError(missing),
               ::testing::AllOf(::testing::HasSubstr(missing), ::testing::HasSubstr("line 1"),
                                ::testing::HasSubstr("starts with data")));
 }

@@ -232,11 +232,11 @@ TEST(PlyTest, ReadsTheInteropFiles) {
   ASSERT_FALSE(extra.normal.empty());
   EXPECT_NEAR(extra.normal.at<cv::Vec3f>(0, 0)[2], 0.999665f, 1e-6f);
 
-  EXPECT_THAT(testing_io::InputErrorOf([&] { ReadScanFile(dir + "no_vertex.ply"); }),
+  EXPECT_THAT(testing_io::ScanError(dir + "no_vertex.ply"),
               ::testing::AllOf(::testing::HasSubstr(dir + "no_vertex.ply"),
                                ::testing::HasSubstr("element vertex"), ::testing::HasSubstr("missing")));
   // issue_2421.ply holds z = 1234567890.12345 (1.2 million km): past kMaxCoordinateM, refused by name.
-  EXPECT_THAT(testing_io::InputErrorOf([&] { ReadScanFile(dir + "issue_2421.ply"); }),
+  EXPECT_THAT(testing_io::ScanError(dir + "issue_2421.ply"),
               ::testing::AllOf(::testing::HasSubstr("vertex 0"), ::testing::HasSubstr("field 'z'"),
                                ::testing::HasSubstr("1234567890.12345")));
 }

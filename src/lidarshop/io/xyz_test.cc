@@ -18,7 +18,6 @@ namespace {
 using testing::AllOf;
 using testing::HasSubstr;
 using testing::StartsWith;
-using testing_io::InputErrorOf;
 using testing_io::TempFolder;
 using testing_io::WriteText;
 
@@ -121,7 +120,7 @@ TEST(XyzTest, MalformedLinesNameFileLineAndColumn) {
   const std::string pts = folder.File("bad.pts");
   auto error_for = [&](const std::string& path, const std::string& text) {
     WriteText(path, text);
-    return InputErrorOf([&] { ReadScanFile(path); });
+    return testing_io::ScanError(path);
   };
   EXPECT_THAT(error_for(xyz, ""), AllOf(HasSubstr(xyz), HasSubstr("empty")));
   EXPECT_THAT(error_for(xyz, "# only a comment\n"), HasSubstr("no points"));
