@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/io/image_io.h"
 #include "lidarshop/raycast/raycast.h"
 #include "lidarshop/recolor/recolor.h"
 #include "lidarshop/recolor/recolor_eval.h"
@@ -24,6 +25,7 @@
 #include "lidarshop/scanner/photo.h"
 #include "lidarshop/testing/scenes.h"
 #include "lidarshop/testing/street_scenes.h"
+#include "lidarshop/util/atomic_file.h"
 
 using namespace lidarshop;
 
@@ -43,8 +45,8 @@ std::string Distribution(std::vector<double> values, bool worst_is_low, int deci
 // The street scenes (test_scenes::MakeStreetRecolorCase, seeds 1..N): camera `offset_m` beside the scanner,
 // `pairs` correspondences with noise and outliers, resected (ours), recoloured with the default options; per
 // seed and the distribution (issue #30 class 3).
-int RunStreet(int seeds, double offset_m, int pair_count, double noise_px, double outliers, bool per_seed,
-              const RecolorOptions& recolor) {
+int RunStreet(int first_seed, int seeds, double offset_m, int pair_count, double noise_px, double outliers,
+              bool per_seed, const RecolorOptions& recolor, int photo_samples) {
   std::vector<double> correct, wrong, unchanged, behind_unchanged, uncertain, true_correct, true_unchanged,
       true_behind_unchanged;
   int64_t changed_total = 0, hidden_total = 0, behind_changed_total = 0, behind_total = 0;
@@ -57,13 +59,13 @@ int RunStreet(int seeds, double offset_m, int pair_count, double noise_px, doubl
         "| "
         "behind an object: changed (of) | uncertain | true camera: visible correct, % | behind an "
         "object: changed |\n|---|---|---|---|---|---|---|---|---|\n");
-  for (int seed = 1; seed <= seeds; ++seed) {
+  for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
     const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
     const Scan truth = test_scenes::ScanScene(c.scene);
     Scan input = Clone(truth);
     input.color.setTo(cv::Scalar(250, 0, 250));
     PhotoOptions photo_options;
-    photo_options.samples_per_axis = 3;  // anti-aliased silhouettes, as a real photo's
+    photo_options.samples_per_axis = photo_samples;  // 3: anti-aliased silhouettes, as a real photo's
     const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
     std::vector<PixelPointPair> exact;
     const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
@@ -96,7 +98,8 @@ int RunStreet(int seeds, double offset_m, int pair_count, double noise_px, doubl
                  score.hidden_behind_changed, score.hidden_behind, result.uncertain,
                  true_score.visible_correct_percent(), true_score.hidden_behind_changed);
   }
-  fmt::print("\n| {} seeds | mean | 5th percentile | worst |\n|---|---|---|---|\n", seeds);
+  fmt::print("\n| seeds {}..{} | mean | 5th percentile | worst |\n|---|---|---|---|\n", first_seed,
+             first_seed + seeds - 1);
   fmt::print("| visible points correct, % (resected camera) | {} |\n", Distribution(correct, true, 2));
   fmt::print("| visible points that took a wrong colour, % (resected camera) | {} |\n",
              Distribution(wrong, false, 2));
@@ -118,13 +121,14 @@ int RunStreet(int seeds, double offset_m, int pair_count, double noise_px, doubl
 
 // Where the errors of one street seed come from (for reading, not a table of the results page).
 int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, double outliers,
-                   bool true_camera, const RecolorOptions& recolor) {
+                   bool true_camera, const RecolorOptions& recolor, int photo_samples,
+                   const std::string& picture_path) {
   const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
   const Scan truth = test_scenes::ScanScene(c.scene);
   Scan input = Clone(truth);
   input.color.setTo(cv::Scalar(250, 0, 250));
   PhotoOptions photo_options;
-  photo_options.samples_per_axis = 3;
+  photo_options.samples_per_axis = photo_samples;
   const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
   std::vector<PixelPointPair> exact;
   const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
@@ -151,6 +155,9 @@ int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, d
     raycast.AddMesh(MeshInWorld(c.scene.objects[i]), static_cast<int32_t>(i));
   raycast.Commit();
   int shown = 0;
+  // The picture (grid, row 0 = top): grey hidden from the camera or outside the photo, green recoloured right,
+  // red recoloured wrong, yellow visible but kept as uncertain, blue visible but taken as hidden.
+  cv::Mat picture(truth.rows, truth.cols, CV_8UC3, cv::Scalar(0, 0, 0));
   std::map<std::string, int> kinds;
   for (int r = 0; r < truth.rows; ++r) {
     for (int col = 0; col < truth.cols; ++col) {
@@ -197,13 +204,29 @@ int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, d
                      r, col, truth.label.at<int32_t>(r, col), distance, occluder, seen, edge_px, got[0],
                      got[1], got[2]);
       } else if (!hidden && !close) {
-        kind = fmt::format("visible wrong: {}, edge {} px, label {}", changed ? "recoloured" : "kept",
+        kind = fmt::format("visible wrong: {}, edge {} px, label {}",
+                           changed                                     ? "recoloured"
+                           : result.uncertain_mask.at<uint8_t>(r, col) ? "kept, uncertain"
+                                                                       : "kept, hidden to us",
                            edge_px > 4 ? 5 : edge_px, truth.label.at<int32_t>(r, col));
       }
       if (!kind.empty()) ++kinds[kind];
+      cv::Vec3b& shade = picture.at<cv::Vec3b>(r, col);
+      if (hidden)
+        shade = cv::Vec3b(90, 90, 90);
+      else if (changed)
+        shade = close ? cv::Vec3b(40, 170, 40) : cv::Vec3b(230, 30, 30);
+      else
+        shade = result.uncertain_mask.at<uint8_t>(r, col) ? cv::Vec3b(240, 220, 0) : cv::Vec3b(40, 80, 240);
     }
   }
   for (const auto& [kind, n] : kinds) fmt::print("{:6d}  {}\n", n, kind);
+  if (!picture_path.empty()) {
+    cv::Mat bgr;
+    cv::cvtColor(picture, bgr, cv::COLOR_RGB2BGR);
+    WritePathAtomically(picture_path, [&](const std::string& path) { return CvImWrite(path, bgr); });
+    fmt::print("wrote {}\n", picture_path);
+  }
   return 0;
 }
 
@@ -233,24 +256,44 @@ int main(int argc, char** argv) {
   double street_offset_m = 2.0;
   app.add_option("--street", street,
                  "instead: the random street scenes, seeds 1..N (test_scenes::MakeStreetRecolorCase)");
+  int street_first = 1;
+  app.add_option("--street-first", street_first,
+                 "street scenes: the first seed (--street N runs N seeds from it)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--street-offset", street_offset_m, "street scenes: camera distance from the scanner, m");
   app.add_option("--street-pairs", street_pairs, "street scenes: correspondences per seed");
   int diagnose = 0;
   bool diagnose_true = false;
   app.add_option("--diagnose", diagnose, "street scenes: where the errors of this seed come from");
   app.add_flag("--diagnose-true-camera", diagnose_true, "--diagnose with the true camera");
+  std::string diagnose_picture;
+  app.add_option(
+      "--diagnose-picture", diagnose_picture,
+      "--diagnose: a PNG on the scan's grid (green right, red wrong, yellow uncertain, blue visible "
+      "but taken as hidden, grey hidden)");
   RecolorOptions street_options;
+  int photo_samples = 3;
+  app.add_option(
+         "--photo-samples", photo_samples,
+         "street scenes: the photo's samples per pixel axis (3: anti-aliased like a real photo; 1: one "
+         "ray per pixel centre)")
+      ->check(CLI::Range(1, 8));
   bool no_guard = false;
   app.add_flag("--no-edge-guard", no_guard, "street scenes: recolour without the edge guard (before #30)");
   app.add_option("--camera-uncertainty", street_options.camera_uncertainty_px,
                  "street scenes: RecolorOptions::camera_uncertainty_px");
+  app.add_option("--skirt-depth-per-width", street_options.skirt_depth_per_width,
+                 "street scenes: RecolorOptions::skirt_depth_per_width (0: every wall skirt_depth_m deep)");
+  app.add_option("--max-blend-levels", street_options.max_blend_levels,
+                 "street scenes: RecolorOptions::max_blend_levels (255: always bilinear)");
   CLI11_PARSE(app, argc, argv);
   street_options.edge_guard = !no_guard;
   if (diagnose > 0)
     return DiagnoseStreet(diagnose, street_offset_m, street_pairs, noise_px, outliers, diagnose_true,
-                          street_options);
+                          street_options, photo_samples, diagnose_picture);
   if (street > 0)
-    return RunStreet(street, street_offset_m, street_pairs, noise_px, outliers, per_draw, street_options);
+    return RunStreet(street_first, street, street_offset_m, street_pairs, noise_px, outliers, per_draw,
+                     street_options, photo_samples);
 
   fmt::print(
       "noise {} px RMS (σ = {:.3f} px per axis), {:.0f} % outliers, {} draws per row (mean; worst in "

@@ -95,6 +95,10 @@ const StructInfo& InfoOf<RecolorOptions>() {
     b.Field(&RecolorOptions::skirt_depth_m, "skirt_depth_m", "skirt walls behind each occluder edge")
         .Unit("m")
         .Min(0);
+    b.Field(&RecolorOptions::skirt_depth_per_width, "skirt_depth_per_width",
+            "skirt walls no deeper than this times the occluder's width where the scan saw it whole (0 = no "
+            "limit)")
+        .Min(0);
     b.Field(&RecolorOptions::edge_guard, "edge_guard",
             "keep points near an occluding depth edge in the photo (uncertain) instead of recolouring them");
     b.Field(&RecolorOptions::camera_uncertainty_px, "camera_uncertainty_px",
@@ -106,6 +110,11 @@ const StructInfo& InfoOf<RecolorOptions>() {
             "a nearer surface is an occluding edge when this much (plus the tolerances) in front")
         .Unit("m")
         .Min(0);
+    b.Field(&RecolorOptions::max_blend_levels, "max_blend_levels",
+            "blend the photo pixels around a projection only when they differ by at most this much (else the "
+            "nearest one's colour); 255 = always bilinear")
+        .Unit("levels")
+        .Range(0, 255);
     b.Field(&RecolorOptions::zbuffer_scale, "zbuffer_scale", "z-buffer size / photo size").AboveZero().Max(1);
     b.Field(&RecolorOptions::max_range_jump_ratio, "max_range_jump_ratio", "scan mesh edge rule").AboveZero();
     return b.Build();

@@ -51,20 +51,45 @@ std::string RecolorResult::Summary() const {
           : fmt::format("; {:.0f} % disagree with the scan's own brightness", 100 * disagreement));
 }
 
-cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px) {
+namespace {
+
+// Blends up to four photo pixels (`weights` sum to > 0): bilinear, unless they differ by more than
+// `max_blend_levels` in a channel, then the colour of the one with the largest weight.
+cv::Vec3b BlendUnlessEdge(const cv::Vec3b (&values)[4], const double (&weights)[4], int max_blend_levels) {
+  double sum[3] = {0, 0, 0}, weight = 0;
+  int heaviest = -1;
+  cv::Vec3b low(255, 255, 255), high(0, 0, 0);
+  for (int k = 0; k < 4; ++k) {
+    if (weights[k] <= 0) continue;
+    if (heaviest < 0 || weights[k] > weights[heaviest]) heaviest = k;
+    for (int c = 0; c < 3; ++c) {
+      sum[c] += weights[k] * values[k][c];
+      low[c] = std::min(low[c], values[k][c]);
+      high[c] = std::max(high[c], values[k][c]);
+    }
+    weight += weights[k];
+  }
+  for (int c = 0; c < 3; ++c)
+    if (high[c] - low[c] > max_blend_levels) return values[heaviest];
+  cv::Vec3b out;
+  for (int c = 0; c < 3; ++c) out[c] = cv::saturate_cast<uint8_t>(sum[c] / weight);
+  return out;
+}
+
+}  // namespace
+
+cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px, int max_blend_levels) {
   // Array coordinates: the centre of pixel (0, 0) is at (0, 0).
   const double x = std::clamp(pixel_px.x() - 0.5, 0.0, photo.cols - 1.0);
   const double y = std::clamp(pixel_px.y() - 0.5, 0.0, photo.rows - 1.0);
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
   const int x1 = std::min(x0 + 1, photo.cols - 1), y1 = std::min(y0 + 1, photo.rows - 1);
   const double fx = x - x0, fy = y - y0;
-  cv::Vec3b out;
-  for (int c = 0; c < 3; ++c) {
-    const double top = (1 - fx) * photo.at<cv::Vec3b>(y0, x0)[c] + fx * photo.at<cv::Vec3b>(y0, x1)[c];
-    const double bottom = (1 - fx) * photo.at<cv::Vec3b>(y1, x0)[c] + fx * photo.at<cv::Vec3b>(y1, x1)[c];
-    out[c] = cv::saturate_cast<uint8_t>((1 - fy) * top + fy * bottom);
-  }
-  return out;
+  const cv::Vec3b values[4] = {photo.at<cv::Vec3b>(y0, x0), photo.at<cv::Vec3b>(y0, x1),
+                               photo.at<cv::Vec3b>(y1, x0), photo.at<cv::Vec3b>(y1, x1)};
+  const double weights[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  if (weights[0] + weights[1] + weights[2] + weights[3] <= 1e-12) return values[0];
+  return BlendUnlessEdge(values, weights, max_blend_levels);
 }
 
 namespace {
@@ -113,24 +138,27 @@ double AngularStepRad(const Scan& scan) {
 }
 
 // The photo's colour at `pixel_px`, bilinear over the pixels whose z-buffer distance is within `allowed` of
-// `distance` (no blend across a depth edge); the nearest pixel's colour when none of the four agrees.
+// `distance` (no blend across a depth edge, nor across a colour edge: BlendUnlessEdge); the nearest pixel's
+// colour when none of the four agrees.
 cv::Vec3b SampleAgreeing(const cv::Mat& photo, const cv::Mat& distance_buffer, double sx, double sy,
-                         const Eigen::Vector2d& pixel_px, double distance, double allowed) {
+                         const Eigen::Vector2d& pixel_px, double distance, double allowed,
+                         int max_blend_levels) {
   const double x = std::clamp(pixel_px.x() - 0.5, 0.0, photo.cols - 1.0);
   const double y = std::clamp(pixel_px.y() - 0.5, 0.0, photo.rows - 1.0);
   const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
   const int xs[2] = {x0, std::min(x0 + 1, photo.cols - 1)}, ys[2] = {y0, std::min(y0 + 1, photo.rows - 1)};
   const double wx[2] = {1 - (x - x0), x - x0}, wy[2] = {1 - (y - y0), y - y0};
-  double sum[3] = {0, 0, 0}, weight = 0;
+  cv::Vec3b values[4];
+  double weights[4], weight = 0;
   for (int j = 0; j < 2; ++j) {
     for (int i = 0; i < 2; ++i) {
+      const int k = 2 * j + i;
+      values[k] = photo.at<cv::Vec3b>(ys[j], xs[i]);
       const int zr = std::min(static_cast<int>((ys[j] + 0.5) * sy), distance_buffer.rows - 1);
       const int zc = std::min(static_cast<int>((xs[i] + 0.5) * sx), distance_buffer.cols - 1);
-      if (std::abs(distance_buffer.at<float>(zr, zc) - distance) > allowed) continue;
-      const double w = wx[i] * wy[j];
-      const cv::Vec3b v = photo.at<cv::Vec3b>(ys[j], xs[i]);
-      for (int c = 0; c < 3; ++c) sum[c] += w * v[c];
-      weight += w;
+      const bool agrees = std::abs(distance_buffer.at<float>(zr, zc) - distance) <= allowed;
+      weights[k] = agrees ? wx[i] * wy[j] : 0.0;
+      weight += weights[k];
     }
   }
   if (weight <= 1e-9) {
@@ -138,9 +166,7 @@ cv::Vec3b SampleAgreeing(const cv::Mat& photo, const cv::Mat& distance_buffer, d
     const int ny = std::clamp(static_cast<int>(pixel_px.y()), 0, photo.rows - 1);
     return photo.at<cv::Vec3b>(ny, nx);
   }
-  cv::Vec3b out;
-  for (int c = 0; c < 3; ++c) out[c] = cv::saturate_cast<uint8_t>(sum[c] / weight);
-  return out;
+  return BlendUnlessEdge(values, weights, max_blend_levels);
 }
 
 }  // namespace
@@ -160,6 +186,7 @@ OcclusionScene BuildOcclusionScene(const Scan& scan, const RecolorOptions& optio
       SilhouetteSkirtOptions skirt_options;
       skirt_options.max_range_jump_ratio = options.max_range_jump_ratio;
       skirt_options.depth_m = options.skirt_depth_m;
+      skirt_options.depth_per_width = options.skirt_depth_per_width;
       scene.skirts = SilhouetteSkirts(scan, skirt_options);
     }
   });
@@ -384,9 +411,10 @@ RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeC
     // No blend across a depth edge: only the photo pixels at the point's own depth (z-buffer visibility).
     out.color.at<cv::Vec3b>(r, c) =
         visibility.distance_buffer.empty()
-            ? SamplePhoto(photo, seen.pixel)
+            ? SamplePhoto(photo, seen.pixel, options.max_blend_levels)
             : SampleAgreeing(photo, visibility.distance_buffer, visibility.buffer_per_photo_px.x(),
-                             visibility.buffer_per_photo_px.y(), seen.pixel, seen.distance_m, seen.agree_m);
+                             visibility.buffer_per_photo_px.y(), seen.pixel, seen.distance_m, seen.agree_m,
+                             options.max_blend_levels);
     result.recolored.at<uint8_t>(r, c) = 255;
     ++result.recolored_count;
   }

@@ -37,7 +37,10 @@
 // 4 px of its silhouette, took the object's colour or a blend; bench/results/recolor.md, "street scenes".)
 // The colour of a recoloured point is bilinear over the photo's pixels whose z-buffer distance agrees with
 // the point's (within the tolerance and the local slope), so no blend is taken across a depth edge; when no
-// neighbour agrees, the nearest pixel's colour.
+// neighbour agrees, the nearest pixel's colour. Nor across a colour edge: when those pixels differ by more than
+// `max_blend_levels` in a channel, the point takes the colour of the one nearest its projection, since a blend
+// of a window frame and its wall is a colour neither surface has (on the street scenes of issue #30, 0.6 % of
+// the visible points took such a blend; bench/results/recolor.md).
 // `VisibilityMethod::kSegment` instead casts the exact segment of every point (Embree occlusion rays, no
 // pixel margin; skirts when `silhouette_skirts`): without skirts, the literal thesis test.
 #pragma once
@@ -77,6 +80,9 @@ struct RecolorOptions {
   // let 29 hidden points past the 0.5 m deep pillar's unseen side, 0.25 m walls none (at 0.14 % of the
   // visible points); deeper walls hide more of what the camera sees beside occluders.
   double skirt_depth_m = 0.25;
+  // ... but no deeper than this × the occluder's width where the scan saw it whole (recolor/silhouette_skirt.h;
+  // 0 = always skirt_depth_m): a thin post's wall hid a strip of the façade beside it (issue #30).
+  double skirt_depth_per_width = 1.0;
   // Keep points near an occluding depth edge (above): they are `uncertain`, not recoloured. z-buffer only.
   bool edge_guard = true;
   // How far (photo pixels) the camera may put a point from its true pixel: the pose's uncertainty. For a
@@ -86,6 +92,9 @@ struct RecolorOptions {
   // A nearer surface counts as an occluding edge when it is this much (plus the depth tolerance and the local
   // slope) in front of the point, metres: smaller steps (a kerb, a window recess) do not hide a point.
   double edge_min_jump_m = 0.2;
+  // Photo levels (0-255, per channel): the pixels around a projection are blended only when they differ by at
+  // most this much; otherwise the nearest one's colour (above). 255 = always bilinear.
+  int max_blend_levels = 24;
   double zbuffer_scale = 1.0;         // z-buffer size / photo size, (0, 1]; 0.5 = a quarter of the rays
   double max_range_jump_ratio = 0.1;  // scan mesh edges (scan/scan_mesh.h)
   void Check() const;                 // throws OptionsError
@@ -149,7 +158,8 @@ const StructInfo& InfoOf<RecolorSummary>();
 RecolorResult RecolorScan(const Scan& scan, const cv::Mat& photo, const PinholeCamera& camera,
                           const RecolorOptions& options = {});
 
-// The photo's colour at a continuous pixel position (geometry/camera.h convention), bilinear, edges clamped.
-cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px);
+// The photo's colour at a continuous pixel position (geometry/camera.h convention), bilinear, edges clamped;
+// the nearest pixel's colour when the four differ by more than `max_blend_levels` in a channel (a colour edge).
+cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px, int max_blend_levels = 255);
 
 }  // namespace lidarshop

@@ -49,6 +49,32 @@ TEST(Recolor, VisiblePointsTakeTheTrueColourAndHiddenOnesNeverChange) {
   EXPECT_EQ(f.input.color.at<cv::Vec3b>(0, 0), cv::Vec3b(250, 0, 250));
 }
 
+TEST(Recolor, APointBetweenPixelsOfTwoColoursTakesOneOfThemNotABlend) {
+  cv::Mat photo(1, 2, CV_8UC3);
+  photo.at<cv::Vec3b>(0, 0) = cv::Vec3b(200, 30, 30);
+  photo.at<cv::Vec3b>(0, 1) = cv::Vec3b(30, 30, 200);
+  const Eigen::Vector2d nearer_left(0.9, 0.5);  // between the two pixel centres, nearer the left one
+  EXPECT_EQ(SamplePhoto(photo, nearer_left), cv::Vec3b(132, 30, 98));  // bilinear: a purple neither pixel has
+  EXPECT_EQ(SamplePhoto(photo, nearer_left, 24), cv::Vec3b(200, 30, 30));
+  photo.at<cv::Vec3b>(0, 1) = cv::Vec3b(210, 40, 30);  // a shade of the same red: still blended
+  EXPECT_EQ(SamplePhoto(photo, nearer_left, 24), cv::Vec3b(204, 34, 30));
+}
+
+TEST(Recolor, ColourEdgesOfThePhotoAreNotBlended) {
+  const Fixture f;
+  RecolorOptions bilinear;
+  bilinear.max_blend_levels = 255;
+  const RecolorScore blended = ScoreRecolor(
+      f.scene, f.truth, f.input, RecolorScan(f.input, f.photo.image, f.camera, bilinear).scan, f.camera);
+  const RecolorScore edges =
+      ScoreRecolor(f.scene, f.truth, f.input, RecolorScan(f.input, f.photo.image, f.camera).scan, f.camera);
+  SCOPED_TRACE(blended.Summary() + "\n" + edges.Summary());
+  // The scene's textures and silhouettes have colour edges; a blend there is a colour no surface has.
+  EXPECT_LT(edges.visible_wrong, blended.visible_wrong * 3 / 4);
+  EXPECT_GT(edges.visible_correct, blended.visible_correct);
+  EXPECT_EQ(edges.hidden_changed, 0);
+}
+
 TEST(Recolor, WithoutSkirtsTheScanMeshLeaksAtSilhouettes) {
   const Fixture f;
   RecolorOptions segment;

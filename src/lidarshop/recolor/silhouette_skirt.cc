@@ -3,15 +3,71 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+
+#include <opencv2/core.hpp>
 
 #include "lidarshop/geometry/transform.h"
 #include "lidarshop/scan/ray_directions.h"
 
 namespace lidarshop {
 
+namespace {
+
+// Per cell, metres: the width of the run of joined cells through it along its row (`along_rows`) or its column,
+// when the run ends on both sides at a silhouette (a farther return, no return or the grid's border); +inf
+// when either end meets a nearer surface (the object continues behind it) or the cell has no return.
+cv::Mat SeenWidths(const Scan& scan, const RayDirections& rays, float ratio, bool along_rows) {
+  const int lines = along_rows ? scan.rows : scan.cols, length = along_rows ? scan.cols : scan.rows;
+  cv::Mat width(scan.rows, scan.cols, CV_32F, cv::Scalar(std::numeric_limits<float>::infinity()));
+  const auto at = [&](int line, int i) { return along_rows ? cv::Point(i, line) : cv::Point(line, i); };
+  const auto valid = [&](int line, int i) { return scan.valid.at<uint8_t>(at(line, i)) != 0; };
+  const auto range = [&](int line, int i) { return scan.range.at<float>(at(line, i)); };
+  for (int line = 0; line < lines; ++line) {
+    int i = 0;
+    while (i < length) {
+      if (!valid(line, i)) {
+        ++i;
+        continue;
+      }
+      int end = i;  // the run is [i, end]
+      while (end + 1 < length && valid(line, end + 1) &&
+             std::abs(range(line, end + 1) - range(line, end)) <=
+                 ratio * std::min(range(line, end + 1), range(line, end)))
+        ++end;
+      // A silhouette on both sides: the neighbour beyond each end is farther or has no return.
+      const bool before_free = i == 0 || !valid(line, i - 1) || range(line, i - 1) > range(line, i);
+      const bool after_free =
+          end + 1 == length || !valid(line, end + 1) || range(line, end + 1) > range(line, end);
+      if (before_free && after_free) {
+        const cv::Vec3f a = scan.point.at<cv::Vec3f>(at(line, i)),
+                        b = scan.point.at<cv::Vec3f>(at(line, end));
+        // The span between the end points and one cell's spacing at the run's range (the silhouette lies up to
+        // a cell beyond): a run of one cell is a cell wide, not zero.
+        const int beyond = i > 0 ? i - 1 : end + 1;
+        float cell = std::numeric_limits<float>::infinity();
+        if (beyond < length) {
+          const cv::Point p = at(line, i), q = at(line, beyond);
+          cell = range(line, i) * static_cast<float>(cv::norm(rays(p.y, p.x) - rays(q.y, q.x)));
+        }
+        const float seen = static_cast<float>(cv::norm(a - b)) + cell;
+        for (int k = i; k <= end; ++k) width.at<float>(at(line, k)) = seen;
+      }
+      i = end + 1;
+    }
+  }
+  return width;
+}
+
+}  // namespace
+
 TriangleMesh SilhouetteSkirts(const Scan& scan, const SilhouetteSkirtOptions& options) {
   const RayDirections rays(scan);
   CheckScan(scan);
+  cv::Mat seen_width;
+  if (options.depth_per_width > 0 && options.depth_m > 0)
+    cv::min(SeenWidths(scan, rays, static_cast<float>(options.max_range_jump_ratio), true),
+            SeenWidths(scan, rays, static_cast<float>(options.max_range_jump_ratio), false), seen_width);
   const int rows = scan.rows, cols = scan.cols;
   const float ratio = static_cast<float>(options.max_range_jump_ratio);
   const auto valid = [&](int r, int c) { return scan.valid.at<uint8_t>(r, c) != 0; };
@@ -66,6 +122,12 @@ TriangleMesh SilhouetteSkirts(const Scan& scan, const SilhouetteSkirtOptions& op
         for (int i = 0; i < 4; ++i) member[i] = ok[i] && find(i) == root;
         // Each corner's cap vertex: its own point for members, else the layer carried along its ray.
         std::array<Eigen::Vector3f, 4> front, back;
+        float wall_m = static_cast<float>(options.depth_m);
+        if (!seen_width.empty())
+          for (int i = 0; i < 4; ++i)
+            if (member[i])
+              wall_m = std::min(
+                  wall_m, static_cast<float>(options.depth_per_width) * seen_width.at<float>(cr[i], cc[i]));
         bool usable = true;
         for (int i = 0; i < 4 && usable; ++i) {
           const cv::Vec3f d = rays(cr[i], cc[i]);
@@ -107,7 +169,7 @@ TriangleMesh SilhouetteSkirts(const Scan& scan, const SilhouetteSkirtOptions& op
             near_range = extrapolated;
             front[i] = near_range * direction;
           }
-          const float back_range = std::min(near_range + static_cast<float>(options.depth_m), limit);
+          const float back_range = std::min(near_range + wall_m, limit);
           back[i] = std::max(back_range, near_range) * direction;
         }
         if (!usable) continue;

@@ -18,6 +18,11 @@
 //   - with `depth_m` > 0, walls: the cap's four sides swept `depth_m` back along their rays (never past a
 //     farther cell's return): an occluder at least that deep behind its edge, which the scan's shadow hides.
 // A block with cells without a return caps every layer (the silhouette against the sky).
+// With `depth_per_width` > 0 a wall is no deeper than that many times the occluder's width where the scan saw
+// it whole: the run of joined cells through the corner along its row, and along its column, that ends on both
+// sides at a farther return or none (a silhouette, not another occluder in front); the narrower run counts. A
+// post 8 cm wide is not 25 cm deep, and a 25 cm wall behind it hides a strip of the façade the camera sees.
+// A run that ends at a nearer surface is a part of something larger: it keeps `depth_m`.
 #pragma once
 
 #include "lidarshop/geometry/mesh.h"
@@ -28,6 +33,7 @@ namespace lidarshop {
 struct SilhouetteSkirtOptions {
   double max_range_jump_ratio = 0.1;  // the grid mesh's edge rule (scan/scan_mesh.h), fraction of range
   double depth_m = 0.0;               // walls swept this far back behind each cap, metres; 0 = caps only
+  double depth_per_width = 0.0;       // walls at most this × the occluder's seen width (above); 0 = no limit
   bool world_frame = true;            // vertices in the world frame (world_from_scanner), else scanner frame
 };
 

@@ -5,7 +5,11 @@
 #include <gtest/gtest.h>
 
 #include "lidarshop/raycast/raycast.h"
+#include "lidarshop/recolor/recolor.h"
+#include "lidarshop/recolor/recolor_eval.h"
 #include "lidarshop/scan/scan_mesh.h"
+#include "lidarshop/scanner/photo.h"
+#include "lidarshop/scanner/primitives.h"
 #include "lidarshop/testing/scenes.h"
 
 namespace lidarshop {
@@ -82,6 +86,66 @@ TEST(SilhouetteSkirt, WallsGoBackAlongTheirRaysByTheirDepth) {
   const TriangleMesh world_mesh = SilhouetteSkirts(scan, world);
   ASSERT_EQ(world_mesh.num_vertices(), cap_mesh.num_vertices());
   EXPECT_LT((world_mesh.vertices[0] - (cap_mesh.vertices[0] + Eigen::Vector3f(0, 0, 1.5f))).norm(), 1e-4f);
+}
+
+// MakeRecolorScene with a post 8 cm square and 2 m tall (label 4) 7 m from the scanner, 5 m before the wall.
+SceneDescription SceneWithAThinPost() {
+  SceneDescription scene = test_scenes::MakeRecolorScene();
+  SceneObject post;
+  post.name = "post";
+  post.mesh = MakeBoxMesh(Eigen::Vector3d(0.08, 0.08, 2.0));
+  post.world_from_object.topRightCorner<3, 1>() = Eigen::Vector3d(0.5, 7, 1.0);
+  post.label = 4;
+  post.material.color = Rgb8(30, 30, 30);
+  scene.objects.push_back(post);
+  return scene;
+}
+
+TEST(SilhouetteSkirt, AThinOccludersWallsAreNoDeeperThanItsWidth) {
+  const Scan scan = test_scenes::ScanScene(SceneWithAThinPost());
+  SilhouetteSkirtOptions options;
+  options.world_frame = false;  // scanner frame: the world shifted down by the scanner's 1.5 m
+  options.depth_m = 0.25;
+  options.depth_per_width = 1.0;
+  const TriangleMesh limited = SilhouetteSkirts(scan, options);
+  options.depth_per_width = 0;
+  const TriangleMesh unlimited = SilhouetteSkirts(scan, options);
+  // Each cap has 4 front then 4 back vertices; the deepest wall of the caps on the post and on the pillar.
+  const auto deepest = [](const TriangleMesh& mesh, const Eigen::Vector2f& centre, float radius) {
+    float depth = 0;
+    for (size_t cap = 0; cap < mesh.num_vertices() / 8; ++cap) {
+      const Eigen::Vector3f front = mesh.vertices[8 * cap], back = mesh.vertices[8 * cap + 4];
+      if ((front.head<2>() - centre).norm() < radius) depth = std::max(depth, (back - front).norm());
+    }
+    return depth;
+  };
+  const Eigen::Vector2f post(0.5f, 7.0f), pillar(1.6f, 8.0f);
+  EXPECT_NEAR(deepest(unlimited, post, 0.15f), 0.25f, 1e-3f);
+  // 8 cm and one cell (2.2 cm at 7 m) at most.
+  EXPECT_GT(deepest(limited, post, 0.15f), 0.05f);
+  EXPECT_LT(deepest(limited, post, 0.15f), 0.12f);
+  // The pillar is 0.5 m wide: its walls keep the full depth.
+  EXPECT_NEAR(deepest(limited, pillar, 0.4f), 0.25f, 1e-3f);
+}
+
+TEST(SilhouetteSkirt, ACameraBesideTheScannerSeesTheWallNextToAThinPost) {
+  const SceneDescription scene = SceneWithAThinPost();
+  const Scan truth = test_scenes::ScanScene(scene);
+  Scan input = Clone(truth);
+  input.color.setTo(cv::Scalar(250, 0, 250));
+  const PinholeCamera camera = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 800, 600, 75);
+  const Photo photo = RenderPhoto(scene, camera);
+  RecolorOptions full_walls;
+  full_walls.skirt_depth_per_width = 0;
+  const RecolorResult deep = RecolorScan(input, photo.image, camera, full_walls);
+  const RecolorResult limited = RecolorScan(input, photo.image, camera);
+  const RecolorScore deep_score = ScoreRecolor(scene, truth, input, deep.scan, camera);
+  const RecolorScore score = ScoreRecolor(scene, truth, input, limited.scan, camera);
+  SCOPED_TRACE(deep_score.Summary() + "\n" + score.Summary());
+  // The post's 25 cm walls hid a strip of the wall the camera sees; the hidden points stay unchanged.
+  EXPECT_LT(limited.hidden, deep.hidden);
+  EXPECT_GT(score.visible_correct, deep_score.visible_correct);
+  EXPECT_EQ(score.hidden_changed, 0);
 }
 
 }  // namespace
