@@ -115,6 +115,10 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
     b.Field(&WholeObjectOptions::neighbour_min_fraction, "neighbour_min_fraction",
             "smaller parts, as a fraction of the stroked parts' cells, stay with the object")
         .Min(0);
+    b.Field(&WholeObjectOptions::strip_max_cells, "strip_max_cells",
+            "the cuts drop strips of at most this many rows they follow along the scene (0 = keeps them)")
+        .Unit("cells")
+        .Min(0);
     return b.Build();
   }();
   return info;
