@@ -112,6 +112,13 @@ struct WholeObjectOptions {
   // occludes it, a lower crate before the box it carries holds it, and one view does not tell them apart.)
   bool join_steps = true;
   double join_max_gap_m = 0.35;  // metres
+  // Parts it rests on: a closed part in front of the object and below it (joined to nothing else in depth but
+  // the support planes it stands on, within the growth's budget) whose top is no higher than
+  // support_distance_m above the object's lowest points where they meet joins it: the lower crate of a stack,
+  // stroked on the box on top. (A crate before a post's foot hides the foot: the post's lowest visible points
+  // lie below the crate's top edge, on the ray that grazes it.)
+  bool join_rests_on = true;
+  double rests_on_max_growth = 8.0;  // ... up to this many times the object's cells in all (dimensionless)
   // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
   // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
   // and the growth does not enter them.
