@@ -271,6 +271,14 @@ int main(int argc, char** argv) {
   app.add_flag("!--no-overhangs", options.whole_object.join_overhangs, "no joining of overhanging parts");
   app.add_flag("!--no-separate", options.whole_object.separate_touching,
                "no separation of touching neighbours");
+  app.add_flag("!--no-join-steps", options.whole_object.join_steps,
+               "no joining of parts across a depth step");
+  app.add_flag("!--no-rests-on", options.whole_object.join_rests_on,
+               "no joining of parts the object rests on");
+  app.add_option("--rests-on-max", options.whole_object.rests_on_max_growth,
+                 "parts the object rests on: at most this many times its cells");
+  app.add_option("--strip-max-cells", options.whole_object.strip_max_cells,
+                 "the cuts drop strips of at most this many rows they follow along the scene (0 = keeps)");
   bool eight = false;
   std::string dump_dir;
   app.add_option("--dump", dump_dir,

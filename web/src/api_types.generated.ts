@@ -840,6 +840,10 @@ export interface WholeObjectOptions {
   join_steps: boolean;
   // ... when its cell next to the object lies this close to the object's in space [m] in >= 0, default 0.35
   join_max_gap_m: number;
+  // a closed part in front of the object and below it, that the object stands on, joins it, default true
+  join_rests_on: boolean;
+  // ... up to this many times the object's cells in all in >= 0, default 8.0
+  rests_on_max_growth: number;
   // parts of the depth cut cut off from the stroked part by crevices are a touching neighbour, default true
   separate_touching: boolean;
   // both flanks of a crevice between touching bodies rise at least this steeply [deg] in (0, 89], default 60.0
@@ -848,6 +852,8 @@ export interface WholeObjectOptions {
   crevice_baseline_cells: number;
   // smaller parts, as a fraction of the stroked parts' cells, stay with the object in >= 0, default 0.25
   neighbour_min_fraction: number;
+  // the cuts drop strips of at most this many rows they follow along the scene (0 = keeps them) [cells] in >= 0, default 8
+  strip_max_cells: number;
 }
 
 // completion by shifted copies at the dominant patch offsets (He & Sun 2012) (C++ OffsetCompletionOptions)

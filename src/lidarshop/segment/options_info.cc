@@ -101,6 +101,11 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "... when its cell next to the object lies this close to the object's in space")
         .Unit("m")
         .Min(0);
+    b.Field(&WholeObjectOptions::join_rests_on, "join_rests_on",
+            "a closed part in front of the object and below it, that the object stands on, joins it");
+    b.Field(&WholeObjectOptions::rests_on_max_growth, "rests_on_max_growth",
+            "... up to this many times the object's cells in all")
+        .Min(0);
     b.Field(&WholeObjectOptions::separate_touching, "separate_touching",
             "parts of the depth cut cut off from the stroked part by crevices are a touching neighbour");
     b.Field(&WholeObjectOptions::crevice_flank_deg, "crevice_flank_deg",
@@ -114,6 +119,10 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
         .Range(1, 32);
     b.Field(&WholeObjectOptions::neighbour_min_fraction, "neighbour_min_fraction",
             "smaller parts, as a fraction of the stroked parts' cells, stay with the object")
+        .Min(0);
+    b.Field(&WholeObjectOptions::strip_max_cells, "strip_max_cells",
+            "the cuts drop strips of at most this many rows they follow along the scene (0 = keeps them)")
+        .Unit("cells")
         .Min(0);
     return b.Build();
   }();

@@ -112,6 +112,13 @@ struct WholeObjectOptions {
   // occludes it, a lower crate before the box it carries holds it, and one view does not tell them apart.)
   bool join_steps = true;
   double join_max_gap_m = 0.35;  // metres
+  // Parts it rests on: a closed part in front of the object and below it (joined to nothing else in depth but
+  // the support planes it stands on, within the growth's budget) whose top is no higher than
+  // support_distance_m above the object's lowest points where they meet joins it: the lower crate of a stack,
+  // stroked on the box on top. (A crate before a post's foot hides the foot: the post's lowest visible points
+  // lie below the crate's top edge, on the ray that grazes it.)
+  bool join_rests_on = true;
+  double rests_on_max_growth = 8.0;  // ... up to this many times the object's cells in all (dimensionless)
   // Touching neighbours (TouchingNeighbours): parts of the step-1 cut that the strokes do not touch, cut off
   // from the stroked parts by crevices, are another object at the same range: step 3 takes them as background
   // and the growth does not enter them.
@@ -119,7 +126,11 @@ struct WholeObjectOptions {
   double crevice_flank_deg = 60.0;       // both flanks of a crevice rise at least this steeply, degrees
   int crevice_baseline_cells = 3;        // the flanks' rise is measured over this many cells
   double neighbour_min_fraction = 0.25;  // smaller parts (× the stroked parts' cells) stay with the object
-  void Check() const;                    // throws OptionsFieldError naming the field
+  // The cuts keep out thin strips along the scene (TrimStrips): the front face of a kerb or a skirting board at
+  // the object's range, cut off from the ground above and below by depth steps, joins the depth cut where the
+  // object stands by it, and the colour cut and the growth follow it on. 0 = keep them.
+  int strip_max_cells = 8;  // rows: the thickest strip dropped (a 0.15 m kerb at 25 m is ~6)
+  void Check() const;       // throws OptionsFieldError naming the field
 };
 template <>
 const StructInfo& InfoOf<WholeObjectOptions>();
@@ -316,6 +327,15 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
 // took. CV_8U 255/0.
 cv::Mat SupportSurfaceCells(const Scan& scan, const cv::Mat& mask,
                             const WholeObjectOptions& options = WholeObjectOptions());
+
+// `mask` (CV_8U: step 1's cut, and the final one) without the thin strips it follows along the scene: the parts
+// of at most strip_max_cells rows (a kerb's face, a skirting board, a wall's foot) beyond the box of the rest
+// that holds a cell of `object_cells` (the object strokes) are dropped when the mask touches two sides of the
+// scan's image (an object lies inside it), or when they lie in the lowest quarter of that box and reach farther
+// beyond it on one side than the box is wide (a strip that long along the object's foot runs along the scene;
+// a thin part higher up, a table's top seen edge-on, is the object's). The mask as it is otherwise. CV_8U 255/0.
+cv::Mat TrimStrips(const Scan& scan, const cv::Mat& mask, const cv::Mat& object_cells,
+                   const WholeObjectOptions& options = WholeObjectOptions());
 
 // Crevices between touching bodies in `region` of the scan: grid edges between valid cells where the range
 // rises towards the edge from both sides, each flank at least crevice_flank_deg steep (a rise of

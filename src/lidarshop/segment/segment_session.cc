@@ -551,10 +551,12 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
         if ((touched = s.TouchesWindowEdge(result.step1_mask))) break;
         // A neighbour touching the object at the same range joins the depth cut; it is background from here on.
         cv::Mat neighbours;
+        cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
+        for (int i = 0; i < s.nodes.num(); ++i)
+          if (hard[i] == kHardObject) object_cells.data[s.nodes.ScanCell(i)] = 255;
+        // A kerb or skirting the depth cut followed out of the picture is not the object either.
+        result.step1_mask = TrimStrips(s.scan, result.step1_mask, object_cells, o.whole_object);
         if (o.whole_object.separate_touching) {
-          cv::Mat object_cells = cv::Mat::zeros(s.scan.rows, s.scan.cols, CV_8U);
-          for (int i = 0; i < s.nodes.num(); ++i)
-            if (hard[i] == kHardObject) object_cells.data[s.nodes.ScanCell(i)] = 255;
           neighbours = TouchingNeighbours(s.scan, result.step1_mask, object_cells, o.whole_object);
           result.step1_mask.setTo(0, neighbours);
         }
@@ -597,6 +599,8 @@ SegmentResult SegmentSession::Run(const cv::Mat& strokes) {
           if (!neighbours.empty()) barrier |= neighbours;
           result.mask = GrowWholeObject(s.scan, result.mask, barrier, o.whole_object);
         }
+        // The colour cut and the growth follow such strips too (a kerb's face of the object's orientation).
+        result.mask = TrimStrips(s.scan, result.mask, object_cells, o.whole_object);
         break;
       }
     }

@@ -10,6 +10,7 @@
 
 #include "lidarshop/pointset/normals.h"
 #include "lidarshop/pointset/planes.h"
+#include "lidarshop/segment/part_below.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/util/error.h"
 
@@ -486,7 +487,7 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   };
   // The support planes of the whole region: a part's foot may stand on ground far from the cut (a post under
   // a box), beyond the band the cut's own support planes are fitted to.
-  if (!options.join_steps || added >= max_added) return grown;
+  if (!options.join_steps && !options.join_rests_on) return grown;
   WholeObjectOptions wide = options;
   wide.support_band_cells = std::max(region.width, region.height);
   const SupportPlanes wide_support(scan, grown, region, wide, cv::Mat(), /*max_points=*/20000);
@@ -494,6 +495,25 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   const auto enter = [&](const cv::Mat& grown, cv::Point b) {
     return open(grown, b) && !wide_support.At(b, normals);
   };
+  // A closed part in front of the object and below it that the object stands on joins it (the lower crate of
+  // a stack), each within what is left of its own budget (a lower crate can be many times the box on it, and
+  // closed parts cannot leak); a part it joins may hold up another.
+  // Only the region's support planes stop it: the planes of the band around the cut hold the crate's top,
+  // the very surface the box stands on.
+  const int max_rests_on = static_cast<int>(options.rests_on_max_growth * object_cells);
+  const auto wide_only = [&](cv::Point q) { return wide_support.At(q, normals); };
+  const auto enter_below = [&](const cv::Mat& grown, cv::Point b) {
+    return region.contains(b) && free(grown, b) && !wide_only(b);
+  };
+  while (options.join_rests_on && added < max_rests_on) {
+    const std::vector<cv::Point> below =
+        whole_object_internal::PartItRestsOn(scan, grown, region, static_cast<size_t>(max_rests_on - added),
+                                             options.support_distance_m, jump_at, enter_below, wide_only);
+    if (below.empty()) break;
+    added += static_cast<int>(below.size());
+    for (const cv::Point& cell : below) grown.at<uint8_t>(cell) = 255;
+  }
+  if (!options.join_steps || added >= max_added) return grown;
   const auto accept = [&](const std::vector<cv::Point>& part) {
     added += static_cast<int>(part.size());
     for (const cv::Point& cell : part) grown.at<uint8_t>(cell) = 255;

@@ -146,6 +146,25 @@ TEST(WholeObjectTest, APartInFrontThatStandsOnTheGroundDoesNotJoin) {
   EXPECT_EQ(cv::countNonZero(lifted_grown & (lifted.label == 2)), cv::countNonZero(lifted.label == 2));
 }
 
+TEST(WholeObjectTest, TheLowerCrateOfAStackJoinsTheBoxOnTopOfIt) {
+  // Issue 30, class 1: a box standing on a crate four times its size, the growth started from the box. The crate
+  // is in front of the box across a depth step (its top face, seen at grazing incidence, between them) and
+  // stands on the ground; the box's lowest points lie on its top.
+  const Block crate = {{-0.4, 4.6, -1.5}, {0.4, 5.2, -1.0}, cv::Vec3b(60, 160, 160), 1};
+  const Block box = {{-0.2, 4.8, -1.0}, {0.2, 5.0, -0.75}, cv::Vec3b(150, 110, 60), 2};
+  const Scan scan = MakeBlocks({crate, box}, 13);
+  const cv::Mat crate_cells = (scan.label == 1) & (scan.valid != 0);
+  ASSERT_GT(cv::countNonZero(crate_cells), 3 * cv::countNonZero(scan.label == 2));
+  WholeObjectOptions options;
+  options.join_rests_on = false;
+  EXPECT_LT(cv::countNonZero(GrowWholeObject(scan, scan.label == 2, cv::Mat(), options) & crate_cells),
+            cv::countNonZero(crate_cells) / 4);
+  options.join_rests_on = true;
+  const cv::Mat grown = GrowWholeObject(scan, scan.label == 2, cv::Mat(), options);
+  EXPECT_GT(cv::countNonZero(grown & crate_cells), 0.95 * cv::countNonZero(crate_cells));
+  EXPECT_LT(cv::countNonZero(grown & (scan.label == 0)), 0.02 * cv::countNonZero(crate_cells));  // no ground
+}
+
 TEST(WholeObjectTest, APlateInFrontOfTheObjectWithTheObjectAllAroundItDoesNotJoin) {
   // A wide board on the ground (the object) and a small plate hanging 0.3 m in front of its middle: in front,
   // held by nothing visible, but the object lies all around it: an occluder, not a part. Lifted to the board's
