@@ -162,6 +162,54 @@ bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::M
   return true;
 }
 
+// The plane the two nearest known cells of hole cell (y, x) along one axis (`pair` 0: left and right, 1:
+// above and below) both lie on, facing its way, within relief_m of it and at one relief (within
+// kReliefStepM): its index `*plane` and that relief `*offset_m`. Only when at most `max_gap` cells lie
+// between them (a negative max_gap: any gap); `*gap` receives that count.
+bool PairPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x, int pair,
+               int max_gap, double relief_m, int* plane, double* offset_m, int* gap) {
+  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
+  const int limit = max_gap < 0 ? std::max(hole.rows, hole.cols) : max_gap;
+  std::array<cv::Point, 2> end;
+  *gap = 1;
+  for (size_t side = 0; side < 2; ++side) {
+    const auto& step = kSteps[2 * static_cast<size_t>(pair) + side];
+    int yy = y, xx = x;
+    do {
+      yy += step[0];
+      xx += step[1];
+      ++*gap;
+    } while (*gap <= limit && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
+             hole.at<uint8_t>(yy, xx));
+    end[side] = cv::Point(xx, yy);
+  }
+  *gap -= 2;  // the steps onto the two known cells
+  if (*gap > limit - 1) return false;
+  std::array<Eigen::Vector3f, 2> normal;
+  if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
+      !CellNormal(known, end[0].y, end[0].x, &normal[0]) || !CellNormal(known, end[1].y, end[1].x, &normal[1]))
+    return false;
+  int best = -1;
+  double best_offset = 0;
+  for (size_t k = 0; k < part.planes.size(); ++k) {
+    const SeenPlane& p = part.planes[k];
+    const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
+    const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
+    if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
+        std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
+        std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
+      continue;
+    if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
+      best = static_cast<int>(k);
+      best_offset = 0.5 * (a + b);
+    }
+  }
+  if (best < 0) return false;
+  *plane = best;
+  *offset_m = best_offset;
+  return true;
+}
+
 // A hole cell in a narrow gap — at most kNarrowGapCells between the known cells left and right of it, or
 // above and below (a post's column, a leg) — whose two known cells lie on one plane at one relief: the plane
 // `*plane` and that relief `*offset_m`. Such a surface runs on behind a thin object; a patch copied from
@@ -169,48 +217,9 @@ bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::M
 constexpr int kNarrowGapCells = 16;
 bool NarrowGapPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
                     double relief_m, int* plane, double* offset_m) {
-  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
-  for (size_t pair = 0; pair < 2; ++pair) {
-    std::array<cv::Point, 2> end;
-    int gap = 1;
-    for (size_t side = 0; side < 2; ++side) {
-      const auto& step = kSteps[2 * pair + side];
-      int yy = y, xx = x;
-      do {
-        yy += step[0];
-        xx += step[1];
-        ++gap;
-      } while (gap <= kNarrowGapCells && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
-               hole.at<uint8_t>(yy, xx));
-      end[side] = cv::Point(xx, yy);
-    }
-    if (gap > kNarrowGapCells + 1) continue;
-    std::array<Eigen::Vector3f, 2> normal;
-    if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
-        !CellNormal(known, end[0].y, end[0].x, &normal[0]) ||
-        !CellNormal(known, end[1].y, end[1].x, &normal[1]))
-      continue;
-    int best = -1;
-    double best_offset = 0;
-    for (size_t k = 0; k < part.planes.size(); ++k) {
-      const SeenPlane& p = part.planes[k];
-      const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
-      const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
-      if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
-          std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
-          std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
-        continue;
-      if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
-        best = static_cast<int>(k);
-        best_offset = 0.5 * (a + b);
-      }
-    }
-    if (best >= 0) {
-      *plane = best;
-      *offset_m = best_offset;
-      return true;
-    }
-  }
+  int gap = 0;
+  for (int pair = 0; pair < 2; ++pair)
+    if (PairPlane(part, known, hole, y, x, pair, kNarrowGapCells, relief_m, plane, offset_m, &gap)) return true;
   return false;
 }
 
@@ -282,6 +291,41 @@ double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::
   return along[static_cast<size_t>(best)];
 }
 
+// The range hole cell `cell` (ray `dir`, placed at range `r`) takes when r lies more than relief_m behind
+// the plane its two nearest known cells left and right (or above and below), however far apart, both lie on
+// at one relief; 0 when it does not. Between two cells of one wall the ray meets that wall: a surface behind
+// it cannot be seen there (random seed 87, a gap 20 cells wide between two cells of a fence's board: the board
+// 0.35 m behind it, copied from beside the hole, floated). Unless a known cell across (above or below, or left
+// and right) lies behind the plane too: the wall has an opening there (a gap between two buildings), seen.
+double RimPlaneRange(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, const cv::Point& cell,
+                     const cv::Vec3f& dir, double r, double relief_m) {
+  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  for (int pair = 0; pair < 2; ++pair) {
+    int k = -1, gap = 0;
+    double offset = 0;
+    if (!PairPlane(part, known, hole, cell.y, cell.x, pair, -1, relief_m, &k, &offset, &gap)) continue;
+    const SeenPlane& p = part.planes[static_cast<size_t>(k)];
+    if (p.SignedDistance((ray * r).cast<float>()) - offset >= -relief_m) continue;
+    const double facing = p.normal.dot(ray);
+    if (std::abs(facing) < 1e-6) continue;
+    const double along = (offset - p.offset_m) / facing;
+    if (!(along > 0)) continue;
+    // The known cells across: an opening in the wall shows behind it there.
+    bool opening = false;
+    const int dy = pair == 0 ? 1 : 0, dx = pair == 0 ? 0 : 1;
+    for (int sign : {-1, 1}) {
+      int yy = cell.y, xx = cell.x;
+      do {
+        yy += sign * dy;
+        xx += sign * dx;
+      } while (yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols && hole.at<uint8_t>(yy, xx));
+      if (known.Usable(yy, xx) && p.SignedDistance(known.PointAt(yy, xx)) - offset < -relief_m) opening = true;
+    }
+    if (!opening) return along;
+  }
+  return 0;
+}
+
 }  // namespace
 
 bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
@@ -330,8 +374,10 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
         const double placed =
             RangeOnPlanes(part, known, hole, cv::Point(x, y), from, direction.at<cv::Vec3f>(y, x), r,
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
-        if (placed <= 0) continue;
-        r = static_cast<float>(placed);
+        const double limited = RimPlaneRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
+                                             placed > 0 ? placed : r, options.relief_m);
+        if (placed <= 0 && limited <= 0) continue;
+        r = static_cast<float>(limited > 0 ? limited : placed);
         ++moved;
       }
     }
