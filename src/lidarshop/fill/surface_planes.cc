@@ -334,6 +334,57 @@ double RimPlaneRange(const PartPlanes& part, const KnownCells& known, const cv::
   return 0;
 }
 
+// The plane known cell (y, x) lies on (facing its way, within kReliefStepM; the nearest), or −1.
+int CellPlane(const PartPlanes& part, const KnownCells& known, int y, int x) {
+  Eigen::Vector3f normal;
+  if (!known.Usable(y, x) || !CellNormal(known, y, x, &normal)) return -1;
+  const Eigen::Vector3f q = known.PointAt(y, x);
+  int best = -1;
+  double best_distance = kReliefStepM;
+  for (size_t k = 0; k < part.planes.size(); ++k) {
+    const double d = std::abs(part.planes[k].SignedDistance(q));
+    if (d > best_distance || std::abs(normal.cast<double>().dot(part.planes[k].normal)) < kFacingNormal)
+      continue;
+    best = static_cast<int>(k);
+    best_distance = d;
+  }
+  return best;
+}
+
+// The range hole cell `cell` (ray `dir`, placed at range `r`) takes when the nearest known cells left and
+// right of it lie on two planes that meet — in a concave crease, where the ray stops at the nearer (two walls
+// of an inner corner, a wall on the ground seen obliquely), or a convex edge, at the farther — and r lies
+// more than relief_m from that and within `tolerance` × r of it; 0 otherwise. A row is one elevation: between
+// its two ends the crease or the edge is the surface, and a reconstruction that drifted off it floats.
+double CornerRange(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, const cv::Point& cell,
+                   const cv::Vec3f& dir, double r, double relief_m, double tolerance) {
+  std::array<int, 2> plane{-1, -1};
+  for (int side = 0; side < 2; ++side) {
+    const int step = side == 0 ? -1 : 1;
+    int x = cell.x;
+    do {
+      x += step;
+    } while (x >= 0 && x < hole.cols && hole.at<uint8_t>(cell.y, x));
+    plane[side] = CellPlane(part, known, cell.y, x);
+    if (plane[side] < 0) return 0;
+  }
+  if (plane[0] == plane[1]) return 0;
+  const Meeting meeting = part.At(static_cast<size_t>(plane[0]), static_cast<size_t>(plane[1]));
+  if (meeting == Meeting::kNone) return 0;
+  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
+  std::array<double, 2> along{};
+  for (int side = 0; side < 2; ++side) {
+    const SeenPlane& p = part.planes[static_cast<size_t>(plane[side])];
+    const double facing = p.normal.dot(ray);
+    along[side] = std::abs(facing) < 1e-6 ? -1.0 : -p.offset_m / facing;
+  }
+  if (!(along[0] > 0) || !(along[1] > 0)) return 0;
+  const double placed =
+      meeting == Meeting::kConcave ? std::min(along[0], along[1]) : std::max(along[0], along[1]);
+  const double off = std::abs(placed - r);
+  return off > relief_m && off <= tolerance * r ? placed : 0;
+}
+
 }  // namespace
 
 bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
@@ -384,8 +435,12 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
         const double limited = RimPlaneRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
                                              placed > 0 ? placed : r, options.relief_m, options.tolerance);
-        if (placed <= 0 && limited <= 0) continue;
-        r = static_cast<float>(limited > 0 ? limited : placed);
+        const double corner =
+            limited > 0 ? 0.0
+                        : CornerRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
+                                      placed > 0 ? placed : r, options.relief_m, options.tolerance);
+        if (placed <= 0 && limited <= 0 && corner <= 0) continue;
+        r = static_cast<float>(limited > 0 ? limited : corner > 0 ? corner : placed);
         ++moved;
       }
     }
