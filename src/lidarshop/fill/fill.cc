@@ -759,10 +759,7 @@ FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOp
     const cv::Mat front =
         fill_internal::FrontCells(in.range, in.known_valid, in.hole, kFrontJumpRatio, reach);
     // The removed object's own returns (the hole's cells that have one) give its range: a neighbour beside it
-    // stands about as near (within the front jump of its farthest part). The upper quartile, not the 90th
-    // percentile: the hole's cells include the margin around the object and what is seen through it (a
-    // bench's slats and legs), a tenth of them or more (random seed 3: a box behind a bench taken for a
-    // neighbour beside it; seeds 1..100: floating 4.08 → 3.87 % on the mean).
+    // stands about as near (within the front jump of its farthest part).
     std::vector<float> object;
     for (int y = 0; y < scan.rows; ++y)
       for (int x = 0; x < scan.cols; ++x)
@@ -770,7 +767,7 @@ FillResult FillScanWindow(const Scan& scan, const cv::Mat& hole_in, const FillOp
           object.push_back(in.range.at<float>(y, x));
     double max_range_m = std::numeric_limits<double>::infinity();
     if (!object.empty()) {
-      const size_t far = object.size() * 3 / 4;
+      const size_t far = object.size() * 9 / 10;
       std::nth_element(object.begin(), object.begin() + static_cast<std::ptrdiff_t>(far), object.end());
       max_range_m = object[far] * (1.0 + kFrontJumpRatio) + 0.1;
     }

@@ -168,19 +168,6 @@ TEST(FillSurroundings, AThinPostsColumnContinuesTheFacadeBesideIt) {
   EXPECT_LT(m.range_rmse_mm, 40.0);  // before: 78 mm
 }
 
-// Random scene 3: a bench 5 m away before a box 6.6 m away that continues behind it, and a wall at 7–8 m. Many
-// of the hole's cells with a return see the box and the wall between the bench's slats and legs; the bench's
-// range taken at the 90th percentile of them (7.6 m) made the box a neighbour standing beside the bench, its
-// cells were filled along with the hole, and the box behind the bench became wall: 22.6 % floating (29.7 %
-// with the plane its rows' ends lie on, the wall, taken through the box). At the upper quartile, 5.4 m.
-TEST(FillSurroundings, ABoxSeenBetweenABenchsSlatsIsNotANeighbourBesideIt) {
-  const SurroundingsCase c = RandomCase(3);
-  const FillResult result = FillScan(c.scan, c.hole);
-  const FillMetrics m = MeasureFill(result.scan, c.truth, c.hole);
-  EXPECT_LT(m.floating_share, 0.15) << "RMSE " << m.range_rmse_mm << " mm";
-  EXPECT_LT(m.range_rmse_mm, 280.0);  // before: 305 mm (363 mm)
-}
-
 // Random scene 30: a person 5 m before a wall, the wall seen left and right of every row of the hole. The
 // reconstruction drifted from the person's range on the hole's rim towards the wall and stood before it:
 // 18.5 % floating. The wall the rows' ends lie on is taken where nothing beside the cell stands before it.
