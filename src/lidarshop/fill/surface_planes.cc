@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>  // cross
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/fill/rim_planes.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -21,15 +22,6 @@ namespace fill_internal {
 namespace {
 
 constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
-
-// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
-constexpr double kFacingNormal = 0.906;
-
-// Two reliefs on one plane differ when they are this far apart (a window recess is 0.1-0.3 m deep; the
-// floating share counts points 0.1 m off the surface).
-constexpr double kReliefStepM = 0.05;
-
-enum class Meeting { kNone, kConcave, kConvex };
 
 // The mean angle between neighbouring rays in `box`, radians.
 double MeanRaySpacing(const cv::Mat& direction, const cv::Rect& box) {
@@ -75,14 +67,6 @@ Meeting HowTheyMeet(const SeenPlane& a, const SeenPlane& b, double threshold_m) 
   if (behind_a >= 0.9 && behind_b >= 0.9) return Meeting::kConvex;
   return Meeting::kNone;
 }
-
-// The planes of one part of the hole, how each pair meets, and the part's ray spacing.
-struct PartPlanes {
-  std::vector<SeenPlane> planes;
-  std::vector<Meeting> meeting;  // planes² (row-major)
-  double spacing_rad = 0;
-  Meeting At(size_t a, size_t b) const { return meeting[a * planes.size() + b]; }
-};
 
 PartPlanes FindPartPlanes(const KnownCells& known, const cv::Mat& part_id, int id, const cv::Rect& box,
                           int part_cells, const FillPlaneOptions& options, uint64_t seed) {
@@ -162,54 +146,6 @@ bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::M
   return true;
 }
 
-// The plane the two nearest known cells of hole cell (y, x) along one axis (`pair` 0: left and right, 1:
-// above and below) both lie on, facing its way, within relief_m of it and at one relief (within
-// kReliefStepM): its index `*plane` and that relief `*offset_m`. Only when at most `max_gap` cells lie
-// between them (a negative max_gap: any gap); `*gap` receives that count.
-bool PairPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x, int pair,
-               int max_gap, double relief_m, int* plane, double* offset_m, int* gap) {
-  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
-  const int limit = max_gap < 0 ? std::max(hole.rows, hole.cols) : max_gap;
-  std::array<cv::Point, 2> end;
-  *gap = 1;
-  for (size_t side = 0; side < 2; ++side) {
-    const auto& step = kSteps[2 * static_cast<size_t>(pair) + side];
-    int yy = y, xx = x;
-    do {
-      yy += step[0];
-      xx += step[1];
-      ++*gap;
-    } while (*gap <= limit && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
-             hole.at<uint8_t>(yy, xx));
-    end[side] = cv::Point(xx, yy);
-  }
-  *gap -= 2;  // the steps onto the two known cells
-  if (*gap > limit - 1) return false;
-  std::array<Eigen::Vector3f, 2> normal;
-  if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
-      !CellNormal(known, end[0].y, end[0].x, &normal[0]) || !CellNormal(known, end[1].y, end[1].x, &normal[1]))
-    return false;
-  int best = -1;
-  double best_offset = 0;
-  for (size_t k = 0; k < part.planes.size(); ++k) {
-    const SeenPlane& p = part.planes[k];
-    const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
-    const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
-    if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
-        std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
-        std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
-      continue;
-    if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
-      best = static_cast<int>(k);
-      best_offset = 0.5 * (a + b);
-    }
-  }
-  if (best < 0) return false;
-  *plane = best;
-  *offset_m = best_offset;
-  return true;
-}
-
 // A hole cell in a narrow gap — at most kNarrowGapCells between the known cells left and right of it, or
 // above and below (a post's column, a leg) — whose two known cells lie on one plane at one relief: the plane
 // `*plane` and that relief `*offset_m`. Such a surface runs on behind a thin object; a patch copied from
@@ -219,7 +155,8 @@ bool NarrowGapPlane(const PartPlanes& part, const KnownCells& known, const cv::M
                     double relief_m, int* plane, double* offset_m) {
   int gap = 0;
   for (int pair = 0; pair < 2; ++pair)
-    if (PairPlane(part, known, hole, y, x, pair, kNarrowGapCells, relief_m, plane, offset_m, &gap)) return true;
+    if (PairPlane(part, known, hole, y, x, pair, kNarrowGapCells, relief_m, plane, offset_m, &gap))
+      return true;
   return false;
 }
 
@@ -291,100 +228,6 @@ double RangeOnPlanes(const PartPlanes& part, const KnownCells& known, const cv::
   return along[static_cast<size_t>(best)];
 }
 
-// The range hole cell `cell` (ray `dir`, placed at range `r`) takes when r lies more than relief_m off the
-// plane its two nearest known cells left and right (or above and below), however far apart, both lie on at
-// one relief; 0 when it does not. Between two cells of one wall the ray meets that wall: a surface behind it
-// cannot be seen there (random seed 87, a gap 20 cells wide between two cells of a fence's board: the board
-// 0.35 m behind it, copied from beside the hole, floated), and a surface in front of it would have to be
-// hidden whole by the removed object in that row, which no fill can know (seed 30, a membrane from a person
-// 5 m away to the wall behind him: 18.5 → 4.8 % floating). Unless a known cell across (above or below, or
-// left and right) lies off the plane on the same side too: the wall has an opening there (a gap between two
-// buildings), or something standing before it reaches into the hole from the side (seed 3, a box beside a
-// bench); and, in front, only within `tolerance` of r (a plane met at grazing incidence is far off).
-double RimPlaneRange(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, const cv::Point& cell,
-                     const cv::Vec3f& dir, double r, double relief_m, double tolerance) {
-  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
-  for (int pair = 0; pair < 2; ++pair) {
-    int k = -1, gap = 0;
-    double offset = 0;
-    if (!PairPlane(part, known, hole, cell.y, cell.x, pair, -1, relief_m, &k, &offset, &gap)) continue;
-    const SeenPlane& p = part.planes[static_cast<size_t>(k)];
-    const double off_plane = p.SignedDistance((ray * r).cast<float>()) - offset;
-    if (std::abs(off_plane) <= relief_m) continue;
-    const double facing = p.normal.dot(ray);
-    if (std::abs(facing) < 1e-6) continue;
-    const double along = (offset - p.offset_m) / facing;
-    if (!(along > 0) || (off_plane > 0 && along > (1 + tolerance) * r)) continue;
-    // The known cells across: an opening in the wall, or a surface before it, seen beside the cell.
-    bool seen_off = false;
-    const int dy = pair == 0 ? 1 : 0, dx = pair == 0 ? 0 : 1;
-    for (int sign : {-1, 1}) {
-      if (off_plane > 0 && pair == 0) break;  // below a wall the ground stands before it: no evidence
-      int yy = cell.y, xx = cell.x;
-      do {
-        yy += sign * dy;
-        xx += sign * dx;
-      } while (yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols && hole.at<uint8_t>(yy, xx));
-      if (!known.Usable(yy, xx)) continue;
-      const double across = p.SignedDistance(known.PointAt(yy, xx)) - offset;
-      if (std::abs(across) > relief_m && (across > 0) == (off_plane > 0)) seen_off = true;
-    }
-    if (!seen_off) return along;
-  }
-  return 0;
-}
-
-// The plane known cell (y, x) lies on (facing its way, within kReliefStepM; the nearest), or −1.
-int CellPlane(const PartPlanes& part, const KnownCells& known, int y, int x) {
-  Eigen::Vector3f normal;
-  if (!known.Usable(y, x) || !CellNormal(known, y, x, &normal)) return -1;
-  const Eigen::Vector3f q = known.PointAt(y, x);
-  int best = -1;
-  double best_distance = kReliefStepM;
-  for (size_t k = 0; k < part.planes.size(); ++k) {
-    const double d = std::abs(part.planes[k].SignedDistance(q));
-    if (d > best_distance || std::abs(normal.cast<double>().dot(part.planes[k].normal)) < kFacingNormal)
-      continue;
-    best = static_cast<int>(k);
-    best_distance = d;
-  }
-  return best;
-}
-
-// The range hole cell `cell` (ray `dir`, placed at range `r`) takes when the nearest known cells left and
-// right of it lie on two planes that meet — in a concave crease, where the ray stops at the nearer (two walls
-// of an inner corner, a wall on the ground seen obliquely), or a convex edge, at the farther — and r lies
-// more than relief_m from that and within `tolerance` × r of it; 0 otherwise. A row is one elevation: between
-// its two ends the crease or the edge is the surface, and a reconstruction that drifted off it floats.
-double CornerRange(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, const cv::Point& cell,
-                   const cv::Vec3f& dir, double r, double relief_m, double tolerance) {
-  std::array<int, 2> plane{-1, -1};
-  for (int side = 0; side < 2; ++side) {
-    const int step = side == 0 ? -1 : 1;
-    int x = cell.x;
-    do {
-      x += step;
-    } while (x >= 0 && x < hole.cols && hole.at<uint8_t>(cell.y, x));
-    plane[side] = CellPlane(part, known, cell.y, x);
-    if (plane[side] < 0) return 0;
-  }
-  if (plane[0] == plane[1]) return 0;
-  const Meeting meeting = part.At(static_cast<size_t>(plane[0]), static_cast<size_t>(plane[1]));
-  if (meeting == Meeting::kNone) return 0;
-  const Eigen::Vector3d ray(dir[0], dir[1], dir[2]);
-  std::array<double, 2> along{};
-  for (int side = 0; side < 2; ++side) {
-    const SeenPlane& p = part.planes[static_cast<size_t>(plane[side])];
-    const double facing = p.normal.dot(ray);
-    along[side] = std::abs(facing) < 1e-6 ? -1.0 : -p.offset_m / facing;
-  }
-  if (!(along[0] > 0) || !(along[1] > 0)) return 0;
-  const double placed =
-      meeting == Meeting::kConcave ? std::min(along[0], along[1]) : std::max(along[0], along[1]);
-  const double off = std::abs(placed - r);
-  return off > relief_m && off <= tolerance * r ? placed : 0;
-}
-
 }  // namespace
 
 bool CellNormal(const KnownCells& known, int y, int x, Eigen::Vector3f* normal) {
@@ -433,8 +276,9 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
         const double placed =
             RangeOnPlanes(part, known, hole, cv::Point(x, y), from, direction.at<cv::Vec3f>(y, x), r,
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
-        const double limited = RimPlaneRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
-                                             placed > 0 ? placed : r, options.relief_m, options.tolerance);
+        const double limited =
+            RimPlaneRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
+                          placed > 0 ? placed : r, options.relief_m, options.tolerance);
         const double corner =
             limited > 0 ? 0.0
                         : CornerRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
