@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>  // cross
 #include <opencv2/imgproc.hpp>
 
+#include "lidarshop/fill/rim_planes.h"
 #include "lidarshop/util/error.h"
 #include "lidarshop/util/options.h"
 
@@ -21,15 +22,6 @@ namespace fill_internal {
 namespace {
 
 constexpr size_t kMaxPlanes = 20;  // the range of FillPlaneOptions::max_planes
-
-// cos 25°: the source of a copied relief faces the plane's way (a window pane, not the face of a kerb).
-constexpr double kFacingNormal = 0.906;
-
-// Two reliefs on one plane differ when they are this far apart (a window recess is 0.1-0.3 m deep; the
-// floating share counts points 0.1 m off the surface).
-constexpr double kReliefStepM = 0.05;
-
-enum class Meeting { kNone, kConcave, kConvex };
 
 // The mean angle between neighbouring rays in `box`, radians.
 double MeanRaySpacing(const cv::Mat& direction, const cv::Rect& box) {
@@ -75,14 +67,6 @@ Meeting HowTheyMeet(const SeenPlane& a, const SeenPlane& b, double threshold_m) 
   if (behind_a >= 0.9 && behind_b >= 0.9) return Meeting::kConvex;
   return Meeting::kNone;
 }
-
-// The planes of one part of the hole, how each pair meets, and the part's ray spacing.
-struct PartPlanes {
-  std::vector<SeenPlane> planes;
-  std::vector<Meeting> meeting;  // planes² (row-major)
-  double spacing_rad = 0;
-  Meeting At(size_t a, size_t b) const { return meeting[a * planes.size() + b]; }
-};
 
 PartPlanes FindPartPlanes(const KnownCells& known, const cv::Mat& part_id, int id, const cv::Rect& box,
                           int part_cells, const FillPlaneOptions& options, uint64_t seed) {
@@ -169,48 +153,10 @@ bool SurroundOffset(const PartPlanes& part, const KnownCells& known, const cv::M
 constexpr int kNarrowGapCells = 16;
 bool NarrowGapPlane(const PartPlanes& part, const KnownCells& known, const cv::Mat& hole, int y, int x,
                     double relief_m, int* plane, double* offset_m) {
-  constexpr std::array<std::array<int, 2>, 4> kSteps{{{0, -1}, {0, 1}, {-1, 0}, {1, 0}}};
-  for (size_t pair = 0; pair < 2; ++pair) {
-    std::array<cv::Point, 2> end;
-    int gap = 1;
-    for (size_t side = 0; side < 2; ++side) {
-      const auto& step = kSteps[2 * pair + side];
-      int yy = y, xx = x;
-      do {
-        yy += step[0];
-        xx += step[1];
-        ++gap;
-      } while (gap <= kNarrowGapCells && yy >= 0 && xx >= 0 && yy < hole.rows && xx < hole.cols &&
-               hole.at<uint8_t>(yy, xx));
-      end[side] = cv::Point(xx, yy);
-    }
-    if (gap > kNarrowGapCells + 1) continue;
-    std::array<Eigen::Vector3f, 2> normal;
-    if (!known.Usable(end[0].y, end[0].x) || !known.Usable(end[1].y, end[1].x) ||
-        !CellNormal(known, end[0].y, end[0].x, &normal[0]) ||
-        !CellNormal(known, end[1].y, end[1].x, &normal[1]))
-      continue;
-    int best = -1;
-    double best_offset = 0;
-    for (size_t k = 0; k < part.planes.size(); ++k) {
-      const SeenPlane& p = part.planes[k];
-      const double a = p.SignedDistance(known.PointAt(end[0].y, end[0].x));
-      const double b = p.SignedDistance(known.PointAt(end[1].y, end[1].x));
-      if (std::abs(normal[0].cast<double>().dot(p.normal)) < kFacingNormal ||
-          std::abs(normal[1].cast<double>().dot(p.normal)) < kFacingNormal || std::abs(a) > relief_m ||
-          std::abs(b) > relief_m || std::abs(a - b) > kReliefStepM)
-        continue;
-      if (best < 0 || std::abs(a + b) < std::abs(2 * best_offset)) {
-        best = static_cast<int>(k);
-        best_offset = 0.5 * (a + b);
-      }
-    }
-    if (best >= 0) {
-      *plane = best;
-      *offset_m = best_offset;
+  int gap = 0;
+  for (int pair = 0; pair < 2; ++pair)
+    if (PairPlane(part, known, hole, y, x, pair, kNarrowGapCells, relief_m, plane, offset_m, &gap))
       return true;
-    }
-  }
   return false;
 }
 
@@ -330,8 +276,15 @@ int64_t SnapToPlanes(const cv::Mat& range, const cv::Mat& known_valid, const cv:
         const double placed =
             RangeOnPlanes(part, known, hole, cv::Point(x, y), from, direction.at<cv::Vec3f>(y, x), r,
                           options.agreement_m + options.agreement_per_m * travelled_m, options);
-        if (placed <= 0) continue;
-        r = static_cast<float>(placed);
+        const double limited =
+            RimPlaneRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
+                          placed > 0 ? placed : r, options.relief_m, options.tolerance);
+        const double corner =
+            limited > 0 ? 0.0
+                        : CornerRange(part, known, hole, cv::Point(x, y), direction.at<cv::Vec3f>(y, x),
+                                      placed > 0 ? placed : r, options.relief_m, options.tolerance);
+        if (placed <= 0 && limited <= 0 && corner <= 0) continue;
+        r = static_cast<float>(limited > 0 ? limited : corner > 0 ? corner : placed);
         ++moved;
       }
     }
