@@ -155,8 +155,9 @@ int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, d
     raycast.AddMesh(MeshInWorld(c.scene.objects[i]), static_cast<int32_t>(i));
   raycast.Commit();
   int shown = 0;
-  // The picture (grid, row 0 = top): grey hidden from the camera or outside the photo, green recoloured right,
-  // red recoloured wrong, yellow visible but kept as uncertain, blue visible but taken as hidden.
+  // The picture (grid, row 0 = top): grey hidden from the camera, white hidden but recoloured (a bleed), green
+  // recoloured right, red recoloured wrong, yellow visible but kept as uncertain, blue visible but taken as
+  // hidden; black outside the photo or no return.
   cv::Mat picture(truth.rows, truth.cols, CV_8UC3, cv::Scalar(0, 0, 0));
   std::map<std::string, int> kinds;
   for (int r = 0; r < truth.rows; ++r) {
@@ -213,7 +214,7 @@ int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, d
       if (!kind.empty()) ++kinds[kind];
       cv::Vec3b& shade = picture.at<cv::Vec3b>(r, col);
       if (hidden)
-        shade = cv::Vec3b(90, 90, 90);
+        shade = changed ? cv::Vec3b(255, 255, 255) : cv::Vec3b(90, 90, 90);
       else if (changed)
         shade = close ? cv::Vec3b(40, 170, 40) : cv::Vec3b(230, 30, 30);
       else
@@ -270,7 +271,7 @@ int main(int argc, char** argv) {
   app.add_option(
       "--diagnose-picture", diagnose_picture,
       "--diagnose: a PNG on the scan's grid (green right, red wrong, yellow uncertain, blue visible "
-      "but taken as hidden, grey hidden)");
+      "but taken as hidden, grey hidden, white hidden but recoloured)");
   RecolorOptions street_options;
   int photo_samples = 3;
   app.add_option(
