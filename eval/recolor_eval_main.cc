@@ -283,6 +283,8 @@ int main(int argc, char** argv) {
   app.add_flag("--no-edge-guard", no_guard, "street scenes: recolour without the edge guard (before #30)");
   app.add_option("--camera-uncertainty", street_options.camera_uncertainty_px,
                  "street scenes: RecolorOptions::camera_uncertainty_px");
+  app.add_option("--skirt-depth", street_options.skirt_depth_m,
+                 "street scenes: RecolorOptions::skirt_depth_m");
   app.add_option("--skirt-depth-per-width", street_options.skirt_depth_per_width,
                  "street scenes: RecolorOptions::skirt_depth_per_width (0: every wall skirt_depth_m deep)");
   app.add_option("--max-blend-levels", street_options.max_blend_levels,

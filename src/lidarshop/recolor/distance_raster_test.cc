@@ -120,10 +120,13 @@ TEST_F(DistanceRasterTest, TrianglesLeftToTheCastMergeIntoTheBuffer) {
   // Inside the scene, a metre before the wall, looking along it: many triangles straddle the image plane
   // (without the view culling, which drops those outside the image's pyramid: then none is left to cast).
   const Camera inside = CameraFromPinhole(CameraLookingAt({0.5, 8.5, 1.0}, {-3, 9.5, 1.0}, 400, 300, 100));
+  // With the culling fewer are left (the skirts' walls, 2 m deep behind the pillar and the box, still reach
+  // the camera's side of the image plane).
   RasterOptions no_cull;
   no_cull.cull_outside_view = false;
-  EXPECT_GT(ExpectSameAsCast(inside, "pinhole inside the scene, not culled", 1.0, no_cull), 0);
-  EXPECT_EQ(ExpectSameAsCast(inside, "pinhole inside the scene"), 0);
+  const int64_t not_culled = ExpectSameAsCast(inside, "pinhole inside the scene, not culled", 1.0, no_cull);
+  EXPECT_GT(not_culled, 0);
+  EXPECT_LT(ExpectSameAsCast(inside, "pinhole inside the scene"), not_culled);
 }
 
 // The view culling (recolor/view_cull.h) changes no pixel: the same buffer, bit for bit, with and without it,

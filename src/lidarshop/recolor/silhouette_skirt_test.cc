@@ -136,9 +136,12 @@ TEST(SilhouetteSkirt, ACameraBesideTheScannerSeesTheWallNextToAThinPost) {
   const PinholeCamera camera = CameraLookingAt({1.5, 0.3, 1.6}, {0, 10, 1.0}, 800, 600, 75);
   const Photo photo = RenderPhoto(scene, camera);
   RecolorOptions full_walls;
+  full_walls.skirt_depth_m = 0.25;
   full_walls.skirt_depth_per_width = 0;
+  RecolorOptions thin_walls = full_walls;
+  thin_walls.skirt_depth_per_width = 1;
   const RecolorResult deep = RecolorScan(input, photo.image, camera, full_walls);
-  const RecolorResult limited = RecolorScan(input, photo.image, camera);
+  const RecolorResult limited = RecolorScan(input, photo.image, camera, thin_walls);
   const RecolorScore deep_score = ScoreRecolor(scene, truth, input, deep.scan, camera);
   const RecolorScore score = ScoreRecolor(scene, truth, input, limited.scan, camera);
   SCOPED_TRACE(deep_score.Summary() + "\n" + score.Summary());
