@@ -112,6 +112,11 @@ struct WholeObjectOptions {
   // occludes it, a lower crate before the box it carries holds it, and one view does not tell them apart.)
   bool join_steps = true;
   double join_max_gap_m = 0.35;  // metres
+  // ... and within the part, neighbouring normals may differ by up to this angle, degrees: wider than
+  // max_crease_deg, because the grid normals of a thin square post (its corner, its top under the box) turn by
+  // more than 45° between neighbouring cells and split it into open pieces (random seeds 12, 43). A closed part
+  // cannot leak, and the ground at its foot is kept out by the support planes, not by the crease.
+  double join_max_crease_deg = 80.0;
   // Parts it rests on: a closed part in front of the object and below it (joined to nothing else in depth but
   // the support planes it stands on, within the growth's budget) whose top is no higher than
   // support_distance_m above the object's lowest points where they meet joins it: the lower crate of a stack,
