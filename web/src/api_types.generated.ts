@@ -840,6 +840,8 @@ export interface WholeObjectOptions {
   join_steps: boolean;
   // ... when its cell next to the object lies this close to the object's in space [m] in >= 0, default 0.35
   join_max_gap_m: number;
+  // ... and its neighbouring normals lie within this angle (a square post's corner) [deg] in (0, 180], default 80.0
+  join_max_crease_deg: number;
   // a closed part in front of the object and below it, that the object stands on, joins it, default true
   join_rests_on: boolean;
   // ... up to this many times the object's cells in all in >= 0, default 8.0
