@@ -92,7 +92,9 @@ struct WholeObjectOptions {
   int normal_window_cells = 2;       // half-width of the grid window of the normals, cells
   double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
   int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
-  double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
+  // A cell this close to a support plane (and parallel) is support, metres: well above the ground's noise
+  // (σ 3 mm along the ray), below the 3 cm of a traffic cone's base plate, which 3 cm took for the ground.
+  double support_distance_m = 0.025;
   // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
   // the support's cells along the object's foot mix in the object's side.
   double support_max_tilt_deg = 75.0;
