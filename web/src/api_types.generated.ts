@@ -826,7 +826,7 @@ export interface WholeObjectOptions {
   max_growth: number;
   // support planes are fitted to the cells this far around the cut [cells] in >= 1, default 10
   support_band_cells: number;
-  // cells this close to a support plane and parallel to it are support, never object [m] in > 0, default 0.03
+  // cells this close to a support plane and parallel to it are support, never object [m] in > 0, default 0.025
   support_distance_m: number;
   // a cell near a support plane is support when its normal is within this angle of the plane's [deg] in (0, 90], default 75.0
   support_max_tilt_deg: number;
