@@ -275,6 +275,10 @@ int main(int argc, char** argv) {
                "no joining of parts across a depth step");
   app.add_flag("!--no-rests-on", options.whole_object.join_rests_on,
                "no joining of parts the object rests on");
+  app.add_option("--support-distance", options.whole_object.support_distance_m,
+                 "whole-object growth: a cell this close to a support plane is support, metres");
+  app.add_option("--join-crease-deg", options.whole_object.join_max_crease_deg,
+                 "parts across a depth step: largest angle between neighbouring normals, degrees");
   app.add_option("--rests-on-max", options.whole_object.rests_on_max_growth,
                  "parts the object rests on: at most this many times its cells");
   app.add_option("--strip-max-cells", options.whole_object.strip_max_cells,

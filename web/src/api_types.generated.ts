@@ -826,7 +826,7 @@ export interface WholeObjectOptions {
   max_growth: number;
   // support planes are fitted to the cells this far around the cut [cells] in >= 1, default 10
   support_band_cells: number;
-  // cells this close to a support plane and parallel to it are support, never object [m] in > 0, default 0.03
+  // cells this close to a support plane and parallel to it are support, never object [m] in > 0, default 0.025
   support_distance_m: number;
   // a cell near a support plane is support when its normal is within this angle of the plane's [deg] in (0, 90], default 75.0
   support_max_tilt_deg: number;
@@ -840,6 +840,8 @@ export interface WholeObjectOptions {
   join_steps: boolean;
   // ... when its cell next to the object lies this close to the object's in space [m] in >= 0, default 0.35
   join_max_gap_m: number;
+  // ... and its neighbouring normals lie within this angle (a square post's corner) [deg] in (0, 180], default 80.0
+  join_max_crease_deg: number;
   // a closed part in front of the object and below it, that the object stands on, joins it, default true
   join_rests_on: boolean;
   // ... up to this many times the object's cells in all in >= 0, default 8.0

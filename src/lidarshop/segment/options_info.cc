@@ -101,6 +101,11 @@ const StructInfo& InfoOf<WholeObjectOptions>() {
             "... when its cell next to the object lies this close to the object's in space")
         .Unit("m")
         .Min(0);
+    b.Field(&WholeObjectOptions::join_max_crease_deg, "join_max_crease_deg",
+            "... and its neighbouring normals lie within this angle (a square post's corner)")
+        .Unit("deg")
+        .AboveZero()
+        .Max(180);
     b.Field(&WholeObjectOptions::join_rests_on, "join_rests_on",
             "a closed part in front of the object and below it, that the object stands on, joins it");
     b.Field(&WholeObjectOptions::rests_on_max_growth, "rests_on_max_growth",

@@ -92,7 +92,9 @@ struct WholeObjectOptions {
   int normal_window_cells = 2;       // half-width of the grid window of the normals, cells
   double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
   int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
-  double support_distance_m = 0.03;  // a cell this close to a support plane (and parallel) is support, metres
+  // A cell this close to a support plane (and parallel) is support, metres: well above the ground's noise
+  // (σ 3 mm along the ray), below the 3 cm of a traffic cone's base plate, which 3 cm took for the ground.
+  double support_distance_m = 0.025;
   // ... and "parallel" means a normal within this angle of the plane's, degrees: wide, because the normals of
   // the support's cells along the object's foot mix in the object's side.
   double support_max_tilt_deg = 75.0;
@@ -112,6 +114,11 @@ struct WholeObjectOptions {
   // occludes it, a lower crate before the box it carries holds it, and one view does not tell them apart.)
   bool join_steps = true;
   double join_max_gap_m = 0.35;  // metres
+  // ... and within the part, neighbouring normals may differ by up to this angle, degrees: wider than
+  // max_crease_deg, because the grid normals of a thin square post (its corner, its top under the box) turn by
+  // more than 45° between neighbouring cells and split it into open pieces (random seeds 12, 43). A closed part
+  // cannot leak, and the ground at its foot is kept out by the support planes, not by the crease.
+  double join_max_crease_deg = 80.0;
   // Parts it rests on: a closed part in front of the object and below it (joined to nothing else in depth but
   // the support planes it stands on, within the growth's budget) whose top is no higher than
   // support_distance_m above the object's lowest points where they meet joins it: the lower crate of a stack,

@@ -481,9 +481,10 @@ cv::Mat GrowWholeObject(const Scan& scan, const cv::Mat& mask, const cv::Mat& ba
   }
   // Closed parts across a depth step that touch the object in space join it (the post under a box), each
   // within what is left of the budget.
+  const float cos_max_part = static_cast<float>(std::cos(options.join_max_crease_deg * M_PI / 180.0));
   const auto continues = [&](cv::Point p, cv::Point q) {
     const cv::Vec3f normal_p = normals.At(p - region.tl()), normal_q = normals.At(q - region.tl());
-    return normal_p != cv::Vec3f() && normal_q != cv::Vec3f() && normal_p.dot(normal_q) >= cos_max;
+    return normal_p != cv::Vec3f() && normal_q != cv::Vec3f() && normal_p.dot(normal_q) >= cos_max_part;
   };
   // The support planes of the whole region: a part's foot may stand on ground far from the cut (a post under
   // a box), beyond the band the cut's own support planes are fitted to.
