@@ -98,7 +98,7 @@ struct FillOptions {
   // discontinuity (a silhouette). Such edges are copied with the gradients and cut out of the Poisson system,
   // so that a wall end and the facade far behind it stay apart instead of being joined by a membrane; a part
   // of the hole cut off from every known range by them is left without a return. 0 = never cut.
-  double depth_jump_ratio = 0.2;
+  double depth_jump_ratio = 0.05;
   // Gradient method: continue the background only (fill/foreground.h). Objects standing in front of the
   // surface behind them (a person beside the removed one, a bench) that touch the hole are filled with it —
   // their own cells are not written — and no patch copying an object in front of the background is taken:
