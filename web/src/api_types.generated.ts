@@ -102,7 +102,7 @@ export interface FillOptions {
   offsets: OffsetCompletionOptions;
   // copy the gradients of 1/range (slowly varying on planes), default true
   inverse_range: boolean;
-  // an edge whose ranges differ by more than this times the nearer one is a silhouette; 0 = never cut in >= 0, default 0.2
+  // an edge whose ranges differ by more than this times the nearer one is a silhouette; 0 = never cut in >= 0, default 0.05
   depth_jump_ratio: number;
   // gradient method: continue the background only (objects in front of it touching the hole are filled with it, not written; no patch copies one), default true
   background_only: boolean;

@@ -86,12 +86,12 @@ const StructInfo& InfoOf<CutWeights>();
 // max_crease_deg), so parts of another colour join while the support surface, which meets the object at a
 // crease, does not. Growth that would add more than max_growth × the object's cells is a leak: none is added.
 struct WholeObjectOptions {
-  double jump_cells = 6.0;           // depth continuity, in cell spacings at the cell's range (dimensionless)
-  double min_jump_m = 0.01;          // floor of the depth-continuity threshold, metres
-  double max_crease_deg = 45.0;      // largest angle between neighbouring normals inside one object, degrees
-  int normal_window_cells = 2;       // half-width of the grid window of the normals, cells
-  double max_growth = 3.0;           // at most this many times the object's cells are added (dimensionless)
-  int support_band_cells = 10;       // support planes are fitted to the cells this far around the cut, cells
+  double jump_cells = 6.0;       // depth continuity, in cell spacings at the cell's range (dimensionless)
+  double min_jump_m = 0.01;      // floor of the depth-continuity threshold, metres
+  double max_crease_deg = 45.0;  // largest angle between neighbouring normals inside one object, degrees
+  int normal_window_cells = 2;   // half-width of the grid window of the normals, cells
+  double max_growth = 3.0;       // at most this many times the object's cells are added (dimensionless)
+  int support_band_cells = 10;   // support planes are fitted to the cells this far around the cut, cells
   // A cell this close to a support plane (and parallel) is support, metres: well above the ground's noise
   // (σ 3 mm along the ray), below the 3 cm of a traffic cone's base plate, which 3 cm took for the ground.
   double support_distance_m = 0.025;

@@ -205,7 +205,8 @@ TEST(WholeObjectTest, AThreeCentimetreBasePlateIsNotTheGround) {
             cv::countNonZero(plate_cells) / 2);
   const cv::Mat grown = GrowWholeObject(scan, scan.label == 2, cv::Mat());
   EXPECT_GT(cv::countNonZero(grown & plate_cells), 0.8 * cv::countNonZero(plate_cells));  // 84 % here
-  EXPECT_LT(cv::countNonZero(grown & (scan.label == 0)), 0.02 * cv::countNonZero(scan.label > 0));  // no ground
+  EXPECT_LT(cv::countNonZero(grown & (scan.label == 0)),
+            0.02 * cv::countNonZero(scan.label > 0));  // no ground
 }
 
 TEST(WholeObjectTest, APlateInFrontOfTheObjectWithTheObjectAllAroundItDoesNotJoin) {
