@@ -1,6 +1,8 @@
-// The hand-made scan of segment_test and segment_window_test (test helper).
+// The hand-made scans of segment_test and segment_window_test, and the blocks of whole_object_test and
+// strips_test (test helpers).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -12,6 +14,29 @@
 namespace lidarshop::segment_test {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// An axis-aligned box for analytic scans (testing/analytic_scan.h).
+struct Block {
+  cv::Vec3d lo, hi;  // axis-aligned box corners, metres (scanner at the origin, z up)
+  cv::Vec3b rgb;
+  int label;
+};
+
+// Distance along `d` to the box (slab method), infinity when missed.
+inline double HitBlock(const cv::Vec3f& d, const Block& block) {
+  double t_near = 0, t_far = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    if (std::abs(d[i]) < 1e-12) {
+      if (0 < block.lo[i] || 0 > block.hi[i]) return std::numeric_limits<double>::infinity();
+      continue;
+    }
+    double t0 = block.lo[i] / d[i], t1 = block.hi[i] / d[i];
+    if (t0 > t1) std::swap(t0, t1);
+    t_near = std::max(t_near, t0);
+    t_far = std::min(t_far, t1);
+  }
+  return t_near <= t_far ? t_near : std::numeric_limits<double>::infinity();
+}
 
 // A hand-made scan (analytic ray casting): a box face 1.2 m wide and 1.3 m tall at y = 8 m standing on a
 // ground plane 1.5 m below the scanner, a wall at y = 20 m behind, sky (no return) above the wall. The box's

@@ -7,33 +7,15 @@
 #include <opencv2/imgproc.hpp>
 
 #include "lidarshop/segment/segment.h"
+#include "lidarshop/segment/segment_test_util.h"
 #include "lidarshop/testing/analytic_scan.h"
 
 namespace lidarshop {
 namespace strips_test {  // named: the tests are compiled in unity batches with whole_object_test's blocks
 namespace {
 
-struct Block {
-  cv::Vec3d lo, hi;  // axis-aligned box corners, metres (scanner at the origin, z up)
-  cv::Vec3b rgb;
-  int label;
-};
-
-// Distance along `d` to the box (slab method), infinity when missed.
-double HitBlock(const cv::Vec3f& d, const Block& block) {
-  double t_near = 0, t_far = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 3; ++i) {
-    if (std::abs(d[i]) < 1e-12) {
-      if (0 < block.lo[i] || 0 > block.hi[i]) return std::numeric_limits<double>::infinity();
-      continue;
-    }
-    double t0 = block.lo[i] / d[i], t1 = block.hi[i] / d[i];
-    if (t0 > t1) std::swap(t0, t1);
-    t_near = std::max(t_near, t0);
-    t_far = std::min(t_far, t1);
-  }
-  return t_near <= t_far ? t_near : std::numeric_limits<double>::infinity();
-}
+using segment_test::Block;
+using segment_test::HitBlock;
 
 // Blocks on a grey ground 1.5 m below the scanner before a wall at y = 14 m, 0.2° between rays (3.5 cm at
 // 10 m: a 0.15 m kerb is 4 rows tall, as a kerb at 25 m in a scan of 400 x 300 rays).
