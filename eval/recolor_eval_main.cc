@@ -42,6 +42,37 @@ std::string Distribution(std::vector<double> values, bool worst_is_low, int deci
                      decimals);
 }
 
+// One street seed drawn as both the table and the diagnosis use it: the scene (test_scenes::
+// MakeStreetRecolorCase), its scan, the scan in magenta, the photo (`photo_samples` per pixel axis; 3:
+// anti-aliased silhouettes, as a real photo's), the noisy pairs with their exact pixels, and the resection.
+struct StreetDraw {
+  test_scenes::StreetRecolorCase c;
+  Scan truth, input;
+  Photo photo;
+  std::vector<PixelPointPair> exact;
+  ResectionResult resection;
+};
+
+StreetDraw DrawStreet(int seed, double offset_m, int pair_count, double noise_px, double outliers,
+                      int photo_samples) {
+  StreetDraw d;
+  d.c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
+  d.truth = test_scenes::ScanScene(d.c.scene);
+  d.input = Clone(d.truth);
+  d.input.color.setTo(cv::Scalar(250, 0, 250));
+  PhotoOptions photo_options;
+  photo_options.samples_per_axis = photo_samples;
+  d.photo = RenderPhoto(d.c.scene, d.c.camera, photo_options);
+  const std::vector<PixelPointPair> pairs = DrawCorrespondences(
+      d.truth, d.c.camera, d.photo.depth_m, pair_count, noise_px, outliers, 1000 + seed, &d.exact);
+  ResectionOptions options;
+  options.width_px = d.c.camera.width_px;
+  options.height_px = d.c.camera.height_px;
+  options.seed = seed;
+  d.resection = Resection(pairs, options);
+  return d;
+}
+
 // The street scenes (test_scenes::MakeStreetRecolorCase, seeds 1..N): camera `offset_m` beside the scanner,
 // `pairs` correspondences with noise and outliers, resected (ours), recoloured with the default options; per
 // seed and the distribution (issue #30 class 3).
@@ -60,21 +91,12 @@ int RunStreet(int first_seed, int seeds, double offset_m, int pair_count, double
         "behind an object: changed (of) | uncertain | true camera: visible correct, % | behind an "
         "object: changed |\n|---|---|---|---|---|---|---|---|---|\n");
   for (int seed = first_seed; seed < first_seed + seeds; ++seed) {
-    const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
-    const Scan truth = test_scenes::ScanScene(c.scene);
-    Scan input = Clone(truth);
-    input.color.setTo(cv::Scalar(250, 0, 250));
-    PhotoOptions photo_options;
-    photo_options.samples_per_axis = photo_samples;  // 3: anti-aliased silhouettes, as a real photo's
-    const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
-    std::vector<PixelPointPair> exact;
-    const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
-                                                                  noise_px, outliers, 1000 + seed, &exact);
-    ResectionOptions options;
-    options.width_px = c.camera.width_px;
-    options.height_px = c.camera.height_px;
-    options.seed = seed;
-    const ResectionResult resection = Resection(pairs, options);
+    const StreetDraw draw = DrawStreet(seed, offset_m, pair_count, noise_px, outliers, photo_samples);
+    const test_scenes::StreetRecolorCase& c = draw.c;
+    const Scan &truth = draw.truth, &input = draw.input;
+    const Photo& photo = draw.photo;
+    const std::vector<PixelPointPair>& exact = draw.exact;
+    const ResectionResult& resection = draw.resection;
     const RecolorResult result = RecolorScan(input, photo.image, resection.camera, recolor);
     const RecolorScore score = ScoreRecolor(c.scene, truth, input, result.scan, c.camera);
     const RecolorResult true_result = RecolorScan(input, photo.image, c.camera, recolor);
@@ -123,21 +145,11 @@ int RunStreet(int first_seed, int seeds, double offset_m, int pair_count, double
 int DiagnoseStreet(int seed, double offset_m, int pair_count, double noise_px, double outliers,
                    bool true_camera, const RecolorOptions& recolor, int photo_samples,
                    const std::string& picture_path) {
-  const test_scenes::StreetRecolorCase c = test_scenes::MakeStreetRecolorCase(seed, offset_m);
-  const Scan truth = test_scenes::ScanScene(c.scene);
-  Scan input = Clone(truth);
-  input.color.setTo(cv::Scalar(250, 0, 250));
-  PhotoOptions photo_options;
-  photo_options.samples_per_axis = photo_samples;
-  const Photo photo = RenderPhoto(c.scene, c.camera, photo_options);
-  std::vector<PixelPointPair> exact;
-  const std::vector<PixelPointPair> pairs = DrawCorrespondences(truth, c.camera, photo.depth_m, pair_count,
-                                                                noise_px, outliers, 1000 + seed, &exact);
-  ResectionOptions options;
-  options.width_px = c.camera.width_px;
-  options.height_px = c.camera.height_px;
-  options.seed = seed;
-  const PinholeCamera camera = true_camera ? c.camera : Resection(pairs, options).camera;
+  const StreetDraw draw = DrawStreet(seed, offset_m, pair_count, noise_px, outliers, photo_samples);
+  const test_scenes::StreetRecolorCase& c = draw.c;
+  const Scan &truth = draw.truth, &input = draw.input;
+  const Photo& photo = draw.photo;
+  const PinholeCamera camera = true_camera ? c.camera : draw.resection.camera;
   const RecolorResult result = RecolorScan(input, photo.image, camera, recolor);
   std::map<int, int64_t> cells_of_label;
   for (int r = 0; r < truth.rows; ++r)

@@ -87,8 +87,7 @@ cv::Vec3b SamplePhoto(const cv::Mat& photo, const Eigen::Vector2d& pixel_px, int
   const double fx = x - x0, fy = y - y0;
   const cv::Vec3b values[4] = {photo.at<cv::Vec3b>(y0, x0), photo.at<cv::Vec3b>(y0, x1),
                                photo.at<cv::Vec3b>(y1, x0), photo.at<cv::Vec3b>(y1, x1)};
-  const double weights[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-  if (weights[0] + weights[1] + weights[2] + weights[3] <= 1e-12) return values[0];
+  const double weights[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};  // sum to 1
   return BlendUnlessEdge(values, weights, max_blend_levels);
 }
 

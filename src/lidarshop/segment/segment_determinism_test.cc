@@ -2,10 +2,8 @@
 // scene seed 17 once gave IoU 0.629 on one thread and 0.948 or 0.629 from run to run on two.
 #include <gtest/gtest.h>
 
-#include "lidarshop/scanner/random_scene.h"
-#include "lidarshop/scanner/scanner.h"
 #include "lidarshop/segment/segment.h"
-#include "lidarshop/segment/segment_eval.h"
+#include "lidarshop/segment/segment_test_util.h"
 #include "lidarshop/util/parallel.h"
 
 namespace lidarshop {
@@ -16,12 +14,9 @@ int Differing(const cv::Mat& a, const cv::Mat& b) { return cv::countNonZero(a !=
 
 TEST(SegmentDeterminismTest, TwoStepCutIsTheSameOnOneAndTwoThreads) {
   for (uint64_t seed : {17u}) {
-    const SceneDescription scene = RandomScene(seed);
-    const Scan scan = SynthesizeScan(scene);
-    const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
-    EvalStrokeOptions stroke_options;
-    stroke_options.upper_and_below = true;  // as segment_eval --random-seeds draws them
-    const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
+    const segment_test::RandomEvalCase c = segment_test::MakeRandomEvalCase(seed);
+    const Scan& scan = c.scan;
+    const cv::Mat &truth = c.truth, &strokes = c.strokes;
     SegmentResult reference;
     {
       ThreadLimit one(1);

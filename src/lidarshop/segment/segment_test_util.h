@@ -10,10 +10,31 @@
 #include <opencv2/core.hpp>
 
 #include "lidarshop/scan/scan.h"
+#include "lidarshop/scanner/random_scene.h"
+#include "lidarshop/scanner/scanner.h"
+#include "lidarshop/segment/segment_eval.h"
 
 namespace lidarshop::segment_test {
 
 constexpr double kPi = 3.14159265358979323846;
+
+// Random scene `seed` as `segment_eval --random-seeds` sees it: its scan, the target's cells and the two
+// automatic strokes (upper part, background below; stroke seed 7919 · seed + 1).
+struct RandomEvalCase {
+  SceneDescription scene;
+  Scan scan;
+  cv::Mat truth, strokes;
+};
+inline RandomEvalCase MakeRandomEvalCase(uint64_t seed) {
+  RandomEvalCase c;
+  c.scene = RandomScene(seed);
+  c.scan = SynthesizeScan(c.scene);
+  c.truth = (c.scan.label == c.scene.target_label) & (c.scan.valid != 0);
+  EvalStrokeOptions stroke_options;
+  stroke_options.upper_and_below = true;
+  c.strokes = MakeEvalStrokes(c.truth, c.scan.valid, seed * 7919 + 1, stroke_options);
+  return c;
+}
 
 // An axis-aligned box for analytic scans (testing/analytic_scan.h).
 struct Block {

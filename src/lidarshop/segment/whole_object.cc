@@ -265,9 +265,12 @@ template <typename JumpAt, typename Enter, typename Continues, typename Support,
 int PartsAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& region, size_t max_cells,
                     double max_gap_m, const JumpAt& jump_at, const Enter& enter, const Continues& continues,
                     const Support& support, const Accept& accept) {
-  constexpr int kDr[4] = {-1, 1, 0, 0}, kDc[4] = {0, 0, -1, 1};
-  constexpr uint8_t kInPart = 1, kRejected = 2;
+  using whole_object_internal::GrowClosedPart, whole_object_internal::kInPart,
+      whole_object_internal::kRejected, whole_object_internal::kPartDc, whole_object_internal::kPartDr;
   const float max_gap_sq = static_cast<float>(max_gap_m * max_gap_m);
+  // What it stands on, or another surface meeting it at a crease (the ground at a post's foot, where the box
+  // holding the post keeps the ground out of the support planes' band), does not continue a part.
+  const auto stops = [&](const cv::Point& p, const cv::Point& q) { return support(q) || !continues(p, q); };
   cv::Rect object_box = cv::boundingRect(grown);
   cv::Mat visited = cv::Mat::zeros(grown.size(), CV_8U);
   std::deque<cv::Point> joined;  // cells of accepted parts, still to seed from
@@ -277,7 +280,7 @@ int PartsAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& regi
     if (!grown.at<uint8_t>(a) || !scan.valid.at<uint8_t>(a)) return true;
     const cv::Vec3f& point_a = scan.point.at<cv::Vec3f>(a);
     for (int k = 0; k < 4; ++k) {
-      const cv::Point seed(a.x + kDc[k], a.y + kDr[k]);
+      const cv::Point seed(a.x + kPartDc[k], a.y + kPartDr[k]);
       if (!region.contains(seed) || visited.at<uint8_t>(seed) || !enter(grown, seed)) continue;
       // Behind the object: a part in front of it that stands on the ground may as well be an occluder (a crate
       // before a post's foot) as what the object rests on.
@@ -286,33 +289,11 @@ int PartsAcrossStep(const Scan& scan, const cv::Mat& grown, const cv::Rect& regi
       if (gap.dot(gap) > max_gap_sq) continue;
       std::vector<cv::Point> part = {seed};
       visited.at<uint8_t>(seed) = kInPart;
-      bool open = false;  // continued by something else
-      for (size_t i = 0; i < part.size() && !open; ++i) {
-        const cv::Point p = part[i];
-        for (int j = 0; j < 4 && !open; ++j) {
-          const cv::Point q(p.x + kDc[j], p.y + kDr[j]);
-          if (!region.contains(q)) {
-            open = true;  // it runs on beyond the region
-            continue;
-          }
-          if (visited.at<uint8_t>(q) == kInPart || !scan.valid.at<uint8_t>(q) || grown.at<uint8_t>(q))
-            continue;
-          if (std::abs(scan.range.at<float>(q) - scan.range.at<float>(p)) > jump_at(p)) continue;  // a step
-          // What it stands on, or another surface meeting it at a crease (the ground at a post's foot,
-          // where the box holding the post keeps the ground out of the support planes' band).
-          if (support(q) || !continues(p, q)) continue;
-          if (visited.at<uint8_t>(q) == kRejected || !enter(grown, q)) {
-            open = true;  // joined in depth to something it may not take: part of something larger
-            continue;
-          }
-          visited.at<uint8_t>(q) = kInPart;
-          part.push_back(q);
-          open = part.size() > max_cells;
-        }
-      }
+      const bool closed =
+          GrowClosedPart(scan, grown, region, max_cells, jump_at, enter, stops, visited, part);
       // What an object holds up lies under it, within its width (a post, legs); a closed surface beside it
       // (a door recess behind a person, a strip of kerb behind a post's foot) is not held by it.
-      if (!open) {
+      if (closed) {
         const cv::Rect part_box = cv::boundingRect(part);
         if (part_box.x >= object_box.x - 2 && part_box.br().x <= object_box.br().x + 2 &&
             part_box.y > object_box.y) {

@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
-#include "lidarshop/scanner/random_scene.h"
-#include "lidarshop/scanner/scanner.h"
 #include "lidarshop/segment/segment.h"
 #include "lidarshop/segment/segment_eval.h"
 #include "lidarshop/segment/segment_test_util.h"
@@ -102,12 +100,9 @@ TEST(WholeObjectTest, ThePostUnderABoxJoinsOnRandomScenes) {
   // max_crease_deg (45°) between neighbouring cells (the post's corner, its top under the box), which split
   // it into open pieces: it stayed out (IoU 0.635, 0.681). Within a closed part a wider crease is allowed.
   for (uint64_t seed : {12u, 43u}) {
-    const SceneDescription scene = RandomScene(seed);
-    const Scan scan = SynthesizeScan(scene);
-    const cv::Mat truth = (scan.label == scene.target_label) & (scan.valid != 0);
-    EvalStrokeOptions stroke_options;
-    stroke_options.upper_and_below = true;  // as segment_eval --random-seeds draws them
-    const cv::Mat strokes = MakeEvalStrokes(truth, scan.valid, seed * 7919 + 1, stroke_options);
+    const segment_test::RandomEvalCase c = segment_test::MakeRandomEvalCase(seed);
+    const Scan& scan = c.scan;
+    const cv::Mat &truth = c.truth, &strokes = c.strokes;
     SegmentOptions options;
     options.whole_object.join_max_crease_deg = options.whole_object.max_crease_deg;
     EXPECT_LT(ScoreMask(SegmentObject(scan, strokes, options).mask, truth, scan.valid).iou, 0.7)
