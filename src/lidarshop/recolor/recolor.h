@@ -80,7 +80,7 @@ struct RecolorOptions {
   // let 29 hidden points past the 0.5 m deep pillar's unseen side, 0.25 m walls none (at 0.14 % of the
   // visible points). The walls also stand for whole objects in the scanner's shadow (a post behind a post),
   // which the camera sees and the scan does not: on 100 random street scenes 0.25 m walls let 0.37 % of the
-  // points behind another object take a colour, 2 m walls 0.04 %, for 1.4 points fewer visible points right
+  // points behind another object take a colour, 2 m walls 0.04 %, for 1.3 points fewer visible points right
   // (bench/results/recolor.md, "Colour edges, thin occluders' walls"). A wall never reaches past the farther
   // return beside it.
   double skirt_depth_m = 2.0;
